@@ -1,0 +1,203 @@
+"""The ``spine-mj`` command line (click).
+
+Bad input ends in one line ``Error: ...`` on stderr and exit code 2, never a traceback;
+outputs are written atomically, so a failed command leaves nothing half-written.
+Printing and progress bars live here; the library reports through return values and
+callbacks.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import click
+
+from spine_mj.errors import SpineInputError
+
+INPUT_ERROR_EXIT = 2
+
+
+class InputError(click.ClickException):
+    """A :class:`SpineInputError` (or unreadable file) shown as one line, exit code 2."""
+
+    exit_code = INPUT_ERROR_EXIT
+
+
+class _Group(click.Group):
+    """Turns the library's input errors into :class:`InputError` for every subcommand."""
+
+    def invoke(self, ctx):
+        try:
+            return super().invoke(ctx)
+        except SpineInputError as exc:
+            raise InputError(str(exc)) from None
+        except (FileNotFoundError, IsADirectoryError, PermissionError) as exc:
+            raise InputError(f"{exc.strerror}: {exc.filename}") from None
+
+
+@click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(package_name="spine_mj")
+def main():
+    """spine_mj: streamline theory and MuJoCo dynamics of bio-inspired spines on rough
+    surfaces."""
+
+
+# --------------------------------------------------------------------------- surface
+
+
+@main.group(cls=_Group)
+def surface():
+    """Make, import, preview and export rough surfaces."""
+
+
+def load_surface_arg(spec: str):
+    """A SURFACE argument: a saved .npz, a preset name, or an instrument file."""
+    from spine_mj import presets, surface_io
+
+    path = Path(spec)
+    if path.suffix == ".npz":
+        return surface_io.load_surface(path)
+    if spec in presets.list_presets() or path.suffix == ".toml":
+        return presets.make_surface(spec)
+    if path.is_file():
+        return surface_io.import_topography(path)
+    raise SpineInputError(
+        f"SURFACE must be a .npz file, a preset ({', '.join(presets.list_presets())}) or an "
+        f"instrument file, got {spec!r}"
+    )
+
+
+@surface.command("list")
+def surface_list():
+    """List the surface presets in surfaces/."""
+    from spine_mj import presets
+
+    for name in presets.list_presets():
+        click.echo(f"{name:24s} {presets.load_preset(name).description}")
+
+
+@surface.command("make")
+@click.argument("preset", required=False)
+@click.option("--from-file", "from_file", type=click.Path(dir_okay=False),
+              help="Import a measured topography (x3p, opd, datx, plu, di, sur, ...).")
+@click.option("-o", "--output", required=True, type=click.Path(dir_okay=False),
+              help="Output .npz file.")
+@click.option("--seed", type=click.IntRange(min=0), help="Override the preset's seed.")
+@click.option("--hurst", type=float, help="Override the Hurst index (fractal presets).")
+@click.option("--set", "sets", multiple=True, metavar="KEY=VALUE",
+              help="Override any generator parameter (TOML value), repeatable.")
+@click.option("--fill", type=click.Choice(["refuse", "harmonic", "nearest", "mean"]),
+              default="refuse", show_default=True, help="Missing points in imported files.")
+@click.option("--no-level", is_flag=True, help="Keep the tilt of an imported file.")
+@click.option("--spacing", type=float, help="Resample an imported file to this spacing [m].")
+@click.option("--channel", type=int, default=0, show_default=True,
+              help="Data channel of an imported file.")
+@click.option("--png", type=click.Path(dir_okay=False), help="Also write a PNG preview.")
+def surface_make(preset, from_file, output, seed, hurst, sets, fill, no_level, spacing,
+                 channel, png):
+    """Make a surface from PRESET (see `spine-mj surface list`) or import one with
+    --from-file, and save it as .npz.
+
+    \b
+    Examples:
+      spine-mj surface make paper-fractal --hurst 0.7 --seed 3 -o fractal.npz
+      spine-mj surface make --from-file scan.plu --fill harmonic -o scan.npz
+    """
+    from spine_mj import presets, surface_io
+
+    if (preset is None) == (from_file is None):
+        raise SpineInputError("give exactly one of PRESET or --from-file")
+    if from_file is not None:
+        surf = surface_io.import_topography(from_file, channel=channel, fill=fill,
+                                            level=not no_level, spacing_m=spacing)
+    else:
+        overrides = dict(presets.parse_override(s) for s in sets)
+        if seed is not None:
+            overrides["seed"] = seed
+        if hurst is not None:
+            overrides["hurst"] = hurst
+        surf = presets.make_surface(preset, **overrides)
+    if png:
+        _check_suffix(png, ".png", "--png")
+    surface_io.save_surface(surf, output)
+    if png:
+        from spine_mj.plotting import save_figure, surface_preview
+
+        save_figure(surface_preview(surf), png)
+    click.echo(f"wrote {output}" + (f" and {png}" if png else ""))
+
+
+def _check_suffix(path: str, suffix: str, option: str) -> None:
+    if Path(path).suffix.lower() != suffix:
+        raise SpineInputError(f"{option} must name a {suffix} file, got {path!r}")
+
+
+@surface.command("show")
+@click.argument("surface_file")
+@click.option("-o", "--output", required=True, type=click.Path(dir_okay=False),
+              help="Output PNG.")
+def surface_show(surface_file, output):
+    """Write a PNG preview (height map and 3-D view) of SURFACE_FILE.
+
+    \b
+    Example:
+      spine-mj surface show fractal.npz -o fractal.png
+    """
+    from spine_mj.plotting import save_figure, surface_preview
+
+    _check_suffix(output, ".png", "-o/--output")
+    surf = load_surface_arg(surface_file)
+    save_figure(surface_preview(surf), output)
+    click.echo(f"wrote {output}")
+
+
+@surface.command("export")
+@click.argument("surface_file")
+@click.option("--stl", type=click.Path(dir_okay=False), help="Watertight STL solid.")
+@click.option("--stl-scale", type=float, default=None,
+              help="Multiply coordinates in the STL (default: metres to mm for physical "
+                   "surfaces, 1 for dimensionless ones).")
+@click.option("--base", "base_thickness", type=float, default=None,
+              help="STL base thickness below the lowest point (surface units).")
+@click.option("--hfield", type=click.Path(dir_okay=False),
+              help="MuJoCo hfield data: .npz with `data` (nrow x ncol in [0, 1]), `size`, `pos`.")
+@click.option("--resolution", type=click.IntRange(min=4), default=None,
+              help="Samples a side for analytic surfaces.")
+def surface_export(surface_file, stl, stl_scale, base_thickness, hfield, resolution):
+    """Export SURFACE_FILE as an STL solid for printing and/or as MuJoCo hfield data.
+
+    \b
+    Example:
+      spine-mj surface export fractal.npz --stl fractal.stl --hfield fractal-hfield.npz
+    """
+    import numpy as np
+
+    from spine_mj import surface_io
+    from spine_mj.errors import atomic_output
+    from spine_mj.surfaces import to_hfield
+
+    if not stl and not hfield:
+        raise SpineInputError("nothing to export: give --stl and/or --hfield")
+    if stl:
+        _check_suffix(stl, ".stl", "--stl")
+    if hfield:
+        _check_suffix(hfield, ".npz", "--hfield")
+    surf = load_surface_arg(surface_file)
+    if stl:
+        scale = stl_scale if stl_scale is not None else (1e3 if surf.unit == "m" else 1.0)
+        mesh_opts = {"scale": scale, "base_thickness": base_thickness}
+        if resolution:
+            mesh_opts["resolution"] = resolution
+        surface_io.write_stl(surf, stl, **mesh_opts)
+        click.echo(f"wrote {stl} (scale {scale:g})")
+    if hfield:
+        hf = to_hfield(surf, ncol=resolution, nrow=resolution) if resolution else to_hfield(surf)
+        with atomic_output(hfield) as tmp, open(tmp, "wb") as fh:
+            np.savez(fh, data=hf.data, size=np.asarray(hf.size), pos=np.asarray(hf.pos),
+                     unit=np.array(surf.unit))
+        click.echo(f"wrote {hfield} ({hf.nrow} x {hf.ncol}, size {json.dumps(hf.size)})")
+
+
+if __name__ == "__main__":  # pragma: no cover
+    main()

@@ -1,0 +1,162 @@
+"""Surface recipes: small TOML presets in the repository's ``surfaces/`` folder.
+
+A preset names a generator and its parameters::
+
+    description = "The paper's single convex Gaussian peak (Figs. 3-4)"
+    generator = "single_gaussian"
+
+    [params]
+    sign = 1
+    k = 31.41592653589793
+
+Other top-level tables (for example ``[engagement]`` with the friction coefficient the
+analytic reproduction uses) travel with the preset in :attr:`Preset.extras`, so that
+calibrated defaults live in the presets, not in code.
+
+``SPINE_MJ_SURFACES`` overrides the folder searched for presets.
+"""
+
+from __future__ import annotations
+
+import inspect
+import os
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from spine_mj import surfaces
+from spine_mj.errors import SpineInputError
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover
+    import tomli as tomllib
+
+__all__ = ["GENERATORS", "Preset", "list_presets", "load_preset", "make_surface",
+           "parse_override", "presets_dir"]
+
+
+def _measured(*, file: str, **options):
+    from spine_mj.surface_io import import_topography
+
+    path = Path(file)
+    if not path.is_absolute():
+        path = presets_dir() / path
+    return import_topography(path, **options)
+
+
+#: Generator names usable in a preset, and the functions they call.
+GENERATORS = {
+    "single_gaussian": surfaces.single_gaussian,
+    "random_gaussians": surfaces.random_gaussians,
+    "fractal_fbm": surfaces.fractal_fbm,
+    "sandpaper": surfaces.sandpaper,
+    "measured": _measured,
+}
+
+
+def presets_dir() -> Path:
+    """The folder holding the ``*.toml`` presets."""
+    env = os.environ.get("SPINE_MJ_SURFACES")
+    return Path(env) if env else Path(__file__).resolve().parent.parent / "surfaces"
+
+
+@dataclass(frozen=True)
+class Preset:
+    """A parsed preset: ``generator(**params, rng=seed)`` makes the surface."""
+
+    name: str
+    generator: str
+    params: dict[str, Any]
+    description: str = ""
+    seed: int | None = None
+    extras: dict[str, Any] = field(default_factory=dict)
+
+    def make(self, **overrides) -> surfaces.Surface:
+        """Build the surface; ``overrides`` replace params (``seed`` replaces the seed)."""
+        return make_surface(self, **overrides)
+
+
+def list_presets() -> list[str]:
+    """Names of all presets, sorted."""
+    return sorted(p.stem for p in presets_dir().glob("*.toml"))
+
+
+def load_preset(name: str) -> Preset:
+    """Load preset ``name`` (a file stem in :func:`presets_dir`) or a path to a .toml."""
+    path = Path(name)
+    if path.suffix != ".toml":
+        path = presets_dir() / f"{name}.toml"
+    if not path.is_file():
+        known = ", ".join(list_presets()) or "none"
+        raise SpineInputError(f"unknown preset {name!r}; known presets: {known}")
+    try:
+        doc = tomllib.loads(path.read_text())
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise SpineInputError(f"preset {path.name} is not valid TOML: {exc}") from None
+    generator = doc.pop("generator", None)
+    if generator not in GENERATORS:
+        raise SpineInputError(
+            f"preset {path.name}: generator must be one of {sorted(GENERATORS)}, got {generator!r}"
+        )
+    params = doc.pop("params", {})
+    if not isinstance(params, dict):
+        raise SpineInputError(f"preset {path.name}: [params] must be a table")
+    seed = doc.pop("seed", None)
+    if seed is not None and (not isinstance(seed, int) or isinstance(seed, bool) or seed < 0):
+        raise SpineInputError(f"preset {path.name}: seed must be a non-negative integer, got {seed!r}")
+    description = str(doc.pop("description", ""))
+    _check_params(generator, params, f"preset {path.name}")
+    return Preset(name=path.stem, generator=generator, params=params, description=description,
+                  seed=seed, extras=doc)
+
+
+def _check_params(generator: str, params: dict, where: str) -> None:
+    allowed = [p for p in inspect.signature(GENERATORS[generator]).parameters if p != "rng"]
+    if generator == "measured":
+        allowed = ["file", "channel", "fill", "level", "spacing_m"]
+    unknown = sorted(set(params) - set(allowed))
+    if unknown:
+        raise SpineInputError(
+            f"{where}: unknown parameter(s) {unknown} for generator {generator}; "
+            f"allowed: {', '.join(allowed)}"
+        )
+
+
+def parse_override(text: str) -> tuple[str, Any]:
+    """Parse ``key=value`` with a TOML value (``hurst=0.7``, ``size=[10, 10]``); bare
+    words are strings."""
+    key, sep, value = text.partition("=")
+    key = key.strip()
+    if not sep or not key:
+        raise SpineInputError(f"override must look like key=value, got {text!r}")
+    try:
+        parsed = tomllib.loads(f"v = {value.strip()}")["v"]
+    except tomllib.TOMLDecodeError:
+        parsed = value.strip()
+    return key, parsed
+
+
+def make_surface(preset: Preset | str, **overrides) -> surfaces.Surface:
+    """Make the surface a preset describes, with parameters replaced by ``overrides``.
+
+    ``seed`` in ``overrides`` replaces the preset's seed; every other key must be a
+    parameter of the preset's generator. The preset's name is recorded in the metadata.
+    """
+    if isinstance(preset, str):
+        preset = load_preset(preset)
+    overrides = dict(overrides)
+    seed = overrides.pop("seed", preset.seed)
+    params = dict(preset.params, **overrides)
+    _check_params(preset.generator, params, f"preset {preset.name}")
+    func = GENERATORS[preset.generator]
+    takes_rng = "rng" in inspect.signature(func).parameters
+    if seed is not None and not takes_rng:
+        raise SpineInputError(f"preset {preset.name} ({preset.generator}) takes no seed")
+    try:
+        surface = func(**params, rng=seed) if takes_rng else func(**params)
+    except TypeError as exc:
+        raise SpineInputError(f"preset {preset.name}: bad parameter: {exc}") from None
+    surface.metadata["preset"] = preset.name
+    return surface

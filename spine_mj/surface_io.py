@@ -1,0 +1,265 @@
+"""Reading and writing surfaces: spine_mj's .npz format, measured instrument files, STL.
+
+* ``.npz``: every array plus a JSON metadata string; loads with ``allow_pickle=False``.
+* measured topographies (x3p, opd, datx, plu, di, sur, ...) through SurfaceTopography,
+  converted to metres, levelled, with missing points filled by a stated method or refused;
+* a watertight STL solid (top surface, side walls, flat bottom) for 3-D printing.
+
+Writers go through :func:`spine_mj.errors.atomic_output`: a failure leaves no file behind.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import zipfile
+from pathlib import Path
+
+import numpy as np
+
+from spine_mj.errors import SpineInputError, atomic_output
+from spine_mj.surfaces import GaussianSurface, GridSurface, Surface
+
+__all__ = ["FILL_METHODS", "import_topography", "load_surface", "save_surface", "surface_mesh",
+           "write_stl"]
+
+FORMAT = "spine_mj.surface/1"
+_GAUSS_KEYS = ("amplitude", "center_x", "center_y", "sigma_x", "sigma_y")
+
+#: How :func:`import_topography` treats missing (NaN / masked) points.
+FILL_METHODS = ("refuse", "harmonic", "nearest", "mean")
+
+
+def save_surface(surface: Surface, path: str | os.PathLike) -> Path:
+    """Write ``surface`` to ``path`` (.npz), atomically. Returns the path."""
+    path = Path(path)
+    if path.suffix != ".npz":
+        raise SpineInputError(f"surface files must end in .npz, got {path.name!r}")
+    common = {
+        "format": np.array(FORMAT),
+        "unit": np.array(surface.unit),
+        "bounds": np.asarray(surface.bounds, dtype=float),
+        "metadata_json": np.array(json.dumps(surface.metadata, default=_json_default)),
+    }
+    if isinstance(surface, GridSurface):
+        arrays = dict(kind=np.array("grid"), heights=surface.heights, x=surface.x, y=surface.y,
+                      periodic=np.array(surface.periodic))
+    elif isinstance(surface, GaussianSurface):
+        arrays = {"kind": np.array("gaussian")}
+        arrays.update({k: getattr(surface, k) for k in _GAUSS_KEYS})
+    else:
+        raise SpineInputError(f"cannot save a surface of type {type(surface).__name__}")
+    with atomic_output(path) as tmp:
+        with open(tmp, "wb") as fh:
+            np.savez_compressed(fh, **common, **arrays)
+    return path
+
+
+def _json_default(obj):
+    if isinstance(obj, np.generic):
+        return obj.item()
+    if isinstance(obj, np.ndarray):
+        return obj.tolist()
+    return str(obj)
+
+
+def load_surface(path: str | os.PathLike) -> Surface:
+    """Read a surface written by :func:`save_surface`.
+
+    Raises
+    ------
+    SpineInputError
+        If the file is missing, not an .npz, corrupt, from another program, or holds
+        invalid data (NaN heights, bad coordinates, ...).
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise SpineInputError(f"surface file not found: {path}")
+    try:
+        with np.load(path, allow_pickle=False) as npz:
+            data = {k: npz[k] for k in npz.files}
+    except (zipfile.BadZipFile, ValueError, OSError, EOFError) as exc:
+        raise SpineInputError(f"{path} is not a readable spine_mj .npz surface ({exc})") from None
+    if str(data.get("format", "")) != FORMAT:
+        raise SpineInputError(f"{path} is not a spine_mj surface file (no format tag {FORMAT!r})")
+    try:
+        metadata = json.loads(str(data["metadata_json"]))
+        kind = str(data["kind"])
+        unit = str(data["unit"])
+        if kind == "grid":
+            return GridSurface(heights=data["heights"], x=data["x"], y=data["y"],
+                               periodic=bool(data["periodic"]), unit=unit, metadata=metadata)
+        if kind == "gaussian":
+            return GaussianSurface(**{k: data[k] for k in _GAUSS_KEYS},
+                                   bounds=tuple(data["bounds"]), unit=unit, metadata=metadata)
+    except KeyError as exc:
+        raise SpineInputError(f"{path} is missing the array {exc.args[0]!r}") from None
+    except json.JSONDecodeError as exc:
+        raise SpineInputError(f"{path} has corrupt metadata ({exc})") from None
+    except SpineInputError as exc:
+        raise SpineInputError(f"{path}: {exc}") from None
+    raise SpineInputError(f"{path} has unknown surface kind {kind!r}; expected 'grid' or 'gaussian'")
+
+
+# --------------------------------------------------------------------------- measured data
+
+
+def import_topography(
+    path: str | os.PathLike,
+    *,
+    channel: int = 0,
+    fill: str = "refuse",
+    level: bool = True,
+    spacing_m: float | None = None,
+) -> GridSurface:
+    """Read a measured topography through SurfaceTopography, in metres.
+
+    Parameters
+    ----------
+    path
+        Any format SurfaceTopography reads (x3p, opd, datx, plu, di, sur, ...).
+    channel
+        Index of the data channel to read (height channels come first in most formats).
+    fill
+        What to do with missing points: ``"refuse"`` (raise, naming their count),
+        ``"harmonic"`` (SurfaceTopography's harmonic interpolation: the solution of
+        Laplace's equation with the measured points as boundary values), ``"nearest"``
+        (value of the nearest measured point), or ``"mean"`` (the mean height).
+    level
+        Remove the best-fit plane (tilt and offset) by least squares.
+    spacing_m
+        Resample to this spacing (metres) with the C2 interpolant; None keeps the
+        instrument's grid.
+    """
+    if fill not in FILL_METHODS:
+        raise SpineInputError(f"fill must be one of {FILL_METHODS}, got {fill!r}")
+    path = Path(path)
+    if not path.is_file():
+        raise SpineInputError(f"topography file not found: {path}")
+    import SurfaceTopography as st
+
+    try:
+        reader = st.open_topography(str(path))
+        n_channels = len(reader.channels)
+        if not (0 <= channel < n_channels):
+            raise SpineInputError(
+                f"channel must be in 0..{n_channels - 1} for {path.name}, got {channel}"
+            )
+        topo = reader.topography(channel_index=channel)
+        if topo.unit is None:
+            raise SpineInputError(f"{path.name} states no length unit; cannot convert to metres")
+        topo = topo.to_unit("m")
+    except SpineInputError:
+        raise
+    except Exception as exc:  # SurfaceTopography raises many types for bad files
+        raise SpineInputError(
+            f"cannot read topography {path.name}: {type(exc).__name__}: {exc}"
+        ) from None
+    if topo.dim != 2 or not topo.is_uniform:
+        raise SpineInputError(f"{path.name} is not a uniform 2-D area scan")
+
+    heights = np.ma.filled(np.ma.masked_invalid(topo.heights()).astype(float), np.nan)
+    missing = ~np.isfinite(heights)
+    n_missing = int(missing.sum())
+    if n_missing:
+        if fill == "refuse":
+            raise SpineInputError(
+                f"{path.name} has {n_missing} missing points ({100 * n_missing / heights.size:.2f} %);"
+                " choose a fill method (harmonic, nearest, mean)"
+            )
+        if n_missing == heights.size:
+            raise SpineInputError(f"{path.name} has no valid height at all")
+        heights = _fill_missing(heights, missing, fill, topo)
+    if level:
+        heights = _remove_plane(heights)
+
+    nx_, ny_ = topo.nb_grid_pts
+    sx, sy = topo.physical_sizes
+    x = np.arange(nx_) * (sx / nx_)
+    y = np.arange(ny_) * (sy / ny_)
+    meta = {"generator": "measured", "source": path.name, "channel": channel, "fill": fill,
+            "missing_points": n_missing, "levelled": bool(level),
+            "instrument": str(topo.info.get("instrument", {}).get("name", ""))}
+    surface = GridSurface(heights=heights.T, x=x - x.mean(), y=y - y.mean(), periodic=False,
+                          unit="m", metadata=meta)
+    return surface if spacing_m is None else surface.resample(spacing_m)
+
+
+def _fill_missing(heights, missing, method, topo):
+    if method == "harmonic":
+        filled = topo.interpolate_undefined_data("harmonic").heights()
+        return np.asarray(np.ma.filled(filled, np.nan), dtype=float)
+    if method == "mean":
+        out = heights.copy()
+        out[missing] = heights[~missing].mean()
+        return out
+    from scipy import ndimage
+
+    _, (ii, jj) = ndimage.distance_transform_edt(missing, return_indices=True)
+    return heights[ii, jj]
+
+
+def _remove_plane(heights: np.ndarray) -> np.ndarray:
+    n0, n1 = heights.shape
+    a, b = np.meshgrid(np.arange(n0, dtype=float), np.arange(n1, dtype=float), indexing="ij")
+    design = np.column_stack([np.ones(heights.size), a.ravel(), b.ravel()])
+    coef, *_ = np.linalg.lstsq(design, heights.ravel(), rcond=None)
+    return heights - (design @ coef).reshape(heights.shape)
+
+
+# --------------------------------------------------------------------------- STL
+
+
+def surface_mesh(surface: Surface, *, resolution: int = 201, base_thickness: float | None = None,
+                 scale: float = 1.0):
+    """A closed, watertight triangle mesh: the surface on top, walls, a flat bottom.
+
+    A :class:`GridSurface` is meshed at its own samples, an analytic surface on a
+    ``resolution x resolution`` grid. ``base_thickness`` (below the lowest point) defaults
+    to 5 % of the larger side. Coordinates are multiplied by ``scale``.
+
+    Returns
+    -------
+    trimesh.Trimesh
+    """
+    import trimesh
+
+    grid = surface if isinstance(surface, GridSurface) else surface.sample(resolution)
+    h = grid.heights
+    ny, nx = h.shape
+    span = max(grid.x[-1] - grid.x[0], grid.y[-1] - grid.y[0])
+    base_thickness = 0.05 * span if base_thickness is None else float(base_thickness)
+    if not base_thickness > 0:
+        raise SpineInputError(f"base_thickness must be > 0, got {base_thickness!r}")
+    z_bottom = h.min() - base_thickness
+    xx, yy = np.meshgrid(grid.x, grid.y)
+    top = np.column_stack([xx.ravel(), yy.ravel(), h.ravel()])
+    bottom = np.column_stack([xx.ravel(), yy.ravel(), np.full(h.size, z_bottom)])
+    vertices = np.vstack([top, bottom]) * scale
+    idx = np.arange(ny * nx).reshape(ny, nx)
+    a, b = idx[:-1, :-1].ravel(), idx[:-1, 1:].ravel()
+    c, d = idx[1:, :-1].ravel(), idx[1:, 1:].ravel()
+    top_faces = np.concatenate([np.column_stack([a, b, d]), np.column_stack([a, d, c])])
+    off = ny * nx
+    bottom_faces = top_faces[:, ::-1] + off
+    ring = np.concatenate([idx[0, :], idx[1:, -1], idx[-1, -2::-1], idx[-2:0:-1, 0]])
+    nxt = np.roll(ring, -1)
+    walls = np.concatenate([np.column_stack([ring, ring + off, nxt + off]),
+                            np.column_stack([ring, nxt + off, nxt])])
+    mesh = trimesh.Trimesh(vertices=vertices,
+                           faces=np.concatenate([top_faces, bottom_faces, walls]), process=False)
+    mesh.fix_normals()
+    return mesh
+
+
+def write_stl(surface: Surface, path: str | os.PathLike, **mesh_options) -> Path:
+    """Write :func:`surface_mesh` as binary STL, atomically; refuse a non-watertight mesh."""
+    path = Path(path)
+    if path.suffix.lower() != ".stl":
+        raise SpineInputError(f"STL output must end in .stl, got {path.name!r}")
+    mesh = surface_mesh(surface, **mesh_options)
+    if not mesh.is_watertight:
+        raise SpineInputError("internal mesh is not watertight; refusing to write an STL")
+    with atomic_output(path) as tmp:
+        mesh.export(tmp, file_type="stl")
+    return path
