@@ -1,0 +1,171 @@
+"""Engagement ratio kappa of a point spine on a surface z = f(x, y) (paper §2.1, Eqs. 1-3).
+
+Conventions (``PHYSICS.md`` §1): drive ``u_x = (1, 0, 0)``, preload ``g = (0, 0, -1)``,
+inward normal ``n = (f_x, f_y, -1) / s`` with ``s = sqrt(1 + f_x^2 + f_y^2)``. Per unit
+preload the resultant is ``r = kappa u_x + g``; the tip sticks while
+``|T| <= mu N`` with ``N = r . n > 0`` and ``T = r - N n``.
+
+Squaring Eq. 1 gives Eq. 2, ``A kappa^2 + B kappa + C = 0``, with (Eq. 3, derived from the
+vectors, not copied from the paper's misprinted ``T_w*``)
+
+.. math::
+
+    A = |a|^2 - \\mu^2 n_x^2,\\quad B = 2 (a \\cdot b + \\mu^2 n_x n_z),\\quad
+    C = |b|^2 - \\mu^2 n_z^2,
+
+``a = u_x - n_x n``, ``b = g + n_z n``. Since ``|a|^2 = 1 - n_x^2``, ``a . b = n_x n_z`` and
+``|b|^2 = 1 - n_z^2``, multiplying by ``s^2 > 0`` leaves the same roots with
+
+.. math::
+
+    A' = 1 + f_y^2 - \\mu^2 f_x^2,\\quad B' = -2 (1 + \\mu^2) f_x,\\quad
+    C' = f_x^2 + f_y^2 - \\mu^2 ,
+
+which is what :func:`kappa` evaluates.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from spine_mj.errors import SpineInputError
+
+__all__ = ["ENGAGED", "REGION_NAMES", "SELF_LOCK", "SLIP", "kappa", "quadratic_coefficients",
+           "slip_direction"]
+
+#: Region codes returned by :func:`kappa` (paper Fig. 2C).
+SLIP = 0
+ENGAGED = 1
+SELF_LOCK = 2
+REGION_NAMES = {SLIP: "slip", ENGAGED: "engaged", SELF_LOCK: "self-lock"}
+
+#: Default tolerance on the scaled leading coefficient ``A'`` (dimensionless, O(1)).
+DEFAULT_TOL = 1e-12
+
+
+def _check_mu(mu) -> float:
+    try:
+        mu = float(mu)
+    except (TypeError, ValueError):
+        raise SpineInputError(f"mu (static friction coefficient) must be a number, got {mu!r}") from None
+    if not (math.isfinite(mu) and mu > 0):
+        raise SpineInputError(f"mu (static friction coefficient) must be finite and > 0, got {mu!r}")
+    return mu
+
+
+def quadratic_coefficients(fx, fy, mu) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Coefficients ``(A', B', C')`` of Eq. 2 scaled by ``1 + f_x^2 + f_y^2`` (see module).
+
+    Parameters
+    ----------
+    fx, fy : array_like
+        Surface slopes, broadcast together.
+    mu : float
+        Static friction coefficient mu_s > 0.
+    """
+    mu = _check_mu(mu)
+    fx = np.asarray(fx, dtype=float)
+    fy = np.asarray(fy, dtype=float)
+    m2 = mu * mu
+    return 1.0 + fy * fy - m2 * fx * fx, -2.0 * (1.0 + m2) * fx, fx * fx + fy * fy - m2
+
+
+def kappa(fx, fy, mu, *, tol: float = DEFAULT_TOL) -> tuple[np.ndarray, np.ndarray]:
+    """Engagement ratio kappa = F_c / W and region at points with slopes ``(fx, fy)``.
+
+    Regions (paper Fig. 2C, ``PHYSICS.md`` §1):
+
+    * ``SELF_LOCK`` (2): ``A' < tol`` and ``f_x > 0`` - the drive direction lies inside the
+      friction cone and pushes into the surface; ``kappa = +inf``.
+    * ``ENGAGED`` (1): a root ``kappa > 0`` of Eq. 2 with ``N > 0`` there (``1 + kappa f_x
+      > 0``); kappa is the larger such root, the force at which the hold breaks.
+    * ``SLIP`` (0): neither; gravity alone slides the tip; ``kappa = NaN``.
+
+    Near ``A' = 0`` (the self-lock boundary) the roots come from the cancellation-free
+    form ``q = -(B + sign(B) sqrt(D)) / 2``, roots ``q / A`` and ``C / q``; ``q / A`` is
+    only used where ``|A'| >= tol``, so no division by a tiny ``A'`` happens.
+
+    Parameters
+    ----------
+    fx, fy : array_like
+        Slopes ``df/dx``, ``df/dy`` (dimensionless), broadcast together to shape ``S``.
+    mu : float
+        Static friction coefficient mu_s > 0.
+    tol : float
+        Tolerance on ``A'`` (dimensionless); points with ``|A'| < tol`` count as on the
+        self-lock boundary (self-locked if ``f_x > 0``, linear equation otherwise).
+
+    Returns
+    -------
+    kappa : ndarray, shape S
+        ``F_c / W`` (dimensionless); ``+inf`` where self-locked, NaN where slipping.
+    region : ndarray of int8, shape S
+        ``SLIP``, ``ENGAGED`` or ``SELF_LOCK``.
+
+    Raises
+    ------
+    SpineInputError
+        If ``mu`` is not a finite number > 0 or ``tol`` is negative.
+
+    Examples
+    --------
+    Flat ground gives ``kappa = mu``; a 2-D slope of angle theta gives
+    ``tan(theta + arctan(mu))``:
+
+    >>> k, r = kappa([0.0, math.tan(0.2)], 0.0, 0.5)
+    >>> bool(np.allclose(k, [0.5, math.tan(0.2 + math.atan(0.5))]))
+    True
+    """
+    mu = _check_mu(mu)
+    tol = float(tol)
+    if not (tol >= 0):
+        raise SpineInputError(f"tol must be >= 0, got {tol!r}")
+    fx, fy = np.broadcast_arrays(np.asarray(fx, dtype=float), np.asarray(fy, dtype=float))
+    a, b, c = quadratic_coefficients(fx, fy, mu)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        disc = b * b - 4.0 * a * c
+        sq = np.sqrt(np.where(disc >= 0, disc, np.nan))
+        q = -0.5 * (b + np.where(b >= 0, 1.0, -1.0) * sq)
+        big_a = np.abs(a) >= tol
+        r1 = np.where(big_a & (q != 0), q / np.where(big_a, a, 1.0), np.nan)
+        r2 = np.where(q != 0, c / q, np.nan)
+        ok1 = (r1 > 0) & (1.0 + r1 * fx > 0)
+        ok2 = (r2 > 0) & (1.0 + r2 * fx > 0)
+        k = np.fmax(np.where(ok1, r1, np.nan), np.where(ok2, r2, np.nan))
+    lock = (a < tol) & (fx > 0)
+    region = np.where(lock, SELF_LOCK, np.where(np.isfinite(k), ENGAGED, SLIP)).astype(np.int8)
+    k = np.where(lock, np.inf, k)
+    return k, region
+
+
+def slip_direction(fx, fy, kappa_value, region) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Unit tangential slip direction ``v = T / |T|`` (paper §2.2).
+
+    ``T = r - (r . n) n`` with ``r = kappa u_x + g`` where engaged and ``r = g`` where
+    slipping. Self-locked points get NaN (the tip does not move).
+
+    Parameters
+    ----------
+    fx, fy, kappa_value, region : array_like, broadcast to shape S
+        Slopes, engagement ratio and region from :func:`kappa`.
+
+    Returns
+    -------
+    vx, vy, vz : ndarray, shape S
+        Components of ``v``; NaN where self-locked or where ``|T| = 0``.
+    """
+    fx, fy, kv, reg = np.broadcast_arrays(np.asarray(fx, dtype=float), np.asarray(fy, dtype=float),
+                                          np.asarray(kappa_value, dtype=float), np.asarray(region))
+    k = np.where(reg == ENGAGED, kv, 0.0)
+    s2 = 1.0 + fx * fx + fy * fy
+    rn = (k * fx + 1.0) / s2
+    tx = k - rn * fx
+    ty = -rn * fy
+    tz = -1.0 + rn
+    norm = np.sqrt(tx * tx + ty * ty + tz * tz)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        bad = (reg == SELF_LOCK) | ~(norm > 0)
+        inv = np.where(bad, np.nan, 1.0 / norm)
+    return tx * inv, ty * inv, tz * inv

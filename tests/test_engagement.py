@@ -1,0 +1,117 @@
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from spine_mj.engagement import ENGAGED, SELF_LOCK, SLIP, kappa, slip_direction
+from spine_mj.errors import SpineInputError
+
+
+def _holds(fx, fy, mu, k, margin=0.0):
+    """Brute force from the vector definitions (PHYSICS.md §1): |T| <= mu N and N > 0."""
+    s = math.sqrt(1 + fx * fx + fy * fy)
+    n = np.array([fx, fy, -1.0]) / s
+    r = np.array([k, 0.0, -1.0])
+    normal = r @ n
+    t = r - normal * n
+    return normal > 0 and np.linalg.norm(t) <= mu * normal * (1 + margin)
+
+
+@pytest.mark.parametrize("mu", [0.2, 0.5, 1.0, 1.25])
+def test_two_d_closed_form(mu):
+    phi = math.atan(mu)
+    theta = np.linspace(-1.5, 1.5, 601)
+    k, region = kappa(np.tan(theta), 0.0, mu)
+    engaged = (theta + phi > 1e-9) & (theta + phi < math.pi / 2 - 1e-9)
+    np.testing.assert_allclose(k[engaged], np.tan(theta[engaged] + phi), rtol=1e-9)
+    assert np.all(region[engaged] == ENGAGED)
+    assert np.all(region[theta + phi > math.pi / 2 + 1e-9] == SELF_LOCK)
+    assert np.all(np.isposinf(k[region == SELF_LOCK]))
+    assert np.all(region[theta + phi < -1e-9] == SLIP)
+    assert np.all(np.isnan(k[region == SLIP]))
+
+
+def test_self_lock_threshold_is_slope_one_over_mu():
+    mu = 1.25
+    k, region = kappa([1 / mu - 1e-6, 1 / mu + 1e-6], 0.0, mu)
+    assert region.tolist() == [ENGAGED, SELF_LOCK]
+    assert k[0] > 1e5
+
+
+def test_boundary_a_zero_is_finite_and_classified():
+    mu = 0.8
+    fy = np.array([0.0, 0.3, 1.0])
+    fx_edge = np.sqrt(1 + fy**2) / mu  # A' = 0 exactly
+    k, region = kappa(fx_edge, fy, mu)
+    assert np.all(region == SELF_LOCK)
+    k, region = kappa(-fx_edge, fy, mu)  # descending side: linear equation, no blow-up
+    assert not np.any(np.isinf(k))
+
+
+def test_flat_ground_gives_mu():
+    for mu in (0.1, 0.5, 1.0, 3.0):
+        k, region = kappa(0.0, 0.0, mu)
+        assert region == ENGAGED
+        assert k == pytest.approx(mu, rel=1e-12)
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.floats(-4, 4), st.floats(-4, 4))
+def test_y_mirror_symmetry(fx, fy):
+    k1, r1 = kappa(fx, fy, 0.7)
+    k2, r2 = kappa(fx, -fy, 0.7)
+    assert r1 == r2
+    np.testing.assert_allclose(k1, k2, rtol=1e-12, equal_nan=True)
+
+
+@settings(max_examples=400, deadline=None)
+@given(st.floats(-3, 3), st.floats(-3, 3), st.floats(0.05, 2.5))
+def test_brute_force_friction_cone(fx, fy, mu):
+    k, region = kappa(fx, fy, mu)
+    k = float(k)
+    if region == SELF_LOCK:
+        for big in (1e3, 1e6):
+            assert _holds(fx, fy, mu, big)
+    elif region == ENGAGED:
+        assert k > 0
+        eps = 1e-6 * max(1.0, k)
+        assert _holds(fx, fy, mu, k - min(eps, 0.5 * k), margin=1e-9)
+        # nothing above kappa holds: the hold really breaks there
+        for above in k + eps + np.geomspace(1e-6, 1e6, 60):
+            assert not _holds(fx, fy, mu, above, margin=-1e-9)
+    else:
+        for trial in np.concatenate([[0.0], np.geomspace(1e-6, 1e6, 200)]):
+            assert not _holds(fx, fy, mu, trial, margin=-1e-9)
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.floats(-3, 3), st.floats(-3, 3), st.floats(0.05, 2.5))
+def test_slip_direction_is_tangent_and_critical(fx, fy, mu):
+    k, region = kappa(fx, fy, mu)
+    v = np.array(slip_direction(fx, fy, k, region), dtype=float)
+    if region == SELF_LOCK:
+        assert np.all(np.isnan(v))
+        return
+    n = np.array([fx, fy, -1.0]) / math.sqrt(1 + fx * fx + fy * fy)
+    assert np.linalg.norm(v) == pytest.approx(1.0, abs=1e-9)
+    assert abs(v @ n) < 1e-9
+    if region == SLIP:
+        assert v[2] <= 1e-12  # gravity alone slides the tip downhill
+
+
+def test_vectorized_equals_pointwise():
+    rng = np.random.default_rng(0)
+    fx, fy = rng.normal(0, 1.5, (2, 50))
+    k, region = kappa(fx, fy, 0.9)
+    for i in range(50):
+        ki, ri = kappa(fx[i], fy[i], 0.9)
+        assert ri == region[i]
+        np.testing.assert_equal(ki, k[i])
+
+
+@pytest.mark.parametrize("bad", [0.0, -1.0, float("nan"), float("inf"), "x"])
+def test_bad_mu_names_the_argument(bad):
+    with pytest.raises(SpineInputError, match="mu"):
+        kappa(0.1, 0.1, bad)
