@@ -541,13 +541,12 @@ def random_gaussians(
 
 
 def _spectral_rms_slope(heights: np.ndarray, dx: float, dy: float) -> float:
+    """``sqrt(<|grad f|^2>)`` of a periodic grid by Parseval: ``sum q^2 |F(q)|^2 / N^2``."""
     ny, nx = heights.shape
-    spec = np.fft.fft2(heights)
-    kx = 2j * np.pi * np.fft.fftfreq(nx, dx)[None, :]
-    ky = 2j * np.pi * np.fft.fftfreq(ny, dy)[:, None]
-    gx = np.fft.ifft2(spec * kx).real
-    gy = np.fft.ifft2(spec * ky).real
-    return float(np.sqrt(np.mean(gx * gx + gy * gy)))
+    power = np.abs(np.fft.fft2(heights)) ** 2 / heights.size**2
+    q2 = (2 * np.pi) ** 2 * (np.fft.fftfreq(nx, dx)[None, :] ** 2
+                             + np.fft.fftfreq(ny, dy)[:, None] ** 2)
+    return float(np.sqrt(np.sum(q2 * power)))
 
 
 def fractal_fbm(
@@ -701,7 +700,7 @@ def sandpaper(
     e_lo, e_hi = _range("embed_range", embed_range, positive=False)
     if not (0 <= e_lo and e_hi < 1):
         raise SpineInputError(f"embed_range must lie within [0, 1), got {embed_range!r}")
-    n = round(size_m / spacing_m)
+    n = math.ceil(size_m / spacing_m - 1e-9)
     if n < _MIN_POINTS_PER_SIDE:
         raise SpineInputError(f"size_m / spacing_m gives {n} points; need at least 4")
     if n > 8192:

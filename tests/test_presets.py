@@ -1,0 +1,63 @@
+"""Surface recipes in surfaces/: every preset builds, seeds reproduce, overrides validate."""
+
+import numpy as np
+import pytest
+
+from spine_mj import SpineInputError
+from spine_mj.presets import list_presets, load_preset, make_surface, parse_override
+
+PAPER = ["paper-single-peak", "paper-single-valley", "paper-random-convex",
+         "paper-random-concave", "paper-fractal", "sandpaper-P36", "sandpaper-P60",
+         "sandpaper-P600"]
+
+
+def test_all_paper_presets_exist():
+    assert set(PAPER) <= set(list_presets())
+
+
+@pytest.mark.parametrize("name", PAPER)
+def test_preset_builds_and_records_its_name(name):
+    surf = make_surface(name)
+    assert surf.metadata["preset"] == name
+    x0, x1, y0, y1 = surf.bounds
+    assert np.isfinite(surf.height(0.5 * (x0 + x1), 0.5 * (y0 + y1)))
+
+
+def test_single_peak_preset_is_the_paper_surface():
+    surf = make_surface("paper-single-peak")
+    assert surf.height(0, 0) == pytest.approx(2.2222, abs=1e-4)
+    assert surf.bounds == (-5, 5, -5, 5)
+    assert make_surface("paper-single-valley").height(0, 0) == pytest.approx(-2.2222, abs=1e-4)
+
+
+def test_overrides_and_seed():
+    a = make_surface("paper-fractal", seed=3, hurst=0.65)
+    b = make_surface("paper-fractal", seed=3, hurst=0.65)
+    c = make_surface("paper-fractal", seed=4, hurst=0.65)
+    np.testing.assert_array_equal(a.heights, b.heights)
+    assert not np.array_equal(a.heights, c.heights)
+    assert a.metadata["params"]["hurst"] == 0.65 and a.metadata["seed"] == 3
+
+
+def test_bad_presets_and_overrides(tmp_path):
+    with pytest.raises(SpineInputError, match="unknown preset 'nope'; known presets: paper-"):
+        load_preset("nope")
+    with pytest.raises(SpineInputError, match=r"unknown parameter\(s\) \['colour'\]"):
+        make_surface("paper-fractal", colour="red")
+    with pytest.raises(SpineInputError, match="takes no seed"):
+        make_surface("paper-single-peak", seed=1)
+    bad = tmp_path / "bad.toml"
+    bad.write_text("generator = 'fractal_fbm'\n[params\n")
+    with pytest.raises(SpineInputError, match="not valid TOML"):
+        load_preset(str(bad))
+    bad.write_text("generator = 'teapot'\n")
+    with pytest.raises(SpineInputError, match="generator must be one of"):
+        load_preset(str(bad))
+
+
+def test_parse_override():
+    assert parse_override("hurst=0.7") == ("hurst", 0.7)
+    assert parse_override("size=[10, 12]") == ("size", [10, 12])
+    assert parse_override("grit=P36") == ("grit", "P36")
+    with pytest.raises(SpineInputError, match="key=value"):
+        parse_override("hurst")

@@ -1,0 +1,157 @@
+"""Saving, loading, importing measured topographies, and the STL solid."""
+
+import numpy as np
+import pytest
+
+from spine_mj import SpineInputError
+from spine_mj.surface_io import (
+    import_topography,
+    load_surface,
+    save_surface,
+    surface_mesh,
+    write_stl,
+)
+from spine_mj.surfaces import GridSurface, fractal_fbm, random_gaussians, single_gaussian
+
+
+def test_npz_round_trip_grid_and_gaussian(tmp_path):
+    grid = fractal_fbm(nx=32, ny=20, hurst=0.6, rng=4, unit="m")
+    back = load_surface(save_surface(grid, tmp_path / "g.npz"))
+    np.testing.assert_array_equal(back.heights, grid.heights)
+    np.testing.assert_array_equal(back.x, grid.x)
+    assert back.periodic and back.unit == "m"
+    assert back.metadata["params"]["hurst"] == 0.6 and back.metadata["seed"] == 4
+
+    gauss = random_gaussians(n_peaks=5, rng=2)
+    back = load_surface(save_surface(gauss, tmp_path / "r.npz"))
+    x, y = np.random.default_rng(0).uniform(-9, 9, (2, 50))
+    np.testing.assert_array_equal(back.height(x, y), gauss.height(x, y))
+    assert back.bounds == gauss.bounds
+    with np.load(tmp_path / "r.npz", allow_pickle=False) as npz:
+        assert "metadata_json" in npz.files
+
+
+def test_load_rejects_corrupt_and_foreign_files(tmp_path):
+    bad = tmp_path / "bad.npz"
+    bad.write_bytes(b"not a zip at all")
+    with pytest.raises(SpineInputError, match="not a readable"):
+        load_surface(bad)
+    foreign = tmp_path / "foreign.npz"
+    np.savez(foreign, a=np.zeros(3))
+    with pytest.raises(SpineInputError, match="not a spine_mj surface"):
+        load_surface(foreign)
+    with pytest.raises(SpineInputError, match="not found"):
+        load_surface(tmp_path / "missing.npz")
+    nan = tmp_path / "nan.npz"
+    save_surface(single_gaussian().sample(8), nan)
+    with np.load(nan) as npz:
+        data = dict(npz)
+    data["heights"] = data["heights"].copy()
+    data["heights"][2, 3] = np.nan
+    np.savez(nan, **data)
+    with pytest.raises(SpineInputError, match="NaN"):
+        load_surface(nan)
+
+
+def test_failed_save_leaves_nothing(tmp_path):
+    class Weird:
+        unit, bounds, metadata = "1", (0, 1, 0, 1), {}
+
+    with pytest.raises(SpineInputError, match="cannot save"):
+        save_surface(Weird(), tmp_path / "w.npz")
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("name, n_expected", [("plu-1.plu", (576, 768)), ("di-1.di", (512, 512))])
+def test_import_shared_instrument_files(topography_dir, name, n_expected):
+    surf = import_topography(topography_dir / name)
+    assert surf.unit == "m"
+    assert surf.shape == n_expected
+    h = surf.heights
+    assert np.isfinite(h).all()
+    # levelled: the least-squares plane of the result is flat
+    yy, xx = np.meshgrid(surf.y, surf.x, indexing="ij")
+    design = np.column_stack([np.ones(h.size), xx.ravel(), yy.ravel()])
+    coef = np.linalg.lstsq(design, h.ravel(), rcond=None)[0]
+    assert np.abs(coef[1:]).max() < 1e-9 and abs(coef[0]) < 1e-3 * h.std()
+    # physical units: micrometre-scale heights on micrometre-to-millimetre fields
+    assert 1e-10 < h.std() < 1e-3
+    assert 1e-7 < surf.bounds[1] - surf.bounds[0] < 1e-2
+    raw = import_topography(topography_dir / name, level=False)
+    assert np.abs(raw.heights - h).max() > 0.01 * h.std()
+
+
+def test_import_resamples_to_spacing(topography_dir):
+    surf = import_topography(topography_dir / "di-1.di")
+    dx = surf.spacing[0]
+    coarse = import_topography(topography_dir / "di-1.di", spacing_m=4 * dx)
+    assert coarse.spacing[0] == pytest.approx(4 * dx)
+    assert coarse.shape[1] == pytest.approx(surf.shape[1] / 4, abs=1)
+    np.testing.assert_allclose(coarse.heights[::1, ::1][5, 5], surf.heights[20, 20], rtol=1e-6)
+
+
+@pytest.fixture
+def holey_x3p(tmp_path):
+    import SurfaceTopography as st
+
+    rng = np.random.default_rng(0)
+    h = np.add.outer(np.linspace(0, 1, 40), np.linspace(0, 2, 30)) + 0.01 * rng.normal(size=(40, 30))
+    masked = np.ma.masked_array(h, mask=np.zeros_like(h, dtype=bool))
+    masked.mask[10:13, 5:9] = True
+    path = tmp_path / "holey.x3p"
+    st.Topography(masked, (40.0, 30.0), unit="um").to_x3p(str(path))
+    return path
+
+
+def test_missing_points_refused_or_filled(holey_x3p):
+    with pytest.raises(SpineInputError, match="12 missing points"):
+        import_topography(holey_x3p)
+    for method in ("harmonic", "nearest", "mean"):
+        surf = import_topography(holey_x3p, fill=method, level=False)
+        assert np.isfinite(surf.heights).all()
+        assert surf.metadata["missing_points"] == 12
+    # a harmonic fill of a smooth ramp stays on the ramp (um -> m)
+    harm = import_topography(holey_x3p, fill="harmonic", level=False)
+    near = import_topography(holey_x3p, fill="nearest", level=False)
+    ramp_value = harm.heights[6, 11]
+    assert abs(ramp_value - near.heights[6, 11]) < 0.2e-6
+
+
+def test_import_rejects_bad_files(tmp_path):
+    corrupt = tmp_path / "scan.plu"
+    corrupt.write_bytes(b"\x00\x01garbage" * 10)
+    with pytest.raises(SpineInputError, match="cannot read topography"):
+        import_topography(corrupt)
+    with pytest.raises(SpineInputError, match="not found"):
+        import_topography(tmp_path / "none.x3p")
+    with pytest.raises(SpineInputError, match="fill must be one of"):
+        import_topography(corrupt, fill="zero")
+
+
+def test_stl_is_watertight_solid(tmp_path):
+    surf = fractal_fbm(nx=24, ny=17, hurst=0.8, rng=1)
+    mesh = surface_mesh(surf, base_thickness=0.5)
+    assert mesh.is_watertight and mesh.is_volume
+    assert mesh.bounds[0][2] == pytest.approx(surf.heights.min() - 0.5)
+    # exact volume of the two-triangles-per-cell solid: A/6 (2 h_a + h_b + h_c + 2 h_d)
+    h = surf.heights - mesh.bounds[0][2]
+    cell = surf.spacing[0] * surf.spacing[1]
+    exact = cell / 6 * np.sum(2 * h[:-1, :-1] + h[:-1, 1:] + h[1:, :-1] + 2 * h[1:, 1:])
+    assert mesh.volume == pytest.approx(exact, rel=1e-9)
+    path = write_stl(single_gaussian(), tmp_path / "peak.stl", resolution=40)
+    import trimesh
+
+    loaded = trimesh.load(path)
+    assert loaded.is_watertight
+
+
+def test_stl_refuses_wrong_suffix(tmp_path):
+    with pytest.raises(SpineInputError, match=r"\.stl"):
+        write_stl(single_gaussian(), tmp_path / "peak.obj")
+    assert not any(tmp_path.iterdir())
+
+
+def test_grid_surface_metadata_survives(tmp_path):
+    surf = GridSurface(heights=np.zeros((4, 4)), x=np.arange(4.0), y=np.arange(4.0),
+                       metadata={"note": "flat", "n": 3})
+    assert load_surface(save_surface(surf, tmp_path / "f.npz")).metadata == {"note": "flat", "n": 3}

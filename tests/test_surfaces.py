@@ -1,0 +1,372 @@
+"""Surface objects and generators: closed forms, derivative accuracy, statistics, seeds."""
+
+import math
+
+import numpy as np
+import pytest
+from scipy import ndimage
+
+from spine_mj import SpineInputError
+from spine_mj.surfaces import (
+    GRIT_PARTICLE_DIAMETER_M,
+    GaussianSurface,
+    GridSurface,
+    fractal_fbm,
+    from_hfield,
+    random_gaussians,
+    sandpaper,
+    single_gaussian,
+    to_hfield,
+)
+
+RNG = np.random.default_rng(12345)
+
+
+# ------------------------------------------------------------------ single Gaussian
+
+
+def test_single_gaussian_paper_normalization():
+    peak = single_gaussian()
+    assert peak.height(0, 0) == pytest.approx(10 * math.pi / (2 * math.pi * 1.5**2))
+    assert peak.height(0, 0) == pytest.approx(2.2222, abs=1e-4)
+    # steepest slope of A exp(-r^2/2s^2) is A/s * exp(-1/2) at r = s
+    x = np.linspace(0, 5, 20001)
+    slope = np.abs(peak.gradient(x, 0 * x)[0]).max()
+    assert slope == pytest.approx(10 / (2 * 1.5**2) / 1.5 * math.exp(-0.5), rel=1e-6)
+    assert slope == pytest.approx(0.8986, abs=1e-4)
+
+
+def test_valley_is_mirror_of_peak():
+    peak, valley = single_gaussian(sign=1), single_gaussian(sign=-1)
+    x, y = RNG.uniform(-5, 5, (2, 100))
+    for a, b in zip(peak.evaluate(x, y), valley.evaluate(x, y)):
+        np.testing.assert_allclose(a, -b)
+
+
+def test_gaussian_derivatives_match_finite_differences():
+    surf = random_gaussians(n_peaks=20, anisotropic=True, rng=4)
+    x, y = RNG.uniform(-8, 8, (2, 200))
+    h = 1e-5
+    _, fx, fy, fxx, fxy, fyy = surf.evaluate(x, y)
+    np.testing.assert_allclose(fx, (surf.height(x + h, y) - surf.height(x - h, y)) / (2 * h),
+                               atol=1e-7)
+    np.testing.assert_allclose(fy, (surf.height(x, y + h) - surf.height(x, y - h)) / (2 * h),
+                               atol=1e-7)
+    gx_p, _ = surf.gradient(x + h, y)
+    gx_m, _ = surf.gradient(x - h, y)
+    _, gy_p = surf.gradient(x, y + h)
+    _, gy_m = surf.gradient(x, y - h)
+    gxy_p, _ = surf.gradient(x, y + h)
+    gxy_m, _ = surf.gradient(x, y - h)
+    np.testing.assert_allclose(fxx, (gx_p - gx_m) / (2 * h), atol=1e-6)
+    np.testing.assert_allclose(fyy, (gy_p - gy_m) / (2 * h), atol=1e-6)
+    np.testing.assert_allclose(fxy, (gxy_p - gxy_m) / (2 * h), atol=1e-6)
+
+
+def test_evaluation_broadcasts_and_matches_separate_calls():
+    surf = single_gaussian()
+    x = np.linspace(-4, 4, 7)[None, :]
+    y = np.linspace(-3, 3, 5)[:, None]
+    f = surf.height(x, y)
+    assert f.shape == (5, 7)
+    fx, fy = surf.gradient(x, y)
+    fxx, fxy, fyy = surf.hessian(x, y)
+    both = surf.evaluate(x, y)
+    for a, b in zip((f, fx, fy, fxx, fxy, fyy), both):
+        np.testing.assert_array_equal(a, b)
+    assert surf.height(1.0, 2.0).shape == ()
+
+
+# ------------------------------------------------------------------ gridded surfaces
+
+
+def _grid_errors(h):
+    """Max interior errors (value, slope, curvature) of a gridded Gaussian at spacing h."""
+    exact = single_gaussian(bounds=(-6, 6, -6, 6))
+    n = round(12 / h) + 1
+    grid = exact.sample(n)
+    x, y = np.random.default_rng(0).uniform(-4, 4, (2, 3000))
+    e = exact.evaluate(x, y)
+    g = grid.evaluate(x, y)
+    return (np.abs(e[0] - g[0]).max(),
+            max(np.abs(e[1] - g[1]).max(), np.abs(e[2] - g[2]).max()),
+            max(np.abs(e[k] - g[k]).max() for k in (3, 4, 5)))
+
+
+def test_grid_interpolant_accuracy_and_convergence_order():
+    coarse, fine = _grid_errors(0.1), _grid_errors(0.05)
+    assert coarse[0] < 2e-6 and coarse[1] < 5e-5 and coarse[2] < 2e-3
+    orders = [math.log2(c / f) for c, f in zip(coarse, fine)]
+    assert orders[0] > 3.5, orders  # O(h^4) heights
+    assert orders[1] > 2.5, orders  # O(h^3) slopes
+    assert orders[2] > 1.7, orders  # O(h^2) curvatures
+
+
+def test_grid_interpolates_its_samples():
+    surf = fractal_fbm(nx=32, hurst=0.6, rng=1, periodic=False)
+    xx, yy = np.meshgrid(surf.x, surf.y)
+    np.testing.assert_allclose(surf.height(xx, yy), surf.heights, atol=1e-12)
+
+
+def test_fast_grid_evaluation_matches_scipy_reference():
+    """The hand-written B-spline gather equals scipy.ndimage.map_coordinates."""
+    surf = fractal_fbm(nx=48, ny=40, hurst=0.7, rng=2)
+    sp = surf.spline
+    u = RNG.uniform(0, 48, 400)
+    v = RNG.uniform(0, 40, 400)
+    ref = ndimage.map_coordinates(surf.heights, [v, u], order=3, mode="grid-wrap")
+    np.testing.assert_allclose(surf.height(sp.x0 + u * sp.dx, sp.y0 + v * sp.dy), ref, atol=1e-12)
+
+    flat = fractal_fbm(nx=30, hurst=0.7, rng=3, periodic=False)
+    pad = 8
+    padded = np.pad(flat.heights, pad, mode="reflect", reflect_type="odd")
+    u = RNG.uniform(0, 29, 300)
+    v = RNG.uniform(0, 29, 300)
+    ref = ndimage.map_coordinates(padded, [v + pad, u + pad], order=3, mode="mirror")
+    sp = flat.spline
+    np.testing.assert_allclose(flat.height(sp.x0 + u * sp.dx, sp.y0 + v * sp.dy), ref, atol=1e-12)
+
+
+def test_periodic_grid_repeats_and_nonperiodic_is_nan_outside():
+    surf = fractal_fbm(nx=32, size=(8.0, 6.0), hurst=0.8, rng=5)
+    x, y = RNG.uniform(-3, 3, (2, 50))
+    lx, ly = 8.0, 6.0
+    for a, b in zip(surf.evaluate(x, y), surf.evaluate(x + lx, y - 2 * ly)):
+        np.testing.assert_allclose(a, b, atol=1e-10)
+    flat = single_gaussian().sample(21)
+    assert np.isnan(flat.height(5.5, 0.0))
+    assert np.isfinite(flat.height(5.0, -5.0))
+    assert not flat.contains(5.5, 0.0) and flat.contains(0.0, 0.0)
+
+
+def test_resample_keeps_surface():
+    exact = single_gaussian()
+    grid = exact.sample(101)
+    fine = grid.resample(0.05)
+    assert fine.spacing == pytest.approx((0.05, 0.05))
+    x, y = RNG.uniform(-4, 4, (2, 200))
+    np.testing.assert_allclose(fine.height(x, y), exact.height(x, y), atol=1e-4)
+
+
+# ------------------------------------------------------------------ random Gaussians
+
+
+def test_random_gaussians_reproducible_and_distributed_as_documented():
+    a = random_gaussians(rng=7)
+    b = random_gaussians(rng=7)
+    c = random_gaussians(rng=8)
+    for name in ("amplitude", "center_x", "center_y", "sigma_x", "sigma_y"):
+        np.testing.assert_array_equal(getattr(a, name), getattr(b, name))
+    assert not np.array_equal(a.center_x, c.center_x)
+    assert a.n_gaussians == 100
+    assert np.all((a.sigma_x >= 0.5) & (a.sigma_x <= 1.5))
+    np.testing.assert_array_equal(a.sigma_x, a.sigma_y)
+    assert np.all((a.amplitude >= 0.5) & (a.amplitude <= 1.5))
+    assert np.all((a.center_x >= -10) & (a.center_x <= 10))
+    concave = random_gaussians(sign=-1, rng=7)
+    np.testing.assert_array_equal(concave.amplitude, -a.amplitude)
+    big = random_gaussians(n_peaks=4000, rng=1)
+    assert big.amplitude.mean() == pytest.approx(1.0, abs=0.02)
+    assert big.center_x.mean() == pytest.approx(0.0, abs=0.3)
+
+
+def test_random_gaussians_without_overlap_respect_separation():
+    s = random_gaussians(n_peaks=30, overlap=False, min_separation=1.5, rng=3)
+    d = np.hypot(s.center_x[:, None] - s.center_x, s.center_y[:, None] - s.center_y)
+    need = 1.5 * (s.sigma_x[:, None] + s.sigma_x[None, :])
+    off = ~np.eye(30, dtype=bool)
+    assert np.all(d[off] >= need[off] - 1e-12)
+    with pytest.raises(SpineInputError, match="could not place peak"):
+        random_gaussians(n_peaks=500, overlap=False, min_separation=3, rng=1)
+
+
+# ------------------------------------------------------------------ fractal
+
+
+def radial_psd_slope(surf: GridSurface, hurst: float) -> float:
+    """Log-log slope of the radially averaged 2-D PSD over the middle of the band."""
+    h = surf.heights
+    ny, nx = h.shape
+    psd = np.abs(np.fft.fft2(h)) ** 2
+    f = np.hypot(*np.meshgrid(np.fft.fftfreq(nx), np.fft.fftfreq(ny)))
+    bins = np.logspace(np.log10(2 / nx), np.log10(0.3), 25)
+    idx = np.digitize(f.ravel(), bins)
+    centres, values = [], []
+    for k in range(1, len(bins)):
+        sel = idx == k
+        if sel.sum() > 3:
+            centres.append(f.ravel()[sel].mean())
+            values.append(psd.ravel()[sel].mean())
+    return np.polyfit(np.log(centres), np.log(values), 1)[0]
+
+
+@pytest.mark.parametrize("hurst", [0.3, 0.5, 0.7, 0.9])
+def test_fractal_psd_slope_matches_hurst(hurst):
+    slopes = [radial_psd_slope(fractal_fbm(nx=256, hurst=hurst, rng=s), hurst) for s in range(3)]
+    assert np.mean(slopes) == pytest.approx(-(2 * hurst + 2), abs=0.1)
+
+
+@pytest.mark.parametrize("hurst", [0.3, 0.6, 0.9])
+def test_fractal_psd_slope_by_surfacetopography(hurst):
+    """Independent estimator: SurfaceTopography's radially averaged PSD."""
+    import SurfaceTopography as st
+
+    slopes = []
+    for seed in range(3):
+        surf = fractal_fbm(nx=256, hurst=hurst, rng=seed)
+        topo = st.Topography(surf.heights.T, (20.0, 20.0), periodic=True)
+        q, c = topo.power_spectrum_from_area(nb_points_per_decade=8)
+        ok = np.isfinite(c) & (q > 2 * np.pi * 4 / 20) & (q < 2 * np.pi * 0.3 / (20 / 256))
+        slopes.append(np.polyfit(np.log(q[ok]), np.log(c[ok]), 1)[0])
+    assert np.mean(slopes) == pytest.approx(-(2 * hurst + 2), abs=0.1)
+
+
+def test_fractal_normalization_and_reproducibility():
+    a = fractal_fbm(nx=64, ny=63, hurst=0.7, rms_height=2.5, rng=11)
+    b = fractal_fbm(nx=64, ny=63, hurst=0.7, rms_height=2.5, rng=11)
+    np.testing.assert_array_equal(a.heights, b.heights)
+    assert a.shape == (63, 64)
+    assert a.heights.std() == pytest.approx(2.5)
+    assert a.heights.mean() == pytest.approx(0.0, abs=1e-12)
+    s = fractal_fbm(nx=128, hurst=0.7, rms_slope=0.4, rng=1)
+    # periodic: the rms of the Fourier derivative (which drops the Nyquist row and column)
+    spec = np.fft.fft2(s.heights)
+    k = 2j * np.pi * np.fft.fftfreq(128, s.spacing[0])
+    gx = np.fft.ifft2(spec * k[None, :]).real
+    gy = np.fft.ifft2(spec * k[:, None]).real
+    assert np.sqrt(np.mean(gx**2 + gy**2)) == pytest.approx(0.4, rel=0.01)
+    nonper = fractal_fbm(nx=64, hurst=0.7, rms_slope=0.4, periodic=False, rng=1)
+    gy, gx = np.gradient(nonper.heights, nonper.spacing[1], nonper.spacing[0])
+    assert np.sqrt(np.mean(gx**2 + gy**2)) == pytest.approx(0.4)
+    assert not nonper.periodic
+
+
+# ------------------------------------------------------------------ sandpaper
+
+
+@pytest.mark.parametrize("grit", ["P36", "P60", "P600"])
+def test_sandpaper_resolves_tip_and_particles(grit):
+    d = GRIT_PARTICLE_DIAMETER_M[grit]
+    size = 12 * d
+    s = sandpaper(grit=grit, size_m=size, rng=2)
+    assert s.unit == "m" and s.periodic
+    dx = s.spacing[0]
+    assert dx <= 25e-6 / 5 + 1e-12 and dx <= d / 10 + 1e-12
+    assert s.heights.min() == 0.0
+    assert s.heights.max() <= 0.7 * d * 1.8  # exposed part of the largest grains
+    np.testing.assert_array_equal(s.heights, sandpaper(grit=grit, size_m=size, rng=2).heights)
+
+
+def test_sandpaper_covered_fraction_follows_boolean_model():
+    """Footprints of random discs cover 1 - exp(-sum of footprint areas / area)."""
+    s = sandpaper(grit="P60", size_m=4e-3, coverage=0.6, rng=9)
+    meta = s.metadata["params"]
+    d = meta["particle_diameter_m"]
+    e_lo, e_hi = meta["embed_range"]
+    # footprint radius^2 = r^2 - zc^2 with zc = r(1 - 2e); E over e ~ U(e_lo, e_hi)
+    e = np.linspace(e_lo, e_hi, 1001)
+    mean_factor = np.mean(1 - (1 - 2 * e) ** 2)
+    cv = meta["size_cv"]
+    mean_r2 = (d / 2) ** 2 * (1 + cv**2)
+    density = meta["n_particles"] / 4e-3**2
+    expected = 1 - math.exp(-density * math.pi * mean_r2 * mean_factor)
+    covered = np.mean(s.heights > 0)
+    assert covered == pytest.approx(expected, abs=0.05)
+
+
+def test_sandpaper_roughness_scales_with_grit():
+    rms = {g: sandpaper(grit=g, size_m=10 * GRIT_PARTICLE_DIAMETER_M[g], rng=1).heights.std()
+           for g in ("P36", "P600")}
+    ratio = GRIT_PARTICLE_DIAMETER_M["P36"] / GRIT_PARTICLE_DIAMETER_M["P600"]
+    assert rms["P36"] / rms["P600"] == pytest.approx(ratio, rel=0.3)
+
+
+# ------------------------------------------------------------------ hfield
+
+
+def _asymmetric_grid():
+    x = np.linspace(-2.0, 3.0, 26)
+    y = np.linspace(-1.0, 1.5, 11)
+    xx, yy = np.meshgrid(x, y)
+    h = 0.1 * xx - 0.05 * yy + 2.0 * np.exp(-((xx - 1.5) ** 2 + (yy - 0.8) ** 2))
+    return GridSurface(heights=h, x=x, y=y)
+
+
+def test_hfield_round_trip_and_layout():
+    surf = _asymmetric_grid()
+    hf = to_hfield(surf)
+    assert hf.data.dtype == np.float32 and hf.data.shape == (11, 26)
+    assert hf.data.min() == 0.0 and hf.data.max() == pytest.approx(1.0)
+    rx, ry, elev, base = hf.size
+    assert (rx, ry) == pytest.approx((2.5, 1.25))
+    assert elev == pytest.approx(np.ptp(surf.heights)) and base > 0
+    assert hf.pos == pytest.approx((0.5, 0.25, surf.heights.min()))
+    # row 0 is the smallest y, column 0 the smallest x
+    iy, ix = np.unravel_index(np.argmax(hf.data), hf.data.shape)
+    assert surf.x[ix] > 1.0 and surf.y[iy] > 0.5
+    back = from_hfield(hf)
+    np.testing.assert_allclose(back.x, surf.x)
+    np.testing.assert_allclose(back.y, surf.y)
+    np.testing.assert_allclose(back.heights, surf.heights, atol=1e-6 * elev)
+
+
+def test_hfield_of_analytic_and_flat_surfaces():
+    hf = to_hfield(single_gaussian(), ncol=51, nrow=41)
+    assert hf.data.shape == (41, 51)
+    assert hf.data[20, 25] == pytest.approx(1.0)
+    flat = GridSurface(heights=np.zeros((5, 5)), x=np.arange(5.0), y=np.arange(5.0))
+    hf = to_hfield(flat)
+    assert hf.size[2] > 0 and np.all(hf.data == 0)
+
+
+# ------------------------------------------------------------------ bad input
+
+
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        (dict(heights=np.full((5, 5), np.nan)), "NaN or infinite"),
+        (dict(heights=np.where(np.eye(5) > 0, np.inf, 0.0)), "NaN or infinite"),
+        (dict(heights=np.zeros((3, 5)), y=np.arange(3.0)), "at least 4 points a side"),
+        (dict(x=np.array([0.0, 1, 1, 2, 3])), "strictly increasing"),
+        (dict(x=np.array([0.0, 1, 2, 4, 5])), "uniformly spaced"),
+        (dict(heights=np.zeros(25)), "2-D"),
+    ],
+)
+def test_grid_surface_rejects_bad_data(kwargs, match):
+    base = dict(heights=np.zeros((5, 5)), x=np.arange(5.0), y=np.arange(5.0))
+    base.update(kwargs)
+    with pytest.raises(SpineInputError, match=match):
+        GridSurface(**base)
+
+
+@pytest.mark.parametrize(
+    "func, kwargs, match",
+    [
+        (fractal_fbm, dict(hurst=1.0), r"hurst must lie in the open interval \(0, 1\)"),
+        (fractal_fbm, dict(hurst=0.0), "hurst"),
+        (fractal_fbm, dict(hurst=0.5, nx=3), "nx must be an integer >= 4"),
+        (fractal_fbm, dict(rms_height=1, rms_slope=1), "not both"),
+        (random_gaussians, dict(n_peaks=0), "n_peaks must be a positive integer"),
+        (random_gaussians, dict(n_peaks=-5), "n_peaks"),
+        (random_gaussians, dict(sigma_range=(0.0, 1.0)), "widths"),
+        (random_gaussians, dict(sigma_range=(-1.0, 1.0)), "widths"),
+        (random_gaussians, dict(sign=0), "sign"),
+        (single_gaussian, dict(sigma_x=0), "sigma_x must be a finite number > 0"),
+        (sandpaper, dict(grit="P80"), "grit must be one of"),
+        (sandpaper, dict(grit="P36", spacing_m=-1), "spacing_m"),
+        (random_gaussians, dict(rng=-1), "rng"),
+    ],
+)
+def test_generators_reject_nonsense(func, kwargs, match):
+    with pytest.raises(SpineInputError, match=match):
+        func(**kwargs)
+
+
+def test_gaussian_surface_rejects_bad_widths():
+    with pytest.raises(SpineInputError, match="sigma_y must be > 0"):
+        GaussianSurface(amplitude=[1.0], center_x=[0.0], center_y=[0.0], sigma_x=[1.0],
+                        sigma_y=[0.0], bounds=(-1, 1, -1, 1))
+    with pytest.raises(SpineInputError, match="bounds"):
+        GaussianSurface(amplitude=[1.0], center_x=[0.0], center_y=[0.0], sigma_x=[1.0],
+                        sigma_y=[1.0], bounds=(1, -1, -1, 1))
