@@ -1,0 +1,232 @@
+"""Metrics comparing a dynamic (MuJoCo) trajectory with the quasistatic streamline.
+
+All lengths come back normalized by the characteristic asperity length ``L_c`` passed in,
+so numbers from surfaces of different scale are comparable (the validation targets are
+stated in units of ``L_c``).
+
+* :func:`frechet_distance`: discrete Frechet distance between two polylines (the
+  shortest "leash" when both walk forward along their paths);
+* :func:`mean_lateral_deviation`: mean distance from points of one path (equally spaced in
+  arc length) to the other polyline, in the x-y plane;
+* :func:`outcome_agreement`: both self-lock or neither, end points within a tolerance,
+  same trap;
+* :func:`kappa_agreement`: quasistatic max kappa against the dynamic peak drive force / W;
+* :func:`capture_rate`: the fraction of runs that end self-locked (trapped).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from spine_mj.errors import SpineInputError
+
+__all__ = ["capture_rate", "frechet_distance", "frechet_distance_reference",
+           "kappa_agreement", "mean_lateral_deviation", "outcome_agreement",
+           "resample_by_arclength"]
+
+
+def _path(name: str, path) -> np.ndarray:
+    arr = np.asarray(path, dtype=float)
+    if arr.ndim != 2 or arr.shape[1] not in (2, 3) or arr.shape[0] < 1:
+        raise SpineInputError(f"{name} must have shape (n, 2) or (n, 3) with n >= 1, got {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise SpineInputError(f"{name} contains NaN or infinite coordinates")
+    return arr
+
+
+def _length_scale(length_scale) -> float:
+    value = float(length_scale)
+    if not (math.isfinite(value) and value > 0):
+        raise SpineInputError(f"length_scale (L_c) must be a finite number > 0, got {length_scale!r}")
+    return value
+
+
+@njit(cache=True)
+def _frechet_kernel(p, q):
+    n, m = p.shape[0], q.shape[0]
+    prev = np.empty(m)
+    cur = np.empty(m)
+    for i in range(n):
+        for j in range(m):
+            d = 0.0
+            for k in range(p.shape[1]):
+                diff = p[i, k] - q[j, k]
+                d += diff * diff
+            d = math.sqrt(d)
+            if i == 0 and j == 0:
+                best = d
+            elif i == 0:
+                best = max(cur[j - 1], d)
+            elif j == 0:
+                best = max(prev[0], d)
+            else:
+                best = max(min(prev[j], prev[j - 1], cur[j - 1]), d)
+            cur[j] = best
+        prev, cur = cur, prev
+    return prev[m - 1]
+
+
+def frechet_distance(path_a, path_b, *, length_scale: float = 1.0) -> float:
+    """Discrete Frechet distance between two polylines, divided by ``length_scale``.
+
+    Parameters
+    ----------
+    path_a, path_b : array_like, shapes (n, d), (m, d), d = 2 or 3
+        Vertices in walking order. Both must have the same ``d``.
+    length_scale
+        ``L_c``; the result is in units of it.
+
+    Notes
+    -----
+    O(n m) time, O(m) memory (a compiled dynamic programme, Eiter and Mannila 1994). For
+    long paths, :func:`resample_by_arclength` both first: the discrete distance then
+    approaches the continuous one as the spacing shrinks.
+    """
+    a, b = _path("path_a", path_a), _path("path_b", path_b)
+    if a.shape[1] != b.shape[1]:
+        raise SpineInputError(f"path_a and path_b must have the same dimension, got "
+                              f"{a.shape[1]} and {b.shape[1]}")
+    return float(_frechet_kernel(np.ascontiguousarray(a), np.ascontiguousarray(b))) \
+        / _length_scale(length_scale)
+
+
+def frechet_distance_reference(path_a, path_b) -> float:
+    """Plain recursive definition of the discrete Frechet distance (slow; for tests)."""
+    a, b = _path("path_a", path_a), _path("path_b", path_b)
+    memo = np.full((len(a), len(b)), -1.0)
+
+    def c(i, j):
+        if memo[i, j] < 0:
+            d = float(np.linalg.norm(a[i] - b[j]))
+            if i == 0 and j == 0:
+                memo[i, j] = d
+            elif i == 0:
+                memo[i, j] = max(c(0, j - 1), d)
+            elif j == 0:
+                memo[i, j] = max(c(i - 1, 0), d)
+            else:
+                memo[i, j] = max(min(c(i - 1, j), c(i - 1, j - 1), c(i, j - 1)), d)
+        return memo[i, j]
+
+    return c(len(a) - 1, len(b) - 1)
+
+
+def resample_by_arclength(path, spacing: float) -> np.ndarray:
+    """Points equally spaced by ``spacing`` in arc length along a polyline (ends kept)."""
+    p = _path("path", path)
+    spacing = _length_scale(spacing)
+    seg = np.linalg.norm(np.diff(p, axis=0), axis=1)
+    s = np.concatenate([[0.0], np.cumsum(seg)])
+    if s[-1] == 0:
+        return p[:1].copy()
+    n = max(2, int(math.ceil(s[-1] / spacing)) + 1)
+    target = np.linspace(0.0, s[-1], n)
+    keep = np.concatenate([[True], seg > 0])
+    return np.column_stack([np.interp(target, s[keep], p[keep, k]) for k in range(p.shape[1])])
+
+
+def _point_segment_distance(points, seg_start, seg_end):
+    """Distance from each point (P, 2) to the nearest of the segments (S, 2) -> (P,)."""
+    d = seg_end - seg_start
+    len2 = np.einsum("sk,sk->s", d, d)
+    best = np.full(points.shape[0], np.inf)
+    for lo in range(0, seg_start.shape[0], 2048):
+        a, dd, l2 = seg_start[lo:lo + 2048], d[lo:lo + 2048], len2[lo:lo + 2048]
+        rel = points[:, None, :] - a[None, :, :]
+        t = np.where(l2 > 0, np.einsum("psk,sk->ps", rel, dd) / np.where(l2 > 0, l2, 1), 0.0)
+        t = np.clip(t, 0.0, 1.0)
+        closest = a[None] + t[..., None] * dd[None]
+        dist = np.linalg.norm(points[:, None, :] - closest, axis=2)
+        best = np.minimum(best, dist.min(axis=1))
+    return best
+
+
+def mean_lateral_deviation(path, reference, *, length_scale: float = 1.0,
+                           spacing: float | None = None) -> float:
+    """Mean x-y distance from ``path`` to the ``reference`` polyline, over ``L_c``.
+
+    ``path`` is resampled to equal arc-length steps (``spacing``, default L_c / 50) so
+    that the mean weighs the path by length, not by how densely it was recorded; each
+    sample's distance to the nearest point of the reference polyline (segments, not only
+    vertices) is averaged.
+    """
+    lc = _length_scale(length_scale)
+    p = _path("path", path)[:, :2]
+    ref = _path("reference", reference)[:, :2]
+    samples = resample_by_arclength(p, lc / 50 if spacing is None else spacing)
+    if ref.shape[0] == 1:
+        dist = np.linalg.norm(samples - ref[0], axis=1)
+    else:
+        dist = _point_segment_distance(samples, ref[:-1], ref[1:])
+    return float(dist.mean() / lc)
+
+
+def outcome_agreement(locked_a, end_a, locked_b, end_b, *, length_scale: float = 1.0,
+                      end_tolerance: float = 0.25) -> dict[str, np.ndarray]:
+    """Agreement of run outcomes, vectorized over runs.
+
+    Parameters
+    ----------
+    locked_a, locked_b : array_like of bool, shape (n,)
+        Whether each run of A (e.g. quasistatic) and B (e.g. MuJoCo) ended self-locked.
+    end_a, end_b : array_like, shape (n, 2) or (n, 3)
+        End points (x, y[, z]); only x and y are compared.
+    end_tolerance
+        End points closer than ``end_tolerance * L_c`` in x-y count as the same place.
+
+    Returns
+    -------
+    dict of bool arrays, shape (n,)
+        ``lock``: both self-locked or neither. ``end``: end points within tolerance.
+        ``same_trap``: both self-locked and in the same place. ``agree``: ``lock`` and,
+        where both locked, ``same_trap`` (the outcome a user cares about: held or not, and
+        where).
+    """
+    lc = _length_scale(length_scale)
+    la = np.asarray(locked_a, dtype=bool)
+    lb = np.asarray(locked_b, dtype=bool)
+    ea = np.asarray(end_a, dtype=float).reshape(la.size, -1)[:, :2]
+    eb = np.asarray(end_b, dtype=float).reshape(lb.size, -1)[:, :2]
+    if not (la.shape == lb.shape and ea.shape[0] == la.size and eb.shape[0] == lb.size):
+        raise SpineInputError(
+            f"locked_a, end_a, locked_b, end_b must describe the same n runs, got "
+            f"{la.shape}, {ea.shape}, {lb.shape}, {eb.shape}"
+        )
+    if not (end_tolerance > 0):
+        raise SpineInputError(f"end_tolerance must be > 0, got {end_tolerance!r}")
+    lock = la == lb
+    end = np.linalg.norm(ea - eb, axis=1) <= end_tolerance * lc
+    same_trap = la & lb & end
+    agree = lock & (~la | same_trap)
+    return {"lock": lock, "end": end, "same_trap": same_trap, "agree": agree}
+
+
+def kappa_agreement(max_kappa_quasistatic, peak_force_over_weight, *,
+                    kappa_cap: float) -> dict[str, np.ndarray]:
+    """Quasistatic max kappa against the dynamic peak drive force / W, per run.
+
+    A self-locked quasistatic run has max kappa = inf and a dynamic one stops at the cap
+    ``kappa_cap`` (force reaching ``kappa_cap * W`` without motion), so both are clipped to
+    the cap before comparing.
+
+    Returns
+    -------
+    dict of arrays, shape (n,)
+        ``ratio``: dynamic / quasistatic (clipped values); ``both_capped``: both at the cap.
+    """
+    if not (kappa_cap > 0 and math.isfinite(kappa_cap)):
+        raise SpineInputError(f"kappa_cap must be a finite number > 0, got {kappa_cap!r}")
+    qs = np.minimum(np.asarray(max_kappa_quasistatic, dtype=float), kappa_cap)
+    dyn = np.minimum(np.asarray(peak_force_over_weight, dtype=float), kappa_cap)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.where(qs > 0, dyn / qs, np.nan)
+    return {"ratio": ratio, "both_capped": (qs >= kappa_cap) & (dyn >= kappa_cap)}
+
+
+def capture_rate(locked) -> float:
+    """Fraction of runs that ended self-locked; NaN for no runs."""
+    arr = np.asarray(locked, dtype=bool)
+    return float(arr.mean()) if arr.size else float("nan")

@@ -1,0 +1,113 @@
+"""Comparison metrics on constructed cases whose answers are known by hand."""
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from spine_mj import SpineInputError
+from spine_mj.compare import (
+    capture_rate,
+    frechet_distance,
+    frechet_distance_reference,
+    kappa_agreement,
+    mean_lateral_deviation,
+    outcome_agreement,
+    resample_by_arclength,
+)
+
+
+def line(y, n=50, x0=0.0, x1=5.0):
+    x = np.linspace(x0, x1, n)
+    return np.column_stack([x, np.full(n, y)])
+
+
+def test_frechet_hand_examples():
+    p = [(0, 0), (1, 0), (2, 0)]
+    q = [(0, 1), (2, 1)]
+    assert frechet_distance(p, q) == pytest.approx(math.sqrt(2))
+    assert frechet_distance(line(0), line(0)) == 0.0
+    assert frechet_distance(line(0), line(0.3), length_scale=0.1) == pytest.approx(3.0)
+    # walking the same path backwards: the leash must span start to end at some moment
+    assert frechet_distance(line(0), line(0)[::-1]) == pytest.approx(5.0)
+
+
+def test_frechet_symmetric_and_bounded_by_hausdorff():
+    rng = np.random.default_rng(3)
+    a, b = rng.normal(size=(30, 2)), rng.normal(size=(20, 2))
+    assert frechet_distance(a, b) == pytest.approx(frechet_distance(b, a))
+    d = np.linalg.norm(a[:, None] - b[None], axis=2)
+    hausdorff = max(d.min(axis=1).max(), d.min(axis=0).max())
+    assert frechet_distance(a, b) >= hausdorff - 1e-12
+    assert frechet_distance(a, b) >= np.linalg.norm(a[0] - b[0])
+    assert frechet_distance(a, b) >= np.linalg.norm(a[-1] - b[-1])
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(1, 12), st.integers(1, 12), st.integers(0, 10_000))
+def test_compiled_frechet_equals_reference(n, m, seed):
+    rng = np.random.default_rng(seed)
+    a, b = rng.normal(size=(n, 3)), rng.normal(size=(m, 3))
+    assert frechet_distance(a, b) == pytest.approx(frechet_distance_reference(a, b), abs=1e-12)
+
+
+def test_lateral_deviation_of_parallel_and_crossing_lines():
+    assert mean_lateral_deviation(line(0.4), line(0.0)) == pytest.approx(0.4)
+    assert mean_lateral_deviation(line(0.4), line(0.0), length_scale=2.0) == pytest.approx(0.2)
+    # sparse reference vertices: distances to segments, not to vertices
+    assert mean_lateral_deviation(line(0.4), line(0.0, n=2)) == pytest.approx(0.4)
+    # a path crossing the reference at 45 degrees: mean |y| of y = x - 1 for x in 0..2
+    diag = np.column_stack([np.linspace(0, 2, 3), np.linspace(-1, 1, 3)])
+    ref = line(0.0, n=2, x0=-5, x1=5)
+    assert mean_lateral_deviation(diag, ref, spacing=1e-3) == pytest.approx(0.5, rel=1e-3)
+
+
+def test_lateral_deviation_weighs_by_length_not_samples():
+    dense_then_sparse = np.vstack([line(1.0, n=500, x1=1.0), line(1.0, n=2, x0=1.0, x1=5.0)[1:]])
+    assert mean_lateral_deviation(dense_then_sparse, line(0.0)) == pytest.approx(1.0)
+
+
+def test_resample_by_arclength():
+    p = np.array([[0.0, 0.0], [3.0, 0.0], [3.0, 4.0]])
+    r = resample_by_arclength(p, 1.0)
+    assert len(r) == 8
+    np.testing.assert_allclose(np.linalg.norm(np.diff(r, axis=0), axis=1), 1.0)
+    np.testing.assert_allclose(r[-1], [3.0, 4.0])
+
+
+def test_outcome_agreement_cases():
+    locked_qs = [True, True, False, False, True]
+    locked_mj = [True, True, False, True, False]
+    end_qs = [[0, 0], [0, 0], [5, 1], [5, 1], [1, 1]]
+    end_mj = [[0.1, 0], [2, 0], [5, -3], [5, 1], [1, 1]]
+    out = outcome_agreement(locked_qs, end_qs, locked_mj, end_mj, length_scale=1.0,
+                            end_tolerance=0.25)
+    np.testing.assert_array_equal(out["lock"], [True, True, True, False, False])
+    np.testing.assert_array_equal(out["same_trap"], [True, False, False, False, False])
+    np.testing.assert_array_equal(out["agree"], [True, False, True, False, False])
+    np.testing.assert_array_equal(out["end"], [True, False, False, True, True])
+
+
+def test_kappa_agreement_and_capture_rate():
+    out = kappa_agreement([2.0, np.inf, 4.0], [1.8, 50.0, 50.0], kappa_cap=20.0)
+    np.testing.assert_allclose(out["ratio"], [0.9, 1.0, 5.0])
+    np.testing.assert_array_equal(out["both_capped"], [False, True, False])
+    assert capture_rate([True, False, True, True]) == 0.75
+    assert math.isnan(capture_rate([]))
+
+
+def test_bad_input_is_named():
+    with pytest.raises(SpineInputError, match=r"path_a must have shape \(n, 2\)"):
+        frechet_distance(np.zeros(5), np.zeros((5, 2)))
+    with pytest.raises(SpineInputError, match="same dimension"):
+        frechet_distance(np.zeros((5, 2)), np.zeros((5, 3)))
+    with pytest.raises(SpineInputError, match="NaN"):
+        mean_lateral_deviation([[0, 0], [np.nan, 1]], [[0, 0], [1, 1]])
+    with pytest.raises(SpineInputError, match="L_c"):
+        frechet_distance([[0, 0]], [[1, 1]], length_scale=0)
+    with pytest.raises(SpineInputError, match="same n runs"):
+        outcome_agreement([True], [[0, 0]], [True, False], [[0, 0], [1, 1]])
+    with pytest.raises(SpineInputError, match="kappa_cap"):
+        kappa_agreement([1.0], [1.0], kappa_cap=np.inf)
