@@ -1,0 +1,1190 @@
+"""MuJoCo rig: any surface as an hfield, a point-like spine tip under gravity, three drives.
+
+The rig (``models/spine_rig.xml``) is a sphere of radius ``tip_radius_m`` on three slide
+joints (x, y, z; no rotation) with mass ``mass_kg``, friction ``mu_s`` (condim 3), gravity
+and an optional extra downward preload. :class:`Rig` loads that file with ``MjSpec``,
+attaches the surface as an hfield through :func:`spine_mj.surfaces.to_hfield` and compiles.
+
+Units. The model is in SI units. A dimensionless surface (``unit == "1"``, the paper's
+Gaussian surfaces) is scaled by ``length_scale_m`` (default 1 cm per unit) in x, y and z; a
+surface in metres is used as it is. Positions in results are in metres; divide by
+``rig.length_scale_m`` for surface units.
+
+Scales and default engine settings (:func:`default_engine`). With
+``F_p = mass_kg * gravity + preload_n`` (the normal preload), ``a_p = F_p / mass_kg`` and
+``L_c`` the surface's characteristic length (:func:`characteristic_length`):
+
+* contacts use ``solref = (2 dt, 1)`` (the stiffest stable time constant, critically
+  damped) and ``solimp = (0.99, 0.99, ...)``; the resting penetration is then about
+  ``a_p dt^2`` (measured: 2.4 um at dt = 0.5 ms, a_p = g);
+* ``dt`` is the largest step (at most 1 ms) with ``a_p dt^2 <= 0.005 min(r_tip, L_c)``:
+  half a percent of the tip radius at rest, a few percent at a drive force of ten
+  preloads, always far below 1 % of ``L_c``;
+* ``cone = elliptic`` with ``noslip_iterations = 3``: MuJoCo's friction is soft and creeps
+  at any in-cone load without the noslip pass (PHYSICS.md §5); ``impratio`` stays 1.
+
+Drives (PHYSICS.md §4): :class:`SpringDrive` (a carriage moves at constant speed in +x and
+pulls the tip through a spring acting in x only), :class:`RampDrive` (force rises at a set
+rate until slip, drops to zero, ramps again once the tip has settled) and
+:class:`StaticProbe` (ramp at one point until breakaway, ``kappa_mj = F / F_p``). Each run
+reports its inertia number ``I_e = m v^2 / (F_p L_c)``; for the force drives ``v`` is the
+equivalent speed ``v_eq = L_c (dF/dt) / F_p`` (the speed at which the tip would cross one
+feature in the time the force takes to rise by one preload).
+
+Spring drives and static probes run open loop through :func:`mujoco.rollout.rollout` on
+native threads (a batch of starts or parameter sets at once); the force ramp with reset
+needs feedback and steps in Python. Every run ends with a recorded :class:`EndReason`,
+never with an exception from the engine.
+"""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+import enum
+import math
+import os
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from spine_mj.errors import SpineInputError, atomic_output
+from spine_mj.surfaces import GaussianSurface, GridSurface, Surface, to_hfield
+
+__all__ = [
+    "Cone",
+    "Detection",
+    "EndReason",
+    "EngineSettings",
+    "Event",
+    "Integrator",
+    "RampDrive",
+    "Rig",
+    "RunResult",
+    "Scales",
+    "SpringDrive",
+    "StaticProbe",
+    "TipParams",
+    "characteristic_length",
+    "default_engine",
+    "inclined_plane",
+]
+
+MODEL_PATH = Path(__file__).resolve().parent.parent / "models" / "spine_rig.xml"
+DEFAULT_LENGTH_SCALE_M = 0.01
+_MAX_TIMESTEP_S = 1e-3
+_REST_PENETRATION_FRACTION = 0.005
+_BATCH_MEMORY_BYTES = 256 * 2**20
+
+
+class Cone(enum.Enum):
+    """Friction cone (MuJoCo ``opt.cone``)."""
+
+    ELLIPTIC = "elliptic"
+    PYRAMIDAL = "pyramidal"
+
+
+class Integrator(enum.Enum):
+    """Integrator (MuJoCo ``opt.integrator``)."""
+
+    EULER = "euler"
+    IMPLICITFAST = "implicitfast"
+    IMPLICIT = "implicit"
+    RK4 = "rk4"
+
+
+class EndReason(enum.Enum):
+    """Why a run ended."""
+
+    COMPLETED = "completed"  # the drive's duration elapsed
+    BREAKAWAY = "breakaway"  # static probe: the tip broke away under the rising force
+    SLID = "slid"  # static probe: the tip slid off under gravity/preload alone
+    SELF_LOCK = "self_lock"  # the drive force reached kappa_cap * F_p without motion
+    LEFT_DOMAIN = "left_domain"  # the tip left the surface's bounds
+    ENGINE_TROUBLE = "engine_trouble"  # non-finite state, MuJoCo warning or deep penetration
+
+
+def _check_positive(name: str, value, *, allow_zero: bool = False) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise SpineInputError(f"{name} must be a number, got {value!r}") from None
+    ok = math.isfinite(v) and (v >= 0 if allow_zero else v > 0)
+    if not ok:
+        raise SpineInputError(f"{name} must be a finite number {'>= 0' if allow_zero else '> 0'}, "
+                              f"got {value!r}")
+    return v
+
+
+def _check_optional(obj, names: Sequence[str], *, allow_zero: bool = False) -> None:
+    for name in names:
+        value = getattr(obj, name)
+        if value is not None:
+            object.__setattr__(obj, name, _check_positive(name, value, allow_zero=allow_zero))
+
+
+@dataclass(frozen=True)
+class TipParams:
+    """The spine tip.
+
+    Attributes
+    ----------
+    tip_radius_m : float or None
+        Sphere radius [m]; None derives it from the surface (:meth:`Rig.__init__`).
+    mass_kg : float
+        Effective moving mass m_eff [kg].
+    mu_s : float
+        Friction coefficient (static = kinetic in MuJoCo), >= 0.
+    preload_n : float
+        Extra downward force on the tip [N], >= 0, added to gravity.
+    gravity_m_s2 : float
+        Gravitational acceleration [m/s^2], >= 0 (0 with a preload gives zero-g).
+    """
+
+    tip_radius_m: float | None = None
+    mass_kg: float = 0.01
+    mu_s: float = 0.5
+    preload_n: float = 0.0
+    gravity_m_s2: float = 9.81
+
+    def __post_init__(self):
+        _check_optional(self, ["tip_radius_m"])
+        object.__setattr__(self, "mass_kg", _check_positive("mass_kg", self.mass_kg))
+        object.__setattr__(self, "mu_s", _check_positive("mu_s", self.mu_s, allow_zero=True))
+        object.__setattr__(self, "preload_n",
+                           _check_positive("preload_n", self.preload_n, allow_zero=True))
+        object.__setattr__(self, "gravity_m_s2",
+                           _check_positive("gravity_m_s2", self.gravity_m_s2, allow_zero=True))
+        if self.preload_n == 0 and self.gravity_m_s2 == 0:
+            raise SpineInputError("preload_n and gravity_m_s2 are both 0: the tip has no normal "
+                                  "preload; give one of them > 0")
+
+    @property
+    def preload_total_n(self) -> float:
+        """F_p = m g + preload [N]."""
+        return self.mass_kg * self.gravity_m_s2 + self.preload_n
+
+
+@dataclass(frozen=True)
+class EngineSettings:
+    """MuJoCo settings, recorded with every run (see :func:`default_engine` for the rule).
+
+    Attributes
+    ----------
+    timestep_s : float
+        Time step [s].
+    integrator, cone : Integrator, Cone
+    impratio : float
+        Ratio of frictional to normal constraint impedance (>= 1 sensible).
+    noslip_iterations : int
+        Noslip solver passes (0 switches it off; then friction creeps).
+    solref : (timeconst_s, dampratio)
+        Contact reference; ``timeconst_s >= 2 timestep_s`` for stability.
+    solimp : (dmin, dmax, width_m, midpoint, power)
+        Contact impedance.
+    hfield_resolution : int or None
+        Samples per side when an analytic surface is turned into an hfield (None: 201;
+        a grid surface keeps its own samples).
+    """
+
+    timestep_s: float
+    integrator: Integrator = Integrator.IMPLICITFAST
+    cone: Cone = Cone.ELLIPTIC
+    impratio: float = 1.0
+    noslip_iterations: int = 3
+    solref: tuple[float, float] = (1e-3, 1.0)
+    solimp: tuple[float, float, float, float, float] = (0.99, 0.99, 1e-3, 0.5, 2.0)
+    hfield_resolution: int | None = None
+
+    def __post_init__(self):
+        object.__setattr__(self, "timestep_s", _check_positive("timestep_s", self.timestep_s))
+        for name, enum_cls in (("integrator", Integrator), ("cone", Cone)):
+            value = getattr(self, name)
+            if not isinstance(value, enum_cls):
+                try:
+                    value = enum_cls(str(value).lower())
+                except ValueError:
+                    raise SpineInputError(f"{name} must be one of {[e.value for e in enum_cls]}, "
+                                          f"got {value!r}") from None
+                object.__setattr__(self, name, value)
+        object.__setattr__(self, "impratio", _check_positive("impratio", self.impratio))
+        ns = self.noslip_iterations
+        if isinstance(ns, bool) or int(ns) != ns or ns < 0:
+            raise SpineInputError(f"noslip_iterations must be an integer >= 0, got {ns!r}")
+        object.__setattr__(self, "noslip_iterations", int(ns))
+        if self.cone is Cone.PYRAMIDAL and self.noslip_iterations > 0:
+            raise SpineInputError("cone='pyramidal' with noslip_iterations > 0 holds only about half "
+                                  "of mu N (PHYSICS.md §5); use the elliptic cone with noslip")
+        try:
+            tc, dr = (float(v) for v in self.solref)
+        except (TypeError, ValueError):
+            raise SpineInputError(f"solref must be (timeconst_s, dampratio), got {self.solref!r}") from None
+        _check_positive("solref dampratio", dr)
+        if not (math.isfinite(tc) and tc >= 2 * self.timestep_s * (1 - 1e-9)):
+            raise SpineInputError(f"solref timeconst_s must be >= 2 timestep_s = {2 * self.timestep_s:g} "
+                                  f"s for a stable contact, got {self.solref[0]!r}")
+        object.__setattr__(self, "solref", (tc, dr))
+        try:
+            si = tuple(float(v) for v in self.solimp)
+        except (TypeError, ValueError):
+            raise SpineInputError(f"solimp must be 5 numbers, got {self.solimp!r}") from None
+        if len(si) != 5 or not (0 < si[0] < 1 and 0 < si[1] < 1 and si[2] > 0):
+            raise SpineInputError("solimp must be (dmin, dmax, width_m, midpoint, power) with "
+                                  f"0 < dmin, dmax < 1 and width_m > 0, got {self.solimp!r}")
+        object.__setattr__(self, "solimp", si)
+        res = self.hfield_resolution
+        if res is not None and (isinstance(res, bool) or int(res) != res or res < 4):
+            raise SpineInputError(f"hfield_resolution must be an integer >= 4 or None, got {res!r}")
+
+    def to_dict(self) -> dict:
+        d = dataclasses.asdict(self)
+        d["integrator"], d["cone"] = self.integrator.value, self.cone.value
+        return d
+
+
+@dataclass(frozen=True)
+class Scales:
+    """The problem's scales, all in SI units.
+
+    Attributes
+    ----------
+    length_scale_m : float
+        Metres per surface length unit (1 for surfaces in metres).
+    char_length_m : float
+        L_c, the characteristic asperity length [m].
+    mass_kg, preload_n, tip_radius_m : float
+        m_eff [kg], F_p [N], tip radius [m].
+    hfield_spacing_m : float
+        Larger of the hfield's two sample spacings [m].
+    """
+
+    length_scale_m: float
+    char_length_m: float
+    mass_kg: float
+    preload_n: float
+    tip_radius_m: float
+    hfield_spacing_m: float
+
+    @property
+    def time_s(self) -> float:
+        """tau = sqrt(m L_c / F_p), the time over which the preload moves the tip by L_c."""
+        return math.sqrt(self.mass_kg * self.char_length_m / self.preload_n)
+
+    @property
+    def speed_m_s(self) -> float:
+        """sqrt(F_p L_c / m): the speed at which I_e = 1."""
+        return math.sqrt(self.preload_n * self.char_length_m / self.mass_kg)
+
+    def inertia_number(self, speed_m_s: float) -> float:
+        """I_e = m v^2 / (F_p L_c) (paper §2.2)."""
+        return self.mass_kg * speed_m_s**2 / (self.preload_n * self.char_length_m)
+
+
+def characteristic_length(surface: Surface) -> float:
+    """L_c of a surface, in the surface's own units.
+
+    Rule: for a Gaussian sum, the mean of its widths ``(sigma_x + sigma_y) / 2``; for a
+    grid, ``2 pi`` times the rms height over the rms slope (the wavelength of a sine with
+    the same rms height and slope), clipped to ``[4 dx, domain size]``; a plane (no
+    height variation) gives the domain size.
+    """
+    xmin, xmax, ymin, ymax = surface.bounds
+    span = float(min(xmax - xmin, ymax - ymin))
+    if isinstance(surface, GaussianSurface):
+        return float(np.mean(0.5 * (surface.sigma_x + surface.sigma_y)))
+    grid = surface if isinstance(surface, GridSurface) else surface.sample(201)
+    h = grid.heights - grid.heights.mean()
+    dx, dy = grid.spacing
+    gy, gx = np.gradient(grid.heights, dy, dx)
+    detrended = h - (gx.mean() * (grid.x[None, :] - grid.x.mean())
+                     + gy.mean() * (grid.y[:, None] - grid.y.mean()))
+    rms_h = float(np.sqrt(np.mean(detrended**2)))
+    rms_s = float(np.sqrt(np.mean((gx - gx.mean()) ** 2 + (gy - gy.mean()) ** 2)))
+    if rms_s <= 1e-12 or rms_h <= 1e-12 * span:
+        return span
+    return float(np.clip(2 * math.pi * rms_h / rms_s, 4 * max(dx, dy), span))
+
+
+def default_engine(scales: Scales, **overrides) -> EngineSettings:
+    """Engine settings derived from the problem's scales (rule in the module docstring).
+
+    ``dt = min(1 ms, sqrt(0.005 min(r_tip, L_c) m / F_p))``, ``solref = (2 dt, 1)``,
+    elliptic cone, 3 noslip iterations, ``impratio = 1``. ``overrides`` replace fields.
+    """
+    length = min(scales.tip_radius_m, scales.char_length_m)
+    dt = math.sqrt(_REST_PENETRATION_FRACTION * length * scales.mass_kg / scales.preload_n)
+    dt = min(_MAX_TIMESTEP_S, dt)
+    dt = float(f"{dt:.2g}")
+    base = {"timestep_s": dt, "solref": (2 * dt, 1.0)}
+    if "timestep_s" in overrides and "solref" not in overrides:
+        base["solref"] = (2 * float(overrides["timestep_s"]), 1.0)
+    base.update(overrides)
+    return EngineSettings(**base)
+
+
+@dataclass(frozen=True)
+class Detection:
+    """Thresholds that turn a trajectory into stick/slip states and events.
+
+    None fields are derived from the scales (:meth:`resolve`), with ``v_c = sqrt(F_p L_c / m)``:
+
+    Attributes
+    ----------
+    slip_speed_m_s : float or None
+        Tangential speed above which the tip slips (default ``1e-3 v_c``).
+    stick_speed_m_s : float or None
+        Tangential speed below which the tip counts as stuck when the breakaway force is
+        read (default ``1e-5 v_c``; noslip holds a stuck tip to ~1e-11 m/s).
+    breakaway_distance_m : float or None
+        Displacement from the start that means breakaway (default ``min(0.1 r_tip, 0.01 L_c)``).
+    kappa_cap : float
+        Self-lock when the drive force reaches ``kappa_cap * F_p`` while stuck.
+    penetration_tol_m : float or None
+        Engine trouble above this penetration (default ``min(0.1 r_tip, 0.01 L_c)``).
+    domain_margin_m : float or None
+        The run ends when the tip centre comes closer than this to the domain's edge
+        (default: the tip radius).
+    """
+
+    slip_speed_m_s: float | None = None
+    stick_speed_m_s: float | None = None
+    breakaway_distance_m: float | None = None
+    kappa_cap: float = 20.0
+    penetration_tol_m: float | None = None
+    domain_margin_m: float | None = None
+
+    def __post_init__(self):
+        _check_optional(self, ["slip_speed_m_s", "stick_speed_m_s", "breakaway_distance_m",
+                               "penetration_tol_m"])
+        _check_optional(self, ["domain_margin_m"], allow_zero=True)
+        object.__setattr__(self, "kappa_cap", _check_positive("kappa_cap", self.kappa_cap))
+
+    def resolve(self, scales: Scales) -> Detection:
+        v_c = scales.speed_m_s
+        small = min(0.1 * scales.tip_radius_m, 0.01 * scales.char_length_m)
+        defaults = {"slip_speed_m_s": 1e-3 * v_c, "stick_speed_m_s": 1e-5 * v_c,
+                    "breakaway_distance_m": small, "penetration_tol_m": small,
+                    "domain_margin_m": scales.tip_radius_m}
+        return dataclasses.replace(self, **{k: v for k, v in defaults.items()
+                                            if getattr(self, k) is None})
+
+
+@dataclass(frozen=True)
+class SpringDrive:
+    """Spring carriage: the carriage moves at ``speed_m_s`` in +x and pulls the tip through a
+    spring of stiffness ``stiffness_n_m`` acting in x only.
+
+    ``stiffness_n_m`` None: ``10 F_p / L_c``. ``duration_s`` None: the time the carriage
+    needs to reach the domain's +x edge from the start, plus 10 %.
+    """
+
+    speed_m_s: float
+    stiffness_n_m: float | None = None
+    duration_s: float | None = None
+    settle_time_s: float | None = None
+
+    def __post_init__(self):
+        object.__setattr__(self, "speed_m_s", _check_positive("speed_m_s", self.speed_m_s))
+        _check_optional(self, ["stiffness_n_m", "duration_s"])
+        _check_optional(self, ["settle_time_s"], allow_zero=True)
+
+
+@dataclass(frozen=True)
+class RampDrive:
+    """Force ramp with reset: F rises from 0 at ``rate_n_s`` until slip is detected, drops
+    to 0, and ramps again once the tip has settled (stuck for ``settle_time_s``).
+
+    ``rate_n_s`` None: ``0.1 F_p / tau`` (``I_e = 0.01``). ``duration_s`` None: 40 ramps to
+    ``kappa_cap F_p``... capped at 200 tau.
+    """
+
+    rate_n_s: float | None = None
+    duration_s: float | None = None
+    settle_time_s: float | None = None
+
+    def __post_init__(self):
+        _check_optional(self, ["rate_n_s", "duration_s"])
+        _check_optional(self, ["settle_time_s"], allow_zero=True)
+
+
+@dataclass(frozen=True)
+class StaticProbe:
+    """Static probe: the tip rests at the start with ``start_force_n`` applied in +x, then
+    the force rises at ``rate_n_s`` until breakaway; ``kappa_mj = F_breakaway / F_p``.
+
+    A start force is needed where gravity alone would slide the tip (a slope steeper than
+    arctan mu): the tip is held by friction at ``start_force_n``. ``rate_n_s`` None:
+    ``0.1 F_p / tau`` (``I_e = 0.01``).
+    """
+
+    rate_n_s: float | None = None
+    start_force_n: float = 0.0
+    settle_time_s: float | None = None
+
+    def __post_init__(self):
+        _check_optional(self, ["rate_n_s"])
+        _check_optional(self, ["settle_time_s"], allow_zero=True)
+        object.__setattr__(self, "start_force_n",
+                           _check_positive("start_force_n", self.start_force_n, allow_zero=True))
+
+
+Drive = SpringDrive | RampDrive | StaticProbe
+
+
+@dataclass(frozen=True)
+class Event:
+    """One event in a run: ``kind`` in {"slip_onset", "slip_stop", "reset"} or an end reason."""
+
+    kind: str
+    index: int
+    time_s: float
+
+
+@dataclass(frozen=True, eq=False)
+class RunResult:
+    """One run. Arrays have ``n`` rows, one per recorded step (the settle phase included).
+
+    Attributes
+    ----------
+    time_s : (n,)
+    position_m, velocity_m_s : (n, 3)
+        Tip centre position and velocity, world frame [m], [m/s].
+    contact : (n,) bool
+        Whether the tip touches the surface.
+    normal : (n, 3)
+        Unit normal of the deepest contact, pointing out of the surface (NaN without contact).
+    contact_point_m : (n, 3)
+        Position of the deepest contact (NaN without contact).
+    penetration_m : (n,)
+        Depth of the deepest contact (>= 0; 0 without contact).
+    normal_force_n, tangential_force_n : (n,)
+        Net contact force on the tip along the normal and its magnitude in the tangent plane.
+    drive_force_n : (n,)
+        Force of the drive on the tip in +x [N].
+    carriage_x_m : (n,)
+        Carriage position (spring drive; NaN otherwise).
+    slipping : (n,) bool
+        Tangential speed above ``detection.slip_speed_m_s``.
+    events : tuple of Event
+    end_reason : EndReason
+    end_detail : str
+    drive_start_index : int
+        First row after the settle phase.
+    kappa_mj : float
+        Static probe: F_breakaway / F_p (NaN unless ``end_reason`` is BREAKAWAY).
+    slip_kappas : (k,)
+        Drive force / F_p at each slip onset after the settle phase.
+    inertia_number, speed_m_s : float
+        I_e and the speed (or equivalent speed) it uses.
+    start : (x0, y0)
+        Start in surface units.
+    """
+
+    time_s: np.ndarray
+    position_m: np.ndarray
+    velocity_m_s: np.ndarray
+    contact: np.ndarray
+    normal: np.ndarray
+    contact_point_m: np.ndarray
+    penetration_m: np.ndarray
+    normal_force_n: np.ndarray
+    tangential_force_n: np.ndarray
+    drive_force_n: np.ndarray
+    carriage_x_m: np.ndarray
+    slipping: np.ndarray
+    events: tuple[Event, ...]
+    end_reason: EndReason
+    end_detail: str
+    drive_start_index: int
+    kappa_mj: float
+    slip_kappas: np.ndarray
+    inertia_number: float
+    speed_m_s: float
+    start: tuple[float, float]
+    drive: Drive
+    tip: TipParams
+    engine: EngineSettings
+    scales: Scales
+    detection: Detection
+
+    @property
+    def n(self) -> int:
+        return self.time_s.size
+
+    def table(self):
+        """The trajectory as a :class:`pandas.DataFrame` (one row per recorded step)."""
+        import pandas as pd
+
+        cols = {"time_s": self.time_s}
+        for name in ("position_m", "velocity_m_s", "normal", "contact_point_m"):
+            arr = getattr(self, name)
+            for k, axis in enumerate("xyz"):
+                cols[f"{name.split('_')[0]}_{axis}{name[len(name.split('_')[0]):]}"] = arr[:, k]
+        for name in ("contact", "penetration_m", "normal_force_n", "tangential_force_n",
+                     "drive_force_n", "carriage_x_m", "slipping"):
+            cols[name] = getattr(self, name)
+        return pd.DataFrame(cols)
+
+    def summary(self) -> dict:
+        """JSON-ready description of the run: parameters, engine settings, outcome."""
+        def enc(obj):
+            d = dataclasses.asdict(obj)
+            return {k: (v.value if isinstance(v, enum.Enum) else v) for k, v in d.items()}
+
+        return {
+            "drive": type(self.drive).__name__, "drive_params": enc(self.drive),
+            "tip": enc(self.tip), "engine": self.engine.to_dict(), "scales": enc(self.scales),
+            "detection": enc(self.detection), "start": list(self.start),
+            "end_reason": self.end_reason.value, "end_detail": self.end_detail,
+            "end_time_s": float(self.time_s[-1]) if self.n else 0.0,
+            "kappa_mj": None if math.isnan(self.kappa_mj) else self.kappa_mj,
+            "slip_kappas": self.slip_kappas.tolist(), "inertia_number": self.inertia_number,
+            "speed_m_s": self.speed_m_s,
+            "n_slip_onsets": sum(e.kind == "slip_onset" for e in self.events),
+            "max_penetration_m": float(self.penetration_m.max()) if self.n else 0.0,
+        }
+
+
+def inclined_plane(*, slope_deg: float, azimuth_deg: float = 0.0, half_width: float = 0.02,
+                   n: int = 41, unit: str = "m") -> GridSurface:
+    """A plane ``z = tan(slope) (x cos(az) + y sin(az))`` on a square grid.
+
+    ``azimuth_deg = 0`` makes the plane rise in +x (the closed form's theta > 0).
+    """
+    slope = float(slope_deg)
+    if not (math.isfinite(slope) and -89.0 <= slope <= 89.0):
+        raise SpineInputError(f"slope_deg must lie in [-89, 89], got {slope_deg!r}")
+    half_width = _check_positive("half_width", half_width)
+    t = math.tan(math.radians(slope))
+    az = math.radians(float(azimuth_deg))
+    x = np.linspace(-half_width, half_width, int(n))
+    h = t * (math.cos(az) * x[None, :] + math.sin(az) * x[:, None])
+    return GridSurface(heights=h, x=x, y=x.copy(), unit=unit,
+                       metadata={"generator": "inclined_plane", "slope_deg": slope,
+                                 "azimuth_deg": float(azimuth_deg)})
+
+
+# --------------------------------------------------------------------------- the rig
+
+
+class Rig:
+    """The MuJoCo model of one surface and one tip, ready to run drives.
+
+    Parameters
+    ----------
+    surface : Surface
+        Any surface; dimensionless ones are scaled by ``length_scale_m``.
+    tip : TipParams
+    engine : EngineSettings or None
+        None: :func:`default_engine` of the scales.
+    length_scale_m : float or None
+        Metres per surface unit; None gives 0.01 for ``unit == "1"`` and 1 for ``"m"``.
+    char_length_m : float or None
+        L_c [m]; None: :func:`characteristic_length` times ``length_scale_m``.
+
+    Raises
+    ------
+    SpineInputError
+        Bad parameters, a surface in another unit, or a surface too coarse for the tip
+        (hfield spacing > 2 tip radii: the sphere would see single facets and their kinks).
+
+    Notes
+    -----
+    Default tip radius: ``surface.metadata["params"]["tip_radius_m"]`` if the surface has
+    one (sandpaper), else the larger of one hfield spacing and ``L_c / 100``.
+    """
+
+    def __init__(self, surface: Surface, *, tip: TipParams | None = None,
+                 engine: EngineSettings | None = None, length_scale_m: float | None = None,
+                 char_length_m: float | None = None):
+        import mujoco
+
+        if not isinstance(surface, Surface):
+            raise SpineInputError(f"surface must be a spine_mj Surface, got {type(surface).__name__}")
+        tip = TipParams() if tip is None else tip
+        if surface.unit not in ("1", "m"):
+            raise SpineInputError(f"surface unit must be '1' (dimensionless) or 'm', got {surface.unit!r}")
+        if length_scale_m is None:
+            length_scale_m = DEFAULT_LENGTH_SCALE_M if surface.unit == "1" else 1.0
+        length_scale_m = _check_positive("length_scale_m", length_scale_m)
+        if char_length_m is None:
+            char_length_m = characteristic_length(surface) * length_scale_m
+        char_length_m = _check_positive("char_length_m", char_length_m)
+        resolution = engine.hfield_resolution if engine is not None else None
+        hf = (to_hfield(surface, nrow=resolution, ncol=resolution) if resolution
+              else to_hfield(surface))
+        spacing = length_scale_m * 2 * max(hf.size[0] / (hf.ncol - 1), hf.size[1] / (hf.nrow - 1))
+        if tip.tip_radius_m is None:
+            params = surface.metadata.get("params", {}) if isinstance(surface.metadata, dict) else {}
+            r = params.get("tip_radius_m") if surface.unit == "m" else None
+            r = float(r) if r else max(spacing, 0.01 * char_length_m)
+            tip = dataclasses.replace(tip, tip_radius_m=float(f"{r:.3g}"))
+        if spacing > 2 * tip.tip_radius_m * (1 + 1e-9):
+            raise SpineInputError(
+                f"surface too coarse for the tip: hfield spacing {spacing:.3g} m > 2 x tip_radius_m "
+                f"= {2 * tip.tip_radius_m:.3g} m; raise hfield_resolution or the tip radius")
+        self.surface = surface
+        self.tip = tip
+        self.length_scale_m = length_scale_m
+        self.scales = Scales(length_scale_m=length_scale_m, char_length_m=char_length_m,
+                             mass_kg=tip.mass_kg, preload_n=tip.preload_total_n,
+                             tip_radius_m=tip.tip_radius_m, hfield_spacing_m=spacing)
+        self.engine = default_engine(self.scales) if engine is None else engine
+        self.hfield = hf
+        xmin, xmax, ymin, ymax = surface.bounds
+        self.bounds_m = tuple(length_scale_m * b for b in (xmin, xmax, ymin, ymax))
+        self.spec = mujoco.MjSpec.from_file(str(MODEL_PATH))
+        self._configure_spec()
+        self.model = self.spec.compile()
+        self._ids()
+
+    # ----------------------------------------------------------------- model building
+
+    def _configure_spec(self) -> None:
+        import mujoco
+
+        spec, eng, tip, s = self.spec, self.engine, self.tip, self.length_scale_m
+        spec.option.timestep = eng.timestep_s
+        spec.option.integrator = getattr(mujoco.mjtIntegrator, f"mjINT_{eng.integrator.name}")
+        spec.option.cone = getattr(mujoco.mjtCone, f"mjCONE_{eng.cone.name}")
+        spec.option.impratio = eng.impratio
+        spec.option.noslip_iterations = eng.noslip_iterations
+        spec.option.gravity = [0.0, 0.0, -tip.gravity_m_s2]
+        spec.modelname = "spine_rig"
+        r = tip.tip_radius_m
+        tip_geom = spec.geom("tip")
+        tip_geom.size = [r, 0, 0]
+        tip_geom.mass = tip.mass_kg
+        car = spec.geom("carriage")
+        car.size = [r, r, r]
+        hf = self.hfield
+        rx, ry, elev, base = hf.size
+        spec.add_hfield(name="surface", size=[rx * s, ry * s, elev * s, base * s],
+                        nrow=hf.nrow, ncol=hf.ncol, userdata=hf.data.ravel().tolist())
+        geom = spec.worldbody.add_geom(
+            name="surface", type=mujoco.mjtGeom.mjGEOM_HFIELD, hfieldname="surface",
+            pos=[p * s for p in hf.pos], material="ground")
+        for g in (tip_geom, geom):
+            g.friction = [tip.mu_s, 0.0, 0.0]
+            g.condim = 3
+            g.solref = list(eng.solref)
+            g.solimp = list(eng.solimp)
+        span = max(rx, ry) * s
+        spec.visual.map.znear = 1e-4
+        spec.stat.extent = 2 * span
+        spec.stat.center = [hf.pos[0] * s, hf.pos[1] * s, (hf.pos[2] + elev / 2) * s]
+
+    def _ids(self) -> None:
+        import mujoco
+
+        m = self.model
+        self.geom_tip = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, "tip")
+        self.geom_surface = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, "surface")
+        self.act_spring = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, "spring")
+        self.act_push = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, "push")
+        self.act_preload = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, "preload")
+        adr = {}
+        for name in ("tip_pos", "tip_vel", "contact_net", "contact_deepest", "spring_force",
+                     "push_force"):
+            sid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SENSOR, name)
+            adr[name] = int(m.sensor_adr[sid])
+        self._sensor_adr = adr
+
+    def set_surface(self, surface: Surface) -> None:
+        """Replace the surface (same grid size) and recompile in place (``spec.recompile``)."""
+        import mujoco
+
+        hf = (to_hfield(surface, nrow=self.engine.hfield_resolution, ncol=self.engine.hfield_resolution)
+              if self.engine.hfield_resolution else to_hfield(surface))
+        if (hf.nrow, hf.ncol) != (self.hfield.nrow, self.hfield.ncol):
+            raise SpineInputError(f"set_surface needs a {self.hfield.nrow} x {self.hfield.ncol} hfield, "
+                                  f"got {hf.nrow} x {hf.ncol}; build a new Rig instead")
+        s = self.length_scale_m
+        h = self.spec.hfield("surface")
+        h.userdata = hf.data.ravel().tolist()
+        h.size = [v * s for v in hf.size]
+        self.spec.geom("surface").pos = [p * s for p in hf.pos]
+        data = mujoco.MjData(self.model)
+        self.model, _ = self.spec.recompile(self.model, data)
+        self.surface, self.hfield = surface, hf
+        xmin, xmax, ymin, ymax = surface.bounds
+        self.bounds_m = tuple(s * b for b in (xmin, xmax, ymin, ymax))
+        self._ids()
+
+    def to_xml(self) -> str:
+        """A self-contained MJCF of the rig (the hfield inlined as ``elevation``)."""
+        return self.spec.to_xml()
+
+    def export_xml(self, path: str | os.PathLike) -> Path:
+        """Write :meth:`to_xml` to ``path`` atomically; MuJoCo's viewer opens it directly."""
+        path = Path(path)
+        with atomic_output(path) as tmp:
+            tmp.write_text(self.to_xml())
+        return path
+
+    # ----------------------------------------------------------------- placement
+
+    def _model_for(self, drive: Drive | None):
+        m = copy.copy(self.model)
+        k = self._stiffness(drive) if isinstance(drive, SpringDrive) else 0.0
+        m.actuator_gainprm[self.act_spring, 0] = k
+        m.actuator_biasprm[self.act_spring, 1] = -k
+        return m
+
+    def place(self, x0: float, y0: float) -> np.ndarray:
+        """qpos ``(3,)`` [m] with the tip resting on the hfield at ``(x0, y0)`` (surface units).
+
+        The sphere is lowered vertically until the engine's own sphere-hfield distance is
+        zero (to 1e-6 tip radii): it starts touching, at rest, never dropped.
+        """
+        import mujoco
+
+        x0, y0 = float(x0), float(y0)
+        if not bool(self.surface.contains(x0, y0)):
+            raise SpineInputError(f"start ({x0:g}, {y0:g}) lies outside the surface bounds "
+                                  f"{self.surface.bounds}")
+        s, r = self.length_scale_m, self.tip.tip_radius_m
+        m = copy.copy(self.model)
+        m.geom_margin[self.geom_tip] = 4 * r
+        d = mujoco.MjData(m)
+        _, _, elev, _ = self.hfield.size
+        z = (self.hfield.pos[2] + elev) * s + 2 * r
+        for _ in range(200):
+            d.qpos[:] = (x0 * s, y0 * s, z)
+            mujoco.mj_forward(m, d)
+            cons = [c for c in d.contact[:d.ncon]]
+            if not cons:
+                z -= 2 * r
+                continue
+            c = min(cons, key=lambda c: c.dist)
+            nz = abs(c.frame[2])
+            if abs(c.dist) < 1e-6 * r:
+                break
+            z -= c.dist / max(nz, 0.05)
+        else:
+            raise SpineInputError(f"could not place the tip on the surface at ({x0:g}, {y0:g})")
+        return np.array([x0 * s, y0 * s, z])
+
+    # ----------------------------------------------------------------- drive parameters
+
+    def _stiffness(self, drive: SpringDrive) -> float:
+        if drive.stiffness_n_m is not None:
+            return drive.stiffness_n_m
+        return 10 * self.scales.preload_n / self.scales.char_length_m
+
+    def _rate(self, drive) -> float:
+        if drive.rate_n_s is not None:
+            return drive.rate_n_s
+        return 0.1 * self.scales.preload_n / self.scales.time_s
+
+    def _settle_steps(self, drive) -> int:
+        t = drive.settle_time_s
+        if t is None:
+            t = 200 * self.engine.timestep_s
+        return max(1, int(round(t / self.engine.timestep_s)))
+
+    def speed_of(self, drive: Drive) -> float:
+        """The drive's speed [m/s]: carriage speed, or ``L_c rate / F_p`` for force drives."""
+        if isinstance(drive, SpringDrive):
+            return drive.speed_m_s
+        return self.scales.char_length_m * self._rate(drive) / self.scales.preload_n
+
+    def inertia_number(self, drive: Drive) -> float:
+        """I_e = m v^2 / (F_p L_c) of a drive (equivalent speed for force drives)."""
+        return self.scales.inertia_number(self.speed_of(drive))
+
+    # ----------------------------------------------------------------- controls
+
+    def _controls(self, drive: Drive, qpos0: np.ndarray, detection: Detection) -> np.ndarray:
+        """Open-loop controls ``(nstep, 6)``: ctrl (spring, push, preload) then mocap xyz."""
+        dt = self.engine.timestep_s
+        n_settle = self._settle_steps(drive)
+        cap = detection.kappa_cap * self.scales.preload_n
+        if isinstance(drive, SpringDrive):
+            duration = drive.duration_s
+            if duration is None:
+                duration = 1.1 * max(self.bounds_m[1] - qpos0[0], 0.0) / drive.speed_m_s
+            n_drive = max(1, int(math.ceil(duration / dt)))
+        elif isinstance(drive, StaticProbe):
+            rate = self._rate(drive)
+            n_drive = max(1, int(math.ceil((cap - drive.start_force_n) / rate / dt)) + 2)
+        else:
+            raise SpineInputError(f"open-loop controls exist for SpringDrive and StaticProbe, "
+                                  f"got {type(drive).__name__}")
+        n = n_settle + n_drive
+        ctrl = np.zeros((n, 6))
+        ctrl[:, 2] = -self.tip.preload_n
+        ctrl[:, 3] = qpos0[0]
+        ctrl[:, 4] = qpos0[1]
+        ctrl[:, 5] = qpos0[2] + 2 * self.tip.tip_radius_m
+        ramp_t = dt * np.arange(1, n_drive + 1)
+        if isinstance(drive, SpringDrive):
+            ctrl[:, 0] = qpos0[0]
+            ctrl[n_settle:, 0] = qpos0[0] + drive.speed_m_s * ramp_t
+            ctrl[:, 3] = ctrl[:, 0]
+        else:
+            ctrl[:, 1] = drive.start_force_n
+            ctrl[n_settle:, 1] = np.minimum(drive.start_force_n + self._rate(drive) * ramp_t,
+                                            cap * (1 + 1e-9))
+        return ctrl
+
+    # ----------------------------------------------------------------- running
+
+    def run(self, drive: Drive, *, start: tuple[float, float], detection: Detection | None = None,
+            backend: str = "rollout", progress: Callable[[float], None] | None = None) -> RunResult:
+        """Run one drive from ``start`` (surface units).
+
+        ``backend`` "rollout" (native) or "python" (a plain ``mj_step`` loop, the reference
+        implementation); the force ramp with reset always steps in Python. ``progress``
+        receives the fraction done (Python backends only).
+        """
+        if isinstance(drive, RampDrive):
+            return self._run_ramp(drive, start, detection, progress)
+        return self.run_batch([drive], [start], detection=detection, backend=backend)[0]
+
+    def run_batch(self, drives: Drive | Sequence[Drive], starts: Sequence[tuple[float, float]], *,
+                  detection: Detection | None = None, backend: str = "rollout",
+                  nthread: int | None = None) -> list[RunResult]:
+        """Run many starts and/or drive parameter sets of this model.
+
+        ``drives`` is one drive for all starts or one per start (SpringDrive or StaticProbe;
+        mixed kinds are allowed). Runs go through :func:`mujoco.rollout.rollout` on
+        ``nthread`` native threads (default: CPU count), in groups sized to stay within
+        256 MiB of output; each run is then cut at its first end event.
+        """
+        import mujoco
+        from mujoco import rollout
+
+        starts = [tuple(float(v) for v in s) for s in starts]
+        if isinstance(drives, (SpringDrive, StaticProbe, RampDrive)):
+            drives = [drives] * len(starts)
+        drives = list(drives)
+        if len(drives) != len(starts):
+            raise SpineInputError(f"drives must be one drive or one per start ({len(starts)}), "
+                                  f"got {len(drives)}")
+        if any(isinstance(d, RampDrive) for d in drives):
+            raise SpineInputError("RampDrive needs feedback; use Rig.run for it")
+        if backend not in ("rollout", "python"):
+            raise SpineInputError(f"backend must be 'rollout' or 'python', got {backend!r}")
+        det = (Detection() if detection is None else detection).resolve(self.scales)
+        qpos0 = [self.place(*s) for s in starts]
+        models = [self._model_for(d) for d in drives]
+        controls = [self._controls(d, q, det) for d, q in zip(drives, qpos0)]
+        nstate = mujoco.mj_stateSize(self.model, mujoco.mjtState.mjSTATE_FULLPHYSICS)
+        spec = int(mujoco.mjtState.mjSTATE_CTRL) | int(mujoco.mjtState.mjSTATE_MOCAP_POS)
+        results: list[RunResult | None] = [None] * len(starts)
+        # group runs of equal length (rollout needs one nstep per call)
+        order = sorted(range(len(starts)), key=lambda i: controls[i].shape[0])
+        per_row = 8 * (nstate + self.model.nsensordata)
+        nthread = os.cpu_count() or 1 if nthread is None else int(nthread)
+        pool = rollout.Rollout(nthread=nthread) if backend == "rollout" else None
+        try:
+            i = 0
+            while i < len(order):
+                nstep = controls[order[i]].shape[0]
+                group = [order[i]]
+                limit = max(1, _BATCH_MEMORY_BYTES // (per_row * nstep))
+                while (i + len(group) < len(order) and len(group) < limit
+                       and controls[order[i + len(group)]].shape[0] == nstep):
+                    group.append(order[i + len(group)])
+                i += len(group)
+                init = np.zeros((len(group), nstate))
+                for row, j in enumerate(group):
+                    init[row, 1:4] = qpos0[j]
+                ctrl = np.stack([controls[j] for j in group])
+                if backend == "rollout":
+                    datas = [mujoco.MjData(self.model) for _ in range(max(1, nthread))]
+                    state, sens = pool.rollout([models[j] for j in group], datas, init, ctrl,
+                                               control_spec=spec,
+                                               initial_warmstart=np.zeros((len(group), self.model.nv)))
+                    warn = [None] * len(group)
+                else:
+                    state, sens, warn = _python_rollout([models[j] for j in group], init, ctrl)
+                for row, j in enumerate(group):
+                    results[j] = self._analyse(drives[j], starts[j], state[row], sens[row],
+                                               controls[j], det, warn[row])
+        finally:
+            if pool is not None:
+                pool.close()
+        return results
+
+    # ----------------------------------------------------------------- analysis
+
+    def _columns(self, state: np.ndarray, sens: np.ndarray):
+        a = self._sensor_adr
+        t = state[:, 0]
+        pos = sens[:, a["tip_pos"]:a["tip_pos"] + 3]
+        vel = sens[:, a["tip_vel"]:a["tip_vel"] + 3]
+        c_net = sens[:, a["contact_net"]:a["contact_net"] + 4]
+        c_deep = sens[:, a["contact_deepest"]:a["contact_deepest"] + 8]
+        contact = c_deep[:, 0] > 0
+        force = -c_net[:, 1:4]  # the sensor reports the force of the tip on the surface
+        normal = c_deep[:, 5:8].copy()
+        flip = np.where((normal[:, 2:3] < 0), -1.0, 1.0)
+        normal *= flip
+        normal[~contact] = np.nan
+        point = c_deep[:, 2:5].copy()
+        point[~contact] = np.nan
+        pen = np.where(contact, np.maximum(-c_deep[:, 1], 0.0), 0.0)
+        fn = np.where(contact, np.einsum("ij,ij->i", np.nan_to_num(normal), force), 0.0)
+        ft = np.where(contact, np.linalg.norm(force - fn[:, None] * np.nan_to_num(normal), axis=1), 0.0)
+        drive_f = sens[:, a["spring_force"]] + sens[:, a["push_force"]]
+        nn = np.nan_to_num(normal)
+        vt = vel - np.einsum("ij,ij->i", vel, nn)[:, None] * nn
+        return t, pos, vel, contact, normal, point, pen, fn, ft, drive_f, np.linalg.norm(vt, axis=1)
+
+    def _analyse(self, drive, start, state, sens, ctrl, det: Detection, warnings) -> RunResult:
+        dt = self.engine.timestep_s
+        t, pos, vel, contact, normal, point, pen, fn, ft, drive_f, vt = self._columns(state, sens)
+        n = t.size
+        n_settle = self._settle_steps(drive)
+        fp = self.scales.preload_n
+        slipping = vt > det.slip_speed_m_s
+        end, reason, detail = n - 1, EndReason.COMPLETED, "drive duration elapsed"
+
+        def first(mask):
+            idx = np.flatnonzero(mask)
+            return int(idx[0]) if idx.size else None
+
+        candidates = []
+        finite = np.isfinite(state).all(axis=1) & np.isfinite(sens).all(axis=1)
+        k = first(~finite)
+        if k is not None:
+            candidates.append((k, 0, EndReason.ENGINE_TROUBLE, "non-finite state"))
+        expected = dt * np.arange(1, n + 1)
+        k = first(np.abs(t - expected) > 0.5 * dt)
+        if k is not None:
+            candidates.append((k, 0, EndReason.ENGINE_TROUBLE,
+                               "MuJoCo reset the simulation (warning: bad qpos/qvel/qacc)"))
+        if warnings is not None:
+            k, text = warnings
+            if k is not None:
+                candidates.append((k, 0, EndReason.ENGINE_TROUBLE, f"MuJoCo warning: {text}"))
+        k = first(pen > det.penetration_tol_m)
+        if k is not None:
+            candidates.append((k, 1, EndReason.ENGINE_TROUBLE,
+                               f"penetration {pen[k]:.3g} m > tolerance {det.penetration_tol_m:.3g} m"))
+        xmin, xmax, ymin, ymax = self.bounds_m
+        mg = det.domain_margin_m
+        outside = ((pos[:, 0] < xmin + mg) | (pos[:, 0] > xmax - mg)
+                   | (pos[:, 1] < ymin + mg) | (pos[:, 1] > ymax - mg))
+        k = first(outside)
+        if k is not None:
+            candidates.append((k, 2, EndReason.LEFT_DOMAIN,
+                               f"tip at ({pos[k, 0]:.4g}, {pos[k, 1]:.4g}) m left the domain"))
+        cap = det.kappa_cap * fp
+        k = first((drive_f >= cap * (1 - 1e-9)) & ~slipping)
+        if k is not None:
+            candidates.append((k, 3, EndReason.SELF_LOCK,
+                               f"drive force reached kappa_cap * F_p = {cap:.4g} N without slip"))
+        kappa = math.nan
+        if isinstance(drive, StaticProbe):
+            p_ref = pos[min(n_settle, n) - 1]
+            moved = np.linalg.norm(pos - pos[0], axis=1) > det.breakaway_distance_m
+            k_settle = first(moved[:n_settle])
+            if k_settle is not None:
+                candidates.append((k_settle, 4, EndReason.SLID,
+                                   "the tip slid during settling at the start force"))
+            moved = np.linalg.norm(pos - p_ref, axis=1) > det.breakaway_distance_m
+            moved[:n_settle] = False
+            k = first(moved)
+            if k is not None:
+                stuck = np.flatnonzero(vt[:k] <= det.stick_speed_m_s)
+                j = int(stuck[-1]) if stuck.size else n_settle - 1
+                f_break = drive_f[max(j, n_settle - 1)]
+                if pos[k, 0] - p_ref[0] <= 0 or j < n_settle:
+                    candidates.append((k, 4, EndReason.SLID,
+                                       f"the tip slid against the drive at F = {f_break:.4g} N"))
+                else:
+                    kappa = float(f_break / fp)
+                    candidates.append((k, 4, EndReason.BREAKAWAY,
+                                       f"breakaway at F = {f_break:.4g} N, kappa_mj = {kappa:.4g}"))
+        if candidates:
+            end, _, reason, detail = min(candidates, key=lambda c: (c[0], c[1]))
+        if reason is not EndReason.BREAKAWAY:
+            kappa = math.nan
+        sl = slice(0, end + 1)
+        events = _slip_events(slipping[sl], t[sl], n_settle)
+        events.append(Event(reason.value, end, float(t[end])))
+        onsets = [e.index for e in events if e.kind == "slip_onset"]
+        carriage = ctrl[:, 3].copy() if isinstance(drive, SpringDrive) else np.full(n, np.nan)
+        return self._result(drive, start, det, t, pos, vel, contact, normal, point, pen, fn, ft,
+                            drive_f, carriage, slipping, sl, events, reason, detail, n_settle, kappa,
+                            np.array([drive_f[i] / fp for i in onsets]))
+
+    def _result(self, drive, start, det, t, pos, vel, contact, normal, point, pen, fn, ft, drive_f,
+                carriage, slipping, sl, events, reason, detail, n_settle, kappa, slip_kappas):
+        def cut(a):
+            out = np.ascontiguousarray(a[sl])
+            out.flags.writeable = False
+            return out
+
+        speed = self.speed_of(drive)
+        return RunResult(
+            time_s=cut(t), position_m=cut(pos), velocity_m_s=cut(vel), contact=cut(contact),
+            normal=cut(normal), contact_point_m=cut(point), penetration_m=cut(pen),
+            normal_force_n=cut(fn), tangential_force_n=cut(ft), drive_force_n=cut(drive_f),
+            carriage_x_m=cut(carriage), slipping=cut(slipping), events=tuple(events),
+            end_reason=reason, end_detail=detail, drive_start_index=n_settle, kappa_mj=kappa,
+            slip_kappas=slip_kappas, inertia_number=self.scales.inertia_number(speed),
+            speed_m_s=speed, start=tuple(start), drive=drive, tip=self.tip, engine=self.engine,
+            scales=self.scales, detection=det)
+
+    # ----------------------------------------------------------------- ramp with reset
+
+    def _run_ramp(self, drive: RampDrive, start, detection, progress) -> RunResult:
+        import mujoco
+
+        det = (Detection() if detection is None else detection).resolve(self.scales)
+        start = tuple(float(v) for v in start)
+        qpos0 = self.place(*start)
+        m = self._model_for(drive)
+        d = mujoco.MjData(m)
+        d.qpos[:] = qpos0
+        d.ctrl[self.act_preload] = -self.tip.preload_n
+        d.mocap_pos[0] = qpos0 + np.array([0.0, 0.0, 2 * self.tip.tip_radius_m])
+        dt = self.engine.timestep_s
+        rate = self._rate(drive)
+        fp = self.scales.preload_n
+        cap = det.kappa_cap * fp
+        n_settle = self._settle_steps(drive)
+        duration = drive.duration_s
+        if duration is None:
+            duration = min(40 * cap / rate, 200 * self.scales.time_s)
+        nstep = n_settle + int(math.ceil(duration / dt))
+        nstate = mujoco.mj_stateSize(m, mujoco.mjtState.mjSTATE_FULLPHYSICS)
+        state = np.empty((nstep, nstate))
+        sens = np.empty((nstep, m.nsensordata))
+        ctrl_log = np.zeros((nstep, 6))
+        a = self._sensor_adr
+        force, ramping, stuck_steps, stop = 0.0, True, 0, nstep
+        resets = []
+        warn_total = _warning_total(d)
+        warn_at = None
+        nrm = np.zeros(3)
+        for i in range(nstep):
+            if i >= n_settle:
+                if ramping:
+                    force = min(force + rate * dt, cap * (1 + 1e-9))
+                d.ctrl[self.act_push] = force if ramping else 0.0
+            mujoco.mj_step(m, d)
+            mujoco.mj_getState(m, d, state[i], mujoco.mjtState.mjSTATE_FULLPHYSICS)
+            sens[i] = d.sensordata
+            ctrl_log[i, 1] = d.ctrl[self.act_push]
+            if i % 64 == 63 and _warning_total(d) != warn_total:
+                warn_at = (i, _warning_text(d))
+                stop = i + 1
+                break
+            if not np.isfinite(state[i]).all():
+                stop = i + 1
+                break
+            vel = sens[i, a["tip_vel"]:a["tip_vel"] + 3]
+            if sens[i, a["contact_deepest"]] > 0:
+                nrm = sens[i, a["contact_deepest"] + 5:a["contact_deepest"] + 8]
+            vt = float(np.linalg.norm(vel - (vel @ nrm) * nrm))
+            if i >= n_settle:
+                if ramping and vt > det.slip_speed_m_s:
+                    ramping, stuck_steps = False, 0
+                    force = 0.0
+                elif not ramping:
+                    stuck_steps = stuck_steps + 1 if vt <= det.slip_speed_m_s else 0
+                    if stuck_steps >= n_settle:
+                        ramping = True
+                        resets.append(i)
+            if progress is not None and i % 2000 == 0:
+                progress(i / nstep)
+        state, sens, ctrl_log = state[:stop], sens[:stop], ctrl_log[:stop]
+        result = self._analyse(drive, start, state, sens, ctrl_log, det, (
+            warn_at if warn_at is not None else (None, "")))
+        events = tuple(sorted(result.events + tuple(Event("reset", i, float(state[i, 0]))
+                                                    for i in resets if i < result.n),
+                              key=lambda e: (e.index, e.kind == result.end_reason.value)))
+        return dataclasses.replace(result, events=events)
+
+    # ----------------------------------------------------------------- rendering
+
+    def render_frames(self, result: RunResult, *, fps: float = 30.0, width: int = 640,
+                      height: int = 480):
+        """Yield RGB frames ``(height, width, 3)`` uint8 of a run (headless, needs a GL backend)."""
+        import mujoco
+
+        m = self._model_for(result.drive)
+        d = mujoco.MjData(m)
+        renderer = mujoco.Renderer(m, height=height, width=width)
+        cam = mujoco.MjvCamera()
+        cam.type = mujoco.mjtCamera.mjCAMERA_FREE
+        span = max(self.bounds_m[1] - self.bounds_m[0], self.bounds_m[3] - self.bounds_m[2])
+        cam.distance = 0.9 * span
+        cam.elevation = -35.0
+        cam.azimuth = 120.0
+        stride = max(1, int(round(1.0 / (fps * self.engine.timestep_s))))
+        try:
+            for i in range(0, result.n, stride):
+                d.qpos[:] = result.position_m[i]
+                if not math.isnan(result.carriage_x_m[i]):
+                    d.mocap_pos[0] = (result.carriage_x_m[i], result.position_m[i, 1],
+                                      result.position_m[i, 2] + 2 * self.tip.tip_radius_m)
+                mujoco.mj_forward(m, d)
+                cam.lookat[:] = result.position_m[i]
+                renderer.update_scene(d, camera=cam)
+                yield renderer.render().copy()
+        finally:
+            renderer.close()
+
+
+def _warning_total(d) -> int:
+    return int(sum(w.number for w in d.warning))
+
+
+def _warning_text(d) -> str:
+    import mujoco
+
+    names = [n for n in dir(mujoco.mjtWarning) if n.startswith("mjWARN_") and n != "mjWARN_NWARNING"]
+    hit = [n for n in names if d.warning[int(getattr(mujoco.mjtWarning, n))].number > 0]
+    return ", ".join(h.removeprefix("mjWARN_") for h in hit) or "unknown"
+
+
+def _python_rollout(models, init, ctrl):
+    """Reference for :func:`mujoco.rollout.rollout`: a plain ``mj_step`` loop per run.
+
+    Returns state ``(nbatch, nstep, nstate)``, sensordata ``(nbatch, nstep, nsensordata)``
+    and per run ``(first step with a new MuJoCo warning or None, warning names)``.
+    """
+    import mujoco
+
+    nbatch, nstep, _ = ctrl.shape
+    m0 = models[0]
+    nstate = mujoco.mj_stateSize(m0, mujoco.mjtState.mjSTATE_FULLPHYSICS)
+    state = np.empty((nbatch, nstep, nstate))
+    sens = np.empty((nbatch, nstep, m0.nsensordata))
+    warns = []
+    full = mujoco.mjtState.mjSTATE_FULLPHYSICS
+    for b, m in enumerate(models):
+        d = mujoco.MjData(m)
+        mujoco.mj_setState(m, d, init[b], full)
+        d.qacc_warmstart[:] = 0
+        first_warn = None
+        for i in range(nstep):
+            d.ctrl[:] = ctrl[b, i, :3]
+            d.mocap_pos[0] = ctrl[b, i, 3:6]
+            mujoco.mj_step(m, d)
+            mujoco.mj_getState(m, d, state[b, i], full)
+            sens[b, i] = d.sensordata
+            if first_warn is None and _warning_total(d):
+                first_warn = (i, _warning_text(d))
+        warns.append(first_warn if first_warn is not None else (None, ""))
+    return state, sens, warns
+
+
+def _slip_events(slipping: np.ndarray, t: np.ndarray, start: int) -> list[Event]:
+    s = slipping.copy()
+    s[:start] = False
+    change = np.flatnonzero(np.diff(s.astype(np.int8)))
+    events = []
+    for k in change:
+        i = int(k) + 1
+        events.append(Event("slip_onset" if s[i] else "slip_stop", i, float(t[i])))
+    return events
+
