@@ -44,6 +44,7 @@ the end of every sweep.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import datetime
 import functools
@@ -105,6 +106,7 @@ MANIFEST = "manifest.json"
 RUNS_TABLE = "runs.parquet"
 RUNS_DIR = "runs"
 TRAJ_DIR = "trajectories"
+LOCK = ".sweep.lock"
 _RESERVED = ("run_id", "case_id", "case_index", "analysis", "start", "start_x", "start_y",
              "surface", "surface_seed", "seed", "status", "reason", "time_s")
 
@@ -994,7 +996,7 @@ def _prepare_store(config: SweepConfig, cases: list[Case], out_dir: Path, *, ove
                 f"{config.hash[:12]}: use another folder or --overwrite to replace it")
         _clear_store(out_dir)
         manifest = None
-    elif manifest is None and out_dir.is_dir() and any(out_dir.iterdir()):
+    elif manifest is None and any(p.name != LOCK for p in out_dir.iterdir()):
         if not overwrite:
             raise SpineInputError(f"--out {out_dir} exists, is not empty and holds no sweep "
                                   f"manifest: use another folder or --overwrite")
@@ -1035,12 +1037,23 @@ def _clear_store(out_dir: Path) -> None:
         if (out_dir / name).is_file():
             (out_dir / name).unlink()
     for p in out_dir.iterdir():
-        if p.is_file() and p.name.startswith("."):
+        if p.is_file() and p.name.startswith(".") and p.name != LOCK:
             p.unlink()
 
 
+def _case_files(out_dir: Path) -> list[Path]:
+    """Finished cases' files (a kill can leave hidden temporary files; they do not count)."""
+    return sorted(p for p in (out_dir / RUNS_DIR).glob("*.parquet") if not p.name.startswith("."))
+
+
 def _finished(out_dir: Path) -> set[str]:
-    return {p.stem for p in (out_dir / RUNS_DIR).glob("*.parquet")}
+    return {p.stem for p in _case_files(out_dir)}
+
+
+def _remove_temporaries(out_dir: Path) -> None:
+    for sub in (RUNS_DIR, TRAJ_DIR):
+        for p in (out_dir / sub).glob(".*"):
+            p.unlink(missing_ok=True)
 
 
 def _store_case(out_dir: Path, case_id: str, rows, traj) -> None:
@@ -1059,8 +1072,7 @@ def consolidate(out_dir: str | os.PathLike):
     import pyarrow.parquet as pq
 
     out_dir = Path(out_dir)
-    files = sorted((out_dir / RUNS_DIR).glob("*.parquet"))
-    tables = [pq.read_table(f) for f in files]
+    tables = [pq.read_table(f) for f in _case_files(out_dir)]
     if not tables:
         table = pa.table({c: pa.array([], pa.string()) for c in ("run_id", "status")})
     else:
@@ -1123,7 +1135,32 @@ def run_sweep(config: SweepConfig | str | os.PathLike, out_dir: str | os.PathLik
                                                                        scheduler)),
                "versions": _versions(), "git": _git_commit()}
     out_dir.mkdir(parents=True, exist_ok=True)
+    with _store_lock(out_dir):
+        return _run_locked(config, cases, out_dir, session, n_workers=n_workers,
+                           scheduler=scheduler, overwrite=overwrite, retry_failed=retry_failed,
+                           progress=progress)
+
+
+@contextlib.contextmanager
+def _store_lock(out_dir: Path):
+    """Exclusive lock on the store for one sweep at a time (released by the OS on a kill)."""
+    import fcntl
+
+    with open(out_dir / LOCK, "w") as fh:
+        try:
+            fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            raise SpineInputError(f"--out {out_dir}: another sweep is writing to it") from None
+        try:
+            yield
+        finally:
+            fcntl.flock(fh, fcntl.LOCK_UN)
+
+
+def _run_locked(config, cases, out_dir, session, *, n_workers, scheduler, overwrite,
+                retry_failed, progress) -> SweepSummary:
     _prepare_store(config, cases, out_dir, overwrite=overwrite, session=session)
+    _remove_temporaries(out_dir)
     done = _finished(out_dir)
     if retry_failed and done:
         import pyarrow.compute as pc
@@ -1258,7 +1295,7 @@ def store_status(out_dir: str | os.PathLike) -> StoreStatus:
     if manifest is None:
         raise SpineInputError(f"{out_dir} holds no sweep ({MANIFEST} not found)")
     counts: dict[str, int] = {}
-    files = sorted((out_dir / RUNS_DIR).glob("*.parquet"))
+    files = _case_files(out_dir)
     for f in files:
         for s in pq.read_table(f, columns=["status"])["status"].to_pylist():
             counts[s] = counts.get(s, 0) + 1
@@ -1278,7 +1315,7 @@ def load_runs(out_dir: str | os.PathLike, *, columns: list[str] | None = None):
     if _read_manifest(out_dir) is None:
         raise SpineInputError(f"{out_dir} holds no sweep ({MANIFEST} not found)")
     path = out_dir / RUNS_TABLE
-    n_files = len(list((out_dir / RUNS_DIR).glob("*.parquet")))
+    n_files = len(_case_files(out_dir))
     stale = not path.is_file() or len(set(
         pq.read_table(path, columns=["case_id"])["case_id"].to_pylist())) != n_files
     table = consolidate(out_dir) if stale else pq.read_table(path)
