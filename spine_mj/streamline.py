@@ -1,0 +1,440 @@
+"""Quasistatic engagement streamlines and ideal trajectories (paper §2.2, Eq. 4).
+
+At each point the tip is classified (:func:`spine_mj.engagement.kappa`); a self-locked tip
+stops. Otherwise the drive is raised to its limit ``F = kappa W`` (engaged) or is zero
+(slip), the tip steps a length ``dl`` along the tangential load ``v = T / |T|`` and is put
+back on the surface vertically::
+
+    A_{k+1} = A_k + dl v_k,    B_{k+1} = (A_{k+1,x}, A_{k+1,y}, f(A_{k+1,x}, A_{k+1,y}))
+
+The ideal trajectory keeps ``y = y0`` and walks in +x with arc-length steps ``dl`` along
+the section; kappa is evaluated on it and it stops on self-lock as well.
+
+Two backends give the same numbers: ``"numba"`` (compiled kernels for
+:class:`~spine_mj.surfaces.GaussianSurface` and :class:`~spine_mj.surfaces.GridSurface`,
+one core) and ``"numpy"`` (a plain loop over steps, vectorized over starts, for any
+:class:`~spine_mj.surfaces.Surface`; the reference the tests check the kernels against).
+
+A finite tip of radius R rides with its centre on the surface dilated by a ball of radius
+R: :func:`dilate` builds that surface (shifted down by R so that R -> 0 gives the
+original), on which the same streamline rules apply.
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from spine_mj.engagement import ENGAGED, SELF_LOCK, SLIP, kappa, slip_direction
+from spine_mj.errors import SpineInputError
+from spine_mj.surfaces import GaussianSurface, GridSurface, Surface
+
+__all__ = ["Outcome", "StreamlineParams", "StreamlineResult", "dilate", "ideal_trajectories",
+           "streamlines"]
+
+
+class Outcome(enum.IntEnum):
+    """Why a trajectory ended."""
+
+    SELF_LOCKED = 1  #: entered the self-lock region (kappa = inf)
+    LEFT_DOMAIN = 2  #: the next step would leave the surface's bounds
+    STALLED = 3  #: no net progress (|T| = 0, or moved < stall_distance in stall_window steps)
+    STEP_CAP = 4  #: max_steps taken without any of the above
+
+
+@dataclass(frozen=True)
+class StreamlineParams:
+    """Parameters of a streamline computation.
+
+    Attributes
+    ----------
+    mu : float
+        Static friction coefficient mu_s (> 0).
+    dl : float
+        Step length along the surface, in the surface's length unit (paper: about
+        0.01 sigma for Gaussian surfaces).
+    max_steps : int
+        Step cap per trajectory (outcome ``STEP_CAP``).
+    stall_window : int
+        Steps between progress checks.
+    stall_distance : float or None
+        Minimum horizontal net displacement per ``stall_window`` steps (surface length
+        unit); less is ``STALLED``. None means ``dl``.
+    tol : float
+        Tolerance on the scaled self-lock coefficient A' (see :func:`~spine_mj.engagement.kappa`).
+    """
+
+    mu: float
+    dl: float = 0.015
+    max_steps: int = 200_000
+    stall_window: int = 64
+    stall_distance: float | None = None
+    tol: float = 1e-12
+
+    def __post_init__(self):
+        for name in ("mu", "dl"):
+            v = getattr(self, name)
+            if not (isinstance(v, (int, float, np.floating)) and math.isfinite(v) and v > 0):
+                raise SpineInputError(f"{name} must be a finite number > 0, got {v!r}")
+        for name in ("max_steps", "stall_window"):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 1:
+                raise SpineInputError(f"{name} must be an integer >= 1, got {v!r}")
+        if self.stall_distance is not None and not (self.stall_distance >= 0):
+            raise SpineInputError(f"stall_distance must be >= 0 or None, got {self.stall_distance!r}")
+        if not (self.tol >= 0):
+            raise SpineInputError(f"tol must be >= 0, got {self.tol!r}")
+
+    @property
+    def stall_distance_value(self) -> float:
+        return self.dl if self.stall_distance is None else float(self.stall_distance)
+
+
+@dataclass(frozen=True, eq=False)
+class StreamlineResult:
+    """Trajectories from ``n`` starts; paths stored back to back (CSR layout).
+
+    Attributes
+    ----------
+    params : StreamlineParams
+    ideal : bool
+        True for ideal trajectories (y = y0), False for streamlines.
+    start_x, start_y : ndarray, shape (n,)
+    outcome : ndarray of int8, shape (n,)
+        :class:`Outcome` codes.
+    end_x, end_y, end_z : ndarray, shape (n,)
+        Last point of each trajectory (the self-lock point for ``SELF_LOCKED``, the last
+        point inside the domain for ``LEFT_DOMAIN``).
+    n_steps : ndarray of int64, shape (n,)
+        Steps taken; the path has ``n_steps + 1`` points.
+    max_kappa : ndarray, shape (n,)
+        Largest kappa met (``inf`` if self-locked, NaN if only slip points were met).
+    offsets : ndarray of int64, shape (n + 1,) or None
+        Path ``i`` occupies ``[offsets[i], offsets[i+1])`` of the flat arrays; None when the
+        paths were not stored.
+    x, y, z, kappa : ndarray, shape (total,) or None
+        Flat path points and kappa at each point.
+    region : ndarray of int8, shape (total,) or None
+        Region code at each point (SLIP, ENGAGED, SELF_LOCK).
+    """
+
+    params: StreamlineParams
+    ideal: bool
+    start_x: np.ndarray
+    start_y: np.ndarray
+    outcome: np.ndarray
+    end_x: np.ndarray
+    end_y: np.ndarray
+    end_z: np.ndarray
+    n_steps: np.ndarray
+    max_kappa: np.ndarray
+    offsets: np.ndarray | None = None
+    x: np.ndarray | None = None
+    y: np.ndarray | None = None
+    z: np.ndarray | None = None
+    kappa: np.ndarray | None = None
+    region: np.ndarray | None = None
+    meta: dict = field(default_factory=dict)
+
+    def __len__(self) -> int:
+        return self.start_x.size
+
+    @property
+    def self_locked(self) -> np.ndarray:
+        """Boolean ``(n,)``: ended in the self-lock region."""
+        return self.outcome == Outcome.SELF_LOCKED
+
+    def path(self, i: int) -> dict[str, np.ndarray]:
+        """Path ``i`` as arrays ``x, y, z, kappa, region`` of shape ``(n_steps[i] + 1,)``."""
+        if self.offsets is None:
+            raise SpineInputError("paths were not stored (store_paths=False)")
+        if not (-len(self) <= i < len(self)):
+            raise SpineInputError(f"path index must be in [0, {len(self)}), got {i}")
+        s = slice(self.offsets[i], self.offsets[i + 1])
+        return {k: getattr(self, k)[s] for k in ("x", "y", "z", "kappa", "region")}
+
+    def to_frame(self):
+        """Long table (pandas DataFrame): one row per path point, columns ``start``,
+        ``step``, ``start_x``, ``start_y``, ``x``, ``y``, ``z``, ``kappa``, ``region``,
+        ``outcome`` (names)."""
+        import pandas as pd
+
+        if self.offsets is None:
+            raise SpineInputError("paths were not stored (store_paths=False)")
+        counts = np.diff(self.offsets)
+        start = np.repeat(np.arange(len(self)), counts)
+        step = np.arange(self.x.size) - np.repeat(self.offsets[:-1], counts)
+        names = np.array(["", *[o.name.lower() for o in Outcome]])
+        return pd.DataFrame({
+            "trajectory": "ideal" if self.ideal else "streamline",
+            "start": start, "step": step,
+            "start_x": self.start_x[start], "start_y": self.start_y[start],
+            "x": self.x, "y": self.y, "z": self.z, "kappa": self.kappa,
+            "region": np.array(["slip", "engaged", "self-lock"])[self.region],
+            "outcome": names[self.outcome[start]],
+        })
+
+
+# --------------------------------------------------------------------------- numba kernels
+
+_KIND_GAUSS = 0
+_KIND_GRID = 1
+
+def _get_kernel():
+    from spine_mj._kernels import run_trajectories
+
+    return run_trajectories
+
+
+def _surface_data(surface: Surface):
+    dummy_g = np.zeros((5, 0))
+    dummy_coef = np.zeros((1, 1))
+    dummy_sp = np.zeros(8)
+    if isinstance(surface, GaussianSurface):
+        g = np.ascontiguousarray(np.stack([surface.amplitude, surface.center_x, surface.center_y,
+                                           1.0 / surface.sigma_x, 1.0 / surface.sigma_y]))
+        return _KIND_GAUSS, g, dummy_coef, dummy_sp
+    if isinstance(surface, GridSurface):
+        s = surface.spline
+        sp = np.array([s.offset, s.x0, s.dx, s.nx, s.y0, s.dy, s.ny, float(s.periodic)])
+        return _KIND_GRID, dummy_g, np.ascontiguousarray(s.coef), sp
+    return None
+
+
+# --------------------------------------------------------------------------- public API
+
+
+def _starts(surface: Surface, starts) -> tuple[np.ndarray, np.ndarray]:
+    arr = np.asarray(starts, dtype=float)
+    if arr.ndim == 1 and arr.size == 2:
+        arr = arr[None, :]
+    if arr.ndim != 2 or arr.shape[1] != 2 or arr.shape[0] == 0:
+        raise SpineInputError(f"starts must have shape (n, 2) with n >= 1, got shape {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise SpineInputError("starts must be finite")
+    inside = surface.contains(arr[:, 0], arr[:, 1])
+    if not np.all(inside):
+        bad = arr[~inside][0]
+        raise SpineInputError(
+            f"starts must lie inside the surface bounds {tuple(round(b, 6) for b in surface.bounds)}, "
+            f"got ({bad[0]:g}, {bad[1]:g})"
+        )
+    return np.ascontiguousarray(arr[:, 0]), np.ascontiguousarray(arr[:, 1])
+
+
+def _trajectories(surface, starts, params, *, ideal, store_paths, backend):
+    if not isinstance(surface, Surface):
+        raise SpineInputError(f"surface must be a spine_mj Surface, got {type(surface).__name__}")
+    if not isinstance(params, StreamlineParams):
+        raise SpineInputError(f"params must be a StreamlineParams, got {type(params).__name__}")
+    if backend not in ("numba", "numpy", "auto"):
+        raise SpineInputError(f"backend must be 'numba', 'numpy' or 'auto', got {backend!r}")
+    xs, ys = _starts(surface, starts)
+    data = _surface_data(surface)
+    if backend == "numba" and data is None:
+        raise SpineInputError(
+            f"backend 'numba' supports GaussianSurface and GridSurface, got {type(surface).__name__}"
+        )
+    if backend == "numpy" or data is None:
+        out = _run_numpy(surface, xs, ys, params, ideal=ideal, store=store_paths)
+    else:
+        kind, g, coef, sp = data
+        out = _get_kernel()(kind, g, coef, sp, np.asarray(surface.bounds, dtype=float), xs, ys,
+                            bool(ideal), float(params.mu), float(params.dl), float(params.tol),
+                            int(params.max_steps), int(params.stall_window),
+                            float(params.stall_distance_value), bool(store_paths))
+    outcome, n_steps, max_k, ex, ey, ez, offsets, px, py, pz, pk, pr = out
+    if not store_paths:
+        offsets = px = py = pz = pk = pr = None
+    return StreamlineResult(params=params, ideal=bool(ideal), start_x=xs, start_y=ys,
+                            outcome=outcome, end_x=ex, end_y=ey, end_z=ez, n_steps=n_steps,
+                            max_kappa=max_k, offsets=offsets, x=px, y=py, z=pz, kappa=pk,
+                            region=pr)
+
+
+def streamlines(surface: Surface, starts, params: StreamlineParams, *, store_paths: bool = True,
+                backend: str = "auto") -> StreamlineResult:
+    """Quasistatic engagement streamlines from many starts (paper Eq. 4, Fig. 2C).
+
+    Parameters
+    ----------
+    surface : Surface
+        Any surface; Gaussian and gridded surfaces run on the compiled kernel.
+    starts : array_like, shape (n, 2)
+        Start points ``(x0, y0)`` inside ``surface.bounds``.
+    params : StreamlineParams
+        Friction coefficient, step length, caps.
+    store_paths : bool
+        Keep every path point (False keeps only outcomes, end points and max kappa).
+    backend : {"auto", "numba", "numpy"}
+        ``"auto"`` uses the kernel where the surface type allows.
+
+    Returns
+    -------
+    StreamlineResult
+
+    Raises
+    ------
+    SpineInputError
+        Starts outside the bounds, wrong shapes or parameter types.
+    """
+    return _trajectories(surface, starts, params, ideal=False, store_paths=store_paths,
+                         backend=backend)
+
+
+def ideal_trajectories(surface: Surface, starts, params: StreamlineParams, *,
+                       store_paths: bool = True, backend: str = "auto") -> StreamlineResult:
+    """Ideal trajectories (paper §3.1.2): ``y = y0``, +x in arc-length steps ``dl``.
+
+    Same parameters and result as :func:`streamlines`; stops on self-lock or at the edge.
+    """
+    return _trajectories(surface, starts, params, ideal=True, store_paths=store_paths,
+                         backend=backend)
+
+
+def _run_numpy(surface, xs, ys, params, *, ideal, store):
+    """The obvious reference: one vectorized step for all active starts per iteration."""
+    n = xs.size
+    xmin, xmax, ymin, ymax = surface.bounds
+    x, y = xs.copy(), ys.copy()
+    cx, cy = x.copy(), y.copy()
+    outcome = np.zeros(n, np.int8)
+    n_steps = np.zeros(n, np.int64)
+    max_k = np.full(n, np.nan)
+    ez = np.full(n, np.nan)
+    paths = [[] for _ in range(n)]
+    active = np.arange(n)
+    step = 0
+    stall_dist = params.stall_distance_value
+    while active.size:
+        xa, ya = x[active], y[active]
+        f, fx, fy = surface.evaluate(xa, ya, order=1)
+        k, reg = kappa(fx, fy, params.mu, tol=params.tol)
+        ez[active] = f
+        max_k[active] = np.fmax(max_k[active], k)
+        if store:
+            for j, idx in enumerate(active):
+                paths[idx].append((xa[j], ya[j], f[j], k[j], reg[j]))
+        done = np.zeros(active.size, bool)
+        locked = reg == SELF_LOCK
+        outcome[active[locked]] = Outcome.SELF_LOCKED
+        done |= locked
+        capped = ~done & (step >= params.max_steps)
+        outcome[active[capped]] = Outcome.STEP_CAP
+        done |= capped
+        if ideal:
+            vx, vy = 1.0 / np.sqrt(1.0 + fx * fx), np.zeros_like(fx)
+        else:
+            vx, vy, _ = slip_direction(fx, fy, k, np.where(locked, SLIP, reg))
+        still = ~done & ~(np.isfinite(vx) & np.isfinite(vy))
+        outcome[active[still]] = Outcome.STALLED
+        done |= still
+        xn = xa + params.dl * np.where(done, 0.0, vx)
+        yn = ya + params.dl * np.where(done, 0.0, vy)
+        out = ~done & ~((xn >= xmin) & (xn <= xmax) & (yn >= ymin) & (yn <= ymax))
+        outcome[active[out]] = Outcome.LEFT_DOMAIN
+        done |= out
+        move = active[~done]
+        x[move], y[move] = xn[~done], yn[~done]
+        n_steps[move] += 1
+        step += 1
+        if step % params.stall_window == 0 and move.size:
+            stuck = np.hypot(x[move] - cx[move], y[move] - cy[move]) < stall_dist
+            outcome[move[stuck]] = Outcome.STALLED
+            cx[move], cy[move] = x[move], y[move]
+            done[np.flatnonzero(~done)[stuck]] = True
+        active = active[~done]
+    offsets = np.zeros(n + 1, np.int64)
+    if store:
+        offsets[1:] = np.cumsum([len(p) for p in paths])
+        flat = np.array([pt for p in paths for pt in p], dtype=float).reshape(-1, 5)
+        px, py, pz, pk = (np.ascontiguousarray(flat[:, c]) for c in range(4))
+        pr = flat[:, 4].astype(np.int8)
+    else:
+        px = py = pz = pk = np.empty(0)
+        pr = np.empty(0, np.int8)
+    return outcome, n_steps, max_k, x.copy(), y.copy(), ez, offsets, px, py, pz, pk, pr
+
+
+# --------------------------------------------------------------------------- finite tip
+
+
+def dilate(surface: Surface, radius: float, *, spacing: float | None = None) -> GridSurface:
+    """Surface traced by a spherical tip of radius R, shifted down by R (R -> 0: the surface).
+
+    ``g(x, y) = max_{u^2 + v^2 <= R^2} [f(x + u, y + v) + sqrt(R^2 - u^2 - v^2)] - R`` is the
+    tip centre's height minus R: grey dilation of the sampled heights with a spherical
+    structuring element (``scipy.ndimage.grey_dilation``). The tip touches the surface
+    at the point of the cap that attains the maximum; its slope is that of ``g``.
+
+    Parameters
+    ----------
+    surface : Surface
+        Analytic surfaces are sampled on ``bounds`` widened by R (so the edge sees the
+        outside); gridded ones at their own spacing unless ``spacing`` is given
+        (non-periodic grids are padded with their edge values).
+    radius : float
+        Tip radius R >= 0 in the surface's length unit; 0 returns the sampled surface.
+    spacing : float, optional
+        Sample spacing; defaults to ``min(R / 8, extent / 400)`` for analytic surfaces.
+
+    Returns
+    -------
+    GridSurface
+        Same bounds as ``surface`` (same periodicity for gridded ones).
+    """
+    from scipy import ndimage
+
+    radius = float(radius)
+    if not (math.isfinite(radius) and radius >= 0):
+        raise SpineInputError(f"radius (tip radius) must be finite and >= 0, got {radius!r}")
+    xmin, xmax, ymin, ymax = surface.bounds
+    if spacing is not None and not (math.isfinite(spacing) and spacing > 0):
+        raise SpineInputError(f"spacing must be finite and > 0, got {spacing!r}")
+    if isinstance(surface, GridSurface) and spacing is None:
+        grid = surface
+    else:
+        h = spacing
+        if h is None:
+            extent = max(xmax - xmin, ymax - ymin)
+            h = min(radius / 8, extent / 400) if radius > 0 else extent / 400
+        if isinstance(surface, GridSurface) and surface.periodic:
+            grid = surface.resample(h)
+        else:
+            nx = int(math.ceil((xmax - xmin) / h)) + 1
+            ny = int(math.ceil((ymax - ymin) / h)) + 1
+            x, y = np.linspace(xmin, xmax, nx), np.linspace(ymin, ymax, ny)
+            grid = GridSurface(heights=surface.height(x[None, :], y[:, None]), x=x, y=y,
+                               unit=surface.unit, metadata=dict(surface.metadata))
+    if radius == 0:
+        return grid
+    dx, dy = grid.spacing
+    rx, ry = int(math.floor(radius / dx)), int(math.floor(radius / dy))
+    u = dx * np.arange(-rx, rx + 1)
+    v = dy * np.arange(-ry, ry + 1)
+    rho2 = u[None, :] ** 2 + v[:, None] ** 2
+    footprint = rho2 <= radius * radius
+    cap = np.sqrt(np.clip(radius * radius - rho2, 0, None)) - radius
+    if grid.periodic:
+        heights = ndimage.grey_dilation(grid.heights, footprint=footprint, structure=cap,
+                                        mode="wrap")
+    elif not isinstance(surface, GridSurface):
+        # sample a margin of R outside so the edge sees the true neighbourhood
+        xw = grid.x[0] + dx * np.arange(-rx, grid.x.size + rx)
+        yw = grid.y[0] + dy * np.arange(-ry, grid.y.size + ry)
+        wide = surface.height(xw[None, :], yw[:, None])
+        heights = ndimage.grey_dilation(wide, footprint=footprint, structure=cap)[ry:-ry or None,
+                                                                                  rx:-rx or None]
+    else:
+        heights = ndimage.grey_dilation(grid.heights, footprint=footprint, structure=cap,
+                                        mode="nearest")
+    meta = dict(surface.metadata, tip_radius=radius)
+    return GridSurface(heights=heights, x=grid.x, y=grid.y, periodic=grid.periodic,
+                       unit=surface.unit, metadata=meta)
+
+
+# keep the region constants importable from here for convenience
+REGIONS = (SLIP, ENGAGED, SELF_LOCK)

@@ -1,0 +1,204 @@
+import math
+
+import numpy as np
+import pytest
+from scipy.spatial import cKDTree
+
+from spine_mj.engagement import ENGAGED, SELF_LOCK
+from spine_mj.errors import SpineInputError
+from spine_mj.presets import load_preset, make_surface
+from spine_mj.streamline import (
+    Outcome,
+    StreamlineParams,
+    dilate,
+    ideal_trajectories,
+    streamlines,
+)
+from spine_mj.surfaces import GridSurface, fractal_fbm, random_gaussians, single_gaussian
+
+FIVE_STARTS = [(-3.0, y) for y in (-4.0, -3.0, -2.0, -1.0, -0.5)]
+MU = load_preset("paper-single-peak").extras["engagement"]["mu"]
+
+
+def _plane(slope, n=41, half=2.0):
+    x = np.linspace(-half, half, n)
+    return GridSurface(heights=np.broadcast_to(slope * x, (n, n)), x=x, y=x.copy())
+
+
+def _same(a, b, atol):
+    np.testing.assert_array_equal(a.outcome, b.outcome)
+    np.testing.assert_array_equal(a.n_steps, b.n_steps)
+    for key in ("x", "y", "z"):
+        np.testing.assert_allclose(getattr(a, key), getattr(b, key), atol=atol)
+    np.testing.assert_array_equal(a.region, b.region)
+
+
+@pytest.mark.parametrize("sign", [1, -1])
+def test_kernel_matches_numpy_reference_single_gaussian(sign):
+    surf = single_gaussian(sign=sign)
+    p = StreamlineParams(mu=MU, dl=0.015)
+    for fn in (streamlines, ideal_trajectories):
+        _same(fn(surf, FIVE_STARTS, p, backend="numba"), fn(surf, FIVE_STARTS, p, backend="numpy"),
+              1e-9)
+
+
+def test_kernel_matches_numpy_reference_random_and_grid():
+    starts = np.c_[np.full(12, -9.5), np.linspace(-8, 8, 12)]
+    p = StreamlineParams(mu=1.0, dl=0.03)
+    surf = random_gaussians(sign=-1, rng=3)
+    _same(streamlines(surf, starts, p, backend="numba"),
+          streamlines(surf, starts, p, backend="numpy"), 1e-8)
+    grid = fractal_fbm(nx=64, size=20.0, hurst=0.8, rms_slope=0.6, rng=2)
+    _same(streamlines(grid, starts, p, backend="numba"),
+          streamlines(grid, starts, p, backend="numpy"), 1e-8)
+    nonperiodic = grid.resample(0.4)  # non-periodic copy
+    assert not nonperiodic.periodic or grid.periodic
+    r1 = streamlines(nonperiodic, starts, p, backend="numba")
+    r2 = streamlines(nonperiodic, starts, p, backend="numpy")
+    np.testing.assert_array_equal(r1.outcome, r2.outcome)
+
+
+def test_store_paths_false_gives_the_same_summary():
+    surf = single_gaussian(sign=-1)
+    p = StreamlineParams(mu=MU)
+    a = streamlines(surf, FIVE_STARTS, p)
+    b = streamlines(surf, FIVE_STARTS, p, store_paths=False)
+    np.testing.assert_array_equal(a.outcome, b.outcome)
+    np.testing.assert_array_equal(a.max_kappa, b.max_kappa)
+    assert b.x is None
+    with pytest.raises(SpineInputError, match="store_paths"):
+        b.path(0)
+
+
+def test_flat_ground_goes_straight_with_kappa_mu():
+    surf = _plane(0.0)
+    p = StreamlineParams(mu=0.6, dl=0.01)
+    r = streamlines(surf, [(-1.5, 0.3)], p)
+    path = r.path(0)
+    assert r.outcome[0] == Outcome.LEFT_DOMAIN
+    np.testing.assert_allclose(path["y"], 0.3, atol=1e-12)
+    np.testing.assert_allclose(path["kappa"], 0.6, rtol=1e-9)
+    assert np.all(np.diff(path["x"]) == pytest.approx(0.01))
+    assert r.n_steps[0] in (349, 350)  # 3.5 / dl, up to rounding of the running sum
+
+
+def test_steep_ramp_self_locks_at_once_and_gentle_one_does_not():
+    p = StreamlineParams(mu=0.5, dl=0.01)
+    steep = streamlines(_plane(2.2), [(0.0, 0.0)], p)  # slope > 1/mu
+    assert steep.outcome[0] == Outcome.SELF_LOCKED and steep.n_steps[0] == 0
+    assert np.isposinf(steep.max_kappa[0])
+    gentle = streamlines(_plane(1.5), [(0.0, 0.0)], p)
+    assert gentle.outcome[0] == Outcome.LEFT_DOMAIN
+    # kappa on a 2-D ramp is tan(theta + phi)
+    path = gentle.path(0)
+    inner = path["x"] < 1.5  # the spline's edge extension is exact only to O(h^3)
+    np.testing.assert_allclose(path["kappa"][inner], math.tan(math.atan(1.5) + math.atan(0.5)),
+                               rtol=1e-6)
+
+
+def test_y_mirror_symmetry_of_streamlines():
+    surf = single_gaussian(sign=-1)
+    p = StreamlineParams(mu=MU)
+    r = streamlines(surf, [(-3.0, -1.3), (-3.0, 1.3)], p)
+    a, b = r.path(0), r.path(1)
+    assert r.outcome[0] == r.outcome[1]
+    np.testing.assert_allclose(a["x"], b["x"], atol=1e-9)
+    np.testing.assert_allclose(a["y"], -b["y"], atol=1e-9)
+
+
+def test_ideal_keeps_y_and_step_cap():
+    surf = single_gaussian(sign=1)
+    p = StreamlineParams(mu=MU, dl=0.02)
+    r = ideal_trajectories(surf, FIVE_STARTS, p)
+    for i in range(5):
+        assert np.all(r.path(i)["y"] == FIVE_STARTS[i][1])
+    capped = streamlines(surf, FIVE_STARTS, StreamlineParams(mu=MU, max_steps=10))
+    assert np.all(capped.outcome == Outcome.STEP_CAP)
+    assert np.all(capped.n_steps == 10)
+
+
+def _polyline_distance(a, b):
+    pa, pb = np.c_[a["x"], a["y"]], np.c_[b["x"], b["y"]]
+    return max(cKDTree(pb).query(pa)[0].max(), cKDTree(pa).query(pb)[0].max())
+
+
+@pytest.mark.parametrize("preset", ["paper-single-peak", "paper-single-valley"])
+def test_halving_dl_converges(preset):
+    surf = make_surface(preset)
+    sigma = 1.5
+    starts = FIVE_STARTS + [(-3.0, y) for y in (-2.5, -1.5, 0.7, 2.2)]
+    coarse = streamlines(surf, starts, StreamlineParams(mu=MU, dl=0.01 * sigma))
+    fine = streamlines(surf, starts, StreamlineParams(mu=MU, dl=0.005 * sigma))
+    np.testing.assert_array_equal(coarse.outcome, fine.outcome)
+    for i in range(len(starts)):
+        assert _polyline_distance(coarse.path(i), fine.path(i)) < 0.01 * sigma
+
+
+def test_regions_along_path_are_consistent():
+    surf = single_gaussian(sign=-1)
+    r = streamlines(surf, FIVE_STARTS, StreamlineParams(mu=MU))
+    for i in np.flatnonzero(r.self_locked):
+        path = r.path(i)
+        assert path["region"][-1] == SELF_LOCK
+        assert np.all(path["region"][:-1] != SELF_LOCK)
+    assert np.any(r.region == ENGAGED)
+
+
+def test_bad_input_names_the_argument():
+    surf = single_gaussian()
+    with pytest.raises(SpineInputError, match="starts must lie inside"):
+        streamlines(surf, [(6.0, 0.0)], StreamlineParams(mu=1.0))
+    with pytest.raises(SpineInputError, match=r"shape \(n, 2\)"):
+        streamlines(surf, [[1.0, 2.0, 3.0]], StreamlineParams(mu=1.0))
+    with pytest.raises(SpineInputError, match="dl"):
+        StreamlineParams(mu=1.0, dl=-0.1)
+    with pytest.raises(SpineInputError, match="mu"):
+        StreamlineParams(mu=0.0)
+    with pytest.raises(SpineInputError, match="radius"):
+        dilate(surf, -1.0)
+
+
+# --------------------------------------------------------------------------- finite tip
+
+
+def _hemisphere(radius=1.0, half=2.6, h=0.02):
+    x = np.arange(-half, half + h / 2, h)
+    rho2 = x[None, :] ** 2 + x[:, None] ** 2
+    heights = np.sqrt(np.clip(radius**2 - rho2, 0, None))
+    return GridSurface(heights=heights, x=x, y=x.copy()), x, rho2
+
+
+def test_dilation_of_a_hemisphere_matches_the_closed_form():
+    big, r = 1.0, 0.5
+    surf, _, rho2 = _hemisphere(big)
+    g = dilate(surf, r)
+    exact = np.maximum(r, np.sqrt(np.clip((big + r) ** 2 - rho2, 0, None))) - r
+    assert np.abs(g.heights - exact).max() < 0.01
+    # steepest slope met by the tip centre along the centre line: arccos(r / (R + r))
+    xs = np.linspace(-2.5, 0.0, 2001)
+    fx, _ = g.gradient(xs, 0.0)
+    steepest = math.degrees(math.atan(np.max(fx)))
+    assert steepest == pytest.approx(math.degrees(math.acos(r / (big + r))), abs=2.0)
+
+
+@pytest.mark.parametrize(("ratio", "locks"), [(4.0, True), (2.0, True), (0.9, False)])
+def test_hemisphere_self_lock_threshold(ratio, locks):
+    # mu = 0.5: self-lock possible only for R / r >= 1 / sin(arctan mu) - 1 = 1.236
+    surf, _, _ = _hemisphere(1.0, h=0.03)
+    g = dilate(surf, 1.0 / ratio)
+    r = streamlines(g, [(-2.55, 0.0)], StreamlineParams(mu=0.5, dl=0.005))
+    assert bool(r.self_locked[0]) is locks
+
+
+def test_zero_radius_recovers_point_contact():
+    surf = make_surface("paper-single-valley")
+    p = StreamlineParams(mu=MU, dl=0.015)
+    point = streamlines(surf, FIVE_STARTS, p)
+    tiny = dilate(surf, 1e-3, spacing=0.01)
+    assert np.abs(tiny.heights - surf.height(tiny.x[None, :], tiny.y[:, None])).max() < 1e-5
+    near = streamlines(tiny, FIVE_STARTS, p)
+    np.testing.assert_array_equal(point.outcome, near.outcome)
+    for i in range(5):
+        assert _polyline_distance(point.path(i), near.path(i)) < 0.01 * 1.5
+    zero = dilate(surf, 0.0, spacing=0.05)
+    np.testing.assert_allclose(zero.heights, surf.height(zero.x[None, :], zero.y[:, None]))
