@@ -36,6 +36,7 @@ __all__ = [
     "GridSurface",
     "HField",
     "Surface",
+    "TriangulatedSurface",
     "fractal_fbm",
     "from_hfield",
     "random_gaussians",
@@ -819,3 +820,74 @@ def from_hfield(hfield: HField, *, unit: str = "1") -> GridSurface:
     y = cy + np.linspace(-ry, ry, nrow)
     return GridSurface(heights=cz + hfield.data.astype(float) * elevation, x=x, y=y,
                        periodic=False, unit=unit, metadata={"generator": "from_hfield"})
+
+
+# --------------------------------------------------------------------------- engine geometry
+
+
+@dataclass(frozen=True, eq=False)
+class TriangulatedSurface(Surface):
+    """The piecewise-linear surface MuJoCo's hfield collides with.
+
+    Each grid cell ``[x_i, x_i+1] x [y_j, y_j+1]`` is split into two triangles along the
+    diagonal from its ``(x_min, y_min)`` corner to its ``(x_max, y_max)`` corner, as in
+    MuJoCo's hfield (``tests/test_sim.py`` checks the facet normals against MuJoCo's
+    contacts). Height and gradient are exact per facet; the Hessian is zero. On a cell
+    edge or diagonal the facet with the smaller index wins (lower triangle, then the cell
+    with the smaller i, j). Points outside the grid evaluate to NaN.
+
+    Build it from the samples MuJoCo sees: ``TriangulatedSurface.from_grid(from_hfield(hf))``
+    or ``from_grid(surface.sample(n))``.
+
+    Attributes
+    ----------
+    heights : ndarray, shape (ny, nx)
+    x, y : ndarray, shapes (nx,), (ny,)
+        Uniform, strictly increasing.
+    """
+
+    heights: np.ndarray
+    x: np.ndarray
+    y: np.ndarray
+    unit: str = "1"
+    metadata: dict = field(default_factory=dict)
+    bounds: tuple[float, float, float, float] = field(init=False)
+
+    def __post_init__(self):
+        grid = GridSurface(heights=self.heights, x=self.x, y=self.y, unit=self.unit)
+        object.__setattr__(self, "heights", grid.heights)
+        object.__setattr__(self, "x", grid.x)
+        object.__setattr__(self, "y", grid.y)
+        object.__setattr__(self, "bounds", grid.bounds)
+
+    @classmethod
+    def from_grid(cls, grid: GridSurface) -> TriangulatedSurface:
+        """The triangulation of a grid surface's own samples (non-periodic)."""
+        return cls(heights=grid.heights, x=grid.x, y=grid.y, unit=grid.unit,
+                   metadata=dict(grid.metadata, triangulated=True))
+
+    def _evaluate(self, x, y, order):
+        ny, nx = self.heights.shape
+        dx = (self.x[-1] - self.x[0]) / (nx - 1)
+        dy = (self.y[-1] - self.y[0]) / (ny - 1)
+        u = (x - self.x[0]) / dx
+        v = (y - self.y[0]) / dy
+        inside = (u >= -1e-9) & (u <= nx - 1 + 1e-9) & (v >= -1e-9) & (v <= ny - 1 + 1e-9)
+        i = np.clip(np.floor(u), 0, nx - 2).astype(np.intp)
+        j = np.clip(np.floor(v), 0, ny - 2).astype(np.intp)
+        s, t = u - i, v - j
+        h = self.heights
+        h00, h10, h01, h11 = h[j, i], h[j, i + 1], h[j + 1, i], h[j + 1, i + 1]
+        lower = s >= t
+        fs = np.where(lower, h10 - h00, h11 - h01)
+        ft = np.where(lower, h11 - h10, h01 - h00)
+        out = [h00 + s * fs + t * ft]
+        if order >= 1:
+            out += [fs / dx, ft / dy]
+        if order >= 2:
+            zero = np.zeros_like(out[0])
+            out += [zero, zero.copy(), zero.copy()]
+        if not inside.all():
+            for arr in out:
+                arr[~inside] = np.nan
+        return tuple(out)
