@@ -322,5 +322,188 @@ def report(out_dir, output):
 # --------------------------------------------------------------------------- end sweep
 
 
+# --------------------------------------------------------------------------- MuJoCo rig (issue 4)
+
+
+def _rig_options(f):
+    """Options shared by `sim export`, `simulate` and `view` (tip, scale, engine)."""
+    opts = [
+        click.option("--tip-radius", type=float, default=None, help="Tip radius [m] (default: derived)."),
+        click.option("--mass", type=float, default=0.01, show_default=True, help="m_eff [kg]."),
+        click.option("--mu", type=float, default=0.5, show_default=True, help="Friction coefficient."),
+        click.option("--preload", type=float, default=0.0, show_default=True,
+                     help="Extra downward preload [N]."),
+        click.option("--length-scale", type=float, default=None,
+                     help="Metres per unit of a dimensionless surface (default 0.01)."),
+        click.option("--resolution", type=int, default=None,
+                     help="hfield samples a side for analytic surfaces (default 201)."),
+        click.option("--timestep", type=float, default=None, help="Time step [s] (default: derived)."),
+        click.option("--noslip", type=int, default=None, help="noslip_iterations (default 3)."),
+        click.option("--impratio", type=float, default=None, help="impratio (default 1)."),
+    ]
+    for opt in reversed(opts):
+        f = opt(f)
+    return f
+
+
+def _build_rig(surface_spec, tip_radius, mass, mu, preload, length_scale, resolution, timestep,
+               noslip, impratio):
+    from spine_mj import sim
+
+    surf = load_surface_arg(surface_spec)
+    tip = sim.TipParams(tip_radius_m=tip_radius, mass_kg=mass, mu_s=mu, preload_n=preload)
+    overrides = {k: v for k, v in (("timestep_s", timestep), ("noslip_iterations", noslip),
+                                   ("impratio", impratio), ("hfield_resolution", resolution))
+                 if v is not None}
+    rig = sim.Rig(surf, tip=tip, length_scale_m=length_scale,
+                  engine=sim.EngineSettings(timestep_s=1e-3, hfield_resolution=resolution)
+                  if resolution else None)
+    if overrides:
+        rig = sim.Rig(surf, tip=rig.tip, length_scale_m=length_scale,
+                      engine=sim.default_engine(rig.scales, **overrides))
+    return rig
+
+
+@main.group("sim", cls=_Group)
+def sim_group():
+    """The MuJoCo rig: export the model of a surface."""
+
+
+@sim_group.command("export")
+@click.argument("surface_spec", metavar="SURFACE")
+@click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="Output .xml.")
+@_rig_options
+def sim_export(surface_spec, output, **rig_opts):
+    """Write a self-contained MJCF of the rig on SURFACE (opens in MuJoCo's viewer).
+
+    \b
+    Example:
+      spine-mj sim export paper-single-peak -o rig.xml && python -m mujoco.viewer --mjcf rig.xml
+    """
+    _check_suffix(output, ".xml", "-o/--output")
+    rig = _build_rig(surface_spec, **rig_opts)
+    rig.export_xml(output)
+    click.echo(f"wrote {output} (hfield {rig.hfield.nrow} x {rig.hfield.ncol}, "
+               f"dt {rig.engine.timestep_s:g} s, tip radius {rig.tip.tip_radius_m:g} m)")
+
+
+def _parse_start(text: str) -> tuple[float, float]:
+    try:
+        x0, y0 = (float(v) for v in text.split(","))
+    except ValueError:
+        raise SpineInputError(f"--start must be 'x0,y0' (surface units), got {text!r}") from None
+    return x0, y0
+
+
+@main.command("simulate")
+@click.argument("surface_spec", metavar="SURFACE")
+@click.option("--start", required=True, help="Start 'x0,y0' in surface units, e.g. -3,-1.")
+@click.option("--drive", type=click.Choice(["spring", "ramp", "static"]), default="spring",
+              show_default=True)
+@click.option("--speed", type=float, default=0.05, show_default=True,
+              help="Carriage speed [m/s] (spring drive).")
+@click.option("--stiffness", type=float, default=None, help="Spring stiffness [N/m] (default 10 F_p/L_c).")
+@click.option("--rate", type=float, default=None, help="Force rate [N/s] (ramp, static).")
+@click.option("--start-force", type=float, default=0.0, show_default=True,
+              help="Static probe: force [N] applied while the tip settles.")
+@click.option("--duration", type=float, default=None, help="Run time [s] (spring, ramp).")
+@click.option("--render", is_flag=True, help="Also write an MP4 rendered headless (MUJOCO_GL=egl).")
+@click.option("-o", "--out-dir", required=True, type=click.Path(file_okay=False))
+@_rig_options
+def simulate(surface_spec, start, drive, speed, stiffness, rate, start_force, duration, render,
+             out_dir, **rig_opts):
+    """Run one drive on SURFACE: writes trajectory.parquet, run.png, summary.json (and run.mp4).
+
+    \b
+    Example:
+      spine-mj simulate paper-single-peak --start -3,-1 --drive spring --speed 0.05 -o out/
+    """
+    import os
+
+    if render:
+        os.environ.setdefault("MUJOCO_GL", "egl")
+    from spine_mj import sim
+    from spine_mj.errors import atomic_output
+    from spine_mj.plotting import save_figure, sim_run_figure
+
+    x0, y0 = _parse_start(start)
+    rig = _build_rig(surface_spec, **rig_opts)
+    if drive == "spring":
+        drv = sim.SpringDrive(speed_m_s=speed, stiffness_n_m=stiffness, duration_s=duration)
+    elif drive == "ramp":
+        drv = sim.RampDrive(rate_n_s=rate, duration_s=duration)
+    else:
+        drv = sim.StaticProbe(rate_n_s=rate, start_force_n=start_force)
+    with click.progressbar(length=100, label="simulating") as bar:
+        done = [0]
+
+        def progress(frac):
+            bar.update(int(100 * frac) - done[0])
+            done[0] = int(100 * frac)
+
+        result = rig.run(drv, start=(x0, y0), progress=progress)
+        bar.update(100 - done[0])
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    with atomic_output(out / "trajectory.parquet") as tmp:
+        result.table().to_parquet(tmp, index=False)
+    with atomic_output(out / "summary.json") as tmp:
+        tmp.write_text(json.dumps(result.summary(), indent=2))
+    save_figure(sim_run_figure(result, rig.surface, length_scale_m=rig.length_scale_m), out / "run.png")
+    written = ["trajectory.parquet", "summary.json", "run.png"]
+    if render:
+        _render_mp4(rig, result, out / "run.mp4")
+        written.append("run.mp4")
+    click.echo(f"end: {result.end_reason.value} ({result.end_detail}); I_e = {result.inertia_number:.3g}")
+    click.echo(f"wrote {', '.join(str(out / w) for w in written)}")
+
+
+def _render_mp4(rig, result, path: Path) -> None:
+    import os
+
+    from spine_mj.errors import atomic_output
+
+    try:
+        import imageio.v2 as imageio
+
+        frames = rig.render_frames(result)
+        first = next(frames)
+    except Exception as exc:  # a missing GL backend surfaces as many exception types
+        backend = os.environ.get("MUJOCO_GL", "")
+        raise SpineInputError(
+            f"no headless renderer (MUJOCO_GL={backend!r}: {type(exc).__name__}: {exc}); "
+            "try MUJOCO_GL=osmesa or run without --render") from None
+    with atomic_output(path) as tmp:
+        with imageio.get_writer(tmp, fps=30, codec="libx264", format="FFMPEG") as writer:
+            writer.append_data(first)
+            for frame in frames:
+                writer.append_data(frame)
+
+
+@main.command("view")
+@click.argument("surface_spec", metavar="SURFACE")
+@_rig_options
+def view(surface_spec, **rig_opts):
+    """Open the rig on SURFACE in MuJoCo's interactive viewer (needs a display)."""
+    import os
+    import sys
+
+    if sys.platform.startswith("linux") and not (os.environ.get("DISPLAY")
+                                                  or os.environ.get("WAYLAND_DISPLAY")):
+        raise click.ClickException("no display (DISPLAY and WAYLAND_DISPLAY are unset): the viewer "
+                                   "needs one; use `spine-mj sim export` or `simulate --render`")
+    import mujoco
+    import mujoco.viewer
+
+    rig = _build_rig(surface_spec, **rig_opts)
+    data = mujoco.MjData(rig.model)
+    data.qpos[:] = rig.place(*(0.5 * (a + b) for a, b in zip(rig.surface.bounds[::2],
+                                                             rig.surface.bounds[1::2])))
+    mujoco.viewer.launch(rig.model, data)
+
+
+# --------------------------------------------------------------------------- end MuJoCo rig
+
+
 if __name__ == "__main__":  # pragma: no cover
     main()

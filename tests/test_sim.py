@@ -304,3 +304,28 @@ def test_engine_settings_are_recorded_with_every_run():
     # the default rule: resting penetration a_p dt^2 <= 0.5 % of the tip radius
     assert rig.scales.preload_n / rig.tip.mass_kg * rig.engine.timestep_s**2 <= 0.005 * R_TIP
     assert res.penetration_m.max() < 0.01 * rig.scales.char_length_m
+
+
+# --------------------------------------------------------------------------- CLI
+
+
+def test_cli_simulate_export_and_view(tmp_path, monkeypatch):
+    import pandas as pd
+    from click.testing import CliRunner
+
+    from spine_mj.cli import main
+
+    runner = CliRunner()
+    res = runner.invoke(main, ["simulate", "paper-single-peak", "--start", "-3,-1", "--drive", "spring",
+                               "--speed", "0.05", "--duration", "0.05", "-o", str(tmp_path)])
+    assert res.exit_code == 0, res.output
+    table = pd.read_parquet(tmp_path / "trajectory.parquet")
+    assert len(table) > 100 and (tmp_path / "run.png").stat().st_size > 0
+    res = runner.invoke(main, ["sim", "export", "paper-single-peak", "-o", str(tmp_path / "rig.xml")])
+    assert res.exit_code == 0 and mujoco.MjModel.from_xml_path(str(tmp_path / "rig.xml")).nhfield == 1
+    res = runner.invoke(main, ["simulate", "paper-single-peak", "--start", "-3", "-o", str(tmp_path)])
+    assert res.exit_code == 2 and "--start must be 'x0,y0'" in res.output
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    res = runner.invoke(main, ["view", "paper-single-peak"])
+    assert res.exit_code != 0 and "no display" in res.output and "Traceback" not in res.output
