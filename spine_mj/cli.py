@@ -505,5 +505,168 @@ def view(surface_spec, **rig_opts):
 # --------------------------------------------------------------------------- end MuJoCo rig
 
 
+# --------------------------------------------------------------------------- engagement theory (issue 3)
+
+
+def _parse_start(text: str) -> tuple[float, float]:
+    try:
+        x, y = (float(v) for v in text.split(","))
+    except ValueError:
+        raise SpineInputError(f"--start must look like X,Y (e.g. -3,-1), got {text!r}") from None
+    return x, y
+
+
+def _engagement_mu(surf, mu):
+    if mu is not None:
+        return mu
+    from spine_mj import presets
+
+    name = surf.metadata.get("preset")
+    if name:
+        value = presets.load_preset(name).extras.get("engagement", {}).get("mu")
+        if value is not None:
+            return float(value)
+    raise SpineInputError("--mu is required for a surface whose preset has no [engagement] mu")
+
+
+@main.command("kappa")
+@click.argument("surface_spec", metavar="SURFACE")
+@click.option("--mu", type=float, help="Static friction coefficient mu_s (default: the preset's).")
+@click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="Output PNG.")
+@click.option("--resolution", type=click.IntRange(min=8), default=301, show_default=True,
+              help="Samples a side.")
+def kappa_cmd(surface_spec, mu, output, resolution):
+    """Map the engagement ratio kappa over SURFACE (paper Fig. 2B): slip blank, self-lock
+    dark red.
+
+    \b
+    Example:
+      spine-mj kappa paper-single-peak --mu 1.2 -o map.png
+    """
+    import numpy as np
+
+    from spine_mj.engagement import kappa
+    from spine_mj.plotting import kappa_map_figure, save_figure
+
+    _check_suffix(output, ".png", "-o/--output")
+    surf = load_surface_arg(surface_spec)
+    mu = _engagement_mu(surf, mu)
+    xmin, xmax, ymin, ymax = surf.bounds
+    xs = np.linspace(xmin, xmax, resolution)
+    ys = np.linspace(ymin, ymax, resolution)
+    _, fx, fy = surf.evaluate(xs[None, :], ys[:, None], order=1)
+    k, region = kappa(fx, fy, mu)
+    heights = surf.height(xs[None, :], ys[:, None])
+    fig = kappa_map_figure({surf.metadata.get("preset", "surface"): (xs, heights, k, region)}, mu)
+    save_figure(fig, output)
+    shares = ", ".join(f"{n} {100 * np.mean(region == c):.1f} %"
+                       for c, n in ((0, "slip"), (1, "engaged"), (2, "self-lock")))
+    click.echo(f"wrote {output} ({shares})")
+
+
+@main.command("streamline")
+@click.argument("surface_spec", metavar="SURFACE")
+@click.option("--mu", type=float, help="Static friction coefficient mu_s (default: the preset's).")
+@click.option("--start", "starts", multiple=True, required=True, metavar="X,Y",
+              help="Start point, repeatable.")
+@click.option("--dl", type=float, default=None, help="Step length (default: 1/1000 of the domain).")
+@click.option("--tip-radius", type=float, default=0.0, show_default=True,
+              help="Spherical tip radius R; the tip centre rides the surface dilated by R.")
+@click.option("--format", "fmt", type=click.Choice(["parquet", "csv"]), default="parquet",
+              show_default=True, help="Table format.")
+@click.option("-o", "--out", "out_dir", required=True, type=click.Path(file_okay=False),
+              help="Output folder (streamlines.parquet|csv and streamlines.png).")
+def streamline_cmd(surface_spec, mu, starts, dl, tip_radius, fmt, out_dir):
+    """Quasistatic streamlines and ideal trajectories from each --start (paper Eq. 4):
+    a table (one row per path point) and a PNG (3-D view and kappa along the paths).
+
+    \b
+    Example:
+      spine-mj streamline paper-single-valley --mu 1.2 --start -3,-1 --start -3,-2 -o out/
+    """
+    import pandas as pd
+
+    from spine_mj.errors import atomic_output
+    from spine_mj.plotting import save_figure, streamline_figure
+    from spine_mj.streamline import StreamlineParams, dilate, ideal_trajectories, streamlines
+
+    pts = [_parse_start(s) for s in starts]
+    surf = load_surface_arg(surface_spec)
+    mu = _engagement_mu(surf, mu)
+    xmin, xmax, ymin, ymax = surf.bounds
+    params = StreamlineParams(mu=mu, dl=dl if dl is not None else max(xmax - xmin, ymax - ymin) / 1000)
+    if tip_radius:
+        surf = dilate(surf, tip_radius)
+    stream = streamlines(surf, pts, params)
+    ideal = ideal_trajectories(surf, pts, params)
+    table = pd.concat([stream.to_frame(), ideal.to_frame()], ignore_index=True)
+    table["mu"] = mu
+    table["tip_radius"] = tip_radius
+    out = Path(out_dir)
+    path = out / f"streamlines.{fmt}"
+    with atomic_output(path) as tmp:
+        if fmt == "parquet":
+            table.to_parquet(tmp, index=False)
+        else:
+            table.to_csv(tmp, index=False)
+    save_figure(streamline_figure(surf, stream, ideal, title=f"mu_s = {mu:g}"), out / "streamlines.png")
+    for i, (x, y) in enumerate(pts):
+        click.echo(f"start ({x:g}, {y:g}): streamline {stream.outcome_names[i]} at "
+                   f"({stream.end_x[i]:.3f}, {stream.end_y[i]:.3f}), max kappa "
+                   f"{stream.max_kappa[i]:.3g}; ideal {ideal.outcome_names[i]}, max kappa "
+                   f"{ideal.max_kappa[i]:.3g}")
+    click.echo(f"wrote {path} and {out / 'streamlines.png'}")
+
+
+@main.command("reproduce")
+@click.argument("name", type=click.Choice(["single-peak", "random-gaussian", "fractal-hurst",
+                                           "kappa-map"]))
+@click.option("--out", "out_dir", required=True, type=click.Path(file_okay=False),
+              help="Output folder for NAME.png and NAME.json.")
+@click.option("--quick", is_flag=True, help="Reduced run (fewer surfaces and starts).")
+@click.option("--surfaces", type=click.IntRange(min=3), default=None,
+              help="fractal-hurst: surfaces per H (default 300).")
+@click.option("--workers", type=click.IntRange(min=1), default=2, show_default=True,
+              help="fractal-hurst: worker processes.")
+def reproduce_cmd(name, out_dir, quick, surfaces, workers):
+    """Reproduce a figure of the paper: writes DIR/NAME.png and DIR/NAME.json.
+
+    \b
+    single-peak      Figs. 3-4: five starts, self-lock start-range ratios
+    random-gaussian  Fig. 5: medians of max kappa, bypass / trap changes
+    fractal-hurst    Figs. 7E, 9: self-lock rate and concavity shares vs H
+    kappa-map        Fig. 2B: kappa over the single peak and valley
+
+    \b
+    Example:
+      spine-mj reproduce single-peak --out repro/
+    """
+    from spine_mj import reproduce
+    from spine_mj.errors import atomic_output
+    from spine_mj.plotting import save_figure
+
+    options = {}
+    if name == "fractal-hurst":
+        options = {"workers": workers}
+        if surfaces is not None:
+            options["surfaces"] = surfaces
+    elif surfaces is not None:
+        raise SpineInputError(f"--surfaces applies to fractal-hurst only, got NAME {name!r}")
+    with click.progressbar(length=1, label=name) as bar:
+        def progress(done, total):
+            bar.length = total
+            bar.update(done - bar.pos)
+
+        numbers, fig = reproduce.run(name, quick=quick, progress=progress, **options)
+    out = Path(out_dir)
+    with atomic_output(out / f"{name}.json") as tmp:
+        tmp.write_text(json.dumps(numbers, indent=2))
+    save_figure(fig, out / f"{name}.png")
+    click.echo(f"wrote {out / name}.json and {out / name}.png")
+
+
+# --------------------------------------------------------------------------- end engagement theory
+
+
 if __name__ == "__main__":  # pragma: no cover
     main()

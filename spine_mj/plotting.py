@@ -103,3 +103,148 @@ def sim_run_figure(result, surface: Surface, *, length_scale_m: float, max_point
 
 
 # --------------------------------------------------------------------------- engagement theory
+
+
+def _kappa_colors(ax, x, y, k, region, *, kmax=10.0):
+    """kappa as colour (slip blank), self-lock in dark red; returns the image."""
+    import matplotlib.colors as mcolors
+
+    shown = np.where(region == 1, np.minimum(k, kmax), np.nan)
+    extent = (x[0], x[-1], y[0], y[-1])
+    im = ax.imshow(shown, origin="lower", extent=extent, cmap="jet", vmin=0, vmax=kmax)
+    lock = np.where(region == 2, 1.0, np.nan)
+    ax.imshow(lock, origin="lower", extent=extent,
+              cmap=mcolors.ListedColormap(["#5a0000"]), vmin=0, vmax=1)
+    return im
+
+
+def kappa_map_figure(maps: dict, mu: float):
+    """Fig. 2B: kappa maps; ``maps[name] = (xs, heights, kappa, region)``."""
+    fig = new_figure(figsize=(11, 4.8), layout="constrained")
+    for i, (name, (xs, h, k, region)) in enumerate(maps.items()):
+        ax = fig.add_subplot(1, len(maps), i + 1)
+        im = _kappa_colors(ax, xs, xs, k, region)
+        ax.contour(xs, xs, h, colors="k", linewidths=0.4, levels=8)
+        ax.set_title(f"{name}: kappa (slip blank, self-lock dark red)")
+        ax.set_xlabel("x")
+        ax.set_ylabel("y")
+        fig.colorbar(im, ax=ax, label="kappa (clipped at 10)")
+    fig.suptitle(f"Engagement ratio kappa, mu_s = {mu:g}")
+    return fig
+
+
+def single_peak_figure(runs: dict, numbers: dict):
+    """Figs. 3-4: streamlines over the surface and kappa along streamline vs ideal."""
+    fig = new_figure(figsize=(12, 8), layout="constrained")
+    for row, (name, (surf, s5, i5)) in enumerate(runs.items()):
+        ax = fig.add_subplot(2, 2, 2 * row + 1)
+        xs = np.linspace(-5, 5, 201)
+        ax.contourf(xs, xs, surf.height(xs[None, :], xs[:, None]), levels=20, cmap="terrain")
+        for i in range(len(s5)):
+            p, q = s5.path(i), i5.path(i)
+            ax.plot(q["x"], q["y"], color="0.5", lw=0.8, ls="--")
+            ax.plot(p["x"], p["y"], lw=1.5)
+            ax.plot(p["x"][0], p["y"][0], "o", mfc="none", color="k")
+            ax.plot(p["x"][-1], p["y"][-1], "x", color="k")
+        ax.set_title(f"{name}: streamlines (solid), ideal (dashed); "
+                     f"ratio {numbers[f'{name}_ratio'] or float('nan'):.3f}")
+        ax.set_aspect("equal")
+        ax2 = fig.add_subplot(2, 2, 2 * row + 2)
+        for i in range(len(s5)):
+            p, q = s5.path(i), i5.path(i)
+            line = ax2.plot(p["x"], np.minimum(p["kappa"], 20), lw=1.2,
+                            label=f"y0 = {s5.start_y[i]:g}")[0]
+            ax2.plot(q["x"], np.minimum(q["kappa"], 20), color=line.get_color(), ls="--", lw=0.8)
+            for path in (p, q):
+                if path["region"][-1] == 2:
+                    ax2.plot(path["x"][-1], 20, "^", color=line.get_color())
+        ax2.set_ylim(0, 21)
+        ax2.set_xlabel("x")
+        ax2.set_ylabel("kappa (self-lock: triangle)")
+        ax2.legend(fontsize=7)
+    fig.suptitle(f"Single Gaussian peak / valley, mu_s = {numbers['mu']:g}")
+    return fig
+
+
+def random_gaussian_figure(scatter: dict, numbers: dict):
+    """Fig. 5 B(III)/C(III): max kappa per run, ideal vs streamline (inf drawn at the top)."""
+    fig = new_figure(figsize=(11, 4.6), layout="constrained")
+    for i, (name, (ideal, stream)) in enumerate(scatter.items()):
+        ax = fig.add_subplot(1, 2, i + 1)
+        top = 30.0
+        for j, (vals, label, color) in enumerate(((ideal, "ideal", "0.5"),
+                                                  (stream, "streamline", "C0" if i == 0 else "C3"))):
+            shown = np.where(np.isfinite(vals), np.minimum(vals, top), top)
+            xj = j + 0.15 * np.random.default_rng(j).uniform(-1, 1, vals.size)
+            ax.plot(xj, shown, "o", ms=3, color=color, label=label)
+            med = np.median(vals)
+            ax.hlines(min(med, top), j - 0.3, j + 0.3, color="k")
+        ax.set_xticks([0, 1], ["ideal", "streamline"])
+        ax.set_ylabel("max kappa (self-lock at top)")
+        ax.set_title(f"{name}: medians {numbers[f'{name}_median_ideal']} -> "
+                     f"{numbers[f'{name}_median_streamline']}")
+    return fig
+
+
+def fractal_hurst_figure(table: list):
+    """Fig. 9B-C: self-lock rate and concavity shares against H (mean +- sd of groups)."""
+    fig = new_figure(figsize=(11, 4.6), layout="constrained")
+    h = [row["hurst"] for row in table]
+
+    def series(key):
+        m = np.array([np.nan if row[f"{key}_mean"] is None else row[f"{key}_mean"] for row in table])
+        s = np.array([np.nan if row[f"{key}_sd"] is None else row[f"{key}_sd"] for row in table])
+        return 100 * m, 100 * s
+
+    ax = fig.add_subplot(1, 2, 1)
+    for key, label in (("rate", "self-lock rate"), ("sect_concave", "concave (sectional)"),
+                       ("sect_convex", "convex (sectional)")):
+        m, s = series(key)
+        ax.errorbar(h, m, yerr=s, marker="o", capsize=3, label=label)
+    ax.set_xlabel("Hurst index H")
+    ax.set_ylabel("%")
+    ax.legend()
+    ax.set_title("Fig. 9B: sectional method")
+    ax = fig.add_subplot(1, 2, 2)
+    for key, label in (("hess_concave", "concave"), ("hess_saddle", "saddle"),
+                       ("hess_convex", "convex")):
+        m, s = series(key)
+        ax.errorbar(h, m, yerr=s, marker="o", capsize=3, label=label)
+    ax.set_xlabel("Hurst index H")
+    ax.set_ylabel("% of self-locks")
+    ax.legend()
+    ax.set_title("Fig. 9C: Hessian method")
+    return fig
+
+
+def streamline_figure(surface, stream, ideal, *, title: str = ""):
+    """3-D view of streamlines (solid) and ideal paths (dashed) over the surface, and kappa
+    along each path."""
+    grid = _display_grid(surface, 150)
+    fig = new_figure(figsize=(12, 5), layout="constrained")
+    ax3 = fig.add_subplot(1, 2, 1, projection="3d")
+    xx, yy = np.meshgrid(grid.x, grid.y)
+    ax3.plot_surface(xx, yy, grid.heights, cmap="terrain", alpha=0.6, linewidth=0,
+                     rcount=min(80, grid.shape[0]), ccount=min(80, grid.shape[1]))
+    ax = fig.add_subplot(1, 2, 2)
+    for i in range(len(stream)):
+        p, q = stream.path(i), ideal.path(i)
+        line = ax3.plot(p["x"], p["y"], p["z"], lw=2)[0]
+        c = line.get_color()
+        ax3.plot(q["x"], q["y"], q["z"], lw=1, ls="--", color=c)
+        ax3.scatter([p["x"][0]], [p["y"][0]], [p["z"][0]], color=c, marker="o")
+        ax3.scatter([p["x"][-1]], [p["y"][-1]], [p["z"][-1]], color=c, marker="x")
+        ax.plot(p["x"], np.minimum(p["kappa"], 20), color=c,
+                label=f"({stream.start_x[i]:g}, {stream.start_y[i]:g})")
+        ax.plot(q["x"], np.minimum(q["kappa"], 20), color=c, ls="--", lw=0.8)
+        if p["region"][-1] == 2:
+            ax.plot(p["x"][-1], 20, "^", color=c)
+    ax3.set_xlabel("x")
+    ax3.set_ylabel("y")
+    ax3.set_zlabel("z")
+    ax.set_ylim(0, 21)
+    ax.set_xlabel("x")
+    ax.set_ylabel("kappa (clipped at 20; triangle = self-lock)")
+    ax.legend(fontsize=7)
+    fig.suptitle(title or "Streamlines (solid) and ideal trajectories (dashed)")
+    return fig

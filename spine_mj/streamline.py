@@ -143,6 +143,11 @@ class StreamlineResult:
         return self.start_x.size
 
     @property
+    def outcome_names(self) -> list[str]:
+        """Outcome of each trajectory as a lower-case name (``self_locked``, ...)."""
+        return [Outcome(int(o)).name.lower() for o in self.outcome]
+
+    @property
     def self_locked(self) -> np.ndarray:
         """Boolean ``(n,)``: ended in the self-lock region."""
         return self.outcome == Outcome.SELF_LOCKED

@@ -1,0 +1,299 @@
+"""Reproductions of the paper's figures: numbers (a JSON-ready dict) plus a figure.
+
+``REPRODUCTIONS`` maps a name to a function ``f(*, quick=False, progress=None, **over)``
+returning ``(numbers, figure)``. Parameters the paper leaves open (mu_s, random-field
+widths and heights, fractal size and normalization) come from the ``[engagement]`` and
+``[reproduce]`` tables of the ``paper-*`` presets (calibrated in
+``analysis/calibration.py``); keyword overrides replace them. ``progress(done, total)`` is
+called as work completes.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from concurrent.futures import ProcessPoolExecutor
+
+import numpy as np
+
+from spine_mj.convexity import CONCAVE, CONVEX, SADDLE, hessian_class, sectional_class
+from spine_mj.engagement import kappa
+from spine_mj.errors import SpineInputError
+from spine_mj.presets import load_preset
+from spine_mj.streamline import Outcome, StreamlineParams, ideal_trajectories, streamlines
+from spine_mj.surfaces import fractal_fbm, random_gaussians, single_gaussian
+
+__all__ = ["REPRODUCTIONS", "fractal_hurst", "kappa_map", "random_gaussian", "raw_rms_height",
+           "run", "single_peak"]
+
+Progress = Callable[[int, int], None] | None
+FIVE_Y0 = (-0.5, -1.0, -2.0, -3.0, -4.0)
+
+
+def _settings(preset: str) -> tuple[dict, dict, object]:
+    p = load_preset(preset)
+    return dict(p.extras.get("engagement", {})), dict(p.extras.get("reproduce", {})), p
+
+
+def _outcome_name(code: int) -> str:
+    return Outcome(int(code)).name.lower()
+
+
+def _finite_or_str(v: float):
+    return float(v) if math.isfinite(v) else ("inf" if v > 0 else "nan")
+
+
+# --------------------------------------------------------------------------- Figs. 3-4
+
+
+def single_peak(*, quick: bool = False, progress: Progress = None, mu: float | None = None,
+                dl: float | None = None, y0_step: float | None = None):
+    """Figs. 3-4: five starts on the convex peak and the concave valley, and the self-lock
+    start-range ratios (streamline range / ideal range of y0 at x0 = -3).
+
+    Returns numbers with keys ``mu``, ``convex_ratio``, ``concave_ratio`` (fractions;
+    paper 0.833 and 5.667), the ranges, and per-start outcomes and max kappa.
+    """
+    eng, rep, _ = _settings("paper-single-peak")
+    mu = float(mu if mu is not None else eng["mu"])
+    dl = float(dl if dl is not None else rep.get("dl", 0.015))
+    y0_step = float(y0_step if y0_step is not None else rep.get("y0_step", 0.01))
+    if quick:
+        y0_step = max(y0_step, 0.05)
+    x0 = float(rep.get("x0", -3.0))
+    params = StreamlineParams(mu=mu, dl=dl)
+    y_scan = np.arange(-5 + y0_step / 2, 5.0, y0_step)
+    scan = np.c_[np.full(y_scan.size, x0), y_scan]
+    five = [(x0, y) for y in FIVE_Y0]
+    numbers = {"mu": mu, "dl": dl, "x0": x0, "y0_step": y0_step, "paper": {
+        "convex_ratio": 0.833, "concave_ratio": 5.667}}
+    runs = {}
+    for k, (name, sign) in enumerate((("convex", 1), ("concave", -1))):
+        surf = single_gaussian(sign=sign)
+        ideal_scan = ideal_trajectories(surf, scan, params, store_paths=False)
+        stream_scan = streamlines(surf, scan, params, store_paths=False)
+        ideal_range = float(ideal_scan.self_locked.sum() * y0_step)
+        stream_range = float(stream_scan.self_locked.sum() * y0_step)
+        numbers[f"{name}_ideal_range"] = ideal_range
+        numbers[f"{name}_streamline_range"] = stream_range
+        numbers[f"{name}_ratio"] = stream_range / ideal_range if ideal_range > 0 else None
+        s5 = streamlines(surf, five, params)
+        i5 = ideal_trajectories(surf, five, params)
+        runs[name] = (surf, s5, i5)
+        numbers[f"{name}_starts"] = [
+            {"y0": y, "streamline": _outcome_name(s5.outcome[i]),
+             "ideal": _outcome_name(i5.outcome[i]),
+             "streamline_max_kappa": _finite_or_str(s5.max_kappa[i]),
+             "ideal_max_kappa": _finite_or_str(i5.max_kappa[i])}
+            for i, y in enumerate(FIVE_Y0)]
+        if progress:
+            progress(k + 1, 2)
+    from spine_mj.plotting import single_peak_figure
+
+    return numbers, single_peak_figure(runs, numbers)
+
+
+# --------------------------------------------------------------------------- Fig. 2B
+
+
+def kappa_map(*, quick: bool = False, progress: Progress = None, mu: float | None = None,
+              n: int | None = None):
+    """Fig. 2B: kappa over the single convex peak and concave valley (slip blank, self-lock
+    marked). Numbers: area fractions of the regions and the kappa range."""
+    eng, _, _ = _settings("paper-single-peak")
+    mu = float(mu if mu is not None else eng["mu"])
+    n = int(n if n is not None else (101 if quick else 301))
+    xs = np.linspace(-5, 5, n)
+    numbers = {"mu": mu, "n": n}
+    maps = {}
+    for name, sign in (("convex", 1), ("concave", -1)):
+        surf = single_gaussian(sign=sign)
+        _, fx, fy = surf.evaluate(xs[None, :], xs[:, None], order=1)
+        k, region = kappa(fx, fy, mu)
+        maps[name] = (xs, surf.height(xs[None, :], xs[:, None]), k, region)
+        for code, label in ((0, "slip"), (1, "engaged"), (2, "self_lock")):
+            numbers[f"{name}_{label}_fraction"] = float(np.mean(region == code))
+    if progress:
+        progress(1, 1)
+    from spine_mj.plotting import kappa_map_figure
+
+    return numbers, kappa_map_figure(maps, mu)
+
+
+# --------------------------------------------------------------------------- Fig. 5
+
+
+def random_gaussian(*, quick: bool = False, progress: Progress = None, mu: float | None = None,
+                    n_runs: int | None = None, **params):
+    """Fig. 5: medians of the maximum kappa along ideal and streamline trajectories on
+    random convex and concave Gaussian surfaces (one surface per run, start at the left
+    edge on y = 0). A self-locked trajectory has max kappa = inf; medians are taken over all
+    runs with inf ranked highest (finite while fewer than half self-lock) and the
+    self-lock counts are reported beside them.
+    """
+    numbers = {"paper": {"convex_median_ideal": 3.18, "convex_median_streamline": 2.87,
+                         "concave_median_ideal": 3.22, "concave_median_streamline": 11.34,
+                         "bypass_change": -0.097, "trap_change": 2.522}}
+    scatter = {}
+    for k, (name, preset) in enumerate((("convex", "paper-random-convex"),
+                                        ("concave", "paper-random-concave"))):
+        eng, rep, pre = _settings(preset)
+        m = float(mu if mu is not None else eng["mu"])
+        runs = int(n_runs if n_runs is not None else rep.get("n_runs", 100))
+        if quick:
+            runs = min(runs, 30)
+        dl = float(rep.get("dl", 0.015))
+        gen = dict(pre.params, **params)
+        seed0 = int(pre.seed or 0)
+        params_s = StreamlineParams(mu=m, dl=dl)
+        ideal_max, stream_max = np.empty(runs), np.empty(runs)
+        for r in range(runs):
+            surf = random_gaussians(**gen, rng=seed0 + r)
+            xmin = surf.bounds[0]
+            start = [(xmin + 1e-9, float(rep.get("y0", 0.0)))]
+            ideal_max[r] = ideal_trajectories(surf, start, params_s, store_paths=False).max_kappa[0]
+            stream_max[r] = streamlines(surf, start, params_s, store_paths=False).max_kappa[0]
+        med_i, med_s = float(np.median(ideal_max)), float(np.median(stream_max))
+        numbers[f"{name}_mu"] = m
+        numbers[f"{name}_runs"] = runs
+        numbers[f"{name}_median_ideal"] = med_i
+        numbers[f"{name}_median_streamline"] = med_s
+        numbers[f"{name}_self_locked_ideal"] = int(np.isposinf(ideal_max).sum())
+        numbers[f"{name}_self_locked_streamline"] = int(np.isposinf(stream_max).sum())
+        scatter[name] = (ideal_max, stream_max)
+        if progress:
+            progress(k + 1, 2)
+    for key, name in (("bypass_change", "convex"), ("trap_change", "concave")):
+        mi, ms = numbers[f"{name}_median_ideal"], numbers[f"{name}_median_streamline"]
+        numbers[key] = (ms - mi) / mi if math.isfinite(ms) else None
+        for k in (f"{name}_median_ideal", f"{name}_median_streamline"):
+            numbers[k] = _finite_or_str(numbers[k])
+    from spine_mj.plotting import random_gaussian_figure
+
+    return numbers, random_gaussian_figure(scatter, numbers)
+
+
+# --------------------------------------------------------------------------- Figs. 7E, 9
+
+
+def raw_rms_height(hurst: float, nx: int, size: float) -> float:
+    """Expected RMS height of the paper's unnormalized synthesis: white noise filtered by
+    ``A(f) = |f|^-(H+1)`` (f in cycles per unit length) on an ``nx x nx`` periodic grid of
+    side ``size``: ``sqrt(mean_k A(f_k)^2)`` (the DC term excluded)."""
+    f = np.fft.fftfreq(nx, size / nx)
+    freq = np.hypot(f[None, :], f[:, None])
+    amp2 = np.zeros_like(freq)
+    amp2[freq > 0] = freq[freq > 0] ** (-2.0 * (hurst + 1.0))
+    return float(math.sqrt(amp2.mean()))
+
+
+def _fractal_chunk(args):
+    hurst, seeds, gen, mu, dl, scale = args
+    params = StreamlineParams(mu=mu, dl=dl)
+    rms = scale * raw_rms_height(hurst, gen["nx"], gen["size"])
+    locked, sect, hess = [], [], []
+    for seed in seeds:
+        surf = fractal_fbm(nx=gen["nx"], size=gen["size"], hurst=hurst, rms_height=rms,
+                           periodic=True, rng=int(seed))
+        xmin, _, ymin, ymax = surf.bounds
+        r = streamlines(surf, [(xmin, 0.5 * (ymin + ymax))], params, store_paths=False)
+        ok = bool(r.self_locked[0])
+        locked.append(ok)
+        if ok:
+            _, fx, fy, fxx, fxy, fyy = surf.evaluate(r.end_x, r.end_y, order=2)
+            sect.append(int(sectional_class(fx, fy, fxx, fxy, fyy)[0]))
+            hess.append(int(hessian_class(fxx, fxy, fyy)[0]))
+        else:
+            sect.append(-1)
+            hess.append(-1)
+    return hurst, np.array(locked), np.array(sect), np.array(hess)
+
+
+def fractal_hurst(*, quick: bool = False, progress: Progress = None, mu: float | None = None,
+                  surfaces: int | None = None, workers: int = 2, hursts=None, **over):
+    """Figs. 7E and 9: self-lock rate and concave / convex (sectional, Eq. 6) and concave /
+    saddle / convex (Hessian, Eqs. 8-10) shares of self-lock points against H.
+
+    For each H, ``surfaces`` fractal surfaces (default 300, in 3 groups) get one streamline
+    each from the middle of the left edge; shares are among self-locked streamlines of a
+    group; mean and sd over the groups. The height scale follows the paper's unnormalized
+    synthesis (:func:`raw_rms_height`) times ``scale`` from the preset.
+    """
+    eng, rep, pre = _settings("paper-fractal")
+    mu = float(mu if mu is not None else eng["mu"])
+    hursts = list(hursts if hursts is not None else rep.get("hursts", [0.65, 0.7, 0.75, 0.8,
+                                                                        0.85, 0.9, 0.95]))
+    n = int(surfaces if surfaces is not None else rep.get("surfaces", 300))
+    if quick:
+        n = min(n, 30)
+    groups = int(rep.get("groups", 3))
+    if n < groups:
+        raise SpineInputError(f"surfaces must be >= groups ({groups}), got {n}")
+    gen = {"nx": int(over.get("nx", pre.params["nx"])), "size": float(over.get("size", pre.params["size"]))}
+    scale = float(over.get("scale", rep["scale"]))
+    dl = float(over.get("dl", rep.get("dl", 0.02)))
+    chunks = []
+    for h_i, h in enumerate(hursts):
+        seeds = 1_000_000 * (h_i + 1) + np.arange(n)
+        for part in np.array_split(seeds, max(1, workers * 2)):
+            chunks.append((h, part, gen, mu, dl, scale))
+    results: dict[float, list] = {h: [] for h in hursts}
+    if workers > 1:
+        with ProcessPoolExecutor(max_workers=workers) as pool:
+            for done, res in enumerate(pool.map(_fractal_chunk, chunks)):
+                results[res[0]].append(res[1:])
+                if progress:
+                    progress(done + 1, len(chunks))
+    else:
+        for done, c in enumerate(chunks):
+            res = _fractal_chunk(c)
+            results[res[0]].append(res[1:])
+            if progress:
+                progress(done + 1, len(chunks))
+    table = []
+    for h in hursts:
+        locked = np.concatenate([r[0] for r in results[h]])
+        sect = np.concatenate([r[1] for r in results[h]])
+        hess = np.concatenate([r[2] for r in results[h]])
+        rows = {"rate": [], "sect_concave": [], "sect_convex": [], "hess_concave": [],
+                "hess_saddle": [], "hess_convex": []}
+        for g in np.array_split(np.arange(n), groups):
+            lk = locked[g]
+            rows["rate"].append(lk.mean())
+            m = max(1, lk.sum())
+            rows["sect_concave"].append((sect[g] == CONCAVE).sum() / m if lk.any() else np.nan)
+            rows["sect_convex"].append((sect[g] == CONVEX).sum() / m if lk.any() else np.nan)
+            rows["hess_concave"].append((hess[g] == CONCAVE).sum() / m if lk.any() else np.nan)
+            rows["hess_saddle"].append((hess[g] == SADDLE).sum() / m if lk.any() else np.nan)
+            rows["hess_convex"].append((hess[g] == CONVEX).sum() / m if lk.any() else np.nan)
+        entry = {"hurst": h, "self_locked": int(locked.sum()), "surfaces": n}
+        for key, vals in rows.items():
+            v = np.asarray(vals, dtype=float)
+            entry[f"{key}_mean"] = _nan_none(np.nanmean(v) if np.isfinite(v).any() else np.nan)
+            entry[f"{key}_sd"] = _nan_none(np.nanstd(v) if np.isfinite(v).sum() > 1 else np.nan)
+        table.append(entry)
+    numbers = {"mu": mu, "nx": gen["nx"], "size": gen["size"], "scale": scale, "dl": dl,
+               "groups": groups, "surfaces_per_hurst": n, "by_hurst": table}
+    from spine_mj.plotting import fractal_hurst_figure
+
+    return numbers, fractal_hurst_figure(table)
+
+
+def _nan_none(v):
+    v = float(v)
+    return v if math.isfinite(v) else None
+
+
+REPRODUCTIONS = {
+    "single-peak": single_peak,
+    "random-gaussian": random_gaussian,
+    "fractal-hurst": fractal_hurst,
+    "kappa-map": kappa_map,
+}
+
+
+def run(name: str, *, quick: bool = False, progress: Progress = None, **options):
+    """Run reproduction ``name`` (one of :data:`REPRODUCTIONS`); returns ``(numbers, fig)``."""
+    if name not in REPRODUCTIONS:
+        raise SpineInputError(f"NAME must be one of {', '.join(REPRODUCTIONS)}, got {name!r}")
+    return REPRODUCTIONS[name](quick=quick, progress=progress, **options)

@@ -1,0 +1,64 @@
+import json
+
+import numpy as np
+from click.testing import CliRunner
+
+from spine_mj.cli import main
+from spine_mj.reproduce import kappa_map, raw_rms_height, single_peak
+
+
+def test_single_peak_qualitative_facts_reduced_run():
+    numbers, _ = single_peak(quick=True)
+    convex = {s["y0"]: s for s in numbers["convex_starts"]}
+    concave = {s["y0"]: s for s in numbers["concave_starts"]}
+    # bypass: no convex streamline from the five starts self-locks; the ideal at -0.5 does
+    assert all(s["streamline"] != "self_locked" for s in convex.values())
+    assert convex[-0.5]["ideal"] == "self_locked"
+    # trap: concave streamlines near the centre self-lock, the farthest does not
+    for y in (-0.5, -1.0, -2.0):
+        assert concave[y]["streamline"] == "self_locked"
+    assert concave[-4.0]["streamline"] != "self_locked"
+    for y in (-1.0, -2.0, -3.0):
+        assert concave[y]["ideal"] != "self_locked"
+    assert numbers["convex_ratio"] < 1 < numbers["concave_ratio"]
+    # mirror symmetry of the kappa field: identical ideal self-lock ranges
+    assert numbers["convex_ideal_range"] == numbers["concave_ideal_range"]
+
+
+def test_kappa_map_peak_and_valley_have_equal_self_lock_area():
+    numbers, _ = kappa_map(quick=True)
+    assert numbers["convex_self_lock_fraction"] == numbers["concave_self_lock_fraction"] > 0
+
+
+def test_raw_rms_height_matches_a_synthesis():
+    from spine_mj.surfaces import fractal_fbm
+
+    h = [fractal_fbm(nx=64, size=20.0, hurst=0.8, rng=s).heights for s in range(1)]
+    assert raw_rms_height(0.8, 64, 20.0) > 0
+    assert np.isfinite(h[0]).all()
+
+
+def test_cli_reproduce_and_errors(tmp_path):
+    runner = CliRunner()
+    res = runner.invoke(main, ["reproduce", "kappa-map", "--out", str(tmp_path), "--quick"])
+    assert res.exit_code == 0, res.output
+    data = json.loads((tmp_path / "kappa-map.json").read_text())
+    assert data["mu"] > 0 and (tmp_path / "kappa-map.png").stat().st_size > 0
+    res = runner.invoke(main, ["streamline", "paper-single-valley", "--start", "9,9", "-o",
+                               str(tmp_path / "bad")])
+    assert res.exit_code == 2 and "starts must lie inside" in res.output
+    assert not (tmp_path / "bad").exists()
+    res = runner.invoke(main, ["streamline", "paper-single-valley", "--start", "x", "-o",
+                               str(tmp_path / "bad")])
+    assert res.exit_code == 2 and "--start" in res.output
+
+
+def test_cli_streamline_writes_a_table(tmp_path):
+    import pandas as pd
+
+    res = CliRunner().invoke(main, ["streamline", "paper-single-valley", "--mu", "1.2", "--start",
+                                    "-3,-1", "--start", "-3,-2", "-o", str(tmp_path)])
+    assert res.exit_code == 0, res.output
+    table = pd.read_parquet(tmp_path / "streamlines.parquet")
+    assert set(table["trajectory"]) == {"streamline", "ideal"}
+    assert (tmp_path / "streamlines.png").exists()
