@@ -387,7 +387,7 @@ def sim_export(surface_spec, output, **rig_opts):
                f"dt {rig.engine.timestep_s:g} s, tip radius {rig.tip.tip_radius_m:g} m)")
 
 
-def _parse_start(text: str) -> tuple[float, float]:
+def _parse_sim_start(text: str) -> tuple[float, float]:
     try:
         x0, y0 = (float(v) for v in text.split(","))
     except ValueError:
@@ -426,7 +426,7 @@ def simulate(surface_spec, start, drive, speed, stiffness, rate, start_force, du
     from spine_mj.errors import atomic_output
     from spine_mj.plotting import save_figure, sim_run_figure
 
-    x0, y0 = _parse_start(start)
+    x0, y0 = _parse_sim_start(start)
     rig = _build_rig(surface_spec, **rig_opts)
     if drive == "spring":
         drv = sim.SpringDrive(speed_m_s=speed, stiffness_n_m=stiffness, duration_s=duration)
@@ -508,7 +508,7 @@ def view(surface_spec, **rig_opts):
 # --------------------------------------------------------------------------- engagement theory (issue 3)
 
 
-def _parse_start(text: str) -> tuple[float, float]:
+def _parse_sim_start(text: str) -> tuple[float, float]:
     try:
         x, y = (float(v) for v in text.split(","))
     except ValueError:

@@ -738,8 +738,8 @@ class Rig:
     def place(self, x0: float, y0: float) -> np.ndarray:
         """qpos ``(3,)`` [m] with the tip resting on the hfield at ``(x0, y0)`` (surface units).
 
-        The sphere centre is found by bisection in z on the engine's own sphere-hfield
-        distance (to 1e-7 tip radii), then lowered by the soft contact's resting depth
+        The sphere centre is found by a safeguarded Newton search in z on the engine's own
+        sphere-hfield distance (to 1e-7 tip radii), then lowered by the soft contact's resting depth
         ``(1 - dmax) (F_p / m) (timeconst dampratio)^2``: it starts at rest and in
         contact, never dropped (a start just above the surface falls for one step).
         """
@@ -750,29 +750,46 @@ class Rig:
             raise SpineInputError(f"start ({x0:g}, {y0:g}) lies outside the surface bounds "
                                   f"{self.surface.bounds}")
         s, r = self.length_scale_m, self.tip.tip_radius_m
-        m = self.model
-        d = mujoco.MjData(m)
+        if getattr(self, "_place_model", None) is None or self._place_model[0] is not self.model:
+            pm = copy.copy(self.model)
+            pm.geom_margin[self.geom_tip] = 0.2 * r  # few contacts, but a gap above the surface
+            self._place_model = (self.model, pm, mujoco.MjData(pm))
+        _, m, d = self._place_model
         _, _, elev, _ = self.hfield.size
 
-        def gap(z):
+        def probe(z):
             d.qpos[:] = (x0 * s, y0 * s, z)
             mujoco.mj_forward(m, d)
-            return min((c.dist for c in d.contact[:d.ncon]), default=r)
+            if not d.ncon:
+                return None, 1.0
+            k = int(np.argmin(d.contact.dist[:d.ncon]))
+            return float(d.contact.dist[k]), abs(float(d.contact.frame[k, 2]))
 
         hi = (self.hfield.pos[2] + elev) * s + 2 * r
         lo = float(self.surface.height(x0, y0)) * s
-        if not (gap(hi) > 0 > gap(lo)):
+        if not (probe(hi)[0] is None and (probe(lo)[0] or 0.0) < 0):
             raise SpineInputError(f"could not place the tip on the surface at ({x0:g}, {y0:g})")
-        while hi - lo > 1e-7 * r:
-            mid = 0.5 * (lo + hi)
-            if gap(mid) > 0:
-                hi = mid
+        z = lo + r
+        for _ in range(100):  # Newton on the engine's distance, safeguarded by [lo, hi]
+            g, nz = probe(z)
+            if g is None:
+                hi, z = z, 0.5 * (z + lo)
+                continue
+            if abs(g) < 1e-7 * r:
+                break
+            if g > 0:
+                hi = z
             else:
-                lo = mid
+                lo = z
+            z_new = z - g / max(nz, 0.05)
+            z = z_new if lo < z_new < hi else 0.5 * (lo + hi)
+        else:
+            raise SpineInputError(f"could not place the tip on the surface at ({x0:g}, {y0:g})")
+        z -= g
         # sink to the soft contact's resting depth (1 - dmax) a_p (timeconst dampratio)^2
         tc, dr = self.engine.solref
         a_p = self.scales.preload_n / self.tip.mass_kg
-        z = hi - (1 - self.engine.solimp[1]) * a_p * (tc * dr) ** 2
+        z -= (1 - self.engine.solimp[1]) * a_p * (tc * dr) ** 2
         return np.array([x0 * s, y0 * s, z])
 
     # ----------------------------------------------------------------- drive parameters
