@@ -508,7 +508,7 @@ def view(surface_spec, **rig_opts):
 # --------------------------------------------------------------------------- engagement theory (issue 3)
 
 
-def _parse_sim_start(text: str) -> tuple[float, float]:
+def _parse_start(text: str) -> tuple[float, float]:
     try:
         x, y = (float(v) for v in text.split(","))
     except ValueError:
