@@ -1077,8 +1077,9 @@ def consolidate(out_dir: str | os.PathLike):
         table = pa.table({c: pa.array([], pa.string()) for c in ("run_id", "status")})
     else:
         table = pa.concat_tables(tables, promote_options="permissive")
-        order = np.lexsort((np.asarray(table["start"]),
-                            np.asarray(table["analysis"].to_pylist(), dtype=object).astype(str),
+        rank = {name: i for i, name in enumerate(ANALYSES)}
+        analysis_rank = np.array([rank.get(a, len(rank)) for a in table["analysis"].to_pylist()])
+        order = np.lexsort((np.asarray(table["start"]), analysis_rank,
                             np.asarray(table["case_index"])))
         table = table.take(pa.array(order))
     with atomic_output(out_dir / RUNS_TABLE) as tmp:
