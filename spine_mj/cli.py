@@ -253,10 +253,12 @@ def sweep_run(config, out_dir, workers, scheduler, overwrite, retry_failed, quie
         if quiet:
             return
         if bar is None:
+            import sys
+
             from tqdm import tqdm
 
             bar = tqdm(total=p.total_cases, initial=p.skipped_cases, unit="case",
-                       desc=cfg.name, dynamic_ncols=True, file=click.get_text_stream("stderr"))
+                       desc=cfg.name, dynamic_ncols=True, file=sys.stderr)
         else:
             bar.update(1)
             bar.set_postfix(ok=p.ok_runs, failed=p.failed_runs, refresh=False)
