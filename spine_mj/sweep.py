@@ -1061,7 +1061,7 @@ def _store_case(out_dir: Path, case_id: str, rows, traj) -> None:
 
     if traj is not None:
         with atomic_output(out_dir / TRAJ_DIR / f"{case_id}.parquet") as tmp:
-            pq.write_table(traj, tmp, row_group_size=65_536)
+            pq.write_table(traj, tmp, row_group_size=65_536, use_dictionary=["analysis"])
     with atomic_output(out_dir / RUNS_DIR / f"{case_id}.parquet") as tmp:
         pq.write_table(rows, tmp)
 
@@ -1223,7 +1223,9 @@ def _run_processes(todo: list[Case], n_workers: int, handle) -> None:
     import multiprocessing
 
     ctx = multiprocessing.get_context("forkserver")
-    ctx.set_forkserver_preload(["spine_mj.sweep"])
+    # workers fork from a server that has imported these once
+    ctx.set_forkserver_preload(["spine_mj.sweep", "spine_mj.streamline", "spine_mj.sim",
+                                "pyarrow.parquet"])
     with cf.ProcessPoolExecutor(max_workers=n_workers, mp_context=ctx) as pool:
         futures = [pool.submit(_run_case_remote, c) for c in todo]
         try:
