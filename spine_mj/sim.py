@@ -896,7 +896,13 @@ class Rig:
             raise SpineInputError(f"backend must be 'rollout' or 'python', got {backend!r}")
         det = (Detection() if detection is None else detection).resolve(self.scales)
         qpos0 = [self.place(*s) for s in starts]
-        models = [self._model_for(d) for d in drives]
+        by_stiffness: dict[float, object] = {}
+        for d in drives:
+            k = self._stiffness(d) if isinstance(d, SpringDrive) else 0.0
+            if k not in by_stiffness:
+                by_stiffness[k] = self._model_for(d)
+        models = [by_stiffness[self._stiffness(d) if isinstance(d, SpringDrive) else 0.0]
+                  for d in drives]
         controls = [self._controls(d, q, det) for d, q in zip(drives, qpos0)]
         nstate = mujoco.mj_stateSize(self.model, mujoco.mjtState.mjSTATE_FULLPHYSICS)
         spec = int(mujoco.mjtState.mjSTATE_CTRL) | int(mujoco.mjtState.mjSTATE_MOCAP_POS)
