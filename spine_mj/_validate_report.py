@@ -1,0 +1,221 @@
+"""Figures and ``report.md`` of the validation suite (:mod:`spine_mj.validate`)."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from spine_mj.errors import atomic_output
+from spine_mj.plotting import new_figure, save_figure
+
+
+def _f(v, digits=3) -> str:
+    if v is None:
+        return "-"
+    if isinstance(v, (bool, np.bool_)):
+        return "yes" if v else "no"
+    if isinstance(v, (int, np.integer)):
+        return str(int(v))
+    try:
+        v = float(v)
+    except (TypeError, ValueError):
+        return str(v)
+    if math.isnan(v):
+        return "-"
+    if math.isinf(v):
+        return "inf"
+    return f"{v:.{digits}g}"
+
+
+def _table(rows: list[dict], cols: list[str], names: list[str] | None = None) -> str:
+    names = names or cols
+    out = ["| " + " | ".join(names) + " |", "|" + "---|" * len(cols)]
+    for r in rows:
+        out.append("| " + " | ".join(_f(r.get(c)) for c in cols) + " |")
+    return "\n".join(out)
+
+
+def _static_figure(st: dict, path: Path) -> None:
+    engines = list(st["per_engine"])
+    fig = new_figure(figsize=(5 * len(engines), 4), constrained_layout=True)
+    axes = fig.subplots(1, len(engines), squeeze=False)[0]
+    for ax, label in zip(axes, engines):
+        rows = [r for r in st["rows"] if r["engine"] == label]
+        for az in sorted({r["azimuth_deg"] for r in rows}):
+            sel = sorted((r for r in rows if r["azimuth_deg"] == az), key=lambda r: r["slope_deg"])
+            ax.plot([r["slope_deg"] for r in sel], [r["ratio"] for r in sel], "o-",
+                    label=f"azimuth {az:g} deg")
+            for r in sel:
+                if r["region"] != "engaged":
+                    mark = {"self_lock": "^", "slip": "v"}[r["region"]]
+                    ok = r["region_agrees"]
+                    ax.plot(r["slope_deg"], 1.0, mark, color="g" if ok else "r", ms=9, mfc="none")
+        ax.axhspan(0.95, 1.05, color="0.9")
+        ax.set(xlabel="slope angle [deg]", ylabel="kappa_mj / kappa", title=label)
+        ax.legend(fontsize=7)
+    fig.suptitle("Static probe on planes (shaded: +-5 %; ^ self-lock, v slip region at 1: "
+                 "green = MuJoCo agrees)", fontsize=9)
+    save_figure(fig, path)
+
+
+def _paths_figure(lim: dict, path: Path) -> None:
+    presets = list(lim["paths"])
+    if not presets:
+        return
+    fig = new_figure(figsize=(5.5 * len(presets), 5), constrained_layout=True)
+    axes = fig.subplots(1, len(presets), squeeze=False)[0]
+    for ax, preset in zip(axes, presets):
+        for i, p in enumerate(lim["paths"][preset]):
+            ax.plot(p["smooth"][:, 0], p["smooth"][:, 1], "k-", lw=1.5,
+                    label="streamline (smooth)" if i == 0 else None)
+            ax.plot(p["tri"][:, 0], p["tri"][:, 1], "b--", lw=1,
+                    label="streamline (hfield facets)" if i == 0 else None)
+            if p["mujoco"].shape[0]:
+                ax.plot(p["mujoco"][:, 0], p["mujoco"][:, 1], "r-", lw=0.8,
+                        label="MuJoCo" if i == 0 else None)
+        circle = np.linspace(0, 2 * np.pi, 100)
+        ax.plot(1.5 * np.cos(circle), 1.5 * np.sin(circle), color="0.6", lw=0.5)
+        ax.set(aspect="equal", xlim=(-5, 5), ylim=(-5, 5), xlabel="x", ylabel="y",
+               title=f"{preset}, I_e = {lim['lowest_ie']:g}")
+        ax.legend(fontsize=7, loc="upper left")
+    save_figure(fig, path)
+
+
+def _boundary_figure(bnd: dict, path: Path) -> None:
+    fig = new_figure(figsize=(11, 4), constrained_layout=True)
+    a1, a2 = fig.subplots(1, 2)
+    for proto, c in bnd["curves"].items():
+        a1.semilogx(c["ie"], c["agreement"], "o-", label=f"{proto}")
+        key = "frechet" if proto == "spring" else "lateral"
+        a2.loglog(c["ie"], np.maximum(np.asarray(c[key], float), 1e-4), "o-",
+                  label=f"{proto}: {'Frechet' if key == 'frechet' else 'lateral dev.'}")
+        s = bnd["ie_star"][proto]
+        if s["kind"] == "bracketed":
+            for ax in (a1, a2):
+                ax.axvspan(s["low"], s["high"], alpha=0.12)
+                ax.axvline(s["value"], ls=":", color="k")
+    a1.axhline(0.95, color="r", lw=0.8)
+    a2.axhline(0.1, color="r", lw=0.8)
+    a1.set(xlabel="I_e", ylabel="outcome agreement (spring) / lock agreement (ramp)")
+    a2.set(xlabel="I_e", ylabel="mean deviation / L_c")
+    a1.legend(fontsize=8)
+    a2.legend(fontsize=8)
+    save_figure(fig, path)
+
+
+def _stick_figure(ss: dict, path: Path) -> None:
+    if not ss["traces"]:
+        return
+    fig = new_figure(figsize=(11, 4), constrained_layout=True)
+    ax = fig.subplots()
+    for (ie, k), (t, f) in sorted(ss["traces"].items()):
+        ax.plot(t / max(t[-1], 1e-12), f, lw=0.8, label=f"I_e {ie:g}, k {k:.3g} N/m")
+    ax.set(xlabel="time / run duration", ylabel="drive force / F_p",
+           title=f"Spring drive on {ss['surface']} (first start)")
+    ax.legend(fontsize=7)
+    save_figure(fig, path)
+
+
+def _sand_figure(sp: dict, path: Path) -> None:
+    grits = list(sp["paths"])
+    if not grits:
+        return
+    fig = new_figure(figsize=(5 * len(grits), 7), constrained_layout=True)
+    axes = fig.subplots(2, len(grits), squeeze=False)
+    for j, g in enumerate(grits):
+        for x, y, _t, f in sp["paths"][g]:
+            axes[0, j].plot(x * 1e3, (y - y[0]) * 1e3, lw=0.8)
+            axes[1, j].plot(x * 1e3, f, lw=0.6)
+        axes[0, j].set(title=f"{g}: path (y - y0)", xlabel="x [mm]", ylabel="y - y0 [mm]")
+        axes[1, j].set(xlabel="x [mm]", ylabel="drive force / F_p")
+    save_figure(fig, path)
+
+
+def write(out: Path, result: dict, *, static, limit, boundary, stick, sand) -> Path:
+    """Write the figures under ``out/figures`` and ``out/report.md``; returns the report path."""
+    figs = out / "figures"
+    figs.mkdir(parents=True, exist_ok=True)
+    _static_figure(static, figs / "static_map.png")
+    _paths_figure(limit, figs / "limit_paths.png")
+    _boundary_figure(boundary, figs / "boundary.png")
+    _stick_figure(stick, figs / "stick_slip.png")
+    _sand_figure(sand, figs / "sandpaper.png")
+
+    lines = [f"# Validation: MuJoCo against the quasistatic streamline ({result['plan']} plan)",
+             "", "Generated by `spine-mj validate`; numbers also in `validation.json`. Lengths "
+             "in L_c (characteristic length of each surface), forces in F_p (preload).", ""]
+    lines += ["## 1. Static breakaway ratio on planes", "",
+              f"mu = {static['mu']:g}; probe ramp at I_e = 0.01; kappa from Eqs. 1-3.", "",
+              _table([{"engine": k, **v} for k, v in static["per_engine"].items()],
+                     ["engine", "engaged_planes", "engaged_breakaways", "max_rel_error",
+                      "mean_rel_error", "region_agreement"]), "",
+              f"`static_kappa_max_rel_error` (engaged, default settings) = "
+              f"{_f(result['static_kappa_max_rel_error'])} (target <= 0.05).", "",
+              "![static](figures/static_map.png)", ""]
+    lines += ["<details><summary>per plane</summary>", "",
+              _table(static["rows"], ["engine", "slope_deg", "azimuth_deg", "region", "kappa",
+                                      "kappa_mj", "ratio", "end_reason", "region_agrees"]),
+              "", "</details>", ""]
+    lines += ["## 2. Quasistatic limit (spring drive, lowest I_e)", "",
+              f"I_e = {limit['lowest_ie']:g}, recommended settings. Total = MuJoCo vs smooth "
+              "streamline; geometry = streamline on MuJoCo's hfield facets vs smooth; "
+              "dynamics = MuJoCo vs facet streamline.", "",
+              _table([{"family": k, **v} for k, v in limit["families"].items()],
+                     ["family", "runs", "outcome_agreement", "mean_frechet",
+                      "mean_lateral_deviation", "mean_geometry_frechet",
+                      "mean_dynamics_frechet", "outcome_agreement_vs_triangulated",
+                      "meets_target"],
+                     ["family", "runs", "outcome agr.", "mean Frechet", "mean lateral",
+                      "geometry Frechet", "dynamics Frechet", "outcome agr. vs facets",
+                      "target met"]), "",
+              "![paths](figures/limit_paths.png)", "",
+              "### What limits agreement: settings varied on the single peak", "",
+              _table([{"setting": k, **v} for k, v in limit["variations"].items()],
+                     ["setting", "runs", "outcome_agreement", "mean_frechet",
+                      "mean_lateral_deviation"]), "",
+              "<details><summary>per run</summary>", "",
+              _table(limit["runs"], ["surface", "start_x", "start_y", "end_reason", "agree",
+                                     "frechet", "lateral_deviation", "end_distance",
+                                     "geometry_frechet", "dynamics_frechet"]),
+              "", "</details>", ""]
+    star_rows = [{"protocol": p, **s} for p, s in boundary["ie_star"].items()]
+    lines += ["## 3. The quasistatic boundary", "",
+              f"Families: {', '.join(boundary['families'])}. Spring: passes when outcome "
+              "agreement >= 95 % and mean Frechet <= 0.1 L_c. Ramp with reset: lock agreement "
+              ">= 95 % and mean lateral deviation <= 0.1 L_c. I_e* interpolated in log I_e "
+              "inside the bracket [last pass, first fail]; ci = 16-84 % bootstrap over starts.",
+              "", _table(star_rows, ["protocol", "kind", "value", "low", "high", "ci_low",
+                                     "ci_high"]), ""]
+    for proto, c in boundary["curves"].items():
+        rows = [{"ie": ie, "agreement": a, "frechet": f, "lateral": la, "engine_trouble": e,
+                 "trap_skip": s} for ie, a, f, la, e, s in zip(
+                     c["ie"], c["agreement"], c["frechet"], c["lateral"], c["engine_trouble"],
+                     boundary["skip_rate"][proto])]
+        lines += [f"**{proto}** ({c['runs_per_ie']} runs per I_e)", "",
+                  _table(rows, ["ie", "agreement", "frechet", "lateral", "engine_trouble",
+                                "trap_skip"]), ""]
+    lines += ["![boundary](figures/boundary.png)", ""]
+    lines += ["## 4. Stick-slip", "", f"Spring drive on {stick['surface']}.", "",
+              _table(stick["rows"], ["ie", "stiffness_fp_per_lc", "runs", "slip_events_per_run",
+                                     "mean_jump_lc", "max_jump_lc", "mean_force_drop_fp",
+                                     "max_force_drop_fp", "quasistatic_traps",
+                                     "skipped_traps", "extra_locks"]), "",
+              "![stick-slip](figures/stick_slip.png)", ""]
+    if sand["rows"]:
+        lines += ["## 5. Sandpaper analogs (25 um tip)", "",
+                  f"Spring drive, mu = {sand['mu']:g} (assumed; the paper gives none for grit).",
+                  "", _table(sand["rows"], ["grit", "runs", "tip_radius_um",
+                                            "max_lateral_excursion_mm",
+                                            "mean_lateral_excursion_tip_radii",
+                                            "rms_lateral_tip_radii", "tortuosity",
+                                            "force_peaks_per_100_tip_radii",
+                                            "peak_over_median_force", "self_locked_fraction"]),
+                  "", "![sandpaper](figures/sandpaper.png)", ""]
+    lines += ["## Engine settings", "", "```", str(result["engine_settings"]), "```", "",
+              f"Study times [s]: {result['timings_s']}", ""]
+    path = out / "report.md"
+    with atomic_output(path) as tmp:
+        tmp.write_text("\n".join(lines))
+    return path
