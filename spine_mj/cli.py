@@ -68,6 +68,17 @@ def load_surface_arg(spec: str):
     )
 
 
+def preset_mu(surf) -> float | None:
+    """The calibrated mu_s of the preset a surface was made from (its [engagement] table)."""
+    from spine_mj import presets
+
+    name = surf.metadata.get("preset")
+    if not name:
+        return None
+    value = presets.load_preset(name).extras.get("engagement", {}).get("mu")
+    return None if value is None else float(value)
+
+
 @surface.command("list")
 def surface_list():
     """List the surface presets in surfaces/."""
@@ -332,7 +343,8 @@ def _rig_options(f):
     opts = [
         click.option("--tip-radius", type=float, default=None, help="Tip radius [m] (default: derived)."),
         click.option("--mass", type=float, default=0.01, show_default=True, help="m_eff [kg]."),
-        click.option("--mu", type=float, default=0.5, show_default=True, help="Friction coefficient."),
+        click.option("--mu", type=float, default=None,
+                     help="Friction coefficient mu_s (default: the preset's [engagement] mu, else 0.5)."),
         click.option("--preload", type=float, default=0.0, show_default=True,
                      help="Extra downward preload [N]."),
         click.option("--length-scale", type=float, default=None,
@@ -353,15 +365,15 @@ def _build_rig(surface_spec, tip_radius, mass, mu, preload, length_scale, resolu
     from spine_mj import sim
 
     surf = load_surface_arg(surface_spec)
-    tip = sim.TipParams(tip_radius_m=tip_radius, mass_kg=mass, mu_s=mu, preload_n=preload)
+    mu = preset_mu(surf) if mu is None else mu
+    tip = sim.TipParams(tip_radius_m=tip_radius, mass_kg=mass, preload_n=preload,
+                        **({} if mu is None else {"mu_s": mu}))
     overrides = {k: v for k, v in (("timestep_s", timestep), ("noslip_iterations", noslip),
                                    ("impratio", impratio), ("hfield_resolution", resolution))
                  if v is not None}
-    rig = sim.Rig(surf, tip=tip, length_scale_m=length_scale,
-                  engine=sim.EngineSettings(timestep_s=1e-3, hfield_resolution=resolution)
-                  if resolution else None)
+    rig = sim.Rig(surf, tip=tip, length_scale_m=length_scale)
     if overrides:
-        rig = sim.Rig(surf, tip=rig.tip, length_scale_m=length_scale,
+        rig = sim.Rig(surf, tip=tip, length_scale_m=length_scale,
                       engine=sim.default_engine(rig.scales, **overrides))
     return rig
 
@@ -387,14 +399,6 @@ def sim_export(surface_spec, output, **rig_opts):
     rig.export_xml(output)
     click.echo(f"wrote {output} (hfield {rig.hfield.nrow} x {rig.hfield.ncol}, "
                f"dt {rig.engine.timestep_s:g} s, tip radius {rig.tip.tip_radius_m:g} m)")
-
-
-def _parse_sim_start(text: str) -> tuple[float, float]:
-    try:
-        x0, y0 = (float(v) for v in text.split(","))
-    except ValueError:
-        raise SpineInputError(f"--start must be 'x0,y0' (surface units), got {text!r}") from None
-    return x0, y0
 
 
 @main.command("simulate")
@@ -428,7 +432,7 @@ def simulate(surface_spec, start, drive, speed, stiffness, rate, start_force, du
     from spine_mj.errors import atomic_output
     from spine_mj.plotting import save_figure, sim_run_figure
 
-    x0, y0 = _parse_sim_start(start)
+    x0, y0 = _parse_start(start)
     rig = _build_rig(surface_spec, **rig_opts)
     if drive == "spring":
         drv = sim.SpringDrive(speed_m_s=speed, stiffness_n_m=stiffness, duration_s=duration)
@@ -519,16 +523,11 @@ def _parse_start(text: str) -> tuple[float, float]:
 
 
 def _engagement_mu(surf, mu):
-    if mu is not None:
-        return mu
-    from spine_mj import presets
-
-    name = surf.metadata.get("preset")
-    if name:
-        value = presets.load_preset(name).extras.get("engagement", {}).get("mu")
-        if value is not None:
-            return float(value)
-    raise SpineInputError("--mu is required for a surface whose preset has no [engagement] mu")
+    if mu is None:
+        mu = preset_mu(surf)
+    if mu is None:
+        raise SpineInputError("--mu is required for a surface whose preset has no [engagement] mu")
+    return mu
 
 
 @main.command("kappa")
@@ -668,6 +667,72 @@ def reproduce_cmd(name, out_dir, quick, surfaces, workers):
 
 
 # --------------------------------------------------------------------------- end engagement theory
+
+
+# --------------------------------------------------------------------------- validation (issue 6)
+
+
+@main.command("validate")
+@click.option("--out", "out_dir", required=True, type=click.Path(),
+              help="Output folder: report.md, validation.json, figures/, sweeps/ (resumable).")
+@click.option("--quick", is_flag=True,
+              help="The quick plan (<= 5 min on 2 cores): fewer starts and I_e values, "
+                   "coarser hfields.")
+@click.option("--plan", "plan_name", type=click.Choice(["smoke", "quick", "full"]),
+              default=None, hidden=True, help="Plan by name (smoke: a seconds-long test size).")
+@click.option("--workers", type=click.IntRange(min=1), default=None,
+              help="Worker processes for the sweeps (default: all cores).")
+@click.option("--quiet", is_flag=True, help="No progress lines.")
+def validate_cmd(out_dir, quick, plan_name, workers, quiet):
+    """Run the validation suite (MuJoCo against the quasistatic streamline across inertia
+    numbers) and write --out/report.md and --out/validation.json.
+
+    \b
+    Example:
+      spine-mj validate --quick --out demo-out
+    """
+    import sys
+
+    from spine_mj import validate
+
+    if plan_name is not None and quick and plan_name != "quick":
+        raise SpineInputError(f"--quick and --plan {plan_name}: give one of them")
+    plan = plan_name or ("quick" if quick else "full")
+    out = Path(out_dir)
+    if out.exists() and not out.is_dir():
+        raise SpineInputError(f"--out {out} exists and is not a folder")
+    last = {"step": None}
+
+    def progress(p):
+        if quiet:
+            return
+        if p.step != last["step"] and last["step"] is not None:
+            sys.stderr.write("\n")
+        last["step"] = p.step
+        count = f" {p.finished_cases}/{p.total_cases} cases" if p.total_cases else ""
+        sys.stderr.write(f"\r[{p.elapsed_s:6.1f} s] {p.study}: {p.step}{count}")
+        sys.stderr.flush()
+
+    result = validate.run_validation(out, plan=plan, workers=workers, progress=progress)
+    if not quiet and last["step"] is not None:
+        sys.stderr.write("\n")
+    click.echo(f"static kappa max rel. error (engaged, default settings): "
+               f"{result['static_kappa_max_rel_error']:.3g}")
+    for fam, agree in result["outcome_agreement_at_lowest_ie"].items():
+        click.echo(f"I_e = {result['lowest_ie']:g}, {fam}: outcome agreement {agree:.0%}, "
+                   f"mean Frechet {result['mean_frechet_at_lowest_ie'][fam]:.3g} L_c")
+    for proto, s in result["ie_star"].items():
+        if s["kind"] == "bracketed":
+            click.echo(f"I_e* ({proto}) = {s['value']:.3g} in [{s['low']:.3g}, {s['high']:.3g}]")
+        elif s["kind"] == "above":
+            click.echo(f"I_e* ({proto}) > {s['low']:.3g} (agreement holds on the whole grid)")
+        else:
+            click.echo(f"I_e* ({proto}) < {s['high']:.3g} (no agreement at the lowest I_e)")
+    click.echo(f"wrote {out / 'report.md'} and {out / 'validation.json'} "
+               f"({result['timings_s']['total']:.0f} s)")
+
+
+# --------------------------------------------------------------------------- end validation
 
 
 if __name__ == "__main__":  # pragma: no cover

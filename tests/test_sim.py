@@ -324,7 +324,7 @@ def test_cli_simulate_export_and_view(tmp_path, monkeypatch):
     res = runner.invoke(main, ["sim", "export", "paper-single-peak", "-o", str(tmp_path / "rig.xml")])
     assert res.exit_code == 0 and mujoco.MjModel.from_xml_path(str(tmp_path / "rig.xml")).nhfield == 1
     res = runner.invoke(main, ["simulate", "paper-single-peak", "--start", "-3", "-o", str(tmp_path)])
-    assert res.exit_code == 2 and "--start must be 'x0,y0'" in res.output
+    assert res.exit_code == 2 and "--start must look like X,Y" in res.output
     monkeypatch.delenv("DISPLAY", raising=False)
     monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
     res = runner.invoke(main, ["view", "paper-single-peak"])
