@@ -15,6 +15,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import resource
 import shutil
 import tempfile
@@ -95,6 +96,7 @@ def main() -> None:
     parser.add_argument("--out", type=Path, default=None, help="scratch folder")
     args = parser.parse_args()
     scratch = args.out or Path(tempfile.mkdtemp(prefix="bench-sweep-"))
+    load = os.getloadavg()
 
     n_ie = 2 if args.quick else 12
     doc = dict(MUJOCO_CONFIG, grid={"mu": 1.23, "ie": {"logspace": [1e-3, 1e-1], "num": n_ie}})
@@ -107,6 +109,8 @@ def main() -> None:
     t1 = timed_sweep(config, scratch / "mj1", workers=1)
     t2 = timed_sweep(config, scratch / "mj2", workers=2)
     runs = sweep.load_runs(scratch / "mj1")
+    cpu1 = runs.groupby("case_id").cpu_s.sum().sum()
+    cpu2 = sweep.load_runs(scratch / "mj2").groupby("case_id").cpu_s.sum().sum()
     steps = int(runs.n_steps.sum())
     print(f"mujoco sweep: {len(cases)} cases, {n_runs} runs, {steps} recorded steps kept "
           f"(runs cut at their end events)")
@@ -115,6 +119,9 @@ def main() -> None:
           f"bare/sweep = {bare / t1:.3f}  (target >= 0.9)")
     print(f"  sweep, 2 workers:                {t2:8.2f} s   parallel efficiency "
           f"T1/(2 T2) = {t1 / (2 * t2):.3f}  (target >= 0.85)")
+    print(f"  CPU time in the analyses: {cpu1:.2f} s (1 worker), {cpu2:.2f} s (2 workers); "
+          f"load average before: {load[0]:.2f} on {os.cpu_count()} cores (a busy machine "
+          f"lowers the 2-worker figure)")
 
     n_cases = 200 if args.quick else 2000
     qs_doc = {

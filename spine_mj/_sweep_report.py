@@ -14,7 +14,7 @@ import numpy as np
 from spine_mj.errors import atomic_output
 
 _MAX_PLOTS_PER_ANALYSIS = 12
-_SKIP = {"start", "case_index", "seed", "surface_seed", "start_x", "start_y", "time_s"}
+_SKIP = {"start", "case_index", "seed", "surface_seed", "start_x", "start_y", "time_s", "cpu_s"}
 
 
 def _png(fig) -> str:

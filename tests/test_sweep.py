@@ -47,7 +47,7 @@ def peak_config(tmp_path, *, nmu=4, ny=3, dl=0.02, name="peak"):
 
 
 def metrics_frame(out_dir):
-    df = sweep.load_runs(out_dir).drop(columns=["time_s"])
+    df = sweep.load_runs(out_dir).drop(columns=["time_s", "cpu_s"])
     return df.sort_values("run_id").reset_index(drop=True)
 
 
