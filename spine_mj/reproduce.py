@@ -47,9 +47,16 @@ def _finite_or_str(v: float):
 
 
 def single_peak(*, quick: bool = False, progress: Progress = None, mu: float | None = None,
-                dl: float | None = None, y0_step: float | None = None):
+                dl: float | None = None, y0_step: float | None = None,
+                y0_range: tuple[float, float] | None = None):
     """Figs. 3-4: five starts on the convex peak and the concave valley, and the self-lock
     start-range ratios (streamline range / ideal range of y0 at x0 = -3).
+
+    The ranges are counted on a scan of starts ``y0 = y0_range[0], ... + y0_step, ...,
+    y0_range[1]`` (end points included): range = number of self-locked starts times
+    ``y0_step``, ratio = ratio of the counts. The paper's 83.3 % and 566.7 % are 5/6 and
+    34/6, ratios of small counts, which points to a coarse scan; the preset sets it.
+    ``*_ratio_fine`` repeats the measurement on a 0.01 scan of -5..5 (no discretisation).
 
     Returns numbers with keys ``mu``, ``convex_ratio``, ``concave_ratio`` (fractions;
     paper 0.833 and 5.667), the ranges, and per-start outcomes and max kappa.
@@ -58,25 +65,34 @@ def single_peak(*, quick: bool = False, progress: Progress = None, mu: float | N
     mu = float(mu if mu is not None else eng["mu"])
     dl = float(dl if dl is not None else rep.get("dl", 0.015))
     y0_step = float(y0_step if y0_step is not None else rep.get("y0_step", 0.01))
+    lo, hi = (float(v) for v in (y0_range if y0_range is not None
+                                 else rep.get("y0_range", (-5.0, 5.0))))
     if quick:
         y0_step = max(y0_step, 0.05)
+    if not (y0_step > 0 and hi > lo):
+        raise SpineInputError(f"y0_step must be > 0 and y0_range increasing, got {y0_step}, "
+                              f"({lo}, {hi})")
     x0 = float(rep.get("x0", -3.0))
     params = StreamlineParams(mu=mu, dl=dl)
-    y_scan = np.arange(-5 + y0_step / 2, 5.0, y0_step)
+    y_scan = np.linspace(lo, hi, int(round((hi - lo) / y0_step)) + 1)
     scan = np.c_[np.full(y_scan.size, x0), y_scan]
+    fine_step = 0.01
+    y_fine = np.arange(-5 + fine_step / 2, 5.0, fine_step)
+    fine = np.c_[np.full(y_fine.size, x0), y_fine]
     five = [(x0, y) for y in FIVE_Y0]
-    numbers = {"mu": mu, "dl": dl, "x0": x0, "y0_step": y0_step, "paper": {
-        "convex_ratio": 0.833, "concave_ratio": 5.667}}
+    numbers = {"mu": mu, "dl": dl, "x0": x0, "y0_step": y0_step, "y0_range": [lo, hi],
+               "paper": {"convex_ratio": 0.833, "concave_ratio": 5.667}}
     runs = {}
     for k, (name, sign) in enumerate((("convex", 1), ("concave", -1))):
         surf = single_gaussian(sign=sign)
-        ideal_scan = ideal_trajectories(surf, scan, params, store_paths=False)
-        stream_scan = streamlines(surf, scan, params, store_paths=False)
-        ideal_range = float(ideal_scan.self_locked.sum() * y0_step)
-        stream_range = float(stream_scan.self_locked.sum() * y0_step)
-        numbers[f"{name}_ideal_range"] = ideal_range
-        numbers[f"{name}_streamline_range"] = stream_range
-        numbers[f"{name}_ratio"] = stream_range / ideal_range if ideal_range > 0 else None
+        for label, pts, step in (("", scan, y0_step), ("_fine", fine, fine_step)):
+            if label and quick:
+                continue
+            n_ideal = int(ideal_trajectories(surf, pts, params, store_paths=False).self_locked.sum())
+            n_stream = int(streamlines(surf, pts, params, store_paths=False).self_locked.sum())
+            numbers[f"{name}_ideal_range{label}"] = n_ideal * step
+            numbers[f"{name}_streamline_range{label}"] = n_stream * step
+            numbers[f"{name}_ratio{label}"] = n_stream / n_ideal if n_ideal > 0 else None
         s5 = streamlines(surf, five, params)
         i5 = ideal_trajectories(surf, five, params)
         runs[name] = (surf, s5, i5)
@@ -124,12 +140,19 @@ def kappa_map(*, quick: bool = False, progress: Progress = None, mu: float | Non
 
 
 def random_gaussian(*, quick: bool = False, progress: Progress = None, mu: float | None = None,
-                    n_runs: int | None = None, **params):
+                    n_runs: int | None = None, starts: str | None = None,
+                    kappa_cap: float | None = None, **params):
     """Fig. 5: medians of the maximum kappa along ideal and streamline trajectories on
-    random convex and concave Gaussian surfaces (one surface per run, start at the left
-    edge on y = 0). A self-locked trajectory has max kappa = inf; medians are taken over all
-    runs with inf ranked highest (finite while fewer than half self-lock) and the
-    self-lock counts are reported beside them.
+    random convex and concave Gaussian surfaces.
+
+    ``starts`` (preset ``[reproduce] starts``): ``"surfaces"`` runs one surface per run
+    (seeds ``seed, seed + 1, ...``) with one start at the left edge on ``y = y0``;
+    ``"edge"`` runs ``n_runs`` starts spread evenly along the left edge of one surface.
+    Conventions for the medians: a self-locked trajectory has max kappa = inf (ranked
+    highest, so the median is finite while fewer than half self-lock) or ``kappa_cap``
+    when one is set; a trajectory that met only slip points (max kappa NaN) counts as 0.
+    The self-lock counts are reported beside the medians. Extra keyword arguments replace
+    the presets' generator parameters (both surfaces).
     """
     numbers = {"paper": {"convex_median_ideal": 3.18, "convex_median_streamline": 2.87,
                          "concave_median_ideal": 3.22, "concave_median_streamline": 11.34,
@@ -140,22 +163,40 @@ def random_gaussian(*, quick: bool = False, progress: Progress = None, mu: float
         eng, rep, pre = _settings(preset)
         m = float(mu if mu is not None else eng["mu"])
         runs = int(n_runs if n_runs is not None else rep.get("n_runs", 100))
+        mode = str(starts if starts is not None else rep.get("starts", "surfaces"))
+        cap = kappa_cap if kappa_cap is not None else rep.get("kappa_cap")
+        if mode not in ("surfaces", "edge"):
+            raise SpineInputError(f"starts must be 'surfaces' or 'edge', got {mode!r}")
         if quick:
             runs = min(runs, 30)
         dl = float(rep.get("dl", 0.015))
         gen = dict(pre.params, **params)
         seed0 = int(pre.seed or 0)
         params_s = StreamlineParams(mu=m, dl=dl)
-        ideal_max, stream_max = np.empty(runs), np.empty(runs)
-        for r in range(runs):
-            surf = random_gaussians(**gen, rng=seed0 + r)
-            xmin = surf.bounds[0]
-            start = [(xmin + 1e-9, float(rep.get("y0", 0.0)))]
-            ideal_max[r] = ideal_trajectories(surf, start, params_s, store_paths=False).max_kappa[0]
-            stream_max[r] = streamlines(surf, start, params_s, store_paths=False).max_kappa[0]
-        med_i, med_s = float(np.median(ideal_max)), float(np.median(stream_max))
+        if mode == "surfaces":
+            jobs = [(random_gaussians(**gen, rng=seed0 + r), None) for r in range(runs)]
+        else:
+            jobs = [(random_gaussians(**gen, rng=seed0), None)]
+        ideal_max, stream_max = [], []
+        for surf, _ in jobs:
+            xmin, _, ymin, ymax = surf.bounds
+            if mode == "surfaces":
+                pts = [(xmin + 1e-9, float(rep.get("y0", 0.0)))]
+            else:
+                ys = ymin + (ymax - ymin) * (np.arange(runs) + 0.5) / runs
+                pts = np.c_[np.full(runs, xmin + 1e-9), ys]
+            ideal_max.append(ideal_trajectories(surf, pts, params_s, store_paths=False).max_kappa)
+            stream_max.append(streamlines(surf, pts, params_s, store_paths=False).max_kappa)
+        ideal_max, stream_max = np.concatenate(ideal_max), np.concatenate(stream_max)
+        ranked = []
+        for v in (ideal_max, stream_max):
+            v = np.where(np.isnan(v), 0.0, v)
+            ranked.append(np.minimum(v, float(cap)) if cap is not None else v)
+        med_i, med_s = float(np.median(ranked[0])), float(np.median(ranked[1]))
         numbers[f"{name}_mu"] = m
         numbers[f"{name}_runs"] = runs
+        numbers[f"{name}_starts"] = mode
+        numbers[f"{name}_kappa_cap"] = cap
         numbers[f"{name}_median_ideal"] = med_i
         numbers[f"{name}_median_streamline"] = med_s
         numbers[f"{name}_self_locked_ideal"] = int(np.isposinf(ideal_max).sum())
@@ -165,7 +206,7 @@ def random_gaussian(*, quick: bool = False, progress: Progress = None, mu: float
             progress(k + 1, 2)
     for key, name in (("bypass_change", "convex"), ("trap_change", "concave")):
         mi, ms = numbers[f"{name}_median_ideal"], numbers[f"{name}_median_streamline"]
-        numbers[key] = (ms - mi) / mi if math.isfinite(ms) else None
+        numbers[key] = (ms - mi) / mi if math.isfinite(ms) and math.isfinite(mi) and mi > 0 else None
         for k in (f"{name}_median_ideal", f"{name}_median_streamline"):
             numbers[k] = _finite_or_str(numbers[k])
     from spine_mj.plotting import random_gaussian_figure
@@ -179,7 +220,8 @@ def random_gaussian(*, quick: bool = False, progress: Progress = None, mu: float
 def raw_rms_height(hurst: float, nx: int, size: float) -> float:
     """Expected RMS height of the paper's unnormalized synthesis: white noise filtered by
     ``A(f) = |f|^-(H+1)`` (f in cycles per unit length) on an ``nx x nx`` periodic grid of
-    side ``size``: ``sqrt(mean_k A(f_k)^2)`` (the DC term excluded)."""
+    side ``size``: ``sqrt(mean_k A(f_k)^2)`` (the DC term excluded). ``size = nx`` gives
+    frequencies in cycles per pixel (all ``|f| <= 0.5`` per axis)."""
     f = np.fft.fftfreq(nx, size / nx)
     freq = np.hypot(f[None, :], f[:, None])
     amp2 = np.zeros_like(freq)
@@ -190,7 +232,8 @@ def raw_rms_height(hurst: float, nx: int, size: float) -> float:
 def _fractal_chunk(args):
     hurst, seeds, gen, mu, dl, scale = args
     params = StreamlineParams(mu=mu, dl=dl)
-    rms = scale * raw_rms_height(hurst, gen["nx"], gen["size"])
+    spectral_size = gen["nx"] if gen["frequency_unit"] == "pixel" else gen["size"]
+    rms = scale * raw_rms_height(hurst, gen["nx"], spectral_size)
     locked, sect, hess = [], [], []
     for seed in seeds:
         surf = fractal_fbm(nx=gen["nx"], size=gen["size"], hurst=hurst, rms_height=rms,
@@ -217,7 +260,9 @@ def fractal_hurst(*, quick: bool = False, progress: Progress = None, mu: float |
     For each H, ``surfaces`` fractal surfaces (default 300, in 3 groups) get one streamline
     each from the middle of the left edge; shares are among self-locked streamlines of a
     group; mean and sd over the groups. The height scale follows the paper's unnormalized
-    synthesis (:func:`raw_rms_height`) times ``scale`` from the preset.
+    synthesis (:func:`raw_rms_height`) times ``scale`` from the preset: a fixed spectral
+    prefactor, so roughness grows with H when frequencies are in cycles per pixel
+    (``frequency_unit = "pixel"``) and barely changes with ``"length"``.
     """
     eng, rep, pre = _settings("paper-fractal")
     mu = float(mu if mu is not None else eng["mu"])
@@ -229,7 +274,12 @@ def fractal_hurst(*, quick: bool = False, progress: Progress = None, mu: float |
     groups = int(rep.get("groups", 3))
     if n < groups:
         raise SpineInputError(f"surfaces must be >= groups ({groups}), got {n}")
-    gen = {"nx": int(over.get("nx", pre.params["nx"])), "size": float(over.get("size", pre.params["size"]))}
+    gen = {"nx": int(over.get("nx", rep.get("nx", pre.params["nx"]))),
+           "size": float(over.get("size", pre.params["size"])),
+           "frequency_unit": str(over.get("frequency_unit", rep.get("frequency_unit", "length")))}
+    if gen["frequency_unit"] not in ("pixel", "length"):
+        raise SpineInputError(f"frequency_unit must be 'pixel' or 'length', got "
+                              f"{gen['frequency_unit']!r}")
     scale = float(over.get("scale", rep["scale"]))
     dl = float(over.get("dl", rep.get("dl", 0.02)))
     chunks = []
@@ -273,6 +323,7 @@ def fractal_hurst(*, quick: bool = False, progress: Progress = None, mu: float |
             entry[f"{key}_sd"] = _nan_none(np.nanstd(v) if np.isfinite(v).sum() > 1 else np.nan)
         table.append(entry)
     numbers = {"mu": mu, "nx": gen["nx"], "size": gen["size"], "scale": scale, "dl": dl,
+               "frequency_unit": gen["frequency_unit"],
                "groups": groups, "surfaces_per_hurst": n, "by_hurst": table}
     from spine_mj.plotting import fractal_hurst_figure
 
