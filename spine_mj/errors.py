@@ -45,6 +45,9 @@ def atomic_output(path: str | os.PathLike, *, suffix: str | None = None) -> Iter
     tmp = Path(tmp_name)
     try:
         yield tmp
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; give the usual permissions
         os.replace(tmp, dest)
     finally:
         if tmp.exists():
