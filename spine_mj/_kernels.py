@@ -144,6 +144,7 @@ def run_trajectories(kind, g, coef, sp, bounds, xs, ys, ideal, mu, dl, tol, max_
         cx = x
         cy = y
         step = 0
+        until_check = stall_window
         mk = math.nan
         while True:
             if kind == 0:
@@ -189,17 +190,17 @@ def run_trajectories(kind, g, coef, sp, bounds, xs, ys, ideal, mu, dl, tol, max_
                 vy = 0.0
             else:
                 kk = k if reg == 1 else 0.0
-                s2 = 1.0 + fx * fx + fy * fy
-                rn = (kk * fx + 1.0) / s2
+                rn = (kk * fx + 1.0) / (1.0 + fx * fx + fy * fy)
                 tx = kk - rn * fx
                 ty = -rn * fy
                 tz = -1.0 + rn
-                tn = math.sqrt(tx * tx + ty * ty + tz * tz)
-                if not (tn > 0.0):
+                tn2 = tx * tx + ty * ty + tz * tz
+                if not (tn2 > 0.0):
                     outcome[i] = 3
                     break
-                vx = tx / tn
-                vy = ty / tn
+                inv = 1.0 / math.sqrt(tn2)
+                vx = tx * inv
+                vy = ty * inv
             xn = x + dl * vx
             yn = y + dl * vy
             if not (xn >= xmin and xn <= xmax and yn >= ymin and yn <= ymax):
@@ -208,8 +209,12 @@ def run_trajectories(kind, g, coef, sp, bounds, xs, ys, ideal, mu, dl, tol, max_
             x = xn
             y = yn
             step += 1
-            if step % stall_window == 0:
-                if math.hypot(x - cx, y - cy) < stall_dist:
+            until_check -= 1
+            if until_check == 0:
+                until_check = stall_window
+                dxs = x - cx
+                dys = y - cy
+                if dxs * dxs + dys * dys < stall_dist * stall_dist:
                     outcome[i] = 3
                     break
                 cx = x
