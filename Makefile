@@ -14,9 +14,7 @@ $(STAMP): pyproject.toml
 	touch $(STAMP)
 
 demo: $(STAMP)
-	$(BIN)/spine-mj surface make paper-fractal -o $(DEMO_OUT)/fractal.npz --png $(DEMO_OUT)/fractal.png
-	$(BIN)/spine-mj surface make sandpaper-P60 -o $(DEMO_OUT)/p60.npz --png $(DEMO_OUT)/p60.png
-	$(BIN)/spine-mj surface export $(DEMO_OUT)/p60.npz --stl $(DEMO_OUT)/p60.stl --hfield $(DEMO_OUT)/p60-hfield.npz
+	$(BIN)/spine-mj validate --quick --out $(DEMO_OUT)
 
 test: $(STAMP)
 	$(BIN)/ruff check .

@@ -211,7 +211,11 @@ def write(out: Path, result: dict, *, static, limit, boundary, stick, sand) -> P
                                             "mean_lateral_excursion_tip_radii",
                                             "rms_lateral_tip_radii", "tortuosity",
                                             "force_peaks_per_100_tip_radii",
-                                            "peak_over_median_force", "self_locked_fraction"]),
+                                            "peak_over_median_force", "self_locked_fraction",
+                                            "failed_runs"]),
+                  "", "Failures: " + "; ".join(f"{r['grit']}: {', '.join(r['failures'])}"
+                                               for r in sand["rows"] if r.get("failures"))
+                  + ".",
                   "", "![sandpaper](figures/sandpaper.png)", ""]
     lines += ["## Engine settings", "", "```", str(result["engine_settings"]), "```", "",
               f"Study times [s]: {result['timings_s']}", ""]

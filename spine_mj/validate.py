@@ -298,13 +298,13 @@ def _hold_force(fx: float, fy: float, mu: float) -> tuple[float, float, int]:
 
     k, region = engagement.kappa(fx, fy, mu)
     a, b, c = (float(v) for v in engagement.quadratic_coefficients(fx, fy, mu))
-    # the tip holds for F/W between the roots of A' k^2 + B' k + C' = 0 (C' < 0: F = 0 holds)
+    # the tip holds where A' k^2 + B' k + C' <= 0; C' > 0 means gravity alone slides it, and
+    # the smallest positive root is then the force that starts to hold it
     low = 0.0
-    if c > 0 and abs(a) > 1e-12:
-        disc = b * b - 4 * a * c
-        if disc >= 0:
-            r = sorted(((-b - math.sqrt(disc)) / (2 * a), (-b + math.sqrt(disc)) / (2 * a)))
-            low = max(0.0, r[0])
+    if c > 0:
+        roots = np.roots([a, b, c]) if abs(a) > 1e-12 else np.array([-c / b])
+        pos = [float(r.real) for r in np.atleast_1d(roots) if abs(r.imag) < 1e-12 and r.real > 0]
+        low = min(pos) if pos else 0.0
     return float(k), low, int(region)
 
 
@@ -346,7 +346,10 @@ def static_map(plan: ValidationPlan, runner: _Runner, *, mu: float = 0.5) -> dic
                                         path)
             keys = sorted({k_ for _, ov in engines for k_, _ in ov})
             for label, ov in engines:
-                grid = {"mu": mu, "kappa_cap": 10.0}
+                # the cap must lie above the breakaway force, or a steep engaged plane
+                # reads as self-locked
+                cap = max(10.0, 1.5 * k) if np.isfinite(k) else 10.0
+                grid = {"mu": mu, "kappa_cap": float(f"{cap:.4g}")}
                 grid.update({k_: _engine_default(k_) for k_ in keys})
                 grid.update(dict(ov))
                 doc = {"sweep": {"name": f"static-s{slope:g}-a{az:g}", "seed": 1,
@@ -980,12 +983,21 @@ def sandpaper(plan: ValidationPlan, runner: _Runner) -> dict:
                "drive": {"protocol": "spring", "ie": plan.sandpaper_ie},
                "grid": {"mu": SANDPAPER_MU, "record_every": 5}}
         df, store = runner(doc, f"sandpaper/{grit}")
-        mj = df[df["analysis"] == "mujoco"]
+        mj_all = df[df["analysis"] == "mujoco"]
+        failed = sorted(set(mj_all.loc[mj_all["status"] != "ok", "reason"].astype(str)))
+        mj = mj_all[mj_all["status"] == "ok"] if "tip_radius_m" in mj_all else mj_all.iloc[:0]
+        if mj.empty:
+            rows.append({"grit": grit, "runs": 0, "failed_runs": int(len(mj_all)),
+                         "failures": failed})
+            continue
         tip_m = float(mj["tip_radius_m"].iloc[0])
         fp = MASS_KG * GRAVITY
         exc, rms, tort, peaks, ratio = [], [], [], [], []
+        ok_starts = set(zip(mj["case_id"], mj["start"].astype(int)))
         for case_id in mj["case_id"].unique():
-            for tr in _mujoco_paths(store, case_id).values():
+            for st, tr in _mujoco_paths(store, case_id).items():
+                if (case_id, st) not in ok_starts:
+                    continue
                 x, y = tr["x"].to_numpy(), tr["y"].to_numpy()
                 f = tr["drive_force_n"].to_numpy() / fp
                 dy = np.abs(y - y[0])
@@ -1008,7 +1020,8 @@ def sandpaper(plan: ValidationPlan, runner: _Runner) -> dict:
                      "force_peaks_per_100_tip_radii": float(np.mean(peaks)),
                      "peak_over_median_force": float(np.nanmean(ratio)),
                      "self_locked_fraction": float(mj["self_locked"].astype(bool).mean()),
-                     "end_reasons": sorted(set(mj["end_reason"].astype(str)))})
+                     "end_reasons": sorted(set(mj_all["end_reason"].dropna().astype(str))),
+                     "failed_runs": int(len(mj_all) - len(mj)), "failures": failed})
     return {"rows": rows, "paths": paths, "mu": SANDPAPER_MU}
 
 
