@@ -77,6 +77,7 @@ MODEL_PATH = Path(__file__).resolve().parent.parent / "models" / "spine_rig.xml"
 DEFAULT_LENGTH_SCALE_M = 0.01
 _MAX_TIMESTEP_S = 1e-3
 _REST_PENETRATION_FRACTION = 0.005
+_MIN_SPACING_PER_TIP_RADIUS = 0.25  # finer hfields exceed MuJoCo's 50 contacts per geom pair
 _BATCH_MEMORY_BYTES = 256 * 2**20
 
 
@@ -623,6 +624,15 @@ class Rig:
             r = params.get("tip_radius_m") if surface.unit == "m" else None
             r = float(r) if r else max(spacing, 0.01 * char_length_m)
             tip = dataclasses.replace(tip, tip_radius_m=float(f"{r:.3g}"))
+        if resolution is None and spacing < _MIN_SPACING_PER_TIP_RADIUS * tip.tip_radius_m:
+            # MuJoCo keeps at most 50 contacts per geom pair: a tip over too many hfield cells
+            # loses its deepest contacts, so coarsen the hfield to ~R/4 (recorded in engine)
+            extent = 2 * max(hf.size[0], hf.size[1]) * length_scale_m
+            resolution = math.ceil(extent / (_MIN_SPACING_PER_TIP_RADIUS * tip.tip_radius_m)) + 1
+            hf = to_hfield(surface, nrow=resolution, ncol=resolution)
+            spacing = length_scale_m * 2 * max(hf.size[0] / (hf.ncol - 1), hf.size[1] / (hf.nrow - 1))
+            if engine is not None:
+                engine = dataclasses.replace(engine, hfield_resolution=resolution)
         if spacing > 2 * tip.tip_radius_m * (1 + 1e-9):
             raise SpineInputError(
                 f"surface too coarse for the tip: hfield spacing {spacing:.3g} m > 2 x tip_radius_m "
@@ -633,7 +643,8 @@ class Rig:
         self.scales = Scales(length_scale_m=length_scale_m, char_length_m=char_length_m,
                              mass_kg=tip.mass_kg, preload_n=tip.preload_total_n,
                              tip_radius_m=tip.tip_radius_m, hfield_spacing_m=spacing)
-        self.engine = default_engine(self.scales) if engine is None else engine
+        self.engine = (default_engine(self.scales, hfield_resolution=resolution) if engine is None
+                       else engine)
         self.hfield = hf
         xmin, xmax, ymin, ymax = surface.bounds
         self.bounds_m = tuple(length_scale_m * b for b in (xmin, xmax, ymin, ymax))

@@ -329,3 +329,17 @@ def test_cli_simulate_export_and_view(tmp_path, monkeypatch):
     monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
     res = runner.invoke(main, ["view", "paper-single-peak"])
     assert res.exit_code != 0 and "no display" in res.output and "Traceback" not in res.output
+
+
+def test_fine_grid_is_coarsened_to_respect_the_contact_cap():
+    """MuJoCo keeps <= 50 contacts per geom pair: the P600 grid (2.6 um) under a 25 um tip
+    would lose the deepest ones, so the rig resamples the hfield to ~R/4 and records it."""
+    from spine_mj.surfaces import sandpaper
+
+    surf = sandpaper(grit="P600", size_m=0.3e-3, rng=1)
+    rig = Rig(surf, tip=TipParams(tip_radius_m=25e-6))
+    assert rig.scales.hfield_spacing_m >= 0.25 * 25e-6 * (1 - 1e-9)
+    assert rig.engine.hfield_resolution == rig.hfield.ncol
+    for start in [(0.0, 0.0), (-1e-4, 5e-5), (1e-4, -1e-4)]:
+        z = rig.place(*start)[2]
+        assert surf.height(*start) < z < surf.heights.max() + 2 * 25e-6
