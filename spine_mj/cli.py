@@ -722,6 +722,8 @@ def validate_cmd(out_dir, quick, plan_name, workers, quiet):
         click.echo(f"I_e = {result['lowest_ie']:g}, {fam}: outcome agreement {agree:.0%}, "
                    f"mean Frechet {result['mean_frechet_at_lowest_ie'][fam]:.3g} L_c")
     for proto, s in result["ie_star"].items():
+        if "criterion" in s:
+            click.echo(f"I_e* ({proto}) criterion: {s['criterion']}")
         if s["kind"] == "bracketed":
             click.echo(f"I_e* ({proto}) = {s['value']:.3g} in [{s['low']:.3g}, {s['high']:.3g}]")
         elif s["kind"] == "above":

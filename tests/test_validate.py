@@ -145,3 +145,52 @@ def test_cli_bad_input_is_one_line_exit_2_and_writes_nothing(tmp_path, args, mat
     lines = res.output.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("Error:") and match in lines[0]
     assert sorted(p.name for p in tmp_path.iterdir()) == before
+
+
+# --------------------------------------------------------------------------- robust I_e*
+
+
+def test_one_outlying_start_moves_the_mean_criterion_but_not_the_median():
+    # 10 starts, all agree in outcome; one start deviates by 5 L_c at every I_e (a marginal
+    # start), the others by 0.02 L_c until 1e-1
+    ag = np.ones((5, 10))
+    ag[3:, :] = 0.0
+    fr = np.full((5, 10), 0.02)
+    fr[:, 0] = 5.0
+    by = validate.ie_star_by_criterion(IE, ag, fr, n_boot=100, rng=1)
+    assert set(by) == set(validate.IE_STAR_CRITERIA)
+    assert by["mean_frechet"]["kind"] == "below"  # mean 0.52 L_c at every I_e
+    for key in ("median_frechet", "outcome"):
+        assert by[key]["kind"] == "bracketed"
+        assert (by[key]["low"], by[key]["high"]) == (1e-2, 1e-1)
+        assert 1e-2 <= by[key]["ci_low"] <= by[key]["ci_high"] <= 1e-1
+    assert "median" in by["median_frechet"]["criterion"]
+
+
+def test_bootstrap_rejects_an_unknown_statistic():
+    with pytest.raises(SpineInputError, match="stat must be"):
+        validate.bootstrap_ie_star(IE, np.ones((5, 2)), np.ones((5, 2)), n_boot=2, rng=0,
+                                   stat="max")
+
+
+def test_prefix_frechet_cuts_the_streamline_at_the_mujoco_arc_length():
+    q = np.column_stack([np.linspace(0, 10, 101), np.zeros(101)])
+    # MuJoCo covered 1 unit of it, 0.05 to the side: the prefix deviation is the offset
+    m = np.column_stack([np.linspace(0, 1, 11), np.full(11, 0.05)])
+    assert validate._prefix_frechet(m, q, 1.0) == pytest.approx(0.05, abs=1e-3)
+    # against the whole streamline it would be the 9 units MuJoCo did not cover
+    assert validate._path_metrics(m, q, 1.0)[0] > 8.9
+
+
+def test_ramp_duration_covers_the_target_from_the_measured_slip_per_cycle():
+    from spine_mj import sim
+
+    rig = sim.Rig(sim.inclined_plane(slope_deg=0.0, azimuth_deg=0.0),
+                  tip=sim.TipParams(mu_s=0.5))
+    rp = validate.ramp_duration(rig, validate._PLANE_START, 1.0, target_lc=0.5, max_steps=4000)
+    assert rp.ie_equivalent == pytest.approx(1.0, rel=1e-9)
+    assert rp.slip_per_cycle_lc > 0 and rp.cycle_s > 0
+    assert rp.required_s == pytest.approx(rp.cycle_s * 0.5 / rp.slip_per_cycle_lc, rel=1e-9)
+    assert rp.duration_s == pytest.approx(min(rp.required_s, 4000 * rp.timestep_s), rel=1e-3)
+    assert rp.capped == (rp.required_s > 4000 * rp.timestep_s)
+    assert 0 < rp.coverage_expected <= 1
