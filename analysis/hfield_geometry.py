@@ -28,8 +28,8 @@ from spine_mj.surfaces import GridSurface
 
 RESOLUTIONS = (151, 201, 401, 801)
 RIG_TIP_MAX_RES = 201
-CASES = (("paper-random-convex", (1, 2, 3)), ("paper-random-concave", (1, 2, 3)),
-         ("paper-fractal", (1, 2)))
+CASES = (("paper-random-convex", (1,)), ("paper-random-concave", (1,)),
+         ("paper-fractal", (1,)))
 
 
 def _starts(surface, n=5, x=0.05):

@@ -210,8 +210,8 @@ PLANS: dict[str, ValidationPlan] = {
             FamilySpec("single_peak_valley", ("paper-single-peak", "paper-single-valley"), None,
                        _paper_starts([-0.5, -1.0, -2.0, -3.0, -4.0])),
             FamilySpec("random_gaussian", ("paper-random-convex", "paper-random-concave"),
-                       (1, 2, 3), _relative_starts(5)),
-            FamilySpec("fractal", ("paper-fractal",), (1, 2), _relative_starts(5)),
+                       (1, 2), _relative_starts(5)),
+            FamilySpec("fractal", ("paper-fractal",), (1,), _relative_starts(5)),
         ),
         lowest_ie=1e-4, hfield_resolution=201,
         limit_variations=(
@@ -223,7 +223,9 @@ PLANS: dict[str, ValidationPlan] = {
             ("timestep / 2", (("timestep_factor", 0.5),)),
         ),
         ie_values=tuple(float(v) for v in np.logspace(-4, 1, 11)),
-        boundary_families=("single_peak_valley", "random_gaussian"),
+        # the random Gaussian boundary (20 runs x 11 I_e x 2 drives) would double the run
+        # time past ~45 min on 2 cores: the full plan keeps the single peak/valley there
+        boundary_families=("single_peak_valley",),
         stick_slip_ie=(1e-3, 1e-2, 1e-1, 1.0), stick_slip_stiffness=(2.0, 10.0, 50.0),
         stick_slip_starts=3, sandpaper_starts=4, bootstrap=500, ramp_max_steps=20000),
 }
