@@ -1,6 +1,12 @@
 """Compiled (numba) kernels behind :mod:`spine_mj.streamline`; imported on first use.
 
-``run_trajectories`` steps many starts one after the other on one core. ``kind`` 0
+``run_trajectories`` steps ``lanes`` starts together on one core (a finished lane takes the
+next start): per iteration every lane gets its height and slopes, then kappa, region and
+slip direction in branch-free loops over the lanes that LLVM vectorizes (AVX2: 4 lanes per
+instruction), then a scalar pass records, stops and steps. The trajectories are independent
+and each is computed with the same operations as one at a time, so the result does not
+depend on ``lanes``. A single Gaussian has its own path (exp through libm, the rest
+vectorized); Gaussian sums and grids evaluate lane by lane. ``kind`` 0
 evaluates a Gaussian sum (``g`` rows: amplitude, centre x, centre y, 1/sigma_x,
 1/sigma_y), ``kind`` 1 a cubic B-spline grid (``coef`` and ``sp`` = offset, x0, dx, nx,
 y0, dy, ny, periodic). The physics mirrors :func:`spine_mj.engagement.kappa` and
@@ -92,36 +98,9 @@ def grid_eval(coef, sp, x, y):
     return f, fx / sp[2], fy / sp[5]
 
 
-@njit(cache=True, fastmath=_FM)
-def kappa_point(fx, fy, mu, tol):
-    m2 = mu * mu
-    a = 1.0 + fy * fy - m2 * fx * fx
-    if a < tol and fx > 0.0:
-        return math.inf, 2
-    b = -2.0 * (1.0 + m2) * fx
-    c = fx * fx + fy * fy - m2
-    disc = b * b - 4.0 * a * c
-    if disc < 0.0:
-        return math.nan, 0
-    sq = math.sqrt(disc)
-    q = -0.5 * (b + sq) if b >= 0.0 else -0.5 * (b - sq)
-    best = math.nan
-    if q != 0.0:
-        if abs(a) >= tol:
-            r1 = q / a
-            if r1 > 0.0 and 1.0 + r1 * fx > 0.0:
-                best = r1
-        r2 = c / q
-        if r2 > 0.0 and 1.0 + r2 * fx > 0.0 and not (r2 <= best):
-            best = r2
-    if best == best:
-        return best, 1
-    return math.nan, 0
-
-
-@njit(cache=True, fastmath=_FM)
+@njit(cache=True, fastmath=_FM, boundscheck=False, error_model="numpy")
 def run_trajectories(kind, g, coef, sp, bounds, xs, ys, ideal, mu, dl, tol, max_steps, stall_window,
-        stall_dist, store):
+                     stall_dist, store, lanes):
     n = xs.size
     outcome = np.zeros(n, np.int8)
     n_steps = np.zeros(n, np.int64)
@@ -129,102 +108,235 @@ def run_trajectories(kind, g, coef, sp, bounds, xs, ys, ideal, mu, dl, tol, max_
     ex = np.empty(n)
     ey = np.empty(n)
     ez = np.empty(n)
-    offsets = np.zeros(n + 1, np.int64)
+    L = lanes  # a run-time count: LLVM vectorizes the lane loops instead of unrolling them
+    # lane state (structure of arrays)
+    lx = np.empty(L)
+    ly = np.empty(L)
+    lcx = np.empty(L)
+    lcy = np.empty(L)
+    lmk = np.empty(L)
+    lstep = np.zeros(L, np.int64)
+    luntil = np.zeros(L, np.int64)
+    lidx = np.full(L, -1, np.int64)
+    # per-step results of the lanes
+    lu = np.empty(L)
+    lv = np.empty(L)
+    le = np.empty(L)
+    lf = np.empty(L)
+    lfx = np.empty(L)
+    lfy = np.empty(L)
+    lk = np.empty(L)
+    lkk = np.empty(L)
+    lreg = np.empty(L, np.int8)
+    lvx = np.empty(L)
+    lvy = np.empty(L)
+    lok = np.empty(L, np.bool_)
+    levent = np.empty(L, np.bool_)
+    # path points in the order they are produced, tagged with their start
     cap = 1024 if store else 1
     bx = np.empty(cap)
     by = np.empty(cap)
     bz = np.empty(cap)
     bk = np.empty(cap)
     br = np.empty(cap, np.int8)
+    bi = np.empty(cap, np.int64)
     pos = 0
     xmin, xmax, ymin, ymax = bounds[0], bounds[1], bounds[2], bounds[3]
-    for i in range(n):
-        x = xs[i]
-        y = ys[i]
-        cx = x
-        cy = y
-        step = 0
-        until_check = stall_window
-        mk = math.nan
-        while True:
-            if kind == 0:
-                f, fx, fy = gauss_eval(g, x, y)
-            else:
-                f, fx, fy = grid_eval(coef, sp, x, y)
-            k, reg = kappa_point(fx, fy, mu, tol)
-            if store:
-                if pos >= cap:
-                    cap *= 2
-                    nbx = np.empty(cap)
-                    nbx[:pos] = bx[:pos]
-                    bx = nbx
-                    nby = np.empty(cap)
-                    nby[:pos] = by[:pos]
-                    by = nby
-                    nbz = np.empty(cap)
-                    nbz[:pos] = bz[:pos]
-                    bz = nbz
-                    nbk = np.empty(cap)
-                    nbk[:pos] = bk[:pos]
-                    bk = nbk
-                    nbr = np.empty(cap, np.int8)
-                    nbr[:pos] = br[:pos]
-                    br = nbr
-                bx[pos] = x
-                by[pos] = y
-                bz[pos] = f
-                bk[pos] = k
-                br[pos] = reg
-                pos += 1
-            if not (k <= mk):
-                if k == k:
-                    mk = k
-            if reg == 2:
-                outcome[i] = 1
-                break
-            if step >= max_steps:
-                outcome[i] = 4
-                break
-            if ideal:
-                vx = 1.0 / math.sqrt(1.0 + fx * fx)
-                vy = 0.0
-            else:
-                kk = k if reg == 1 else 0.0
+    sd2 = stall_dist * stall_dist
+    m2 = mu * mu
+    single = kind == 0 and g.shape[1] == 1
+    amp = g[0, 0] if single else 0.0
+    gx = g[1, 0] if single else 0.0
+    gy = g[2, 0] if single else 0.0
+    isx = g[3, 0] if single else 0.0
+    isy = g[4, 0] if single else 0.0
+    nxt = 0
+    nact = 0
+    for j in range(L):
+        lx[j] = xs[0]  # idle lanes compute on a valid point, results unused
+        ly[j] = ys[0]
+        if nxt < n:
+            lidx[j] = nxt
+            lx[j] = xs[nxt]
+            ly[j] = ys[nxt]
+            lcx[j] = xs[nxt]
+            lcy[j] = ys[nxt]
+            lmk[j] = math.nan
+            lstep[j] = 0
+            luntil[j] = stall_window
+            nxt += 1
+            nact += 1
+    while nact > 0:
+        # 1. height and slopes of every lane
+        if single:
+            for j in range(L):
+                u = (lx[j] - gx) * isx
+                v = (ly[j] - gy) * isy
+                lu[j] = u
+                lv[j] = v
+                le[j] = -0.5 * (u * u + v * v)
+            for j in range(L):
+                le[j] = math.exp(le[j])  # libm, as the reference; the rest vectorizes
+            for j in range(L):
+                e = amp * le[j] if lu[j] * lu[j] + lv[j] * lv[j] <= _GAUSS_CUTOFF else 0.0
+                lf[j] = e
+                lfx[j] = -(e * lu[j] * isx)
+                lfy[j] = -(e * lv[j] * isy)
+        elif kind == 0:
+            for j in range(L):
+                lf[j], lfx[j], lfy[j] = gauss_eval(g, lx[j], ly[j])
+        else:
+            for j in range(L):
+                lf[j], lfx[j], lfy[j] = grid_eval(coef, sp, lx[j], ly[j])
+        # 2. kappa, region and slip direction (branch-free, vectorizes)
+        for j in range(L):
+            fx = lfx[j]
+            fy = lfy[j]
+            a = 1.0 + fy * fy - m2 * fx * fx
+            lock = (a < tol) & (fx > 0.0)
+            b = -2.0 * (1.0 + m2) * fx
+            c = fx * fx + fy * fy - m2
+            sq = math.sqrt(b * b - 4.0 * a * c)  # NaN when no real root: slip
+            q = -0.5 * (b + sq) if b >= 0.0 else -0.5 * (b - sq)
+            r1 = q / a  # used only where |a| >= tol
+            r2 = c / q
+            qnz = q != 0.0
+            ok1 = qnz & (abs(a) >= tol) & (r1 > 0.0) & (1.0 + r1 * fx > 0.0)
+            best = r1 if ok1 else math.nan
+            ok2 = qnz & (r2 > 0.0) & (1.0 + r2 * fx > 0.0) & ((r2 > best) | (best != best))
+            best = r2 if ok2 else best
+            eng = best == best
+            lk[j] = math.inf if lock else best
+            lreg[j] = 2 if lock else (1 if eng else 0)
+            lkk[j] = 0.0 if lock else (best if eng else 0.0)
+        if ideal:
+            for j in range(L):
+                fx = lfx[j]
+                lvx[j] = 1.0 / math.sqrt(1.0 + fx * fx)
+                lvy[j] = 0.0
+                lok[j] = True
+        else:
+            for j in range(L):
+                fx = lfx[j]
+                fy = lfy[j]
+                kk = lkk[j]
                 rn = (kk * fx + 1.0) / (1.0 + fx * fx + fy * fy)
                 tx = kk - rn * fx
                 ty = -rn * fy
                 tz = -1.0 + rn
                 tn2 = tx * tx + ty * ty + tz * tz
-                if not (tn2 > 0.0):
-                    outcome[i] = 3
-                    break
                 inv = 1.0 / math.sqrt(tn2)
-                vx = tx * inv
-                vy = ty * inv
-            xn = x + dl * vx
-            yn = y + dl * vy
-            if not (xn >= xmin and xn <= xmax and yn >= ymin and yn <= ymax):
-                outcome[i] = 2
-                break
-            x = xn
-            y = yn
-            step += 1
-            until_check -= 1
-            if until_check == 0:
-                until_check = stall_window
-                dxs = x - cx
-                dys = y - cy
-                if dxs * dxs + dys * dys < stall_dist * stall_dist:
-                    outcome[i] = 3
-                    break
-                cx = x
-                cy = y
-        n_steps[i] = step
-        max_k[i] = mk
-        ex[i] = x
-        ey[i] = y
-        ez[i] = f
-        offsets[i + 1] = pos
-    return (outcome, n_steps, max_k, ex, ey, ez, offsets, bx[:pos], by[:pos], bz[:pos],
-            bk[:pos], br[:pos])
+                lvx[j] = tx * inv
+                lvy[j] = ty * inv
+                lok[j] = tn2 > 0.0
+        # 3. record the points, then move every lane that goes on (branch-free)
+        if store:
+            if pos + L > cap:
+                cap *= 2
+                bx = _grow(bx, pos, cap)
+                by = _grow(by, pos, cap)
+                bz = _grow(bz, pos, cap)
+                bk = _grow(bk, pos, cap)
+                br = _grow(br, pos, cap)
+                bi = _grow(bi, pos, cap)
+            for j in range(L):
+                if lidx[j] >= 0:
+                    bx[pos] = lx[j]
+                    by[pos] = ly[j]
+                    bz[pos] = lf[j]
+                    bk[pos] = lk[j]
+                    br[pos] = lreg[j]
+                    bi[pos] = lidx[j]
+                    pos += 1
+        for j in range(L):
+            k = lk[j]
+            mk = lmk[j]
+            lmk[j] = k if ((k > mk) | (mk != mk)) & (k == k) else mk
+            x = lx[j]
+            y = ly[j]
+            xn = x + dl * lvx[j]
+            yn = y + dl * lvy[j]
+            inside = (xn >= xmin) & (xn <= xmax) & (yn >= ymin) & (yn <= ymax)
+            go = (lreg[j] != 2) & (lstep[j] < max_steps) & lok[j] & inside
+            lx[j] = xn if go else x
+            ly[j] = yn if go else y
+            lstep[j] += go
+            u = luntil[j] - go
+            luntil[j] = u
+            levent[j] = (not go) | (u == 0)
+        # 4. the rare events: a trajectory ends (the lane takes the next start), stall checks
+        for j in range(L):
+            if not levent[j]:
+                continue
+            i = lidx[j]
+            if i < 0:
+                continue
+            x = lx[j]
+            y = ly[j]
+            code = 0
+            if lreg[j] == 2:
+                code = 1
+            elif lstep[j] >= max_steps:
+                code = 4
+            elif not lok[j]:
+                code = 3
+            elif luntil[j] != 0:
+                code = 2
+            else:
+                luntil[j] = stall_window
+                dxs = x - lcx[j]
+                dys = y - lcy[j]
+                if dxs * dxs + dys * dys < sd2:
+                    code = 3
+                lcx[j] = x
+                lcy[j] = y
+            if code != 0:
+                outcome[i] = code
+                n_steps[i] = lstep[j]
+                max_k[i] = lmk[j]
+                ex[i] = x
+                ey[i] = y
+                ez[i] = lf[j]  # height at the last evaluated point, as the reference
+                if nxt < n:
+                    lidx[j] = nxt
+                    lx[j] = xs[nxt]
+                    ly[j] = ys[nxt]
+                    lcx[j] = xs[nxt]
+                    lcy[j] = ys[nxt]
+                    lmk[j] = math.nan
+                    lstep[j] = 0
+                    luntil[j] = stall_window
+                    nxt += 1
+                else:
+                    lidx[j] = -1
+                    nact -= 1
+    # paths back to back in start order (points of one start were produced in step order)
+    offsets = np.zeros(n + 1, np.int64)
+    if not store:
+        return (outcome, n_steps, max_k, ex, ey, ez, offsets, bx[:0], by[:0], bz[:0], bk[:0],
+                br[:0])
+    for i in range(n):
+        offsets[i + 1] = offsets[i] + n_steps[i] + 1
+    px = np.empty(pos)
+    py = np.empty(pos)
+    pz = np.empty(pos)
+    pk = np.empty(pos)
+    pr = np.empty(pos, np.int8)
+    cur = offsets[:-1].copy()
+    for p in range(pos):
+        i = bi[p]
+        d = cur[i]
+        cur[i] = d + 1
+        px[d] = bx[p]
+        py[d] = by[p]
+        pz[d] = bz[p]
+        pk[d] = bk[p]
+        pr[d] = br[p]
+    return outcome, n_steps, max_k, ex, ey, ez, offsets, px, py, pz, pk, pr
 
+
+@njit(cache=True)
+def _grow(a, used, cap):
+    b = np.empty(cap, a.dtype)
+    b[:used] = a[:used]
+    return b

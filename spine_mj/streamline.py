@@ -187,6 +187,7 @@ class StreamlineResult:
 
 _KIND_GAUSS = 0
 _KIND_GRID = 1
+_LANES = 32  # starts the kernel steps together (one core, 2,000 starts: 8 -> 4.3e7 steps/s, 32 -> 6.5e7)
 
 def _get_kernel():
     from spine_mj._kernels import run_trajectories
@@ -250,7 +251,8 @@ def _trajectories(surface, starts, params, *, ideal, store_paths, backend):
         out = _get_kernel()(kind, g, coef, sp, np.asarray(surface.bounds, dtype=float), xs, ys,
                             bool(ideal), float(params.mu), float(params.dl), float(params.tol),
                             int(params.max_steps), int(params.stall_window),
-                            float(params.stall_distance_value), bool(store_paths))
+                            float(params.stall_distance_value), bool(store_paths),
+                            min(_LANES, xs.size))
     outcome, n_steps, max_k, ex, ey, ez, offsets, px, py, pz, pk, pr = out
     if not store_paths:
         offsets = px = py = pz = pk = pr = None

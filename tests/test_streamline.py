@@ -58,6 +58,28 @@ def test_kernel_matches_numpy_reference_random_and_grid():
     np.testing.assert_array_equal(r1.outcome, r2.outcome)
 
 
+@pytest.mark.parametrize("sign", [1, -1])
+def test_kernel_matches_reference_with_more_starts_than_lanes(sign):
+    # the kernel steps starts in lanes and refills a lane when its trajectory ends; paths
+    # come back in start order whatever the order in which trajectories finish
+    surf = single_gaussian(sign=sign)
+    starts = np.c_[np.linspace(-4.8, 0.0, 45), np.linspace(-4.8, 4.8, 45)]
+    p = StreamlineParams(mu=MU, dl=0.05, max_steps=120)
+    for fn in (streamlines, ideal_trajectories):
+        ref = fn(surf, starts, p, backend="numpy")
+        assert len(set(ref.outcome.tolist())) == 3  # lock, edge, cap: ragged lengths
+        for store in (True, False):
+            got = fn(surf, starts, p, backend="numba", store_paths=store)
+            np.testing.assert_array_equal(got.outcome, ref.outcome)
+            np.testing.assert_array_equal(got.n_steps, ref.n_steps)
+            np.testing.assert_allclose(got.max_kappa, ref.max_kappa, rtol=1e-9)
+            for key in ("end_x", "end_y", "end_z"):
+                np.testing.assert_allclose(getattr(got, key), getattr(ref, key), atol=1e-9)
+            if store:
+                _same(got, ref, 1e-9)
+                np.testing.assert_array_equal(got.offsets, ref.offsets)
+
+
 def test_store_paths_false_gives_the_same_summary():
     surf = single_gaussian(sign=-1)
     p = StreamlineParams(mu=MU)
