@@ -226,14 +226,18 @@ def _mujoco(case, surface, starts, upstream):
     k = p["record_every"]
     parts = []
     for i, r in enumerate(runs):
-        idx = np.unique(np.r_[np.arange(0, r.n, k), r.n - 1])
+        # every k-th step and the last one (a slice, not a copy, when k is 1)
+        idx = np.arange(0, r.n, k, dtype=np.int64)
+        if r.n and idx[-1] != r.n - 1:
+            idx = np.append(idx, r.n - 1)
+        rows = slice(None) if k == 1 else idx
+        pos = r.position_m[rows]
         parts.append({
-            "start": np.full(idx.size, i, np.int64), "step": idx.astype(np.int64),
-            "time_s": r.time_s[idx], "x": r.position_m[idx, 0] / s,
-            "y": r.position_m[idx, 1] / s, "z": r.position_m[idx, 2] / s,
-            "drive_force_n": r.drive_force_n[idx], "normal_force_n": r.normal_force_n[idx],
-            "tangential_force_n": r.tangential_force_n[idx], "slipping": r.slipping[idx],
-            "contact": r.contact[idx]})
+            "start": np.full(idx.size, i, np.int64), "step": idx,
+            "time_s": r.time_s[rows], "x": pos[:, 0] / s, "y": pos[:, 1] / s, "z": pos[:, 2] / s,
+            "drive_force_n": r.drive_force_n[rows], "normal_force_n": r.normal_force_n[rows],
+            "tangential_force_n": r.tangential_force_n[rows], "slipping": r.slipping[rows],
+            "contact": r.contact[rows]})
     traj = {c: np.concatenate([part[c] for part in parts]) for c in parts[0]}
     return AnalysisResult(metrics=metrics, trajectories=traj, status=status, reason=reason,
                           data=(rig, runs))

@@ -79,6 +79,8 @@ _MAX_TIMESTEP_S = 1e-3
 _REST_PENETRATION_FRACTION = 0.005
 _MIN_SPACING_PER_TIP_RADIUS = 0.25  # finer hfields exceed MuJoCo's 50 contacts per geom pair
 _BATCH_MEMORY_BYTES = 256 * 2**20
+_PLACE_CACHE_SIZE = 4096  # placements kept per rig (by start)
+_PIPELINE_PIECES = 8  # a batch group is simulated in up to this many pieces
 
 
 class Cone(enum.Enum):
@@ -757,15 +759,15 @@ class Rig:
         import mujoco
 
         x0, y0 = float(x0), float(y0)
-        if not bool(self.surface.contains(x0, y0)):
-            raise SpineInputError(f"start ({x0:g}, {y0:g}) lies outside the surface bounds "
-                                  f"{self.surface.bounds}")
+        self._check_start(x0, y0)
         s, r = self.length_scale_m, self.tip.tip_radius_m
         if getattr(self, "_place_model", None) is None or self._place_model[0] is not self.model:
             pm = copy.copy(self.model)
             pm.geom_margin[self.geom_tip] = 0.2 * r  # few contacts, but a gap above the surface
-            self._place_model = (self.model, pm, mujoco.MjData(pm))
-        _, m, d = self._place_model
+            self._place_model = (self.model, pm, mujoco.MjData(pm), {})
+        _, m, d, placed = self._place_model
+        if (x0, y0) in placed:  # the search is deterministic: a start seen before is reused
+            return placed[(x0, y0)].copy()
         _, _, elev, _ = self.hfield.size
 
         def probe(z):
@@ -801,7 +803,16 @@ class Rig:
         tc, dr = self.engine.solref
         a_p = self.scales.preload_n / self.tip.mass_kg
         z -= (1 - self.engine.solimp[1]) * a_p * (tc * dr) ** 2
-        return np.array([x0 * s, y0 * s, z])
+        qpos = np.array([x0 * s, y0 * s, z])
+        if len(placed) >= _PLACE_CACHE_SIZE:
+            placed.pop(next(iter(placed)))
+        placed[(x0, y0)] = qpos
+        return qpos.copy()
+
+    def _check_start(self, x0: float, y0: float) -> None:
+        if not bool(self.surface.contains(x0, y0)):
+            raise SpineInputError(f"start ({x0:g}, {y0:g}) lies outside the surface bounds "
+                                  f"{self.surface.bounds}")
 
     # ----------------------------------------------------------------- drive parameters
 
@@ -833,23 +844,28 @@ class Rig:
 
     # ----------------------------------------------------------------- controls
 
+    def _drive_steps(self, drive: Drive, x0_m: float, detection: Detection) -> int:
+        """Steps of the drive phase of an open-loop run starting at ``x0_m`` [m]."""
+        dt = self.engine.timestep_s
+        if isinstance(drive, SpringDrive):
+            duration = drive.duration_s
+            if duration is None:
+                stretch = (1 + self.tip.mu_s) * self.scales.preload_n / self._stiffness(drive)
+                duration = (1.1 * max(self.bounds_m[1] - x0_m, 0.0) + stretch) / drive.speed_m_s
+            return max(1, int(math.ceil(duration / dt)))
+        if isinstance(drive, StaticProbe):
+            cap = detection.kappa_cap * self.scales.preload_n
+            rate = self._rate(drive)
+            return max(1, int(math.ceil((cap - drive.start_force_n) / rate / dt)) + 2)
+        raise SpineInputError(f"open-loop controls exist for SpringDrive and StaticProbe, "
+                              f"got {type(drive).__name__}")
+
     def _controls(self, drive: Drive, qpos0: np.ndarray, detection: Detection) -> np.ndarray:
         """Open-loop controls ``(nstep, 6)``: ctrl (spring, push, preload) then mocap xyz."""
         dt = self.engine.timestep_s
         n_settle = self._settle_steps(drive)
         cap = detection.kappa_cap * self.scales.preload_n
-        if isinstance(drive, SpringDrive):
-            duration = drive.duration_s
-            if duration is None:
-                stretch = (1 + self.tip.mu_s) * self.scales.preload_n / self._stiffness(drive)
-                duration = (1.1 * max(self.bounds_m[1] - qpos0[0], 0.0) + stretch) / drive.speed_m_s
-            n_drive = max(1, int(math.ceil(duration / dt)))
-        elif isinstance(drive, StaticProbe):
-            rate = self._rate(drive)
-            n_drive = max(1, int(math.ceil((cap - drive.start_force_n) / rate / dt)) + 2)
-        else:
-            raise SpineInputError(f"open-loop controls exist for SpringDrive and StaticProbe, "
-                                  f"got {type(drive).__name__}")
+        n_drive = self._drive_steps(drive, qpos0[0], detection)
         n = n_settle + n_drive
         ctrl = np.zeros((n, 6))
         ctrl[:, 2] = -self.tip.preload_n
@@ -889,7 +905,11 @@ class Rig:
         ``drives`` is one drive for all starts or one per start (SpringDrive or StaticProbe;
         mixed kinds are allowed). Runs go through :func:`mujoco.rollout.rollout` on
         ``nthread`` native threads (default: CPU count), in groups sized to stay within
-        256 MiB of output; each run is then cut at its first end event.
+        256 MiB of output; each run is then cut at its first end event. A group runs in up
+        to 8 pieces, pipelined: while the native threads simulate one piece, the calling
+        thread analyses the previous one and places the next (``rollout`` releases the GIL);
+        the results are those of one run at a time. The arrays of a result are read-only
+        views of its group's columns.
         """
         import mujoco
         from mujoco import rollout
@@ -906,7 +926,8 @@ class Rig:
         if backend not in ("rollout", "python"):
             raise SpineInputError(f"backend must be 'rollout' or 'python', got {backend!r}")
         det = (Detection() if detection is None else detection).resolve(self.scales)
-        qpos0 = [self.place(*s) for s in starts]
+        for x0, y0 in starts:
+            self._check_start(x0, y0)
         by_stiffness: dict[float, object] = {}
         for d in drives:
             k = self._stiffness(d) if isinstance(d, SpringDrive) else 0.0
@@ -914,153 +935,230 @@ class Rig:
                 by_stiffness[k] = self._model_for(d)
         models = [by_stiffness[self._stiffness(d) if isinstance(d, SpringDrive) else 0.0]
                   for d in drives]
-        controls = [self._controls(d, q, det) for d, q in zip(drives, qpos0)]
+        s = self.length_scale_m
+        lengths = [self._settle_steps(d) + self._drive_steps(d, x0 * s, det)
+                   for d, (x0, _) in zip(drives, starts)]
         nstate = mujoco.mj_stateSize(self.model, mujoco.mjtState.mjSTATE_FULLPHYSICS)
         spec = int(mujoco.mjtState.mjSTATE_CTRL) | int(mujoco.mjtState.mjSTATE_MOCAP_POS)
         results: list[RunResult | None] = [None] * len(starts)
         # group runs of equal length (rollout needs one nstep per call)
-        order = sorted(range(len(starts)), key=lambda i: controls[i].shape[0])
+        order = sorted(range(len(starts)), key=lambda i: lengths[i])
         per_row = 8 * (nstate + self.model.nsensordata)
         nthread = os.cpu_count() or 1 if nthread is None else int(nthread)
-        pool = rollout.Rollout(nthread=nthread) if backend == "rollout" else None
+        batches = []
+        i = 0
+        while i < len(order):
+            nstep = lengths[order[i]]
+            group = [order[i]]
+            limit = max(1, _BATCH_MEMORY_BYTES // (per_row * nstep))
+            while (i + len(group) < len(order) and len(group) < limit
+                   and lengths[order[i + len(group)]] == nstep):
+                group.append(order[i + len(group)])
+            i += len(group)
+            # pieces of a group pipeline: one piece is simulated while the previous one is
+            # analysed (and the next one placed) on the calling thread
+            size = max(nthread, -(-len(group) // _PIPELINE_PIECES))
+            batches += [group[k:k + size] for k in range(0, len(group), size)]
+
+        def prepare(batch):
+            qpos0 = [self.place(*starts[j]) for j in batch]
+            ctrls = [self._controls(drives[j], q, det) for j, q in zip(batch, qpos0)]
+            init = np.zeros((len(batch), nstate))
+            init[:, 1:4] = qpos0
+            return batch, ctrls, init, np.stack(ctrls)
+
+        def analyse(batch, ctrls, state, sens, warn):
+            for j, res in zip(batch, self._analyse_group(
+                    [drives[j] for j in batch], [starts[j] for j in batch], state, sens, ctrls,
+                    det, warn)):
+                results[j] = res
+
+        if backend == "python":
+            for batch in batches:
+                batch, ctrls, init, ctrl = prepare(batch)
+                state, sens, warn = _python_rollout([models[j] for j in batch], init, ctrl)
+                analyse(batch, ctrls, state, sens, warn)
+            return results
+        import concurrent.futures as cf
+
+        pool = rollout.Rollout(nthread=nthread)
+        datas = [mujoco.MjData(self.model) for _ in range(max(1, nthread))]
+
+        def simulate(batch, init, ctrl):
+            return pool.rollout([models[j] for j in batch], datas, init, ctrl, control_spec=spec,
+                                initial_warmstart=np.zeros((len(batch), self.model.nv)))
+
         try:
-            i = 0
-            while i < len(order):
-                nstep = controls[order[i]].shape[0]
-                group = [order[i]]
-                limit = max(1, _BATCH_MEMORY_BYTES // (per_row * nstep))
-                while (i + len(group) < len(order) and len(group) < limit
-                       and controls[order[i + len(group)]].shape[0] == nstep):
-                    group.append(order[i + len(group)])
-                i += len(group)
-                init = np.zeros((len(group), nstate))
-                for row, j in enumerate(group):
-                    init[row, 1:4] = qpos0[j]
-                ctrl = np.stack([controls[j] for j in group])
-                if backend == "rollout":
-                    datas = [mujoco.MjData(self.model) for _ in range(max(1, nthread))]
-                    state, sens = pool.rollout([models[j] for j in group], datas, init, ctrl,
-                                               control_spec=spec,
-                                               initial_warmstart=np.zeros((len(group), self.model.nv)))
-                    warn = [None] * len(group)
-                else:
-                    state, sens, warn = _python_rollout([models[j] for j in group], init, ctrl)
-                for row, j in enumerate(group):
-                    results[j] = self._analyse(drives[j], starts[j], state[row], sens[row],
-                                               controls[j], det, warn[row])
+            with cf.ThreadPoolExecutor(max_workers=1) as sim_thread:
+                running = None
+                ready = prepare(batches[0]) if batches else None
+                for k in range(len(batches)):
+                    batch, ctrls, init, ctrl = ready
+                    future = sim_thread.submit(simulate, batch, init, ctrl)
+                    if running is not None:
+                        analyse(*running)
+                    ready = prepare(batches[k + 1]) if k + 1 < len(batches) else None
+                    running = (batch, ctrls, *future.result(), [None] * len(batch))
+                if running is not None:
+                    analyse(*running)
         finally:
-            if pool is not None:
-                pool.close()
+            pool.close()
         return results
 
     # ----------------------------------------------------------------- analysis
 
     def _columns(self, state: np.ndarray, sens: np.ndarray):
+        """Per-step columns of ``N`` steps (``state`` ``(N, nstate)``, ``sens`` ``(N, nsensordata)``).
+
+        Every column is a fresh C-contiguous array: the strided sensor slices are copied
+        once, so the arithmetic reads contiguous memory (the row-wise operations, einsum
+        and norm included, are those of a plain per-row evaluation: same results).
+        """
         a = self._sensor_adr
-        t = state[:, 0]
-        pos = sens[:, a["tip_pos"]:a["tip_pos"] + 3]
-        vel = sens[:, a["tip_vel"]:a["tip_vel"] + 3]
-        c_net = sens[:, a["contact_net"]:a["contact_net"] + 4]
-        c_deep = sens[:, a["contact_deepest"]:a["contact_deepest"] + 8]
-        contact = c_deep[:, 0] > 0
-        force = -c_net[:, 1:4]  # the sensor reports the force of the tip on the surface
-        normal = c_deep[:, 5:8].copy()
-        flip = np.where((normal[:, 2:3] < 0), -1.0, 1.0)
-        normal *= flip
-        normal[~contact] = np.nan
-        point = c_deep[:, 2:5].copy()
-        point[~contact] = np.nan
-        pen = np.where(contact, np.maximum(-c_deep[:, 1], 0.0), 0.0)
-        fn = np.where(contact, np.einsum("ij,ij->i", np.nan_to_num(normal), force), 0.0)
-        ft = np.where(contact, np.linalg.norm(force - fn[:, None] * np.nan_to_num(normal), axis=1), 0.0)
-        drive_f = sens[:, a["spring_force"]] + sens[:, a["push_force"]]
+        cn, cd = a["contact_net"], a["contact_deepest"]
+        t = state[:, 0].copy()
+        pos = sens[:, a["tip_pos"]:a["tip_pos"] + 3].copy()
+        vel = sens[:, a["tip_vel"]:a["tip_vel"] + 3].copy()
+        contact = sens[:, cd] > 0
+        no_contact = ~contact[:, None]
+        force = np.negative(sens[:, cn + 1:cn + 4])  # the sensor reports the tip's force on the surface
+        normal = sens[:, cd + 5:cd + 8].copy()
+        np.negative(normal, out=normal, where=normal[:, 2:3] < 0)  # point out of the surface
+        np.copyto(normal, np.nan, where=no_contact)
+        point = sens[:, cd + 2:cd + 5].copy()
+        np.copyto(point, np.nan, where=no_contact)
+        pen = np.where(contact, np.maximum(-sens[:, cd + 1], 0.0), 0.0)
         nn = np.nan_to_num(normal)
+        fn = np.where(contact, np.einsum("ij,ij->i", nn, force), 0.0)
+        ft = np.where(contact, np.linalg.norm(force - fn[:, None] * nn, axis=1), 0.0)
+        drive_f = sens[:, a["spring_force"]] + sens[:, a["push_force"]]
         vt = vel - np.einsum("ij,ij->i", vel, nn)[:, None] * nn
         return t, pos, vel, contact, normal, point, pen, fn, ft, drive_f, np.linalg.norm(vt, axis=1)
 
     def _analyse(self, drive, start, state, sens, ctrl, det: Detection, warnings) -> RunResult:
+        return self._analyse_group([drive], [start], state[None], sens[None], [ctrl], det,
+                                   [warnings])[0]
+
+    def _analyse_group(self, drives, starts, state, sens, ctrls, det: Detection,
+                       warnings) -> list[RunResult]:
+        """:meth:`_analyse` of a group of runs of equal length at once.
+
+        ``state`` ``(g, n, nstate)`` and ``sens`` ``(g, n, nsensordata)``: the per-step
+        columns and the event masks are computed for the whole group in one pass (the same
+        arithmetic per row as one run at a time); only the events of each run are read
+        per run.
+        """
+        g, n = state.shape[:2]
         dt = self.engine.timestep_s
-        t, pos, vel, contact, normal, point, pen, fn, ft, drive_f, vt = self._columns(state, sens)
-        n = t.size
-        n_settle = self._settle_steps(drive)
         fp = self.scales.preload_n
+        cols = self._columns(state.reshape(g * n, -1), sens.reshape(g * n, -1))
+        t, pos, vel, contact, normal, point, pen, fn, ft, drive_f, vt = (
+            c.reshape(g, n, *c.shape[1:]) for c in cols)
         slipping = vt > det.slip_speed_m_s
-        end, reason, detail = n - 1, EndReason.COMPLETED, "drive duration elapsed"
+        rows = np.arange(g)
+
+        def firsts(mask):
+            """First index of each row's True, or -1."""
+            idx = mask.argmax(axis=1)
+            return np.where(mask[rows, idx], idx, -1)
+
+        finite = np.isfinite(state).all(axis=2) & np.isfinite(sens).all(axis=2)
+        k_nonfinite = firsts(~finite)
+        expected = dt * np.arange(1, n + 1)
+        k_reset = firsts(np.abs(t - expected) > 0.5 * dt)
+        k_deep = firsts(pen > det.penetration_tol_m)
+        xmin, xmax, ymin, ymax = self.bounds_m
+        mg = det.domain_margin_m
+        px, py = pos[:, :, 0], pos[:, :, 1]
+        k_out = firsts((px < xmin + mg) | (px > xmax - mg) | (py < ymin + mg) | (py > ymax - mg))
+        cap = det.kappa_cap * fp
+        k_lock = firsts((drive_f >= cap * (1 - 1e-9)) & ~slipping)
+        results = []
+        for r in range(g):
+            drive = drives[r]
+            n_settle = self._settle_steps(drive)
+            candidates = []
+            if k_nonfinite[r] >= 0:
+                candidates.append((int(k_nonfinite[r]), 0, EndReason.ENGINE_TROUBLE,
+                                   "non-finite state"))
+            if k_reset[r] >= 0:
+                candidates.append((int(k_reset[r]), 0, EndReason.ENGINE_TROUBLE,
+                                   "MuJoCo reset the simulation (warning: bad qpos/qvel/qacc)"))
+            if warnings[r] is not None:
+                k, text = warnings[r]
+                if k is not None:
+                    candidates.append((k, 0, EndReason.ENGINE_TROUBLE, f"MuJoCo warning: {text}"))
+            if k_deep[r] >= 0:
+                k = int(k_deep[r])
+                candidates.append((k, 1, EndReason.ENGINE_TROUBLE,
+                                   f"penetration {pen[r, k]:.3g} m > tolerance "
+                                   f"{det.penetration_tol_m:.3g} m"))
+            if k_out[r] >= 0:
+                k = int(k_out[r])
+                candidates.append((k, 2, EndReason.LEFT_DOMAIN,
+                                   f"tip at ({pos[r, k, 0]:.4g}, {pos[r, k, 1]:.4g}) m left the "
+                                   "domain"))
+            if k_lock[r] >= 0:
+                candidates.append((int(k_lock[r]), 3, EndReason.SELF_LOCK,
+                                   f"drive force reached kappa_cap * F_p = {cap:.4g} N without slip"))
+            kappa = math.nan
+            if isinstance(drive, StaticProbe):
+                kappa = self._probe_events(candidates, pos[r], vt[r], drive_f[r], n_settle, det,
+                                            fp)
+            end, reason, detail = n - 1, EndReason.COMPLETED, "drive duration elapsed"
+            if candidates:
+                end, _, reason, detail = min(candidates, key=lambda c: (c[0], c[1]))
+            if reason is not EndReason.BREAKAWAY:
+                kappa = math.nan
+            sl = slice(0, end + 1)
+            events = _slip_events(slipping[r, sl], t[r, sl], n_settle)
+            events.append(Event(reason.value, end, float(t[r, end])))
+            onsets = [e.index for e in events if e.kind == "slip_onset"]
+            carriage = (ctrls[r][:, 3].copy() if isinstance(drive, SpringDrive)
+                        else np.full(n, np.nan))
+            results.append(self._result(
+                drive, starts[r], det, t[r], pos[r], vel[r], contact[r], normal[r], point[r],
+                pen[r], fn[r], ft[r], drive_f[r], carriage, slipping[r], sl, events, reason,
+                detail, n_settle, kappa, np.array([drive_f[r, i] / fp for i in onsets])))
+        return results
+
+    @staticmethod
+    def _probe_events(candidates, pos, vt, drive_f, n_settle, det: Detection,
+                      fp: float) -> float:
+        """Static probe: append slid/breakaway candidates; returns kappa_mj (NaN if none)."""
+        n = pos.shape[0]
+        kappa = math.nan
 
         def first(mask):
             idx = np.flatnonzero(mask)
             return int(idx[0]) if idx.size else None
 
-        candidates = []
-        finite = np.isfinite(state).all(axis=1) & np.isfinite(sens).all(axis=1)
-        k = first(~finite)
+        p_ref = pos[min(n_settle, n) - 1]
+        moved = np.linalg.norm(pos - pos[0], axis=1) > det.breakaway_distance_m
+        k_settle = first(moved[:n_settle])
+        if k_settle is not None:
+            candidates.append((k_settle, 4, EndReason.SLID,
+                               "the tip slid during settling at the start force"))
+        moved = np.linalg.norm(pos - p_ref, axis=1) > det.breakaway_distance_m
+        moved[:n_settle] = False
+        k = first(moved)
         if k is not None:
-            candidates.append((k, 0, EndReason.ENGINE_TROUBLE, "non-finite state"))
-        expected = dt * np.arange(1, n + 1)
-        k = first(np.abs(t - expected) > 0.5 * dt)
-        if k is not None:
-            candidates.append((k, 0, EndReason.ENGINE_TROUBLE,
-                               "MuJoCo reset the simulation (warning: bad qpos/qvel/qacc)"))
-        if warnings is not None:
-            k, text = warnings
-            if k is not None:
-                candidates.append((k, 0, EndReason.ENGINE_TROUBLE, f"MuJoCo warning: {text}"))
-        k = first(pen > det.penetration_tol_m)
-        if k is not None:
-            candidates.append((k, 1, EndReason.ENGINE_TROUBLE,
-                               f"penetration {pen[k]:.3g} m > tolerance {det.penetration_tol_m:.3g} m"))
-        xmin, xmax, ymin, ymax = self.bounds_m
-        mg = det.domain_margin_m
-        outside = ((pos[:, 0] < xmin + mg) | (pos[:, 0] > xmax - mg)
-                   | (pos[:, 1] < ymin + mg) | (pos[:, 1] > ymax - mg))
-        k = first(outside)
-        if k is not None:
-            candidates.append((k, 2, EndReason.LEFT_DOMAIN,
-                               f"tip at ({pos[k, 0]:.4g}, {pos[k, 1]:.4g}) m left the domain"))
-        cap = det.kappa_cap * fp
-        k = first((drive_f >= cap * (1 - 1e-9)) & ~slipping)
-        if k is not None:
-            candidates.append((k, 3, EndReason.SELF_LOCK,
-                               f"drive force reached kappa_cap * F_p = {cap:.4g} N without slip"))
-        kappa = math.nan
-        if isinstance(drive, StaticProbe):
-            p_ref = pos[min(n_settle, n) - 1]
-            moved = np.linalg.norm(pos - pos[0], axis=1) > det.breakaway_distance_m
-            k_settle = first(moved[:n_settle])
-            if k_settle is not None:
-                candidates.append((k_settle, 4, EndReason.SLID,
-                                   "the tip slid during settling at the start force"))
-            moved = np.linalg.norm(pos - p_ref, axis=1) > det.breakaway_distance_m
-            moved[:n_settle] = False
-            k = first(moved)
-            if k is not None:
-                stuck = np.flatnonzero(vt[:k] <= det.stick_speed_m_s)
-                j = int(stuck[-1]) if stuck.size else n_settle - 1
-                f_break = drive_f[max(j, n_settle - 1)]
-                if pos[k, 0] - p_ref[0] <= 0 or j < n_settle:
-                    candidates.append((k, 4, EndReason.SLID,
-                                       f"the tip slid against the drive at F = {f_break:.4g} N"))
-                else:
-                    kappa = float(f_break / fp)
-                    candidates.append((k, 4, EndReason.BREAKAWAY,
-                                       f"breakaway at F = {f_break:.4g} N, kappa_mj = {kappa:.4g}"))
-        if candidates:
-            end, _, reason, detail = min(candidates, key=lambda c: (c[0], c[1]))
-        if reason is not EndReason.BREAKAWAY:
-            kappa = math.nan
-        sl = slice(0, end + 1)
-        events = _slip_events(slipping[sl], t[sl], n_settle)
-        events.append(Event(reason.value, end, float(t[end])))
-        onsets = [e.index for e in events if e.kind == "slip_onset"]
-        carriage = ctrl[:, 3].copy() if isinstance(drive, SpringDrive) else np.full(n, np.nan)
-        return self._result(drive, start, det, t, pos, vel, contact, normal, point, pen, fn, ft,
-                            drive_f, carriage, slipping, sl, events, reason, detail, n_settle, kappa,
-                            np.array([drive_f[i] / fp for i in onsets]))
+            stuck = np.flatnonzero(vt[:k] <= det.stick_speed_m_s)
+            j = int(stuck[-1]) if stuck.size else n_settle - 1
+            f_break = drive_f[max(j, n_settle - 1)]
+            if pos[k, 0] - p_ref[0] <= 0 or j < n_settle:
+                candidates.append((k, 4, EndReason.SLID,
+                                   f"the tip slid against the drive at F = {f_break:.4g} N"))
+            else:
+                kappa = float(f_break / fp)
+                candidates.append((k, 4, EndReason.BREAKAWAY,
+                                   f"breakaway at F = {f_break:.4g} N, kappa_mj = {kappa:.4g}"))
+        return kappa
 
     def _result(self, drive, start, det, t, pos, vel, contact, normal, point, pen, fn, ft, drive_f,
                 carriage, slipping, sl, events, reason, detail, n_settle, kappa, slip_kappas):
         def cut(a):
-            out = np.ascontiguousarray(a[sl])
+            out = a[sl]  # a view of the group's column (C-contiguous rows), read-only
             out.flags.writeable = False
             return out
 

@@ -887,7 +887,7 @@ def _traj_table(traj: Mapping[str, np.ndarray], analysis: str):
 
     cols = {k: np.asarray(v) for k, v in traj.items()}
     n = len(next(iter(cols.values())))
-    return pa.table({"analysis": pa.array([analysis] * n, pa.string()), **cols})
+    return pa.table({"analysis": pa.repeat(pa.scalar(analysis, pa.string()), n), **cols})
 
 
 # --------------------------------------------------------------------------- the store
@@ -1058,13 +1058,36 @@ def _remove_temporaries(out_dir: Path) -> None:
 
 
 def _store_case(out_dir: Path, case_id: str, rows, traj) -> None:
+    _store_encoded(out_dir, _encode_case(case_id, rows, traj))
+
+
+def _encode_case(case_id: str, rows, traj) -> tuple:
+    """A finished case as Parquet bytes: ``(case_id, statuses, rows file, trajectory file)``.
+
+    Workers encode (the CPU-heavy part of writing) and send these few compressed bytes back;
+    the process that owns the store only writes them (:func:`_store_encoded`), so workers
+    need no shared file system.
+    """
+    import pyarrow as pa
     import pyarrow.parquet as pq
 
-    if traj is not None:
+    def encode(table, **kwargs) -> bytes:
+        sink = pa.BufferOutputStream()
+        pq.write_table(table, sink, **kwargs)
+        return sink.getvalue().to_pybytes()
+
+    traj_bytes = (None if traj is None
+                  else encode(traj, row_group_size=65_536, use_dictionary=["analysis"]))
+    return case_id, rows["status"].to_pylist(), encode(rows), traj_bytes
+
+
+def _store_encoded(out_dir: Path, encoded: tuple) -> None:
+    case_id, _, rows_bytes, traj_bytes = encoded
+    if traj_bytes is not None:
         with atomic_output(out_dir / TRAJ_DIR / f"{case_id}.parquet") as tmp:
-            pq.write_table(traj, tmp, row_group_size=65_536, use_dictionary=["analysis"])
-    with atomic_output(out_dir / RUNS_DIR / f"{case_id}.parquet") as tmp:
-        pq.write_table(rows, tmp)
+            tmp.write_bytes(traj_bytes)
+    with atomic_output(out_dir / RUNS_DIR / f"{case_id}.parquet") as tmp:  # written last: done
+        tmp.write_bytes(rows_bytes)
 
 
 def consolidate(out_dir: str | os.PathLike):
@@ -1185,23 +1208,23 @@ def _run_locked(config, cases, out_dir, session, *, n_workers, scheduler, overwr
                               failed_runs=counts["failed"],
                               elapsed_s=time.perf_counter() - t0, case_id=case_id))
 
-    def handle(case_id, rows, traj):
-        _store_case(out_dir, case_id, rows, traj)
-        ok = sum(1 for s in rows["status"].to_pylist() if s == "ok")
+    def handle(encoded):
+        _store_encoded(out_dir, encoded)
+        case_id, statuses = encoded[:2]
+        ok = sum(1 for s in statuses if s == "ok")
         counts["finished"] += 1
         counts["ok"] += ok
-        counts["failed"] += rows.num_rows - ok
+        counts["failed"] += len(statuses) - ok
         report(case_id)
 
     report(None)
     if todo:
         if scheduler is not None:
-            _run_dask(todo, scheduler, handle)
+            _run_dask(_longest_first(todo), scheduler, handle)
         elif n_workers == 1:
-            for case in todo:
-                handle(case.case_id, *run_case(case))
+            _run_here(todo, handle)
         else:
-            _run_processes(todo, n_workers, handle)
+            _run_processes(_longest_first(todo), n_workers, handle)
     table = consolidate(out_dir)
     status_counts = {}
     if table.num_rows:
@@ -1216,7 +1239,43 @@ def _run_locked(config, cases, out_dir, session, *, n_workers, scheduler, overwr
 
 
 def _run_case_remote(case: Case):
-    return (case.case_id, *run_case(case))
+    return _encode_case(case.case_id, *run_case(case))
+
+
+def _run_here(todo: list[Case], handle) -> None:
+    """One worker: the cases run in this process, in order; each case's store files are
+    encoded and written on a helper thread while the next case runs (pyarrow releases the
+    GIL), and handled here in order as they complete."""
+    import concurrent.futures as cf
+
+    with cf.ThreadPoolExecutor(max_workers=1) as writer:
+        pending = None
+        for case in todo:
+            rows, traj = run_case(case)
+            if pending is not None:
+                handle(pending.result())
+            pending = writer.submit(_encode_case, case.case_id, rows, traj)
+        if pending is not None:
+            handle(pending.result())
+
+
+def _case_cost(case: Case) -> float:
+    """A rough relative cost of a case, to start the longest cases first (the order of the
+    cases changes no result). MuJoCo spring runs last ~ 1 / speed ~ I_e^-1/2."""
+    p = case.params
+    cost = 1.0
+    if "mujoco" in case.analyses and p.get("protocol", "spring") == "spring":
+        if p.get("duration") is not None:
+            cost = float(p["duration"])
+        elif p.get("speed") is not None:
+            cost = 1.0 / float(p["speed"])
+        else:
+            cost = (1e-3 if p.get("ie") is None else float(p["ie"])) ** -0.5
+    return cost * case.starts.count
+
+
+def _longest_first(todo: list[Case]) -> list[Case]:
+    return sorted(todo, key=lambda c: -_case_cost(c))  # stable: ties keep the config order
 
 
 def _run_processes(todo: list[Case], n_workers: int, handle) -> None:
@@ -1244,13 +1303,14 @@ def _run_pool(todo: list[Case], n_workers: int, handle) -> None:
 
     ctx = multiprocessing.get_context("forkserver")
     # workers fork from a server that has imported these once
+    # (pandas: pyarrow imports it when it builds a table; mujoco: spine_mj.sim imports it lazily)
     ctx.set_forkserver_preload(["spine_mj.sweep", "spine_mj.streamline", "spine_mj.sim",
-                                "pyarrow.parquet"])
+                                "pyarrow.parquet", "pandas", "mujoco", "mujoco.rollout"])
     with cf.ProcessPoolExecutor(max_workers=n_workers, mp_context=ctx) as pool:
         futures = [pool.submit(_run_case_remote, c) for c in todo]
         try:
             for fut in cf.as_completed(futures):
-                handle(*fut.result())
+                handle(fut.result())
         except BaseException:
             for f in futures:
                 f.cancel()
@@ -1268,7 +1328,7 @@ def _run_dask(todo: list[Case], scheduler, handle) -> None:
         for fut in as_completed(futures):
             result = fut.result()
             fut.release()
-            handle(*result)
+            handle(result)
     finally:
         if own:
             client.close()
