@@ -142,7 +142,8 @@ def study_random(quick):
     for ov, ms, sr in ((True, 2.0, (0.5, 1.5)), (False, 1.0, (0.3, 0.6)),
                        (False, 1.5, (0.3, 0.6))):
         for ar in ((0.15, 0.45), (0.2, 0.5), (0.25, 0.55), (0.3, 0.6)):
-                grid.append(dict(overlap=ov, min_separation=ms, sigma_range=sr, amplitude_range=ar))
+                grid.append(dict(overlap=ov, min_separation=ms, sigma_range=sr, amplitude_range=ar,
+                                 k_range=None))
     if quick:
         grid = grid[::3]
     rows = []
@@ -155,16 +156,16 @@ def study_random(quick):
     rows.sort(key=lambda r: r[0])
     # sensitivity around the preset defaults
     sens = []
-    variants = [("defaults", {})]
+    variants = [("defaults", {"n_runs": None})]
     for mu in (1.15, 1.2, 1.3, 1.35):
         variants.append((f"mu {mu}", {"mu": mu}))
-    variants += [("starts: 100 along one left edge", {"starts": "edge"}),
+    variants += [("starts: 100 along one left edge", {"starts": "edge", "n_runs": 100}),
                  ("kappa cap 50 in the median", {"kappa_cap": 50.0}),
                  ("dl halved", {"dl": None})]
     for label, over in variants:
         if "dl" in over:
             continue
-        n, fig = random_gaussian(n_runs=runs, **over)
+        n, fig = random_gaussian(**({"n_runs": None} | over))
         if label == "defaults":
             fig.savefig(OUT / "cal_random_gaussian_default.png", dpi=100)
             default = n
@@ -208,6 +209,106 @@ def study_fractal(quick):
     return hursts, n_surf, rows, full, wall
 
 
+# --------------------------------------------------------------------------- hypotheses (issue 3)
+
+MED = ("convex_median_ideal", "convex_median_streamline", "concave_median_ideal",
+       "concave_median_streamline")
+K_FAMILY = {"overlap": True, "sigma_range": (0.5, 1.5)}
+
+
+def rg_line(label, n):
+    return [label, *[fmt(float(n[k]) if n[k] != "inf" else math.inf) for k in MED],
+            pct(n["bypass_change"]) if n["bypass_change"] is not None else "-",
+            pct(n["trap_change"]) if n["trap_change"] is not None else "-",
+            f'{n["convex_self_locked_streamline"]}/{n["concave_self_locked_streamline"]}',
+            pct(max(abs(rel(n[k], PAPER_RG[k])) for k in MED))]
+
+
+def study_hypotheses(quick):
+    """H1-H3 on random Gaussian surfaces, H4 on fractal surfaces."""
+    runs = 40 if quick else 100
+    out = {}
+    # H1: max-kappa convention and its dl dependence on a family where > 50 % of the concave
+    # streamlines self-lock (for the defaults the convention changes nothing: few self-lock)
+    h1 = []
+    fams = [("preset family (k on [0, 0.7 pi])", {}),
+            ("k = pi/2 for all peaks", dict(K_FAMILY, k_range=(math.pi / 2, math.pi / 2))),
+            ("sep 1.5, sigma (0.3, 0.6), a (0.3, 0.6)",
+             dict(overlap=False, min_separation=1.5, sigma_range=(0.3, 0.6),
+                  amplitude_range=(0.3, 0.6), k_range=None))]
+    dls = (0.015, 0.06) if quick else (0.0075, 0.015, 0.03, 0.06, 0.12, 0.24)
+    for label, g in fams:
+        for conv in ("inf", "finite"):
+            for dl in (dls if conv == "finite" else (0.015,)):
+                n, fig = random_gaussian(n_runs=runs, max_kappa=conv, dl=dl, **g)
+                plt.close(fig)
+                h1.append(rg_line(f"{label}; {conv}; dl {dl}", n))
+    out["h1"] = h1
+    # H2: start point
+    h2 = []
+    for off in (1e-9, 0.05, 0.5, 1.0):
+        n, fig = random_gaussian(n_runs=runs, x0_offset=off)
+        plt.close(fig)
+        h2.append([f"x0 = -10 + {off:g}",
+                   f'{n["convex_starts_in_slip"]}/{n["concave_starts_in_slip"]}',
+                   *rg_line("", n)[1:]])
+    n, fig = random_gaussian(n_runs=runs, starts="edge")
+    plt.close(fig)
+    h2.append(["one surface, 100 starts along the left edge",
+               f'{n["convex_starts_in_slip"]}/{n["concave_starts_in_slip"]}', *rg_line("", n)[1:]])
+    out["h2"] = h2
+    # H3: random-field families with the single peak's normalization a = k / (2 pi sigma^2)
+    h3 = []
+    pooled = 100 if quick else 500
+    kfams = [("sigma (0.5, 1.5), k = pi/4", dict(K_FAMILY, k_range=(math.pi / 4,) * 2)),
+             ("sigma (0.5, 1.5), k = 3 pi/8", dict(K_FAMILY, k_range=(3 * math.pi / 8,) * 2)),
+             ("sigma (0.5, 1.5), k = pi/2", dict(K_FAMILY, k_range=(math.pi / 2,) * 2)),
+             ("sigma (0.5, 1.5), k = 10 pi (paper's k)", dict(K_FAMILY, k_range=(10 * math.pi,) * 2)),
+             ("sigma 1.5, k = 10 pi (paper's single peak x 100)",
+              dict(K_FAMILY, sigma_range=(1.5, 1.5), k_range=(10 * math.pi,) * 2)),
+             ("sigma (1, 2), k = 1.5 pi", dict(K_FAMILY, sigma_range=(1.0, 2.0),
+                                                 k_range=(1.5 * math.pi,) * 2)),
+             ("sigma (1, 2), k on [0, 3 pi]", dict(K_FAMILY, sigma_range=(1.0, 2.0),
+                                                     k_range=(0.0, 3 * math.pi))),
+             ("sigma (0.3, 0.6), k on [0, 3 pi/16]", dict(K_FAMILY, sigma_range=(0.3, 0.6),
+                                                            k_range=(0.0, 3 * math.pi / 16)))]
+    for khi in ((0.7,) if quick else (0.6, 0.65, 0.7, 0.75, 0.8)):
+        kfams.append((f"sigma (0.5, 1.5), k on [0, {khi} pi]",
+                      dict(K_FAMILY, k_range=(0.0, khi * math.pi))))
+    for label, g in kfams:
+        n, fig = random_gaussian(n_runs=pooled, **g)
+        plt.close(fig)
+        h3.append(rg_line(f"{label} ({pooled} runs)", n))
+    out["h3"] = h3
+    # batch-to-batch scatter of 100-run medians (the paper's sample size)
+    spread = []
+    for label, g in (("preset family", {}),
+                     ("previous defaults (sep 1.5, sigma (0.3, 0.6), a (0.15, 0.45))",
+                      dict(overlap=False, min_separation=1.5, sigma_range=(0.3, 0.6),
+                           amplitude_range=(0.15, 0.45), k_range=None))):
+        for seed in ((1, 1001) if quick else (1, 1001, 2001, 3001, 4001)):
+            n, fig = random_gaussian(n_runs=runs, seed=seed, **g)
+            plt.close(fig)
+            spread.append(rg_line(f"{label}, seeds {seed}..{seed + runs - 1}", n))
+    out["spread"] = spread
+    # H4: fractal shares: lock point vs one step before, dl, and ideal trajectories
+    h4 = []
+    hs = [0.65, 0.8, 0.95]
+    nsurf = 60 if quick else 150
+    cases = [(dl, lp, "streamline") for dl in ((0.02, 0.01) if quick else (0.04, 0.02, 0.01, 0.005))
+             for lp in ("lock", "before")]
+    cases.append((0.01, "lock", "ideal"))
+    for dl, lp, tr in cases:
+        n, fig = fractal_hurst(surfaces=nsurf, hursts=hs, dl=dl, lock_point=lp, trajectory=tr)
+        plt.close(fig)
+        for e in n["by_hurst"]:
+            h4.append([tr, lp, dl, e["hurst"], fmt(e["rate_mean"], 2),
+                       *[fmt(e[k], 2) for k in ("sect_concave_mean", "hess_concave_mean",
+                                                 "hess_saddle_mean", "hess_convex_mean")]])
+    out["h4"] = (nsurf, h4)
+    return out
+
+
 # --------------------------------------------------------------------------- report
 
 
@@ -223,6 +324,10 @@ def main():
     print(f"random Gaussian done {time.perf_counter() - t0:.0f} s", flush=True)
     hursts, n_surf, fr_rows, fr, fr_wall = study_fractal(quick)
     print(f"fractal done {time.perf_counter() - t0:.0f} s", flush=True)
+    hy = study_hypotheses(quick)
+    print(f"hypotheses done {time.perf_counter() - t0:.0f} s", flush=True)
+    rg_head = ["variant", "cvx ideal", "cvx stream", "ccv ideal", "ccv stream", "bypass", "trap",
+               "locked", "worst"]
 
     eng = {name: load_preset(name).extras for name in
            ("paper-single-peak", "paper-random-convex", "paper-fractal")}
@@ -277,6 +382,34 @@ def main():
                   fmt(e["hess_saddle_mean"], 2), fmt(e["hess_convex_mean"], 2)]
                  for e in fr["by_hurst"]]), "",
           "![fractal default](cal_fractal_default.png)", "",
+          "## 4. Hypotheses about what the paper did", "",
+          "### H1. Max kappa over the finite values (self-lock step excluded)", "",
+          "`finite`: a self-locked path scores the largest kappa over its engaged points, i.e.",
+          "the last one before the self-lock boundary, where kappa diverges as A -> 0; `inf`:",
+          "self-locked = inf (ranked highest). The two differ only when a median falls among",
+          "self-locked paths; the `finite` value then scales roughly as 1/dl (halving dl about",
+          "doubles it), so it is a property of the step, not of the surface. A median near 11",
+          "needs dl ~ 0.2 (about 0.2-0.5 sigma), 20-50 x the paper's dl ~ 0.01 sigma.", "",
+          table(rg_head, hy["h1"]), "",
+          "### H2. Start point (one surface per run, one start on y = 0 at the left edge)", "",
+          "The implementation runs the ideal trajectory and the streamline from the same start",
+          "(x0 = -10 + offset, y0 = 0), one new surface per run, as the paper's Fig. 5A/D and",
+          "'100 simulations' read. `slip starts` = starts in the slip region (convex/concave).", "",
+          table(["start", "slip starts", *rg_head[1:]], hy["h2"]), "",
+          "### H3. Random-field families with the single peak's normalization", "",
+          "a = k / (2 pi sigma^2) per peak (Figs. 3-4 use k = 10 pi, sigma = 1.5), overlapping",
+          "centres. With the paper's k = 10 pi every family self-locks almost everywhere",
+          "(medians inf, or 0 when starts already sit in the self-lock region); k must be",
+          "10-40 x smaller for medians near 3.", "",
+          table(rg_head, hy["h3"]), "",
+          "Scatter of 100-run medians (the paper's sample size) between disjoint seed batches:", "",
+          table(rg_head, hy["spread"]), "",
+          "### H4. Fractal shares: where the self-lock point is classified", "",
+          f"{hy['h4'][0]} surfaces per H. `lock`: the first self-lock point the trajectory",
+          "reaches; `before`: the engaged point one step earlier; `ideal`: the same statistics",
+          "for ideal trajectories (the paper's Fig. 9 uses streamlines).", "",
+          table(["trajectory", "point", "dl", "H", "self-lock rate", "sectional concave",
+                 "Hessian concave", "Hessian saddle", "Hessian convex"], hy["h4"][1]), "",
           "## Defaults chosen", "",
           f"- single peak: mu_s = {sp['mu']}, y0 scan {sp['y0_range']} step {sp['y0_step']}: "
           f"convex {fmt(sp['convex_ratio'])} (paper 0.833), concave {fmt(sp['concave_ratio'])} "

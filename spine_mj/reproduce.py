@@ -17,11 +17,11 @@ from concurrent.futures import ProcessPoolExecutor
 import numpy as np
 
 from spine_mj.convexity import CONCAVE, CONVEX, SADDLE, hessian_class, sectional_class
-from spine_mj.engagement import kappa
+from spine_mj.engagement import ENGAGED, SLIP, kappa
 from spine_mj.errors import SpineInputError
 from spine_mj.presets import load_preset
 from spine_mj.streamline import Outcome, StreamlineParams, ideal_trajectories, streamlines
-from spine_mj.surfaces import fractal_fbm, random_gaussians, single_gaussian
+from spine_mj.surfaces import GaussianSurface, fractal_fbm, random_gaussians, single_gaussian
 
 __all__ = ["REPRODUCTIONS", "fractal_hurst", "kappa_map", "random_gaussian", "raw_rms_height",
            "run", "single_peak"]
@@ -139,20 +139,62 @@ def kappa_map(*, quick: bool = False, progress: Progress = None, mu: float | Non
 # --------------------------------------------------------------------------- Fig. 5
 
 
+def _random_surface(gen: dict, seed: int):
+    """One random Gaussian surface from the preset's generator table ``gen``.
+
+    Besides :func:`~spine_mj.surfaces.random_gaussians`' own parameters, ``k_range``
+    (when set) applies the single peak's normalization of Figs. 3-4 to every peak: the
+    amplitude is ``k / (2 pi sigma_x sigma_y)`` with ``k`` uniform on ``k_range`` (equal
+    ends: one fixed ``k``), replacing ``amplitude_range``. Centres and widths are drawn as
+    without it, so one seed gives the same layout either way.
+    """
+    gen = dict(gen)
+    k_range = gen.pop("k_range", None)
+    surf = random_gaussians(**gen, rng=seed)
+    if k_range is None:
+        return surf
+    k_lo, k_hi = (float(v) for v in k_range)
+    if not (0 <= k_lo <= k_hi and k_hi > 0):
+        raise SpineInputError(f"k_range must satisfy 0 <= lo <= hi, hi > 0, got {k_range!r}")
+    k = np.random.default_rng([seed, 7]).uniform(k_lo, k_hi, surf.amplitude.size)
+    amp = np.sign(surf.amplitude) * k / (2 * np.pi * surf.sigma_x * surf.sigma_y)
+    return GaussianSurface(amplitude=amp, center_x=surf.center_x, center_y=surf.center_y,
+                           sigma_x=surf.sigma_x, sigma_y=surf.sigma_y, bounds=surf.bounds,
+                           unit=surf.unit, metadata=dict(surf.metadata, k_range=[k_lo, k_hi]))
+
+
+def _max_kappa(res, convention: str) -> np.ndarray:
+    """Max kappa per trajectory under ``convention``: ``"inf"`` (self-locked = inf, the
+    kernel's value) or ``"finite"`` (largest kappa over the engaged points only: the
+    self-lock step is excluded, so a self-locked path scores the last engaged kappa before
+    the self-lock boundary). NaN (slip points only) is returned as NaN in both."""
+    if convention == "inf":
+        return res.max_kappa
+    vals = np.where(res.region == ENGAGED, res.kappa, -np.inf)
+    out = np.maximum.reduceat(vals, res.offsets[:-1])
+    return np.where(np.isneginf(out), np.nan, out)
+
+
 def random_gaussian(*, quick: bool = False, progress: Progress = None, mu: float | None = None,
                     n_runs: int | None = None, starts: str | None = None,
-                    kappa_cap: float | None = None, **params):
+                    kappa_cap: float | None = None, max_kappa: str | None = None,
+                    dl: float | None = None, x0_offset: float | None = None,
+                    seed: int | None = None, **params):
     """Fig. 5: medians of the maximum kappa along ideal and streamline trajectories on
     random convex and concave Gaussian surfaces.
 
     ``starts`` (preset ``[reproduce] starts``): ``"surfaces"`` runs one surface per run
-    (seeds ``seed, seed + 1, ...``) with one start at the left edge on ``y = y0``;
-    ``"edge"`` runs ``n_runs`` starts spread evenly along the left edge of one surface.
-    Conventions for the medians: a self-locked trajectory has max kappa = inf (ranked
-    highest, so the median is finite while fewer than half self-lock) or ``kappa_cap``
-    when one is set; a trajectory that met only slip points (max kappa NaN) counts as 0.
-    The self-lock counts are reported beside the medians. Extra keyword arguments replace
-    the presets' generator parameters (both surfaces).
+    (seeds ``seed, seed + 1, ...``) with one start ``x0_offset`` inside the left edge on
+    ``y = y0``; ``"edge"`` runs ``n_runs`` starts spread evenly along the left edge of one
+    surface. Conventions for the medians (``max_kappa``, preset ``[reproduce] max_kappa``):
+    ``"inf"``, a self-locked trajectory has max kappa = inf (ranked highest, so the median is
+    finite while fewer than half self-lock) or ``kappa_cap`` when one is set; ``"finite"``,
+    the self-lock step is excluded and the max is taken over the engaged points (it then
+    depends on ``dl``, since kappa diverges at the self-lock boundary). A trajectory that met
+    only slip points counts as 0. The self-lock counts and the number of starts in the slip
+    region are reported beside the medians. Extra keyword arguments replace the presets'
+    generator parameters (both surfaces); ``k_range`` there selects the single-peak
+    normalization (:func:`_random_surface`). ``seed`` replaces the presets' first seed.
     """
     numbers = {"paper": {"convex_median_ideal": 3.18, "convex_median_streamline": 2.87,
                          "concave_median_ideal": 3.22, "concave_median_streamline": 11.34,
@@ -165,28 +207,41 @@ def random_gaussian(*, quick: bool = False, progress: Progress = None, mu: float
         runs = int(n_runs if n_runs is not None else rep.get("n_runs", 100))
         mode = str(starts if starts is not None else rep.get("starts", "surfaces"))
         cap = kappa_cap if kappa_cap is not None else rep.get("kappa_cap")
+        conv = str(max_kappa if max_kappa is not None else rep.get("max_kappa", "inf"))
+        off = float(x0_offset if x0_offset is not None else rep.get("x0_offset", 1e-9))
         if mode not in ("surfaces", "edge"):
             raise SpineInputError(f"starts must be 'surfaces' or 'edge', got {mode!r}")
+        if conv not in ("inf", "finite"):
+            raise SpineInputError(f"max_kappa must be 'inf' or 'finite', got {conv!r}")
         if quick:
             runs = min(runs, 30)
-        dl = float(rep.get("dl", 0.015))
+        step = float(dl if dl is not None else rep.get("dl", 0.015))
         gen = dict(pre.params, **params)
-        seed0 = int(pre.seed or 0)
-        params_s = StreamlineParams(mu=m, dl=dl)
-        if mode == "surfaces":
-            jobs = [(random_gaussians(**gen, rng=seed0 + r), None) for r in range(runs)]
-        else:
-            jobs = [(random_gaussians(**gen, rng=seed0), None)]
-        ideal_max, stream_max = [], []
-        for surf, _ in jobs:
+        if "k_range" in rep and "k_range" not in params:
+            gen["k_range"] = rep["k_range"]
+        if gen.get("k_range") is None:
+            gen.pop("k_range", None)
+        seed0 = int(seed if seed is not None else (pre.seed or 0))
+        params_s = StreamlineParams(mu=m, dl=step)
+        seeds = range(seed0, seed0 + runs) if mode == "surfaces" else [seed0]
+        store = conv == "finite"
+        ideal_max, stream_max, ideal_lock, stream_lock, slip_start = [], [], [], [], 0
+        for s in seeds:
+            surf = _random_surface(gen, s)
             xmin, _, ymin, ymax = surf.bounds
             if mode == "surfaces":
-                pts = [(xmin + 1e-9, float(rep.get("y0", 0.0)))]
+                pts = np.array([(xmin + off, float(rep.get("y0", 0.0)))])
             else:
                 ys = ymin + (ymax - ymin) * (np.arange(runs) + 0.5) / runs
-                pts = np.c_[np.full(runs, xmin + 1e-9), ys]
-            ideal_max.append(ideal_trajectories(surf, pts, params_s, store_paths=False).max_kappa)
-            stream_max.append(streamlines(surf, pts, params_s, store_paths=False).max_kappa)
+                pts = np.c_[np.full(runs, xmin + off), ys]
+            _, fx0, fy0 = surf.evaluate(pts[:, 0], pts[:, 1], order=1)
+            slip_start += int((kappa(fx0, fy0, m)[1] == SLIP).sum())
+            ri = ideal_trajectories(surf, pts, params_s, store_paths=store)
+            rs = streamlines(surf, pts, params_s, store_paths=store)
+            ideal_max.append(_max_kappa(ri, conv))
+            stream_max.append(_max_kappa(rs, conv))
+            ideal_lock.append(ri.self_locked)
+            stream_lock.append(rs.self_locked)
         ideal_max, stream_max = np.concatenate(ideal_max), np.concatenate(stream_max)
         ranked = []
         for v in (ideal_max, stream_max):
@@ -196,11 +251,15 @@ def random_gaussian(*, quick: bool = False, progress: Progress = None, mu: float
         numbers[f"{name}_mu"] = m
         numbers[f"{name}_runs"] = runs
         numbers[f"{name}_starts"] = mode
+        numbers[f"{name}_dl"] = step
+        numbers[f"{name}_x0_offset"] = off
+        numbers[f"{name}_max_kappa"] = conv
         numbers[f"{name}_kappa_cap"] = cap
         numbers[f"{name}_median_ideal"] = med_i
         numbers[f"{name}_median_streamline"] = med_s
-        numbers[f"{name}_self_locked_ideal"] = int(np.isposinf(ideal_max).sum())
-        numbers[f"{name}_self_locked_streamline"] = int(np.isposinf(stream_max).sum())
+        numbers[f"{name}_self_locked_ideal"] = int(np.concatenate(ideal_lock).sum())
+        numbers[f"{name}_self_locked_streamline"] = int(np.concatenate(stream_lock).sum())
+        numbers[f"{name}_starts_in_slip"] = slip_start
         scatter[name] = (ideal_max, stream_max)
         if progress:
             progress(k + 1, 2)
@@ -230,20 +289,26 @@ def raw_rms_height(hurst: float, nx: int, size: float) -> float:
 
 
 def _fractal_chunk(args):
-    hurst, seeds, gen, mu, dl, scale = args
+    hurst, seeds, gen, mu, dl, scale, lock_point, trajectory = args
     params = StreamlineParams(mu=mu, dl=dl)
     spectral_size = gen["nx"] if gen["frequency_unit"] == "pixel" else gen["size"]
     rms = scale * raw_rms_height(hurst, gen["nx"], spectral_size)
+    trace = ideal_trajectories if trajectory == "ideal" else streamlines
+    before = lock_point == "before"
     locked, sect, hess = [], [], []
     for seed in seeds:
         surf = fractal_fbm(nx=gen["nx"], size=gen["size"], hurst=hurst, rms_height=rms,
                            periodic=True, rng=int(seed))
         xmin, _, ymin, ymax = surf.bounds
-        r = streamlines(surf, [(xmin, 0.5 * (ymin + ymax))], params, store_paths=False)
+        r = trace(surf, [(xmin, 0.5 * (ymin + ymax))], params, store_paths=before)
         ok = bool(r.self_locked[0])
         locked.append(ok)
         if ok:
-            _, fx, fy, fxx, fxy, fyy = surf.evaluate(r.end_x, r.end_y, order=2)
+            px, py = r.end_x, r.end_y
+            if before and r.n_steps[0] > 0:
+                j = r.offsets[1] - 2
+                px, py = r.x[j:j + 1], r.y[j:j + 1]
+            _, fx, fy, fxx, fxy, fyy = surf.evaluate(px, py, order=2)
             sect.append(int(sectional_class(fx, fy, fxx, fxy, fyy)[0]))
             hess.append(int(hessian_class(fxx, fxy, fyy)[0]))
         else:
@@ -263,6 +328,11 @@ def fractal_hurst(*, quick: bool = False, progress: Progress = None, mu: float |
     synthesis (:func:`raw_rms_height`) times ``scale`` from the preset: a fixed spectral
     prefactor, so roughness grows with H when frequencies are in cycles per pixel
     (``frequency_unit = "pixel"``) and barely changes with ``"length"``.
+
+    ``lock_point`` (preset ``[reproduce] lock_point``): ``"lock"`` classifies the first
+    self-lock point the trajectory reaches, ``"before"`` the engaged point one step
+    earlier. ``trajectory``: ``"streamline"`` (the paper's Fig. 9) or ``"ideal"`` (the
+    same statistics for ideal trajectories, for comparison).
     """
     eng, rep, pre = _settings("paper-fractal")
     mu = float(mu if mu is not None else eng["mu"])
@@ -282,11 +352,16 @@ def fractal_hurst(*, quick: bool = False, progress: Progress = None, mu: float |
                               f"{gen['frequency_unit']!r}")
     scale = float(over.get("scale", rep["scale"]))
     dl = float(over.get("dl", rep.get("dl", 0.02)))
+    lock_point = str(over.get("lock_point", rep.get("lock_point", "lock")))
+    trajectory = str(over.get("trajectory", rep.get("trajectory", "streamline")))
+    if lock_point not in ("lock", "before") or trajectory not in ("streamline", "ideal"):
+        raise SpineInputError(f"lock_point must be 'lock' or 'before' and trajectory "
+                              f"'streamline' or 'ideal', got {lock_point!r}, {trajectory!r}")
     chunks = []
     for h_i, h in enumerate(hursts):
         seeds = 1_000_000 * (h_i + 1) + np.arange(n)
         for part in np.array_split(seeds, max(1, workers * 2)):
-            chunks.append((h, part, gen, mu, dl, scale))
+            chunks.append((h, part, gen, mu, dl, scale, lock_point, trajectory))
     results: dict[float, list] = {h: [] for h in hursts}
     if workers > 1:
         with ProcessPoolExecutor(max_workers=workers) as pool:
@@ -323,7 +398,8 @@ def fractal_hurst(*, quick: bool = False, progress: Progress = None, mu: float |
             entry[f"{key}_sd"] = _nan_none(np.nanstd(v) if np.isfinite(v).sum() > 1 else np.nan)
         table.append(entry)
     numbers = {"mu": mu, "nx": gen["nx"], "size": gen["size"], "scale": scale, "dl": dl,
-               "frequency_unit": gen["frequency_unit"],
+               "frequency_unit": gen["frequency_unit"], "lock_point": lock_point,
+               "trajectory": trajectory,
                "groups": groups, "surfaces_per_hurst": n, "by_hurst": table}
     from spine_mj.plotting import fractal_hurst_figure
 

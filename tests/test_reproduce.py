@@ -62,3 +62,21 @@ def test_cli_streamline_writes_a_table(tmp_path):
     table = pd.read_parquet(tmp_path / "streamlines.parquet")
     assert set(table["trajectory"]) == {"streamline", "ideal"}
     assert (tmp_path / "streamlines.png").exists()
+
+
+def test_random_surface_single_peak_normalization_and_finite_max_kappa():
+    from spine_mj.reproduce import _max_kappa, _random_surface
+    from spine_mj.streamline import StreamlineParams, streamlines
+
+    gen = {"n_peaks": 20, "sign": -1, "sigma_range": (0.5, 1.5), "overlap": True,
+           "k_range": (1.0, 2.0)}
+    surf = _random_surface(gen, 3)
+    k = -surf.amplitude * 2 * np.pi * surf.sigma_x * surf.sigma_y
+    assert np.all((k >= 1.0) & (k <= 2.0))
+    res = streamlines(surf, [(-9.99, y) for y in np.linspace(-5, 5, 11)],
+                      StreamlineParams(mu=1.25, dl=0.02))
+    fin, inf = _max_kappa(res, "finite"), _max_kappa(res, "inf")
+    # the finite convention never exceeds the kernel's max and is finite wherever engaged
+    ok = np.isfinite(fin)
+    assert np.all(fin[ok] <= inf[ok]) and not np.isposinf(fin).any()
+    assert np.array_equal(np.isposinf(inf), res.self_locked)
