@@ -198,6 +198,8 @@ def write(out: Path, result: dict, *, static, limit, boundary, stick, sand) -> P
               "(headline: median); ci = 16-84 % bootstrap over starts.", "",
               _table(star_rows, ["protocol", "criterion", "kind", "value", "low", "high",
                                  "ci_low", "ci_high"]), ""]
+    lines += [f"**I_e* ({p}) {s['note']}**" for p, s in boundary["ie_star"].items()
+              if s.get("valid") is False] + [""]
     for proto, c in boundary["curves"].items():
         rows = [{"ie": ie, "agreement": a, "mean_frechet": f, "median_frechet": fm,
                  "lateral": la, "engine_trouble": e, "trap_skip": s}

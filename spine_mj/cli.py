@@ -724,6 +724,9 @@ def validate_cmd(out_dir, quick, plan_name, workers, quiet):
     for proto, s in result["ie_star"].items():
         if "criterion" in s:
             click.echo(f"I_e* ({proto}) criterion: {s['criterion']}")
+        if s.get("valid") is False:
+            click.echo(f"I_e* ({proto}) {s['note']}")
+            continue
         if s["kind"] == "bracketed":
             click.echo(f"I_e* ({proto}) = {s['value']:.3g} in [{s['low']:.3g}, {s['high']:.3g}]")
         elif s["kind"] == "above":

@@ -65,6 +65,8 @@ __all__ = [
     "stick_slip",
 ]
 
+#: A ramp whose runs cover less of the path to the domain edge gives no I_e*.
+RAMP_MIN_COVERAGE = 0.5
 #: Agreement thresholds of the issue's targets.
 OUTCOME_TARGET = 0.95
 FRECHET_TARGET = 0.1
@@ -1089,6 +1091,12 @@ def boundary(plan: ValidationPlan, runner: _Runner) -> dict:
         by = ie_star_by_criterion(ies, np.array([x[:n_min] for x in amat]),
                                   np.array([x[:n_min] for x in fmat]), n_boot=plan.bootstrap)
         stars[proto] = {**by["median_frechet"], "by_criterion": by}
+        if proto == "ramp" and not (np.nanmax(cov) >= RAMP_MIN_COVERAGE):
+            # a ramp that covers a sliver of the path agrees trivially: its I_e* says nothing
+            stars[proto]["valid"] = False
+            stars[proto]["note"] = (
+                f"not measured: the capped ramp covers at most {np.nanmax(cov):.2g} of the "
+                f"path (needs >= {RAMP_MIN_COVERAGE:g}); see ramp_plans for the steps needed")
         curves[proto] = {"ie": ies.tolist(), "agreement": ag, "frechet": fr,
                          "median_frechet": frm, "lateral": lat, "engine_trouble": trouble,
                          "runs_per_ie": int(n_min),
