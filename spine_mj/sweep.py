@@ -1306,15 +1306,28 @@ def _run_pool(todo: list[Case], n_workers: int, handle) -> None:
     # (pandas: pyarrow imports it when it builds a table; mujoco: spine_mj.sim imports it lazily)
     ctx.set_forkserver_preload(["spine_mj.sweep", "spine_mj.streamline", "spine_mj.sim",
                                 "pyarrow.parquet", "pandas", "mujoco", "mujoco.rollout"])
-    with cf.ProcessPoolExecutor(max_workers=n_workers, mp_context=ctx) as pool:
+    started = ctx.SimpleQueue()
+    with cf.ProcessPoolExecutor(max_workers=n_workers, mp_context=ctx,
+                                initializer=_worker_started, initargs=(started,)) as pool:
         futures = [pool.submit(_run_case_remote, c) for c in todo]
         try:
-            for fut in cf.as_completed(futures):
+            # until the first worker is up (a fresh forkserver imports mujoco, numba,
+            # pyarrow... on one core first), this process runs the shortest pending cases
+            # itself; a case is taken only if its future could be cancelled: never twice
+            for case, fut in zip(reversed(todo), reversed(futures)):
+                if not started.empty() or not fut.cancel():
+                    break
+                handle(_encode_case(case.case_id, *run_case(case)))
+            for fut in cf.as_completed([f for f in futures if not f.cancelled()]):
                 handle(fut.result())
         except BaseException:
             for f in futures:
                 f.cancel()
             raise
+
+
+def _worker_started(queue) -> None:
+    queue.put(os.getpid())
 
 
 def _run_dask(todo: list[Case], scheduler, handle) -> None:
