@@ -132,6 +132,7 @@ def run_trajectories(kind, g, coef, sp, bounds, xs, ys, ideal, mu, dl, tol, max_
     lvy = np.empty(L)
     lok = np.empty(L, np.bool_)
     levent = np.empty(L, np.bool_)
+    lstall = np.zeros(L, np.bool_)  # no progress over a window: ends after its next evaluation
     # path points in the order they are produced, tagged with their start
     cap = 1024 if store else 1
     bx = np.empty(cap)
@@ -257,7 +258,7 @@ def run_trajectories(kind, g, coef, sp, bounds, xs, ys, ideal, mu, dl, tol, max_
             xn = x + dl * lvx[j]
             yn = y + dl * lvy[j]
             inside = (xn >= xmin) & (xn <= xmax) & (yn >= ymin) & (yn <= ymax)
-            go = (lreg[j] != 2) & (lstep[j] < max_steps) & lok[j] & inside
+            go = (lreg[j] != 2) & (lstep[j] < max_steps) & lok[j] & inside & (not lstall[j])
             lx[j] = xn if go else x
             ly[j] = yn if go else y
             lstep[j] += go
@@ -276,6 +277,8 @@ def run_trajectories(kind, g, coef, sp, bounds, xs, ys, ideal, mu, dl, tol, max_
             code = 0
             if lreg[j] == 2:
                 code = 1
+            elif lstall[j]:
+                code = 3
             elif lstep[j] >= max_steps:
                 code = 4
             elif not lok[j]:
@@ -287,7 +290,7 @@ def run_trajectories(kind, g, coef, sp, bounds, xs, ys, ideal, mu, dl, tol, max_
                 dxs = x - lcx[j]
                 dys = y - lcy[j]
                 if dxs * dxs + dys * dys < sd2:
-                    code = 3
+                    lstall[j] = True
                 lcx[j] = x
                 lcy[j] = y
             if code != 0:
@@ -296,7 +299,7 @@ def run_trajectories(kind, g, coef, sp, bounds, xs, ys, ideal, mu, dl, tol, max_
                 max_k[i] = lmk[j]
                 ex[i] = x
                 ey[i] = y
-                ez[i] = lf[j]  # height at the last evaluated point, as the reference
+                ez[i] = lf[j]
                 if nxt < n:
                     lidx[j] = nxt
                     lx[j] = xs[nxt]
@@ -306,6 +309,7 @@ def run_trajectories(kind, g, coef, sp, bounds, xs, ys, ideal, mu, dl, tol, max_
                     lmk[j] = math.nan
                     lstep[j] = 0
                     luntil[j] = stall_window
+                    lstall[j] = False
                     nxt += 1
                 else:
                     lidx[j] = -1

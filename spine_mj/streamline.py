@@ -314,6 +314,7 @@ def _run_numpy(surface, xs, ys, params, *, ideal, store):
     ez = np.full(n, np.nan)
     paths = [[] for _ in range(n)]
     active = np.arange(n)
+    stall_pending = np.zeros(n, bool)  # no progress over a window: ends at the next evaluation
     step = 0
     stall_dist = params.stall_distance_value
     while active.size:
@@ -329,6 +330,9 @@ def _run_numpy(surface, xs, ys, params, *, ideal, store):
         locked = reg == SELF_LOCK
         outcome[active[locked]] = Outcome.SELF_LOCKED
         done |= locked
+        stalled = ~done & stall_pending[active]
+        outcome[active[stalled]] = Outcome.STALLED
+        done |= stalled
         capped = ~done & (step >= params.max_steps)
         outcome[active[capped]] = Outcome.STEP_CAP
         done |= capped
@@ -350,9 +354,8 @@ def _run_numpy(surface, xs, ys, params, *, ideal, store):
         step += 1
         if step % params.stall_window == 0 and move.size:
             stuck = np.hypot(x[move] - cx[move], y[move] - cy[move]) < stall_dist
-            outcome[move[stuck]] = Outcome.STALLED
+            stall_pending[move[stuck]] = True
             cx[move], cy[move] = x[move], y[move]
-            done[np.flatnonzero(~done)[stuck]] = True
         active = active[~done]
     offsets = np.zeros(n + 1, np.int64)
     if store:

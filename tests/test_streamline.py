@@ -224,3 +224,24 @@ def test_zero_radius_recovers_point_contact():
         assert _polyline_distance(point.path(i), near.path(i)) < 0.01 * 1.5
     zero = dilate(surf, 0.0, spacing=0.05)
     np.testing.assert_allclose(zero.heights, surf.height(zero.x[None, :], zero.y[:, None]))
+
+
+def test_stalled_trajectories_end_on_an_evaluated_point():
+    """A stall (too little progress over a window) ends like every other outcome: at a
+    point that was evaluated, so the end point is on the surface and is the path's last
+    point, identically in the kernel and the reference."""
+    surf = single_gaussian(sign=-1)
+    starts = np.column_stack([np.full(7, -3.0), np.linspace(-4.0, -0.5, 7)])
+    params = StreamlineParams(mu=1.25, dl=0.02, stall_window=25, stall_distance=1.0)
+    fast = streamlines(surf, starts, params, backend="numba")
+    ref = streamlines(surf, starts, params, backend="numpy")
+    assert np.all(fast.outcome == Outcome.STALLED)
+    np.testing.assert_array_equal(fast.n_steps, ref.n_steps)
+    np.testing.assert_array_equal(fast.n_steps, 25)
+    for res in (fast, ref):
+        np.testing.assert_allclose(res.end_z, surf.height(res.end_x, res.end_y), atol=1e-12)
+        for i in range(len(starts)):
+            path = res.path(i)
+            assert len(path["x"]) == res.n_steps[i] + 1
+            last = [path["x"][-1], path["y"][-1], path["z"][-1]]
+            np.testing.assert_allclose(last, [res.end_x[i], res.end_y[i], res.end_z[i]], atol=1e-12)
