@@ -96,6 +96,8 @@ MUJOCO_PARAMS = (
               drive=True),
     ParamSpec("start_force", "float", "static probe: force held at the start [N]", 0.0, 0.0,
               drive=True),
+    ParamSpec("slide_distance", "float", "ramp: distance slid after breakaway before the force "
+              "resets [m] (default 0.01 L_c, the paper's step dl)", None, 0.0, drive=True),
     ParamSpec("mass", "float", "effective moving mass m_eff [kg]", 0.01, 0.0, exclusive=True),
     ParamSpec("preload", "float", "extra downward preload [N] (added to m g)", 0.0, 0.0),
     ParamSpec("gravity", "float", "gravitational acceleration [m/s^2]", 9.81, 0.0),
@@ -190,7 +192,8 @@ def _mujoco(case, surface, starts, upstream):
         runs = rig.run_batch(drive, pts, detection=det, nthread=1)
     else:
         drive = sim.RampDrive(rate_n_s=rate, duration_s=p["duration"],
-                              settle_time_s=p["settle_time"])
+                              settle_time_s=p["settle_time"],
+                              slide_distance_m=p["slide_distance"])
         runs = [rig.run(drive, start=s, detection=det) for s in pts]
     s = rig.length_scale_m
     n = len(runs)
