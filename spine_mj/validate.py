@@ -148,6 +148,11 @@ class ValidationPlan:
         Time cap of a ramp-with-reset run in engine steps (after the settle phase). The
         ramp's duration is the time its measured per-cycle slip needs to cover the path to
         the domain edge, capped here (see :func:`ramp_duration`).
+    ramp_slide_lc : float
+        Distance the tip slides after each breakaway before the force resets, in ``L_c``
+        (the step of the paper's algorithm). The paper's dl = 0.01 sigma would need ~500
+        cycles per path here; 0.1 L_c keeps a run affordable and is compared with the
+        streamline stepped at its own, converged dl.
     """
 
     name: str
@@ -169,6 +174,7 @@ class ValidationPlan:
     sandpaper_ie: float = 1e-3
     bootstrap: int = 200
     ramp_max_steps: int = 20000
+    ramp_slide_lc: float = 0.1
     extra: dict = field(default_factory=dict, compare=False)
 
 
@@ -229,7 +235,7 @@ PLANS: dict[str, ValidationPlan] = {
         # time past ~45 min on 2 cores: the full plan keeps the single peak/valley there
         boundary_families=("single_peak_valley",),
         stick_slip_ie=(1e-3, 1e-2, 1e-1, 1.0), stick_slip_stiffness=(2.0, 10.0, 50.0),
-        stick_slip_starts=3, sandpaper_starts=4, bootstrap=500, ramp_max_steps=20000),
+        stick_slip_starts=3, sandpaper_starts=4, bootstrap=500, ramp_max_steps=200_000),
 }
 
 
@@ -883,7 +889,7 @@ def _pilot_rig(preset: str, seed, mu: float, tip: float, resolution: int):
 
 
 def ramp_duration(rig, start, ie: float, *, target_lc: float, max_steps: int,
-                  pilot_cycles: int = 6) -> RampPlan:
+                  slide_lc: float = 0.1, pilot_cycles: int = 6) -> RampPlan:
     """Duration of a ramp-with-reset run at ``ie`` that covers ``target_lc`` along x.
 
     A pilot run from ``start`` (at most ``max_steps // 4`` steps, or ``pilot_cycles`` ramp
@@ -899,7 +905,8 @@ def ramp_duration(rig, start, ie: float, *, target_lc: float, max_steps: int,
     rate = speed * sc.preload_n / sc.char_length_m
     settle = 200 * dt
     pilot = min(pilot_cycles * (3 * sc.preload_n / rate + settle), max(max_steps // 4, 10) * dt)
-    r = rig.run(sim.RampDrive(rate_n_s=rate, duration_s=pilot), start=start)
+    r = rig.run(sim.RampDrive(rate_n_s=rate, duration_s=pilot,
+                              slide_distance_m=slide_lc * sc.char_length_m), start=start)
     i0 = r.drive_start_index
     onsets = [e for e in r.events if e.kind == "slip_onset"]
     resets = [e for e in r.events if e.kind == "reset"]
@@ -1023,13 +1030,15 @@ def boundary(plan: ValidationPlan, runner: _Runner) -> dict:
                 by_dur: dict[float, list[float]] = {}
                 for v in plan.ie_values:
                     rp = ramp_duration(rig, (sx, sy), v, target_lc=(surface.bounds[1] - sx) / lc,
-                                       max_steps=plan.ramp_max_steps)
+                                       max_steps=plan.ramp_max_steps, slide_lc=plan.ramp_slide_lc)
                     ramp_plans.setdefault(preset, {})[float(v)] = rp.as_dict()
                     by_dur.setdefault(rp.duration_s, []).append(float(v))
                 for j, (dur, ies_) in enumerate(sorted(by_dur.items())):
                     doc = _family_doc(fam, name=f"boundary-ramp-{preset}-{j}", plan=plan,
-                                      preset=preset, drive={"protocol": "ramp", "ie": ies_,
-                                                            "duration": dur}, grid=grid)
+                                      preset=preset, drive={
+                                          "protocol": "ramp", "ie": ies_, "duration": dur,
+                                          "slide_distance": plan.ramp_slide_lc
+                                          * rig.scales.char_length_m}, grid=grid)
                     df, store = runner(doc, f"boundary/ramp-{preset}-d{dur:.4g}")
                     c = df[df["analysis"] == "compare"].copy()
                     m = df[df["analysis"] == "mujoco"]
