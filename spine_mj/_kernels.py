@@ -157,14 +157,8 @@ def run_trajectories(kind, g, coef, sp, bounds, xs, ys, ideal, mu, dl, tol, max_
         lx[j] = xs[0]  # idle lanes compute on a valid point, results unused
         ly[j] = ys[0]
         if nxt < n:
-            lidx[j] = nxt
-            lx[j] = xs[nxt]
-            ly[j] = ys[nxt]
-            lcx[j] = xs[nxt]
-            lcy[j] = ys[nxt]
-            lmk[j] = math.nan
-            lstep[j] = 0
-            luntil[j] = stall_window
+            _load_lane(j, nxt, xs, ys, stall_window, lidx, lx, ly, lcx, lcy, lmk, lstep, luntil,
+                       lstall)
             nxt += 1
             nact += 1
     while nact > 0:
@@ -301,15 +295,8 @@ def run_trajectories(kind, g, coef, sp, bounds, xs, ys, ideal, mu, dl, tol, max_
                 ey[i] = y
                 ez[i] = lf[j]
                 if nxt < n:
-                    lidx[j] = nxt
-                    lx[j] = xs[nxt]
-                    ly[j] = ys[nxt]
-                    lcx[j] = xs[nxt]
-                    lcy[j] = ys[nxt]
-                    lmk[j] = math.nan
-                    lstep[j] = 0
-                    luntil[j] = stall_window
-                    lstall[j] = False
+                    _load_lane(j, nxt, xs, ys, stall_window, lidx, lx, ly, lcx, lcy, lmk, lstep,
+                               luntil, lstall)
                     nxt += 1
                 else:
                     lidx[j] = -1
@@ -337,6 +324,20 @@ def run_trajectories(kind, g, coef, sp, bounds, xs, ys, ideal, mu, dl, tol, max_
         pk[d] = bk[p]
         pr[d] = br[p]
     return outcome, n_steps, max_k, ex, ey, ez, offsets, px, py, pz, pk, pr
+
+
+@njit(cache=True, inline="always")
+def _load_lane(j, i, xs, ys, stall_window, lidx, lx, ly, lcx, lcy, lmk, lstep, luntil, lstall):
+    """Put start ``i`` into lane ``j``: position, progress anchor, fresh counters."""
+    lidx[j] = i
+    lx[j] = xs[i]
+    ly[j] = ys[i]
+    lcx[j] = xs[i]
+    lcy[j] = ys[i]
+    lmk[j] = math.nan
+    lstep[j] = 0
+    luntil[j] = stall_window
+    lstall[j] = False
 
 
 @njit(cache=True)
