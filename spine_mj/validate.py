@@ -894,8 +894,11 @@ def ramp_duration(rig, start, ie: float, *, target_lc: float, max_steps: int,
 
     A pilot run from ``start`` (at most ``max_steps // 4`` steps, or ``pilot_cycles`` ramp
     cycles estimated at 3 F_p / rate + settle each) measures the x advance and time per
-    cycle; the duration is the time that many cycles take to cover the target, capped at
-    ``max_steps`` engine steps. The cap is the honest limit of a run here: see the report.
+    cycle. The duration is three times the time that many cycles take to cover the target
+    (cycles lengthen along the path as kappa, the force each ramp must reach, grows) plus
+    one ramp to the self-lock cap ``kappa_cap F_p`` (a trapped tip must get there to count as
+    locked), capped at ``max_steps`` engine steps. A run that leaves the domain or locks
+    ends early. The cap is the honest limit of a run here: see the report.
     """
     from spine_mj import sim
 
@@ -922,7 +925,8 @@ def ramp_duration(rig, start, ie: float, *, target_lc: float, max_steps: int,
         else:
             n_cyc, adv, t_cyc = len(onsets), dx, r.time_s[-1] - r.time_s[i0]
         per = adv / n_cyc if adv > 0 else dx / len(onsets)
-        required = t_cyc * target_lc / per if per > 0 else float("inf")
+        lock_s = sim.Detection().kappa_cap * sc.preload_n / rate
+        required = 3 * t_cyc * target_lc / per + lock_s if per > 0 else float("inf")
     else:
         per, t_cyc, required = float("nan"), float("nan"), float("inf")
     duration = float(f"{min(required, cap):.4g}")
