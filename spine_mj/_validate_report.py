@@ -194,8 +194,10 @@ def write(out: Path, result: dict, *, static, limit, boundary, stick, sand) -> P
               "capped at a step budget. A ramp run agrees when it has no engine trouble, does "
               "not self-lock where the streamline does not, and deviates <= 0.1 L_c from the "
               "streamline cut at its own arc length (prefix Frechet). I_e* interpolated in "
-              "log I_e inside the bracket [last pass, first fail] for three criteria "
-              "(headline: median); ci = 16-84 % bootstrap over starts.", "",
+              "log I_e inside the bracket [last pass, first fail] for four criteria "
+              "(headline: median; `departure` measures where agreement falls below its own "
+              "low-I_e level); ramp I_e values whose runs cover under half the path take no "
+              "part; ci = 16-84 % bootstrap over starts.", "",
               _table(star_rows, ["protocol", "criterion", "kind", "value", "low", "high",
                                  "ci_low", "ci_high"]), ""]
     lines += [f"**I_e* ({p}) {s['note']}**" for p, s in boundary["ie_star"].items()

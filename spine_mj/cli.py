@@ -722,17 +722,19 @@ def validate_cmd(out_dir, quick, plan_name, workers, quiet):
         click.echo(f"I_e = {result['lowest_ie']:g}, {fam}: outcome agreement {agree:.0%}, "
                    f"mean Frechet {result['mean_frechet_at_lowest_ie'][fam]:.3g} L_c")
     for proto, s in result["ie_star"].items():
-        if "criterion" in s:
-            click.echo(f"I_e* ({proto}) criterion: {s['criterion']}")
         if s.get("valid") is False:
             click.echo(f"I_e* ({proto}) {s['note']}")
             continue
-        if s["kind"] == "bracketed":
-            click.echo(f"I_e* ({proto}) = {s['value']:.3g} in [{s['low']:.3g}, {s['high']:.3g}]")
-        elif s["kind"] == "above":
-            click.echo(f"I_e* ({proto}) > {s['low']:.3g} (agreement holds on the whole grid)")
-        else:
-            click.echo(f"I_e* ({proto}) < {s['high']:.3g} (no agreement at the lowest I_e)")
+        for star in (s, s["by_criterion"].get("departure")):
+            if star is None:
+                continue
+            click.echo(f"I_e* ({proto}) criterion: {star['criterion']}")
+            if star["kind"] == "bracketed":
+                click.echo(f"  I_e* = {star['value']:.3g} in [{star['low']:.3g}, {star['high']:.3g}]")
+            elif star["kind"] == "above":
+                click.echo(f"  I_e* > {star['low']:.3g} (agreement holds on the whole grid)")
+            else:
+                click.echo(f"  I_e* < {star['high']:.3g} (no agreement at the lowest I_e)")
     click.echo(f"wrote {out / 'report.md'} and {out / 'validation.json'} "
                f"({result['timings_s']['total']:.0f} s)")
 

@@ -158,7 +158,7 @@ def test_one_outlying_start_moves_the_mean_criterion_but_not_the_median():
     fr = np.full((5, 10), 0.02)
     fr[:, 0] = 5.0
     by = validate.ie_star_by_criterion(IE, ag, fr, n_boot=100, rng=1)
-    assert set(by) == set(validate.IE_STAR_CRITERIA)
+    assert set(by) == set(validate.IE_STAR_CRITERIA) | {"departure"}
     assert by["mean_frechet"]["kind"] == "below"  # mean 0.52 L_c at every I_e
     for key in ("median_frechet", "outcome"):
         assert by[key]["kind"] == "bracketed"
@@ -197,3 +197,19 @@ def test_ramp_duration_covers_the_target_from_the_measured_slip_per_cycle():
     assert rp.duration_s == pytest.approx(min(rp.required_s, 4000 * rp.timestep_s), rel=1e-3)
     assert rp.capped == (rp.required_s > 4000 * rp.timestep_s)
     assert 0 < rp.coverage_expected <= 1
+
+
+def test_departure_ie_star_finds_the_break_below_an_imperfect_plateau():
+    """Agreement stuck at 90 % (one start always disagrees) fails the absolute 95 % rule at
+    every I_e; the departure criterion still brackets the drop between 1e-2 and 1e-1."""
+    ie = np.logspace(-4, 0, 5)
+    runs = np.ones((5, 10))
+    runs[:, 0] = 0  # an I_e-independent disagreement
+    runs[3:, 1:6] = 0  # inertia breaks agreement from I_e = 0.1 on
+    absolute = validate.estimate_ie_star(ie, runs.mean(axis=1))
+    assert absolute.kind == "below"
+    dep = validate.departure_ie_star(ie, runs, n_boot=50)
+    assert dep.kind == "bracketed" and (dep.low, dep.high) == pytest.approx((1e-2, 1e-1))
+    assert 1e-2 <= dep.value <= 1e-1
+    flat = validate.departure_ie_star(ie, np.ones((5, 10)), n_boot=0)
+    assert flat.kind == "above"
