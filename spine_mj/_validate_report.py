@@ -88,16 +88,23 @@ def _boundary_figure(bnd: dict, path: Path) -> None:
     a1, a2 = fig.subplots(1, 2)
     for proto, c in bnd["curves"].items():
         lab = proto if proto != "ramp" else "ramp (equivalent I_e)"
-        a1.semilogx(c["ie"], c["agreement"], "o-", label=lab)
+        (line,) = a1.semilogx(c["ie"], c["agreement"], "o-", label=lab)
+        used = bnd["ie_star"][proto].get("ie_used", c["ie"])
+        off = [i for i, v in enumerate(c["ie"]) if not np.isclose(used, v).any()]
+        if off:  # points that take no part in I_e* (a capped ramp covering < half the path)
+            a1.plot(np.asarray(c["ie"])[off], np.asarray(c["agreement"])[off], "o", ms=9,
+                    mfc="white", mec=line.get_color(), label=f"{proto}: not used for I_e*")
         for key, style in (("frechet", "o-"), ("median_frechet", "s--")):
             a2.loglog(c["ie"], np.maximum(np.asarray(c[key], float), 1e-5), style,
                       label=f"{proto}: {'mean' if key == 'frechet' else 'median'} "
                             f"{'prefix ' if proto == 'ramp' else ''}Frechet")
         s = bnd["ie_star"][proto]
-        if s["kind"] == "bracketed":
+        if s.get("kind") != "bracketed":
+            s = s.get("by_criterion", {}).get("departure") or s
+        if s.get("kind") == "bracketed":
             for ax in (a1, a2):
-                ax.axvspan(s["low"], s["high"], alpha=0.12)
-                ax.axvline(s["value"], ls=":", color="k")
+                ax.axvspan(s["low"], s["high"], alpha=0.12, color=line.get_color())
+                ax.axvline(s["value"], ls=":", color=line.get_color())
     a1.axhline(0.95, color="r", lw=0.8)
     a2.axhline(0.1, color="r", lw=0.8)
     a1.set(xlabel="I_e", ylabel="fraction of runs that agree")
