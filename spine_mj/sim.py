@@ -777,7 +777,8 @@ class Rig:
 
         def probe(z):
             d.qpos[:] = (x0 * s, y0 * s, z)
-            mujoco.mj_forward(m, d)
+            mujoco.mj_kinematics(m, d)  # positions and contacts only: no dynamics needed
+            mujoco.mj_collision(m, d)
             if not d.ncon:
                 return None, 1.0
             k = int(np.argmin(d.contact.dist[:d.ncon]))
