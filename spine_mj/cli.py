@@ -268,6 +268,7 @@ def sweep_run(config, out_dir, workers, scheduler, overwrite, retry_failed, quie
 
             from tqdm import tqdm
 
+            tqdm.monitor_interval = 0  # no monitor thread: a single-threaded CLI forks its workers
             bar = tqdm(total=p.total_cases, initial=p.skipped_cases, unit="case",
                        desc=cfg.name, dynamic_ncols=True, file=sys.stderr)
         else:

@@ -1300,12 +1300,18 @@ _ONE_THREAD = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
 def _run_pool(todo: list[Case], n_workers: int, handle) -> None:
     import concurrent.futures as cf
     import multiprocessing
+    import threading
 
-    ctx = multiprocessing.get_context("forkserver")
-    # workers fork from a server that has imported these once
-    # (pandas: pyarrow imports it when it builds a table; mujoco: spine_mj.sim imports it lazily)
-    ctx.set_forkserver_preload(["spine_mj.sweep", "spine_mj.streamline", "spine_mj.sim",
-                                "pyarrow.parquet", "pandas", "mujoco", "mujoco.rollout"])
+    if threading.active_count() == 1 and "fork" in multiprocessing.get_all_start_methods():
+        # a single-threaded process forks safely, and its workers inherit every module it
+        # has imported: no second start-up (about 1 s of imports on one core per pool)
+        _preload_worker_modules()
+        ctx = multiprocessing.get_context("fork")
+    else:
+        # with other threads alive a fork could copy a held lock: workers fork instead from
+        # a server that has imported these once
+        ctx = multiprocessing.get_context("forkserver")
+        ctx.set_forkserver_preload(list(_WORKER_MODULES))
     started = ctx.SimpleQueue()
     with cf.ProcessPoolExecutor(max_workers=n_workers, mp_context=ctx,
                                 initializer=_worker_started, initargs=(started,)) as pool:
@@ -1324,6 +1330,19 @@ def _run_pool(todo: list[Case], n_workers: int, handle) -> None:
             for f in futures:
                 f.cancel()
             raise
+
+
+#: What a worker imports before its first case (pandas: pyarrow imports it when it builds a
+#: table; mujoco: spine_mj.sim imports it lazily).
+_WORKER_MODULES = ("spine_mj.sweep", "spine_mj.streamline", "spine_mj.sim", "pyarrow.parquet",
+                   "pandas", "mujoco", "mujoco.rollout")
+
+
+def _preload_worker_modules() -> None:
+    import importlib
+
+    for name in _WORKER_MODULES:
+        importlib.import_module(name)
 
 
 def _worker_started(queue) -> None:
