@@ -1327,13 +1327,19 @@ def sandpaper(plan: ValidationPlan, runner: _Runner) -> dict:
     """
     from scipy.signal import find_peaks
 
+    from spine_mj import presets
+
     runner.study = "sandpaper"
     rows, paths = [], {}
     for grit in plan.sandpaper_grits:
         preset = f"sandpaper-{grit}"
+        params = presets.load_preset(preset).params
+        # start at least four tip radii inside the patch: the rig ends a run whose tip comes
+        # within one tip radius of the edge (the P600 patch is only 16 tip radii wide)
+        x_rel = max(0.05, 4 * params.get("tip_radius_m", 25e-6) / params["size_m"])
         doc = {"sweep": {"name": f"sandpaper-{grit}", "seed": 3, "analyses": ["mujoco"]},
                "surfaces": [{"preset": preset}],
-               "starts": {"frame": "relative", "x": [0.05],
+               "starts": {"frame": "relative", "x": [round(x_rel, 4)],
                           "y": list(np.linspace(0.25, 0.75, plan.sandpaper_starts).round(4))},
                "drive": {"protocol": "spring", "ie": plan.sandpaper_ie},
                "grid": {"mu": SANDPAPER_MU, "record_every": 5}}
