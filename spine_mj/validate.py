@@ -1422,7 +1422,7 @@ def run_validation(out_dir: str | os.PathLike, *, plan: ValidationPlan | str = "
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
                                 or workers < 1):
         raise SpineInputError(f"workers must be an integer >= 1, got {workers!r}")
-    out = Path(out_dir)
+    out = Path(out_dir).resolve()  # stores refer to files under it: one absolute root
     if out.exists() and not out.is_dir():
         raise SpineInputError(f"--out {out} exists and is not a folder")
     out.mkdir(parents=True, exist_ok=True)

@@ -103,9 +103,10 @@ def test_slip_statistics_rejects_mismatched_arrays():
 # --------------------------------------------------------------------------- end to end
 
 
-def test_smoke_validation_writes_report_and_json(tmp_path):
+def test_smoke_validation_writes_report_and_json(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)  # a relative --out, as `make demo` passes it
     out = tmp_path / "val"
-    res = CliRunner().invoke(main, ["validate", "--plan", "smoke", "--out", str(out),
+    res = CliRunner().invoke(main, ["validate", "--plan", "smoke", "--out", "val",
                                     "--workers", "1"])
     assert res.exit_code == 0, res.output
     doc = json.loads((out / "validation.json").read_text())
