@@ -196,24 +196,21 @@ def fractal_hurst_figure(table: list):
         s = np.array([np.nan if row[f"{key}_sd"] is None else row[f"{key}_sd"] for row in table])
         return 100 * m, 100 * s
 
-    ax = fig.add_subplot(1, 2, 1)
-    for key, label in (("rate", "self-lock rate"), ("sect_concave", "concave (sectional)"),
-                       ("sect_convex", "convex (sectional)")):
-        m, s = series(key)
-        ax.errorbar(h, m, yerr=s, marker="o", capsize=3, label=label)
-    ax.set_xlabel("Hurst index H")
-    ax.set_ylabel("%")
-    ax.legend()
-    ax.set_title("Fig. 9B: sectional method")
-    ax = fig.add_subplot(1, 2, 2)
-    for key, label in (("hess_concave", "concave"), ("hess_saddle", "saddle"),
-                       ("hess_convex", "convex")):
-        m, s = series(key)
-        ax.errorbar(h, m, yerr=s, marker="o", capsize=3, label=label)
-    ax.set_xlabel("Hurst index H")
-    ax.set_ylabel("% of self-locks")
-    ax.legend()
-    ax.set_title("Fig. 9C: Hessian method")
+    panels = (
+        ("Fig. 9B: sectional method", "%", (("rate", "self-lock rate"),
+                                             ("sect_concave", "concave (sectional)"),
+                                             ("sect_convex", "convex (sectional)"))),
+        ("Fig. 9C: Hessian method", "% of self-locks", (("hess_concave", "concave"),
+                                                        ("hess_saddle", "saddle"),
+                                                        ("hess_convex", "convex"))),
+    )
+    for col, (title, ylabel, curves) in enumerate(panels, start=1):
+        ax = fig.add_subplot(1, 2, col)
+        for key, label in curves:
+            m, s = series(key)
+            ax.errorbar(h, m, yerr=s, marker="o", capsize=3, label=label)
+        ax.set(xlabel="Hurst index H", ylabel=ylabel, title=title)
+        ax.legend()
     return fig
 
 
