@@ -8,16 +8,30 @@ exit code 2; library users can catch it as a ``ValueError``.
 from __future__ import annotations
 
 import contextlib
+import math
 import os
 import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 
-__all__ = ["SpineInputError", "atomic_output"]
+__all__ = ["SpineInputError", "atomic_output", "check_positive"]
 
 
 class SpineInputError(ValueError):
     """Bad input: a malformed file or config, non-finite data, or nonsense parameters."""
+
+
+def check_positive(name: str, value, *, allow_zero: bool = False) -> float:
+    """``float(value)`` if it is a finite number > 0 (>= 0 with ``allow_zero``), else a
+    :class:`SpineInputError` naming ``name``, the expectation and what arrived."""
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise SpineInputError(f"{name} must be a number, got {value!r}") from None
+    if not (math.isfinite(v) and (v >= 0 if allow_zero else v > 0)):
+        raise SpineInputError(f"{name} must be a finite number {'>= 0' if allow_zero else '> 0'}, "
+                              f"got {value!r}")
+    return v
 
 
 @contextlib.contextmanager

@@ -42,15 +42,20 @@ def _display_grid(surface: Surface, max_points: int) -> GridSurface:
     return surface.sample(max_points)
 
 
+def _height_map(fig, ax, grid: GridSurface, unit: str):
+    """Height map of ``grid`` on ``ax`` with a colour bar; returns ``ax``."""
+    extent = (grid.x[0], grid.x[-1], grid.y[0], grid.y[-1])
+    im = ax.imshow(grid.heights, origin="lower", extent=extent, cmap="terrain", aspect="equal")
+    fig.colorbar(im, ax=ax, label=f"height{unit}")
+    return ax
+
+
 def surface_preview(surface: Surface, *, title: str | None = None, max_points: int = 300):
     """Height map (left) and 3-D view (right) of a surface."""
     grid = _display_grid(surface, max_points)
     unit = "" if surface.unit == "1" else f" [{surface.unit}]"
     fig = new_figure(figsize=(11, 4.6), layout="constrained")
-    ax = fig.add_subplot(1, 2, 1)
-    extent = (grid.x[0], grid.x[-1], grid.y[0], grid.y[-1])
-    im = ax.imshow(grid.heights, origin="lower", extent=extent, cmap="terrain", aspect="equal")
-    fig.colorbar(im, ax=ax, label=f"height{unit}")
+    ax = _height_map(fig, fig.add_subplot(1, 2, 1), grid, unit)
     ax.set_xlabel(f"x{unit}")
     ax.set_ylabel(f"y{unit}")
     ax3 = fig.add_subplot(1, 2, 2, projection="3d")
@@ -76,10 +81,7 @@ def sim_run_figure(result, surface: Surface, *, length_scale_m: float, max_point
     grid = _display_grid(surface, max_points)
     unit = "" if surface.unit == "1" else f" [{surface.unit}]"
     fig = new_figure(figsize=(11, 4.6), layout="constrained")
-    ax = fig.add_subplot(1, 2, 1)
-    extent = (grid.x[0], grid.x[-1], grid.y[0], grid.y[-1])
-    im = ax.imshow(grid.heights, origin="lower", extent=extent, cmap="terrain", aspect="equal")
-    fig.colorbar(im, ax=ax, label=f"height{unit}")
+    ax = _height_map(fig, fig.add_subplot(1, 2, 1), grid, unit)
     path = result.position_m / length_scale_m
     ax.plot(path[:, 0], path[:, 1], color="crimson", lw=1.5, label="tip")
     ax.plot(path[0, 0], path[0, 1], "o", color="white", mec="k", label="start")

@@ -51,7 +51,7 @@ from pathlib import Path
 
 import numpy as np
 
-from spine_mj.errors import SpineInputError, atomic_output
+from spine_mj.errors import SpineInputError, atomic_output, check_positive
 from spine_mj.surfaces import GaussianSurface, GridSurface, Surface, to_hfield
 
 __all__ = [
@@ -110,23 +110,11 @@ class EndReason(enum.Enum):
     ENGINE_TROUBLE = "engine_trouble"  # non-finite state, MuJoCo warning or deep penetration
 
 
-def _check_positive(name: str, value, *, allow_zero: bool = False) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise SpineInputError(f"{name} must be a number, got {value!r}") from None
-    ok = math.isfinite(v) and (v >= 0 if allow_zero else v > 0)
-    if not ok:
-        raise SpineInputError(f"{name} must be a finite number {'>= 0' if allow_zero else '> 0'}, "
-                              f"got {value!r}")
-    return v
-
-
 def _check_optional(obj, names: Sequence[str], *, allow_zero: bool = False) -> None:
     for name in names:
         value = getattr(obj, name)
         if value is not None:
-            object.__setattr__(obj, name, _check_positive(name, value, allow_zero=allow_zero))
+            object.__setattr__(obj, name, check_positive(name, value, allow_zero=allow_zero))
 
 
 @dataclass(frozen=True)
@@ -155,12 +143,12 @@ class TipParams:
 
     def __post_init__(self):
         _check_optional(self, ["tip_radius_m"])
-        object.__setattr__(self, "mass_kg", _check_positive("mass_kg", self.mass_kg))
-        object.__setattr__(self, "mu_s", _check_positive("mu_s", self.mu_s, allow_zero=True))
+        object.__setattr__(self, "mass_kg", check_positive("mass_kg", self.mass_kg))
+        object.__setattr__(self, "mu_s", check_positive("mu_s", self.mu_s, allow_zero=True))
         object.__setattr__(self, "preload_n",
-                           _check_positive("preload_n", self.preload_n, allow_zero=True))
+                           check_positive("preload_n", self.preload_n, allow_zero=True))
         object.__setattr__(self, "gravity_m_s2",
-                           _check_positive("gravity_m_s2", self.gravity_m_s2, allow_zero=True))
+                           check_positive("gravity_m_s2", self.gravity_m_s2, allow_zero=True))
         if self.preload_n == 0 and self.gravity_m_s2 == 0:
             raise SpineInputError("preload_n and gravity_m_s2 are both 0: the tip has no normal "
                                   "preload; give one of them > 0")
@@ -203,7 +191,7 @@ class EngineSettings:
     hfield_resolution: int | None = None
 
     def __post_init__(self):
-        object.__setattr__(self, "timestep_s", _check_positive("timestep_s", self.timestep_s))
+        object.__setattr__(self, "timestep_s", check_positive("timestep_s", self.timestep_s))
         for name, enum_cls in (("integrator", Integrator), ("cone", Cone)):
             value = getattr(self, name)
             if not isinstance(value, enum_cls):
@@ -213,7 +201,7 @@ class EngineSettings:
                     raise SpineInputError(f"{name} must be one of {[e.value for e in enum_cls]}, "
                                           f"got {value!r}") from None
                 object.__setattr__(self, name, value)
-        object.__setattr__(self, "impratio", _check_positive("impratio", self.impratio))
+        object.__setattr__(self, "impratio", check_positive("impratio", self.impratio))
         ns = self.noslip_iterations
         if isinstance(ns, bool) or int(ns) != ns or ns < 0:
             raise SpineInputError(f"noslip_iterations must be an integer >= 0, got {ns!r}")
@@ -225,7 +213,7 @@ class EngineSettings:
             tc, dr = (float(v) for v in self.solref)
         except (TypeError, ValueError):
             raise SpineInputError(f"solref must be (timeconst_s, dampratio), got {self.solref!r}") from None
-        _check_positive("solref dampratio", dr)
+        check_positive("solref dampratio", dr)
         if not (math.isfinite(tc) and tc >= 2 * self.timestep_s * (1 - 1e-9)):
             raise SpineInputError(f"solref timeconst_s must be >= 2 timestep_s = {2 * self.timestep_s:g} "
                                   f"s for a stable contact, got {self.solref[0]!r}")
@@ -363,7 +351,7 @@ class Detection:
         _check_optional(self, ["slip_speed_m_s", "stick_speed_m_s", "breakaway_distance_m",
                                "penetration_tol_m"])
         _check_optional(self, ["domain_margin_m"], allow_zero=True)
-        object.__setattr__(self, "kappa_cap", _check_positive("kappa_cap", self.kappa_cap))
+        object.__setattr__(self, "kappa_cap", check_positive("kappa_cap", self.kappa_cap))
 
     def resolve(self, scales: Scales) -> Detection:
         v_c = scales.speed_m_s
@@ -391,7 +379,7 @@ class SpringDrive:
     settle_time_s: float | None = None
 
     def __post_init__(self):
-        object.__setattr__(self, "speed_m_s", _check_positive("speed_m_s", self.speed_m_s))
+        object.__setattr__(self, "speed_m_s", check_positive("speed_m_s", self.speed_m_s))
         _check_optional(self, ["stiffness_n_m", "duration_s"])
         _check_optional(self, ["settle_time_s"], allow_zero=True)
 
@@ -437,7 +425,7 @@ class StaticProbe:
         _check_optional(self, ["rate_n_s"])
         _check_optional(self, ["settle_time_s"], allow_zero=True)
         object.__setattr__(self, "start_force_n",
-                           _check_positive("start_force_n", self.start_force_n, allow_zero=True))
+                           check_positive("start_force_n", self.start_force_n, allow_zero=True))
 
 
 Drive = SpringDrive | RampDrive | StaticProbe
@@ -566,7 +554,7 @@ def inclined_plane(*, slope_deg: float, azimuth_deg: float = 0.0, half_width: fl
     slope = float(slope_deg)
     if not (math.isfinite(slope) and -89.0 <= slope <= 89.0):
         raise SpineInputError(f"slope_deg must lie in [-89, 89], got {slope_deg!r}")
-    half_width = _check_positive("half_width", half_width)
+    half_width = check_positive("half_width", half_width)
     t = math.tan(math.radians(slope))
     az = math.radians(float(azimuth_deg))
     x = np.linspace(-half_width, half_width, int(n))
@@ -618,10 +606,10 @@ class Rig:
             raise SpineInputError(f"surface unit must be '1' (dimensionless) or 'm', got {surface.unit!r}")
         if length_scale_m is None:
             length_scale_m = DEFAULT_LENGTH_SCALE_M if surface.unit == "1" else 1.0
-        length_scale_m = _check_positive("length_scale_m", length_scale_m)
+        length_scale_m = check_positive("length_scale_m", length_scale_m)
         if char_length_m is None:
             char_length_m = characteristic_length(surface) * length_scale_m
-        char_length_m = _check_positive("char_length_m", char_length_m)
+        char_length_m = check_positive("char_length_m", char_length_m)
         resolution = engine.hfield_resolution if engine is not None else None
         hf = (to_hfield(surface, nrow=resolution, ncol=resolution) if resolution
               else to_hfield(surface))

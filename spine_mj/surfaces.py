@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 from scipy import ndimage
 
-from spine_mj.errors import SpineInputError
+from spine_mj.errors import SpineInputError, check_positive
 
 __all__ = [
     "GRIT_PARTICLE_DIAMETER_M",
@@ -61,13 +61,6 @@ def _rng_and_seed(rng: int | np.random.Generator | None) -> tuple[np.random.Gene
     if isinstance(rng, (int, np.integer)) and not isinstance(rng, bool) and rng >= 0:
         return np.random.default_rng(int(rng)), int(rng)
     raise SpineInputError(f"rng must be a non-negative int seed or a numpy Generator, got {rng!r}")
-
-
-def _positive(name: str, value: float) -> float:
-    value = float(value)
-    if not (math.isfinite(value) and value > 0):
-        raise SpineInputError(f"{name} must be a finite number > 0, got {value!r}")
-    return value
 
 
 def _range(name: str, value, *, positive: bool = True) -> tuple[float, float]:
@@ -410,7 +403,7 @@ class GridSurface(Surface):
         whole steps allow.
         """
         sx, sy = (spacing, spacing) if np.isscalar(spacing) else spacing
-        sx, sy = _positive("spacing x", sx), _positive("spacing y", sy)
+        sx, sy = check_positive("spacing x", sx), check_positive("spacing y", sy)
         xmin, xmax, ymin, ymax = self.bounds
         if self.periodic:
             nx, ny = round((xmax - xmin) / sx), round((ymax - ymin) / sy)
@@ -457,8 +450,8 @@ def single_gaussian(
     """
     if sign not in (1, -1):
         raise SpineInputError(f"sign must be +1 (peak) or -1 (valley), got {sign!r}")
-    k = _positive("k", k)
-    sx, sy = _positive("sigma_x", sigma_x), _positive("sigma_y", sigma_y)
+    k = check_positive("k", k)
+    sx, sy = check_positive("sigma_x", sigma_x), check_positive("sigma_y", sigma_y)
     mx, my = (float(c) for c in center)
     amplitude = sign * k / (2 * math.pi * sx * sy)
     return GaussianSurface(
@@ -591,20 +584,20 @@ def fractal_fbm(
     nx = _grid_count("nx", nx)
     ny = nx if ny is None else _grid_count("ny", ny)
     lx, ly = (size, size) if np.isscalar(size) else size
-    lx, ly = _positive("size x", lx), _positive("size y", ly)
+    lx, ly = check_positive("size x", lx), check_positive("size y", ly)
     hurst = float(hurst)
     if not (0.0 < hurst < 1.0):
         raise SpineInputError(f"hurst must lie in the open interval (0, 1), got {hurst!r}")
     if rms_height is not None and rms_slope is not None:
         raise SpineInputError("give rms_height or rms_slope, not both")
     if rms_slope is not None:
-        rms_slope = _positive("rms_slope", rms_slope)
+        rms_slope = check_positive("rms_slope", rms_slope)
     else:
-        rms_height = 1.0 if rms_height is None else _positive("rms_height", rms_height)
+        rms_height = 1.0 if rms_height is None else check_positive("rms_height", rms_height)
     if long_cutoff is not None:
-        long_cutoff = _positive("long_cutoff", long_cutoff)
+        long_cutoff = check_positive("long_cutoff", long_cutoff)
     if short_cutoff is not None:
-        short_cutoff = _positive("short_cutoff", short_cutoff)
+        short_cutoff = check_positive("short_cutoff", short_cutoff)
     gen, seed = _rng_and_seed(rng)
 
     dx, dy = lx / nx, ly / ny
@@ -689,12 +682,12 @@ def sandpaper(
             particle_diameter_m = GRIT_PARTICLE_DIAMETER_M[grit]
     if particle_diameter_m is None:
         raise SpineInputError("give grit (P36, P60, P600) or particle_diameter_m")
-    d_mean = _positive("particle_diameter_m", particle_diameter_m)
-    size_m = _positive("size_m", size_m)
-    tip_radius_m = _positive("tip_radius_m", tip_radius_m)
+    d_mean = check_positive("particle_diameter_m", particle_diameter_m)
+    size_m = check_positive("size_m", size_m)
+    tip_radius_m = check_positive("tip_radius_m", tip_radius_m)
     spacing_m = (min(tip_radius_m / 5, d_mean / 10) if spacing_m is None
-                 else _positive("spacing_m", spacing_m))
-    coverage = _positive("coverage", coverage)
+                 else check_positive("spacing_m", spacing_m))
+    coverage = check_positive("coverage", coverage)
     size_cv = float(size_cv)
     if not (0 <= size_cv < 2):
         raise SpineInputError(f"size_cv must be in [0, 2), got {size_cv!r}")
@@ -806,7 +799,7 @@ def to_hfield(surface: Surface, *, nrow: int | None = None, ncol: int | None = N
     if elevation <= 1e-12 * max(rx, ry):
         elevation = 1e-9 * max(rx, ry)
     data = ((h - zmin) / elevation).astype(np.float32)
-    base = 0.1 * max(rx, ry) if base_z is None else _positive("base_z", base_z)
+    base = 0.1 * max(rx, ry) if base_z is None else check_positive("base_z", base_z)
     pos = (0.5 * float(grid.x[0] + grid.x[-1]), 0.5 * float(grid.y[0] + grid.y[-1]), zmin)
     return HField(data=data, size=(rx, ry, elevation, base), pos=pos)
 

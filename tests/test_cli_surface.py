@@ -60,6 +60,8 @@ def test_import_from_file(tmp_path, topography_dir):
          "n_peaks"),
         (["surface", "make", "paper-random-convex", "--set", "sigma_range=[0, 1]", "-o",
           "{d}/x.npz"], "widths"),
+        (["surface", "make", "paper-single-peak", "--set", "k=abc", "-o", "{d}/x.npz"],
+         "k must be a number, got 'abc'"),
         (["surface", "make", "--from-file", "{d}/corrupt.plu", "-o", "{d}/x.npz"],
          "cannot read topography"),
         (["surface", "make", "--from-file", "{d}/missing.x3p", "-o", "{d}/x.npz"], "not found"),
