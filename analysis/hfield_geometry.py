@@ -28,8 +28,7 @@ from spine_mj.surfaces import GridSurface
 
 RESOLUTIONS = (151, 201, 401, 801)
 RIG_TIP_MAX_RES = 201
-CASES = (("paper-random-convex", (1,)), ("paper-random-concave", (1,)),
-         ("paper-fractal", (1,)))
+CASES = (("paper-random-convex", (1,)), ("paper-random-concave", (1,)), ("paper-fractal", (1,)))
 
 
 def _starts(surface, n=5, x=0.05):
@@ -51,7 +50,7 @@ def main(argv=None):
             starts = _starts(surface)
             tip151 = V._tip_radius(preset, (seed,), 151)
             grid = isinstance(surface, GridSurface)
-            for res in ((surface.heights.shape[1],) if grid else RESOLUTIONS):
+            for res in (surface.heights.shape[1],) if grid else RESOLUTIONS:
                 tips = {"fixed (quick-plan tip)": tip151}
                 if res <= RIG_TIP_MAX_RES:
                     # the facet sampling step follows the tip (tip / 8): finer tips cost more
@@ -59,41 +58,58 @@ def main(argv=None):
                 for label, tip in tips.items():
                     t0 = time.perf_counter()
                     smooth = V._streamline_paths(surface, starts, mu, tip / 2, tip)
-                    tri = V._streamline_paths(V._triangulated(surface, None if grid else res),
-                                              starts, mu, tip / 2, tip)
+                    tri = V._streamline_paths(
+                        V._triangulated(surface, None if grid else res), starts, mu, tip / 2, tip
+                    )
                     fr, lock_agree = [], []
                     for i in range(len(starts)):
                         a, b = smooth.path(i), tri.path(i)
-                        g, _ = V._path_metrics(np.column_stack([b["x"], b["y"]]),
-                                               np.column_stack([a["x"], a["y"]]), lc)
+                        g, _ = V._path_metrics(
+                            np.column_stack([b["x"], b["y"]]), np.column_stack([a["x"], a["y"]]), lc
+                        )
                         fr.append(g)
                         lock_agree.append(bool(smooth.self_locked[i]) == bool(tri.self_locked[i]))
                     span = surface.bounds[1] - surface.bounds[0]
-                    rows.append({"preset": preset, "seed": seed, "resolution": res,
-                                 "spacing_over_lc": span / (res - 1) / lc, "tip": label,
-                                 "tip_over_lc": tip / lc, "frechet": fr,
-                                 "median_frechet": float(np.nanmedian(fr)),
-                                 "mean_frechet": float(np.nanmean(fr)),
-                                 "max_frechet": float(np.nanmax(fr)),
-                                 "lock_agreement": float(np.mean(lock_agree)),
-                                 "seconds": round(time.perf_counter() - t0, 1)})
+                    rows.append(
+                        {
+                            "preset": preset,
+                            "seed": seed,
+                            "resolution": res,
+                            "spacing_over_lc": span / (res - 1) / lc,
+                            "tip": label,
+                            "tip_over_lc": tip / lc,
+                            "frechet": fr,
+                            "median_frechet": float(np.nanmedian(fr)),
+                            "mean_frechet": float(np.nanmean(fr)),
+                            "max_frechet": float(np.nanmax(fr)),
+                            "lock_agreement": float(np.mean(lock_agree)),
+                            "seconds": round(time.perf_counter() - t0, 1),
+                        }
+                    )
                     r = rows[-1]
-                    print(f"{preset}#{seed} res {res} {label}: median {r['median_frechet']:.3g} "
-                          f"mean {r['mean_frechet']:.3g} max {r['max_frechet']:.3g} L_c, "
-                          f"lock agr {r['lock_agreement']:.2f} ({r['seconds']} s)", flush=True)
+                    print(
+                        f"{preset}#{seed} res {res} {label}: median {r['median_frechet']:.3g} "
+                        f"mean {r['mean_frechet']:.3g} max {r['max_frechet']:.3g} L_c, "
+                        f"lock agr {r['lock_agreement']:.2f} ({r['seconds']} s)",
+                        flush=True,
+                    )
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     (out / "hfield_geometry.json").write_text(json.dumps(rows, indent=1) + "\n")
     # summary per preset family x resolution x tip
-    print("\n| surface | hfield samples | spacing / L_c | tip | median Frechet | mean | max | "
-          "lock agreement |\n|---|---|---|---|---|---|---|---|")
+    print(
+        "\n| surface | hfield samples | spacing / L_c | tip | median Frechet | mean | max | "
+        "lock agreement |\n|---|---|---|---|---|---|---|---|"
+    )
     keys = sorted({(r["preset"], r["resolution"], r["tip"]) for r in rows})
     for p, res, tip in keys:
         sel = [r for r in rows if (r["preset"], r["resolution"], r["tip"]) == (p, res, tip)]
         fr = np.concatenate([r["frechet"] for r in sel])
-        print(f"| {p} | {res} | {sel[0]['spacing_over_lc']:.3g} | {tip} | "
-              f"{np.nanmedian(fr):.3g} | {np.nanmean(fr):.3g} | {np.nanmax(fr):.3g} | "
-              f"{np.mean([r['lock_agreement'] for r in sel]):.2f} |")
+        print(
+            f"| {p} | {res} | {sel[0]['spacing_over_lc']:.3g} | {tip} | "
+            f"{np.nanmedian(fr):.3g} | {np.nanmean(fr):.3g} | {np.nanmax(fr):.3g} | "
+            f"{np.mean([r['lock_agreement'] for r in sel]):.2f} |"
+        )
 
 
 if __name__ == "__main__":

@@ -50,8 +50,14 @@ def main() -> None:
     def bare():
         with rollout.Rollout(nthread=args.threads) as pool:
             datas = [mujoco.MjData(model) for _ in range(args.threads)]
-            pool.rollout([model] * args.runs, datas, init, ctrl, control_spec=spec,
-                         initial_warmstart=np.zeros((args.runs, model.nv)))
+            pool.rollout(
+                [model] * args.runs,
+                datas,
+                init,
+                ctrl,
+                control_spec=spec,
+                initial_warmstart=np.zeros((args.runs, model.nv)),
+            )
 
     calls = iter(range(1, 10**6))
 
@@ -71,8 +77,10 @@ def main() -> None:
             dt = time.perf_counter() - t0
             best[name] = min(best.get(name, np.inf), dt)
     for name, dt in best.items():
-        print(f"{name:22s} {args.runs / dt:8.1f} runs/s  {args.runs * nstep / dt:10.3g} steps/s "
-              f"({args.runs} runs x {nstep} steps, {args.threads} threads)")
+        print(
+            f"{name:22s} {args.runs / dt:8.1f} runs/s  {args.runs * nstep / dt:10.3g} steps/s "
+            f"({args.runs} runs x {nstep} steps, {args.threads} threads)"
+        )
     ratio = best["bare mujoco.rollout"] / best["spine_mj run_batch"]
     print(f"ratio spine_mj / bare = {ratio:.3f} (target >= 0.9)")
 

@@ -53,12 +53,31 @@ def bare_rollout_time(config: sweep.SweepConfig) -> float:
     for case in sweep.expand_cases(config):
         p = case.params
         surface = case.surface.make()
-        key = tuple(sorted({
-            "tip_radius_m": None,
-            **{k: p[k] for k in ("mass", "mu", "preload", "gravity", "length_scale", "timestep",
-                                 "integrator", "cone", "impratio", "noslip_iterations",
-                                 "solref_timeconst", "solref_dampratio", "hfield_resolution")},
-        }.items()))
+        key = tuple(
+            sorted(
+                {
+                    "tip_radius_m": None,
+                    **{
+                        k: p[k]
+                        for k in (
+                            "mass",
+                            "mu",
+                            "preload",
+                            "gravity",
+                            "length_scale",
+                            "timestep",
+                            "integrator",
+                            "cone",
+                            "impratio",
+                            "noslip_iterations",
+                            "solref_timeconst",
+                            "solref_dampratio",
+                            "hfield_resolution",
+                        )
+                    },
+                }.items()
+            )
+        )
         rig = an._rig(case.surface, key)
         sc = rig.scales
         speed = (p["ie"] * sc.preload_n * sc.char_length_m / sc.mass_kg) ** 0.5
@@ -75,8 +94,14 @@ def bare_rollout_time(config: sweep.SweepConfig) -> float:
         with rollout.Rollout(nthread=1) as pool:
             datas = [mujoco.MjData(rig.model)]
             t0 = time.perf_counter()
-            pool.rollout(models, datas, init, ctrl, control_spec=spec,
-                         initial_warmstart=np.zeros((len(qpos0), rig.model.nv)))
+            pool.rollout(
+                models,
+                datas,
+                init,
+                ctrl,
+                control_spec=spec,
+                initial_warmstart=np.zeros((len(qpos0), rig.model.nv)),
+            )
             total += time.perf_counter() - t0
     return total
 
@@ -117,16 +142,24 @@ def main() -> None:
     cpu1 = runs.groupby("case_id").cpu_s.sum().sum()
     cpu2 = sweep.load_runs(scratch / "mj2").groupby("case_id").cpu_s.sum().sum()
     steps = int(runs.n_steps.sum())
-    print(f"mujoco sweep: {len(cases)} cases, {n_runs} runs, {steps} recorded steps kept "
-          f"(runs cut at their end events)")
+    print(
+        f"mujoco sweep: {len(cases)} cases, {n_runs} runs, {steps} recorded steps kept "
+        f"(runs cut at their end events)"
+    )
     print(f"  bare mujoco.rollout (1 thread):  {bare:8.2f} s")
-    print(f"  sweep, 1 worker:                 {t1:8.2f} s   throughput ratio "
-          f"bare/sweep = {bare / t1:.3f}  (target >= 0.9)")
-    print(f"  sweep, 2 workers:                {t2:8.2f} s   parallel efficiency "
-          f"T1/(2 T2) = {t1 / (2 * t2):.3f}  (target >= 0.85)")
-    print(f"  CPU time in the analyses: {cpu1:.2f} s (1 worker), {cpu2:.2f} s (2 workers); "
-          f"load average before: {load[0]:.2f} on {os.cpu_count()} cores (a busy machine "
-          f"lowers the 2-worker figure)")
+    print(
+        f"  sweep, 1 worker:                 {t1:8.2f} s   throughput ratio "
+        f"bare/sweep = {bare / t1:.3f}  (target >= 0.9)"
+    )
+    print(
+        f"  sweep, 2 workers:                {t2:8.2f} s   parallel efficiency "
+        f"T1/(2 T2) = {t1 / (2 * t2):.3f}  (target >= 0.85)"
+    )
+    print(
+        f"  CPU time in the analyses: {cpu1:.2f} s (1 worker), {cpu2:.2f} s (2 workers); "
+        f"load average before: {load[0]:.2f} on {os.cpu_count()} cores (a busy machine "
+        f"lowers the 2-worker figure)"
+    )
 
     n_cases = 200 if args.quick else 2000
     qs_doc = {
@@ -148,12 +181,16 @@ def main() -> None:
     sweep.run_sweep(qs, out, workers=1, progress=progress)
     elapsed = time.perf_counter() - t0
     n_qs = len(sweep.load_runs(out, columns=["run_id"]))
-    print(f"quasistatic sweep: {n_qs} runs in {n_cases} cases, {elapsed:.1f} s "
-          f"({n_qs / elapsed:.0f} runs/s, 1 worker, store included)")
+    print(
+        f"quasistatic sweep: {n_qs} runs in {n_cases} cases, {elapsed:.1f} s "
+        f"({n_qs / elapsed:.0f} runs/s, 1 worker, store included)"
+    )
     print("  RSS [MiB] after cases: " + ", ".join(f"{c}: {m:.0f}" for c, m in samples))
     first = samples[1][1] if len(samples) > 1 else samples[0][1]
-    print(f"  growth from 10 % to 100 % of the runs: {samples[-1][1] - first:+.1f} MiB; "
-          f"peak RSS {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} MiB")
+    print(
+        f"  growth from 10 % to 100 % of the runs: {samples[-1][1] - first:+.1f} MiB; "
+        f"peak RSS {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} MiB"
+    )
     if args.out is None:
         shutil.rmtree(scratch, ignore_errors=True)
 

@@ -50,9 +50,21 @@ from spine_mj.surfaces import (
 
 _LAZY = {
     name: "spine_mj.sim"
-    for name in ("Rig", "TipParams", "EngineSettings", "SpringDrive", "RampDrive",
-                 "StaticProbe", "Detection", "RunResult", "EndReason", "Cone", "Integrator",
-                 "default_engine", "inclined_plane")
+    for name in (
+        "Rig",
+        "TipParams",
+        "EngineSettings",
+        "SpringDrive",
+        "RampDrive",
+        "StaticProbe",
+        "Detection",
+        "RunResult",
+        "EndReason",
+        "Cone",
+        "Integrator",
+        "default_engine",
+        "inclined_plane",
+    )
 }
 
 

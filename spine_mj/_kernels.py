@@ -51,9 +51,16 @@ def bspl(t):
     s = 1.0 - t
     t2 = t * t
     t3 = t2 * t
-    return (s * s * s / 6.0, (3.0 * t3 - 6.0 * t2 + 4.0) / 6.0,
-            (-3.0 * t3 + 3.0 * t2 + 3.0 * t + 1.0) / 6.0, t3 / 6.0,
-            -0.5 * s * s, 1.5 * t2 - 2.0 * t, -1.5 * t2 + t + 0.5, 0.5 * t2)
+    return (
+        s * s * s / 6.0,
+        (3.0 * t3 - 6.0 * t2 + 4.0) / 6.0,
+        (-3.0 * t3 + 3.0 * t2 + 3.0 * t + 1.0) / 6.0,
+        t3 / 6.0,
+        -0.5 * s * s,
+        1.5 * t2 - 2.0 * t,
+        -1.5 * t2 + t + 0.5,
+        0.5 * t2,
+    )
 
 
 @njit(cache=True, fastmath=_FM)
@@ -99,8 +106,9 @@ def grid_eval(coef, sp, x, y):
 
 
 @njit(cache=True, fastmath=_FM, boundscheck=False, error_model="numpy")
-def run_trajectories(kind, g, coef, sp, bounds, xs, ys, ideal, mu, dl, tol, max_steps, stall_window,
-                     stall_dist, store, lanes):
+def run_trajectories(
+    kind, g, coef, sp, bounds, xs, ys, ideal, mu, dl, tol, max_steps, stall_window, stall_dist, store, lanes
+):
     n = xs.size
     outcome = np.zeros(n, np.int8)
     n_steps = np.zeros(n, np.int64)
@@ -157,8 +165,7 @@ def run_trajectories(kind, g, coef, sp, bounds, xs, ys, ideal, mu, dl, tol, max_
         lx[j] = xs[0]  # idle lanes compute on a valid point, results unused
         ly[j] = ys[0]
         if nxt < n:
-            _load_lane(j, nxt, xs, ys, stall_window, lidx, lx, ly, lcx, lcy, lmk, lstep, luntil,
-                       lstall)
+            _load_lane(j, nxt, xs, ys, stall_window, lidx, lx, ly, lcx, lcy, lmk, lstep, luntil, lstall)
             nxt += 1
             nact += 1
     while nact > 0:
@@ -295,8 +302,9 @@ def run_trajectories(kind, g, coef, sp, bounds, xs, ys, ideal, mu, dl, tol, max_
                 ey[i] = y
                 ez[i] = lf[j]
                 if nxt < n:
-                    _load_lane(j, nxt, xs, ys, stall_window, lidx, lx, ly, lcx, lcy, lmk, lstep,
-                               luntil, lstall)
+                    _load_lane(
+                        j, nxt, xs, ys, stall_window, lidx, lx, ly, lcx, lcy, lmk, lstep, luntil, lstall
+                    )
                     nxt += 1
                 else:
                     lidx[j] = -1
@@ -304,8 +312,7 @@ def run_trajectories(kind, g, coef, sp, bounds, xs, ys, ideal, mu, dl, tol, max_
     # paths back to back in start order (points of one start were produced in step order)
     offsets = np.zeros(n + 1, np.int64)
     if not store:
-        return (outcome, n_steps, max_k, ex, ey, ez, offsets, bx[:0], by[:0], bz[:0], bk[:0],
-                br[:0])
+        return (outcome, n_steps, max_k, ex, ey, ez, offsets, bx[:0], by[:0], bz[:0], bk[:0], br[:0])
     for i in range(n):
         offsets[i + 1] = offsets[i] + n_steps[i] + 1
     px = np.empty(pos)

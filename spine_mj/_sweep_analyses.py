@@ -24,13 +24,17 @@ from spine_mj.sweep import (
 
 QUASISTATIC_PARAMS = (
     ParamSpec("mu", "float", "static friction coefficient mu_s", REQUIRED, 0.0, exclusive=True),
-    ParamSpec("tip_radius", "float", "tip radius in the surface's length unit (0: a point)",
-              0.0, 0.0),
-    ParamSpec("dl", "float", "streamline step in the surface's length unit (default: 0.0015 "
-              "times the smaller side of the domain)", None, 0.0, exclusive=True),
+    ParamSpec("tip_radius", "float", "tip radius in the surface's length unit (0: a point)", 0.0, 0.0),
+    ParamSpec(
+        "dl",
+        "float",
+        "streamline step in the surface's length unit (default: 0.0015 times the smaller side of the domain)",
+        None,
+        0.0,
+        exclusive=True,
+    ),
     ParamSpec("max_steps", "int", "step cap per streamline", 200_000, 1),
-    ParamSpec("trajectory", "str", "quasistatic path kind", "streamline",
-              choices=("streamline", "ideal")),
+    ParamSpec("trajectory", "str", "quasistatic path kind", "streamline", choices=("streamline", "ideal")),
 )
 
 
@@ -56,7 +60,9 @@ def _quasistatic(case, surface, starts, upstream):
     metrics = {
         "outcome": names[res.outcome],
         "self_locked": res.outcome == sl.Outcome.SELF_LOCKED,
-        "end_x": res.end_x, "end_y": res.end_y, "end_z": res.end_z,
+        "end_x": res.end_x,
+        "end_y": res.end_y,
+        "end_z": res.end_z,
         "n_steps": res.n_steps,
         "path_length": res.n_steps * dl,
         "max_kappa": res.max_kappa,
@@ -64,60 +70,133 @@ def _quasistatic(case, surface, starts, upstream):
     }
     counts = np.diff(res.offsets)
     start = np.repeat(np.arange(len(res)), counts)
-    traj = {"start": start, "step": np.arange(res.x.size) - np.repeat(res.offsets[:-1], counts),
-            "x": res.x, "y": res.y, "z": res.z, "kappa": res.kappa,
-            "region": res.region.astype(np.int8)}
+    traj = {
+        "start": start,
+        "step": np.arange(res.x.size) - np.repeat(res.offsets[:-1], counts),
+        "x": res.x,
+        "y": res.y,
+        "z": res.z,
+        "kappa": res.kappa,
+        "region": res.region.astype(np.int8),
+    }
     return AnalysisResult(metrics=metrics, trajectories=traj, data=res)
 
 
-register_analysis(Analysis(
-    "quasistatic", _quasistatic, QUASISTATIC_PARAMS,
-    doc="quasistatic streamline (or ideal trajectory) from every start: spine_mj.streamline"))
+register_analysis(
+    Analysis(
+        "quasistatic",
+        _quasistatic,
+        QUASISTATIC_PARAMS,
+        doc="quasistatic streamline (or ideal trajectory) from every start: spine_mj.streamline",
+    )
+)
 
 
 # --------------------------------------------------------------------------- mujoco
 
 MUJOCO_PARAMS = (
     ParamSpec("mu", "float", "static friction coefficient mu_s", REQUIRED, 0.0, exclusive=True),
-    ParamSpec("tip_radius", "float", "tip radius in the surface's length unit (mujoco: 0 lets "
-              "the rig choose one hfield spacing or L_c / 100)", 0.0, 0.0),
-    ParamSpec("protocol", "str", "drive protocol", "spring",
-              choices=("spring", "ramp", "static"), drive=True),
-    ParamSpec("ie", "float", "inertia number I_e = m v^2 / (F_p L_c); sets the carriage speed "
-              "(spring) or the force rate (ramp, static); default 1e-3 unless speed is given",
-              None, 0.0, exclusive=True, drive=True),
-    ParamSpec("speed", "float", "carriage speed [m/s] (spring; instead of ie)", None, 0.0,
-              exclusive=True, drive=True),
-    ParamSpec("stiffness", "float", "spring stiffness [N/m] (default 10 F_p / L_c)", None, 0.0,
-              exclusive=True, drive=True),
-    ParamSpec("duration", "float", "drive duration [s] (default: from the drive)", None, 0.0,
-              exclusive=True, drive=True),
-    ParamSpec("settle_time", "float", "settling time before the drive [s]", None, 0.0,
-              drive=True),
-    ParamSpec("start_force", "float", "static probe: force held at the start [N]", 0.0, 0.0,
-              drive=True),
-    ParamSpec("slide_distance", "float", "ramp: distance slid after breakaway before the force "
-              "resets [m] (default 0.01 L_c, the paper's step dl)", None, 0.0, drive=True),
+    ParamSpec(
+        "tip_radius",
+        "float",
+        "tip radius in the surface's length unit (mujoco: 0 lets "
+        "the rig choose one hfield spacing or L_c / 100)",
+        0.0,
+        0.0,
+    ),
+    ParamSpec(
+        "protocol", "str", "drive protocol", "spring", choices=("spring", "ramp", "static"), drive=True
+    ),
+    ParamSpec(
+        "ie",
+        "float",
+        "inertia number I_e = m v^2 / (F_p L_c); sets the carriage speed "
+        "(spring) or the force rate (ramp, static); default 1e-3 unless speed is given",
+        None,
+        0.0,
+        exclusive=True,
+        drive=True,
+    ),
+    ParamSpec(
+        "speed",
+        "float",
+        "carriage speed [m/s] (spring; instead of ie)",
+        None,
+        0.0,
+        exclusive=True,
+        drive=True,
+    ),
+    ParamSpec(
+        "stiffness",
+        "float",
+        "spring stiffness [N/m] (default 10 F_p / L_c)",
+        None,
+        0.0,
+        exclusive=True,
+        drive=True,
+    ),
+    ParamSpec(
+        "duration",
+        "float",
+        "drive duration [s] (default: from the drive)",
+        None,
+        0.0,
+        exclusive=True,
+        drive=True,
+    ),
+    ParamSpec("settle_time", "float", "settling time before the drive [s]", None, 0.0, drive=True),
+    ParamSpec("start_force", "float", "static probe: force held at the start [N]", 0.0, 0.0, drive=True),
+    ParamSpec(
+        "slide_distance",
+        "float",
+        "ramp: distance slid after breakaway before the force "
+        "resets [m] (default 0.01 L_c, the paper's step dl)",
+        None,
+        0.0,
+        drive=True,
+    ),
     ParamSpec("mass", "float", "effective moving mass m_eff [kg]", 0.01, 0.0, exclusive=True),
     ParamSpec("preload", "float", "extra downward preload [N] (added to m g)", 0.0, 0.0),
     ParamSpec("gravity", "float", "gravitational acceleration [m/s^2]", 9.81, 0.0),
-    ParamSpec("length_scale", "float", "metres per surface unit (default 0.01 for "
-              "dimensionless surfaces, 1 for metres)", None, 0.0, exclusive=True),
-    ParamSpec("timestep", "float", "MuJoCo time step [s] (default: from the scales)", None, 0.0,
-              exclusive=True),
-    ParamSpec("integrator", "str", "MuJoCo integrator", "implicitfast",
-              choices=("euler", "implicitfast", "implicit", "rk4")),
+    ParamSpec(
+        "length_scale",
+        "float",
+        "metres per surface unit (default 0.01 for dimensionless surfaces, 1 for metres)",
+        None,
+        0.0,
+        exclusive=True,
+    ),
+    ParamSpec(
+        "timestep", "float", "MuJoCo time step [s] (default: from the scales)", None, 0.0, exclusive=True
+    ),
+    ParamSpec(
+        "integrator",
+        "str",
+        "MuJoCo integrator",
+        "implicitfast",
+        choices=("euler", "implicitfast", "implicit", "rk4"),
+    ),
     ParamSpec("cone", "str", "friction cone", "elliptic", choices=("elliptic", "pyramidal")),
-    ParamSpec("impratio", "float", "frictional / normal impedance ratio", 1.0, 0.0,
-              exclusive=True),
+    ParamSpec("impratio", "float", "frictional / normal impedance ratio", 1.0, 0.0, exclusive=True),
     ParamSpec("noslip_iterations", "int", "noslip solver passes", 3, 0),
-    ParamSpec("solref_timeconst", "float", "contact time constant [s] (default 2 timestep)",
-              None, 0.0, exclusive=True),
+    ParamSpec(
+        "solref_timeconst",
+        "float",
+        "contact time constant [s] (default 2 timestep)",
+        None,
+        0.0,
+        exclusive=True,
+    ),
     ParamSpec("solref_dampratio", "float", "contact damping ratio", 1.0, 0.0, exclusive=True),
-    ParamSpec("hfield_resolution", "int", "hfield samples per side for analytic surfaces",
-              None, 4),
-    ParamSpec("kappa_cap", "float", "self-lock when the drive reaches kappa_cap F_p unmoved",
-              20.0, 0.0, exclusive=True),
+    ParamSpec("hfield_resolution", "int", "hfield samples per side for analytic surfaces", None, 4),
+    ParamSpec(
+        "kappa_cap",
+        "float",
+        "self-lock when the drive reaches kappa_cap F_p unmoved",
+        20.0,
+        0.0,
+        exclusive=True,
+    ),
     ParamSpec("record_every", "int", "store every k-th recorded step of the trajectories", 1, 1),
 )
 
@@ -127,9 +206,11 @@ def _check_speed(config) -> None:
 
     grid = dict(config.grid)
     if "mujoco" in config.analyses and grid["ie"] != (None,) and grid["speed"] != (None,):
-        raise SpineInputError("config keys grid.ie and grid.speed: give one of them (the "
-                              f"inertia number or the speed), got ie = {list(grid['ie'])} and "
-                              f"speed = {list(grid['speed'])}")
+        raise SpineInputError(
+            "config keys grid.ie and grid.speed: give one of them (the "
+            f"inertia number or the speed), got ie = {list(grid['ie'])} and "
+            f"speed = {list(grid['speed'])}"
+        )
 
 
 @functools.lru_cache(maxsize=4)
@@ -140,15 +221,29 @@ def _rig(spec, key):
 
     p = dict(key)
     surface = spec.make()
-    tip = sim.TipParams(tip_radius_m=p["tip_radius_m"], mass_kg=p["mass"], mu_s=p["mu"],
-                        preload_n=p["preload"], gravity_m_s2=p["gravity"])
+    tip = sim.TipParams(
+        tip_radius_m=p["tip_radius_m"],
+        mass_kg=p["mass"],
+        mu_s=p["mu"],
+        preload_n=p["preload"],
+        gravity_m_s2=p["gravity"],
+    )
     # a first rig gives the scales that the default engine settings derive from
-    probe = sim.Rig(surface, tip=tip, length_scale_m=p["length_scale"],
-                    engine=sim.EngineSettings(timestep_s=1e-3, solref=(2e-3, 1.0),
-                                              hfield_resolution=p["hfield_resolution"]))
-    overrides = {"integrator": p["integrator"], "cone": p["cone"], "impratio": p["impratio"],
-                 "noslip_iterations": p["noslip_iterations"],
-                 "hfield_resolution": p["hfield_resolution"]}
+    probe = sim.Rig(
+        surface,
+        tip=tip,
+        length_scale_m=p["length_scale"],
+        engine=sim.EngineSettings(
+            timestep_s=1e-3, solref=(2e-3, 1.0), hfield_resolution=p["hfield_resolution"]
+        ),
+    )
+    overrides = {
+        "integrator": p["integrator"],
+        "cone": p["cone"],
+        "impratio": p["impratio"],
+        "noslip_iterations": p["noslip_iterations"],
+        "hfield_resolution": p["hfield_resolution"],
+    }
     if p["timestep"] is not None:
         overrides["timestep_s"] = p["timestep"]
     dt = p["timestep"] if p["timestep"] is not None else sim.default_engine(probe.scales).timestep_s
@@ -167,12 +262,31 @@ def _mujoco(case, surface, starts, upstream):
         unit_m = p["length_scale"]
     elif surface.unit == "1":
         unit_m = sim.DEFAULT_LENGTH_SCALE_M
-    key = tuple(sorted({
-        "tip_radius_m": p["tip_radius"] * unit_m if p["tip_radius"] > 0 else None,
-        **{k: p[k] for k in ("mass", "mu", "preload", "gravity", "length_scale", "timestep",
-                             "integrator", "cone", "impratio", "noslip_iterations",
-                             "solref_timeconst", "solref_dampratio", "hfield_resolution")},
-    }.items()))
+    key = tuple(
+        sorted(
+            {
+                "tip_radius_m": p["tip_radius"] * unit_m if p["tip_radius"] > 0 else None,
+                **{
+                    k: p[k]
+                    for k in (
+                        "mass",
+                        "mu",
+                        "preload",
+                        "gravity",
+                        "length_scale",
+                        "timestep",
+                        "integrator",
+                        "cone",
+                        "impratio",
+                        "noslip_iterations",
+                        "solref_timeconst",
+                        "solref_dampratio",
+                        "hfield_resolution",
+                    )
+                },
+            }.items()
+        )
+    )
     rig = _rig(case.surface, key)
     sc = rig.scales
     speed = p["speed"]
@@ -183,17 +297,23 @@ def _mujoco(case, surface, starts, upstream):
     det = sim.Detection(kappa_cap=p["kappa_cap"])
     pts = [tuple(s) for s in starts]
     if p["protocol"] == "spring":
-        drive = sim.SpringDrive(speed_m_s=speed, stiffness_n_m=p["stiffness"],
-                                duration_s=p["duration"], settle_time_s=p["settle_time"])
+        drive = sim.SpringDrive(
+            speed_m_s=speed,
+            stiffness_n_m=p["stiffness"],
+            duration_s=p["duration"],
+            settle_time_s=p["settle_time"],
+        )
         runs = rig.run_batch(drive, pts, detection=det, nthread=1)
     elif p["protocol"] == "static":
-        drive = sim.StaticProbe(rate_n_s=rate, start_force_n=p["start_force"],
-                                settle_time_s=p["settle_time"])
+        drive = sim.StaticProbe(rate_n_s=rate, start_force_n=p["start_force"], settle_time_s=p["settle_time"])
         runs = rig.run_batch(drive, pts, detection=det, nthread=1)
     else:
-        drive = sim.RampDrive(rate_n_s=rate, duration_s=p["duration"],
-                              settle_time_s=p["settle_time"],
-                              slide_distance_m=p["slide_distance"])
+        drive = sim.RampDrive(
+            rate_n_s=rate,
+            duration_s=p["duration"],
+            settle_time_s=p["settle_time"],
+            slide_distance_m=p["slide_distance"],
+        )
         runs = [rig.run(drive, start=s, detection=det) for s in pts]
     s = rig.length_scale_m
     n = len(runs)
@@ -204,22 +324,37 @@ def _mujoco(case, surface, starts, upstream):
             warned = "warning" in r.end_detail or "reset" in r.end_detail
             status[i] = "engine_warning" if warned else "diverged"
     end = np.array([r.position_m[-1] for r in runs]) / s
-    path_len = np.array([np.linalg.norm(np.diff(r.position_m[r.drive_start_index:, :2], axis=0),
-                                        axis=1).sum() for r in runs]) / s
+    path_len = (
+        np.array(
+            [
+                np.linalg.norm(np.diff(r.position_m[r.drive_start_index :, :2], axis=0), axis=1).sum()
+                for r in runs
+            ]
+        )
+        / s
+    )
     metrics = {
         "end_reason": np.array([r.end_reason.value for r in runs], dtype=object),
         "self_locked": np.array([r.end_reason is sim.EndReason.SELF_LOCK for r in runs]),
-        "end_x": end[:, 0], "end_y": end[:, 1], "end_z": end[:, 2],
+        "end_x": end[:, 0],
+        "end_y": end[:, 1],
+        "end_z": end[:, 2],
         "path_length": path_len,
         "end_time_s": np.array([r.time_s[-1] for r in runs]),
         "n_steps": np.array([r.n for r in runs], dtype=np.int64),
         "inertia_number": np.array([r.inertia_number for r in runs]),
         "speed_m_s": np.array([r.speed_m_s for r in runs]),
-        "max_drive_over_fp": np.array([
-            r.drive_force_n[r.drive_start_index:].max() / sc.preload_n
-            if r.n > r.drive_start_index else np.nan for r in runs]),
-        "n_slip_onsets": np.array([sum(e.kind == "slip_onset" for e in r.events) for r in runs],
-                                  dtype=np.int64),
+        "max_drive_over_fp": np.array(
+            [
+                r.drive_force_n[r.drive_start_index :].max() / sc.preload_n
+                if r.n > r.drive_start_index
+                else np.nan
+                for r in runs
+            ]
+        ),
+        "n_slip_onsets": np.array(
+            [sum(e.kind == "slip_onset" for e in r.events) for r in runs], dtype=np.int64
+        ),
         "max_penetration_m": np.array([r.penetration_m.max() for r in runs]),
         "kappa_mj": np.array([r.kappa_mj for r in runs]),
         "timestep_s": np.full(n, rig.engine.timestep_s),
@@ -235,21 +370,34 @@ def _mujoco(case, surface, starts, upstream):
             idx = np.append(idx, r.n - 1)
         rows = slice(None) if k == 1 else idx
         pos = r.position_m[rows]
-        parts.append({
-            "start": np.full(idx.size, i, np.int64), "step": idx,
-            "time_s": r.time_s[rows], "x": pos[:, 0] / s, "y": pos[:, 1] / s, "z": pos[:, 2] / s,
-            "drive_force_n": r.drive_force_n[rows], "normal_force_n": r.normal_force_n[rows],
-            "tangential_force_n": r.tangential_force_n[rows], "slipping": r.slipping[rows],
-            "contact": r.contact[rows]})
+        parts.append(
+            {
+                "start": np.full(idx.size, i, np.int64),
+                "step": idx,
+                "time_s": r.time_s[rows],
+                "x": pos[:, 0] / s,
+                "y": pos[:, 1] / s,
+                "z": pos[:, 2] / s,
+                "drive_force_n": r.drive_force_n[rows],
+                "normal_force_n": r.normal_force_n[rows],
+                "tangential_force_n": r.tangential_force_n[rows],
+                "slipping": r.slipping[rows],
+                "contact": r.contact[rows],
+            }
+        )
     traj = {c: np.concatenate([part[c] for part in parts]) for c in parts[0]}
-    return AnalysisResult(metrics=metrics, trajectories=traj, status=status, reason=reason,
-                          data=(rig, runs))
+    return AnalysisResult(metrics=metrics, trajectories=traj, status=status, reason=reason, data=(rig, runs))
 
 
 _CONFIG_CHECKS.append(_check_speed)
-register_analysis(Analysis(
-    "mujoco", _mujoco, MUJOCO_PARAMS,
-    doc="MuJoCo rig run from every start with the chosen drive: spine_mj.sim"))
+register_analysis(
+    Analysis(
+        "mujoco",
+        _mujoco,
+        MUJOCO_PARAMS,
+        doc="MuJoCo rig run from every start with the chosen drive: spine_mj.sim",
+    )
+)
 
 
 # --------------------------------------------------------------------------- compare
@@ -268,36 +416,57 @@ def _compare(case, surface, starts, upstream):
     for i, r in enumerate(runs):
         q = qs.path(i)
         qpath = np.column_stack([q["x"], q["y"]])
-        mpath = r.position_m[r.drive_start_index:, :2] / s
+        mpath = r.position_m[r.drive_start_index :, :2] / s
         if mpath.shape[0] == 0:
             continue
         spacing = lc / 50
-        frechet[i] = compare.frechet_distance(compare.resample_by_arclength(qpath, spacing),
-                                              compare.resample_by_arclength(mpath, spacing),
-                                              length_scale=lc)
+        frechet[i] = compare.frechet_distance(
+            compare.resample_by_arclength(qpath, spacing),
+            compare.resample_by_arclength(mpath, spacing),
+            length_scale=lc,
+        )
         lateral[i] = compare.mean_lateral_deviation(mpath, qpath, length_scale=lc)
     mj_locked = np.array([r.end_reason.value == "self_lock" for r in runs])
     mj_end = np.array([r.position_m[-1, :2] / s for r in runs])
-    agree = compare.outcome_agreement(qs.self_locked, np.column_stack([qs.end_x, qs.end_y]),
-                                      mj_locked, mj_end, length_scale=lc)
-    peak = np.array([r.drive_force_n[r.drive_start_index:].max() / rig.scales.preload_n
-                     if r.n > r.drive_start_index else np.nan for r in runs])
+    agree = compare.outcome_agreement(
+        qs.self_locked, np.column_stack([qs.end_x, qs.end_y]), mj_locked, mj_end, length_scale=lc
+    )
+    peak = np.array(
+        [
+            r.drive_force_n[r.drive_start_index :].max() / rig.scales.preload_n
+            if r.n > r.drive_start_index
+            else np.nan
+            for r in runs
+        ]
+    )
     kap = compare.kappa_agreement(qs.max_kappa, peak, kappa_cap=runs[0].detection.kappa_cap)
     metrics = {
-        "frechet": frechet, "lateral_deviation": lateral,
+        "frechet": frechet,
+        "lateral_deviation": lateral,
         "end_distance": np.linalg.norm(np.column_stack([qs.end_x, qs.end_y]) - mj_end, axis=1) / lc,
-        "agree_lock": agree["lock"], "agree_end": agree["end"], "same_trap": agree["same_trap"],
-        "agree": agree["agree"], "kappa_ratio": kap["ratio"],
+        "agree_lock": agree["lock"],
+        "agree_end": agree["end"],
+        "same_trap": agree["same_trap"],
+        "agree": agree["agree"],
+        "kappa_ratio": kap["ratio"],
         "inertia_number": np.array([r.inertia_number for r in runs]),
     }
-    status = np.array(upstream["mujoco"].status if upstream["mujoco"].status is not None
-                      else np.full(n, "ok"), dtype=object)
-    reason = np.where(status == "ok", "", "mujoco run: " + np.asarray(
-        upstream["mujoco"].reason, dtype=object)).astype(object)
+    status = np.array(
+        upstream["mujoco"].status if upstream["mujoco"].status is not None else np.full(n, "ok"), dtype=object
+    )
+    reason = np.where(
+        status == "ok", "", "mujoco run: " + np.asarray(upstream["mujoco"].reason, dtype=object)
+    ).astype(object)
     status = np.where(status == "ok", "ok", "dependency_failed").astype(object)
     return AnalysisResult(metrics=metrics, status=status, reason=reason)
 
 
-register_analysis(Analysis(
-    "compare", _compare, (), requires=("quasistatic", "mujoco"),
-    doc="quasistatic against MuJoCo per start (lengths over L_c): spine_mj.compare"))
+register_analysis(
+    Analysis(
+        "compare",
+        _compare,
+        (),
+        requires=("quasistatic", "mujoco"),
+        doc="quasistatic against MuJoCo per start (lengths over L_c): spine_mj.compare",
+    )
+)

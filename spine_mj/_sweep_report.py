@@ -28,8 +28,7 @@ def _numeric_metrics(df, params) -> list[str]:
 
     cols = []
     for c in df.columns:
-        if c in _SKIP or c in params or c in ("run_id", "case_id", "analysis", "surface",
-                                              "status", "reason"):
+        if c in _SKIP or c in params or c in ("run_id", "case_id", "analysis", "surface", "status", "reason"):
             continue
         if is_numeric_dtype(df[c]) and df[c].notna().any():
             cols.append(c)
@@ -63,10 +62,11 @@ def write_report(out_dir: Path, output: Path) -> Path:
         bad = df[df.status != "ok"]
         if len(bad):
             parts.append("<h3>Not ok (first 50)</h3>")
-            parts.append(bad[["analysis", "surface", "start", "status", "reason"]].head(50)
-                         .to_html(index=False))
+            parts.append(
+                bad[["analysis", "surface", "start", "status", "reason"]].head(50).to_html(index=False)
+            )
     by = ["surface", *swept]
-    for analysis, sub in ([] if df.empty else df.groupby("analysis", sort=False)):
+    for analysis, sub in [] if df.empty else df.groupby("analysis", sort=False):
         ok = sub[sub.status == "ok"].dropna(axis=1, how="all")
         metrics = _numeric_metrics(ok, params)
         parts.append(f"<h2>{html.escape(analysis)}</h2>")
@@ -98,14 +98,19 @@ def write_report(out_dir: Path, output: Path) -> Path:
                 ax.set_ylabel(metric)
                 ax.set_title(f"{analysis}: {metric} (mean over starts, band min-max)")
                 ax.legend(fontsize="small")
-                parts.append(f'<img alt="{html.escape(metric)} vs {html.escape(param)}" '
-                             f'src="data:image/png;base64,{_png(fig)}">')
+                parts.append(
+                    f'<img alt="{html.escape(metric)} vs {html.escape(param)}" '
+                    f'src="data:image/png;base64,{_png(fig)}">'
+                )
                 n_plots += 1
-    doc = ("<!DOCTYPE html><html><head><meta charset='utf-8'><title>"
-           f"{html.escape(st.name)}</title><style>body{{font-family:sans-serif;max-width:1100px;"
-           "margin:auto}} table{{border-collapse:collapse;font-size:12px}} td,th{{border:1px "
-           "solid #ccc;padding:2px 6px}} img{{max-width:100%}}</style></head><body>"
-           + "\n".join(parts) + "</body></html>\n")
+    doc = (
+        "<!DOCTYPE html><html><head><meta charset='utf-8'><title>"
+        f"{html.escape(st.name)}</title><style>body{{font-family:sans-serif;max-width:1100px;"
+        "margin:auto}} table{{border-collapse:collapse;font-size:12px}} td,th{{border:1px "
+        "solid #ccc;padding:2px 6px}} img{{max-width:100%}}</style></head><body>"
+        + "\n".join(parts)
+        + "</body></html>\n"
+    )
     with atomic_output(output) as tmp:
         tmp.write_text(doc)
     return output

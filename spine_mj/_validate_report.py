@@ -45,8 +45,9 @@ def _static_figure(st: dict, path: Path) -> None:
         rows = [r for r in st["rows"] if r["engine"] == label]
         for az in sorted({r["azimuth_deg"] for r in rows}):
             sel = sorted((r for r in rows if r["azimuth_deg"] == az), key=lambda r: r["slope_deg"])
-            ax.plot([r["slope_deg"] for r in sel], [r["ratio"] for r in sel], "o-",
-                    label=f"azimuth {az:g} deg")
+            ax.plot(
+                [r["slope_deg"] for r in sel], [r["ratio"] for r in sel], "o-", label=f"azimuth {az:g} deg"
+            )
             for r in sel:
                 if r["region"] != "engaged":
                     mark = {"self_lock": "^", "slip": "v"}[r["region"]]
@@ -55,8 +56,10 @@ def _static_figure(st: dict, path: Path) -> None:
         ax.axhspan(0.95, 1.05, color="0.9")
         ax.set(xlabel="slope angle [deg]", ylabel="kappa_mj / kappa", title=label)
         ax.legend(fontsize=7)
-    fig.suptitle("Static probe on planes (shaded: +-5 %; ^ self-lock, v slip region at 1: "
-                 "green = MuJoCo agrees)", fontsize=9)
+    fig.suptitle(
+        "Static probe on planes (shaded: +-5 %; ^ self-lock, v slip region at 1: green = MuJoCo agrees)",
+        fontsize=9,
+    )
     save_figure(fig, path)
 
 
@@ -68,17 +71,34 @@ def _paths_figure(lim: dict, path: Path) -> None:
     axes = fig.subplots(1, len(presets), squeeze=False)[0]
     for ax, preset in zip(axes, presets):
         for i, p in enumerate(lim["paths"][preset]):
-            ax.plot(p["smooth"][:, 0], p["smooth"][:, 1], "k-", lw=1.5,
-                    label="streamline (smooth)" if i == 0 else None)
-            ax.plot(p["tri"][:, 0], p["tri"][:, 1], "b--", lw=1,
-                    label="streamline (hfield facets)" if i == 0 else None)
+            ax.plot(
+                p["smooth"][:, 0],
+                p["smooth"][:, 1],
+                "k-",
+                lw=1.5,
+                label="streamline (smooth)" if i == 0 else None,
+            )
+            ax.plot(
+                p["tri"][:, 0],
+                p["tri"][:, 1],
+                "b--",
+                lw=1,
+                label="streamline (hfield facets)" if i == 0 else None,
+            )
             if p["mujoco"].shape[0]:
-                ax.plot(p["mujoco"][:, 0], p["mujoco"][:, 1], "r-", lw=0.8,
-                        label="MuJoCo" if i == 0 else None)
+                ax.plot(
+                    p["mujoco"][:, 0], p["mujoco"][:, 1], "r-", lw=0.8, label="MuJoCo" if i == 0 else None
+                )
         circle = np.linspace(0, 2 * np.pi, 100)
         ax.plot(1.5 * np.cos(circle), 1.5 * np.sin(circle), color="0.6", lw=0.5)
-        ax.set(aspect="equal", xlim=(-5, 5), ylim=(-5, 5), xlabel="x", ylabel="y",
-               title=f"{preset}, I_e = {lim['lowest_ie']:g}")
+        ax.set(
+            aspect="equal",
+            xlim=(-5, 5),
+            ylim=(-5, 5),
+            xlabel="x",
+            ylabel="y",
+            title=f"{preset}, I_e = {lim['lowest_ie']:g}",
+        )
         ax.legend(fontsize=7, loc="upper left")
     save_figure(fig, path)
 
@@ -92,12 +112,23 @@ def _boundary_figure(bnd: dict, path: Path) -> None:
         used = bnd["ie_star"][proto].get("ie_used", c["ie"])
         off = [i for i, v in enumerate(c["ie"]) if not np.isclose(used, v).any()]
         if off:  # points that take no part in I_e* (a capped ramp covering < half the path)
-            a1.plot(np.asarray(c["ie"])[off], np.asarray(c["agreement"])[off], "o", ms=9,
-                    mfc="white", mec=line.get_color(), label=f"{proto}: not used for I_e*")
+            a1.plot(
+                np.asarray(c["ie"])[off],
+                np.asarray(c["agreement"])[off],
+                "o",
+                ms=9,
+                mfc="white",
+                mec=line.get_color(),
+                label=f"{proto}: not used for I_e*",
+            )
         for key, style in (("frechet", "o-"), ("median_frechet", "s--")):
-            a2.loglog(c["ie"], np.maximum(np.asarray(c[key], float), 1e-5), style,
-                      label=f"{proto}: {'mean' if key == 'frechet' else 'median'} "
-                            f"{'prefix ' if proto == 'ramp' else ''}Frechet")
+            a2.loglog(
+                c["ie"],
+                np.maximum(np.asarray(c[key], float), 1e-5),
+                style,
+                label=f"{proto}: {'mean' if key == 'frechet' else 'median'} "
+                f"{'prefix ' if proto == 'ramp' else ''}Frechet",
+            )
         s = bnd["ie_star"][proto]
         if s.get("kind") != "bracketed":
             s = s.get("by_criterion", {}).get("departure") or s
@@ -121,8 +152,11 @@ def _stick_figure(ss: dict, path: Path) -> None:
     ax = fig.subplots()
     for (ie, k), (t, f) in sorted(ss["traces"].items()):
         ax.plot(t / max(t[-1], 1e-12), f, lw=0.8, label=f"I_e {ie:g}, k {k:.3g} N/m")
-    ax.set(xlabel="time / run duration", ylabel="drive force / F_p",
-           title=f"Spring drive on {ss['surface']} (first start)")
+    ax.set(
+        xlabel="time / run duration",
+        ylabel="drive force / F_p",
+        title=f"Spring drive on {ss['surface']} (first start)",
+    )
     ax.legend(fontsize=7)
     save_figure(fig, path)
 
@@ -152,109 +186,273 @@ def write(out: Path, result: dict, *, static, limit, boundary, stick, sand) -> P
     _stick_figure(stick, figs / "stick_slip.png")
     _sand_figure(sand, figs / "sandpaper.png")
 
-    lines = [f"# Validation: MuJoCo against the quasistatic streamline ({result['plan']} plan)",
-             "", "Generated by `spine-mj validate`; numbers also in `validation.json`. Lengths "
-             "in L_c (characteristic length of each surface), forces in F_p (preload).", ""]
-    lines += ["## 1. Static breakaway ratio on planes", "",
-              f"mu = {static['mu']:g}; probe ramp at I_e = 0.01; kappa from Eqs. 1-3.", "",
-              _table([{"engine": k, **v} for k, v in static["per_engine"].items()],
-                     ["engine", "engaged_planes", "engaged_breakaways", "max_rel_error",
-                      "mean_rel_error", "region_agreement"]), "",
-              f"`static_kappa_max_rel_error` (engaged, default settings) = "
-              f"{_f(result['static_kappa_max_rel_error'])} (target <= 0.05).", "",
-              "![static](figures/static_map.png)", ""]
-    lines += ["<details><summary>per plane</summary>", "",
-              _table(static["rows"], ["engine", "slope_deg", "azimuth_deg", "region", "kappa",
-                                      "kappa_mj", "ratio", "end_reason", "region_agrees"]),
-              "", "</details>", ""]
-    lines += ["## 2. Quasistatic limit (spring drive, lowest I_e)", "",
-              f"I_e = {limit['lowest_ie']:g}, recommended settings. Total = MuJoCo vs smooth "
-              "streamline; geometry = streamline on MuJoCo's hfield facets vs smooth; "
-              "dynamics = MuJoCo vs facet streamline.", "",
-              _table([{"family": k, **v} for k, v in limit["families"].items()],
-                     ["family", "runs", "outcome_agreement", "mean_frechet",
-                      "mean_lateral_deviation", "mean_geometry_frechet",
-                      "mean_dynamics_frechet", "outcome_agreement_vs_triangulated",
-                      "meets_target"],
-                     ["family", "runs", "outcome agr.", "mean Frechet", "mean lateral",
-                      "geometry Frechet", "dynamics Frechet", "outcome agr. vs facets",
-                      "target met"]), "",
-              "![paths](figures/limit_paths.png)", "",
-              "### What limits agreement: settings varied on the single peak", "",
-              _table([{"setting": k, **v} for k, v in limit["variations"].items()],
-                     ["setting", "runs", "outcome_agreement", "mean_frechet",
-                      "mean_lateral_deviation"]), "",
-              "<details><summary>per run</summary>", "",
-              _table(limit["runs"], ["surface", "start_x", "start_y", "end_reason", "agree",
-                                     "frechet", "lateral_deviation", "end_distance",
-                                     "geometry_frechet", "dynamics_frechet"]),
-              "", "</details>", ""]
-    star_rows = [{"protocol": p, "criterion_id": k, **v}
-                 for p, s in boundary["ie_star"].items()
-                 for k, v in s["by_criterion"].items()]
-    lines += ["## 3. The quasistatic boundary", "",
-              f"Families: {', '.join(boundary['families'])}. Spring: a run agrees when its "
-              "outcome agrees (`compare.outcome_agreement`); its deviation is the Frechet "
-              "distance from the streamline. Ramp with reset: its I_e is the equivalent one, "
-              "m v_eq^2 / (F_p L_c) with v_eq = L_c rate / F_p; its duration comes from a "
-              "pilot run's per-cycle slip so that it would cover the path to the domain edge, "
-              "capped at a step budget. A ramp run agrees when it has no engine trouble, does "
-              "not self-lock where the streamline does not, and deviates <= 0.1 L_c from the "
-              "streamline cut at its own arc length (prefix Frechet). I_e* interpolated in "
-              "log I_e inside the bracket [last pass, first fail] for four criteria "
-              "(headline: median; `departure` measures where agreement falls below its own "
-              "low-I_e level); ramp I_e values whose runs cover under half the path take no "
-              "part; ci = 16-84 % bootstrap over starts.", "",
-              _table(star_rows, ["protocol", "criterion", "kind", "value", "low", "high",
-                                 "ci_low", "ci_high"]), ""]
-    lines += [f"**I_e* ({p}) {s['note']}**" for p, s in boundary["ie_star"].items()
-              if s.get("valid") is False] + [""]
+    lines = [
+        f"# Validation: MuJoCo against the quasistatic streamline ({result['plan']} plan)",
+        "",
+        "Generated by `spine-mj validate`; numbers also in `validation.json`. Lengths "
+        "in L_c (characteristic length of each surface), forces in F_p (preload).",
+        "",
+    ]
+    lines += [
+        "## 1. Static breakaway ratio on planes",
+        "",
+        f"mu = {static['mu']:g}; probe ramp at I_e = 0.01; kappa from Eqs. 1-3.",
+        "",
+        _table(
+            [{"engine": k, **v} for k, v in static["per_engine"].items()],
+            [
+                "engine",
+                "engaged_planes",
+                "engaged_breakaways",
+                "max_rel_error",
+                "mean_rel_error",
+                "region_agreement",
+            ],
+        ),
+        "",
+        f"`static_kappa_max_rel_error` (engaged, default settings) = "
+        f"{_f(result['static_kappa_max_rel_error'])} (target <= 0.05).",
+        "",
+        "![static](figures/static_map.png)",
+        "",
+    ]
+    lines += [
+        "<details><summary>per plane</summary>",
+        "",
+        _table(
+            static["rows"],
+            [
+                "engine",
+                "slope_deg",
+                "azimuth_deg",
+                "region",
+                "kappa",
+                "kappa_mj",
+                "ratio",
+                "end_reason",
+                "region_agrees",
+            ],
+        ),
+        "",
+        "</details>",
+        "",
+    ]
+    lines += [
+        "## 2. Quasistatic limit (spring drive, lowest I_e)",
+        "",
+        f"I_e = {limit['lowest_ie']:g}, recommended settings. Total = MuJoCo vs smooth "
+        "streamline; geometry = streamline on MuJoCo's hfield facets vs smooth; "
+        "dynamics = MuJoCo vs facet streamline.",
+        "",
+        _table(
+            [{"family": k, **v} for k, v in limit["families"].items()],
+            [
+                "family",
+                "runs",
+                "outcome_agreement",
+                "mean_frechet",
+                "mean_lateral_deviation",
+                "mean_geometry_frechet",
+                "mean_dynamics_frechet",
+                "outcome_agreement_vs_triangulated",
+                "meets_target",
+            ],
+            [
+                "family",
+                "runs",
+                "outcome agr.",
+                "mean Frechet",
+                "mean lateral",
+                "geometry Frechet",
+                "dynamics Frechet",
+                "outcome agr. vs facets",
+                "target met",
+            ],
+        ),
+        "",
+        "![paths](figures/limit_paths.png)",
+        "",
+        "### What limits agreement: settings varied on the single peak",
+        "",
+        _table(
+            [{"setting": k, **v} for k, v in limit["variations"].items()],
+            ["setting", "runs", "outcome_agreement", "mean_frechet", "mean_lateral_deviation"],
+        ),
+        "",
+        "<details><summary>per run</summary>",
+        "",
+        _table(
+            limit["runs"],
+            [
+                "surface",
+                "start_x",
+                "start_y",
+                "end_reason",
+                "agree",
+                "frechet",
+                "lateral_deviation",
+                "end_distance",
+                "geometry_frechet",
+                "dynamics_frechet",
+            ],
+        ),
+        "",
+        "</details>",
+        "",
+    ]
+    star_rows = [
+        {"protocol": p, "criterion_id": k, **v}
+        for p, s in boundary["ie_star"].items()
+        for k, v in s["by_criterion"].items()
+    ]
+    lines += [
+        "## 3. The quasistatic boundary",
+        "",
+        f"Families: {', '.join(boundary['families'])}. Spring: a run agrees when its "
+        "outcome agrees (`compare.outcome_agreement`); its deviation is the Frechet "
+        "distance from the streamline. Ramp with reset: its I_e is the equivalent one, "
+        "m v_eq^2 / (F_p L_c) with v_eq = L_c rate / F_p; its duration comes from a "
+        "pilot run's per-cycle slip so that it would cover the path to the domain edge, "
+        "capped at a step budget. A ramp run agrees when it has no engine trouble, does "
+        "not self-lock where the streamline does not, and deviates <= 0.1 L_c from the "
+        "streamline cut at its own arc length (prefix Frechet). I_e* interpolated in "
+        "log I_e inside the bracket [last pass, first fail] for four criteria "
+        "(headline: median; `departure` measures where agreement falls below its own "
+        "low-I_e level); ramp I_e values whose runs cover under half the path take no "
+        "part; ci = 16-84 % bootstrap over starts.",
+        "",
+        _table(star_rows, ["protocol", "criterion", "kind", "value", "low", "high", "ci_low", "ci_high"]),
+        "",
+    ]
+    lines += [
+        f"**I_e* ({p}) {s['note']}**" for p, s in boundary["ie_star"].items() if s.get("valid") is False
+    ] + [""]
     for proto, c in boundary["curves"].items():
-        rows = [{"ie": ie, "agreement": a, "mean_frechet": f, "median_frechet": fm,
-                 "lateral": la, "engine_trouble": e, "trap_skip": s}
-                for ie, a, f, fm, la, e, s in zip(
-                     c["ie"], c["agreement"], c["frechet"], c["median_frechet"], c["lateral"],
-                     c["engine_trouble"], boundary["skip_rate"][proto])]
-        cols = ["ie", "agreement", "mean_frechet", "median_frechet", "lateral",
-                "engine_trouble", "trap_skip"]
+        rows = [
+            {
+                "ie": ie,
+                "agreement": a,
+                "mean_frechet": f,
+                "median_frechet": fm,
+                "lateral": la,
+                "engine_trouble": e,
+                "trap_skip": s,
+            }
+            for ie, a, f, fm, la, e, s in zip(
+                c["ie"],
+                c["agreement"],
+                c["frechet"],
+                c["median_frechet"],
+                c["lateral"],
+                c["engine_trouble"],
+                boundary["skip_rate"][proto],
+            )
+        ]
+        cols = ["ie", "agreement", "mean_frechet", "median_frechet", "lateral", "engine_trouble", "trap_skip"]
         if proto == "ramp":
             for r, cv, ach in zip(rows, c["coverage"], c["ie_achieved"]):
                 r.update({"coverage": cv, "ie_achieved": ach})
             cols += ["coverage", "ie_achieved"]
-        lines += [f"**{proto}** ({c['runs_per_ie']} runs per I_e; deviation: "
-                  f"{c['frechet_kind']})", "", _table(rows, cols), ""]
+        lines += [
+            f"**{proto}** ({c['runs_per_ie']} runs per I_e; deviation: {c['frechet_kind']})",
+            "",
+            _table(rows, cols),
+            "",
+        ]
         if proto == "ramp":
-            plans = [{"surface": p, "ie": float(ie), **rp}
-                     for p, d in c["ramp_plans"].items() for ie, rp in d.items()]
-            lines += [f"Ramp durations (pilot from the family's first start; cap "
-                      f"{c['ramp_max_steps']} steps; coverage = x advance / distance to the "
-                      "domain edge; ie_achieved from the mean x speed):", "",
-                      _table(plans, ["surface", "ie", "rate_n_s", "slip_per_cycle_lc",
-                                     "cycle_s", "target_lc", "required_steps", "duration_s",
-                                     "capped", "coverage_expected"]), ""]
+            plans = [
+                {"surface": p, "ie": float(ie), **rp}
+                for p, d in c["ramp_plans"].items()
+                for ie, rp in d.items()
+            ]
+            lines += [
+                f"Ramp durations (pilot from the family's first start; cap "
+                f"{c['ramp_max_steps']} steps; coverage = x advance / distance to the "
+                "domain edge; ie_achieved from the mean x speed):",
+                "",
+                _table(
+                    plans,
+                    [
+                        "surface",
+                        "ie",
+                        "rate_n_s",
+                        "slip_per_cycle_lc",
+                        "cycle_s",
+                        "target_lc",
+                        "required_steps",
+                        "duration_s",
+                        "capped",
+                        "coverage_expected",
+                    ],
+                ),
+                "",
+            ]
     lines += ["![boundary](figures/boundary.png)", ""]
-    lines += ["## 4. Stick-slip", "", f"Spring drive on {stick['surface']}.", "",
-              _table(stick["rows"], ["ie", "stiffness_fp_per_lc", "runs", "slip_events_per_run",
-                                     "mean_jump_lc", "max_jump_lc", "mean_force_drop_fp",
-                                     "max_force_drop_fp", "quasistatic_traps",
-                                     "skipped_traps", "extra_locks"]), "",
-              "![stick-slip](figures/stick_slip.png)", ""]
+    lines += [
+        "## 4. Stick-slip",
+        "",
+        f"Spring drive on {stick['surface']}.",
+        "",
+        _table(
+            stick["rows"],
+            [
+                "ie",
+                "stiffness_fp_per_lc",
+                "runs",
+                "slip_events_per_run",
+                "mean_jump_lc",
+                "max_jump_lc",
+                "mean_force_drop_fp",
+                "max_force_drop_fp",
+                "quasistatic_traps",
+                "skipped_traps",
+                "extra_locks",
+            ],
+        ),
+        "",
+        "![stick-slip](figures/stick_slip.png)",
+        "",
+    ]
     if sand["rows"]:
-        lines += ["## 5. Sandpaper analogs (25 um tip)", "",
-                  f"Spring drive, mu = {sand['mu']:g} (assumed; the paper gives none for grit).",
-                  "", _table(sand["rows"], ["grit", "runs", "tip_radius_um",
-                                            "max_lateral_excursion_mm",
-                                            "mean_lateral_excursion_tip_radii",
-                                            "rms_lateral_tip_radii", "tortuosity",
-                                            "force_peaks_per_100_tip_radii",
-                                            "peak_over_median_force", "self_locked_fraction",
-                                            "failed_runs"]),
-                  "", "Failures: " + "; ".join(f"{r['grit']}: {', '.join(r['failures'])}"
-                                               for r in sand["rows"] if r.get("failures"))
-                  + ".",
-                  "", "![sandpaper](figures/sandpaper.png)", ""]
-    lines += ["## Engine settings", "", "```", str(result["engine_settings"]), "```", "",
-              f"Study times [s]: {result['timings_s']}", ""]
+        lines += [
+            "## 5. Sandpaper analogs (25 um tip)",
+            "",
+            f"Spring drive, mu = {sand['mu']:g} (assumed; the paper gives none for grit).",
+            "",
+            _table(
+                sand["rows"],
+                [
+                    "grit",
+                    "runs",
+                    "tip_radius_um",
+                    "max_lateral_excursion_mm",
+                    "mean_lateral_excursion_tip_radii",
+                    "rms_lateral_tip_radii",
+                    "tortuosity",
+                    "force_peaks_per_100_tip_radii",
+                    "peak_over_median_force",
+                    "self_locked_fraction",
+                    "failed_runs",
+                ],
+            ),
+            "",
+            "Failures: "
+            + "; ".join(f"{r['grit']}: {', '.join(r['failures'])}" for r in sand["rows"] if r.get("failures"))
+            + ".",
+            "",
+            "![sandpaper](figures/sandpaper.png)",
+            "",
+        ]
+    lines += [
+        "## Engine settings",
+        "",
+        "```",
+        str(result["engine_settings"]),
+        "```",
+        "",
+        f"Study times [s]: {result['timings_s']}",
+        "",
+    ]
     path = out / "report.md"
     with atomic_output(path) as tmp:
         tmp.write_text("\n".join(lines))

@@ -90,23 +90,34 @@ def surface_list():
 
 @surface.command("make")
 @click.argument("preset", required=False)
-@click.option("--from-file", "from_file", type=click.Path(dir_okay=False),
-              help="Import a measured topography (x3p, opd, datx, plu, di, sur, ...).")
-@click.option("-o", "--output", required=True, type=click.Path(dir_okay=False),
-              help="Output .npz file.")
+@click.option(
+    "--from-file",
+    "from_file",
+    type=click.Path(dir_okay=False),
+    help="Import a measured topography (x3p, opd, datx, plu, di, sur, ...).",
+)
+@click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="Output .npz file.")
 @click.option("--seed", type=click.IntRange(min=0), help="Override the preset's seed.")
 @click.option("--hurst", type=float, help="Override the Hurst index (fractal presets).")
-@click.option("--set", "sets", multiple=True, metavar="KEY=VALUE",
-              help="Override any generator parameter (TOML value), repeatable.")
-@click.option("--fill", type=click.Choice(["refuse", "harmonic", "nearest", "mean"]),
-              default="refuse", show_default=True, help="Missing points in imported files.")
+@click.option(
+    "--set",
+    "sets",
+    multiple=True,
+    metavar="KEY=VALUE",
+    help="Override any generator parameter (TOML value), repeatable.",
+)
+@click.option(
+    "--fill",
+    type=click.Choice(["refuse", "harmonic", "nearest", "mean"]),
+    default="refuse",
+    show_default=True,
+    help="Missing points in imported files.",
+)
 @click.option("--no-level", is_flag=True, help="Keep the tilt of an imported file.")
 @click.option("--spacing", type=float, help="Resample an imported file to this spacing [m].")
-@click.option("--channel", type=int, default=0, show_default=True,
-              help="Data channel of an imported file.")
+@click.option("--channel", type=int, default=0, show_default=True, help="Data channel of an imported file.")
 @click.option("--png", type=click.Path(dir_okay=False), help="Also write a PNG preview.")
-def surface_make(preset, from_file, output, seed, hurst, sets, fill, no_level, spacing,
-                 channel, png):
+def surface_make(preset, from_file, output, seed, hurst, sets, fill, no_level, spacing, channel, png):
     """Make a surface from PRESET (see `spine-mj surface list`) or import one with
     --from-file, and save it as .npz.
 
@@ -120,8 +131,9 @@ def surface_make(preset, from_file, output, seed, hurst, sets, fill, no_level, s
     if (preset is None) == (from_file is None):
         raise SpineInputError("give exactly one of PRESET or --from-file")
     if from_file is not None:
-        surf = surface_io.import_topography(from_file, channel=channel, fill=fill,
-                                            level=not no_level, spacing_m=spacing)
+        surf = surface_io.import_topography(
+            from_file, channel=channel, fill=fill, level=not no_level, spacing_m=spacing
+        )
     else:
         overrides = dict(presets.parse_override(s) for s in sets)
         if seed is not None:
@@ -146,8 +158,7 @@ def _check_suffix(path: str, suffix: str, option: str) -> None:
 
 @surface.command("show")
 @click.argument("surface_file")
-@click.option("-o", "--output", required=True, type=click.Path(dir_okay=False),
-              help="Output PNG.")
+@click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="Output PNG.")
 def surface_show(surface_file, output):
     """Write a PNG preview (height map and 3-D view) of SURFACE_FILE.
 
@@ -166,15 +177,28 @@ def surface_show(surface_file, output):
 @surface.command("export")
 @click.argument("surface_file")
 @click.option("--stl", type=click.Path(dir_okay=False), help="Watertight STL solid.")
-@click.option("--stl-scale", type=float, default=None,
-              help="Multiply coordinates in the STL (default: metres to mm for physical "
-                   "surfaces, 1 for dimensionless ones).")
-@click.option("--base", "base_thickness", type=float, default=None,
-              help="STL base thickness below the lowest point (surface units).")
-@click.option("--hfield", type=click.Path(dir_okay=False),
-              help="MuJoCo hfield data: .npz with `data` (nrow x ncol in [0, 1]), `size`, `pos`.")
-@click.option("--resolution", type=click.IntRange(min=4), default=None,
-              help="Samples a side for analytic surfaces.")
+@click.option(
+    "--stl-scale",
+    type=float,
+    default=None,
+    help="Multiply coordinates in the STL (default: metres to mm for physical "
+    "surfaces, 1 for dimensionless ones).",
+)
+@click.option(
+    "--base",
+    "base_thickness",
+    type=float,
+    default=None,
+    help="STL base thickness below the lowest point (surface units).",
+)
+@click.option(
+    "--hfield",
+    type=click.Path(dir_okay=False),
+    help="MuJoCo hfield data: .npz with `data` (nrow x ncol in [0, 1]), `size`, `pos`.",
+)
+@click.option(
+    "--resolution", type=click.IntRange(min=4), default=None, help="Samples a side for analytic surfaces."
+)
 def surface_export(surface_file, stl, stl_scale, base_thickness, hfield, resolution):
     """Export SURFACE_FILE as an STL solid for printing and/or as MuJoCo hfield data.
 
@@ -205,8 +229,9 @@ def surface_export(surface_file, stl, stl_scale, base_thickness, hfield, resolut
     if hfield:
         hf = to_hfield(surf, ncol=resolution, nrow=resolution) if resolution else to_hfield(surf)
         with atomic_output(hfield) as tmp, open(tmp, "wb") as fh:
-            np.savez(fh, data=hf.data, size=np.asarray(hf.size), pos=np.asarray(hf.pos),
-                     unit=np.array(surf.unit))
+            np.savez(
+                fh, data=hf.data, size=np.asarray(hf.size), pos=np.asarray(hf.pos), unit=np.array(surf.unit)
+            )
         click.echo(f"wrote {hfield} ({hf.nrow} x {hf.ncol}, size {json.dumps(hf.size)})")
 
 
@@ -237,14 +262,20 @@ def sweep():
 
 @sweep.command("run")
 @click.argument("config", type=click.Path(dir_okay=False))
-@click.option("--out", "out_dir", required=True, type=click.Path(file_okay=False),
-              help="Result store folder (resumed if it holds this config's sweep).")
-@click.option("--workers", type=click.IntRange(min=1), default=None,
-              help="Local worker processes [default: all cores].")
-@click.option("--scheduler", metavar="ADDRESS",
-              help="Run on a Dask distributed cluster (e.g. tcp://head:8786).")
-@click.option("--overwrite", is_flag=True,
-              help="Replace a store in --out that holds another config's sweep.")
+@click.option(
+    "--out",
+    "out_dir",
+    required=True,
+    type=click.Path(file_okay=False),
+    help="Result store folder (resumed if it holds this config's sweep).",
+)
+@click.option(
+    "--workers", type=click.IntRange(min=1), default=None, help="Local worker processes [default: all cores]."
+)
+@click.option(
+    "--scheduler", metavar="ADDRESS", help="Run on a Dask distributed cluster (e.g. tcp://head:8786)."
+)
+@click.option("--overwrite", is_flag=True, help="Replace a store in --out that holds another config's sweep.")
 @click.option("--retry-failed", is_flag=True, help="Run again the cases with failed runs.")
 @click.option("--quiet", is_flag=True, help="No progress bar.")
 def sweep_run(config, out_dir, workers, scheduler, overwrite, retry_failed, quiet):
@@ -269,27 +300,48 @@ def sweep_run(config, out_dir, workers, scheduler, overwrite, retry_failed, quie
             from tqdm import tqdm
 
             tqdm.monitor_interval = 0  # no monitor thread: a single-threaded CLI forks its workers
-            bar = tqdm(total=p.total_cases, initial=p.skipped_cases, unit="case",
-                       desc=cfg.name, dynamic_ncols=True, file=sys.stderr)
+            bar = tqdm(
+                total=p.total_cases,
+                initial=p.skipped_cases,
+                unit="case",
+                desc=cfg.name,
+                dynamic_ncols=True,
+                file=sys.stderr,
+            )
         else:
             bar.update(1)
             bar.set_postfix(ok=p.ok_runs, failed=p.failed_runs, refresh=False)
 
     try:
-        summary = sw.run_sweep(cfg, out_dir, workers=workers, scheduler=scheduler,
-                               overwrite=overwrite, retry_failed=retry_failed, progress=progress)
+        summary = sw.run_sweep(
+            cfg,
+            out_dir,
+            workers=workers,
+            scheduler=scheduler,
+            overwrite=overwrite,
+            retry_failed=retry_failed,
+            progress=progress,
+        )
     finally:
         if bar is not None:
             bar.close()
-    where = (f"scheduler {scheduler}" if scheduler
-             else f"{summary.workers} worker{'s' if summary.workers != 1 else ''}")
-    click.echo(f"{cfg.name}: {summary.total_runs} runs in {summary.total_cases} cases; "
-               f"done {summary.ok_runs}, failed {summary.failed_runs}, skipped "
-               f"{summary.skipped_runs} (finished before); {summary.elapsed_s:.1f} s on {where}")
+    where = (
+        f"scheduler {scheduler}"
+        if scheduler
+        else f"{summary.workers} worker{'s' if summary.workers != 1 else ''}"
+    )
+    click.echo(
+        f"{cfg.name}: {summary.total_runs} runs in {summary.total_cases} cases; "
+        f"done {summary.ok_runs}, failed {summary.failed_runs}, skipped "
+        f"{summary.skipped_runs} (finished before); {summary.elapsed_s:.1f} s on {where}"
+    )
     bad = {k: v for k, v in summary.status_counts.items() if k != "ok"}
     if bad:
-        click.echo("not ok in the store: " + ", ".join(f"{k} {v}" for k, v in sorted(bad.items()))
-                   + f" (see {Path(out_dir) / 'runs.parquet'}, column reason)")
+        click.echo(
+            "not ok in the store: "
+            + ", ".join(f"{k} {v}" for k, v in sorted(bad.items()))
+            + f" (see {Path(out_dir) / 'runs.parquet'}, column reason)"
+        )
     click.echo(f"wrote {Path(out_dir) / 'runs.parquet'}")
 
 
@@ -306,18 +358,21 @@ def sweep_status(out_dir):
 
     st = sw.store_status(out_dir)
     runs = sum(st.status_counts.values())
-    click.echo(f"{st.name} (config {st.config_hash[:12]}, created {st.created}, "
-               f"{st.sessions} session{'s' if st.sessions != 1 else ''})")
-    click.echo(f"cases {st.finished_cases}/{st.total_cases}, runs {runs}/{st.total_runs}"
-               + (" - complete" if st.complete else " - unfinished: run the same command again"))
+    click.echo(
+        f"{st.name} (config {st.config_hash[:12]}, created {st.created}, "
+        f"{st.sessions} session{'s' if st.sessions != 1 else ''})"
+    )
+    click.echo(
+        f"cases {st.finished_cases}/{st.total_cases}, runs {runs}/{st.total_runs}"
+        + (" - complete" if st.complete else " - unfinished: run the same command again")
+    )
     for status, n in sorted(st.status_counts.items()):
         click.echo(f"  {status:18s} {n}")
 
 
 @main.command("report")
 @click.argument("out_dir", metavar="DIR", type=click.Path(file_okay=False))
-@click.option("-o", "--output", required=True, type=click.Path(dir_okay=False),
-              help="Output .html file.")
+@click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="Output .html file.")
 def report(out_dir, output):
     """Write an HTML report of the sweep in DIR: runs by status, metric tables and plots of
     the metrics against the swept parameters.
@@ -344,14 +399,27 @@ def _rig_options(f):
     opts = [
         click.option("--tip-radius", type=float, default=None, help="Tip radius [m] (default: derived)."),
         click.option("--mass", type=float, default=0.01, show_default=True, help="m_eff [kg]."),
-        click.option("--mu", type=float, default=None,
-                     help="Friction coefficient mu_s (default: the preset's [engagement] mu, else 0.5)."),
-        click.option("--preload", type=float, default=0.0, show_default=True,
-                     help="Extra downward preload [N]."),
-        click.option("--length-scale", type=float, default=None,
-                     help="Metres per unit of a dimensionless surface (default 0.01)."),
-        click.option("--resolution", type=int, default=None,
-                     help="hfield samples a side for analytic surfaces (default 201)."),
+        click.option(
+            "--mu",
+            type=float,
+            default=None,
+            help="Friction coefficient mu_s (default: the preset's [engagement] mu, else 0.5).",
+        ),
+        click.option(
+            "--preload", type=float, default=0.0, show_default=True, help="Extra downward preload [N]."
+        ),
+        click.option(
+            "--length-scale",
+            type=float,
+            default=None,
+            help="Metres per unit of a dimensionless surface (default 0.01).",
+        ),
+        click.option(
+            "--resolution",
+            type=int,
+            default=None,
+            help="hfield samples a side for analytic surfaces (default 201).",
+        ),
         click.option("--timestep", type=float, default=None, help="Time step [s] (default: derived)."),
         click.option("--noslip", type=int, default=None, help="noslip_iterations (default 3)."),
         click.option("--impratio", type=float, default=None, help="impratio (default 1)."),
@@ -361,21 +429,31 @@ def _rig_options(f):
     return f
 
 
-def _build_rig(surface_spec, tip_radius, mass, mu, preload, length_scale, resolution, timestep,
-               noslip, impratio):
+def _build_rig(
+    surface_spec, tip_radius, mass, mu, preload, length_scale, resolution, timestep, noslip, impratio
+):
     from spine_mj import sim
 
     surf = load_surface_arg(surface_spec)
     mu = preset_mu(surf) if mu is None else mu
-    tip = sim.TipParams(tip_radius_m=tip_radius, mass_kg=mass, preload_n=preload,
-                        **({} if mu is None else {"mu_s": mu}))
-    overrides = {k: v for k, v in (("timestep_s", timestep), ("noslip_iterations", noslip),
-                                   ("impratio", impratio), ("hfield_resolution", resolution))
-                 if v is not None}
+    tip = sim.TipParams(
+        tip_radius_m=tip_radius, mass_kg=mass, preload_n=preload, **({} if mu is None else {"mu_s": mu})
+    )
+    overrides = {
+        k: v
+        for k, v in (
+            ("timestep_s", timestep),
+            ("noslip_iterations", noslip),
+            ("impratio", impratio),
+            ("hfield_resolution", resolution),
+        )
+        if v is not None
+    }
     rig = sim.Rig(surf, tip=tip, length_scale_m=length_scale)
     if overrides:
-        rig = sim.Rig(surf, tip=tip, length_scale_m=length_scale,
-                      engine=sim.default_engine(rig.scales, **overrides))
+        rig = sim.Rig(
+            surf, tip=tip, length_scale_m=length_scale, engine=sim.default_engine(rig.scales, **overrides)
+        )
     return rig
 
 
@@ -398,27 +476,35 @@ def sim_export(surface_spec, output, **rig_opts):
     _check_suffix(output, ".xml", "-o/--output")
     rig = _build_rig(surface_spec, **rig_opts)
     rig.export_xml(output)
-    click.echo(f"wrote {output} (hfield {rig.hfield.nrow} x {rig.hfield.ncol}, "
-               f"dt {rig.engine.timestep_s:g} s, tip radius {rig.tip.tip_radius_m:g} m)")
+    click.echo(
+        f"wrote {output} (hfield {rig.hfield.nrow} x {rig.hfield.ncol}, "
+        f"dt {rig.engine.timestep_s:g} s, tip radius {rig.tip.tip_radius_m:g} m)"
+    )
 
 
 @main.command("simulate")
 @click.argument("surface_spec", metavar="SURFACE")
 @click.option("--start", required=True, help="Start 'x0,y0' in surface units, e.g. -3,-1.")
-@click.option("--drive", type=click.Choice(["spring", "ramp", "static"]), default="spring",
-              show_default=True)
-@click.option("--speed", type=float, default=0.05, show_default=True,
-              help="Carriage speed [m/s] (spring drive).")
+@click.option("--drive", type=click.Choice(["spring", "ramp", "static"]), default="spring", show_default=True)
+@click.option(
+    "--speed", type=float, default=0.05, show_default=True, help="Carriage speed [m/s] (spring drive)."
+)
 @click.option("--stiffness", type=float, default=None, help="Spring stiffness [N/m] (default 10 F_p/L_c).")
 @click.option("--rate", type=float, default=None, help="Force rate [N/s] (ramp, static).")
-@click.option("--start-force", type=float, default=0.0, show_default=True,
-              help="Static probe: force [N] applied while the tip settles.")
+@click.option(
+    "--start-force",
+    type=float,
+    default=0.0,
+    show_default=True,
+    help="Static probe: force [N] applied while the tip settles.",
+)
 @click.option("--duration", type=float, default=None, help="Run time [s] (spring, ramp).")
 @click.option("--render", is_flag=True, help="Also write an MP4 rendered headless (MUJOCO_GL=egl).")
 @click.option("-o", "--out-dir", required=True, type=click.Path(file_okay=False))
 @_rig_options
-def simulate(surface_spec, start, drive, speed, stiffness, rate, start_force, duration, render,
-             out_dir, **rig_opts):
+def simulate(
+    surface_spec, start, drive, speed, stiffness, rate, start_force, duration, render, out_dir, **rig_opts
+):
     """Run one drive on SURFACE: writes trajectory.parquet, run.png, summary.json (and run.mp4).
 
     \b
@@ -479,7 +565,8 @@ def _render_mp4(rig, result, path: Path) -> None:
         backend = os.environ.get("MUJOCO_GL", "")
         raise SpineInputError(
             f"no headless renderer (MUJOCO_GL={backend!r}: {type(exc).__name__}: {exc}); "
-            "try MUJOCO_GL=osmesa or run without --render") from None
+            "try MUJOCO_GL=osmesa or run without --render"
+        ) from None
     with atomic_output(path) as tmp:
         with imageio.get_writer(tmp, fps=30, codec="libx264", format="FFMPEG") as writer:
             writer.append_data(first)
@@ -495,17 +582,21 @@ def view(surface_spec, **rig_opts):
     import os
     import sys
 
-    if sys.platform.startswith("linux") and not (os.environ.get("DISPLAY")
-                                                  or os.environ.get("WAYLAND_DISPLAY")):
-        raise click.ClickException("no display (DISPLAY and WAYLAND_DISPLAY are unset): the viewer "
-                                   "needs one; use `spine-mj sim export` or `simulate --render`")
+    if sys.platform.startswith("linux") and not (
+        os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
+    ):
+        raise click.ClickException(
+            "no display (DISPLAY and WAYLAND_DISPLAY are unset): the viewer "
+            "needs one; use `spine-mj sim export` or `simulate --render`"
+        )
     import mujoco
     import mujoco.viewer
 
     rig = _build_rig(surface_spec, **rig_opts)
     data = mujoco.MjData(rig.model)
-    data.qpos[:] = rig.place(*(0.5 * (a + b) for a, b in zip(rig.surface.bounds[::2],
-                                                             rig.surface.bounds[1::2])))
+    data.qpos[:] = rig.place(
+        *(0.5 * (a + b) for a, b in zip(rig.surface.bounds[::2], rig.surface.bounds[1::2]))
+    )
     mujoco.viewer.launch(rig.model, data)
 
 
@@ -535,8 +626,9 @@ def _engagement_mu(surf, mu):
 @click.argument("surface_spec", metavar="SURFACE")
 @click.option("--mu", type=float, help="Static friction coefficient mu_s (default: the preset's).")
 @click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="Output PNG.")
-@click.option("--resolution", type=click.IntRange(min=8), default=301, show_default=True,
-              help="Samples a side.")
+@click.option(
+    "--resolution", type=click.IntRange(min=8), default=301, show_default=True, help="Samples a side."
+)
 def kappa_cmd(surface_spec, mu, output, resolution):
     """Map the engagement ratio kappa over SURFACE (paper Fig. 2B): slip blank, self-lock
     dark red.
@@ -561,23 +653,42 @@ def kappa_cmd(surface_spec, mu, output, resolution):
     heights = surf.height(xs[None, :], ys[:, None])
     fig = kappa_map_figure({surf.metadata.get("preset", "surface"): (xs, heights, k, region)}, mu)
     save_figure(fig, output)
-    shares = ", ".join(f"{n} {100 * np.mean(region == c):.1f} %"
-                       for c, n in ((0, "slip"), (1, "engaged"), (2, "self-lock")))
+    shares = ", ".join(
+        f"{n} {100 * np.mean(region == c):.1f} %" for c, n in ((0, "slip"), (1, "engaged"), (2, "self-lock"))
+    )
     click.echo(f"wrote {output} ({shares})")
 
 
 @main.command("streamline")
 @click.argument("surface_spec", metavar="SURFACE")
 @click.option("--mu", type=float, help="Static friction coefficient mu_s (default: the preset's).")
-@click.option("--start", "starts", multiple=True, required=True, metavar="X,Y",
-              help="Start point, repeatable.")
+@click.option(
+    "--start", "starts", multiple=True, required=True, metavar="X,Y", help="Start point, repeatable."
+)
 @click.option("--dl", type=float, default=None, help="Step length (default: 1/1000 of the domain).")
-@click.option("--tip-radius", type=float, default=0.0, show_default=True,
-              help="Spherical tip radius R; the tip centre rides the surface dilated by R.")
-@click.option("--format", "fmt", type=click.Choice(["parquet", "csv"]), default="parquet",
-              show_default=True, help="Table format.")
-@click.option("-o", "--out", "out_dir", required=True, type=click.Path(file_okay=False),
-              help="Output folder (streamlines.parquet|csv and streamlines.png).")
+@click.option(
+    "--tip-radius",
+    type=float,
+    default=0.0,
+    show_default=True,
+    help="Spherical tip radius R; the tip centre rides the surface dilated by R.",
+)
+@click.option(
+    "--format",
+    "fmt",
+    type=click.Choice(["parquet", "csv"]),
+    default="parquet",
+    show_default=True,
+    help="Table format.",
+)
+@click.option(
+    "-o",
+    "--out",
+    "out_dir",
+    required=True,
+    type=click.Path(file_okay=False),
+    help="Output folder (streamlines.parquet|csv and streamlines.png).",
+)
 def streamline_cmd(surface_spec, mu, starts, dl, tip_radius, fmt, out_dir):
     """Quasistatic streamlines and ideal trajectories from each --start (paper Eq. 4):
     a table (one row per path point) and a PNG (3-D view and kappa along the paths).
@@ -613,23 +724,38 @@ def streamline_cmd(surface_spec, mu, starts, dl, tip_radius, fmt, out_dir):
             table.to_csv(tmp, index=False)
     save_figure(streamline_figure(surf, stream, ideal, title=f"mu_s = {mu:g}"), out / "streamlines.png")
     for i, (x, y) in enumerate(pts):
-        click.echo(f"start ({x:g}, {y:g}): streamline {stream.outcome_names[i]} at "
-                   f"({stream.end_x[i]:.3f}, {stream.end_y[i]:.3f}), max kappa "
-                   f"{stream.max_kappa[i]:.3g}; ideal {ideal.outcome_names[i]}, max kappa "
-                   f"{ideal.max_kappa[i]:.3g}")
+        click.echo(
+            f"start ({x:g}, {y:g}): streamline {stream.outcome_names[i]} at "
+            f"({stream.end_x[i]:.3f}, {stream.end_y[i]:.3f}), max kappa "
+            f"{stream.max_kappa[i]:.3g}; ideal {ideal.outcome_names[i]}, max kappa "
+            f"{ideal.max_kappa[i]:.3g}"
+        )
     click.echo(f"wrote {path} and {out / 'streamlines.png'}")
 
 
 @main.command("reproduce")
-@click.argument("name", type=click.Choice(["single-peak", "random-gaussian", "fractal-hurst",
-                                           "kappa-map"]))
-@click.option("--out", "out_dir", required=True, type=click.Path(file_okay=False),
-              help="Output folder for NAME.png and NAME.json.")
+@click.argument("name", type=click.Choice(["single-peak", "random-gaussian", "fractal-hurst", "kappa-map"]))
+@click.option(
+    "--out",
+    "out_dir",
+    required=True,
+    type=click.Path(file_okay=False),
+    help="Output folder for NAME.png and NAME.json.",
+)
 @click.option("--quick", is_flag=True, help="Reduced run (fewer surfaces and starts).")
-@click.option("--surfaces", type=click.IntRange(min=3), default=None,
-              help="fractal-hurst: surfaces per H (default 300).")
-@click.option("--workers", type=click.IntRange(min=1), default=2, show_default=True,
-              help="fractal-hurst: worker processes.")
+@click.option(
+    "--surfaces",
+    type=click.IntRange(min=3),
+    default=None,
+    help="fractal-hurst: surfaces per H (default 300).",
+)
+@click.option(
+    "--workers",
+    type=click.IntRange(min=1),
+    default=2,
+    show_default=True,
+    help="fractal-hurst: worker processes.",
+)
 def reproduce_cmd(name, out_dir, quick, surfaces, workers):
     """Reproduce a figure of the paper: writes DIR/NAME.png and DIR/NAME.json.
 
@@ -655,6 +781,7 @@ def reproduce_cmd(name, out_dir, quick, surfaces, workers):
     elif surfaces is not None:
         raise SpineInputError(f"--surfaces applies to fractal-hurst only, got NAME {name!r}")
     with click.progressbar(length=1, label=name) as bar:
+
         def progress(done, total):
             bar.length = total
             bar.update(done - bar.pos)
@@ -674,15 +801,32 @@ def reproduce_cmd(name, out_dir, quick, surfaces, workers):
 
 
 @main.command("validate")
-@click.option("--out", "out_dir", required=True, type=click.Path(),
-              help="Output folder: report.md, validation.json, figures/, sweeps/ (resumable).")
-@click.option("--quick", is_flag=True,
-              help="The quick plan (<= 5 min on 2 cores): fewer starts and I_e values, "
-                   "coarser hfields.")
-@click.option("--plan", "plan_name", type=click.Choice(["smoke", "quick", "full"]),
-              default=None, hidden=True, help="Plan by name (smoke: a seconds-long test size).")
-@click.option("--workers", type=click.IntRange(min=1), default=None,
-              help="Worker processes for the sweeps (default: all cores).")
+@click.option(
+    "--out",
+    "out_dir",
+    required=True,
+    type=click.Path(),
+    help="Output folder: report.md, validation.json, figures/, sweeps/ (resumable).",
+)
+@click.option(
+    "--quick",
+    is_flag=True,
+    help="The quick plan (<= 5 min on 2 cores): fewer starts and I_e values, coarser hfields.",
+)
+@click.option(
+    "--plan",
+    "plan_name",
+    type=click.Choice(["smoke", "quick", "full"]),
+    default=None,
+    hidden=True,
+    help="Plan by name (smoke: a seconds-long test size).",
+)
+@click.option(
+    "--workers",
+    type=click.IntRange(min=1),
+    default=None,
+    help="Worker processes for the sweeps (default: all cores).",
+)
 @click.option("--quiet", is_flag=True, help="No progress lines.")
 def validate_cmd(out_dir, quick, plan_name, workers, quiet):
     """Run the validation suite (MuJoCo against the quasistatic streamline across inertia
@@ -717,11 +861,14 @@ def validate_cmd(out_dir, quick, plan_name, workers, quiet):
     result = validate.run_validation(out, plan=plan, workers=workers, progress=progress)
     if not quiet and last["step"] is not None:
         sys.stderr.write("\n")
-    click.echo(f"static kappa max rel. error (engaged, default settings): "
-               f"{result['static_kappa_max_rel_error']:.3g}")
+    click.echo(
+        f"static kappa max rel. error (engaged, default settings): {result['static_kappa_max_rel_error']:.3g}"
+    )
     for fam, agree in result["outcome_agreement_at_lowest_ie"].items():
-        click.echo(f"I_e = {result['lowest_ie']:g}, {fam}: outcome agreement {agree:.0%}, "
-                   f"mean Frechet {result['mean_frechet_at_lowest_ie'][fam]:.3g} L_c")
+        click.echo(
+            f"I_e = {result['lowest_ie']:g}, {fam}: outcome agreement {agree:.0%}, "
+            f"mean Frechet {result['mean_frechet_at_lowest_ie'][fam]:.3g} L_c"
+        )
     for proto, s in result["ie_star"].items():
         if s.get("valid") is False:
             click.echo(f"I_e* ({proto}) {s['note']}")
@@ -736,8 +883,9 @@ def validate_cmd(out_dir, quick, plan_name, workers, quiet):
                 click.echo(f"  I_e* > {star['low']:.3g} (agreement holds on the whole grid)")
             else:
                 click.echo(f"  I_e* < {star['high']:.3g} (no agreement at the lowest I_e)")
-    click.echo(f"wrote {out / 'report.md'} and {out / 'validation.json'} "
-               f"({result['timings_s']['total']:.0f} s)")
+    click.echo(
+        f"wrote {out / 'report.md'} and {out / 'validation.json'} ({result['timings_s']['total']:.0f} s)"
+    )
 
 
 # --------------------------------------------------------------------------- end validation

@@ -23,9 +23,15 @@ from numba import njit
 
 from spine_mj.errors import SpineInputError
 
-__all__ = ["capture_rate", "frechet_distance", "frechet_distance_reference",
-           "kappa_agreement", "mean_lateral_deviation", "outcome_agreement",
-           "resample_by_arclength"]
+__all__ = [
+    "capture_rate",
+    "frechet_distance",
+    "frechet_distance_reference",
+    "kappa_agreement",
+    "mean_lateral_deviation",
+    "outcome_agreement",
+    "resample_by_arclength",
+]
 
 
 def _path(name: str, path) -> np.ndarray:
@@ -87,10 +93,12 @@ def frechet_distance(path_a, path_b, *, length_scale: float = 1.0) -> float:
     """
     a, b = _path("path_a", path_a), _path("path_b", path_b)
     if a.shape[1] != b.shape[1]:
-        raise SpineInputError(f"path_a and path_b must have the same dimension, got "
-                              f"{a.shape[1]} and {b.shape[1]}")
-    return float(_frechet_kernel(np.ascontiguousarray(a), np.ascontiguousarray(b))) \
-        / _length_scale(length_scale)
+        raise SpineInputError(
+            f"path_a and path_b must have the same dimension, got {a.shape[1]} and {b.shape[1]}"
+        )
+    return float(_frechet_kernel(np.ascontiguousarray(a), np.ascontiguousarray(b))) / _length_scale(
+        length_scale
+    )
 
 
 def frechet_distance_reference(path_a, path_b) -> float:
@@ -134,7 +142,7 @@ def _point_segment_distance(points, seg_start, seg_end):
     len2 = np.einsum("sk,sk->s", d, d)
     best = np.full(points.shape[0], np.inf)
     for lo in range(0, seg_start.shape[0], 2048):
-        a, dd, l2 = seg_start[lo:lo + 2048], d[lo:lo + 2048], len2[lo:lo + 2048]
+        a, dd, l2 = seg_start[lo : lo + 2048], d[lo : lo + 2048], len2[lo : lo + 2048]
         rel = points[:, None, :] - a[None, :, :]
         t = np.where(l2 > 0, np.einsum("psk,sk->ps", rel, dd) / np.where(l2 > 0, l2, 1), 0.0)
         t = np.clip(t, 0.0, 1.0)
@@ -144,8 +152,9 @@ def _point_segment_distance(points, seg_start, seg_end):
     return best
 
 
-def mean_lateral_deviation(path, reference, *, length_scale: float = 1.0,
-                           spacing: float | None = None) -> float:
+def mean_lateral_deviation(
+    path, reference, *, length_scale: float = 1.0, spacing: float | None = None
+) -> float:
     """Mean x-y distance from ``path`` to the ``reference`` polyline, over ``L_c``.
 
     ``path`` is resampled to equal arc-length steps (``spacing``, default L_c / 50) so
@@ -164,8 +173,9 @@ def mean_lateral_deviation(path, reference, *, length_scale: float = 1.0,
     return float(dist.mean() / lc)
 
 
-def outcome_agreement(locked_a, end_a, locked_b, end_b, *, length_scale: float = 1.0,
-                      end_tolerance: float = 0.25) -> dict[str, np.ndarray]:
+def outcome_agreement(
+    locked_a, end_a, locked_b, end_b, *, length_scale: float = 1.0, end_tolerance: float = 0.25
+) -> dict[str, np.ndarray]:
     """Agreement of run outcomes, vectorized over runs.
 
     Parameters
@@ -204,8 +214,9 @@ def outcome_agreement(locked_a, end_a, locked_b, end_b, *, length_scale: float =
     return {"lock": lock, "end": end, "same_trap": same_trap, "agree": agree}
 
 
-def kappa_agreement(max_kappa_quasistatic, peak_force_over_weight, *,
-                    kappa_cap: float) -> dict[str, np.ndarray]:
+def kappa_agreement(
+    max_kappa_quasistatic, peak_force_over_weight, *, kappa_cap: float
+) -> dict[str, np.ndarray]:
     """Quasistatic max kappa against the dynamic peak drive force / W, per run.
 
     A self-locked quasistatic run has max kappa = inf and a dynamic one stops at the cap

@@ -17,8 +17,17 @@ import numpy as np
 
 from spine_mj.errors import SpineInputError
 
-__all__ = ["CONCAVE", "CONVEX", "FLAT", "HESSIAN_NAMES", "SADDLE", "SECTIONAL_NAMES",
-           "hessian_class", "section_curvature", "sectional_class"]
+__all__ = [
+    "CONCAVE",
+    "CONVEX",
+    "FLAT",
+    "HESSIAN_NAMES",
+    "SADDLE",
+    "SECTIONAL_NAMES",
+    "hessian_class",
+    "section_curvature",
+    "sectional_class",
+]
 
 #: Class codes shared by both methods; SADDLE only from the Hessian method, FLAT where the
 #: criterion is exactly zero (or undefined, f_x = 0, for the sectional method).
@@ -69,9 +78,11 @@ def hessian_class(fxx, fxy, fyy) -> np.ndarray:
     CONVEX (det > 0, f_xx < 0), FLAT otherwise. Returns int8 codes."""
     fxx, fxy, fyy = _arrays(fxx, fxy, fyy)
     det = fxx * fyy - fxy * fxy
-    return np.where(det < 0, SADDLE,
-                    np.where((det > 0) & (fxx > 0), CONCAVE,
-                             np.where((det > 0) & (fxx < 0), CONVEX, FLAT))).astype(np.int8)
+    return np.where(
+        det < 0,
+        SADDLE,
+        np.where((det > 0) & (fxx > 0), CONCAVE, np.where((det > 0) & (fxx < 0), CONVEX, FLAT)),
+    ).astype(np.int8)
 
 
 def classify_points(surface, x, y) -> tuple[np.ndarray, np.ndarray]:

@@ -32,8 +32,15 @@ import numpy as np
 
 from spine_mj.errors import SpineInputError
 
-__all__ = ["ENGAGED", "REGION_NAMES", "SELF_LOCK", "SLIP", "kappa", "quadratic_coefficients",
-           "slip_direction"]
+__all__ = [
+    "ENGAGED",
+    "REGION_NAMES",
+    "SELF_LOCK",
+    "SLIP",
+    "kappa",
+    "quadratic_coefficients",
+    "slip_direction",
+]
 
 #: Region codes returned by :func:`kappa` (paper Fig. 2C).
 SLIP = 0
@@ -156,8 +163,12 @@ def slip_direction(fx, fy, kappa_value, region) -> tuple[np.ndarray, np.ndarray,
     vx, vy, vz : ndarray, shape S
         Components of ``v``; NaN where self-locked or where ``|T| = 0``.
     """
-    fx, fy, kv, reg = np.broadcast_arrays(np.asarray(fx, dtype=float), np.asarray(fy, dtype=float),
-                                          np.asarray(kappa_value, dtype=float), np.asarray(region))
+    fx, fy, kv, reg = np.broadcast_arrays(
+        np.asarray(fx, dtype=float),
+        np.asarray(fy, dtype=float),
+        np.asarray(kappa_value, dtype=float),
+        np.asarray(region),
+    )
     k = np.where(reg == ENGAGED, kv, 0.0)
     s2 = 1.0 + fx * fx + fy * fy
     rn = (k * fx + 1.0) / s2

@@ -29,8 +29,9 @@ def check_positive(name: str, value, *, allow_zero: bool = False) -> float:
     except (TypeError, ValueError):
         raise SpineInputError(f"{name} must be a number, got {value!r}") from None
     if not (math.isfinite(v) and (v >= 0 if allow_zero else v > 0)):
-        raise SpineInputError(f"{name} must be a finite number {'>= 0' if allow_zero else '> 0'}, "
-                              f"got {value!r}")
+        raise SpineInputError(
+            f"{name} must be a finite number {'>= 0' if allow_zero else '> 0'}, got {value!r}"
+        )
     return v
 
 
@@ -52,7 +53,8 @@ def atomic_output(path: str | os.PathLike, *, suffix: str | None = None) -> Iter
     dest = Path(path)
     dest.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp_name = tempfile.mkstemp(
-        prefix=f".{dest.name}.", suffix=suffix if suffix is not None else dest.suffix,
+        prefix=f".{dest.name}.",
+        suffix=suffix if suffix is not None else dest.suffix,
         dir=dest.parent,
     )
     os.close(fd)

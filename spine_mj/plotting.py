@@ -37,8 +37,12 @@ def _display_grid(surface: Surface, max_points: int) -> GridSurface:
         return surface
     if isinstance(surface, GridSurface):
         step = int(np.ceil(max(surface.shape) / max_points))
-        return GridSurface(heights=surface.heights[::step, ::step], x=surface.x[::step],
-                           y=surface.y[::step], unit=surface.unit)
+        return GridSurface(
+            heights=surface.heights[::step, ::step],
+            x=surface.x[::step],
+            y=surface.y[::step],
+            unit=surface.unit,
+        )
     return surface.sample(max_points)
 
 
@@ -60,8 +64,16 @@ def surface_preview(surface: Surface, *, title: str | None = None, max_points: i
     ax.set_ylabel(f"y{unit}")
     ax3 = fig.add_subplot(1, 2, 2, projection="3d")
     xx, yy = np.meshgrid(grid.x, grid.y)
-    ax3.plot_surface(xx, yy, grid.heights, cmap="terrain", linewidth=0, antialiased=False,
-                     rcount=min(120, grid.shape[0]), ccount=min(120, grid.shape[1]))
+    ax3.plot_surface(
+        xx,
+        yy,
+        grid.heights,
+        cmap="terrain",
+        linewidth=0,
+        antialiased=False,
+        rcount=min(120, grid.shape[0]),
+        ccount=min(120, grid.shape[1]),
+    )
     ax3.set_xlabel("x")
     ax3.set_ylabel("y")
     ax3.set_zlabel("z")
@@ -94,13 +106,20 @@ def sim_run_figure(result, surface: Surface, *, length_scale_m: float, max_point
     ax2.plot(result.time_s, result.drive_force_n / fp, color="navy", lw=1)
     onsets = [e.index for e in result.events if e.kind == "slip_onset"]
     if onsets:
-        ax2.plot(result.time_s[onsets], result.drive_force_n[onsets] / fp, "v", color="crimson",
-                 ms=4, label="slip onset")
+        ax2.plot(
+            result.time_s[onsets],
+            result.drive_force_n[onsets] / fp,
+            "v",
+            color="crimson",
+            ms=4,
+            label="slip onset",
+        )
         ax2.legend(loc="upper left", fontsize=8)
     ax2.set_xlabel("time [s]")
     ax2.set_ylabel("drive force / F_p")
-    fig.suptitle(f"{type(result.drive).__name__}, I_e = {result.inertia_number:.3g}, "
-                 f"end: {result.end_reason.value}")
+    fig.suptitle(
+        f"{type(result.drive).__name__}, I_e = {result.inertia_number:.3g}, end: {result.end_reason.value}"
+    )
     return fig
 
 
@@ -115,8 +134,7 @@ def _kappa_colors(ax, x, y, k, region, *, kmax=10.0):
     extent = (x[0], x[-1], y[0], y[-1])
     im = ax.imshow(shown, origin="lower", extent=extent, cmap="jet", vmin=0, vmax=kmax)
     lock = np.where(region == 2, 1.0, np.nan)
-    ax.imshow(lock, origin="lower", extent=extent,
-              cmap=mcolors.ListedColormap(["#5a0000"]), vmin=0, vmax=1)
+    ax.imshow(lock, origin="lower", extent=extent, cmap=mcolors.ListedColormap(["#5a0000"]), vmin=0, vmax=1)
     return im
 
 
@@ -148,14 +166,15 @@ def single_peak_figure(runs: dict, numbers: dict):
             ax.plot(p["x"], p["y"], lw=1.5)
             ax.plot(p["x"][0], p["y"][0], "o", mfc="none", color="k")
             ax.plot(p["x"][-1], p["y"][-1], "x", color="k")
-        ax.set_title(f"{name}: streamlines (solid), ideal (dashed); "
-                     f"ratio {numbers[f'{name}_ratio'] or float('nan'):.3f}")
+        ax.set_title(
+            f"{name}: streamlines (solid), ideal (dashed); "
+            f"ratio {numbers[f'{name}_ratio'] or float('nan'):.3f}"
+        )
         ax.set_aspect("equal")
         ax2 = fig.add_subplot(2, 2, 2 * row + 2)
         for i in range(len(s5)):
             p, q = s5.path(i), i5.path(i)
-            line = ax2.plot(p["x"], np.minimum(p["kappa"], 20), lw=1.2,
-                            label=f"y0 = {s5.start_y[i]:g}")[0]
+            line = ax2.plot(p["x"], np.minimum(p["kappa"], 20), lw=1.2, label=f"y0 = {s5.start_y[i]:g}")[0]
             ax2.plot(q["x"], np.minimum(q["kappa"], 20), color=line.get_color(), ls="--", lw=0.8)
             for path in (p, q):
                 if path["region"][-1] == 2:
@@ -174,8 +193,9 @@ def random_gaussian_figure(scatter: dict, numbers: dict):
     for i, (name, (ideal, stream)) in enumerate(scatter.items()):
         ax = fig.add_subplot(1, 2, i + 1)
         top = 30.0
-        for j, (vals, label, color) in enumerate(((ideal, "ideal", "0.5"),
-                                                  (stream, "streamline", "C0" if i == 0 else "C3"))):
+        for j, (vals, label, color) in enumerate(
+            ((ideal, "ideal", "0.5"), (stream, "streamline", "C0" if i == 0 else "C3"))
+        ):
             shown = np.where(np.isfinite(vals), np.minimum(vals, top), top)
             xj = j + 0.15 * np.random.default_rng(j).uniform(-1, 1, vals.size)
             ax.plot(xj, shown, "o", ms=3, color=color, label=label)
@@ -183,8 +203,9 @@ def random_gaussian_figure(scatter: dict, numbers: dict):
             ax.hlines(min(med, top), j - 0.3, j + 0.3, color="k")
         ax.set_xticks([0, 1], ["ideal", "streamline"])
         ax.set_ylabel("max kappa (self-lock at top)")
-        ax.set_title(f"{name}: medians {numbers[f'{name}_median_ideal']} -> "
-                     f"{numbers[f'{name}_median_streamline']}")
+        ax.set_title(
+            f"{name}: medians {numbers[f'{name}_median_ideal']} -> {numbers[f'{name}_median_streamline']}"
+        )
     return fig
 
 
@@ -199,12 +220,20 @@ def fractal_hurst_figure(table: list):
         return 100 * m, 100 * s
 
     panels = (
-        ("Fig. 9B: sectional method", "%", (("rate", "self-lock rate"),
-                                             ("sect_concave", "concave (sectional)"),
-                                             ("sect_convex", "convex (sectional)"))),
-        ("Fig. 9C: Hessian method", "% of self-locks", (("hess_concave", "concave"),
-                                                        ("hess_saddle", "saddle"),
-                                                        ("hess_convex", "convex"))),
+        (
+            "Fig. 9B: sectional method",
+            "%",
+            (
+                ("rate", "self-lock rate"),
+                ("sect_concave", "concave (sectional)"),
+                ("sect_convex", "convex (sectional)"),
+            ),
+        ),
+        (
+            "Fig. 9C: Hessian method",
+            "% of self-locks",
+            (("hess_concave", "concave"), ("hess_saddle", "saddle"), ("hess_convex", "convex")),
+        ),
     )
     for col, (title, ylabel, curves) in enumerate(panels, start=1):
         ax = fig.add_subplot(1, 2, col)
@@ -223,8 +252,16 @@ def streamline_figure(surface, stream, ideal, *, title: str = ""):
     fig = new_figure(figsize=(12, 5), layout="constrained")
     ax3 = fig.add_subplot(1, 2, 1, projection="3d")
     xx, yy = np.meshgrid(grid.x, grid.y)
-    ax3.plot_surface(xx, yy, grid.heights, cmap="terrain", alpha=0.6, linewidth=0,
-                     rcount=min(80, grid.shape[0]), ccount=min(80, grid.shape[1]))
+    ax3.plot_surface(
+        xx,
+        yy,
+        grid.heights,
+        cmap="terrain",
+        alpha=0.6,
+        linewidth=0,
+        rcount=min(80, grid.shape[0]),
+        ccount=min(80, grid.shape[1]),
+    )
     ax = fig.add_subplot(1, 2, 2)
     for i in range(len(stream)):
         p, q = stream.path(i), ideal.path(i)
@@ -233,8 +270,12 @@ def streamline_figure(surface, stream, ideal, *, title: str = ""):
         ax3.plot(q["x"], q["y"], q["z"], lw=1, ls="--", color=c)
         ax3.scatter([p["x"][0]], [p["y"][0]], [p["z"][0]], color=c, marker="o")
         ax3.scatter([p["x"][-1]], [p["y"][-1]], [p["z"][-1]], color=c, marker="x")
-        ax.plot(p["x"], np.minimum(p["kappa"], 20), color=c,
-                label=f"({stream.start_x[i]:g}, {stream.start_y[i]:g})")
+        ax.plot(
+            p["x"],
+            np.minimum(p["kappa"], 20),
+            color=c,
+            label=f"({stream.start_x[i]:g}, {stream.start_y[i]:g})",
+        )
         ax.plot(q["x"], np.minimum(q["kappa"], 20), color=c, ls="--", lw=0.8)
         if p["region"][-1] == 2:
             ax.plot(p["x"][-1], 20, "^", color=c)

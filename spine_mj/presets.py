@@ -33,8 +33,15 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover
     import tomli as tomllib
 
-__all__ = ["GENERATORS", "Preset", "list_presets", "load_preset", "make_surface",
-           "parse_override", "presets_dir"]
+__all__ = [
+    "GENERATORS",
+    "Preset",
+    "list_presets",
+    "load_preset",
+    "make_surface",
+    "parse_override",
+    "presets_dir",
+]
 
 
 def _measured(*, file: str, **options):
@@ -108,8 +115,9 @@ def load_preset(name: str) -> Preset:
         raise SpineInputError(f"preset {path.name}: seed must be a non-negative integer, got {seed!r}")
     description = str(doc.pop("description", ""))
     _check_params(generator, params, f"preset {path.name}")
-    return Preset(name=path.stem, generator=generator, params=params, description=description,
-                  seed=seed, extras=doc)
+    return Preset(
+        name=path.stem, generator=generator, params=params, description=description, seed=seed, extras=doc
+    )
 
 
 def _check_params(generator: str, params: dict, where: str) -> None:

@@ -23,8 +23,15 @@ from spine_mj.presets import load_preset
 from spine_mj.streamline import Outcome, StreamlineParams, ideal_trajectories, streamlines
 from spine_mj.surfaces import GaussianSurface, fractal_fbm, random_gaussians, single_gaussian
 
-__all__ = ["REPRODUCTIONS", "fractal_hurst", "kappa_map", "random_gaussian", "raw_rms_height",
-           "run", "single_peak"]
+__all__ = [
+    "REPRODUCTIONS",
+    "fractal_hurst",
+    "kappa_map",
+    "random_gaussian",
+    "raw_rms_height",
+    "run",
+    "single_peak",
+]
 
 Progress = Callable[[int, int], None] | None
 FIVE_Y0 = (-0.5, -1.0, -2.0, -3.0, -4.0)
@@ -46,9 +53,15 @@ def _finite_or_str(v: float):
 # --------------------------------------------------------------------------- Figs. 3-4
 
 
-def single_peak(*, quick: bool = False, progress: Progress = None, mu: float | None = None,
-                dl: float | None = None, y0_step: float | None = None,
-                y0_range: tuple[float, float] | None = None):
+def single_peak(
+    *,
+    quick: bool = False,
+    progress: Progress = None,
+    mu: float | None = None,
+    dl: float | None = None,
+    y0_step: float | None = None,
+    y0_range: tuple[float, float] | None = None,
+):
     """Figs. 3-4: five starts on the convex peak and the concave valley, and the self-lock
     start-range ratios (streamline range / ideal range of y0 at x0 = -3).
 
@@ -65,13 +78,11 @@ def single_peak(*, quick: bool = False, progress: Progress = None, mu: float | N
     mu = float(mu if mu is not None else eng["mu"])
     dl = float(dl if dl is not None else rep.get("dl", 0.015))
     y0_step = float(y0_step if y0_step is not None else rep.get("y0_step", 0.01))
-    lo, hi = (float(v) for v in (y0_range if y0_range is not None
-                                 else rep.get("y0_range", (-5.0, 5.0))))
+    lo, hi = (float(v) for v in (y0_range if y0_range is not None else rep.get("y0_range", (-5.0, 5.0))))
     if quick:
         y0_step = max(y0_step, 0.05)
     if not (y0_step > 0 and hi > lo):
-        raise SpineInputError(f"y0_step must be > 0 and y0_range increasing, got {y0_step}, "
-                              f"({lo}, {hi})")
+        raise SpineInputError(f"y0_step must be > 0 and y0_range increasing, got {y0_step}, ({lo}, {hi})")
     x0 = float(rep.get("x0", -3.0))
     params = StreamlineParams(mu=mu, dl=dl)
     y_scan = np.linspace(lo, hi, int(round((hi - lo) / y0_step)) + 1)
@@ -80,8 +91,14 @@ def single_peak(*, quick: bool = False, progress: Progress = None, mu: float | N
     y_fine = np.arange(-5 + fine_step / 2, 5.0, fine_step)
     fine = np.c_[np.full(y_fine.size, x0), y_fine]
     five = [(x0, y) for y in FIVE_Y0]
-    numbers = {"mu": mu, "dl": dl, "x0": x0, "y0_step": y0_step, "y0_range": [lo, hi],
-               "paper": {"convex_ratio": 0.833, "concave_ratio": 5.667}}
+    numbers = {
+        "mu": mu,
+        "dl": dl,
+        "x0": x0,
+        "y0_step": y0_step,
+        "y0_range": [lo, hi],
+        "paper": {"convex_ratio": 0.833, "concave_ratio": 5.667},
+    }
     runs = {}
     for k, (name, sign) in enumerate((("convex", 1), ("concave", -1))):
         surf = single_gaussian(sign=sign)
@@ -97,11 +114,15 @@ def single_peak(*, quick: bool = False, progress: Progress = None, mu: float | N
         i5 = ideal_trajectories(surf, five, params)
         runs[name] = (surf, s5, i5)
         numbers[f"{name}_starts"] = [
-            {"y0": y, "streamline": _outcome_name(s5.outcome[i]),
-             "ideal": _outcome_name(i5.outcome[i]),
-             "streamline_max_kappa": _finite_or_str(s5.max_kappa[i]),
-             "ideal_max_kappa": _finite_or_str(i5.max_kappa[i])}
-            for i, y in enumerate(FIVE_Y0)]
+            {
+                "y0": y,
+                "streamline": _outcome_name(s5.outcome[i]),
+                "ideal": _outcome_name(i5.outcome[i]),
+                "streamline_max_kappa": _finite_or_str(s5.max_kappa[i]),
+                "ideal_max_kappa": _finite_or_str(i5.max_kappa[i]),
+            }
+            for i, y in enumerate(FIVE_Y0)
+        ]
         if progress:
             progress(k + 1, 2)
     from spine_mj.plotting import single_peak_figure
@@ -112,8 +133,9 @@ def single_peak(*, quick: bool = False, progress: Progress = None, mu: float | N
 # --------------------------------------------------------------------------- Fig. 2B
 
 
-def kappa_map(*, quick: bool = False, progress: Progress = None, mu: float | None = None,
-              n: int | None = None):
+def kappa_map(
+    *, quick: bool = False, progress: Progress = None, mu: float | None = None, n: int | None = None
+):
     """Fig. 2B: kappa over the single convex peak and concave valley (slip blank, self-lock
     marked). Numbers: area fractions of the regions and the kappa range."""
     eng, _, _ = _settings("paper-single-peak")
@@ -158,9 +180,16 @@ def _random_surface(gen: dict, seed: int):
         raise SpineInputError(f"k_range must satisfy 0 <= lo <= hi, hi > 0, got {k_range!r}")
     k = np.random.default_rng([seed, 7]).uniform(k_lo, k_hi, surf.amplitude.size)
     amp = np.sign(surf.amplitude) * k / (2 * np.pi * surf.sigma_x * surf.sigma_y)
-    return GaussianSurface(amplitude=amp, center_x=surf.center_x, center_y=surf.center_y,
-                           sigma_x=surf.sigma_x, sigma_y=surf.sigma_y, bounds=surf.bounds,
-                           unit=surf.unit, metadata=dict(surf.metadata, k_range=[k_lo, k_hi]))
+    return GaussianSurface(
+        amplitude=amp,
+        center_x=surf.center_x,
+        center_y=surf.center_y,
+        sigma_x=surf.sigma_x,
+        sigma_y=surf.sigma_y,
+        bounds=surf.bounds,
+        unit=surf.unit,
+        metadata=dict(surf.metadata, k_range=[k_lo, k_hi]),
+    )
 
 
 def _max_kappa(res, convention: str) -> np.ndarray:
@@ -175,11 +204,20 @@ def _max_kappa(res, convention: str) -> np.ndarray:
     return np.where(np.isneginf(out), np.nan, out)
 
 
-def random_gaussian(*, quick: bool = False, progress: Progress = None, mu: float | None = None,
-                    n_runs: int | None = None, starts: str | None = None,
-                    kappa_cap: float | None = None, max_kappa: str | None = None,
-                    dl: float | None = None, x0_offset: float | None = None,
-                    seed: int | None = None, **params):
+def random_gaussian(
+    *,
+    quick: bool = False,
+    progress: Progress = None,
+    mu: float | None = None,
+    n_runs: int | None = None,
+    starts: str | None = None,
+    kappa_cap: float | None = None,
+    max_kappa: str | None = None,
+    dl: float | None = None,
+    x0_offset: float | None = None,
+    seed: int | None = None,
+    **params,
+):
     """Fig. 5: medians of the maximum kappa along ideal and streamline trajectories on
     random convex and concave Gaussian surfaces.
 
@@ -196,12 +234,20 @@ def random_gaussian(*, quick: bool = False, progress: Progress = None, mu: float
     generator parameters (both surfaces); ``k_range`` there selects the single-peak
     normalization (:func:`_random_surface`). ``seed`` replaces the presets' first seed.
     """
-    numbers = {"paper": {"convex_median_ideal": 3.18, "convex_median_streamline": 2.87,
-                         "concave_median_ideal": 3.22, "concave_median_streamline": 11.34,
-                         "bypass_change": -0.097, "trap_change": 2.522}}
+    numbers = {
+        "paper": {
+            "convex_median_ideal": 3.18,
+            "convex_median_streamline": 2.87,
+            "concave_median_ideal": 3.22,
+            "concave_median_streamline": 11.34,
+            "bypass_change": -0.097,
+            "trap_change": 2.522,
+        }
+    }
     scatter = {}
-    for k, (name, preset) in enumerate((("convex", "paper-random-convex"),
-                                        ("concave", "paper-random-concave"))):
+    for k, (name, preset) in enumerate(
+        (("convex", "paper-random-convex"), ("concave", "paper-random-concave"))
+    ):
         eng, rep, pre = _settings(preset)
         m = float(mu if mu is not None else eng["mu"])
         runs = int(n_runs if n_runs is not None else rep.get("n_runs", 100))
@@ -297,8 +343,9 @@ def _fractal_chunk(args):
     before = lock_point == "before"
     locked, sect, hess = [], [], []
     for seed in seeds:
-        surf = fractal_fbm(nx=gen["nx"], size=gen["size"], hurst=hurst, rms_height=rms,
-                           periodic=True, rng=int(seed))
+        surf = fractal_fbm(
+            nx=gen["nx"], size=gen["size"], hurst=hurst, rms_height=rms, periodic=True, rng=int(seed)
+        )
         xmin, _, ymin, ymax = surf.bounds
         r = trace(surf, [(xmin, 0.5 * (ymin + ymax))], params, store_paths=before)
         ok = bool(r.self_locked[0])
@@ -307,7 +354,7 @@ def _fractal_chunk(args):
             px, py = r.end_x, r.end_y
             if before and r.n_steps[0] > 0:
                 j = r.offsets[1] - 2
-                px, py = r.x[j:j + 1], r.y[j:j + 1]
+                px, py = r.x[j : j + 1], r.y[j : j + 1]
             _, fx, fy, fxx, fxy, fyy = surf.evaluate(px, py, order=2)
             sect.append(int(sectional_class(fx, fy, fxx, fxy, fyy)[0]))
             hess.append(int(hessian_class(fxx, fxy, fyy)[0]))
@@ -317,8 +364,16 @@ def _fractal_chunk(args):
     return hurst, np.array(locked), np.array(sect), np.array(hess)
 
 
-def fractal_hurst(*, quick: bool = False, progress: Progress = None, mu: float | None = None,
-                  surfaces: int | None = None, workers: int = 2, hursts=None, **over):
+def fractal_hurst(
+    *,
+    quick: bool = False,
+    progress: Progress = None,
+    mu: float | None = None,
+    surfaces: int | None = None,
+    workers: int = 2,
+    hursts=None,
+    **over,
+):
     """Figs. 7E and 9: self-lock rate and concave / convex (sectional, Eq. 6) and concave /
     saddle / convex (Hessian, Eqs. 8-10) shares of self-lock points against H.
 
@@ -336,27 +391,31 @@ def fractal_hurst(*, quick: bool = False, progress: Progress = None, mu: float |
     """
     eng, rep, pre = _settings("paper-fractal")
     mu = float(mu if mu is not None else eng["mu"])
-    hursts = list(hursts if hursts is not None else rep.get("hursts", [0.65, 0.7, 0.75, 0.8,
-                                                                        0.85, 0.9, 0.95]))
+    hursts = list(
+        hursts if hursts is not None else rep.get("hursts", [0.65, 0.7, 0.75, 0.8, 0.85, 0.9, 0.95])
+    )
     n = int(surfaces if surfaces is not None else rep.get("surfaces", 300))
     if quick:
         n = min(n, 30)
     groups = int(rep.get("groups", 3))
     if n < groups:
         raise SpineInputError(f"surfaces must be >= groups ({groups}), got {n}")
-    gen = {"nx": int(over.get("nx", rep.get("nx", pre.params["nx"]))),
-           "size": float(over.get("size", pre.params["size"])),
-           "frequency_unit": str(over.get("frequency_unit", rep.get("frequency_unit", "length")))}
+    gen = {
+        "nx": int(over.get("nx", rep.get("nx", pre.params["nx"]))),
+        "size": float(over.get("size", pre.params["size"])),
+        "frequency_unit": str(over.get("frequency_unit", rep.get("frequency_unit", "length"))),
+    }
     if gen["frequency_unit"] not in ("pixel", "length"):
-        raise SpineInputError(f"frequency_unit must be 'pixel' or 'length', got "
-                              f"{gen['frequency_unit']!r}")
+        raise SpineInputError(f"frequency_unit must be 'pixel' or 'length', got {gen['frequency_unit']!r}")
     scale = float(over.get("scale", rep["scale"]))
     dl = float(over.get("dl", rep.get("dl", 0.02)))
     lock_point = str(over.get("lock_point", rep.get("lock_point", "lock")))
     trajectory = str(over.get("trajectory", rep.get("trajectory", "streamline")))
     if lock_point not in ("lock", "before") or trajectory not in ("streamline", "ideal"):
-        raise SpineInputError(f"lock_point must be 'lock' or 'before' and trajectory "
-                              f"'streamline' or 'ideal', got {lock_point!r}, {trajectory!r}")
+        raise SpineInputError(
+            f"lock_point must be 'lock' or 'before' and trajectory "
+            f"'streamline' or 'ideal', got {lock_point!r}, {trajectory!r}"
+        )
     chunks = []
     for h_i, h in enumerate(hursts):
         seeds = 1_000_000 * (h_i + 1) + np.arange(n)
@@ -380,8 +439,14 @@ def fractal_hurst(*, quick: bool = False, progress: Progress = None, mu: float |
         locked = np.concatenate([r[0] for r in results[h]])
         sect = np.concatenate([r[1] for r in results[h]])
         hess = np.concatenate([r[2] for r in results[h]])
-        rows = {"rate": [], "sect_concave": [], "sect_convex": [], "hess_concave": [],
-                "hess_saddle": [], "hess_convex": []}
+        rows = {
+            "rate": [],
+            "sect_concave": [],
+            "sect_convex": [],
+            "hess_concave": [],
+            "hess_saddle": [],
+            "hess_convex": [],
+        }
         for g in np.array_split(np.arange(n), groups):
             lk = locked[g]
             rows["rate"].append(lk.mean())
@@ -397,10 +462,19 @@ def fractal_hurst(*, quick: bool = False, progress: Progress = None, mu: float |
             entry[f"{key}_mean"] = _nan_none(np.nanmean(v) if np.isfinite(v).any() else np.nan)
             entry[f"{key}_sd"] = _nan_none(np.nanstd(v) if np.isfinite(v).sum() > 1 else np.nan)
         table.append(entry)
-    numbers = {"mu": mu, "nx": gen["nx"], "size": gen["size"], "scale": scale, "dl": dl,
-               "frequency_unit": gen["frequency_unit"], "lock_point": lock_point,
-               "trajectory": trajectory,
-               "groups": groups, "surfaces_per_hurst": n, "by_hurst": table}
+    numbers = {
+        "mu": mu,
+        "nx": gen["nx"],
+        "size": gen["size"],
+        "scale": scale,
+        "dl": dl,
+        "frequency_unit": gen["frequency_unit"],
+        "lock_point": lock_point,
+        "trajectory": trajectory,
+        "groups": groups,
+        "surfaces_per_hurst": n,
+        "by_hurst": table,
+    }
     from spine_mj.plotting import fractal_hurst_figure
 
     return numbers, fractal_hurst_figure(table)

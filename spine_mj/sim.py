@@ -145,13 +145,14 @@ class TipParams:
         _check_optional(self, ["tip_radius_m"])
         object.__setattr__(self, "mass_kg", check_positive("mass_kg", self.mass_kg))
         object.__setattr__(self, "mu_s", check_positive("mu_s", self.mu_s, allow_zero=True))
-        object.__setattr__(self, "preload_n",
-                           check_positive("preload_n", self.preload_n, allow_zero=True))
-        object.__setattr__(self, "gravity_m_s2",
-                           check_positive("gravity_m_s2", self.gravity_m_s2, allow_zero=True))
+        object.__setattr__(self, "preload_n", check_positive("preload_n", self.preload_n, allow_zero=True))
+        object.__setattr__(
+            self, "gravity_m_s2", check_positive("gravity_m_s2", self.gravity_m_s2, allow_zero=True)
+        )
         if self.preload_n == 0 and self.gravity_m_s2 == 0:
-            raise SpineInputError("preload_n and gravity_m_s2 are both 0: the tip has no normal "
-                                  "preload; give one of them > 0")
+            raise SpineInputError(
+                "preload_n and gravity_m_s2 are both 0: the tip has no normal preload; give one of them > 0"
+            )
 
     @property
     def preload_total_n(self) -> float:
@@ -198,8 +199,9 @@ class EngineSettings:
                 try:
                     value = enum_cls(str(value).lower())
                 except ValueError:
-                    raise SpineInputError(f"{name} must be one of {[e.value for e in enum_cls]}, "
-                                          f"got {value!r}") from None
+                    raise SpineInputError(
+                        f"{name} must be one of {[e.value for e in enum_cls]}, got {value!r}"
+                    ) from None
                 object.__setattr__(self, name, value)
         object.__setattr__(self, "impratio", check_positive("impratio", self.impratio))
         ns = self.noslip_iterations
@@ -207,24 +209,30 @@ class EngineSettings:
             raise SpineInputError(f"noslip_iterations must be an integer >= 0, got {ns!r}")
         object.__setattr__(self, "noslip_iterations", int(ns))
         if self.cone is Cone.PYRAMIDAL and self.noslip_iterations > 0:
-            raise SpineInputError("cone='pyramidal' with noslip_iterations > 0 holds only about half "
-                                  "of mu N (PHYSICS.md §5); use the elliptic cone with noslip")
+            raise SpineInputError(
+                "cone='pyramidal' with noslip_iterations > 0 holds only about half "
+                "of mu N (PHYSICS.md §5); use the elliptic cone with noslip"
+            )
         try:
             tc, dr = (float(v) for v in self.solref)
         except (TypeError, ValueError):
             raise SpineInputError(f"solref must be (timeconst_s, dampratio), got {self.solref!r}") from None
         check_positive("solref dampratio", dr)
         if not (math.isfinite(tc) and tc >= 2 * self.timestep_s * (1 - 1e-9)):
-            raise SpineInputError(f"solref timeconst_s must be >= 2 timestep_s = {2 * self.timestep_s:g} "
-                                  f"s for a stable contact, got {self.solref[0]!r}")
+            raise SpineInputError(
+                f"solref timeconst_s must be >= 2 timestep_s = {2 * self.timestep_s:g} "
+                f"s for a stable contact, got {self.solref[0]!r}"
+            )
         object.__setattr__(self, "solref", (tc, dr))
         try:
             si = tuple(float(v) for v in self.solimp)
         except (TypeError, ValueError):
             raise SpineInputError(f"solimp must be 5 numbers, got {self.solimp!r}") from None
         if len(si) != 5 or not (0 < si[0] < 1 and 0 < si[1] < 1 and si[2] > 0):
-            raise SpineInputError("solimp must be (dmin, dmax, width_m, midpoint, power) with "
-                                  f"0 < dmin, dmax < 1 and width_m > 0, got {self.solimp!r}")
+            raise SpineInputError(
+                "solimp must be (dmin, dmax, width_m, midpoint, power) with "
+                f"0 < dmin, dmax < 1 and width_m > 0, got {self.solimp!r}"
+            )
         object.__setattr__(self, "solimp", si)
         res = self.hfield_resolution
         if res is not None and (isinstance(res, bool) or int(res) != res or res < 4):
@@ -290,8 +298,9 @@ def characteristic_length(surface: Surface) -> float:
     h = grid.heights - grid.heights.mean()
     dx, dy = grid.spacing
     gy, gx = np.gradient(grid.heights, dy, dx)
-    detrended = h - (gx.mean() * (grid.x[None, :] - grid.x.mean())
-                     + gy.mean() * (grid.y[:, None] - grid.y.mean()))
+    detrended = h - (
+        gx.mean() * (grid.x[None, :] - grid.x.mean()) + gy.mean() * (grid.y[:, None] - grid.y.mean())
+    )
     rms_h = float(np.sqrt(np.mean(detrended**2)))
     rms_s = float(np.sqrt(np.mean((gx - gx.mean()) ** 2 + (gy - gy.mean()) ** 2)))
     if rms_s <= 1e-12 or rms_h <= 1e-12 * span:
@@ -348,19 +357,23 @@ class Detection:
     domain_margin_m: float | None = None
 
     def __post_init__(self):
-        _check_optional(self, ["slip_speed_m_s", "stick_speed_m_s", "breakaway_distance_m",
-                               "penetration_tol_m"])
+        _check_optional(
+            self, ["slip_speed_m_s", "stick_speed_m_s", "breakaway_distance_m", "penetration_tol_m"]
+        )
         _check_optional(self, ["domain_margin_m"], allow_zero=True)
         object.__setattr__(self, "kappa_cap", check_positive("kappa_cap", self.kappa_cap))
 
     def resolve(self, scales: Scales) -> Detection:
         v_c = scales.speed_m_s
         small = min(0.1 * scales.tip_radius_m, 0.01 * scales.char_length_m)
-        defaults = {"slip_speed_m_s": 1e-3 * v_c, "stick_speed_m_s": 1e-5 * v_c,
-                    "breakaway_distance_m": small, "penetration_tol_m": small,
-                    "domain_margin_m": scales.tip_radius_m}
-        return dataclasses.replace(self, **{k: v for k, v in defaults.items()
-                                            if getattr(self, k) is None})
+        defaults = {
+            "slip_speed_m_s": 1e-3 * v_c,
+            "stick_speed_m_s": 1e-5 * v_c,
+            "breakaway_distance_m": small,
+            "penetration_tol_m": small,
+            "domain_margin_m": scales.tip_radius_m,
+        }
+        return dataclasses.replace(self, **{k: v for k, v in defaults.items() if getattr(self, k) is None})
 
 
 @dataclass(frozen=True)
@@ -424,8 +437,9 @@ class StaticProbe:
     def __post_init__(self):
         _check_optional(self, ["rate_n_s"])
         _check_optional(self, ["settle_time_s"], allow_zero=True)
-        object.__setattr__(self, "start_force_n",
-                           check_positive("start_force_n", self.start_force_n, allow_zero=True))
+        object.__setattr__(
+            self, "start_force_n", check_positive("start_force_n", self.start_force_n, allow_zero=True)
+        )
 
 
 Drive = SpringDrive | RampDrive | StaticProbe
@@ -519,34 +533,49 @@ class RunResult:
         for name in ("position_m", "velocity_m_s", "normal", "contact_point_m"):
             arr = getattr(self, name)
             for k, axis in enumerate("xyz"):
-                cols[f"{name.split('_')[0]}_{axis}{name[len(name.split('_')[0]):]}"] = arr[:, k]
-        for name in ("contact", "penetration_m", "normal_force_n", "tangential_force_n",
-                     "drive_force_n", "carriage_x_m", "slipping"):
+                cols[f"{name.split('_')[0]}_{axis}{name[len(name.split('_')[0]) :]}"] = arr[:, k]
+        for name in (
+            "contact",
+            "penetration_m",
+            "normal_force_n",
+            "tangential_force_n",
+            "drive_force_n",
+            "carriage_x_m",
+            "slipping",
+        ):
             cols[name] = getattr(self, name)
         return pd.DataFrame(cols)
 
     def summary(self) -> dict:
         """JSON-ready description of the run: parameters, engine settings, outcome."""
+
         def enc(obj):
             d = dataclasses.asdict(obj)
             return {k: (v.value if isinstance(v, enum.Enum) else v) for k, v in d.items()}
 
         return {
-            "drive": type(self.drive).__name__, "drive_params": enc(self.drive),
-            "tip": enc(self.tip), "engine": self.engine.to_dict(), "scales": enc(self.scales),
-            "detection": enc(self.detection), "start": list(self.start),
-            "end_reason": self.end_reason.value, "end_detail": self.end_detail,
+            "drive": type(self.drive).__name__,
+            "drive_params": enc(self.drive),
+            "tip": enc(self.tip),
+            "engine": self.engine.to_dict(),
+            "scales": enc(self.scales),
+            "detection": enc(self.detection),
+            "start": list(self.start),
+            "end_reason": self.end_reason.value,
+            "end_detail": self.end_detail,
             "end_time_s": float(self.time_s[-1]) if self.n else 0.0,
             "kappa_mj": None if math.isnan(self.kappa_mj) else self.kappa_mj,
-            "slip_kappas": self.slip_kappas.tolist(), "inertia_number": self.inertia_number,
+            "slip_kappas": self.slip_kappas.tolist(),
+            "inertia_number": self.inertia_number,
             "speed_m_s": self.speed_m_s,
             "n_slip_onsets": sum(e.kind == "slip_onset" for e in self.events),
             "max_penetration_m": float(self.penetration_m.max()) if self.n else 0.0,
         }
 
 
-def inclined_plane(*, slope_deg: float, azimuth_deg: float = 0.0, half_width: float = 0.02,
-                   n: int = 41, unit: str = "m") -> GridSurface:
+def inclined_plane(
+    *, slope_deg: float, azimuth_deg: float = 0.0, half_width: float = 0.02, n: int = 41, unit: str = "m"
+) -> GridSurface:
     """A plane ``z = tan(slope) (x cos(az) + y sin(az))`` on a square grid.
 
     ``azimuth_deg = 0`` makes the plane rise in +x (the closed form's theta > 0).
@@ -559,9 +588,13 @@ def inclined_plane(*, slope_deg: float, azimuth_deg: float = 0.0, half_width: fl
     az = math.radians(float(azimuth_deg))
     x = np.linspace(-half_width, half_width, int(n))
     h = t * (math.cos(az) * x[None, :] + math.sin(az) * x[:, None])
-    return GridSurface(heights=h, x=x, y=x.copy(), unit=unit,
-                       metadata={"generator": "inclined_plane", "slope_deg": slope,
-                                 "azimuth_deg": float(azimuth_deg)})
+    return GridSurface(
+        heights=h,
+        x=x,
+        y=x.copy(),
+        unit=unit,
+        metadata={"generator": "inclined_plane", "slope_deg": slope, "azimuth_deg": float(azimuth_deg)},
+    )
 
 
 # --------------------------------------------------------------------------- the rig
@@ -594,9 +627,15 @@ class Rig:
     one (sandpaper), else the larger of one hfield spacing and ``L_c / 100``.
     """
 
-    def __init__(self, surface: Surface, *, tip: TipParams | None = None,
-                 engine: EngineSettings | None = None, length_scale_m: float | None = None,
-                 char_length_m: float | None = None):
+    def __init__(
+        self,
+        surface: Surface,
+        *,
+        tip: TipParams | None = None,
+        engine: EngineSettings | None = None,
+        length_scale_m: float | None = None,
+        char_length_m: float | None = None,
+    ):
         import mujoco
 
         if not isinstance(surface, Surface):
@@ -611,8 +650,7 @@ class Rig:
             char_length_m = characteristic_length(surface) * length_scale_m
         char_length_m = check_positive("char_length_m", char_length_m)
         resolution = engine.hfield_resolution if engine is not None else None
-        hf = (to_hfield(surface, nrow=resolution, ncol=resolution) if resolution
-              else to_hfield(surface))
+        hf = to_hfield(surface, nrow=resolution, ncol=resolution) if resolution else to_hfield(surface)
         spacing = length_scale_m * 2 * max(hf.size[0] / (hf.ncol - 1), hf.size[1] / (hf.nrow - 1))
         if tip.tip_radius_m is None:
             params = surface.metadata.get("params", {}) if isinstance(surface.metadata, dict) else {}
@@ -631,15 +669,20 @@ class Rig:
         if spacing > 2 * tip.tip_radius_m * (1 + 1e-9):
             raise SpineInputError(
                 f"surface too coarse for the tip: hfield spacing {spacing:.3g} m > 2 x tip_radius_m "
-                f"= {2 * tip.tip_radius_m:.3g} m; raise hfield_resolution or the tip radius")
+                f"= {2 * tip.tip_radius_m:.3g} m; raise hfield_resolution or the tip radius"
+            )
         self.surface = surface
         self.tip = tip
         self.length_scale_m = length_scale_m
-        self.scales = Scales(length_scale_m=length_scale_m, char_length_m=char_length_m,
-                             mass_kg=tip.mass_kg, preload_n=tip.preload_total_n,
-                             tip_radius_m=tip.tip_radius_m, hfield_spacing_m=spacing)
-        self.engine = (default_engine(self.scales, hfield_resolution=resolution) if engine is None
-                       else engine)
+        self.scales = Scales(
+            length_scale_m=length_scale_m,
+            char_length_m=char_length_m,
+            mass_kg=tip.mass_kg,
+            preload_n=tip.preload_total_n,
+            tip_radius_m=tip.tip_radius_m,
+            hfield_spacing_m=spacing,
+        )
+        self.engine = default_engine(self.scales, hfield_resolution=resolution) if engine is None else engine
         self.hfield = hf
         xmin, xmax, ymin, ymax = surface.bounds
         self.bounds_m = tuple(length_scale_m * b for b in (xmin, xmax, ymin, ymax))
@@ -669,11 +712,20 @@ class Rig:
         car.size = [r, r, r]
         hf = self.hfield
         rx, ry, elev, base = hf.size
-        spec.add_hfield(name="surface", size=[rx * s, ry * s, elev * s, base * s],
-                        nrow=hf.nrow, ncol=hf.ncol, userdata=hf.data.ravel().tolist())
+        spec.add_hfield(
+            name="surface",
+            size=[rx * s, ry * s, elev * s, base * s],
+            nrow=hf.nrow,
+            ncol=hf.ncol,
+            userdata=hf.data.ravel().tolist(),
+        )
         geom = spec.worldbody.add_geom(
-            name="surface", type=mujoco.mjtGeom.mjGEOM_HFIELD, hfieldname="surface",
-            pos=[p * s for p in hf.pos], material="ground")
+            name="surface",
+            type=mujoco.mjtGeom.mjGEOM_HFIELD,
+            hfieldname="surface",
+            pos=[p * s for p in hf.pos],
+            material="ground",
+        )
         for g in (tip_geom, geom):
             g.friction = [tip.mu_s, 0.0, 0.0]
             g.condim = 3
@@ -694,8 +746,7 @@ class Rig:
         self.act_push = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, "push")
         self.act_preload = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, "preload")
         adr = {}
-        for name in ("tip_pos", "tip_vel", "contact_net", "contact_deepest", "spring_force",
-                     "push_force"):
+        for name in ("tip_pos", "tip_vel", "contact_net", "contact_deepest", "spring_force", "push_force"):
             sid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SENSOR, name)
             adr[name] = int(m.sensor_adr[sid])
         self._sensor_adr = adr
@@ -704,11 +755,16 @@ class Rig:
         """Replace the surface (same grid size) and recompile in place (``spec.recompile``)."""
         import mujoco
 
-        hf = (to_hfield(surface, nrow=self.engine.hfield_resolution, ncol=self.engine.hfield_resolution)
-              if self.engine.hfield_resolution else to_hfield(surface))
+        hf = (
+            to_hfield(surface, nrow=self.engine.hfield_resolution, ncol=self.engine.hfield_resolution)
+            if self.engine.hfield_resolution
+            else to_hfield(surface)
+        )
         if (hf.nrow, hf.ncol) != (self.hfield.nrow, self.hfield.ncol):
-            raise SpineInputError(f"set_surface needs a {self.hfield.nrow} x {self.hfield.ncol} hfield, "
-                                  f"got {hf.nrow} x {hf.ncol}; build a new Rig instead")
+            raise SpineInputError(
+                f"set_surface needs a {self.hfield.nrow} x {self.hfield.ncol} hfield, "
+                f"got {hf.nrow} x {hf.ncol}; build a new Rig instead"
+            )
         s = self.length_scale_m
         h = self.spec.hfield("surface")
         h.userdata = hf.data.ravel().tolist()
@@ -769,7 +825,7 @@ class Rig:
             mujoco.mj_collision(m, d)
             if not d.ncon:
                 return None, 1.0
-            k = int(np.argmin(d.contact.dist[:d.ncon]))
+            k = int(np.argmin(d.contact.dist[: d.ncon]))
             return float(d.contact.dist[k]), abs(float(d.contact.frame[k, 2]))
 
         hi = (self.hfield.pos[2] + elev) * s + 2 * r
@@ -805,8 +861,9 @@ class Rig:
 
     def _check_start(self, x0: float, y0: float) -> None:
         if not bool(self.surface.contains(x0, y0)):
-            raise SpineInputError(f"start ({x0:g}, {y0:g}) lies outside the surface bounds "
-                                  f"{self.surface.bounds}")
+            raise SpineInputError(
+                f"start ({x0:g}, {y0:g}) lies outside the surface bounds {self.surface.bounds}"
+            )
 
     # ----------------------------------------------------------------- drive parameters
 
@@ -851,8 +908,9 @@ class Rig:
             cap = detection.kappa_cap * self.scales.preload_n
             rate = self._rate(drive)
             return max(1, int(math.ceil((cap - drive.start_force_n) / rate / dt)) + 2)
-        raise SpineInputError(f"open-loop controls exist for SpringDrive and StaticProbe, "
-                              f"got {type(drive).__name__}")
+        raise SpineInputError(
+            f"open-loop controls exist for SpringDrive and StaticProbe, got {type(drive).__name__}"
+        )
 
     def _controls(self, drive: Drive, qpos0: np.ndarray, detection: Detection) -> np.ndarray:
         """Open-loop controls ``(nstep, 6)``: ctrl (spring, push, preload) then mocap xyz."""
@@ -873,14 +931,22 @@ class Rig:
             ctrl[:, 3] = ctrl[:, 0]
         else:
             ctrl[:, 1] = drive.start_force_n
-            ctrl[n_settle:, 1] = np.minimum(drive.start_force_n + self._rate(drive) * ramp_t,
-                                            cap * (1 + 1e-9))
+            ctrl[n_settle:, 1] = np.minimum(
+                drive.start_force_n + self._rate(drive) * ramp_t, cap * (1 + 1e-9)
+            )
         return ctrl
 
     # ----------------------------------------------------------------- running
 
-    def run(self, drive: Drive, *, start: tuple[float, float], detection: Detection | None = None,
-            backend: str = "rollout", progress: Callable[[float], None] | None = None) -> RunResult:
+    def run(
+        self,
+        drive: Drive,
+        *,
+        start: tuple[float, float],
+        detection: Detection | None = None,
+        backend: str = "rollout",
+        progress: Callable[[float], None] | None = None,
+    ) -> RunResult:
         """Run one drive from ``start`` (surface units).
 
         ``backend`` "rollout" (native) or "python" (a plain ``mj_step`` loop, the reference
@@ -891,9 +957,15 @@ class Rig:
             return self._run_ramp(drive, start, detection, progress)
         return self.run_batch([drive], [start], detection=detection, backend=backend)[0]
 
-    def run_batch(self, drives: Drive | Sequence[Drive], starts: Sequence[tuple[float, float]], *,
-                  detection: Detection | None = None, backend: str = "rollout",
-                  nthread: int | None = None) -> list[RunResult]:
+    def run_batch(
+        self,
+        drives: Drive | Sequence[Drive],
+        starts: Sequence[tuple[float, float]],
+        *,
+        detection: Detection | None = None,
+        backend: str = "rollout",
+        nthread: int | None = None,
+    ) -> list[RunResult]:
         """Run many starts and/or drive parameter sets of this model.
 
         ``drives`` is one drive for all starts or one per start (SpringDrive or StaticProbe;
@@ -913,8 +985,9 @@ class Rig:
             drives = [drives] * len(starts)
         drives = list(drives)
         if len(drives) != len(starts):
-            raise SpineInputError(f"drives must be one drive or one per start ({len(starts)}), "
-                                  f"got {len(drives)}")
+            raise SpineInputError(
+                f"drives must be one drive or one per start ({len(starts)}), got {len(drives)}"
+            )
         if any(isinstance(d, RampDrive) for d in drives):
             raise SpineInputError("RampDrive needs feedback; use Rig.run for it")
         if backend not in ("rollout", "python"):
@@ -927,11 +1000,11 @@ class Rig:
             k = self._stiffness(d) if isinstance(d, SpringDrive) else 0.0
             if k not in by_stiffness:
                 by_stiffness[k] = self._model_for(d)
-        models = [by_stiffness[self._stiffness(d) if isinstance(d, SpringDrive) else 0.0]
-                  for d in drives]
+        models = [by_stiffness[self._stiffness(d) if isinstance(d, SpringDrive) else 0.0] for d in drives]
         s = self.length_scale_m
-        lengths = [self._settle_steps(d) + self._drive_steps(d, x0 * s, det)
-                   for d, (x0, _) in zip(drives, starts)]
+        lengths = [
+            self._settle_steps(d) + self._drive_steps(d, x0 * s, det) for d, (x0, _) in zip(drives, starts)
+        ]
         nstate = mujoco.mj_stateSize(self.model, mujoco.mjtState.mjSTATE_FULLPHYSICS)
         spec = int(mujoco.mjtState.mjSTATE_CTRL) | int(mujoco.mjtState.mjSTATE_MOCAP_POS)
         results: list[RunResult | None] = [None] * len(starts)
@@ -945,14 +1018,15 @@ class Rig:
             nstep = lengths[order[i]]
             group = [order[i]]
             limit = max(1, _BATCH_MEMORY_BYTES // (per_row * nstep))
-            while (i + len(group) < len(order) and len(group) < limit
-                   and lengths[order[i + len(group)]] == nstep):
+            while (
+                i + len(group) < len(order) and len(group) < limit and lengths[order[i + len(group)]] == nstep
+            ):
                 group.append(order[i + len(group)])
             i += len(group)
             # pieces of a group pipeline: one piece is simulated while the previous one is
             # analysed (and the next one placed) on the calling thread
             size = max(nthread, -(-len(group) // _PIPELINE_PIECES))
-            batches += [group[k:k + size] for k in range(0, len(group), size)]
+            batches += [group[k : k + size] for k in range(0, len(group), size)]
 
         def prepare(batch):
             qpos0 = [self.place(*starts[j]) for j in batch]
@@ -962,9 +1036,12 @@ class Rig:
             return batch, ctrls, init, np.stack(ctrls)
 
         def analyse(batch, ctrls, state, sens, warn):
-            for j, res in zip(batch, self._analyse_group(
-                    [drives[j] for j in batch], [starts[j] for j in batch], state, sens, ctrls,
-                    det, warn)):
+            for j, res in zip(
+                batch,
+                self._analyse_group(
+                    [drives[j] for j in batch], [starts[j] for j in batch], state, sens, ctrls, det, warn
+                ),
+            ):
                 results[j] = res
 
         if backend == "python":
@@ -979,8 +1056,14 @@ class Rig:
         datas = [mujoco.MjData(self.model) for _ in range(max(1, nthread))]
 
         def simulate(batch, init, ctrl):
-            return pool.rollout([models[j] for j in batch], datas, init, ctrl, control_spec=spec,
-                                initial_warmstart=np.zeros((len(batch), self.model.nv)))
+            return pool.rollout(
+                [models[j] for j in batch],
+                datas,
+                init,
+                ctrl,
+                control_spec=spec,
+                initial_warmstart=np.zeros((len(batch), self.model.nv)),
+            )
 
         try:
             with cf.ThreadPoolExecutor(max_workers=1) as sim_thread:
@@ -1011,15 +1094,15 @@ class Rig:
         a = self._sensor_adr
         cn, cd = a["contact_net"], a["contact_deepest"]
         t = state[:, 0].copy()
-        pos = sens[:, a["tip_pos"]:a["tip_pos"] + 3].copy()
-        vel = sens[:, a["tip_vel"]:a["tip_vel"] + 3].copy()
+        pos = sens[:, a["tip_pos"] : a["tip_pos"] + 3].copy()
+        vel = sens[:, a["tip_vel"] : a["tip_vel"] + 3].copy()
         contact = sens[:, cd] > 0
         no_contact = ~contact[:, None]
-        force = np.negative(sens[:, cn + 1:cn + 4])  # the sensor reports the tip's force on the surface
-        normal = sens[:, cd + 5:cd + 8].copy()
+        force = np.negative(sens[:, cn + 1 : cn + 4])  # the sensor reports the tip's force on the surface
+        normal = sens[:, cd + 5 : cd + 8].copy()
         np.negative(normal, out=normal, where=normal[:, 2:3] < 0)  # point out of the surface
         np.copyto(normal, np.nan, where=no_contact)
-        point = sens[:, cd + 2:cd + 5].copy()
+        point = sens[:, cd + 2 : cd + 5].copy()
         np.copyto(point, np.nan, where=no_contact)
         pen = np.where(contact, np.maximum(-sens[:, cd + 1], 0.0), 0.0)
         nn = np.nan_to_num(normal)
@@ -1030,11 +1113,9 @@ class Rig:
         return t, pos, vel, contact, normal, point, pen, fn, ft, drive_f, _norm3(vt)
 
     def _analyse(self, drive, start, state, sens, ctrl, det: Detection, warnings) -> RunResult:
-        return self._analyse_group([drive], [start], state[None], sens[None], [ctrl], det,
-                                   [warnings])[0]
+        return self._analyse_group([drive], [start], state[None], sens[None], [ctrl], det, [warnings])[0]
 
-    def _analyse_group(self, drives, starts, state, sens, ctrls, det: Detection,
-                       warnings) -> list[RunResult]:
+    def _analyse_group(self, drives, starts, state, sens, ctrls, det: Detection, warnings) -> list[RunResult]:
         """:meth:`_analyse` of a group of runs of equal length at once.
 
         ``state`` ``(g, n, nstate)`` and ``sens`` ``(g, n, nsensordata)``: the per-step
@@ -1047,7 +1128,8 @@ class Rig:
         fp = self.scales.preload_n
         cols = self._columns(state.reshape(g * n, -1), sens.reshape(g * n, -1))
         t, pos, vel, contact, normal, point, pen, fn, ft, drive_f, vt = (
-            c.reshape(g, n, *c.shape[1:]) for c in cols)
+            c.reshape(g, n, *c.shape[1:]) for c in cols
+        )
         slipping = vt > det.slip_speed_m_s
         rows = np.arange(g)
 
@@ -1075,32 +1157,52 @@ class Rig:
             n_settle = self._settle_steps(drive)
             candidates = []
             if k_nonfinite[r] >= 0:
-                candidates.append((int(k_nonfinite[r]), 0, EndReason.ENGINE_TROUBLE,
-                                   "non-finite state"))
+                candidates.append((int(k_nonfinite[r]), 0, EndReason.ENGINE_TROUBLE, "non-finite state"))
             if k_reset[r] >= 0:
-                candidates.append((int(k_reset[r]), 0, EndReason.ENGINE_TROUBLE,
-                                   "MuJoCo reset the simulation (warning: bad qpos/qvel/qacc)"))
+                candidates.append(
+                    (
+                        int(k_reset[r]),
+                        0,
+                        EndReason.ENGINE_TROUBLE,
+                        "MuJoCo reset the simulation (warning: bad qpos/qvel/qacc)",
+                    )
+                )
             if warnings[r] is not None:
                 k, text = warnings[r]
                 if k is not None:
                     candidates.append((k, 0, EndReason.ENGINE_TROUBLE, f"MuJoCo warning: {text}"))
             if k_deep[r] >= 0:
                 k = int(k_deep[r])
-                candidates.append((k, 1, EndReason.ENGINE_TROUBLE,
-                                   f"penetration {pen[r, k]:.3g} m > tolerance "
-                                   f"{det.penetration_tol_m:.3g} m"))
+                candidates.append(
+                    (
+                        k,
+                        1,
+                        EndReason.ENGINE_TROUBLE,
+                        f"penetration {pen[r, k]:.3g} m > tolerance {det.penetration_tol_m:.3g} m",
+                    )
+                )
             if k_out[r] >= 0:
                 k = int(k_out[r])
-                candidates.append((k, 2, EndReason.LEFT_DOMAIN,
-                                   f"tip at ({pos[r, k, 0]:.4g}, {pos[r, k, 1]:.4g}) m left the "
-                                   "domain"))
+                candidates.append(
+                    (
+                        k,
+                        2,
+                        EndReason.LEFT_DOMAIN,
+                        f"tip at ({pos[r, k, 0]:.4g}, {pos[r, k, 1]:.4g}) m left the domain",
+                    )
+                )
             if k_lock[r] >= 0:
-                candidates.append((int(k_lock[r]), 3, EndReason.SELF_LOCK,
-                                   f"drive force reached kappa_cap * F_p = {cap:.4g} N without slip"))
+                candidates.append(
+                    (
+                        int(k_lock[r]),
+                        3,
+                        EndReason.SELF_LOCK,
+                        f"drive force reached kappa_cap * F_p = {cap:.4g} N without slip",
+                    )
+                )
             kappa = math.nan
             if isinstance(drive, StaticProbe):
-                kappa = self._probe_events(candidates, pos[r], vt[r], drive_f[r], n_settle, det,
-                                            fp)
+                kappa = self._probe_events(candidates, pos[r], vt[r], drive_f[r], n_settle, det, fp)
             end, reason, detail = n - 1, EndReason.COMPLETED, "drive duration elapsed"
             if candidates:
                 end, _, reason, detail = min(candidates, key=lambda c: (c[0], c[1]))
@@ -1110,17 +1212,37 @@ class Rig:
             events = _slip_events(slipping[r, sl], t[r, sl], n_settle)
             events.append(Event(reason.value, end, float(t[r, end])))
             onsets = [e.index for e in events if e.kind == "slip_onset"]
-            carriage = (ctrls[r][:, 3].copy() if isinstance(drive, SpringDrive)
-                        else np.full(n, np.nan))
-            results.append(self._result(
-                drive, starts[r], det, t[r], pos[r], vel[r], contact[r], normal[r], point[r],
-                pen[r], fn[r], ft[r], drive_f[r], carriage, slipping[r], sl, events, reason,
-                detail, n_settle, kappa, np.array([drive_f[r, i] / fp for i in onsets])))
+            carriage = ctrls[r][:, 3].copy() if isinstance(drive, SpringDrive) else np.full(n, np.nan)
+            results.append(
+                self._result(
+                    drive,
+                    starts[r],
+                    det,
+                    t[r],
+                    pos[r],
+                    vel[r],
+                    contact[r],
+                    normal[r],
+                    point[r],
+                    pen[r],
+                    fn[r],
+                    ft[r],
+                    drive_f[r],
+                    carriage,
+                    slipping[r],
+                    sl,
+                    events,
+                    reason,
+                    detail,
+                    n_settle,
+                    kappa,
+                    np.array([drive_f[r, i] / fp for i in onsets]),
+                )
+            )
         return results
 
     @staticmethod
-    def _probe_events(candidates, pos, vt, drive_f, n_settle, det: Detection,
-                      fp: float) -> float:
+    def _probe_events(candidates, pos, vt, drive_f, n_settle, det: Detection, fp: float) -> float:
         """Static probe: append slid/breakaway candidates; returns kappa_mj (NaN if none)."""
         n = pos.shape[0]
         kappa = math.nan
@@ -1133,8 +1255,9 @@ class Rig:
         moved = np.linalg.norm(pos - pos[0], axis=1) > det.breakaway_distance_m
         k_settle = first(moved[:n_settle])
         if k_settle is not None:
-            candidates.append((k_settle, 4, EndReason.SLID,
-                               "the tip slid during settling at the start force"))
+            candidates.append(
+                (k_settle, 4, EndReason.SLID, "the tip slid during settling at the start force")
+            )
         moved = np.linalg.norm(pos - p_ref, axis=1) > det.breakaway_distance_m
         moved[:n_settle] = False
         k = first(moved)
@@ -1143,16 +1266,41 @@ class Rig:
             j = int(stuck[-1]) if stuck.size else n_settle - 1
             f_break = drive_f[max(j, n_settle - 1)]
             if pos[k, 0] - p_ref[0] <= 0 or j < n_settle:
-                candidates.append((k, 4, EndReason.SLID,
-                                   f"the tip slid against the drive at F = {f_break:.4g} N"))
+                candidates.append(
+                    (k, 4, EndReason.SLID, f"the tip slid against the drive at F = {f_break:.4g} N")
+                )
             else:
                 kappa = float(f_break / fp)
-                candidates.append((k, 4, EndReason.BREAKAWAY,
-                                   f"breakaway at F = {f_break:.4g} N, kappa_mj = {kappa:.4g}"))
+                candidates.append(
+                    (k, 4, EndReason.BREAKAWAY, f"breakaway at F = {f_break:.4g} N, kappa_mj = {kappa:.4g}")
+                )
         return kappa
 
-    def _result(self, drive, start, det, t, pos, vel, contact, normal, point, pen, fn, ft, drive_f,
-                carriage, slipping, sl, events, reason, detail, n_settle, kappa, slip_kappas):
+    def _result(
+        self,
+        drive,
+        start,
+        det,
+        t,
+        pos,
+        vel,
+        contact,
+        normal,
+        point,
+        pen,
+        fn,
+        ft,
+        drive_f,
+        carriage,
+        slipping,
+        sl,
+        events,
+        reason,
+        detail,
+        n_settle,
+        kappa,
+        slip_kappas,
+    ):
         def cut(a):
             out = a[sl]  # a view of the group's column (C-contiguous rows), read-only
             out.flags.writeable = False
@@ -1160,14 +1308,33 @@ class Rig:
 
         speed = self.speed_of(drive)
         return RunResult(
-            time_s=cut(t), position_m=cut(pos), velocity_m_s=cut(vel), contact=cut(contact),
-            normal=cut(normal), contact_point_m=cut(point), penetration_m=cut(pen),
-            normal_force_n=cut(fn), tangential_force_n=cut(ft), drive_force_n=cut(drive_f),
-            carriage_x_m=cut(carriage), slipping=cut(slipping), events=tuple(events),
-            end_reason=reason, end_detail=detail, drive_start_index=n_settle, kappa_mj=kappa,
-            slip_kappas=slip_kappas, inertia_number=self.scales.inertia_number(speed),
-            speed_m_s=speed, start=tuple(start), drive=drive, tip=self.tip, engine=self.engine,
-            scales=self.scales, detection=det)
+            time_s=cut(t),
+            position_m=cut(pos),
+            velocity_m_s=cut(vel),
+            contact=cut(contact),
+            normal=cut(normal),
+            contact_point_m=cut(point),
+            penetration_m=cut(pen),
+            normal_force_n=cut(fn),
+            tangential_force_n=cut(ft),
+            drive_force_n=cut(drive_f),
+            carriage_x_m=cut(carriage),
+            slipping=cut(slipping),
+            events=tuple(events),
+            end_reason=reason,
+            end_detail=detail,
+            drive_start_index=n_settle,
+            kappa_mj=kappa,
+            slip_kappas=slip_kappas,
+            inertia_number=self.scales.inertia_number(speed),
+            speed_m_s=speed,
+            start=tuple(start),
+            drive=drive,
+            tip=self.tip,
+            engine=self.engine,
+            scales=self.scales,
+            detection=det,
+        )
 
     # ----------------------------------------------------------------- ramp with reset
 
@@ -1196,8 +1363,7 @@ class Rig:
         sens = np.empty((nstep, m.nsensordata))
         ctrl_log = np.zeros((nstep, 6))
         a = self._sensor_adr
-        slide = (0.01 * self.scales.char_length_m if drive.slide_distance_m is None
-                 else drive.slide_distance_m)
+        slide = 0.01 * self.scales.char_length_m if drive.slide_distance_m is None else drive.slide_distance_m
         force, ramping, stuck_steps, stop = 0.0, True, 0, nstep
         slip_from = None  # (x, y) where the current slip began, while the force still acts
         resets = []
@@ -1220,15 +1386,15 @@ class Rig:
             if not np.isfinite(state[i]).all():
                 stop = i + 1
                 break
-            vel = sens[i, a["tip_vel"]:a["tip_vel"] + 3]
+            vel = sens[i, a["tip_vel"] : a["tip_vel"] + 3]
             if sens[i, a["contact_deepest"]] > 0:
-                nrm = sens[i, a["contact_deepest"] + 5:a["contact_deepest"] + 8]
+                nrm = sens[i, a["contact_deepest"] + 5 : a["contact_deepest"] + 8]
             vt = float(np.linalg.norm(vel - (vel @ nrm) * nrm))
             if i >= n_settle:
                 if ramping and slip_from is None and vt > det.slip_speed_m_s:
-                    slip_from = sens[i, a["tip_pos"]:a["tip_pos"] + 2].copy()
+                    slip_from = sens[i, a["tip_pos"] : a["tip_pos"] + 2].copy()
                 if ramping and slip_from is not None:
-                    moved = sens[i, a["tip_pos"]:a["tip_pos"] + 2] - slip_from
+                    moved = sens[i, a["tip_pos"] : a["tip_pos"] + 2] - slip_from
                     if math.hypot(moved[0], moved[1]) >= slide:
                         ramping, stuck_steps, slip_from = False, 0, None
                         force = 0.0
@@ -1240,17 +1406,20 @@ class Rig:
             if progress is not None and i % 2000 == 0:
                 progress(i / nstep)
         state, sens, ctrl_log = state[:stop], sens[:stop], ctrl_log[:stop]
-        result = self._analyse(drive, start, state, sens, ctrl_log, det, (
-            warn_at if warn_at is not None else (None, "")))
-        events = tuple(sorted(result.events + tuple(Event("reset", i, float(state[i, 0]))
-                                                    for i in resets if i < result.n),
-                              key=lambda e: (e.index, e.kind == result.end_reason.value)))
+        result = self._analyse(
+            drive, start, state, sens, ctrl_log, det, (warn_at if warn_at is not None else (None, ""))
+        )
+        events = tuple(
+            sorted(
+                result.events + tuple(Event("reset", i, float(state[i, 0])) for i in resets if i < result.n),
+                key=lambda e: (e.index, e.kind == result.end_reason.value),
+            )
+        )
         return dataclasses.replace(result, events=events)
 
     # ----------------------------------------------------------------- rendering
 
-    def render_frames(self, result: RunResult, *, fps: float = 30.0, width: int = 640,
-                      height: int = 480):
+    def render_frames(self, result: RunResult, *, fps: float = 30.0, width: int = 640, height: int = 480):
         """Yield RGB frames ``(height, width, 3)`` uint8 of a run (headless, needs a GL backend)."""
         import mujoco
 
@@ -1268,8 +1437,11 @@ class Rig:
             for i in range(0, result.n, stride):
                 d.qpos[:] = result.position_m[i]
                 if not math.isnan(result.carriage_x_m[i]):
-                    d.mocap_pos[0] = (result.carriage_x_m[i], result.position_m[i, 1],
-                                      result.position_m[i, 2] + 2 * self.tip.tip_radius_m)
+                    d.mocap_pos[0] = (
+                        result.carriage_x_m[i],
+                        result.position_m[i, 1],
+                        result.position_m[i, 2] + 2 * self.tip.tip_radius_m,
+                    )
                 mujoco.mj_forward(m, d)
                 cam.lookat[:] = result.position_m[i]
                 renderer.update_scene(d, camera=cam)
@@ -1338,4 +1510,3 @@ def _slip_events(slipping: np.ndarray, t: np.ndarray, start: int) -> list[Event]
         i = int(k) + 1
         events.append(Event("slip_onset" if s[i] else "slip_stop", i, float(t[i])))
     return events
-

@@ -32,8 +32,7 @@ from spine_mj.engagement import ENGAGED, SELF_LOCK, SLIP, kappa, slip_direction
 from spine_mj.errors import SpineInputError
 from spine_mj.surfaces import GaussianSurface, GridSurface, Surface
 
-__all__ = ["Outcome", "StreamlineParams", "StreamlineResult", "dilate", "ideal_trajectories",
-           "streamlines"]
+__all__ = ["Outcome", "StreamlineParams", "StreamlineResult", "dilate", "ideal_trajectories", "streamlines"]
 
 
 class Outcome(enum.IntEnum):
@@ -173,14 +172,21 @@ class StreamlineResult:
         start = np.repeat(np.arange(len(self)), counts)
         step = np.arange(self.x.size) - np.repeat(self.offsets[:-1], counts)
         names = np.array(["", *[o.name.lower() for o in Outcome]])
-        return pd.DataFrame({
-            "trajectory": "ideal" if self.ideal else "streamline",
-            "start": start, "step": step,
-            "start_x": self.start_x[start], "start_y": self.start_y[start],
-            "x": self.x, "y": self.y, "z": self.z, "kappa": self.kappa,
-            "region": np.array(["slip", "engaged", "self-lock"])[self.region],
-            "outcome": names[self.outcome[start]],
-        })
+        return pd.DataFrame(
+            {
+                "trajectory": "ideal" if self.ideal else "streamline",
+                "start": start,
+                "step": step,
+                "start_x": self.start_x[start],
+                "start_y": self.start_y[start],
+                "x": self.x,
+                "y": self.y,
+                "z": self.z,
+                "kappa": self.kappa,
+                "region": np.array(["slip", "engaged", "self-lock"])[self.region],
+                "outcome": names[self.outcome[start]],
+            }
+        )
 
 
 # --------------------------------------------------------------------------- numba kernels
@@ -188,6 +194,7 @@ class StreamlineResult:
 _KIND_GAUSS = 0
 _KIND_GRID = 1
 _LANES = 32  # starts the kernel steps together (one core, 2,000 starts: 8 -> 4.3e7 steps/s, 32 -> 6.5e7)
+
 
 def _get_kernel():
     from spine_mj._kernels import run_trajectories
@@ -200,8 +207,17 @@ def _surface_data(surface: Surface):
     dummy_coef = np.zeros((1, 1))
     dummy_sp = np.zeros(8)
     if isinstance(surface, GaussianSurface):
-        g = np.ascontiguousarray(np.stack([surface.amplitude, surface.center_x, surface.center_y,
-                                           1.0 / surface.sigma_x, 1.0 / surface.sigma_y]))
+        g = np.ascontiguousarray(
+            np.stack(
+                [
+                    surface.amplitude,
+                    surface.center_x,
+                    surface.center_y,
+                    1.0 / surface.sigma_x,
+                    1.0 / surface.sigma_y,
+                ]
+            )
+        )
         return _KIND_GAUSS, g, dummy_coef, dummy_sp
     if isinstance(surface, GridSurface):
         s = surface.spline
@@ -248,22 +264,50 @@ def _trajectories(surface, starts, params, *, ideal, store_paths, backend):
         out = _run_numpy(surface, xs, ys, params, ideal=ideal, store=store_paths)
     else:
         kind, g, coef, sp = data
-        out = _get_kernel()(kind, g, coef, sp, np.asarray(surface.bounds, dtype=float), xs, ys,
-                            bool(ideal), float(params.mu), float(params.dl), float(params.tol),
-                            int(params.max_steps), int(params.stall_window),
-                            float(params.stall_distance_value), bool(store_paths),
-                            min(_LANES, xs.size))
+        out = _get_kernel()(
+            kind,
+            g,
+            coef,
+            sp,
+            np.asarray(surface.bounds, dtype=float),
+            xs,
+            ys,
+            bool(ideal),
+            float(params.mu),
+            float(params.dl),
+            float(params.tol),
+            int(params.max_steps),
+            int(params.stall_window),
+            float(params.stall_distance_value),
+            bool(store_paths),
+            min(_LANES, xs.size),
+        )
     outcome, n_steps, max_k, ex, ey, ez, offsets, px, py, pz, pk, pr = out
     if not store_paths:
         offsets = px = py = pz = pk = pr = None
-    return StreamlineResult(params=params, ideal=bool(ideal), start_x=xs, start_y=ys,
-                            outcome=outcome, end_x=ex, end_y=ey, end_z=ez, n_steps=n_steps,
-                            max_kappa=max_k, offsets=offsets, x=px, y=py, z=pz, kappa=pk,
-                            region=pr)
+    return StreamlineResult(
+        params=params,
+        ideal=bool(ideal),
+        start_x=xs,
+        start_y=ys,
+        outcome=outcome,
+        end_x=ex,
+        end_y=ey,
+        end_z=ez,
+        n_steps=n_steps,
+        max_kappa=max_k,
+        offsets=offsets,
+        x=px,
+        y=py,
+        z=pz,
+        kappa=pk,
+        region=pr,
+    )
 
 
-def streamlines(surface: Surface, starts, params: StreamlineParams, *, store_paths: bool = True,
-                backend: str = "auto") -> StreamlineResult:
+def streamlines(
+    surface: Surface, starts, params: StreamlineParams, *, store_paths: bool = True, backend: str = "auto"
+) -> StreamlineResult:
     """Quasistatic engagement streamlines from many starts (paper Eq. 4, Fig. 2C).
 
     Parameters
@@ -288,18 +332,17 @@ def streamlines(surface: Surface, starts, params: StreamlineParams, *, store_pat
     SpineInputError
         Starts outside the bounds, wrong shapes or parameter types.
     """
-    return _trajectories(surface, starts, params, ideal=False, store_paths=store_paths,
-                         backend=backend)
+    return _trajectories(surface, starts, params, ideal=False, store_paths=store_paths, backend=backend)
 
 
-def ideal_trajectories(surface: Surface, starts, params: StreamlineParams, *,
-                       store_paths: bool = True, backend: str = "auto") -> StreamlineResult:
+def ideal_trajectories(
+    surface: Surface, starts, params: StreamlineParams, *, store_paths: bool = True, backend: str = "auto"
+) -> StreamlineResult:
     """Ideal trajectories (paper §3.1.2): ``y = y0``, +x in arc-length steps ``dl``.
 
     Same parameters and result as :func:`streamlines`; stops on self-lock or at the edge.
     """
-    return _trajectories(surface, starts, params, ideal=True, store_paths=store_paths,
-                         backend=backend)
+    return _trajectories(surface, starts, params, ideal=True, store_paths=store_paths, backend=backend)
 
 
 def _run_numpy(surface, xs, ys, params, *, ideal, store):
@@ -417,8 +460,13 @@ def dilate(surface: Surface, radius: float, *, spacing: float | None = None) -> 
             nx = int(math.ceil((xmax - xmin) / h)) + 1
             ny = int(math.ceil((ymax - ymin) / h)) + 1
             x, y = np.linspace(xmin, xmax, nx), np.linspace(ymin, ymax, ny)
-            grid = GridSurface(heights=surface.height(x[None, :], y[:, None]), x=x, y=y,
-                               unit=surface.unit, metadata=dict(surface.metadata))
+            grid = GridSurface(
+                heights=surface.height(x[None, :], y[:, None]),
+                x=x,
+                y=y,
+                unit=surface.unit,
+                metadata=dict(surface.metadata),
+            )
     if radius == 0:
         return grid
     dx, dy = grid.spacing
@@ -429,21 +477,21 @@ def dilate(surface: Surface, radius: float, *, spacing: float | None = None) -> 
     footprint = rho2 <= radius * radius
     cap = np.sqrt(np.clip(radius * radius - rho2, 0, None)) - radius
     if grid.periodic:
-        heights = ndimage.grey_dilation(grid.heights, footprint=footprint, structure=cap,
-                                        mode="wrap")
+        heights = ndimage.grey_dilation(grid.heights, footprint=footprint, structure=cap, mode="wrap")
     elif not isinstance(surface, GridSurface):
         # sample a margin of R outside so the edge sees the true neighbourhood
         xw = grid.x[0] + dx * np.arange(-rx, grid.x.size + rx)
         yw = grid.y[0] + dy * np.arange(-ry, grid.y.size + ry)
         wide = surface.height(xw[None, :], yw[:, None])
-        heights = ndimage.grey_dilation(wide, footprint=footprint, structure=cap)[ry:-ry or None,
-                                                                                  rx:-rx or None]
+        heights = ndimage.grey_dilation(wide, footprint=footprint, structure=cap)[
+            ry : -ry or None, rx : -rx or None
+        ]
     else:
-        heights = ndimage.grey_dilation(grid.heights, footprint=footprint, structure=cap,
-                                        mode="nearest")
+        heights = ndimage.grey_dilation(grid.heights, footprint=footprint, structure=cap, mode="nearest")
     meta = dict(surface.metadata, tip_radius=radius)
-    return GridSurface(heights=heights, x=grid.x, y=grid.y, periodic=grid.periodic,
-                       unit=surface.unit, metadata=meta)
+    return GridSurface(
+        heights=heights, x=grid.x, y=grid.y, periodic=grid.periodic, unit=surface.unit, metadata=meta
+    )
 
 
 # keep the region constants importable from here for convenience

@@ -20,8 +20,7 @@ import numpy as np
 from spine_mj.errors import SpineInputError, atomic_output
 from spine_mj.surfaces import GaussianSurface, GridSurface, Surface
 
-__all__ = ["FILL_METHODS", "import_topography", "load_surface", "save_surface", "surface_mesh",
-           "write_stl"]
+__all__ = ["FILL_METHODS", "import_topography", "load_surface", "save_surface", "surface_mesh", "write_stl"]
 
 FORMAT = "spine_mj.surface/1"
 _GAUSS_KEYS = ("amplitude", "center_x", "center_y", "sigma_x", "sigma_y")
@@ -42,8 +41,13 @@ def save_surface(surface: Surface, path: str | os.PathLike) -> Path:
         "metadata_json": np.array(json.dumps(surface.metadata, default=_json_default)),
     }
     if isinstance(surface, GridSurface):
-        arrays = dict(kind=np.array("grid"), heights=surface.heights, x=surface.x, y=surface.y,
-                      periodic=np.array(surface.periodic))
+        arrays = dict(
+            kind=np.array("grid"),
+            heights=surface.heights,
+            x=surface.x,
+            y=surface.y,
+            periodic=np.array(surface.periodic),
+        )
     elif isinstance(surface, GaussianSurface):
         arrays = {"kind": np.array("gaussian")}
         arrays.update({k: getattr(surface, k) for k in _GAUSS_KEYS})
@@ -87,11 +91,21 @@ def load_surface(path: str | os.PathLike) -> Surface:
         kind = str(data["kind"])
         unit = str(data["unit"])
         if kind == "grid":
-            return GridSurface(heights=data["heights"], x=data["x"], y=data["y"],
-                               periodic=bool(data["periodic"]), unit=unit, metadata=metadata)
+            return GridSurface(
+                heights=data["heights"],
+                x=data["x"],
+                y=data["y"],
+                periodic=bool(data["periodic"]),
+                unit=unit,
+                metadata=metadata,
+            )
         if kind == "gaussian":
-            return GaussianSurface(**{k: data[k] for k in _GAUSS_KEYS},
-                                   bounds=tuple(data["bounds"]), unit=unit, metadata=metadata)
+            return GaussianSurface(
+                **{k: data[k] for k in _GAUSS_KEYS},
+                bounds=tuple(data["bounds"]),
+                unit=unit,
+                metadata=metadata,
+            )
     except KeyError as exc:
         raise SpineInputError(f"{path} is missing the array {exc.args[0]!r}") from None
     except json.JSONDecodeError as exc:
@@ -142,9 +156,7 @@ def import_topography(
         reader = st.open_topography(str(path))
         n_channels = len(reader.channels)
         if not (0 <= channel < n_channels):
-            raise SpineInputError(
-                f"channel must be in 0..{n_channels - 1} for {path.name}, got {channel}"
-            )
+            raise SpineInputError(f"channel must be in 0..{n_channels - 1} for {path.name}, got {channel}")
         topo = reader.topography(channel_index=channel)
         if topo.unit is None:
             raise SpineInputError(f"{path.name} states no length unit; cannot convert to metres")
@@ -152,9 +164,7 @@ def import_topography(
     except SpineInputError:
         raise
     except Exception as exc:  # SurfaceTopography raises many types for bad files
-        raise SpineInputError(
-            f"cannot read topography {path.name}: {type(exc).__name__}: {exc}"
-        ) from None
+        raise SpineInputError(f"cannot read topography {path.name}: {type(exc).__name__}: {exc}") from None
     if topo.dim != 2 or not topo.is_uniform:
         raise SpineInputError(f"{path.name} is not a uniform 2-D area scan")
 
@@ -177,11 +187,18 @@ def import_topography(
     sx, sy = topo.physical_sizes
     x = np.arange(nx_) * (sx / nx_)
     y = np.arange(ny_) * (sy / ny_)
-    meta = {"generator": "measured", "source": path.name, "channel": channel, "fill": fill,
-            "missing_points": n_missing, "levelled": bool(level),
-            "instrument": str(topo.info.get("instrument", {}).get("name", ""))}
-    surface = GridSurface(heights=heights.T, x=x - x.mean(), y=y - y.mean(), periodic=False,
-                          unit="m", metadata=meta)
+    meta = {
+        "generator": "measured",
+        "source": path.name,
+        "channel": channel,
+        "fill": fill,
+        "missing_points": n_missing,
+        "levelled": bool(level),
+        "instrument": str(topo.info.get("instrument", {}).get("name", "")),
+    }
+    surface = GridSurface(
+        heights=heights.T, x=x - x.mean(), y=y - y.mean(), periodic=False, unit="m", metadata=meta
+    )
     return surface if spacing_m is None else surface.resample(spacing_m)
 
 
@@ -210,8 +227,9 @@ def _remove_plane(heights: np.ndarray) -> np.ndarray:
 # --------------------------------------------------------------------------- STL
 
 
-def surface_mesh(surface: Surface, *, resolution: int = 201, base_thickness: float | None = None,
-                 scale: float = 1.0):
+def surface_mesh(
+    surface: Surface, *, resolution: int = 201, base_thickness: float | None = None, scale: float = 1.0
+):
     """A closed, watertight triangle mesh: the surface on top, walls, a flat bottom.
 
     A :class:`GridSurface` is meshed at its own samples, an analytic surface on a
@@ -244,10 +262,12 @@ def surface_mesh(surface: Surface, *, resolution: int = 201, base_thickness: flo
     bottom_faces = top_faces[:, ::-1] + off
     ring = np.concatenate([idx[0, :], idx[1:, -1], idx[-1, -2::-1], idx[-2:0:-1, 0]])
     nxt = np.roll(ring, -1)
-    walls = np.concatenate([np.column_stack([ring, ring + off, nxt + off]),
-                            np.column_stack([ring, nxt + off, nxt])])
-    mesh = trimesh.Trimesh(vertices=vertices,
-                           faces=np.concatenate([top_faces, bottom_faces, walls]), process=False)
+    walls = np.concatenate(
+        [np.column_stack([ring, ring + off, nxt + off]), np.column_stack([ring, nxt + off, nxt])]
+    )
+    mesh = trimesh.Trimesh(
+        vertices=vertices, faces=np.concatenate([top_faces, bottom_faces, walls]), process=False
+    )
     mesh.fix_normals()
     return mesh
 

@@ -79,9 +79,7 @@ def _bounds(value) -> tuple[float, float, float, float]:
     try:
         xmin, xmax, ymin, ymax = (float(v) for v in value)
     except (TypeError, ValueError):
-        raise SpineInputError(
-            f"bounds must be (xmin, xmax, ymin, ymax), got {value!r}"
-        ) from None
+        raise SpineInputError(f"bounds must be (xmin, xmax, ymin, ymax), got {value!r}") from None
     if not all(math.isfinite(v) for v in (xmin, xmax, ymin, ymax)):
         raise SpineInputError(f"bounds must be finite, got {value!r}")
     if not (xmin < xmax and ymin < ymax):
@@ -111,10 +109,10 @@ class Surface:
 
     def _eval_shaped(self, x, y, order: int) -> tuple[np.ndarray, ...]:
         xf, yf, shape = _broadcast_points(x, y)
-        parts = [self._evaluate(xf[s:s + _CHUNK], yf[s:s + _CHUNK], order)
-                 for s in range(0, xf.size, _CHUNK)] or [self._evaluate(xf, yf, order)]
-        return tuple(np.concatenate([p[k] for p in parts]).reshape(shape)
-                     for k in range(len(parts[0])))
+        parts = [
+            self._evaluate(xf[s : s + _CHUNK], yf[s : s + _CHUNK], order) for s in range(0, xf.size, _CHUNK)
+        ] or [self._evaluate(xf, yf, order)]
+        return tuple(np.concatenate([p[k] for p in parts]).reshape(shape) for k in range(len(parts[0])))
 
     def height(self, x, y) -> np.ndarray:
         """Height f(x, y), broadcast over ``x`` and ``y``."""
@@ -151,8 +149,7 @@ class Surface:
         y = np.linspace(ymin, ymax, int(ny))
         heights = self.height(x[None, :], y[:, None])
         meta = dict(self.metadata, sampled_from=self.metadata.get("generator", type(self).__name__))
-        return GridSurface(heights=heights, x=x, y=y, periodic=False, unit=self.unit,
-                           metadata=meta)
+        return GridSurface(heights=heights, x=x, y=y, periodic=False, unit=self.unit, metadata=meta)
 
 
 @dataclass(frozen=True, eq=False)
@@ -249,11 +246,9 @@ def _bspline_weights(t: np.ndarray, order: int) -> list[np.ndarray]:
     s = 1.0 - t
     t2 = t * t
     t3 = t2 * t
-    w = [np.stack([s**3 / 6, (3 * t3 - 6 * t2 + 4) / 6, (-3 * t3 + 3 * t2 + 3 * t + 1) / 6,
-                   t3 / 6], axis=1)]
+    w = [np.stack([s**3 / 6, (3 * t3 - 6 * t2 + 4) / 6, (-3 * t3 + 3 * t2 + 3 * t + 1) / 6, t3 / 6], axis=1)]
     if order >= 1:
-        w.append(np.stack([-0.5 * s * s, 1.5 * t2 - 2 * t, -1.5 * t2 + t + 0.5, 0.5 * t2],
-                          axis=1))
+        w.append(np.stack([-0.5 * s * s, 1.5 * t2 - 2 * t, -1.5 * t2 + t + 0.5, 0.5 * t2], axis=1))
     if order >= 2:
         w.append(np.stack([s, 3 * t - 2, 1 - 3 * t, t], axis=1))
     return w
@@ -330,8 +325,7 @@ class GridSurface(Surface):
         dx, dy = (x[-1] - x[0]) / (nx - 1), (y[-1] - y[0]) / (ny - 1)
         periodic = bool(self.periodic)
         if periodic:
-            coef = np.pad(ndimage.spline_filter(heights, order=3, mode="grid-wrap"), 2,
-                          mode="wrap")
+            coef = np.pad(ndimage.spline_filter(heights, order=3, mode="grid-wrap"), 2, mode="wrap")
             offset = 2
             bounds = (x[0], x[0] + nx * dx, y[0], y[0] + ny * dy)
         else:
@@ -345,9 +339,21 @@ class GridSurface(Surface):
         object.__setattr__(self, "y", y)
         object.__setattr__(self, "periodic", periodic)
         object.__setattr__(self, "bounds", tuple(float(b) for b in bounds))
-        object.__setattr__(self, "spline", BSplineGrid(
-            coef=coef, offset=offset, x0=float(x[0]), dx=float(dx), nx=nx,
-            y0=float(y[0]), dy=float(dy), ny=ny, periodic=periodic))
+        object.__setattr__(
+            self,
+            "spline",
+            BSplineGrid(
+                coef=coef,
+                offset=offset,
+                x0=float(x[0]),
+                dx=float(dx),
+                nx=nx,
+                y0=float(y[0]),
+                dy=float(dy),
+                ny=ny,
+                periodic=periodic,
+            ),
+        )
 
     @property
     def shape(self) -> tuple[int, int]:
@@ -388,8 +394,11 @@ class GridSurface(Surface):
         if order >= 1:
             out += [comb(wy[0], wx[1], 1 / sp.dx), comb(wy[1], wx[0], 1 / sp.dy)]
         if order >= 2:
-            out += [comb(wy[0], wx[2], 1 / sp.dx**2), comb(wy[1], wx[1], 1 / (sp.dx * sp.dy)),
-                    comb(wy[2], wx[0], 1 / sp.dy**2)]
+            out += [
+                comb(wy[0], wx[2], 1 / sp.dx**2),
+                comb(wy[1], wx[1], 1 / (sp.dx * sp.dy)),
+                comb(wy[2], wx[0], 1 / sp.dy**2),
+            ]
         outside = ~(in_x & in_y)
         if outside.any():
             for arr in out:
@@ -419,8 +428,7 @@ class GridSurface(Surface):
             )
         heights = self.height(x[None, :], y[:, None])
         meta = dict(self.metadata, resampled_spacing=[float(sx), float(sy)])
-        return GridSurface(heights=heights, x=x, y=y, periodic=self.periodic, unit=self.unit,
-                           metadata=meta)
+        return GridSurface(heights=heights, x=x, y=y, periodic=self.periodic, unit=self.unit, metadata=meta)
 
 
 # --------------------------------------------------------------------------- generators
@@ -455,10 +463,23 @@ def single_gaussian(
     mx, my = (float(c) for c in center)
     amplitude = sign * k / (2 * math.pi * sx * sy)
     return GaussianSurface(
-        amplitude=[amplitude], center_x=[mx], center_y=[my], sigma_x=[sx], sigma_y=[sy],
-        bounds=_bounds(bounds), unit="1",
-        metadata=_meta("single_gaussian", None, sign=sign, k=k, sigma_x=sx, sigma_y=sy,
-                       center=(mx, my), bounds=tuple(bounds)),
+        amplitude=[amplitude],
+        center_x=[mx],
+        center_y=[my],
+        sigma_x=[sx],
+        sigma_y=[sy],
+        bounds=_bounds(bounds),
+        unit="1",
+        metadata=_meta(
+            "single_gaussian",
+            None,
+            sign=sign,
+            k=k,
+            sigma_x=sx,
+            sigma_y=sy,
+            center=(mx, my),
+            bounds=tuple(bounds),
+        ),
     )
 
 
@@ -525,12 +546,25 @@ def random_gaussians(
                     "min_separation, or allow overlap"
                 )
     return GaussianSurface(
-        amplitude=amplitude, center_x=cx, center_y=cy, sigma_x=sigma_x, sigma_y=sigma_y,
-        bounds=(xmin, xmax, ymin, ymax), unit="1",
-        metadata=_meta("random_gaussians", seed, n_peaks=n_peaks, sign=sign,
-                       bounds=(xmin, xmax, ymin, ymax), sigma_range=(s_lo, s_hi),
-                       amplitude_range=(a_lo, a_hi), anisotropic=bool(anisotropic),
-                       overlap=bool(overlap), min_separation=min_separation),
+        amplitude=amplitude,
+        center_x=cx,
+        center_y=cy,
+        sigma_x=sigma_x,
+        sigma_y=sigma_y,
+        bounds=(xmin, xmax, ymin, ymax),
+        unit="1",
+        metadata=_meta(
+            "random_gaussians",
+            seed,
+            n_peaks=n_peaks,
+            sign=sign,
+            bounds=(xmin, xmax, ymin, ymax),
+            sigma_range=(s_lo, s_hi),
+            amplitude_range=(a_lo, a_hi),
+            anisotropic=bool(anisotropic),
+            overlap=bool(overlap),
+            min_separation=min_separation,
+        ),
     )
 
 
@@ -538,8 +572,7 @@ def _spectral_rms_slope(heights: np.ndarray, dx: float, dy: float) -> float:
     """``sqrt(<|grad f|^2>)`` of a periodic grid by Parseval: ``sum q^2 |F(q)|^2 / N^2``."""
     ny, nx = heights.shape
     power = np.abs(np.fft.fft2(heights)) ** 2 / heights.size**2
-    q2 = (2 * np.pi) ** 2 * (np.fft.fftfreq(nx, dx)[None, :] ** 2
-                             + np.fft.fftfreq(ny, dy)[:, None] ** 2)
+    q2 = (2 * np.pi) ** 2 * (np.fft.fftfreq(nx, dx)[None, :] ** 2 + np.fft.fftfreq(ny, dy)[:, None] ** 2)
     return float(np.sqrt(np.sum(q2 * power)))
 
 
@@ -628,10 +661,25 @@ def fractal_fbm(
     x = -lx / 2 + dx * np.arange(nx)
     y = -ly / 2 + dy * np.arange(ny)
     return GridSurface(
-        heights=heights, x=x, y=y, periodic=bool(periodic), unit=unit,
-        metadata=_meta("fractal_fbm", seed, nx=nx, ny=ny, size=(lx, ly), hurst=hurst,
-                       rms_height=rms_height, rms_slope=rms_slope, periodic=bool(periodic),
-                       long_cutoff=long_cutoff, short_cutoff=short_cutoff, unit=unit),
+        heights=heights,
+        x=x,
+        y=y,
+        periodic=bool(periodic),
+        unit=unit,
+        metadata=_meta(
+            "fractal_fbm",
+            seed,
+            nx=nx,
+            ny=ny,
+            size=(lx, ly),
+            hurst=hurst,
+            rms_height=rms_height,
+            rms_slope=rms_slope,
+            periodic=bool(periodic),
+            long_cutoff=long_cutoff,
+            short_cutoff=short_cutoff,
+            unit=unit,
+        ),
     )
 
 
@@ -675,9 +723,7 @@ def sandpaper(
     """
     if grit is not None:
         if grit not in GRIT_PARTICLE_DIAMETER_M:
-            raise SpineInputError(
-                f"grit must be one of {sorted(GRIT_PARTICLE_DIAMETER_M)}, got {grit!r}"
-            )
+            raise SpineInputError(f"grit must be one of {sorted(GRIT_PARTICLE_DIAMETER_M)}, got {grit!r}")
         if particle_diameter_m is None:
             particle_diameter_m = GRIT_PARTICLE_DIAMETER_M[grit]
     if particle_diameter_m is None:
@@ -685,8 +731,9 @@ def sandpaper(
     d_mean = check_positive("particle_diameter_m", particle_diameter_m)
     size_m = check_positive("size_m", size_m)
     tip_radius_m = check_positive("tip_radius_m", tip_radius_m)
-    spacing_m = (min(tip_radius_m / 5, d_mean / 10) if spacing_m is None
-                 else check_positive("spacing_m", spacing_m))
+    spacing_m = (
+        min(tip_radius_m / 5, d_mean / 10) if spacing_m is None else check_positive("spacing_m", spacing_m)
+    )
     coverage = check_positive("coverage", coverage)
     size_cv = float(size_cv)
     if not (0 <= size_cv < 2):
@@ -699,8 +746,7 @@ def sandpaper(
         raise SpineInputError(f"size_m / spacing_m gives {n} points; need at least 4")
     if n > 8192:
         raise SpineInputError(
-            f"size_m / spacing_m gives {n} points a side (> 8192); shrink size_m or coarsen "
-            "spacing_m"
+            f"size_m / spacing_m gives {n} points a side (> 8192); shrink size_m or coarsen spacing_m"
         )
     if size_m < 2 * d_mean:
         raise SpineInputError(
@@ -736,11 +782,24 @@ def sandpaper(
         heights[np.ix_(rows, cols)] = np.maximum(block, cap)
     coords = spacing * np.arange(n) - size_m / 2
     return GridSurface(
-        heights=heights, x=coords, y=coords.copy(), periodic=True, unit="m",
-        metadata=_meta("sandpaper", seed, grit=grit, particle_diameter_m=d_mean,
-                       size_m=size_m, tip_radius_m=tip_radius_m, spacing_m=spacing,
-                       coverage=coverage, size_cv=size_cv, embed_range=(e_lo, e_hi),
-                       n_particles=n_particles),
+        heights=heights,
+        x=coords,
+        y=coords.copy(),
+        periodic=True,
+        unit="m",
+        metadata=_meta(
+            "sandpaper",
+            seed,
+            grit=grit,
+            particle_diameter_m=d_mean,
+            size_m=size_m,
+            tip_radius_m=tip_radius_m,
+            spacing_m=spacing,
+            coverage=coverage,
+            size_cv=size_cv,
+            embed_range=(e_lo, e_hi),
+            n_particles=n_particles,
+        ),
     )
 
 
@@ -776,8 +835,9 @@ class HField:
         return self.data.shape[1]
 
 
-def to_hfield(surface: Surface, *, nrow: int | None = None, ncol: int | None = None,
-              base_z: float | None = None) -> HField:
+def to_hfield(
+    surface: Surface, *, nrow: int | None = None, ncol: int | None = None, base_z: float | None = None
+) -> HField:
     """The one conversion from a surface to MuJoCo hfield data (see :class:`HField`).
 
     A :class:`GridSurface` is used at its own samples unless ``nrow``/``ncol`` ask for a
@@ -811,8 +871,14 @@ def from_hfield(hfield: HField, *, unit: str = "1") -> GridSurface:
     cx, cy, cz = hfield.pos
     x = cx + np.linspace(-rx, rx, ncol)
     y = cy + np.linspace(-ry, ry, nrow)
-    return GridSurface(heights=cz + hfield.data.astype(float) * elevation, x=x, y=y,
-                       periodic=False, unit=unit, metadata={"generator": "from_hfield"})
+    return GridSurface(
+        heights=cz + hfield.data.astype(float) * elevation,
+        x=x,
+        y=y,
+        periodic=False,
+        unit=unit,
+        metadata={"generator": "from_hfield"},
+    )
 
 
 # --------------------------------------------------------------------------- engine geometry
@@ -856,8 +922,13 @@ class TriangulatedSurface(Surface):
     @classmethod
     def from_grid(cls, grid: GridSurface) -> TriangulatedSurface:
         """The triangulation of a grid surface's own samples (non-periodic)."""
-        return cls(heights=grid.heights, x=grid.x, y=grid.y, unit=grid.unit,
-                   metadata=dict(grid.metadata, triangulated=True))
+        return cls(
+            heights=grid.heights,
+            x=grid.x,
+            y=grid.y,
+            unit=grid.unit,
+            metadata=dict(grid.metadata, triangulated=True),
+        )
 
     def _evaluate(self, x, y, order):
         ny, nx = self.heights.shape

@@ -107,8 +107,22 @@ RUNS_TABLE = "runs.parquet"
 RUNS_DIR = "runs"
 TRAJ_DIR = "trajectories"
 LOCK = ".sweep.lock"
-_RESERVED = ("run_id", "case_id", "case_index", "analysis", "start", "start_x", "start_y",
-             "surface", "surface_seed", "seed", "status", "reason", "time_s", "cpu_s")
+_RESERVED = (
+    "run_id",
+    "case_id",
+    "case_index",
+    "analysis",
+    "start",
+    "start_x",
+    "start_y",
+    "surface",
+    "surface_seed",
+    "seed",
+    "status",
+    "reason",
+    "time_s",
+    "cpu_s",
+)
 
 
 # --------------------------------------------------------------------------- parameters
@@ -147,8 +161,9 @@ class ParamSpec:
     def expected(self) -> str:
         if self.choices:
             return "one of " + ", ".join(repr(c) for c in self.choices)
-        what = {"float": "a finite number", "int": "an integer", "str": "a string",
-                "bool": "true or false"}[self.kind]
+        what = {"float": "a finite number", "int": "an integer", "str": "a string", "bool": "true or false"}[
+            self.kind
+        ]
         if self.minimum is not None:
             what += f" {'>' if self.exclusive else '>='} {self.minimum:g}"
         return what
@@ -157,8 +172,7 @@ class ParamSpec:
         """``value`` converted to the parameter's type, or SpineInputError naming ``key``."""
         ok = False
         if self.kind == "float":
-            ok = (isinstance(value, (int, float)) and not isinstance(value, bool)
-                  and math.isfinite(value))
+            ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
             value = float(value) if ok else value
         elif self.kind == "int":
             ok = isinstance(value, int) and not isinstance(value, bool)
@@ -169,8 +183,9 @@ class ParamSpec:
         if ok and self.minimum is not None:
             ok = value > self.minimum if self.exclusive else value >= self.minimum
         if not ok:
-            raise SpineInputError(f"config key {key}: must be {self.expected()} (or a list of "
-                                  f"them), got {value!r}")
+            raise SpineInputError(
+                f"config key {key}: must be {self.expected()} (or a list of them), got {value!r}"
+            )
         return value
 
 
@@ -266,8 +281,12 @@ class SurfaceSpec:
     label: str = ""
 
     def as_dict(self) -> dict:
-        return {"kind": self.kind, "source": self.source, "seed": self.seed,
-                "overrides": {k: _jsonable(v) for k, v in self.overrides}}
+        return {
+            "kind": self.kind,
+            "source": self.source,
+            "seed": self.seed,
+            "overrides": {k: _jsonable(v) for k, v in self.overrides},
+        }
 
     def make(self):
         """Build the surface (cached per process)."""
@@ -317,8 +336,7 @@ class StartsSpec:
             pts = np.column_stack([gx.ravel(), gy.ravel()])
         if self.frame == "relative" or self.random is not None:
             xmin, xmax, ymin, ymax = bounds
-            pts = np.column_stack([xmin + pts[:, 0] * (xmax - xmin),
-                                   ymin + pts[:, 1] * (ymax - ymin)])
+            pts = np.column_stack([xmin + pts[:, 0] * (xmax - xmin), ymin + pts[:, 1] * (ymax - ymin)])
         return pts
 
 
@@ -362,7 +380,9 @@ class SweepConfig:
     def as_dict(self) -> dict:
         """The normalized config (what the hash covers)."""
         return {
-            "name": self.name, "seed": self.seed, "analyses": list(self.analyses),
+            "name": self.name,
+            "seed": self.seed,
+            "analyses": list(self.analyses),
             "surfaces": [s.as_dict() for s in self.surfaces],
             "starts": self.starts.as_dict(),
             "surface_starts": [None if s is None else s.as_dict() for s in self.surface_starts],
@@ -396,8 +416,7 @@ def load_config(path: str | os.PathLike) -> SweepConfig:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise SpineInputError(f"config {path} is not valid TOML: {exc}") from None
-    return dataclasses.replace(parse_config(doc, base_dir=path.resolve().parent),
-                               source=str(path))
+    return dataclasses.replace(parse_config(doc, base_dir=path.resolve().parent), source=str(path))
 
 
 def parse_config(doc: Mapping, *, base_dir: str | os.PathLike = ".") -> SweepConfig:
@@ -416,32 +435,36 @@ def parse_config(doc: Mapping, *, base_dir: str | os.PathLike = ".") -> SweepCon
     _check_seed(seed, "sweep.seed")
     store = sweep.get("store_trajectories", True)
     if not isinstance(store, bool):
-        raise SpineInputError(f"config key sweep.store_trajectories: must be true or false, "
-                              f"got {store!r}")
+        raise SpineInputError(f"config key sweep.store_trajectories: must be true or false, got {store!r}")
     analyses = sweep.get("analyses", ["quasistatic"])
     if isinstance(analyses, str):
         analyses = [analyses]
     if not isinstance(analyses, list) or not analyses:
-        raise SpineInputError(f"config key sweep.analyses: must be a non-empty list of "
-                              f"{_names(ANALYSES)}, got {analyses!r}")
+        raise SpineInputError(
+            f"config key sweep.analyses: must be a non-empty list of {_names(ANALYSES)}, got {analyses!r}"
+        )
     for a in analyses:
         if a not in ANALYSES:
-            raise SpineInputError(f"config key sweep.analyses: allowed values are "
-                                  f"{_names(ANALYSES)}, got {a!r}")
+            raise SpineInputError(
+                f"config key sweep.analyses: allowed values are {_names(ANALYSES)}, got {a!r}"
+            )
     if len(set(analyses)) != len(analyses):
         raise SpineInputError(f"config key sweep.analyses: each analysis once, got {analyses!r}")
     for a in analyses:
         missing = [r for r in ANALYSES[a].requires if r not in analyses]
         if missing:
-            raise SpineInputError(f"config key sweep.analyses: {a!r} needs {missing} as well, "
-                                  f"got {analyses!r}")
+            raise SpineInputError(
+                f"config key sweep.analyses: {a!r} needs {missing} as well, got {analyses!r}"
+            )
     order = tuple(a for a in ANALYSES if a in analyses)
 
     raw_surfaces = doc.get("surfaces")
     if not isinstance(raw_surfaces, list) or not raw_surfaces:
-        raise SpineInputError("config key surfaces: must be a non-empty array of tables "
-                              "([[surfaces]] with preset = ... or file = ...), got "
-                              f"{raw_surfaces!r}")
+        raise SpineInputError(
+            "config key surfaces: must be a non-empty array of tables "
+            "([[surfaces]] with preset = ... or file = ...), got "
+            f"{raw_surfaces!r}"
+        )
     base_dir = Path(base_dir)
     surfaces_, per_surface = [], []
     for i, entry in enumerate(raw_surfaces):
@@ -450,20 +473,24 @@ def parse_config(doc: Mapping, *, base_dir: str | os.PathLike = ".") -> SweepCon
             raise SpineInputError(f"config key {key}: must be a table, got {entry!r}")
         _allowed_keys(entry, key, ("preset", "file", "seed", "seeds", "n_seeds", "set", "starts"))
         if ("preset" in entry) == ("file" in entry):
-            raise SpineInputError(f"config key {key}: give exactly one of preset or file, "
-                                  f"got {sorted(entry)}")
+            raise SpineInputError(
+                f"config key {key}: give exactly one of preset or file, got {sorted(entry)}"
+            )
         n_seed_keys = sum(k in entry for k in ("seed", "seeds", "n_seeds"))
         if n_seed_keys > 1:
             raise SpineInputError(f"config key {key}: give at most one of seed, seeds, n_seeds")
         overrides = entry.get("set", {})
         if not isinstance(overrides, dict):
-            raise SpineInputError(f"config key {key}.set: must be a table of generator "
-                                  f"parameters, got {overrides!r}")
+            raise SpineInputError(
+                f"config key {key}.set: must be a table of generator parameters, got {overrides!r}"
+            )
         if "preset" in entry:
             preset_name = entry["preset"]
             if not isinstance(preset_name, str) or preset_name not in presets.list_presets():
-                raise SpineInputError(f"config key {key}.preset: allowed values are "
-                                      f"{', '.join(presets.list_presets())}, got {preset_name!r}")
+                raise SpineInputError(
+                    f"config key {key}.preset: allowed values are "
+                    f"{', '.join(presets.list_presets())}, got {preset_name!r}"
+                )
             preset = presets.load_preset(preset_name)
             try:
                 presets._check_params(preset.generator, overrides, f"config key {key}.set")
@@ -473,8 +500,9 @@ def parse_config(doc: Mapping, *, base_dir: str | os.PathLike = ".") -> SweepCon
             takes_seed = "rng" in inspect.signature(presets.GENERATORS[preset.generator]).parameters
         else:
             if overrides:
-                raise SpineInputError(f"config key {key}.set: only presets take generator "
-                                      f"overrides, got {sorted(overrides)}")
+                raise SpineInputError(
+                    f"config key {key}.set: only presets take generator overrides, got {sorted(overrides)}"
+                )
             file = entry["file"]
             if not isinstance(file, str):
                 raise SpineInputError(f"config key {key}.file: must be a path, got {file!r}")
@@ -483,8 +511,10 @@ def parse_config(doc: Mapping, *, base_dir: str | os.PathLike = ".") -> SweepCon
                 raise SpineInputError(f"config key {key}.file: no such file {str(path)!r}")
             kind, source, takes_seed = "file", str(path), False
         if n_seed_keys and not takes_seed:
-            raise SpineInputError(f"config key {key}: {source!r} takes no seed, got "
-                                  f"{[k for k in ('seed', 'seeds', 'n_seeds') if k in entry]}")
+            raise SpineInputError(
+                f"config key {key}: {source!r} takes no seed, got "
+                f"{[k for k in ('seed', 'seeds', 'n_seeds') if k in entry]}"
+            )
         seeds: list[int | None]
         if "seed" in entry:
             _check_seed(entry["seed"], f"{key}.seed")
@@ -492,8 +522,10 @@ def parse_config(doc: Mapping, *, base_dir: str | os.PathLike = ".") -> SweepCon
         elif "seeds" in entry:
             seeds = entry["seeds"]
             if not isinstance(seeds, list) or not seeds:
-                raise SpineInputError(f"config key {key}.seeds: must be a non-empty list of "
-                                      f"non-negative integers, got {seeds!r}")
+                raise SpineInputError(
+                    f"config key {key}.seeds: must be a non-empty list of "
+                    f"non-negative integers, got {seeds!r}"
+                )
             for s in seeds:
                 _check_seed(s, f"{key}.seeds")
             if len(set(seeds)) != len(seeds):
@@ -501,8 +533,7 @@ def parse_config(doc: Mapping, *, base_dir: str | os.PathLike = ".") -> SweepCon
         elif "n_seeds" in entry:
             n = entry["n_seeds"]
             if not isinstance(n, int) or isinstance(n, bool) or n < 1:
-                raise SpineInputError(f"config key {key}.n_seeds: must be an integer >= 1, "
-                                      f"got {n!r}")
+                raise SpineInputError(f"config key {key}.n_seeds: must be an integer >= 1, got {n!r}")
             seeds = [int(s) for s in np.random.SeedSequence([seed, i]).generate_state(n) >> 1]
         else:
             seeds = [None]
@@ -510,29 +541,44 @@ def parse_config(doc: Mapping, *, base_dir: str | os.PathLike = ".") -> SweepCon
         frozen = tuple(sorted((k, _freeze(v)) for k, v in overrides.items()))
         stem = source if kind == "preset" else Path(source).stem
         for s in seeds:
-            surfaces_.append(SurfaceSpec(kind=kind, source=source, seed=s, overrides=frozen,
-                                         label=stem if s is None else f"{stem}#{s}"))
+            surfaces_.append(
+                SurfaceSpec(
+                    kind=kind,
+                    source=source,
+                    seed=s,
+                    overrides=frozen,
+                    label=stem if s is None else f"{stem}#{s}",
+                )
+            )
             per_surface.append(starts_i)
 
     if "starts" not in doc and any(s is None for s in per_surface):
-        raise SpineInputError("config key starts: required (a [starts] table, or starts in "
-                              "every [[surfaces]] entry)")
-    starts = _parse_starts(doc["starts"], "starts") if "starts" in doc else StartsSpec(
-        frame="relative", points=((0.0, 0.0),))
+        raise SpineInputError(
+            "config key starts: required (a [starts] table, or starts in every [[surfaces]] entry)"
+        )
+    starts = (
+        _parse_starts(doc["starts"], "starts")
+        if "starts" in doc
+        else StartsSpec(frame="relative", points=((0.0, 0.0),))
+    )
 
     specs = _param_specs(order)
     grid_doc = _table(doc, "grid")
     drive_doc = _table(doc, "drive")
     for key in grid_doc:
         if key not in specs:
-            raise SpineInputError(f"config key grid.{key}: unknown parameter for analyses "
-                                  f"{list(order)}; allowed: {', '.join(sorted(specs))}")
+            raise SpineInputError(
+                f"config key grid.{key}: unknown parameter for analyses "
+                f"{list(order)}; allowed: {', '.join(sorted(specs))}"
+            )
     drive_keys = sorted(k for k, s in specs.items() if s.drive)
     for key in drive_doc:
         if key not in specs or not specs[key].drive:
-            raise SpineInputError(f"config key drive.{key}: unknown drive parameter for "
-                                  f"analyses {list(order)}; allowed: "
-                                  f"{', '.join(drive_keys) or 'none'}")
+            raise SpineInputError(
+                f"config key drive.{key}: unknown drive parameter for "
+                f"analyses {list(order)}; allowed: "
+                f"{', '.join(drive_keys) or 'none'}"
+            )
         if key in grid_doc:
             raise SpineInputError(f"config key drive.{key}: also given as grid.{key}; give it once")
     values = {**grid_doc, **drive_doc}
@@ -545,14 +591,23 @@ def parse_config(doc: Mapping, *, base_dir: str | os.PathLike = ".") -> SweepCon
             if len(set(vals)) != len(vals):
                 raise SpineInputError(f"config key {key}: repeated value in {list(vals)!r}")
         elif spec.default is REQUIRED:
-            raise SpineInputError(f"config key grid.{pname}: required by analyses "
-                                  f"{list(order)} ({spec.doc}); must be {spec.expected()}")
+            raise SpineInputError(
+                f"config key grid.{pname}: required by analyses "
+                f"{list(order)} ({spec.doc}); must be {spec.expected()}"
+            )
         else:
             vals = (spec.default,)
         grid.append((pname, vals))
-    config = SweepConfig(name=name, seed=seed, analyses=order, surfaces=tuple(surfaces_),
-                         starts=starts, grid=tuple(grid), store_trajectories=store,
-                         surface_starts=tuple(per_surface))
+    config = SweepConfig(
+        name=name,
+        seed=seed,
+        analyses=order,
+        surfaces=tuple(surfaces_),
+        starts=starts,
+        grid=tuple(grid),
+        store_trajectories=store,
+        surface_starts=tuple(per_surface),
+    )
     for check in _CONFIG_CHECKS:
         check(config)
     return config
@@ -568,38 +623,46 @@ def _parse_starts(doc, key: str) -> StartsSpec:
     _allowed_keys(doc, key, ("frame", "points", "x", "y", "random"))
     frame = doc.get("frame", "relative")
     if frame not in ("relative", "absolute"):
-        raise SpineInputError(f"config key {key}.frame: allowed values are 'relative', "
-                              f"'absolute', got {frame!r}")
+        raise SpineInputError(
+            f"config key {key}.frame: allowed values are 'relative', 'absolute', got {frame!r}"
+        )
     modes = [m for m in ("points", "x", "random") if m in doc]
     if "y" in doc and "x" not in doc:
         modes.append("y")
     if len(modes) != 1:
-        raise SpineInputError(f"config key {key}: give exactly one of points, x and y, or "
-                              f"random, got {sorted(doc)}")
+        raise SpineInputError(
+            f"config key {key}: give exactly one of points, x and y, or random, got {sorted(doc)}"
+        )
     lo_hi = "in [0, 1]" if frame == "relative" else "finite"
 
     def coord(v, k):
-        if (isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v)
-                or (frame == "relative" and not 0 <= v <= 1)):
-            raise SpineInputError(f"config key {k}: coordinates must be numbers {lo_hi}, "
-                                  f"got {v!r}")
+        if (
+            isinstance(v, bool)
+            or not isinstance(v, (int, float))
+            or not math.isfinite(v)
+            or (frame == "relative" and not 0 <= v <= 1)
+        ):
+            raise SpineInputError(f"config key {k}: coordinates must be numbers {lo_hi}, got {v!r}")
         return float(v)
 
     if "points" in doc:
         pts = doc["points"]
-        if (not isinstance(pts, list) or not pts
-                or not all(isinstance(p, list) and len(p) == 2 for p in pts)):
-            raise SpineInputError(f"config key {key}.points: must be a non-empty list of "
-                                  f"[x, y] pairs, got {pts!r}")
-        return StartsSpec(frame=frame, points=tuple(
-            (coord(p[0], f"{key}.points"), coord(p[1], f"{key}.points")) for p in pts))
+        if not isinstance(pts, list) or not pts or not all(isinstance(p, list) and len(p) == 2 for p in pts):
+            raise SpineInputError(
+                f"config key {key}.points: must be a non-empty list of [x, y] pairs, got {pts!r}"
+            )
+        return StartsSpec(
+            frame=frame,
+            points=tuple((coord(p[0], f"{key}.points"), coord(p[1], f"{key}.points")) for p in pts),
+        )
     if "random" in doc:
         n = doc["random"]
         if not isinstance(n, int) or isinstance(n, bool) or n < 1:
             raise SpineInputError(f"config key {key}.random: must be an integer >= 1, got {n!r}")
         if frame != "relative":
-            raise SpineInputError(f"config key {key}.frame: random starts need frame = "
-                                  f"'relative', got {frame!r}")
+            raise SpineInputError(
+                f"config key {key}.frame: random starts need frame = 'relative', got {frame!r}"
+            )
         return StartsSpec(frame=frame, random=n)
     if "y" not in doc:
         raise SpineInputError(f"config key {key}.y: required with {key}.x")
@@ -618,20 +681,29 @@ def _expand_values(value, key: str) -> list:
         kinds = [k for k in ("linspace", "logspace") if k in value]
         extra = sorted(set(value) - {"linspace", "logspace", "num"})
         if len(kinds) != 1 or extra or "num" not in value:
-            raise SpineInputError(f"config key {key}: a table must be {{linspace = [a, b], "
-                                  f"num = n}} or {{logspace = [a, b], num = n}}, got {value!r}")
+            raise SpineInputError(
+                f"config key {key}: a table must be {{linspace = [a, b], "
+                f"num = n}} or {{logspace = [a, b], num = n}}, got {value!r}"
+            )
         ends, num = value[kinds[0]], value["num"]
-        if (not isinstance(ends, list) or len(ends) != 2
-                or not all(isinstance(e, (int, float)) and not isinstance(e, bool)
-                           and math.isfinite(e) for e in ends)):
-            raise SpineInputError(f"config key {key}.{kinds[0]}: must be [a, b] (finite end "
-                                  f"values), got {ends!r}")
+        if (
+            not isinstance(ends, list)
+            or len(ends) != 2
+            or not all(
+                isinstance(e, (int, float)) and not isinstance(e, bool) and math.isfinite(e) for e in ends
+            )
+        ):
+            raise SpineInputError(
+                f"config key {key}.{kinds[0]}: must be [a, b] (finite end values), got {ends!r}"
+            )
         if not isinstance(num, int) or isinstance(num, bool) or num < 1:
             raise SpineInputError(f"config key {key}.num: must be an integer >= 1, got {num!r}")
         if kinds[0] == "logspace":
             if min(ends) <= 0:
-                raise SpineInputError(f"config key {key}.logspace: end values must be > 0 "
-                                      f"(they are values, not exponents), got {ends!r}")
+                raise SpineInputError(
+                    f"config key {key}.logspace: end values must be > 0 "
+                    f"(they are values, not exponents), got {ends!r}"
+                )
             return [float(v) for v in np.geomspace(ends[0], ends[1], num)]
         return [float(v) for v in np.linspace(ends[0], ends[1], num)]
     return [value]
@@ -641,8 +713,10 @@ def _allowed_keys(doc: Mapping, where: str, allowed: tuple[str, ...]) -> None:
     for key in doc:
         if key not in allowed:
             name = f"{where}.{key}" if where else key
-            raise SpineInputError(f"config key {name}: unknown; allowed keys"
-                                  f"{' in ' + where if where else ''}: {', '.join(allowed)}")
+            raise SpineInputError(
+                f"config key {name}: unknown; allowed keys"
+                f"{' in ' + where if where else ''}: {', '.join(allowed)}"
+            )
 
 
 def _table(doc: Mapping, key: str) -> dict:
@@ -729,22 +803,41 @@ def expand_cases(config: SweepConfig) -> list[Case]:
     combos = list(itertools.product(*(v for _, v in config.grid)))
     cases, seen = [], set()
     for si, surf in enumerate(config.surfaces):
-        starts = config.surface_starts[si] if (
-            si < len(config.surface_starts) and config.surface_starts[si] is not None
-        ) else config.starts
+        starts = (
+            config.surface_starts[si]
+            if (si < len(config.surface_starts) and config.surface_starts[si] is not None)
+            else config.starts
+        )
         for combo in combos:
             params = dict(zip(names, combo))
-            case_id = _digest({"surface": surf.as_dict(), "starts": starts.as_dict(),
-                               "params": {k: _jsonable(v) for k, v in params.items()}})[:16]
+            case_id = _digest(
+                {
+                    "surface": surf.as_dict(),
+                    "starts": starts.as_dict(),
+                    "params": {k: _jsonable(v) for k, v in params.items()},
+                }
+            )[:16]
             if case_id in seen:
-                raise SpineInputError(f"config produces the same case twice (surface "
-                                      f"{surf.label}, parameters {params})")
+                raise SpineInputError(
+                    f"config produces the same case twice (surface {surf.label}, parameters {params})"
+                )
             seen.add(case_id)
-            case_seed = int(np.random.SeedSequence([config.seed, int(case_id, 16)])
-                            .generate_state(1, np.uint64)[0] >> np.uint64(1))
-            cases.append(Case(case_id=case_id, index=len(cases), surface=surf, starts=starts,
-                              params=params, seed=case_seed, analyses=config.analyses,
-                              store_trajectories=config.store_trajectories))
+            case_seed = int(
+                np.random.SeedSequence([config.seed, int(case_id, 16)]).generate_state(1, np.uint64)[0]
+                >> np.uint64(1)
+            )
+            cases.append(
+                Case(
+                    case_id=case_id,
+                    index=len(cases),
+                    surface=surf,
+                    starts=starts,
+                    params=params,
+                    seed=case_seed,
+                    analyses=config.analyses,
+                    store_trajectories=config.store_trajectories,
+                )
+            )
     return cases
 
 
@@ -765,8 +858,7 @@ def _make_surface(spec: SurfaceSpec):
 
 def _thaw(value):
     if isinstance(value, tuple):
-        if value and all(isinstance(v, tuple) and len(v) == 2 and isinstance(v[0], str)
-                         for v in value):
+        if value and all(isinstance(v, tuple) and len(v) == 2 and isinstance(v[0], str) for v in value):
             return {k: _thaw(v) for k, v in value}
         return [_thaw(v) for v in value]
     return value
@@ -808,8 +900,7 @@ def run_case(case: Case) -> tuple[Any, Any]:
             status[:], reason[:] = "bad_surface", surface_error
         elif any(r not in results for r in analysis.requires):
             status[:] = "dependency_failed"
-            reason[:] = "no result from " + ", ".join(r for r in analysis.requires
-                                                       if r not in results)
+            reason[:] = "no result from " + ", ".join(r for r in analysis.requires if r not in results)
         else:
             try:
                 res = analysis.func(case, surface, starts, {r: results[r] for r in analysis.requires})
@@ -831,7 +922,8 @@ def run_case(case: Case) -> tuple[Any, Any]:
             "case_index": np.full(n, case.index, np.int64),
             "analysis": [name] * n,
             "start": np.arange(n, dtype=np.int64),
-            "start_x": starts[:, 0], "start_y": starts[:, 1],
+            "start_x": starts[:, 0],
+            "start_y": starts[:, 1],
             "surface": [case.surface.label] * n,
             "surface_seed": pa.array([case.surface.seed] * n, pa.int64()),
             "seed": np.full(n, case.seed, np.int64),
@@ -876,8 +968,7 @@ def _check_metrics(metrics: Mapping, n: int, analysis: str) -> dict[str, np.ndar
         if arr.ndim == 0:
             arr = np.full(n, arr[()])
         if arr.shape != (n,):
-            raise RuntimeError(f"analysis {analysis}: metric {k!r} must have shape ({n},), "
-                               f"got {arr.shape}")
+            raise RuntimeError(f"analysis {analysis}: metric {k!r} must have shape ({n},), got {arr.shape}")
         out[k] = arr
     return out
 
@@ -961,11 +1052,23 @@ def _versions() -> dict:
 def _git_commit() -> dict:
     repo = Path(__file__).resolve().parent.parent
     try:
-        commit = subprocess.run(["git", "-C", str(repo), "rev-parse", "HEAD"], capture_output=True,
-                                text=True, timeout=10, check=True).stdout.strip()
-        dirty = subprocess.run(["git", "-C", str(repo), "status", "--porcelain",
-                                "--untracked-files=no"], capture_output=True, text=True,
-                               timeout=10, check=True).stdout.strip() != ""
+        commit = subprocess.run(
+            ["git", "-C", str(repo), "rev-parse", "HEAD"],
+            capture_output=True,
+            text=True,
+            timeout=10,
+            check=True,
+        ).stdout.strip()
+        dirty = (
+            subprocess.run(
+                ["git", "-C", str(repo), "status", "--porcelain", "--untracked-files=no"],
+                capture_output=True,
+                text=True,
+                timeout=10,
+                check=True,
+            ).stdout.strip()
+            != ""
+        )
     except (OSError, subprocess.SubprocessError):
         return {"commit": None, "dirty": None}
     return {"commit": commit, "dirty": dirty}
@@ -986,21 +1089,25 @@ def _read_manifest(out_dir: Path) -> dict | None:
         raise SpineInputError(f"{path} is not a sweep manifest: {exc}") from None
 
 
-def _prepare_store(config: SweepConfig, cases: list[Case], out_dir: Path, *, overwrite: bool,
-                   session: dict) -> dict:
+def _prepare_store(
+    config: SweepConfig, cases: list[Case], out_dir: Path, *, overwrite: bool, session: dict
+) -> dict:
     manifest = _read_manifest(out_dir)
     if manifest is not None and manifest.get("config_hash") != config.hash:
         if not overwrite:
             raise SpineInputError(
                 f"--out {out_dir} holds a sweep of another config ({manifest.get('name')!r}, "
                 f"hash {str(manifest.get('config_hash'))[:12]}); this config has hash "
-                f"{config.hash[:12]}: use another folder or --overwrite to replace it")
+                f"{config.hash[:12]}: use another folder or --overwrite to replace it"
+            )
         _clear_store(out_dir)
         manifest = None
     elif manifest is None and any(p.name != LOCK for p in out_dir.iterdir()):
         if not overwrite:
-            raise SpineInputError(f"--out {out_dir} exists, is not empty and holds no sweep "
-                                  f"manifest: use another folder or --overwrite")
+            raise SpineInputError(
+                f"--out {out_dir} exists, is not empty and holds no sweep "
+                f"manifest: use another folder or --overwrite"
+            )
         _clear_store(out_dir)
     if manifest is None:
         manifest = {
@@ -1076,8 +1183,7 @@ def _encode_case(case_id: str, rows, traj) -> tuple:
         pq.write_table(table, sink, **kwargs)
         return sink.getvalue().to_pybytes()
 
-    traj_bytes = (None if traj is None
-                  else encode(traj, row_group_size=65_536, use_dictionary=["analysis"]))
+    traj_bytes = None if traj is None else encode(traj, row_group_size=65_536, use_dictionary=["analysis"])
     return case_id, rows["status"].to_pylist(), encode(rows), traj_bytes
 
 
@@ -1103,18 +1209,23 @@ def consolidate(out_dir: str | os.PathLike):
         table = pa.concat_tables(tables, promote_options="permissive")
         rank = {name: i for i, name in enumerate(ANALYSES)}
         analysis_rank = np.array([rank.get(a, len(rank)) for a in table["analysis"].to_pylist()])
-        order = np.lexsort((np.asarray(table["start"]), analysis_rank,
-                            np.asarray(table["case_index"])))
+        order = np.lexsort((np.asarray(table["start"]), analysis_rank, np.asarray(table["case_index"])))
         table = table.take(pa.array(order))
     with atomic_output(out_dir / RUNS_TABLE) as tmp:
         pq.write_table(table, tmp)
     return table
 
 
-def run_sweep(config: SweepConfig | str | os.PathLike, out_dir: str | os.PathLike, *,
-              workers: int | None = None, scheduler=None, overwrite: bool = False,
-              retry_failed: bool = False,
-              progress: Callable[[Progress], None] | None = None) -> SweepSummary:
+def run_sweep(
+    config: SweepConfig | str | os.PathLike,
+    out_dir: str | os.PathLike,
+    *,
+    workers: int | None = None,
+    scheduler=None,
+    overwrite: bool = False,
+    retry_failed: bool = False,
+    progress: Callable[[Progress], None] | None = None,
+) -> SweepSummary:
     """Run (or resume) a sweep into ``out_dir``.
 
     Parameters
@@ -1146,24 +1257,33 @@ def run_sweep(config: SweepConfig | str | os.PathLike, out_dir: str | os.PathLik
     """
     if not isinstance(config, SweepConfig):
         config = load_config(config)
-    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
-                                or workers < 1):
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise SpineInputError(f"workers must be an integer >= 1, got {workers!r}")
     out_dir = Path(out_dir)
     if out_dir.exists() and not out_dir.is_dir():
         raise SpineInputError(f"--out {out_dir} exists and is not a folder")
     cases = expand_cases(config)
     n_workers = None if scheduler is not None else (workers or os.cpu_count() or 1)
-    session = {"started": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
-               "workers": n_workers,
-               "scheduler": None if scheduler is None else str(getattr(scheduler, "scheduler",
-                                                                       scheduler)),
-               "versions": _versions(), "git": _git_commit()}
+    session = {
+        "started": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+        "workers": n_workers,
+        "scheduler": None if scheduler is None else str(getattr(scheduler, "scheduler", scheduler)),
+        "versions": _versions(),
+        "git": _git_commit(),
+    }
     out_dir.mkdir(parents=True, exist_ok=True)
     with _store_lock(out_dir):
-        return _run_locked(config, cases, out_dir, session, n_workers=n_workers,
-                           scheduler=scheduler, overwrite=overwrite, retry_failed=retry_failed,
-                           progress=progress)
+        return _run_locked(
+            config,
+            cases,
+            out_dir,
+            session,
+            n_workers=n_workers,
+            scheduler=scheduler,
+            overwrite=overwrite,
+            retry_failed=retry_failed,
+            progress=progress,
+        )
 
 
 @contextlib.contextmanager
@@ -1182,8 +1302,9 @@ def _store_lock(out_dir: Path):
             fcntl.flock(fh, fcntl.LOCK_UN)
 
 
-def _run_locked(config, cases, out_dir, session, *, n_workers, scheduler, overwrite,
-                retry_failed, progress) -> SweepSummary:
+def _run_locked(
+    config, cases, out_dir, session, *, n_workers, scheduler, overwrite, retry_failed, progress
+) -> SweepSummary:
     _prepare_store(config, cases, out_dir, overwrite=overwrite, session=session)
     _remove_temporaries(out_dir)
     done = _finished(out_dir)
@@ -1203,10 +1324,17 @@ def _run_locked(config, cases, out_dir, session, *, n_workers, scheduler, overwr
 
     def report(case_id):
         if progress is not None:
-            progress(Progress(total_cases=len(cases), finished_cases=counts["finished"],
-                              skipped_cases=skipped, ok_runs=counts["ok"],
-                              failed_runs=counts["failed"],
-                              elapsed_s=time.perf_counter() - t0, case_id=case_id))
+            progress(
+                Progress(
+                    total_cases=len(cases),
+                    finished_cases=counts["finished"],
+                    skipped_cases=skipped,
+                    ok_runs=counts["ok"],
+                    failed_runs=counts["failed"],
+                    elapsed_s=time.perf_counter() - t0,
+                    case_id=case_id,
+                )
+            )
 
     def handle(encoded):
         _store_encoded(out_dir, encoded)
@@ -1230,12 +1358,19 @@ def _run_locked(config, cases, out_dir, session, *, n_workers, scheduler, overwr
     if table.num_rows:
         vals, cnt = np.unique(np.asarray(table["status"].to_pylist(), dtype=str), return_counts=True)
         status_counts = {str(v): int(c) for v, c in zip(vals, cnt)}
-    return SweepSummary(out_dir=out_dir, total_cases=len(cases), run_cases=counts["finished"],
-                        skipped_cases=skipped,
-                        total_runs=sum(c.starts.count for c in cases) * len(config.analyses),
-                        ok_runs=counts["ok"], failed_runs=counts["failed"],
-                        skipped_runs=skipped_runs, elapsed_s=time.perf_counter() - t0,
-                        workers=n_workers, status_counts=status_counts)
+    return SweepSummary(
+        out_dir=out_dir,
+        total_cases=len(cases),
+        run_cases=counts["finished"],
+        skipped_cases=skipped,
+        total_runs=sum(c.starts.count for c in cases) * len(config.analyses),
+        ok_runs=counts["ok"],
+        failed_runs=counts["failed"],
+        skipped_runs=skipped_runs,
+        elapsed_s=time.perf_counter() - t0,
+        workers=n_workers,
+        status_counts=status_counts,
+    )
 
 
 def _run_case_remote(case: Case):
@@ -1313,8 +1448,9 @@ def _run_pool(todo: list[Case], n_workers: int, handle) -> None:
         ctx = multiprocessing.get_context("forkserver")
         ctx.set_forkserver_preload(list(_WORKER_MODULES))
     started = ctx.SimpleQueue()
-    with cf.ProcessPoolExecutor(max_workers=n_workers, mp_context=ctx,
-                                initializer=_worker_started, initargs=(started,)) as pool:
+    with cf.ProcessPoolExecutor(
+        max_workers=n_workers, mp_context=ctx, initializer=_worker_started, initargs=(started,)
+    ) as pool:
         futures = [pool.submit(_run_case_remote, c) for c in todo]
         try:
             # until the first worker is up (a fresh forkserver imports mujoco, numba,
@@ -1334,8 +1470,15 @@ def _run_pool(todo: list[Case], n_workers: int, handle) -> None:
 
 #: What a worker imports before its first case (pandas: pyarrow imports it when it builds a
 #: table; mujoco: spine_mj.sim imports it lazily).
-_WORKER_MODULES = ("spine_mj.sweep", "spine_mj.streamline", "spine_mj.sim", "pyarrow.parquet",
-                   "pandas", "mujoco", "mujoco.rollout")
+_WORKER_MODULES = (
+    "spine_mj.sweep",
+    "spine_mj.streamline",
+    "spine_mj.sim",
+    "pyarrow.parquet",
+    "pandas",
+    "mujoco",
+    "mujoco.rollout",
+)
 
 
 def _preload_worker_modules() -> None:
@@ -1355,8 +1498,12 @@ def _run_dask(todo: list[Case], scheduler, handle) -> None:
     own = not isinstance(scheduler, Client)
     client = Client(scheduler) if own else scheduler
     try:
-        futures = client.map(_run_case_remote, todo, pure=False, key=[
-            f"spine-mj-case-{c.case_id}-{os.getpid()}-{time.monotonic_ns()}" for c in todo])
+        futures = client.map(
+            _run_case_remote,
+            todo,
+            pure=False,
+            key=[f"spine-mj-case-{c.case_id}-{os.getpid()}-{time.monotonic_ns()}" for c in todo],
+        )
         for fut in as_completed(futures):
             result = fut.result()
             fut.release()
@@ -1414,12 +1561,17 @@ def store_status(out_dir: str | os.PathLike) -> StoreStatus:
     for f in files:
         for s in pq.read_table(f, columns=["status"])["status"].to_pylist():
             counts[s] = counts.get(s, 0) + 1
-    return StoreStatus(name=manifest["name"], config_hash=manifest["config_hash"],
-                       total_cases=manifest["n_cases"], finished_cases=len(files),
-                       total_runs=manifest["n_runs"], status_counts=counts,
-                       sessions=len(manifest.get("sessions", [])),
-                       created=manifest.get("created", ""),
-                       git_commit=manifest.get("git", {}).get("commit"))
+    return StoreStatus(
+        name=manifest["name"],
+        config_hash=manifest["config_hash"],
+        total_cases=manifest["n_cases"],
+        finished_cases=len(files),
+        total_runs=manifest["n_runs"],
+        status_counts=counts,
+        sessions=len(manifest.get("sessions", [])),
+        created=manifest.get("created", ""),
+        git_commit=manifest.get("git", {}).get("commit"),
+    )
 
 
 def load_runs(out_dir: str | os.PathLike, *, columns: list[str] | None = None):
@@ -1431,16 +1583,24 @@ def load_runs(out_dir: str | os.PathLike, *, columns: list[str] | None = None):
         raise SpineInputError(f"{out_dir} holds no sweep ({MANIFEST} not found)")
     path = out_dir / RUNS_TABLE
     n_files = len(_case_files(out_dir))
-    stale = not path.is_file() or len(set(
-        pq.read_table(path, columns=["case_id"])["case_id"].to_pylist())) != n_files
+    stale = (
+        not path.is_file()
+        or len(set(pq.read_table(path, columns=["case_id"])["case_id"].to_pylist())) != n_files
+    )
     table = consolidate(out_dir) if stale else pq.read_table(path)
     if columns is not None:
         table = table.select(columns)
     return table.to_pandas()
 
 
-def load_trajectories(out_dir: str | os.PathLike, case_id: str, *, analysis: str | None = None,
-                      start: int | None = None, columns: list[str] | None = None):
+def load_trajectories(
+    out_dir: str | os.PathLike,
+    case_id: str,
+    *,
+    analysis: str | None = None,
+    start: int | None = None,
+    columns: list[str] | None = None,
+):
     """Paths of one case as a pandas DataFrame, reading only the rows and columns asked for.
 
     Parameters

@@ -184,46 +184,81 @@ _IMPRATIO = ("no noslip, impratio 10", (("noslip_iterations", 0), ("impratio", 1
 
 PLANS: dict[str, ValidationPlan] = {
     "smoke": ValidationPlan(
-        name="smoke", slopes_deg=(20.0, 70.0), azimuths_deg=(0.0,),
+        name="smoke",
+        slopes_deg=(20.0, 70.0),
+        azimuths_deg=(0.0,),
         static_engines=(_RECOMMENDED,),
-        families=(FamilySpec("single_peak_valley", ("paper-single-peak",), None,
-                             _paper_starts([-2.0, -4.0])),),
-        lowest_ie=1e-2, hfield_resolution=101, limit_variations=(),
-        ie_values=(1e-2, 1.0), boundary_families=("single_peak_valley",), protocols=("spring",),
-        stick_slip_ie=(1e-1,), stick_slip_stiffness=(10.0,), stick_slip_starts=1,
-        sandpaper_grits=(), bootstrap=20, ramp_max_steps=2000),
+        families=(
+            FamilySpec("single_peak_valley", ("paper-single-peak",), None, _paper_starts([-2.0, -4.0])),
+        ),
+        lowest_ie=1e-2,
+        hfield_resolution=101,
+        limit_variations=(),
+        ie_values=(1e-2, 1.0),
+        boundary_families=("single_peak_valley",),
+        protocols=("spring",),
+        stick_slip_ie=(1e-1,),
+        stick_slip_stiffness=(10.0,),
+        stick_slip_starts=1,
+        sandpaper_grits=(),
+        bootstrap=20,
+        ramp_max_steps=2000,
+    ),
     "quick": ValidationPlan(
-        name="quick", slopes_deg=(0.0, 15.0, 30.0, 45.0, 60.0, 75.0),
+        name="quick",
+        slopes_deg=(0.0, 15.0, 30.0, 45.0, 60.0, 75.0),
         azimuths_deg=(0.0, 60.0, 120.0, 180.0),
         static_engines=(_RECOMMENDED, _NO_NOSLIP),
         families=(
-            FamilySpec("single_peak_valley", ("paper-single-peak", "paper-single-valley"), None,
-                       _paper_starts([-0.5, -1.0, -2.0, -3.0, -4.0])),
-            FamilySpec("random_gaussian", ("paper-random-convex", "paper-random-concave"), (1,),
-                       _relative_starts(3)),
+            FamilySpec(
+                "single_peak_valley",
+                ("paper-single-peak", "paper-single-valley"),
+                None,
+                _paper_starts([-0.5, -1.0, -2.0, -3.0, -4.0]),
+            ),
+            FamilySpec(
+                "random_gaussian", ("paper-random-convex", "paper-random-concave"), (1,), _relative_starts(3)
+            ),
             FamilySpec("fractal", ("paper-fractal",), (1,), _relative_starts(3)),
         ),
-        lowest_ie=1e-4, hfield_resolution=151,
+        lowest_ie=1e-4,
+        hfield_resolution=151,
         limit_variations=(_NO_NOSLIP, _IMPRATIO),
         ie_values=(1e-4, 1e-3, 1e-2, 1e-1, 1.0, 10.0),
         boundary_families=("single_peak_valley",),
-        stick_slip_ie=(1e-2, 1.0), stick_slip_stiffness=(2.0, 50.0), stick_slip_starts=2,
-        sandpaper_grits=("P36", "P600"), sandpaper_starts=2, bootstrap=200,
-        ramp_max_steps=20000),
+        stick_slip_ie=(1e-2, 1.0),
+        stick_slip_stiffness=(2.0, 50.0),
+        stick_slip_starts=2,
+        sandpaper_grits=("P36", "P600"),
+        sandpaper_starts=2,
+        bootstrap=200,
+        ramp_max_steps=20000,
+    ),
     "full": ValidationPlan(
-        name="full", slopes_deg=tuple(np.arange(0.0, 76.0, 7.5)),
+        name="full",
+        slopes_deg=tuple(np.arange(0.0, 76.0, 7.5)),
         azimuths_deg=(0.0, 30.0, 60.0, 90.0, 120.0, 150.0, 180.0),
         static_engines=(_RECOMMENDED, _NO_NOSLIP, _IMPRATIO),
         families=(
-            FamilySpec("single_peak_valley", ("paper-single-peak", "paper-single-valley"), None,
-                       _paper_starts([-0.5, -1.0, -2.0, -3.0, -4.0])),
-            FamilySpec("random_gaussian", ("paper-random-convex", "paper-random-concave"),
-                       (1, 2), _relative_starts(5)),
+            FamilySpec(
+                "single_peak_valley",
+                ("paper-single-peak", "paper-single-valley"),
+                None,
+                _paper_starts([-0.5, -1.0, -2.0, -3.0, -4.0]),
+            ),
+            FamilySpec(
+                "random_gaussian",
+                ("paper-random-convex", "paper-random-concave"),
+                (1, 2),
+                _relative_starts(5),
+            ),
             FamilySpec("fractal", ("paper-fractal",), (1,), _relative_starts(5)),
         ),
-        lowest_ie=1e-4, hfield_resolution=201,
+        lowest_ie=1e-4,
+        hfield_resolution=201,
         limit_variations=(
-            _NO_NOSLIP, _IMPRATIO,
+            _NO_NOSLIP,
+            _IMPRATIO,
             ("no noslip, impratio 100", (("noslip_iterations", 0), ("impratio", 100.0))),
             ("hfield 101", (("hfield_resolution", 101),)),
             ("hfield 401", (("hfield_resolution", 401),)),
@@ -234,8 +269,13 @@ PLANS: dict[str, ValidationPlan] = {
         # the random Gaussian boundary (20 runs x 11 I_e x 2 drives) would double the run
         # time past ~45 min on 2 cores: the full plan keeps the single peak/valley there
         boundary_families=("single_peak_valley",),
-        stick_slip_ie=(1e-3, 1e-2, 1e-1, 1.0), stick_slip_stiffness=(2.0, 10.0, 50.0),
-        stick_slip_starts=3, sandpaper_starts=4, bootstrap=500, ramp_max_steps=200_000),
+        stick_slip_ie=(1e-3, 1e-2, 1e-1, 1.0),
+        stick_slip_stiffness=(2.0, 10.0, 50.0),
+        stick_slip_starts=3,
+        sandpaper_starts=4,
+        bootstrap=500,
+        ramp_max_steps=200_000,
+    ),
 }
 
 
@@ -284,9 +324,15 @@ class _Runner:
 
         def cb(p):
             if self.progress is not None:
-                self.progress(ValidationProgress(
-                    self.study, name, p.finished_cases + p.skipped_cases, p.total_cases,
-                    time.perf_counter() - self.t0))
+                self.progress(
+                    ValidationProgress(
+                        self.study,
+                        name,
+                        p.finished_cases + p.skipped_cases,
+                        p.total_cases,
+                        time.perf_counter() - self.t0,
+                    )
+                )
 
         n_cases = len(sweep.expand_cases(config))
         w = workers if workers is not None else self.workers
@@ -361,12 +407,10 @@ def static_map(plan: ValidationPlan, runner: _Runner, *, mu: float = 0.5) -> dic
             t = math.tan(math.radians(slope))
             fx, fy = t * math.cos(math.radians(az)), t * math.sin(math.radians(az))
             k, low, region = _hold_force(fx, fy, mu)
-            hold = 0.5 * (low + k) if (low > 0 and np.isfinite(k)) else (
-                1.5 * low if low > 0 else 0.0)
+            hold = 0.5 * (low + k) if (low > 0 and np.isfinite(k)) else (1.5 * low if low > 0 else 0.0)
             path = surf_dir / f"plane_s{slope:g}_a{az:g}.npz"
             if not path.is_file():
-                surface_io.save_surface(sim.inclined_plane(slope_deg=slope, azimuth_deg=az),
-                                        path)
+                surface_io.save_surface(sim.inclined_plane(slope_deg=slope, azimuth_deg=az), path)
             keys = sorted({k_ for _, ov in engines for k_, _ in ov})
             for label, ov in engines:
                 # the cap must lie above the breakaway force, or a steep engaged plane
@@ -375,32 +419,46 @@ def static_map(plan: ValidationPlan, runner: _Runner, *, mu: float = 0.5) -> dic
                 grid = {"mu": mu, "kappa_cap": float(f"{cap:.4g}")}
                 grid.update({k_: _engine_default(k_) for k_ in keys})
                 grid.update(dict(ov))
-                doc = {"sweep": {"name": f"static-s{slope:g}-a{az:g}", "seed": 1,
-                                 "analyses": ["mujoco"], "store_trajectories": False},
-                       "surfaces": [{"file": str(path)}],
-                       "starts": {"frame": "absolute", "points": [list(_PLANE_START)]},
-                       "drive": {"protocol": "static", "ie": 1e-2,
-                                 "start_force": hold * MASS_KG * GRAVITY},
-                       "grid": grid}
+                doc = {
+                    "sweep": {
+                        "name": f"static-s{slope:g}-a{az:g}",
+                        "seed": 1,
+                        "analyses": ["mujoco"],
+                        "store_trajectories": False,
+                    },
+                    "surfaces": [{"file": str(path)}],
+                    "starts": {"frame": "absolute", "points": [list(_PLANE_START)]},
+                    "drive": {"protocol": "static", "ie": 1e-2, "start_force": hold * MASS_KG * GRAVITY},
+                    "grid": grid,
+                }
                 tag = "-".join(f"{k_}{v}" for k_, v in ov) or "default"
                 df, _ = runner(doc, f"static/s{slope:g}-a{az:g}-{tag}", workers=1)
                 r = df.iloc[0]
                 kmj = float(r.get("kappa_mj", np.nan))
                 end = str(r.get("end_reason", r["status"]))
-                mj_region = {"breakaway": "engaged", "self_lock": "self_lock",
-                             "slid": "slip"}.get(end, end)
-                rows.append({"engine": label, "slope_deg": float(slope), "azimuth_deg": float(az),
-                             "region": region_names[region], "kappa": k, "kappa_mj": kmj,
-                             "ratio": kmj / k if (region == 1 and k > 0) else float("nan"),
-                             "end_reason": end, "hold_over_w": hold,
-                             "region_agrees": mj_region == region_names[region]})
+                mj_region = {"breakaway": "engaged", "self_lock": "self_lock", "slid": "slip"}.get(end, end)
+                rows.append(
+                    {
+                        "engine": label,
+                        "slope_deg": float(slope),
+                        "azimuth_deg": float(az),
+                        "region": region_names[region],
+                        "kappa": k,
+                        "kappa_mj": kmj,
+                        "ratio": kmj / k if (region == 1 and k > 0) else float("nan"),
+                        "end_reason": end,
+                        "hold_over_w": hold,
+                        "region_agrees": mj_region == region_names[region],
+                    }
+                )
     per_engine = {}
     for label, _ in engines:
         sel = [r for r in rows if r["engine"] == label]
         eng = [abs(r["ratio"] - 1) for r in sel if r["region"] == "engaged"]
         eng_f = [e for e in eng if np.isfinite(e)]
         per_engine[label] = {
-            "engaged_planes": len(eng), "engaged_breakaways": len(eng_f),
+            "engaged_planes": len(eng),
+            "engaged_breakaways": len(eng_f),
             "max_rel_error": float(max(eng_f)) if eng_f else float("nan"),
             "mean_rel_error": float(np.mean(eng_f)) if eng_f else float("nan"),
             "region_agreement": float(np.mean([r["region_agrees"] for r in sel])),
@@ -409,8 +467,7 @@ def static_map(plan: ValidationPlan, runner: _Runner, *, mu: float = 0.5) -> dic
     max_err = first["max_rel_error"]
     if first["engaged_breakaways"] < first["engaged_planes"]:
         max_err = float("inf")  # an engaged plane that did not break away is no agreement
-    return {"rows": rows, "per_engine": per_engine, "mu": mu,
-            "static_kappa_max_rel_error": max_err}
+    return {"rows": rows, "per_engine": per_engine, "mu": mu, "static_kappa_max_rel_error": max_err}
 
 
 def _engine_default(key: str):
@@ -422,11 +479,23 @@ def _engine_default(key: str):
 # --------------------------------------------------------------------------- helpers
 
 
-def _family_doc(fam: FamilySpec, *, name: str, plan: ValidationPlan, preset: str,
-                drive: dict, grid: dict, analyses=("quasistatic", "mujoco", "compare")) -> dict:
-    return {"sweep": {"name": name, "seed": 11, "analyses": list(analyses)},
-            "surfaces": _surfaces_table([preset], fam.seeds),
-            "starts": fam.starts_table(), "drive": drive, "grid": grid}
+def _family_doc(
+    fam: FamilySpec,
+    *,
+    name: str,
+    plan: ValidationPlan,
+    preset: str,
+    drive: dict,
+    grid: dict,
+    analyses=("quasistatic", "mujoco", "compare"),
+) -> dict:
+    return {
+        "sweep": {"name": name, "seed": 11, "analyses": list(analyses)},
+        "surfaces": _surfaces_table([preset], fam.seeds),
+        "starts": fam.starts_table(),
+        "drive": drive,
+        "grid": grid,
+    }
 
 
 def _tip_radius(preset: str, seeds, resolution: int) -> float:
@@ -436,14 +505,18 @@ def _tip_radius(preset: str, seeds, resolution: int) -> float:
     from spine_mj.surfaces import GridSurface, to_hfield
 
     surface = presets.make_surface(preset, **({} if seeds is None else {"seed": seeds[0]}))
-    hf = to_hfield(surface) if isinstance(surface, GridSurface) else to_hfield(
-        surface, nrow=resolution, ncol=resolution)
+    hf = (
+        to_hfield(surface)
+        if isinstance(surface, GridSurface)
+        else to_hfield(surface, nrow=resolution, ncol=resolution)
+    )
     spacing = 2 * max(hf.size[0] / (hf.ncol - 1), hf.size[1] / (hf.nrow - 1))
     return float(f"{max(spacing, 0.01 * sim.characteristic_length(surface)):.3g}")
 
 
-def _engine_grid(plan: ValidationPlan, overrides: Sequence[tuple[str, Any]], preset: str,
-                 seeds, tip: float) -> dict:
+def _engine_grid(
+    plan: ValidationPlan, overrides: Sequence[tuple[str, Any]], preset: str, seeds, tip: float
+) -> dict:
     """Grid keys of an engine variation; ``*_factor`` keys scale the rig's default dt."""
     from spine_mj import presets, sim
 
@@ -452,10 +525,14 @@ def _engine_grid(plan: ValidationPlan, overrides: Sequence[tuple[str, Any]], pre
     if "timestep_factor" in ov or "solref_timeconst_factor" in ov:
         surface = presets.make_surface(preset, **({} if seeds is None else {"seed": seeds[0]}))
         unit_m = sim.DEFAULT_LENGTH_SCALE_M if surface.unit == "1" else 1.0
-        scales = sim.Scales(length_scale_m=unit_m,
-                            char_length_m=sim.characteristic_length(surface) * unit_m,
-                            mass_kg=MASS_KG, preload_n=MASS_KG * GRAVITY,
-                            tip_radius_m=tip * unit_m, hfield_spacing_m=tip * unit_m)
+        scales = sim.Scales(
+            length_scale_m=unit_m,
+            char_length_m=sim.characteristic_length(surface) * unit_m,
+            mass_kg=MASS_KG,
+            preload_n=MASS_KG * GRAVITY,
+            tip_radius_m=tip * unit_m,
+            hfield_spacing_m=tip * unit_m,
+        )
         dt = sim.default_engine(scales).timestep_s
         dt_new = dt * float(ov.pop("timestep_factor", 1.0))
         out["timestep"] = dt_new
@@ -474,19 +551,22 @@ def _streamline_paths(surface, starts, mu: float, dl: float, tip: float):
         h = min(tip / 8, max(xmax - xmin, ymax - ymin) / 400)
         x = np.linspace(xmin, xmax, int(math.ceil((xmax - xmin) / h)) + 1)
         y = np.linspace(ymin, ymax, int(math.ceil((ymax - ymin) / h)) + 1)
-        surface = GridSurface(heights=surface.height(x[None, :], y[:, None]), x=x, y=y,
-                              unit=surface.unit)
+        surface = GridSurface(heights=surface.height(x[None, :], y[:, None]), x=x, y=y, unit=surface.unit)
     if tip > 0:
         surface = sl.dilate(surface, tip)
-    return sl.streamlines(surface, np.asarray(starts, float), sl.StreamlineParams(mu=mu, dl=dl),
-                          store_paths=True)
+    return sl.streamlines(
+        surface, np.asarray(starts, float), sl.StreamlineParams(mu=mu, dl=dl), store_paths=True
+    )
 
 
 def _triangulated(surface, resolution: int | None):
     from spine_mj.surfaces import GridSurface, TriangulatedSurface, from_hfield, to_hfield
 
-    hf = to_hfield(surface) if (isinstance(surface, GridSurface) or not resolution) else (
-        to_hfield(surface, nrow=resolution, ncol=resolution))
+    hf = (
+        to_hfield(surface)
+        if (isinstance(surface, GridSurface) or not resolution)
+        else (to_hfield(surface, nrow=resolution, ncol=resolution))
+    )
     return TriangulatedSurface.from_grid(from_hfield(hf, unit=surface.unit))
 
 
@@ -496,8 +576,11 @@ def _path_metrics(mpath: np.ndarray, qpath: np.ndarray, lc: float) -> tuple[floa
     if mpath.shape[0] < 2 or qpath.shape[0] < 2:
         return float("nan"), float("nan")
     spacing = lc / 50
-    fr = compare.frechet_distance(compare.resample_by_arclength(qpath, spacing),
-                                  compare.resample_by_arclength(mpath, spacing), length_scale=lc)
+    fr = compare.frechet_distance(
+        compare.resample_by_arclength(qpath, spacing),
+        compare.resample_by_arclength(mpath, spacing),
+        length_scale=lc,
+    )
     return float(fr), float(compare.mean_lateral_deviation(mpath, qpath, length_scale=lc))
 
 
@@ -505,8 +588,9 @@ def _mujoco_paths(store: Path, case_id: str) -> dict[int, np.ndarray]:
     from spine_mj import sweep
 
     try:
-        tr = sweep.load_trajectories(store, case_id, analysis="mujoco",
-                                     columns=["x", "y", "drive_force_n", "time_s", "slipping"])
+        tr = sweep.load_trajectories(
+            store, case_id, analysis="mujoco", columns=["x", "y", "drive_force_n", "time_s", "slipping"]
+        )
     except SpineInputError:
         return {}
     return {int(s): g.sort_values("step") for s, g in tr.groupby("start")}
@@ -516,13 +600,12 @@ def _family_summary(comp) -> dict:
     ok = comp[comp["status"] == "ok"]
     n = int(len(comp))
     return {
-        "runs": n, "ok_runs": int(len(ok)),
-        "outcome_agreement": float(comp["agree"].fillna(False).astype(bool).mean()) if n else
-        float("nan"),
+        "runs": n,
+        "ok_runs": int(len(ok)),
+        "outcome_agreement": float(comp["agree"].fillna(False).astype(bool).mean()) if n else float("nan"),
         "mean_frechet": float(np.nanmean(comp["frechet"])) if n else float("nan"),
         "median_frechet": float(np.nanmedian(comp["frechet"])) if n else float("nan"),
-        "mean_lateral_deviation": float(np.nanmean(comp["lateral_deviation"])) if n else
-        float("nan"),
+        "mean_lateral_deviation": float(np.nanmean(comp["lateral_deviation"])) if n else float("nan"),
     }
 
 
@@ -557,10 +640,15 @@ def quasistatic_limit(plan: ValidationPlan, runner: _Runner) -> dict:
             mu = _preset_mu(preset)
             tip = _tip_radius(preset, fam.seeds, plan.hfield_resolution)
             dl = tip / 2
-            grid = {"mu": mu, "tip_radius": tip, "dl": dl,
-                    **_engine_grid(plan, (), preset, fam.seeds, tip)}
-            doc = _family_doc(fam, name=f"limit-{preset}", plan=plan, preset=preset,
-                              drive={"protocol": "spring", "ie": plan.lowest_ie}, grid=grid)
+            grid = {"mu": mu, "tip_radius": tip, "dl": dl, **_engine_grid(plan, (), preset, fam.seeds, tip)}
+            doc = _family_doc(
+                fam,
+                name=f"limit-{preset}",
+                plan=plan,
+                preset=preset,
+                drive={"protocol": "spring", "ie": plan.lowest_ie},
+                grid=grid,
+            )
             df, store = runner(doc, f"limit/{preset}")
             comp = df[df["analysis"] == "compare"].copy()
             mj = df[df["analysis"] == "mujoco"].set_index(["case_id", "start"])
@@ -568,13 +656,11 @@ def quasistatic_limit(plan: ValidationPlan, runner: _Runner) -> dict:
             geo, dyn, dyn_agree = [], [], []
             for case_id, grp in comp.groupby("case_id", sort=False):
                 seed = grp["surface_seed"].iloc[0]
-                surface = presets.make_surface(preset, **({} if pd.isna(seed)
-                                                          else {"seed": int(seed)}))
+                surface = presets.make_surface(preset, **({} if pd.isna(seed) else {"seed": int(seed)}))
                 starts = grp[["start_x", "start_y"]].to_numpy()
                 lc = float(mj.loc[(case_id, int(grp["start"].iloc[0])), "char_length"])
                 smooth = _streamline_paths(surface, starts, mu, dl, tip)
-                tri = _streamline_paths(_triangulated(surface, plan.hfield_resolution), starts,
-                                        mu, dl, tip)
+                tri = _streamline_paths(_triangulated(surface, plan.hfield_resolution), starts, mu, dl, tip)
                 mpaths = _mujoco_paths(store, case_id)
                 for i, s in enumerate(grp["start"].astype(int)):
                     qs_p = smooth.path(i)
@@ -587,61 +673,100 @@ def quasistatic_limit(plan: ValidationPlan, runner: _Runner) -> dict:
                     d, _ = _path_metrics(mp, ta, lc)
                     row = mj.loc[(case_id, s)]
                     ag = compare.outcome_agreement(
-                        [bool(tri.self_locked[i])], [[tri.end_x[i], tri.end_y[i]]],
-                        [bool(row["self_locked"])], [[row["end_x"], row["end_y"]]],
-                        length_scale=lc)["agree"][0]
+                        [bool(tri.self_locked[i])],
+                        [[tri.end_x[i], tri.end_y[i]]],
+                        [bool(row["self_locked"])],
+                        [[row["end_x"], row["end_y"]]],
+                        length_scale=lc,
+                    )["agree"][0]
                     geo.append(g)
                     dyn.append(d)
                     dyn_agree.append(bool(ag))
                     if fam.name == "single_peak_valley":
                         paths.setdefault(preset, []).append(
-                            {"smooth": qa, "tri": ta, "mujoco": mp, "start": tuple(starts[i])})
+                            {"smooth": qa, "tri": ta, "mujoco": mp, "start": tuple(starts[i])}
+                        )
             comp["geometry_frechet"] = geo
             comp["dynamics_frechet"] = dyn
             comp["dynamics_agree"] = dyn_agree
             comp["preset"] = preset
-            comp["end_reason"] = [mj.loc[(c, int(s)), "end_reason"]
-                                  for c, s in zip(comp["case_id"], comp["start"])]
+            comp["end_reason"] = [
+                mj.loc[(c, int(s)), "end_reason"] for c, s in zip(comp["case_id"], comp["start"])
+            ]
             comps.append(comp)
         allc = pd.concat(comps, ignore_index=True)
         summ = _family_summary(allc)
-        summ.update({
-            "mean_geometry_frechet": float(np.nanmean(allc["geometry_frechet"])),
-            "mean_dynamics_frechet": float(np.nanmean(allc["dynamics_frechet"])),
-            "outcome_agreement_vs_triangulated": float(np.mean(allc["dynamics_agree"])),
-            "meets_target": bool(summ["outcome_agreement"] >= OUTCOME_TARGET
-                                 and summ["mean_frechet"] <= FRECHET_TARGET),
-        })
+        summ.update(
+            {
+                "mean_geometry_frechet": float(np.nanmean(allc["geometry_frechet"])),
+                "mean_dynamics_frechet": float(np.nanmean(allc["dynamics_frechet"])),
+                "outcome_agreement_vs_triangulated": float(np.mean(allc["dynamics_agree"])),
+                "meets_target": bool(
+                    summ["outcome_agreement"] >= OUTCOME_TARGET and summ["mean_frechet"] <= FRECHET_TARGET
+                ),
+            }
+        )
         families[fam.name] = summ
         for _, r in allc.iterrows():
-            runs_rows.append({k: _plain(r[k]) for k in (
-                "preset", "surface", "start", "start_x", "start_y", "frechet",
-                "lateral_deviation", "end_distance", "agree", "geometry_frechet",
-                "dynamics_frechet", "dynamics_agree", "end_reason")})
+            runs_rows.append(
+                {
+                    k: _plain(r[k])
+                    for k in (
+                        "preset",
+                        "surface",
+                        "start",
+                        "start_x",
+                        "start_y",
+                        "frechet",
+                        "lateral_deviation",
+                        "end_distance",
+                        "agree",
+                        "geometry_frechet",
+                        "dynamics_frechet",
+                        "dynamics_agree",
+                        "end_reason",
+                    )
+                }
+            )
 
     variations = {}
     fam0 = plan.families[0]
     preset = fam0.presets[0]
     for label, ov in plan.limit_variations:
         mu = _preset_mu(preset)
-        tip = _tip_radius(preset, fam0.seeds, dict(ov).get("hfield_resolution",
-                                                            plan.hfield_resolution))
-        grid = {"mu": mu, "tip_radius": tip, "dl": tip / 2,
-                **_engine_grid(plan, ov, preset, fam0.seeds, tip)}
-        doc = _family_doc(fam0, name=f"limit-var-{label}", plan=plan, preset=preset,
-                          drive={"protocol": "spring", "ie": plan.lowest_ie}, grid=grid)
+        tip = _tip_radius(preset, fam0.seeds, dict(ov).get("hfield_resolution", plan.hfield_resolution))
+        grid = {"mu": mu, "tip_radius": tip, "dl": tip / 2, **_engine_grid(plan, ov, preset, fam0.seeds, tip)}
+        doc = _family_doc(
+            fam0,
+            name=f"limit-var-{label}",
+            plan=plan,
+            preset=preset,
+            drive={"protocol": "spring", "ie": plan.lowest_ie},
+            grid=grid,
+        )
         tag = "-".join(f"{k}{v}" for k, v in ov)
         df, _ = runner(doc, f"limit-var/{preset}-{tag}")
         comp = df[df["analysis"] == "compare"]
         variations[label] = {**_family_summary(comp), "settings": dict(ov), "surface": preset}
     base = [r for r in runs_rows if r["preset"] == preset]
-    variations = {"recommended (elliptic, noslip 3)": {
-        "outcome_agreement": float(np.mean([bool(r["agree"]) for r in base])),
-        "mean_frechet": float(np.nanmean([r["frechet"] for r in base])),
-        "mean_lateral_deviation": float(np.nanmean([r["lateral_deviation"] for r in base])),
-        "runs": len(base), "settings": {}, "surface": preset}, **variations}
-    return {"families": families, "runs": runs_rows, "variations": variations, "paths": paths,
-            "lowest_ie": plan.lowest_ie}
+    variations = {
+        "recommended (elliptic, noslip 3)": {
+            "outcome_agreement": float(np.mean([bool(r["agree"]) for r in base])),
+            "mean_frechet": float(np.nanmean([r["frechet"] for r in base])),
+            "mean_lateral_deviation": float(np.nanmean([r["lateral_deviation"] for r in base])),
+            "runs": len(base),
+            "settings": {},
+            "surface": preset,
+        },
+        **variations,
+    }
+    return {
+        "families": families,
+        "runs": runs_rows,
+        "variations": variations,
+        "paths": paths,
+        "lowest_ie": plan.lowest_ie,
+    }
 
 
 def _plain(v):
@@ -688,12 +813,16 @@ class IeStar:
 
 
 def _passes(agree: float, frechet: float, *, agree_min: float, frechet_max: float) -> bool:
-    return bool(agree >= agree_min and (not np.isfinite(frechet) or frechet <= frechet_max)) \
-        if np.isfinite(agree) else False
+    return (
+        bool(agree >= agree_min and (not np.isfinite(frechet) or frechet <= frechet_max))
+        if np.isfinite(agree)
+        else False
+    )
 
 
-def estimate_ie_star(ie, agreement, frechet=None, *, agree_min: float = OUTCOME_TARGET,
-                     frechet_max: float = FRECHET_TARGET) -> IeStar:
+def estimate_ie_star(
+    ie, agreement, frechet=None, *, agree_min: float = OUTCOME_TARGET, frechet_max: float = FRECHET_TARGET
+) -> IeStar:
     """The I_e at which agreement first breaks along an increasing grid.
 
     Agreement passes at a grid value when ``agreement >= agree_min`` and (if given)
@@ -723,12 +852,13 @@ def estimate_ie_star(ie, agreement, frechet=None, *, agree_min: float = OUTCOME_
     ag = np.asarray(agreement, dtype=float)
     fr = np.full_like(ie, np.nan) if frechet is None else np.asarray(frechet, dtype=float)
     if ie.ndim != 1 or ie.size < 2 or ag.shape != ie.shape or fr.shape != ie.shape:
-        raise SpineInputError(f"ie, agreement and frechet must be 1-D of the same length >= 2, "
-                              f"got {ie.shape}, {ag.shape}, {fr.shape}")
+        raise SpineInputError(
+            f"ie, agreement and frechet must be 1-D of the same length >= 2, "
+            f"got {ie.shape}, {ag.shape}, {fr.shape}"
+        )
     if not (np.all(ie > 0) and np.all(np.diff(ie) > 0)):
         raise SpineInputError(f"ie must be positive and strictly increasing, got {ie.tolist()}")
-    ok = np.array([_passes(a, f, agree_min=agree_min, frechet_max=frechet_max)
-                   for a, f in zip(ag, fr)])
+    ok = np.array([_passes(a, f, agree_min=agree_min, frechet_max=frechet_max) for a, f in zip(ag, fr)])
     if not ok[0]:
         return IeStar(float("nan"), float("nan"), float(ie[0]), "below")
     bad = np.flatnonzero(~ok)
@@ -748,10 +878,17 @@ def estimate_ie_star(ie, agreement, frechet=None, *, agree_min: float = OUTCOME_
     return IeStar(float(value), float(ie[i]), float(ie[j]), "bracketed")
 
 
-def bootstrap_ie_star(ie, agree_matrix, frechet_matrix, *, n_boot: int, rng,
-                      agree_min: float = OUTCOME_TARGET,
-                      frechet_max: float = FRECHET_TARGET,
-                      stat: str | None = "mean") -> tuple[float, float]:
+def bootstrap_ie_star(
+    ie,
+    agree_matrix,
+    frechet_matrix,
+    *,
+    n_boot: int,
+    rng,
+    agree_min: float = OUTCOME_TARGET,
+    frechet_max: float = FRECHET_TARGET,
+    stat: str | None = "mean",
+) -> tuple[float, float]:
     """16th / 84th percentiles of I_e* when the starts are resampled with replacement.
 
     ``agree_matrix`` and ``frechet_matrix`` have shape ``(n_ie, n_starts)``; ``stat``
@@ -773,12 +910,12 @@ def bootstrap_ie_star(ie, agree_matrix, frechet_matrix, *, n_boot: int, rng,
         idx = rng.integers(0, n, n)
         with np.errstate(all="ignore"), _quiet_nan_warnings():
             fr = None if reduce is None else reduce(f[:, idx], axis=1)
-            est = estimate_ie_star(ie, a[:, idx].mean(axis=1), fr,
-                                   agree_min=agree_min, frechet_max=frechet_max)
-        vals.append(est.value if est.kind == "bracketed" else (
-            est.low if est.kind == "above" else est.high))
+            est = estimate_ie_star(
+                ie, a[:, idx].mean(axis=1), fr, agree_min=agree_min, frechet_max=frechet_max
+            )
+        vals.append(est.value if est.kind == "bracketed" else (est.low if est.kind == "above" else est.high))
     lo, hi = np.percentile(np.log10(vals), [16, 84])
-    return float(10 ** lo), float(10 ** hi)
+    return float(10**lo), float(10**hi)
 
 
 @contextlib.contextmanager
@@ -793,13 +930,15 @@ def _quiet_nan_warnings():
 IE_STAR_CRITERIA = {
     "median_frechet": ("median", "outcome agreement >= 95 % and median Frechet <= 0.1 L_c"),
     "outcome": (None, "outcome agreement >= 95 %"),
-    "mean_frechet": ("mean", "outcome agreement >= 95 % and mean Frechet <= 0.1 L_c "
-                             "(the issue's wording; one outlying start moves it)"),
+    "mean_frechet": (
+        "mean",
+        "outcome agreement >= 95 % and mean Frechet <= 0.1 L_c "
+        "(the issue's wording; one outlying start moves it)",
+    ),
 }
 
 
-def ie_star_by_criterion(ie, agree_matrix, frechet_matrix, *, n_boot: int,
-                         rng=12345) -> dict:
+def ie_star_by_criterion(ie, agree_matrix, frechet_matrix, *, n_boot: int, rng=12345) -> dict:
     """I_e* under each of :data:`IE_STAR_CRITERIA`, with its bootstrap interval over starts.
 
     Parameters
@@ -818,16 +957,20 @@ def ie_star_by_criterion(ie, agree_matrix, frechet_matrix, *, n_boot: int,
     out = {}
     for label, (stat, text) in IE_STAR_CRITERIA.items():
         with _quiet_nan_warnings():
-            fr = None if stat is None else (np.nanmean(f, axis=1) if stat == "mean"
-                                            else np.nanmedian(f, axis=1))
+            fr = (
+                None
+                if stat is None
+                else (np.nanmean(f, axis=1) if stat == "mean" else np.nanmedian(f, axis=1))
+            )
         star = estimate_ie_star(ie, a.mean(axis=1), fr)
         lo, hi = bootstrap_ie_star(ie, a, f, n_boot=n_boot, rng=rng, stat=stat)
-        out[label] = {**dataclasses.replace(star, ci_low=lo, ci_high=hi).as_dict(),
-                      "criterion": text}
-    out["departure"] = {**departure_ie_star(ie, a, n_boot=n_boot, rng=rng).as_dict(),
-                        "criterion": f"outcome agreement within {100 * DEPARTURE:g} points of "
-                                     "its value at the lowest I_e (where the picture breaks "
-                                     "relative to the engine's own low-speed agreement)"}
+        out[label] = {**dataclasses.replace(star, ci_low=lo, ci_high=hi).as_dict(), "criterion": text}
+    out["departure"] = {
+        **departure_ie_star(ie, a, n_boot=n_boot, rng=rng).as_dict(),
+        "criterion": f"outcome agreement within {100 * DEPARTURE:g} points of "
+        "its value at the lowest I_e (where the picture breaks "
+        "relative to the engine's own low-speed agreement)",
+    }
     return out
 
 
@@ -859,10 +1002,9 @@ def departure_ie_star(ie, agree_matrix, *, n_boot: int, rng=12345) -> IeStar:
     vals = []
     for _ in range(n_boot):
         est = estimate(a[:, gen.integers(0, n, n)])
-        vals.append(est.value if est.kind == "bracketed" else (
-            est.low if est.kind == "above" else est.high))
+        vals.append(est.value if est.kind == "bracketed" else (est.low if est.kind == "above" else est.high))
     lo, hi = np.percentile(np.log10(vals), [16, 84])
-    return dataclasses.replace(star, ci_low=float(10 ** lo), ci_high=float(10 ** hi))
+    return dataclasses.replace(star, ci_low=float(10**lo), ci_high=float(10**hi))
 
 
 # --------------------------------------------------------------------------- ramp duration
@@ -908,8 +1050,9 @@ class RampPlan:
 
     def as_dict(self) -> dict:
         d = dataclasses.asdict(self)
-        d["required_steps"] = (self.required_s / self.timestep_s
-                               if math.isfinite(self.required_s) else float("inf"))
+        d["required_steps"] = (
+            self.required_s / self.timestep_s if math.isfinite(self.required_s) else float("inf")
+        )
         return d
 
 
@@ -920,14 +1063,18 @@ def _pilot_rig(preset: str, seed, mu: float, tip: float, resolution: int):
     surface = presets.make_surface(preset, **({} if seed is None else {"seed": int(seed)}))
     unit_m = sim.DEFAULT_LENGTH_SCALE_M if surface.unit == "1" else 1.0
     tp = sim.TipParams(tip_radius_m=tip * unit_m, mass_kg=MASS_KG, mu_s=mu)
-    probe = sim.Rig(surface, tip=tp, engine=sim.EngineSettings(
-        timestep_s=1e-3, solref=(2e-3, 1.0), hfield_resolution=resolution))
+    probe = sim.Rig(
+        surface,
+        tip=tp,
+        engine=sim.EngineSettings(timestep_s=1e-3, solref=(2e-3, 1.0), hfield_resolution=resolution),
+    )
     engine = sim.default_engine(probe.scales, hfield_resolution=resolution)
     return sim.Rig(surface, tip=probe.tip, engine=engine), unit_m
 
 
-def ramp_duration(rig, start, ie: float, *, target_lc: float, max_steps: int,
-                  slide_lc: float = 0.1, pilot_cycles: int = 6) -> RampPlan:
+def ramp_duration(
+    rig, start, ie: float, *, target_lc: float, max_steps: int, slide_lc: float = 0.1, pilot_cycles: int = 6
+) -> RampPlan:
     """Duration of a ramp-with-reset run at ``ie`` that covers ``target_lc`` along x.
 
     A pilot run from ``start`` (at most ``max_steps // 4`` steps, or ``pilot_cycles`` ramp
@@ -946,8 +1093,10 @@ def ramp_duration(rig, start, ie: float, *, target_lc: float, max_steps: int,
     rate = speed * sc.preload_n / sc.char_length_m
     settle = 200 * dt
     pilot = min(pilot_cycles * (3 * sc.preload_n / rate + settle), max(max_steps // 4, 10) * dt)
-    r = rig.run(sim.RampDrive(rate_n_s=rate, duration_s=pilot,
-                              slide_distance_m=slide_lc * sc.char_length_m), start=start)
+    r = rig.run(
+        sim.RampDrive(rate_n_s=rate, duration_s=pilot, slide_distance_m=slide_lc * sc.char_length_m),
+        start=start,
+    )
     i0 = r.drive_start_index
     onsets = [e for e in r.events if e.kind == "slip_onset"]
     resets = [e for e in r.events if e.kind == "reset"]
@@ -969,11 +1118,18 @@ def ramp_duration(rig, start, ie: float, *, target_lc: float, max_steps: int,
         per, t_cyc, required = float("nan"), float("nan"), float("inf")
     duration = float(f"{min(required, cap):.4g}")
     covered = (duration / t_cyc * per / target_lc) if (np.isfinite(per) and t_cyc > 0) else 0.0
-    return RampPlan(ie_equivalent=float(rig.scales.inertia_number(speed)), rate_n_s=rate,
-                    target_lc=float(target_lc), slip_per_cycle_lc=float(per),
-                    cycle_s=float(t_cyc), required_s=float(required), duration_s=duration,
-                    timestep_s=dt, capped=bool(required > cap), coverage_expected=float(
-                        min(covered, 1.0)))
+    return RampPlan(
+        ie_equivalent=float(rig.scales.inertia_number(speed)),
+        rate_n_s=rate,
+        target_lc=float(target_lc),
+        slip_per_cycle_lc=float(per),
+        cycle_s=float(t_cyc),
+        required_s=float(required),
+        duration_s=duration,
+        timestep_s=dt,
+        capped=bool(required > cap),
+        coverage_expected=float(min(covered, 1.0)),
+    )
 
 
 def _prefix_frechet(mpath: np.ndarray, qpath: np.ndarray, lc: float) -> float:
@@ -995,9 +1151,13 @@ def _prefix_frechet(mpath: np.ndarray, qpath: np.ndarray, lc: float) -> float:
     from spine_mj import compare
 
     spacing = max(min(lc / 50, arc_m / 20), 1e-9 * lc)
-    return float(compare.frechet_distance(compare.resample_by_arclength(q, spacing),
-                                          compare.resample_by_arclength(mpath, spacing),
-                                          length_scale=lc))
+    return float(
+        compare.frechet_distance(
+            compare.resample_by_arclength(q, spacing),
+            compare.resample_by_arclength(mpath, spacing),
+            length_scale=lc,
+        )
+    )
 
 
 def _paths_of(store: Path, case_id: str, analysis: str) -> dict[int, np.ndarray]:
@@ -1007,8 +1167,7 @@ def _paths_of(store: Path, case_id: str, analysis: str) -> dict[int, np.ndarray]
         tr = sweep.load_trajectories(store, case_id, analysis=analysis, columns=["x", "y"])
     except SpineInputError:
         return {}
-    return {int(s): g.sort_values("step")[["x", "y"]].to_numpy()
-            for s, g in tr.groupby("start")}
+    return {int(s): g.sort_values("step")[["x", "y"]].to_numpy() for s, g in tr.groupby("start")}
 
 
 def boundary(plan: ValidationPlan, runner: _Runner) -> dict:
@@ -1049,13 +1208,21 @@ def boundary(plan: ValidationPlan, runner: _Runner) -> dict:
             for preset in fam.presets:
                 mu = _preset_mu(preset)
                 tip = _tip_radius(preset, fam.seeds, plan.hfield_resolution)
-                grid = {"mu": mu, "tip_radius": tip, "dl": tip / 2,
-                        "hfield_resolution": plan.hfield_resolution}
+                grid = {
+                    "mu": mu,
+                    "tip_radius": tip,
+                    "dl": tip / 2,
+                    "hfield_resolution": plan.hfield_resolution,
+                }
                 if proto != "ramp":
-                    doc = _family_doc(fam, name=f"boundary-{proto}-{preset}", plan=plan,
-                                      preset=preset, drive={"protocol": proto,
-                                                            "ie": list(plan.ie_values)},
-                                      grid=grid)
+                    doc = _family_doc(
+                        fam,
+                        name=f"boundary-{proto}-{preset}",
+                        plan=plan,
+                        preset=preset,
+                        drive={"protocol": proto, "ie": list(plan.ie_values)},
+                        grid=grid,
+                    )
                     df, _ = runner(doc, f"boundary/{proto}-{preset}")
                     comps.append(df[df["analysis"] == "compare"])
                     mjs.append(df[df["analysis"] == "mujoco"])
@@ -1064,23 +1231,36 @@ def boundary(plan: ValidationPlan, runner: _Runner) -> dict:
                 # run in one sweep
                 seed = None if fam.seeds is None else fam.seeds[0]
                 rig, _ = _pilot_rig(preset, seed, mu, tip, plan.hfield_resolution)
-                surface = presets.make_surface(preset, **({} if seed is None
-                                                          else {"seed": int(seed)}))
+                surface = presets.make_surface(preset, **({} if seed is None else {"seed": int(seed)}))
                 lc = sim.characteristic_length(surface)
                 sx, sy = _first_start(fam, surface)
                 runner.note(f"ramp pilots on {preset}")
                 by_dur: dict[float, list[float]] = {}
                 for v in plan.ie_values:
-                    rp = ramp_duration(rig, (sx, sy), v, target_lc=(surface.bounds[1] - sx) / lc,
-                                       max_steps=plan.ramp_max_steps, slide_lc=plan.ramp_slide_lc)
+                    rp = ramp_duration(
+                        rig,
+                        (sx, sy),
+                        v,
+                        target_lc=(surface.bounds[1] - sx) / lc,
+                        max_steps=plan.ramp_max_steps,
+                        slide_lc=plan.ramp_slide_lc,
+                    )
                     ramp_plans.setdefault(preset, {})[float(v)] = rp.as_dict()
                     by_dur.setdefault(rp.duration_s, []).append(float(v))
                 for j, (dur, ies_) in enumerate(sorted(by_dur.items())):
-                    doc = _family_doc(fam, name=f"boundary-ramp-{preset}-{j}", plan=plan,
-                                      preset=preset, drive={
-                                          "protocol": "ramp", "ie": ies_, "duration": dur,
-                                          "slide_distance": plan.ramp_slide_lc
-                                          * rig.scales.char_length_m}, grid=grid)
+                    doc = _family_doc(
+                        fam,
+                        name=f"boundary-ramp-{preset}-{j}",
+                        plan=plan,
+                        preset=preset,
+                        drive={
+                            "protocol": "ramp",
+                            "ie": ies_,
+                            "duration": dur,
+                            "slide_distance": plan.ramp_slide_lc * rig.scales.char_length_m,
+                        },
+                        grid=grid,
+                    )
                     df, store = runner(doc, f"boundary/ramp-{preset}-d{dur:.4g}")
                     c = df[df["analysis"] == "compare"].copy()
                     m = df[df["analysis"] == "mujoco"]
@@ -1095,8 +1275,8 @@ def boundary(plan: ValidationPlan, runner: _Runner) -> dict:
                             a = mp.get(s, np.zeros((0, 2)))
                             pf.append(_prefix_frechet(a, qp.get(s, np.zeros((0, 2))), lc_run))
                             x0 = float(grp.loc[grp["start"] == s, "start_x"].iloc[0])
-                            target = (surface.bounds[1] - x0)
-                            dx = (float(row["end_x"]) - x0)
+                            target = surface.bounds[1] - x0
+                            dx = float(row["end_x"]) - x0
                             cov.append(dx / target if target > 0 else float("nan"))
                             t_run = float(row["end_time_s"])
                             v_mean = dx * rig.length_scale_m / max(t_run, 1e-12)
@@ -1120,8 +1300,7 @@ def boundary(plan: ValidationPlan, runner: _Runner) -> dict:
             if proto == "ramp":
                 f_run = c["prefix_frechet"].to_numpy(dtype=float)
                 ok = (m["end_reason"] != "engine_trouble").to_numpy()
-                a_run = ok & ~(mj_locked & ~qs_locked) & (np.nan_to_num(f_run, nan=np.inf)
-                                                         <= FRECHET_TARGET)
+                a_run = ok & ~(mj_locked & ~qs_locked) & (np.nan_to_num(f_run, nan=np.inf) <= FRECHET_TARGET)
                 cov.append(float(np.nanmean(c["coverage"])))
                 ach.append(float(np.nanmedian(c["ie_achieved"])))
             else:
@@ -1143,30 +1322,46 @@ def boundary(plan: ValidationPlan, runner: _Runner) -> dict:
         # take no part in its I_e*
         use = (np.asarray(cov) >= RAMP_MIN_COVERAGE) if proto == "ramp" else np.ones(len(ies), bool)
         if use.sum() >= 2:
-            by = ie_star_by_criterion(ies[use], np.array([x[:n_min] for x, u in zip(amat, use) if u]),
-                                      np.array([x[:n_min] for x, u in zip(fmat, use) if u]),
-                                      n_boot=plan.bootstrap)
-            stars[proto] = {**by["median_frechet"], "by_criterion": by,
-                            "ie_used": ies[use].tolist()}
+            by = ie_star_by_criterion(
+                ies[use],
+                np.array([x[:n_min] for x, u in zip(amat, use) if u]),
+                np.array([x[:n_min] for x, u in zip(fmat, use) if u]),
+                n_boot=plan.bootstrap,
+            )
+            stars[proto] = {**by["median_frechet"], "by_criterion": by, "ie_used": ies[use].tolist()}
         else:
-            stars[proto] = {"kind": "not measured", "valid": False, "by_criterion": {},
-                            "note": f"the capped ramp covers >= {RAMP_MIN_COVERAGE:g} of the path "
-                                    f"at fewer than two I_e values (best {np.nanmax(cov):.2g}); "
-                                    "see ramp_plans for the steps needed"}
-        curves[proto] = {"ie": ies.tolist(), "agreement": ag, "frechet": fr,
-                         "median_frechet": frm, "lateral": lat, "engine_trouble": trouble,
-                         "runs_per_ie": int(n_min),
-                         "frechet_kind": "prefix Frechet (streamline cut at the MuJoCo path's "
-                                         "arc length)" if proto == "ramp" else "Frechet"}
+            stars[proto] = {
+                "kind": "not measured",
+                "valid": False,
+                "by_criterion": {},
+                "note": f"the capped ramp covers >= {RAMP_MIN_COVERAGE:g} of the path "
+                f"at fewer than two I_e values (best {np.nanmax(cov):.2g}); "
+                "see ramp_plans for the steps needed",
+            }
+        curves[proto] = {
+            "ie": ies.tolist(),
+            "agreement": ag,
+            "frechet": fr,
+            "median_frechet": frm,
+            "lateral": lat,
+            "engine_trouble": trouble,
+            "runs_per_ie": int(n_min),
+            "frechet_kind": "prefix Frechet (streamline cut at the MuJoCo path's arc length)"
+            if proto == "ramp"
+            else "Frechet",
+        }
         if proto == "ramp":
-            curves[proto].update({"coverage": cov, "ie_achieved": ach,
-                                  "ie_kind": "equivalent: m v_eq^2 / (F_p L_c), "
-                                             "v_eq = L_c rate / F_p",
-                                  "ramp_max_steps": plan.ramp_max_steps,
-                                  "ramp_plans": ramp_plans})
+            curves[proto].update(
+                {
+                    "coverage": cov,
+                    "ie_achieved": ach,
+                    "ie_kind": "equivalent: m v_eq^2 / (F_p L_c), v_eq = L_c rate / F_p",
+                    "ramp_max_steps": plan.ramp_max_steps,
+                    "ramp_plans": ramp_plans,
+                }
+            )
         skip[proto] = skips
-    return {"curves": curves, "ie_star": stars, "skip_rate": skip,
-            "families": [f.name for f in fams]}
+    return {"curves": curves, "ie_star": stars, "skip_rate": skip, "families": [f.name for f in fams]}
 
 
 def _first_start(fam: FamilySpec, surface) -> tuple[float, float]:
@@ -1207,10 +1402,13 @@ class SlipStats:
         def stat(a):
             return float(np.mean(a)) if a.size else 0.0
 
-        return {"count": self.count, "mean_jump": stat(self.jump_lengths),
-                "max_jump": float(self.jump_lengths.max()) if self.count else 0.0,
-                "mean_force_drop": stat(self.force_drops),
-                "max_force_drop": float(self.force_drops.max()) if self.count else 0.0}
+        return {
+            "count": self.count,
+            "mean_jump": stat(self.jump_lengths),
+            "max_jump": float(self.jump_lengths.max()) if self.count else 0.0,
+            "mean_force_drop": stat(self.force_drops),
+            "max_force_drop": float(self.force_drops.max()) if self.count else 0.0,
+        }
 
 
 def slip_statistics(time_s, x, y, force, slipping, *, min_samples: int = 1) -> SlipStats:
@@ -1233,8 +1431,10 @@ def slip_statistics(time_s, x, y, force, slipping, *, min_samples: int = 1) -> S
     f = np.asarray(force, float)
     s = np.asarray(slipping, bool)
     if not (t.shape == x.shape == y.shape == f.shape == s.shape) or t.ndim != 1:
-        raise SpineInputError(f"time_s, x, y, force and slipping must be 1-D of one length, "
-                              f"got {t.shape}, {x.shape}, {y.shape}, {f.shape}, {s.shape}")
+        raise SpineInputError(
+            f"time_s, x, y, force and slipping must be 1-D of one length, "
+            f"got {t.shape}, {x.shape}, {y.shape}, {f.shape}, {s.shape}"
+        )
     edges = np.diff(np.r_[0, s.astype(np.int8), 0])
     on, off = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)  # [on, off)
     keep = (off - on) >= min_samples
@@ -1243,7 +1443,7 @@ def slip_statistics(time_s, x, y, force, slipping, *, min_samples: int = 1) -> S
     for a, b in zip(on, off):
         end = min(b, t.size - 1)
         start = max(a - 1, 0)  # the last stuck sample before the slip
-        seg = np.column_stack([x[start:end + 1], y[start:end + 1]])
+        seg = np.column_stack([x[start : end + 1], y[start : end + 1]])
         jumps.append(float(np.linalg.norm(np.diff(seg, axis=0), axis=1).sum()))
         drops.append(float(f[start] - f[end]))
         durs.append(float(t[end] - t[start]))
@@ -1270,11 +1470,20 @@ def stick_slip(plan: ValidationPlan, runner: _Runner) -> dict:
     fp = MASS_KG * GRAVITY
     lc_m = lc_units * sim.DEFAULT_LENGTH_SCALE_M
     stiff = [float(f"{k * fp / lc_m:.6g}") for k in plan.stick_slip_stiffness]
-    grid = {"mu": _preset_mu(preset), "tip_radius": tip, "dl": tip / 2,
-            "hfield_resolution": plan.hfield_resolution}
-    doc = _family_doc(fam, name="stick-slip", plan=plan, preset=preset,
-                      drive={"protocol": "spring", "ie": list(plan.stick_slip_ie),
-                             "stiffness": stiff}, grid=grid)
+    grid = {
+        "mu": _preset_mu(preset),
+        "tip_radius": tip,
+        "dl": tip / 2,
+        "hfield_resolution": plan.hfield_resolution,
+    }
+    doc = _family_doc(
+        fam,
+        name="stick-slip",
+        plan=plan,
+        preset=preset,
+        drive={"protocol": "spring", "ie": list(plan.stick_slip_ie), "stiffness": stiff},
+        grid=grid,
+    )
     df, store = runner(doc, "stick-slip")
     mj = df[df["analysis"] == "mujoco"]
     comp = df[df["analysis"] == "compare"].set_index(["case_id", "start"])
@@ -1283,30 +1492,38 @@ def stick_slip(plan: ValidationPlan, runner: _Runner) -> dict:
         paths = _mujoco_paths(store, case_id)
         stats = []
         for s, tr in paths.items():
-            st = slip_statistics(tr["time_s"], tr["x"] / lc_units, tr["y"] / lc_units,
-                                 tr["drive_force_n"] / fp, tr["slipping"], min_samples=3)
+            st = slip_statistics(
+                tr["time_s"],
+                tr["x"] / lc_units,
+                tr["y"] / lc_units,
+                tr["drive_force_n"] / fp,
+                tr["slipping"],
+                min_samples=3,
+            )
             stats.append(st)
             if s == 0:
-                traces[(float(ie), float(k))] = (tr["time_s"].to_numpy(),
-                                                 tr["drive_force_n"].to_numpy() / fp)
+                traces[(float(ie), float(k))] = (tr["time_s"].to_numpy(), tr["drive_force_n"].to_numpy() / fp)
         jumps = np.concatenate([st.jump_lengths for st in stats]) if stats else np.array([])
         drops = np.concatenate([st.force_drops for st in stats]) if stats else np.array([])
         locked_mj = grp["self_locked"].astype(bool).to_numpy()
-        agree_lock = np.array([bool(comp.loc[(case_id, int(s)), "agree_lock"])
-                               for s in grp["start"]])
+        agree_lock = np.array([bool(comp.loc[(case_id, int(s)), "agree_lock"]) for s in grp["start"]])
         qs_locked = np.where(agree_lock, locked_mj, ~locked_mj)  # agree_lock: same as qs
         traps = int(qs_locked.sum())
-        rows.append({"ie": float(ie), "stiffness_fp_per_lc": float(k) * lc_m / fp,
-                     "runs": len(stats),
-                     "slip_events_per_run": float(np.mean([st.count for st in stats]))
-                     if stats else 0.0,
-                     "mean_jump_lc": float(jumps.mean()) if jumps.size else 0.0,
-                     "max_jump_lc": float(jumps.max()) if jumps.size else 0.0,
-                     "mean_force_drop_fp": float(drops.mean()) if drops.size else 0.0,
-                     "max_force_drop_fp": float(drops.max()) if drops.size else 0.0,
-                     "quasistatic_traps": traps,
-                     "skipped_traps": int((qs_locked & ~locked_mj).sum()),
-                     "extra_locks": int((~qs_locked & locked_mj).sum())})
+        rows.append(
+            {
+                "ie": float(ie),
+                "stiffness_fp_per_lc": float(k) * lc_m / fp,
+                "runs": len(stats),
+                "slip_events_per_run": float(np.mean([st.count for st in stats])) if stats else 0.0,
+                "mean_jump_lc": float(jumps.mean()) if jumps.size else 0.0,
+                "max_jump_lc": float(jumps.max()) if jumps.size else 0.0,
+                "mean_force_drop_fp": float(drops.mean()) if drops.size else 0.0,
+                "max_force_drop_fp": float(drops.max()) if drops.size else 0.0,
+                "quasistatic_traps": traps,
+                "skipped_traps": int((qs_locked & ~locked_mj).sum()),
+                "extra_locks": int((~qs_locked & locked_mj).sum()),
+            }
+        )
     rows.sort(key=lambda r: (r["ie"], r["stiffness_fp_per_lc"]))
     return {"rows": rows, "traces": traces, "surface": f"{preset}#1"}
 
@@ -1337,19 +1554,23 @@ def sandpaper(plan: ValidationPlan, runner: _Runner) -> dict:
         # start at least four tip radii inside the patch: the rig ends a run whose tip comes
         # within one tip radius of the edge (the P600 patch is only 16 tip radii wide)
         x_rel = max(0.05, 4 * params.get("tip_radius_m", 25e-6) / params["size_m"])
-        doc = {"sweep": {"name": f"sandpaper-{grit}", "seed": 3, "analyses": ["mujoco"]},
-               "surfaces": [{"preset": preset}],
-               "starts": {"frame": "relative", "x": [round(x_rel, 4)],
-                          "y": list(np.linspace(0.25, 0.75, plan.sandpaper_starts).round(4))},
-               "drive": {"protocol": "spring", "ie": plan.sandpaper_ie},
-               "grid": {"mu": SANDPAPER_MU, "record_every": 5}}
+        doc = {
+            "sweep": {"name": f"sandpaper-{grit}", "seed": 3, "analyses": ["mujoco"]},
+            "surfaces": [{"preset": preset}],
+            "starts": {
+                "frame": "relative",
+                "x": [round(x_rel, 4)],
+                "y": list(np.linspace(0.25, 0.75, plan.sandpaper_starts).round(4)),
+            },
+            "drive": {"protocol": "spring", "ie": plan.sandpaper_ie},
+            "grid": {"mu": SANDPAPER_MU, "record_every": 5},
+        }
         df, store = runner(doc, f"sandpaper/{grit}")
         mj_all = df[df["analysis"] == "mujoco"]
         failed = sorted(set(mj_all.loc[mj_all["status"] != "ok", "reason"].astype(str)))
         mj = mj_all[mj_all["status"] == "ok"] if "tip_radius_m" in mj_all else mj_all.iloc[:0]
         if mj.empty:
-            rows.append({"grit": grit, "runs": 0, "failed_runs": int(len(mj_all)),
-                         "failures": failed})
+            rows.append({"grit": grit, "runs": 0, "failed_runs": int(len(mj_all)), "failures": failed})
             continue
         tip_m = float(mj["tip_radius_m"].iloc[0])
         fp = MASS_KG * GRAVITY
@@ -1365,33 +1586,42 @@ def sandpaper(plan: ValidationPlan, runner: _Runner) -> dict:
                 exc.append(dy.max())
                 rms.append(np.sqrt(np.mean((y - y.mean()) ** 2)))
                 travel = max(x[-1] - x[0], 1e-12)
-                tort.append(np.linalg.norm(np.diff(np.column_stack([x, y]), axis=0),
-                                           axis=1).sum() / travel)
+                tort.append(np.linalg.norm(np.diff(np.column_stack([x, y]), axis=0), axis=1).sum() / travel)
                 med = np.median(f[f > 0]) if np.any(f > 0) else 0.0
-                pk, _ = find_peaks(f, height=1.5 * med if med > 0 else None,
-                                   prominence=0.2)
+                pk, _ = find_peaks(f, height=1.5 * med if med > 0 else None, prominence=0.2)
                 peaks.append(len(pk) / max(travel / tip_m, 1e-12) * 100)
                 ratio.append(f.max() / med if med > 0 else float("nan"))
                 paths.setdefault(grit, []).append((x, y, tr["time_s"].to_numpy(), f))
-        rows.append({"grit": grit, "runs": len(exc), "tip_radius_um": tip_m * 1e6,
-                     "max_lateral_excursion_mm": float(np.max(exc)) * 1e3,
-                     "mean_lateral_excursion_tip_radii": float(np.mean(exc)) / tip_m,
-                     "rms_lateral_tip_radii": float(np.mean(rms)) / tip_m,
-                     "tortuosity": float(np.mean(tort)),
-                     "force_peaks_per_100_tip_radii": float(np.mean(peaks)),
-                     "peak_over_median_force": float(np.nanmean(ratio)),
-                     "self_locked_fraction": float(mj["self_locked"].astype(bool).mean()),
-                     "end_reasons": sorted(set(mj_all["end_reason"].dropna().astype(str))),
-                     "failed_runs": int(len(mj_all) - len(mj)), "failures": failed})
+        rows.append(
+            {
+                "grit": grit,
+                "runs": len(exc),
+                "tip_radius_um": tip_m * 1e6,
+                "max_lateral_excursion_mm": float(np.max(exc)) * 1e3,
+                "mean_lateral_excursion_tip_radii": float(np.mean(exc)) / tip_m,
+                "rms_lateral_tip_radii": float(np.mean(rms)) / tip_m,
+                "tortuosity": float(np.mean(tort)),
+                "force_peaks_per_100_tip_radii": float(np.mean(peaks)),
+                "peak_over_median_force": float(np.nanmean(ratio)),
+                "self_locked_fraction": float(mj["self_locked"].astype(bool).mean()),
+                "end_reasons": sorted(set(mj_all["end_reason"].dropna().astype(str))),
+                "failed_runs": int(len(mj_all) - len(mj)),
+                "failures": failed,
+            }
+        )
     return {"rows": rows, "paths": paths, "mu": SANDPAPER_MU}
 
 
 # --------------------------------------------------------------------------- the suite
 
 
-def run_validation(out_dir: str | os.PathLike, *, plan: ValidationPlan | str = "quick",
-                   workers: int | None = None,
-                   progress: Callable[[ValidationProgress], None] | None = None) -> dict:
+def run_validation(
+    out_dir: str | os.PathLike,
+    *,
+    plan: ValidationPlan | str = "quick",
+    workers: int | None = None,
+    progress: Callable[[ValidationProgress], None] | None = None,
+) -> dict:
     """Run the validation suite into ``out_dir``: sweeps, ``validation.json``, ``report.md``.
 
     Parameters
@@ -1419,8 +1649,7 @@ def run_validation(out_dir: str | os.PathLike, *, plan: ValidationPlan | str = "
         if plan not in PLANS:
             raise SpineInputError(f"plan must be one of {sorted(PLANS)}, got {plan!r}")
         plan = PLANS[plan]
-    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
-                                or workers < 1):
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise SpineInputError(f"workers must be an integer >= 1, got {workers!r}")
     out = Path(out_dir).resolve()  # stores refer to files under it: one absolute root
     if out.exists() and not out.is_dir():
@@ -1440,8 +1669,11 @@ def run_validation(out_dir: str | os.PathLike, *, plan: ValidationPlan | str = "
     lim = timed("limit", quasistatic_limit, plan, runner)
     bnd = timed("boundary", boundary, plan, runner)
     ss = timed("stick_slip", stick_slip, plan, runner)
-    sp = timed("sandpaper", sandpaper, plan, runner) if plan.sandpaper_grits else {
-        "rows": [], "paths": {}, "mu": SANDPAPER_MU}
+    sp = (
+        timed("sandpaper", sandpaper, plan, runner)
+        if plan.sandpaper_grits
+        else {"rows": [], "paths": {}, "mu": SANDPAPER_MU}
+    )
     runner.study = "report"
     runner.note("figures and report")
     from spine_mj import sim
@@ -1451,8 +1683,7 @@ def run_validation(out_dir: str | os.PathLike, *, plan: ValidationPlan | str = "
         "static_kappa_max_rel_error": st["static_kappa_max_rel_error"],
         "static_by_engine": st["per_engine"],
         "lowest_ie": plan.lowest_ie,
-        "outcome_agreement_at_lowest_ie": {k: v["outcome_agreement"]
-                                           for k, v in lim["families"].items()},
+        "outcome_agreement_at_lowest_ie": {k: v["outcome_agreement"] for k, v in lim["families"].items()},
         "mean_frechet_at_lowest_ie": {k: v["mean_frechet"] for k, v in lim["families"].items()},
         "limit_families": lim["families"],
         "limit_variations": lim["variations"],
@@ -1461,19 +1692,33 @@ def run_validation(out_dir: str | os.PathLike, *, plan: ValidationPlan | str = "
         "trap_skip_rate": bnd["skip_rate"],
         "stick_slip": ss["rows"],
         "sandpaper": sp["rows"],
-        "targets": {"outcome_agreement": OUTCOME_TARGET, "mean_frechet_lc": FRECHET_TARGET,
-                    "static_kappa_rel_error": STATIC_TARGET},
+        "targets": {
+            "outcome_agreement": OUTCOME_TARGET,
+            "mean_frechet_lc": FRECHET_TARGET,
+            "static_kappa_rel_error": STATIC_TARGET,
+        },
         "engine_settings": {
-            "recommended": {k: (v.value if hasattr(v, "value") else v) for k, v in
-                            dataclasses.asdict(sim.default_engine(sim.Scales(
-                                length_scale_m=0.01, char_length_m=0.015, mass_kg=MASS_KG,
-                                preload_n=MASS_KG * GRAVITY, tip_radius_m=5e-4,
-                                hfield_spacing_m=5e-4))).items()},
+            "recommended": {
+                k: (v.value if hasattr(v, "value") else v)
+                for k, v in dataclasses.asdict(
+                    sim.default_engine(
+                        sim.Scales(
+                            length_scale_m=0.01,
+                            char_length_m=0.015,
+                            mass_kg=MASS_KG,
+                            preload_n=MASS_KG * GRAVITY,
+                            tip_radius_m=5e-4,
+                            hfield_spacing_m=5e-4,
+                        )
+                    )
+                ).items()
+            },
             "rule": "dt = min(1 ms, sqrt(0.005 min(r_tip, L_c) m / F_p)), solref = (2 dt, 1), "
-                    "elliptic cone, noslip_iterations = 3, impratio = 1 (spine_mj.sim)",
+            "elliptic cone, noslip_iterations = 3, impratio = 1 (spine_mj.sim)",
             "static_variants": {label: dict(ov) for label, ov in plan.static_engines},
             "hfield_resolution": plan.hfield_resolution,
-            "mass_kg": MASS_KG, "length_scale_m": sim.DEFAULT_LENGTH_SCALE_M,
+            "mass_kg": MASS_KG,
+            "length_scale_m": sim.DEFAULT_LENGTH_SCALE_M,
         },
         "timings_s": timings,
     }

@@ -16,9 +16,14 @@ def run(*args):
 
 
 def test_help_on_every_surface_command():
-    for args in (["--help"], ["surface", "--help"], ["surface", "make", "--help"],
-                 ["surface", "show", "--help"], ["surface", "export", "--help"],
-                 ["surface", "list", "--help"]):
+    for args in (
+        ["--help"],
+        ["surface", "--help"],
+        ["surface", "make", "--help"],
+        ["surface", "show", "--help"],
+        ["surface", "export", "--help"],
+        ["surface", "list", "--help"],
+    ):
         result = run(*args)
         assert result.exit_code == 0, result.output
         assert "Usage" in result.output
@@ -26,15 +31,29 @@ def test_help_on_every_surface_command():
 
 def test_make_show_export(tmp_path):
     out = tmp_path / "f.npz"
-    result = run("surface", "make", "paper-fractal", "--hurst", "0.7", "--seed", "3",
-                 "--set", "nx=64", "-o", str(out), "--png", str(tmp_path / "f.png"))
+    result = run(
+        "surface",
+        "make",
+        "paper-fractal",
+        "--hurst",
+        "0.7",
+        "--seed",
+        "3",
+        "--set",
+        "nx=64",
+        "-o",
+        str(out),
+        "--png",
+        str(tmp_path / "f.png"),
+    )
     assert result.exit_code == 0, result.output
     surf = load_surface(out)
     assert surf.shape == (64, 64) and surf.metadata["params"]["hurst"] == 0.7
     assert (tmp_path / "f.png").stat().st_size > 10_000
     assert run("surface", "show", str(out), "-o", str(tmp_path / "s.png")).exit_code == 0
-    result = run("surface", "export", str(out), "--stl", str(tmp_path / "f.stl"),
-                 "--hfield", str(tmp_path / "h.npz"))
+    result = run(
+        "surface", "export", str(out), "--stl", str(tmp_path / "f.stl"), "--hfield", str(tmp_path / "h.npz")
+    )
     assert result.exit_code == 0, result.output
     with np.load(tmp_path / "h.npz", allow_pickle=False) as hf:
         assert hf["data"].shape == (64, 64) and hf["size"].shape == (4,)
@@ -45,8 +64,9 @@ def test_make_show_export(tmp_path):
 
 def test_import_from_file(tmp_path, topography_dir):
     out = tmp_path / "di.npz"
-    result = run("surface", "make", "--from-file", str(topography_dir / "di-1.di"),
-                 "--spacing", "4e-9", "-o", str(out))
+    result = run(
+        "surface", "make", "--from-file", str(topography_dir / "di-1.di"), "--spacing", "4e-9", "-o", str(out)
+    )
     assert result.exit_code == 0, result.output
     assert load_surface(out).spacing[0] == pytest.approx(4e-9)
 
@@ -56,14 +76,16 @@ def test_import_from_file(tmp_path, topography_dir):
     [
         (["surface", "make", "nope", "-o", "{d}/x.npz"], "unknown preset 'nope'"),
         (["surface", "make", "paper-fractal", "--hurst", "1.5", "-o", "{d}/x.npz"], "hurst"),
-        (["surface", "make", "paper-random-convex", "--set", "n_peaks=0", "-o", "{d}/x.npz"],
-         "n_peaks"),
-        (["surface", "make", "paper-random-convex", "--set", "sigma_range=[0, 1]", "-o",
-          "{d}/x.npz"], "widths"),
-        (["surface", "make", "paper-single-peak", "--set", "k=abc", "-o", "{d}/x.npz"],
-         "k must be a number, got 'abc'"),
-        (["surface", "make", "--from-file", "{d}/corrupt.plu", "-o", "{d}/x.npz"],
-         "cannot read topography"),
+        (["surface", "make", "paper-random-convex", "--set", "n_peaks=0", "-o", "{d}/x.npz"], "n_peaks"),
+        (
+            ["surface", "make", "paper-random-convex", "--set", "sigma_range=[0, 1]", "-o", "{d}/x.npz"],
+            "widths",
+        ),
+        (
+            ["surface", "make", "paper-single-peak", "--set", "k=abc", "-o", "{d}/x.npz"],
+            "k must be a number, got 'abc'",
+        ),
+        (["surface", "make", "--from-file", "{d}/corrupt.plu", "-o", "{d}/x.npz"], "cannot read topography"),
         (["surface", "make", "--from-file", "{d}/missing.x3p", "-o", "{d}/x.npz"], "not found"),
         (["surface", "show", "{d}/corrupt.npz", "-o", "{d}/x.png"], "not a readable"),
         (["surface", "make", "-o", "{d}/x.npz"], "exactly one of PRESET or --from-file"),
@@ -82,8 +104,11 @@ def test_bad_input_exits_2_with_one_line_and_no_output(tmp_path, args, message):
 
 
 def test_console_script_exit_code_and_stderr(tmp_path):
-    proc = subprocess.run([sys.executable, "-m", "spine_mj.cli", "surface", "make", "nope", "-o",
-                           str(tmp_path / "x.npz")], capture_output=True, text=True)
+    proc = subprocess.run(
+        [sys.executable, "-m", "spine_mj.cli", "surface", "make", "nope", "-o", str(tmp_path / "x.npz")],
+        capture_output=True,
+        text=True,
+    )
     assert proc.returncode == 2
     assert proc.stderr.strip().splitlines() == [proc.stderr.strip().splitlines()[0]]
     assert proc.stderr.startswith("Error: unknown preset")

@@ -82,8 +82,7 @@ def test_outcome_agreement_cases():
     locked_mj = [True, True, False, True, False]
     end_qs = [[0, 0], [0, 0], [5, 1], [5, 1], [1, 1]]
     end_mj = [[0.1, 0], [2, 0], [5, -3], [5, 1], [1, 1]]
-    out = outcome_agreement(locked_qs, end_qs, locked_mj, end_mj, length_scale=1.0,
-                            end_tolerance=0.25)
+    out = outcome_agreement(locked_qs, end_qs, locked_mj, end_mj, length_scale=1.0, end_tolerance=0.25)
     np.testing.assert_array_equal(out["lock"], [True, True, True, False, False])
     np.testing.assert_array_equal(out["same_trap"], [True, False, False, False, False])
     np.testing.assert_array_equal(out["agree"], [True, False, True, False, False])

@@ -12,7 +12,6 @@ def test_every_exported_name_resolves():
 
 
 def test_analytic_side_imports_without_mujoco():
-    code = ("import sys, spine_mj; spine_mj.streamlines; spine_mj.kappa; "
-            "print('mujoco' in sys.modules)")
+    code = "import sys, spine_mj; spine_mj.streamlines; spine_mj.kappa; print('mujoco' in sys.modules)"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "False"

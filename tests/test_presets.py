@@ -6,9 +6,16 @@ import pytest
 from spine_mj import SpineInputError
 from spine_mj.presets import list_presets, load_preset, make_surface, parse_override
 
-PAPER = ["paper-single-peak", "paper-single-valley", "paper-random-convex",
-         "paper-random-concave", "paper-fractal", "sandpaper-P36", "sandpaper-P60",
-         "sandpaper-P600"]
+PAPER = [
+    "paper-single-peak",
+    "paper-single-valley",
+    "paper-random-convex",
+    "paper-random-concave",
+    "paper-fractal",
+    "sandpaper-P36",
+    "sandpaper-P60",
+    "sandpaper-P600",
+]
 
 
 def test_all_paper_presets_exist():

@@ -44,20 +44,35 @@ def test_cli_reproduce_and_errors(tmp_path):
     assert res.exit_code == 0, res.output
     data = json.loads((tmp_path / "kappa-map.json").read_text())
     assert data["mu"] > 0 and (tmp_path / "kappa-map.png").stat().st_size > 0
-    res = runner.invoke(main, ["streamline", "paper-single-valley", "--start", "9,9", "-o",
-                               str(tmp_path / "bad")])
+    res = runner.invoke(
+        main, ["streamline", "paper-single-valley", "--start", "9,9", "-o", str(tmp_path / "bad")]
+    )
     assert res.exit_code == 2 and "starts must lie inside" in res.output
     assert not (tmp_path / "bad").exists()
-    res = runner.invoke(main, ["streamline", "paper-single-valley", "--start", "x", "-o",
-                               str(tmp_path / "bad")])
+    res = runner.invoke(
+        main, ["streamline", "paper-single-valley", "--start", "x", "-o", str(tmp_path / "bad")]
+    )
     assert res.exit_code == 2 and "--start" in res.output
 
 
 def test_cli_streamline_writes_a_table(tmp_path):
     import pandas as pd
 
-    res = CliRunner().invoke(main, ["streamline", "paper-single-valley", "--mu", "1.2", "--start",
-                                    "-3,-1", "--start", "-3,-2", "-o", str(tmp_path)])
+    res = CliRunner().invoke(
+        main,
+        [
+            "streamline",
+            "paper-single-valley",
+            "--mu",
+            "1.2",
+            "--start",
+            "-3,-1",
+            "--start",
+            "-3,-2",
+            "-o",
+            str(tmp_path),
+        ],
+    )
     assert res.exit_code == 0, res.output
     table = pd.read_parquet(tmp_path / "streamlines.parquet")
     assert set(table["trajectory"]) == {"streamline", "ideal"}
@@ -68,13 +83,11 @@ def test_random_surface_single_peak_normalization_and_finite_max_kappa():
     from spine_mj.reproduce import _max_kappa, _random_surface
     from spine_mj.streamline import StreamlineParams, streamlines
 
-    gen = {"n_peaks": 20, "sign": -1, "sigma_range": (0.5, 1.5), "overlap": True,
-           "k_range": (1.0, 2.0)}
+    gen = {"n_peaks": 20, "sign": -1, "sigma_range": (0.5, 1.5), "overlap": True, "k_range": (1.0, 2.0)}
     surf = _random_surface(gen, 3)
     k = -surf.amplitude * 2 * np.pi * surf.sigma_x * surf.sigma_y
     assert np.all((k >= 1.0) & (k <= 2.0))
-    res = streamlines(surf, [(-9.99, y) for y in np.linspace(-5, 5, 11)],
-                      StreamlineParams(mu=1.25, dl=0.02))
+    res = streamlines(surf, [(-9.99, y) for y in np.linspace(-5, 5, 11)], StreamlineParams(mu=1.25, dl=0.02))
     fin, inf = _max_kappa(res, "finite"), _max_kappa(res, "inf")
     # the finite convention never exceeds the kernel's max and is finite wherever engaged
     ok = np.isfinite(fin)

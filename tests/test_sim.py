@@ -45,7 +45,7 @@ def deepest_contacts(rig, q):
     d.qpos[:] = q
     mujoco.mj_forward(rig.model, d)
     out = []
-    for c in d.contact[:d.ncon]:
+    for c in d.contact[: d.ncon]:
         n = c.frame[:3] * (1 if c.frame[2] > 0 else -1)
         out.append((c.pos - 0.5 * c.dist * n, n))
     return out
@@ -170,9 +170,13 @@ def test_static_probe_matches_closed_form(slope_deg):
 
 def test_static_probe_self_locks_beyond_90_degrees():
     rig = plane_rig(70.0)  # theta + arctan(mu) = 96.6 deg
-    res = rig.run(StaticProbe(start_force_n=1.5 * math.tan(math.radians(70) - PHI)
-                              * rig.scales.preload_n, rate_n_s=20 * rig.scales.preload_n),
-                  start=START)
+    res = rig.run(
+        StaticProbe(
+            start_force_n=1.5 * math.tan(math.radians(70) - PHI) * rig.scales.preload_n,
+            rate_n_s=20 * rig.scales.preload_n,
+        ),
+        start=START,
+    )
     assert res.end_reason is EndReason.SELF_LOCK
     assert res.drive_force_n[-1] >= res.detection.kappa_cap * rig.scales.preload_n * (1 - 1e-9)
     assert math.isnan(res.kappa_mj)
@@ -191,8 +195,9 @@ def test_tip_on_slope_steeper_than_friction_angle_slides():
 
 
 def flat_rig():
-    return Rig(inclined_plane(slope_deg=0.0, half_width=0.05, n=101),
-               tip=TipParams(tip_radius_m=R_TIP, mu_s=MU))
+    return Rig(
+        inclined_plane(slope_deg=0.0, half_width=0.05, n=101), tip=TipParams(tip_radius_m=R_TIP, mu_s=MU)
+    )
 
 
 def test_flat_ground_spring_drive_pulls_with_mu_w():
@@ -204,7 +209,8 @@ def test_flat_ground_spring_drive_pulls_with_mu_w():
     assert force == pytest.approx(MU * rig.scales.preload_n, rel=0.02)
     assert res.slipping[half:].mean() > 0.5
     assert res.inertia_number == pytest.approx(
-        rig.tip.mass_kg * 0.005**2 / (rig.scales.preload_n * rig.scales.char_length_m))
+        rig.tip.mass_kg * 0.005**2 / (rig.scales.preload_n * rig.scales.char_length_m)
+    )
     # cell edges give two contacts: a few um of drift over 80 mm, no more
     assert abs(res.position_m[-1, 1] - res.position_m[0, 1]) < 1e-5
     table = res.table()
@@ -227,15 +233,18 @@ def test_ramp_slides_the_set_distance_per_cycle():
     tip at least slide_distance_m (and not runaway far), breaking away at mu W each time."""
     rig = flat_rig()
     slide = 0.05 * rig.scales.char_length_m
-    res = rig.run(RampDrive(rate_n_s=2 * rig.scales.preload_n, duration_s=1.2,
-                            slide_distance_m=slide), start=(-0.04, 0.0))
+    res = rig.run(
+        RampDrive(rate_n_s=2 * rig.scales.preload_n, duration_s=1.2, slide_distance_m=slide),
+        start=(-0.04, 0.0),
+    )
     resets = [e.index for e in res.events if e.kind == "reset"]
     assert len(resets) >= 2
     steps = np.diff(res.position_m[resets, 0])
     assert np.all(steps >= slide) and np.all(steps < 3 * slide)
     np.testing.assert_allclose(res.slip_kappas, MU, rtol=0.05)
-    short = rig.run(RampDrive(rate_n_s=2 * rig.scales.preload_n, duration_s=1.2,
-                              slide_distance_m=0.0), start=(-0.04, 0.0))
+    short = rig.run(
+        RampDrive(rate_n_s=2 * rig.scales.preload_n, duration_s=1.2, slide_distance_m=0.0), start=(-0.04, 0.0)
+    )
     short_resets = [e.index for e in short.events if e.kind == "reset"]
     assert np.diff(short.position_m[short_resets, 0]).max() < slide
 
@@ -251,19 +260,27 @@ def test_every_end_reason_is_reachable_and_recorded():
     res = rig.run(SpringDrive(speed_m_s=0.05), start=(0.044, 0.0))
     assert res.end_reason is EndReason.LEFT_DOMAIN
     reasons[res.end_reason] = res
-    res = rig.run(SpringDrive(speed_m_s=0.02, duration_s=0.3), start=(0.0, 0.0),
-                  detection=Detection(penetration_tol_m=1e-7))
+    res = rig.run(
+        SpringDrive(speed_m_s=0.02, duration_s=0.3),
+        start=(0.0, 0.0),
+        detection=Detection(penetration_tol_m=1e-7),
+    )
     assert "penetration" in res.end_detail
     reasons[res.end_reason] = res
-    res = rig.run(SpringDrive(speed_m_s=0.01, stiffness_n_m=1e9, duration_s=0.05), start=(0.0, 0.0),
-                  detection=Detection(kappa_cap=1e12))
+    res = rig.run(
+        SpringDrive(speed_m_s=0.01, stiffness_n_m=1e9, duration_s=0.05),
+        start=(0.0, 0.0),
+        detection=Detection(kappa_cap=1e12),
+    )
     assert res.end_reason is EndReason.ENGINE_TROUBLE and "reset" in res.end_detail
     for slope, probe in ((0.0, StaticProbe()), (40.0, StaticProbe())):
         res = plane_rig(slope).run(probe, start=START)
         reasons[res.end_reason] = res
     lock = plane_rig(70.0)
-    res = lock.run(StaticProbe(start_force_n=1.5 * lock.scales.preload_n,
-                               rate_n_s=20 * lock.scales.preload_n), start=START)
+    res = lock.run(
+        StaticProbe(start_force_n=1.5 * lock.scales.preload_n, rate_n_s=20 * lock.scales.preload_n),
+        start=START,
+    )
     reasons[res.end_reason] = res
     assert set(reasons) == set(EndReason)
     for reason, res in reasons.items():
@@ -276,9 +293,11 @@ def test_every_end_reason_is_reachable_and_recorded():
 
 def test_batch_equals_one_at_a_time_and_python_reference():
     rig = flat_rig()
-    drives = [SpringDrive(speed_m_s=0.01, duration_s=0.15),
-              SpringDrive(speed_m_s=0.03, duration_s=0.15, stiffness_n_m=50.0),
-              StaticProbe(rate_n_s=5 * rig.scales.preload_n)]
+    drives = [
+        SpringDrive(speed_m_s=0.01, duration_s=0.15),
+        SpringDrive(speed_m_s=0.03, duration_s=0.15, stiffness_n_m=50.0),
+        StaticProbe(rate_n_s=5 * rig.scales.preload_n),
+    ]
     starts = [(-0.02, 0.0), (0.01, 0.013), (0.0, -0.01)]
     batch = rig.run_batch(drives, starts, nthread=2)
     for drive, start, b in zip(drives, starts, batch):
@@ -293,19 +312,24 @@ def test_batch_equals_one_at_a_time_and_python_reference():
 # --------------------------------------------------------------------------- validation
 
 
-@pytest.mark.parametrize(("make", "match"), [
-    (lambda: TipParams(mass_kg=-0.01), r"mass_kg must be a finite number > 0, got -0\.01"),
-    (lambda: TipParams(mu_s=-0.1), r"mu_s must be a finite number >= 0, got -0\.1"),
-    (lambda: EngineSettings(timestep_s=0.0), r"timestep_s must be a finite number > 0, got 0\.0"),
-    (lambda: EngineSettings(timestep_s=1e-3, solref=(1e-3, 1.0)), r"solref timeconst_s must be >= 2"),
-    (lambda: EngineSettings(timestep_s=1e-3, cone="pyramidal"), r"pyramidal.*noslip"),
-    (lambda: EngineSettings(timestep_s=1e-3, cone="conical"), r"cone must be one of"),
-    (lambda: SpringDrive(speed_m_s=0.0), r"speed_m_s must be a finite number > 0"),
-    (lambda: TipParams(gravity_m_s2=0.0), r"no normal preload"),
-    (lambda: Rig(single_gaussian(), tip=TipParams(tip_radius_m=1e-5)),
-     r"surface too coarse for the tip: hfield spacing 0\.0005 m > 2 x tip_radius_m"),
-    (lambda: flat_rig().run(StaticProbe(), start=(1.0, 0.0)), r"start \(1, 0\) lies outside"),
-])
+@pytest.mark.parametrize(
+    ("make", "match"),
+    [
+        (lambda: TipParams(mass_kg=-0.01), r"mass_kg must be a finite number > 0, got -0\.01"),
+        (lambda: TipParams(mu_s=-0.1), r"mu_s must be a finite number >= 0, got -0\.1"),
+        (lambda: EngineSettings(timestep_s=0.0), r"timestep_s must be a finite number > 0, got 0\.0"),
+        (lambda: EngineSettings(timestep_s=1e-3, solref=(1e-3, 1.0)), r"solref timeconst_s must be >= 2"),
+        (lambda: EngineSettings(timestep_s=1e-3, cone="pyramidal"), r"pyramidal.*noslip"),
+        (lambda: EngineSettings(timestep_s=1e-3, cone="conical"), r"cone must be one of"),
+        (lambda: SpringDrive(speed_m_s=0.0), r"speed_m_s must be a finite number > 0"),
+        (lambda: TipParams(gravity_m_s2=0.0), r"no normal preload"),
+        (
+            lambda: Rig(single_gaussian(), tip=TipParams(tip_radius_m=1e-5)),
+            r"surface too coarse for the tip: hfield spacing 0\.0005 m > 2 x tip_radius_m",
+        ),
+        (lambda: flat_rig().run(StaticProbe(), start=(1.0, 0.0)), r"start \(1, 0\) lies outside"),
+    ],
+)
 def test_bad_parameters_are_rejected_clearly(make, match):
     with pytest.raises(SpineInputError, match=match):
         make()
@@ -317,8 +341,9 @@ def test_engine_settings_are_recorded_with_every_run():
     summary = res.summary()
     eng = summary["engine"]
     assert eng["timestep_s"] == rig.engine.timestep_s and eng["cone"] == "elliptic"
-    assert {"integrator", "impratio", "noslip_iterations", "solref", "solimp",
-            "hfield_resolution"} <= set(eng)
+    assert {"integrator", "impratio", "noslip_iterations", "solref", "solimp", "hfield_resolution"} <= set(
+        eng
+    )
     # the default rule: resting penetration a_p dt^2 <= 0.5 % of the tip radius
     assert rig.scales.preload_n / rig.tip.mass_kg * rig.engine.timestep_s**2 <= 0.005 * R_TIP
     assert res.penetration_m.max() < 0.01 * rig.scales.char_length_m
@@ -334,8 +359,23 @@ def test_cli_simulate_export_and_view(tmp_path, monkeypatch):
     from spine_mj.cli import main
 
     runner = CliRunner()
-    res = runner.invoke(main, ["simulate", "paper-single-peak", "--start", "-3,-1", "--drive", "spring",
-                               "--speed", "0.05", "--duration", "0.05", "-o", str(tmp_path)])
+    res = runner.invoke(
+        main,
+        [
+            "simulate",
+            "paper-single-peak",
+            "--start",
+            "-3,-1",
+            "--drive",
+            "spring",
+            "--speed",
+            "0.05",
+            "--duration",
+            "0.05",
+            "-o",
+            str(tmp_path),
+        ],
+    )
     assert res.exit_code == 0, res.output
     table = pd.read_parquet(tmp_path / "trajectory.parquet")
     assert len(table) > 100 and (tmp_path / "run.png").stat().st_size > 0

@@ -38,19 +38,16 @@ def test_kernel_matches_numpy_reference_single_gaussian(sign):
     surf = single_gaussian(sign=sign)
     p = StreamlineParams(mu=MU, dl=0.015)
     for fn in (streamlines, ideal_trajectories):
-        _same(fn(surf, FIVE_STARTS, p, backend="numba"), fn(surf, FIVE_STARTS, p, backend="numpy"),
-              1e-9)
+        _same(fn(surf, FIVE_STARTS, p, backend="numba"), fn(surf, FIVE_STARTS, p, backend="numpy"), 1e-9)
 
 
 def test_kernel_matches_numpy_reference_random_and_grid():
     starts = np.c_[np.full(12, -9.5), np.linspace(-8, 8, 12)]
     p = StreamlineParams(mu=1.0, dl=0.03)
     surf = random_gaussians(sign=-1, rng=3)
-    _same(streamlines(surf, starts, p, backend="numba"),
-          streamlines(surf, starts, p, backend="numpy"), 1e-8)
+    _same(streamlines(surf, starts, p, backend="numba"), streamlines(surf, starts, p, backend="numpy"), 1e-8)
     grid = fractal_fbm(nx=64, size=20.0, hurst=0.8, rms_slope=0.6, rng=2)
-    _same(streamlines(grid, starts, p, backend="numba"),
-          streamlines(grid, starts, p, backend="numpy"), 1e-8)
+    _same(streamlines(grid, starts, p, backend="numba"), streamlines(grid, starts, p, backend="numpy"), 1e-8)
     nonperiodic = grid.resample(0.4)  # non-periodic copy
     assert not nonperiodic.periodic or grid.periodic
     r1 = streamlines(nonperiodic, starts, p, backend="numba")
@@ -114,8 +111,7 @@ def test_steep_ramp_self_locks_at_once_and_gentle_one_does_not():
     # kappa on a 2-D ramp is tan(theta + phi)
     path = gentle.path(0)
     inner = path["x"] < 1.5  # the spline's edge extension is exact only to O(h^3)
-    np.testing.assert_allclose(path["kappa"][inner], math.tan(math.atan(1.5) + math.atan(0.5)),
-                               rtol=1e-6)
+    np.testing.assert_allclose(path["kappa"][inner], math.tan(math.atan(1.5) + math.atan(0.5)), rtol=1e-6)
 
 
 def test_y_mirror_symmetry_of_streamlines():

@@ -152,6 +152,7 @@ def test_stl_refuses_wrong_suffix(tmp_path):
 
 
 def test_grid_surface_metadata_survives(tmp_path):
-    surf = GridSurface(heights=np.zeros((4, 4)), x=np.arange(4.0), y=np.arange(4.0),
-                       metadata={"note": "flat", "n": 3})
+    surf = GridSurface(
+        heights=np.zeros((4, 4)), x=np.arange(4.0), y=np.arange(4.0), metadata={"note": "flat", "n": 3}
+    )
     assert load_surface(save_surface(surf, tmp_path / "f.npz")).metadata == {"note": "flat", "n": 3}

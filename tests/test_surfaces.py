@@ -48,10 +48,8 @@ def test_gaussian_derivatives_match_finite_differences():
     x, y = RNG.uniform(-8, 8, (2, 200))
     h = 1e-5
     _, fx, fy, fxx, fxy, fyy = surf.evaluate(x, y)
-    np.testing.assert_allclose(fx, (surf.height(x + h, y) - surf.height(x - h, y)) / (2 * h),
-                               atol=1e-7)
-    np.testing.assert_allclose(fy, (surf.height(x, y + h) - surf.height(x, y - h)) / (2 * h),
-                               atol=1e-7)
+    np.testing.assert_allclose(fx, (surf.height(x + h, y) - surf.height(x - h, y)) / (2 * h), atol=1e-7)
+    np.testing.assert_allclose(fy, (surf.height(x, y + h) - surf.height(x, y - h)) / (2 * h), atol=1e-7)
     gx_p, _ = surf.gradient(x + h, y)
     gx_m, _ = surf.gradient(x - h, y)
     _, gy_p = surf.gradient(x, y + h)
@@ -88,9 +86,11 @@ def _grid_errors(h):
     x, y = np.random.default_rng(0).uniform(-4, 4, (2, 3000))
     e = exact.evaluate(x, y)
     g = grid.evaluate(x, y)
-    return (np.abs(e[0] - g[0]).max(),
-            max(np.abs(e[1] - g[1]).max(), np.abs(e[2] - g[2]).max()),
-            max(np.abs(e[k] - g[k]).max() for k in (3, 4, 5)))
+    return (
+        np.abs(e[0] - g[0]).max(),
+        max(np.abs(e[1] - g[1]).max(), np.abs(e[2] - g[2]).max()),
+        max(np.abs(e[k] - g[k]).max() for k in (3, 4, 5)),
+    )
 
 
 def test_grid_interpolant_accuracy_and_convergence_order():
@@ -275,8 +275,10 @@ def test_sandpaper_covered_fraction_follows_boolean_model():
 
 
 def test_sandpaper_roughness_scales_with_grit():
-    rms = {g: sandpaper(grit=g, size_m=10 * GRIT_PARTICLE_DIAMETER_M[g], rng=1).heights.std()
-           for g in ("P36", "P600")}
+    rms = {
+        g: sandpaper(grit=g, size_m=10 * GRIT_PARTICLE_DIAMETER_M[g], rng=1).heights.std()
+        for g in ("P36", "P600")
+    }
     ratio = GRIT_PARTICLE_DIAMETER_M["P36"] / GRIT_PARTICLE_DIAMETER_M["P600"]
     assert rms["P36"] / rms["P600"] == pytest.approx(ratio, rel=0.3)
 
@@ -365,8 +367,20 @@ def test_generators_reject_nonsense(func, kwargs, match):
 
 def test_gaussian_surface_rejects_bad_widths():
     with pytest.raises(SpineInputError, match="sigma_y must be > 0"):
-        GaussianSurface(amplitude=[1.0], center_x=[0.0], center_y=[0.0], sigma_x=[1.0],
-                        sigma_y=[0.0], bounds=(-1, 1, -1, 1))
+        GaussianSurface(
+            amplitude=[1.0],
+            center_x=[0.0],
+            center_y=[0.0],
+            sigma_x=[1.0],
+            sigma_y=[0.0],
+            bounds=(-1, 1, -1, 1),
+        )
     with pytest.raises(SpineInputError, match="bounds"):
-        GaussianSurface(amplitude=[1.0], center_x=[0.0], center_y=[0.0], sigma_x=[1.0],
-                        sigma_y=[1.0], bounds=(1, -1, -1, 1))
+        GaussianSurface(
+            amplitude=[1.0],
+            center_x=[0.0],
+            center_y=[0.0],
+            sigma_x=[1.0],
+            sigma_y=[1.0],
+            bounds=(1, -1, -1, 1),
+        )

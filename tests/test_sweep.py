@@ -51,10 +51,12 @@ def metrics_frame(out_dir):
     return df.sort_values("run_id").reset_index(drop=True)
 
 
-BASE = {"sweep": {"analyses": ["quasistatic"]},
-        "surfaces": [{"preset": "paper-single-peak"}],
-        "starts": {"points": [[0.1, 0.5]]},
-        "grid": {"mu": 0.5}}
+BASE = {
+    "sweep": {"analyses": ["quasistatic"]},
+    "surfaces": [{"preset": "paper-single-peak"}],
+    "starts": {"points": [[0.1, 0.5]]},
+    "grid": {"mu": 0.5},
+}
 
 
 def with_(**changes):
@@ -74,30 +76,35 @@ def with_(**changes):
 # --------------------------------------------------------------------------- config
 
 
-@pytest.mark.parametrize("doc, match", [
-    (with_(extra=1), r"config key extra: unknown; allowed keys: sweep, surfaces"),
-    (with_(sweep__analyses=["quasistatic", "nope"]),
-     r"sweep.analyses: allowed values are .*'quasistatic'.*, got 'nope'"),
-    (with_(sweep__analyses=["compare"]), r"sweep.analyses: 'compare' needs"),
-    (with_(sweep__seed=-1), r"sweep.seed: must be a non-negative integer, got -1"),
-    (with_(grid__mu=-0.5), r"grid.mu: must be a finite number > 0 .*got -0.5"),
-    (with_(grid__mu=None), r"grid.mu: required by analyses \['quasistatic'\]"),
-    (with_(grid__mu=[0.5, 0.5]), r"grid.mu: repeated value"),
-    (with_(grid__speed=1.0), r"grid.speed: unknown parameter .*allowed: .*mu"),
-    (with_(grid__trajectory="curvy"), r"grid.trajectory: must be one of 'streamline', 'ideal'"),
-    (with_(grid__max_steps=1.5), r"grid.max_steps: must be an integer >= 1"),
-    (with_(grid__mu={"logspace": [0, 1], "num": 3}), r"grid.mu.logspace: end values must be > 0"),
-    (with_(grid__mu={"linspace": [0.1, 1]}), r"grid.mu: a table must be \{linspace"),
-    (with_(surfaces=[]), r"config key surfaces: must be a non-empty array"),
-    (with_(surfaces__0__preset="nope"), r"surfaces\[0\].preset: allowed values are .*got 'nope'"),
-    (with_(surfaces__0__seeds=[1, 2]), r"surfaces\[0\]: 'paper-single-peak' takes no seed"),
-    (with_(surfaces__0__file="x.npz"), r"surfaces\[0\]: give exactly one of preset or file"),
-    (with_(surfaces__0__set={"nope": 1}), r"unknown parameter\(s\) \['nope'\]"),
-    (with_(starts=None), r"config key starts: required"),
-    (with_(starts__points=[[1.5, 0.5]]), r"starts.points: coordinates must be numbers in \[0, 1\]"),
-    (with_(starts__x=[0.5]), r"config key starts: give exactly one of points, x and y, or random"),
-    (with_(starts__frame="polar"), r"starts.frame: allowed values are 'relative', 'absolute'"),
-])
+@pytest.mark.parametrize(
+    "doc, match",
+    [
+        (with_(extra=1), r"config key extra: unknown; allowed keys: sweep, surfaces"),
+        (
+            with_(sweep__analyses=["quasistatic", "nope"]),
+            r"sweep.analyses: allowed values are .*'quasistatic'.*, got 'nope'",
+        ),
+        (with_(sweep__analyses=["compare"]), r"sweep.analyses: 'compare' needs"),
+        (with_(sweep__seed=-1), r"sweep.seed: must be a non-negative integer, got -1"),
+        (with_(grid__mu=-0.5), r"grid.mu: must be a finite number > 0 .*got -0.5"),
+        (with_(grid__mu=None), r"grid.mu: required by analyses \['quasistatic'\]"),
+        (with_(grid__mu=[0.5, 0.5]), r"grid.mu: repeated value"),
+        (with_(grid__speed=1.0), r"grid.speed: unknown parameter .*allowed: .*mu"),
+        (with_(grid__trajectory="curvy"), r"grid.trajectory: must be one of 'streamline', 'ideal'"),
+        (with_(grid__max_steps=1.5), r"grid.max_steps: must be an integer >= 1"),
+        (with_(grid__mu={"logspace": [0, 1], "num": 3}), r"grid.mu.logspace: end values must be > 0"),
+        (with_(grid__mu={"linspace": [0.1, 1]}), r"grid.mu: a table must be \{linspace"),
+        (with_(surfaces=[]), r"config key surfaces: must be a non-empty array"),
+        (with_(surfaces__0__preset="nope"), r"surfaces\[0\].preset: allowed values are .*got 'nope'"),
+        (with_(surfaces__0__seeds=[1, 2]), r"surfaces\[0\]: 'paper-single-peak' takes no seed"),
+        (with_(surfaces__0__file="x.npz"), r"surfaces\[0\]: give exactly one of preset or file"),
+        (with_(surfaces__0__set={"nope": 1}), r"unknown parameter\(s\) \['nope'\]"),
+        (with_(starts=None), r"config key starts: required"),
+        (with_(starts__points=[[1.5, 0.5]]), r"starts.points: coordinates must be numbers in \[0, 1\]"),
+        (with_(starts__x=[0.5]), r"config key starts: give exactly one of points, x and y, or random"),
+        (with_(starts__frame="polar"), r"starts.frame: allowed values are 'relative', 'absolute'"),
+    ],
+)
 def test_config_errors_name_key_allowed_values_and_what_arrived(doc, match):
     with pytest.raises(SpineInputError, match=match):
         sweep.parse_config(doc)
@@ -109,14 +116,17 @@ def test_config_file_errors(tmp_path):
     bad = write_config(tmp_path, "[sweep\nname=1")
     with pytest.raises(SpineInputError, match="is not valid TOML"):
         sweep.load_config(bad)
-    missing_file = write_config(tmp_path, """
+    missing_file = write_config(
+        tmp_path,
+        """
         [[surfaces]]
         file = "nowhere.npz"
         [starts]
         points = [[0.5, 0.5]]
         [grid]
         mu = 0.5
-    """)
+    """,
+    )
     with pytest.raises(SpineInputError, match=r"surfaces\[0\].file: no such file"):
         sweep.load_config(missing_file)
 
@@ -125,11 +135,16 @@ def test_config_file_errors(tmp_path):
 
 
 def test_grid_expansion_counts_ids_and_seeds():
-    doc = with_(grid__mu=[0.5, 1.0, 1.5], grid__trajectory=["streamline", "ideal"],
-                grid__tip_radius={"logspace": [0.01, 1.0], "num": 3})
-    doc["surfaces"] = [{"preset": "paper-single-peak"},
-                       {"preset": "paper-random-convex", "seeds": [3, 4]},
-                       {"preset": "paper-random-concave", "n_seeds": 2}]
+    doc = with_(
+        grid__mu=[0.5, 1.0, 1.5],
+        grid__trajectory=["streamline", "ideal"],
+        grid__tip_radius={"logspace": [0.01, 1.0], "num": 3},
+    )
+    doc["surfaces"] = [
+        {"preset": "paper-single-peak"},
+        {"preset": "paper-random-convex", "seeds": [3, 4]},
+        {"preset": "paper-random-concave", "n_seeds": 2},
+    ]
     config = sweep.parse_config(doc)
     cases = sweep.expand_cases(config)
     assert len(cases) == 5 * 3 * 2 * 3
@@ -155,8 +170,11 @@ def test_grid_expansion_counts_ids_and_seeds():
 
 def test_config_hash_ignores_comments_and_key_order(tmp_path):
     a = peak_config(tmp_path, name="h")
-    b = write_config(tmp_path, "# a comment\n" + a.read_text().replace(
-        "[grid]\nmu", "[grid]\n# another\nmu"), name="b.toml")
+    b = write_config(
+        tmp_path,
+        "# a comment\n" + a.read_text().replace("[grid]\nmu", "[grid]\n# another\nmu"),
+        name="b.toml",
+    )
     assert sweep.load_config(a).hash == sweep.load_config(b).hash
 
 
@@ -189,8 +207,7 @@ def test_store_layout_manifest_and_partial_trajectory_reads(tmp_path):
     assert len(runs) == 6 and set(runs.status) == {"ok"}
     assert {"mu", "dl", "end_x", "max_kappa", "self_locked", "time_s"} <= set(runs.columns)
     case_id = runs.case_id.iloc[0]
-    one = sweep.load_trajectories(out, case_id, analysis="quasistatic", start=2,
-                                  columns=["x", "kappa"])
+    one = sweep.load_trajectories(out, case_id, analysis="quasistatic", start=2, columns=["x", "kappa"])
     assert list(one.columns) == ["analysis", "start", "step", "x", "kappa"]
     assert set(one.start) == {2} and one.step.tolist() == list(range(len(one)))
     row = runs[(runs.case_id == case_id) & (runs.start == 2)].iloc[0]
@@ -227,9 +244,22 @@ def test_kill_9_midway_then_resume_loses_and_duplicates_nothing(tmp_path):
     cfg = peak_config(tmp_path, nmu=150, ny=8, dl=0.01)
     out = tmp_path / "out"
     proc = subprocess.Popen(
-        [sys.executable, "-m", "spine_mj.cli", "sweep", str(cfg), "--out", str(out),
-         "--workers", "2", "--quiet"],
-        stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, start_new_session=True)
+        [
+            sys.executable,
+            "-m",
+            "spine_mj.cli",
+            "sweep",
+            str(cfg),
+            "--out",
+            str(out),
+            "--workers",
+            "2",
+            "--quiet",
+        ],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        start_new_session=True,
+    )
     deadline = time.monotonic() + 60
     try:
         while time.monotonic() < deadline and proc.poll() is None:
@@ -248,8 +278,9 @@ def test_kill_9_midway_then_resume_loses_and_duplicates_nothing(tmp_path):
     summary = sweep.run_sweep(cfg, out, workers=2)
     assert summary.skipped_cases >= n_done and summary.run_cases == 150 - summary.skipped_cases
     runs = sweep.load_runs(out)
-    expected = {f"{c.case_id}-quasistatic-{i}" for c in sweep.expand_cases(sweep.load_config(cfg))
-                for i in range(8)}
+    expected = {
+        f"{c.case_id}-quasistatic-{i}" for c in sweep.expand_cases(sweep.load_config(cfg)) for i in range(8)
+    }
     assert len(runs) == len(expected) == 1200
     assert runs.run_id.is_unique and set(runs.run_id) == expected
     assert set(runs.status) == {"ok"}
@@ -266,7 +297,9 @@ def test_kill_9_midway_then_resume_loses_and_duplicates_nothing(tmp_path):
 
 def test_failing_runs_are_recorded_and_the_sweep_goes_on(tmp_path):
     (tmp_path / "broken.npz").write_bytes(b"not a zip file at all" * 10)
-    cfg = write_config(tmp_path, """
+    cfg = write_config(
+        tmp_path,
+        """
         [sweep]
         name = "failures"
         [[surfaces]]
@@ -280,7 +313,8 @@ def test_failing_runs_are_recorded_and_the_sweep_goes_on(tmp_path):
         points = [[0.05, 0.5], [0.05, 0.3]]
         [grid]
         mu = [0.5, 1.25]
-    """)
+    """,
+    )
     out = tmp_path / "out"
     summary = sweep.run_sweep(cfg, out, workers=2)
     assert summary.status_counts == {"ok": 4, "failed": 4, "bad_surface": 4}
@@ -322,8 +356,7 @@ def test_same_metrics_with_one_or_two_workers_and_on_a_dask_cluster(tmp_path):
     cfg = write_config(tmp_path, RANDOM_QS)
     sweep.run_sweep(cfg, tmp_path / "w1", workers=1)
     sweep.run_sweep(cfg, tmp_path / "w2", workers=2)
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=False,
-                      dashboard_address=None) as cluster:
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None) as cluster:
         summary = sweep.run_sweep(cfg, tmp_path / "dask", scheduler=cluster.scheduler_address)
     assert summary.workers is None and summary.run_cases == 8
     ref = metrics_frame(tmp_path / "w1")
@@ -356,22 +389,34 @@ def test_cli_sweep_status_report(tmp_path):
     assert result.exit_code == 0, result.output
     html = (tmp_path / "r.html").read_text()
     assert "data:image/png;base64," in html and "max_kappa" in html
-    for args in (["sweep", "--help"], ["sweep", "status", "--help"], ["sweep", cfg, "--help"],
-                 ["report", "--help"]):
+    for args in (
+        ["sweep", "--help"],
+        ["sweep", "status", "--help"],
+        ["sweep", cfg, "--help"],
+        ["report", "--help"],
+    ):
         result = run_cli(*args)
         assert result.exit_code == 0 and "Usage" in result.output
 
 
-@pytest.mark.parametrize("text, message", [
-    (PEAK_QS.format(name="x", nmu=2, ny=2, dl=0.02).replace("mu =", "mu_s ="),
-     "Error: config key grid.mu_s: unknown parameter"),
-    ("[sweep\n", "is not valid TOML"),
-    (PEAK_QS.format(name="x", nmu=2, ny=2, dl=-1), "Error: config key grid.dl: must be"),
-])
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        (
+            PEAK_QS.format(name="x", nmu=2, ny=2, dl=0.02).replace("mu =", "mu_s ="),
+            "Error: config key grid.mu_s: unknown parameter",
+        ),
+        ("[sweep\n", "is not valid TOML"),
+        (PEAK_QS.format(name="x", nmu=2, ny=2, dl=-1), "Error: config key grid.dl: must be"),
+    ],
+)
 def test_cli_bad_config_exits_2_with_one_line_and_writes_nothing(tmp_path, text, message):
     cfg = write_config(tmp_path, text)
-    proc = subprocess.run([sys.executable, "-m", "spine_mj.cli", "sweep", str(cfg), "--out",
-                           str(tmp_path / "out")], capture_output=True, text=True)
+    proc = subprocess.run(
+        [sys.executable, "-m", "spine_mj.cli", "sweep", str(cfg), "--out", str(tmp_path / "out")],
+        capture_output=True,
+        text=True,
+    )
     assert proc.returncode == 2
     assert len(proc.stderr.strip().splitlines()) == 1 and message in proc.stderr
     assert not (tmp_path / "out").exists()
@@ -379,13 +424,13 @@ def test_cli_bad_config_exits_2_with_one_line_and_writes_nothing(tmp_path, text,
 
 def test_cli_refuses_another_config_in_dir(tmp_path):
     out = tmp_path / "out"
-    assert run_cli("sweep", peak_config(tmp_path, nmu=2), "--out", out, "--workers", 1,
-                   "--quiet").exit_code == 0
+    assert (
+        run_cli("sweep", peak_config(tmp_path, nmu=2), "--out", out, "--workers", 1, "--quiet").exit_code == 0
+    )
     other = peak_config(tmp_path, nmu=3, name="other")
     result = run_cli("sweep", other, "--out", out, "--workers", 1)
     assert result.exit_code == 2 and "holds a sweep of another config" in result.output
-    assert run_cli("sweep", other, "--out", out, "--workers", 1, "--overwrite",
-                   "--quiet").exit_code == 0
+    assert run_cli("sweep", other, "--out", out, "--workers", 1, "--overwrite", "--quiet").exit_code == 0
     assert run_cli("sweep", "status", tmp_path / "nowhere").exit_code == 2
 
 
@@ -429,8 +474,7 @@ def test_mujoco_and_compare_runs_match_the_rig_run_directly(tmp_path):
     cmp_ = runs[runs.analysis == "compare"].set_index(["case_id", "start"])
     expected = qs.self_locked.astype(bool) == mjs.self_locked.astype(bool)
     assert (cmp_.agree_lock.astype(bool) == expected.loc[cmp_.index]).all()
-    assert (cmp_.status == np.where(mjs.status.loc[cmp_.index] == "ok", "ok",
-                                    "dependency_failed")).all()
+    assert (cmp_.status == np.where(mjs.status.loc[cmp_.index] == "ok", "ok", "dependency_failed")).all()
     ran = mjs.status.loc[cmp_.index] == "ok"
     assert cmp_.frechet[ran].notna().all() and (cmp_.frechet[ran] >= 0).all()
     # the stored run is the rig's own run at that speed

@@ -41,11 +41,14 @@ def test_ie_star_reports_when_the_grid_does_not_bracket_it():
     assert below.kind == "below" and below.high == 1e-4 and math.isnan(below.value)
 
 
-@pytest.mark.parametrize("ie, ag, match", [
-    ([1e-3, 1e-4], [1, 1], "strictly increasing"),
-    ([1e-3], [1], "same length >= 2"),
-    ([1e-3, 1e-2], [1, 1, 1], "same length >= 2"),
-])
+@pytest.mark.parametrize(
+    "ie, ag, match",
+    [
+        ([1e-3, 1e-4], [1, 1], "strictly increasing"),
+        ([1e-3], [1], "same length >= 2"),
+        ([1e-3, 1e-2], [1, 1, 1], "same length >= 2"),
+    ],
+)
 def test_ie_star_rejects_bad_grids(ie, ag, match):
     with pytest.raises(SpineInputError, match=match):
         validate.estimate_ie_star(ie, ag)
@@ -106,12 +109,17 @@ def test_slip_statistics_rejects_mismatched_arrays():
 def test_smoke_validation_writes_report_and_json(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)  # a relative --out, as `make demo` passes it
     out = tmp_path / "val"
-    res = CliRunner().invoke(main, ["validate", "--plan", "smoke", "--out", "val",
-                                    "--workers", "1"])
+    res = CliRunner().invoke(main, ["validate", "--plan", "smoke", "--out", "val", "--workers", "1"])
     assert res.exit_code == 0, res.output
     doc = json.loads((out / "validation.json").read_text())
-    for key in ("static_kappa_max_rel_error", "lowest_ie", "outcome_agreement_at_lowest_ie",
-                "mean_frechet_at_lowest_ie", "ie_star", "engine_settings"):
+    for key in (
+        "static_kappa_max_rel_error",
+        "lowest_ie",
+        "outcome_agreement_at_lowest_ie",
+        "mean_frechet_at_lowest_ie",
+        "ie_star",
+        "engine_settings",
+    ):
         assert key in doc
     assert doc["lowest_ie"] == validate.PLANS["smoke"].lowest_ie
     assert set(doc["outcome_agreement_at_lowest_ie"]) == {"single_peak_valley"}
@@ -131,10 +139,13 @@ def test_unknown_plan_is_rejected():
         validate.run_validation("unused", plan="huge")
 
 
-@pytest.mark.parametrize("args, match", [
-    (["--quick", "--plan", "smoke"], "give one of them"),
-    (["--plan", "smoke", "--out-is-file"], "is not a folder"),
-])
+@pytest.mark.parametrize(
+    "args, match",
+    [
+        (["--quick", "--plan", "smoke"], "give one of them"),
+        (["--plan", "smoke", "--out-is-file"], "is not a folder"),
+    ],
+)
 def test_cli_bad_input_is_one_line_exit_2_and_writes_nothing(tmp_path, args, match):
     target = tmp_path / "out"
     if "--out-is-file" in args:
@@ -170,8 +181,7 @@ def test_one_outlying_start_moves_the_mean_criterion_but_not_the_median():
 
 def test_bootstrap_rejects_an_unknown_statistic():
     with pytest.raises(SpineInputError, match="stat must be"):
-        validate.bootstrap_ie_star(IE, np.ones((5, 2)), np.ones((5, 2)), n_boot=2, rng=0,
-                                   stat="max")
+        validate.bootstrap_ie_star(IE, np.ones((5, 2)), np.ones((5, 2)), n_boot=2, rng=0, stat="max")
 
 
 def test_prefix_frechet_cuts_the_streamline_at_the_mujoco_arc_length():
@@ -186,15 +196,13 @@ def test_prefix_frechet_cuts_the_streamline_at_the_mujoco_arc_length():
 def test_ramp_duration_covers_the_target_from_the_measured_slip_per_cycle():
     from spine_mj import sim
 
-    rig = sim.Rig(sim.inclined_plane(slope_deg=0.0, azimuth_deg=0.0),
-                  tip=sim.TipParams(mu_s=0.5))
+    rig = sim.Rig(sim.inclined_plane(slope_deg=0.0, azimuth_deg=0.0), tip=sim.TipParams(mu_s=0.5))
     rp = validate.ramp_duration(rig, validate._PLANE_START, 1.0, target_lc=0.5, max_steps=4000)
     assert rp.ie_equivalent == pytest.approx(1.0, rel=1e-9)
     assert rp.slip_per_cycle_lc > 0 and rp.cycle_s > 0
     # three times the pilot's cycles over the target, plus one ramp to the self-lock cap
     lock_s = sim.Detection().kappa_cap * rig.scales.preload_n / rp.rate_n_s
-    assert rp.required_s == pytest.approx(3 * rp.cycle_s * 0.5 / rp.slip_per_cycle_lc + lock_s,
-                                          rel=1e-9)
+    assert rp.required_s == pytest.approx(3 * rp.cycle_s * 0.5 / rp.slip_per_cycle_lc + lock_s, rel=1e-9)
     assert rp.duration_s == pytest.approx(min(rp.required_s, 4000 * rp.timestep_s), rel=1e-3)
     assert rp.capped == (rp.required_s > 4000 * rp.timestep_s)
     assert 0 < rp.coverage_expected <= 1
