@@ -419,12 +419,7 @@ def _compare(case, surface, starts, upstream):
         mpath = r.position_m[r.drive_start_index :, :2] / s
         if mpath.shape[0] == 0:
             continue
-        spacing = lc / 50
-        frechet[i] = compare.frechet_distance(
-            compare.resample_by_arclength(qpath, spacing),
-            compare.resample_by_arclength(mpath, spacing),
-            length_scale=lc,
-        )
+        frechet[i] = compare.path_frechet(mpath, qpath, length_scale=lc)
         lateral[i] = compare.mean_lateral_deviation(mpath, qpath, length_scale=lc)
     mj_locked = np.array([r.end_reason.value == "self_lock" for r in runs])
     mj_end = np.array([r.position_m[-1, :2] / s for r in runs])

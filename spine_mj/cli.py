@@ -13,6 +13,7 @@ from pathlib import Path
 
 import click
 
+from spine_mj import engagement, presets
 from spine_mj.errors import SpineInputError
 
 INPUT_ERROR_EXIT = 2
@@ -66,17 +67,6 @@ def load_surface_arg(spec: str):
         f"SURFACE must be a .npz file, a preset ({', '.join(presets.list_presets())}) or an "
         f"instrument file, got {spec!r}"
     )
-
-
-def preset_mu(surf) -> float | None:
-    """The calibrated mu_s of the preset a surface was made from (its [engagement] table)."""
-    from spine_mj import presets
-
-    name = surf.metadata.get("preset")
-    if not name:
-        return None
-    value = presets.load_preset(name).extras.get("engagement", {}).get("mu")
-    return None if value is None else float(value)
 
 
 @surface.command("list")
@@ -435,7 +425,7 @@ def _build_rig(
     from spine_mj import sim
 
     surf = load_surface_arg(surface_spec)
-    mu = preset_mu(surf) if mu is None else mu
+    mu = presets.preset_mu(surf) if mu is None else mu
     tip = sim.TipParams(
         tip_radius_m=tip_radius, mass_kg=mass, preload_n=preload, **({} if mu is None else {"mu_s": mu})
     )
@@ -616,7 +606,7 @@ def _parse_start(text: str) -> tuple[float, float]:
 
 def _engagement_mu(surf, mu):
     if mu is None:
-        mu = preset_mu(surf)
+        mu = presets.preset_mu(surf)
     if mu is None:
         raise SpineInputError("--mu is required for a surface whose preset has no [engagement] mu")
     return mu
@@ -653,9 +643,7 @@ def kappa_cmd(surface_spec, mu, output, resolution):
     heights = surf.height(xs[None, :], ys[:, None])
     fig = kappa_map_figure({surf.metadata.get("preset", "surface"): (xs, heights, k, region)}, mu)
     save_figure(fig, output)
-    shares = ", ".join(
-        f"{n} {100 * np.mean(region == c):.1f} %" for c, n in ((0, "slip"), (1, "engaged"), (2, "self-lock"))
-    )
+    shares = ", ".join(f"{n} {100 * np.mean(region == c):.1f} %" for c, n in engagement.REGION_NAMES.items())
     click.echo(f"wrote {output} ({shares})")
 
 

@@ -30,6 +30,7 @@ __all__ = [
     "kappa_agreement",
     "mean_lateral_deviation",
     "outcome_agreement",
+    "path_frechet",
     "resample_by_arclength",
 ]
 
@@ -134,6 +135,20 @@ def resample_by_arclength(path, spacing: float) -> np.ndarray:
     target = np.linspace(0.0, s[-1], n)
     keep = np.concatenate([[True], seg > 0])
     return np.column_stack([np.interp(target, s[keep], p[keep, k]) for k in range(p.shape[1])])
+
+
+def path_frechet(path, reference, *, length_scale: float, spacing: float | None = None) -> float:
+    """Frechet distance between two recorded paths over ``L_c``, both resampled first.
+
+    The one path-deviation rule of the project: both polylines are resampled to equal
+    arc-length steps (``spacing``, default ``L_c / 50``) so that the discrete distance
+    approximates the continuous one whatever the recording density, then
+    :func:`frechet_distance` is taken in units of ``length_scale``.
+    """
+    a, b = _path("path", path), _path("reference", reference)
+    lc = _length_scale(length_scale)
+    step = lc / 50 if spacing is None else spacing
+    return frechet_distance(resample_by_arclength(b, step), resample_by_arclength(a, step), length_scale=lc)
 
 
 def _point_segment_distance(points, seg_start, seg_end):

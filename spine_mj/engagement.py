@@ -46,7 +46,7 @@ __all__ = [
 SLIP = 0
 ENGAGED = 1
 SELF_LOCK = 2
-REGION_NAMES = {SLIP: "slip", ENGAGED: "engaged", SELF_LOCK: "self-lock"}
+REGION_NAMES = {SLIP: "slip", ENGAGED: "engaged", SELF_LOCK: "self_lock"}
 
 #: Default tolerance on the scaled leading coefficient ``A'`` (dimensionless, O(1)).
 DEFAULT_TOL = 1e-12

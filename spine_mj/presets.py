@@ -40,6 +40,7 @@ __all__ = [
     "load_preset",
     "make_surface",
     "parse_override",
+    "preset_mu",
     "presets_dir",
 ]
 
@@ -118,6 +119,25 @@ def load_preset(name: str) -> Preset:
     return Preset(
         name=path.stem, generator=generator, params=params, description=description, seed=seed, extras=doc
     )
+
+
+def preset_mu(preset: Preset | str | surfaces.Surface | None) -> float | None:
+    """The calibrated friction coefficient mu_s of a preset (its ``[engagement] mu``).
+
+    ``preset`` is a :class:`Preset`, a preset name, or a surface made from a preset (its
+    ``metadata["preset"]``). ``None`` where there is no preset or it has no calibrated mu:
+    callers decide their own fallback, so no default hides here.
+    """
+    if isinstance(preset, surfaces.Surface):
+        meta = preset.metadata if isinstance(preset.metadata, dict) else {}
+        preset = meta.get("preset")
+    if not preset:
+        return None
+    if isinstance(preset, str):
+        preset = load_preset(preset)
+    engagement = preset.extras.get("engagement", {})
+    value = engagement.get("mu") if isinstance(engagement, dict) else None
+    return None if value is None else float(value)
 
 
 def _check_params(generator: str, params: dict, where: str) -> None:

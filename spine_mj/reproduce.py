@@ -17,7 +17,7 @@ from concurrent.futures import ProcessPoolExecutor
 import numpy as np
 
 from spine_mj.convexity import CONCAVE, CONVEX, SADDLE, hessian_class, sectional_class
-from spine_mj.engagement import ENGAGED, SLIP, kappa
+from spine_mj.engagement import ENGAGED, REGION_NAMES, SLIP, kappa
 from spine_mj.errors import SpineInputError
 from spine_mj.presets import load_preset
 from spine_mj.streamline import Outcome, StreamlineParams, ideal_trajectories, streamlines
@@ -149,7 +149,7 @@ def kappa_map(
         _, fx, fy = surf.evaluate(xs[None, :], xs[:, None], order=1)
         k, region = kappa(fx, fy, mu)
         maps[name] = (xs, surf.height(xs[None, :], xs[:, None]), k, region)
-        for code, label in ((0, "slip"), (1, "engaged"), (2, "self_lock")):
+        for code, label in REGION_NAMES.items():
             numbers[f"{name}_{label}_fraction"] = float(np.mean(region == code))
     if progress:
         progress(1, 1)

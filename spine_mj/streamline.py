@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from spine_mj.engagement import ENGAGED, SELF_LOCK, SLIP, kappa, slip_direction
+from spine_mj.engagement import ENGAGED, REGION_NAMES, SELF_LOCK, SLIP, kappa, slip_direction
 from spine_mj.errors import SpineInputError
 from spine_mj.surfaces import GaussianSurface, GridSurface, Surface
 
@@ -183,7 +183,7 @@ class StreamlineResult:
                 "y": self.y,
                 "z": self.z,
                 "kappa": self.kappa,
-                "region": np.array(["slip", "engaged", "self-lock"])[self.region],
+                "region": np.array([REGION_NAMES[c] for c in sorted(REGION_NAMES)])[self.region],
                 "outcome": names[self.outcome[start]],
             }
         )

@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from spine_mj.errors import SpineInputError, atomic_output
+from spine_mj.jsonio import to_jsonable
 from spine_mj.surfaces import GaussianSurface, GridSurface, Surface
 
 __all__ = ["FILL_METHODS", "import_topography", "load_surface", "save_surface", "surface_mesh", "write_stl"]
@@ -38,7 +39,7 @@ def save_surface(surface: Surface, path: str | os.PathLike) -> Path:
         "format": np.array(FORMAT),
         "unit": np.array(surface.unit),
         "bounds": np.asarray(surface.bounds, dtype=float),
-        "metadata_json": np.array(json.dumps(surface.metadata, default=_json_default)),
+        "metadata_json": np.array(json.dumps(to_jsonable(surface.metadata))),
     }
     if isinstance(surface, GridSurface):
         arrays = dict(
@@ -57,14 +58,6 @@ def save_surface(surface: Surface, path: str | os.PathLike) -> Path:
         with open(tmp, "wb") as fh:
             np.savez_compressed(fh, **common, **arrays)
     return path
-
-
-def _json_default(obj):
-    if isinstance(obj, np.generic):
-        return obj.item()
-    if isinstance(obj, np.ndarray):
-        return obj.tolist()
-    return str(obj)
 
 
 def load_surface(path: str | os.PathLike) -> Surface:

@@ -66,6 +66,7 @@ from typing import Any
 import numpy as np
 
 from spine_mj.errors import SpineInputError, atomic_output
+from spine_mj.jsonio import to_jsonable, write_json
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -285,7 +286,7 @@ class SurfaceSpec:
             "kind": self.kind,
             "source": self.source,
             "seed": self.seed,
-            "overrides": {k: _jsonable(v) for k, v in self.overrides},
+            "overrides": {k: to_jsonable(v) for k, v in self.overrides},
         }
 
     def make(self):
@@ -321,7 +322,7 @@ class StartsSpec:
         return len(self.x) * len(self.y)
 
     def as_dict(self) -> dict:
-        return {k: _jsonable(v) for k, v in dataclasses.asdict(self).items() if v is not None}
+        return {k: to_jsonable(v) for k, v in dataclasses.asdict(self).items() if v is not None}
 
     def resolve(self, bounds, seed: int) -> np.ndarray:
         """Start points ``(n_starts, 2)`` in the surface's length unit."""
@@ -386,7 +387,7 @@ class SweepConfig:
             "surfaces": [s.as_dict() for s in self.surfaces],
             "starts": self.starts.as_dict(),
             "surface_starts": [None if s is None else s.as_dict() for s in self.surface_starts],
-            "grid": {k: [_jsonable(v) for v in vals] for k, vals in self.grid},
+            "grid": {k: [to_jsonable(v) for v in vals] for k, vals in self.grid},
             "store_trajectories": self.store_trajectories,
         }
 
@@ -743,16 +744,6 @@ def _freeze(value):
     return value
 
 
-def _jsonable(value):
-    if isinstance(value, tuple):
-        return [_jsonable(v) for v in value]
-    if isinstance(value, (np.integer,)):
-        return int(value)
-    if isinstance(value, (np.floating,)):
-        return float(value)
-    return value
-
-
 def _digest(obj) -> str:
     text = json.dumps(obj, sort_keys=True, separators=(",", ":"), allow_nan=True)
     return hashlib.sha256(text.encode()).hexdigest()
@@ -814,7 +805,7 @@ def expand_cases(config: SweepConfig) -> list[Case]:
                 {
                     "surface": surf.as_dict(),
                     "starts": starts.as_dict(),
-                    "params": {k: _jsonable(v) for k, v in params.items()},
+                    "params": {k: to_jsonable(v) for k, v in params.items()},
                 }
             )[:16]
             if case_id in seen:
@@ -1074,11 +1065,6 @@ def _git_commit() -> dict:
     return {"commit": commit, "dirty": dirty}
 
 
-def _write_json(path: Path, obj) -> None:
-    with atomic_output(path) as tmp:
-        tmp.write_text(json.dumps(obj, indent=2, sort_keys=False, allow_nan=True) + "\n")
-
-
 def _read_manifest(out_dir: Path) -> dict | None:
     path = out_dir / MANIFEST
     if not path.is_file():
@@ -1131,7 +1117,7 @@ def _prepare_store(
     manifest["sessions"].append(session)
     (out_dir / RUNS_DIR).mkdir(parents=True, exist_ok=True)
     (out_dir / TRAJ_DIR).mkdir(parents=True, exist_ok=True)
-    _write_json(out_dir / MANIFEST, manifest)
+    write_json(out_dir / MANIFEST, manifest)
     return manifest
 
 

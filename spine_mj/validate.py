@@ -29,7 +29,6 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
-import json
 import math
 import os
 import time
@@ -41,7 +40,8 @@ from typing import Any
 
 import numpy as np
 
-from spine_mj.errors import SpineInputError, atomic_output
+from spine_mj.errors import SpineInputError
+from spine_mj.jsonio import write_json
 
 __all__ = [
     "IE_STAR_CRITERIA",
@@ -341,11 +341,14 @@ class _Runner:
         return sweep.load_runs(store), store
 
 
-def _preset_mu(name: str, default: float = 1.23) -> float:
+def _preset_mu(name: str) -> float:
+    """The preset's calibrated mu_s; every validation preset must carry one."""
     from spine_mj import presets
 
-    eng = presets.load_preset(name).extras.get("engagement", {})
-    return float(eng.get("mu", default)) if isinstance(eng, dict) else default
+    mu = presets.preset_mu(name)
+    if mu is None:
+        raise SpineInputError(f"preset {name!r} has no [engagement] mu; validation needs a calibrated mu_s")
+    return mu
 
 
 def _surfaces_table(presets_: Sequence[str], seeds) -> list[dict]:
@@ -393,11 +396,11 @@ def static_map(plan: ValidationPlan, runner: _Runner, *, mu: float = 0.5) -> dic
         the max and mean ``|kappa_mj / kappa - 1|`` over the engaged planes and the region
         agreement; ``static_kappa_max_rel_error`` of the default (first) setting.
     """
-    from spine_mj import sim, surface_io
+    from spine_mj import engagement, sim, surface_io
 
     runner.study = "static"
     surf_dir = runner.out_dir / "surfaces"
-    region_names = {0: "slip", 1: "engaged", 2: "self_lock"}
+    region_names = engagement.REGION_NAMES
     rows = []
     engines = plan.static_engines
     for slope in plan.slopes_deg:
@@ -575,13 +578,8 @@ def _path_metrics(mpath: np.ndarray, qpath: np.ndarray, lc: float) -> tuple[floa
 
     if mpath.shape[0] < 2 or qpath.shape[0] < 2:
         return float("nan"), float("nan")
-    spacing = lc / 50
-    fr = compare.frechet_distance(
-        compare.resample_by_arclength(qpath, spacing),
-        compare.resample_by_arclength(mpath, spacing),
-        length_scale=lc,
-    )
-    return float(fr), float(compare.mean_lateral_deviation(mpath, qpath, length_scale=lc))
+    fr = compare.path_frechet(mpath, qpath, length_scale=lc)
+    return fr, float(compare.mean_lateral_deviation(mpath, qpath, length_scale=lc))
 
 
 def _mujoco_paths(store: Path, case_id: str) -> dict[int, np.ndarray]:
@@ -1151,13 +1149,7 @@ def _prefix_frechet(mpath: np.ndarray, qpath: np.ndarray, lc: float) -> float:
     from spine_mj import compare
 
     spacing = max(min(lc / 50, arc_m / 20), 1e-9 * lc)
-    return float(
-        compare.frechet_distance(
-            compare.resample_by_arclength(q, spacing),
-            compare.resample_by_arclength(mpath, spacing),
-            length_scale=lc,
-        )
-    )
+    return compare.path_frechet(mpath, q, length_scale=lc, spacing=spacing)
 
 
 def _paths_of(store: Path, case_id: str, analysis: str) -> dict[int, np.ndarray]:
@@ -1726,21 +1718,5 @@ def run_validation(
 
     _validate_report.write(out, result, static=st, limit=lim, boundary=bnd, stick=ss, sand=sp)
     result["timings_s"]["total"] = round(time.perf_counter() - t0, 2)
-    with atomic_output(out / "validation.json") as tmp:
-        tmp.write_text(json.dumps(_jsonable(result), indent=2) + "\n")
+    write_json(out / "validation.json", result)
     return result
-
-
-def _jsonable(obj):
-    if isinstance(obj, dict):
-        return {str(k): _jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_jsonable(v) for v in obj]
-    if isinstance(obj, (np.floating, float)):
-        v = float(obj)
-        return v if math.isfinite(v) else (None if math.isnan(v) else str(v))
-    if isinstance(obj, (np.integer,)):
-        return int(obj)
-    if isinstance(obj, np.bool_):
-        return bool(obj)
-    return obj
