@@ -228,14 +228,8 @@ def _rig(spec, key):
         preload_n=p["preload"],
         gravity_m_s2=p["gravity"],
     )
-    # a first rig gives the scales that the default engine settings derive from
-    probe = sim.Rig(
-        surface,
-        tip=tip,
-        length_scale_m=p["length_scale"],
-        engine=sim.EngineSettings(
-            timestep_s=1e-3, solref=(2e-3, 1.0), hfield_resolution=p["hfield_resolution"]
-        ),
+    scales = sim.Scales.for_surface(
+        surface, tip=tip, length_scale_m=p["length_scale"], hfield_resolution=p["hfield_resolution"]
     )
     overrides = {
         "integrator": p["integrator"],
@@ -246,11 +240,11 @@ def _rig(spec, key):
     }
     if p["timestep"] is not None:
         overrides["timestep_s"] = p["timestep"]
-    dt = p["timestep"] if p["timestep"] is not None else sim.default_engine(probe.scales).timestep_s
+    dt = p["timestep"] if p["timestep"] is not None else sim.default_engine(scales).timestep_s
     tc = p["solref_timeconst"] if p["solref_timeconst"] is not None else 2 * dt
     overrides["solref"] = (tc, p["solref_dampratio"])
-    engine = sim.default_engine(probe.scales, **overrides)
-    return sim.Rig(surface, tip=probe.tip, engine=engine, length_scale_m=p["length_scale"])
+    engine = sim.default_engine(scales, **overrides)
+    return sim.Rig(surface, tip=tip, engine=engine, length_scale_m=p["length_scale"])
 
 
 def _mujoco(case, surface, starts, upstream):

@@ -439,12 +439,9 @@ def _build_rig(
         )
         if v is not None
     }
-    rig = sim.Rig(surf, tip=tip, length_scale_m=length_scale)
-    if overrides:
-        rig = sim.Rig(
-            surf, tip=tip, length_scale_m=length_scale, engine=sim.default_engine(rig.scales, **overrides)
-        )
-    return rig
+    scales = sim.Scales.for_surface(surf, tip=tip, length_scale_m=length_scale, hfield_resolution=resolution)
+    engine = sim.default_engine(scales, **overrides)
+    return sim.Rig(surf, tip=tip, length_scale_m=length_scale, engine=engine)
 
 
 @main.group("sim", cls=_Group)

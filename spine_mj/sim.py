@@ -52,7 +52,7 @@ from pathlib import Path
 import numpy as np
 
 from spine_mj.errors import SpineInputError, atomic_output, check_positive
-from spine_mj.surfaces import GaussianSurface, GridSurface, Surface, to_hfield
+from spine_mj.surfaces import GaussianSurface, GridSurface, HField, Surface, to_hfield
 
 __all__ = [
     "Cone",
@@ -70,6 +70,8 @@ __all__ = [
     "TipParams",
     "characteristic_length",
     "default_engine",
+    "hfield_of",
+    "hfield_spacing",
     "inclined_plane",
 ]
 
@@ -246,7 +248,7 @@ class EngineSettings:
 
 @dataclass(frozen=True)
 class Scales:
-    """The problem's scales, all in SI units.
+    """The problem's scales, all in SI units; :meth:`for_surface` derives them.
 
     Attributes
     ----------
@@ -258,6 +260,9 @@ class Scales:
         m_eff [kg], F_p [N], tip radius [m].
     hfield_spacing_m : float
         Larger of the hfield's two sample spacings [m].
+    hfield_resolution : int or None
+        Samples a side the hfield is resampled to (None: a grid keeps its own samples,
+        an analytic surface gets :func:`spine_mj.surfaces.to_hfield`'s default).
     """
 
     length_scale_m: float
@@ -266,6 +271,74 @@ class Scales:
     preload_n: float
     tip_radius_m: float
     hfield_spacing_m: float
+    hfield_resolution: int | None = None
+
+    @classmethod
+    def for_surface(
+        cls,
+        surface: Surface,
+        *,
+        tip: TipParams | None = None,
+        length_scale_m: float | None = None,
+        char_length_m: float | None = None,
+        hfield_resolution: int | None = None,
+    ) -> Scales:
+        """The scales of ``tip`` on ``surface``: the one place the rig's sizing rules live.
+
+        * ``length_scale_m``: None gives :data:`DEFAULT_LENGTH_SCALE_M` for a dimensionless
+          surface (``unit == "1"``) and 1 for one in metres.
+        * ``char_length_m``: None gives :func:`characteristic_length` in metres.
+        * tip radius (when ``tip.tip_radius_m`` is None): the surface's own
+          ``metadata["params"]["tip_radius_m"]`` (sandpaper), else the larger of one hfield
+          spacing and ``L_c / 100``, to 3 significant digits.
+        * hfield resolution: an hfield finer than a quarter tip radius is coarsened to that
+          (MuJoCo keeps at most 50 contacts per geom pair: a tip over too many cells loses
+          its deepest contacts).
+
+        Raises
+        ------
+        SpineInputError
+            A surface in a unit other than "1" or "m", non-positive scales, or an hfield
+            coarser than two tip radii (the sphere would see single facets and their kinks).
+        """
+        if not isinstance(surface, Surface):
+            raise SpineInputError(f"surface must be a spine_mj Surface, got {type(surface).__name__}")
+        tip = TipParams() if tip is None else tip
+        if surface.unit not in ("1", "m"):
+            raise SpineInputError(f"surface unit must be '1' (dimensionless) or 'm', got {surface.unit!r}")
+        if length_scale_m is None:
+            length_scale_m = DEFAULT_LENGTH_SCALE_M if surface.unit == "1" else 1.0
+        length_scale_m = check_positive("length_scale_m", length_scale_m)
+        if char_length_m is None:
+            char_length_m = characteristic_length(surface) * length_scale_m
+        char_length_m = check_positive("char_length_m", char_length_m)
+        resolution = hfield_resolution
+        hf = hfield_of(surface, resolution)
+        spacing = hfield_spacing(hf, length_scale_m)
+        radius = tip.tip_radius_m
+        if radius is None:
+            params = surface.metadata.get("params", {}) if isinstance(surface.metadata, dict) else {}
+            radius = params.get("tip_radius_m") if surface.unit == "m" else None
+            radius = float(radius) if radius else max(spacing, 0.01 * char_length_m)
+            radius = float(f"{radius:.3g}")
+        if resolution is None and spacing < _MIN_SPACING_PER_TIP_RADIUS * radius:
+            extent = 2 * max(hf.size[0], hf.size[1]) * length_scale_m
+            resolution = math.ceil(extent / (_MIN_SPACING_PER_TIP_RADIUS * radius)) + 1
+            spacing = hfield_spacing(hfield_of(surface, resolution), length_scale_m)
+        if spacing > 2 * radius * (1 + 1e-9):
+            raise SpineInputError(
+                f"surface too coarse for the tip: hfield spacing {spacing:.3g} m > 2 x tip_radius_m "
+                f"= {2 * radius:.3g} m; raise hfield_resolution or the tip radius"
+            )
+        return cls(
+            length_scale_m=length_scale_m,
+            char_length_m=char_length_m,
+            mass_kg=tip.mass_kg,
+            preload_n=tip.preload_total_n,
+            tip_radius_m=radius,
+            hfield_spacing_m=spacing,
+            hfield_resolution=resolution,
+        )
 
     @property
     def time_s(self) -> float:
@@ -280,6 +353,21 @@ class Scales:
     def inertia_number(self, speed_m_s: float) -> float:
         """I_e = m v^2 / (F_p L_c) (paper §2.2)."""
         return self.mass_kg * speed_m_s**2 / (self.preload_n * self.char_length_m)
+
+    def speed_for(self, inertia_number: float) -> float:
+        """The drive speed [m/s] of inertia number ``inertia_number`` (inverse of I_e)."""
+        return math.sqrt(inertia_number) * self.speed_m_s
+
+
+def hfield_of(surface: Surface, resolution: int | None = None) -> HField:
+    """The surface as MuJoCo hfield data, resampled to ``resolution`` a side when given."""
+    return to_hfield(surface, nrow=resolution, ncol=resolution) if resolution else to_hfield(surface)
+
+
+def hfield_spacing(hfield: HField, length_scale_m: float = 1.0) -> float:
+    """The larger of an hfield's two sample spacings, in metres."""
+    rx, ry = hfield.size[0], hfield.size[1]
+    return length_scale_m * 2 * max(rx / (hfield.ncol - 1), ry / (hfield.nrow - 1))
 
 
 def characteristic_length(surface: Surface) -> float:
@@ -318,7 +406,7 @@ def default_engine(scales: Scales, **overrides) -> EngineSettings:
     dt = math.sqrt(_REST_PENETRATION_FRACTION * length * scales.mass_kg / scales.preload_n)
     dt = min(_MAX_TIMESTEP_S, dt)
     dt = float(f"{dt:.2g}")
-    base = {"timestep_s": dt, "solref": (2 * dt, 1.0)}
+    base = {"timestep_s": dt, "solref": (2 * dt, 1.0), "hfield_resolution": scales.hfield_resolution}
     if "timestep_s" in overrides and "solref" not in overrides:
         base["solref"] = (2 * float(overrides["timestep_s"]), 1.0)
     base.update(overrides)
@@ -641,48 +729,21 @@ class Rig:
         if not isinstance(surface, Surface):
             raise SpineInputError(f"surface must be a spine_mj Surface, got {type(surface).__name__}")
         tip = TipParams() if tip is None else tip
-        if surface.unit not in ("1", "m"):
-            raise SpineInputError(f"surface unit must be '1' (dimensionless) or 'm', got {surface.unit!r}")
-        if length_scale_m is None:
-            length_scale_m = DEFAULT_LENGTH_SCALE_M if surface.unit == "1" else 1.0
-        length_scale_m = check_positive("length_scale_m", length_scale_m)
-        if char_length_m is None:
-            char_length_m = characteristic_length(surface) * length_scale_m
-        char_length_m = check_positive("char_length_m", char_length_m)
-        resolution = engine.hfield_resolution if engine is not None else None
-        hf = to_hfield(surface, nrow=resolution, ncol=resolution) if resolution else to_hfield(surface)
-        spacing = length_scale_m * 2 * max(hf.size[0] / (hf.ncol - 1), hf.size[1] / (hf.nrow - 1))
-        if tip.tip_radius_m is None:
-            params = surface.metadata.get("params", {}) if isinstance(surface.metadata, dict) else {}
-            r = params.get("tip_radius_m") if surface.unit == "m" else None
-            r = float(r) if r else max(spacing, 0.01 * char_length_m)
-            tip = dataclasses.replace(tip, tip_radius_m=float(f"{r:.3g}"))
-        if resolution is None and spacing < _MIN_SPACING_PER_TIP_RADIUS * tip.tip_radius_m:
-            # MuJoCo keeps at most 50 contacts per geom pair: a tip over too many hfield cells
-            # loses its deepest contacts, so coarsen the hfield to ~R/4 (recorded in engine)
-            extent = 2 * max(hf.size[0], hf.size[1]) * length_scale_m
-            resolution = math.ceil(extent / (_MIN_SPACING_PER_TIP_RADIUS * tip.tip_radius_m)) + 1
-            hf = to_hfield(surface, nrow=resolution, ncol=resolution)
-            spacing = length_scale_m * 2 * max(hf.size[0] / (hf.ncol - 1), hf.size[1] / (hf.nrow - 1))
-            if engine is not None:
-                engine = dataclasses.replace(engine, hfield_resolution=resolution)
-        if spacing > 2 * tip.tip_radius_m * (1 + 1e-9):
-            raise SpineInputError(
-                f"surface too coarse for the tip: hfield spacing {spacing:.3g} m > 2 x tip_radius_m "
-                f"= {2 * tip.tip_radius_m:.3g} m; raise hfield_resolution or the tip radius"
-            )
-        self.surface = surface
-        self.tip = tip
-        self.length_scale_m = length_scale_m
-        self.scales = Scales(
+        self.scales = Scales.for_surface(
+            surface,
+            tip=tip,
             length_scale_m=length_scale_m,
             char_length_m=char_length_m,
-            mass_kg=tip.mass_kg,
-            preload_n=tip.preload_total_n,
-            tip_radius_m=tip.tip_radius_m,
-            hfield_spacing_m=spacing,
+            hfield_resolution=engine.hfield_resolution if engine is not None else None,
         )
-        self.engine = default_engine(self.scales, hfield_resolution=resolution) if engine is None else engine
+        resolution = self.scales.hfield_resolution
+        if engine is not None and engine.hfield_resolution != resolution:
+            engine = dataclasses.replace(engine, hfield_resolution=resolution)
+        self.surface = surface
+        self.tip = dataclasses.replace(tip, tip_radius_m=self.scales.tip_radius_m)
+        self.length_scale_m = length_scale_m = self.scales.length_scale_m
+        self.engine = default_engine(self.scales) if engine is None else engine
+        self.hfield = hf = hfield_of(surface, resolution)
         self.hfield = hf
         xmin, xmax, ymin, ymax = surface.bounds
         self.bounds_m = tuple(length_scale_m * b for b in (xmin, xmax, ymin, ymax))
@@ -755,11 +816,7 @@ class Rig:
         """Replace the surface (same grid size) and recompile in place (``spec.recompile``)."""
         import mujoco
 
-        hf = (
-            to_hfield(surface, nrow=self.engine.hfield_resolution, ncol=self.engine.hfield_resolution)
-            if self.engine.hfield_resolution
-            else to_hfield(surface)
-        )
+        hf = hfield_of(surface, self.engine.hfield_resolution)
         if (hf.nrow, hf.ncol) != (self.hfield.nrow, self.hfield.ncol):
             raise SpineInputError(
                 f"set_surface needs a {self.hfield.nrow} x {self.hfield.ncol} hfield, "

@@ -42,6 +42,7 @@ import numpy as np
 
 from spine_mj.errors import SpineInputError
 from spine_mj.jsonio import write_json
+from spine_mj.surfaces import single_gaussian
 
 __all__ = [
     "IE_STAR_CRITERIA",
@@ -502,19 +503,19 @@ def _family_doc(
 
 
 def _tip_radius(preset: str, seeds, resolution: int) -> float:
-    """The rig's default tip radius (one hfield spacing, at least L_c / 100) in surface units,
-    so that the quasistatic streamline runs on the surface traced by the same sphere."""
+    """The rig's default tip radius (:meth:`spine_mj.sim.Scales.for_surface`) in surface
+    units, so that the quasistatic streamline runs on the surface traced by the same sphere.
+    A grid keeps its own samples here; ``resolution`` applies to analytic surfaces."""
     from spine_mj import presets, sim
-    from spine_mj.surfaces import GridSurface, to_hfield
+    from spine_mj.surfaces import GridSurface
 
     surface = presets.make_surface(preset, **({} if seeds is None else {"seed": seeds[0]}))
-    hf = (
-        to_hfield(surface)
-        if isinstance(surface, GridSurface)
-        else to_hfield(surface, nrow=resolution, ncol=resolution)
+    scales = sim.Scales.for_surface(
+        surface,
+        tip=sim.TipParams(mass_kg=MASS_KG),
+        hfield_resolution=None if isinstance(surface, GridSurface) else resolution,
     )
-    spacing = 2 * max(hf.size[0] / (hf.ncol - 1), hf.size[1] / (hf.nrow - 1))
-    return float(f"{max(spacing, 0.01 * sim.characteristic_length(surface)):.3g}")
+    return float(f"{scales.tip_radius_m / scales.length_scale_m:.3g}")
 
 
 def _engine_grid(
@@ -528,13 +529,8 @@ def _engine_grid(
     if "timestep_factor" in ov or "solref_timeconst_factor" in ov:
         surface = presets.make_surface(preset, **({} if seeds is None else {"seed": seeds[0]}))
         unit_m = sim.DEFAULT_LENGTH_SCALE_M if surface.unit == "1" else 1.0
-        scales = sim.Scales(
-            length_scale_m=unit_m,
-            char_length_m=sim.characteristic_length(surface) * unit_m,
-            mass_kg=MASS_KG,
-            preload_n=MASS_KG * GRAVITY,
-            tip_radius_m=tip * unit_m,
-            hfield_spacing_m=tip * unit_m,
+        scales = sim.Scales.for_surface(
+            surface, tip=sim.TipParams(tip_radius_m=tip * unit_m, mass_kg=MASS_KG)
         )
         dt = sim.default_engine(scales).timestep_s
         dt_new = dt * float(ov.pop("timestep_factor", 1.0))
@@ -1061,13 +1057,9 @@ def _pilot_rig(preset: str, seed, mu: float, tip: float, resolution: int):
     surface = presets.make_surface(preset, **({} if seed is None else {"seed": int(seed)}))
     unit_m = sim.DEFAULT_LENGTH_SCALE_M if surface.unit == "1" else 1.0
     tp = sim.TipParams(tip_radius_m=tip * unit_m, mass_kg=MASS_KG, mu_s=mu)
-    probe = sim.Rig(
-        surface,
-        tip=tp,
-        engine=sim.EngineSettings(timestep_s=1e-3, solref=(2e-3, 1.0), hfield_resolution=resolution),
-    )
-    engine = sim.default_engine(probe.scales, hfield_resolution=resolution)
-    return sim.Rig(surface, tip=probe.tip, engine=engine), unit_m
+    scales = sim.Scales.for_surface(surface, tip=tp, hfield_resolution=resolution)
+    engine = sim.default_engine(scales, hfield_resolution=resolution)
+    return sim.Rig(surface, tip=tp, engine=engine), unit_m
 
 
 def ramp_duration(
@@ -1694,13 +1686,8 @@ def run_validation(
                 k: (v.value if hasattr(v, "value") else v)
                 for k, v in dataclasses.asdict(
                     sim.default_engine(
-                        sim.Scales(
-                            length_scale_m=0.01,
-                            char_length_m=0.015,
-                            mass_kg=MASS_KG,
-                            preload_n=MASS_KG * GRAVITY,
-                            tip_radius_m=5e-4,
-                            hfield_spacing_m=5e-4,
+                        sim.Scales.for_surface(
+                            single_gaussian(), tip=sim.TipParams(tip_radius_m=5e-4, mass_kg=MASS_KG)
                         )
                     )
                 ).items()

@@ -401,3 +401,23 @@ def test_fine_grid_is_coarsened_to_respect_the_contact_cap():
     for start in [(0.0, 0.0), (-1e-4, 5e-5), (1e-4, -1e-4)]:
         z = rig.place(*start)[2]
         assert surf.height(*start) < z < surf.heights.max() + 2 * 25e-6
+
+
+def test_scales_for_surface_are_the_rigs_scales_without_building_a_model():
+    """Scales.for_surface is the one sizing rule: a rig's scales equal it, and the default
+    tip radius is max(one hfield spacing, L_c / 100) in metres for a dimensionless surface."""
+    from spine_mj.sim import DEFAULT_LENGTH_SCALE_M, Scales, characteristic_length
+
+    surf = single_gaussian()
+    tip = TipParams(mass_kg=0.02)
+    scales = Scales.for_surface(surf, tip=tip, hfield_resolution=101)
+    rig = Rig(
+        surf, tip=tip, engine=EngineSettings(timestep_s=1e-3, solref=(2e-3, 1.0), hfield_resolution=101)
+    )
+    assert scales == rig.scales
+    lc_m = characteristic_length(surf) * DEFAULT_LENGTH_SCALE_M
+    spacing_m = 10 / 100 * DEFAULT_LENGTH_SCALE_M
+    assert scales.char_length_m == pytest.approx(lc_m, rel=1e-12)
+    assert scales.hfield_spacing_m == pytest.approx(spacing_m, rel=1e-12)
+    assert scales.tip_radius_m == pytest.approx(max(spacing_m, lc_m / 100), rel=1e-3)
+    assert scales.inertia_number(scales.speed_for(3e-4)) == pytest.approx(3e-4, rel=1e-12)
