@@ -9,12 +9,28 @@ callbacks.
 from __future__ import annotations
 
 import json
+import os
+import sys
 from pathlib import Path
 
 import click
+import numpy as np
+import pandas as pd
+from tqdm import tqdm
 
-from spine_mj import engagement, presets
-from spine_mj.errors import SpineInputError
+from spine_mj import engagement, presets, reproduce, sim, surface_io, validate
+from spine_mj import sweep as sw
+from spine_mj.engagement import kappa
+from spine_mj.errors import SpineInputError, atomic_output
+from spine_mj.plotting import (
+    kappa_map_figure,
+    save_figure,
+    sim_run_figure,
+    streamline_figure,
+    surface_preview,
+)
+from spine_mj.streamline import StreamlineParams, dilate, ideal_trajectories, streamlines
+from spine_mj.surfaces import to_hfield
 
 INPUT_ERROR_EXIT = 2
 
@@ -54,7 +70,6 @@ def surface():
 
 def load_surface_arg(spec: str):
     """A SURFACE argument: a saved .npz, a preset name, or an instrument file."""
-    from spine_mj import presets, surface_io
 
     path = Path(spec)
     if path.suffix == ".npz":
@@ -72,7 +87,6 @@ def load_surface_arg(spec: str):
 @surface.command("list")
 def surface_list():
     """List the surface presets in surfaces/."""
-    from spine_mj import presets
 
     for name in presets.list_presets():
         click.echo(f"{name:24s} {presets.load_preset(name).description}")
@@ -116,7 +130,6 @@ def surface_make(preset, from_file, output, seed, hurst, sets, fill, no_level, s
       spine-mj surface make paper-fractal --hurst 0.7 --seed 3 -o fractal.npz
       spine-mj surface make --from-file scan.plu --fill harmonic -o scan.npz
     """
-    from spine_mj import presets, surface_io
 
     if (preset is None) == (from_file is None):
         raise SpineInputError("give exactly one of PRESET or --from-file")
@@ -135,8 +148,6 @@ def surface_make(preset, from_file, output, seed, hurst, sets, fill, no_level, s
         _check_suffix(png, ".png", "--png")
     surface_io.save_surface(surf, output)
     if png:
-        from spine_mj.plotting import save_figure, surface_preview
-
         save_figure(surface_preview(surf), png)
     click.echo(f"wrote {output}" + (f" and {png}" if png else ""))
 
@@ -156,7 +167,6 @@ def surface_show(surface_file, output):
     Example:
       spine-mj surface show fractal.npz -o fractal.png
     """
-    from spine_mj.plotting import save_figure, surface_preview
 
     _check_suffix(output, ".png", "-o/--output")
     surf = load_surface_arg(surface_file)
@@ -196,11 +206,6 @@ def surface_export(surface_file, stl, stl_scale, base_thickness, hfield, resolut
     Example:
       spine-mj surface export fractal.npz --stl fractal.stl --hfield fractal-hfield.npz
     """
-    import numpy as np
-
-    from spine_mj import surface_io
-    from spine_mj.errors import atomic_output
-    from spine_mj.surfaces import to_hfield
 
     if not stl and not hfield:
         raise SpineInputError("nothing to export: give --stl and/or --hfield")
@@ -275,7 +280,6 @@ def sweep_run(config, out_dir, workers, scheduler, overwrite, retry_failed, quie
     Example:
       spine-mj sweep analysis/sweeps/paper-quasistatic.toml --out runs/qs --workers 4
     """
-    from spine_mj import sweep as sw
 
     cfg = sw.load_config(config)
     bar = None
@@ -285,10 +289,6 @@ def sweep_run(config, out_dir, workers, scheduler, overwrite, retry_failed, quie
         if quiet:
             return
         if bar is None:
-            import sys
-
-            from tqdm import tqdm
-
             tqdm.monitor_interval = 0  # no monitor thread: a single-threaded CLI forks its workers
             bar = tqdm(
                 total=p.total_cases,
@@ -344,7 +344,6 @@ def sweep_status(out_dir):
     Example:
       spine-mj sweep status runs/qs
     """
-    from spine_mj import sweep as sw
 
     st = sw.store_status(out_dir)
     runs = sum(st.status_counts.values())
@@ -371,7 +370,6 @@ def report(out_dir, output):
     Example:
       spine-mj report runs/qs -o qs-report.html
     """
-    from spine_mj import sweep as sw
 
     _check_suffix(output, ".html", "-o/--output")
     sw.write_report(out_dir, output)
@@ -422,7 +420,6 @@ def _rig_options(f):
 def _build_rig(
     surface_spec, tip_radius, mass, mu, preload, length_scale, resolution, timestep, noslip, impratio
 ):
-    from spine_mj import sim
 
     surf = load_surface_arg(surface_spec)
     mu = presets.preset_mu(surf) if mu is None else mu
@@ -498,13 +495,9 @@ def simulate(
     Example:
       spine-mj simulate paper-single-peak --start -3,-1 --drive spring --speed 0.05 -o out/
     """
-    import os
 
     if render:
         os.environ.setdefault("MUJOCO_GL", "egl")
-    from spine_mj import sim
-    from spine_mj.errors import atomic_output
-    from spine_mj.plotting import save_figure, sim_run_figure
 
     x0, y0 = _parse_start(start)
     rig = _build_rig(surface_spec, **rig_opts)
@@ -539,9 +532,6 @@ def simulate(
 
 
 def _render_mp4(rig, result, path: Path) -> None:
-    import os
-
-    from spine_mj.errors import atomic_output
 
     try:
         import imageio.v2 as imageio
@@ -566,8 +556,6 @@ def _render_mp4(rig, result, path: Path) -> None:
 @_rig_options
 def view(surface_spec, **rig_opts):
     """Open the rig on SURFACE in MuJoCo's interactive viewer (needs a display)."""
-    import os
-    import sys
 
     if sys.platform.startswith("linux") and not (
         os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
@@ -624,10 +612,6 @@ def kappa_cmd(surface_spec, mu, output, resolution):
     Example:
       spine-mj kappa paper-single-peak --mu 1.2 -o map.png
     """
-    import numpy as np
-
-    from spine_mj.engagement import kappa
-    from spine_mj.plotting import kappa_map_figure, save_figure
 
     _check_suffix(output, ".png", "-o/--output")
     surf = load_surface_arg(surface_spec)
@@ -682,11 +666,6 @@ def streamline_cmd(surface_spec, mu, starts, dl, tip_radius, fmt, out_dir):
     Example:
       spine-mj streamline paper-single-valley --mu 1.2 --start -3,-1 --start -3,-2 -o out/
     """
-    import pandas as pd
-
-    from spine_mj.errors import atomic_output
-    from spine_mj.plotting import save_figure, streamline_figure
-    from spine_mj.streamline import StreamlineParams, dilate, ideal_trajectories, streamlines
 
     pts = [_parse_start(s) for s in starts]
     surf = load_surface_arg(surface_spec)
@@ -754,9 +733,6 @@ def reproduce_cmd(name, out_dir, quick, surfaces, workers):
     Example:
       spine-mj reproduce single-peak --out repro/
     """
-    from spine_mj import reproduce
-    from spine_mj.errors import atomic_output
-    from spine_mj.plotting import save_figure
 
     options = {}
     if name == "fractal-hurst":
@@ -821,9 +797,6 @@ def validate_cmd(out_dir, quick, plan_name, workers, quiet):
     Example:
       spine-mj validate --quick --out demo-out
     """
-    import sys
-
-    from spine_mj import validate
 
     if plan_name is not None and quick and plan_name != "quick":
         raise SpineInputError(f"--quick and --plan {plan_name}: give one of them")

@@ -245,68 +245,22 @@ def random_gaussian(
         }
     }
     scatter = {}
+    options = dict(
+        mu=mu,
+        n_runs=n_runs,
+        starts=starts,
+        kappa_cap=kappa_cap,
+        max_kappa=max_kappa,
+        dl=dl,
+        x0_offset=x0_offset,
+        seed=seed,
+        quick=quick,
+    )
     for k, (name, preset) in enumerate(
         (("convex", "paper-random-convex"), ("concave", "paper-random-concave"))
     ):
-        eng, rep, pre = _settings(preset)
-        m = float(mu if mu is not None else eng["mu"])
-        runs = int(n_runs if n_runs is not None else rep.get("n_runs", 100))
-        mode = str(starts if starts is not None else rep.get("starts", "surfaces"))
-        cap = kappa_cap if kappa_cap is not None else rep.get("kappa_cap")
-        conv = str(max_kappa if max_kappa is not None else rep.get("max_kappa", "inf"))
-        off = float(x0_offset if x0_offset is not None else rep.get("x0_offset", 1e-9))
-        if mode not in ("surfaces", "edge"):
-            raise SpineInputError(f"starts must be 'surfaces' or 'edge', got {mode!r}")
-        if conv not in ("inf", "finite"):
-            raise SpineInputError(f"max_kappa must be 'inf' or 'finite', got {conv!r}")
-        if quick:
-            runs = min(runs, 30)
-        step = float(dl if dl is not None else rep.get("dl", 0.015))
-        gen = dict(pre.params, **params)
-        if "k_range" in rep and "k_range" not in params:
-            gen["k_range"] = rep["k_range"]
-        if gen.get("k_range") is None:
-            gen.pop("k_range", None)
-        seed0 = int(seed if seed is not None else (pre.seed or 0))
-        params_s = StreamlineParams(mu=m, dl=step)
-        seeds = range(seed0, seed0 + runs) if mode == "surfaces" else [seed0]
-        store = conv == "finite"
-        ideal_max, stream_max, ideal_lock, stream_lock, slip_start = [], [], [], [], 0
-        for s in seeds:
-            surf = _random_surface(gen, s)
-            xmin, _, ymin, ymax = surf.bounds
-            if mode == "surfaces":
-                pts = np.array([(xmin + off, float(rep.get("y0", 0.0)))])
-            else:
-                ys = ymin + (ymax - ymin) * (np.arange(runs) + 0.5) / runs
-                pts = np.c_[np.full(runs, xmin + off), ys]
-            _, fx0, fy0 = surf.evaluate(pts[:, 0], pts[:, 1], order=1)
-            slip_start += int((kappa(fx0, fy0, m)[1] == SLIP).sum())
-            ri = ideal_trajectories(surf, pts, params_s, store_paths=store)
-            rs = streamlines(surf, pts, params_s, store_paths=store)
-            ideal_max.append(_max_kappa(ri, conv))
-            stream_max.append(_max_kappa(rs, conv))
-            ideal_lock.append(ri.self_locked)
-            stream_lock.append(rs.self_locked)
-        ideal_max, stream_max = np.concatenate(ideal_max), np.concatenate(stream_max)
-        ranked = []
-        for v in (ideal_max, stream_max):
-            v = np.where(np.isnan(v), 0.0, v)
-            ranked.append(np.minimum(v, float(cap)) if cap is not None else v)
-        med_i, med_s = float(np.median(ranked[0])), float(np.median(ranked[1]))
-        numbers[f"{name}_mu"] = m
-        numbers[f"{name}_runs"] = runs
-        numbers[f"{name}_starts"] = mode
-        numbers[f"{name}_dl"] = step
-        numbers[f"{name}_x0_offset"] = off
-        numbers[f"{name}_max_kappa"] = conv
-        numbers[f"{name}_kappa_cap"] = cap
-        numbers[f"{name}_median_ideal"] = med_i
-        numbers[f"{name}_median_streamline"] = med_s
-        numbers[f"{name}_self_locked_ideal"] = int(np.concatenate(ideal_lock).sum())
-        numbers[f"{name}_self_locked_streamline"] = int(np.concatenate(stream_lock).sum())
-        numbers[f"{name}_starts_in_slip"] = slip_start
-        scatter[name] = (ideal_max, stream_max)
+        family, scatter[name] = _random_family(preset, params, **options)
+        numbers.update({f"{name}_{key}": value for key, value in family.items()})
         if progress:
             progress(k + 1, 2)
     for key, name in (("bypass_change", "convex"), ("trap_change", "concave")):
@@ -317,6 +271,73 @@ def random_gaussian(
     from spine_mj.plotting import random_gaussian_figure
 
     return numbers, random_gaussian_figure(scatter, numbers)
+
+
+def _random_family(
+    preset: str, params: dict, *, mu, n_runs, starts, kappa_cap, max_kappa, dl, x0_offset, seed, quick
+) -> tuple[dict, tuple[np.ndarray, np.ndarray]]:
+    """One family of :func:`random_gaussian`: its numbers (keys without the family
+    prefix) and the (ideal, streamline) max-kappa scatter."""
+    eng, rep, pre = _settings(preset)
+    m = float(mu if mu is not None else eng["mu"])
+    runs = int(n_runs if n_runs is not None else rep.get("n_runs", 100))
+    mode = str(starts if starts is not None else rep.get("starts", "surfaces"))
+    cap = kappa_cap if kappa_cap is not None else rep.get("kappa_cap")
+    conv = str(max_kappa if max_kappa is not None else rep.get("max_kappa", "inf"))
+    off = float(x0_offset if x0_offset is not None else rep.get("x0_offset", 1e-9))
+    if mode not in ("surfaces", "edge"):
+        raise SpineInputError(f"starts must be 'surfaces' or 'edge', got {mode!r}")
+    if conv not in ("inf", "finite"):
+        raise SpineInputError(f"max_kappa must be 'inf' or 'finite', got {conv!r}")
+    if quick:
+        runs = min(runs, 30)
+    step = float(dl if dl is not None else rep.get("dl", 0.015))
+    gen = dict(pre.params, **params)
+    if "k_range" in rep and "k_range" not in params:
+        gen["k_range"] = rep["k_range"]
+    if gen.get("k_range") is None:
+        gen.pop("k_range", None)
+    seed0 = int(seed if seed is not None else (pre.seed or 0))
+    params_s = StreamlineParams(mu=m, dl=step)
+    seeds = range(seed0, seed0 + runs) if mode == "surfaces" else [seed0]
+    store = conv == "finite"
+    ideal_max, stream_max, ideal_lock, stream_lock, slip_start = [], [], [], [], 0
+    for s in seeds:
+        surf = _random_surface(gen, s)
+        xmin, _, ymin, ymax = surf.bounds
+        if mode == "surfaces":
+            pts = np.array([(xmin + off, float(rep.get("y0", 0.0)))])
+        else:
+            ys = ymin + (ymax - ymin) * (np.arange(runs) + 0.5) / runs
+            pts = np.c_[np.full(runs, xmin + off), ys]
+        _, fx0, fy0 = surf.evaluate(pts[:, 0], pts[:, 1], order=1)
+        slip_start += int((kappa(fx0, fy0, m)[1] == SLIP).sum())
+        ri = ideal_trajectories(surf, pts, params_s, store_paths=store)
+        rs = streamlines(surf, pts, params_s, store_paths=store)
+        ideal_max.append(_max_kappa(ri, conv))
+        stream_max.append(_max_kappa(rs, conv))
+        ideal_lock.append(ri.self_locked)
+        stream_lock.append(rs.self_locked)
+    ideal_max, stream_max = np.concatenate(ideal_max), np.concatenate(stream_max)
+    ranked = []
+    for v in (ideal_max, stream_max):
+        v = np.where(np.isnan(v), 0.0, v)
+        ranked.append(np.minimum(v, float(cap)) if cap is not None else v)
+    family = {
+        "mu": m,
+        "runs": runs,
+        "starts": mode,
+        "dl": step,
+        "x0_offset": off,
+        "max_kappa": conv,
+        "kappa_cap": cap,
+        "median_ideal": float(np.median(ranked[0])),
+        "median_streamline": float(np.median(ranked[1])),
+        "self_locked_ideal": int(np.concatenate(ideal_lock).sum()),
+        "self_locked_streamline": int(np.concatenate(stream_lock).sum()),
+        "starts_in_slip": slip_start,
+    }
+    return family, (ideal_max, stream_max)
 
 
 # --------------------------------------------------------------------------- Figs. 7E, 9
@@ -422,46 +443,9 @@ def fractal_hurst(
         for part in np.array_split(seeds, max(1, workers * 2)):
             chunks.append((h, part, gen, mu, dl, scale, lock_point, trajectory))
     results: dict[float, list] = {h: [] for h in hursts}
-    if workers > 1:
-        with ProcessPoolExecutor(max_workers=workers) as pool:
-            for done, res in enumerate(pool.map(_fractal_chunk, chunks)):
-                results[res[0]].append(res[1:])
-                if progress:
-                    progress(done + 1, len(chunks))
-    else:
-        for done, c in enumerate(chunks):
-            res = _fractal_chunk(c)
-            results[res[0]].append(res[1:])
-            if progress:
-                progress(done + 1, len(chunks))
-    table = []
-    for h in hursts:
-        locked = np.concatenate([r[0] for r in results[h]])
-        sect = np.concatenate([r[1] for r in results[h]])
-        hess = np.concatenate([r[2] for r in results[h]])
-        rows = {
-            "rate": [],
-            "sect_concave": [],
-            "sect_convex": [],
-            "hess_concave": [],
-            "hess_saddle": [],
-            "hess_convex": [],
-        }
-        for g in np.array_split(np.arange(n), groups):
-            lk = locked[g]
-            rows["rate"].append(lk.mean())
-            m = max(1, lk.sum())
-            rows["sect_concave"].append((sect[g] == CONCAVE).sum() / m if lk.any() else np.nan)
-            rows["sect_convex"].append((sect[g] == CONVEX).sum() / m if lk.any() else np.nan)
-            rows["hess_concave"].append((hess[g] == CONCAVE).sum() / m if lk.any() else np.nan)
-            rows["hess_saddle"].append((hess[g] == SADDLE).sum() / m if lk.any() else np.nan)
-            rows["hess_convex"].append((hess[g] == CONVEX).sum() / m if lk.any() else np.nan)
-        entry = {"hurst": h, "self_locked": int(locked.sum()), "surfaces": n}
-        for key, vals in rows.items():
-            v = np.asarray(vals, dtype=float)
-            entry[f"{key}_mean"] = _nan_none(np.nanmean(v) if np.isfinite(v).any() else np.nan)
-            entry[f"{key}_sd"] = _nan_none(np.nanstd(v) if np.isfinite(v).sum() > 1 else np.nan)
-        table.append(entry)
+    for res in _run_chunks(chunks, workers, progress):
+        results[res[0]].append(res[1:])
+    table = [_hurst_row(h, results[h], n, groups) for h in hursts]
     numbers = {
         "mu": mu,
         "nx": gen["nx"],
@@ -478,6 +462,48 @@ def fractal_hurst(
     from spine_mj.plotting import fractal_hurst_figure
 
     return numbers, fractal_hurst_figure(table)
+
+
+def _run_chunks(chunks: list, workers: int, progress: Progress):
+    """:func:`_fractal_chunk` over ``chunks``, on ``workers`` processes when > 1."""
+    if workers > 1:
+        with ProcessPoolExecutor(max_workers=workers) as pool:
+            for done, res in enumerate(pool.map(_fractal_chunk, chunks)):
+                yield res
+                if progress:
+                    progress(done + 1, len(chunks))
+    else:
+        for done, c in enumerate(chunks):
+            yield _fractal_chunk(c)
+            if progress:
+                progress(done + 1, len(chunks))
+
+
+def _hurst_row(hurst: float, parts: list, n: int, groups: int) -> dict:
+    """Self-lock rate and convexity shares at one H: mean and sd over ``groups`` groups."""
+    locked = np.concatenate([r[0] for r in parts])
+    sect = np.concatenate([r[1] for r in parts])
+    hess = np.concatenate([r[2] for r in parts])
+    classes = {
+        "sect_concave": (sect, CONCAVE),
+        "sect_convex": (sect, CONVEX),
+        "hess_concave": (hess, CONCAVE),
+        "hess_saddle": (hess, SADDLE),
+        "hess_convex": (hess, CONVEX),
+    }
+    rows = {"rate": [], **{key: [] for key in classes}}
+    for g in np.array_split(np.arange(n), groups):
+        lk = locked[g]
+        rows["rate"].append(lk.mean())
+        m = max(1, lk.sum())
+        for key, (labels, cls) in classes.items():
+            rows[key].append((labels[g] == cls).sum() / m if lk.any() else np.nan)
+    entry = {"hurst": hurst, "self_locked": int(locked.sum()), "surfaces": n}
+    for key, vals in rows.items():
+        v = np.asarray(vals, dtype=float)
+        entry[f"{key}_mean"] = _nan_none(np.nanmean(v) if np.isfinite(v).any() else np.nan)
+        entry[f"{key}_sd"] = _nan_none(np.nanstd(v) if np.isfinite(v).sum() > 1 else np.nan)
+    return entry
 
 
 def _nan_none(v):

@@ -689,6 +689,29 @@ def _grid_count(name: str, n) -> int:
     return int(n)
 
 
+def _particle_envelope(n, spacing, diam, px, py, embed) -> np.ndarray:
+    """Upper envelope ``(n, n)`` of the base z = 0 and spheres of diameters ``diam`` at
+    ``(px, py)``, each sunk by ``embed`` times its diameter, on a periodic grid."""
+    heights = np.zeros((n, n))
+    grid = np.arange(n)
+    for d, cx, cy, e in zip(diam, px, py, embed):
+        r = d / 2
+        zc = r - e * d
+        half = int(math.ceil(r / spacing)) + 1
+        ix0, iy0 = int(round(cx / spacing)), int(round(cy / spacing))
+        ix = np.arange(ix0 - half, ix0 + half + 1)
+        iy = np.arange(iy0 - half, iy0 + half + 1)
+        ddx = ix * spacing - cx
+        ddy = iy * spacing - cy
+        rho2 = ddy[:, None] ** 2 + ddx[None, :] ** 2
+        cap = zc + np.sqrt(np.clip(r * r - rho2, 0, None))
+        cap[rho2 >= r * r] = 0.0
+        rows, cols = grid[np.mod(iy, n)], grid[np.mod(ix, n)]
+        block = heights[np.ix_(rows, cols)]
+        heights[np.ix_(rows, cols)] = np.maximum(block, cap)
+    return heights
+
+
 def sandpaper(
     *,
     grit: str | None = None,
@@ -763,23 +786,7 @@ def sandpaper(
     py = gen.uniform(0, size_m, n_particles)
     embed = gen.uniform(e_lo, e_hi, n_particles)
 
-    heights = np.zeros((n, n))
-    grid = np.arange(n)
-    for d, cx, cy, e in zip(diam, px, py, embed):
-        r = d / 2
-        zc = r - e * d
-        half = int(math.ceil(r / spacing)) + 1
-        ix0, iy0 = int(round(cx / spacing)), int(round(cy / spacing))
-        ix = np.arange(ix0 - half, ix0 + half + 1)
-        iy = np.arange(iy0 - half, iy0 + half + 1)
-        ddx = ix * spacing - cx
-        ddy = iy * spacing - cy
-        rho2 = ddy[:, None] ** 2 + ddx[None, :] ** 2
-        cap = zc + np.sqrt(np.clip(r * r - rho2, 0, None))
-        cap[rho2 >= r * r] = 0.0
-        rows, cols = grid[np.mod(iy, n)], grid[np.mod(ix, n)]
-        block = heights[np.ix_(rows, cols)]
-        heights[np.ix_(rows, cols)] = np.maximum(block, cap)
+    heights = _particle_envelope(n, spacing, diam, px, py, embed)
     coords = spacing * np.arange(n) - size_m / 2
     return GridSurface(
         heights=heights,
