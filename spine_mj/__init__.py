@@ -10,10 +10,9 @@ Modules: :mod:`~spine_mj.surfaces`, :mod:`~spine_mj.surface_io`,
 :mod:`~spine_mj.sweep`, :mod:`~spine_mj.reproduce`, :mod:`~spine_mj.cli`.
 """
 
-__version__ = "0.1.0"
-
 import importlib
 
+from spine_mj._version import __version__
 from spine_mj.compare import (
     capture_rate,
     frechet_distance,

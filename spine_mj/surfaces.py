@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 from scipy import ndimage
 
+from spine_mj._version import __version__
 from spine_mj.errors import SpineInputError, check_positive
 
 __all__ = [
@@ -435,8 +436,6 @@ class GridSurface(Surface):
 
 
 def _meta(generator: str, seed, **params) -> dict:
-    from spine_mj import __version__
-
     clean = {k: (list(v) if isinstance(v, tuple) else v) for k, v in params.items()}
     return {"generator": generator, "seed": seed, "params": clean, "spine_mj_version": __version__}
 
