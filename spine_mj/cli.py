@@ -21,7 +21,8 @@ from tqdm import tqdm
 from spine_mj import engagement, presets, reproduce, sim, surface_io, validate
 from spine_mj import sweep as sw
 from spine_mj.engagement import kappa
-from spine_mj.errors import SpineInputError, atomic_output
+from spine_mj.errors import SpineInputError, all_or_none, atomic_output, check_positive
+from spine_mj.jsonio import write_json
 from spine_mj.plotting import (
     kappa_map_figure,
     save_figure,
@@ -48,14 +49,18 @@ class _Group(click.Group):
         try:
             return super().invoke(ctx)
         except SpineInputError as exc:
+            root = ctx.find_root()
+            if exc.details and root.params.get("verbose"):
+                click.echo(exc.details, err=True)
             raise InputError(str(exc)) from None
-        except (FileNotFoundError, IsADirectoryError, PermissionError) as exc:
-            raise InputError(f"{exc.strerror}: {exc.filename}") from None
+        except OSError as exc:
+            raise InputError(f"{exc.strerror or exc}: {exc.filename}") from None
 
 
 @click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(package_name="spine_mj")
-def main():
+@click.option("-v", "--verbose", is_flag=True, help="Show the full text behind an error (e.g. a reader's).")
+def main(verbose):
     """spine_mj: streamline theory and MuJoCo dynamics of bio-inspired spines on rough
     surfaces."""
 
@@ -146,9 +151,10 @@ def surface_make(preset, from_file, output, seed, hurst, sets, fill, no_level, s
         surf = presets.make_surface(preset, **overrides)
     if png:
         _check_suffix(png, ".png", "--png")
-    surface_io.save_surface(surf, output)
-    if png:
-        save_figure(surface_preview(surf), png)
+    with all_or_none(output, png):
+        surface_io.save_surface(surf, output)
+        if png:
+            save_figure(surface_preview(surf), png)
     click.echo(f"wrote {output}" + (f" and {png}" if png else ""))
 
 
@@ -214,20 +220,30 @@ def surface_export(surface_file, stl, stl_scale, base_thickness, hfield, resolut
     if hfield:
         _check_suffix(hfield, ".npz", "--hfield")
     surf = load_surface_arg(surface_file)
-    if stl:
-        scale = stl_scale if stl_scale is not None else (1e3 if surf.unit == "m" else 1.0)
-        mesh_opts = {"scale": scale, "base_thickness": base_thickness}
-        if resolution:
-            mesh_opts["resolution"] = resolution
-        surface_io.write_stl(surf, stl, **mesh_opts)
-        click.echo(f"wrote {stl} (scale {scale:g})")
-    if hfield:
-        hf = to_hfield(surf, ncol=resolution, nrow=resolution) if resolution else to_hfield(surf)
-        with atomic_output(hfield) as tmp, open(tmp, "wb") as fh:
-            np.savez(
-                fh, data=hf.data, size=np.asarray(hf.size), pos=np.asarray(hf.pos), unit=np.array(surf.unit)
-            )
-        click.echo(f"wrote {hfield} ({hf.nrow} x {hf.ncol}, size {json.dumps(hf.size)})")
+    scale = stl_scale if stl_scale is not None else (1e3 if surf.unit == "m" else 1.0)
+    scale = check_positive("--stl-scale", scale)
+    if base_thickness is not None:
+        base_thickness = check_positive("--base", base_thickness)
+    written = []
+    with all_or_none(stl, hfield):
+        if stl:
+            mesh_opts = {"scale": scale, "base_thickness": base_thickness}
+            if resolution:
+                mesh_opts["resolution"] = resolution
+            surface_io.write_stl(surf, stl, **mesh_opts)
+            written.append(f"wrote {stl} (scale {scale:g})")
+        if hfield:
+            hf = to_hfield(surf, ncol=resolution, nrow=resolution) if resolution else to_hfield(surf)
+            with atomic_output(hfield) as tmp, open(tmp, "wb") as fh:
+                np.savez(
+                    fh,
+                    data=hf.data,
+                    size=np.asarray(hf.size),
+                    pos=np.asarray(hf.pos),
+                    unit=np.array(surf.unit),
+                )
+            written.append(f"wrote {hfield} ({hf.nrow} x {hf.ncol}, size {json.dumps(hf.size)})")
+    click.echo("\n".join(written))
 
 
 # --------------------------------------------------------------------------- sweep (issue 5)
@@ -517,16 +533,14 @@ def simulate(
         result = rig.run(drv, start=(x0, y0), progress=progress)
         bar.update(100 - done[0])
     out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    with atomic_output(out / "trajectory.parquet") as tmp:
-        result.table().to_parquet(tmp, index=False)
-    with atomic_output(out / "summary.json") as tmp:
-        tmp.write_text(json.dumps(result.summary(), indent=2))
-    save_figure(sim_run_figure(result, rig.surface, length_scale_m=rig.length_scale_m), out / "run.png")
-    written = ["trajectory.parquet", "summary.json", "run.png"]
-    if render:
-        _render_mp4(rig, result, out / "run.mp4")
-        written.append("run.mp4")
+    written = ["trajectory.parquet", "summary.json", "run.png"] + (["run.mp4"] if render else [])
+    with all_or_none(*(out / name for name in written)):
+        with atomic_output(out / "trajectory.parquet") as tmp:
+            result.table().to_parquet(tmp, index=False)
+        write_json(out / "summary.json", result.summary())
+        save_figure(sim_run_figure(result, rig.surface, length_scale_m=rig.length_scale_m), out / "run.png")
+        if render:
+            _render_mp4(rig, result, out / "run.mp4")
     click.echo(f"end: {result.end_reason.value} ({result.end_detail}); I_e = {result.inertia_number:.3g}")
     click.echo(f"wrote {', '.join(str(out / w) for w in written)}")
 
@@ -560,7 +574,7 @@ def view(surface_spec, **rig_opts):
     if sys.platform.startswith("linux") and not (
         os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
     ):
-        raise click.ClickException(
+        raise InputError(
             "no display (DISPLAY and WAYLAND_DISPLAY are unset): the viewer "
             "needs one; use `spine-mj sim export` or `simulate --render`"
         )
@@ -681,12 +695,13 @@ def streamline_cmd(surface_spec, mu, starts, dl, tip_radius, fmt, out_dir):
     table["tip_radius"] = tip_radius
     out = Path(out_dir)
     path = out / f"streamlines.{fmt}"
-    with atomic_output(path) as tmp:
-        if fmt == "parquet":
-            table.to_parquet(tmp, index=False)
-        else:
-            table.to_csv(tmp, index=False)
-    save_figure(streamline_figure(surf, stream, ideal, title=f"mu_s = {mu:g}"), out / "streamlines.png")
+    with all_or_none(path, out / "streamlines.png"):
+        with atomic_output(path) as tmp:
+            if fmt == "parquet":
+                table.to_parquet(tmp, index=False)
+            else:
+                table.to_csv(tmp, index=False)
+        save_figure(streamline_figure(surf, stream, ideal, title=f"mu_s = {mu:g}"), out / "streamlines.png")
     for i, (x, y) in enumerate(pts):
         click.echo(
             f"start ({x:g}, {y:g}): streamline {stream.outcome_names[i]} at "
@@ -749,9 +764,9 @@ def reproduce_cmd(name, out_dir, quick, surfaces, workers):
 
         numbers, fig = reproduce.run(name, quick=quick, progress=progress, **options)
     out = Path(out_dir)
-    with atomic_output(out / f"{name}.json") as tmp:
-        tmp.write_text(json.dumps(numbers, indent=2))
-    save_figure(fig, out / f"{name}.png")
+    with all_or_none(out / f"{name}.json", out / f"{name}.png"):
+        write_json(out / f"{name}.json", numbers)
+        save_figure(fig, out / f"{name}.png")
     click.echo(f"wrote {out / name}.json and {out / name}.png")
 
 

@@ -10,15 +10,22 @@ from __future__ import annotations
 import contextlib
 import math
 import os
+import shutil
 import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 
-__all__ = ["SpineInputError", "atomic_output", "check_positive"]
+__all__ = ["SpineInputError", "all_or_none", "atomic_output", "check_positive", "writable_path"]
 
 
 class SpineInputError(ValueError):
-    """Bad input: a malformed file or config, non-finite data, or nonsense parameters."""
+    """Bad input: a malformed file or config, non-finite data, or nonsense parameters.
+
+    ``str(error)`` is one line for the user; ``details`` (optional) holds longer text,
+    such as a reader's full report, that the CLI shows with ``--verbose``.
+    """
+
+    details: str | None = None
 
 
 def check_positive(name: str, value, *, allow_zero: bool = False) -> float:
@@ -50,8 +57,7 @@ def atomic_output(path: str | os.PathLike, *, suffix: str | None = None) -> Iter
         Suffix of the temporary file (some writers pick the format from it); defaults to
         the suffix of ``path``.
     """
-    dest = Path(path)
-    dest.parent.mkdir(parents=True, exist_ok=True)
+    dest = writable_path(path)
     fd, tmp_name = tempfile.mkstemp(
         prefix=f".{dest.name}.",
         suffix=suffix if suffix is not None else dest.suffix,
@@ -68,3 +74,60 @@ def atomic_output(path: str | os.PathLike, *, suffix: str | None = None) -> Iter
     finally:
         if tmp.exists():
             tmp.unlink()
+
+
+def writable_path(path: str | os.PathLike) -> Path:
+    """``path`` as a :class:`Path` whose folder exists (created if missing) and takes files.
+
+    Raises
+    ------
+    SpineInputError
+        The folder cannot be made (a parent is a file, no permission) or written to, or
+        ``path`` is a folder: named with the system's reason, before any work is done.
+    """
+    dest = Path(path)
+    if dest.is_dir():
+        raise SpineInputError(f"cannot write {dest}: it is a folder, expected a file path")
+    blocking = next((p for p in dest.parents if p.exists() and not p.is_dir()), None)
+    if blocking is not None:
+        raise SpineInputError(f"cannot write {dest}: {blocking} is a file, not a folder")
+    try:
+        dest.parent.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=dest.parent):
+            pass
+    except OSError as exc:
+        raise SpineInputError(f"cannot write {dest}: {exc.strerror or exc}") from None
+    return dest
+
+
+@contextlib.contextmanager
+def all_or_none(*paths: str | os.PathLike | None) -> Iterator[None]:
+    """Outputs of one command: all of them are written, or none is changed.
+
+    Every path is checked for writability on entry (:func:`writable_path`), so a bad
+    second output fails before the first is written. Files that existed are kept aside
+    (a hard link) and restored if the block raises; files the block created are removed.
+    ``None`` entries are skipped, so optional outputs can be passed as they are.
+    """
+    dests = [writable_path(p) for p in paths if p is not None]
+    backups: dict[Path, Path] = {}
+    try:
+        for dest in dests:
+            if dest.is_file():
+                backup = dest.with_name(f".{dest.name}.{os.getpid()}.keep")
+                try:
+                    os.link(dest, backup)
+                except OSError:  # a file system without hard links
+                    shutil.copy2(dest, backup)
+                backups[dest] = backup
+        yield
+    except BaseException:
+        for dest in dests:
+            if dest in backups:
+                os.replace(backups.pop(dest), dest)
+            elif dest.exists():
+                dest.unlink()
+        raise
+    finally:
+        for backup in backups.values():
+            backup.unlink(missing_ok=True)

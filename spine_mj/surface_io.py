@@ -12,12 +12,13 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import zipfile
 from pathlib import Path
 
 import numpy as np
 
-from spine_mj.errors import SpineInputError, atomic_output
+from spine_mj.errors import SpineInputError, atomic_output, check_positive
 from spine_mj.jsonio import to_jsonable
 from spine_mj.surfaces import GaussianSurface, GridSurface, Surface
 
@@ -60,6 +61,9 @@ def save_surface(surface: Surface, path: str | os.PathLike) -> Path:
     return path
 
 
+_NUMERIC_KEYS = {"heights", "x", "y", "bounds", *_GAUSS_KEYS}
+
+
 def load_surface(path: str | os.PathLike) -> Surface:
     """Read a surface written by :func:`save_surface`.
 
@@ -81,6 +85,11 @@ def load_surface(path: str | os.PathLike) -> Surface:
         raise SpineInputError(f"{path} is not a spine_mj surface file (no format tag {FORMAT!r})")
     try:
         metadata = json.loads(str(data["metadata_json"]))
+        if not isinstance(metadata, dict):
+            raise SpineInputError(f"metadata_json must be a JSON object, got {type(metadata).__name__}")
+        for name, arr in data.items():
+            if name in _NUMERIC_KEYS and not np.issubdtype(arr.dtype, np.number):
+                raise SpineInputError(f"array {name!r} must be numeric, got dtype {arr.dtype}")
         kind = str(data["kind"])
         unit = str(data["unit"])
         if kind == "grid":
@@ -109,6 +118,21 @@ def load_surface(path: str | os.PathLike) -> Surface:
 
 
 # --------------------------------------------------------------------------- measured data
+
+
+def _unreadable(path: Path, exc: Exception) -> SpineInputError:
+    """One line for a file SurfaceTopography cannot read: the readers it tried (or the
+    first line of its message); the full text rides along as ``details``."""
+    text = str(exc)
+    tried = re.findall(r"tried (\w+?)(?:Reader)?:", text)
+    if tried:
+        reason = f"no reader recognises it (tried {', '.join(tried)})"
+    else:
+        first = text.strip().splitlines()[0] if text.strip() else ""
+        reason = f"{type(exc).__name__}: {first[:200]}"
+    error = SpineInputError(f"cannot read topography {path.name}: {reason}")
+    error.details = f"{type(exc).__name__}: {text}"
+    return error
 
 
 def import_topography(
@@ -157,7 +181,7 @@ def import_topography(
     except SpineInputError:
         raise
     except Exception as exc:  # SurfaceTopography raises many types for bad files
-        raise SpineInputError(f"cannot read topography {path.name}: {type(exc).__name__}: {exc}") from None
+        raise _unreadable(path, exc) from None
     if topo.dim != 2 or not topo.is_uniform:
         raise SpineInputError(f"{path.name} is not a uniform 2-D area scan")
 
@@ -239,9 +263,10 @@ def surface_mesh(
     h = grid.heights
     ny, nx = h.shape
     span = max(grid.x[-1] - grid.x[0], grid.y[-1] - grid.y[0])
-    base_thickness = 0.05 * span if base_thickness is None else float(base_thickness)
-    if not base_thickness > 0:
-        raise SpineInputError(f"base_thickness must be > 0, got {base_thickness!r}")
+    base_thickness = (
+        0.05 * span if base_thickness is None else check_positive("base_thickness", base_thickness)
+    )
+    scale = check_positive("scale", scale)
     z_bottom = h.min() - base_thickness
     xx, yy = np.meshgrid(grid.x, grid.y)
     top = np.column_stack([xx.ravel(), yy.ravel(), h.ravel()])

@@ -50,6 +50,8 @@ __all__ = [
 GRIT_PARTICLE_DIAMETER_M = {"P36": 538e-6, "P60": 269e-6, "P600": 25.8e-6}
 
 _MIN_POINTS_PER_SIDE = 4
+#: Most points a generated or resampled grid may have (512 MiB per float64 array).
+MAX_GRID_POINTS = 2**26
 _CHUNK = 1 << 15
 _NONPERIODIC_PAD = 8  # cells of odd reflection before the spline filter, see GridSurface
 
@@ -141,10 +143,9 @@ class Surface:
 
     def sample(self, nx: int, ny: int | None = None) -> GridSurface:
         """Sample on a uniform ``ny x nx`` grid spanning ``bounds`` (edges included)."""
-        ny = nx if ny is None else ny
-        for name, n in (("nx", nx), ("ny", ny)):
-            if int(n) != n or n < _MIN_POINTS_PER_SIDE:
-                raise SpineInputError(f"{name} must be an integer >= 4, got {n!r}")
+        nx = _grid_count("nx", nx)
+        ny = nx if ny is None else _grid_count("ny", ny)
+        check_grid_size(nx, ny, where="sampling a surface")
         xmin, xmax, ymin, ymax = self.bounds
         x = np.linspace(xmin, xmax, int(nx))
         y = np.linspace(ymin, ymax, int(ny))
@@ -416,13 +417,13 @@ class GridSurface(Surface):
         sx, sy = check_positive("spacing x", sx), check_positive("spacing y", sy)
         xmin, xmax, ymin, ymax = self.bounds
         if self.periodic:
-            nx, ny = round((xmax - xmin) / sx), round((ymax - ymin) / sy)
+            nx, ny = max(1, round((xmax - xmin) / sx)), max(1, round((ymax - ymin) / sy))
             sx, sy = (xmax - xmin) / nx, (ymax - ymin) / ny
-            x, y = xmin + sx * np.arange(nx), ymin + sy * np.arange(ny)
         else:
             nx = int(math.floor((xmax - xmin) / sx * (1 + 1e-12))) + 1
             ny = int(math.floor((ymax - ymin) / sy * (1 + 1e-12))) + 1
-            x, y = xmin + sx * np.arange(nx), ymin + sy * np.arange(ny)
+        check_grid_size(nx, ny, where=f"resampling to spacing {sx:g} x {sy:g}")
+        x, y = xmin + sx * np.arange(nx), ymin + sy * np.arange(ny)
         if nx < _MIN_POINTS_PER_SIDE or ny < _MIN_POINTS_PER_SIDE:
             raise SpineInputError(
                 f"spacing {spacing!r} leaves only {ny} x {nx} points; at least 4 a side are needed"
@@ -615,6 +616,7 @@ def fractal_fbm(
     """
     nx = _grid_count("nx", nx)
     ny = nx if ny is None else _grid_count("ny", ny)
+    check_grid_size((1 if periodic else 2) * nx, (1 if periodic else 2) * ny, where="fractal_fbm")
     lx, ly = (size, size) if np.isscalar(size) else size
     lx, ly = check_positive("size x", lx), check_positive("size y", ly)
     hurst = float(hurst)
@@ -683,9 +685,29 @@ def fractal_fbm(
 
 
 def _grid_count(name: str, n) -> int:
-    if isinstance(n, bool) or int(n) != n or n < _MIN_POINTS_PER_SIDE:
+    """``n`` as a number of grid points a side: an integer in [4, MAX_GRID_POINTS]."""
+    ok = isinstance(n, (int, np.integer, float, np.floating)) and not isinstance(n, (bool, np.bool_))
+    if not ok or not math.isfinite(n) or int(n) != n or n < _MIN_POINTS_PER_SIDE:
         raise SpineInputError(f"{name} must be an integer >= {_MIN_POINTS_PER_SIDE}, got {n!r}")
     return int(n)
+
+
+def check_grid_size(nx: int, ny: int, *, where: str) -> None:
+    """Refuse a grid of more than :data:`MAX_GRID_POINTS` points before allocating it.
+
+    Raises
+    ------
+    SpineInputError
+        Naming ``where``, the grid's shape, the limit and the memory one height array
+        of that shape would take.
+    """
+    points = int(nx) * int(ny)
+    if points > MAX_GRID_POINTS:
+        gib = points * 8 / 2**30
+        raise SpineInputError(
+            f"{where}: a {int(ny)} x {int(nx)} grid has {points:.3g} points, more than the limit "
+            f"{MAX_GRID_POINTS:.3g} ({gib:.3g} GiB per height array); use fewer points or a coarser spacing"
+        )
 
 
 def _particle_envelope(n, spacing, diam, px, py, embed) -> np.ndarray:
@@ -766,10 +788,7 @@ def sandpaper(
     n = math.ceil(size_m / spacing_m - 1e-9)
     if n < _MIN_POINTS_PER_SIDE:
         raise SpineInputError(f"size_m / spacing_m gives {n} points; need at least 4")
-    if n > 8192:
-        raise SpineInputError(
-            f"size_m / spacing_m gives {n} points a side (> 8192); shrink size_m or coarsen spacing_m"
-        )
+    check_grid_size(n, n, where="sandpaper (size_m / spacing_m points a side)")
     if size_m < 2 * d_mean:
         raise SpineInputError(
             f"size_m ({size_m:g}) must be at least twice the particle diameter ({d_mean:g})"

@@ -5,7 +5,7 @@ import stat
 
 import pytest
 
-from spine_mj.errors import atomic_output
+from spine_mj.errors import SpineInputError, all_or_none, atomic_output, writable_path
 
 
 def test_atomic_output_writes_on_success_with_umask_permissions(tmp_path):
@@ -26,3 +26,34 @@ def test_atomic_output_leaves_nothing_on_failure(tmp_path):
         tmp.write_text("half")
         raise RuntimeError("boom")
     assert list(tmp_path.iterdir()) == []
+
+
+def test_all_or_none_restores_what_existed_and_removes_what_it_made(tmp_path):
+    kept, made = tmp_path / "kept.txt", tmp_path / "made.txt"
+    kept.write_text("old")
+    with pytest.raises(RuntimeError), all_or_none(kept, made, None):
+        with atomic_output(kept) as tmp:
+            tmp.write_text("new")
+        with atomic_output(made) as tmp:
+            tmp.write_text("new")
+        raise RuntimeError("the third output failed")
+    assert kept.read_text() == "old"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["kept.txt"]
+
+
+def test_all_or_none_keeps_every_output_on_success(tmp_path):
+    a, b = tmp_path / "a.txt", tmp_path / "b.txt"
+    a.write_text("old")
+    with all_or_none(a, b):
+        a.write_text("new a")
+        b.write_text("new b")
+    assert (a.read_text(), b.read_text()) == ("new a", "new b")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.txt", "b.txt"]
+
+
+def test_an_unwritable_path_is_refused_before_any_work(tmp_path):
+    (tmp_path / "file").write_text("x")
+    with pytest.raises(SpineInputError, match="file is a file, not a folder"):
+        writable_path(tmp_path / "file" / "out.txt")
+    with pytest.raises(SpineInputError, match="it is a folder"):
+        writable_path(tmp_path)
