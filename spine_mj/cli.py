@@ -18,13 +18,14 @@ import numpy as np
 import pandas as pd
 from tqdm import tqdm
 
-from spine_mj import engagement, presets, reproduce, sim, surface_io, validate
+from spine_mj import engagement, presets, reproduce, roughness, sim, surface_io, validate
 from spine_mj import sweep as sw
 from spine_mj.engagement import kappa
 from spine_mj.errors import SpineInputError, all_or_none, atomic_output, check_positive
-from spine_mj.jsonio import write_json
+from spine_mj.jsonio import to_jsonable, write_json
 from spine_mj.plotting import (
     kappa_map_figure,
+    roughness_figure,
     save_figure,
     sim_run_figure,
     streamline_figure,
@@ -178,6 +179,38 @@ def surface_show(surface_file, output):
     surf = load_surface_arg(surface_file)
     save_figure(surface_preview(surf), output)
     click.echo(f"wrote {output}")
+
+
+@surface.command("info")
+@click.argument("surface_spec", metavar="SURFACE")
+@click.option("-o", "--output", type=click.Path(dir_okay=False), help="Also write the PSD plot (.png).")
+@click.option("--json", "as_json", is_flag=True, help="Print the numbers as JSON.")
+def surface_info(surface_spec, output, as_json):
+    """Roughness of SURFACE (preset, .npz or instrument file): rms height, slope and
+    curvature, L_c, the slope correlation length l_s, a Hurst estimate and the PSD.
+
+    \b
+    Example:
+      spine-mj surface info tests/data/plu-1.plu -o psd.png
+    """
+    if output:
+        _check_suffix(output, ".png", "-o/--output")
+    surf = load_surface_arg(surface_spec)
+    rough = roughness.summarize(surf)
+    if output:
+        save_figure(roughness_figure(rough), output)
+    if as_json:
+        click.echo(json.dumps(to_jsonable(rough.as_dict()), indent=2))
+        return
+    unit = "" if surf.unit == "1" else f" {surf.unit}"
+    click.echo(f"rms height               {rough.rms_height:.4g}{unit}")
+    click.echo(f"rms slope                {rough.rms_slope:.4g}")
+    click.echo(f"rms curvature            {rough.rms_curvature:.4g}{'' if not unit else ' 1/' + surf.unit}")
+    click.echo(f"L_c (asperity length)    {rough.char_length:.4g}{unit}")
+    click.echo(f"l_s (slope correlation)  {rough.slope_correlation_length:.4g}{unit}")
+    click.echo(f"Hurst estimate (PSD fit) {rough.hurst:.3g}")
+    if output:
+        click.echo(f"wrote {output}")
 
 
 @surface.command("export")

@@ -288,3 +288,26 @@ def streamline_figure(surface, stream, ideal, *, title: str = ""):
     ax.legend(fontsize=7)
     fig.suptitle(title or "Streamlines (solid) and ideal trajectories (dashed)")
     return fig
+
+
+def roughness_figure(rough, *, title: str = ""):
+    """Radially averaged PSD on log axes with the fitted Hurst slope, and the numbers."""
+    fig = new_figure(figsize=(6.4, 4.4), layout="constrained")
+    ax = fig.add_subplot()
+    unit = "" if rough.unit == "1" else f" [{rough.unit}]"
+    ax.loglog(rough.q, rough.psd, "o-", ms=3, lw=1, color="#1f4e79", label="radial PSD")
+    if np.isfinite(rough.hurst):
+        q = np.geomspace(*rough.fit_range, 20)
+        fit = rough.psd_prefactor * q ** (-(2 * rough.hurst + 2))
+        ax.loglog(q, fit, "--", color="#c55a11", lw=2, label=f"fit: C ~ q^-(2H+2), H = {rough.hurst:.2f}")
+    ax.set_xlabel(f"wavevector q = 2π/λ [rad{'' if rough.unit == '1' else ' / ' + rough.unit}]")
+    ax.set_ylabel(f"PSD C(q){'' if rough.unit == '1' else f' [{rough.unit}^4]'}")
+    ax.set_title(
+        title
+        or f"rms height {rough.rms_height:.3g}{unit}, rms slope {rough.rms_slope:.3g}, "
+        f"L_c {rough.char_length:.3g}, l_s {rough.slope_correlation_length:.3g}",
+        fontsize=9,
+    )
+    ax.legend()
+    ax.grid(True, which="both", alpha=0.3)
+    return fig

@@ -1,0 +1,102 @@
+"""Roughness statistics against closed forms and SurfaceTopography."""
+
+import math
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from spine_mj import roughness
+from spine_mj.cli import main
+from spine_mj.errors import SpineInputError
+from spine_mj.surfaces import GaussianSurface, GridSurface, fractal_fbm, single_gaussian
+
+
+def sine_surface(wavelength=2.0, periods=4, n=256, amplitude=0.3):
+    x = np.arange(n) * periods * wavelength / n
+    y = np.arange(32) * x[1]
+    h = amplitude * np.sin(2 * np.pi * x / wavelength)[None, :] * np.ones((y.size, 1))
+    return GridSurface(heights=h, x=x, y=y, periodic=True, unit="1")
+
+
+def test_slope_correlation_length_of_a_sine():
+    """grad f = A k cos(k x): C(r) = cos(k r), 1/e at r = lambda arccos(1/e) / (2 pi)."""
+    lam = 2.0
+    expected = lam * math.acos(1 / math.e) / (2 * math.pi)
+    # linear interpolation of a cosine between lags lambda / 64 apart: error < 1e-3 relative
+    assert roughness.slope_correlation_length(sine_surface(lam)) == pytest.approx(expected, rel=1e-3)
+
+
+def test_slope_correlation_length_of_a_gaussian_bump():
+    """Gradient autocorrelation of a Gaussian of width sigma: (1 - u) e^-u, u = r^2 / 4 sigma^2."""
+    u = 0.5
+    for _ in range(50):  # Newton on (1 - u) e^-u = 1/e
+        g = (1 - u) * math.exp(-u) - 1 / math.e
+        u -= g / ((u - 2) * math.exp(-u))
+    sigma = 1.5
+    expected = 2 * sigma * math.sqrt(u)
+    assert expected == pytest.approx(1.315 * sigma, rel=1e-3)
+    # sampled at sigma / 10 and cut off at the paper's domain (+-3.3 sigma): 1e-3 relative
+    assert roughness.slope_correlation_length(single_gaussian()) == pytest.approx(expected, rel=1e-3)
+    wide = GaussianSurface(
+        amplitude=np.array([1.0]),
+        center_x=np.array([0.0]),
+        center_y=np.array([0.0]),
+        sigma_x=np.array([0.5]),
+        sigma_y=np.array([0.5]),
+        bounds=(-4.0, 4.0, -4.0, 4.0),
+    )
+    assert roughness.slope_correlation_length(wide) == pytest.approx(2 * 0.5 * math.sqrt(u), rel=1e-3)
+
+
+def test_slope_correlation_is_a_few_spacings_on_a_fractal_far_below_lc():
+    surf = fractal_fbm(nx=256, hurst=0.7, rng=1)
+    ls = roughness.slope_correlation_length(surf)
+    dx = surf.spacing[0]
+    assert dx < ls < 5 * dx
+    assert roughness.characteristic_length(surf) > 10 * ls
+
+
+def test_a_plane_has_no_slope_correlation_length():
+    x = np.linspace(0, 1, 16)
+    plane = GridSurface(heights=0.2 * x[None, :] * np.ones((16, 1)), x=x, y=x.copy(), unit="1")
+    with pytest.raises(SpineInputError, match="plane"):
+        roughness.slope_correlation_length(plane)
+
+
+def test_summary_matches_closed_forms_of_a_sine():
+    amp, lam = 0.3, 2.0
+    rough = roughness.summarize(sine_surface(lam, amplitude=amp))
+    assert rough.rms_height == pytest.approx(amp / math.sqrt(2), rel=1e-6)
+    # SurfaceTopography's rms gradient on the grid: finite differences, 1e-3 at 64 points a period
+    assert rough.rms_slope == pytest.approx(amp * 2 * math.pi / lam / math.sqrt(2), rel=1e-3)
+
+
+@pytest.mark.parametrize("hurst", [0.5, 0.8])
+def test_hurst_estimate_of_fractals(hurst):
+    estimates = [roughness.summarize(fractal_fbm(nx=256, hurst=hurst, rng=s)).hurst for s in range(3)]
+    assert np.mean(estimates) == pytest.approx(hurst, abs=0.1)
+
+
+def test_radial_psd_agrees_with_surfacetopography():
+    """Our numpy PSD (fast path) against SurfaceTopography's power_spectrum_from_area."""
+    import SurfaceTopography as st
+
+    surf = fractal_fbm(nx=128, hurst=0.7, size=10.0, rng=3)
+    q, psd = roughness.radial_psd(surf)
+    topo = st.Topography(surf.heights.T, (10.0, 10.0), periodic=True)
+    q_ref, c_ref = topo.power_spectrum_from_area(nb_points_per_decade=8)
+    ok = np.isfinite(c_ref) & (q_ref > q.min()) & (q_ref < q.max())
+    mine = np.exp(np.interp(np.log(q_ref[ok]), np.log(q), np.log(psd)))
+    # different ring edges: compare the log-spectra on average, not ring by ring
+    assert np.median(np.abs(np.log(mine / c_ref[ok]))) < 0.3
+
+
+def test_cli_surface_info(tmp_path):
+    png = tmp_path / "psd.png"
+    result = CliRunner().invoke(main, ["surface", "info", "paper-single-peak", "-o", str(png)])
+    assert result.exit_code == 0, result.output
+    assert "l_s (slope correlation)" in result.output and png.stat().st_size > 0
+    result = CliRunner().invoke(main, ["surface", "info", "paper-single-peak", "--json"])
+    assert result.exit_code == 0, result.output
+    assert '"slope_correlation_length": 1.97' in result.output
