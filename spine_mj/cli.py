@@ -37,6 +37,44 @@ from spine_mj.surfaces import to_hfield
 INPUT_ERROR_EXIT = 2
 
 
+class Progress:
+    """The CLI's one progress display: a tqdm bar on stderr, or nothing with ``quiet``.
+
+    ``update(done, total, desc=None, **postfix)`` moves the bar to ``done`` of ``total``
+    (a new ``desc`` starts a fresh bar); used as a context manager it closes the bar.
+    """
+
+    def __init__(self, desc: str, *, unit: str = "it", quiet: bool = False):
+        self.desc, self.unit, self.quiet, self.bar = desc, unit, quiet, None
+
+    def update(self, done: float, total: float, desc: str | None = None, **postfix) -> None:
+        if self.quiet:
+            return
+        if self.bar is not None and desc is not None and desc != self.bar.desc:
+            self.close()
+        if self.bar is None:
+            tqdm.monitor_interval = 0  # no monitor thread: a single-threaded CLI forks its workers
+            self.bar = tqdm(
+                total=total, desc=desc or self.desc, unit=self.unit, dynamic_ncols=True, file=sys.stderr
+            )
+        self.bar.total = total
+        self.bar.n = done
+        if postfix:
+            self.bar.set_postfix(postfix, refresh=False)
+        self.bar.refresh()
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
+            self.bar = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+
 class InputError(click.ClickException):
     """A :class:`SpineInputError` (or unreadable file) shown as one line, exit code 2."""
 
@@ -331,27 +369,7 @@ def sweep_run(config, out_dir, workers, scheduler, overwrite, retry_failed, quie
     """
 
     cfg = sw.load_config(config)
-    bar = None
-
-    def progress(p):
-        nonlocal bar
-        if quiet:
-            return
-        if bar is None:
-            tqdm.monitor_interval = 0  # no monitor thread: a single-threaded CLI forks its workers
-            bar = tqdm(
-                total=p.total_cases,
-                initial=p.skipped_cases,
-                unit="case",
-                desc=cfg.name,
-                dynamic_ncols=True,
-                file=sys.stderr,
-            )
-        else:
-            bar.update(1)
-            bar.set_postfix(ok=p.ok_runs, failed=p.failed_runs, refresh=False)
-
-    try:
+    with Progress(cfg.name, unit="case", quiet=quiet) as bar:
         summary = sw.run_sweep(
             cfg,
             out_dir,
@@ -359,11 +377,10 @@ def sweep_run(config, out_dir, workers, scheduler, overwrite, retry_failed, quie
             scheduler=scheduler,
             overwrite=overwrite,
             retry_failed=retry_failed,
-            progress=progress,
+            progress=lambda p: bar.update(
+                p.finished_cases + p.skipped_cases, p.total_cases, ok=p.ok_runs, failed=p.failed_runs
+            ),
         )
-    finally:
-        if bar is not None:
-            bar.close()
     where = (
         f"scheduler {scheduler}"
         if scheduler
@@ -556,15 +573,8 @@ def simulate(
         drv = sim.RampDrive(rate_n_s=rate, duration_s=duration)
     else:
         drv = sim.StaticProbe(rate_n_s=rate, start_force_n=start_force)
-    with click.progressbar(length=100, label="simulating") as bar:
-        done = [0]
-
-        def progress(frac):
-            bar.update(int(100 * frac) - done[0])
-            done[0] = int(100 * frac)
-
-        result = rig.run(drv, start=(x0, y0), progress=progress)
-        bar.update(100 - done[0])
+    with Progress("simulating", unit="%") as bar:
+        result = rig.run(drv, start=(x0, y0), progress=lambda frac: bar.update(round(100 * frac, 1), 100))
     out = Path(out_dir)
     written = ["trajectory.parquet", "summary.json", "run.png"] + (["run.mp4"] if render else [])
     with all_or_none(*(out / name for name in written)):
@@ -789,13 +799,8 @@ def reproduce_cmd(name, out_dir, quick, surfaces, workers):
             options["surfaces"] = surfaces
     elif surfaces is not None:
         raise SpineInputError(f"--surfaces applies to fractal-hurst only, got NAME {name!r}")
-    with click.progressbar(length=1, label=name) as bar:
-
-        def progress(done, total):
-            bar.length = total
-            bar.update(done - bar.pos)
-
-        numbers, fig = reproduce.run(name, quick=quick, progress=progress, **options)
+    with Progress(name) as bar:
+        numbers, fig = reproduce.run(name, quick=quick, progress=bar.update, **options)
     out = Path(out_dir)
     with all_or_none(out / f"{name}.json", out / f"{name}.png"):
         write_json(out / f"{name}.json", numbers)
@@ -852,21 +857,15 @@ def validate_cmd(out_dir, quick, plan_name, workers, quiet):
     out = Path(out_dir)
     if out.exists() and not out.is_dir():
         raise SpineInputError(f"--out {out} exists and is not a folder")
-    last = {"step": None}
-
-    def progress(p):
-        if quiet:
-            return
-        if p.step != last["step"] and last["step"] is not None:
-            sys.stderr.write("\n")
-        last["step"] = p.step
-        count = f" {p.finished_cases}/{p.total_cases} cases" if p.total_cases else ""
-        sys.stderr.write(f"\r[{p.elapsed_s:6.1f} s] {p.study}: {p.step}{count}")
-        sys.stderr.flush()
-
-    result = validate.run_validation(out, plan=plan, workers=workers, progress=progress)
-    if not quiet and last["step"] is not None:
-        sys.stderr.write("\n")
+    with Progress("validate", unit="case", quiet=quiet) as bar:
+        result = validate.run_validation(
+            out,
+            plan=plan,
+            workers=workers,
+            progress=lambda p: bar.update(
+                p.finished_cases, max(p.total_cases, 1), desc=f"{p.study}: {p.step}"
+            ),
+        )
     click.echo(
         f"static kappa max rel. error (engaged, default settings): {result['static_kappa_max_rel_error']:.3g}"
     )
