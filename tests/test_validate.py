@@ -188,16 +188,16 @@ def test_prefix_frechet_cuts_the_streamline_at_the_mujoco_arc_length():
     q = np.column_stack([np.linspace(0, 10, 101), np.zeros(101)])
     # MuJoCo covered 1 unit of it, 0.05 to the side: the prefix deviation is the offset
     m = np.column_stack([np.linspace(0, 1, 11), np.full(11, 0.05)])
-    assert validate._prefix_frechet(m, q, 1.0) == pytest.approx(0.05, abs=1e-3)
+    assert validate.prefix_frechet(m, q, 1.0) == pytest.approx(0.05, abs=1e-3)
     # against the whole streamline it would be the 9 units MuJoCo did not cover
-    assert validate._path_metrics(m, q, 1.0)[0] > 8.9
+    assert validate.path_metrics(m, q, 1.0)[0] > 8.9
 
 
 def test_ramp_duration_covers_the_target_from_the_measured_slip_per_cycle():
     from spine_mj import sim
 
     rig = sim.Rig(sim.inclined_plane(slope_deg=0.0, azimuth_deg=0.0), tip=sim.TipParams(mu_s=0.5))
-    rp = validate.ramp_duration(rig, validate._PLANE_START, 1.0, target_lc=0.5, max_steps=4000)
+    rp = validate.ramp_duration(rig, validate.PLANE_START, 1.0, target_lc=0.5, max_steps=4000)
     assert rp.ie_equivalent == pytest.approx(1.0, rel=1e-9)
     assert rp.slip_per_cycle_lc > 0 and rp.cycle_s > 0
     # three times the pilot's cycles over the target, plus one ramp to the self-lock cap
