@@ -16,7 +16,6 @@ writes ``hfield_geometry.json`` and prints a Markdown table.
 from __future__ import annotations
 
 import argparse
-import json
 import time
 from pathlib import Path
 
@@ -24,6 +23,7 @@ import numpy as np
 
 from spine_mj import presets, sim
 from spine_mj import validate as V
+from spine_mj.jsonio import write_json
 from spine_mj.surfaces import GridSurface
 
 RESOLUTIONS = (151, 201, 401, 801)
@@ -95,7 +95,7 @@ def main(argv=None):
                     )
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    (out / "hfield_geometry.json").write_text(json.dumps(rows, indent=1) + "\n")
+    write_json(out / "hfield_geometry.json", rows, indent=1)
     # summary per preset family x resolution x tip
     print(
         "\n| surface | hfield samples | spacing / L_c | tip | median Frechet | mean | max | "
