@@ -16,7 +16,6 @@ writes ``hfield_geometry.json`` and prints a Markdown table.
 from __future__ import annotations
 
 import argparse
-import json
 import time
 from pathlib import Path
 
@@ -24,6 +23,7 @@ import numpy as np
 
 from spine_mj import presets, sim
 from spine_mj import validate as V
+from spine_mj.jsonio import write_json
 from spine_mj.surfaces import GridSurface
 
 RESOLUTIONS = (151, 201, 401, 801)
@@ -43,28 +43,28 @@ def main(argv=None):
     args = ap.parse_args(argv)
     rows = []
     for preset, seeds in CASES:
-        mu = V._preset_mu(preset)
+        mu = V.calibrated_mu(preset)
         for seed in seeds:
             surface = presets.make_surface(preset, seed=seed)
             lc = sim.characteristic_length(surface)
             starts = _starts(surface)
-            tip151 = V._tip_radius(preset, (seed,), 151)
+            tip151 = V.tip_radius(preset, (seed,), 151)
             grid = isinstance(surface, GridSurface)
             for res in (surface.heights.shape[1],) if grid else RESOLUTIONS:
                 tips = {"fixed (quick-plan tip)": tip151}
                 if res <= RIG_TIP_MAX_RES:
                     # the facet sampling step follows the tip (tip / 8): finer tips cost more
-                    tips["rig default at this resolution"] = V._tip_radius(preset, (seed,), res)
+                    tips["rig default at this resolution"] = V.tip_radius(preset, (seed,), res)
                 for label, tip in tips.items():
                     t0 = time.perf_counter()
-                    smooth = V._streamline_paths(surface, starts, mu, tip / 2, tip)
-                    tri = V._streamline_paths(
-                        V._triangulated(surface, None if grid else res), starts, mu, tip / 2, tip
+                    smooth = V.streamline_paths(surface, starts, mu, tip / 2, tip)
+                    tri = V.streamline_paths(
+                        V.triangulated_surface(surface, None if grid else res), starts, mu, tip / 2, tip
                     )
                     fr, lock_agree = [], []
                     for i in range(len(starts)):
                         a, b = smooth.path(i), tri.path(i)
-                        g, _ = V._path_metrics(
+                        g, _ = V.path_metrics(
                             np.column_stack([b["x"], b["y"]]), np.column_stack([a["x"], a["y"]]), lc
                         )
                         fr.append(g)
@@ -95,7 +95,7 @@ def main(argv=None):
                     )
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    (out / "hfield_geometry.json").write_text(json.dumps(rows, indent=1) + "\n")
+    write_json(out / "hfield_geometry.json", rows, indent=1)
     # summary per preset family x resolution x tip
     print(
         "\n| surface | hfield samples | spacing / L_c | tip | median Frechet | mean | max | "

@@ -1,0 +1,120 @@
+"""The validation harness: MuJoCo against the quasistatic streamline across inertia numbers.
+
+Five studies (issue 6), each a function that runs its MuJoCo cases through the sweep runner
+(:func:`spine_mj.sweep.run_sweep`, one resumable store per study under ``out/sweeps/``, so a
+killed validation resumes where it stopped) and returns a typed result with the numbers
+and the data of its figures (``as_dict()`` gives the keys of ``validation.json``):
+
+1. :func:`static_map` - breakaway ratio ``kappa_mj / kappa`` of the static probe on inclined
+   planes over slope angle and azimuth (engaged, self-lock and slip regions), per engine
+   setting.
+2. :func:`quasistatic_limit` - spring-drive paths at the lowest inertia number against the
+   streamline on the smooth surface and on MuJoCo's own triangulated hfield surface (which
+   separates the geometry error from the dynamics error), per surface family; the engine
+   settings that limit agreement varied one at a time.
+3. :func:`boundary` - agreement against ``I_e`` for the spring and ramp drives and the
+   ``I_e*`` where it breaks, with a bracketing interval and a bootstrap over starts.
+4. :func:`stick_slip` - drive-force curves, slip-event statistics and trap skipping against
+   ``I_e`` and spring stiffness.
+5. :func:`sandpaper` - P36 / P60 / P600 analogs with a 25 um tip: path waviness and force
+   peaks.
+
+:func:`run_validation` runs them all for a :class:`ValidationPlan` (``"quick"``, ``"full"``
+or the test-size ``"smoke"``), writes ``report.md`` with PNG figures and ``validation.json``.
+
+Lengths in the metrics are in units of the surface's characteristic length ``L_c``
+(:func:`spine_mj.sim.characteristic_length`), forces in units of the preload ``F_p``.
+
+Modules: :mod:`~spine_mj.validate.plans` (plans, targets, constants),
+:mod:`~spine_mj.validate.runner` (the sweep runner), :mod:`~spine_mj.validate.sweep_docs`
+(sweep configs), :mod:`~spine_mj.validate.paths` (streamlines on the tip-dilated surface,
+path metrics), :mod:`~spine_mj.validate.ie_star`, :mod:`~spine_mj.validate.ramp_plan`, one
+module per study, :mod:`~spine_mj.validate.report` and :mod:`~spine_mj.validate.run`.
+"""
+
+from spine_mj.validate.boundary import BoundaryCurve, BoundaryResult, boundary
+from spine_mj.validate.ie_star import (
+    DEPARTURE,
+    IE_STAR_CRITERIA,
+    IeStar,
+    bootstrap_ie_star,
+    departure_ie_star,
+    estimate_ie_star,
+    ie_star_by_criterion,
+)
+from spine_mj.validate.paths import (
+    path_metrics,
+    prefix_frechet,
+    streamline_paths,
+    tip_radius,
+    triangulated_surface,
+)
+from spine_mj.validate.plans import (
+    FRECHET_TARGET,
+    GRAVITY,
+    MASS_KG,
+    OUTCOME_TARGET,
+    PLANS,
+    RAMP_MIN_COVERAGE,
+    SANDPAPER_MU,
+    STATIC_TARGET,
+    FamilySpec,
+    ValidationPlan,
+)
+from spine_mj.validate.quasistatic_limit import LimitPath, QuasistaticLimitResult, quasistatic_limit
+from spine_mj.validate.ramp_plan import RampPlan, pilot_rig, ramp_duration
+from spine_mj.validate.report import write_report
+from spine_mj.validate.run import run_validation
+from spine_mj.validate.runner import StudyRunner, ValidationProgress
+from spine_mj.validate.sandpaper import SandpaperResult, sandpaper
+from spine_mj.validate.static_map import PLANE_START, StaticMapResult, static_map
+from spine_mj.validate.stick_slip import SlipStats, StickSlipResult, slip_statistics, stick_slip
+from spine_mj.validate.sweep_docs import calibrated_mu
+
+__all__ = [
+    "DEPARTURE",
+    "FRECHET_TARGET",
+    "GRAVITY",
+    "IE_STAR_CRITERIA",
+    "MASS_KG",
+    "OUTCOME_TARGET",
+    "PLANE_START",
+    "PLANS",
+    "RAMP_MIN_COVERAGE",
+    "SANDPAPER_MU",
+    "STATIC_TARGET",
+    "BoundaryCurve",
+    "BoundaryResult",
+    "FamilySpec",
+    "IeStar",
+    "LimitPath",
+    "QuasistaticLimitResult",
+    "RampPlan",
+    "SandpaperResult",
+    "SlipStats",
+    "StaticMapResult",
+    "StickSlipResult",
+    "StudyRunner",
+    "ValidationPlan",
+    "ValidationProgress",
+    "bootstrap_ie_star",
+    "boundary",
+    "calibrated_mu",
+    "departure_ie_star",
+    "estimate_ie_star",
+    "ie_star_by_criterion",
+    "path_metrics",
+    "pilot_rig",
+    "prefix_frechet",
+    "quasistatic_limit",
+    "ramp_duration",
+    "run_validation",
+    "sandpaper",
+    "slip_statistics",
+    "static_map",
+    "stick_slip",
+    "streamline_paths",
+    "tip_radius",
+    "triangulated_surface",
+    "write_report",
+]

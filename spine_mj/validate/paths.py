@@ -1,0 +1,126 @@
+"""Paths of the validation: streamlines on the surface the MuJoCo tip traces, path metrics,
+and the MuJoCo paths a sweep stored.
+
+The quasistatic streamline runs on the surface dilated by the rig's tip radius
+(:func:`tip_radius`), on the smooth surface or on MuJoCo's triangulated hfield
+(:func:`triangulated_surface`), which separates the geometry error of the facets from the
+dynamics error. Deviations are resampled Frechet distances in units of ``L_c``
+(:func:`spine_mj.compare.path_frechet`).
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from spine_mj import compare, presets, sim, sweep
+from spine_mj import streamline as sl
+from spine_mj.errors import SpineInputError
+from spine_mj.surfaces import GridSurface, TriangulatedSurface, from_hfield, to_hfield
+from spine_mj.validate.plans import MASS_KG
+
+__all__ = [
+    "mujoco_traces",
+    "path_metrics",
+    "prefix_frechet",
+    "stored_paths",
+    "streamline_paths",
+    "tip_radius",
+    "triangulated_surface",
+]
+
+
+def tip_radius(preset: str, seeds, resolution: int) -> float:
+    """The rig's default tip radius (:meth:`spine_mj.sim.Scales.for_surface`) in surface
+    units, so that the quasistatic streamline runs on the surface traced by the same sphere.
+    A grid keeps its own samples here; ``resolution`` applies to analytic surfaces."""
+    surface = presets.make_surface(preset, **({} if seeds is None else {"seed": seeds[0]}))
+    scales = sim.Scales.for_surface(
+        surface,
+        tip=sim.TipParams(mass_kg=MASS_KG),
+        hfield_resolution=None if isinstance(surface, GridSurface) else resolution,
+    )
+    return float(f"{scales.tip_radius_m / scales.length_scale_m:.3g}")
+
+
+def streamline_paths(surface, starts, mu: float, dl: float, tip: float) -> sl.StreamlineResult:
+    """Streamlines (with paths) from ``starts`` on ``surface`` dilated by ``tip``.
+
+    A triangulated surface is first sampled finely inside its bounds (``tip / 8``, at most
+    400 samples per side of the longer edge) and that grid dilated.
+    """
+    if tip > 0 and isinstance(surface, TriangulatedSurface):
+        # sample the facets finely inside the bounds (no NaN margin), then dilate that grid
+        xmin, xmax, ymin, ymax = surface.bounds
+        h = min(tip / 8, max(xmax - xmin, ymax - ymin) / 400)
+        x = np.linspace(xmin, xmax, int(math.ceil((xmax - xmin) / h)) + 1)
+        y = np.linspace(ymin, ymax, int(math.ceil((ymax - ymin) / h)) + 1)
+        surface = GridSurface(heights=surface.height(x[None, :], y[:, None]), x=x, y=y, unit=surface.unit)
+    if tip > 0:
+        surface = sl.dilate(surface, tip)
+    return sl.streamlines(
+        surface, np.asarray(starts, float), sl.StreamlineParams(mu=mu, dl=dl), store_paths=True
+    )
+
+
+def triangulated_surface(surface, resolution: int | None) -> TriangulatedSurface:
+    """MuJoCo's hfield of ``surface`` as facets (a grid keeps its samples; else
+    ``resolution`` per side, or the default when None)."""
+    hf = (
+        to_hfield(surface)
+        if (isinstance(surface, GridSurface) or not resolution)
+        else (to_hfield(surface, nrow=resolution, ncol=resolution))
+    )
+    return TriangulatedSurface.from_grid(from_hfield(hf, unit=surface.unit))
+
+
+def path_metrics(mpath: np.ndarray, qpath: np.ndarray, lc: float) -> tuple[float, float]:
+    """Frechet and mean lateral deviation of ``mpath`` from ``qpath`` over ``lc`` (NaN, NaN
+    when either has fewer than two points)."""
+    if mpath.shape[0] < 2 or qpath.shape[0] < 2:
+        return float("nan"), float("nan")
+    fr = compare.path_frechet(mpath, qpath, length_scale=lc)
+    return fr, float(compare.mean_lateral_deviation(mpath, qpath, length_scale=lc))
+
+
+def prefix_frechet(mpath: np.ndarray, qpath: np.ndarray, lc: float) -> float:
+    """Frechet deviation of a MuJoCo path from the streamline cut at the same arc length."""
+    if mpath.shape[0] < 2 or qpath.shape[0] < 2:
+        return float("nan")
+    arc_m = float(np.linalg.norm(np.diff(mpath, axis=0), axis=1).sum())
+    seg = np.linalg.norm(np.diff(qpath, axis=0), axis=1)
+    cum = np.r_[0.0, np.cumsum(seg)]
+    k = int(np.searchsorted(cum, arc_m))
+    if k >= cum.size:
+        q = qpath
+    else:
+        t = (arc_m - cum[k - 1]) / seg[k - 1] if k > 0 and seg[k - 1] > 0 else 0.0
+        end = qpath[k - 1] + t * (qpath[k] - qpath[k - 1]) if k > 0 else qpath[0]
+        q = np.vstack([qpath[:k], end[None, :]])
+    if q.shape[0] < 2:
+        q = np.vstack([qpath[0], qpath[0]])
+    spacing = max(min(lc / 50, arc_m / 20), 1e-9 * lc)
+    return compare.path_frechet(mpath, q, length_scale=lc, spacing=spacing)
+
+
+def mujoco_traces(store: Path, case_id: str) -> dict:
+    """MuJoCo trajectories of a stored case: start -> DataFrame (``x``, ``y``,
+    ``drive_force_n``, ``time_s``, ``slipping``) sorted by step; empty without any."""
+    try:
+        tr = sweep.load_trajectories(
+            store, case_id, analysis="mujoco", columns=["x", "y", "drive_force_n", "time_s", "slipping"]
+        )
+    except SpineInputError:
+        return {}
+    return {int(s): g.sort_values("step") for s, g in tr.groupby("start")}
+
+
+def stored_paths(store: Path, case_id: str, analysis: str) -> dict[int, np.ndarray]:
+    """Paths of ``analysis`` for a stored case: start -> ``(n, 2)`` x, y; empty without any."""
+    try:
+        tr = sweep.load_trajectories(store, case_id, analysis=analysis, columns=["x", "y"])
+    except SpineInputError:
+        return {}
+    return {int(s): g.sort_values("step")[["x", "y"]].to_numpy() for s, g in tr.groupby("start")}

@@ -1,0 +1,255 @@
+"""Sizes and targets of a validation run: the plans, their surface families and engine variations.
+
+A :class:`ValidationPlan` fixes every grid of the five studies (planes, families, I_e
+values, stiffnesses, grits, bootstrap size, ramp caps); :data:`PLANS` holds the ``smoke``
+(test size), ``quick`` and ``full`` plans. The agreement targets and the physical
+constants every study shares (tip mass, gravity, the sandpaper mu) live here, so that the
+studies, the summary and the report read one value.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+__all__ = [
+    "FRECHET_TARGET",
+    "GRAVITY",
+    "IMPRATIO",
+    "MASS_KG",
+    "NO_NOSLIP",
+    "OUTCOME_TARGET",
+    "PLANS",
+    "RAMP_MIN_COVERAGE",
+    "RECOMMENDED",
+    "SANDPAPER_MU",
+    "STATIC_TARGET",
+    "FamilySpec",
+    "ValidationPlan",
+    "paper_starts",
+    "relative_starts",
+]
+
+#: A ramp whose runs cover less of the path to the domain edge gives no I_e*.
+RAMP_MIN_COVERAGE = 0.5
+#: Agreement thresholds of the issue's targets.
+OUTCOME_TARGET = 0.95
+FRECHET_TARGET = 0.1
+STATIC_TARGET = 0.05
+MASS_KG = 0.01
+GRAVITY = 9.81
+SANDPAPER_MU = 0.5
+
+
+@dataclass(frozen=True)
+class FamilySpec:
+    """A surface family of the quasistatic-limit and boundary studies.
+
+    Attributes
+    ----------
+    name : str
+        Key in ``validation.json`` (``single_peak_valley``, ``random_gaussian``, ``fractal``).
+    presets : tuple of str
+    seeds : tuple of int or None
+        Surface seeds (None: the preset's own).
+    starts : dict
+        A sweep ``starts`` table.
+    """
+
+    name: str
+    presets: tuple[str, ...]
+    seeds: tuple[int, ...] | None
+    starts: tuple[tuple[str, Any], ...]
+
+    def starts_table(self) -> dict:
+        return {k: (list(v) if isinstance(v, tuple) else v) for k, v in self.starts}
+
+    def first_start(self, surface) -> tuple[float, float]:
+        """The first start in ``surface`` units (a relative frame scaled to its bounds)."""
+        t = self.starts_table()
+        x, y = float(t["x"][0]), float(t["y"][0])
+        if t.get("frame") == "relative":
+            xmin, xmax, ymin, ymax = surface.bounds
+            x, y = xmin + x * (xmax - xmin), ymin + y * (ymax - ymin)
+        return x, y
+
+
+def paper_starts(ys: Sequence[float]) -> tuple:
+    """Starts at x = -3 and the given ``ys`` in surface units (the paper's single peak/valley)."""
+    return (("frame", "absolute"), ("x", (-3.0,)), ("y", tuple(float(y) for y in ys)))
+
+
+def relative_starts(n: int, x: float = 0.05) -> tuple:
+    """``n`` starts at relative ``x``, spread over y in [0.2, 0.8] of the domain."""
+    return (("frame", "relative"), ("x", (x,)), ("y", tuple(np.linspace(0.2, 0.8, n).round(4))))
+
+
+@dataclass(frozen=True)
+class ValidationPlan:
+    """Sizes of a validation run.
+
+    Attributes
+    ----------
+    name : str
+    slopes_deg, azimuths_deg : tuple of float
+        Inclined planes of the static map (azimuth 0: rising in the drive direction +x).
+    static_engines : tuple of (label, ((key, value), ...))
+        Engine settings of the static map as sweep grid keys; the first is the default.
+    families : tuple of FamilySpec
+        Quasistatic-limit families.
+    lowest_ie : float
+    hfield_resolution : int
+        Samples per side of analytic surfaces (grid surfaces keep their own).
+    limit_variations : tuple of (label, ((key, value), ...))
+        Settings varied one at a time on the single peak at the lowest I_e.
+    ie_values : tuple of float
+        Boundary study grid.
+    boundary_families : tuple of str
+        Families (by name) of the boundary study.
+    protocols : tuple of str
+    stick_slip_ie : tuple of float
+    stick_slip_stiffness : tuple of float
+        Spring stiffness in units of ``F_p / L_c``.
+    stick_slip_starts : int
+    sandpaper_grits : tuple of str
+    sandpaper_starts : int
+    sandpaper_ie : float
+    bootstrap : int
+        Bootstrap resamples of the starts for the I_e* uncertainty.
+    ramp_max_steps : int
+        Time cap of a ramp-with-reset run in engine steps (after the settle phase). The
+        ramp's duration is the time its measured per-cycle slip needs to cover the path to
+        the domain edge, capped here (see :func:`ramp_duration`).
+    ramp_slide_lc : float
+        Distance the tip slides after each breakaway before the force resets, in ``L_c``
+        (the step of the paper's algorithm). The paper's dl = 0.01 sigma would need ~500
+        cycles per path here; 0.1 L_c keeps a run affordable and is compared with the
+        streamline stepped at its own, converged dl.
+    """
+
+    name: str
+    slopes_deg: tuple[float, ...]
+    azimuths_deg: tuple[float, ...]
+    static_engines: tuple[tuple[str, tuple[tuple[str, Any], ...]], ...]
+    families: tuple[FamilySpec, ...]
+    lowest_ie: float
+    hfield_resolution: int
+    limit_variations: tuple[tuple[str, tuple[tuple[str, Any], ...]], ...]
+    ie_values: tuple[float, ...]
+    boundary_families: tuple[str, ...]
+    protocols: tuple[str, ...] = ("spring", "ramp")
+    stick_slip_ie: tuple[float, ...] = (1e-3, 1e-1, 1.0)
+    stick_slip_stiffness: tuple[float, ...] = (2.0, 10.0, 50.0)
+    stick_slip_starts: int = 3
+    sandpaper_grits: tuple[str, ...] = ("P36", "P60", "P600")
+    sandpaper_starts: int = 3
+    sandpaper_ie: float = 1e-3
+    bootstrap: int = 200
+    ramp_max_steps: int = 20000
+    ramp_slide_lc: float = 0.1
+    extra: dict = field(default_factory=dict, compare=False)
+
+
+#: Engine variations: (label, sweep grid overrides); the first is the rig's default.
+RECOMMENDED = ("recommended (elliptic, noslip 3)", ())
+NO_NOSLIP = ("no noslip (elliptic, impratio 1)", (("noslip_iterations", 0),))
+IMPRATIO = ("no noslip, impratio 10", (("noslip_iterations", 0), ("impratio", 10.0)))
+
+PLANS: dict[str, ValidationPlan] = {
+    "smoke": ValidationPlan(
+        name="smoke",
+        slopes_deg=(20.0, 70.0),
+        azimuths_deg=(0.0,),
+        static_engines=(RECOMMENDED,),
+        families=(
+            FamilySpec("single_peak_valley", ("paper-single-peak",), None, paper_starts([-2.0, -4.0])),
+        ),
+        lowest_ie=1e-2,
+        hfield_resolution=101,
+        limit_variations=(),
+        ie_values=(1e-2, 1.0),
+        boundary_families=("single_peak_valley",),
+        protocols=("spring",),
+        stick_slip_ie=(1e-1,),
+        stick_slip_stiffness=(10.0,),
+        stick_slip_starts=1,
+        sandpaper_grits=(),
+        bootstrap=20,
+        ramp_max_steps=2000,
+    ),
+    "quick": ValidationPlan(
+        name="quick",
+        slopes_deg=(0.0, 15.0, 30.0, 45.0, 60.0, 75.0),
+        azimuths_deg=(0.0, 60.0, 120.0, 180.0),
+        static_engines=(RECOMMENDED, NO_NOSLIP),
+        families=(
+            FamilySpec(
+                "single_peak_valley",
+                ("paper-single-peak", "paper-single-valley"),
+                None,
+                paper_starts([-0.5, -1.0, -2.0, -3.0, -4.0]),
+            ),
+            FamilySpec(
+                "random_gaussian", ("paper-random-convex", "paper-random-concave"), (1,), relative_starts(3)
+            ),
+            FamilySpec("fractal", ("paper-fractal",), (1,), relative_starts(3)),
+        ),
+        lowest_ie=1e-4,
+        hfield_resolution=151,
+        limit_variations=(NO_NOSLIP, IMPRATIO),
+        ie_values=(1e-4, 1e-3, 1e-2, 1e-1, 1.0, 10.0),
+        boundary_families=("single_peak_valley",),
+        stick_slip_ie=(1e-2, 1.0),
+        stick_slip_stiffness=(2.0, 50.0),
+        stick_slip_starts=2,
+        sandpaper_grits=("P36", "P600"),
+        sandpaper_starts=2,
+        bootstrap=200,
+        ramp_max_steps=20000,
+    ),
+    "full": ValidationPlan(
+        name="full",
+        slopes_deg=tuple(np.arange(0.0, 76.0, 7.5)),
+        azimuths_deg=(0.0, 30.0, 60.0, 90.0, 120.0, 150.0, 180.0),
+        static_engines=(RECOMMENDED, NO_NOSLIP, IMPRATIO),
+        families=(
+            FamilySpec(
+                "single_peak_valley",
+                ("paper-single-peak", "paper-single-valley"),
+                None,
+                paper_starts([-0.5, -1.0, -2.0, -3.0, -4.0]),
+            ),
+            FamilySpec(
+                "random_gaussian",
+                ("paper-random-convex", "paper-random-concave"),
+                (1, 2),
+                relative_starts(5),
+            ),
+            FamilySpec("fractal", ("paper-fractal",), (1,), relative_starts(5)),
+        ),
+        lowest_ie=1e-4,
+        hfield_resolution=201,
+        limit_variations=(
+            NO_NOSLIP,
+            IMPRATIO,
+            ("no noslip, impratio 100", (("noslip_iterations", 0), ("impratio", 100.0))),
+            ("hfield 101", (("hfield_resolution", 101),)),
+            ("hfield 401", (("hfield_resolution", 401),)),
+            ("soft contact (timeconst 10 dt)", (("solref_timeconst_factor", 10.0),)),
+            ("timestep / 2", (("timestep_factor", 0.5),)),
+        ),
+        ie_values=tuple(float(v) for v in np.logspace(-4, 1, 11)),
+        # the random Gaussian boundary (20 runs x 11 I_e x 2 drives) would double the run
+        # time past ~45 min on 2 cores: the full plan keeps the single peak/valley there
+        boundary_families=("single_peak_valley",),
+        stick_slip_ie=(1e-3, 1e-2, 1e-1, 1.0),
+        stick_slip_stiffness=(2.0, 10.0, 50.0),
+        stick_slip_starts=3,
+        sandpaper_starts=4,
+        bootstrap=500,
+        ramp_max_steps=200_000,
+    ),
+}

@@ -1,0 +1,109 @@
+"""The study runner: drives :func:`spine_mj.sweep.run_sweep` for the validation's studies.
+
+Every study hands its sweep configs (dicts) to one :class:`StudyRunner`, which runs each
+into its own resumable store under ``out/sweeps/<name>`` (a killed validation resumes
+where it stopped) and reports :class:`ValidationProgress` to the caller's callback.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+from spine_mj import sweep
+
+__all__ = ["StudyRunner", "ValidationProgress"]
+
+
+@dataclass(frozen=True)
+class ValidationProgress:
+    """Progress of a validation, passed to the ``progress`` callback.
+
+    Attributes
+    ----------
+    study : str
+        ``static``, ``limit``, ``boundary``, ``stick_slip``, ``sandpaper`` or ``report``.
+    step : str
+        What runs now (a sweep name or a phase).
+    finished_cases, total_cases : int
+        Of the current sweep (0, 0 between sweeps).
+    elapsed_s : float
+        Since the validation started.
+    """
+
+    study: str
+    step: str
+    finished_cases: int
+    total_cases: int
+    elapsed_s: float
+
+
+class StudyRunner:
+    """Runs sweep configs (dicts) into ``out/sweeps/<name>`` and reports progress.
+
+    Parameters
+    ----------
+    out_dir : Path
+        The validation's output folder (absolute: the stores refer to files under it).
+    workers : int or None
+        Worker processes per sweep (None: all cores), capped at the sweep's case count.
+    progress : callable or None
+        Called with :class:`ValidationProgress`.
+    t0 : float
+        ``time.perf_counter()`` at the start of the validation.
+
+    Attributes
+    ----------
+    study : str
+        The study now running; each study sets it before its first sweep.
+    """
+
+    def __init__(
+        self,
+        out_dir: Path,
+        workers: int | None,
+        progress: Callable[[ValidationProgress], None] | None,
+        t0: float,
+    ):
+        self.out_dir = out_dir
+        self.workers = workers
+        self.progress = progress
+        self.t0 = t0
+        self.study = ""
+
+    def note(self, step: str) -> None:
+        """Report a phase that runs no sweep (``step``)."""
+        if self.progress is not None:
+            self.progress(ValidationProgress(self.study, step, 0, 0, time.perf_counter() - self.t0))
+
+    def __call__(self, doc: dict, name: str, *, workers: int | None = None):
+        """Run the sweep config ``doc`` into ``out/sweeps/<name>`` (overwriting it).
+
+        Returns
+        -------
+        (DataFrame, Path)
+            The run table (:func:`spine_mj.sweep.load_runs`) and the store.
+        """
+        config = sweep.parse_config(doc, base_dir=self.out_dir)
+        store = self.out_dir / "sweeps" / name
+
+        def cb(p):
+            if self.progress is not None:
+                self.progress(
+                    ValidationProgress(
+                        self.study,
+                        name,
+                        p.finished_cases + p.skipped_cases,
+                        p.total_cases,
+                        time.perf_counter() - self.t0,
+                    )
+                )
+
+        n_cases = len(sweep.expand_cases(config))
+        w = workers if workers is not None else self.workers
+        w = max(1, min(w or os.cpu_count() or 1, n_cases))
+        sweep.run_sweep(config, store, workers=w, overwrite=True, progress=cb)
+        return sweep.load_runs(store), store

@@ -1,0 +1,166 @@
+"""Study 1: the static probe on inclined planes against the analytic engagement ratio.
+
+The breakaway ratio ``kappa_mj / kappa`` over slope angle and azimuth (engaged, self-lock
+and slip regions, Eqs. 1-3), per engine setting of the plan.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from spine_mj import engagement, sim, surface_io
+from spine_mj.validate.plans import GRAVITY, MASS_KG, ValidationPlan
+from spine_mj.validate.runner import StudyRunner
+from spine_mj.validate.sweep_docs import engine_default
+
+__all__ = ["PLANE_START", "StaticMapResult", "static_map"]
+
+#: Where the probe starts on every plane (metres).
+PLANE_START = (3.1e-4, 2.7e-4)
+
+
+@dataclass(frozen=True)
+class StaticMapResult:
+    """Result of :func:`static_map`.
+
+    Attributes
+    ----------
+    rows : list of dict
+        One per (plane, engine setting): ``engine``, ``slope_deg``, ``azimuth_deg``,
+        ``region`` (``engaged`` / ``self_lock`` / ``slip``), ``kappa``, ``kappa_mj``,
+        ``ratio``, ``end_reason``, ``hold_over_w``, ``region_agrees``.
+    per_engine : dict
+        Engine label -> ``engaged_planes``, ``engaged_breakaways``, ``max_rel_error`` and
+        ``mean_rel_error`` of ``|kappa_mj / kappa - 1|`` over the engaged planes,
+        ``region_agreement``.
+    mu : float
+    static_kappa_max_rel_error : float
+        ``max_rel_error`` of the default (first) setting; inf when an engaged plane did not
+        break away.
+    """
+
+    rows: list[dict]
+    per_engine: dict[str, dict]
+    mu: float
+    static_kappa_max_rel_error: float
+
+    def as_dict(self) -> dict:
+        return {
+            "rows": self.rows,
+            "per_engine": self.per_engine,
+            "mu": self.mu,
+            "static_kappa_max_rel_error": self.static_kappa_max_rel_error,
+        }
+
+
+def _hold_force(fx: float, fy: float, mu: float) -> tuple[float, float, int]:
+    """Analytic kappa, the smallest drive force / W that holds the tip, and the region."""
+    k, region = engagement.kappa(fx, fy, mu)
+    a, b, c = (float(v) for v in engagement.quadratic_coefficients(fx, fy, mu))
+    # the tip holds where A' k^2 + B' k + C' <= 0; C' > 0 means gravity alone slides it, and
+    # the smallest positive root is then the force that starts to hold it
+    low = 0.0
+    if c > 0:
+        roots = np.roots([a, b, c]) if abs(a) > 1e-12 else np.array([-c / b])
+        pos = [float(r.real) for r in np.atleast_1d(roots) if abs(r.imag) < 1e-12 and r.real > 0]
+        low = min(pos) if pos else 0.0
+    return float(k), low, int(region)
+
+
+def static_map(plan: ValidationPlan, runner: StudyRunner, *, mu: float = 0.5) -> StaticMapResult:
+    """Study 1: static probe on inclined planes against the analytic kappa (Eqs. 1-3).
+
+    Every plane is a surface file under ``out/surfaces``; the probe starts at rest with the
+    smallest holding force plus half the gap to the breakaway force (where gravity alone
+    would slide the tip) and ramps the force at ``I_e = 0.01`` until breakaway.
+
+    Returns
+    -------
+    StaticMapResult
+    """
+    runner.study = "static"
+    rows = []
+    for slope in plan.slopes_deg:
+        for az in plan.azimuths_deg:
+            if slope == 0.0 and az != plan.azimuths_deg[0]:
+                continue
+            rows += _plane_rows(plan, runner, slope, az, mu)
+    per_engine = {
+        label: _engine_summary([r for r in rows if r["engine"] == label]) for label, _ in plan.static_engines
+    }
+    first = per_engine[plan.static_engines[0][0]]
+    max_err = first["max_rel_error"]
+    if first["engaged_breakaways"] < first["engaged_planes"]:
+        max_err = float("inf")  # an engaged plane that did not break away is no agreement
+    return StaticMapResult(rows=rows, per_engine=per_engine, mu=mu, static_kappa_max_rel_error=max_err)
+
+
+def _plane_rows(plan: ValidationPlan, runner: StudyRunner, slope: float, az: float, mu: float) -> list[dict]:
+    """The probe on one plane under every engine setting of the plan."""
+    region_names = engagement.REGION_NAMES
+    engines = plan.static_engines
+    t = math.tan(math.radians(slope))
+    fx, fy = t * math.cos(math.radians(az)), t * math.sin(math.radians(az))
+    k, low, region = _hold_force(fx, fy, mu)
+    hold = 0.5 * (low + k) if (low > 0 and np.isfinite(k)) else (1.5 * low if low > 0 else 0.0)
+    path = runner.out_dir / "surfaces" / f"plane_s{slope:g}_a{az:g}.npz"
+    if not path.is_file():
+        surface_io.save_surface(sim.inclined_plane(slope_deg=slope, azimuth_deg=az), path)
+    keys = sorted({k_ for _, ov in engines for k_, _ in ov})
+    rows = []
+    for label, ov in engines:
+        # the cap must lie above the breakaway force, or a steep engaged plane
+        # reads as self-locked
+        cap = max(10.0, 1.5 * k) if np.isfinite(k) else 10.0
+        grid = {"mu": mu, "kappa_cap": float(f"{cap:.4g}")}
+        grid.update({k_: engine_default(k_) for k_ in keys})
+        grid.update(dict(ov))
+        doc = {
+            "sweep": {
+                "name": f"static-s{slope:g}-a{az:g}",
+                "seed": 1,
+                "analyses": ["mujoco"],
+                "store_trajectories": False,
+            },
+            "surfaces": [{"file": str(path)}],
+            "starts": {"frame": "absolute", "points": [list(PLANE_START)]},
+            "drive": {"protocol": "static", "ie": 1e-2, "start_force": hold * MASS_KG * GRAVITY},
+            "grid": grid,
+        }
+        tag = "-".join(f"{k_}{v}" for k_, v in ov) or "default"
+        df, _ = runner(doc, f"static/s{slope:g}-a{az:g}-{tag}", workers=1)
+        r = df.iloc[0]
+        kmj = float(r.get("kappa_mj", np.nan))
+        end = str(r.get("end_reason", r["status"]))
+        mj_region = {"breakaway": "engaged", "self_lock": "self_lock", "slid": "slip"}.get(end, end)
+        rows.append(
+            {
+                "engine": label,
+                "slope_deg": float(slope),
+                "azimuth_deg": float(az),
+                "region": region_names[region],
+                "kappa": k,
+                "kappa_mj": kmj,
+                "ratio": kmj / k if (region == engagement.ENGAGED and k > 0) else float("nan"),
+                "end_reason": end,
+                "hold_over_w": hold,
+                "region_agrees": mj_region == region_names[region],
+            }
+        )
+    return rows
+
+
+def _engine_summary(sel: list[dict]) -> dict:
+    """Breakaway errors over the engaged planes and region agreement of one setting's rows."""
+    eng = [abs(r["ratio"] - 1) for r in sel if r["region"] == "engaged"]
+    eng_f = [e for e in eng if np.isfinite(e)]
+    return {
+        "engaged_planes": len(eng),
+        "engaged_breakaways": len(eng_f),
+        "max_rel_error": float(max(eng_f)) if eng_f else float("nan"),
+        "mean_rel_error": float(np.mean(eng_f)) if eng_f else float("nan"),
+        "region_agreement": float(np.mean([r["region_agrees"] for r in sel])),
+    }

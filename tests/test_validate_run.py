@@ -1,0 +1,63 @@
+"""The validation suite end to end: a smoke-size run, bad plans, the CLI."""
+
+import json
+
+import pytest
+from click.testing import CliRunner
+
+from spine_mj import validate
+from spine_mj.cli import main
+from spine_mj.errors import SpineInputError
+
+
+def test_smoke_validation_writes_report_and_json(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)  # a relative --out, as `make demo` passes it
+    out = tmp_path / "val"
+    res = CliRunner().invoke(main, ["validate", "--plan", "smoke", "--out", "val", "--workers", "1"])
+    assert res.exit_code == 0, res.output
+    doc = json.loads((out / "validation.json").read_text())
+    for key in (
+        "static_kappa_max_rel_error",
+        "lowest_ie",
+        "outcome_agreement_at_lowest_ie",
+        "mean_frechet_at_lowest_ie",
+        "ie_star",
+        "engine_settings",
+    ):
+        assert key in doc
+    assert doc["lowest_ie"] == validate.PLANS["smoke"].lowest_ie
+    assert set(doc["outcome_agreement_at_lowest_ie"]) == {"single_peak_valley"}
+    assert 0.0 <= doc["outcome_agreement_at_lowest_ie"]["single_peak_valley"] <= 1.0
+    assert {"value", "low", "high", "kind"} <= set(doc["ie_star"]["spring"])
+    # the static probe on a 20 deg plane (engaged) matches tan(theta + arctan mu) closely
+    assert doc["static_kappa_max_rel_error"] < 0.05
+    report = (out / "report.md").read_text()
+    assert "Quasistatic limit" in report and "figures/boundary.png" in report
+    assert (out / "figures" / "boundary.png").stat().st_size > 1000
+    assert (out / "sweeps" / "boundary" / "spring-paper-single-peak" / "runs.parquet").is_file()
+    assert "outcome agreement" in res.output
+
+
+def test_unknown_plan_is_rejected():
+    with pytest.raises(SpineInputError, match="plan must be one of"):
+        validate.run_validation("unused", plan="huge")
+
+
+@pytest.mark.parametrize(
+    "args, match",
+    [
+        (["--quick", "--plan", "smoke"], "give one of them"),
+        (["--plan", "smoke", "--out-is-file"], "is not a folder"),
+    ],
+)
+def test_cli_bad_input_is_one_line_exit_2_and_writes_nothing(tmp_path, args, match):
+    target = tmp_path / "out"
+    if "--out-is-file" in args:
+        args = [a for a in args if a != "--out-is-file"]
+        target.write_text("not a folder")
+    before = sorted(p.name for p in tmp_path.iterdir())
+    res = CliRunner().invoke(main, ["validate", *args, "--out", str(target)])
+    assert res.exit_code == 2
+    lines = res.output.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("Error:") and match in lines[0]
+    assert sorted(p.name for p in tmp_path.iterdir()) == before
