@@ -39,8 +39,8 @@ def main() -> None:
     # the bare side gets everything spine_mj computes before the rollout, for free
     det_r = det.resolve(rig.scales)
     qpos0 = [rig.place(*s) for s in starts]
-    model = rig._model_for(drive)
-    ctrl = np.stack([rig._controls(drive, q, det_r) for q in qpos0])
+    model = rig.model_for(drive)
+    ctrl = np.stack([rig.controls(drive, q, det_r) for q in qpos0])
     nstate = mujoco.mj_stateSize(model, mujoco.mjtState.mjSTATE_FULLPHYSICS)
     init = np.zeros((args.runs, nstate))
     init[:, 1:4] = qpos0

@@ -85,8 +85,8 @@ def bare_rollout_time(config: sweep.SweepConfig) -> float:
         det = sim.Detection().resolve(sc)
         starts = case.starts.resolve(surface.bounds, case.seed)
         qpos0 = [rig.place(*s) for s in starts]
-        ctrl = np.stack([rig._controls(drive, q, det) for q in qpos0])
-        models = [rig._model_for(drive) for _ in qpos0]
+        ctrl = np.stack([rig.controls(drive, q, det) for q in qpos0])
+        models = [rig.model_for(drive) for _ in qpos0]
         nstate = mujoco.mj_stateSize(rig.model, mujoco.mjtState.mjSTATE_FULLPHYSICS)
         init = np.zeros((len(qpos0), nstate))
         init[:, 1:4] = qpos0

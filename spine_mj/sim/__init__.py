@@ -1,0 +1,91 @@
+"""MuJoCo rig: any surface as an hfield, a point-like spine tip under gravity, three drives.
+
+The rig (``models/spine_rig.xml``) is a sphere of radius ``tip_radius_m`` on three slide
+joints (x, y, z; no rotation) with mass ``mass_kg``, friction ``mu_s`` (condim 3), gravity
+and an optional extra downward preload. :class:`Rig` loads that file with ``MjSpec``,
+attaches the surface as an hfield through :func:`spine_mj.surfaces.to_hfield` and compiles.
+
+Units. The model is in SI units. A dimensionless surface (``unit == "1"``, the paper's
+Gaussian surfaces) is scaled by ``length_scale_m`` (default 1 cm per unit) in x, y and z; a
+surface in metres is used as it is. Positions in results are in metres; divide by
+``rig.length_scale_m`` for surface units.
+
+Scales and default engine settings (:func:`default_engine`). With
+``F_p = mass_kg * gravity + preload_n`` (the normal preload), ``a_p = F_p / mass_kg`` and
+``L_c`` the surface's characteristic length (:func:`characteristic_length`):
+
+* contacts use ``solref = (2 dt, 1)`` (the stiffest stable time constant, critically
+  damped) and ``solimp = (0.99, 0.99, ...)``; the resting depth is then
+  ``(1 - 0.99) a_p (2 dt)^2 = 0.04 a_p dt^2``, and the deepest contact seen while a drive
+  loads the tip stays within a few ``a_p dt^2`` per preload of drive force;
+* ``dt`` is the largest step (at most 1 ms) with ``a_p dt^2 <= 0.005 min(r_tip, L_c)``:
+  measured penetration 2-4 um for a 0.5 mm tip at F <= 5 F_p and 37 um at 17 F_p (a
+  60 degree slope), always far below 1 % of ``L_c``;
+* ``cone = elliptic`` with ``noslip_iterations = 3``: MuJoCo's friction is soft and creeps
+  at any in-cone load without the noslip pass (PHYSICS.md §5); ``impratio`` stays 1.
+
+Drives (PHYSICS.md §4): :class:`SpringDrive` (a carriage moves at constant speed in +x and
+pulls the tip through a spring acting in x only), :class:`RampDrive` (force rises at a set
+rate until slip, drops to zero, ramps again once the tip has settled) and
+:class:`StaticProbe` (ramp at one point until breakaway, ``kappa_mj = F / F_p``). Each run
+reports its inertia number ``I_e = m v^2 / (F_p L_c)``; for the force drives ``v`` is the
+equivalent speed ``v_eq = L_c (dF/dt) / F_p`` (the speed at which the tip would cross one
+feature in the time the force takes to rise by one preload).
+
+Spring drives and static probes run open loop through :func:`mujoco.rollout.rollout` on
+native threads (a batch of starts or parameter sets at once); the force ramp with reset
+needs feedback and steps in Python. Every run ends with a recorded :class:`EndReason`,
+never with an exception from the engine.
+
+Modules: :mod:`~spine_mj.sim.params` (tip, engine, scales and their rules),
+:mod:`~spine_mj.sim.drives`, :mod:`~spine_mj.sim.model` (building the MuJoCo model),
+:mod:`~spine_mj.sim.placement`, :mod:`~spine_mj.sim.recording` (per-step columns),
+:mod:`~spine_mj.sim.detection` (events, end reasons), :mod:`~spine_mj.sim.results`,
+:mod:`~spine_mj.sim.rollout` (open-loop batches), :mod:`~spine_mj.sim.ramp` (closed loop),
+:mod:`~spine_mj.sim.render`, :mod:`~spine_mj.sim.planes` and :mod:`~spine_mj.sim.rig`
+(:class:`Rig`, the object users hold).
+"""
+
+from spine_mj.sim.detection import Detection, Event
+from spine_mj.sim.drives import Drive, RampDrive, SpringDrive, StaticProbe
+from spine_mj.sim.model import MODEL_PATH
+from spine_mj.sim.params import (
+    DEFAULT_LENGTH_SCALE_M,
+    Cone,
+    EndReason,
+    EngineSettings,
+    Integrator,
+    Scales,
+    TipParams,
+    characteristic_length,
+    default_engine,
+    hfield_of,
+    hfield_spacing,
+)
+from spine_mj.sim.planes import inclined_plane
+from spine_mj.sim.results import RunResult
+from spine_mj.sim.rig import Rig
+
+__all__ = [
+    "DEFAULT_LENGTH_SCALE_M",
+    "MODEL_PATH",
+    "Cone",
+    "Detection",
+    "Drive",
+    "EndReason",
+    "EngineSettings",
+    "Event",
+    "Integrator",
+    "RampDrive",
+    "Rig",
+    "RunResult",
+    "Scales",
+    "SpringDrive",
+    "StaticProbe",
+    "TipParams",
+    "characteristic_length",
+    "default_engine",
+    "hfield_of",
+    "hfield_spacing",
+    "inclined_plane",
+]

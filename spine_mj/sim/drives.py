@@ -1,0 +1,112 @@
+"""The three drives and the rules that turn a drive into numbers on a rig.
+
+:class:`SpringDrive`, :class:`RampDrive` and :class:`StaticProbe` are frozen parameter
+records (PHYSICS.md §4); None fields are derived from the problem's :class:`Scales` and
+the engine's time step by the functions below (spring stiffness, force rate, settle steps,
+the drive's speed), so a drive means the same wherever it is run.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from spine_mj.errors import check_positive
+from spine_mj.sim.params import Scales, check_optional
+
+
+@dataclass(frozen=True)
+class SpringDrive:
+    """Spring carriage: the carriage moves at ``speed_m_s`` in +x and pulls the tip through a
+    spring of stiffness ``stiffness_n_m`` acting in x only.
+
+    ``stiffness_n_m`` None: ``10 F_p / L_c``. ``duration_s`` None: the time the carriage
+    needs to cover 1.1 times the distance to the domain's +x edge plus the spring stretch
+    at ``(1 + mu_s) F_p``.
+    """
+
+    speed_m_s: float
+    stiffness_n_m: float | None = None
+    duration_s: float | None = None
+    settle_time_s: float | None = None
+
+    def __post_init__(self):
+        object.__setattr__(self, "speed_m_s", check_positive("speed_m_s", self.speed_m_s))
+        check_optional(self, ["stiffness_n_m", "duration_s"])
+        check_optional(self, ["settle_time_s"], allow_zero=True)
+
+
+@dataclass(frozen=True)
+class RampDrive:
+    """Force ramp with reset, the paper's algorithm (§2.2) in dynamics: F rises from 0 at
+    ``rate_n_s`` until slip is detected, keeps rising while the tip slides
+    ``slide_distance_m`` (horizontal distance from where the slip began; the paper's step
+    dl), then drops to 0; the ramp starts again once the tip has settled (stuck for
+    ``settle_time_s``).
+
+    ``rate_n_s`` None: ``0.1 F_p / tau`` (``I_e = 0.01``). ``duration_s`` None: 40 ramps to
+    ``kappa_cap F_p``, capped at 200 tau. ``slide_distance_m`` None: ``0.01 L_c`` (the
+    paper's dl ~ 0.01 sigma); 0 drops the force at the first sign of slip.
+    """
+
+    rate_n_s: float | None = None
+    duration_s: float | None = None
+    settle_time_s: float | None = None
+    slide_distance_m: float | None = None
+
+    def __post_init__(self):
+        check_optional(self, ["rate_n_s", "duration_s"])
+        check_optional(self, ["settle_time_s", "slide_distance_m"], allow_zero=True)
+
+
+@dataclass(frozen=True)
+class StaticProbe:
+    """Static probe: the tip rests at the start with ``start_force_n`` applied in +x, then
+    the force rises at ``rate_n_s`` until breakaway; ``kappa_mj = F_breakaway / F_p``.
+
+    A start force is needed where gravity alone would slide the tip (a slope steeper than
+    arctan mu): the tip is held by friction at ``start_force_n``. ``rate_n_s`` None:
+    ``0.1 F_p / tau`` (``I_e = 0.01``).
+    """
+
+    rate_n_s: float | None = None
+    start_force_n: float = 0.0
+    settle_time_s: float | None = None
+
+    def __post_init__(self):
+        check_optional(self, ["rate_n_s"])
+        check_optional(self, ["settle_time_s"], allow_zero=True)
+        object.__setattr__(
+            self, "start_force_n", check_positive("start_force_n", self.start_force_n, allow_zero=True)
+        )
+
+
+Drive = SpringDrive | RampDrive | StaticProbe
+
+
+def stiffness_n_m(drive: SpringDrive, scales: Scales) -> float:
+    """The spring's stiffness [N/m]: the drive's own, else ``10 F_p / L_c``."""
+    if drive.stiffness_n_m is not None:
+        return drive.stiffness_n_m
+    return 10 * scales.preload_n / scales.char_length_m
+
+
+def rate_n_s(drive: RampDrive | StaticProbe, scales: Scales) -> float:
+    """The force rate [N/s]: the drive's own, else ``0.1 F_p / tau`` (``I_e = 0.01``)."""
+    if drive.rate_n_s is not None:
+        return drive.rate_n_s
+    return 0.1 * scales.preload_n / scales.time_s
+
+
+def settle_steps(drive: Drive, timestep_s: float) -> int:
+    """Steps of the settle phase before the drive starts (default 200 steps)."""
+    t = drive.settle_time_s
+    if t is None:
+        t = 200 * timestep_s
+    return max(1, int(round(t / timestep_s)))
+
+
+def speed_m_s(drive: Drive, scales: Scales) -> float:
+    """The drive's speed [m/s]: carriage speed, or ``L_c rate / F_p`` for force drives."""
+    if isinstance(drive, SpringDrive):
+        return drive.speed_m_s
+    return scales.char_length_m * rate_n_s(drive, scales) / scales.preload_n

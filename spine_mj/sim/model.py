@@ -1,0 +1,215 @@
+"""The compiled MuJoCo model of one surface and one tip: building, surface swaps, export, placement.
+
+:class:`RigModel` loads ``models/spine_rig.xml`` with ``MjSpec``, sizes it from the
+:class:`~spine_mj.sim.params.Scales` (the rule lives in :mod:`spine_mj.sim.params`),
+attaches the surface as an hfield, compiles, and knows its ids and sensor addresses;
+it places tips (:mod:`spine_mj.sim.placement`) and gives each drive its model.
+:class:`~spine_mj.sim.Rig` adds running on top; the run machinery
+(:mod:`~spine_mj.sim.rollout`, :mod:`~spine_mj.sim.ramp`, :mod:`~spine_mj.sim.results`,
+:mod:`~spine_mj.sim.render`) works on a :class:`RigModel`.
+"""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+import os
+from pathlib import Path
+
+import numpy as np
+
+from spine_mj.errors import SpineInputError, atomic_output
+from spine_mj.sim.drives import Drive, SpringDrive, speed_m_s, stiffness_n_m
+from spine_mj.sim.params import EngineSettings, Scales, TipParams, default_engine, hfield_of
+from spine_mj.sim.placement import Placer
+from spine_mj.sim.recording import SENSOR_NAMES
+from spine_mj.surfaces import Surface
+
+MODEL_PATH = Path(__file__).resolve().parent.parent.parent / "models" / "spine_rig.xml"
+
+
+class RigModel:
+    """The MuJoCo model of one surface and one tip (parameters as for :class:`~spine_mj.sim.Rig`)."""
+
+    def __init__(
+        self,
+        surface: Surface,
+        *,
+        tip: TipParams | None = None,
+        engine: EngineSettings | None = None,
+        length_scale_m: float | None = None,
+        char_length_m: float | None = None,
+    ):
+        import mujoco
+
+        if not isinstance(surface, Surface):
+            raise SpineInputError(f"surface must be a spine_mj Surface, got {type(surface).__name__}")
+        tip = TipParams() if tip is None else tip
+        self.scales = Scales.for_surface(
+            surface,
+            tip=tip,
+            length_scale_m=length_scale_m,
+            char_length_m=char_length_m,
+            hfield_resolution=engine.hfield_resolution if engine is not None else None,
+        )
+        resolution = self.scales.hfield_resolution
+        if engine is not None and engine.hfield_resolution != resolution:
+            engine = dataclasses.replace(engine, hfield_resolution=resolution)
+        self.surface = surface
+        self.tip = dataclasses.replace(tip, tip_radius_m=self.scales.tip_radius_m)
+        self.length_scale_m = length_scale_m = self.scales.length_scale_m
+        self.engine = default_engine(self.scales) if engine is None else engine
+        self.hfield = hfield_of(surface, resolution)
+        xmin, xmax, ymin, ymax = surface.bounds
+        self.bounds_m = tuple(length_scale_m * b for b in (xmin, xmax, ymin, ymax))
+        self.spec = mujoco.MjSpec.from_file(str(MODEL_PATH))
+        self._configure_spec()
+        self.model = self.spec.compile()
+        self._ids()
+        self._placer: Placer | None = None
+
+    # ----------------------------------------------------------------- model building
+
+    def _configure_spec(self) -> None:
+        """Options, tip, carriage and the hfield from the engine settings, tip and scales."""
+        import mujoco
+
+        spec, eng, tip, s = self.spec, self.engine, self.tip, self.length_scale_m
+        spec.option.timestep = eng.timestep_s
+        spec.option.integrator = getattr(mujoco.mjtIntegrator, f"mjINT_{eng.integrator.name}")
+        spec.option.cone = getattr(mujoco.mjtCone, f"mjCONE_{eng.cone.name}")
+        spec.option.impratio = eng.impratio
+        spec.option.noslip_iterations = eng.noslip_iterations
+        spec.option.gravity = [0.0, 0.0, -tip.gravity_m_s2]
+        spec.modelname = "spine_rig"
+        r = tip.tip_radius_m
+        tip_geom = spec.geom("tip")
+        tip_geom.size = [r, 0, 0]
+        tip_geom.mass = tip.mass_kg
+        car = spec.geom("carriage")
+        car.size = [r, r, r]
+        hf = self.hfield
+        rx, ry, elev, base = hf.size
+        spec.add_hfield(
+            name="surface",
+            size=[rx * s, ry * s, elev * s, base * s],
+            nrow=hf.nrow,
+            ncol=hf.ncol,
+            userdata=hf.data.ravel().tolist(),
+        )
+        geom = spec.worldbody.add_geom(
+            name="surface",
+            type=mujoco.mjtGeom.mjGEOM_HFIELD,
+            hfieldname="surface",
+            pos=[p * s for p in hf.pos],
+            material="ground",
+        )
+        for g in (tip_geom, geom):
+            g.friction = [tip.mu_s, 0.0, 0.0]
+            g.condim = 3
+            g.solref = list(eng.solref)
+            g.solimp = list(eng.solimp)
+        span = max(rx, ry) * s
+        spec.visual.map.znear = 1e-4
+        spec.stat.extent = 2 * span
+        spec.stat.center = [hf.pos[0] * s, hf.pos[1] * s, (hf.pos[2] + elev / 2) * s]
+
+    def _ids(self) -> None:
+        """Ids of the geoms and actuators and the sensors' addresses in the compiled model."""
+        import mujoco
+
+        m = self.model
+        self.geom_tip = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, "tip")
+        self.geom_surface = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, "surface")
+        self.act_spring = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, "spring")
+        self.act_push = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, "push")
+        self.act_preload = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, "preload")
+        adr = {}
+        for name in SENSOR_NAMES:
+            sid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SENSOR, name)
+            adr[name] = int(m.sensor_adr[sid])
+        self.sensor_adr = adr  # sensor name -> first index in sensordata
+
+    def set_surface(self, surface: Surface) -> None:
+        """Replace the surface (same grid size) and recompile in place (``spec.recompile``)."""
+        import mujoco
+
+        hf = hfield_of(surface, self.engine.hfield_resolution)
+        if (hf.nrow, hf.ncol) != (self.hfield.nrow, self.hfield.ncol):
+            raise SpineInputError(
+                f"set_surface needs a {self.hfield.nrow} x {self.hfield.ncol} hfield, "
+                f"got {hf.nrow} x {hf.ncol}; build a new Rig instead"
+            )
+        s = self.length_scale_m
+        h = self.spec.hfield("surface")
+        h.userdata = hf.data.ravel().tolist()
+        h.size = [v * s for v in hf.size]
+        self.spec.geom("surface").pos = [p * s for p in hf.pos]
+        data = mujoco.MjData(self.model)
+        self.model, _ = self.spec.recompile(self.model, data)
+        self.surface, self.hfield = surface, hf
+        xmin, xmax, ymin, ymax = surface.bounds
+        self.bounds_m = tuple(s * b for b in (xmin, xmax, ymin, ymax))
+        self._ids()
+
+    def to_xml(self) -> str:
+        """A self-contained MJCF of the rig (the hfield inlined as ``elevation``)."""
+        return self.spec.to_xml()
+
+    def export_xml(self, path: str | os.PathLike) -> Path:
+        """Write :meth:`to_xml` to ``path`` atomically; MuJoCo's viewer opens it directly."""
+        path = Path(path)
+        with atomic_output(path) as tmp:
+            tmp.write_text(self.to_xml())
+        return path
+
+    def model_for(self, drive: Drive | None):
+        """A shallow copy of the model with the drive's spring stiffness (0 for force drives)."""
+        m = copy.copy(self.model)
+        k = stiffness_n_m(drive, self.scales) if isinstance(drive, SpringDrive) else 0.0
+        m.actuator_gainprm[self.act_spring, 0] = k
+        m.actuator_biasprm[self.act_spring, 1] = -k
+        return m
+
+    # ----------------------------------------------------------------- placement
+
+    def place(self, x0: float, y0: float) -> np.ndarray:
+        """qpos ``(3,)`` [m] with the tip resting on the hfield at ``(x0, y0)`` (surface units).
+
+        The sphere centre is found by a safeguarded Newton search in z on the engine's own
+        sphere-hfield distance (to 1e-7 tip radii), then lowered by the soft contact's resting depth
+        ``(1 - dmax) (F_p / m) (timeconst dampratio)^2``: it starts at rest and in
+        contact, never dropped (a start just above the surface falls for one step).
+        """
+        x0, y0 = float(x0), float(y0)
+        self.check_start(x0, y0)
+        if self._placer is None or self._placer.model is not self.model:
+            tc, dr = self.engine.solref
+            a_p = self.scales.preload_n / self.tip.mass_kg
+            self._placer = Placer(
+                self.model,
+                geom_tip=self.geom_tip,
+                surface=self.surface,
+                hfield=self.hfield,
+                length_scale_m=self.length_scale_m,
+                tip_radius_m=self.tip.tip_radius_m,
+                rest_depth_m=(1 - self.engine.solimp[1]) * a_p * (tc * dr) ** 2,
+            )
+        return self._placer.place(x0, y0)
+
+    def check_start(self, x0: float, y0: float) -> None:
+        """Raise :class:`SpineInputError` unless ``(x0, y0)`` (surface units) lies on the surface."""
+        if not bool(self.surface.contains(x0, y0)):
+            raise SpineInputError(
+                f"start ({x0:g}, {y0:g}) lies outside the surface bounds {self.surface.bounds}"
+            )
+
+    # ----------------------------------------------------------------- drive parameters
+
+    def speed_of(self, drive: Drive) -> float:
+        """The drive's speed [m/s]: carriage speed, or ``L_c rate / F_p`` for force drives."""
+        return speed_m_s(drive, self.scales)
+
+    def inertia_number(self, drive: Drive) -> float:
+        """I_e = m v^2 / (F_p L_c) of a drive (equivalent speed for force drives)."""
+        return self.scales.inertia_number(self.speed_of(drive))

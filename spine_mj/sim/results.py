@@ -1,0 +1,243 @@
+"""The result of a run, and the analysis that turns a rollout into results.
+
+:class:`RunResult` is what every drive returns. :func:`analyse_group` reads a group of
+runs of equal length at once: the per-step :class:`~spine_mj.sim.recording.Recording` and
+the end conditions for the whole group in one pass, then per run its ending, its slip
+events and its result, a cut of the group's columns.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import enum
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from spine_mj.sim.detection import (
+    Detection,
+    Ending,
+    Event,
+    decide_end,
+    end_candidates,
+    end_marks,
+    probe_candidates,
+    slip_events,
+)
+from spine_mj.sim.drives import Drive, SpringDrive, StaticProbe, settle_steps
+from spine_mj.sim.model import RigModel
+from spine_mj.sim.params import EndReason, EngineSettings, Scales, TipParams
+from spine_mj.sim.recording import Recording
+
+
+@dataclass(frozen=True, eq=False)
+class RunResult:
+    """One run. Arrays have ``n`` rows, one per recorded step (the settle phase included).
+
+    Attributes
+    ----------
+    time_s : (n,)
+    position_m, velocity_m_s : (n, 3)
+        Tip centre position and velocity, world frame [m], [m/s].
+    contact : (n,) bool
+        Whether the tip touches the surface.
+    normal : (n, 3)
+        Unit normal of the deepest contact, pointing out of the surface (NaN without contact).
+    contact_point_m : (n, 3)
+        Position of the deepest contact (NaN without contact).
+    penetration_m : (n,)
+        Depth of the deepest contact (>= 0; 0 without contact).
+    normal_force_n, tangential_force_n : (n,)
+        Net contact force on the tip along the normal and its magnitude in the tangent plane.
+    drive_force_n : (n,)
+        Force of the drive on the tip in +x [N].
+    carriage_x_m : (n,)
+        Carriage position (spring drive; NaN otherwise).
+    slipping : (n,) bool
+        Tangential speed above ``detection.slip_speed_m_s``.
+    events : tuple of Event
+    end_reason : EndReason
+    end_detail : str
+    drive_start_index : int
+        First row after the settle phase.
+    kappa_mj : float
+        Static probe: F_breakaway / F_p (NaN unless ``end_reason`` is BREAKAWAY).
+    slip_kappas : (k,)
+        Drive force / F_p at each slip onset after the settle phase.
+    inertia_number, speed_m_s : float
+        I_e and the speed (or equivalent speed) it uses.
+    start : (x0, y0)
+        Start in surface units.
+    """
+
+    time_s: np.ndarray
+    position_m: np.ndarray
+    velocity_m_s: np.ndarray
+    contact: np.ndarray
+    normal: np.ndarray
+    contact_point_m: np.ndarray
+    penetration_m: np.ndarray
+    normal_force_n: np.ndarray
+    tangential_force_n: np.ndarray
+    drive_force_n: np.ndarray
+    carriage_x_m: np.ndarray
+    slipping: np.ndarray
+    events: tuple[Event, ...]
+    end_reason: EndReason
+    end_detail: str
+    drive_start_index: int
+    kappa_mj: float
+    slip_kappas: np.ndarray
+    inertia_number: float
+    speed_m_s: float
+    start: tuple[float, float]
+    drive: Drive
+    tip: TipParams
+    engine: EngineSettings
+    scales: Scales
+    detection: Detection
+
+    @property
+    def n(self) -> int:
+        return self.time_s.size
+
+    def table(self):
+        """The trajectory as a :class:`pandas.DataFrame` (one row per recorded step)."""
+        import pandas as pd
+
+        cols = {"time_s": self.time_s}
+        for name in ("position_m", "velocity_m_s", "normal", "contact_point_m"):
+            arr = getattr(self, name)
+            for k, axis in enumerate("xyz"):
+                cols[f"{name.split('_')[0]}_{axis}{name[len(name.split('_')[0]) :]}"] = arr[:, k]
+        for name in (
+            "contact",
+            "penetration_m",
+            "normal_force_n",
+            "tangential_force_n",
+            "drive_force_n",
+            "carriage_x_m",
+            "slipping",
+        ):
+            cols[name] = getattr(self, name)
+        return pd.DataFrame(cols)
+
+    def summary(self) -> dict:
+        """JSON-ready description of the run: parameters, engine settings, outcome."""
+
+        def enc(obj):
+            d = dataclasses.asdict(obj)
+            return {k: (v.value if isinstance(v, enum.Enum) else v) for k, v in d.items()}
+
+        return {
+            "drive": type(self.drive).__name__,
+            "drive_params": enc(self.drive),
+            "tip": enc(self.tip),
+            "engine": self.engine.to_dict(),
+            "scales": enc(self.scales),
+            "detection": enc(self.detection),
+            "start": list(self.start),
+            "end_reason": self.end_reason.value,
+            "end_detail": self.end_detail,
+            "end_time_s": float(self.time_s[-1]) if self.n else 0.0,
+            "kappa_mj": None if math.isnan(self.kappa_mj) else self.kappa_mj,
+            "slip_kappas": self.slip_kappas.tolist(),
+            "inertia_number": self.inertia_number,
+            "speed_m_s": self.speed_m_s,
+            "n_slip_onsets": sum(e.kind == "slip_onset" for e in self.events),
+            "max_penetration_m": float(self.penetration_m.max()) if self.n else 0.0,
+        }
+
+
+def analyse(rig: RigModel, drive: Drive, start, state, sens, ctrl, det: Detection, warning) -> RunResult:
+    """:func:`analyse_group` of one run (``state`` ``(n, nstate)``, ``sens`` ``(n, nsensordata)``)."""
+    return analyse_group(rig, [drive], [start], state[None], sens[None], [ctrl], det, [warning])[0]
+
+
+def analyse_group(
+    rig: RigModel,
+    drives: Sequence[Drive],
+    starts: Sequence[tuple[float, float]],
+    state: np.ndarray,
+    sens: np.ndarray,
+    ctrls: Sequence[np.ndarray],
+    det: Detection,
+    warnings: Sequence[tuple[int | None, str] | None],
+) -> list[RunResult]:
+    """The results of a group of runs of equal length on ``rig``.
+
+    ``state`` ``(g, n, nstate)`` and ``sens`` ``(g, n, nsensordata)``: the per-step
+    columns and the event masks are computed for the whole group in one pass (the same
+    arithmetic per row as one run at a time); only the events of each run are read
+    per run. ``ctrls`` are the runs' controls (the carriage is column 3), ``warnings``
+    per run ``(first step with a MuJoCo warning or None, its text)`` or None.
+    """
+    n = state.shape[1]
+    fp = rig.scales.preload_n
+    carriage = np.stack(
+        [
+            ctrl[:, 3].copy() if isinstance(d, SpringDrive) else np.full(n, np.nan)
+            for d, ctrl in zip(drives, ctrls)
+        ]
+    )
+    group = Recording.from_sensors(
+        rig.sensor_adr, state, sens, carriage_x_m=carriage, slip_speed_m_s=det.slip_speed_m_s
+    )
+    marks = end_marks(
+        group, state, sens, timestep_s=rig.engine.timestep_s, bounds_m=rig.bounds_m, det=det, preload_n=fp
+    )
+    results = []
+    for r, drive in enumerate(drives):
+        rec = group.run(r)
+        n_settle = settle_steps(drive, rig.engine.timestep_s)
+        candidates = end_candidates(marks, r, rec, warnings[r], det, fp)
+        kappa = math.nan
+        if isinstance(drive, StaticProbe):
+            probe, kappa = probe_candidates(rec, n_settle, det, fp)
+            candidates += probe
+        ending = decide_end(candidates, n)
+        if ending.reason is not EndReason.BREAKAWAY:
+            kappa = math.nan
+        results.append(
+            _run_result(rig, drive, starts[r], det, rec.cut(ending.index), ending, n_settle, kappa)
+        )
+    return results
+
+
+def _run_result(
+    rig: RigModel,
+    drive: Drive,
+    start,
+    det: Detection,
+    rec: Recording,
+    ending: Ending,
+    n_settle: int,
+    kappa_mj: float,
+) -> RunResult:
+    """The result of one run, its recording cut at its ending."""
+    events = slip_events(rec.slipping, rec.time_s, n_settle)
+    events.append(Event(ending.reason.value, ending.index, float(rec.time_s[ending.index])))
+    onsets = [e.index for e in events if e.kind == "slip_onset"]
+    arrays = {
+        f.name: getattr(rec, f.name) for f in dataclasses.fields(rec) if f.name != "tangential_speed_m_s"
+    }
+    speed = rig.speed_of(drive)
+    return RunResult(
+        **arrays,
+        events=tuple(events),
+        end_reason=ending.reason,
+        end_detail=ending.detail,
+        drive_start_index=n_settle,
+        kappa_mj=kappa_mj,
+        slip_kappas=np.array([rec.drive_force_n[i] / rig.scales.preload_n for i in onsets]),
+        inertia_number=rig.scales.inertia_number(speed),
+        speed_m_s=speed,
+        start=tuple(start),
+        drive=drive,
+        tip=rig.tip,
+        engine=rig.engine,
+        scales=rig.scales,
+        detection=det,
+    )

@@ -1,0 +1,102 @@
+"""The user-facing rig: one surface and one tip, ready to run drives.
+
+:class:`Rig` is the compiled model (:class:`~spine_mj.sim.model.RigModel`: building,
+surface swaps, export, placement) plus thin methods that hand each kind of run to its
+module: open-loop batches to :mod:`~spine_mj.sim.rollout`, the force ramp with reset to
+:mod:`~spine_mj.sim.ramp`, frames to :mod:`~spine_mj.sim.render`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+
+import numpy as np
+
+from spine_mj.sim.detection import Detection
+from spine_mj.sim.drives import Drive, RampDrive
+from spine_mj.sim.model import RigModel
+from spine_mj.sim.ramp import run_ramp
+from spine_mj.sim.render import render_frames
+from spine_mj.sim.results import RunResult
+from spine_mj.sim.rollout import controls, run_batch
+
+
+class Rig(RigModel):
+    """The MuJoCo model of one surface and one tip, ready to run drives.
+
+    Parameters
+    ----------
+    surface : Surface
+        Any surface; dimensionless ones are scaled by ``length_scale_m``.
+    tip : TipParams
+    engine : EngineSettings or None
+        None: :func:`default_engine` of the scales.
+    length_scale_m : float or None
+        Metres per surface unit; None gives 0.01 for ``unit == "1"`` and 1 for ``"m"``.
+    char_length_m : float or None
+        L_c [m]; None: :func:`characteristic_length` times ``length_scale_m``.
+
+    Raises
+    ------
+    SpineInputError
+        Bad parameters, a surface in another unit, or a surface too coarse for the tip
+        (hfield spacing > 2 tip radii: the sphere would see single facets and their kinks).
+
+    Notes
+    -----
+    Default tip radius: ``surface.metadata["params"]["tip_radius_m"]`` if the surface has
+    one (sandpaper), else the larger of one hfield spacing and ``L_c / 100``.
+    """
+
+    def run(
+        self,
+        drive: Drive,
+        *,
+        start: tuple[float, float],
+        detection: Detection | None = None,
+        backend: str = "rollout",
+        progress: Callable[[float], None] | None = None,
+    ) -> RunResult:
+        """Run one drive from ``start`` (surface units).
+
+        ``backend`` "rollout" (native) or "python" (a plain ``mj_step`` loop, the reference
+        implementation); the force ramp with reset always steps in Python. ``progress``
+        receives the fraction done (Python backends only).
+        """
+        if isinstance(drive, RampDrive):
+            return run_ramp(self, drive, start, detection, progress)
+        return self.run_batch([drive], [start], detection=detection, backend=backend)[0]
+
+    def run_batch(
+        self,
+        drives: Drive | Sequence[Drive],
+        starts: Sequence[tuple[float, float]],
+        *,
+        detection: Detection | None = None,
+        backend: str = "rollout",
+        nthread: int | None = None,
+    ) -> list[RunResult]:
+        """Run many starts and/or drive parameter sets of this model.
+
+        ``drives`` is one drive for all starts or one per start (SpringDrive or StaticProbe;
+        mixed kinds are allowed). Runs go through :func:`mujoco.rollout.rollout` on
+        ``nthread`` native threads (default: CPU count), in groups sized to stay within
+        256 MiB of output; each run is then cut at its first end event. A group runs in up
+        to 4 pieces, pipelined: while the native threads simulate one piece, the calling
+        thread analyses the previous one and places the next (``rollout`` releases the GIL);
+        the results are those of one run at a time. The arrays of a result are read-only
+        views of its group's columns.
+        """
+        return run_batch(self, drives, starts, detection=detection, backend=backend, nthread=nthread)
+
+    def controls(self, drive: Drive, qpos0: np.ndarray, detection: Detection) -> np.ndarray:
+        """Open-loop controls ``(nstep, 6)`` of a run from the placed start ``qpos0``.
+
+        Columns: ctrl (spring, push, preload) then mocap xyz; ``detection`` resolved
+        (:meth:`Detection.resolve`). See :func:`spine_mj.sim.rollout.controls`.
+        """
+        return controls(self, drive, qpos0, detection)
+
+    def render_frames(self, result: RunResult, *, fps: float = 30.0, width: int = 640, height: int = 480):
+        """Yield RGB frames ``(height, width, 3)`` uint8 of a run (headless, needs a GL backend)."""
+        return render_frames(self, result, fps=fps, width=width, height=height)

@@ -1,0 +1,42 @@
+"""The CLI's simulate, sim export and view commands."""
+
+from __future__ import annotations
+
+import mujoco
+
+
+def test_cli_simulate_export_and_view(tmp_path, monkeypatch):
+    import pandas as pd
+    from click.testing import CliRunner
+
+    from spine_mj.cli import main
+
+    runner = CliRunner()
+    res = runner.invoke(
+        main,
+        [
+            "simulate",
+            "paper-single-peak",
+            "--start",
+            "-3,-1",
+            "--drive",
+            "spring",
+            "--speed",
+            "0.05",
+            "--duration",
+            "0.05",
+            "-o",
+            str(tmp_path),
+        ],
+    )
+    assert res.exit_code == 0, res.output
+    table = pd.read_parquet(tmp_path / "trajectory.parquet")
+    assert len(table) > 100 and (tmp_path / "run.png").stat().st_size > 0
+    res = runner.invoke(main, ["sim", "export", "paper-single-peak", "-o", str(tmp_path / "rig.xml")])
+    assert res.exit_code == 0 and mujoco.MjModel.from_xml_path(str(tmp_path / "rig.xml")).nhfield == 1
+    res = runner.invoke(main, ["simulate", "paper-single-peak", "--start", "-3", "-o", str(tmp_path)])
+    assert res.exit_code == 2 and "--start must look like X,Y" in res.output
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    res = runner.invoke(main, ["view", "paper-single-peak"])
+    assert res.exit_code != 0 and "no display" in res.output and "Traceback" not in res.output

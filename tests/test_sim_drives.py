@@ -1,0 +1,62 @@
+"""The open-loop drives against closed forms: static probes on planes, the spring drive on flat ground."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+from sim_rigs import MU, PHI, START, flat_rig, plane_rig
+
+from spine_mj.sim import EndReason, SpringDrive, StaticProbe
+
+
+@pytest.mark.parametrize("slope_deg", [-15.0, 0.0, 20.0, 45.0, 60.0])
+def test_static_probe_matches_closed_form(slope_deg):
+    rig = plane_rig(slope_deg)
+    theta = math.radians(slope_deg)
+    low = max(0.0, math.tan(theta - PHI))  # smallest force that holds the tip
+    hold = 0.5 * (low + math.tan(theta + PHI)) if low > 0 else 0.0
+    res = rig.run(StaticProbe(start_force_n=hold * rig.scales.preload_n), start=START)
+    assert res.end_reason is EndReason.BREAKAWAY, res.end_detail
+    assert res.kappa_mj == pytest.approx(math.tan(theta + PHI), rel=0.05)
+    assert res.events[-1].kind == "breakaway"
+
+
+def test_static_probe_self_locks_beyond_90_degrees():
+    rig = plane_rig(70.0)  # theta + arctan(mu) = 96.6 deg
+    res = rig.run(
+        StaticProbe(
+            start_force_n=1.5 * math.tan(math.radians(70) - PHI) * rig.scales.preload_n,
+            rate_n_s=20 * rig.scales.preload_n,
+        ),
+        start=START,
+    )
+    assert res.end_reason is EndReason.SELF_LOCK
+    assert res.drive_force_n[-1] >= res.detection.kappa_cap * rig.scales.preload_n * (1 - 1e-9)
+    assert math.isnan(res.kappa_mj)
+
+
+def test_tip_on_slope_steeper_than_friction_angle_slides():
+    rig = plane_rig(40.0)
+    res = rig.run(StaticProbe(), start=START)
+    assert res.end_reason is EndReason.SLID
+    assert res.position_m[-1, 0] < res.position_m[0, 0]  # downhill, against the drive
+    # and at 20 deg (< arctan 0.5) the same tip stays put until pushed
+    assert plane_rig(20.0).run(StaticProbe(), start=START).end_reason is EndReason.BREAKAWAY
+
+
+def test_flat_ground_spring_drive_pulls_with_mu_w():
+    rig = flat_rig()
+    res = rig.run(SpringDrive(speed_m_s=0.005, duration_s=2.0), start=(-0.04, 2.3e-4))
+    assert res.end_reason is EndReason.COMPLETED
+    half = res.n // 2
+    force = res.drive_force_n[half:].mean()
+    assert force == pytest.approx(MU * rig.scales.preload_n, rel=0.02)
+    assert res.slipping[half:].mean() > 0.5
+    assert res.inertia_number == pytest.approx(
+        rig.tip.mass_kg * 0.005**2 / (rig.scales.preload_n * rig.scales.char_length_m)
+    )
+    # cell edges give two contacts: a few um of drift over 80 mm, no more
+    assert abs(res.position_m[-1, 1] - res.position_m[0, 1]) < 1e-5
+    table = res.table()
+    assert len(table) == res.n and {"position_x_m", "drive_force_n", "slipping"} <= set(table)

@@ -1,0 +1,127 @@
+"""The rig's model: hfield geometry against the surface and MuJoCo's facets, placement, export,
+surface swaps."""
+
+from __future__ import annotations
+
+import math
+
+import mujoco
+import numpy as np
+import pytest
+from sim_rigs import R_TIP, START, asymmetric_surface, deepest_contacts, plane_rig
+
+from spine_mj.sim import Rig, StaticProbe, TipParams
+from spine_mj.surfaces import GridSurface, TriangulatedSurface, from_hfield, single_gaussian
+
+
+def test_hfield_orientation_extent_and_scale_match_the_surface():
+    surf = asymmetric_surface()
+    rig = Rig(surf, tip=TipParams(tip_radius_m=1e-3))
+    s = rig.length_scale_m
+    tri = TriangulatedSurface.from_grid(from_hfield(rig.hfield))
+    chord = 0.05**2 / 8 * 2.3 * s  # spacing^2 max|f''| / 8, in metres
+    rng = np.random.default_rng(0)
+    for x0, y0 in rng.uniform(-2.5, 2.5, (12, 2)):
+        q = rig.place(x0, y0)
+        contacts = deepest_contacts(rig, q)
+        assert contacts, (x0, y0)
+        for p, n in contacts:
+            # the contact lies on the surface (in metres) and faces the smooth normal
+            assert p[2] == pytest.approx(s * surf.height(p[0] / s, p[1] / s), abs=chord)
+            assert p[2] == pytest.approx(s * tri.height(p[0] / s, p[1] / s), abs=1e-9)
+            fx, fy = surf.gradient(p[0] / s, p[1] / s)
+            ns = np.array([-fx, -fy, 1.0]) / math.hypot(1, math.hypot(fx, fy))
+            assert math.degrees(math.acos(min(1.0, float(n @ ns)))) < 4.0
+        # the sphere centre sits one radius from its contact
+        assert np.linalg.norm(q - contacts[0][0]) == pytest.approx(rig.tip.tip_radius_m, rel=1e-3)
+
+
+def _alt_normal(grid, x, y):
+    """Facet normal with the *other* diagonal (x_max, y_min)-(x_min, y_max): must not match."""
+    dx, dy = grid.spacing
+    i = int((x - grid.x[0]) // dx)
+    j = int((y - grid.y[0]) // dy)
+    s, t = (x - grid.x[i]) / dx, (y - grid.y[j]) / dy
+    h = grid.heights
+    if s + t <= 1:
+        fx, fy = (h[j, i + 1] - h[j, i]) / dx, (h[j + 1, i] - h[j, i]) / dy
+    else:
+        fx, fy = (h[j + 1, i + 1] - h[j + 1, i]) / dx, (h[j + 1, i + 1] - h[j, i + 1]) / dy
+    n = np.array([-fx, -fy, 1.0])
+    return n / np.linalg.norm(n)
+
+
+def test_triangulated_surface_matches_mujoco_facets():
+    rng = np.random.default_rng(1)
+    x = np.linspace(-0.02, 0.02, 9)
+    grid = GridSurface(heights=rng.uniform(0, 0.004, (9, 9)), x=x, y=x.copy(), unit="m")
+    rig = Rig(grid, tip=TipParams(tip_radius_m=3e-3))
+    tri = TriangulatedSurface.from_grid(from_hfield(rig.hfield, unit="m"))
+    n_facet, n_alt_mismatch = 0, 0
+    for x0, y0 in rng.uniform(-0.015, 0.015, (30, 2)):
+        contacts = deepest_contacts(rig, rig.place(x0, y0))
+        for p, _n in contacts:
+            assert p[2] == pytest.approx(float(tri.height(p[0], p[1])), abs=1e-9)
+        if len(contacts) == 1:  # inside a facet: the engine's normal is the facet normal
+            p, n = contacts[0]
+            fx, fy = tri.gradient(p[0], p[1])
+            nt = np.array([-fx, -fy, 1.0]) / math.hypot(1, math.hypot(fx, fy))
+            np.testing.assert_allclose(n, nt, atol=1e-6)
+            n_facet += 1
+            n_alt_mismatch += not np.allclose(n, _alt_normal(grid, p[0], p[1]), atol=1e-3)
+    assert n_facet >= 10
+    assert n_alt_mismatch >= 3
+
+
+def test_triangulated_surface_interpolates_nodes_and_is_linear_per_facet():
+    x = np.array([0.0, 1.0, 2.0, 3.0])
+    h = np.arange(16.0).reshape(4, 4) ** 1.5
+    tri = TriangulatedSurface(heights=h, x=x, y=x.copy())
+    np.testing.assert_allclose(tri.height(x[None, :], x[:, None]), h)
+    # lower triangle of cell (0, 0): vertices (0,0), (1,0), (1,1)
+    fx, fy = tri.gradient(0.7, 0.2)
+    assert fx == pytest.approx(h[0, 1] - h[0, 0]) and fy == pytest.approx(h[1, 1] - h[0, 1])
+    fx, fy = tri.gradient(0.2, 0.7)
+    assert fx == pytest.approx(h[1, 1] - h[1, 0]) and fy == pytest.approx(h[1, 0] - h[0, 0])
+    assert np.all(np.asarray(tri.hessian(0.3, 0.6)) == 0)
+    assert np.isnan(tri.height(5.0, 0.0))
+
+
+def test_placement_starts_at_rest_without_impact():
+    rig = plane_rig(20.0)
+    res = rig.run(StaticProbe(start_force_n=0.5 * rig.scales.preload_n), start=START)
+    settle = slice(0, res.drive_start_index)
+    # a start one step above the surface would fall to g dt = 5 mm/s
+    assert np.abs(res.velocity_m_s[settle]).max() < 2e-5
+    assert res.penetration_m[settle].max() < 0.01 * R_TIP
+
+
+def test_export_xml_is_self_contained(tmp_path):
+    rig = Rig(single_gaussian(), engine=None)
+    path = rig.export_xml(tmp_path / "rig.xml")
+    m = mujoco.MjModel.from_xml_path(str(path))
+    assert m.nhfield == 1 and m.hfield_nrow[0] == rig.hfield.nrow
+    np.testing.assert_allclose(m.hfield_data, rig.model.hfield_data, atol=2e-6)
+    assert m.opt.timestep == rig.engine.timestep_s
+    assert m.opt.noslip_iterations == rig.engine.noslip_iterations
+
+
+def test_set_surface_recompiles_in_place():
+    rig = Rig(single_gaussian(sign=1), tip=TipParams(tip_radius_m=5e-4))
+    z_peak = rig.place(0.0, 0.0)[2]
+    rig.set_surface(single_gaussian(sign=-1))
+    assert rig.place(0.0, 0.0)[2] < z_peak - 0.03
+
+
+def test_fine_grid_is_coarsened_to_respect_the_contact_cap():
+    """MuJoCo keeps <= 50 contacts per geom pair: the P600 grid (2.6 um) under a 25 um tip
+    would lose the deepest ones, so the rig resamples the hfield to ~R/4 and records it."""
+    from spine_mj.surfaces import sandpaper
+
+    surf = sandpaper(grit="P600", size_m=0.3e-3, rng=1)
+    rig = Rig(surf, tip=TipParams(tip_radius_m=25e-6))
+    assert rig.scales.hfield_spacing_m >= 0.25 * 25e-6 * (1 - 1e-9)
+    assert rig.engine.hfield_resolution == rig.hfield.ncol
+    for start in [(0.0, 0.0), (-1e-4, 5e-5), (1e-4, -1e-4)]:
+        z = rig.place(*start)[2]
+        assert surf.height(*start) < z < surf.heights.max() + 2 * 25e-6

@@ -1,0 +1,67 @@
+"""Parameters: bad values rejected clearly, engine settings recorded, the scaling rule."""
+
+from __future__ import annotations
+
+import pytest
+from sim_rigs import R_TIP, flat_rig
+
+from spine_mj.errors import SpineInputError
+from spine_mj.sim import EngineSettings, Rig, SpringDrive, StaticProbe, TipParams
+from spine_mj.surfaces import single_gaussian
+
+
+@pytest.mark.parametrize(
+    ("make", "match"),
+    [
+        (lambda: TipParams(mass_kg=-0.01), r"mass_kg must be a finite number > 0, got -0\.01"),
+        (lambda: TipParams(mu_s=-0.1), r"mu_s must be a finite number >= 0, got -0\.1"),
+        (lambda: EngineSettings(timestep_s=0.0), r"timestep_s must be a finite number > 0, got 0\.0"),
+        (lambda: EngineSettings(timestep_s=1e-3, solref=(1e-3, 1.0)), r"solref timeconst_s must be >= 2"),
+        (lambda: EngineSettings(timestep_s=1e-3, cone="pyramidal"), r"pyramidal.*noslip"),
+        (lambda: EngineSettings(timestep_s=1e-3, cone="conical"), r"cone must be one of"),
+        (lambda: SpringDrive(speed_m_s=0.0), r"speed_m_s must be a finite number > 0"),
+        (lambda: TipParams(gravity_m_s2=0.0), r"no normal preload"),
+        (
+            lambda: Rig(single_gaussian(), tip=TipParams(tip_radius_m=1e-5)),
+            r"surface too coarse for the tip: hfield spacing 0\.0005 m > 2 x tip_radius_m",
+        ),
+        (lambda: flat_rig().run(StaticProbe(), start=(1.0, 0.0)), r"start \(1, 0\) lies outside"),
+    ],
+)
+def test_bad_parameters_are_rejected_clearly(make, match):
+    with pytest.raises(SpineInputError, match=match):
+        make()
+
+
+def test_engine_settings_are_recorded_with_every_run():
+    rig = flat_rig()
+    res = rig.run(SpringDrive(speed_m_s=0.02, duration_s=0.05), start=(0.0, 0.0))
+    summary = res.summary()
+    eng = summary["engine"]
+    assert eng["timestep_s"] == rig.engine.timestep_s and eng["cone"] == "elliptic"
+    assert {"integrator", "impratio", "noslip_iterations", "solref", "solimp", "hfield_resolution"} <= set(
+        eng
+    )
+    # the default rule: resting penetration a_p dt^2 <= 0.5 % of the tip radius
+    assert rig.scales.preload_n / rig.tip.mass_kg * rig.engine.timestep_s**2 <= 0.005 * R_TIP
+    assert res.penetration_m.max() < 0.01 * rig.scales.char_length_m
+
+
+def test_scales_for_surface_are_the_rigs_scales_without_building_a_model():
+    """Scales.for_surface is the one sizing rule: a rig's scales equal it, and the default
+    tip radius is max(one hfield spacing, L_c / 100) in metres for a dimensionless surface."""
+    from spine_mj.sim import DEFAULT_LENGTH_SCALE_M, Scales, characteristic_length
+
+    surf = single_gaussian()
+    tip = TipParams(mass_kg=0.02)
+    scales = Scales.for_surface(surf, tip=tip, hfield_resolution=101)
+    rig = Rig(
+        surf, tip=tip, engine=EngineSettings(timestep_s=1e-3, solref=(2e-3, 1.0), hfield_resolution=101)
+    )
+    assert scales == rig.scales
+    lc_m = characteristic_length(surf) * DEFAULT_LENGTH_SCALE_M
+    spacing_m = 10 / 100 * DEFAULT_LENGTH_SCALE_M
+    assert scales.char_length_m == pytest.approx(lc_m, rel=1e-12)
+    assert scales.hfield_spacing_m == pytest.approx(spacing_m, rel=1e-12)
+    assert scales.tip_radius_m == pytest.approx(max(spacing_m, lc_m / 100), rel=1e-3)
+    assert scales.inertia_number(scales.speed_for(3e-4)) == pytest.approx(3e-4, rel=1e-12)
