@@ -10,7 +10,7 @@ from spine_mj.errors import SpineInputError
 
 
 def _holds(fx, fy, mu, k, margin=0.0):
-    """Brute force from the vector definitions (PHYSICS.md §1): |T| <= mu N and N > 0."""
+    """Brute force from the vector definitions (docs/physics.md §1): |T| <= mu N and N > 0."""
     s = math.sqrt(1 + fx * fx + fy * fy)
     n = np.array([fx, fy, -1.0]) / s
     r = np.array([k, 0.0, -1.0])
