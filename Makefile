@@ -30,7 +30,7 @@ bench: $(STAMP)
 # outside the repository: presets and the MuJoCo rig must come from the installed package.
 wheel-check: $(STAMP)
 	@set -e; tmp=$$(mktemp -d); trap 'rm -rf "$$tmp"' EXIT; \
-	$(BIN)/python -m pip wheel --quiet --no-deps --wheel-dir "$$tmp/dist" . ; \
+	$(BIN)/python -m pip wheel --quiet --no-deps --wheel-dir "$$tmp/dist" . ; rm -rf build; \
 	$(PYTHON) -m venv "$$tmp/venv"; \
 	"$$tmp/venv/bin/python" -m pip install --quiet "$$tmp"/dist/spine_mj-*.whl; \
 	mkdir "$$tmp/run"; cd "$$tmp/run"; \
