@@ -433,7 +433,7 @@ def main():
         "## 1. Single peak / valley (Figs. 3-4)",
         "",
         "Geometry fixed by the paper (k = 10 pi, sigma = 1.5, amplitude 2.22 with the",
-        "normalization of PHYSICS.md §3); mu_s is the only free parameter. Ranges are widths of",
+        "normalization of docs/physics.md §3); mu_s is the only free parameter. Ranges are widths of",
         "the self-locking start set y0 at x0 = -3. *fine*: 0.01 scan of -5..5; *preset scan*: the",
         f"preset's y0 scan ({sp['y0_range']}, step {sp['y0_step']}, end points included), ratio of",
         "counts. The paper's 83.3 % = 5/6 and 566.7 % = 34/6 are ratios of small integers",

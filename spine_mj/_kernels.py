@@ -139,6 +139,7 @@ def run_trajectories(
     lvx = np.empty(L)
     lvy = np.empty(L)
     lok = np.empty(L, np.bool_)
+    lmoved = np.empty(L, np.bool_)  # stepped to a new point, not yet evaluated
     levent = np.empty(L, np.bool_)
     lstall = np.zeros(L, np.bool_)  # no progress over a window: ends after its next evaluation
     # path points in the order they are produced, tagged with their start
@@ -265,8 +266,14 @@ def run_trajectories(
             lstep[j] += go
             u = luntil[j] - go
             luntil[j] = u
+            lmoved[j] = go
             levent[j] = (not go) | (u == 0)
-        # 4. the rare events: a trajectory ends (the lane takes the next start), stall checks
+        # 4. the rare events: a trajectory ends (the lane takes the next start), stall checks.
+        # A lane that moved is on a point not evaluated yet: it only gets its progress check
+        # here (a stall or the step cap ends it after the next pass has recorded that point).
+        # A lane that did not move ends now, on the point just recorded. Deciding an end for
+        # a lane that moved (as the cap test once did when the cap fell on a progress check,
+        # max_steps a multiple of stall_window) loses the path's last point.
         for j in range(L):
             if not levent[j]:
                 continue
@@ -276,17 +283,7 @@ def run_trajectories(
             x = lx[j]
             y = ly[j]
             code = 0
-            if lreg[j] == 2:
-                code = 1
-            elif lstall[j]:
-                code = 3
-            elif lstep[j] >= max_steps:
-                code = 4
-            elif not lok[j]:
-                code = 3
-            elif luntil[j] != 0:
-                code = 2
-            else:
+            if lmoved[j]:
                 luntil[j] = stall_window
                 dxs = x - lcx[j]
                 dys = y - lcy[j]
@@ -294,6 +291,16 @@ def run_trajectories(
                     lstall[j] = True
                 lcx[j] = x
                 lcy[j] = y
+            elif lreg[j] == 2:
+                code = 1
+            elif lstall[j]:
+                code = 3
+            elif lstep[j] >= max_steps:
+                code = 4
+            elif not lok[j]:
+                code = 3
+            else:
+                code = 2  # the next step would leave the bounds
             if code != 0:
                 outcome[i] = code
                 n_steps[i] = lstep[j]
@@ -315,6 +322,8 @@ def run_trajectories(
         return (outcome, n_steps, max_k, ex, ey, ez, offsets, bx[:0], by[:0], bz[:0], bk[:0], br[:0])
     for i in range(n):
         offsets[i + 1] = offsets[i] + n_steps[i] + 1
+    if offsets[n] != pos:  # every path has n_steps + 1 points; never scatter out of bounds
+        raise RuntimeError("streamline kernel: stored points do not match the step counts")
     px = np.empty(pos)
     py = np.empty(pos)
     pz = np.empty(pos)

@@ -1,6 +1,6 @@
 """Engagement ratio kappa of a point spine on a surface z = f(x, y) (paper §2.1, Eqs. 1-3).
 
-Conventions (``PHYSICS.md`` §1): drive ``u_x = (1, 0, 0)``, preload ``g = (0, 0, -1)``,
+Conventions (``docs/physics.md`` §1): drive ``u_x = (1, 0, 0)``, preload ``g = (0, 0, -1)``,
 inward normal ``n = (f_x, f_y, -1) / s`` with ``s = sqrt(1 + f_x^2 + f_y^2)``. Per unit
 preload the resultant is ``r = kappa u_x + g``; the tip sticks while
 ``|T| <= mu N`` with ``N = r . n > 0`` and ``T = r - N n``.
@@ -82,7 +82,7 @@ def quadratic_coefficients(fx, fy, mu) -> tuple[np.ndarray, np.ndarray, np.ndarr
 def kappa(fx, fy, mu, *, tol: float = DEFAULT_TOL) -> tuple[np.ndarray, np.ndarray]:
     """Engagement ratio kappa = F_c / W and region at points with slopes ``(fx, fy)``.
 
-    Regions (paper Fig. 2C, ``PHYSICS.md`` §1):
+    Regions (paper Fig. 2C, ``docs/physics.md`` §1):
 
     * ``SELF_LOCK`` (2): ``A' < tol`` and ``f_x > 0`` - the drive direction lies inside the
       friction cone and pushes into the surface; ``kappa = +inf``.

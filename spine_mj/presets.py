@@ -1,4 +1,5 @@
-"""Surface recipes: small TOML presets in the repository's ``surfaces/`` folder.
+"""Surface recipes: small TOML presets in the repository's ``surfaces/`` folder (shipped
+in the package as ``spine_mj._data.surfaces``, see :mod:`spine_mj.resources`).
 
 A preset names a generator and its parameters::
 
@@ -25,7 +26,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from spine_mj import surfaces
+from spine_mj import resources, surfaces
 from spine_mj.errors import SpineInputError
 
 if sys.version_info >= (3, 11):
@@ -65,9 +66,10 @@ GENERATORS = {
 
 
 def presets_dir() -> Path:
-    """The folder holding the ``*.toml`` presets."""
+    """The folder holding the ``*.toml`` presets (``SPINE_MJ_SURFACES``, else the ones
+    shipped with the package: :func:`spine_mj.resources.presets_dir`)."""
     env = os.environ.get("SPINE_MJ_SURFACES")
-    return Path(env) if env else Path(__file__).resolve().parent.parent / "surfaces"
+    return Path(env) if env else resources.presets_dir()
 
 
 @dataclass(frozen=True)

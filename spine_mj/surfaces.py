@@ -454,7 +454,7 @@ def single_gaussian(
 
     ``f = sign * k / (2 pi sx sy) * exp(-(x-mx)^2/(2 sx^2) - (y-my)^2/(2 sy^2))``; with the
     paper's ``k = 10 pi`` and ``sx = sy = 1.5`` the amplitude is 2.22 and the steepest
-    slope 0.90 (PHYSICS.md §3). Dimensionless.
+    slope 0.90 (docs/physics.md §3). Dimensionless.
     """
     if sign not in (1, -1):
         raise SpineInputError(f"sign must be +1 (peak) or -1 (valley), got {sign!r}")

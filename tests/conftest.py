@@ -1,15 +1,13 @@
-"""Shared fixtures: paths to the measured topographies beside the repository."""
+"""Shared fixtures: the measured topographies shipped with the tests (tests/data)."""
 
 from pathlib import Path
 
 import pytest
 
-REPO = Path(__file__).resolve().parent.parent
-TOPOGRAPHIES = REPO.parent / "shared" / "data" / "topographies"
+TOPOGRAPHIES = Path(__file__).resolve().parent / "data"
 
 
 @pytest.fixture(scope="session")
 def topography_dir() -> Path:
-    if not TOPOGRAPHIES.is_dir():
-        pytest.skip(f"measured topographies not found at {TOPOGRAPHIES}")
+    """Folder with ``plu-1.plu`` and ``di-1.di`` (see tests/data/README.md)."""
     return TOPOGRAPHIES

@@ -40,9 +40,13 @@ def test_frechet_symmetric_and_bounded_by_hausdorff():
     assert frechet_distance(a, b) == pytest.approx(frechet_distance(b, a))
     d = np.linalg.norm(a[:, None] - b[None], axis=2)
     hausdorff = max(d.min(axis=1).max(), d.min(axis=0).max())
-    assert frechet_distance(a, b) >= hausdorff - 1e-12
-    assert frechet_distance(a, b) >= np.linalg.norm(a[0] - b[0])
-    assert frechet_distance(a, b) >= np.linalg.norm(a[-1] - b[-1])
+    # the bounds are equalities at worst (the leash at a pair of points), and the compiled
+    # distance and numpy's norm round differently (a few ulps of O(1) distances, CPU-
+    # dependent): allow 1e-12, far below any real violation
+    fd = frechet_distance(a, b)
+    assert fd >= hausdorff - 1e-12
+    assert fd >= np.linalg.norm(a[0] - b[0]) - 1e-12
+    assert fd >= np.linalg.norm(a[-1] - b[-1]) - 1e-12
 
 
 @settings(max_examples=40, deadline=None)

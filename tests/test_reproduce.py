@@ -1,6 +1,7 @@
 import json
 
 import numpy as np
+import pytest
 from click.testing import CliRunner
 
 from spine_mj.cli import main
@@ -21,13 +22,22 @@ def test_single_peak_qualitative_facts_reduced_run():
     for y in (-1.0, -2.0, -3.0):
         assert concave[y]["ideal"] != "self_locked"
     assert numbers["convex_ratio"] < 1 < numbers["concave_ratio"]
-    # mirror symmetry of the kappa field: identical ideal self-lock ranges
-    assert numbers["convex_ideal_range"] == numbers["concave_ideal_range"]
+    # mirror symmetry of the kappa field: the same ideal self-lock ranges. The two walks
+    # sample mirrored slopes at different x, so a start right at the threshold could
+    # count on one side only: allow one scan step
+    assert numbers["convex_ideal_range"] == pytest.approx(
+        numbers["concave_ideal_range"], abs=numbers["y0_step"]
+    )
 
 
 def test_kappa_map_peak_and_valley_have_equal_self_lock_area():
     numbers, _ = kappa_map(quick=True)
-    assert numbers["convex_self_lock_fraction"] == numbers["concave_self_lock_fraction"] > 0
+    # mirror images, but linspace(-5, 5) is not bitwise symmetric about 0: a grid point
+    # within rounding of the self-lock boundary may fall on either side, so allow one
+    # point per side (the fraction of one point is 1 / n^2)
+    convex, concave = numbers["convex_self_lock_fraction"], numbers["concave_self_lock_fraction"]
+    assert convex > 0
+    assert convex == pytest.approx(concave, abs=2.0 / numbers["n"] ** 2)
 
 
 def test_raw_rms_height_matches_a_synthesis():

@@ -83,6 +83,7 @@ def test_store_paths_false_gives_the_same_summary():
     a = streamlines(surf, FIVE_STARTS, p)
     b = streamlines(surf, FIVE_STARTS, p, store_paths=False)
     np.testing.assert_array_equal(a.outcome, b.outcome)
+    # one compiled kernel, store_paths only switches the recording off: bitwise equal
     np.testing.assert_array_equal(a.max_kappa, b.max_kappa)
     assert b.x is None
     with pytest.raises(SpineInputError, match="store_paths"):
@@ -241,3 +242,63 @@ def test_stalled_trajectories_end_on_an_evaluated_point():
             assert len(path["x"]) == res.n_steps[i] + 1
             last = [path["x"][-1], path["y"][-1], path["z"][-1]]
             np.testing.assert_allclose(last, [res.end_x[i], res.end_y[i], res.end_z[i]], atol=1e-12)
+
+
+# --------------------------------------------------------------------------- step cap
+
+
+def _capped_starts():
+    # 40 starts (more than the kernel's 32 lanes) on the valley, too short a cap for any to end
+    return np.c_[np.full(40, -3.0), np.linspace(-4.0, 4.0, 40)]
+
+
+@pytest.mark.parametrize(("max_steps", "stall_window"), [(128, 64), (192, 64), (64, 16), (100, 64)])
+def test_capped_paths_match_the_reference_when_the_cap_falls_on_a_progress_check(max_steps, stall_window):
+    # A cap that is a multiple of stall_window (the default 200_000 is one of 64) coincides
+    # with a progress check; the kernel used to end the path there, one point short, and
+    # with two or more capped starts wrote the last start's points past its arrays.
+    surf = single_gaussian(sign=-1)
+    starts = _capped_starts()
+    p = StreamlineParams(mu=MU, dl=0.001, max_steps=max_steps, stall_window=stall_window)
+    for fn in (streamlines, ideal_trajectories):
+        ref = fn(surf, starts, p, backend="numpy")
+        assert np.all(ref.outcome == Outcome.STEP_CAP)
+        for store in (True, False):
+            got = fn(surf, starts, p, backend="numba", store_paths=store)
+            np.testing.assert_array_equal(got.outcome, ref.outcome)
+            np.testing.assert_array_equal(got.n_steps, max_steps)
+            for key in ("end_x", "end_y", "end_z"):
+                np.testing.assert_allclose(getattr(got, key), getattr(ref, key), atol=1e-9)
+            if store:
+                np.testing.assert_array_equal(got.offsets, ref.offsets)
+                _same(got, ref, 1e-9)
+                last = got.offsets[1:] - 1
+                np.testing.assert_allclose(got.x[last], got.end_x, atol=1e-12)
+                np.testing.assert_allclose(got.y[last], got.end_y, atol=1e-12)
+                assert len(got.to_frame()) == got.offsets[-1]
+
+
+def test_kernel_has_no_out_of_bounds_access_on_capped_paths(monkeypatch):
+    # numba does not bounds-check the kernel (boundscheck=False): compile its Python source
+    # again with checks on, so any index past an array raises IndexError instead of
+    # silently writing outside it, and run it on capped, ragged and locking starts.
+    from numba import njit
+
+    import spine_mj.streamline as sl
+    from spine_mj import _kernels
+
+    checked = njit(boundscheck=True, fastmath=_kernels._FM, error_model="numpy")(
+        _kernels.run_trajectories.py_func
+    )
+    monkeypatch.setattr(sl, "_get_kernel", lambda: checked)
+    surf = single_gaussian(sign=-1)
+    ragged = np.c_[np.linspace(-4.8, 0.0, 45), np.linspace(-4.8, 4.8, 45)]
+    for starts, dl in ((_capped_starts(), 0.001), (ragged, 0.05)):
+        p = StreamlineParams(mu=MU, dl=dl, max_steps=128)
+        for store in (True, False):
+            got = streamlines(surf, starts, p, backend="numba", store_paths=store)
+            ref = streamlines(surf, starts, p, backend="numpy", store_paths=store)
+            np.testing.assert_array_equal(got.outcome, ref.outcome)
+            np.testing.assert_array_equal(got.n_steps, ref.n_steps)
+            if store:
+                _same(got, ref, 1e-9)

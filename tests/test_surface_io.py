@@ -63,7 +63,7 @@ def test_failed_save_leaves_nothing(tmp_path):
 
 
 @pytest.mark.parametrize("name, n_expected", [("plu-1.plu", (576, 768)), ("di-1.di", (512, 512))])
-def test_import_shared_instrument_files(topography_dir, name, n_expected):
+def test_import_instrument_files(topography_dir, name, n_expected):
     surf = import_topography(topography_dir / name)
     assert surf.unit == "m"
     assert surf.shape == n_expected
