@@ -9,7 +9,9 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+import matplotlib.colors as mcolors
 import numpy as np
+from matplotlib.figure import Figure
 
 from spine_mj.errors import atomic_output
 from spine_mj.surfaces import GridSurface, Surface
@@ -19,7 +21,6 @@ __all__ = ["new_figure", "save_figure", "sim_run_figure", "surface_preview"]
 
 def new_figure(**kwargs):
     """A figure not tied to any GUI (safe in threads, workers and headless machines)."""
-    from matplotlib.figure import Figure
 
     return Figure(**kwargs)
 
@@ -128,7 +129,6 @@ def sim_run_figure(result, surface: Surface, *, length_scale_m: float, max_point
 
 def _kappa_colors(ax, x, y, k, region, *, kmax=10.0):
     """kappa as colour (slip blank), self-lock in dark red; returns the image."""
-    import matplotlib.colors as mcolors
 
     shown = np.where(region == 1, np.minimum(k, kmax), np.nan)
     extent = (x[0], x[-1], y[0], y[-1])

@@ -28,6 +28,7 @@ from typing import Any
 
 from spine_mj import resources, surfaces
 from spine_mj.errors import SpineInputError
+from spine_mj.surface_io import import_topography
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -47,7 +48,6 @@ __all__ = [
 
 
 def _measured(*, file: str, **options):
-    from spine_mj.surface_io import import_topography
 
     path = Path(file)
     if not path.is_absolute():

@@ -19,6 +19,12 @@ import numpy as np
 from spine_mj.convexity import CONCAVE, CONVEX, SADDLE, hessian_class, sectional_class
 from spine_mj.engagement import ENGAGED, REGION_NAMES, SLIP, kappa
 from spine_mj.errors import SpineInputError
+from spine_mj.plotting import (
+    fractal_hurst_figure,
+    kappa_map_figure,
+    random_gaussian_figure,
+    single_peak_figure,
+)
 from spine_mj.presets import load_preset
 from spine_mj.streamline import Outcome, StreamlineParams, ideal_trajectories, streamlines
 from spine_mj.surfaces import GaussianSurface, fractal_fbm, random_gaussians, single_gaussian
@@ -125,7 +131,6 @@ def single_peak(
         ]
         if progress:
             progress(k + 1, 2)
-    from spine_mj.plotting import single_peak_figure
 
     return numbers, single_peak_figure(runs, numbers)
 
@@ -153,7 +158,6 @@ def kappa_map(
             numbers[f"{name}_{label}_fraction"] = float(np.mean(region == code))
     if progress:
         progress(1, 1)
-    from spine_mj.plotting import kappa_map_figure
 
     return numbers, kappa_map_figure(maps, mu)
 
@@ -268,7 +272,6 @@ def random_gaussian(
         numbers[key] = (ms - mi) / mi if math.isfinite(ms) and math.isfinite(mi) and mi > 0 else None
         for k in (f"{name}_median_ideal", f"{name}_median_streamline"):
             numbers[k] = _finite_or_str(numbers[k])
-    from spine_mj.plotting import random_gaussian_figure
 
     return numbers, random_gaussian_figure(scatter, numbers)
 
@@ -459,7 +462,6 @@ def fractal_hurst(
         "surfaces_per_hurst": n,
         "by_hurst": table,
     }
-    from spine_mj.plotting import fractal_hurst_figure
 
     return numbers, fractal_hurst_figure(table)
 

@@ -237,7 +237,8 @@ def summarize(surface: Surface) -> Roughness:
     (``rms_height_from_area``, ``rms_gradient``, ``rms_curvature_from_area``) on the same
     grid, with the grid's periodicity.
     """
-    import SurfaceTopography as st
+
+    import SurfaceTopography as st  # lazy like mujoco: 1.7 s to import
 
     grid = surface if isinstance(surface, GridSurface) else surface.sample(201)
     ny, nx = grid.shape

@@ -27,7 +27,10 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+import pandas as pd
+from scipy import ndimage
 
+from spine_mj._kernels import run_trajectories
 from spine_mj.engagement import ENGAGED, REGION_NAMES, SELF_LOCK, SLIP, kappa, slip_direction
 from spine_mj.errors import SpineInputError
 from spine_mj.surfaces import GaussianSurface, GridSurface, Surface
@@ -164,7 +167,6 @@ class StreamlineResult:
         """Long table (pandas DataFrame): one row per path point, columns ``start``,
         ``step``, ``start_x``, ``start_y``, ``x``, ``y``, ``z``, ``kappa``, ``region``,
         ``outcome`` (names)."""
-        import pandas as pd
 
         if self.offsets is None:
             raise SpineInputError("paths were not stored (store_paths=False)")
@@ -197,7 +199,6 @@ _LANES = 32  # starts the kernel steps together (one core, 2,000 starts: 8 -> 4.
 
 
 def _get_kernel():
-    from spine_mj._kernels import run_trajectories
 
     return run_trajectories
 
@@ -439,7 +440,6 @@ def dilate(surface: Surface, radius: float, *, spacing: float | None = None) -> 
     GridSurface
         Same bounds as ``surface`` (same periodicity for gridded ones).
     """
-    from scipy import ndimage
 
     radius = float(radius)
     if not (math.isfinite(radius) and radius >= 0):

@@ -17,6 +17,8 @@ import zipfile
 from pathlib import Path
 
 import numpy as np
+import trimesh
+from scipy import ndimage
 
 from spine_mj.errors import SpineInputError, atomic_output, check_positive
 from spine_mj.jsonio import to_jsonable
@@ -167,7 +169,8 @@ def import_topography(
     path = Path(path)
     if not path.is_file():
         raise SpineInputError(f"topography file not found: {path}")
-    import SurfaceTopography as st
+
+    import SurfaceTopography as st  # lazy like mujoco: 1.7 s to import, needed only for instrument files
 
     try:
         reader = st.open_topography(str(path))
@@ -227,7 +230,6 @@ def _fill_missing(heights, missing, method, topo):
         out = heights.copy()
         out[missing] = heights[~missing].mean()
         return out
-    from scipy import ndimage
 
     _, (ii, jj) = ndimage.distance_transform_edt(missing, return_indices=True)
     return heights[ii, jj]
@@ -257,7 +259,6 @@ def surface_mesh(
     -------
     trimesh.Trimesh
     """
-    import trimesh
 
     grid = surface if isinstance(surface, GridSurface) else surface.sample(resolution)
     h = grid.heights

@@ -22,9 +22,9 @@ Scales and default engine settings (:func:`default_engine`). With
   measured penetration 2-4 um for a 0.5 mm tip at F <= 5 F_p and 37 um at 17 F_p (a
   60 degree slope), always far below 1 % of ``L_c``;
 * ``cone = elliptic`` with ``noslip_iterations = 3``: MuJoCo's friction is soft and creeps
-  at any in-cone load without the noslip pass (PHYSICS.md §5); ``impratio`` stays 1.
+  at any in-cone load without the noslip pass (docs/physics.md §5); ``impratio`` stays 1.
 
-Drives (PHYSICS.md §4): :class:`SpringDrive` (a carriage moves at constant speed in +x and
+Drives (docs/physics.md §4): :class:`SpringDrive` (a carriage moves at constant speed in +x and
 pulls the tip through a spring acting in x only), :class:`RampDrive` (force rises at a set
 rate until slip, drops to zero, ramps again once the tip has settled) and
 :class:`StaticProbe` (ramp at one point until breakaway, ``kappa_mj = F / F_p``). Each run

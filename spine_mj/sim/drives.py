@@ -1,7 +1,7 @@
 """The three drives and the rules that turn a drive into numbers on a rig.
 
 :class:`SpringDrive`, :class:`RampDrive` and :class:`StaticProbe` are frozen parameter
-records (PHYSICS.md §4); None fields are derived from the problem's :class:`Scales` and
+records (docs/physics.md §4); None fields are derived from the problem's :class:`Scales` and
 the engine's time step by the functions below (spring stiffness, force rate, settle steps,
 the drive's speed), so a drive means the same wherever it is run.
 """

@@ -19,13 +19,14 @@ from pathlib import Path
 import numpy as np
 
 from spine_mj.errors import SpineInputError, atomic_output
+from spine_mj.resources import model_path
 from spine_mj.sim.drives import Drive, SpringDrive, speed_m_s, stiffness_n_m
 from spine_mj.sim.params import EngineSettings, Scales, TipParams, default_engine, hfield_of
 from spine_mj.sim.placement import Placer
 from spine_mj.sim.recording import SENSOR_NAMES
 from spine_mj.surfaces import Surface
 
-MODEL_PATH = Path(__file__).resolve().parent.parent.parent / "models" / "spine_rig.xml"
+MODEL_PATH = model_path()
 
 
 class RigModel:

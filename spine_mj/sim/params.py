@@ -16,10 +16,9 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-import numpy as np
-
 from spine_mj.errors import SpineInputError, check_positive
-from spine_mj.surfaces import GaussianSurface, GridSurface, HField, Surface, to_hfield
+from spine_mj.roughness import characteristic_length
+from spine_mj.surfaces import HField, Surface, to_hfield
 
 DEFAULT_LENGTH_SCALE_M = 0.01
 _MAX_TIMESTEP_S = 1e-3
@@ -156,7 +155,7 @@ class EngineSettings:
         if self.cone is Cone.PYRAMIDAL and self.noslip_iterations > 0:
             raise SpineInputError(
                 "cone='pyramidal' with noslip_iterations > 0 holds only about half "
-                "of mu N (PHYSICS.md §5); use the elliptic cone with noslip"
+                "of mu N (docs/physics.md §5); use the elliptic cone with noslip"
             )
         try:
             tc, dr = (float(v) for v in self.solref)
@@ -311,32 +310,6 @@ def hfield_spacing(hfield: HField, length_scale_m: float = 1.0) -> float:
     """The larger of an hfield's two sample spacings, in metres."""
     rx, ry = hfield.size[0], hfield.size[1]
     return length_scale_m * 2 * max(rx / (hfield.ncol - 1), ry / (hfield.nrow - 1))
-
-
-def characteristic_length(surface: Surface) -> float:
-    """L_c of a surface, in the surface's own units.
-
-    Rule: for a Gaussian sum, the mean of its widths ``(sigma_x + sigma_y) / 2``; for a
-    grid, ``2 pi`` times the rms height over the rms slope (the wavelength of a sine with
-    the same rms height and slope), clipped to ``[4 dx, domain size]``; a plane (no
-    height variation) gives the domain size.
-    """
-    xmin, xmax, ymin, ymax = surface.bounds
-    span = float(min(xmax - xmin, ymax - ymin))
-    if isinstance(surface, GaussianSurface):
-        return float(np.mean(0.5 * (surface.sigma_x + surface.sigma_y)))
-    grid = surface if isinstance(surface, GridSurface) else surface.sample(201)
-    h = grid.heights - grid.heights.mean()
-    dx, dy = grid.spacing
-    gy, gx = np.gradient(grid.heights, dy, dx)
-    detrended = h - (
-        gx.mean() * (grid.x[None, :] - grid.x.mean()) + gy.mean() * (grid.y[:, None] - grid.y.mean())
-    )
-    rms_h = float(np.sqrt(np.mean(detrended**2)))
-    rms_s = float(np.sqrt(np.mean((gx - gx.mean()) ** 2 + (gy - gy.mean()) ** 2)))
-    if rms_s <= 1e-12 or rms_h <= 1e-12 * span:
-        return span
-    return float(np.clip(2 * math.pi * rms_h / rms_s, 4 * max(dx, dy), span))
 
 
 def default_engine(scales: Scales, **overrides) -> EngineSettings:

@@ -15,6 +15,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+import pandas as pd
 
 from spine_mj.sim.detection import (
     Detection,
@@ -105,7 +106,6 @@ class RunResult:
 
     def table(self):
         """The trajectory as a :class:`pandas.DataFrame` (one row per recorded step)."""
-        import pandas as pd
 
         cols = {"time_s": self.time_s}
         for name in ("position_m", "velocity_m_s", "normal", "contact_point_m"):
