@@ -12,7 +12,6 @@ import functools
 import numpy as np
 
 from spine_mj.sweep import (
-    _CONFIG_CHECKS,
     REQUIRED,
     Analysis,
     AnalysisResult,
@@ -205,7 +204,7 @@ def _check_speed(config) -> None:
     from spine_mj.errors import SpineInputError
 
     grid = dict(config.grid)
-    if "mujoco" in config.analyses and grid["ie"] != (None,) and grid["speed"] != (None,):
+    if grid["ie"] != (None,) and grid["speed"] != (None,):
         raise SpineInputError(
             "config keys grid.ie and grid.speed: give one of them (the "
             f"inertia number or the speed), got ie = {list(grid['ie'])} and "
@@ -383,13 +382,13 @@ def _mujoco(case, surface, starts, upstream):
     return AnalysisResult(metrics=metrics, trajectories=traj, status=status, reason=reason, data=(rig, runs))
 
 
-_CONFIG_CHECKS.append(_check_speed)
 register_analysis(
     Analysis(
         "mujoco",
         _mujoco,
         MUJOCO_PARAMS,
         doc="MuJoCo rig run from every start with the chosen drive: spine_mj.sim",
+        check_config=_check_speed,
     )
 )
 

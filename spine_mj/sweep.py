@@ -224,7 +224,9 @@ class Analysis:
     """A named analysis: ``func(case, surface, starts, upstream) -> AnalysisResult``.
 
     ``starts`` is ``(n_starts, 2)`` in the surface's length unit; ``upstream`` maps the
-    names in ``requires`` to their results for the same case.
+    names in ``requires`` to their results for the same case. ``check_config``, if given,
+    is called with every validated config that chooses this analysis and raises
+    SpineInputError for a combination of values its parameters cannot check one by one.
     """
 
     name: str
@@ -232,6 +234,7 @@ class Analysis:
     parameters: tuple[ParamSpec, ...]
     requires: tuple[str, ...] = ()
     doc: str = ""
+    check_config: Callable[[Any], None] | None = None
 
 
 #: Registry of analyses by name; :func:`register_analysis` adds to it.
@@ -609,13 +612,10 @@ def parse_config(doc: Mapping, *, base_dir: str | os.PathLike = ".") -> SweepCon
         store_trajectories=store,
         surface_starts=tuple(per_surface),
     )
-    for check in _CONFIG_CHECKS:
-        check(config)
+    for a in order:
+        if ANALYSES[a].check_config is not None:
+            ANALYSES[a].check_config(config)
     return config
-
-
-#: Extra whole-config checks an analysis may register (``f(config)`` raising SpineInputError).
-_CONFIG_CHECKS: list[Callable[[SweepConfig], None]] = []
 
 
 def _parse_starts(doc, key: str) -> StartsSpec:
