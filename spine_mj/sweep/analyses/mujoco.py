@@ -1,8 +1,8 @@
-"""The built-in sweep analyses: ``quasistatic``, ``mujoco`` and ``compare``.
+"""The ``mujoco`` analysis: a run of the MuJoCo rig from every start with the chosen drive.
 
-Each analysis touches the API of its module in one function (``_quasistatic`` ->
-:mod:`spine_mj.streamline`, ``_mujoco`` -> :mod:`spine_mj.sim`, ``_compare`` ->
-:mod:`spine_mj.compare`), so that a change there is a change here in one place.
+Touches the API of :mod:`spine_mj.sim` here only. The rig of a case is built from
+:meth:`spine_mj.sim.Scales.for_surface` and cached per process, so cases that differ only
+in the drive share it.
 """
 
 from __future__ import annotations
@@ -11,87 +11,9 @@ import functools
 
 import numpy as np
 
-from spine_mj.sweep import (
-    REQUIRED,
-    Analysis,
-    AnalysisResult,
-    ParamSpec,
-    register_analysis,
-)
-
-# --------------------------------------------------------------------------- quasistatic
-
-QUASISTATIC_PARAMS = (
-    ParamSpec("mu", "float", "static friction coefficient mu_s", REQUIRED, 0.0, exclusive=True),
-    ParamSpec("tip_radius", "float", "tip radius in the surface's length unit (0: a point)", 0.0, 0.0),
-    ParamSpec(
-        "dl",
-        "float",
-        "streamline step in the surface's length unit (default: 0.0015 times the smaller side of the domain)",
-        None,
-        0.0,
-        exclusive=True,
-    ),
-    ParamSpec("max_steps", "int", "step cap per streamline", 200_000, 1),
-    ParamSpec("trajectory", "str", "quasistatic path kind", "streamline", choices=("streamline", "ideal")),
-)
-
-
-@functools.lru_cache(maxsize=4)
-def _dilated(spec, radius: float):
-    from spine_mj.streamline import dilate
-
-    return dilate(spec.make(), radius)
-
-
-def _quasistatic(case, surface, starts, upstream):
-    from spine_mj import streamline as sl
-
-    p = case.params
-    if p["tip_radius"] > 0:
-        surface = _dilated(case.surface, p["tip_radius"])
-    xmin, xmax, ymin, ymax = surface.bounds
-    dl = p["dl"] if p["dl"] is not None else 0.0015 * min(xmax - xmin, ymax - ymin)
-    params = sl.StreamlineParams(mu=p["mu"], dl=dl, max_steps=p["max_steps"])
-    func = sl.streamlines if p["trajectory"] == "streamline" else sl.ideal_trajectories
-    res = func(surface, starts, params, store_paths=True)
-    names = np.array(["", *[o.name.lower() for o in sl.Outcome]], dtype=object)
-    metrics = {
-        "outcome": names[res.outcome],
-        "self_locked": res.outcome == sl.Outcome.SELF_LOCKED,
-        "end_x": res.end_x,
-        "end_y": res.end_y,
-        "end_z": res.end_z,
-        "n_steps": res.n_steps,
-        "path_length": res.n_steps * dl,
-        "max_kappa": res.max_kappa,
-        "dl_used": np.full(len(res), dl),
-    }
-    counts = np.diff(res.offsets)
-    start = np.repeat(np.arange(len(res)), counts)
-    traj = {
-        "start": start,
-        "step": np.arange(res.x.size) - np.repeat(res.offsets[:-1], counts),
-        "x": res.x,
-        "y": res.y,
-        "z": res.z,
-        "kappa": res.kappa,
-        "region": res.region.astype(np.int8),
-    }
-    return AnalysisResult(metrics=metrics, trajectories=traj, data=res)
-
-
-register_analysis(
-    Analysis(
-        "quasistatic",
-        _quasistatic,
-        QUASISTATIC_PARAMS,
-        doc="quasistatic streamline (or ideal trajectory) from every start: spine_mj.streamline",
-    )
-)
-
-
-# --------------------------------------------------------------------------- mujoco
+from spine_mj import sim
+from spine_mj.errors import SpineInputError
+from spine_mj.sweep.registry import REQUIRED, Analysis, AnalysisResult, ParamSpec, register_analysis
 
 MUJOCO_PARAMS = (
     ParamSpec("mu", "float", "static friction coefficient mu_s", REQUIRED, 0.0, exclusive=True),
@@ -201,8 +123,6 @@ MUJOCO_PARAMS = (
 
 
 def _check_speed(config) -> None:
-    from spine_mj.errors import SpineInputError
-
     grid = dict(config.grid)
     if grid["ie"] != (None,) and grid["speed"] != (None,):
         raise SpineInputError(
@@ -216,8 +136,6 @@ def _check_speed(config) -> None:
 def _rig(spec, key):
     """The rig of a surface and tip/engine parameters (cached: cases differing only in the
     drive share it)."""
-    from spine_mj import sim
-
     p = dict(key)
     surface = spec.make()
     tip = sim.TipParams(
@@ -247,40 +165,53 @@ def _rig(spec, key):
 
 
 def _mujoco(case, surface, starts, upstream):
-    from spine_mj import sim
-
     p = case.params
+    rig = _rig(case.surface, _rig_key(p, surface))
+    runs = _runs(rig, p, starts)
+    n = len(runs)
+    status = np.full(n, "ok", dtype=object)
+    reason = np.array([r.end_detail for r in runs], dtype=object)
+    for i, r in enumerate(runs):
+        if r.end_reason is sim.EndReason.ENGINE_TROUBLE:
+            warned = "warning" in r.end_detail or "reset" in r.end_detail
+            status[i] = "engine_warning" if warned else "diverged"
+    traj = _trajectories(runs, rig.length_scale_m, p["record_every"])
+    return AnalysisResult(
+        metrics=_metrics(rig, runs), trajectories=traj, status=status, reason=reason, data=(rig, runs)
+    )
+
+
+_RIG_KEYS = (
+    "mass",
+    "mu",
+    "preload",
+    "gravity",
+    "length_scale",
+    "timestep",
+    "integrator",
+    "cone",
+    "impratio",
+    "noslip_iterations",
+    "solref_timeconst",
+    "solref_dampratio",
+    "hfield_resolution",
+)
+
+
+def _rig_key(p: dict, surface) -> tuple:
+    """The parameters of a case that make its rig, as a hashable key of :func:`_rig`."""
     unit_m = 1.0
     if p["length_scale"] is not None:
         unit_m = p["length_scale"]
     elif surface.unit == "1":
         unit_m = sim.DEFAULT_LENGTH_SCALE_M
-    key = tuple(
-        sorted(
-            {
-                "tip_radius_m": p["tip_radius"] * unit_m if p["tip_radius"] > 0 else None,
-                **{
-                    k: p[k]
-                    for k in (
-                        "mass",
-                        "mu",
-                        "preload",
-                        "gravity",
-                        "length_scale",
-                        "timestep",
-                        "integrator",
-                        "cone",
-                        "impratio",
-                        "noslip_iterations",
-                        "solref_timeconst",
-                        "solref_dampratio",
-                        "hfield_resolution",
-                    )
-                },
-            }.items()
-        )
-    )
-    rig = _rig(case.surface, key)
+    tip_radius_m = p["tip_radius"] * unit_m if p["tip_radius"] > 0 else None
+    return tuple(sorted({"tip_radius_m": tip_radius_m, **{k: p[k] for k in _RIG_KEYS}}.items()))
+
+
+def _runs(rig, p: dict, starts) -> list:
+    """The runs of ``rig`` from every start with the case's drive (speed from ``ie`` unless
+    given; the ramp and static rates from the speed)."""
     sc = rig.scales
     speed = p["speed"]
     if speed is None:
@@ -296,26 +227,33 @@ def _mujoco(case, surface, starts, upstream):
             duration_s=p["duration"],
             settle_time_s=p["settle_time"],
         )
-        runs = rig.run_batch(drive, pts, detection=det, nthread=1)
-    elif p["protocol"] == "static":
+        return rig.run_batch(drive, pts, detection=det, nthread=1)
+    if p["protocol"] == "static":
         drive = sim.StaticProbe(rate_n_s=rate, start_force_n=p["start_force"], settle_time_s=p["settle_time"])
-        runs = rig.run_batch(drive, pts, detection=det, nthread=1)
-    else:
-        drive = sim.RampDrive(
-            rate_n_s=rate,
-            duration_s=p["duration"],
-            settle_time_s=p["settle_time"],
-            slide_distance_m=p["slide_distance"],
-        )
-        runs = [rig.run(drive, start=s, detection=det) for s in pts]
+        return rig.run_batch(drive, pts, detection=det, nthread=1)
+    drive = sim.RampDrive(
+        rate_n_s=rate,
+        duration_s=p["duration"],
+        settle_time_s=p["settle_time"],
+        slide_distance_m=p["slide_distance"],
+    )
+    return [rig.run(drive, start=s, detection=det) for s in pts]
+
+
+def peak_drive_over_fp(run, preload_n: float) -> float:
+    """Largest drive force after the settling phase over F_p (NaN for a run that never drove)."""
+    return (
+        run.drive_force_n[run.drive_start_index :].max() / preload_n
+        if run.n > run.drive_start_index
+        else np.nan
+    )
+
+
+def _metrics(rig, runs) -> dict[str, np.ndarray]:
+    """Per-run metrics; lengths in the surface's unit."""
     s = rig.length_scale_m
+    sc = rig.scales
     n = len(runs)
-    status = np.full(n, "ok", dtype=object)
-    reason = np.array([r.end_detail for r in runs], dtype=object)
-    for i, r in enumerate(runs):
-        if r.end_reason is sim.EndReason.ENGINE_TROUBLE:
-            warned = "warning" in r.end_detail or "reset" in r.end_detail
-            status[i] = "engine_warning" if warned else "diverged"
     end = np.array([r.position_m[-1] for r in runs]) / s
     path_len = (
         np.array(
@@ -326,7 +264,7 @@ def _mujoco(case, surface, starts, upstream):
         )
         / s
     )
-    metrics = {
+    return {
         "end_reason": np.array([r.end_reason.value for r in runs], dtype=object),
         "self_locked": np.array([r.end_reason is sim.EndReason.SELF_LOCK for r in runs]),
         "end_x": end[:, 0],
@@ -337,14 +275,7 @@ def _mujoco(case, surface, starts, upstream):
         "n_steps": np.array([r.n for r in runs], dtype=np.int64),
         "inertia_number": np.array([r.inertia_number for r in runs]),
         "speed_m_s": np.array([r.speed_m_s for r in runs]),
-        "max_drive_over_fp": np.array(
-            [
-                r.drive_force_n[r.drive_start_index :].max() / sc.preload_n
-                if r.n > r.drive_start_index
-                else np.nan
-                for r in runs
-            ]
-        ),
+        "max_drive_over_fp": np.array([peak_drive_over_fp(r, sc.preload_n) for r in runs]),
         "n_slip_onsets": np.array(
             [sum(e.kind == "slip_onset" for e in r.events) for r in runs], dtype=np.int64
         ),
@@ -354,7 +285,11 @@ def _mujoco(case, surface, starts, upstream):
         "char_length": np.full(n, sc.char_length_m / s),
         "tip_radius_m": np.full(n, rig.tip.tip_radius_m),
     }
-    k = p["record_every"]
+
+
+def _trajectories(runs, s: float, k: int) -> dict[str, np.ndarray]:
+    """Long table of the runs' paths: every ``k``-th recorded step and the last one;
+    lengths in the surface's unit (metres over ``s``)."""
     parts = []
     for i, r in enumerate(runs):
         # every k-th step and the last one (a slice, not a copy, when k is 1)
@@ -378,8 +313,7 @@ def _mujoco(case, surface, starts, upstream):
                 "contact": r.contact[rows],
             }
         )
-    traj = {c: np.concatenate([part[c] for part in parts]) for c in parts[0]}
-    return AnalysisResult(metrics=metrics, trajectories=traj, status=status, reason=reason, data=(rig, runs))
+    return {c: np.concatenate([part[c] for part in parts]) for c in parts[0]}
 
 
 register_analysis(
@@ -389,72 +323,5 @@ register_analysis(
         MUJOCO_PARAMS,
         doc="MuJoCo rig run from every start with the chosen drive: spine_mj.sim",
         check_config=_check_speed,
-    )
-)
-
-
-# --------------------------------------------------------------------------- compare
-
-
-def _compare(case, surface, starts, upstream):
-    from spine_mj import compare
-
-    qs = upstream["quasistatic"].data
-    rig, runs = upstream["mujoco"].data
-    s = rig.length_scale_m
-    lc = rig.scales.char_length_m / s
-    n = len(runs)
-    frechet = np.full(n, np.nan)
-    lateral = np.full(n, np.nan)
-    for i, r in enumerate(runs):
-        q = qs.path(i)
-        qpath = np.column_stack([q["x"], q["y"]])
-        mpath = r.position_m[r.drive_start_index :, :2] / s
-        if mpath.shape[0] == 0:
-            continue
-        frechet[i] = compare.path_frechet(mpath, qpath, length_scale=lc)
-        lateral[i] = compare.mean_lateral_deviation(mpath, qpath, length_scale=lc)
-    mj_locked = np.array([r.end_reason.value == "self_lock" for r in runs])
-    mj_end = np.array([r.position_m[-1, :2] / s for r in runs])
-    agree = compare.outcome_agreement(
-        qs.self_locked, np.column_stack([qs.end_x, qs.end_y]), mj_locked, mj_end, length_scale=lc
-    )
-    peak = np.array(
-        [
-            r.drive_force_n[r.drive_start_index :].max() / rig.scales.preload_n
-            if r.n > r.drive_start_index
-            else np.nan
-            for r in runs
-        ]
-    )
-    kap = compare.kappa_agreement(qs.max_kappa, peak, kappa_cap=runs[0].detection.kappa_cap)
-    metrics = {
-        "frechet": frechet,
-        "lateral_deviation": lateral,
-        "end_distance": np.linalg.norm(np.column_stack([qs.end_x, qs.end_y]) - mj_end, axis=1) / lc,
-        "agree_lock": agree["lock"],
-        "agree_end": agree["end"],
-        "same_trap": agree["same_trap"],
-        "agree": agree["agree"],
-        "kappa_ratio": kap["ratio"],
-        "inertia_number": np.array([r.inertia_number for r in runs]),
-    }
-    status = np.array(
-        upstream["mujoco"].status if upstream["mujoco"].status is not None else np.full(n, "ok"), dtype=object
-    )
-    reason = np.where(
-        status == "ok", "", "mujoco run: " + np.asarray(upstream["mujoco"].reason, dtype=object)
-    ).astype(object)
-    status = np.where(status == "ok", "ok", "dependency_failed").astype(object)
-    return AnalysisResult(metrics=metrics, status=status, reason=reason)
-
-
-register_analysis(
-    Analysis(
-        "compare",
-        _compare,
-        (),
-        requires=("quasistatic", "mujoco"),
-        doc="quasistatic against MuJoCo per start (lengths over L_c): spine_mj.compare",
     )
 )
