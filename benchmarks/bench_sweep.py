@@ -46,8 +46,8 @@ def bare_rollout_time(config: sweep.SweepConfig) -> float:
     import mujoco
     from mujoco import rollout
 
-    from spine_mj import _sweep_analyses as an
     from spine_mj import sim
+    from spine_mj.sweep.analyses import mujoco as an
 
     total = 0.0
     for case in sweep.expand_cases(config):
@@ -133,9 +133,9 @@ def main() -> None:
     bare = bare_rollout_time(config)
     # the bare timing built and placed through the in-process rig cache: empty it, so the
     # one-worker sweep starts as cold as the two-worker one (rigs, placements)
-    from spine_mj import _sweep_analyses
+    from spine_mj.sweep.analyses import mujoco as an
 
-    _sweep_analyses._rig.cache_clear()
+    an._rig.cache_clear()
     t1 = timed_sweep(config, scratch / "mj1", workers=1)
     t2 = timed_sweep(config, scratch / "mj2", workers=2)
     runs = sweep.load_runs(scratch / "mj1")

@@ -1,0 +1,97 @@
+"""Headless batch sweeps: a TOML config, cases, a resumable result store, local or Dask workers.
+
+A sweep config names surfaces (presets or files, with seeds), start points, a parameter
+grid and the analyses to run on every case::
+
+    [sweep]
+    name = "quasistatic-mu"
+    seed = 0                          # master seed; each case derives its own
+    analyses = ["quasistatic"]        # any of: quasistatic, mujoco, compare
+
+    [[surfaces]]
+    preset = "paper-random-convex"
+    seeds = [1, 2, 3]                 # or seed = 1, or n_seeds = 3 (derived from the master seed)
+    set = { n_peaks = 40 }            # generator overrides
+
+    [[surfaces]]
+    file = "scan.npz"                 # relative to the config file
+
+    [starts]
+    frame = "relative"                # or "absolute" (the surface's length unit)
+    x = [0.05]                        # starts: product of x and y, or points = [[x, y], ...],
+    y = { linspace = [0.1, 0.9], num = 9 }   # or random = N (uniform, from the case seed)
+
+    [grid]
+    mu = [0.3, 0.5, 0.8]              # a value, a list, or { linspace | logspace = [a, b], num = n }
+    tip_radius = 0.0
+
+A *case* is one surface instance and one point of the grid, with all its starts; its id is
+a hash of those parameters, and its seed is derived from the master seed and that id, so a
+case gives the same numbers whatever the order or the machine it runs on. A *run* is one
+start of one case under one analysis: a row of the result table.
+
+The store in the output folder::
+
+    manifest.json              config, its hash, seeds, versions, git commit
+    runs.parquet               one row per run (parameters, metrics, status, reason, timing)
+    runs/<case_id>.parquet     the rows of one case, written atomically when the case ends
+    trajectories/<case_id>.parquet   long table of the case's paths (analysis, start, step, ...)
+
+A case counts as finished when its ``runs/`` file exists, so a sweep killed at any moment
+resumes without losing or repeating a run; ``runs.parquet`` is rebuilt from those files at
+the end of every sweep.
+
+Modules, each importing only those above it: :mod:`~spine_mj.sweep.registry` (analyses and
+their parameters), :mod:`~spine_mj.sweep.config` (the TOML schema),
+:mod:`~spine_mj.sweep.cases` (expansion, ids, seeds), :mod:`~spine_mj.sweep.runner` (one
+case), :mod:`~spine_mj.sweep.store` (the result store and its readers),
+:mod:`~spine_mj.sweep.executors` (in-process, local processes, Dask),
+:mod:`~spine_mj.sweep.session` (:func:`run_sweep`), :mod:`~spine_mj.sweep.report` (HTML),
+and :mod:`~spine_mj.sweep.analyses` (the built-in analyses, registered on import).
+"""
+
+from spine_mj.sweep.analyses import MUJOCO_PARAMS, QUASISTATIC_PARAMS
+from spine_mj.sweep.cases import Case, expand_cases
+from spine_mj.sweep.config import StartsSpec, SurfaceSpec, SweepConfig, load_config, parse_config
+from spine_mj.sweep.registry import (
+    ANALYSES,
+    REQUIRED,
+    STATUSES,
+    Analysis,
+    AnalysisResult,
+    ParamSpec,
+    register_analysis,
+)
+from spine_mj.sweep.report import write_report
+from spine_mj.sweep.runner import run_case
+from spine_mj.sweep.session import Progress, SweepSummary, run_sweep
+from spine_mj.sweep.store import StoreStatus, consolidate, load_runs, load_trajectories, store_status
+
+__all__ = [
+    "ANALYSES",
+    "MUJOCO_PARAMS",
+    "QUASISTATIC_PARAMS",
+    "REQUIRED",
+    "STATUSES",
+    "Analysis",
+    "AnalysisResult",
+    "Case",
+    "ParamSpec",
+    "Progress",
+    "StartsSpec",
+    "StoreStatus",
+    "SurfaceSpec",
+    "SweepConfig",
+    "SweepSummary",
+    "consolidate",
+    "expand_cases",
+    "load_config",
+    "load_runs",
+    "load_trajectories",
+    "parse_config",
+    "register_analysis",
+    "run_case",
+    "run_sweep",
+    "store_status",
+    "write_report",
+]

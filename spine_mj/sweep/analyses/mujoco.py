@@ -1,0 +1,327 @@
+"""The ``mujoco`` analysis: a run of the MuJoCo rig from every start with the chosen drive.
+
+Touches the API of :mod:`spine_mj.sim` here only. The rig of a case is built from
+:meth:`spine_mj.sim.Scales.for_surface` and cached per process, so cases that differ only
+in the drive share it.
+"""
+
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+
+from spine_mj import sim
+from spine_mj.errors import SpineInputError
+from spine_mj.sweep.registry import REQUIRED, Analysis, AnalysisResult, ParamSpec, register_analysis
+
+MUJOCO_PARAMS = (
+    ParamSpec("mu", "float", "static friction coefficient mu_s", REQUIRED, 0.0, exclusive=True),
+    ParamSpec(
+        "tip_radius",
+        "float",
+        "tip radius in the surface's length unit (mujoco: 0 lets "
+        "the rig choose one hfield spacing or L_c / 100)",
+        0.0,
+        0.0,
+    ),
+    ParamSpec(
+        "protocol", "str", "drive protocol", "spring", choices=("spring", "ramp", "static"), drive=True
+    ),
+    ParamSpec(
+        "ie",
+        "float",
+        "inertia number I_e = m v^2 / (F_p L_c); sets the carriage speed "
+        "(spring) or the force rate (ramp, static); default 1e-3 unless speed is given",
+        None,
+        0.0,
+        exclusive=True,
+        drive=True,
+    ),
+    ParamSpec(
+        "speed",
+        "float",
+        "carriage speed [m/s] (spring; instead of ie)",
+        None,
+        0.0,
+        exclusive=True,
+        drive=True,
+    ),
+    ParamSpec(
+        "stiffness",
+        "float",
+        "spring stiffness [N/m] (default 10 F_p / L_c)",
+        None,
+        0.0,
+        exclusive=True,
+        drive=True,
+    ),
+    ParamSpec(
+        "duration",
+        "float",
+        "drive duration [s] (default: from the drive)",
+        None,
+        0.0,
+        exclusive=True,
+        drive=True,
+    ),
+    ParamSpec("settle_time", "float", "settling time before the drive [s]", None, 0.0, drive=True),
+    ParamSpec("start_force", "float", "static probe: force held at the start [N]", 0.0, 0.0, drive=True),
+    ParamSpec(
+        "slide_distance",
+        "float",
+        "ramp: distance slid after breakaway before the force "
+        "resets [m] (default 0.01 L_c, the paper's step dl)",
+        None,
+        0.0,
+        drive=True,
+    ),
+    ParamSpec("mass", "float", "effective moving mass m_eff [kg]", 0.01, 0.0, exclusive=True),
+    ParamSpec("preload", "float", "extra downward preload [N] (added to m g)", 0.0, 0.0),
+    ParamSpec("gravity", "float", "gravitational acceleration [m/s^2]", 9.81, 0.0),
+    ParamSpec(
+        "length_scale",
+        "float",
+        "metres per surface unit (default 0.01 for dimensionless surfaces, 1 for metres)",
+        None,
+        0.0,
+        exclusive=True,
+    ),
+    ParamSpec(
+        "timestep", "float", "MuJoCo time step [s] (default: from the scales)", None, 0.0, exclusive=True
+    ),
+    ParamSpec(
+        "integrator",
+        "str",
+        "MuJoCo integrator",
+        "implicitfast",
+        choices=("euler", "implicitfast", "implicit", "rk4"),
+    ),
+    ParamSpec("cone", "str", "friction cone", "elliptic", choices=("elliptic", "pyramidal")),
+    ParamSpec("impratio", "float", "frictional / normal impedance ratio", 1.0, 0.0, exclusive=True),
+    ParamSpec("noslip_iterations", "int", "noslip solver passes", 3, 0),
+    ParamSpec(
+        "solref_timeconst",
+        "float",
+        "contact time constant [s] (default 2 timestep)",
+        None,
+        0.0,
+        exclusive=True,
+    ),
+    ParamSpec("solref_dampratio", "float", "contact damping ratio", 1.0, 0.0, exclusive=True),
+    ParamSpec("hfield_resolution", "int", "hfield samples per side for analytic surfaces", None, 4),
+    ParamSpec(
+        "kappa_cap",
+        "float",
+        "self-lock when the drive reaches kappa_cap F_p unmoved",
+        20.0,
+        0.0,
+        exclusive=True,
+    ),
+    ParamSpec("record_every", "int", "store every k-th recorded step of the trajectories", 1, 1),
+)
+
+
+def _check_speed(config) -> None:
+    grid = dict(config.grid)
+    if grid["ie"] != (None,) and grid["speed"] != (None,):
+        raise SpineInputError(
+            "config keys grid.ie and grid.speed: give one of them (the "
+            f"inertia number or the speed), got ie = {list(grid['ie'])} and "
+            f"speed = {list(grid['speed'])}"
+        )
+
+
+@functools.lru_cache(maxsize=4)
+def _rig(spec, key):
+    """The rig of a surface and tip/engine parameters (cached: cases differing only in the
+    drive share it)."""
+    p = dict(key)
+    surface = spec.make()
+    tip = sim.TipParams(
+        tip_radius_m=p["tip_radius_m"],
+        mass_kg=p["mass"],
+        mu_s=p["mu"],
+        preload_n=p["preload"],
+        gravity_m_s2=p["gravity"],
+    )
+    scales = sim.Scales.for_surface(
+        surface, tip=tip, length_scale_m=p["length_scale"], hfield_resolution=p["hfield_resolution"]
+    )
+    overrides = {
+        "integrator": p["integrator"],
+        "cone": p["cone"],
+        "impratio": p["impratio"],
+        "noslip_iterations": p["noslip_iterations"],
+        "hfield_resolution": p["hfield_resolution"],
+    }
+    if p["timestep"] is not None:
+        overrides["timestep_s"] = p["timestep"]
+    dt = p["timestep"] if p["timestep"] is not None else sim.default_engine(scales).timestep_s
+    tc = p["solref_timeconst"] if p["solref_timeconst"] is not None else 2 * dt
+    overrides["solref"] = (tc, p["solref_dampratio"])
+    engine = sim.default_engine(scales, **overrides)
+    return sim.Rig(surface, tip=tip, engine=engine, length_scale_m=p["length_scale"])
+
+
+def _mujoco(case, surface, starts, upstream):
+    p = case.params
+    rig = _rig(case.surface, _rig_key(p, surface))
+    runs = _runs(rig, p, starts)
+    n = len(runs)
+    status = np.full(n, "ok", dtype=object)
+    reason = np.array([r.end_detail for r in runs], dtype=object)
+    for i, r in enumerate(runs):
+        if r.end_reason is sim.EndReason.ENGINE_TROUBLE:
+            warned = "warning" in r.end_detail or "reset" in r.end_detail
+            status[i] = "engine_warning" if warned else "diverged"
+    traj = _trajectories(runs, rig.length_scale_m, p["record_every"])
+    return AnalysisResult(
+        metrics=_metrics(rig, runs), trajectories=traj, status=status, reason=reason, data=(rig, runs)
+    )
+
+
+_RIG_KEYS = (
+    "mass",
+    "mu",
+    "preload",
+    "gravity",
+    "length_scale",
+    "timestep",
+    "integrator",
+    "cone",
+    "impratio",
+    "noslip_iterations",
+    "solref_timeconst",
+    "solref_dampratio",
+    "hfield_resolution",
+)
+
+
+def _rig_key(p: dict, surface) -> tuple:
+    """The parameters of a case that make its rig, as a hashable key of :func:`_rig`."""
+    unit_m = 1.0
+    if p["length_scale"] is not None:
+        unit_m = p["length_scale"]
+    elif surface.unit == "1":
+        unit_m = sim.DEFAULT_LENGTH_SCALE_M
+    tip_radius_m = p["tip_radius"] * unit_m if p["tip_radius"] > 0 else None
+    return tuple(sorted({"tip_radius_m": tip_radius_m, **{k: p[k] for k in _RIG_KEYS}}.items()))
+
+
+def _runs(rig, p: dict, starts) -> list:
+    """The runs of ``rig`` from every start with the case's drive (speed from ``ie`` unless
+    given; the ramp and static rates from the speed)."""
+    sc = rig.scales
+    speed = p["speed"]
+    if speed is None:
+        ie = 1e-3 if p["ie"] is None else p["ie"]
+        speed = (ie * sc.preload_n * sc.char_length_m / sc.mass_kg) ** 0.5
+    rate = speed * sc.preload_n / sc.char_length_m
+    det = sim.Detection(kappa_cap=p["kappa_cap"])
+    pts = [tuple(s) for s in starts]
+    if p["protocol"] == "spring":
+        drive = sim.SpringDrive(
+            speed_m_s=speed,
+            stiffness_n_m=p["stiffness"],
+            duration_s=p["duration"],
+            settle_time_s=p["settle_time"],
+        )
+        return rig.run_batch(drive, pts, detection=det, nthread=1)
+    if p["protocol"] == "static":
+        drive = sim.StaticProbe(rate_n_s=rate, start_force_n=p["start_force"], settle_time_s=p["settle_time"])
+        return rig.run_batch(drive, pts, detection=det, nthread=1)
+    drive = sim.RampDrive(
+        rate_n_s=rate,
+        duration_s=p["duration"],
+        settle_time_s=p["settle_time"],
+        slide_distance_m=p["slide_distance"],
+    )
+    return [rig.run(drive, start=s, detection=det) for s in pts]
+
+
+def peak_drive_over_fp(run, preload_n: float) -> float:
+    """Largest drive force after the settling phase over F_p (NaN for a run that never drove)."""
+    return (
+        run.drive_force_n[run.drive_start_index :].max() / preload_n
+        if run.n > run.drive_start_index
+        else np.nan
+    )
+
+
+def _metrics(rig, runs) -> dict[str, np.ndarray]:
+    """Per-run metrics; lengths in the surface's unit."""
+    s = rig.length_scale_m
+    sc = rig.scales
+    n = len(runs)
+    end = np.array([r.position_m[-1] for r in runs]) / s
+    path_len = (
+        np.array(
+            [
+                np.linalg.norm(np.diff(r.position_m[r.drive_start_index :, :2], axis=0), axis=1).sum()
+                for r in runs
+            ]
+        )
+        / s
+    )
+    return {
+        "end_reason": np.array([r.end_reason.value for r in runs], dtype=object),
+        "self_locked": np.array([r.end_reason is sim.EndReason.SELF_LOCK for r in runs]),
+        "end_x": end[:, 0],
+        "end_y": end[:, 1],
+        "end_z": end[:, 2],
+        "path_length": path_len,
+        "end_time_s": np.array([r.time_s[-1] for r in runs]),
+        "n_steps": np.array([r.n for r in runs], dtype=np.int64),
+        "inertia_number": np.array([r.inertia_number for r in runs]),
+        "speed_m_s": np.array([r.speed_m_s for r in runs]),
+        "max_drive_over_fp": np.array([peak_drive_over_fp(r, sc.preload_n) for r in runs]),
+        "n_slip_onsets": np.array(
+            [sum(e.kind == "slip_onset" for e in r.events) for r in runs], dtype=np.int64
+        ),
+        "max_penetration_m": np.array([r.penetration_m.max() for r in runs]),
+        "kappa_mj": np.array([r.kappa_mj for r in runs]),
+        "timestep_s": np.full(n, rig.engine.timestep_s),
+        "char_length": np.full(n, sc.char_length_m / s),
+        "tip_radius_m": np.full(n, rig.tip.tip_radius_m),
+    }
+
+
+def _trajectories(runs, s: float, k: int) -> dict[str, np.ndarray]:
+    """Long table of the runs' paths: every ``k``-th recorded step and the last one;
+    lengths in the surface's unit (metres over ``s``)."""
+    parts = []
+    for i, r in enumerate(runs):
+        # every k-th step and the last one (a slice, not a copy, when k is 1)
+        idx = np.arange(0, r.n, k, dtype=np.int64)
+        if r.n and idx[-1] != r.n - 1:
+            idx = np.append(idx, r.n - 1)
+        rows = slice(None) if k == 1 else idx
+        pos = r.position_m[rows]
+        parts.append(
+            {
+                "start": np.full(idx.size, i, np.int64),
+                "step": idx,
+                "time_s": r.time_s[rows],
+                "x": pos[:, 0] / s,
+                "y": pos[:, 1] / s,
+                "z": pos[:, 2] / s,
+                "drive_force_n": r.drive_force_n[rows],
+                "normal_force_n": r.normal_force_n[rows],
+                "tangential_force_n": r.tangential_force_n[rows],
+                "slipping": r.slipping[rows],
+                "contact": r.contact[rows],
+            }
+        )
+    return {c: np.concatenate([part[c] for part in parts]) for c in parts[0]}
+
+
+register_analysis(
+    Analysis(
+        "mujoco",
+        _mujoco,
+        MUJOCO_PARAMS,
+        doc="MuJoCo rig run from every start with the chosen drive: spine_mj.sim",
+        check_config=_check_speed,
+    )
+)

@@ -1,0 +1,79 @@
+"""The ``quasistatic`` analysis: a streamline (or ideal trajectory) from every start.
+
+Touches the API of :mod:`spine_mj.streamline` here only, so that a change there is a
+change here in one place.
+"""
+
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+
+from spine_mj import streamline as sl
+from spine_mj.sweep.registry import REQUIRED, Analysis, AnalysisResult, ParamSpec, register_analysis
+
+QUASISTATIC_PARAMS = (
+    ParamSpec("mu", "float", "static friction coefficient mu_s", REQUIRED, 0.0, exclusive=True),
+    ParamSpec("tip_radius", "float", "tip radius in the surface's length unit (0: a point)", 0.0, 0.0),
+    ParamSpec(
+        "dl",
+        "float",
+        "streamline step in the surface's length unit (default: 0.0015 times the smaller side of the domain)",
+        None,
+        0.0,
+        exclusive=True,
+    ),
+    ParamSpec("max_steps", "int", "step cap per streamline", 200_000, 1),
+    ParamSpec("trajectory", "str", "quasistatic path kind", "streamline", choices=("streamline", "ideal")),
+)
+
+
+@functools.lru_cache(maxsize=4)
+def _dilated(spec, radius: float):
+    return sl.dilate(spec.make(), radius)
+
+
+def _quasistatic(case, surface, starts, upstream):
+    p = case.params
+    if p["tip_radius"] > 0:
+        surface = _dilated(case.surface, p["tip_radius"])
+    xmin, xmax, ymin, ymax = surface.bounds
+    dl = p["dl"] if p["dl"] is not None else 0.0015 * min(xmax - xmin, ymax - ymin)
+    params = sl.StreamlineParams(mu=p["mu"], dl=dl, max_steps=p["max_steps"])
+    func = sl.streamlines if p["trajectory"] == "streamline" else sl.ideal_trajectories
+    res = func(surface, starts, params, store_paths=True)
+    names = np.array(["", *[o.name.lower() for o in sl.Outcome]], dtype=object)
+    metrics = {
+        "outcome": names[res.outcome],
+        "self_locked": res.outcome == sl.Outcome.SELF_LOCKED,
+        "end_x": res.end_x,
+        "end_y": res.end_y,
+        "end_z": res.end_z,
+        "n_steps": res.n_steps,
+        "path_length": res.n_steps * dl,
+        "max_kappa": res.max_kappa,
+        "dl_used": np.full(len(res), dl),
+    }
+    counts = np.diff(res.offsets)
+    start = np.repeat(np.arange(len(res)), counts)
+    traj = {
+        "start": start,
+        "step": np.arange(res.x.size) - np.repeat(res.offsets[:-1], counts),
+        "x": res.x,
+        "y": res.y,
+        "z": res.z,
+        "kappa": res.kappa,
+        "region": res.region.astype(np.int8),
+    }
+    return AnalysisResult(metrics=metrics, trajectories=traj, data=res)
+
+
+register_analysis(
+    Analysis(
+        "quasistatic",
+        _quasistatic,
+        QUASISTATIC_PARAMS,
+        doc="quasistatic streamline (or ideal trajectory) from every start: spine_mj.streamline",
+    )
+)

@@ -1,0 +1,127 @@
+"""Cases: one surface instance at one point of the grid, with all its starts.
+
+A case's id is a hash of its surface, starts and parameters, and its seed is derived from
+the master seed and that id, so a case gives the same numbers whatever the order or the
+machine it runs on. :func:`expand_cases` lists the cases of a config; :func:`longest_first`
+orders them for the workers by a rough cost (the order changes no result).
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from spine_mj.errors import SpineInputError
+from spine_mj.jsonio import to_jsonable
+from spine_mj.sweep.config import StartsSpec, SurfaceSpec, SweepConfig, digest
+
+
+@dataclass(frozen=True)
+class Case:
+    """One surface instance at one point of the grid, with all its starts.
+
+    Attributes
+    ----------
+    case_id : str
+        16 hex digits of the sha256 of ``surface``, ``starts`` and ``params``.
+    index : int
+        Position in the expansion (for ordering tables).
+    surface : SurfaceSpec
+    starts : StartsSpec
+    params : dict
+        Every parameter of the sweep's analyses (one value each).
+    seed : int
+        Derived from the master seed and ``case_id``: the only randomness of the case.
+    analyses : tuple of str
+    store_trajectories : bool
+    """
+
+    case_id: str
+    index: int
+    surface: SurfaceSpec
+    starts: StartsSpec
+    params: dict = field(hash=False)
+    seed: int = 0
+    analyses: tuple[str, ...] = ()
+    store_trajectories: bool = True
+
+
+def expand_cases(config: SweepConfig) -> list[Case]:
+    """The cases of ``config``: surfaces x grid (product of all parameter lists), in order.
+
+    Raises
+    ------
+    SpineInputError
+        When two cases have the same parameters.
+    """
+    names = [k for k, _ in config.grid]
+    combos = list(itertools.product(*(v for _, v in config.grid)))
+    cases, seen = [], set()
+    for si, surf in enumerate(config.surfaces):
+        starts = (
+            config.surface_starts[si]
+            if (si < len(config.surface_starts) and config.surface_starts[si] is not None)
+            else config.starts
+        )
+        for combo in combos:
+            params = dict(zip(names, combo))
+            case_id = _case_id(surf, starts, params)
+            if case_id in seen:
+                raise SpineInputError(
+                    f"config produces the same case twice (surface {surf.label}, parameters {params})"
+                )
+            seen.add(case_id)
+            cases.append(
+                Case(
+                    case_id=case_id,
+                    index=len(cases),
+                    surface=surf,
+                    starts=starts,
+                    params=params,
+                    seed=case_seed(config.seed, case_id),
+                    analyses=config.analyses,
+                    store_trajectories=config.store_trajectories,
+                )
+            )
+    return cases
+
+
+def _case_id(surface: SurfaceSpec, starts: StartsSpec, params: dict) -> str:
+    """16 hex digits of the sha256 of the case's surface, starts and parameters."""
+    return digest(
+        {
+            "surface": surface.as_dict(),
+            "starts": starts.as_dict(),
+            "params": {k: to_jsonable(v) for k, v in params.items()},
+        }
+    )[:16]
+
+
+def case_seed(master_seed: int, case_id: str) -> int:
+    """The seed of a case: from a SeedSequence of the master seed and the case id (63 bits)."""
+    return int(
+        np.random.SeedSequence([master_seed, int(case_id, 16)]).generate_state(1, np.uint64)[0]
+        >> np.uint64(1)
+    )
+
+
+def case_cost(case: Case) -> float:
+    """A rough relative cost of a case, to start the longest cases first (the order of the
+    cases changes no result). MuJoCo spring runs last ~ 1 / speed ~ I_e^-1/2."""
+    p = case.params
+    cost = 1.0
+    if "mujoco" in case.analyses and p.get("protocol", "spring") == "spring":
+        if p.get("duration") is not None:
+            cost = float(p["duration"])
+        elif p.get("speed") is not None:
+            cost = 1.0 / float(p["speed"])
+        else:
+            cost = (1e-3 if p.get("ie") is None else float(p["ie"])) ** -0.5
+    return cost * case.starts.count
+
+
+def longest_first(todo: list[Case]) -> list[Case]:
+    """``todo`` by decreasing :func:`case_cost`."""
+    return sorted(todo, key=lambda c: -case_cost(c))  # stable: ties keep the config order

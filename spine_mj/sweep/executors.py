@@ -1,0 +1,137 @@
+"""Where the cases of a sweep run: in this process, in local worker processes, or on Dask.
+
+Every backend takes the cases to run and a ``handle`` callback, and calls it in this
+process with each finished case encoded as Parquet bytes (:func:`spine_mj.sweep.store.
+encode_case`); the caller writes the store, so workers never touch it. Workers receive
+:class:`~spine_mj.sweep.cases.Case` objects and :func:`encoded_case` by qualified name
+(pickled), so these must stay importable module-level names.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures as cf
+import importlib
+import multiprocessing
+import os
+import threading
+import time
+
+from distributed import Client, as_completed
+
+from spine_mj.sweep.cases import Case
+from spine_mj.sweep.runner import run_case
+from spine_mj.sweep.store import encode_case
+
+
+def encoded_case(case: Case) -> tuple:
+    """Run ``case`` and encode its rows and paths for the store (what a worker sends back)."""
+    return encode_case(case.case_id, *run_case(case))
+
+
+def run_here(todo: list[Case], handle) -> None:
+    """One worker: the cases run in this process, in order; each case's store files are
+    encoded and written on a helper thread while the next case runs (pyarrow releases the
+    GIL), and handled here in order as they complete."""
+    with cf.ThreadPoolExecutor(max_workers=1) as writer:
+        pending = None
+        for case in todo:
+            rows, traj = run_case(case)
+            if pending is not None:
+                handle(pending.result())
+            pending = writer.submit(encode_case, case.case_id, rows, traj)
+        if pending is not None:
+            handle(pending.result())
+
+
+def run_processes(todo: list[Case], n_workers: int, handle) -> None:
+    """``n_workers`` local worker processes, taking the cases in the order of ``todo``."""
+    # one BLAS thread per worker process (idle BLAS threads spinning in every worker cost a
+    # third of the throughput on 2 cores); the worker server reads these when it starts
+    saved = {k: os.environ.get(k) for k in _ONE_THREAD}
+    for k in _ONE_THREAD:
+        os.environ.setdefault(k, "1")
+    try:
+        _run_pool(todo, n_workers, handle)
+    finally:
+        for k, v in saved.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
+
+
+_ONE_THREAD = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
+
+
+def _run_pool(todo: list[Case], n_workers: int, handle) -> None:
+    if threading.active_count() == 1 and "fork" in multiprocessing.get_all_start_methods():
+        # a single-threaded process forks safely, and its workers inherit every module it
+        # has imported: no second start-up (about 1 s of imports on one core per pool)
+        _preload_worker_modules()
+        ctx = multiprocessing.get_context("fork")
+    else:
+        # with other threads alive a fork could copy a held lock: workers fork instead from
+        # a server that has imported these once
+        ctx = multiprocessing.get_context("forkserver")
+        ctx.set_forkserver_preload(list(_WORKER_MODULES))
+    started = ctx.SimpleQueue()
+    with cf.ProcessPoolExecutor(
+        max_workers=n_workers, mp_context=ctx, initializer=_worker_started, initargs=(started,)
+    ) as pool:
+        futures = [pool.submit(encoded_case, c) for c in todo]
+        try:
+            # until the first worker is up (a fresh forkserver imports mujoco, numba,
+            # pyarrow... on one core first), this process runs the shortest pending cases
+            # itself; a case is taken only if its future could be cancelled: never twice
+            for case, fut in zip(reversed(todo), reversed(futures)):
+                if not started.empty() or not fut.cancel():
+                    break
+                handle(encoded_case(case))
+            for fut in cf.as_completed([f for f in futures if not f.cancelled()]):
+                handle(fut.result())
+        except BaseException:
+            for f in futures:
+                f.cancel()
+            raise
+
+
+#: What a worker imports before its first case (pandas: pyarrow imports it when it builds a
+#: table; mujoco: spine_mj.sim imports it lazily).
+_WORKER_MODULES = (
+    "spine_mj.sweep",
+    "spine_mj.streamline",
+    "spine_mj.sim",
+    "pyarrow.parquet",
+    "pandas",
+    "mujoco",
+    "mujoco.rollout",
+)
+
+
+def _preload_worker_modules() -> None:
+    for name in _WORKER_MODULES:
+        importlib.import_module(name)
+
+
+def _worker_started(queue) -> None:
+    queue.put(os.getpid())
+
+
+def run_dask(todo: list[Case], scheduler, handle) -> None:
+    """The workers of a Dask scheduler (an address, or a connected ``distributed.Client``)."""
+    own = not isinstance(scheduler, Client)
+    client = Client(scheduler) if own else scheduler
+    try:
+        futures = client.map(
+            encoded_case,
+            todo,
+            pure=False,
+            key=[f"spine-mj-case-{c.case_id}-{os.getpid()}-{time.monotonic_ns()}" for c in todo],
+        )
+        for fut in as_completed(futures):
+            result = fut.result()
+            fut.release()
+            handle(result)
+    finally:
+        if own:
+            client.close()

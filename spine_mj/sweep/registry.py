@@ -1,0 +1,171 @@
+"""The analysis registry: what an analysis is, the parameters it reads, what it returns.
+
+An analysis declares its sweepable parameters (:class:`ParamSpec`), the analyses it needs
+first and, optionally, a whole-config check; :func:`register_analysis` adds it to
+:data:`ANALYSES`, whose order is the run order. The config parser reads the schema of a
+sweep from here, so every parameter is declared once, next to the analysis that reads it.
+This module imports nothing else from :mod:`spine_mj.sweep`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from spine_mj.errors import SpineInputError
+
+#: Row statuses. ``ok``; ``failed`` (an exception in the analysis); ``bad_surface`` (the
+#: surface could not be made or loaded); ``diverged`` and ``engine_warning`` (MuJoCo);
+#: ``dependency_failed`` (an analysis this one needs did not give a result for the start).
+STATUSES = ("ok", "failed", "bad_surface", "diverged", "engine_warning", "dependency_failed")
+
+
+#: Columns of the run table that every run has; no parameter or metric may take these names.
+RESERVED = (
+    "run_id",
+    "case_id",
+    "case_index",
+    "analysis",
+    "start",
+    "start_x",
+    "start_y",
+    "surface",
+    "surface_seed",
+    "seed",
+    "status",
+    "reason",
+    "time_s",
+    "cpu_s",
+)
+
+
+@dataclass(frozen=True)
+class ParamSpec:
+    """A sweepable parameter that an analysis reads from ``case.params``.
+
+    Attributes
+    ----------
+    name : str
+    kind : {"float", "int", "str", "bool"}
+    doc : str
+        One line: meaning and unit.
+    default : Any
+        Used when the config does not set it; ``REQUIRED`` makes the key mandatory.
+    minimum : float, optional
+        Lower bound (inclusive unless ``exclusive``).
+    exclusive : bool
+    choices : tuple of str, optional
+        Allowed values of a ``str`` parameter.
+    drive : bool
+        May also be given in the ``[drive]`` table.
+    """
+
+    name: str
+    kind: str
+    doc: str
+    default: Any = None
+    minimum: float | None = None
+    exclusive: bool = False
+    choices: tuple[str, ...] | None = None
+    drive: bool = False
+
+    def expected(self) -> str:
+        if self.choices:
+            return "one of " + ", ".join(repr(c) for c in self.choices)
+        what = {"float": "a finite number", "int": "an integer", "str": "a string", "bool": "true or false"}[
+            self.kind
+        ]
+        if self.minimum is not None:
+            what += f" {'>' if self.exclusive else '>='} {self.minimum:g}"
+        return what
+
+    def check(self, value, key: str):
+        """``value`` converted to the parameter's type, or SpineInputError naming ``key``."""
+        ok = False
+        if self.kind == "float":
+            ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+            value = float(value) if ok else value
+        elif self.kind == "int":
+            ok = isinstance(value, int) and not isinstance(value, bool)
+        elif self.kind == "str":
+            ok = isinstance(value, str) and (not self.choices or value in self.choices)
+        elif self.kind == "bool":
+            ok = isinstance(value, bool)
+        if ok and self.minimum is not None:
+            ok = value > self.minimum if self.exclusive else value >= self.minimum
+        if not ok:
+            raise SpineInputError(
+                f"config key {key}: must be {self.expected()} (or a list of them), got {value!r}"
+            )
+        return value
+
+
+#: ``ParamSpec.default`` of a parameter that every config must set.
+REQUIRED = object()
+
+
+@dataclass(frozen=True, eq=False)
+class AnalysisResult:
+    """What one analysis gives for one case.
+
+    Attributes
+    ----------
+    metrics : dict of str to ndarray, each shape (n_starts,)
+        Scalars per start (floats, ints or bools); stored as columns of the run table.
+    trajectories : dict of str to ndarray, each shape (n_points,), optional
+        Long table of paths; must contain ``start`` (int) and ``step`` (int).
+    status, reason : ndarray of str, shape (n_starts,), optional
+        Per-start status (see :data:`STATUSES`) and reason; None means all ``ok``.
+    data : Any
+        In-memory result for the analyses that depend on this one (not stored).
+    """
+
+    metrics: dict[str, np.ndarray]
+    trajectories: dict[str, np.ndarray] | None = None
+    status: np.ndarray | None = None
+    reason: np.ndarray | None = None
+    data: Any = None
+
+
+@dataclass(frozen=True)
+class Analysis:
+    """A named analysis: ``func(case, surface, starts, upstream) -> AnalysisResult``.
+
+    ``starts`` is ``(n_starts, 2)`` in the surface's length unit; ``upstream`` maps the
+    names in ``requires`` to their results for the same case. ``check_config``, if given,
+    is called with every validated config that chooses this analysis and raises
+    SpineInputError for a combination of values its parameters cannot check one by one.
+    """
+
+    name: str
+    func: Callable[..., AnalysisResult]
+    parameters: tuple[ParamSpec, ...]
+    requires: tuple[str, ...] = ()
+    doc: str = ""
+    check_config: Callable[[Any], None] | None = None
+
+
+#: Registry of analyses by name; :func:`register_analysis` adds to it.
+ANALYSES: dict[str, Analysis] = {}
+
+
+def register_analysis(analysis: Analysis) -> Analysis:
+    """Add ``analysis`` to :data:`ANALYSES` (replacing one of the same name)."""
+    for spec in analysis.parameters:
+        if spec.name in RESERVED:
+            raise SpineInputError(f"parameter name {spec.name!r} is reserved for the run table")
+    ANALYSES[analysis.name] = analysis
+    return analysis
+
+
+def param_specs(analyses: tuple[str, ...]) -> dict[str, ParamSpec]:
+    """The parameters of ``analyses`` by name (the first declaration of a shared name wins)."""
+    specs: dict[str, ParamSpec] = {}
+    for name in analyses:
+        for spec in ANALYSES[name].parameters:
+            specs.setdefault(spec.name, spec)
+    return specs

@@ -1,0 +1,59 @@
+"""The built-in analyses: the mujoco and compare rows are the rig's own runs."""
+
+import numpy as np
+import pytest
+from sweep_support import write_config
+
+from spine_mj import sweep
+
+MJ = """
+[sweep]
+name = "mujoco"
+analyses = ["quasistatic", "mujoco", "compare"]
+[[surfaces]]
+preset = "paper-single-peak"
+[starts]
+frame = "absolute"
+points = [[-4.0, 0.0], [-4.0, 1.0]]
+[drive]
+protocol = "spring"
+ie = [0.01, 0.1]
+[grid]
+mu = 1.25
+dl = 0.02
+"""
+
+
+def test_mujoco_and_compare_runs_match_the_rig_run_directly(tmp_path):
+    from spine_mj import presets, sim
+
+    cfg = write_config(tmp_path, MJ)
+    out = tmp_path / "out"
+    summary = sweep.run_sweep(cfg, out, workers=1)
+    assert summary.total_runs == 12
+    runs = sweep.load_runs(out)
+    mj = runs[runs.analysis == "mujoco"]
+    assert mj.status.isin(["ok", "diverged", "engine_warning"]).all()
+    np.testing.assert_allclose(mj.inertia_number, mj.ie, rtol=1e-9)
+    # the start on the peak's ridge self-locks quasistatically; compare's outcome agreement
+    # is that of the two rows it compares
+    qs = runs[runs.analysis == "quasistatic"].set_index(["case_id", "start"])
+    assert qs.self_locked.xs(0, level="start").astype(bool).all()
+    mjs = mj.set_index(["case_id", "start"])
+    cmp_ = runs[runs.analysis == "compare"].set_index(["case_id", "start"])
+    expected = qs.self_locked.astype(bool) == mjs.self_locked.astype(bool)
+    assert (cmp_.agree_lock.astype(bool) == expected.loc[cmp_.index]).all()
+    assert (cmp_.status == np.where(mjs.status.loc[cmp_.index] == "ok", "ok", "dependency_failed")).all()
+    ran = mjs.status.loc[cmp_.index] == "ok"
+    assert cmp_.frechet[ran].notna().all() and (cmp_.frechet[ran] >= 0).all()
+    # the stored run is the rig's own run at that speed
+    case_id = mj.case_id[mj.ie == 0.01].iloc[0]
+    rig = sim.Rig(presets.make_surface("paper-single-peak"), tip=sim.TipParams(mu_s=1.25))
+    sc = rig.scales
+    speed = (0.01 * sc.preload_n * sc.char_length_m / sc.mass_kg) ** 0.5
+    direct = rig.run_batch(sim.SpringDrive(speed_m_s=speed), [(-4.0, 1.0)], nthread=1)[0]
+    row = mj[(mj.case_id == case_id) & (mj.start == 1)].iloc[0]
+    assert row.end_x == pytest.approx(direct.position_m[-1, 0] / rig.length_scale_m, abs=1e-12)
+    traj = sweep.load_trajectories(out, case_id, analysis="mujoco", start=1, columns=["x"])
+    assert len(traj) == direct.n
+    np.testing.assert_allclose(traj.x, direct.position_m[:, 0] / rig.length_scale_m)

@@ -1,0 +1,55 @@
+"""Cases: grid expansion, case ids and seeds, relative and random starts."""
+
+import json
+
+import numpy as np
+import pytest
+from sweep_support import with_
+
+from spine_mj import sweep
+
+
+def test_grid_expansion_counts_ids_and_seeds():
+    doc = with_(
+        grid__mu=[0.5, 1.0, 1.5],
+        grid__trajectory=["streamline", "ideal"],
+        grid__tip_radius={"logspace": [0.01, 1.0], "num": 3},
+    )
+    doc["surfaces"] = [
+        {"preset": "paper-single-peak"},
+        {"preset": "paper-random-convex", "seeds": [3, 4]},
+        {"preset": "paper-random-concave", "n_seeds": 2},
+    ]
+    config = sweep.parse_config(doc)
+    cases = sweep.expand_cases(config)
+    assert len(cases) == 5 * 3 * 2 * 3
+    assert set(config.swept) == {"mu", "trajectory", "tip_radius"}
+    assert dict(config.grid)["tip_radius"] == pytest.approx((0.01, 0.1, 1.0))
+    assert len({c.case_id for c in cases}) == len(cases)
+    assert len({c.seed for c in cases}) == len(cases)
+    assert [c.index for c in cases] == list(range(len(cases)))
+    labels = sorted({c.surface.label for c in cases})
+    assert "paper-random-convex#3" in labels and "paper-single-peak" in labels
+    # ids are a function of the parameters only: same after re-parsing, a changed master
+    # seed changes the case seeds (and the derived surface seeds) but not explicit ids
+    again = sweep.expand_cases(sweep.parse_config(json.loads(json.dumps(doc))))
+    assert [c.case_id for c in again] == [c.case_id for c in cases]
+    assert [c.seed for c in again] == [c.seed for c in cases]
+    doc["sweep"]["seed"] = 7
+    other = sweep.expand_cases(sweep.parse_config(doc))
+    explicit = [c for c in cases if c.surface.source != "paper-random-concave"]
+    assert {c.case_id for c in explicit} <= {c.case_id for c in other}
+    assert not {c.seed for c in cases} & {c.seed for c in other}
+    assert sweep.parse_config(doc).hash != config.hash
+
+
+def test_relative_and_random_starts():
+    doc = with_(starts={"random": 4})
+    case = sweep.expand_cases(sweep.parse_config(doc))[0]
+    bounds = case.surface.make().bounds
+    pts = case.starts.resolve(bounds, case.seed)
+    assert pts.shape == (4, 2)
+    assert np.all((pts[:, 0] >= bounds[0]) & (pts[:, 0] <= bounds[1]))
+    np.testing.assert_array_equal(pts, case.starts.resolve(bounds, case.seed))
+    rel = sweep.StartsSpec(frame="relative", points=((0.0, 1.0), (0.5, 0.5)))
+    np.testing.assert_allclose(rel.resolve((-5, 5, -2, 2), 0), [[-5, 2], [0, 0]])

@@ -1,0 +1,73 @@
+"""The sweep, sweep status and report commands."""
+
+import subprocess
+import sys
+
+import pytest
+from click.testing import CliRunner
+from sweep_support import PEAK_QS, peak_config, write_config
+
+from spine_mj.cli import main
+
+
+def run_cli(*args):
+    return CliRunner().invoke(main, [str(a) for a in args])
+
+
+def test_cli_sweep_status_report(tmp_path):
+    cfg = peak_config(tmp_path, nmu=3, ny=2)
+    out = tmp_path / "out"
+    result = run_cli("sweep", cfg, "--out", out, "--workers", 1)
+    assert result.exit_code == 0, result.output
+    assert "done 6, failed 0, skipped 0" in result.output
+    result = run_cli("sweep", cfg, "--out", out, "--workers", 1, "--quiet")
+    assert "done 0, failed 0, skipped 6" in result.output
+    result = run_cli("sweep", "status", out)
+    assert result.exit_code == 0 and "cases 3/3, runs 6/6 - complete" in result.output
+    result = run_cli("report", out, "-o", tmp_path / "r.html")
+    assert result.exit_code == 0, result.output
+    html = (tmp_path / "r.html").read_text()
+    assert "data:image/png;base64," in html and "max_kappa" in html
+    for args in (
+        ["sweep", "--help"],
+        ["sweep", "status", "--help"],
+        ["sweep", cfg, "--help"],
+        ["report", "--help"],
+    ):
+        result = run_cli(*args)
+        assert result.exit_code == 0 and "Usage" in result.output
+
+
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        (
+            PEAK_QS.format(name="x", nmu=2, ny=2, dl=0.02).replace("mu =", "mu_s ="),
+            "Error: config key grid.mu_s: unknown parameter",
+        ),
+        ("[sweep\n", "is not valid TOML"),
+        (PEAK_QS.format(name="x", nmu=2, ny=2, dl=-1), "Error: config key grid.dl: must be"),
+    ],
+)
+def test_cli_bad_config_exits_2_with_one_line_and_writes_nothing(tmp_path, text, message):
+    cfg = write_config(tmp_path, text)
+    proc = subprocess.run(
+        [sys.executable, "-m", "spine_mj.cli", "sweep", str(cfg), "--out", str(tmp_path / "out")],
+        capture_output=True,
+        text=True,
+    )
+    assert proc.returncode == 2
+    assert len(proc.stderr.strip().splitlines()) == 1 and message in proc.stderr
+    assert not (tmp_path / "out").exists()
+
+
+def test_cli_refuses_another_config_in_dir(tmp_path):
+    out = tmp_path / "out"
+    assert (
+        run_cli("sweep", peak_config(tmp_path, nmu=2), "--out", out, "--workers", 1, "--quiet").exit_code == 0
+    )
+    other = peak_config(tmp_path, nmu=3, name="other")
+    result = run_cli("sweep", other, "--out", out, "--workers", 1)
+    assert result.exit_code == 2 and "holds a sweep of another config" in result.output
+    assert run_cli("sweep", other, "--out", out, "--workers", 1, "--overwrite", "--quiet").exit_code == 0
+    assert run_cli("sweep", "status", tmp_path / "nowhere").exit_code == 2

@@ -1,0 +1,85 @@
+"""Sweep configs: validation errors name the key, the allowed values and what arrived;
+the config hash ignores comments and key order; the analyses' own config checks."""
+
+import pytest
+from sweep_support import peak_config, with_, write_config
+
+from spine_mj import sweep
+from spine_mj.errors import SpineInputError
+
+
+@pytest.mark.parametrize(
+    "doc, match",
+    [
+        (with_(extra=1), r"config key extra: unknown; allowed keys: sweep, surfaces"),
+        (
+            with_(sweep__analyses=["quasistatic", "nope"]),
+            r"sweep.analyses: allowed values are .*'quasistatic'.*, got 'nope'",
+        ),
+        (with_(sweep__analyses=["compare"]), r"sweep.analyses: 'compare' needs"),
+        (with_(sweep__seed=-1), r"sweep.seed: must be a non-negative integer, got -1"),
+        (with_(grid__mu=-0.5), r"grid.mu: must be a finite number > 0 .*got -0.5"),
+        (with_(grid__mu=None), r"grid.mu: required by analyses \['quasistatic'\]"),
+        (with_(grid__mu=[0.5, 0.5]), r"grid.mu: repeated value"),
+        (with_(grid__speed=1.0), r"grid.speed: unknown parameter .*allowed: .*mu"),
+        (with_(grid__trajectory="curvy"), r"grid.trajectory: must be one of 'streamline', 'ideal'"),
+        (with_(grid__max_steps=1.5), r"grid.max_steps: must be an integer >= 1"),
+        (with_(grid__mu={"logspace": [0, 1], "num": 3}), r"grid.mu.logspace: end values must be > 0"),
+        (with_(grid__mu={"linspace": [0.1, 1]}), r"grid.mu: a table must be \{linspace"),
+        (with_(surfaces=[]), r"config key surfaces: must be a non-empty array"),
+        (with_(surfaces__0__preset="nope"), r"surfaces\[0\].preset: allowed values are .*got 'nope'"),
+        (with_(surfaces__0__seeds=[1, 2]), r"surfaces\[0\]: 'paper-single-peak' takes no seed"),
+        (with_(surfaces__0__file="x.npz"), r"surfaces\[0\]: give exactly one of preset or file"),
+        (with_(surfaces__0__set={"nope": 1}), r"unknown parameter\(s\) \['nope'\]"),
+        (with_(starts=None), r"config key starts: required"),
+        (with_(starts__points=[[1.5, 0.5]]), r"starts.points: coordinates must be numbers in \[0, 1\]"),
+        (with_(starts__x=[0.5]), r"config key starts: give exactly one of points, x and y, or random"),
+        (with_(starts__frame="polar"), r"starts.frame: allowed values are 'relative', 'absolute'"),
+    ],
+)
+def test_config_errors_name_key_allowed_values_and_what_arrived(doc, match):
+    with pytest.raises(SpineInputError, match=match):
+        sweep.parse_config(doc)
+
+
+def test_config_file_errors(tmp_path):
+    with pytest.raises(SpineInputError, match="config file not found"):
+        sweep.load_config(tmp_path / "missing.toml")
+    bad = write_config(tmp_path, "[sweep\nname=1")
+    with pytest.raises(SpineInputError, match="is not valid TOML"):
+        sweep.load_config(bad)
+    missing_file = write_config(
+        tmp_path,
+        """
+        [[surfaces]]
+        file = "nowhere.npz"
+        [starts]
+        points = [[0.5, 0.5]]
+        [grid]
+        mu = 0.5
+    """,
+    )
+    with pytest.raises(SpineInputError, match=r"surfaces\[0\].file: no such file"):
+        sweep.load_config(missing_file)
+
+
+def test_config_hash_ignores_comments_and_key_order(tmp_path):
+    a = peak_config(tmp_path, name="h")
+    b = write_config(
+        tmp_path,
+        "# a comment\n" + a.read_text().replace("[grid]\nmu", "[grid]\n# another\nmu"),
+        name="b.toml",
+    )
+    assert sweep.load_config(a).hash == sweep.load_config(b).hash
+
+
+def test_mujoco_config_checks():
+    doc = with_(sweep__analyses=["mujoco"], grid__ie=0.1, grid__speed=0.01)
+    with pytest.raises(SpineInputError, match=r"grid.ie and grid.speed: give one of them"):
+        sweep.parse_config(doc)
+    doc = with_(sweep__analyses=["mujoco"], drive__protocol="pull")
+    with pytest.raises(SpineInputError, match=r"drive.protocol: must be one of 'spring', 'ramp'"):
+        sweep.parse_config(doc)
+    doc = with_(sweep__analyses=["quasistatic"], drive__protocol="spring")
+    with pytest.raises(SpineInputError, match=r"drive.protocol: unknown drive parameter"):
+        sweep.parse_config(doc)
