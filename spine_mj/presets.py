@@ -38,6 +38,7 @@ else:  # pragma: no cover
 __all__ = [
     "GENERATORS",
     "Preset",
+    "check_generator_params",
     "list_presets",
     "load_preset",
     "make_surface",
@@ -117,7 +118,7 @@ def load_preset(name: str) -> Preset:
     if seed is not None and (not isinstance(seed, int) or isinstance(seed, bool) or seed < 0):
         raise SpineInputError(f"preset {path.name}: seed must be a non-negative integer, got {seed!r}")
     description = str(doc.pop("description", ""))
-    _check_params(generator, params, f"preset {path.name}")
+    check_generator_params(generator, params, f"preset {path.name}")
     return Preset(
         name=path.stem, generator=generator, params=params, description=description, seed=seed, extras=doc
     )
@@ -142,7 +143,8 @@ def preset_mu(preset: Preset | str | surfaces.Surface | None) -> float | None:
     return None if value is None else float(value)
 
 
-def _check_params(generator: str, params: dict, where: str) -> None:
+def check_generator_params(generator: str, params: dict, where: str) -> None:
+    """Refuse parameters that ``generator`` does not take, naming them, ``where`` and the allowed ones."""
     allowed = [p for p in inspect.signature(GENERATORS[generator]).parameters if p != "rng"]
     if generator == "measured":
         allowed = ["file", "channel", "fill", "level", "spacing_m"]
@@ -179,7 +181,7 @@ def make_surface(preset: Preset | str, **overrides) -> surfaces.Surface:
     overrides = dict(overrides)
     seed = overrides.pop("seed", preset.seed)
     params = dict(preset.params, **overrides)
-    _check_params(preset.generator, params, f"preset {preset.name}")
+    check_generator_params(preset.generator, params, f"preset {preset.name}")
     func = GENERATORS[preset.generator]
     takes_rng = "rng" in inspect.signature(func).parameters
     if seed is not None and not takes_rng:

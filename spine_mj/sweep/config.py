@@ -334,7 +334,7 @@ def _surface_source(entry: dict, key: str, overrides: dict, base_dir: Path) -> t
             )
         preset = presets.load_preset(preset_name)
         try:
-            presets._check_params(preset.generator, overrides, f"config key {key}.set")
+            presets.check_generator_params(preset.generator, overrides, f"config key {key}.set")
         except SpineInputError as exc:
             raise SpineInputError(str(exc)) from None
         takes_seed = "rng" in inspect.signature(presets.GENERATORS[preset.generator]).parameters
