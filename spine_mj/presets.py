@@ -38,6 +38,7 @@ else:  # pragma: no cover
 __all__ = [
     "GENERATORS",
     "Preset",
+    "calibrated_mu",
     "check_generator_params",
     "list_presets",
     "load_preset",
@@ -141,6 +142,21 @@ def preset_mu(preset: Preset | str | surfaces.Surface | None) -> float | None:
     engagement = preset.extras.get("engagement", {})
     value = engagement.get("mu") if isinstance(engagement, dict) else None
     return None if value is None else float(value)
+
+
+def calibrated_mu(preset: Preset | str) -> float:
+    """:func:`preset_mu` for code that needs one (validation, the paper's reproductions).
+
+    Raises
+    ------
+    SpineInputError
+        The preset has no ``[engagement] mu``.
+    """
+    mu = preset_mu(preset)
+    if mu is None:
+        name = preset if isinstance(preset, str) else preset.name
+        raise SpineInputError(f"preset {name!r} has no [engagement] mu; a calibrated mu_s is needed here")
+    return mu
 
 
 def check_generator_params(generator: str, params: dict, where: str) -> None:

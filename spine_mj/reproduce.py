@@ -25,7 +25,7 @@ from spine_mj.plotting import (
     random_gaussian_figure,
     single_peak_figure,
 )
-from spine_mj.presets import load_preset
+from spine_mj.presets import calibrated_mu, load_preset
 from spine_mj.streamline import Outcome, StreamlineParams, ideal_trajectories, streamlines
 from spine_mj.surfaces import GaussianSurface, fractal_fbm, random_gaussians, single_gaussian
 
@@ -43,9 +43,10 @@ Progress = Callable[[int, int], None] | None
 FIVE_Y0 = (-0.5, -1.0, -2.0, -3.0, -4.0)
 
 
-def _settings(preset: str) -> tuple[dict, dict, object]:
+def _settings(preset: str) -> tuple[float, dict, object]:
+    """The preset's calibrated mu_s, its ``[reproduce]`` table and the preset itself."""
     p = load_preset(preset)
-    return dict(p.extras.get("engagement", {})), dict(p.extras.get("reproduce", {})), p
+    return calibrated_mu(p), dict(p.extras.get("reproduce", {})), p
 
 
 def _outcome_name(code: int) -> str:
@@ -80,8 +81,8 @@ def single_peak(
     Returns numbers with keys ``mu``, ``convex_ratio``, ``concave_ratio`` (fractions;
     paper 0.833 and 5.667), the ranges, and per-start outcomes and max kappa.
     """
-    eng, rep, _ = _settings("paper-single-peak")
-    mu = float(mu if mu is not None else eng["mu"])
+    preset_mu_s, rep, _ = _settings("paper-single-peak")
+    mu = float(mu if mu is not None else preset_mu_s)
     dl = float(dl if dl is not None else rep.get("dl", 0.015))
     y0_step = float(y0_step if y0_step is not None else rep.get("y0_step", 0.01))
     lo, hi = (float(v) for v in (y0_range if y0_range is not None else rep.get("y0_range", (-5.0, 5.0))))
@@ -143,8 +144,8 @@ def kappa_map(
 ):
     """Fig. 2B: kappa over the single convex peak and concave valley (slip blank, self-lock
     marked). Numbers: area fractions of the regions and the kappa range."""
-    eng, _, _ = _settings("paper-single-peak")
-    mu = float(mu if mu is not None else eng["mu"])
+    preset_mu_s, _, _ = _settings("paper-single-peak")
+    mu = float(mu if mu is not None else preset_mu_s)
     n = int(n if n is not None else (101 if quick else 301))
     xs = np.linspace(-5, 5, n)
     numbers = {"mu": mu, "n": n}
@@ -281,8 +282,8 @@ def _random_family(
 ) -> tuple[dict, tuple[np.ndarray, np.ndarray]]:
     """One family of :func:`random_gaussian`: its numbers (keys without the family
     prefix) and the (ideal, streamline) max-kappa scatter."""
-    eng, rep, pre = _settings(preset)
-    m = float(mu if mu is not None else eng["mu"])
+    preset_mu_s, rep, pre = _settings(preset)
+    m = float(mu if mu is not None else preset_mu_s)
     runs = int(n_runs if n_runs is not None else rep.get("n_runs", 100))
     mode = str(starts if starts is not None else rep.get("starts", "surfaces"))
     cap = kappa_cap if kappa_cap is not None else rep.get("kappa_cap")
@@ -413,8 +414,8 @@ def fractal_hurst(
     earlier. ``trajectory``: ``"streamline"`` (the paper's Fig. 9) or ``"ideal"`` (the
     same statistics for ideal trajectories, for comparison).
     """
-    eng, rep, pre = _settings("paper-fractal")
-    mu = float(mu if mu is not None else eng["mu"])
+    preset_mu_s, rep, pre = _settings("paper-fractal")
+    mu = float(mu if mu is not None else preset_mu_s)
     hursts = list(
         hursts if hursts is not None else rep.get("hursts", [0.65, 0.7, 0.75, 0.8, 0.85, 0.9, 0.95])
     )

@@ -32,6 +32,7 @@ path metrics), :mod:`~spine_mj.validate.ie_star`, :mod:`~spine_mj.validate.ramp_
 module per study, :mod:`~spine_mj.validate.report` and :mod:`~spine_mj.validate.run`.
 """
 
+from spine_mj.presets import calibrated_mu
 from spine_mj.validate.boundary import BoundaryCurve, BoundaryResult, boundary
 from spine_mj.validate.ie_star import (
     DEPARTURE,
@@ -69,7 +70,6 @@ from spine_mj.validate.runner import StudyRunner, ValidationProgress
 from spine_mj.validate.sandpaper import SandpaperResult, sandpaper
 from spine_mj.validate.static_map import PLANE_START, StaticMapResult, static_map
 from spine_mj.validate.stick_slip import SlipStats, StickSlipResult, slip_statistics, stick_slip
-from spine_mj.validate.sweep_docs import calibrated_mu
 
 __all__ = [
     "DEPARTURE",

@@ -14,6 +14,7 @@ import numpy as np
 import pandas as pd
 
 from spine_mj import compare, presets
+from spine_mj.presets import calibrated_mu
 from spine_mj.validate.paths import (
     mujoco_traces,
     path_metrics,
@@ -23,7 +24,7 @@ from spine_mj.validate.paths import (
 )
 from spine_mj.validate.plans import FRECHET_TARGET, OUTCOME_TARGET, RECOMMENDED, FamilySpec, ValidationPlan
 from spine_mj.validate.runner import StudyRunner
-from spine_mj.validate.sweep_docs import calibrated_mu, engine_grid, family_doc
+from spine_mj.validate.sweep_docs import engine_grid, family_doc
 
 __all__ = ["LimitPath", "QuasistaticLimitResult", "quasistatic_limit"]
 

@@ -10,10 +10,11 @@ import numpy as np
 
 from spine_mj import presets, sim
 from spine_mj.errors import SpineInputError
+from spine_mj.presets import calibrated_mu
 from spine_mj.validate.paths import mujoco_traces, tip_radius
 from spine_mj.validate.plans import GRAVITY, MASS_KG, FamilySpec, ValidationPlan, relative_starts
 from spine_mj.validate.runner import StudyRunner
-from spine_mj.validate.sweep_docs import calibrated_mu, family_doc
+from spine_mj.validate.sweep_docs import family_doc
 
 __all__ = ["SlipStats", "StickSlipResult", "slip_statistics", "stick_slip"]
 

@@ -11,24 +11,9 @@ from collections.abc import Sequence
 from typing import Any
 
 from spine_mj import presets, sim, sweep
-from spine_mj.errors import SpineInputError
 from spine_mj.validate.plans import MASS_KG, FamilySpec, ValidationPlan
 
-__all__ = ["calibrated_mu", "engine_default", "engine_grid", "family_doc", "surfaces_table"]
-
-
-def calibrated_mu(name: str) -> float:
-    """The preset's calibrated mu_s; every validation preset must carry one.
-
-    Raises
-    ------
-    SpineInputError
-        The preset has no ``[engagement] mu``.
-    """
-    mu = presets.preset_mu(name)
-    if mu is None:
-        raise SpineInputError(f"preset {name!r} has no [engagement] mu; validation needs a calibrated mu_s")
-    return mu
+__all__ = ["engine_default", "engine_grid", "family_doc", "surfaces_table"]
 
 
 def surfaces_table(presets_: Sequence[str], seeds) -> list[dict]:
