@@ -53,32 +53,7 @@ def bare_rollout_time(config: sweep.SweepConfig) -> float:
     for case in sweep.expand_cases(config):
         p = case.params
         surface = case.surface.make()
-        key = tuple(
-            sorted(
-                {
-                    "tip_radius_m": None,
-                    **{
-                        k: p[k]
-                        for k in (
-                            "mass",
-                            "mu",
-                            "preload",
-                            "gravity",
-                            "length_scale",
-                            "timestep",
-                            "integrator",
-                            "cone",
-                            "impratio",
-                            "noslip_iterations",
-                            "solref_timeconst",
-                            "solref_dampratio",
-                            "hfield_resolution",
-                        )
-                    },
-                }.items()
-            )
-        )
-        rig = an._rig(case.surface, key)
+        rig = an.case_rig(case, surface)
         sc = rig.scales
         speed = (p["ie"] * sc.preload_n * sc.char_length_m / sc.mass_kg) ** 0.5
         drive = sim.SpringDrive(speed_m_s=speed)
@@ -135,7 +110,7 @@ def main() -> None:
     # one-worker sweep starts as cold as the two-worker one (rigs, placements)
     from spine_mj.sweep.analyses import mujoco as an
 
-    an._rig.cache_clear()
+    an.case_rig.cache_clear()
     t1 = timed_sweep(config, scratch / "mj1", workers=1)
     t2 = timed_sweep(config, scratch / "mj2", workers=2)
     runs = sweep.load_runs(scratch / "mj1")

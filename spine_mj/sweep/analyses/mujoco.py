@@ -164,9 +164,21 @@ def _rig(spec, key):
     return sim.Rig(surface, tip=tip, engine=engine, length_scale_m=p["length_scale"])
 
 
+def case_rig(case, surface=None):
+    """The (cached) rig a sweep case runs on: the one place a case's parameters become a Rig.
+
+    ``surface`` is ``case.surface.make()``, passed when the caller already has it.
+    """
+    surface = case.surface.make() if surface is None else surface
+    return _rig(case.surface, _rig_key(case.params, surface))
+
+
+case_rig.cache_clear = _rig.cache_clear
+
+
 def _mujoco(case, surface, starts, upstream):
     p = case.params
-    rig = _rig(case.surface, _rig_key(p, surface))
+    rig = case_rig(case, surface)
     runs = _runs(rig, p, starts)
     n = len(runs)
     status = np.full(n, "ok", dtype=object)
