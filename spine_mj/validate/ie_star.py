@@ -15,6 +15,7 @@ import warnings
 from dataclasses import dataclass
 
 import numpy as np
+from scipy import stats
 
 from spine_mj.errors import SpineInputError
 from spine_mj.validate.plans import FRECHET_TARGET, OUTCOME_TARGET
@@ -149,22 +150,42 @@ def bootstrap_ie_star(
         raise SpineInputError(f"stat must be 'mean', 'median' or None, got {stat!r}")
     a = np.asarray(agree_matrix, dtype=float)
     f = np.asarray(frechet_matrix, dtype=float)
-    rng = np.random.default_rng(rng)
     n = a.shape[1]
     if n == 0 or n_boot <= 0:
         return float("nan"), float("nan")
     reduce = {"mean": np.nanmean, "median": np.nanmedian}.get(stat)
-    vals = []
-    for _ in range(n_boot):
-        idx = rng.integers(0, n, n)
+
+    def estimate(idx):
         with np.errstate(all="ignore"), quiet_nan_warnings():
             fr = None if reduce is None else reduce(f[:, idx], axis=1)
-            est = estimate_ie_star(
+            return estimate_ie_star(
                 ie, a[:, idx].mean(axis=1), fr, agree_min=agree_min, frechet_max=frechet_max
             )
-        vals.append(est.value if est.kind == "bracketed" else (est.low if est.kind == "above" else est.high))
-    lo, hi = np.percentile(np.log10(vals), [16, 84])
-    return float(10**lo), float(10**hi)
+
+    return _log_interval(estimate, n, n_boot, rng)
+
+
+def _grid_point(est: IeStar) -> float:
+    """I_e* of an estimate, or the edge of the grid it points at when not bracketed."""
+    return est.value if est.kind == "bracketed" else (est.low if est.kind == "above" else est.high)
+
+
+def _log_interval(estimate, n_starts: int, n_boot: int, rng) -> tuple[float, float]:
+    """16th / 84th percentiles of ``log10 I_e*`` over resamples of the starts
+    (``scipy.stats.bootstrap``, percentile method); ``estimate(indices) -> IeStar``."""
+    if n_starts < 2:
+        value = _grid_point(estimate(np.arange(n_starts)))
+        return value, value
+    res = stats.bootstrap(
+        (np.arange(n_starts),),
+        lambda idx: math.log10(_grid_point(estimate(idx))),
+        n_resamples=n_boot,
+        confidence_level=0.68,
+        method="percentile",
+        vectorized=False,
+        rng=np.random.default_rng(rng),
+    )
+    return float(10**res.confidence_interval.low), float(10**res.confidence_interval.high)
 
 
 @contextlib.contextmanager
@@ -247,13 +268,8 @@ def departure_ie_star(ie, agree_matrix, *, n_boot: int, rng=12345) -> IeStar:
     n = a.shape[1]
     if n == 0 or n_boot <= 0:
         return star
-    gen = np.random.default_rng(rng)
-    vals = []
-    for _ in range(n_boot):
-        est = estimate(a[:, gen.integers(0, n, n)])
-        vals.append(est.value if est.kind == "bracketed" else (est.low if est.kind == "above" else est.high))
-    lo, hi = np.percentile(np.log10(vals), [16, 84])
-    return dataclasses.replace(star, ci_low=float(10**lo), ci_high=float(10**hi))
+    lo, hi = _log_interval(lambda idx: estimate(a[:, idx]), n, n_boot, rng)
+    return dataclasses.replace(star, ci_low=lo, ci_high=hi)
 
 
 # --------------------------------------------------------------------------- ramp duration
