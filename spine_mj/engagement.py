@@ -38,6 +38,7 @@ __all__ = [
     "SELF_LOCK",
     "SLIP",
     "kappa",
+    "kappa_of_normal",
     "quadratic_coefficients",
     "slip_direction",
 ]
@@ -144,6 +145,42 @@ def kappa(fx, fy, mu, *, tol: float = DEFAULT_TOL) -> tuple[np.ndarray, np.ndarr
     lock = (a < tol) & (fx > 0)
     region = np.where(lock, SELF_LOCK, np.where(np.isfinite(k), ENGAGED, SLIP)).astype(np.int8)
     k = np.where(lock, np.inf, k)
+    return k, region
+
+
+def kappa_of_normal(normal, mu, *, tol: float = DEFAULT_TOL) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`kappa` and region for contact normals instead of slopes.
+
+    The one lock rule both sides of a comparison use: the quasistatic streamline evaluates
+    :func:`kappa` at the surface's slope; a MuJoCo contact reports the normal of the facet
+    it touches, pointing out of the solid (``n_out = (-f_x, -f_y, 1) / s``, the opposite of
+    the paper's inward normal), which this converts to slopes ``f_x = -n_x / n_z``,
+    ``f_y = -n_y / n_z``. A normal with ``n_z <= 0`` (a wall or an overhang: no height
+    function) is self-locked when it faces the drive (``n_x < 0``), else slip.
+
+    Parameters
+    ----------
+    normal : array_like, shape (..., 3)
+        Outward unit (or any positive length) contact normals.
+    mu, tol
+        As in :func:`kappa`.
+
+    Returns
+    -------
+    kappa, region : ndarray, shape (...)
+    """
+    n = np.asarray(normal, dtype=float)
+    if n.ndim == 0 or n.shape[-1] != 3:
+        raise SpineInputError(f"normal must have shape (..., 3), got {n.shape}")
+    nx, ny, nz = n[..., 0], n[..., 1], n[..., 2]
+    up = nz > 0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        fx = np.where(up, -nx / np.where(up, nz, 1.0), 0.0)
+        fy = np.where(up, -ny / np.where(up, nz, 1.0), 0.0)
+    k, region = kappa(fx, fy, mu, tol=tol)
+    wall_lock = ~up & (nx < 0)
+    region = np.where(up, region, np.where(wall_lock, SELF_LOCK, SLIP)).astype(np.int8)
+    k = np.where(up, k, np.where(wall_lock, np.inf, np.nan))
     return k, region
 
 

@@ -5,7 +5,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from spine_mj.engagement import ENGAGED, SELF_LOCK, SLIP, kappa, slip_direction
+from spine_mj.engagement import ENGAGED, SELF_LOCK, SLIP, kappa, kappa_of_normal, slip_direction
 from spine_mj.errors import SpineInputError
 
 
@@ -117,3 +117,29 @@ def test_vectorized_equals_pointwise():
 def test_bad_mu_names_the_argument(bad):
     with pytest.raises(SpineInputError, match="mu"):
         kappa(0.1, 0.1, bad)
+
+
+@pytest.mark.parametrize("slope_deg", [-30.0, 0.0, 20.0, 40.0, 60.0, 80.0])
+def test_kappa_of_normal_is_kappa_of_the_slope_it_stands_for(slope_deg):
+    """The shared lock rule: a contact normal gives the verdict of the slope it belongs to."""
+    mu = 0.5
+    t = math.tan(math.radians(slope_deg))
+    normal = np.array([-t, 0.0, 1.0]) / math.hypot(t, 1.0)  # outward, surface rising in +x
+    k_n, r_n = kappa_of_normal(normal, mu)
+    k_s, r_s = kappa(t, 0.0, mu)
+    assert int(r_n) == int(r_s)
+    if np.isfinite(k_s):
+        # the slope recovered from the normal differs by rounding only
+        assert float(k_n) == pytest.approx(float(k_s), rel=1e-12)
+    # 2-D closed form: self-lock exactly when theta + arctan(mu) >= 90 deg
+    assert (int(r_n) == SELF_LOCK) == (slope_deg + math.degrees(math.atan(mu)) >= 90)
+
+
+def test_kappa_of_normal_handles_walls_and_batches():
+    mu = 0.3
+    normals = np.array([[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
+    k, region = kappa_of_normal(normals, mu)
+    assert region.tolist() == [SELF_LOCK, SLIP, ENGAGED]
+    assert k[0] == np.inf and np.isnan(k[1]) and k[2] == pytest.approx(mu)
+    with pytest.raises(SpineInputError, match=r"shape \(\.\.\., 3\)"):
+        kappa_of_normal([1.0, 0.0], mu)
