@@ -708,7 +708,6 @@ def kappa_cmd(surface_spec, mu, output, resolution):
     help="Table format.",
 )
 @click.option(
-    "-o",
     "--out",
     "out_dir",
     required=True,

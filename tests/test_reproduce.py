@@ -55,12 +55,12 @@ def test_cli_reproduce_and_errors(tmp_path):
     data = json.loads((tmp_path / "kappa-map.json").read_text())
     assert data["mu"] > 0 and (tmp_path / "kappa-map.png").stat().st_size > 0
     res = runner.invoke(
-        main, ["streamline", "paper-single-valley", "--start", "9,9", "-o", str(tmp_path / "bad")]
+        main, ["streamline", "paper-single-valley", "--start", "9,9", "--out", str(tmp_path / "bad")]
     )
     assert res.exit_code == 2 and "starts must lie inside" in res.output
     assert not (tmp_path / "bad").exists()
     res = runner.invoke(
-        main, ["streamline", "paper-single-valley", "--start", "x", "-o", str(tmp_path / "bad")]
+        main, ["streamline", "paper-single-valley", "--start", "x", "--out", str(tmp_path / "bad")]
     )
     assert res.exit_code == 2 and "--start" in res.output
 
