@@ -79,7 +79,7 @@ def test_cli_streamline_writes_a_table(tmp_path):
             "-3,-1",
             "--start",
             "-3,-2",
-            "-o",
+            "--out",
             str(tmp_path),
         ],
     )
