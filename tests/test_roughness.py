@@ -85,7 +85,7 @@ def test_radial_psd_agrees_with_surfacetopography():
     surf = fractal_fbm(nx=128, hurst=0.7, size=10.0, rng=3)
     q, psd = roughness.radial_psd(surf)
     topo = st.Topography(surf.heights.T, (10.0, 10.0), periodic=True)
-    q_ref, c_ref = topo.power_spectrum_from_area(nb_points_per_decade=8)
+    q_ref, c_ref = (np.ma.filled(a, np.nan) for a in topo.power_spectrum_from_area(nb_points_per_decade=8))
     ok = np.isfinite(c_ref) & (q_ref > q.min()) & (q_ref < q.max())
     mine = np.exp(np.interp(np.log(q_ref[ok]), np.log(q), np.log(psd)))
     # different ring edges: compare the log-spectra on average, not ring by ring
