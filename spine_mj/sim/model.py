@@ -16,6 +16,7 @@ back to SI in one place (:meth:`~spine_mj.sim.recording.Recording.from_sensors`)
 
 from __future__ import annotations
 
+import collections
 import copy
 import dataclasses
 import os
@@ -32,6 +33,20 @@ from spine_mj.sim.recording import SENSOR_NAMES
 from spine_mj.surfaces import Surface
 
 MODEL_PATH = model_path()
+#: MuJoCo's latest warning messages (the engine's own text), newest last.
+ENGINE_MESSAGES: collections.deque[str] = collections.deque(maxlen=64)
+_ENGINE_QUIET = []
+
+
+def quiet_engine() -> None:
+    """Route MuJoCo's warnings to :data:`ENGINE_MESSAGES` instead of stdout and a
+    ``MUJOCO_LOG.TXT`` in the working folder (once per process; runs record their warnings
+    in their end detail)."""
+    import mujoco
+
+    if not _ENGINE_QUIET:
+        mujoco.set_mju_user_warning(ENGINE_MESSAGES.append)
+        _ENGINE_QUIET.append(True)
 
 
 def compile_spec(spec):
@@ -58,6 +73,7 @@ class RigModel:
 
         if not isinstance(surface, Surface):
             raise SpineInputError(f"surface must be a spine_mj Surface, got {type(surface).__name__}")
+        quiet_engine()
         tip = TipParams() if tip is None else tip
         self.scales = Scales.for_surface(
             surface,

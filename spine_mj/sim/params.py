@@ -322,13 +322,13 @@ class Scales:
         radius = tip.tip_radius_m
         if radius is None:
             radius = default_tip_radius(surface, spacing, char_length_m)
+        xmin, xmax, ymin, ymax = (length_scale_m * b for b in surface.bounds)
+        _check_sizes(radius, spacing, char_length_m, min(xmax - xmin, ymax - ymin))
         resolution = hfield_resolution
         if resolution is None and spacing < _MIN_SPACING_PER_TIP_RADIUS * radius:
             extent = 2 * max(hf.size[0], hf.size[1]) * length_scale_m
             resolution = math.ceil(extent / (_MIN_SPACING_PER_TIP_RADIUS * radius)) + 1
             spacing = hfield_spacing(hfield_of(surface, resolution), length_scale_m)
-        xmin, xmax, ymin, ymax = (length_scale_m * b for b in surface.bounds)
-        _check_sizes(radius, spacing, char_length_m, min(xmax - xmin, ymax - ymin))
         return cls(
             length_scale_m=length_scale_m,
             char_length_m=char_length_m,
