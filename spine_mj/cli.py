@@ -451,7 +451,13 @@ def report(out_dir, output):
 def _rig_options(f):
     """Options shared by `sim export`, `simulate` and `view` (tip, scale, engine)."""
     opts = [
-        click.option("--tip-radius", type=float, default=None, help="Tip radius [m] (default: derived)."),
+        click.option(
+            "--tip-radius",
+            type=float,
+            default=None,
+            help="Tip radius [m] (default: the surface's own, 2 spacings for a scan, else "
+            "max(1 spacing, L_c / 100)).",
+        ),
         click.option("--mass", type=float, default=0.01, show_default=True, help="m_eff [kg]."),
         click.option(
             "--mu",
@@ -537,10 +543,27 @@ def sim_export(surface_spec, output, **rig_opts):
 @click.option("--start", required=True, help="Start 'x0,y0' in surface units, e.g. -3,-1.")
 @click.option("--drive", type=click.Choice(["spring", "ramp", "static"]), default="spring", show_default=True)
 @click.option(
-    "--speed", type=float, default=0.05, show_default=True, help="Carriage speed [m/s] (spring drive)."
+    "--ie",
+    type=float,
+    default=None,
+    help="Inertia number I_e = m v^2 / (F_p L_c): sets the carriage speed (spring) or the "
+    "force rate (ramp, static); default 1e-3 unless --speed or --rate is given.",
 )
-@click.option("--stiffness", type=float, default=None, help="Spring stiffness [N/m] (default 10 F_p/L_c).")
-@click.option("--rate", type=float, default=None, help="Force rate [N/s] (ramp, static).")
+@click.option("--speed", type=float, default=None, help="Carriage speed [m/s] (spring; instead of --ie).")
+@click.option(
+    "--K",
+    "stiffness_number",
+    type=float,
+    default=None,
+    help="Drive stiffness number K = k l_s / F_p (l_s: slope correlation length; spring).",
+)
+@click.option(
+    "--stiffness",
+    type=float,
+    default=None,
+    help="Spring stiffness [N/m] (instead of --K; default 10 F_p/L_c).",
+)
+@click.option("--rate", type=float, default=None, help="Force rate [N/s] (ramp, static; instead of --ie).")
 @click.option(
     "--start-force",
     type=float,
@@ -553,20 +576,47 @@ def sim_export(surface_spec, output, **rig_opts):
 @click.option("-o", "--out-dir", required=True, type=click.Path(file_okay=False))
 @_rig_options
 def simulate(
-    surface_spec, start, drive, speed, stiffness, rate, start_force, duration, render, out_dir, **rig_opts
+    surface_spec,
+    start,
+    drive,
+    ie,
+    speed,
+    stiffness_number,
+    stiffness,
+    rate,
+    start_force,
+    duration,
+    render,
+    out_dir,
+    **rig_opts,
 ):
     """Run one drive on SURFACE: writes trajectory.parquet, run.png, summary.json (and run.mp4).
 
+    Lengths, forces and times are SI; --ie and --K give the drive in dimensionless terms.
+
     \b
     Example:
-      spine-mj simulate paper-single-peak --start -3,-1 --drive spring --speed 0.05 -o out/
+      spine-mj simulate paper-single-peak --start -3,-1 --drive spring --ie 1e-3 --K 10 -o out/
     """
 
     if render:
         os.environ.setdefault("MUJOCO_GL", "egl")
 
     x0, y0 = _parse_start(start)
+    for a, b, names in ((ie, speed, "--ie or --speed"), (ie, rate, "--ie or --rate")):
+        if a is not None and b is not None:
+            raise SpineInputError(f"give one of {names}, got both")
+    if stiffness_number is not None and stiffness is not None:
+        raise SpineInputError("give one of --K or --stiffness, got both")
     rig = _build_rig(surface_spec, **rig_opts)
+    sc = rig.scales
+    if ie is None and speed is None and rate is None:
+        ie = 1e-3
+    if ie is not None:
+        speed = sc.speed_for(check_positive("--ie", ie))
+        rate = speed * sc.preload_n / sc.char_length_m
+    if stiffness_number is not None:
+        stiffness = sc.stiffness_for(check_positive("--K", stiffness_number))
     if drive == "spring":
         drv = sim.SpringDrive(speed_m_s=speed, stiffness_n_m=stiffness, duration_s=duration)
     elif drive == "ramp":
@@ -584,7 +634,10 @@ def simulate(
         save_figure(sim_run_figure(result, rig.surface, length_scale_m=rig.length_scale_m), out / "run.png")
         if render:
             _render_mp4(rig, result, out / "run.mp4")
-    click.echo(f"end: {result.end_reason.value} ({result.end_detail}); I_e = {result.inertia_number:.3g}")
+    click.echo(
+        f"end: {result.end_reason.value} ({result.end_detail}); I_e = {result.inertia_number:.3g}"
+        + (f", K = {result.stiffness_number:.3g}" if drive == "spring" else "")
+    )
     click.echo(f"wrote {', '.join(str(out / w) for w in written)}")
 
 

@@ -29,13 +29,14 @@ def asymmetric_surface(n=121):
 
 
 def deepest_contacts(rig, q):
+    """Contact points [m] and normals of the tip at qpos ``q`` (engine units)."""
     d = mujoco.MjData(rig.model)
     d.qpos[:] = q
     mujoco.mj_forward(rig.model, d)
     out = []
     for c in d.contact[: d.ncon]:
         n = c.frame[:3] * (1 if c.frame[2] > 0 else -1)
-        out.append((c.pos - 0.5 * c.dist * n, n))
+        out.append(((c.pos - 0.5 * c.dist * n) * rig.units.length_m, n))
     return out
 
 

@@ -24,6 +24,7 @@ def test_hfield_orientation_extent_and_scale_match_the_surface():
     for x0, y0 in rng.uniform(-2.5, 2.5, (12, 2)):
         q = rig.place(x0, y0)
         contacts = deepest_contacts(rig, q)
+        q = q * rig.units.length_m
         assert contacts, (x0, y0)
         for p, n in contacts:
             # the contact lies on the surface (in metres) and faces the smooth normal
@@ -102,15 +103,16 @@ def test_export_xml_is_self_contained(tmp_path):
     m = mujoco.MjModel.from_xml_path(str(path))
     assert m.nhfield == 1 and m.hfield_nrow[0] == rig.hfield.nrow
     np.testing.assert_allclose(m.hfield_data, rig.model.hfield_data, atol=2e-6)
-    assert m.opt.timestep == rig.engine.timestep_s
+    # the model is in engine units: time in tau = sqrt(m L_c / F_p)
+    assert m.opt.timestep == pytest.approx(rig.engine.timestep_s / rig.units.time_s, rel=1e-15)
     assert m.opt.noslip_iterations == rig.engine.noslip_iterations
 
 
 def test_set_surface_recompiles_in_place():
     rig = Rig(single_gaussian(sign=1), tip=TipParams(tip_radius_m=5e-4))
-    z_peak = rig.place(0.0, 0.0)[2]
+    z_peak = rig.place(0.0, 0.0)[2] * rig.units.length_m
     rig.set_surface(single_gaussian(sign=-1))
-    assert rig.place(0.0, 0.0)[2] < z_peak - 0.03
+    assert rig.place(0.0, 0.0)[2] * rig.units.length_m < z_peak - 0.03
 
 
 def test_fine_grid_is_coarsened_to_respect_the_contact_cap():
@@ -123,5 +125,5 @@ def test_fine_grid_is_coarsened_to_respect_the_contact_cap():
     assert rig.scales.hfield_spacing_m >= 0.25 * 25e-6 * (1 - 1e-9)
     assert rig.engine.hfield_resolution == rig.hfield.ncol
     for start in [(0.0, 0.0), (-1e-4, 5e-5), (1e-4, -1e-4)]:
-        z = rig.place(*start)[2]
+        z = rig.place(*start)[2] * rig.units.length_m
         assert surf.height(*start) < z < surf.heights.max() + 2 * 25e-6

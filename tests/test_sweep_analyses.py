@@ -33,7 +33,7 @@ def test_mujoco_and_compare_runs_match_the_rig_run_directly(tmp_path):
     assert summary.total_runs == 12
     runs = sweep.load_runs(out)
     mj = runs[runs.analysis == "mujoco"]
-    assert mj.status.isin(["ok", "diverged", "engine_warning"]).all()
+    assert mj.status.isin(["ok", "nan", "engine_warning", "penetration", "diverged"]).all()
     np.testing.assert_allclose(mj.inertia_number, mj.ie, rtol=1e-9)
     # the start on the peak's ridge self-locks quasistatically; compare's outcome agreement
     # is that of the two rows it compares

@@ -5,24 +5,30 @@ joints (x, y, z; no rotation) with mass ``mass_kg``, friction ``mu_s`` (condim 3
 and an optional extra downward preload. :class:`Rig` loads that file with ``MjSpec``,
 attaches the surface as an hfield through :func:`spine_mj.surfaces.to_hfield` and compiles.
 
-Units. The model is in SI units. A dimensionless surface (``unit == "1"``, the paper's
-Gaussian surfaces) is scaled by ``length_scale_m`` (default 1 cm per unit) in x, y and z; a
-surface in metres is used as it is. Positions in results are in metres; divide by
-``rig.length_scale_m`` for surface units.
+Units. Users give and get SI: a dimensionless surface (``unit == "1"``, the paper's
+Gaussian surfaces) is scaled by ``length_scale_m`` (default 1 cm per unit) in x, y and z, a
+surface in a length unit ("m", "mm", "um", "nm") by that unit. Positions in results are in
+metres; divide by ``rig.length_scale_m`` for surface units. MuJoCo itself works in the
+problem's own units (:class:`EngineUnits`: length ``L_c``, force ``F_p = m g + preload``,
+mass ``m``, time ``tau = sqrt(m L_c / F_p)``), so a nanometre AFM scan and a centimetre
+print are the same kind of model; ``rig.model``, :meth:`Rig.place` and :meth:`Rig.controls`
+are in engine units, everything in a :class:`RunResult` is SI.
 
-Scales and default engine settings (:func:`default_engine`). With
-``F_p = mass_kg * gravity + preload_n`` (the normal preload), ``a_p = F_p / mass_kg`` and
-``L_c`` the surface's characteristic length (:func:`characteristic_length`):
+Scales and default engine settings (:func:`default_engine`). With ``a_p = F_p / mass_kg``
+and ``L_c`` the surface's characteristic length (:func:`characteristic_length`):
 
 * contacts use ``solref = (2 dt, 1)`` (the stiffest stable time constant, critically
   damped) and ``solimp = (0.99, 0.99, ...)``; the resting depth is then
   ``(1 - 0.99) a_p (2 dt)^2 = 0.04 a_p dt^2``, and the deepest contact seen while a drive
   loads the tip stays within a few ``a_p dt^2`` per preload of drive force;
-* ``dt`` is the largest step (at most 1 ms) with ``a_p dt^2 <= 0.005 min(r_tip, L_c)``:
-  measured penetration 2-4 um for a 0.5 mm tip at F <= 5 F_p and 37 um at 17 F_p (a
-  60 degree slope), always far below 1 % of ``L_c``;
+* ``dt = sqrt(0.005 min(r_tip, L_c) / L_c) tau`` (``a_p dt^2 = 0.005 min(r_tip, L_c)``),
+  rounded in engine units: resting penetration ``2e-4 min(r_tip, L_c)``;
 * ``cone = elliptic`` with ``noslip_iterations = 3``: MuJoCo's friction is soft and creeps
-  at any in-cone load without the noslip pass (docs/physics.md §5); ``impratio`` stays 1.
+  at any in-cone load without the noslip pass (docs/physics.md §5); ``impratio`` stays 1;
+* a run ends as engine trouble (:data:`~spine_mj.sim.detection.TROUBLES`) on a MuJoCo
+  warning or a non-finite number anywhere, or, before any physical ending, on a speed
+  beyond the energy bound, a tip far below or above the surface, or penetration above
+  :func:`~spine_mj.sim.params.penetration_tolerance_m`.
 
 Drives (docs/physics.md §4): :class:`SpringDrive` (a carriage moves at constant speed in +x and
 pulls the tip through a spring acting in x only), :class:`RampDrive` (force rises at a set
@@ -51,9 +57,11 @@ from spine_mj.sim.drives import Drive, RampDrive, SpringDrive, StaticProbe
 from spine_mj.sim.model import MODEL_PATH
 from spine_mj.sim.params import (
     DEFAULT_LENGTH_SCALE_M,
+    LENGTH_UNITS_M,
     Cone,
     EndReason,
     EngineSettings,
+    EngineUnits,
     Integrator,
     Scales,
     TipParams,
@@ -61,6 +69,7 @@ from spine_mj.sim.params import (
     default_engine,
     hfield_of,
     hfield_spacing,
+    penetration_tolerance_m,
 )
 from spine_mj.sim.planes import inclined_plane
 from spine_mj.sim.results import RunResult
@@ -68,12 +77,14 @@ from spine_mj.sim.rig import Rig
 
 __all__ = [
     "DEFAULT_LENGTH_SCALE_M",
+    "LENGTH_UNITS_M",
     "MODEL_PATH",
     "Cone",
     "Detection",
     "Drive",
     "EndReason",
     "EngineSettings",
+    "EngineUnits",
     "Event",
     "Integrator",
     "RampDrive",
@@ -88,4 +99,5 @@ __all__ = [
     "hfield_of",
     "hfield_spacing",
     "inclined_plane",
+    "penetration_tolerance_m",
 ]

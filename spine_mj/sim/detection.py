@@ -3,9 +3,13 @@
 :class:`Detection` holds the thresholds (derived from the scales where not given). The
 end conditions are found for a whole group of runs at once (:func:`end_marks`: first step
 of each condition per run); each run's candidates (:func:`end_candidates`, plus
-:func:`probe_candidates` for a static probe) are then reduced to the earliest, ties going
-to the more basic condition (:func:`decide_end`): engine trouble, deep penetration,
-leaving the domain, self-lock, then the probe's slide or breakaway.
+:func:`probe_candidates` for a static probe) are then reduced to one (:func:`decide_end`):
+a MuJoCo warning or a non-finite number anywhere in a run makes it engine trouble, whatever
+happened before; otherwise the earliest ending wins, ties going to the more basic
+condition: divergence (speed beyond the energy bound, the tip far below or above the
+surface), deep penetration, leaving the domain, self-lock, then the probe's slide or
+breakaway. Engine trouble names what happened in :attr:`Ending.trouble` (one of
+:data:`TROUBLES`).
 """
 
 from __future__ import annotations
@@ -18,8 +22,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from spine_mj.errors import check_positive
-from spine_mj.sim.params import EndReason, Scales, check_optional
+from spine_mj.sim.params import EndReason, Scales, check_optional, penetration_tolerance_m
 from spine_mj.sim.recording import Recording
+
+#: Kinds of engine trouble: a non-finite number, a MuJoCo warning (the engine stopped or
+#: reset the run), penetration above tolerance, or a diverging state (speed or position).
+TROUBLES = ("nan", "engine_warning", "penetration", "diverged")
 
 
 @dataclass(frozen=True)
@@ -40,7 +48,8 @@ class Detection:
     kappa_cap : float
         Self-lock when the drive force reaches ``kappa_cap * F_p`` while stuck.
     penetration_tol_m : float or None
-        Engine trouble above this penetration (default ``min(0.1 r_tip, 0.01 L_c)``).
+        Engine trouble above this penetration (default
+        :func:`~spine_mj.sim.params.penetration_tolerance_m`).
     domain_margin_m : float or None
         The run ends when the tip centre comes closer than this to the domain's edge
         (default: the tip radius).
@@ -67,10 +76,18 @@ class Detection:
             "slip_speed_m_s": 1e-3 * v_c,
             "stick_speed_m_s": 1e-5 * v_c,
             "breakaway_distance_m": small,
-            "penetration_tol_m": small,
+            "penetration_tol_m": penetration_tolerance_m(scales),
             "domain_margin_m": scales.tip_radius_m,
         }
         return dataclasses.replace(self, **{k: v for k, v in defaults.items() if getattr(self, k) is None})
+
+    def speed_limit_m_s(self, scales: Scales, drive_speed_m_s: float) -> float:
+        """Speed above which a run diverges: 10 times the larger of the drive's speed and the
+        speed the drive (at most ``kappa_cap F_p``) and the preload could give the tip over
+        the whole domain, ``sqrt(2 (kappa_cap + 1) F_p D / m)`` (energy bound)."""
+        extent = scales.extent_m if scales.extent_m is not None else scales.char_length_m
+        energy = math.sqrt(2 * (self.kappa_cap + 1) * scales.preload_n * extent / scales.mass_kg)
+        return 10 * max(drive_speed_m_s, energy)
 
 
 @dataclass(frozen=True)
@@ -90,6 +107,7 @@ class Ending:
     rank: int
     reason: EndReason
     detail: str
+    trouble: str = ""  # engine trouble: one of TROUBLES
 
 
 def first_indices(mask: np.ndarray) -> np.ndarray:
@@ -107,12 +125,16 @@ def end_marks(
     bounds_m: Sequence[float],
     det: Detection,
     preload_n: float,
+    speed_limit_m_s: np.ndarray,
 ) -> dict[str, np.ndarray]:
     """First step of each end condition for each run of a group (``rec`` ``(g, n, ...)``), or -1.
 
-    Keys: ``nonfinite``, ``reset`` (MuJoCo restarted the time), ``deep`` (penetration
-    above tolerance), ``out`` (the tip left the domain) and ``lock`` (the drive force
-    reached ``kappa_cap F_p`` while stuck).
+    Keys: ``nonfinite``, ``reset`` (MuJoCo reset the time, or froze it: the native rollout
+    stops a run at its first warning), ``fast`` (speed above the run's ``speed_limit_m_s``,
+    ``(g,)``), ``sank`` / ``flew`` (the tip centre below the surface's lowest point or
+    above its highest by the domain's size; ``bounds_m`` is ``(xmin, xmax, ymin, ymax,
+    zmin, zmax)``), ``deep`` (penetration above tolerance), ``out`` (the tip left the
+    domain) and ``lock`` (the drive force reached ``kappa_cap F_p`` while stuck).
     """
     g, n = state.shape[:2]
     dt = timestep_s
@@ -121,13 +143,19 @@ def end_marks(
     else:
         nonfinite = first_indices(~(np.isfinite(state).all(axis=2) & np.isfinite(sens).all(axis=2)))
     expected = dt * np.arange(1, n + 1)
-    xmin, xmax, ymin, ymax = bounds_m
+    xmin, xmax, ymin, ymax, zmin, zmax = bounds_m
     mg = det.domain_margin_m
-    px, py = rec.position_m[:, :, 0], rec.position_m[:, :, 1]
+    px, py, pz = rec.position_m[:, :, 0], rec.position_m[:, :, 1], rec.position_m[:, :, 2]
+    v = rec.velocity_m_s
+    speed2 = v[:, :, 0] ** 2 + v[:, :, 1] ** 2 + v[:, :, 2] ** 2
     cap = det.kappa_cap * preload_n
+    span = max(xmax - xmin, ymax - ymin)
     return {
         "nonfinite": nonfinite,
-        "reset": first_indices(np.abs(rec.time_s - expected) > 0.5 * dt),
+        "reset": first_indices(~(np.abs(rec.time_s - expected) <= 0.5 * dt)),
+        "fast": first_indices(~(speed2 <= np.asarray(speed_limit_m_s)[:, None] ** 2)),
+        "sank": first_indices(pz < zmin),
+        "flew": first_indices(pz > zmax + span),
         "deep": first_indices(rec.penetration_m > det.penetration_tol_m),
         "out": first_indices((px < xmin + mg) | (px > xmax - mg) | (py < ymin + mg) | (py > ymax - mg)),
         "lock": first_indices((rec.drive_force_n >= cap * (1 - 1e-9)) & ~rec.slipping),
@@ -143,35 +171,40 @@ def end_candidates(
     preload_n: float,
 ) -> list[Ending]:
     """The endings run ``r`` of a group reached (``rec`` is that run's recording)."""
+    trouble = EndReason.ENGINE_TROUBLE
     candidates = []
-    if marks["nonfinite"][r] >= 0:
-        candidates.append(Ending(int(marks["nonfinite"][r]), 0, EndReason.ENGINE_TROUBLE, "non-finite state"))
-    if marks["reset"][r] >= 0:
-        candidates.append(
-            Ending(
-                int(marks["reset"][r]),
-                0,
-                EndReason.ENGINE_TROUBLE,
-                "MuJoCo reset the simulation (warning: bad qpos/qvel/qacc)",
-            )
+
+    def mark(key):
+        return int(marks[key][r]) if marks[key][r] >= 0 else None
+
+    if (k := mark("nonfinite")) is not None:
+        candidates.append(Ending(k, 0, trouble, f"non-finite state at t = {rec.time_s[k]:.4g} s", "nan"))
+    if (k := mark("reset")) is not None:
+        detail = (
+            f"MuJoCo warning: the engine reset or stopped the run at step {k} "
+            "(bad qpos/qvel/qacc or a full contact buffer)"
         )
-    if warning is not None:
-        k, text = warning
-        if k is not None:
-            candidates.append(Ending(k, 0, EndReason.ENGINE_TROUBLE, f"MuJoCo warning: {text}"))
-    if marks["deep"][r] >= 0:
-        k = int(marks["deep"][r])
+        candidates.append(Ending(k, 0, trouble, detail, "engine_warning"))
+    if warning is not None and warning[0] is not None:
+        candidates.append(Ending(warning[0], 0, trouble, f"MuJoCo warning: {warning[1]}", "engine_warning"))
+    pos, vel = rec.position_m, rec.velocity_m_s
+    if (k := mark("fast")) is not None:
+        detail = f"speed {np.linalg.norm(vel[k]):.3g} m/s beyond the energy bound (diverged)"
+        candidates.append(Ending(k, 1, trouble, detail, "diverged"))
+    for key, where in (("sank", "below the surface's lowest point"), ("flew", "far above the surface")):
+        if (k := mark(key)) is not None:
+            detail = f"tip centre at z = {pos[k, 2]:.4g} m, {where} (diverged)"
+            candidates.append(Ending(k, 1, trouble, detail, "diverged"))
+    if (k := mark("deep")) is not None:
         detail = f"penetration {rec.penetration_m[k]:.3g} m > tolerance {det.penetration_tol_m:.3g} m"
-        candidates.append(Ending(k, 1, EndReason.ENGINE_TROUBLE, detail))
-    if marks["out"][r] >= 0:
-        k = int(marks["out"][r])
-        pos = rec.position_m
+        candidates.append(Ending(k, 1, trouble, detail, "penetration"))
+    if (k := mark("out")) is not None:
         detail = f"tip at ({pos[k, 0]:.4g}, {pos[k, 1]:.4g}) m left the domain"
         candidates.append(Ending(k, 2, EndReason.LEFT_DOMAIN, detail))
-    if marks["lock"][r] >= 0:
+    if (k := mark("lock")) is not None:
         cap = det.kappa_cap * preload_n
         detail = f"drive force reached kappa_cap * F_p = {cap:.4g} N without slip"
-        candidates.append(Ending(int(marks["lock"][r]), 3, EndReason.SELF_LOCK, detail))
+        candidates.append(Ending(k, 3, EndReason.SELF_LOCK, detail))
     return candidates
 
 
@@ -214,7 +247,12 @@ def probe_candidates(
 
 
 def decide_end(candidates: Sequence[Ending], n: int) -> Ending:
-    """The earliest of the candidates (ties: the lower rank), else completion at step ``n - 1``."""
+    """The ending of a run: the first MuJoCo warning or non-finite number if there is one
+    (never a physical outcome), else the earliest candidate (ties: the lower rank), else
+    completion at step ``n - 1``."""
+    engine = [c for c in candidates if c.rank == 0]
+    if engine:
+        return min(engine, key=lambda c: c.index)
     if not candidates:
         return Ending(n - 1, 0, EndReason.COMPLETED, "drive duration elapsed")
     return min(candidates, key=lambda c: (c.index, c.rank))

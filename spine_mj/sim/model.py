@@ -4,6 +4,11 @@
 :class:`~spine_mj.sim.params.Scales` (the rule lives in :mod:`spine_mj.sim.params`),
 attaches the surface as an hfield, compiles, and knows its ids and sensor addresses;
 it places tips (:mod:`spine_mj.sim.placement`) and gives each drive its model.
+
+The model is built in engine units (:class:`~spine_mj.sim.params.EngineUnits`: length
+``L_c``, force ``F_p``, mass ``m``): ``rig.units`` converts. Everything that talks to MuJoCo
+(``model``, :meth:`RigModel.place`, the controls) is in those units; results are converted
+back to SI in one place (:meth:`~spine_mj.sim.recording.Recording.from_sensors`).
 :class:`~spine_mj.sim.Rig` adds running on top; the run machinery
 (:mod:`~spine_mj.sim.rollout`, :mod:`~spine_mj.sim.ramp`, :mod:`~spine_mj.sim.results`,
 :mod:`~spine_mj.sim.render`) works on a :class:`RigModel`.
@@ -11,6 +16,7 @@ it places tips (:mod:`spine_mj.sim.placement`) and gives each drive its model.
 
 from __future__ import annotations
 
+import collections
 import copy
 import dataclasses
 import os
@@ -27,6 +33,28 @@ from spine_mj.sim.recording import SENSOR_NAMES
 from spine_mj.surfaces import Surface
 
 MODEL_PATH = model_path()
+#: MuJoCo's latest warning messages (the engine's own text), newest last.
+ENGINE_MESSAGES: collections.deque[str] = collections.deque(maxlen=64)
+_ENGINE_QUIET = []
+
+
+def quiet_engine() -> None:
+    """Route MuJoCo's warnings to :data:`ENGINE_MESSAGES` instead of stdout and a
+    ``MUJOCO_LOG.TXT`` in the working folder (once per process; runs record their warnings
+    in their end detail)."""
+    import mujoco
+
+    if not _ENGINE_QUIET:
+        mujoco.set_mju_user_warning(ENGINE_MESSAGES.append)
+        _ENGINE_QUIET.append(True)
+
+
+def compile_spec(spec):
+    """``spec.compile()``, a model MuJoCo refuses raised as :class:`SpineInputError` (one line)."""
+    try:
+        return spec.compile()
+    except ValueError as exc:
+        raise SpineInputError(f"MuJoCo refused the rig's model: {str(exc).strip().splitlines()[0]}") from None
 
 
 class RigModel:
@@ -45,6 +73,7 @@ class RigModel:
 
         if not isinstance(surface, Surface):
             raise SpineInputError(f"surface must be a spine_mj Surface, got {type(surface).__name__}")
+        quiet_engine()
         tip = TipParams() if tip is None else tip
         self.scales = Scales.for_surface(
             surface,
@@ -59,13 +88,15 @@ class RigModel:
         self.surface = surface
         self.tip = dataclasses.replace(tip, tip_radius_m=self.scales.tip_radius_m)
         self.length_scale_m = length_scale_m = self.scales.length_scale_m
+        self.units = self.scales.units
         self.engine = default_engine(self.scales) if engine is None else engine
         self.hfield = hfield_of(surface, resolution)
         xmin, xmax, ymin, ymax = surface.bounds
         self.bounds_m = tuple(length_scale_m * b for b in (xmin, xmax, ymin, ymax))
+        self.z_range_m = self._z_range_m()
         self.spec = mujoco.MjSpec.from_file(str(MODEL_PATH))
         self._configure_spec()
-        self.model = self.spec.compile()
+        self.model = compile_spec(self.spec)
         self._ids()
         self._placer: Placer | None = None
 
@@ -75,18 +106,19 @@ class RigModel:
         """Options, tip, carriage and the hfield from the engine settings, tip and scales."""
         import mujoco
 
-        spec, eng, tip, s = self.spec, self.engine, self.tip, self.length_scale_m
-        spec.option.timestep = eng.timestep_s
+        spec, eng, tip, u = self.spec, self.engine, self.tip, self.units
+        s = self.length_scale_m / u.length_m  # engine lengths per surface unit
+        spec.option.timestep = eng.timestep_s / u.time_s
         spec.option.integrator = getattr(mujoco.mjtIntegrator, f"mjINT_{eng.integrator.name}")
         spec.option.cone = getattr(mujoco.mjtCone, f"mjCONE_{eng.cone.name}")
         spec.option.impratio = eng.impratio
         spec.option.noslip_iterations = eng.noslip_iterations
-        spec.option.gravity = [0.0, 0.0, -tip.gravity_m_s2]
+        spec.option.gravity = [0.0, 0.0, -tip.gravity_m_s2 / u.acceleration_m_s2]
         spec.modelname = "spine_rig"
-        r = tip.tip_radius_m
+        r = tip.tip_radius_m / u.length_m
         tip_geom = spec.geom("tip")
         tip_geom.size = [r, 0, 0]
-        tip_geom.mass = tip.mass_kg
+        tip_geom.mass = tip.mass_kg / u.mass_kg
         car = spec.geom("carriage")
         car.size = [r, r, r]
         hf = self.hfield
@@ -108,12 +140,17 @@ class RigModel:
         for g in (tip_geom, geom):
             g.friction = [tip.mu_s, 0.0, 0.0]
             g.condim = 3
-            g.solref = list(eng.solref)
-            g.solimp = list(eng.solimp)
+            g.solref = [eng.solref[0] / u.time_s, eng.solref[1]]
+            g.solimp = [*eng.solimp[:2], eng.solimp[2] / u.length_m, *eng.solimp[3:]]
         span = max(rx, ry) * s
         spec.visual.map.znear = 1e-4
         spec.stat.extent = 2 * span
         spec.stat.center = [hf.pos[0] * s, hf.pos[1] * s, (hf.pos[2] + elev / 2) * s]
+
+    def _z_range_m(self) -> tuple[float, float]:
+        """Lowest and highest point of the hfield [m]."""
+        hf, s = self.hfield, self.length_scale_m
+        return hf.pos[2] * s, (hf.pos[2] + hf.size[2]) * s
 
     def _ids(self) -> None:
         """Ids of the geoms and actuators and the sensors' addresses in the compiled model."""
@@ -141,7 +178,7 @@ class RigModel:
                 f"set_surface needs a {self.hfield.nrow} x {self.hfield.ncol} hfield, "
                 f"got {hf.nrow} x {hf.ncol}; build a new Rig instead"
             )
-        s = self.length_scale_m
+        s = self.length_scale_m / self.units.length_m
         h = self.spec.hfield("surface")
         h.userdata = hf.data.ravel().tolist()
         h.size = [v * s for v in hf.size]
@@ -150,11 +187,12 @@ class RigModel:
         self.model, _ = self.spec.recompile(self.model, data)
         self.surface, self.hfield = surface, hf
         xmin, xmax, ymin, ymax = surface.bounds
-        self.bounds_m = tuple(s * b for b in (xmin, xmax, ymin, ymax))
+        self.bounds_m = tuple(self.length_scale_m * b for b in (xmin, xmax, ymin, ymax))
+        self.z_range_m = self._z_range_m()
         self._ids()
 
     def to_xml(self) -> str:
-        """A self-contained MJCF of the rig (the hfield inlined as ``elevation``)."""
+        """A self-contained MJCF of the rig (the hfield inlined as ``elevation``), in engine units."""
         return self.spec.to_xml()
 
     def export_xml(self, path: str | os.PathLike) -> Path:
@@ -168,6 +206,7 @@ class RigModel:
         """A shallow copy of the model with the drive's spring stiffness (0 for force drives)."""
         m = copy.copy(self.model)
         k = stiffness_n_m(drive, self.scales) if isinstance(drive, SpringDrive) else 0.0
+        k /= self.units.stiffness_n_m
         m.actuator_gainprm[self.act_spring, 0] = k
         m.actuator_biasprm[self.act_spring, 1] = -k
         return m
@@ -175,7 +214,8 @@ class RigModel:
     # ----------------------------------------------------------------- placement
 
     def place(self, x0: float, y0: float) -> np.ndarray:
-        """qpos ``(3,)`` [m] with the tip resting on the hfield at ``(x0, y0)`` (surface units).
+        """qpos ``(3,)`` (engine units: metres over ``units.length_m``) with the tip resting on the
+        hfield at ``(x0, y0)`` (surface units).
 
         The sphere centre is found by a safeguarded Newton search in z on the engine's own
         sphere-hfield distance (to 1e-7 tip radii), then lowered by the soft contact's resting depth
@@ -185,6 +225,7 @@ class RigModel:
         x0, y0 = float(x0), float(y0)
         self.check_start(x0, y0)
         if self._placer is None or self._placer.model is not self.model:
+            u = self.units
             tc, dr = self.engine.solref
             a_p = self.scales.preload_n / self.tip.mass_kg
             self._placer = Placer(
@@ -192,9 +233,9 @@ class RigModel:
                 geom_tip=self.geom_tip,
                 surface=self.surface,
                 hfield=self.hfield,
-                length_scale_m=self.length_scale_m,
-                tip_radius_m=self.tip.tip_radius_m,
-                rest_depth_m=(1 - self.engine.solimp[1]) * a_p * (tc * dr) ** 2,
+                length_scale=self.length_scale_m / u.length_m,
+                tip_radius=self.tip.tip_radius_m / u.length_m,
+                rest_depth=(1 - self.engine.solimp[1]) * a_p * (tc * dr) ** 2 / u.length_m,
             )
         return self._placer.place(x0, y0)
 

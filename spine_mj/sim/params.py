@@ -3,9 +3,18 @@
 Parameter records (frozen, validated on construction): :class:`TipParams` (the spine tip),
 :class:`EngineSettings` (MuJoCo settings, recorded with every run) and the enums they use,
 plus :class:`EndReason`. :class:`Scales` derives the problem's scales from a surface and a
-tip (:meth:`Scales.for_surface`: length scale, ``L_c``, default tip radius, hfield spacing
-and coarsening), and :func:`default_engine` the engine settings from the scales (rule in
-:mod:`spine_mj.sim`'s docstring). Nothing here needs MuJoCo.
+tip (:meth:`Scales.for_surface`: length scale, ``L_c``, ``l_s``, default tip radius, hfield
+spacing and coarsening), :class:`EngineUnits` the units MuJoCo works in, and
+:func:`default_engine` the engine settings from the scales (rule in :mod:`spine_mj.sim`'s
+docstring). Nothing here needs MuJoCo.
+
+The scaling rule. MuJoCo sees the problem in its own units: length ``L_c``, force
+``F_p = m g + preload``, mass ``m``, hence time ``tau = sqrt(m L_c / F_p)`` and speed
+``sqrt(F_p L_c / m)`` (a drive of inertia number ``I_e`` moves at ``sqrt(I_e)``). The same
+dimensionless problem at any physical scale is then the same model, bit for bit, and every
+number the engine meets (mass 1, tip radius ``r / L_c``, time step ``dt / tau``) is O(1)
+or a ratio of the problem's own lengths, far from MuJoCo's absolute floors (``mjMINVAL =
+1e-15``) that a micrometre tip in SI units falls below.
 """
 
 from __future__ import annotations
@@ -17,13 +26,20 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from spine_mj.errors import SpineInputError, check_positive
-from spine_mj.roughness import characteristic_length
-from spine_mj.surfaces import HField, Surface, to_hfield
+from spine_mj.roughness import characteristic_length, slope_correlation_length
+from spine_mj.surfaces import GridSurface, HField, Surface, to_hfield
 
 DEFAULT_LENGTH_SCALE_M = 0.01
-_MAX_TIMESTEP_S = 1e-3
 _REST_PENETRATION_FRACTION = 0.005
 _MIN_SPACING_PER_TIP_RADIUS = 0.25  # finer hfields exceed MuJoCo's 50 contacts per geom pair
+_SCAN_TIP_SPACINGS = 2.0  # default tip radius of a measured scan, in lateral spacings
+MAX_HFIELD_SIDE = 8192  # samples a side of an hfield (memory; MuJoCo's collision stays local)
+_MIN_ENGINE_RATIO = 1e-9  # smallest length ratio (tip / L_c, spacing / L_c) the engine resolves
+#: Metres per unit of the length units a surface may carry ("1": dimensionless, scaled).
+#: Physical range of lengths [m] and masses [kg] (outside it the model means nothing).
+PHYSICAL_LENGTH_M = (1e-12, 1e3)
+PHYSICAL_MASS_KG = (1e-24, 1e6)
+LENGTH_UNITS_M = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "µm": 1e-6, "nm": 1e-9, "pm": 1e-12}
 
 
 class Cone(enum.Enum):
@@ -88,6 +104,9 @@ class TipParams:
     def __post_init__(self):
         check_optional(self, ["tip_radius_m"])
         object.__setattr__(self, "mass_kg", check_positive("mass_kg", self.mass_kg))
+        lo, hi = PHYSICAL_MASS_KG
+        if not lo <= self.mass_kg <= hi:
+            raise SpineInputError(f"mass_kg must lie in [{lo:g}, {hi:g}] kg, got {self.mass_kg:g}")
         object.__setattr__(self, "mu_s", check_positive("mu_s", self.mu_s, allow_zero=True))
         object.__setattr__(self, "preload_n", check_positive("preload_n", self.preload_n, allow_zero=True))
         object.__setattr__(
@@ -189,6 +208,40 @@ class EngineSettings:
 
 
 @dataclass(frozen=True)
+class EngineUnits:
+    """The units MuJoCo works in: length ``L_c``, force ``F_p``, mass ``m`` (module docstring).
+
+    A number in engine units times the matching unit here is the SI value; the rig
+    converts with these and nowhere else.
+
+    Attributes
+    ----------
+    length_m, force_n, mass_kg : float
+    """
+
+    length_m: float
+    force_n: float
+    mass_kg: float
+
+    @property
+    def time_s(self) -> float:
+        """sqrt(m L_c / F_p)."""
+        return math.sqrt(self.mass_kg * self.length_m / self.force_n)
+
+    @property
+    def speed_m_s(self) -> float:
+        return self.length_m / self.time_s
+
+    @property
+    def acceleration_m_s2(self) -> float:
+        return self.force_n / self.mass_kg
+
+    @property
+    def stiffness_n_m(self) -> float:
+        return self.force_n / self.length_m
+
+
+@dataclass(frozen=True)
 class Scales:
     """The problem's scales, all in SI units; :meth:`for_surface` derives them.
 
@@ -205,6 +258,11 @@ class Scales:
     hfield_resolution : int or None
         Samples a side the hfield is resampled to (None: a grid keeps its own samples,
         an analytic surface gets :func:`spine_mj.surfaces.to_hfield`'s default).
+    slope_length_m : float or None
+        l_s, the slope correlation length [m] (:func:`slope_correlation_length`; L_c where
+        the surface has none, a plane); the length of the drive stiffness number K.
+    extent_m : float or None
+        Diagonal of the surface's domain [m] (bounds the energy a run can gain).
     """
 
     length_scale_m: float
@@ -214,6 +272,8 @@ class Scales:
     tip_radius_m: float
     hfield_spacing_m: float
     hfield_resolution: int | None = None
+    slope_length_m: float | None = None
+    extent_m: float | None = None
 
     @classmethod
     def for_surface(
@@ -228,11 +288,13 @@ class Scales:
         """The scales of ``tip`` on ``surface``: the one place the rig's sizing rules live.
 
         * ``length_scale_m``: None gives :data:`DEFAULT_LENGTH_SCALE_M` for a dimensionless
-          surface (``unit == "1"``) and 1 for one in metres.
+          surface (``unit == "1"``) and the unit's size (:data:`LENGTH_UNITS_M`) otherwise.
         * ``char_length_m``: None gives :func:`characteristic_length` in metres.
         * tip radius (when ``tip.tip_radius_m`` is None): the surface's own
-          ``metadata["params"]["tip_radius_m"]`` (sandpaper), else the larger of one hfield
-          spacing and ``L_c / 100``, to 3 significant digits.
+          ``metadata["params"]["tip_radius_m"]`` (sandpaper); for a measured scan (a grid
+          in a physical unit) the larger of two lateral spacings and ``L_c / 100`` (the
+          sphere rests on several facets, never in one pixel); else the larger of one
+          hfield spacing and ``L_c / 100``; to 3 significant digits.
         * hfield resolution: an hfield finer than a quarter tip radius is coarsened to that
           (MuJoCo keeps at most 50 contacts per geom pair: a tip over too many cells loses
           its deepest contacts).
@@ -240,38 +302,33 @@ class Scales:
         Raises
         ------
         SpineInputError
-            A surface in a unit other than "1" or "m", non-positive scales, or an hfield
-            coarser than two tip radii (the sphere would see single facets and their kinks).
+            A surface in an unknown unit, scales outside the physical range, a tip larger
+            than the surface, or an hfield coarser than two tip radii (the sphere would see
+            single facets and their kinks).
         """
         if not isinstance(surface, Surface):
             raise SpineInputError(f"surface must be a spine_mj Surface, got {type(surface).__name__}")
         tip = TipParams() if tip is None else tip
-        if surface.unit not in ("1", "m"):
-            raise SpineInputError(f"surface unit must be '1' (dimensionless) or 'm', got {surface.unit!r}")
-        if length_scale_m is None:
-            length_scale_m = DEFAULT_LENGTH_SCALE_M if surface.unit == "1" else 1.0
-        length_scale_m = check_positive("length_scale_m", length_scale_m)
+        length_scale_m = surface_unit_m(surface, length_scale_m)
         if char_length_m is None:
             char_length_m = characteristic_length(surface) * length_scale_m
-        char_length_m = check_positive("char_length_m", char_length_m)
-        resolution = hfield_resolution
-        hf = hfield_of(surface, resolution)
+        char_length_m = check_physical_length("char_length_m", char_length_m)
+        if hfield_resolution is not None and hfield_resolution > MAX_HFIELD_SIDE:
+            raise SpineInputError(
+                f"hfield_resolution must be <= {MAX_HFIELD_SIDE} samples a side, got {hfield_resolution}"
+            )
+        hf = hfield_of(surface, hfield_resolution)
         spacing = hfield_spacing(hf, length_scale_m)
         radius = tip.tip_radius_m
         if radius is None:
-            params = surface.metadata.get("params", {}) if isinstance(surface.metadata, dict) else {}
-            radius = params.get("tip_radius_m") if surface.unit == "m" else None
-            radius = float(radius) if radius else max(spacing, 0.01 * char_length_m)
-            radius = float(f"{radius:.3g}")
+            radius = default_tip_radius(surface, spacing, char_length_m)
+        xmin, xmax, ymin, ymax = (length_scale_m * b for b in surface.bounds)
+        _check_sizes(radius, spacing, char_length_m, min(xmax - xmin, ymax - ymin))
+        resolution = hfield_resolution
         if resolution is None and spacing < _MIN_SPACING_PER_TIP_RADIUS * radius:
             extent = 2 * max(hf.size[0], hf.size[1]) * length_scale_m
             resolution = math.ceil(extent / (_MIN_SPACING_PER_TIP_RADIUS * radius)) + 1
             spacing = hfield_spacing(hfield_of(surface, resolution), length_scale_m)
-        if spacing > 2 * radius * (1 + 1e-9):
-            raise SpineInputError(
-                f"surface too coarse for the tip: hfield spacing {spacing:.3g} m > 2 x tip_radius_m "
-                f"= {2 * radius:.3g} m; raise hfield_resolution or the tip radius"
-            )
         return cls(
             length_scale_m=length_scale_m,
             char_length_m=char_length_m,
@@ -280,7 +337,14 @@ class Scales:
             tip_radius_m=radius,
             hfield_spacing_m=spacing,
             hfield_resolution=resolution,
+            slope_length_m=_slope_length(surface, length_scale_m, char_length_m),
+            extent_m=math.hypot(xmax - xmin, ymax - ymin),
         )
+
+    @property
+    def units(self) -> EngineUnits:
+        """The engine's units: length L_c, force F_p, mass m."""
+        return EngineUnits(length_m=self.char_length_m, force_n=self.preload_n, mass_kg=self.mass_kg)
 
     @property
     def time_s(self) -> float:
@@ -300,6 +364,76 @@ class Scales:
         """The drive speed [m/s] of inertia number ``inertia_number`` (inverse of I_e)."""
         return math.sqrt(inertia_number) * self.speed_m_s
 
+    def stiffness_number(self, stiffness_n_m: float) -> float:
+        """K = k l_s / F_p (docs/physics.md §4), l_s the slope correlation length."""
+        return stiffness_n_m * self.slope_length_m / self.preload_n
+
+    def stiffness_for(self, stiffness_number: float) -> float:
+        """The spring stiffness [N/m] of drive stiffness number ``K`` (inverse of K)."""
+        return stiffness_number * self.preload_n / self.slope_length_m
+
+
+def surface_unit_m(surface: Surface, length_scale_m: float | None) -> float:
+    """Metres per surface length unit: ``length_scale_m``, else by the surface's unit."""
+    if surface.unit != "1" and surface.unit not in LENGTH_UNITS_M:
+        raise SpineInputError(
+            f"surface unit must be '1' (dimensionless) or a length unit {sorted(LENGTH_UNITS_M)}, "
+            f"got {surface.unit!r}"
+        )
+    if length_scale_m is None:
+        length_scale_m = DEFAULT_LENGTH_SCALE_M if surface.unit == "1" else LENGTH_UNITS_M[surface.unit]
+    return check_physical_length("length_scale_m", length_scale_m)
+
+
+def check_physical_length(name: str, value: float) -> float:
+    """``value`` [m] if it lies in :data:`PHYSICAL_LENGTH_M`, else :class:`SpineInputError`."""
+    value = check_positive(name, value)
+    lo, hi = PHYSICAL_LENGTH_M
+    if not lo <= value <= hi:
+        raise SpineInputError(
+            f"{name} must lie in [{lo:g}, {hi:g}] m (a rigid-sphere contact means nothing outside), "
+            f"got {value:g}"
+        )
+    return value
+
+
+def default_tip_radius(surface: Surface, spacing_m: float, char_length_m: float) -> float:
+    """The default tip radius [m] (rule in :meth:`Scales.for_surface`)."""
+    params = surface.metadata.get("params", {}) if isinstance(surface.metadata, dict) else {}
+    radius = params.get("tip_radius_m") if surface.unit != "1" else None
+    if radius:
+        return float(radius)
+    scan = isinstance(surface, GridSurface) and surface.unit != "1"
+    spacings = _SCAN_TIP_SPACINGS if scan else 1.0
+    return float(f"{max(spacings * spacing_m, 0.01 * char_length_m):.3g}")
+
+
+def _check_sizes(radius: float, spacing: float, char_length: float, span: float) -> None:
+    """Tip, hfield spacing and L_c against each other and the domain (all in metres)."""
+    if 2 * radius >= span:
+        raise SpineInputError(
+            f"tip_radius_m {radius:.3g} m is larger than the surface: its diameter must be "
+            f"smaller than the domain's width {span:.3g} m"
+        )
+    if min(radius, spacing) < _MIN_ENGINE_RATIO * char_length:
+        raise SpineInputError(
+            f"tip_radius_m {radius:.3g} m or hfield spacing {spacing:.3g} m is finer than the engine "
+            f"resolves: both must exceed {_MIN_ENGINE_RATIO:g} L_c = {_MIN_ENGINE_RATIO * char_length:.3g} m"
+        )
+    if spacing > 2 * radius * (1 + 1e-9):
+        raise SpineInputError(
+            f"surface too coarse for the tip: hfield spacing {spacing:.3g} m > 2 x tip_radius_m "
+            f"= {2 * radius:.3g} m; raise hfield_resolution or the tip radius"
+        )
+
+
+def _slope_length(surface: Surface, length_scale_m: float, char_length_m: float) -> float:
+    """l_s [m], or L_c for a surface without one (a plane)."""
+    try:
+        return slope_correlation_length(surface) * length_scale_m
+    except SpineInputError:
+        return char_length_m
+
 
 def hfield_of(surface: Surface, resolution: int | None = None) -> HField:
     """The surface as MuJoCo hfield data, resampled to ``resolution`` a side when given."""
@@ -313,17 +447,36 @@ def hfield_spacing(hfield: HField, length_scale_m: float = 1.0) -> float:
 
 
 def default_engine(scales: Scales, **overrides) -> EngineSettings:
-    """Engine settings derived from the problem's scales (rule in the module docstring).
+    """Engine settings derived from the problem's scales, by one rule in engine units.
 
-    ``dt = min(1 ms, sqrt(0.005 min(r_tip, L_c) m / F_p))``, ``solref = (2 dt, 1)``,
-    elliptic cone, 3 noslip iterations, ``impratio = 1``. ``overrides`` replace fields.
+    ``dt = sqrt(0.005 min(r_tip, L_c) / L_c) tau`` (``dt / tau`` rounded to 2 digits, so the
+    rule gives the same engine step at every physical scale): the resting depth of the
+    soft contact, ``(1 - dmax) a_p (2 dt)^2 = 0.04 a_p dt^2`` with ``a_p = F_p / m``, is
+    then ``2e-4 min(r_tip, L_c)``, well under 0.5 % of the tip radius. ``solref = (2 dt,
+    1)`` (the stiffest stable time constant, critically damped), ``solimp`` width 1 % of the
+    tip radius (no effect while ``dmin = dmax``), elliptic cone, 3 noslip iterations,
+    ``impratio = 1``. ``overrides`` replace fields (a ``timestep_s`` alone also sets
+    ``solref = (2 timestep_s, 1)``).
     """
-    length = min(scales.tip_radius_m, scales.char_length_m)
-    dt = math.sqrt(_REST_PENETRATION_FRACTION * length * scales.mass_kg / scales.preload_n)
-    dt = min(_MAX_TIMESTEP_S, dt)
-    dt = float(f"{dt:.2g}")
-    base = {"timestep_s": dt, "solref": (2 * dt, 1.0), "hfield_resolution": scales.hfield_resolution}
+    ratio = min(scales.tip_radius_m / scales.char_length_m, 1.0)
+    dt = float(f"{math.sqrt(_REST_PENETRATION_FRACTION * ratio):.2g}") * scales.time_s
+    base = {
+        "timestep_s": dt,
+        "solref": (2 * dt, 1.0),
+        "solimp": (0.99, 0.99, 0.01 * scales.tip_radius_m, 0.5, 2.0),
+        "hfield_resolution": scales.hfield_resolution,
+    }
     if "timestep_s" in overrides and "solref" not in overrides:
         base["solref"] = (2 * float(overrides["timestep_s"]), 1.0)
     base.update(overrides)
     return EngineSettings(**base)
+
+
+def penetration_tolerance_m(scales: Scales) -> float:
+    """Penetration [m] above which a run ends as engine trouble: ``min(0.1 r_tip, 0.01 L_c)``.
+
+    Beyond ~10 % of the tip radius the contacts of neighbouring facets tilt the normal by
+    tens of degrees (docs/physics.md §5); beyond 1 % of L_c the tip no longer follows the
+    surface it is meant to probe.
+    """
+    return min(0.1 * scales.tip_radius_m, 0.01 * scales.char_length_m)

@@ -27,10 +27,10 @@ class Placer:
         The tip geom's id.
     surface, hfield : Surface, HField
         The surface (its heights bracket the search) and its hfield.
-    length_scale_m, tip_radius_m : float
-        Metres per surface unit; the tip radius [m].
-    rest_depth_m : float
-        Depth of the soft contact at rest, subtracted from the touching height.
+    length_scale, tip_radius : float
+        Engine lengths per surface unit; the tip radius (engine units).
+    rest_depth : float
+        Depth of the soft contact at rest (engine units), subtracted from the touching height.
     """
 
     def __init__(
@@ -40,28 +40,28 @@ class Placer:
         geom_tip: int,
         surface: Surface,
         hfield: HField,
-        length_scale_m: float,
-        tip_radius_m: float,
-        rest_depth_m: float,
+        length_scale: float,
+        tip_radius: float,
+        rest_depth: float,
     ):
         import mujoco
 
         self.model = model
         pm = copy.copy(model)
-        pm.geom_margin[geom_tip] = 0.2 * tip_radius_m  # few contacts, but a gap above the surface
+        pm.geom_margin[geom_tip] = 0.2 * tip_radius  # few contacts, but a gap above the surface
         self._m, self._d = pm, mujoco.MjData(pm)
         self._surface, self._hfield = surface, hfield
-        self._s, self._r = length_scale_m, tip_radius_m
-        self._rest_depth_m = rest_depth_m
+        self._s, self._r = length_scale, tip_radius
+        self._rest_depth = rest_depth
         self._placed: dict[tuple[float, float], np.ndarray] = {}
 
     def place(self, x0: float, y0: float) -> np.ndarray:
-        """qpos ``(3,)`` [m] with the tip resting on the hfield at ``(x0, y0)`` (surface units)."""
+        """qpos ``(3,)`` (engine units) with the tip resting on the hfield at ``(x0, y0)`` (surface units)."""
         placed = self._placed
         if (x0, y0) in placed:  # the search is deterministic: a start seen before is reused
             return placed[(x0, y0)].copy()
         s = self._s
-        z = self._touching_z(x0, y0) - self._rest_depth_m
+        z = self._touching_z(x0, y0) - self._rest_depth
         qpos = np.array([x0 * s, y0 * s, z])
         if len(placed) >= PLACE_CACHE_SIZE:
             placed.pop(next(iter(placed)))
@@ -82,7 +82,7 @@ class Placer:
         return float(d.contact.dist[k]), abs(float(d.contact.frame[k, 2]))
 
     def _touching_z(self, x0: float, y0: float) -> float:
-        """Height [m] of the sphere centre touching the hfield (distance within 1e-7 radii)."""
+        """Height (engine units) of the sphere centre touching the hfield (distance within 1e-7 radii)."""
         s, r = self._s, self._r
         _, _, elev, _ = self._hfield.size
         hi = (self._hfield.pos[2] + elev) * s + 2 * r

@@ -91,12 +91,13 @@ def run_ramp(
 
     det = (Detection() if detection is None else detection).resolve(rig.scales)
     start = tuple(float(v) for v in start)
+    u = rig.units  # the model is in engine units (spine_mj.sim.params.EngineUnits)
     qpos0 = rig.place(*start)
     m = rig.model_for(drive)
     d = mujoco.MjData(m)
     d.qpos[:] = qpos0
-    d.ctrl[rig.act_preload] = -rig.tip.preload_n
-    d.mocap_pos[0] = qpos0 + np.array([0.0, 0.0, 2 * rig.tip.tip_radius_m])
+    d.ctrl[rig.act_preload] = -rig.tip.preload_n / u.force_n
+    d.mocap_pos[0] = qpos0 + np.array([0.0, 0.0, 2 * rig.tip.tip_radius_m / u.length_m])
     dt = rig.engine.timestep_s
     rate = rate_n_s(drive, rig.scales)
     cap = det.kappa_cap * rig.scales.preload_n
@@ -111,11 +112,11 @@ def run_ramp(
     ctrl_log = np.zeros((nstep, 6))
     slide = 0.01 * rig.scales.char_length_m if drive.slide_distance_m is None else drive.slide_distance_m
     ctl = ResetController(
-        step_n=rate * dt,
-        cap_n=cap * (1 + 1e-9),
-        slide_distance_m=slide,
+        step_n=rate * dt / u.force_n,
+        cap_n=cap * (1 + 1e-9) / u.force_n,
+        slide_distance_m=slide / u.length_m,
         settle_steps=n_settle,
-        slip_speed_m_s=det.slip_speed_m_s,
+        slip_speed_m_s=det.slip_speed_m_s / u.speed_m_s,
         sensor_adr=rig.sensor_adr,
     )
     stop, warn_total, warn_at = nstep, warning_total(d), None

@@ -4,7 +4,9 @@
 runs of equal length) under the names :class:`~spine_mj.sim.RunResult` gives them, plus
 the tangential speed the stick/slip states come from. It is built once per group from the
 rollout's state and sensordata (:meth:`Recording.from_sensors`) and passed whole to the
-event detection and to the result, instead of a dozen loose arrays.
+event detection and to the result, instead of a dozen loose arrays. MuJoCo's numbers are
+in engine units (:class:`~spine_mj.sim.params.EngineUnits`); :meth:`Recording.from_sensors`
+is the one place they become SI.
 """
 
 from __future__ import annotations
@@ -13,6 +15,8 @@ import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
+
+from spine_mj.sim.params import EngineUnits
 
 SENSOR_NAMES = ("tip_pos", "tip_vel", "contact_net", "contact_deepest", "spring_force", "push_force")
 
@@ -52,20 +56,22 @@ class Recording:
         state: np.ndarray,
         sens: np.ndarray,
         *,
-        carriage_x_m: np.ndarray,
+        units: EngineUnits,
+        carriage_x: np.ndarray,
         slip_speed_m_s: float,
     ) -> Recording:
-        """The recording of a group: ``state`` ``(g, n, nstate)``, ``sens`` ``(g, n, nsensordata)``.
+        """The recording of a group in SI: ``state`` ``(g, n, nstate)``, ``sens`` ``(g, n,
+        nsensordata)`` and the carriage ``carriage_x`` ``(g, n)`` in engine ``units``.
 
         The columns are computed for the whole group in one pass (the same arithmetic per
-        row as one run at a time); ``carriage_x_m`` ``(g, n)``; a step slips when its
-        tangential speed exceeds ``slip_speed_m_s``.
+        row as one run at a time); a step slips when its tangential speed exceeds
+        ``slip_speed_m_s``.
         """
         g, n = state.shape[:2]
         cols = sensor_columns(sensor_adr, state.reshape(g * n, -1), sens.reshape(g * n, -1))
-        cols = {k: c.reshape(g, n, *c.shape[1:]) for k, c in cols.items()}
+        cols = {k: to_si(k, c, units).reshape(g, n, *c.shape[1:]) for k, c in cols.items()}
         slipping = cols["tangential_speed_m_s"] > slip_speed_m_s
-        return cls(**cols, carriage_x_m=carriage_x_m, slipping=slipping)
+        return cls(**cols, carriage_x_m=carriage_x * units.length_m, slipping=slipping)
 
     def run(self, r: int) -> Recording:
         """Run ``r`` of a group (views of the group's columns)."""
@@ -121,6 +127,20 @@ def sensor_columns(sensor_adr: dict[str, int], state: np.ndarray, sens: np.ndarr
         "drive_force_n": drive_f,
         "tangential_speed_m_s": _norm3(vt),
     }
+
+
+def to_si(name: str, column: np.ndarray, units: EngineUnits) -> np.ndarray:
+    """A column of :func:`sensor_columns` converted from engine units to SI, by its name's unit."""
+    unit = {
+        "_s": units.time_s,
+        "_m": units.length_m,
+        "_m_s": units.speed_m_s,
+        "_n": units.force_n,
+    }
+    for suffix in ("_m_s", "_s", "_m", "_n"):
+        if name.endswith(suffix):
+            return column * unit[suffix] if column.dtype.kind == "f" else column
+    return column
 
 
 def _norm3(v: np.ndarray) -> np.ndarray:

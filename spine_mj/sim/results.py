@@ -27,7 +27,7 @@ from spine_mj.sim.detection import (
     probe_candidates,
     slip_events,
 )
-from spine_mj.sim.drives import Drive, SpringDrive, StaticProbe, settle_steps
+from spine_mj.sim.drives import Drive, SpringDrive, StaticProbe, settle_steps, stiffness_n_m
 from spine_mj.sim.model import RigModel
 from spine_mj.sim.params import EndReason, EngineSettings, Scales, TipParams
 from spine_mj.sim.recording import Recording
@@ -61,6 +61,10 @@ class RunResult:
     events : tuple of Event
     end_reason : EndReason
     end_detail : str
+        What ended the run, with its numbers.
+    engine_trouble : str
+        For ENGINE_TROUBLE the kind (``nan``, ``engine_warning``, ``penetration`` or
+        ``diverged``; :data:`~spine_mj.sim.detection.TROUBLES`), else "".
     drive_start_index : int
         First row after the settle phase.
     kappa_mj : float
@@ -69,6 +73,8 @@ class RunResult:
         Drive force / F_p at each slip onset after the settle phase.
     inertia_number, speed_m_s : float
         I_e and the speed (or equivalent speed) it uses.
+    stiffness_number, stiffness_n_m : float
+        K = k l_s / F_p and the spring's stiffness k (0 for force drives).
     start : (x0, y0)
         Start in surface units.
     """
@@ -88,11 +94,14 @@ class RunResult:
     events: tuple[Event, ...]
     end_reason: EndReason
     end_detail: str
+    engine_trouble: str
     drive_start_index: int
     kappa_mj: float
     slip_kappas: np.ndarray
     inertia_number: float
     speed_m_s: float
+    stiffness_number: float
+    stiffness_n_m: float
     start: tuple[float, float]
     drive: Drive
     tip: TipParams
@@ -141,11 +150,17 @@ class RunResult:
             "start": list(self.start),
             "end_reason": self.end_reason.value,
             "end_detail": self.end_detail,
+            "engine_trouble": self.engine_trouble,
             "end_time_s": float(self.time_s[-1]) if self.n else 0.0,
             "kappa_mj": None if math.isnan(self.kappa_mj) else self.kappa_mj,
             "slip_kappas": self.slip_kappas.tolist(),
             "inertia_number": self.inertia_number,
             "speed_m_s": self.speed_m_s,
+            "stiffness_number_K": self.stiffness_number,
+            "stiffness_n_m": self.stiffness_n_m,
+            "slope_length_m": self.scales.slope_length_m,
+            "char_length_m": self.scales.char_length_m,
+            "engine_units": enc(self.scales.units),
             "n_slip_onsets": sum(e.kind == "slip_onset" for e in self.events),
             "max_penetration_m": float(self.penetration_m.max()) if self.n else 0.0,
         }
@@ -183,10 +198,18 @@ def analyse_group(
         ]
     )
     group = Recording.from_sensors(
-        rig.sensor_adr, state, sens, carriage_x_m=carriage, slip_speed_m_s=det.slip_speed_m_s
+        rig.sensor_adr, state, sens, units=rig.units, carriage_x=carriage, slip_speed_m_s=det.slip_speed_m_s
     )
+    limits = np.array([det.speed_limit_m_s(rig.scales, rig.speed_of(d)) for d in drives])
     marks = end_marks(
-        group, state, sens, timestep_s=rig.engine.timestep_s, bounds_m=rig.bounds_m, det=det, preload_n=fp
+        group,
+        state,
+        sens,
+        timestep_s=rig.engine.timestep_s,
+        bounds_m=(*rig.bounds_m, *rig.z_range_m),
+        det=det,
+        preload_n=fp,
+        speed_limit_m_s=limits,
     )
     results = []
     for r, drive in enumerate(drives):
@@ -224,16 +247,20 @@ def _run_result(
         f.name: getattr(rec, f.name) for f in dataclasses.fields(rec) if f.name != "tangential_speed_m_s"
     }
     speed = rig.speed_of(drive)
+    k = stiffness_n_m(drive, rig.scales) if isinstance(drive, SpringDrive) else 0.0
     return RunResult(
         **arrays,
         events=tuple(events),
         end_reason=ending.reason,
         end_detail=ending.detail,
+        engine_trouble=ending.trouble,
         drive_start_index=n_settle,
         kappa_mj=kappa_mj,
         slip_kappas=np.array([rec.drive_force_n[i] / rig.scales.preload_n for i in onsets]),
         inertia_number=rig.scales.inertia_number(speed),
         speed_m_s=speed,
+        stiffness_number=rig.scales.stiffness_number(k),
+        stiffness_n_m=k,
         start=tuple(start),
         drive=drive,
         tip=rig.tip,

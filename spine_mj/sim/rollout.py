@@ -55,31 +55,32 @@ def drive_steps(rig: RigModel, drive: Drive, x0_m: float, detection: Detection) 
 
 
 def controls(rig: RigModel, drive: Drive, qpos0: np.ndarray, detection: Detection) -> np.ndarray:
-    """Open-loop controls ``(nstep, 6)``: ctrl (spring, push, preload) then mocap xyz.
+    """Open-loop controls ``(nstep, 6)`` in engine units: ctrl (spring, push, preload) then mocap xyz.
 
-    ``qpos0`` is the placed start (:meth:`RigModel.place`), ``detection`` resolved
-    (:meth:`Detection.resolve`): its ``kappa_cap`` bounds a probe's force.
+    ``qpos0`` is the placed start (:meth:`RigModel.place`, engine units), ``detection``
+    resolved (:meth:`Detection.resolve`): its ``kappa_cap`` bounds a probe's force.
     """
+    u = rig.units
     dt = rig.engine.timestep_s
     n_settle = settle_steps(drive, dt)
-    cap = detection.kappa_cap * rig.scales.preload_n
-    n_drive = drive_steps(rig, drive, qpos0[0], detection)
+    cap = detection.kappa_cap * rig.scales.preload_n / u.force_n
+    n_drive = drive_steps(rig, drive, qpos0[0] * u.length_m, detection)
     n = n_settle + n_drive
     ctrl = np.zeros((n, 6))
-    ctrl[:, 2] = -rig.tip.preload_n
+    ctrl[:, 2] = -rig.tip.preload_n / u.force_n
     ctrl[:, 3] = qpos0[0]
     ctrl[:, 4] = qpos0[1]
-    ctrl[:, 5] = qpos0[2] + 2 * rig.tip.tip_radius_m
-    ramp_t = dt * np.arange(1, n_drive + 1)
+    ctrl[:, 5] = qpos0[2] + 2 * rig.tip.tip_radius_m / u.length_m
+    ramp_t = (dt / u.time_s) * np.arange(1, n_drive + 1)
     if isinstance(drive, SpringDrive):
         ctrl[:, 0] = qpos0[0]
-        ctrl[n_settle:, 0] = qpos0[0] + drive.speed_m_s * ramp_t
+        ctrl[n_settle:, 0] = qpos0[0] + (drive.speed_m_s / u.speed_m_s) * ramp_t
         ctrl[:, 3] = ctrl[:, 0]
     else:
-        ctrl[:, 1] = drive.start_force_n
-        ctrl[n_settle:, 1] = np.minimum(
-            drive.start_force_n + rate_n_s(drive, rig.scales) * ramp_t, cap * (1 + 1e-9)
-        )
+        f0 = drive.start_force_n / u.force_n
+        ctrl[:, 1] = f0
+        rate = rate_n_s(drive, rig.scales) * u.time_s / u.force_n
+        ctrl[n_settle:, 1] = np.minimum(f0 + rate * ramp_t, cap * (1 + 1e-9))
     return ctrl
 
 

@@ -50,7 +50,17 @@ MUJOCO_PARAMS = (
     ParamSpec(
         "stiffness",
         "float",
-        "spring stiffness [N/m] (default 10 F_p / L_c)",
+        "spring stiffness [N/m] (instead of K; default 10 F_p / L_c)",
+        None,
+        0.0,
+        exclusive=True,
+        drive=True,
+    ),
+    ParamSpec(
+        "K",
+        "float",
+        "drive stiffness number K = k l_s / F_p, l_s the slope correlation length "
+        "(spring; instead of stiffness)",
         None,
         0.0,
         exclusive=True,
@@ -124,12 +134,12 @@ MUJOCO_PARAMS = (
 
 def _check_speed(config) -> None:
     grid = dict(config.grid)
-    if grid["ie"] != (None,) and grid["speed"] != (None,):
-        raise SpineInputError(
-            "config keys grid.ie and grid.speed: give one of them (the "
-            f"inertia number or the speed), got ie = {list(grid['ie'])} and "
-            f"speed = {list(grid['speed'])}"
-        )
+    for a, b, what in (("ie", "speed", "the inertia number or the speed"), ("K", "stiffness", "K or k")):
+        if grid[a] != (None,) and grid[b] != (None,):
+            raise SpineInputError(
+                f"config keys grid.{a} and grid.{b}: give one of them ({what}), got "
+                f"{a} = {list(grid[a])} and {b} = {list(grid[b])}"
+            )
 
 
 @functools.lru_cache(maxsize=4)
@@ -180,13 +190,9 @@ def _mujoco(case, surface, starts, upstream):
     p = case.params
     rig = case_rig(case, surface)
     runs = _runs(rig, p, starts)
-    n = len(runs)
-    status = np.full(n, "ok", dtype=object)
+    # engine trouble is named by its kind: nan, engine_warning, penetration or diverged
+    status = np.array([r.engine_trouble or "ok" for r in runs], dtype=object)
     reason = np.array([r.end_detail for r in runs], dtype=object)
-    for i, r in enumerate(runs):
-        if r.end_reason is sim.EndReason.ENGINE_TROUBLE:
-            warned = "warning" in r.end_detail or "reset" in r.end_detail
-            status[i] = "engine_warning" if warned else "diverged"
     traj = _trajectories(runs, rig.length_scale_m, p["record_every"])
     return AnalysisResult(
         metrics=_metrics(rig, runs), trajectories=traj, status=status, reason=reason, data=(rig, runs)
@@ -232,10 +238,11 @@ def _runs(rig, p: dict, starts) -> list:
     rate = speed * sc.preload_n / sc.char_length_m
     det = sim.Detection(kappa_cap=p["kappa_cap"])
     pts = [tuple(s) for s in starts]
+    stiffness = p["stiffness"] if p["K"] is None else sc.stiffness_for(p["K"])
     if p["protocol"] == "spring":
         drive = sim.SpringDrive(
             speed_m_s=speed,
-            stiffness_n_m=p["stiffness"],
+            stiffness_n_m=stiffness,
             duration_s=p["duration"],
             settle_time_s=p["settle_time"],
         )
@@ -287,6 +294,9 @@ def _metrics(rig, runs) -> dict[str, np.ndarray]:
         "n_steps": np.array([r.n for r in runs], dtype=np.int64),
         "inertia_number": np.array([r.inertia_number for r in runs]),
         "speed_m_s": np.array([r.speed_m_s for r in runs]),
+        "stiffness_number": np.array([r.stiffness_number for r in runs]),
+        "stiffness_n_m": np.array([r.stiffness_n_m for r in runs]),
+        "slope_length": np.full(n, sc.slope_length_m / s),
         "max_drive_over_fp": np.array([peak_drive_over_fp(r, sc.preload_n) for r in runs]),
         "n_slip_onsets": np.array(
             [sum(e.kind == "slip_onset" for e in r.events) for r in runs], dtype=np.int64
