@@ -19,22 +19,24 @@ def render_frames(
     renderer = mujoco.Renderer(m, height=height, width=width)
     cam = mujoco.MjvCamera()
     cam.type = mujoco.mjtCamera.mjCAMERA_FREE
-    span = max(rig.bounds_m[1] - rig.bounds_m[0], rig.bounds_m[3] - rig.bounds_m[2])
+    to_engine = 1.0 / rig.units.length_m
+    span = max(rig.bounds_m[1] - rig.bounds_m[0], rig.bounds_m[3] - rig.bounds_m[2]) * to_engine
     cam.distance = 0.9 * span
     cam.elevation = -35.0
     cam.azimuth = 120.0
     stride = max(1, int(round(1.0 / (fps * rig.engine.timestep_s))))
     try:
         for i in range(0, result.n, stride):
-            d.qpos[:] = result.position_m[i]
+            pos = result.position_m[i] * to_engine
+            d.qpos[:] = pos
             if not math.isnan(result.carriage_x_m[i]):
                 d.mocap_pos[0] = (
-                    result.carriage_x_m[i],
-                    result.position_m[i, 1],
-                    result.position_m[i, 2] + 2 * rig.tip.tip_radius_m,
+                    result.carriage_x_m[i] * to_engine,
+                    pos[1],
+                    pos[2] + 2 * rig.tip.tip_radius_m * to_engine,
                 )
             mujoco.mj_forward(m, d)
-            cam.lookat[:] = result.position_m[i]
+            cam.lookat[:] = pos
             renderer.update_scene(d, camera=cam)
             yield renderer.render().copy()
     finally:

@@ -19,9 +19,20 @@ import numpy as np
 from spine_mj.errors import SpineInputError
 
 #: Row statuses. ``ok``; ``failed`` (an exception in the analysis); ``bad_surface`` (the
-#: surface could not be made or loaded); ``diverged`` and ``engine_warning`` (MuJoCo);
-#: ``dependency_failed`` (an analysis this one needs did not give a result for the start).
-STATUSES = ("ok", "failed", "bad_surface", "diverged", "engine_warning", "dependency_failed")
+#: surface could not be made or loaded); MuJoCo trouble by kind: ``nan`` (a non-finite
+#: state), ``penetration`` (deeper than the tolerance), ``diverged`` (a speed or position
+#: blow-up), ``engine_warning`` (a MuJoCo warning); ``dependency_failed`` (an analysis this
+#: one needs did not give a result for the start).
+STATUSES = (
+    "ok",
+    "failed",
+    "bad_surface",
+    "nan",
+    "penetration",
+    "diverged",
+    "engine_warning",
+    "dependency_failed",
+)
 
 
 #: Columns of the run table that every run has; no parameter or metric may take these names.
