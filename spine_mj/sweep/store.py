@@ -24,6 +24,7 @@ import os
 import shutil
 import subprocess
 import sys
+import threading
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -222,18 +223,38 @@ def consolidate(out_dir: str | os.PathLike):
     return table
 
 
+_HELD: set[str] = set()
+_HELD_GUARD = threading.Lock()
+
+
 @contextlib.contextmanager
 def store_lock(out_dir: Path):
-    """Exclusive lock on the store for one sweep at a time (released by the OS on a kill)."""
-    with open(out_dir / LOCK, "w") as fh:
-        try:
-            fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            raise SpineInputError(f"--out {out_dir}: another sweep is writing to it") from None
-        try:
-            yield
-        finally:
-            fcntl.flock(fh, fcntl.LOCK_UN)
+    """Exclusive lock on the store for one sweep at a time.
+
+    A POSIX record lock (``lockf``): it belongs to this process alone, so worker processes
+    forked while it is held do not hold it, and the OS releases it the moment this process
+    ends, however it ends; a resume after a kill starts at once. Record locks do not
+    exclude within one process, so the stores locked here are also kept in a set.
+    """
+    key = str(out_dir.resolve())
+    busy = SpineInputError(f"--out {out_dir}: another sweep is writing to it")
+    with _HELD_GUARD:
+        if key in _HELD:
+            raise busy
+        _HELD.add(key)
+    try:
+        with open(out_dir / LOCK, "a") as fh:
+            try:
+                fcntl.lockf(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except OSError:
+                raise busy from None
+            try:
+                yield
+            finally:
+                fcntl.lockf(fh, fcntl.LOCK_UN)
+    finally:
+        with _HELD_GUARD:
+            _HELD.discard(key)
 
 
 @dataclass(frozen=True)
