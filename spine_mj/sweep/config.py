@@ -543,6 +543,44 @@ def _freeze(value):
     return value
 
 
+def input_digests(config: SweepConfig) -> dict[str, str]:
+    """sha256 of every input of ``config`` beyond its text: the contents of each surface
+    file, and the resolved preset (generator, parameters, seed, [engagement] and other
+    tables; the contents of a measured preset's file). Keyed ``file:<path>`` /
+    ``preset:<name>``; a store resumes only while these are unchanged."""
+    out = {}
+    for spec in config.surfaces:
+        key = f"{spec.kind}:{spec.source}"
+        if key in out:
+            continue
+        if spec.kind == "file":
+            out[key] = _file_digest(Path(spec.source))
+            continue
+        preset = presets.load_preset(spec.source)
+        resolved = {
+            "generator": preset.generator,
+            "params": to_jsonable(preset.params),
+            "seed": preset.seed,
+            "extras": to_jsonable(preset.extras),
+        }
+        measured = preset.params.get("file") if preset.generator == "measured" else None
+        if isinstance(measured, str) and Path(measured).is_file():
+            resolved["file_sha256"] = _file_digest(Path(measured))
+        out[key] = digest(resolved)
+    return out
+
+
+def _file_digest(path: Path) -> str:
+    h = hashlib.sha256()
+    try:
+        with open(path, "rb") as fh:
+            for block in iter(lambda: fh.read(1 << 20), b""):
+                h.update(block)
+    except OSError as exc:
+        raise SpineInputError(f"surface file {str(path)!r} cannot be read: {exc.strerror or exc}") from None
+    return h.hexdigest()
+
+
 def digest(obj) -> str:
     """sha256 (hex) of ``obj`` as canonical JSON (sorted keys): config hashes and case ids."""
     text = json.dumps(obj, sort_keys=True, separators=(",", ":"), allow_nan=True)

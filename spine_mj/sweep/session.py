@@ -24,6 +24,7 @@ from spine_mj.sweep.config import SweepConfig, load_config
 from spine_mj.sweep.executors import run_dask, run_here, run_processes
 from spine_mj.sweep.store import (
     consolidate,
+    corrupt_cases,
     finished_cases,
     git_commit,
     prepare_store,
@@ -75,6 +76,8 @@ class SweepSummary:
         Local worker processes (None for a Dask scheduler).
     status_counts : dict of str to int
         Whole store (including earlier sessions).
+    rerun_corrupt : tuple of str
+        Cases whose stored rows could not be read, run again in this session.
     """
 
     out_dir: Path
@@ -88,6 +91,7 @@ class SweepSummary:
     elapsed_s: float
     workers: int | None
     status_counts: dict[str, int]
+    rerun_corrupt: tuple[str, ...] = ()
 
 
 def run_sweep(
@@ -165,6 +169,8 @@ def _run_locked(
 ) -> SweepSummary:
     prepare_store(config, cases, out_dir, overwrite=overwrite, session=session)
     remove_temporaries(out_dir)
+    corrupt = corrupt_cases(out_dir)
+    reopen_cases(out_dir, corrupt)  # unreadable: run again
     done = _done_cases(out_dir, retry_failed)
     todo = [c for c in cases if c.case_id not in done]
     skipped = len(cases) - len(todo)
@@ -216,6 +222,7 @@ def _run_locked(
         elapsed_s=time.perf_counter() - t0,
         workers=n_workers,
         status_counts=status_counts,
+        rerun_corrupt=tuple(corrupt),
     )
 
 
