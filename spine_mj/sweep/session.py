@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import datetime
 import os
+import re
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -17,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 import pyarrow.compute as pc
+from distributed import Client
 
 from spine_mj.errors import SpineInputError
 from spine_mj.sweep.cases import expand_cases, longest_first
@@ -135,8 +137,8 @@ def run_sweep(
     """
     if not isinstance(config, SweepConfig):
         config = load_config(config)
-    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
-        raise SpineInputError(f"workers must be an integer >= 1, got {workers!r}")
+    if workers is not None:
+        check_workers(workers)
     out_dir = Path(out_dir)
     if out_dir.exists() and not out_dir.is_dir():
         raise SpineInputError(f"--out {out_dir} exists and is not a folder")
@@ -149,19 +151,62 @@ def run_sweep(
         "versions": versions(),
         "git": git_commit(),
     }
-    out_dir.mkdir(parents=True, exist_ok=True)
-    with store_lock(out_dir):
-        return _run_locked(
-            config,
-            cases,
-            out_dir,
-            session,
-            n_workers=n_workers,
-            scheduler=scheduler,
-            overwrite=overwrite,
-            retry_failed=retry_failed,
-            progress=progress,
+    client = None if scheduler is None else connect(scheduler)  # before anything is written
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+        with store_lock(out_dir):
+            return _run_locked(
+                config,
+                cases,
+                out_dir,
+                session,
+                n_workers=n_workers,
+                scheduler=client,
+                overwrite=overwrite,
+                retry_failed=retry_failed,
+                progress=progress,
+            )
+    finally:
+        if client is not None and client is not scheduler:
+            client.close()
+
+
+#: Local worker processes allowed per core (more only cost memory: ~300 MB each).
+MAX_WORKERS_PER_CORE = 4
+
+
+def check_workers(workers) -> int:
+    """``workers`` if it is an integer from 1 to :data:`MAX_WORKERS_PER_CORE` per core."""
+    cores = os.cpu_count() or 1
+    limit = MAX_WORKERS_PER_CORE * cores
+    if isinstance(workers, bool) or not isinstance(workers, int) or not 1 <= workers <= limit:
+        raise SpineInputError(
+            f"--workers: must be an integer from 1 to {limit} ({MAX_WORKERS_PER_CORE} per core "
+            f"on {cores} cores), got {workers!r}"
         )
+    return workers
+
+
+_ADDRESS = re.compile(r"^((tcp|tls|ucx|ws|wss)://)?[A-Za-z0-9._-]+(:[0-9]{1,5})?$|^inproc://\S+$")
+
+
+def connect(scheduler):
+    """A client of the Dask scheduler ``scheduler`` (an address, or a connected client,
+    returned as is); SpineInputError for a malformed or unreachable address."""
+    if isinstance(scheduler, Client):
+        return scheduler
+    if not isinstance(scheduler, str) or not _ADDRESS.match(scheduler):
+        raise SpineInputError(
+            f"--scheduler: must be a Dask scheduler address like tcp://host:8786, got {scheduler!r}"
+        )
+    try:
+        return Client(scheduler, timeout=CONNECT_TIMEOUT_S)
+    except (OSError, TimeoutError, ValueError) as exc:
+        raise SpineInputError(f"--scheduler {scheduler}: cannot connect ({exc})") from None
+
+
+#: Seconds to wait for a Dask scheduler to answer.
+CONNECT_TIMEOUT_S = 10
 
 
 def _run_locked(
