@@ -11,6 +11,7 @@ config hash, and so the resume of a store, covers.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import functools
 import hashlib
@@ -80,8 +81,14 @@ class SurfaceSpec:
         }
 
     def make(self):
-        """Build the surface (cached per process)."""
-        return _make_surface(self)
+        """Build the surface (cached per process; a file's cache entry lasts while its size
+        and modification time do)."""
+        stamp = None
+        if self.kind == "file":
+            with contextlib.suppress(OSError):
+                st = os.stat(self.source)
+                stamp = (st.st_mtime_ns, st.st_size)
+        return _make_surface(self, stamp)
 
 
 @dataclass(frozen=True)
@@ -643,7 +650,7 @@ def digest(obj) -> str:
 
 
 @functools.lru_cache(maxsize=8)
-def _make_surface(spec: SurfaceSpec):
+def _make_surface(spec: SurfaceSpec, stamp=None):
     if spec.kind == "file":
         path = Path(spec.source)
         if path.suffix == ".npz":

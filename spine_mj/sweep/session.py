@@ -21,8 +21,10 @@ import pyarrow.compute as pc
 from distributed import Client
 
 from spine_mj.errors import SpineInputError
+from spine_mj.sweep.analyses import quasistatic
+from spine_mj.sweep.analyses.mujoco import case_rig
 from spine_mj.sweep.cases import expand_cases, longest_first
-from spine_mj.sweep.config import SweepConfig, load_config
+from spine_mj.sweep.config import SweepConfig, _make_surface, load_config
 from spine_mj.sweep.executors import run_dask, run_here, run_processes
 from spine_mj.sweep.store import (
     consolidate,
@@ -152,6 +154,7 @@ def run_sweep(
         "git": git_commit(),
     }
     client = None if scheduler is None else connect(scheduler)  # before anything is written
+    clear_caches()
     try:
         out_dir.mkdir(parents=True, exist_ok=True)
         with store_lock(out_dir):
@@ -169,6 +172,14 @@ def run_sweep(
     finally:
         if client is not None and client is not scheduler:
             client.close()
+
+
+def clear_caches() -> None:
+    """Forget the surfaces and rigs this process built: a session reads its inputs afresh
+    (a preset edited since an earlier session in this process is read again)."""
+    _make_surface.cache_clear()
+    quasistatic.clear_cache()
+    case_rig.cache_clear()
 
 
 #: Local worker processes allowed per core (more only cost memory: ~300 MB each).

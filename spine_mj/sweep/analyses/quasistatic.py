@@ -41,6 +41,11 @@ def _dilated(spec, radius: float):
     return sl.dilate(spec.make(), radius)
 
 
+def clear_cache() -> None:
+    """Forget the dilated surfaces built in this process."""
+    _dilated.cache_clear()
+
+
 def _quasistatic(case, surface, starts, upstream):
     p = case.params
     if p["tip_radius"] > 0:
