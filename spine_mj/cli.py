@@ -328,6 +328,15 @@ class _SweepGroup(_Group):
             args = ["run", *args]
         return super().parse_args(ctx, args)
 
+    def format_options(self, ctx, formatter):
+        """The group's help lists the options of `sweep run`, the command it runs by default."""
+        super().format_options(ctx, formatter)
+        run = self.commands["run"]
+        opts = [p for p in run.params if isinstance(p, click.Option)]
+        records = [r for r in (p.get_help_record(ctx) for p in opts) if r]
+        with formatter.section("Options of `sweep CONFIG.toml` (sweep run)"):
+            formatter.write_dl(records)
+
 
 @main.group(cls=_SweepGroup)
 def sweep():
@@ -352,12 +361,20 @@ def sweep():
     help="Result store folder (resumed if it holds this config's sweep).",
 )
 @click.option(
-    "--workers", type=click.IntRange(min=1), default=None, help="Local worker processes [default: all cores]."
+    "--workers",
+    type=click.IntRange(min=1),
+    default=None,
+    help="Local worker processes [default: all cores; at most 4 per core].",
 )
 @click.option(
     "--scheduler", metavar="ADDRESS", help="Run on a Dask distributed cluster (e.g. tcp://head:8786)."
 )
-@click.option("--overwrite", is_flag=True, help="Replace a store in --out that holds another config's sweep.")
+@click.option(
+    "--overwrite",
+    is_flag=True,
+    help="Replace a store in --out that holds another config's sweep or one computed on changed "
+    "inputs (removes only the files the store wrote).",
+)
 @click.option("--retry-failed", is_flag=True, help="Run again the cases with failed runs.")
 @click.option("--quiet", is_flag=True, help="No progress bar.")
 def sweep_run(config, out_dir, workers, scheduler, overwrite, retry_failed, quiet):
@@ -380,6 +397,12 @@ def sweep_run(config, out_dir, workers, scheduler, overwrite, retry_failed, quie
             progress=lambda p: bar.update(
                 p.finished_cases + p.skipped_cases, p.total_cases, ok=p.ok_runs, failed=p.failed_runs
             ),
+        )
+    if summary.rerun_corrupt:
+        click.echo(
+            f"ran again {len(summary.rerun_corrupt)} case(s) whose stored rows could not be read: "
+            + ", ".join(summary.rerun_corrupt[:10])
+            + (" ..." if len(summary.rerun_corrupt) > 10 else "")
         )
     where = (
         f"scheduler {scheduler}"
@@ -423,6 +446,11 @@ def sweep_status(out_dir):
     )
     for status, n in sorted(st.status_counts.items()):
         click.echo(f"  {status:18s} {n}")
+    if st.corrupt_cases:
+        click.echo(
+            f"corrupt case files ({len(st.corrupt_cases)}, run again by a resume): "
+            + ", ".join(f"runs/{c}.parquet" for c in st.corrupt_cases)
+        )
 
 
 @main.command("report")

@@ -19,7 +19,10 @@ from spine_mj.errors import SpineInputError
         (with_(sweep__analyses=["compare"]), r"sweep.analyses: 'compare' needs"),
         (with_(sweep__seed=-1), r"sweep.seed: must be a non-negative integer, got -1"),
         (with_(grid__mu=-0.5), r"grid.mu: must be a finite number > 0 .*got -0.5"),
-        (with_(grid__mu=None), r"grid.mu: required by analyses \['quasistatic'\]"),
+        (
+            with_(grid__mu=None, surfaces=[{"preset": "sandpaper-P60"}]),
+            r"grid.mu: required by analyses \['quasistatic'\].*sandpaper-P60 has no calibrated mu",
+        ),
         (with_(grid__mu=[0.5, 0.5]), r"grid.mu: repeated value"),
         (with_(grid__speed=1.0), r"grid.speed: unknown parameter .*allowed: .*mu"),
         (with_(grid__trajectory="curvy"), r"grid.trajectory: must be one of 'streamline', 'ideal'"),

@@ -32,7 +32,7 @@ start of one case under one analysis: a row of the result table.
 
 The store in the output folder::
 
-    manifest.json              config, its hash, seeds, versions, git commit
+    manifest.json              config, its hash, input hashes, seeds, versions, git commit
     runs.parquet               one row per run (parameters, metrics, status, reason, timing)
     runs/<case_id>.parquet     the rows of one case, written atomically when the case ends
     trajectories/<case_id>.parquet   long table of the case's paths (analysis, start, step, ...)
@@ -45,6 +45,7 @@ Modules, each importing only those above it: :mod:`~spine_mj.sweep.registry` (an
 their parameters), :mod:`~spine_mj.sweep.config` (the TOML schema),
 :mod:`~spine_mj.sweep.cases` (expansion, ids, seeds), :mod:`~spine_mj.sweep.runner` (one
 case), :mod:`~spine_mj.sweep.store` (the result store and its readers),
+:mod:`~spine_mj.sweep.pool` (local worker processes that die with their parent),
 :mod:`~spine_mj.sweep.executors` (in-process, local processes, Dask),
 :mod:`~spine_mj.sweep.session` (:func:`run_sweep`), :mod:`~spine_mj.sweep.report` (HTML),
 and :mod:`~spine_mj.sweep.analyses` (the built-in analyses, registered on import).

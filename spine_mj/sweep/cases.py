@@ -13,9 +13,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from spine_mj import presets
 from spine_mj.errors import SpineInputError
 from spine_mj.jsonio import to_jsonable
 from spine_mj.sweep.config import StartsSpec, SurfaceSpec, SweepConfig, digest
+from spine_mj.sweep.registry import PRESET_MU, param_specs
 
 
 @dataclass(frozen=True)
@@ -58,6 +60,8 @@ def expand_cases(config: SweepConfig) -> list[Case]:
     """
     names = [k for k, _ in config.grid]
     combos = list(itertools.product(*(v for _, v in config.grid)))
+    specs = param_specs(config.analyses)
+    from_preset = [k for k in names if specs[k].default is PRESET_MU]
     cases, seen = [], set()
     for si, surf in enumerate(config.surfaces):
         starts = (
@@ -67,6 +71,9 @@ def expand_cases(config: SweepConfig) -> list[Case]:
         )
         for combo in combos:
             params = dict(zip(names, combo))
+            for k in from_preset:
+                if params[k] is None:
+                    params[k] = presets.preset_mu(surf.source)
             case_id = _case_id(surf, starts, params)
             if case_id in seen:
                 raise SpineInputError(

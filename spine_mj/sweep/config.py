@@ -11,6 +11,7 @@ config hash, and so the resume of a store, covers.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import functools
 import hashlib
@@ -29,7 +30,7 @@ import numpy as np
 from spine_mj import presets, surface_io
 from spine_mj.errors import SpineInputError
 from spine_mj.jsonio import to_jsonable
-from spine_mj.sweep.registry import ANALYSES, REQUIRED, param_specs
+from spine_mj.sweep.registry import ANALYSES, PRESET_MU, REQUIRED, param_specs
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -40,6 +41,12 @@ _TOP_KEYS = ("sweep", "surfaces", "starts", "grid", "drive")
 _SWEEP_KEYS = ("name", "seed", "analyses", "store_trajectories")
 _SURFACE_KEYS = ("preset", "file", "seed", "seeds", "n_seeds", "set", "starts")
 _STARTS_KEYS = ("frame", "points", "x", "y", "random")
+
+#: Most cases and runs one config may expand to (checked before anything is allocated).
+MAX_CASES = 1_000_000
+MAX_RUNS = 10_000_000
+#: Rough bytes of the run table per run, for the size in the message.
+_BYTES_PER_RUN = 300
 
 
 @dataclass(frozen=True)
@@ -74,8 +81,14 @@ class SurfaceSpec:
         }
 
     def make(self):
-        """Build the surface (cached per process)."""
-        return _make_surface(self)
+        """Build the surface (cached per process; a file's cache entry lasts while its size
+        and modification time do)."""
+        stamp = None
+        if self.kind == "file":
+            with contextlib.suppress(OSError):
+                st = os.stat(self.source)
+                stamp = (st.st_mtime_ns, st.st_size)
+        return _make_surface(self, stamp)
 
 
 @dataclass(frozen=True)
@@ -226,14 +239,41 @@ def parse_config(doc: Mapping, *, base_dir: str | os.PathLike = ".") -> SweepCon
         analyses=order,
         surfaces=surfaces,
         starts=starts,
-        grid=_parse_grid(_table(doc, "grid"), _table(doc, "drive"), order),
+        grid=_parse_grid(_table(doc, "grid"), _table(doc, "drive"), order, surfaces),
         store_trajectories=store,
         surface_starts=per_surface,
     )
+    check_size(config)
     for a in order:
         if ANALYSES[a].check_config is not None:
             ANALYSES[a].check_config(config)
     return config
+
+
+def check_size(config: SweepConfig) -> None:
+    """Refuse a config of more than :data:`MAX_CASES` cases or :data:`MAX_RUNS` runs,
+    with its size, before any case is made."""
+    points = math.prod(len(v) for _, v in config.grid)
+    n_cases = len(config.surfaces) * points
+    n_runs = 0
+    for i, _ in enumerate(config.surfaces):
+        own = config.surface_starts[i] if i < len(config.surface_starts) else None
+        n_runs += (own or config.starts).count * points * len(config.analyses)
+    if n_cases > MAX_CASES or n_runs > MAX_RUNS:
+        raise SpineInputError(
+            f"config expands to {n_cases:,} cases ({len(config.surfaces)} surfaces x {points:,} "
+            f"grid points) and {n_runs:,} runs, a run table of about "
+            f"{_human_bytes(n_runs * _BYTES_PER_RUN)}; the limit is {MAX_CASES:,} cases and "
+            f"{MAX_RUNS:,} runs per sweep: split it into several sweeps"
+        )
+
+
+def _human_bytes(n: float) -> str:
+    for unit in ("B", "kB", "MB", "GB", "TB"):
+        if n < 1000:
+            return f"{n:.3g} {unit}"
+        n /= 1000
+    return f"{n:.3g} PB"
 
 
 def _parse_sweep_table(sweep: dict) -> tuple[str, int, bool, tuple[str, ...]]:
@@ -371,15 +411,20 @@ def _surface_seeds(entry: dict, key: str, master_seed: int, index: int) -> list[
         return seeds
     if "n_seeds" in entry:
         n = entry["n_seeds"]
-        if not isinstance(n, int) or isinstance(n, bool) or n < 1:
-            raise SpineInputError(f"config key {key}.n_seeds: must be an integer >= 1, got {n!r}")
+        if not isinstance(n, int) or isinstance(n, bool) or not 1 <= n <= MAX_CASES:
+            raise SpineInputError(
+                f"config key {key}.n_seeds: must be an integer from 1 to {MAX_CASES:,}, got {n!r}"
+            )
         return [int(s) for s in np.random.SeedSequence([master_seed, index]).generate_state(n) >> 1]
     return [None]
 
 
-def _parse_grid(grid_doc: dict, drive_doc: dict, order: tuple[str, ...]) -> tuple[tuple[str, tuple], ...]:
+def _parse_grid(
+    grid_doc: dict, drive_doc: dict, order: tuple[str, ...], surfaces: tuple[SurfaceSpec, ...]
+) -> tuple[tuple[str, tuple], ...]:
     """Every parameter of the analyses ``order`` with its values from [grid] or [drive]
-    (checked by its ParamSpec) or its default."""
+    (checked by its ParamSpec) or its default (None for :data:`PRESET_MU`: each case's
+    preset's, filled in by :func:`spine_mj.sweep.cases.expand_cases`)."""
     specs = param_specs(order)
     for key in grid_doc:
         if key not in specs:
@@ -411,10 +456,23 @@ def _parse_grid(grid_doc: dict, drive_doc: dict, order: tuple[str, ...]) -> tupl
                 f"config key grid.{pname}: required by analyses "
                 f"{list(order)} ({spec.doc}); must be {spec.expected()}"
             )
+        elif spec.default is PRESET_MU:
+            _check_preset_mu(surfaces, pname, spec, order)
+            vals = (None,)
         else:
             vals = (spec.default,)
         grid.append((pname, vals))
     return tuple(grid)
+
+
+def _check_preset_mu(surfaces, pname: str, spec, order) -> None:
+    """Every surface must come from a preset with a calibrated mu when the config sets none."""
+    lacking = sorted({s.label for s in surfaces if s.kind != "preset" or presets.preset_mu(s.source) is None})
+    if lacking:
+        raise SpineInputError(
+            f"config key grid.{pname}: required by analyses {list(order)} ({spec.doc}) since "
+            f"{', '.join(lacking)} has no calibrated mu; must be {spec.expected()}"
+        )
 
 
 def _parse_starts(doc, key: str) -> StartsSpec:
@@ -457,8 +515,10 @@ def _parse_starts(doc, key: str) -> StartsSpec:
         )
     if "random" in doc:
         n = doc["random"]
-        if not isinstance(n, int) or isinstance(n, bool) or n < 1:
-            raise SpineInputError(f"config key {key}.random: must be an integer >= 1, got {n!r}")
+        if not isinstance(n, int) or isinstance(n, bool) or not 1 <= n <= MAX_RUNS:
+            raise SpineInputError(
+                f"config key {key}.random: must be an integer from 1 to {MAX_RUNS:,}, got {n!r}"
+            )
         if frame != "relative":
             raise SpineInputError(
                 f"config key {key}.frame: random starts need frame = 'relative', got {frame!r}"
@@ -496,8 +556,10 @@ def _expand_values(value, key: str) -> list:
             raise SpineInputError(
                 f"config key {key}.{kinds[0]}: must be [a, b] (finite end values), got {ends!r}"
             )
-        if not isinstance(num, int) or isinstance(num, bool) or num < 1:
-            raise SpineInputError(f"config key {key}.num: must be an integer >= 1, got {num!r}")
+        if not isinstance(num, int) or isinstance(num, bool) or not 1 <= num <= MAX_CASES:
+            raise SpineInputError(
+                f"config key {key}.num: must be an integer from 1 to {MAX_CASES:,}, got {num!r}"
+            )
         if kinds[0] == "logspace":
             if min(ends) <= 0:
                 raise SpineInputError(
@@ -543,6 +605,44 @@ def _freeze(value):
     return value
 
 
+def input_digests(config: SweepConfig) -> dict[str, str]:
+    """sha256 of every input of ``config`` beyond its text: the contents of each surface
+    file, and the resolved preset (generator, parameters, seed, [engagement] and other
+    tables; the contents of a measured preset's file). Keyed ``file:<path>`` /
+    ``preset:<name>``; a store resumes only while these are unchanged."""
+    out = {}
+    for spec in config.surfaces:
+        key = f"{spec.kind}:{spec.source}"
+        if key in out:
+            continue
+        if spec.kind == "file":
+            out[key] = _file_digest(Path(spec.source))
+            continue
+        preset = presets.load_preset(spec.source)
+        resolved = {
+            "generator": preset.generator,
+            "params": to_jsonable(preset.params),
+            "seed": preset.seed,
+            "extras": to_jsonable(preset.extras),
+        }
+        measured = preset.params.get("file") if preset.generator == "measured" else None
+        if isinstance(measured, str) and Path(measured).is_file():
+            resolved["file_sha256"] = _file_digest(Path(measured))
+        out[key] = digest(resolved)
+    return out
+
+
+def _file_digest(path: Path) -> str:
+    h = hashlib.sha256()
+    try:
+        with open(path, "rb") as fh:
+            for block in iter(lambda: fh.read(1 << 20), b""):
+                h.update(block)
+    except OSError as exc:
+        raise SpineInputError(f"surface file {str(path)!r} cannot be read: {exc.strerror or exc}") from None
+    return h.hexdigest()
+
+
 def digest(obj) -> str:
     """sha256 (hex) of ``obj`` as canonical JSON (sorted keys): config hashes and case ids."""
     text = json.dumps(obj, sort_keys=True, separators=(",", ":"), allow_nan=True)
@@ -550,7 +650,7 @@ def digest(obj) -> str:
 
 
 @functools.lru_cache(maxsize=8)
-def _make_surface(spec: SurfaceSpec):
+def _make_surface(spec: SurfaceSpec, stamp=None):
     if spec.kind == "file":
         path = Path(spec.source)
         if path.suffix == ".npz":

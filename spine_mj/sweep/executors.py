@@ -19,7 +19,8 @@ import time
 from distributed import Client, as_completed
 
 from spine_mj.sweep.cases import Case
-from spine_mj.sweep.runner import run_case
+from spine_mj.sweep.pool import run_pool
+from spine_mj.sweep.runner import failed_rows, run_case
 from spine_mj.sweep.store import encode_case
 
 
@@ -68,31 +69,18 @@ def _run_pool(todo: list[Case], n_workers: int, handle) -> None:
         # a single-threaded process forks safely, and its workers inherit every module it
         # has imported: no second start-up (about 1 s of imports on one core per pool)
         _preload_worker_modules()
-        ctx = multiprocessing.get_context("fork")
+        ctx, parent = multiprocessing.get_context("fork"), os.getpid()
     else:
         # with other threads alive a fork could copy a held lock: workers fork instead from
         # a server that has imported these once
-        ctx = multiprocessing.get_context("forkserver")
+        ctx, parent = multiprocessing.get_context("forkserver"), None
         ctx.set_forkserver_preload(list(_WORKER_MODULES))
-    started = ctx.SimpleQueue()
-    with cf.ProcessPoolExecutor(
-        max_workers=n_workers, mp_context=ctx, initializer=_worker_started, initargs=(started,)
-    ) as pool:
-        futures = [pool.submit(encoded_case, c) for c in todo]
-        try:
-            # until the first worker is up (a fresh forkserver imports mujoco, numba,
-            # pyarrow... on one core first), this process runs the shortest pending cases
-            # itself; a case is taken only if its future could be cancelled: never twice
-            for case, fut in zip(reversed(todo), reversed(futures)):
-                if not started.empty() or not fut.cancel():
-                    break
-                handle(encoded_case(case))
-            for fut in cf.as_completed([f for f in futures if not f.cancelled()]):
-                handle(fut.result())
-        except BaseException:
-            for f in futures:
-                f.cancel()
-            raise
+    run_pool(todo, n_workers, ctx, encoded_case, dead_worker_case, handle, parent_pid=parent)
+
+
+def dead_worker_case(case: Case, reason: str) -> tuple:
+    """The store entry of a case whose worker process died: every run ``failed``."""
+    return encode_case(case.case_id, failed_rows(case, reason), None)
 
 
 #: What a worker imports before its first case (pandas: pyarrow imports it when it builds a
@@ -111,10 +99,6 @@ _WORKER_MODULES = (
 def _preload_worker_modules() -> None:
     for name in _WORKER_MODULES:
         importlib.import_module(name)
-
-
-def _worker_started(queue) -> None:
-    queue.put(os.getpid())
 
 
 def run_dask(todo: list[Case], scheduler, handle) -> None:

@@ -118,6 +118,11 @@ class ParamSpec:
 #: ``ParamSpec.default`` of a parameter that every config must set.
 REQUIRED = object()
 
+#: ``ParamSpec.default`` of ``mu``: each case takes the calibrated mu_s of its surface's
+#: preset (``[engagement] mu``, :func:`spine_mj.presets.preset_mu`); a config must set it
+#: when a surface has none (a file, a preset without a calibration).
+PRESET_MU = object()
+
 
 @dataclass(frozen=True, eq=False)
 class AnalysisResult:

@@ -72,6 +72,17 @@ def run_case(case: Case) -> tuple[Any, Any]:
     return table, traj
 
 
+def failed_rows(case: Case, reason: str):
+    """The rows of ``case`` when it gave no result at all (its worker process died): every
+    run ``failed`` with ``reason``, start points unknown (NaN)."""
+    n = case.starts.count
+    starts = np.full((n, 2), np.nan)
+    status = np.full(n, "failed", dtype=object)
+    why = np.full(n, reason, dtype=object)
+    tables = [_rows(case, name, starts, status, why, {}, 0.0, 0.0) for name in case.analyses]
+    return pa.concat_tables(tables, promote_options="permissive")
+
+
 def _rows(case: Case, analysis: str, starts, status, reason, metrics, elapsed: float, cpu: float):
     """The rows of one analysis of ``case``: the reserved columns, parameters, metrics."""
     n = case.starts.count

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import datetime
 import os
+import re
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -17,13 +18,17 @@ from pathlib import Path
 
 import numpy as np
 import pyarrow.compute as pc
+from distributed import Client
 
 from spine_mj.errors import SpineInputError
+from spine_mj.sweep.analyses import quasistatic
+from spine_mj.sweep.analyses.mujoco import case_rig
 from spine_mj.sweep.cases import expand_cases, longest_first
-from spine_mj.sweep.config import SweepConfig, load_config
+from spine_mj.sweep.config import SweepConfig, _make_surface, load_config
 from spine_mj.sweep.executors import run_dask, run_here, run_processes
 from spine_mj.sweep.store import (
     consolidate,
+    corrupt_cases,
     finished_cases,
     git_commit,
     prepare_store,
@@ -75,6 +80,8 @@ class SweepSummary:
         Local worker processes (None for a Dask scheduler).
     status_counts : dict of str to int
         Whole store (including earlier sessions).
+    rerun_corrupt : tuple of str
+        Cases whose stored rows could not be read, run again in this session.
     """
 
     out_dir: Path
@@ -88,6 +95,7 @@ class SweepSummary:
     elapsed_s: float
     workers: int | None
     status_counts: dict[str, int]
+    rerun_corrupt: tuple[str, ...] = ()
 
 
 def run_sweep(
@@ -131,8 +139,8 @@ def run_sweep(
     """
     if not isinstance(config, SweepConfig):
         config = load_config(config)
-    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
-        raise SpineInputError(f"workers must be an integer >= 1, got {workers!r}")
+    if workers is not None:
+        check_workers(workers)
     out_dir = Path(out_dir)
     if out_dir.exists() and not out_dir.is_dir():
         raise SpineInputError(f"--out {out_dir} exists and is not a folder")
@@ -145,19 +153,71 @@ def run_sweep(
         "versions": versions(),
         "git": git_commit(),
     }
-    out_dir.mkdir(parents=True, exist_ok=True)
-    with store_lock(out_dir):
-        return _run_locked(
-            config,
-            cases,
-            out_dir,
-            session,
-            n_workers=n_workers,
-            scheduler=scheduler,
-            overwrite=overwrite,
-            retry_failed=retry_failed,
-            progress=progress,
+    client = None if scheduler is None else connect(scheduler)  # before anything is written
+    clear_caches()
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+        with store_lock(out_dir):
+            return _run_locked(
+                config,
+                cases,
+                out_dir,
+                session,
+                n_workers=n_workers,
+                scheduler=client,
+                overwrite=overwrite,
+                retry_failed=retry_failed,
+                progress=progress,
+            )
+    finally:
+        if client is not None and client is not scheduler:
+            client.close()
+
+
+def clear_caches() -> None:
+    """Forget the surfaces and rigs this process built: a session reads its inputs afresh
+    (a preset edited since an earlier session in this process is read again)."""
+    _make_surface.cache_clear()
+    quasistatic.clear_cache()
+    case_rig.cache_clear()
+
+
+#: Local worker processes allowed per core (more only cost memory: ~300 MB each).
+MAX_WORKERS_PER_CORE = 4
+
+
+def check_workers(workers) -> int:
+    """``workers`` if it is an integer from 1 to :data:`MAX_WORKERS_PER_CORE` per core."""
+    cores = os.cpu_count() or 1
+    limit = MAX_WORKERS_PER_CORE * cores
+    if isinstance(workers, bool) or not isinstance(workers, int) or not 1 <= workers <= limit:
+        raise SpineInputError(
+            f"--workers: must be an integer from 1 to {limit} ({MAX_WORKERS_PER_CORE} per core "
+            f"on {cores} cores), got {workers!r}"
         )
+    return workers
+
+
+_ADDRESS = re.compile(r"^((tcp|tls|ucx|ws|wss)://)?[A-Za-z0-9._-]+(:[0-9]{1,5})?$|^inproc://\S+$")
+
+
+def connect(scheduler):
+    """A client of the Dask scheduler ``scheduler`` (an address, or a connected client,
+    returned as is); SpineInputError for a malformed or unreachable address."""
+    if isinstance(scheduler, Client):
+        return scheduler
+    if not isinstance(scheduler, str) or not _ADDRESS.match(scheduler):
+        raise SpineInputError(
+            f"--scheduler: must be a Dask scheduler address like tcp://host:8786, got {scheduler!r}"
+        )
+    try:
+        return Client(scheduler, timeout=CONNECT_TIMEOUT_S)
+    except (OSError, TimeoutError, ValueError) as exc:
+        raise SpineInputError(f"--scheduler {scheduler}: cannot connect ({exc})") from None
+
+
+#: Seconds to wait for a Dask scheduler to answer.
+CONNECT_TIMEOUT_S = 10
 
 
 def _run_locked(
@@ -165,6 +225,8 @@ def _run_locked(
 ) -> SweepSummary:
     prepare_store(config, cases, out_dir, overwrite=overwrite, session=session)
     remove_temporaries(out_dir)
+    corrupt = corrupt_cases(out_dir)
+    reopen_cases(out_dir, corrupt)  # unreadable: run again
     done = _done_cases(out_dir, retry_failed)
     todo = [c for c in cases if c.case_id not in done]
     skipped = len(cases) - len(todo)
@@ -216,6 +278,7 @@ def _run_locked(
         elapsed_s=time.perf_counter() - t0,
         workers=n_workers,
         status_counts=status_counts,
+        rerun_corrupt=tuple(corrupt),
     )
 
 

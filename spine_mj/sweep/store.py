@@ -21,9 +21,10 @@ import fcntl
 import importlib.metadata
 import json
 import os
-import shutil
+import re
 import subprocess
 import sys
+import threading
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -34,7 +35,7 @@ import pyarrow.parquet as pq
 from spine_mj.errors import SpineInputError, atomic_output
 from spine_mj.jsonio import write_json
 from spine_mj.sweep.cases import Case
-from spine_mj.sweep.config import SweepConfig
+from spine_mj.sweep.config import SweepConfig, input_digests
 from spine_mj.sweep.registry import ANALYSES
 
 MANIFEST = "manifest.json"
@@ -42,6 +43,9 @@ RUNS_TABLE = "runs.parquet"
 RUNS_DIR = "runs"
 TRAJ_DIR = "trajectories"
 LOCK = ".sweep.lock"
+#: What a store writes in its folder (folders end in "/": their case files and temporaries),
+#: recorded in the manifest; --overwrite removes these and nothing else.
+WRITTEN = (MANIFEST, RUNS_TABLE, f"{RUNS_DIR}/", f"{TRAJ_DIR}/")
 
 
 def versions() -> dict:
@@ -96,45 +100,27 @@ def prepare_store(
     config: SweepConfig, cases: list[Case], out_dir: Path, *, overwrite: bool, session: dict
 ) -> dict:
     """Make ``out_dir`` the store of ``config`` (a new manifest, or the one of an earlier
-    session of the same config, with ``session`` appended) and return its manifest.
-    A store of another config, or a folder holding anything else, is cleared only with
-    ``overwrite``."""
+    session of the same config and inputs, with ``session`` appended) and return its
+    manifest. A store of another config or of changed inputs (surface files, presets) is
+    replaced only with ``overwrite``, and then only the files the store wrote are removed;
+    a folder holding anything else is refused."""
     manifest = read_manifest(out_dir)
-    if manifest is not None and manifest.get("config_hash") != config.hash:
-        if not overwrite:
-            raise SpineInputError(
-                f"--out {out_dir} holds a sweep of another config ({manifest.get('name')!r}, "
-                f"hash {str(manifest.get('config_hash'))[:12]}); this config has hash "
-                f"{config.hash[:12]}: use another folder or --overwrite to replace it"
-            )
-        _clear_store(out_dir)
-        manifest = None
-    elif manifest is None and any(p.name != LOCK for p in out_dir.iterdir()):
-        if not overwrite:
-            raise SpineInputError(
-                f"--out {out_dir} exists, is not empty and holds no sweep "
-                f"manifest: use another folder or --overwrite"
-            )
-        _clear_store(out_dir)
+    inputs = input_digests(config)
+    if manifest is None and any(p.name != LOCK for p in out_dir.iterdir()):
+        raise SpineInputError(
+            f"--out {out_dir} exists, is not empty and holds no sweep manifest: use another "
+            f"folder (--overwrite replaces only a sweep store)"
+        )
+    if manifest is not None:
+        why = _mismatch(manifest, config, inputs, out_dir)
+        if why and not overwrite:
+            raise SpineInputError(f"{why}: use another folder or --overwrite to replace it")
+        if why:
+            _clear_store(out_dir)
+            manifest = None
     if manifest is None:
-        manifest = {
-            "format": "spine_mj-sweep/1",
-            "name": config.name,
-            "config_hash": config.hash,
-            "config": config.as_dict(),
-            "config_source": config.source,
-            "seeds": {
-                "master": config.seed,
-                "surfaces": {s.label: s.seed for s in config.surfaces},
-            },
-            "n_cases": len(cases),
-            "n_runs": sum(c.starts.count for c in cases) * len(config.analyses),
-            "swept": list(config.swept),
-            "versions": versions(),
-            "git": git_commit(),
-            "created": session["started"],
-            "sessions": [],
-        }
+        manifest = _new_manifest(config, cases, inputs, session)
+    manifest.setdefault("inputs", inputs)
     manifest["sessions"].append(session)
     (out_dir / RUNS_DIR).mkdir(parents=True, exist_ok=True)
     (out_dir / TRAJ_DIR).mkdir(parents=True, exist_ok=True)
@@ -142,16 +128,63 @@ def prepare_store(
     return manifest
 
 
+def _mismatch(manifest: dict, config: SweepConfig, inputs: dict, out_dir: Path) -> str:
+    """Why the store in ``out_dir`` cannot be resumed with ``config`` ("" if it can)."""
+    if manifest.get("config_hash") != config.hash:
+        return (
+            f"--out {out_dir} holds a sweep of another config ({manifest.get('name')!r}, "
+            f"hash {str(manifest.get('config_hash'))[:12]}); this config has hash {config.hash[:12]}"
+        )
+    old = manifest.get("inputs")
+    if old is None or old == inputs:  # a store from before inputs were recorded: taken as is
+        return ""
+    changed = sorted(k for k in set(old) | set(inputs) if old.get(k) != inputs.get(k))
+    return (
+        f"--out {out_dir} holds a sweep of this config computed on other inputs: "
+        f"{', '.join(changed)} changed since (resuming would mix old and new results)"
+    )
+
+
+def _new_manifest(config: SweepConfig, cases: list[Case], inputs: dict, session: dict) -> dict:
+    return {
+        "format": "spine_mj-sweep/1",
+        "name": config.name,
+        "config_hash": config.hash,
+        "config": config.as_dict(),
+        "config_source": config.source,
+        "inputs": inputs,
+        "written": list(WRITTEN),
+        "seeds": {
+            "master": config.seed,
+            "surfaces": {s.label: s.seed for s in config.surfaces},
+        },
+        "n_cases": len(cases),
+        "n_runs": sum(c.starts.count for c in cases) * len(config.analyses),
+        "swept": list(config.swept),
+        "versions": versions(),
+        "git": git_commit(),
+        "created": session["started"],
+        "sessions": [],
+    }
+
+
+_CASE_FILE = re.compile(r"^[0-9a-f]{16}\.parquet$")
+
+
 def _clear_store(out_dir: Path) -> None:
-    for name in (RUNS_DIR, TRAJ_DIR):
-        if (out_dir / name).is_dir():
-            shutil.rmtree(out_dir / name)
-    for name in (MANIFEST, RUNS_TABLE, "report.html"):
-        if (out_dir / name).is_file():
-            (out_dir / name).unlink()
-    for p in out_dir.iterdir():
-        if p.is_file() and p.name.startswith(".") and p.name != LOCK:
-            p.unlink()
+    """Remove what the store wrote (its manifest, run table, case files and their
+    temporaries); any other file in the folder stays."""
+    for sub in (w.rstrip("/") for w in WRITTEN if w.endswith("/")):
+        folder = out_dir / sub
+        if not folder.is_dir():
+            continue
+        for p in folder.iterdir():
+            if p.is_file() and (_CASE_FILE.match(p.name) or p.name.startswith(".")):
+                p.unlink()
+        with contextlib.suppress(OSError):
+            folder.rmdir()  # only if nothing else is in it
+    for name in (w for w in WRITTEN if not w.endswith("/")):
+        (out_dir / name).unlink(missing_ok=True)
 
 
 def _case_files(out_dir: Path) -> list[Path]:
@@ -162,6 +195,26 @@ def _case_files(out_dir: Path) -> list[Path]:
 def finished_cases(out_dir: Path) -> set[str]:
     """Ids of the cases whose rows are in the store."""
     return {p.stem for p in _case_files(out_dir)}
+
+
+def _read(path: Path, **kwargs):
+    """A Parquet file of the store as a table, or None where it is unreadable (a disk
+    that filled up, a copy cut short...)."""
+    try:
+        return pq.read_table(path, **kwargs)
+    except (pa.ArrowException, OSError):
+        return None
+
+
+def corrupt_cases(out_dir: Path) -> list[str]:
+    """Ids of the finished cases whose rows file cannot be read (its footer is checked)."""
+    bad = []
+    for f in _case_files(out_dir):
+        try:
+            pq.read_metadata(f)
+        except (pa.ArrowException, OSError):
+            bad.append(f.stem)
+    return bad
 
 
 def remove_temporaries(out_dir: Path) -> None:
@@ -202,13 +255,13 @@ def store_encoded(out_dir: Path, encoded: tuple) -> None:
 def reopen_cases(out_dir: Path, case_ids) -> None:
     """Mark the cases ``case_ids`` unfinished (their rows leave the store)."""
     for cid in case_ids:
-        (out_dir / RUNS_DIR / f"{cid}.parquet").unlink()
+        (out_dir / RUNS_DIR / f"{cid}.parquet").unlink(missing_ok=True)
 
 
 def consolidate(out_dir: str | os.PathLike):
     """Rebuild ``runs.parquet`` from the per-case files; returns the table (pyarrow)."""
     out_dir = Path(out_dir)
-    tables = [pq.read_table(f) for f in _case_files(out_dir)]
+    tables = [t for t in (_read(f) for f in _case_files(out_dir)) if t is not None]
     if not tables:
         table = pa.table({c: pa.array([], pa.string()) for c in ("run_id", "status")})
     else:
@@ -222,18 +275,38 @@ def consolidate(out_dir: str | os.PathLike):
     return table
 
 
+_HELD: set[str] = set()
+_HELD_GUARD = threading.Lock()
+
+
 @contextlib.contextmanager
 def store_lock(out_dir: Path):
-    """Exclusive lock on the store for one sweep at a time (released by the OS on a kill)."""
-    with open(out_dir / LOCK, "w") as fh:
-        try:
-            fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            raise SpineInputError(f"--out {out_dir}: another sweep is writing to it") from None
-        try:
-            yield
-        finally:
-            fcntl.flock(fh, fcntl.LOCK_UN)
+    """Exclusive lock on the store for one sweep at a time.
+
+    A POSIX record lock (``lockf``): it belongs to this process alone, so worker processes
+    forked while it is held do not hold it, and the OS releases it the moment this process
+    ends, however it ends; a resume after a kill starts at once. Record locks do not
+    exclude within one process, so the stores locked here are also kept in a set.
+    """
+    key = str(out_dir.resolve())
+    busy = SpineInputError(f"--out {out_dir}: another sweep is writing to it")
+    with _HELD_GUARD:
+        if key in _HELD:
+            raise busy
+        _HELD.add(key)
+    try:
+        with open(out_dir / LOCK, "a") as fh:
+            try:
+                fcntl.lockf(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except OSError:
+                raise busy from None
+            try:
+                yield
+            finally:
+                fcntl.lockf(fh, fcntl.LOCK_UN)
+    finally:
+        with _HELD_GUARD:
+            _HELD.discard(key)
 
 
 @dataclass(frozen=True)
@@ -251,6 +324,9 @@ class StoreStatus:
         How many times the sweep was started on this store.
     created : str
     git_commit : str or None
+    corrupt_cases : tuple of str
+        Ids of the cases whose rows file cannot be read (not counted as finished; a resume
+        runs them again).
     """
 
     name: str
@@ -262,6 +338,7 @@ class StoreStatus:
     sessions: int
     created: str
     git_commit: str | None
+    corrupt_cases: tuple[str, ...] = ()
 
     @property
     def complete(self) -> bool:
@@ -275,21 +352,30 @@ def store_status(out_dir: str | os.PathLike) -> StoreStatus:
     if manifest is None:
         raise SpineInputError(f"{out_dir} holds no sweep ({MANIFEST} not found)")
     counts: dict[str, int] = {}
-    files = _case_files(out_dir)
-    for f in files:
-        for s in pq.read_table(f, columns=["status"])["status"].to_pylist():
+    corrupt, n_good = [], 0
+    for f in _case_files(out_dir):
+        table = _read(f, columns=["status"])
+        if table is None:
+            corrupt.append(f.stem)
+            continue
+        n_good += 1
+        for s in table["status"].to_pylist():
             counts[s] = counts.get(s, 0) + 1
-    return StoreStatus(
-        name=manifest["name"],
-        config_hash=manifest["config_hash"],
-        total_cases=manifest["n_cases"],
-        finished_cases=len(files),
-        total_runs=manifest["n_runs"],
-        status_counts=counts,
-        sessions=len(manifest.get("sessions", [])),
-        created=manifest.get("created", ""),
-        git_commit=manifest.get("git", {}).get("commit"),
-    )
+    try:
+        return StoreStatus(
+            name=str(manifest["name"]),
+            config_hash=str(manifest["config_hash"]),
+            total_cases=int(manifest["n_cases"]),
+            finished_cases=n_good,
+            total_runs=int(manifest["n_runs"]),
+            status_counts=counts,
+            sessions=len(manifest.get("sessions", [])),
+            created=str(manifest.get("created", "")),
+            git_commit=(manifest.get("git") or {}).get("commit"),
+            corrupt_cases=tuple(corrupt),
+        )
+    except (KeyError, TypeError, ValueError, AttributeError) as exc:
+        raise SpineInputError(f"{out_dir / MANIFEST} is not a sweep manifest: {exc!r}") from None
 
 
 def load_runs(out_dir: str | os.PathLike, *, columns: list[str] | None = None):
@@ -298,12 +384,13 @@ def load_runs(out_dir: str | os.PathLike, *, columns: list[str] | None = None):
     if read_manifest(out_dir) is None:
         raise SpineInputError(f"{out_dir} holds no sweep ({MANIFEST} not found)")
     path = out_dir / RUNS_TABLE
-    n_files = len(_case_files(out_dir))
-    stale = (
-        not path.is_file()
-        or len(set(pq.read_table(path, columns=["case_id"])["case_id"].to_pylist())) != n_files
-    )
-    table = consolidate(out_dir) if stale else pq.read_table(path)
+    ids = _read(path, columns=["case_id"]) if path.is_file() else None
+    files = {f.stem for f in _case_files(out_dir)}
+    table = None
+    if ids is not None and set(ids["case_id"].to_pylist()) == files:
+        table = _read(path)
+    if table is None:
+        table = consolidate(out_dir)
     if columns is not None:
         table = table.select(columns)
     return table.to_pandas()
@@ -340,5 +427,10 @@ def load_trajectories(
         filters.append(("start", "=", int(start)))
     if columns is not None:
         columns = list(dict.fromkeys(["analysis", "start", "step", *columns]))
-    table = pq.read_table(path, columns=columns, filters=filters or None)
+    try:
+        table = pq.read_table(path, columns=columns, filters=filters or None)
+    except (pa.ArrowException, OSError) as exc:
+        raise SpineInputError(
+            f"trajectories of case {case_id!r} in {out_dir} cannot be read: {exc}"
+        ) from None
     return table.to_pandas()

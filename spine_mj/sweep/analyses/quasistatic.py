@@ -11,10 +11,17 @@ import functools
 import numpy as np
 
 from spine_mj import streamline as sl
-from spine_mj.sweep.registry import REQUIRED, Analysis, AnalysisResult, ParamSpec, register_analysis
+from spine_mj.sweep.registry import PRESET_MU, Analysis, AnalysisResult, ParamSpec, register_analysis
 
 QUASISTATIC_PARAMS = (
-    ParamSpec("mu", "float", "static friction coefficient mu_s", REQUIRED, 0.0, exclusive=True),
+    ParamSpec(
+        "mu",
+        "float",
+        "static friction coefficient mu_s (default: the preset's calibrated [engagement] mu)",
+        PRESET_MU,
+        0.0,
+        exclusive=True,
+    ),
     ParamSpec("tip_radius", "float", "tip radius in the surface's length unit (0: a point)", 0.0, 0.0),
     ParamSpec(
         "dl",
@@ -32,6 +39,11 @@ QUASISTATIC_PARAMS = (
 @functools.lru_cache(maxsize=4)
 def _dilated(spec, radius: float):
     return sl.dilate(spec.make(), radius)
+
+
+def clear_cache() -> None:
+    """Forget the dilated surfaces built in this process."""
+    _dilated.cache_clear()
 
 
 def _quasistatic(case, surface, starts, upstream):
