@@ -13,10 +13,23 @@ import numpy as np
 
 from spine_mj import sim
 from spine_mj.errors import SpineInputError
-from spine_mj.sweep.registry import REQUIRED, Analysis, AnalysisResult, ParamSpec, register_analysis
+from spine_mj.sweep.registry import (
+    PRESET_MU,
+    Analysis,
+    AnalysisResult,
+    ParamSpec,
+    register_analysis,
+)
 
 MUJOCO_PARAMS = (
-    ParamSpec("mu", "float", "static friction coefficient mu_s", REQUIRED, 0.0, exclusive=True),
+    ParamSpec(
+        "mu",
+        "float",
+        "static friction coefficient mu_s (default: the preset's calibrated [engagement] mu)",
+        PRESET_MU,
+        0.0,
+        exclusive=True,
+    ),
     ParamSpec(
         "tip_radius",
         "float",
