@@ -522,7 +522,8 @@ def path_overlay_figure(panels: list[dict], *, length_label: str = "[surface uni
                     label="MuJoCo" if i == 0 else None,
                 )
             ax.plot(qs[0, 0], qs[0, 1], "o", mfc="white", mec="k", ms=5, label="start" if i == 0 else None)
-        ax.set(title=panel["title"], xlabel=f"x {length_label}", ylabel=f"y {length_label}", aspect="equal")
+        ax.set(title=panel["title"], xlabel=f"x {length_label}", ylabel=f"y {length_label}")
+        ax.set_aspect("equal", adjustable="datalim")
         ax.legend(loc="upper left")
     for ax in axes[n:]:
         ax.set_visible(False)
