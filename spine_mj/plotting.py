@@ -39,6 +39,7 @@ __all__ = [
     "path_overlay_figure",
     "protocol_color",
     "save_figure",
+    "shared_height_norm",
     "sig",
     "sim_run_figure",
     "styled",
@@ -497,13 +498,14 @@ def path_overlay_figure(panels: list[dict], *, length_label: str = "[surface uni
     nrows = -(-n // ncols)
     fig = new_figure(figsize=(5.4 * ncols + 0.8, 4.8 * nrows), layout="constrained")
     axes = fig.subplots(nrows, ncols, squeeze=False).ravel()
-    norm, field = _shared_height_norm(panels), None
+    norm, field = shared_height_norm(panels), None
     for ax, panel in zip(axes, panels):
         if panel.get("surface") is not None and norm is not None:
             x0, x1, y0, y1 = panel.get("extent") or panel["surface"].bounds
             xs, ys = np.linspace(x0, x1, 161), np.linspace(y0, y1, 161)
             h = panel["surface"].height(xs[None, :], ys[:, None])
-            field = ax.contourf(xs, ys, h, levels=15, cmap=DIVERGING_CMAP, norm=norm)
+            levels = np.linspace(norm.vmin, norm.vmax, 17)  # one set of levels: one colour bar for all
+            field = ax.contourf(xs, ys, h, levels=levels, cmap=DIVERGING_CMAP, norm=norm)
         for i, (qs, mj) in enumerate(panel["paths"]):
             ax.plot(
                 qs[:, 0],
@@ -534,7 +536,7 @@ def path_overlay_figure(panels: list[dict], *, length_label: str = "[surface uni
     return fig
 
 
-def _shared_height_norm(panels: list[dict]):
+def shared_height_norm(panels: list[dict]):
     """One colour scale, symmetric about 0, for the surfaces of all panels (None if none)."""
     top = 0.0
     for panel in panels:
