@@ -22,6 +22,7 @@ from pathlib import Path
 import matplotlib
 import matplotlib.colors as mcolors
 import numpy as np
+from matplotlib.cm import ScalarMappable
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
@@ -33,6 +34,7 @@ __all__ = [
     "DIVERGING_CMAP",
     "PROTOCOL_COLORS",
     "SEQUENTIAL_CMAP",
+    "height_mappable",
     "house_style",
     "length_unit",
     "new_figure",
@@ -531,9 +533,17 @@ def path_overlay_figure(panels: list[dict], *, length_label: str = "[surface uni
         ax.set_visible(False)
     if field is not None:
         fig.colorbar(
-            field, ax=list(axes[:n]), label=f"surface height {length_label} (peaks red, valleys blue)"
+            height_mappable(field),
+            ax=list(axes[:n]),
+            label=f"surface height {length_label} (peaks red, valleys blue)",
         )
     return fig
+
+
+def height_mappable(field):
+    """A colour bar source covering the whole shared scale of ``field`` (a contour set
+    keeps only the levels its own data reach)."""
+    return ScalarMappable(norm=field.norm, cmap=DIVERGING_CMAP)
 
 
 def shared_height_norm(panels: list[dict]):

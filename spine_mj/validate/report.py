@@ -16,6 +16,7 @@ from spine_mj.plotting import (
     DIVERGING_CMAP,
     PATH_COLORS,
     THRESHOLD_COLOR,
+    height_mappable,
     new_figure,
     path_overlay_figure,
     protocol_color,
@@ -126,7 +127,11 @@ def _paths_figure(lim: QuasistaticLimitResult, path: Path) -> Path | None:
         ax.set(xlim=(x0, x1), ylim=(y0, y1), xlabel="x [surface units]", ylabel="y [surface units]")
         ax.set(aspect="equal", title=f"{preset}, I_e = {sig(lim.lowest_ie)}")
         ax.legend(loc="upper left")
-    fig.colorbar(field, ax=list(axes), label="surface height [surface units] (peak red, valley blue)")
+    fig.colorbar(
+        height_mappable(field),
+        ax=list(axes),
+        label="surface height [surface units] (peak red, valley blue)",
+    )
     return save_figure(fig, path)
 
 
