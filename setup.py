@@ -14,5 +14,9 @@ DATA = {"spine_mj._data.models": "models", "spine_mj._data.surfaces": "surfaces"
 setup(
     packages=[*find_packages(include=["spine_mj", "spine_mj.*"]), *DATA],
     package_dir=DATA,
-    package_data={"spine_mj._data.models": ["*.xml"], "spine_mj._data.surfaces": ["*.toml"]},
+    package_data={
+        "spine_mj._data.models": ["*.xml"],
+        "spine_mj._data.surfaces": ["*.toml"],
+        "spine_mj.templates": ["*.j2"],
+    },
 )

@@ -6,14 +6,31 @@ the summary that ``validation.json`` holds, so that both say the same numbers.
 
 from __future__ import annotations
 
-import math
+import json
 from pathlib import Path
 
 import numpy as np
 
 from spine_mj.errors import atomic_output
-from spine_mj.plotting import new_figure, save_figure
+from spine_mj.plotting import (
+    DIVERGING_CMAP,
+    PATH_COLORS,
+    THRESHOLD_COLOR,
+    height_mappable,
+    new_figure,
+    path_overlay_figure,
+    protocol_color,
+    save_figure,
+    shared_height_norm,
+    sig,
+    styled,
+)
+from spine_mj.presets import list_presets, make_surface
+from spine_mj.sweep.store import load_runs
+from spine_mj.templates import render
 from spine_mj.validate.boundary import BoundaryCurve, BoundaryResult
+from spine_mj.validate.paths import stored_paths
+from spine_mj.validate.plans import FRECHET_TARGET, OUTCOME_TARGET, STATIC_TARGET
 from spine_mj.validate.quasistatic_limit import QuasistaticLimitResult
 from spine_mj.validate.sandpaper import SandpaperResult
 from spine_mj.validate.static_map import StaticMapResult
@@ -23,21 +40,12 @@ __all__ = ["write_report"]
 
 
 def _f(v, digits=3) -> str:
-    if v is None:
-        return "-"
-    if isinstance(v, (bool, np.bool_)):
-        return "yes" if v else "no"
-    if isinstance(v, (int, np.integer)):
-        return str(int(v))
+    """A table cell: numbers to ``digits`` significant digits, NaN and None as ``-``."""
     try:
-        v = float(v)
+        text = sig(v, digits)
     except (TypeError, ValueError):
         return str(v)
-    if math.isnan(v):
-        return "-"
-    if math.isinf(v):
-        return "inf"
-    return f"{v:.{digits}g}"
+    return "-" if text in ("nan", "-") else text
 
 
 def _table(rows: list[dict], cols: list[str], names: list[str] | None = None) -> str:
@@ -48,76 +56,103 @@ def _table(rows: list[dict], cols: list[str], names: list[str] | None = None) ->
     return "\n".join(out)
 
 
-def _static_figure(st: StaticMapResult, path: Path) -> None:
+@styled
+def _static_figure(st: StaticMapResult, path: Path) -> Path | None:
     engines = list(st.per_engine)
-    fig = new_figure(figsize=(5 * len(engines), 4), constrained_layout=True)
+    if not engines:
+        return None
+    fig = new_figure(figsize=(5 * len(engines), 4.2), constrained_layout=True)
     axes = fig.subplots(1, len(engines), squeeze=False)[0]
     for ax, label in zip(axes, engines):
         rows = [r for r in st.rows if r["engine"] == label]
+        ax.axhspan(0.95, 1.05, color="0.9", label="+-5 % (target)")
         for az in sorted({r["azimuth_deg"] for r in rows}):
             sel = sorted((r for r in rows if r["azimuth_deg"] == az), key=lambda r: r["slope_deg"])
             ax.plot(
-                [r["slope_deg"] for r in sel], [r["ratio"] for r in sel], "o-", label=f"azimuth {az:g} deg"
+                [r["slope_deg"] for r in sel], [r["ratio"] for r in sel], "o-", label=f"azimuth {sig(az)} deg"
             )
             for r in sel:
                 if r["region"] != "engaged":
                     mark = {"self_lock": "^", "slip": "v"}[r["region"]]
-                    ok = r["region_agrees"]
-                    ax.plot(r["slope_deg"], 1.0, mark, color="g" if ok else "r", ms=9, mfc="none")
-        ax.axhspan(0.95, 1.05, color="0.9")
-        ax.set(xlabel="slope angle [deg]", ylabel="kappa_mj / kappa", title=label)
-        ax.legend(fontsize=7)
-    fig.suptitle(
-        "Static probe on planes (shaded: +-5 %; ^ self-lock, v slip region at 1: green = MuJoCo agrees)",
-        fontsize=9,
-    )
-    save_figure(fig, path)
+                    ax.plot(
+                        r["slope_deg"], 1.0, mark, color="g" if r["region_agrees"] else "r", ms=9, mfc="none"
+                    )
+        ax.plot([], [], "^", color="g", mfc="none", label="self-lock / slip plane: MuJoCo agrees")
+        ax.plot([], [], "v", color="r", mfc="none", label="... MuJoCo disagrees")
+        ax.set(xlabel="slope angle [deg]", ylabel="breakaway ratio kappa_mj / kappa [1]", title=label)
+        ax.legend()
+    fig.suptitle(f"Static probe on inclined planes, mu = {sig(st.mu)}")
+    return save_figure(fig, path)
 
 
-def _paths_figure(lim: QuasistaticLimitResult, path: Path) -> None:
+@styled
+def _paths_figure(lim: QuasistaticLimitResult, path: Path) -> Path | None:
+    """Paths at the lowest I_e over the peak / valley (shared diverging height scale)."""
     presets = list(lim.paths)
     if not presets:
-        return
-    fig = new_figure(figsize=(5.5 * len(presets), 5), constrained_layout=True)
+        return None
+    surfaces = {p: make_surface(p) for p in presets}
+    norm = shared_height_norm([{"surface": s} for s in surfaces.values()])
+    fig = new_figure(figsize=(5.4 * len(presets) + 0.8, 5), constrained_layout=True)
     axes = fig.subplots(1, len(presets), squeeze=False)[0]
+    field = None
     for ax, preset in zip(axes, presets):
+        x0, x1, y0, y1 = surfaces[preset].bounds
+        xs, ys = np.linspace(x0, x1, 161), np.linspace(y0, y1, 161)
+        field = ax.contourf(
+            xs, ys, surfaces[preset].height(xs[None, :], ys[:, None]), 15, cmap=DIVERGING_CMAP, norm=norm
+        )
         for i, p in enumerate(lim.paths[preset]):
+            first = i == 0
             ax.plot(
-                p.smooth[:, 0],
-                p.smooth[:, 1],
-                "k-",
+                *p.smooth.T,
+                color=PATH_COLORS["streamline"],
                 lw=1.5,
-                label="streamline (smooth)" if i == 0 else None,
+                label="streamline (smooth surface)" if first else None,
             )
             ax.plot(
-                p.tri[:, 0],
-                p.tri[:, 1],
-                "b--",
+                *p.tri.T,
+                color=PATH_COLORS["facets"],
+                ls="--",
                 lw=1,
-                label="streamline (hfield facets)" if i == 0 else None,
+                label="streamline (MuJoCo's hfield facets)" if first else None,
             )
             if p.mujoco.shape[0]:
-                ax.plot(p.mujoco[:, 0], p.mujoco[:, 1], "r-", lw=0.8, label="MuJoCo" if i == 0 else None)
-        circle = np.linspace(0, 2 * np.pi, 100)
-        ax.plot(1.5 * np.cos(circle), 1.5 * np.sin(circle), color="0.6", lw=0.5)
-        ax.set(
-            aspect="equal",
-            xlim=(-5, 5),
-            ylim=(-5, 5),
-            xlabel="x",
-            ylabel="y",
-            title=f"{preset}, I_e = {lim.lowest_ie:g}",
-        )
-        ax.legend(fontsize=7, loc="upper left")
-    save_figure(fig, path)
+                ax.plot(
+                    *p.mujoco.T,
+                    color=PATH_COLORS["mujoco"],
+                    lw=0.9,
+                    label="MuJoCo (spring drive)" if first else None,
+                )
+        ax.set(xlim=(x0, x1), ylim=(y0, y1), xlabel="x [surface units]", ylabel="y [surface units]")
+        ax.set(aspect="equal", title=f"{preset}, I_e = {sig(lim.lowest_ie)}")
+        ax.legend(loc="upper left")
+    fig.colorbar(
+        height_mappable(field),
+        ax=list(axes),
+        label="surface height [surface units] (peak red, valley blue)",
+    )
+    return save_figure(fig, path)
 
 
-def _boundary_figure(bnd: BoundaryResult, path: Path) -> None:
-    fig = new_figure(figsize=(11, 4), constrained_layout=True)
+def _star_for_figure(star: dict) -> dict | None:
+    """The bracketed I_e* to draw: the headline one, else the departure criterion's."""
+    if star.get("kind") == "bracketed":
+        return star
+    dep = star.get("by_criterion", {}).get("departure")
+    return dep if dep and dep.get("kind") == "bracketed" else None
+
+
+@styled
+def _boundary_figure(bnd: BoundaryResult, path: Path) -> Path | None:
+    if not bnd.curves:
+        return None
+    fig = new_figure(figsize=(12, 4.6), constrained_layout=True)
     a1, a2 = fig.subplots(1, 2)
     for proto, c in bnd.curves.items():
+        color = protocol_color(proto)
         lab = proto if proto != "ramp" else "ramp (equivalent I_e)"
-        (line,) = a1.semilogx(c.ie, c.agreement, "o-", label=lab)
+        a1.semilogx(c.ie, c.agreement, "o-", color=color, label=lab)
         used = bnd.ie_star[proto].get("ie_used", c.ie)
         off = [i for i, v in enumerate(c.ie) if not np.isclose(used, v).any()]
         if off:  # points that take no part in I_e* (a capped ramp covering < half the path)
@@ -125,64 +160,114 @@ def _boundary_figure(bnd: BoundaryResult, path: Path) -> None:
                 np.asarray(c.ie)[off],
                 np.asarray(c.agreement)[off],
                 "o",
-                ms=9,
+                ms=10,
                 mfc="white",
-                mec=line.get_color(),
-                label=f"{proto}: not used for I_e*",
+                mec=color,
+                zorder=0,
+                label=f"{proto}: not used for I_e* (path coverage < 50 %)",
             )
-        for key, style in (("frechet", "o-"), ("median_frechet", "s--")):
-            a2.loglog(
-                c.ie,
-                np.maximum(np.asarray(getattr(c, key), float), 1e-5),
-                style,
-                label=f"{proto}: {'mean' if key == 'frechet' else 'median'} "
-                f"{'prefix ' if proto == 'ramp' else ''}Frechet",
-            )
-        s = bnd.ie_star[proto]
-        if s.get("kind") != "bracketed":
-            s = s.get("by_criterion", {}).get("departure") or s
-        if s.get("kind") == "bracketed":
+        a2.loglog(
+            c.ie, np.maximum(np.asarray(c.frechet, float), 1e-5), "o-", color=color, label=f"{proto}: mean"
+        )
+        a2.loglog(
+            c.ie,
+            np.maximum(np.asarray(c.median_frechet, float), 1e-5),
+            "s--",
+            color=color,
+            label=f"{proto}: median",
+        )
+        s = _star_for_figure(bnd.ie_star[proto])
+        if s is not None:
             for ax in (a1, a2):
-                ax.axvspan(s["low"], s["high"], alpha=0.12, color=line.get_color())
-                ax.axvline(s["value"], ls=":", color=line.get_color())
-    a1.axhline(0.95, color="r", lw=0.8)
-    a2.axhline(0.1, color="r", lw=0.8)
-    a1.set(xlabel="I_e", ylabel="fraction of runs that agree")
-    a2.set(xlabel="I_e", ylabel="deviation / L_c")
-    a1.legend(fontsize=8)
+                ax.axvspan(
+                    s["low"],
+                    s["high"],
+                    alpha=0.12,
+                    color=color,
+                    label=f"{proto}: I_e* bracket [{sig(s['low'])}, {sig(s['high'])}]" if ax is a1 else None,
+                )
+                ax.axvline(
+                    s["value"],
+                    ls=":",
+                    color=color,
+                    label=f"{proto}: I_e* = {sig(s['value'])}" if ax is a1 else None,
+                )
+    a1.axhline(
+        OUTCOME_TARGET,
+        color=THRESHOLD_COLOR,
+        lw=1,
+        ls="--",
+        label=f"target: agreement >= {sig(OUTCOME_TARGET)}",
+    )
+    a2.axhline(
+        FRECHET_TARGET,
+        color=THRESHOLD_COLOR,
+        lw=1,
+        ls="--",
+        label=f"target: deviation <= {sig(FRECHET_TARGET)} L_c",
+    )
+    a1.set(xlabel="inertia number I_e [1]", ylabel="runs that agree [fraction]", ylim=(-0.05, 1.05))
+    a2.set(xlabel="inertia number I_e [1]", ylabel="Frechet deviation [L_c] (ramp: prefix)")
+    a1.legend(fontsize=7)
     a2.legend(fontsize=7)
-    save_figure(fig, path)
+    fig.suptitle("Agreement with the quasistatic streamline against I_e (colour = drive protocol)")
+    return save_figure(fig, path)
 
 
-def _stick_figure(ss: StickSlipResult, path: Path) -> None:
+def _stiffness_labels(ss: StickSlipResult) -> dict:
+    """``(ie, k [N/m])`` of the traces -> stiffness in F_p / L_c from the rows (matched by
+    rank within each I_e: the two units differ by one positive factor)."""
+    out = {}
+    for ie in {k[0] for k in ss.traces}:
+        n_m = sorted(k for i, k in ss.traces if i == ie)
+        fp = sorted(r["stiffness_fp_per_lc"] for r in ss.rows if np.isclose(r["ie"], ie))
+        out.update({(ie, a): b for a, b in zip(n_m, fp)} if len(n_m) == len(fp) else {})
+    return out
+
+
+@styled
+def _stick_figure(ss: StickSlipResult, path: Path) -> Path | None:
     if not ss.traces:
-        return
-    fig = new_figure(figsize=(11, 4), constrained_layout=True)
+        return None
+    fig = new_figure(figsize=(11, 4.2), constrained_layout=True)
     ax = fig.subplots()
+    labels = _stiffness_labels(ss)
     for (ie, k), (t, f) in sorted(ss.traces.items()):
-        ax.plot(t / max(t[-1], 1e-12), f, lw=0.8, label=f"I_e {ie:g}, k {k:.3g} N/m")
+        kl = f"{sig(labels[(ie, k)])} F_p/L_c" if (ie, k) in labels else f"{sig(k)} N/m"
+        ax.plot(t / max(t[-1], 1e-12), f, lw=0.8, label=f"I_e = {sig(ie)}, k = {kl}")
     ax.set(
-        xlabel="time / run duration",
-        ylabel="drive force / F_p",
+        xlabel="time / run duration [1]",
+        ylabel="drive force / F_p [1]",
         title=f"Spring drive on {ss.surface} (first start)",
     )
-    ax.legend(fontsize=7)
-    save_figure(fig, path)
+    ax.legend()
+    return save_figure(fig, path)
 
 
-def _sand_figure(sp: SandpaperResult, path: Path) -> None:
-    grits = list(sp.paths)
+@styled
+def _sand_figure(sp: SandpaperResult, path: Path) -> Path | None:
+    grits = [g for g in sp.paths if sp.paths[g]]
     if not grits:
-        return
+        return None
     fig = new_figure(figsize=(5 * len(grits), 7), constrained_layout=True)
     axes = fig.subplots(2, len(grits), squeeze=False)
     for j, g in enumerate(grits):
         for x, y, _t, f in sp.paths[g]:
-            axes[0, j].plot(x * 1e3, (y - y[0]) * 1e3, lw=0.8)
+            axes[0, j].plot(x * 1e3, (y - y[0]) * 1e6, lw=0.8)
             axes[1, j].plot(x * 1e3, f, lw=0.6)
-        axes[0, j].set(title=f"{g}: path (y - y0)", xlabel="x [mm]", ylabel="y - y0 [mm]")
-        axes[1, j].set(xlabel="x [mm]", ylabel="drive force / F_p")
-    save_figure(fig, path)
+        axes[0, j].set(title=f"{g}: path", xlabel="x [mm]", ylabel="lateral excursion y - y0 [um]")
+        axes[1, j].set(xlabel="x [mm]", ylabel="drive force / F_p [1]")
+    return save_figure(fig, path)
+
+
+#: What each plan is, for the report's first lines.
+PLAN_NOTES = {
+    "smoke": "the seconds-long test plan: two planes, one family with two starts, two I_e values; "
+    "its numbers only show that the pipeline runs",
+    "quick": "the quick plan (`spine-mj validate --quick`, `make demo`): few starts, six I_e values, "
+    "coarse hfields; its agreement numbers are noisier and usually lower than the full plan's",
+    "full": "the full plan (`spine-mj validate`), the one the README's headline numbers come from",
+}
 
 
 def write_report(
@@ -198,47 +283,100 @@ def write_report(
     """Write the figures under ``out/figures`` and ``out/report.md``; returns the report path.
 
     ``result`` is the content of ``validation.json`` (plan, static error, engine settings,
-    timings); the studies' results give the tables and figures.
+    timings); the studies' results give the tables and figures. The report links only
+    figures that were written (a study with nothing to draw has no figure).
     """
+    out = Path(out)
     figs = out / "figures"
     figs.mkdir(parents=True, exist_ok=True)
-    _static_figure(static, figs / "static_map.png")
-    _paths_figure(limit, figs / "limit_paths.png")
-    _boundary_figure(boundary, figs / "boundary.png")
-    _stick_figure(stick, figs / "stick_slip.png")
-    _sand_figure(sand, figs / "sandpaper.png")
-
-    lines = [
-        f"# Validation: MuJoCo against the quasistatic streamline ({result['plan']} plan)",
-        "",
-        "Generated by `spine-mj validate`; numbers also in `validation.json`. Lengths "
-        "in L_c (characteristic length of each surface), forces in F_p (preload).",
-        "",
-    ]
-    lines += _static_section(static, result)
-    lines += _limit_section(limit)
-    lines += _boundary_section(boundary)
-    lines += _stick_section(stick)
-    lines += _sand_section(sand)
-    lines += [
-        "## Engine settings",
-        "",
-        "```",
-        str(result["engine_settings"]),
-        "```",
-        "",
-        f"Study times [s]: {result['timings_s']}",
-        "",
-    ]
+    drawn = {
+        "static": _static_figure(static, figs / "static_map.png"),
+        "limit": _paths_figure(limit, figs / "limit_paths.png"),
+        "boundary": _boundary_figure(boundary, figs / "boundary.png"),
+        "overlays": _overlay_figure(out, figs / "boundary_paths.png"),
+        "stick": _stick_figure(stick, figs / "stick_slip.png"),
+        "sand": _sand_figure(sand, figs / "sandpaper.png"),
+    }
+    figures = {
+        k: (p.relative_to(out).as_posix() if p is not None and p.is_file() else None)
+        for k, p in drawn.items()
+    }
+    plan = result["plan"]
+    text = render(
+        "validation_report.md.j2",
+        plan=plan,
+        plan_note=PLAN_NOTES.get(plan, f"the plan {plan!r}"),
+        figures=figures,
+        headline=_headline(result, boundary),
+        targets={"outcome": OUTCOME_TARGET, "frechet": FRECHET_TARGET, "static": STATIC_TARGET},
+        boundary="\n".join(_boundary_section(boundary)),
+        static="\n".join(_static_section(static, result)),
+        limit="\n".join(_limit_section(limit)),
+        stick="\n".join(_stick_section(stick)),
+        sand="\n".join(_sand_section(sand)),
+        engine_settings=json.dumps(result["engine_settings"], indent=2, default=str),
+        timings=", ".join(f"{k} {sig(v)}" for k, v in result["timings_s"].items()),
+    )
     path = out / "report.md"
     with atomic_output(path) as tmp:
-        tmp.write_text("\n".join(lines))
+        tmp.write_text(text)
     return path
+
+
+def _headline(result: dict, boundary: BoundaryResult) -> list[str]:
+    """One line per protocol: its I_e* (or why there is none)."""
+    lines = []
+    for proto, s in boundary.ie_star.items():
+        if s.get("valid") is False:
+            lines.append(f"{proto}: I_e* not measured ({s.get('note', '')})")
+            continue
+        for star in (s, s.get("by_criterion", {}).get("departure")):
+            if not star:
+                continue
+            crit = star.get("criterion", "")
+            if star["kind"] == "bracketed":
+                value, low, high = (sig(star[k]) for k in ("value", "low", "high"))
+                lines.append(f"{proto} ({crit}): I_e* = {value} in [{low}, {high}]")
+            elif star["kind"] == "above":
+                lines.append(
+                    f"{proto} ({crit}): I_e* > {sig(star['low'])} (agreement holds on the whole grid)"
+                )
+            else:
+                lines.append(f"{proto} ({crit}): I_e* < {sig(star['high'])} (no agreement at the lowest I_e)")
+    return lines
+
+
+def _overlay_figure(out: Path, path: Path) -> Path | None:
+    """MuJoCo paths over the streamline at the lowest and highest I_e of the boundary
+    study's spring sweeps (``out/sweeps/boundary/spring-*``); None when there are none."""
+    panels = []
+    for store in sorted((out / "sweeps" / "boundary").glob("spring-*")):
+        if not (store / "manifest.json").is_file():
+            continue
+        df = load_runs(store)
+        mj = df[(df.analysis == "mujoco") & (df.status == "ok")]
+        comp = df[(df.analysis == "compare") & (df.status == "ok")].set_index(["case_id", "start"])
+        if mj.empty:
+            continue
+        preset = str(mj["surface"].iloc[0]).split("#")[0]
+        surface = make_surface(preset) if preset in list_presets() else None
+        for ie in sorted({mj["ie"].min(), mj["ie"].max()}):
+            case_id = mj.loc[mj["ie"] == ie, "case_id"].iloc[0]
+            starts = sorted(mj.loc[mj["case_id"] == case_id, "start"].astype(int))[:3]
+            qs = stored_paths(store, case_id, "quasistatic")
+            mp = stored_paths(store, case_id, "mujoco")
+            pairs = [(qs[s], mp.get(s, np.zeros((0, 2)))) for s in starts if s in qs]
+            n_agree = sum(bool(comp["agree"].get((case_id, s), False)) for s in starts)
+            title = f"{preset}, spring, I_e = {sig(ie)}: {n_agree}/{len(starts)} agree"
+            panels.append({"title": title, "paths": pairs, "surface": surface})
+    if not panels:
+        return None
+    return save_figure(path_overlay_figure(panels), path)
 
 
 def _static_section(static: StaticMapResult, result: dict) -> list[str]:
     return [
-        "## 1. Static breakaway ratio on planes",
+        "## Static breakaway ratio on inclined planes",
         "",
         f"mu = {static.mu:g}; probe ramp at I_e = 0.01; kappa from Eqs. 1-3.",
         "",
@@ -256,8 +394,6 @@ def _static_section(static: StaticMapResult, result: dict) -> list[str]:
         "",
         f"`static_kappa_max_rel_error` (engaged, default settings) = "
         f"{_f(result['static_kappa_max_rel_error'])} (target <= 0.05).",
-        "",
-        "![static](figures/static_map.png)",
         "",
         "<details><summary>per plane</summary>",
         "",
@@ -283,17 +419,17 @@ def _static_section(static: StaticMapResult, result: dict) -> list[str]:
 
 def _limit_section(limit: QuasistaticLimitResult) -> list[str]:
     return [
-        "## 2. Quasistatic limit (spring drive, lowest I_e)",
+        "## Quasistatic limit (spring drive, lowest I_e)",
         "",
         f"I_e = {limit.lowest_ie:g}, recommended settings. Total = MuJoCo vs smooth "
         "streamline; geometry = streamline on MuJoCo's hfield facets vs smooth; "
         "dynamics = MuJoCo vs facet streamline.",
         "",
         _table(
-            [{"family": k, **v} for k, v in limit.families.items()],
+            [{"family": k, "ok_n": f"{v['ok_runs']}/{v['runs']}", **v} for k, v in limit.families.items()],
             [
                 "family",
-                "runs",
+                "ok_n",
                 "outcome_agreement",
                 "mean_frechet",
                 "mean_lateral_deviation",
@@ -304,18 +440,16 @@ def _limit_section(limit: QuasistaticLimitResult) -> list[str]:
             ],
             [
                 "family",
-                "runs",
+                "ok/runs",
                 "outcome agr.",
                 "mean Frechet",
                 "mean lateral",
                 "geometry Frechet",
                 "dynamics Frechet",
                 "outcome agr. vs facets",
-                "target met",
+                "target met (this plan)",
             ],
         ),
-        "",
-        "![paths](figures/limit_paths.png)",
         "",
         "### What limits agreement: settings varied on the single peak",
         "",
@@ -354,7 +488,7 @@ def _boundary_section(boundary: BoundaryResult) -> list[str]:
         for k, v in s["by_criterion"].items()
     ]
     lines = [
-        "## 3. The quasistatic boundary",
+        "## Agreement against I_e (boundary study)",
         "",
         f"Families: {', '.join(boundary.families)}. Spring: a run agrees when its "
         "outcome agrees (`compare.outcome_agreement`); its deviation is the Frechet "
@@ -377,7 +511,6 @@ def _boundary_section(boundary: BoundaryResult) -> list[str]:
     ] + [""]
     for proto, c in boundary.curves.items():
         lines += _curve_table(c, proto, boundary.skip_rate[proto])
-    lines += ["![boundary](figures/boundary.png)", ""]
     return lines
 
 
@@ -396,7 +529,21 @@ def _curve_table(c: BoundaryCurve, proto: str, skip_rate: list[float]) -> list[s
             c.ie, c.agreement, c.frechet, c.median_frechet, c.lateral, c.engine_trouble, skip_rate
         )
     ]
-    cols = ["ie", "agreement", "mean_frechet", "median_frechet", "lateral", "engine_trouble", "trap_skip"]
+    n = c.runs_per_ie
+    for r in rows:
+        r["agree_n"] = f"{round(r['agreement'] * n)}/{n}"
+        r["ok_n"] = f"{round((1 - r['engine_trouble']) * n)}/{n}"
+    cols = [
+        "ie",
+        "agreement",
+        "agree_n",
+        "mean_frechet",
+        "median_frechet",
+        "lateral",
+        "ok_n",
+        "engine_trouble",
+        "trap_skip",
+    ]
     if proto == "ramp":
         for r, cv, ach in zip(rows, c.coverage, c.ie_achieved):
             r.update({"coverage": cv, "ie_achieved": ach})
@@ -438,7 +585,7 @@ def _curve_table(c: BoundaryCurve, proto: str, skip_rate: list[float]) -> list[s
 
 def _stick_section(stick: StickSlipResult) -> list[str]:
     return [
-        "## 4. Stick-slip",
+        "## Stick-slip",
         "",
         f"Spring drive on {stick.surface}.",
         "",
@@ -459,8 +606,6 @@ def _stick_section(stick: StickSlipResult) -> list[str]:
             ],
         ),
         "",
-        "![stick-slip](figures/stick_slip.png)",
-        "",
     ]
 
 
@@ -468,7 +613,7 @@ def _sand_section(sand: SandpaperResult) -> list[str]:
     if not sand.rows:
         return []
     return [
-        "## 5. Sandpaper analogs (25 um tip)",
+        "## Sandpaper analogs (25 um tip)",
         "",
         f"Spring drive, mu = {sand.mu:g} (assumed; the paper gives none for grit).",
         "",
@@ -492,7 +637,5 @@ def _sand_section(sand: SandpaperResult) -> list[str]:
         "Failures: "
         + "; ".join(f"{r['grit']}: {', '.join(r['failures'])}" for r in sand.rows if r.get("failures"))
         + ".",
-        "",
-        "![sandpaper](figures/sandpaper.png)",
         "",
     ]
