@@ -23,8 +23,9 @@ lint: $(STAMP)
 	$(BIN)/ruff check .
 	$(BIN)/ruff format --check .
 
+# make bench BENCH_ARGS="--quick --readme": CI-size runs, README Performance section rewritten
 bench: $(STAMP)
-	$(BIN)/python benchmarks/run_all.py
+	$(BIN)/python benchmarks/run_all.py $(BENCH_ARGS)
 
 # Build the wheel, install it (not editable) into a fresh venv and use it from a folder
 # outside the repository: presets and the MuJoCo rig must come from the installed package.

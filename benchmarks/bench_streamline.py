@@ -9,14 +9,15 @@ from spine_mj.streamline import StreamlineParams, streamlines
 from spine_mj.surfaces import fractal_fbm, single_gaussian
 
 
-def steps_per_second(surface, starts, params, repeat=5):
+def steps_per_second(surface, starts, params, repeat=5, backend="auto"):
     """Steps actually taken (sum of n_steps) over the wall time of one call, best of
-    ``repeat`` calls (the machine is shared). The kernel runs on one core."""
-    streamlines(surface, starts[:2], params, store_paths=False)  # compile / load cache
+    ``repeat`` calls (the machine is shared). The kernel runs on one core; ``backend``
+    "numpy" times the plain numpy reference instead."""
+    streamlines(surface, starts[:2], params, store_paths=False, backend=backend)  # compile / load cache
     best = 0.0
     for _ in range(repeat):
         t = time.perf_counter()
-        r = streamlines(surface, starts, params, store_paths=False)
+        r = streamlines(surface, starts, params, store_paths=False, backend=backend)
         best = max(best, r.n_steps.sum() / (time.perf_counter() - t))
     return best
 
