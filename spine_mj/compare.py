@@ -23,7 +23,14 @@ from numba import njit
 
 from spine_mj.errors import SpineInputError
 
+#: What "agree" means at the quasistatic corner, for sweeps and validation alike: outcome
+#: agreement at least this share of the runs, and path deviation (Frechet over L_c) at most.
+OUTCOME_TARGET = 0.95
+FRECHET_TARGET = 0.1
+
 __all__ = [
+    "FRECHET_TARGET",
+    "OUTCOME_TARGET",
     "capture_rate",
     "frechet_distance",
     "frechet_distance_reference",

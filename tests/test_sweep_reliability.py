@@ -158,9 +158,10 @@ def test_corrupt_case_files_are_named_read_around_and_run_again(tmp_path):
 def test_mu_defaults_to_the_preset_calibrated_mu_and_is_required_otherwise(tmp_path):
     config = sweep.parse_config(with_(grid__mu=None))
     (case,) = sweep.expand_cases(config)
-    assert case.params["mu"] == presets.preset_mu("paper-single-peak") == 1.25
+    calibrated = presets.preset_mu("paper-single-peak")
+    assert calibrated is not None and case.params["mu"] == calibrated
     rows, _ = sweep.run_case(case)
-    assert rows["status"].to_pylist() == ["ok"] and rows["mu"].to_pylist() == [1.25]
+    assert rows["status"].to_pylist() == ["ok"] and rows["mu"].to_pylist() == [calibrated]
     surf = tmp_path / "s.npz"
     surface_io.save_surface(presets.make_surface("paper-single-peak"), surf)
     doc = with_(grid__mu=None, surfaces=[{"file": str(surf)}])

@@ -14,6 +14,7 @@ import numpy as np
 
 from spine_mj.sim.detection import Detection
 from spine_mj.sim.drives import Drive, RampDrive
+from spine_mj.sim.gpu import run_batch_gpu
 from spine_mj.sim.model import RigModel
 from spine_mj.sim.ramp import run_ramp
 from spine_mj.sim.render import render_frames
@@ -86,7 +87,13 @@ class Rig(RigModel):
         thread analyses the previous one and places the next (``rollout`` releases the GIL);
         the results are those of one run at a time. The arrays of a result are read-only
         views of its group's columns.
+
+        ``backend``: ``"rollout"`` (native CPU threads), ``"python"`` (the plain reference
+        loop), ``"gpu"`` (MuJoCo Warp on a CUDA device, :mod:`spine_mj.sim.gpu`; the
+        ``[gpu]`` extra) or ``"auto"`` (the GPU where one is present, else the CPU rollout).
         """
+        if backend in ("gpu", "auto"):
+            return run_batch_gpu(self, drives, starts, detection=detection, backend=backend, nthread=nthread)
         return run_batch(self, drives, starts, detection=detection, backend=backend, nthread=nthread)
 
     def controls(self, drive: Drive, qpos0: np.ndarray, detection: Detection) -> np.ndarray:

@@ -19,6 +19,7 @@ import numpy as np
 import pandas as pd
 from pandas.api.types import is_bool_dtype, is_numeric_dtype
 
+from spine_mj.compare import FRECHET_TARGET, OUTCOME_TARGET
 from spine_mj.errors import atomic_output
 from spine_mj.plotting import (
     THRESHOLD_COLOR,
@@ -307,7 +308,6 @@ def _agreement_section(df: pd.DataFrame) -> dict | None:
                 "lateral": _mean_cell(ok["lateral_deviation"], len(ok)),
             }
         )
-    from spine_mj.validate.plans import FRECHET_TARGET, OUTCOME_TARGET  # lazy: validate imports sweep
 
     fig = _agreement_figure(comp[comp.status == "ok"], by_k, OUTCOME_TARGET, FRECHET_TARGET)
     return {

@@ -132,7 +132,7 @@ def boundary(plan: ValidationPlan, runner: StudyRunner) -> BoundaryResult:
 
     I_e* comes from three criteria (:data:`IE_STAR_CRITERIA`): outcome agreement alone, with
     the median Frechet over starts (the headline: robust to one marginal start), and with
-    the mean (the issue's wording), each with a bootstrap interval over starts.
+    the mean, each with a bootstrap interval over starts.
 
     Returns
     -------

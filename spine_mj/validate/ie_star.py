@@ -207,8 +207,7 @@ IE_STAR_CRITERIA = {
     "outcome": (None, "outcome agreement >= 95 %"),
     "mean_frechet": (
         "mean",
-        "outcome agreement >= 95 % and mean Frechet <= 0.1 L_c "
-        "(the issue's wording; one outlying start moves it)",
+        "outcome agreement >= 95 % and mean Frechet <= 0.1 L_c (sensitive: one outlying start moves it)",
     ),
 }
 

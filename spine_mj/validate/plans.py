@@ -15,6 +15,8 @@ from typing import Any
 
 import numpy as np
 
+from spine_mj.compare import FRECHET_TARGET, OUTCOME_TARGET
+
 __all__ = [
     "FRECHET_TARGET",
     "GRAVITY",
@@ -35,9 +37,6 @@ __all__ = [
 
 #: A ramp whose runs cover less of the path to the domain edge gives no I_e*.
 RAMP_MIN_COVERAGE = 0.5
-#: Agreement thresholds of the issue's targets.
-OUTCOME_TARGET = 0.95
-FRECHET_TARGET = 0.1
 STATIC_TARGET = 0.05
 MASS_KG = 0.01
 GRAVITY = 9.81
