@@ -518,8 +518,22 @@ def _rig_options(f):
 
 
 def _build_rig(
-    surface_spec, tip_radius, mass, mu, preload, length_scale, resolution, timestep, noslip, impratio
+    surface_spec,
+    tip_radius,
+    mass,
+    mu,
+    preload,
+    length_scale,
+    resolution,
+    timestep,
+    noslip,
+    impratio,
+    *,
+    ie=None,
+    speed=None,
 ):
+    """The rig of the shared rig options; ``ie`` or ``speed`` (the drive's) bound the engine
+    step for impacts (:func:`spine_mj.sim.default_engine`)."""
 
     surf = load_surface_arg(surface_spec)
     mu = presets.preset_mu(surf) if mu is None else mu
@@ -537,7 +551,9 @@ def _build_rig(
         if v is not None
     }
     scales = sim.Scales.for_surface(surf, tip=tip, length_scale_m=length_scale, hfield_resolution=resolution)
-    engine = sim.default_engine(scales, **overrides)
+    if ie is not None:
+        speed = scales.speed_for(check_positive("--ie", ie))
+    engine = sim.default_engine(scales, speed_m_s=speed, **overrides)
     return sim.Rig(surf, tip=tip, length_scale_m=length_scale, engine=engine)
 
 
@@ -636,10 +652,10 @@ def simulate(
             raise SpineInputError(f"give one of {names}, got both")
     if stiffness_number is not None and stiffness is not None:
         raise SpineInputError("give one of --K or --stiffness, got both")
-    rig = _build_rig(surface_spec, **rig_opts)
-    sc = rig.scales
     if ie is None and speed is None and rate is None:
         ie = 1e-3
+    rig = _build_rig(surface_spec, **rig_opts, ie=ie, speed=speed)
+    sc = rig.scales
     if ie is not None:
         speed = sc.speed_for(check_positive("--ie", ie))
         rate = speed * sc.preload_n / sc.char_length_m

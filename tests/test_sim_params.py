@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import pytest
 from sim_rigs import R_TIP, flat_rig
 
@@ -65,3 +67,17 @@ def test_scales_for_surface_are_the_rigs_scales_without_building_a_model():
     assert scales.hfield_spacing_m == pytest.approx(spacing_m, rel=1e-12)
     assert scales.tip_radius_m == pytest.approx(max(spacing_m, lc_m / 100), rel=1e-3)
     assert scales.inertia_number(scales.speed_for(3e-4)) == pytest.approx(3e-4, rel=1e-12)
+
+
+def test_a_fast_drive_shortens_the_step_so_impacts_stay_shallow():
+    """dt <= 0.05 e r / (2 v): an arrival at the drive's speed sinks at most ~5 % of r."""
+    from spine_mj.sim import Scales, default_engine
+
+    scales = Scales.for_surface(single_gaussian(), tip=TipParams(mass_kg=0.01))
+    rest = default_engine(scales)
+    assert default_engine(scales, speed_m_s=scales.speed_for(1e-6)).timestep_s == rest.timestep_s
+    fast = scales.speed_for(1.0)
+    dt = default_engine(scales, speed_m_s=fast).timestep_s
+    bound = 0.05 * math.e * scales.tip_radius_m / (2 * fast)
+    assert dt < rest.timestep_s and dt <= bound * 1.05  # 2-digit rounding in engine units
+    assert default_engine(scales, speed_m_s=fast).solref[0] == pytest.approx(2 * dt)

@@ -31,6 +31,7 @@ from spine_mj.surfaces import GridSurface, HField, Surface, to_hfield
 
 DEFAULT_LENGTH_SCALE_M = 0.01
 _REST_PENETRATION_FRACTION = 0.005
+_IMPACT_DEPTH_FRACTION = 0.05  # impact depth of a drive-speed arrival, in tip radii
 _MIN_SPACING_PER_TIP_RADIUS = 0.25  # finer hfields exceed MuJoCo's 50 contacts per geom pair
 _SCAN_TIP_SPACINGS = 2.0  # default tip radius of a measured scan, in lateral spacings
 MAX_HFIELD_SIDE = 8192  # samples a side of an hfield (memory; MuJoCo's collision stays local)
@@ -446,7 +447,7 @@ def hfield_spacing(hfield: HField, length_scale_m: float = 1.0) -> float:
     return length_scale_m * 2 * max(rx / (hfield.ncol - 1), ry / (hfield.nrow - 1))
 
 
-def default_engine(scales: Scales, **overrides) -> EngineSettings:
+def default_engine(scales: Scales, *, speed_m_s: float | None = None, **overrides) -> EngineSettings:
     """Engine settings derived from the problem's scales, by one rule in engine units.
 
     ``dt = sqrt(0.005 min(r_tip, L_c) / L_c) tau`` (``dt / tau`` rounded to 2 digits, so the
@@ -457,9 +458,19 @@ def default_engine(scales: Scales, **overrides) -> EngineSettings:
     tip radius (no effect while ``dmin = dmax``), elliptic cone, 3 noslip iterations,
     ``impratio = 1``. ``overrides`` replace fields (a ``timestep_s`` alone also sets
     ``solref = (2 timestep_s, 1)``).
+
+    A fast drive also limits the step: a tip arriving at speed ``v`` sinks about
+    ``v t_c / e`` into the soft contact (time constant ``t_c = 2 dt``) before it stops, so
+    with the drive's speed ``speed_m_s`` given, ``dt <= 0.05 e r_tip / (2 v)`` keeps that
+    impact depth at 5 % of the tip radius, half the penetration tolerance.
     """
     ratio = min(scales.tip_radius_m / scales.char_length_m, 1.0)
-    dt = float(f"{math.sqrt(_REST_PENETRATION_FRACTION * ratio):.2g}") * scales.time_s
+    dt_tau = math.sqrt(_REST_PENETRATION_FRACTION * ratio)
+    if speed_m_s is not None:
+        v = check_positive("speed_m_s", speed_m_s) * scales.time_s / scales.char_length_m
+        r = scales.tip_radius_m / scales.char_length_m
+        dt_tau = min(dt_tau, _IMPACT_DEPTH_FRACTION * math.e * r / (2 * v))
+    dt = float(f"{dt_tau:.2g}") * scales.time_s
     base = {
         "timestep_s": dt,
         "solref": (2 * dt, 1.0),

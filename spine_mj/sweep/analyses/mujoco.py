@@ -158,7 +158,7 @@ def _check_speed(config) -> None:
 @functools.lru_cache(maxsize=4)
 def _rig(spec, key):
     """The rig of a surface and tip/engine parameters (cached: cases differing only in the
-    drive share it)."""
+    drive's stiffness or protocol share it; the speed sets the engine step)."""
     p = dict(key)
     surface = spec.make()
     tip = sim.TipParams(
@@ -180,10 +180,13 @@ def _rig(spec, key):
     }
     if p["timestep"] is not None:
         overrides["timestep_s"] = p["timestep"]
-    dt = p["timestep"] if p["timestep"] is not None else sim.default_engine(scales).timestep_s
+    speed = drive_speed_m_s(p, scales)
+    dt = (
+        p["timestep"] if p["timestep"] is not None else sim.default_engine(scales, speed_m_s=speed).timestep_s
+    )
     tc = p["solref_timeconst"] if p["solref_timeconst"] is not None else 2 * dt
     overrides["solref"] = (tc, p["solref_dampratio"])
-    engine = sim.default_engine(scales, **overrides)
+    engine = sim.default_engine(scales, speed_m_s=speed, **overrides)
     return sim.Rig(surface, tip=tip, engine=engine, length_scale_m=p["length_scale"])
 
 
@@ -213,6 +216,8 @@ def _mujoco(case, surface, starts, upstream):
 
 
 _RIG_KEYS = (
+    "ie",  # the drive speed limits the engine step (impacts)
+    "speed",
     "mass",
     "mu",
     "preload",
@@ -240,14 +245,18 @@ def _rig_key(p: dict, surface) -> tuple:
     return tuple(sorted({"tip_radius_m": tip_radius_m, **{k: p[k] for k in _RIG_KEYS}}.items()))
 
 
+def drive_speed_m_s(p: dict, scales) -> float:
+    """A case's drive speed: ``speed`` when given, else from ``ie`` (default 1e-3)."""
+    if p["speed"] is not None:
+        return p["speed"]
+    return scales.speed_for(1e-3 if p["ie"] is None else p["ie"])
+
+
 def _runs(rig, p: dict, starts) -> list:
     """The runs of ``rig`` from every start with the case's drive (speed from ``ie`` unless
     given; the ramp and static rates from the speed)."""
     sc = rig.scales
-    speed = p["speed"]
-    if speed is None:
-        ie = 1e-3 if p["ie"] is None else p["ie"]
-        speed = (ie * sc.preload_n * sc.char_length_m / sc.mass_kg) ** 0.5
+    speed = drive_speed_m_s(p, sc)
     rate = speed * sc.preload_n / sc.char_length_m
     det = sim.Detection(kappa_cap=p["kappa_cap"])
     pts = [tuple(s) for s in starts]
