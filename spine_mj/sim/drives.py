@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from spine_mj.errors import check_positive
+from spine_mj.errors import SpineInputError, check_positive
 from spine_mj.sim.params import Scales, check_optional
 
 
@@ -46,16 +46,29 @@ class RampDrive:
     ``rate_n_s`` None: ``0.1 F_p / tau`` (``I_e = 0.01``). ``duration_s`` None: 40 ramps to
     ``kappa_cap F_p``, capped at 200 tau. ``slide_distance_m`` None: ``0.01 L_c`` (the
     paper's dl ~ 0.01 sigma); 0 drops the force at the first sign of slip.
+
+    ``fast_forward``: while the tip sticks (noslip on), the force climbs quickly to
+    ``1 - fast_forward_margin`` of the breakaway force predicted from the contact normal,
+    then at ``rate_n_s`` through breakaway (:mod:`spine_mj.sim.ramp`; ``duration_s`` counts
+    engine time). ``stop_early``: the run stops stepping at its first end event (left the
+    domain, self-lock, engine trouble) instead of running out its duration.
     """
 
     rate_n_s: float | None = None
     duration_s: float | None = None
     settle_time_s: float | None = None
     slide_distance_m: float | None = None
+    fast_forward: bool = True
+    fast_forward_margin: float = 0.03
+    stop_early: bool = True
 
     def __post_init__(self):
         check_optional(self, ["rate_n_s", "duration_s"])
         check_optional(self, ["settle_time_s", "slide_distance_m"], allow_zero=True)
+        m = check_positive("fast_forward_margin", self.fast_forward_margin)
+        if m >= 1:
+            raise SpineInputError(f"fast_forward_margin must be < 1, got {m!r}")
+        object.__setattr__(self, "fast_forward_margin", m)
 
 
 @dataclass(frozen=True)

@@ -5,6 +5,43 @@ rises until slip is detected, keeps rising while the tip slides the set distance
 zero, and ramps again once the tip has been stuck for the settle time.
 :class:`ResetController` is that feedback; :func:`run_ramp` steps the model with it and
 analyses the run like any other, adding the resets to the events.
+
+Stick-phase fast-forward (``RampDrive.fast_forward``, on by default). At a low rate most
+steps integrate a tip that does not move while the force climbs. While the ramp is on,
+the noslip solver is on and the tip has been still for :data:`QUIET_STEPS` steps on one
+contact normal (tangential speed at most ``Detection.stick_speed_m_s``, the normal
+unchanged), :class:`StickFastForward` predicts the breakaway force
+``F_b = kappa_of_normal(n, mu) F_p`` (the lock rule the streamline uses; infinite in the
+self-lock region) and raises the force to ``min((1 - margin) F_b, F_b - NOMINAL_STEPS increments,
+kappa_cap F_p)`` in :data:`RISE_STEPS` steps, then hands back to the nominal rate, which carries the force
+through breakaway and the slip. A phase ends early when the contact normal changes; when
+the tip moves during a phase (tangential speed above the stick speed, or contact lost),
+the run is put back to the checkpoint taken 16 to 32 steps earlier (state, controller and
+recorded rows) and goes on at the nominal rate. A new phase needs the tip to have slipped
+since the last one. ``duration_s`` and ``time_s`` count engine time, so a fast-forwarded
+run covers more of the path in the same duration; :func:`nominal_time_s` gives the time
+the plain ramp would have taken.
+
+What the equivalence neglects. (1) Creep: noslip makes the stick rigid (a stuck tip moves
+~1e-11 m/s), so the plain ramp's long stick moves the tip by nothing measurable; without
+noslip friction creeps at any load and fast-forward is off. (2) The soft normal contact:
+the faster rise loads the contact within ``RISE_STEPS = 50`` contact time constants, far
+slower than its response, and the nominal ramp that follows lasts many time constants
+before breakaway, so the breakaway starts from the same quasistatic contact. (3) The
+margin: the prediction uses the deepest contact's normal; where two facets share the load
+(an hfield edge) the breakaway can lie below it by a few per cent (measured up to 1.5 %
+on the single peak), inside the default 3 % margin; a larger error is caught by the
+rollback. On the cases of ``tests/test_sim_fastforward.py`` and
+``benchmarks/bench_fastforward.py`` the breakaway forces agree with the plain ramp's within
+0.5 % and the outcomes and paths agree (Frechet <= 0.01 L_c).
+
+Early termination (``RampDrive.stop_early``): every :data:`END_CHECK_STEPS` steps outside
+a fast-forward phase the new rows are run through the same end rules as the analysis
+(:func:`~spine_mj.sim.detection.end_marks`: deep penetration, leaving the domain, the force
+at ``kappa_cap F_p`` while stuck); at the first one the run stops, so the recorded
+trajectory and end reason are those of the full run up to its end. With fast-forward a
+tip on a self-locking normal reaches the cap within a phase instead of after
+``kappa_cap F_p / rate``.
 """
 
 from __future__ import annotations
@@ -15,11 +52,85 @@ from collections.abc import Callable
 
 import numpy as np
 
-from spine_mj.sim.detection import Detection, Event
+from spine_mj.engagement import SELF_LOCK, kappa_of_normal
+from spine_mj.sim.detection import Detection, Event, end_marks
 from spine_mj.sim.drives import RampDrive, rate_n_s, settle_steps
 from spine_mj.sim.model import RigModel
+from spine_mj.sim.recording import Recording
 from spine_mj.sim.results import RunResult, analyse
 from spine_mj.sim.rollout import warning_text, warning_total
+
+#: Steps the tip must be still on one normal before a fast-forward phase starts.
+QUIET_STEPS = 8
+#: Steps over which a fast-forward phase raises the force (50 contact time constants).
+RISE_STEPS = 100
+#: Nominal-rate steps a phase leaves before the predicted breakaway, at least (50 contact
+#: time constants: at a fast rate the 3 % margin alone is a few steps, and the contact
+#: loaded by the rise breaks away late).
+NOMINAL_STEPS = 100
+#: Steps between checkpoints inside a phase (a rollback goes back 16 to 32 steps).
+CHECKPOINT_STEPS = 16
+#: Steps between two early-termination checks.
+END_CHECK_STEPS = 256
+#: Largest change of a unit normal (any component) that counts as the same normal.
+NORMAL_TOL = 1e-4
+
+
+class StickFastForward:
+    """Decides when the ramp may climb fast and how far (see the module docstring).
+
+    Parameters
+    ----------
+    mu : float
+        Friction coefficient of the contact.
+    preload_n, cap_n : float
+        F_p [N] and the largest force ``kappa_cap F_p`` [N].
+    margin : float
+        A phase stops at ``(1 - margin)`` of the predicted breakaway force.
+    stick_speed_m_s, slip_speed_m_s : float
+        Still below the first; a slip (which allows a new phase) above the second.
+    """
+
+    def __init__(self, *, mu, preload_n, cap_n, margin, stick_speed_m_s, slip_speed_m_s):
+        self.mu, self.preload_n, self.cap_n, self.margin = mu, preload_n, cap_n, margin
+        self.stick, self.slip = stick_speed_m_s, slip_speed_m_s
+        self.active, self.blocked, self.quiet = False, False, 0
+        self.target_n, self.step_n = 0.0, 0.0
+        self.normal0 = np.zeros(3)
+        self.prev = np.zeros(3)
+        self.phases = self.rollbacks = 0
+
+    def watch(self, vt: float, normal: np.ndarray, contact: bool, force: float, step_n: float) -> str:
+        """Verdict on one ramping step: ``"start"`` (a phase begins), ``"rollback"`` (the tip
+        moved during a phase), or ``""``. ``normal`` points out of the surface."""
+        same = contact and float(np.abs(normal - self.prev).max()) <= NORMAL_TOL
+        self.prev = normal.copy()
+        if self.active:
+            if not contact or vt > self.stick:
+                self.active, self.blocked, self.quiet = False, True, 0
+                self.rollbacks += 1
+                return "rollback"
+            if float(np.abs(normal - self.normal0).max()) > NORMAL_TOL or force >= self.target_n:
+                self.active, self.blocked, self.quiet = False, True, 0
+            return ""
+        if vt > self.slip:
+            self.blocked = False
+        self.quiet = self.quiet + 1 if (same and vt <= self.stick) else 0
+        if self.blocked or self.quiet < QUIET_STEPS:
+            return ""
+        k, region = kappa_of_normal(normal, self.mu)
+        f_b = math.inf if int(region) == SELF_LOCK else float(k) * self.preload_n
+        if not math.isfinite(f_b) and int(region) != SELF_LOCK:
+            return ""  # the slip region: no hold to predict
+        # leave the nominal ramp at least NOMINAL_STEPS before the predicted breakaway, so
+        # the contact loaded by the fast rise settles before it is tested
+        target = min((1 - self.margin) * f_b, f_b - NOMINAL_STEPS * step_n, self.cap_n)
+        if target - force <= 2 * RISE_STEPS * step_n:
+            return ""  # the nominal ramp gets there about as fast
+        self.active, self.target_n, self.normal0 = True, target, normal.copy()
+        self.step_n = (target - force) / RISE_STEPS
+        self.phases += 1
+        return "start"
 
 
 class ResetController:
@@ -28,7 +139,7 @@ class ResetController:
     Parameters
     ----------
     step_n : float
-        Force added per step while ramping [N].
+        Force added per step while ramping at the nominal rate [N].
     cap_n : float
         Largest force [N].
     slide_distance_m : float
@@ -39,32 +150,62 @@ class ResetController:
         Tangential speed above which the tip slips.
     sensor_adr : dict
         Sensor addresses of the rig (:attr:`RigModel.sensor_adr`).
+    fast_forward : StickFastForward or None
+        Stick-phase fast-forward; None ramps at the nominal rate throughout.
     """
 
-    def __init__(self, *, step_n, cap_n, slide_distance_m, settle_steps, slip_speed_m_s, sensor_adr):
+    _SNAPSHOT = ("force", "ramping", "stuck_steps", "slip_from", "normal", "resets")
+
+    def __init__(
+        self, *, step_n, cap_n, slide_distance_m, settle_steps, slip_speed_m_s, sensor_adr, fast_forward=None
+    ):
         self.step_n, self.cap_n, self.slide_distance_m = step_n, cap_n, slide_distance_m
         self.settle_steps, self.slip_speed_m_s, self.adr = settle_steps, slip_speed_m_s, sensor_adr
+        self.ff = fast_forward
         self.force, self.ramping, self.stuck_steps = 0.0, True, 0
         self.slip_from = None  # (x, y) where the current slip began, while the force still acts
         self.normal = np.zeros(3)  # normal of the last contact
         self.resets: list[int] = []
 
+    def snapshot(self) -> dict:
+        """The controller's state (the fast-forward's own state is not part of it)."""
+        snap = {k: getattr(self, k) for k in self._SNAPSHOT}
+        snap["normal"], snap["resets"] = self.normal.copy(), list(self.resets)
+        return snap
+
+    def restore(self, snap: dict) -> None:
+        for k, v in snap.items():
+            setattr(self, k, v.copy() if isinstance(v, (np.ndarray, list)) else v)
+
     def push(self) -> float:
         """The push force of the next step (the ramp advances while ramping)."""
         if self.ramping:
-            self.force = min(self.force + self.step_n, self.cap_n)
+            if self.ff is not None and self.ff.active:
+                self.force = min(self.force + self.ff.step_n, self.ff.target_n)
+            else:
+                self.force = min(self.force + self.step_n, self.cap_n)
         return self.force if self.ramping else 0.0
 
-    def observe(self, i: int, sens: np.ndarray, *, driving: bool) -> None:
-        """Update from step ``i``'s sensordata; ``driving`` is False during the settle phase."""
+    def observe(self, i: int, sens: np.ndarray, *, driving: bool) -> str:
+        """Update from step ``i``'s sensordata; ``driving`` is False during the settle phase.
+
+        Returns the fast-forward's verdict (``"start"``, ``"rollback"`` or ``""``).
+        """
         a = self.adr
         vel = sens[a["tip_vel"] : a["tip_vel"] + 3]
-        if sens[a["contact_deepest"]] > 0:
+        contact = bool(sens[a["contact_deepest"]] > 0)
+        if contact:
             self.normal = sens[a["contact_deepest"] + 5 : a["contact_deepest"] + 8]
         nrm = self.normal
         vt = float(np.linalg.norm(vel - (vel @ nrm) * nrm))
         if not driving:
-            return
+            return ""
+        verdict = ""
+        if self.ff is not None and self.ramping:
+            out = nrm if nrm[2] >= 0 else -nrm
+            verdict = self.ff.watch(vt, out, contact, self.force, self.step_n)
+            if verdict == "rollback":
+                return verdict
         if self.ramping and self.slip_from is None and vt > self.slip_speed_m_s:
             self.slip_from = sens[a["tip_pos"] : a["tip_pos"] + 2].copy()
         if self.ramping and self.slip_from is not None:
@@ -72,11 +213,166 @@ class ResetController:
             if math.hypot(moved[0], moved[1]) >= self.slide_distance_m:
                 self.ramping, self.stuck_steps, self.slip_from = False, 0, None
                 self.force = 0.0
+                if self.ff is not None:
+                    self.ff.active = False
         elif not self.ramping:
             self.stuck_steps = self.stuck_steps + 1 if vt <= self.slip_speed_m_s else 0
             if self.stuck_steps >= self.settle_steps:
                 self.ramping = True
                 self.resets.append(i)
+        return verdict
+
+
+def nominal_time_s(result: RunResult) -> np.ndarray:
+    """The time the plain ramp (no fast-forward) would have taken to reach each row [s].
+
+    A step whose force rose by more than the nominal increment counts for the time the
+    nominal rate needs for that rise; every other step for one time step. Equals
+    ``result.time_s`` for a run without fast-forward.
+    """
+    dt = result.engine.timestep_s
+    step = rate_n_s(result.drive, result.scales) * dt
+    rise = np.diff(result.drive_force_n, prepend=0.0)
+    per = np.where(rise > step * (1 + 1e-6), rise / step, 1.0) * dt
+    per[: result.drive_start_index] = dt
+    return result.time_s[0] - dt + np.cumsum(per)
+
+
+class _Stepper:
+    """The stepping loop's arrays and checkpoints: one row per engine step."""
+
+    def __init__(self, m, d, nstep: int, ctl: ResetController):
+        import mujoco
+
+        self.m, self.d, self.ctl = m, d, ctl
+        self.full = mujoco.mjtState.mjSTATE_FULLPHYSICS
+        self.exact = mujoco.mjtState.mjSTATE_INTEGRATION  # warm start included: an exact restart
+        self.state = np.empty((nstep, mujoco.mj_stateSize(m, self.full)))
+        self.sens = np.empty((nstep, m.nsensordata))
+        self.ctrl_log = np.zeros((nstep, 6))
+        self.ck_size = mujoco.mj_stateSize(m, self.exact)
+        self.checkpoints: list[tuple[int, np.ndarray, dict]] = []
+
+    def record(self, i: int, push_id: int) -> None:
+        import mujoco
+
+        mujoco.mj_getState(self.m, self.d, self.state[i], self.full)
+        self.sens[i] = self.d.sensordata
+        self.ctrl_log[i, 1] = self.d.ctrl[push_id]
+
+    def checkpoint(self, next_row: int, *, fresh: bool) -> None:
+        """Remember the state before row ``next_row``: the last two of a phase are kept
+        (``fresh``: the first of a new phase)."""
+        import mujoco
+
+        buf = np.empty(self.ck_size)
+        mujoco.mj_getState(self.m, self.d, buf, self.exact)
+        kept = [] if fresh else self.checkpoints[-1:]
+        self.checkpoints = [*kept, (next_row, buf, self.ctl.snapshot())]
+
+    def rollback(self) -> int:
+        """Go back to the older checkpoint; returns the row to write next."""
+        import mujoco
+
+        row, buf, snap = self.checkpoints[0]
+        mujoco.mj_setState(self.m, self.d, buf, self.exact)
+        self.ctl.restore(snap)
+        self.checkpoints = []
+        return row
+
+
+def _first_end(rig: RigModel, st: _Stepper, a: int, b: int, det: Detection) -> int | None:
+    """The first row in ``a..b-1`` at which the analysis would end the run (deep
+    penetration, left the domain, self-lock), or None."""
+    state, sens = st.state[None, a:b], st.sens[None, a:b]
+    rec = Recording.from_sensors(
+        rig.sensor_adr,
+        state,
+        sens,
+        units=rig.units,
+        carriage_x=np.full((1, b - a), np.nan),
+        slip_speed_m_s=det.slip_speed_m_s,
+    )
+    marks = end_marks(
+        rec,
+        state,
+        sens,
+        timestep_s=rig.engine.timestep_s,
+        bounds_m=(*rig.bounds_m, *rig.z_range_m),
+        det=det,
+        preload_n=rig.scales.preload_n,
+        speed_limit_m_s=np.array([np.inf]),  # only deep, out and lock are read here
+    )
+    found = [int(marks[k][0]) for k in ("deep", "out", "lock") if marks[k][0] >= 0]
+    return a + min(found) if found else None
+
+
+def _controller(rig: RigModel, drive: RampDrive, det: Detection, n_settle: int) -> ResetController:
+    """The drive's controller, with stick-phase fast-forward where the drive and engine allow it.
+
+    The controller reads the engine's sensors, so its forces, lengths and speeds are given
+    in engine units (``rig.units``); the drive and detection settings are SI.
+    """
+    u = rig.units
+    dt = rig.engine.timestep_s
+    cap = det.kappa_cap * rig.scales.preload_n / u.force_n
+    ff = None
+    if drive.fast_forward and rig.engine.noslip_iterations > 0 and rig.tip.mu_s > 0:
+        ff = StickFastForward(
+            mu=rig.tip.mu_s,
+            preload_n=rig.scales.preload_n / u.force_n,
+            cap_n=cap * (1 + 1e-9),
+            margin=drive.fast_forward_margin,
+            stick_speed_m_s=det.stick_speed_m_s / u.speed_m_s,
+            slip_speed_m_s=det.slip_speed_m_s / u.speed_m_s,
+        )
+    slide = drive.slide_distance_m
+    return ResetController(
+        step_n=rate_n_s(drive, rig.scales) * dt / u.force_n,
+        cap_n=cap * (1 + 1e-9),
+        slide_distance_m=(0.01 * rig.scales.char_length_m if slide is None else slide) / u.length_m,
+        settle_steps=n_settle,
+        slip_speed_m_s=det.slip_speed_m_s / u.speed_m_s,
+        sensor_adr=rig.sensor_adr,
+        fast_forward=ff,
+    )
+
+
+def _step_loop(rig, st: _Stepper, nstep: int, n_settle: int, det, stop_early: bool, progress):
+    """Step until ``nstep`` rows, an early end or engine trouble; returns (rows, warning)."""
+    import mujoco
+
+    m, d, ctl = st.m, st.d, st.ctl
+    ff = ctl.ff
+    warn_total, checked, i = warning_total(d), n_settle, 0
+    while i < nstep:
+        if i >= n_settle:
+            d.ctrl[rig.act_push] = ctl.push()
+        mujoco.mj_step(m, d)
+        st.record(i, rig.act_push)
+        if i % 64 == 63 and warning_total(d) != warn_total:
+            return i + 1, (i, warning_text(d))
+        if not np.isfinite(st.state[i]).all():
+            return i + 1, None
+        verdict = ctl.observe(i, st.sens[i], driving=i >= n_settle)
+        if verdict == "rollback":
+            i = st.rollback()
+            continue
+        i += 1
+        if verdict == "start" or (ff is not None and ff.active and i % CHECKPOINT_STEPS == 0):
+            st.checkpoint(i, fresh=verdict == "start")
+        if (
+            stop_early
+            and not (ff is not None and ff.active)
+            and (i - checked >= END_CHECK_STEPS or i == nstep)
+        ):
+            end = _first_end(rig, st, checked, i, det)
+            if end is not None:
+                return end + 1, None
+            checked = i
+        if progress is not None and i % 2000 == 0:
+            progress(i / nstep)
+    return nstep, None
 
 
 def run_ramp(
@@ -99,46 +395,18 @@ def run_ramp(
     d.ctrl[rig.act_preload] = -rig.tip.preload_n / u.force_n
     d.mocap_pos[0] = qpos0 + np.array([0.0, 0.0, 2 * rig.tip.tip_radius_m / u.length_m])
     dt = rig.engine.timestep_s
-    rate = rate_n_s(drive, rig.scales)
-    cap = det.kappa_cap * rig.scales.preload_n
     n_settle = settle_steps(drive, dt)
     duration = drive.duration_s
     if duration is None:
-        duration = min(40 * cap / rate, 200 * rig.scales.time_s)
+        duration = min(
+            40 * det.kappa_cap * rig.scales.preload_n / rate_n_s(drive, rig.scales), 200 * rig.scales.time_s
+        )
     nstep = n_settle + int(math.ceil(duration / dt))
-    nstate = mujoco.mj_stateSize(m, mujoco.mjtState.mjSTATE_FULLPHYSICS)
-    state = np.empty((nstep, nstate))
-    sens = np.empty((nstep, m.nsensordata))
-    ctrl_log = np.zeros((nstep, 6))
-    slide = 0.01 * rig.scales.char_length_m if drive.slide_distance_m is None else drive.slide_distance_m
-    ctl = ResetController(
-        step_n=rate * dt / u.force_n,
-        cap_n=cap * (1 + 1e-9) / u.force_n,
-        slide_distance_m=slide / u.length_m,
-        settle_steps=n_settle,
-        slip_speed_m_s=det.slip_speed_m_s / u.speed_m_s,
-        sensor_adr=rig.sensor_adr,
-    )
-    stop, warn_total, warn_at = nstep, warning_total(d), None
-    for i in range(nstep):
-        if i >= n_settle:
-            d.ctrl[rig.act_push] = ctl.push()
-        mujoco.mj_step(m, d)
-        mujoco.mj_getState(m, d, state[i], mujoco.mjtState.mjSTATE_FULLPHYSICS)
-        sens[i] = d.sensordata
-        ctrl_log[i, 1] = d.ctrl[rig.act_push]
-        if i % 64 == 63 and warning_total(d) != warn_total:
-            warn_at, stop = (i, warning_text(d)), i + 1
-            break
-        if not np.isfinite(state[i]).all():
-            stop = i + 1
-            break
-        ctl.observe(i, sens[i], driving=i >= n_settle)
-        if progress is not None and i % 2000 == 0:
-            progress(i / nstep)
-    state, sens, ctrl_log = state[:stop], sens[:stop], ctrl_log[:stop]
-    warning = warn_at if warn_at is not None else (None, "")
-    result = analyse(rig, drive, start, state, sens, ctrl_log, det, warning)
+    ctl = _controller(rig, drive, det, n_settle)
+    st = _Stepper(m, d, nstep, ctl)
+    stop, warning = _step_loop(rig, st, nstep, n_settle, det, drive.stop_early, progress)
+    state, sens, ctrl_log = st.state[:stop], st.sens[:stop], st.ctrl_log[:stop]
+    result = analyse(rig, drive, start, state, sens, ctrl_log, det, warning or (None, ""))
     resets = tuple(Event("reset", i, float(state[i, 0])) for i in ctl.resets if i < result.n)
     events = sorted(result.events + resets, key=lambda e: (e.index, e.kind == result.end_reason.value))
     return dataclasses.replace(result, events=tuple(events))
