@@ -48,9 +48,11 @@ def test_mujoco_and_compare_runs_match_the_rig_run_directly(tmp_path):
     assert cmp_.frechet[ran].notna().all() and (cmp_.frechet[ran] >= 0).all()
     # the stored run is the rig's own run at that speed
     case_id = mj.case_id[mj.ie == 0.01].iloc[0]
-    rig = sim.Rig(presets.make_surface("paper-single-peak"), tip=sim.TipParams(mu_s=1.25))
-    sc = rig.scales
-    speed = (0.01 * sc.preload_n * sc.char_length_m / sc.mass_kg) ** 0.5
+    # the engine's step follows the drive speed (impacts): the rule of sim.default_engine
+    surface, tip = presets.make_surface("paper-single-peak"), sim.TipParams(mu_s=1.25)
+    scales = sim.Scales.for_surface(surface, tip=tip)
+    speed = scales.speed_for(0.01)
+    rig = sim.Rig(surface, tip=tip, engine=sim.default_engine(scales, speed_m_s=speed))
     direct = rig.run_batch(sim.SpringDrive(speed_m_s=speed), [(-4.0, 1.0)], nthread=1)[0]
     row = mj[(mj.case_id == case_id) & (mj.start == 1)].iloc[0]
     assert row.end_x == pytest.approx(direct.position_m[-1, 0] / rig.length_scale_m, abs=1e-12)
