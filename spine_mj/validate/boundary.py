@@ -233,8 +233,9 @@ def _ramp_runs(
 
 
 def _ramp_metrics(c: pd.DataFrame, m: pd.DataFrame, store, surface, rig) -> tuple[list, list, list]:
-    """Per ramp run: prefix Frechet, covered fraction of the path to the domain edge, and
-    the I_e of its mean x speed."""
+    """Per ramp run: prefix Frechet, covered fraction of the path (x advance over the
+    distance to the domain edge; 1 for a run that self-locked or left the domain: its
+    outcome is decided), and the I_e of its mean x speed over the plain ramp's time."""
     mi = m.set_index(["case_id", "start"])
     pf, cov, ach = [], [], []
     for case_id, grp in c.groupby("case_id", sort=False):
@@ -248,8 +249,10 @@ def _ramp_metrics(c: pd.DataFrame, m: pd.DataFrame, store, surface, rig) -> tupl
             x0 = float(grp.loc[grp["start"] == s, "start_x"].iloc[0])
             target = surface.bounds[1] - x0
             dx = float(row["end_x"]) - x0
-            cov.append(dx / target if target > 0 else float("nan"))
-            t_run = float(row["end_time_s"])
+            # a run that locked or left the domain has covered its whole path
+            decided = row["end_reason"] in ("self_lock", "left_domain")
+            cov.append(1.0 if decided else (dx / target if target > 0 else float("nan")))
+            t_run = float(row["nominal_end_time_s"])
             v_mean = dx * rig.length_scale_m / max(t_run, 1e-12)
             ach.append(rig.scales.inertia_number(max(v_mean, 0.0)))
     return pf, cov, ach

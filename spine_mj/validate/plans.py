@@ -207,7 +207,7 @@ PLANS: dict[str, ValidationPlan] = {
         sandpaper_grits=("P36", "P600"),
         sandpaper_starts=2,
         bootstrap=200,
-        ramp_max_steps=20000,
+        ramp_max_steps=60000,
     ),
     "full": ValidationPlan(
         name="full",

@@ -13,6 +13,7 @@ import numpy as np
 
 from spine_mj import sim
 from spine_mj.errors import SpineInputError
+from spine_mj.sim.ramp import nominal_time_s
 from spine_mj.sweep.registry import (
     PRESET_MU,
     Analysis,
@@ -313,6 +314,11 @@ def _metrics(rig, runs) -> dict[str, np.ndarray]:
         "end_z": end[:, 2],
         "path_length": path_len,
         "end_time_s": np.array([r.time_s[-1] for r in runs]),
+        # a fast-forwarded ramp covers its stick phases in less engine time: the time the
+        # plain ramp would have taken
+        "nominal_end_time_s": np.array(
+            [nominal_time_s(r)[-1] if isinstance(r.drive, sim.RampDrive) else r.time_s[-1] for r in runs]
+        ),
         "n_steps": np.array([r.n for r in runs], dtype=np.int64),
         "inertia_number": np.array([r.inertia_number for r in runs]),
         "speed_m_s": np.array([r.speed_m_s for r in runs]),
