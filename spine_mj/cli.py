@@ -617,7 +617,13 @@ def sim_export(surface_spec, output, **rig_opts):
 )
 @click.option("--duration", type=float, default=None, help="Run time [s] (spring, ramp).")
 @click.option("--render", is_flag=True, help="Also write an MP4 rendered headless (MUJOCO_GL=egl).")
-@click.option("-o", "--out-dir", required=True, type=click.Path(file_okay=False))
+@click.option(
+    "--out",
+    "out_dir",
+    required=True,
+    type=click.Path(file_okay=False),
+    help="Output folder (trajectory.parquet, summary.json, run.png, run.mp4).",
+)
 @_rig_options
 def simulate(
     surface_spec,
@@ -640,7 +646,7 @@ def simulate(
 
     \b
     Example:
-      spine-mj simulate paper-single-peak --start -3,-1 --drive spring --ie 1e-3 --K 10 -o out/
+      spine-mj simulate paper-single-peak --start -3,-1 --drive spring --ie 1e-3 --K 10 --out out/
     """
 
     if render:

@@ -75,7 +75,7 @@ def test_surface_make_random_overrides(tmp_path_factory, preset, sets, hurst):
 def test_simulate_random_numbers(tmp_path_factory, mass, mu, speed, timestep, start):
     out = tmp_path_factory.mktemp("sim")
     args = ["simulate", "paper-single-peak", "--start", start, "--duration", 0.01]
-    args += ["--resolution", 21, "-o", out / "run"]
+    args += ["--resolution", 21, "--out", out / "run"]
     for name, value in (("--mass", mass), ("--mu", mu), ("--speed", speed), ("--timestep", timestep)):
         if value is not None:
             args += [name, value]

@@ -25,7 +25,7 @@ def test_cli_simulate_export_and_view(tmp_path, monkeypatch):
             "0.05",
             "--duration",
             "0.05",
-            "-o",
+            "--out",
             str(tmp_path),
         ],
     )
@@ -34,7 +34,7 @@ def test_cli_simulate_export_and_view(tmp_path, monkeypatch):
     assert len(table) > 100 and (tmp_path / "run.png").stat().st_size > 0
     res = runner.invoke(main, ["sim", "export", "paper-single-peak", "-o", str(tmp_path / "rig.xml")])
     assert res.exit_code == 0 and mujoco.MjModel.from_xml_path(str(tmp_path / "rig.xml")).nhfield == 1
-    res = runner.invoke(main, ["simulate", "paper-single-peak", "--start", "-3", "-o", str(tmp_path)])
+    res = runner.invoke(main, ["simulate", "paper-single-peak", "--start", "-3", "--out", str(tmp_path)])
     assert res.exit_code == 2 and "--start must look like X,Y" in res.output
     monkeypatch.delenv("DISPLAY", raising=False)
     monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
