@@ -58,6 +58,7 @@ from spine_mj.sim.model import MODEL_PATH
 from spine_mj.sim.params import (
     DEFAULT_LENGTH_SCALE_M,
     LENGTH_UNITS_M,
+    MAX_INERTIA_NUMBER,
     Cone,
     EndReason,
     EngineSettings,
@@ -78,6 +79,7 @@ from spine_mj.sim.rig import Rig
 __all__ = [
     "DEFAULT_LENGTH_SCALE_M",
     "LENGTH_UNITS_M",
+    "MAX_INERTIA_NUMBER",
     "MODEL_PATH",
     "Cone",
     "Detection",

@@ -31,6 +31,9 @@ from spine_mj.surfaces import GridSurface, HField, Surface, to_hfield
 
 DEFAULT_LENGTH_SCALE_M = 0.01
 _REST_PENETRATION_FRACTION = 0.005
+#: Largest inertia number a drive may have: beyond it the quasistatic question is moot and
+#: the engine step (bounded by impacts at the drive speed) shrinks without end.
+MAX_INERTIA_NUMBER = 1e4
 _IMPACT_DEPTH_FRACTION = 0.05  # impact depth of a drive-speed arrival, in tip radii
 _MIN_SPACING_PER_TIP_RADIUS = 0.25  # finer hfields exceed MuJoCo's 50 contacts per geom pair
 _SCAN_TIP_SPACINGS = 2.0  # default tip radius of a measured scan, in lateral spacings
@@ -362,8 +365,20 @@ class Scales:
         return self.mass_kg * speed_m_s**2 / (self.preload_n * self.char_length_m)
 
     def speed_for(self, inertia_number: float) -> float:
-        """The drive speed [m/s] of inertia number ``inertia_number`` (inverse of I_e)."""
-        return math.sqrt(inertia_number) * self.speed_m_s
+        """The drive speed [m/s] of inertia number ``inertia_number`` (inverse of I_e).
+
+        Raises
+        ------
+        SpineInputError
+            Unless ``0 < I_e <= MAX_INERTIA_NUMBER``.
+        """
+        ie = check_positive("inertia number I_e", inertia_number)
+        if ie > MAX_INERTIA_NUMBER:
+            raise SpineInputError(
+                f"inertia number I_e must be <= {MAX_INERTIA_NUMBER:g} (the tip crosses an asperity "
+                f"{math.sqrt(MAX_INERTIA_NUMBER):g} times faster than the preload can move it), got {ie:g}"
+            )
+        return math.sqrt(ie) * self.speed_m_s
 
     def stiffness_number(self, stiffness_n_m: float) -> float:
         """K = k l_s / F_p (docs/physics.md §4), l_s the slope correlation length."""

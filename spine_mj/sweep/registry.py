@@ -69,6 +69,8 @@ class ParamSpec:
     minimum : float, optional
         Lower bound (inclusive unless ``exclusive``).
     exclusive : bool
+    maximum : float, optional
+        Upper bound (inclusive): where larger values stop making physical sense.
     choices : tuple of str, optional
         Allowed values of a ``str`` parameter.
     drive : bool
@@ -83,6 +85,7 @@ class ParamSpec:
     exclusive: bool = False
     choices: tuple[str, ...] | None = None
     drive: bool = False
+    maximum: float | None = None
 
     def expected(self) -> str:
         if self.choices:
@@ -92,6 +95,8 @@ class ParamSpec:
         ]
         if self.minimum is not None:
             what += f" {'>' if self.exclusive else '>='} {self.minimum:g}"
+        if self.maximum is not None:
+            what += f" and <= {self.maximum:g}"
         return what
 
     def check(self, value, key: str):
@@ -108,6 +113,8 @@ class ParamSpec:
             ok = isinstance(value, bool)
         if ok and self.minimum is not None:
             ok = value > self.minimum if self.exclusive else value >= self.minimum
+        if ok and self.maximum is not None:
+            ok = value <= self.maximum
         if not ok:
             raise SpineInputError(
                 f"config key {key}: must be {self.expected()} (or a list of them), got {value!r}"

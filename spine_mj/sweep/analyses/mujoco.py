@@ -51,6 +51,7 @@ MUJOCO_PARAMS = (
         0.0,
         exclusive=True,
         drive=True,
+        maximum=sim.MAX_INERTIA_NUMBER,
     ),
     ParamSpec(
         "speed",
