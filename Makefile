@@ -39,6 +39,8 @@ wheel-check: $(STAMP)
 	"$$tmp/venv/bin/python" -c "import spine_mj.presets as p; p.make_surface('paper-single-peak')"; \
 	"$$tmp/venv/bin/python" -c "import mujoco; from spine_mj.resources import model_path; \
 	m = mujoco.MjModel.from_xml_path(str(model_path())); print('rig compiles:', model_path(), m.nbody, 'bodies')"; \
+	"$$tmp/venv/bin/spine-mj" simulate paper-single-peak --start -3,-1 --duration 0.05 --resolution 41 --out sim; \
+	"$$tmp/venv/bin/spine-mj" reproduce single-peak --quick --out repro; \
 	echo "wheel-check: OK"
 
 clean:
