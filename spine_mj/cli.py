@@ -565,9 +565,22 @@ def sim_group():
 @sim_group.command("export")
 @click.argument("surface_spec", metavar="SURFACE")
 @click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="Output .xml.")
+@click.option(
+    "--start",
+    default=None,
+    help="Where the tip rests, 'x0,y0' in surface units (default: a tenth in from the -x edge, mid y).",
+)
+@click.option("--stiffness", type=float, default=None, help="Spring stiffness [N/m] (default 10 F_p/L_c).")
 @_rig_options
-def sim_export(surface_spec, output, **rig_opts):
-    """Write a self-contained MJCF of the rig on SURFACE (opens in MuJoCo's viewer).
+def sim_export(surface_spec, output, start, stiffness, **rig_opts):
+    """Write a self-contained MJCF of the rig on SURFACE, ready for MuJoCo's viewer.
+
+    The tip rests on the surface at --start (keyframe 'home', also the initial state),
+    the spring is on with its target at the tip. Plain MJCF has no controller, so
+    nothing moves by itself: in the viewer's Control panel move the 'spring' slider (the
+    carriage's x, engine units) to pull the tip in x, or 'push' (a force, +-2 F_p).
+    Press Backspace (reset) to return to the start. The camera 'follow' tracks the tip.
+    Units are engine units: length L_c, force F_p, mass m (printed below).
 
     \b
     Example:
@@ -575,11 +588,17 @@ def sim_export(surface_spec, output, **rig_opts):
     """
     _check_suffix(output, ".xml", "-o/--output")
     rig = _build_rig(surface_spec, **rig_opts)
-    rig.export_xml(output)
+    xy = None if start is None else _parse_start(start)
+    if stiffness is not None:
+        check_positive("--stiffness", stiffness)
+    rig.export_xml(output, start=xy, stiffness_n_m=stiffness)
+    u = rig.units
     click.echo(
         f"wrote {output} (hfield {rig.hfield.nrow} x {rig.hfield.ncol}, "
-        f"dt {rig.engine.timestep_s:g} s, tip radius {rig.tip.tip_radius_m:g} m)"
+        f"dt {rig.engine.timestep_s:g} s, tip radius {rig.tip.tip_radius_m:g} m; "
+        f"engine units: L_c = {u.length_m:g} m, F_p = {u.force_n:g} N, m = {u.mass_kg:g} kg)"
     )
+    click.echo("in the viewer: Control panel, move 'spring' (carriage x) or 'push' to drive the tip")
 
 
 @main.command("simulate")
