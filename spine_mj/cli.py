@@ -31,6 +31,8 @@ from spine_mj.plotting import (
     streamline_figure,
     surface_preview,
 )
+from spine_mj.sim.render import Track, choose_gl_backend, default_speed, render_frames
+from spine_mj.sim.replay import load_run, play_in_viewer
 from spine_mj.streamline import StreamlineParams, dilate, ideal_trajectories, streamlines
 from spine_mj.surfaces import to_hfield
 
@@ -635,7 +637,12 @@ def sim_export(surface_spec, output, start, stiffness, **rig_opts):
     help="Static probe: force [N] applied while the tip settles.",
 )
 @click.option("--duration", type=float, default=None, help="Run time [s] (spring, ramp).")
-@click.option("--render", is_flag=True, help="Also write an MP4 rendered headless (MUJOCO_GL=egl).")
+@click.option(
+    "--render",
+    is_flag=True,
+    help="Also write run.mp4 (headless: MUJOCO_GL=egl, else osmesa) with the tip's path, the "
+    "streamline from the same start and the drive force.",
+)
 @click.option("-o", "--out-dir", required=True, type=click.Path(file_okay=False))
 @_rig_options
 def simulate(
@@ -663,7 +670,7 @@ def simulate(
     """
 
     if render:
-        os.environ.setdefault("MUJOCO_GL", "egl")
+        choose_gl_backend()
 
     x0, y0 = _parse_start(start)
     for a, b, names in ((ie, speed, "--ie or --speed"), (ie, rate, "--ie or --rate")):
@@ -689,11 +696,14 @@ def simulate(
     with Progress("simulating", unit="%") as bar:
         result = rig.run(drv, start=(x0, y0), progress=lambda frac: bar.update(round(100 * frac, 1), 100))
     out = Path(out_dir)
-    written = ["trajectory.parquet", "summary.json", "run.png"] + (["run.mp4"] if render else [])
+    written = ["trajectory.parquet", "summary.json", "surface.npz", "run.png"] + (
+        ["run.mp4"] if render else []
+    )
     with all_or_none(*(out / name for name in written)):
         with atomic_output(out / "trajectory.parquet") as tmp:
             result.table().to_parquet(tmp, index=False)
         write_json(out / "summary.json", result.summary())
+        surface_io.save_surface(rig.surface, out / "surface.npz")  # for `spine-mj replay`
         save_figure(sim_run_figure(result, rig.surface, length_scale_m=rig.length_scale_m), out / "run.png")
         if render:
             _render_mp4(rig, result, out / "run.mp4")
@@ -704,24 +714,70 @@ def simulate(
     click.echo(f"wrote {', '.join(str(out / w) for w in written)}")
 
 
-def _render_mp4(rig, result, path: Path) -> None:
-
+def _render_mp4(rig, run, path: Path, *, speed: float | None = None, fps: float = 30.0) -> None:
+    """Write the MP4 of a run (a RunResult or a replay Track), with a progress bar."""
     try:
         import imageio.v2 as imageio
 
-        frames = rig.render_frames(result)
+        frames = render_frames(rig, run, fps=fps, speed=speed, progress=None)
         first = next(frames)
+    except SpineInputError:
+        raise
     except Exception as exc:  # a missing GL backend surfaces as many exception types
         backend = os.environ.get("MUJOCO_GL", "")
         raise SpineInputError(
             f"no headless renderer (MUJOCO_GL={backend!r}: {type(exc).__name__}: {exc}); "
-            "try MUJOCO_GL=osmesa or run without --render"
+            "try MUJOCO_GL=osmesa (Debian: libosmesa6) or run without --render"
         ) from None
-    with atomic_output(path) as tmp:
-        with imageio.get_writer(tmp, fps=30, codec="libx264", format="FFMPEG") as writer:
+    t = Track.of(run).time_s
+    total = max(1, int((t[-1] - t[0]) * fps / (speed or default_speed(t))) + 1)
+    with Progress("rendering MP4", unit="frame") as bar, atomic_output(path) as tmp:
+        with imageio.get_writer(tmp, fps=fps, codec="libx264", format="FFMPEG") as writer:
             writer.append_data(first)
-            for frame in frames:
+            for k, frame in enumerate(frames, start=2):
                 writer.append_data(frame)
+                bar.update(min(k, total), total)
+
+
+@main.command("replay")
+@click.argument("run_dir", type=click.Path(file_okay=False, exists=True))
+@click.option(
+    "--speed", type=float, default=None, help="Playback speed, times real time (default: the run in ~10 s)."
+)
+@click.option("--duration", type=float, default=None, help="Close the viewer after this many seconds.")
+@click.option(
+    "--mp4", type=click.Path(dir_okay=False), default=None, help="Write this MP4 instead (headless)."
+)
+def replay(run_dir, speed, duration, mp4):
+    """Play a run recorded by `spine-mj simulate` in MuJoCo's viewer (RUN_DIR: its --out-dir).
+
+    The tip moves through its recorded positions at the recorded times (times --speed),
+    with its path so far (orange) and the streamline from the same start (cyan). Without a
+    display, or with --mp4, it writes an MP4 instead (RUN_DIR/replay.mp4 by default).
+
+    \b
+    Example:
+      spine-mj simulate paper-single-peak --start -3,-1 -o run/ && spine-mj replay run/
+    """
+    headless = mp4 is not None or (
+        sys.platform.startswith("linux")
+        and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+    )
+    if headless:
+        choose_gl_backend()
+    rig, track = load_run(run_dir)
+    span = float(track.time_s[-1] - track.time_s[0])
+    speed = check_positive("--speed", speed) if speed is not None else default_speed(track.time_s)
+    if headless:
+        path = Path(mp4) if mp4 is not None else Path(run_dir) / "replay.mp4"
+        _check_suffix(str(path), ".mp4", "--mp4")
+        if mp4 is None:
+            click.echo("no display: writing an MP4 instead of opening the viewer", err=True)
+        _render_mp4(rig, track, path, speed=speed)
+        click.echo(f"wrote {path}")
+        return
+    click.echo(f"replaying {span:g} s of run at {speed:g}x; close the window to stop", err=True)
+    play_in_viewer(rig, track, speed=speed, duration_s=duration)
 
 
 @main.command("view")
