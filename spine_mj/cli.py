@@ -31,6 +31,7 @@ from spine_mj.plotting import (
     streamline_figure,
     surface_preview,
 )
+from spine_mj.sim.model import compile_spec
 from spine_mj.sim.render import Track, choose_gl_backend, default_speed, render_frames
 from spine_mj.sim.replay import load_run, play_in_viewer
 from spine_mj.streamline import StreamlineParams, dilate, ideal_trajectories, streamlines
@@ -782,26 +783,32 @@ def replay(run_dir, speed, duration, mp4):
 
 @main.command("view")
 @click.argument("surface_spec", metavar="SURFACE")
+@click.option(
+    "--start",
+    default=None,
+    help="Where the tip rests, 'x0,y0' in surface units (default: a tenth in from the -x edge, mid y).",
+)
 @_rig_options
-def view(surface_spec, **rig_opts):
-    """Open the rig on SURFACE in MuJoCo's interactive viewer (needs a display)."""
+def view(surface_spec, start, **rig_opts):
+    """Open the rig on SURFACE in MuJoCo's interactive viewer (needs a display).
+
+    The model is the one `sim export` writes: the tip rests at --start with the spring on;
+    drive it with the 'spring' (carriage x) or 'push' slider in the Control panel.
+    To watch a recorded run instead, use `spine-mj replay RUN_DIR`.
+    """
 
     if sys.platform.startswith("linux") and not (
         os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
     ):
         raise InputError(
             "no display (DISPLAY and WAYLAND_DISPLAY are unset): the viewer "
-            "needs one; use `spine-mj sim export` or `simulate --render`"
+            "needs one; use `spine-mj sim export`, `simulate --render` or `replay --mp4`"
         )
-    import mujoco
     import mujoco.viewer
 
     rig = _build_rig(surface_spec, **rig_opts)
-    data = mujoco.MjData(rig.model)
-    data.qpos[:] = rig.place(
-        *(0.5 * (a + b) for a, b in zip(rig.surface.bounds[::2], rig.surface.bounds[1::2]))
-    )
-    mujoco.viewer.launch(rig.model, data)
+    model = compile_spec(rig.export_spec(None if start is None else _parse_start(start)))
+    mujoco.viewer.launch(model)
 
 
 # --------------------------------------------------------------------------- end MuJoCo rig
