@@ -32,7 +32,7 @@ from spine_mj.plotting import (
     surface_preview,
 )
 from spine_mj.sim.model import compile_spec
-from spine_mj.sim.render import Track, choose_gl_backend, default_speed, render_frames
+from spine_mj.sim.render import FPS, choose_gl_backend, default_speed, render_frames
 from spine_mj.sim.replay import load_run, play_in_viewer
 from spine_mj.streamline import StreamlineParams, dilate, ideal_trajectories, streamlines
 from spine_mj.surfaces import to_hfield
@@ -715,29 +715,27 @@ def simulate(
     click.echo(f"wrote {', '.join(str(out / w) for w in written)}")
 
 
-def _render_mp4(rig, run, path: Path, *, speed: float | None = None, fps: float = 30.0) -> None:
+def _render_mp4(rig, run, path: Path, *, speed: float | None = None) -> None:
     """Write the MP4 of a run (a RunResult or a replay Track), with a progress bar."""
-    try:
-        import imageio.v2 as imageio
+    import imageio.v2 as imageio
 
-        frames = render_frames(rig, run, fps=fps, speed=speed, progress=None)
-        first = next(frames)
-    except SpineInputError:
-        raise
-    except Exception as exc:  # a missing GL backend surfaces as many exception types
-        backend = os.environ.get("MUJOCO_GL", "")
-        raise SpineInputError(
-            f"no headless renderer (MUJOCO_GL={backend!r}: {type(exc).__name__}: {exc}); "
-            "try MUJOCO_GL=osmesa (Debian: libosmesa6) or run without --render"
-        ) from None
-    t = Track.of(run).time_s
-    total = max(1, int((t[-1] - t[0]) * fps / (speed or default_speed(t))) + 1)
-    with Progress("rendering MP4", unit="frame") as bar, atomic_output(path) as tmp:
-        with imageio.get_writer(tmp, fps=fps, codec="libx264", format="FFMPEG") as writer:
-            writer.append_data(first)
-            for k, frame in enumerate(frames, start=2):
-                writer.append_data(frame)
-                bar.update(min(k, total), total)
+    with Progress("rendering MP4", unit="frame") as bar:
+        frames = render_frames(rig, run, speed=speed, progress=bar.update)
+        try:
+            first = next(frames)
+        except SpineInputError:
+            raise
+        except Exception as exc:  # a missing GL backend surfaces as many exception types
+            backend = os.environ.get("MUJOCO_GL", "")
+            raise SpineInputError(
+                f"no headless renderer (MUJOCO_GL={backend!r}: {type(exc).__name__}: {exc}); "
+                "install EGL (libegl1) or OSMesa (libosmesa6), or run without --render"
+            ) from None
+        with atomic_output(path) as tmp:
+            with imageio.get_writer(tmp, fps=FPS, codec="libx264", format="FFMPEG") as writer:
+                writer.append_data(first)
+                for frame in frames:
+                    writer.append_data(frame)
 
 
 @main.command("replay")

@@ -26,6 +26,7 @@ from spine_mj.sim.model import RigModel
 TRAIL_RGBA = (1.0, 0.55, 0.0, 1.0)
 STREAMLINE_RGBA = (0.0, 0.8, 0.9, 0.9)
 MAX_SEGMENTS = 300  # per polyline
+FPS = 30.0  # of the MP4
 _ZERO3, _EYE9 = np.zeros(3), np.eye(3).ravel()
 
 
@@ -136,7 +137,7 @@ def render_frames(
     rig: RigModel,
     run,
     *,
-    fps: float = 30.0,
+    fps: float = FPS,
     width: int = 640,
     height: int = 480,
     speed: float | None = None,
@@ -147,7 +148,7 @@ def render_frames(
 
     One frame per ``speed / fps`` seconds of run time (``speed`` None: :func:`default_speed`),
     camera following the tip; trail, streamline and overlay as in the module docstring.
-    ``progress(done, total)`` is called after each frame.
+    ``progress(done, total)`` is called as each frame is ready.
     """
     import mujoco
 
@@ -183,8 +184,9 @@ def render_frames(
             add_polyline(renderer.scene, trail, TRAIL_RGBA, 0.35 * r)
             f = track.drive_force_n[i]
             lines = [f"t = {t[i]:.4f} s", f"drive force = {f * 1e3:.3g} mN = {f / f_p:.3f} F_p"]
-            yield overlay_text(renderer.render(), lines)
+            frame = overlay_text(renderer.render(), lines)
             if progress is not None:
                 progress(k + 1, len(rows))
+            yield frame
     finally:
         renderer.close()
