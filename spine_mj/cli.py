@@ -33,7 +33,7 @@ from spine_mj.plotting import (
 )
 from spine_mj.sim.model import compile_spec
 from spine_mj.sim.render import FPS, choose_gl_backend, default_speed, render_frames
-from spine_mj.sim.replay import load_run, play_in_viewer
+from spine_mj.sim.replay import load_run, play_in_viewer, run_in_viewer
 from spine_mj.streamline import StreamlineParams, dilate, ideal_trajectories, streamlines
 from spine_mj.surfaces import to_hfield
 
@@ -786,12 +786,14 @@ def replay(run_dir, speed, duration, mp4):
     default=None,
     help="Where the tip rests, 'x0,y0' in surface units (default: a tenth in from the -x edge, mid y).",
 )
+@click.option("--duration", type=float, default=None, help="Close the viewer after this many seconds.")
 @_rig_options
-def view(surface_spec, start, **rig_opts):
+def view(surface_spec, start, duration, **rig_opts):
     """Open the rig on SURFACE in MuJoCo's interactive viewer (needs a display).
 
     The model is the one `sim export` writes: the tip rests at --start with the spring on;
-    drive it with the 'spring' (carriage x) or 'push' slider in the Control panel.
+    drive it with the 'spring' (carriage x) or 'push' slider in the Control panel. It
+    runs in physical real time, seen from the camera 'follow' (Esc: the free camera).
     To watch a recorded run instead, use `spine-mj replay RUN_DIR`.
     """
 
@@ -802,11 +804,9 @@ def view(surface_spec, start, **rig_opts):
             "no display (DISPLAY and WAYLAND_DISPLAY are unset): the viewer "
             "needs one; use `spine-mj sim export`, `simulate --render` or `replay --mp4`"
         )
-    import mujoco.viewer
-
     rig = _build_rig(surface_spec, **rig_opts)
     model = compile_spec(rig.export_spec(None if start is None else _parse_start(start)))
-    mujoco.viewer.launch(model)
+    run_in_viewer(model, time_scale=1.0 / rig.units.time_s, duration_s=duration)
 
 
 # --------------------------------------------------------------------------- end MuJoCo rig

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import os
 import shutil
-import signal
 import subprocess
 import sys
 
@@ -155,17 +154,10 @@ def test_replay_opens_the_viewer_under_xvfb_and_exits_by_itself(run_dir):
 @pytest.mark.skipif(
     shutil.which("xvfb-run") is None, reason="xvfb-run not installed (Debian: apt-get install xvfb)"
 )
-def test_view_opens_the_ready_model_under_xvfb():
+def test_view_runs_the_ready_model_under_xvfb_and_exits_by_itself():
     env = dict(os.environ)
     env.pop("MUJOCO_GL", None)
     cmd = ["xvfb-run", "-a", "-s", "-screen 0 1024x768x24", *SPINE_MJ, "view", "paper-single-peak"]
-    proc = subprocess.Popen(cmd, env=env, stderr=subprocess.PIPE, text=True, start_new_session=True)
-    try:
-        # the managed viewer runs until its window is closed: alive after 15 s means it opened
-        with pytest.raises(subprocess.TimeoutExpired):
-            proc.wait(timeout=15)
-    finally:
-        if proc.poll() is None:
-            os.killpg(proc.pid, signal.SIGTERM)
-        _, err = proc.communicate(timeout=30)
-    assert "Traceback" not in err and "Error" not in err, err
+    proc = subprocess.run([*cmd, "--duration", "3"], env=env, capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    assert "Traceback" not in proc.stderr

@@ -217,8 +217,7 @@ class RigModel:
         in +x from the start (L_c; spring of ``stiffness_n_m``, None: the spring drive's
         ``10 F_p / L_c``, relaxed at 0), ``push`` a force within +-2 F_p, and the preload
         is built into its actuator's bias. The carriage box marks where the spring starts
-        (it does not follow the slider); the viewer opens on the camera ``follow``, which
-        tracks the tip.
+        (it does not follow the slider); the camera ``follow`` tracks the tip.
         """
         import mujoco
 
@@ -246,7 +245,6 @@ class RigModel:
         car.size, car.rgba = [0.5 * r] * 3, [0.2, 0.4, 0.9, 0.35]
         spec.add_key(name="home", qpos=qpos, qvel=[0.0] * 3, mpos=mpos, ctrl=[0.0] * 3)
         tip.add_camera(name="follow", mode=mujoco.mjtCamLight.mjCAMLIGHT_TRACK, **_follow_camera(60 * r))
-        spec.visual.global_.cameraid = 0  # the viewer opens on it (Esc: the free camera)
         return spec
 
     def to_xml(self, start: tuple[float, float] | None = None, stiffness_n_m: float | None = None) -> str:

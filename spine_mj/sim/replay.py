@@ -69,6 +69,38 @@ def load_run(run_dir: str | Path) -> tuple[RigModel, Track]:
     return rig, track
 
 
+def run_in_viewer(model, *, time_scale: float = 1.0, duration_s: float | None = None) -> None:
+    """Simulate ``model`` live in MuJoCo's passive viewer, on its first camera (needs a display).
+
+    ``time_scale`` is model seconds per wall second (``1 / units.time_s`` runs an engine-unit
+    model in physical real time). Ends when the window is closed or after ``duration_s``
+    wall seconds. The viewer's own sliders and Reset act on the running model.
+    """
+    import mujoco
+    import mujoco.viewer
+
+    d = mujoco.MjData(model)
+    mujoco.mj_forward(model, d)
+    most = max(1, int(0.1 * time_scale / model.opt.timestep))  # steps per frame, at most 0.1 s
+    before = set(threading.enumerate())
+    t0 = time.monotonic()
+    with mujoco.viewer.launch_passive(model, d) as viewer:
+        if model.ncam:
+            viewer.cam.type, viewer.cam.fixedcamid = mujoco.mjtCamera.mjCAMERA_FIXED, 0
+        sim0 = d.time
+        while viewer.is_running():
+            wall = time.monotonic() - t0
+            if duration_s is not None and wall >= duration_s:
+                break
+            with viewer.lock():
+                n = min(most, int((sim0 + wall * time_scale - d.time) / model.opt.timestep))
+                for _ in range(max(0, n)):
+                    mujoco.mj_step(model, d)
+            viewer.sync()
+            time.sleep(1 / 60)
+    _join_new_threads(before)
+
+
 def play_in_viewer(
     rig: RigModel,
     track: Track,
@@ -117,6 +149,11 @@ def play_in_viewer(
             if on_frame is not None:
                 on_frame(float(t[i]))
             time.sleep(1 / 60)
-    # the viewer's daemon thread still tears down its window: an exit now crashes in GLFW
+    _join_new_threads(before)
+
+
+def _join_new_threads(before: set) -> None:
+    """Wait for the viewer's daemon thread to tear down its window: an exit before that
+    crashes in GLFW."""
     for thread in set(threading.enumerate()) - before:
         thread.join(timeout=10)
