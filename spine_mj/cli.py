@@ -31,6 +31,9 @@ from spine_mj.plotting import (
     streamline_figure,
     surface_preview,
 )
+from spine_mj.sim.model import compile_spec
+from spine_mj.sim.render import FPS, choose_gl_backend, default_speed, render_frames
+from spine_mj.sim.replay import load_run, play_in_viewer, run_in_viewer
 from spine_mj.streamline import StreamlineParams, dilate, ideal_trajectories, streamlines
 from spine_mj.surfaces import to_hfield
 
@@ -565,9 +568,22 @@ def sim_group():
 @sim_group.command("export")
 @click.argument("surface_spec", metavar="SURFACE")
 @click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="Output .xml.")
+@click.option(
+    "--start",
+    default=None,
+    help="Where the tip rests, 'x0,y0' in surface units (default: a tenth in from the -x edge, mid y).",
+)
+@click.option("--stiffness", type=float, default=None, help="Spring stiffness [N/m] (default 10 F_p/L_c).")
 @_rig_options
-def sim_export(surface_spec, output, **rig_opts):
-    """Write a self-contained MJCF of the rig on SURFACE (opens in MuJoCo's viewer).
+def sim_export(surface_spec, output, start, stiffness, **rig_opts):
+    """Write a self-contained MJCF of the rig on SURFACE, ready for MuJoCo's viewer.
+
+    The tip rests on the surface at --start (keyframe 'home', also the initial state),
+    the spring is on with its target at the tip. Plain MJCF has no controller, so
+    nothing moves by itself: in the viewer's Control panel move the 'spring' slider (the
+    carriage's x, engine units) to pull the tip in x, or 'push' (a force, +-2 F_p).
+    Press Backspace (reset) to return to the start. The camera 'follow' tracks the tip.
+    Units are engine units: length L_c, force F_p, mass m (printed below).
 
     \b
     Example:
@@ -575,11 +591,17 @@ def sim_export(surface_spec, output, **rig_opts):
     """
     _check_suffix(output, ".xml", "-o/--output")
     rig = _build_rig(surface_spec, **rig_opts)
-    rig.export_xml(output)
+    xy = None if start is None else _parse_start(start)
+    if stiffness is not None:
+        check_positive("--stiffness", stiffness)
+    rig.export_xml(output, start=xy, stiffness_n_m=stiffness)
+    u = rig.units
     click.echo(
         f"wrote {output} (hfield {rig.hfield.nrow} x {rig.hfield.ncol}, "
-        f"dt {rig.engine.timestep_s:g} s, tip radius {rig.tip.tip_radius_m:g} m)"
+        f"dt {rig.engine.timestep_s:g} s, tip radius {rig.tip.tip_radius_m:g} m; "
+        f"engine units: L_c = {u.length_m:g} m, F_p = {u.force_n:g} N, m = {u.mass_kg:g} kg)"
     )
+    click.echo("in the viewer: Control panel, move 'spring' (carriage x) or 'push' to drive the tip")
 
 
 @main.command("simulate")
@@ -616,13 +638,18 @@ def sim_export(surface_spec, output, **rig_opts):
     help="Static probe: force [N] applied while the tip settles.",
 )
 @click.option("--duration", type=float, default=None, help="Run time [s] (spring, ramp).")
-@click.option("--render", is_flag=True, help="Also write an MP4 rendered headless (MUJOCO_GL=egl).")
+@click.option(
+    "--render",
+    is_flag=True,
+    help="Also write run.mp4 (headless: MUJOCO_GL=egl, else osmesa) with the tip's path, the "
+    "streamline from the same start and the drive force.",
+)
 @click.option(
     "--out",
     "out_dir",
     required=True,
     type=click.Path(file_okay=False),
-    help="Output folder (trajectory.parquet, summary.json, run.png, run.mp4).",
+    help="Output folder (trajectory.parquet, summary.json, surface.npz, run.png, run.mp4).",
 )
 @_rig_options
 def simulate(
@@ -650,7 +677,7 @@ def simulate(
     """
 
     if render:
-        os.environ.setdefault("MUJOCO_GL", "egl")
+        choose_gl_backend()
 
     x0, y0 = _parse_start(start)
     for a, b, names in ((ie, speed, "--ie or --speed"), (ie, rate, "--ie or --rate")):
@@ -676,11 +703,14 @@ def simulate(
     with Progress("simulating", unit="%") as bar:
         result = rig.run(drv, start=(x0, y0), progress=lambda frac: bar.update(round(100 * frac, 1), 100))
     out = Path(out_dir)
-    written = ["trajectory.parquet", "summary.json", "run.png"] + (["run.mp4"] if render else [])
+    written = ["trajectory.parquet", "summary.json", "surface.npz", "run.png"] + (
+        ["run.mp4"] if render else []
+    )
     with all_or_none(*(out / name for name in written)):
         with atomic_output(out / "trajectory.parquet") as tmp:
             result.table().to_parquet(tmp, index=False)
         write_json(out / "summary.json", result.summary())
+        surface_io.save_surface(rig.surface, out / "surface.npz")  # for `spine-mj replay`
         save_figure(sim_run_figure(result, rig.surface, length_scale_m=rig.length_scale_m), out / "run.png")
         if render:
             _render_mp4(rig, result, out / "run.mp4")
@@ -691,48 +721,98 @@ def simulate(
     click.echo(f"wrote {', '.join(str(out / w) for w in written)}")
 
 
-def _render_mp4(rig, result, path: Path) -> None:
+def _render_mp4(rig, run, path: Path, *, speed: float | None = None) -> None:
+    """Write the MP4 of a run (a RunResult or a replay Track), with a progress bar."""
+    import imageio.v2 as imageio
 
-    try:
-        import imageio.v2 as imageio
+    with Progress("rendering MP4", unit="frame") as bar:
+        frames = render_frames(rig, run, speed=speed, progress=bar.update)
+        try:
+            first = next(frames)
+        except SpineInputError:
+            raise
+        except Exception as exc:  # a missing GL backend surfaces as many exception types
+            backend = os.environ.get("MUJOCO_GL", "")
+            raise SpineInputError(
+                f"no headless renderer (MUJOCO_GL={backend!r}: {type(exc).__name__}: {exc}); "
+                "install EGL (libegl1) or OSMesa (libosmesa6), or run without --render"
+            ) from None
+        with atomic_output(path) as tmp:
+            with imageio.get_writer(tmp, fps=FPS, codec="libx264", format="FFMPEG") as writer:
+                writer.append_data(first)
+                for frame in frames:
+                    writer.append_data(frame)
 
-        frames = rig.render_frames(result)
-        first = next(frames)
-    except Exception as exc:  # a missing GL backend surfaces as many exception types
-        backend = os.environ.get("MUJOCO_GL", "")
-        raise SpineInputError(
-            f"no headless renderer (MUJOCO_GL={backend!r}: {type(exc).__name__}: {exc}); "
-            "try MUJOCO_GL=osmesa or run without --render"
-        ) from None
-    with atomic_output(path) as tmp:
-        with imageio.get_writer(tmp, fps=30, codec="libx264", format="FFMPEG") as writer:
-            writer.append_data(first)
-            for frame in frames:
-                writer.append_data(frame)
+
+@main.command("replay")
+@click.argument("run_dir", type=click.Path(file_okay=False, exists=True))
+@click.option(
+    "--speed", type=float, default=None, help="Playback speed, times real time (default: the run in ~10 s)."
+)
+@click.option("--duration", type=float, default=None, help="Close the viewer after this many seconds.")
+@click.option(
+    "--mp4", type=click.Path(dir_okay=False), default=None, help="Write this MP4 instead (headless)."
+)
+def replay(run_dir, speed, duration, mp4):
+    """Play a run recorded by `spine-mj simulate` in MuJoCo's viewer (RUN_DIR: its --out-dir).
+
+    The tip moves through its recorded positions at the recorded times (times --speed),
+    with its path so far (orange) and the streamline from the same start (cyan). Without a
+    display, or with --mp4, it writes an MP4 instead (RUN_DIR/replay.mp4 by default).
+
+    \b
+    Example:
+      spine-mj simulate paper-single-peak --start -3,-1 --out run/ && spine-mj replay run/
+    """
+    headless = mp4 is not None or (
+        sys.platform.startswith("linux")
+        and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+    )
+    if headless:
+        choose_gl_backend()
+    rig, track = load_run(run_dir)
+    span = float(track.time_s[-1] - track.time_s[0])
+    speed = check_positive("--speed", speed) if speed is not None else default_speed(track.time_s)
+    if headless:
+        path = Path(mp4) if mp4 is not None else Path(run_dir) / "replay.mp4"
+        _check_suffix(str(path), ".mp4", "--mp4")
+        if mp4 is None:
+            click.echo("no display: writing an MP4 instead of opening the viewer", err=True)
+        _render_mp4(rig, track, path, speed=speed)
+        click.echo(f"wrote {path}")
+        return
+    click.echo(f"replaying {span:g} s of run at {speed:g}x; close the window to stop", err=True)
+    play_in_viewer(rig, track, speed=speed, duration_s=duration)
 
 
 @main.command("view")
 @click.argument("surface_spec", metavar="SURFACE")
+@click.option(
+    "--start",
+    default=None,
+    help="Where the tip rests, 'x0,y0' in surface units (default: a tenth in from the -x edge, mid y).",
+)
+@click.option("--duration", type=float, default=None, help="Close the viewer after this many seconds.")
 @_rig_options
-def view(surface_spec, **rig_opts):
-    """Open the rig on SURFACE in MuJoCo's interactive viewer (needs a display)."""
+def view(surface_spec, start, duration, **rig_opts):
+    """Open the rig on SURFACE in MuJoCo's interactive viewer (needs a display).
+
+    The model is the one `sim export` writes: the tip rests at --start with the spring on;
+    drive it with the 'spring' (carriage x) or 'push' slider in the Control panel. It
+    runs in physical real time, seen from the camera 'follow' (Esc: the free camera).
+    To watch a recorded run instead, use `spine-mj replay RUN_DIR`.
+    """
 
     if sys.platform.startswith("linux") and not (
         os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
     ):
         raise InputError(
             "no display (DISPLAY and WAYLAND_DISPLAY are unset): the viewer "
-            "needs one; use `spine-mj sim export` or `simulate --render`"
+            "needs one; use `spine-mj sim export`, `simulate --render` or `replay --mp4`"
         )
-    import mujoco
-    import mujoco.viewer
-
     rig = _build_rig(surface_spec, **rig_opts)
-    data = mujoco.MjData(rig.model)
-    data.qpos[:] = rig.place(
-        *(0.5 * (a + b) for a, b in zip(rig.surface.bounds[::2], rig.surface.bounds[1::2]))
-    )
-    mujoco.viewer.launch(rig.model, data)
+    model = compile_spec(rig.export_spec(None if start is None else _parse_start(start)))
+    run_in_viewer(model, time_scale=1.0 / rig.units.time_s, duration_s=duration)
 
 
 # --------------------------------------------------------------------------- end MuJoCo rig

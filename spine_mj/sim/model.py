@@ -27,6 +27,7 @@ import numpy as np
 from spine_mj.errors import SpineInputError, atomic_output
 from spine_mj.resources import model_path
 from spine_mj.sim.drives import Drive, SpringDrive, speed_m_s, stiffness_n_m
+from spine_mj.sim.drives import stiffness_n_m as spring_stiffness_n_m
 from spine_mj.sim.params import EngineSettings, Scales, TipParams, default_engine, hfield_of
 from spine_mj.sim.placement import Placer
 from spine_mj.sim.recording import SENSOR_NAMES
@@ -55,6 +56,15 @@ def compile_spec(spec):
         return spec.compile()
     except ValueError as exc:
         raise SpineInputError(f"MuJoCo refused the rig's model: {str(exc).strip().splitlines()[0]}") from None
+
+
+def _follow_camera(distance: float) -> dict:
+    """``pos`` and ``xyaxes`` of a camera ``distance`` from its body, looking at it from
+    the -x, -y side and 40 degrees above."""
+    ahead = np.array([1.0, 1.0, -1.2]) / np.linalg.norm([1.0, 1.0, -1.2])
+    right = np.array([1.0, -1.0, 0.0]) / np.sqrt(2)
+    up = np.cross(right, ahead)
+    return {"pos": list(-distance * ahead), "xyaxes": [*right, *up]}
 
 
 class RigModel:
@@ -191,15 +201,68 @@ class RigModel:
         self.z_range_m = self._z_range_m()
         self._ids()
 
-    def to_xml(self) -> str:
-        """A self-contained MJCF of the rig (the hfield inlined as ``elevation``), in engine units."""
-        return self.spec.to_xml()
+    def default_start(self) -> tuple[float, float]:
+        """The export's and viewer's start (surface units): a tenth of the way in from the
+        -x edge, at mid y, so a +x drive has the whole surface ahead of it."""
+        xmin, xmax, ymin, ymax = self.surface.bounds
+        return xmin + 0.1 * (xmax - xmin), 0.5 * (ymin + ymax)
 
-    def export_xml(self, path: str | os.PathLike) -> Path:
-        """Write :meth:`to_xml` to ``path`` atomically; MuJoCo's viewer opens it directly."""
+    def export_spec(self, start: tuple[float, float] | None = None, stiffness_n_m: float | None = None):
+        """A copy of the spec ready for MuJoCo's viewer: the tip resting at ``start``, spring on.
+
+        The tip's rest state is the model's reference state (body position and joint
+        ``ref``), so a fresh ``MjData`` and a reset both start there; keyframe ``home``
+        holds it too (qpos stays the world position). Plain MJCF has no controller, so the
+        controls are offsets from that state: ``spring`` is the carriage's displacement
+        in +x from the start (L_c; spring of ``stiffness_n_m``, None: the spring drive's
+        ``10 F_p / L_c``, relaxed at 0), ``push`` a force within +-2 F_p, and the preload
+        is built into its actuator's bias. The carriage box marks where the spring starts
+        (it does not follow the slider); the camera ``follow`` tracks the tip.
+        """
+        import mujoco
+
+        x0, y0 = self.default_start() if start is None else start
+        qpos = [float(v) for v in self.place(x0, y0)]
+        u = self.units
+        drive = SpringDrive(speed_m_s=1.0, stiffness_n_m=stiffness_n_m)  # the speed is not used
+        k = spring_stiffness_n_m(drive, self.scales) / u.stiffness_n_m
+        spec = self.spec.copy()
+        tip = spec.body("tip")
+        tip.pos = qpos
+        for axis, q in zip("xyz", qpos):
+            spec.joint(f"tip_{axis}").ref = q
+        spring, push, preload = (spec.actuator(n) for n in ("spring", "push", "preload"))
+        spring.gainprm[0], spring.biasprm[:2] = k, [k * qpos[0], -k]
+        xmin, xmax = (b / u.length_m - qpos[0] for b in self.bounds_m[:2])
+        spring.ctrlrange, push.ctrlrange = [xmin, xmax], [-2.0, 2.0]
+        spring.ctrllimited = push.ctrllimited = mujoco.mjtLimited.mjLIMITED_TRUE
+        preload.biastype = mujoco.mjtBias.mjBIAS_AFFINE
+        preload.biasprm[0] = -self.tip.preload_n / u.force_n
+        r = self.tip.tip_radius_m / u.length_m
+        mpos = [qpos[0], qpos[1], qpos[2] + 2 * r]
+        spec.body("carriage").pos = mpos
+        car = spec.geom("carriage")
+        car.size, car.rgba = [0.5 * r] * 3, [0.2, 0.4, 0.9, 0.35]
+        spec.add_key(name="home", qpos=qpos, qvel=[0.0] * 3, mpos=mpos, ctrl=[0.0] * 3)
+        tip.add_camera(name="follow", mode=mujoco.mjtCamLight.mjCAMLIGHT_TRACK, **_follow_camera(60 * r))
+        return spec
+
+    def to_xml(self, start: tuple[float, float] | None = None, stiffness_n_m: float | None = None) -> str:
+        """A self-contained MJCF of the rig ready for the viewer (:meth:`export_spec`; the
+        hfield inlined as ``elevation``), in engine units."""
+        return self.export_spec(start, stiffness_n_m).to_xml()
+
+    def export_xml(
+        self,
+        path: str | os.PathLike,
+        start: tuple[float, float] | None = None,
+        stiffness_n_m: float | None = None,
+    ) -> Path:
+        """Write :meth:`to_xml` to ``path`` atomically; MuJoCo's viewer opens it directly
+        (load the keyframe ``home`` to start, move the ``spring`` slider to drive)."""
         path = Path(path)
         with atomic_output(path) as tmp:
-            tmp.write_text(self.to_xml())
+            tmp.write_text(self.to_xml(start, stiffness_n_m))
         return path
 
     def model_for(self, drive: Drive | None):

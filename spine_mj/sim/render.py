@@ -1,43 +1,192 @@
-"""Rendering a run's frames offscreen (headless; needs a GL backend such as EGL or OSMesa)."""
+"""Pictures of a run: offscreen MP4 frames and the scene decorations the viewer shares.
+
+A frame shows the tip, the path it has travelled so far (orange trail), the quasistatic
+streamline from the same start for comparison (cyan; :func:`streamline_path_m`) and a text
+overlay with the time and the drive force. Headless rendering needs a GL backend; MuJoCo
+picks it from ``MUJOCO_GL`` when it is first imported (:func:`choose_gl_backend`).
+"""
 
 from __future__ import annotations
 
+import itertools
 import math
+import os
+import subprocess
+import sys
+from collections.abc import Callable
+from dataclasses import dataclass
 
+import numpy as np
+
+from spine_mj import streamline as sl
+from spine_mj.errors import SpineInputError
+from spine_mj.sim.drives import Drive
 from spine_mj.sim.model import RigModel
-from spine_mj.sim.results import RunResult
+
+TRAIL_RGBA = (1.0, 0.55, 0.0, 1.0)
+STREAMLINE_RGBA = (0.0, 0.8, 0.9, 0.9)
+MAX_SEGMENTS = 300  # per polyline
+FPS = 30.0  # of the MP4
+_ZERO3, _EYE9 = np.zeros(3), np.eye(3).ravel()
+
+
+@dataclass(frozen=True)
+class Track:
+    """What a picture of a run needs (SI): times, tip centres, carriage x, drive force."""
+
+    time_s: np.ndarray
+    position_m: np.ndarray
+    carriage_x_m: np.ndarray
+    drive_force_n: np.ndarray
+    start: tuple[float, float]
+    drive: Drive
+
+    @classmethod
+    def of(cls, run) -> Track:
+        """The track of a :class:`~spine_mj.sim.results.RunResult` (a Track passes through)."""
+        if isinstance(run, Track):
+            return run
+        return cls(run.time_s, run.position_m, run.carriage_x_m, run.drive_force_n, run.start, run.drive)
+
+
+def default_speed(time_s: np.ndarray, seconds: float = 10.0) -> float:
+    """Playback speed (run seconds per wall second) that shows the whole run in ``seconds``."""
+    return max(float(time_s[-1] - time_s[0]) / seconds, 1e-12)
+
+
+def choose_gl_backend() -> str:
+    """Set ``MUJOCO_GL`` to a headless backend that works here (EGL, else OSMesa) and return it.
+
+    A value already set is kept. Each candidate is tried in a child process, since MuJoCo
+    reads the variable once, on import. Raises :class:`SpineInputError` naming what to install.
+    """
+    if os.environ.get("MUJOCO_GL"):
+        return os.environ["MUJOCO_GL"]
+    probe = "import mujoco; mujoco.Renderer(mujoco.MjModel.from_xml_string('<mujoco/>'), 8, 8).render()"
+    for backend in ("egl", "osmesa"):
+        env = dict(os.environ, MUJOCO_GL=backend, PYOPENGL_PLATFORM=backend)
+        ok = subprocess.run([sys.executable, "-c", probe], env=env, capture_output=True, timeout=120)
+        if ok.returncode == 0:
+            os.environ["MUJOCO_GL"] = backend
+            return backend
+    raise SpineInputError(
+        "no headless OpenGL backend works (tried MUJOCO_GL=egl and osmesa): install EGL "
+        "(Debian: apt-get install libegl1 libegl-mesa0, or a GPU driver) or OSMesa (libosmesa6)"
+    )
+
+
+def streamline_path_m(rig: RigModel, start: tuple[float, float]) -> np.ndarray:
+    """Tip-centre path ``(k, 3)`` [m] of the quasistatic streamline from ``start`` with the
+    rig's mu_s, on the surface dilated by the tip radius (what the rig's sphere rides on)."""
+    s = rig.length_scale_m
+    radius = rig.tip.tip_radius_m / s
+    xmin, xmax, ymin, ymax = rig.surface.bounds
+    params = sl.StreamlineParams(mu=rig.tip.mu_s, dl=max(xmax - xmin, ymax - ymin) / 1000)
+    path = sl.streamlines(sl.dilate(rig.surface, radius), [start], params).path(0)
+    return s * np.column_stack([path["x"], path["y"], path["z"] + radius])
+
+
+def decimate(points: np.ndarray, n: int = MAX_SEGMENTS) -> np.ndarray:
+    """Row indices of ``points`` keeping at most ``n + 1`` of them, the first and last included."""
+    step = max(1, math.ceil((len(points) - 1) / n))
+    idx = np.arange(0, len(points), step)
+    return idx if idx[-1] == len(points) - 1 else np.append(idx, len(points) - 1)
+
+
+def add_polyline(scene, points: np.ndarray, rgba, width: float) -> None:
+    """Append a polyline (engine units; :func:`decimate` it first) to an ``MjvScene`` as
+    capsules of diameter ``2 width``, while the scene has room."""
+    import mujoco
+
+    rgba = np.asarray(rgba, dtype=np.float32)
+    for a, b in itertools.pairwise(points):
+        if scene.ngeom >= scene.maxgeom:
+            return
+        g = scene.geoms[scene.ngeom]
+        mujoco.mjv_initGeom(g, mujoco.mjtGeom.mjGEOM_CAPSULE, _ZERO3, _ZERO3, _EYE9, rgba)
+        mujoco.mjv_connector(g, mujoco.mjtGeom.mjGEOM_CAPSULE, width, a, b)
+        scene.ngeom += 1
+
+
+def plain_scene(scene) -> None:
+    """No shadows or reflections: a software renderer draws four times as fast, and the
+    hfield's shadow hides the path."""
+    import mujoco
+
+    scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = 0
+    scene.flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = 0
+
+
+def overlay_text(frame: np.ndarray, lines: list[str]) -> np.ndarray:
+    """``frame`` with ``lines`` written in its top-left corner on a dark band (Pillow)."""
+    from PIL import Image, ImageDraw, ImageFont
+
+    img = Image.fromarray(frame)
+    draw = ImageDraw.Draw(img, "RGBA")
+    font = ImageFont.load_default(size=max(12, frame.shape[0] // 30))
+    box = draw.multiline_textbbox((8, 6), "\n".join(lines), font=font)
+    draw.rectangle((0, 0, box[2] + 8, box[3] + 6), fill=(0, 0, 0, 150))
+    draw.multiline_text((8, 6), "\n".join(lines), font=font, fill=(255, 255, 255, 255))
+    draw.text(
+        (8, frame.shape[0] - 24), "orange: tip path   cyan: streamline", font=font, fill=(255, 255, 255, 255)
+    )
+    return np.asarray(img)
 
 
 def render_frames(
-    rig: RigModel, result: RunResult, *, fps: float = 30.0, width: int = 640, height: int = 480
+    rig: RigModel,
+    run,
+    *,
+    fps: float = FPS,
+    width: int = 640,
+    height: int = 480,
+    speed: float | None = None,
+    streamline: bool = True,
+    progress: Callable[[int, int], None] | None = None,
 ):
-    """Yield RGB frames ``(height, width, 3)`` uint8 of a run (headless, needs a GL backend)."""
+    """Yield RGB frames ``(height, width, 3)`` uint8 of a run (a RunResult or :class:`Track`).
+
+    One frame per ``speed / fps`` seconds of run time (``speed`` None: :func:`default_speed`),
+    camera following the tip; trail, streamline and overlay as in the module docstring.
+    ``progress(done, total)`` is called as each frame is ready.
+    """
     import mujoco
 
-    m = rig.model_for(result.drive)
+    track = Track.of(run)
+    m = rig.model_for(track.drive)
     d = mujoco.MjData(m)
-    renderer = mujoco.Renderer(m, height=height, width=width)
+    renderer = mujoco.Renderer(m, height=height, width=width, max_geom=2 * MAX_SEGMENTS + 100)
+    to_engine = 1.0 / rig.units.length_m
+    r = rig.tip.tip_radius_m * to_engine
+    ref = streamline_path_m(rig, track.start) * to_engine if streamline else np.empty((0, 3))
+    ref = ref[decimate(ref)] if len(ref) else ref
+    pos = track.position_m * to_engine
+    kept = decimate(pos)
     cam = mujoco.MjvCamera()
     cam.type = mujoco.mjtCamera.mjCAMERA_FREE
-    to_engine = 1.0 / rig.units.length_m
-    span = max(rig.bounds_m[1] - rig.bounds_m[0], rig.bounds_m[3] - rig.bounds_m[2]) * to_engine
-    cam.distance = 0.9 * span
-    cam.elevation = -35.0
-    cam.azimuth = 120.0
-    stride = max(1, int(round(1.0 / (fps * rig.engine.timestep_s))))
+    cam.distance, cam.elevation, cam.azimuth = 80 * r, -30.0, 20.0
+    f_p = rig.scales.preload_n
+    t = track.time_s
+    speed = default_speed(t) if speed is None else speed
+    rows = np.unique(np.searchsorted(t, np.arange(t[0], t[-1], speed / fps)).clip(0, len(t) - 1))
+    rows = np.append(rows, len(t) - 1) if rows[-1] != len(t) - 1 else rows
     try:
-        for i in range(0, result.n, stride):
-            pos = result.position_m[i] * to_engine
-            d.qpos[:] = pos
-            if not math.isnan(result.carriage_x_m[i]):
-                d.mocap_pos[0] = (
-                    result.carriage_x_m[i] * to_engine,
-                    pos[1],
-                    pos[2] + 2 * rig.tip.tip_radius_m * to_engine,
-                )
+        for k, i in enumerate(rows):
+            d.qpos[:] = pos[i]
+            if not math.isnan(track.carriage_x_m[i]):
+                d.mocap_pos[0] = (track.carriage_x_m[i] * to_engine, pos[i, 1], pos[i, 2] + 2 * r)
             mujoco.mj_forward(m, d)
-            cam.lookat[:] = pos
+            cam.lookat[:] = pos[i]
             renderer.update_scene(d, camera=cam)
-            yield renderer.render().copy()
+            plain_scene(renderer.scene)
+            add_polyline(renderer.scene, ref, STREAMLINE_RGBA, 0.25 * r)
+            trail = np.vstack([pos[kept[kept < i]], pos[i : i + 1]])
+            add_polyline(renderer.scene, trail, TRAIL_RGBA, 0.35 * r)
+            f = track.drive_force_n[i]
+            lines = [f"t = {t[i]:.4f} s", f"drive force = {f * 1e3:.3g} mN = {f / f_p:.3f} F_p"]
+            frame = overlay_text(renderer.render(), lines)
+            if progress is not None:
+                progress(k + 1, len(rows))
+            yield frame
     finally:
         renderer.close()
