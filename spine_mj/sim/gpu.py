@@ -35,10 +35,10 @@ import numpy as np
 
 from spine_mj.errors import SpineInputError
 from spine_mj.sim.detection import Detection
-from spine_mj.sim.drives import Drive, RampDrive, SpringDrive, StaticProbe, settle_steps, stiffness_n_m
+from spine_mj.sim.drives import Drive, SpringDrive, settle_steps, stiffness_n_m
 from spine_mj.sim.model import RigModel
 from spine_mj.sim.results import RunResult, analyse_group
-from spine_mj.sim.rollout import controls, drive_steps
+from spine_mj.sim.rollout import batch_drives, controls, drive_steps
 
 # import name -> the PyPI package that provides it
 GPU_PACKAGES = {"warp": "warp-lang", "mujoco_warp": "mujoco-warp"}
@@ -112,18 +112,6 @@ def resolve_backend(backend: str) -> str:
     return backend
 
 
-def _normalise(drives, starts) -> tuple[list[Drive], list[tuple[float, float]]]:
-    starts = [tuple(float(v) for v in s) for s in starts]
-    if isinstance(drives, (SpringDrive, StaticProbe, RampDrive)):
-        drives = [drives] * len(starts)
-    drives = list(drives)
-    if len(drives) != len(starts):
-        raise SpineInputError(f"drives must be one drive or one per start ({len(starts)}), got {len(drives)}")
-    if any(isinstance(d, RampDrive) for d in drives):
-        raise SpineInputError("RampDrive needs feedback; use Rig.run for it")
-    return drives, starts
-
-
 def run_batch_gpu(
     rig: RigModel,
     drives: Drive | Sequence[Drive],
@@ -163,7 +151,7 @@ def run_batch_gpu(
 
         return run_batch(rig, drives, starts, detection=detection, backend=backend, nthread=nthread)
     wp, mjw = require_packages()
-    drives, starts = _normalise(drives, starts)
+    drives, starts = batch_drives(drives, starts)
     det = (Detection() if detection is None else detection).resolve(rig.scales)
     for x0, y0 in starts:
         rig.check_start(x0, y0)

@@ -106,6 +106,20 @@ def plan_batches(lengths: Sequence[int], bytes_per_step: int, nthread: int) -> l
     return batches
 
 
+def batch_drives(drives, starts) -> tuple[list[Drive], list[tuple[float, float]]]:
+    """``drives`` as one drive per start (one drive is shared by all), checked: an open-loop
+    batch takes spring drives and static probes only."""
+    starts = [tuple(float(v) for v in s) for s in starts]
+    if isinstance(drives, (SpringDrive, StaticProbe, RampDrive)):
+        drives = [drives] * len(starts)
+    drives = list(drives)
+    if len(drives) != len(starts):
+        raise SpineInputError(f"drives must be one drive or one per start ({len(starts)}), got {len(drives)}")
+    if any(isinstance(d, RampDrive) for d in drives):
+        raise SpineInputError("RampDrive needs feedback; use Rig.run for it")
+    return drives, starts
+
+
 def run_batch(
     rig: RigModel,
     drives: Drive | Sequence[Drive],
@@ -116,14 +130,7 @@ def run_batch(
     nthread: int | None = None,
 ) -> list[RunResult]:
     """Run many starts and/or drive parameter sets of ``rig``'s model (see :meth:`Rig.run_batch`)."""
-    starts = [tuple(float(v) for v in s) for s in starts]
-    if isinstance(drives, (SpringDrive, StaticProbe, RampDrive)):
-        drives = [drives] * len(starts)
-    drives = list(drives)
-    if len(drives) != len(starts):
-        raise SpineInputError(f"drives must be one drive or one per start ({len(starts)}), got {len(drives)}")
-    if any(isinstance(d, RampDrive) for d in drives):
-        raise SpineInputError("RampDrive needs feedback; use Rig.run for it")
+    drives, starts = batch_drives(drives, starts)
     if backend not in ("rollout", "python"):
         raise SpineInputError(f"backend must be 'rollout' or 'python', got {backend!r}")
     det = (Detection() if detection is None else detection).resolve(rig.scales)

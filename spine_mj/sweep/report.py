@@ -29,7 +29,7 @@ from spine_mj.plotting import (
     sig,
     styled,
 )
-from spine_mj.sweep.registry import ANALYSES
+from spine_mj.sweep.registry import ANALYSES, RESERVED
 from spine_mj.sweep.store import load_runs, load_trajectories, read_manifest, store_status
 from spine_mj.templates import render
 
@@ -65,22 +65,7 @@ METRIC_UNITS = {
 PARAM_UNITS = {"ie": "1", "mu": "1", "stiffness": "N/m", "speed": "m/s", "mass": "kg", "timestep": "s"}
 #: Columns that are bookkeeping or positions, not results to average or plot.
 _HIDDEN = {"end_x", "end_y", "end_z", "n_steps"}
-_ID_COLUMNS = {
-    "run_id",
-    "case_id",
-    "case_index",
-    "analysis",
-    "start",
-    "start_x",
-    "start_y",
-    "surface",
-    "surface_seed",
-    "seed",
-    "status",
-    "reason",
-    "time_s",
-    "cpu_s",
-}
+_ID_COLUMNS = set(RESERVED)
 #: Metrics plotted first (the rest follow in table order), at most this many per analysis.
 _PRIORITY = (
     "agree",
