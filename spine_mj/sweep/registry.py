@@ -130,6 +130,16 @@ REQUIRED = object()
 #: when a surface has none (a file, a preset without a calibration).
 PRESET_MU = object()
 
+#: The friction coefficient, shared by every analysis that needs one (declared once).
+MU_PARAM = ParamSpec(
+    "mu",
+    "float",
+    "static friction coefficient mu_s (default: the preset's calibrated [engagement] mu)",
+    PRESET_MU,
+    0.0,
+    exclusive=True,
+)
+
 
 @dataclass(frozen=True, eq=False)
 class AnalysisResult:

@@ -15,7 +15,7 @@ from spine_mj import sim
 from spine_mj.errors import SpineInputError
 from spine_mj.sim.ramp import nominal_time_s
 from spine_mj.sweep.registry import (
-    PRESET_MU,
+    MU_PARAM,
     Analysis,
     AnalysisResult,
     ParamSpec,
@@ -23,14 +23,7 @@ from spine_mj.sweep.registry import (
 )
 
 MUJOCO_PARAMS = (
-    ParamSpec(
-        "mu",
-        "float",
-        "static friction coefficient mu_s (default: the preset's calibrated [engagement] mu)",
-        PRESET_MU,
-        0.0,
-        exclusive=True,
-    ),
+    MU_PARAM,
     ParamSpec(
         "tip_radius",
         "float",

@@ -11,17 +11,10 @@ import functools
 import numpy as np
 
 from spine_mj import streamline as sl
-from spine_mj.sweep.registry import PRESET_MU, Analysis, AnalysisResult, ParamSpec, register_analysis
+from spine_mj.sweep.registry import MU_PARAM, Analysis, AnalysisResult, ParamSpec, register_analysis
 
 QUASISTATIC_PARAMS = (
-    ParamSpec(
-        "mu",
-        "float",
-        "static friction coefficient mu_s (default: the preset's calibrated [engagement] mu)",
-        PRESET_MU,
-        0.0,
-        exclusive=True,
-    ),
+    MU_PARAM,
     ParamSpec("tip_radius", "float", "tip radius in the surface's length unit (0: a point)", 0.0, 0.0),
     ParamSpec(
         "dl",
