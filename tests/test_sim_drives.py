@@ -7,6 +7,7 @@ import math
 import pytest
 from sim_rigs import MU, PHI, START, flat_rig, plane_rig
 
+from spine_mj.engagement import SELF_LOCK, kappa
 from spine_mj.sim import EndReason, SpringDrive, StaticProbe
 
 
@@ -32,8 +33,25 @@ def test_static_probe_self_locks_beyond_90_degrees():
         start=START,
     )
     assert res.end_reason is EndReason.SELF_LOCK
-    assert res.drive_force_n[-1] >= res.detection.kappa_cap * rig.scales.preload_n * (1 - 1e-9)
+    # the shared lock rule ends it (the force cap is only the safety net): stuck on a
+    # self-locking normal while the force rose one preload, the streamline's verdict too
+    assert res.end_detail.startswith("lock rule")
+    fp = rig.scales.preload_n
+    # (the held stretch starts in the settle phase, one force increment before the drive)
+    assert 0.99 * fp <= res.drive_force_n[-1] - res.drive_force_n[res.drive_start_index] < 2 * fp
+    assert res.drive_force_n[-1] < res.detection.kappa_cap * fp
+    assert int(kappa(math.tan(math.radians(70)), 0.0, MU)[1]) == SELF_LOCK
     assert math.isnan(res.kappa_mj)
+
+
+@pytest.mark.parametrize(("slope_deg", "locks"), [(55.0, False), (70.0, True)])
+def test_spring_drive_and_streamline_give_the_same_lock_verdict_on_planes(slope_deg, locks):
+    """Below the self-lock angle (55 + 26.6 < 90 deg) the tip breaks away on both sides;
+    above it (70 + 26.6 > 90) both call it self-locked, by the same rule."""
+    rig = plane_rig(slope_deg)
+    res = rig.run(SpringDrive(speed_m_s=0.02, duration_s=1.0), start=START)
+    assert (res.end_reason is EndReason.SELF_LOCK) == locks
+    assert (int(kappa(math.tan(math.radians(slope_deg)), 0.0, MU)[1]) == SELF_LOCK) == locks
 
 
 def test_tip_on_slope_steeper_than_friction_angle_slides():

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from spine_mj.engagement import SELF_LOCK, kappa_of_normal
 from spine_mj.errors import check_positive
 from spine_mj.sim.params import EndReason, Scales, check_optional, penetration_tolerance_m
 from spine_mj.sim.recording import Recording
@@ -116,6 +117,34 @@ def first_indices(mask: np.ndarray) -> np.ndarray:
     return np.where(mask[np.arange(mask.shape[0]), idx], idx, -1)
 
 
+#: The MuJoCo side of the shared lock rule: the drive force must rise by this many F_p while
+#: the tip stays stuck on a contact normal in the self-lock region.
+LOCK_RISE_FP = 1.0
+
+
+def normal_lock_marks(rec: Recording, mu: float, preload_n: float) -> np.ndarray:
+    """First step of each run at which the shared lock rule holds, or -1.
+
+    The rule the streamline uses (:func:`spine_mj.engagement.kappa_of_normal`, paper
+    Fig. 2C), made sustained for a dynamic run: the tip is stuck in contact, the normal of
+    its deepest contact lies in the self-lock region, and while both hold without a break
+    the drive force has risen by :data:`LOCK_RISE_FP` preloads (the drive pushes into the
+    surface and the contact holds, as the theory says it must at any force).
+    """
+    _, region = kappa_of_normal(np.nan_to_num(rec.normal), mu)
+    held = rec.contact & ~rec.slipping & (region == SELF_LOCK)
+    g, n = held.shape
+    out = np.full(g, -1)
+    for r in range(g):
+        if not held[r].any():
+            continue
+        run_start = np.maximum.accumulate(np.where(~held[r], np.arange(n) + 1, 0))
+        rise = rec.drive_force_n[r] - rec.drive_force_n[r, np.minimum(run_start, n - 1)]
+        hit = np.flatnonzero(held[r] & (rise >= LOCK_RISE_FP * preload_n))
+        out[r] = hit[0] if hit.size else -1
+    return out
+
+
 def end_marks(
     rec: Recording,
     state: np.ndarray,
@@ -126,6 +155,7 @@ def end_marks(
     det: Detection,
     preload_n: float,
     speed_limit_m_s: np.ndarray,
+    mu: float | None = None,
 ) -> dict[str, np.ndarray]:
     """First step of each end condition for each run of a group (``rec`` ``(g, n, ...)``), or -1.
 
@@ -134,7 +164,8 @@ def end_marks(
     ``(g,)``), ``sank`` / ``flew`` (the tip centre below the surface's lowest point or
     above its highest by the domain's size; ``bounds_m`` is ``(xmin, xmax, ymin, ymax,
     zmin, zmax)``), ``deep`` (penetration above tolerance), ``out`` (the tip left the
-    domain) and ``lock`` (the drive force reached ``kappa_cap F_p`` while stuck).
+    domain), ``lock_rule`` (the shared lock rule, :func:`normal_lock_marks`; needs ``mu``)
+    and ``lock`` (the safety net: the drive force reached ``kappa_cap F_p`` while stuck).
     """
     g, n = state.shape[:2]
     dt = timestep_s
@@ -159,6 +190,7 @@ def end_marks(
         "deep": first_indices(rec.penetration_m > det.penetration_tol_m),
         "out": first_indices((px < xmin + mg) | (px > xmax - mg) | (py < ymin + mg) | (py > ymax - mg)),
         "lock": first_indices((rec.drive_force_n >= cap * (1 - 1e-9)) & ~rec.slipping),
+        "lock_rule": np.full(g, -1) if mu is None else normal_lock_marks(rec, mu, preload_n),
     }
 
 
@@ -201,9 +233,15 @@ def end_candidates(
     if (k := mark("out")) is not None:
         detail = f"tip at ({pos[k, 0]:.4g}, {pos[k, 1]:.4g}) m left the domain"
         candidates.append(Ending(k, 2, EndReason.LEFT_DOMAIN, detail))
+    if (k := mark("lock_rule")) is not None:
+        detail = (
+            f"lock rule: stuck on a contact normal in the self-lock region while the drive force "
+            f"rose by {LOCK_RISE_FP:g} F_p (to {rec.drive_force_n[k] / preload_n:.3g} F_p)"
+        )
+        candidates.append(Ending(k, 3, EndReason.SELF_LOCK, detail))
     if (k := mark("lock")) is not None:
         cap = det.kappa_cap * preload_n
-        detail = f"drive force reached kappa_cap * F_p = {cap:.4g} N without slip"
+        detail = f"force cap: drive force reached kappa_cap * F_p = {cap:.4g} N without slip"
         candidates.append(Ending(k, 3, EndReason.SELF_LOCK, detail))
     return candidates
 

@@ -301,9 +301,10 @@ def _first_end(rig: RigModel, st: _Stepper, a: int, b: int, det: Detection) -> i
         bounds_m=(*rig.bounds_m, *rig.z_range_m),
         det=det,
         preload_n=rig.scales.preload_n,
-        speed_limit_m_s=np.array([np.inf]),  # only deep, out and lock are read here
+        speed_limit_m_s=np.array([np.inf]),  # only deep, out and the locks are read here
+        mu=rig.tip.mu_s,
     )
-    found = [int(marks[k][0]) for k in ("deep", "out", "lock") if marks[k][0] >= 0]
+    found = [int(marks[k][0]) for k in ("deep", "out", "lock", "lock_rule") if marks[k][0] >= 0]
     return a + min(found) if found else None
 
 

@@ -210,6 +210,7 @@ def analyse_group(
         det=det,
         preload_n=fp,
         speed_limit_m_s=limits,
+        mu=rig.tip.mu_s,
     )
     results = []
     for r, drive in enumerate(drives):
