@@ -21,23 +21,8 @@ import time
 import numpy as np
 
 from spine_mj import compare, sim
+from spine_mj.sim.ramp import cycle_breakaways, rows_to_reset
 from spine_mj.validate.ramp_plan import pilot_rig
-
-
-def _cut(res, cycles):
-    resets = [e.index for e in res.events if e.kind == "reset"]
-    return resets[cycles - 1] + 1 if len(resets) >= cycles else res.n
-
-
-def _breakaways(res, cycles):
-    out, armed = [], True
-    for e in res.events:
-        if e.kind == "reset":
-            armed = True
-        elif e.kind == "slip_onset" and armed:
-            out.append(res.drive_force_n[e.index] / res.scales.preload_n)
-            armed = False
-    return np.array(out[:cycles])
 
 
 def _cases(res: int):
@@ -68,15 +53,15 @@ def main() -> None:
         t1 = time.perf_counter()
         fast = rig.run(drive, start=start)
         t2 = time.perf_counter()
-        kp, kf = _breakaways(plain, args.cycles), _breakaways(fast, args.cycles)
+        kp, kf = cycle_breakaways(plain, args.cycles), cycle_breakaways(fast, args.cycles)
         k = min(kp.size, kf.size)
         dk = float(np.max(np.abs(kf[:k] / kp[:k] - 1))) if k else math.nan
         a, b = (
-            plain.position_m[: _cut(plain, args.cycles), :2],
-            fast.position_m[: _cut(fast, args.cycles), :2],
+            plain.position_m[: rows_to_reset(plain, args.cycles), :2],
+            fast.position_m[: rows_to_reset(fast, args.cycles), :2],
         )
         fr = compare.path_frechet(b, a, length_scale=sc.char_length_m)
-        n_p, n_f = _cut(plain, args.cycles), _cut(fast, args.cycles)
+        n_p, n_f = rows_to_reset(plain, args.cycles), rows_to_reset(fast, args.cycles)
         print(
             f"{name:32s} breakaways {k}/{kp.size} max rel diff {dk:.2e}  Frechet/L_c {fr:.2e}  "
             f"end {plain.end_reason.value}/{fast.end_reason.value}  "

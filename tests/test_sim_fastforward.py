@@ -16,33 +16,18 @@ from sim_rigs import PHI, plane_rig
 
 from spine_mj import compare, sim
 from spine_mj.sim import EndReason, RampDrive
-from spine_mj.sim.ramp import nominal_time_s
-
-
-def _reset_cut(res, cycles):
-    """Rows up to the ``cycles``-th reset (the whole run if it has fewer)."""
-    resets = [e.index for e in res.events if e.kind == "reset"]
-    return resets[cycles - 1] + 1 if len(resets) >= cycles else res.n
-
-
-def _first_breakaways(res, cycles):
-    """Drive force / F_p at the first slip onset after the start and after each reset."""
-    out, armed = [], True
-    for e in res.events:
-        if e.kind == "reset":
-            armed = True
-        elif e.kind == "slip_onset" and armed:
-            out.append(res.drive_force_n[e.index] / res.scales.preload_n)
-            armed = False
-    return np.array(out[:cycles])
+from spine_mj.sim.ramp import cycle_breakaways, nominal_time_s, rows_to_reset
 
 
 def _assert_same_physics(plain, fast, cycles):
     lc = plain.scales.char_length_m
-    kp, kf = _first_breakaways(plain, cycles), _first_breakaways(fast, cycles)
+    kp, kf = cycle_breakaways(plain, cycles), cycle_breakaways(fast, cycles)
     assert kp.size == cycles and kf.size == cycles
     np.testing.assert_allclose(kf, kp, rtol=0.005)
-    a, b = plain.position_m[: _reset_cut(plain, cycles), :2], fast.position_m[: _reset_cut(fast, cycles), :2]
+    a, b = (
+        plain.position_m[: rows_to_reset(plain, cycles), :2],
+        fast.position_m[: rows_to_reset(fast, cycles), :2],
+    )
     assert compare.path_frechet(b, a, length_scale=lc) <= 0.01
 
 
@@ -56,15 +41,15 @@ def test_fast_forward_breaks_away_where_the_plain_ramp_does_on_planes(slope):
     plain = rig.run(dataclasses.replace(drive, fast_forward=False), start=(-0.01, 0.0))
     fast = rig.run(drive, start=(-0.01, 0.0))
     _assert_same_physics(plain, fast, 2)
-    kf = _first_breakaways(fast, 2)
+    kf = cycle_breakaways(fast, 2)
     np.testing.assert_allclose(kf, math.tan(math.radians(slope) + PHI), rtol=0.05)
     # the stick phases are skipped: the same two cycles in fewer steps, at most the
     # settle, slide and the nominal approach through the margin, RISE_STEPS and QUIET_STEPS
-    n_plain, n_fast = _reset_cut(plain, 2), _reset_cut(fast, 2)
+    n_plain, n_fast = rows_to_reset(plain, 2), rows_to_reset(fast, 2)
     assert n_fast < n_plain
     np.testing.assert_allclose(nominal_time_s(plain), plain.time_s)
-    t_nom = nominal_time_s(fast)[_reset_cut(fast, 2) - 1]
-    assert t_nom == pytest.approx(plain.time_s[_reset_cut(plain, 2) - 1], rel=0.05)
+    t_nom = nominal_time_s(fast)[rows_to_reset(fast, 2) - 1]
+    assert t_nom == pytest.approx(plain.time_s[rows_to_reset(plain, 2) - 1], rel=0.05)
 
 
 @pytest.mark.parametrize("y0", [-1.0, -2.0])
@@ -79,7 +64,7 @@ def test_fast_forward_breaks_away_where_the_plain_ramp_does_on_the_single_peak(y
     plain = rig.run(dataclasses.replace(drive, fast_forward=False), start=(-3.0, y0))
     fast = rig.run(drive, start=(-3.0, y0))
     _assert_same_physics(plain, fast, 2)
-    assert _reset_cut(fast, 2) < 0.5 * _reset_cut(plain, 2)
+    assert rows_to_reset(fast, 2) < 0.5 * rows_to_reset(plain, 2)
 
 
 def _lock_rig():

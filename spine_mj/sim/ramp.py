@@ -223,6 +223,25 @@ class ResetController:
         return verdict
 
 
+def rows_to_reset(result: RunResult, cycles: int) -> int:
+    """Rows of a ramp run up to its ``cycles``-th reset (the whole run if it has fewer)."""
+    resets = [e.index for e in result.events if e.kind == "reset"]
+    return resets[cycles - 1] + 1 if len(resets) >= cycles else result.n
+
+
+def cycle_breakaways(result: RunResult, cycles: int) -> np.ndarray:
+    """Drive force / F_p at the first slip onset of each ramp cycle (after the start and
+    after each reset), at most ``cycles`` of them: what a fast-forwarded ramp must keep."""
+    out, armed = [], True
+    for e in result.events:
+        if e.kind == "reset":
+            armed = True
+        elif e.kind == "slip_onset" and armed:
+            out.append(result.drive_force_n[e.index] / result.scales.preload_n)
+            armed = False
+    return np.array(out[:cycles])
+
+
 def nominal_time_s(result: RunResult) -> np.ndarray:
     """The time the plain ramp (no fast-forward) would have taken to reach each row [s].
 
