@@ -53,11 +53,10 @@ from collections.abc import Callable
 import numpy as np
 
 from spine_mj.engagement import SELF_LOCK, kappa_of_normal
-from spine_mj.sim.detection import Detection, Event, end_marks
+from spine_mj.sim.detection import Detection, Event
 from spine_mj.sim.drives import RampDrive, rate_n_s, settle_steps
 from spine_mj.sim.model import RigModel
-from spine_mj.sim.recording import Recording
-from spine_mj.sim.results import RunResult, analyse
+from spine_mj.sim.results import RunResult, analyse, recorded_marks
 from spine_mj.sim.rollout import warning_text, warning_total
 
 #: Steps the tip must be still on one normal before a fast-forward phase starts.
@@ -304,25 +303,8 @@ def _first_end(rig: RigModel, st: _Stepper, a: int, b: int, det: Detection) -> i
     """The first row in ``a..b-1`` at which the analysis would end the run (deep
     penetration, left the domain, self-lock), or None."""
     state, sens = st.state[None, a:b], st.sens[None, a:b]
-    rec = Recording.from_sensors(
-        rig.sensor_adr,
-        state,
-        sens,
-        units=rig.units,
-        carriage_x=np.full((1, b - a), np.nan),
-        slip_speed_m_s=det.slip_speed_m_s,
-    )
-    marks = end_marks(
-        rec,
-        state,
-        sens,
-        timestep_s=rig.engine.timestep_s,
-        bounds_m=(*rig.bounds_m, *rig.z_range_m),
-        det=det,
-        preload_n=rig.scales.preload_n,
-        speed_limit_m_s=np.array([np.inf]),  # only deep, out and the locks are read here
-        mu=rig.tip.mu_s,
-    )
+    # only deep, out and the locks are read here: no speed limit
+    _, marks = recorded_marks(rig, state, sens, np.full((1, b - a), np.nan), det, np.array([np.inf]))
     found = [int(marks[k][0]) for k in ("deep", "out", "lock", "lock_rule") if marks[k][0] >= 0]
     return a + min(found) if found else None
 

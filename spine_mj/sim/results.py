@@ -171,6 +171,25 @@ def analyse(rig: RigModel, drive: Drive, start, state, sens, ctrl, det: Detectio
     return analyse_group(rig, [drive], [start], state[None], sens[None], [ctrl], det, [warning])[0]
 
 
+def recorded_marks(rig: RigModel, state, sens, carriage_x, det: Detection, speed_limit_m_s):
+    """A group's SI :class:`Recording` and its end marks (:func:`end_marks`) on ``rig``."""
+    group = Recording.from_sensors(
+        rig.sensor_adr, state, sens, units=rig.units, carriage_x=carriage_x, slip_speed_m_s=det.slip_speed_m_s
+    )
+    marks = end_marks(
+        group,
+        state,
+        sens,
+        timestep_s=rig.engine.timestep_s,
+        bounds_m=(*rig.bounds_m, *rig.z_range_m),
+        det=det,
+        preload_n=rig.scales.preload_n,
+        speed_limit_m_s=speed_limit_m_s,
+        mu=rig.tip.mu_s,
+    )
+    return group, marks
+
+
 def analyse_group(
     rig: RigModel,
     drives: Sequence[Drive],
@@ -197,21 +216,8 @@ def analyse_group(
             for d, ctrl in zip(drives, ctrls)
         ]
     )
-    group = Recording.from_sensors(
-        rig.sensor_adr, state, sens, units=rig.units, carriage_x=carriage, slip_speed_m_s=det.slip_speed_m_s
-    )
     limits = np.array([det.speed_limit_m_s(rig.scales, rig.speed_of(d)) for d in drives])
-    marks = end_marks(
-        group,
-        state,
-        sens,
-        timestep_s=rig.engine.timestep_s,
-        bounds_m=(*rig.bounds_m, *rig.z_range_m),
-        det=det,
-        preload_n=fp,
-        speed_limit_m_s=limits,
-        mu=rig.tip.mu_s,
-    )
+    group, marks = recorded_marks(rig, state, sens, carriage, det, limits)
     results = []
     for r, drive in enumerate(drives):
         rec = group.run(r)
