@@ -157,6 +157,14 @@ RECOMMENDED = ("recommended (elliptic, noslip 3)", ())
 NO_NOSLIP = ("no noslip (elliptic, impratio 1)", (("noslip_iterations", 0),))
 IMPRATIO = ("no noslip, impratio 10", (("noslip_iterations", 0), ("impratio", 10.0)))
 
+#: The paper's single peak and valley with the five starts of Figs. 3-4 (every plan).
+PEAK_VALLEY = FamilySpec(
+    "single_peak_valley",
+    ("paper-single-peak", "paper-single-valley"),
+    None,
+    paper_starts([-0.5, -1.0, -2.0, -3.0, -4.0]),
+)
+
 PLANS: dict[str, ValidationPlan] = {
     "smoke": ValidationPlan(
         name="smoke",
@@ -185,12 +193,7 @@ PLANS: dict[str, ValidationPlan] = {
         azimuths_deg=(0.0, 60.0, 120.0, 180.0),
         static_engines=(RECOMMENDED, NO_NOSLIP),
         families=(
-            FamilySpec(
-                "single_peak_valley",
-                ("paper-single-peak", "paper-single-valley"),
-                None,
-                paper_starts([-0.5, -1.0, -2.0, -3.0, -4.0]),
-            ),
+            PEAK_VALLEY,
             FamilySpec(
                 "random_gaussian", ("paper-random-convex", "paper-random-concave"), (1,), relative_starts(3)
             ),
@@ -215,12 +218,7 @@ PLANS: dict[str, ValidationPlan] = {
         azimuths_deg=(0.0, 30.0, 60.0, 90.0, 120.0, 150.0, 180.0),
         static_engines=(RECOMMENDED, NO_NOSLIP, IMPRATIO),
         families=(
-            FamilySpec(
-                "single_peak_valley",
-                ("paper-single-peak", "paper-single-valley"),
-                None,
-                paper_starts([-0.5, -1.0, -2.0, -3.0, -4.0]),
-            ),
+            PEAK_VALLEY,
             FamilySpec(
                 "random_gaussian",
                 ("paper-random-convex", "paper-random-concave"),
