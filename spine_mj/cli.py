@@ -573,7 +573,7 @@ def sim_group():
     default=None,
     help="Where the tip rests, 'x0,y0' in surface units (default: a tenth in from the -x edge, mid y).",
 )
-@click.option("--stiffness", type=float, default=None, help="Spring stiffness [N/m] (default 10 F_p/L_c).")
+@click.option("--stiffness", type=float, default=None, help="Spring stiffness [N/m] (default K = 30).")
 @_rig_options
 def sim_export(surface_spec, output, start, stiffness, **rig_opts):
     """Write a self-contained MJCF of the rig on SURFACE, ready for MuJoCo's viewer.

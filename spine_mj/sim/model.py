@@ -215,7 +215,7 @@ class RigModel:
         holds it too (qpos stays the world position). Plain MJCF has no controller, so the
         controls are offsets from that state: ``spring`` is the carriage's displacement
         in +x from the start (L_c; spring of ``stiffness_n_m``, None: the spring drive's
-        ``10 F_p / L_c``, relaxed at 0), ``push`` a force within +-2 F_p, and the preload
+        default ``K = 30``, relaxed at 0), ``push`` a force within +-2 F_p, and the preload
         is built into its actuator's bias. The carriage box marks where the spring starts
         (it does not follow the slider); the camera ``follow`` tracks the tip.
         """

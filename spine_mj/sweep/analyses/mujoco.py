@@ -58,7 +58,7 @@ MUJOCO_PARAMS = (
     ParamSpec(
         "stiffness",
         "float",
-        "spring stiffness [N/m] (instead of K; default 10 F_p / L_c)",
+        "spring stiffness [N/m] (instead of K; default K = 30)",
         None,
         0.0,
         exclusive=True,
