@@ -107,7 +107,23 @@ def grid_eval(coef, sp, x, y):
 
 @njit(cache=True, fastmath=_FM, boundscheck=False, error_model="numpy")
 def run_trajectories(
-    kind, g, coef, sp, bounds, xs, ys, ideal, mu, dl, tol, max_steps, stall_window, stall_dist, store, lanes
+    kind,
+    g,
+    coef,
+    sp,
+    bounds,
+    xs,
+    ys,
+    ideal,
+    mu,
+    dl,
+    tol,
+    max_steps,
+    stall_window,
+    stall_dist,
+    store,
+    lanes,
+    kappa_cap,
 ):
     n = xs.size
     outcome = np.zeros(n, np.int8)
@@ -260,7 +276,14 @@ def run_trajectories(
             xn = x + dl * lvx[j]
             yn = y + dl * lvy[j]
             inside = (xn >= xmin) & (xn <= xmax) & (yn >= ymin) & (yn <= ymax)
-            go = (lreg[j] != 2) & (lstep[j] < max_steps) & lok[j] & inside & (not lstall[j])
+            go = (
+                (lreg[j] != 2)
+                & (not (k > kappa_cap))
+                & (lstep[j] < max_steps)
+                & lok[j]
+                & inside
+                & (not lstall[j])
+            )
             lx[j] = xn if go else x
             ly[j] = yn if go else y
             lstep[j] += go
@@ -293,6 +316,8 @@ def run_trajectories(
                 lcy[j] = y
             elif lreg[j] == 2:
                 code = 1
+            elif lk[j] > kappa_cap:
+                code = 5
             elif lstall[j]:
                 code = 3
             elif lstep[j] >= max_steps:

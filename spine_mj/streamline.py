@@ -33,7 +33,7 @@ from scipy import ndimage
 from spine_mj._kernels import run_trajectories
 from spine_mj.engagement import ENGAGED, REGION_NAMES, SELF_LOCK, SLIP, kappa, slip_direction
 from spine_mj.errors import SpineInputError
-from spine_mj.surfaces import GaussianSurface, GridSurface, Surface
+from spine_mj.surfaces import GaussianSurface, GridSurface, Surface, TriangulatedSurface
 
 __all__ = ["Outcome", "StreamlineParams", "StreamlineResult", "dilate", "ideal_trajectories", "streamlines"]
 
@@ -45,6 +45,7 @@ class Outcome(enum.IntEnum):
     LEFT_DOMAIN = 2  #: the next step would leave the surface's bounds
     STALLED = 3  #: no net progress (|T| = 0, or moved < stall_distance in stall_window steps)
     STEP_CAP = 4  #: max_steps taken without any of the above
+    FORCE_CAP = 5  #: the drive force needed, kappa W, exceeds ``kappa_cap`` W (held by the cap)
 
 
 @dataclass(frozen=True)
@@ -67,6 +68,13 @@ class StreamlineParams:
         unit); less is ``STALLED``. None means ``dl``.
     tol : float
         Tolerance on the scaled self-lock coefficient A' (see :func:`~spine_mj.engagement.kappa`).
+    kappa_cap : float
+        The force cap, the safety net a comparison with the engine shares: a point whose
+        kappa exceeds it ends the path as ``FORCE_CAP`` (held: no drive up to ``kappa_cap W``
+        moves it), as a MuJoCo drive that reaches ``kappa_cap F_p`` unmoved ends there
+        (:class:`spine_mj.sim.Detection`, the same default
+        :data:`spine_mj.engagement.DEFAULT_KAPPA_CAP` in a comparison). ``inf``, the
+        paper's theory: only the self-lock region stops a path.
     """
 
     mu: float
@@ -75,6 +83,7 @@ class StreamlineParams:
     stall_window: int = 64
     stall_distance: float | None = None
     tol: float = 1e-12
+    kappa_cap: float = math.inf
 
     def __post_init__(self):
         for name in ("mu", "dl"):
@@ -89,6 +98,8 @@ class StreamlineParams:
             raise SpineInputError(f"stall_distance must be >= 0 or None, got {self.stall_distance!r}")
         if not (self.tol >= 0):
             raise SpineInputError(f"tol must be >= 0, got {self.tol!r}")
+        if not (self.kappa_cap > 0):
+            raise SpineInputError(f"kappa_cap must be > 0 (inf: no cap), got {self.kappa_cap!r}")
 
     @property
     def stall_distance_value(self) -> float:
@@ -151,8 +162,9 @@ class StreamlineResult:
 
     @property
     def self_locked(self) -> np.ndarray:
-        """Boolean ``(n,)``: ended in the self-lock region."""
-        return self.outcome == Outcome.SELF_LOCKED
+        """Boolean ``(n,)``: held, in the self-lock region or by the force cap
+        (``params.kappa_cap``; never with the default ``inf``)."""
+        return (self.outcome == Outcome.SELF_LOCKED) | (self.outcome == Outcome.FORCE_CAP)
 
     def path(self, i: int) -> dict[str, np.ndarray]:
         """Path ``i`` as arrays ``x, y, z, kappa, region`` of shape ``(n_steps[i] + 1,)``."""
@@ -282,6 +294,7 @@ def _trajectories(surface, starts, params, *, ideal, store_paths, backend):
             float(params.stall_distance_value),
             bool(store_paths),
             min(_LANES, xs.size),
+            float(params.kappa_cap),
         )
     outcome, n_steps, max_k, ex, ey, ez, offsets, px, py, pz, pk, pr = out
     if not store_paths:
@@ -374,6 +387,9 @@ def _run_numpy(surface, xs, ys, params, *, ideal, store):
         locked = reg == SELF_LOCK
         outcome[active[locked]] = Outcome.SELF_LOCKED
         done |= locked
+        held = ~done & (k > params.kappa_cap)
+        outcome[active[held]] = Outcome.FORCE_CAP
+        done |= held
         stalled = ~done & stall_pending[active]
         outcome[active[stalled]] = Outcome.STALLED
         done |= stalled
@@ -428,8 +444,9 @@ def dilate(surface: Surface, radius: float, *, spacing: float | None = None) -> 
     ----------
     surface : Surface
         Analytic surfaces are sampled on ``bounds`` widened by R (so the edge sees the
-        outside); gridded ones at their own spacing unless ``spacing`` is given
-        (non-periodic grids are padded with their edge values).
+        outside); gridded ones at their own spacing unless ``spacing`` is given; surfaces
+        defined only inside their bounds (non-periodic grids, MuJoCo's facets as a
+        :class:`~spine_mj.surfaces.TriangulatedSurface`) are padded with their edge values.
     radius : float
         Tip radius R >= 0 in the surface's length unit; 0 returns the sampled surface.
     spacing : float, optional
@@ -478,8 +495,8 @@ def dilate(surface: Surface, radius: float, *, spacing: float | None = None) -> 
     cap = np.sqrt(np.clip(radius * radius - rho2, 0, None)) - radius
     if grid.periodic:
         heights = ndimage.grey_dilation(grid.heights, footprint=footprint, structure=cap, mode="wrap")
-    elif not isinstance(surface, GridSurface):
-        # sample a margin of R outside so the edge sees the true neighbourhood
+    elif not isinstance(surface, (GridSurface, TriangulatedSurface)):
+        # an analytic surface: sample a margin of R outside so the edge sees the true neighbourhood
         xw = grid.x[0] + dx * np.arange(-rx, grid.x.size + rx)
         yw = grid.y[0] + dy * np.arange(-ry, grid.y.size + ry)
         wide = surface.height(xw[None, :], yw[:, None])

@@ -302,3 +302,43 @@ def test_kernel_has_no_out_of_bounds_access_on_capped_paths(monkeypatch):
             np.testing.assert_array_equal(got.n_steps, ref.n_steps)
             if store:
                 _same(got, ref, 1e-9)
+
+
+@pytest.mark.parametrize("backend", ["numba", "numpy"])
+def test_force_cap_ends_a_path_where_kappa_first_exceeds_it(backend):
+    """The shared force cap: the capped path is the uncapped one cut at its first point of
+    kappa > cap (held there, FORCE_CAP); a cap above the path's largest kappa changes nothing."""
+    surf = single_gaussian(sign=1)
+    free = streamlines(surf, FIVE_STARTS, StreamlineParams(mu=MU, dl=0.015), backend=backend)
+    finite = np.where(np.isfinite(free.max_kappa), free.max_kappa, np.nan)
+    cap = float(np.nanmin(finite[finite > 2.0])) * 0.9  # below one path's finite peak kappa
+    capped = streamlines(surf, FIVE_STARTS, StreamlineParams(mu=MU, dl=0.015, kappa_cap=cap), backend=backend)
+    hit = 0
+    for i in range(len(free)):
+        k = free.path(i)["kappa"]
+        over = np.flatnonzero(np.isfinite(k) & (k > cap))
+        if free.outcome[i] == Outcome.SELF_LOCKED and (over.size == 0 or over[0] == k.size - 1):
+            assert capped.outcome[i] == Outcome.SELF_LOCKED
+            continue
+        if over.size == 0:
+            assert capped.outcome[i] == free.outcome[i]
+            assert capped.n_steps[i] == free.n_steps[i]
+            continue
+        hit += 1
+        assert capped.outcome[i] == Outcome.FORCE_CAP and capped.self_locked[i]
+        assert capped.n_steps[i] == over[0]
+        np.testing.assert_array_equal(capped.path(i)["x"], free.path(i)["x"][: over[0] + 1])
+    assert hit >= 1
+    above = StreamlineParams(mu=MU, dl=0.015, kappa_cap=1e6)
+    again = streamlines(surf, FIVE_STARTS, above, backend=backend)
+    np.testing.assert_array_equal(again.outcome, free.outcome)
+    np.testing.assert_array_equal(again.n_steps, free.n_steps)
+
+
+def test_force_cap_kernel_matches_numpy_reference():
+    grid = fractal_fbm(nx=64, size=20.0, hurst=0.8, rms_slope=0.6, rng=2)
+    starts = np.c_[np.full(12, -9.5), np.linspace(-8, 8, 12)]
+    p = StreamlineParams(mu=1.0, dl=0.03, kappa_cap=3.0)
+    a, b = streamlines(grid, starts, p, backend="numba"), streamlines(grid, starts, p, backend="numpy")
+    _same(a, b, 1e-8)
+    assert (a.outcome == Outcome.FORCE_CAP).any()

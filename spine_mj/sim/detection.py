@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from spine_mj.engagement import SELF_LOCK, kappa_of_normal
+from spine_mj.engagement import DEFAULT_KAPPA_CAP, SELF_LOCK, kappa_of_normal
 from spine_mj.errors import check_positive
 from spine_mj.sim.params import EndReason, Scales, check_optional, penetration_tolerance_m
 from spine_mj.sim.recording import Recording
@@ -59,7 +59,7 @@ class Detection:
     slip_speed_m_s: float | None = None
     stick_speed_m_s: float | None = None
     breakaway_distance_m: float | None = None
-    kappa_cap: float = 20.0
+    kappa_cap: float = DEFAULT_KAPPA_CAP
     penetration_tol_m: float | None = None
     domain_margin_m: float | None = None
 

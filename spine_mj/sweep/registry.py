@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from spine_mj.engagement import DEFAULT_KAPPA_CAP
 from spine_mj.errors import SpineInputError
 
 #: Row statuses. ``ok``; ``failed`` (an exception in the analysis); ``bad_surface`` (the
@@ -136,6 +137,18 @@ MU_PARAM = ParamSpec(
     "float",
     "static friction coefficient mu_s (default: the preset's calibrated [engagement] mu)",
     PRESET_MU,
+    0.0,
+    exclusive=True,
+)
+
+
+#: The force cap, shared by the streamline and the engine so that both call "held" by the
+#: same test (declared once; :data:`spine_mj.engagement.DEFAULT_KAPPA_CAP`).
+KAPPA_CAP_PARAM = ParamSpec(
+    "kappa_cap",
+    "float",
+    "force cap: a path needing a drive above kappa_cap F_p is held, on the streamline and in MuJoCo alike",
+    DEFAULT_KAPPA_CAP,
     0.0,
     exclusive=True,
 )

@@ -10,7 +10,6 @@ dynamics error. Deviations are resampled Frechet distances in units of ``L_c``
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import numpy as np
@@ -46,23 +45,12 @@ def tip_radius(preset: str, seeds, resolution: int) -> float:
 
 
 def streamline_paths(surface, starts, mu: float, dl: float, tip: float) -> sl.StreamlineResult:
-    """Streamlines (with paths) from ``starts`` on ``surface`` dilated by ``tip``.
-
-    A triangulated surface is first sampled finely inside its bounds (``tip / 8``, at most
-    400 samples per side of the longer edge) and that grid dilated.
-    """
-    if tip > 0 and isinstance(surface, TriangulatedSurface):
-        # sample the facets finely inside the bounds (no NaN margin), then dilate that grid
-        xmin, xmax, ymin, ymax = surface.bounds
-        h = min(tip / 8, max(xmax - xmin, ymax - ymin) / 400)
-        x = np.linspace(xmin, xmax, int(math.ceil((xmax - xmin) / h)) + 1)
-        y = np.linspace(ymin, ymax, int(math.ceil((ymax - ymin) / h)) + 1)
-        surface = GridSurface(heights=surface.height(x[None, :], y[:, None]), x=x, y=y, unit=surface.unit)
-    if tip > 0:
-        surface = sl.dilate(surface, tip)
-    return sl.streamlines(
-        surface, np.asarray(starts, float), sl.StreamlineParams(mu=mu, dl=dl), store_paths=True
-    )
+    """Streamlines (with paths) from ``starts`` on ``surface`` dilated by ``tip``
+    (:func:`spine_mj.streamline.dilate`: MuJoCo's facets are sampled at ``tip / 8``, finer
+    than the hfield, before the dilation)."""
+    traced = sl.dilate(surface, tip) if tip > 0 else surface
+    params = sl.StreamlineParams(mu=mu, dl=dl)
+    return sl.streamlines(traced, np.asarray(starts, float), params, store_paths=True)
 
 
 def triangulated_surface(surface, resolution: int | None) -> TriangulatedSurface:

@@ -1,7 +1,13 @@
-"""The ``compare`` analysis: quasistatic against MuJoCo per start, lengths over L_c.
+"""The ``compare`` analysis: the streamline against MuJoCo per start, lengths over L_c.
 
-Touches the API of :mod:`spine_mj.compare` here only; needs the results of the
-``quasistatic`` and ``mujoco`` analyses of the same case.
+Like for like (docs/physics.md §4): the reference streamline is traced on the surface the
+MuJoCo tip touches, the rig's hfield facets dilated by its tip radius
+(:meth:`spine_mj.sim.Rig.contact_surface`), with the quasistatic analysis's mu_s, step and
+force cap, so both sides share the geometry and the lock test. The comparison with the
+quasistatic analysis's own path (the smooth surface, or whatever it traced) is kept beside
+it (``*_smooth``), and the gap between the two streamlines is the geometry part
+(``geometry_frechet``). Touches the API of :mod:`spine_mj.compare` here only; needs the
+results of the ``quasistatic`` and ``mujoco`` analyses of the same case.
 """
 
 from __future__ import annotations
@@ -9,46 +15,76 @@ from __future__ import annotations
 import numpy as np
 
 from spine_mj import compare
+from spine_mj import streamline as sl
 from spine_mj.sweep.analyses.mujoco import peak_drive_over_fp
 from spine_mj.sweep.registry import Analysis, AnalysisResult, register_analysis
 
 
-def _compare(case, surface, starts, upstream):
-    qs = upstream["quasistatic"].data
-    rig, runs = upstream["mujoco"].data
-    s = rig.length_scale_m
-    lc = rig.scales.char_length_m / s
-    n = len(runs)
-    frechet = np.full(n, np.nan)
-    lateral = np.full(n, np.nan)
-    for i, r in enumerate(runs):
+def _deviations(mpaths, qs: sl.StreamlineResult, lc: float) -> tuple[np.ndarray, np.ndarray]:
+    """Frechet and mean lateral deviation of each MuJoCo path from the streamline of its start."""
+    frechet = np.full(len(mpaths), np.nan)
+    lateral = np.full(len(mpaths), np.nan)
+    for i, mpath in enumerate(mpaths):
         q = qs.path(i)
         qpath = np.column_stack([q["x"], q["y"]])
-        mpath = r.position_m[r.drive_start_index :, :2] / s
         if mpath.shape[0] == 0:
             continue
         frechet[i] = compare.path_frechet(mpath, qpath, length_scale=lc)
         lateral[i] = compare.mean_lateral_deviation(mpath, qpath, length_scale=lc)
-    mj_locked = np.array([r.end_reason.value == "self_lock" for r in runs])
-    mj_end = np.array([r.position_m[-1, :2] / s for r in runs])
-    agree = compare.outcome_agreement(
+    return frechet, lateral
+
+
+def _outcomes(qs: sl.StreamlineResult, mj_locked, mj_end, lc: float) -> dict[str, np.ndarray]:
+    return compare.outcome_agreement(
         qs.self_locked, np.column_stack([qs.end_x, qs.end_y]), mj_locked, mj_end, length_scale=lc
     )
+
+
+def _compare(case, surface, starts, upstream):
+    smooth = upstream["quasistatic"].data
+    rig, runs = upstream["mujoco"].data
+    trace = sl.ideal_trajectories if smooth.ideal else sl.streamlines
+    facets = trace(rig.contact_surface(), starts, smooth.params, store_paths=True)
+    s = rig.length_scale_m
+    lc = rig.scales.char_length_m / s
+    mpaths = [r.position_m[r.drive_start_index :, :2] / s for r in runs]
+    frechet, lateral = _deviations(mpaths, facets, lc)
+    frechet_smooth, _ = _deviations(mpaths, smooth, lc)
+    geometry = np.array(
+        [
+            compare.path_frechet(
+                np.column_stack([facets.path(i)["x"], facets.path(i)["y"]]),
+                np.column_stack([smooth.path(i)["x"], smooth.path(i)["y"]]),
+                length_scale=lc,
+            )
+            for i in range(len(facets))
+        ]
+    )
+    mj_locked = np.array([r.end_reason.value == "self_lock" for r in runs])
+    mj_end = np.array([r.position_m[-1, :2] / s for r in runs])
+    agree = _outcomes(facets, mj_locked, mj_end, lc)
+    agree_smooth = _outcomes(smooth, mj_locked, mj_end, lc)
     peak = np.array([peak_drive_over_fp(r, rig.scales.preload_n) for r in runs])
-    kap = compare.kappa_agreement(qs.max_kappa, peak, kappa_cap=runs[0].detection.kappa_cap)
+    kap = compare.kappa_agreement(facets.max_kappa, peak, kappa_cap=runs[0].detection.kappa_cap)
     metrics = {
         "frechet": frechet,
         "lateral_deviation": lateral,
-        "end_distance": np.linalg.norm(np.column_stack([qs.end_x, qs.end_y]) - mj_end, axis=1) / lc,
+        "end_distance": np.linalg.norm(np.column_stack([facets.end_x, facets.end_y]) - mj_end, axis=1) / lc,
         "agree_lock": agree["lock"],
         "agree_end": agree["end"],
         "same_trap": agree["same_trap"],
         "agree": agree["agree"],
+        "reference_outcome": np.array(facets.outcome_names, dtype=object),
+        "reference_max_kappa": facets.max_kappa,
+        "frechet_smooth": frechet_smooth,
+        "agree_smooth": agree_smooth["agree"],
+        "geometry_frechet": geometry,
         "kappa_ratio": kap["ratio"],
         "inertia_number": np.array([r.inertia_number for r in runs]),
     }
     status = np.array(
-        upstream["mujoco"].status if upstream["mujoco"].status is not None else np.full(n, "ok"), dtype=object
+        upstream["mujoco"].status if upstream["mujoco"].status is not None else np.full(len(runs), "ok"),
+        dtype=object,
     )
     reason = np.where(
         status == "ok", "", "mujoco run: " + np.asarray(upstream["mujoco"].reason, dtype=object)
@@ -63,6 +99,8 @@ register_analysis(
         _compare,
         (),
         requires=("quasistatic", "mujoco"),
-        doc="quasistatic against MuJoCo per start (lengths over L_c): spine_mj.compare",
+        doc="MuJoCo against the streamline traced on the rig's facets dilated by its tip "
+        "(like for like), and against the quasistatic analysis's own path (*_smooth); "
+        "lengths over L_c: spine_mj.compare",
     )
 )

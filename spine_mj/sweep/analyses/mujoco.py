@@ -15,6 +15,7 @@ from spine_mj import sim
 from spine_mj.errors import SpineInputError
 from spine_mj.sim.ramp import nominal_time_s
 from spine_mj.sweep.registry import (
+    KAPPA_CAP_PARAM,
     MU_PARAM,
     Analysis,
     AnalysisResult,
@@ -128,14 +129,7 @@ MUJOCO_PARAMS = (
     ),
     ParamSpec("solref_dampratio", "float", "contact damping ratio", 1.0, 0.0, exclusive=True),
     ParamSpec("hfield_resolution", "int", "hfield samples per side for analytic surfaces", None, 4),
-    ParamSpec(
-        "kappa_cap",
-        "float",
-        "self-lock when the drive reaches kappa_cap F_p unmoved",
-        20.0,
-        0.0,
-        exclusive=True,
-    ),
+    KAPPA_CAP_PARAM,
     ParamSpec("record_every", "int", "store every k-th recorded step of the trajectories", 1, 1),
 )
 
@@ -302,6 +296,8 @@ def _metrics(rig, runs) -> dict[str, np.ndarray]:
     )
     return {
         "end_reason": np.array([r.end_reason.value for r in runs], dtype=object),
+        # which test ended the run, with its numbers ("lock rule: ...", "force cap: ...")
+        "end_detail": np.array([r.end_detail for r in runs], dtype=object),
         "self_locked": np.array([r.end_reason is sim.EndReason.SELF_LOCK for r in runs]),
         "end_x": end[:, 0],
         "end_y": end[:, 1],

@@ -11,7 +11,14 @@ import functools
 import numpy as np
 
 from spine_mj import streamline as sl
-from spine_mj.sweep.registry import MU_PARAM, Analysis, AnalysisResult, ParamSpec, register_analysis
+from spine_mj.sweep.registry import (
+    KAPPA_CAP_PARAM,
+    MU_PARAM,
+    Analysis,
+    AnalysisResult,
+    ParamSpec,
+    register_analysis,
+)
 
 QUASISTATIC_PARAMS = (
     MU_PARAM,
@@ -26,6 +33,7 @@ QUASISTATIC_PARAMS = (
     ),
     ParamSpec("max_steps", "int", "step cap per streamline", 200_000, 1),
     ParamSpec("trajectory", "str", "quasistatic path kind", "streamline", choices=("streamline", "ideal")),
+    KAPPA_CAP_PARAM,
 )
 
 
@@ -45,13 +53,13 @@ def _quasistatic(case, surface, starts, upstream):
         surface = _dilated(case.surface, p["tip_radius"])
     xmin, xmax, ymin, ymax = surface.bounds
     dl = p["dl"] if p["dl"] is not None else 0.0015 * min(xmax - xmin, ymax - ymin)
-    params = sl.StreamlineParams(mu=p["mu"], dl=dl, max_steps=p["max_steps"])
+    params = sl.StreamlineParams(mu=p["mu"], dl=dl, max_steps=p["max_steps"], kappa_cap=p["kappa_cap"])
     func = sl.streamlines if p["trajectory"] == "streamline" else sl.ideal_trajectories
     res = func(surface, starts, params, store_paths=True)
     names = np.array(["", *[o.name.lower() for o in sl.Outcome]], dtype=object)
     metrics = {
         "outcome": names[res.outcome],
-        "self_locked": res.outcome == sl.Outcome.SELF_LOCKED,
+        "self_locked": res.self_locked,  # held: the self-lock region or the force cap
         "end_x": res.end_x,
         "end_y": res.end_y,
         "end_z": res.end_z,
