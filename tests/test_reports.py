@@ -137,7 +137,8 @@ def _validation_results():
     star = {"kind": "bracketed", "value": 0.01, "low": 1e-4, "high": 1.0, "ci_low": 1e-4, "ci_high": 1.0}
     star |= {"criterion": "outcome agreement >= 95 %", "ie_used": [1e-4, 1.0]}
     star["by_criterion"] = {"outcome": dict(star)}
-    fam = {"runs": 10, "ok_runs": 9, "outcome_agreement": 0.9, "mean_frechet": 0.05}
+    fam = {"runs": 10, "ok_runs": 9, "outcome_agreement": 0.9, "mean_frechet": 0.05, "median_frechet": 0.04}
+    fam |= {"failed_runs": {"penetration": 1}}
     return {
         "static": StaticMapResult(rows=[], per_engine={}, mu=1.0, static_kappa_max_rel_error=0.01),
         "limit": QuasistaticLimitResult(
@@ -178,4 +179,5 @@ def test_validation_report_links_only_written_figures_and_names_its_plan(tmp_pat
     assert "figures/boundary.png" in text and "figures/limit_paths.png" in text
     assert "sandpaper.png" not in text and not (tmp_path / "figures" / "sandpaper.png").exists()
     assert "9/10" in text  # agree / runs beside the agreement
+    assert "penetration 1" in text  # the engine stops of a family, by kind
     assert "the issue" not in text

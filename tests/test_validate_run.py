@@ -21,6 +21,8 @@ def test_smoke_validation_writes_report_and_json(tmp_path, monkeypatch):
         "lowest_ie",
         "outcome_agreement_at_lowest_ie",
         "mean_frechet_at_lowest_ie",
+        "median_frechet_at_lowest_ie",
+        "failed_runs",
         "ie_star",
         "engine_settings",
     ):
@@ -28,6 +30,8 @@ def test_smoke_validation_writes_report_and_json(tmp_path, monkeypatch):
     assert doc["lowest_ie"] == validate.PLANS["smoke"].lowest_ie
     assert set(doc["outcome_agreement_at_lowest_ie"]) == {"single_peak_valley"}
     assert 0.0 <= doc["outcome_agreement_at_lowest_ie"]["single_peak_valley"] <= 1.0
+    # runs the engine stopped, by status, per family (none expected on the smoke plan's peak)
+    assert doc["failed_runs"] == {"single_peak_valley": {}}
     assert {"value", "low", "high", "kind"} <= set(doc["ie_star"]["spring"])
     # the static probe on a 20 deg plane (engaged) matches tan(theta + arctan mu) closely
     assert doc["static_kappa_max_rel_error"] < 0.05

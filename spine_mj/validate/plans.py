@@ -56,12 +56,19 @@ class FamilySpec:
         Surface seeds (None: the preset's own).
     starts : dict
         A sweep ``starts`` table.
+    variants : tuple
+        Generator parameter sets (a sweep surface's ``set`` table as ``((key, value),
+        ...)``), each a surface of every seed; ``((),)``: the preset as it is.
+    mu : float or None
+        mu_s of the family (None: each preset's calibrated one).
     """
 
     name: str
     presets: tuple[str, ...]
     seeds: tuple[int, ...] | None
     starts: tuple[tuple[str, Any], ...]
+    variants: tuple[tuple[tuple[str, Any], ...], ...] = ((),)
+    mu: float | None = None
 
     def starts_table(self) -> dict:
         return {k: (list(v) if isinstance(v, tuple) else v) for k, v in self.starts}
@@ -158,6 +165,25 @@ NO_NOSLIP = ("no noslip (elliptic, impratio 1)", (("noslip_iterations", 0),))
 IMPRATIO = ("no noslip, impratio 10", (("noslip_iterations", 0), ("impratio", 10.0)))
 
 #: The paper's single peak and valley with the five starts of Figs. 3-4 (every plan).
+#: The fractal family: 3 seeds x 2 Hurst exponents x 5 starts.
+FRACTAL = FamilySpec(
+    "fractal",
+    ("paper-fractal",),
+    (1, 2, 3),
+    relative_starts(5),
+    variants=((("hurst", 0.7),), (("hurst", 0.9),)),
+)
+
+#: The three sandpaper grits with their 25 um tip. Starts a quarter in: the rig ends a run
+#: whose tip comes within a tip radius of the edge, and the P600 patch is 16 radii wide.
+SANDPAPER = FamilySpec(
+    "sandpaper",
+    ("sandpaper-P36", "sandpaper-P60", "sandpaper-P600"),
+    None,
+    relative_starts(3, 0.25),
+    mu=SANDPAPER_MU,
+)
+
 PEAK_VALLEY = FamilySpec(
     "single_peak_valley",
     ("paper-single-peak", "paper-single-valley"),
@@ -197,7 +223,8 @@ PLANS: dict[str, ValidationPlan] = {
             FamilySpec(
                 "random_gaussian", ("paper-random-convex", "paper-random-concave"), (1,), relative_starts(3)
             ),
-            FamilySpec("fractal", ("paper-fractal",), (1,), relative_starts(3)),
+            FRACTAL,
+            SANDPAPER,
         ),
         lowest_ie=1e-4,
         hfield_resolution=151,
@@ -225,7 +252,8 @@ PLANS: dict[str, ValidationPlan] = {
                 (1, 2),
                 relative_starts(5),
             ),
-            FamilySpec("fractal", ("paper-fractal",), (1,), relative_starts(5)),
+            FRACTAL,
+            SANDPAPER,
         ),
         lowest_ie=1e-4,
         hfield_resolution=201,

@@ -1,9 +1,10 @@
 """Study 2: the quasistatic limit. Spring-drive paths at the lowest inertia number against the
 streamline, per surface family, with the engine settings that limit agreement varied.
 
-Three comparisons per run separate the errors: MuJoCo against the streamline on the smooth
-surface (total), the streamline on MuJoCo's triangulated hfield against the smooth one
-(geometry), MuJoCo against the triangulated streamline (dynamics).
+Three comparisons per run separate the errors (the sweep's ``compare`` analysis): MuJoCo
+against the streamline traced on the surface its tip touches, the rig's facets dilated by
+the tip (like for like: what the targets judge), MuJoCo against the streamline on the
+smooth surface (the total), and the two streamlines against each other (the geometry).
 """
 
 from __future__ import annotations
@@ -13,15 +14,8 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from spine_mj import compare, presets
 from spine_mj.presets import calibrated_mu
-from spine_mj.validate.paths import (
-    mujoco_traces,
-    path_metrics,
-    streamline_paths,
-    tip_radius,
-    triangulated_surface,
-)
+from spine_mj.validate.paths import stored_paths, tip_radius
 from spine_mj.validate.plans import FRECHET_TARGET, OUTCOME_TARGET, RECOMMENDED, FamilySpec, ValidationPlan
 from spine_mj.validate.runner import StudyRunner
 from spine_mj.validate.sweep_docs import engine_grid, family_doc
@@ -35,14 +29,17 @@ RUN_COLUMNS = (
     "start",
     "start_x",
     "start_y",
+    "agree",
     "frechet",
     "lateral_deviation",
     "end_distance",
-    "agree",
-    "geometry_frechet",
-    "dynamics_frechet",
-    "dynamics_agree",
+    "reference_outcome",
     "end_reason",
+    "end_detail",
+    "mujoco_status",
+    "agree_smooth",
+    "frechet_smooth",
+    "geometry_frechet",
 )
 
 
@@ -67,9 +64,10 @@ class QuasistaticLimitResult:
     ----------
     families : dict
         Family name -> summary: ``runs``, ``ok_runs``, ``outcome_agreement``,
-        ``mean_frechet``, ``median_frechet``, ``mean_lateral_deviation``,
-        ``mean_geometry_frechet``, ``mean_dynamics_frechet``,
-        ``outcome_agreement_vs_triangulated``, ``meets_target``.
+        ``mean_frechet``, ``median_frechet``, ``mean_lateral_deviation`` (against the
+        facet-traced streamline), ``outcome_agreement_smooth``, ``median_frechet_smooth``
+        (against the smooth one), ``mean_geometry_frechet``, ``failed_runs`` (engine stops
+        by status), ``meets_target``.
     runs : list of dict
         Per-run rows (:data:`RUN_COLUMNS`).
     variations : dict
@@ -98,11 +96,13 @@ class QuasistaticLimitResult:
 def quasistatic_limit(plan: ValidationPlan, runner: StudyRunner) -> QuasistaticLimitResult:
     """Study 2: spring drive at the lowest I_e against the streamline, per surface family.
 
-    For every run, three comparisons (lengths over L_c): MuJoCo against the streamline on
-    the smooth surface (the total error; the sweep's ``compare`` analysis), the streamline
-    on MuJoCo's triangulated hfield against the smooth one (geometry error), and MuJoCo
-    against the triangulated streamline (dynamics error). Then on the single peak the
-    settings of ``plan.limit_variations`` one at a time.
+    For every run, three comparisons from the sweep's ``compare`` analysis (lengths over
+    L_c): MuJoCo against the streamline traced on the surface its tip touches (the rig's
+    facets dilated by the tip: the like-for-like comparison the targets judge), MuJoCo
+    against the streamline on the smooth surface (the total), and the two streamlines
+    against each other (the geometry part). Runs the engine stopped count as
+    disagreements and are listed per family by status (``failed_runs``). Then on the single
+    peak the settings of ``plan.limit_variations`` one at a time.
 
     Returns
     -------
@@ -114,13 +114,17 @@ def quasistatic_limit(plan: ValidationPlan, runner: StudyRunner) -> QuasistaticL
         comps = [_preset_comparison(plan, runner, fam, preset, paths) for preset in fam.presets]
         allc = pd.concat(comps, ignore_index=True)
         summ = _family_summary(allc)
+        failed = allc.loc[allc["mujoco_status"] != "ok", "mujoco_status"].value_counts()
         summ.update(
             {
+                "median_frechet_smooth": float(np.nanmedian(allc["frechet_smooth"])),
+                "outcome_agreement_smooth": float(allc["agree_smooth"].fillna(False).astype(bool).mean()),
                 "mean_geometry_frechet": float(np.nanmean(allc["geometry_frechet"])),
-                "mean_dynamics_frechet": float(np.nanmean(allc["dynamics_frechet"])),
-                "outcome_agreement_vs_triangulated": float(np.mean(allc["dynamics_agree"])),
+                "failed_runs": {str(k): int(v) for k, v in failed.items()},
                 "meets_target": bool(
-                    summ["outcome_agreement"] >= OUTCOME_TARGET and summ["mean_frechet"] <= FRECHET_TARGET
+                    summ["outcome_agreement"] >= OUTCOME_TARGET
+                    and summ["median_frechet"] <= FRECHET_TARGET
+                    and "penetration" not in failed
                 ),
             }
         )
@@ -136,62 +140,45 @@ def quasistatic_limit(plan: ValidationPlan, runner: StudyRunner) -> QuasistaticL
     )
 
 
+def _limit_doc(plan: ValidationPlan, fam: FamilySpec, preset: str, name: str, overrides=()) -> dict:
+    """The sweep config of one preset of ``fam`` at the lowest I_e with the rig's tip on
+    both sides (``overrides``: an engine variation)."""
+    res = dict(overrides).get("hfield_resolution", plan.hfield_resolution)
+    tip = tip_radius(preset, fam.seeds, res)
+    grid = {
+        "mu": fam.mu if fam.mu is not None else calibrated_mu(preset),
+        "tip_radius": tip,
+        "dl": tip / 2,
+        **engine_grid(plan, overrides, preset, fam.seeds, tip),
+    }
+    return family_doc(
+        fam, name=name, preset=preset, drive={"protocol": "spring", "ie": plan.lowest_ie}, grid=grid
+    )
+
+
 def _preset_comparison(
     plan: ValidationPlan, runner: StudyRunner, fam: FamilySpec, preset: str, paths: dict
 ) -> pd.DataFrame:
-    """The ``compare`` rows of one preset's sweep with geometry and dynamics errors added;
-    the single peak/valley family's paths go into ``paths``."""
-    mu = calibrated_mu(preset)
-    tip = tip_radius(preset, fam.seeds, plan.hfield_resolution)
-    dl = tip / 2
-    grid = {"mu": mu, "tip_radius": tip, "dl": dl, **engine_grid(plan, (), preset, fam.seeds, tip)}
-    doc = family_doc(
-        fam,
-        name=f"limit-{preset}",
-        preset=preset,
-        drive={"protocol": "spring", "ie": plan.lowest_ie},
-        grid=grid,
-    )
-    df, store = runner(doc, f"limit/{preset}")
+    """The ``compare`` rows of one preset's sweep with the MuJoCo row's end and status; the
+    single peak/valley family's paths go into ``paths``."""
+    df, store = runner(_limit_doc(plan, fam, preset, f"limit-{preset}"), f"limit/{preset}")
     comp = df[df["analysis"] == "compare"].copy()
     mj = df[df["analysis"] == "mujoco"].set_index(["case_id", "start"])
-    runner.note(f"triangulated streamlines on {preset}")
-    geo, dyn, dyn_agree = [], [], []
-    for case_id, grp in comp.groupby("case_id", sort=False):
-        seed = grp["surface_seed"].iloc[0]
-        surface = presets.make_surface(preset, **({} if pd.isna(seed) else {"seed": int(seed)}))
-        starts = grp[["start_x", "start_y"]].to_numpy()
-        lc = float(mj.loc[(case_id, int(grp["start"].iloc[0])), "char_length"])
-        smooth = streamline_paths(surface, starts, mu, dl, tip)
-        tri = streamline_paths(triangulated_surface(surface, plan.hfield_resolution), starts, mu, dl, tip)
-        mpaths = mujoco_traces(store, case_id)
-        for i, s in enumerate(grp["start"].astype(int)):
-            qs_p = smooth.path(i)
-            tr_p = tri.path(i)
-            qa = np.column_stack([qs_p["x"], qs_p["y"]])
-            ta = np.column_stack([tr_p["x"], tr_p["y"]])
-            g, _ = path_metrics(ta, qa, lc)
-            m = mpaths.get(s)
-            mp = np.column_stack([m["x"], m["y"]]) if m is not None else np.zeros((0, 2))
-            d, _ = path_metrics(mp, ta, lc)
-            row = mj.loc[(case_id, s)]
-            ag = compare.outcome_agreement(
-                [bool(tri.self_locked[i])],
-                [[tri.end_x[i], tri.end_y[i]]],
-                [bool(row["self_locked"])],
-                [[row["end_x"], row["end_y"]]],
-                length_scale=lc,
-            )["agree"][0]
-            geo.append(g)
-            dyn.append(d)
-            dyn_agree.append(bool(ag))
-            if fam.name == "single_peak_valley":
-                paths.setdefault(preset, []).append(LimitPath(qa, ta, mp, tuple(starts[i])))
-    comp["geometry_frechet"] = geo
-    comp["dynamics_frechet"] = dyn
-    comp["dynamics_agree"] = dyn_agree
+    key = list(zip(comp["case_id"], comp["start"].astype(int)))
     comp["preset"] = preset
-    comp["end_reason"] = [mj.loc[(c, int(s)), "end_reason"] for c, s in zip(comp["case_id"], comp["start"])]
+    comp["end_reason"] = [mj.loc[k, "end_reason"] for k in key]
+    comp["end_detail"] = [mj.loc[k, "end_detail"] for k in key]
+    comp["mujoco_status"] = [mj.loc[k, "status"] for k in key]
+    if fam.name == "single_peak_valley":
+        for case_id, grp in comp.groupby("case_id", sort=False):
+            smooth = stored_paths(store, case_id, "quasistatic")
+            facets = stored_paths(store, case_id, "compare")
+            mpaths = stored_paths(store, case_id, "mujoco")
+            for s, x0, y0 in zip(grp["start"].astype(int), grp["start_x"], grp["start_y"]):
+                empty = np.zeros((0, 2))
+                paths.setdefault(preset, []).append(
+                    LimitPath(smooth[s], facets.get(s, empty), mpaths.get(s, empty), (x0, y0))
+                )
     return comp
 
 
@@ -202,24 +189,15 @@ def _variations(plan: ValidationPlan, runner: StudyRunner, runs_rows: list[dict]
     fam0 = plan.families[0]
     preset = fam0.presets[0]
     for label, ov in plan.limit_variations:
-        mu = calibrated_mu(preset)
-        tip = tip_radius(preset, fam0.seeds, dict(ov).get("hfield_resolution", plan.hfield_resolution))
-        grid = {"mu": mu, "tip_radius": tip, "dl": tip / 2, **engine_grid(plan, ov, preset, fam0.seeds, tip)}
-        doc = family_doc(
-            fam0,
-            name=f"limit-var-{label}",
-            preset=preset,
-            drive={"protocol": "spring", "ie": plan.lowest_ie},
-            grid=grid,
-        )
         tag = "-".join(f"{k}{v}" for k, v in ov)
-        df, _ = runner(doc, f"limit-var/{preset}-{tag}")
+        df, _ = runner(_limit_doc(plan, fam0, preset, f"limit-var-{label}", ov), f"limit-var/{preset}-{tag}")
         comp = df[df["analysis"] == "compare"]
         variations[label] = {**_family_summary(comp), "settings": dict(ov), "surface": preset}
     base = [r for r in runs_rows if r["preset"] == preset]
     return {
         RECOMMENDED[0]: {
             "outcome_agreement": float(np.mean([bool(r["agree"]) for r in base])),
+            "median_frechet": float(np.nanmedian([r["frechet"] for r in base])),
             "mean_frechet": float(np.nanmean([r["frechet"] for r in base])),
             "mean_lateral_deviation": float(np.nanmean([r["lateral_deviation"] for r in base])),
             "runs": len(base),

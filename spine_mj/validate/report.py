@@ -418,35 +418,50 @@ def _static_section(static: StaticMapResult, result: dict) -> list[str]:
 
 
 def _limit_section(limit: QuasistaticLimitResult) -> list[str]:
+    families = [
+        {
+            "family": k,
+            "ok_n": f"{v['ok_runs']}/{v['runs']}",
+            "stopped": ", ".join(f"{s} {n}" for s, n in v["failed_runs"].items()) or "none",
+            **v,
+        }
+        for k, v in limit.families.items()
+    ]
     return [
         "## Quasistatic limit (spring drive, lowest I_e)",
         "",
-        f"I_e = {limit.lowest_ie:g}, recommended settings. Total = MuJoCo vs smooth "
-        "streamline; geometry = streamline on MuJoCo's hfield facets vs smooth; "
-        "dynamics = MuJoCo vs facet streamline.",
+        f"I_e = {limit.lowest_ie:g}, default drive (K = k l_s / F_p = 30) and engine. Like for "
+        "like: each MuJoCo path is compared with the streamline traced on the surface its tip "
+        "touches (MuJoCo's hfield facets dilated by the tip radius, sampled at an eighth of the "
+        "radius), with the same force cap on both sides (a path needing more than the cap times "
+        "F_p is held). A run the engine stopped counts as a disagreement. Beside it: the "
+        "comparison with the streamline on the smooth surface and the geometry part (smooth vs "
+        "facet streamline).",
         "",
         _table(
-            [{"family": k, "ok_n": f"{v['ok_runs']}/{v['runs']}", **v} for k, v in limit.families.items()],
+            families,
             [
                 "family",
                 "ok_n",
+                "stopped",
                 "outcome_agreement",
+                "median_frechet",
                 "mean_frechet",
-                "mean_lateral_deviation",
+                "outcome_agreement_smooth",
+                "median_frechet_smooth",
                 "mean_geometry_frechet",
-                "mean_dynamics_frechet",
-                "outcome_agreement_vs_triangulated",
                 "meets_target",
             ],
             [
                 "family",
                 "ok/runs",
+                "engine stops",
                 "outcome agr.",
+                "median Frechet",
                 "mean Frechet",
-                "mean lateral",
+                "outcome agr. (smooth)",
+                "median Frechet (smooth)",
                 "geometry Frechet",
-                "dynamics Frechet",
-                "outcome agr. vs facets",
                 "target met (this plan)",
             ],
         ),
@@ -455,7 +470,14 @@ def _limit_section(limit: QuasistaticLimitResult) -> list[str]:
         "",
         _table(
             [{"setting": k, **v} for k, v in limit.variations.items()],
-            ["setting", "runs", "outcome_agreement", "mean_frechet", "mean_lateral_deviation"],
+            [
+                "setting",
+                "runs",
+                "outcome_agreement",
+                "median_frechet",
+                "mean_frechet",
+                "mean_lateral_deviation",
+            ],
         ),
         "",
         "<details><summary>per run</summary>",
@@ -466,13 +488,14 @@ def _limit_section(limit: QuasistaticLimitResult) -> list[str]:
                 "surface",
                 "start_x",
                 "start_y",
-                "end_reason",
                 "agree",
                 "frechet",
-                "lateral_deviation",
-                "end_distance",
+                "reference_outcome",
+                "end_reason",
+                "end_detail",
+                "agree_smooth",
+                "frechet_smooth",
                 "geometry_frechet",
-                "dynamics_frechet",
             ],
         ),
         "",

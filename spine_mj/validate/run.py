@@ -119,6 +119,8 @@ def _summary(
         "lowest_ie": plan.lowest_ie,
         "outcome_agreement_at_lowest_ie": {k: v["outcome_agreement"] for k, v in lim.families.items()},
         "mean_frechet_at_lowest_ie": {k: v["mean_frechet"] for k, v in lim.families.items()},
+        "median_frechet_at_lowest_ie": {k: v["median_frechet"] for k, v in lim.families.items()},
+        "failed_runs": {k: v["failed_runs"] for k, v in lim.families.items()},
         "limit_families": lim.families,
         "limit_variations": lim.variations,
         "ie_star": bnd.ie_star,

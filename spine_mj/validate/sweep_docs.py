@@ -16,14 +16,18 @@ from spine_mj.validate.plans import MASS_KG, FamilySpec, ValidationPlan
 __all__ = ["engine_default", "engine_grid", "family_doc", "surfaces_table"]
 
 
-def surfaces_table(presets_: Sequence[str], seeds) -> list[dict]:
-    """A sweep ``surfaces`` table: one entry per preset, with ``seeds`` when given."""
+def surfaces_table(presets_: Sequence[str], seeds, variants=((),)) -> list[dict]:
+    """A sweep ``surfaces`` table: one entry per preset and generator parameter set
+    (``variants``, see :class:`FamilySpec`), with ``seeds`` when given."""
     out = []
     for p in presets_:
-        entry = {"preset": p}
-        if seeds is not None:
-            entry["seeds"] = list(seeds)
-        out.append(entry)
+        for variant in variants:
+            entry = {"preset": p}
+            if seeds is not None:
+                entry["seeds"] = list(seeds)
+            if variant:
+                entry["set"] = dict(variant)
+            out.append(entry)
     return out
 
 
@@ -39,7 +43,7 @@ def family_doc(
     """The sweep config of one preset of ``fam`` with its starts, ``drive`` and ``grid``."""
     return {
         "sweep": {"name": name, "seed": 11, "analyses": list(analyses)},
-        "surfaces": surfaces_table([preset], fam.seeds),
+        "surfaces": surfaces_table([preset], fam.seeds, fam.variants),
         "starts": fam.starts_table(),
         "drive": drive,
         "grid": grid,

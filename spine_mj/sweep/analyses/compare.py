@@ -17,6 +17,7 @@ import numpy as np
 from spine_mj import compare
 from spine_mj import streamline as sl
 from spine_mj.sweep.analyses.mujoco import peak_drive_over_fp
+from spine_mj.sweep.analyses.quasistatic import path_table
 from spine_mj.sweep.registry import Analysis, AnalysisResult, register_analysis
 
 
@@ -90,7 +91,8 @@ def _compare(case, surface, starts, upstream):
         status == "ok", "", "mujoco run: " + np.asarray(upstream["mujoco"].reason, dtype=object)
     ).astype(object)
     status = np.where(status == "ok", "ok", "dependency_failed").astype(object)
-    return AnalysisResult(metrics=metrics, status=status, reason=reason)
+    # the trajectories are the facet-traced reference paths
+    return AnalysisResult(metrics=metrics, trajectories=path_table(facets), status=status, reason=reason)
 
 
 register_analysis(

@@ -68,10 +68,15 @@ def _quasistatic(case, surface, starts, upstream):
         "max_kappa": res.max_kappa,
         "dl_used": np.full(len(res), dl),
     }
+    return AnalysisResult(metrics=metrics, trajectories=path_table(res), data=res)
+
+
+def path_table(res: sl.StreamlineResult) -> dict[str, np.ndarray]:
+    """The stored paths of ``res`` as a long table: ``start``, ``step``, ``x``, ``y``, ``z``,
+    ``kappa``, ``region`` (surface units)."""
     counts = np.diff(res.offsets)
-    start = np.repeat(np.arange(len(res)), counts)
-    traj = {
-        "start": start,
+    return {
+        "start": np.repeat(np.arange(len(res)), counts),
         "step": np.arange(res.x.size) - np.repeat(res.offsets[:-1], counts),
         "x": res.x,
         "y": res.y,
@@ -79,7 +84,6 @@ def _quasistatic(case, surface, starts, upstream):
         "kappa": res.kappa,
         "region": res.region.astype(np.int8),
     }
-    return AnalysisResult(metrics=metrics, trajectories=traj, data=res)
 
 
 register_analysis(
