@@ -31,6 +31,8 @@ from spine_mj.surfaces import GaussianSurface, fractal_fbm, random_gaussians, si
 
 __all__ = [
     "REPRODUCTIONS",
+    "fig9_rms_height",
+    "fig9_seeds",
     "fractal_hurst",
     "kappa_map",
     "random_gaussian",
@@ -421,11 +423,25 @@ def raw_rms_height(hurst: float, nx: int, size: float) -> float:
     return float(math.sqrt(amp2.mean()))
 
 
+def fig9_rms_height(hurst: float, nx: int, size: float, frequency_unit: str, scale: float) -> float:
+    """RMS height of a Fig. 9 surface at ``hurst``: ``scale`` times :func:`raw_rms_height`
+    with frequencies in cycles per pixel (``frequency_unit = "pixel"``) or per unit length
+    (``"length"``). One rule, shared by :func:`fractal_hurst` and the validation's
+    fractal study, so both draw the same surfaces."""
+    spectral_size = nx if frequency_unit == "pixel" else size
+    return scale * raw_rms_height(hurst, nx, spectral_size)
+
+
+def fig9_seeds(hurst_index: int, n: int) -> np.ndarray:
+    """Seeds of the ``n`` surfaces at the ``hurst_index``-th H of a Fig. 9 run (distinct
+    per surface and per H)."""
+    return 1_000_000 * (hurst_index + 1) + np.arange(n)
+
+
 def _fractal_chunk(args):
     hurst, seeds, gen, mu, dl, scale, lock_point, trajectory = args
     params = StreamlineParams(mu=mu, dl=dl)
-    spectral_size = gen["nx"] if gen["frequency_unit"] == "pixel" else gen["size"]
-    rms = scale * raw_rms_height(hurst, gen["nx"], spectral_size)
+    rms = fig9_rms_height(hurst, gen["nx"], gen["size"], gen["frequency_unit"], scale)
     trace = ideal_trajectories if trajectory == "ideal" else streamlines
     before = lock_point == "before"
     locked, sect, hess = [], [], []
@@ -505,7 +521,7 @@ def fractal_hurst(
         )
     chunks = []
     for h_i, h in enumerate(hursts):
-        seeds = 1_000_000 * (h_i + 1) + np.arange(n)
+        seeds = fig9_seeds(h_i, n)
         for part in np.array_split(seeds, max(1, workers * 2)):
             chunks.append((h, part, gen, mu, dl, scale, lock_point, trajectory))
     results: dict[float, list] = {h: [] for h in hursts}

@@ -40,6 +40,18 @@ def test_smoke_validation_writes_report_and_json(tmp_path, monkeypatch):
     assert (out / "figures" / "boundary.png").stat().st_size > 1000
     assert (out / "sweeps" / "boundary" / "spring-paper-single-peak" / "runs.parquet").is_file()
     assert "outcome agreement" in res.output
+    # the fractal self-lock study: one row per H of the plan, every rate with its count
+    fractal = doc["fractal_lock_rate"]
+    plan = validate.PLANS["smoke"]
+    assert [r["hurst"] for r in fractal["rows"]] == list(plan.fractal_hursts)
+    for row in fractal["rows"]:
+        for series in ("streamline", "mujoco_corner", "mujoco_dynamic"):
+            assert row[f"n_{series}"] == plan.fractal_surfaces
+            assert row[f"n_ok_{series}"] + row[f"failed_runs_{series}"] == plan.fractal_surfaces
+    assert fractal["corner_ie"] == plan.lowest_ie and fractal["dynamic_ie"] == plan.fractal_dynamic_ie
+    assert "fractal_lock" in doc["timings_s"]
+    assert "Self-lock rate against the Hurst exponent" in report and "figures/fractal_lock_rate.png" in report
+    assert (out / "figures" / "fractal_lock_rate.png").stat().st_size > 1000
 
 
 def test_unknown_plan_is_rejected():

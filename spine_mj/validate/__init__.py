@@ -1,9 +1,10 @@
 """The validation harness: MuJoCo against the quasistatic streamline across inertia numbers.
 
-Five studies (issue 6), each a function that runs its MuJoCo cases through the sweep runner
-(:func:`spine_mj.sweep.run_sweep`, one resumable store per study under ``out/sweeps/``, so a
-killed validation resumes where it stopped) and returns a typed result with the numbers
-and the data of its figures (``as_dict()`` gives the keys of ``validation.json``):
+Six studies (1-5 from issue 6), each a function that runs its MuJoCo cases through the
+sweep runner (:func:`spine_mj.sweep.run_sweep`, one resumable store per study under
+``out/sweeps/``, so a killed validation resumes where it stopped) and returns a typed
+result with the numbers and the data of its figures (``as_dict()`` gives the keys of
+``validation.json``):
 
 1. :func:`static_map` - breakaway ratio ``kappa_mj / kappa`` of the static probe on inclined
    planes over slope angle and azimuth (engaged, self-lock and slip regions), per engine
@@ -18,6 +19,9 @@ and the data of its figures (``as_dict()`` gives the keys of ``validation.json``
    ``I_e`` and spring stiffness.
 5. :func:`sandpaper` - P36 / P60 / P600 analogs with a 25 um tip: path waviness and force
    peaks.
+6. :func:`fractal_lock` - the self-lock rate against the Hurst exponent H on fractal
+   surfaces (the paper's Figs. 7E and 9), streamline beside MuJoCo at the quasistatic
+   corner and at one dynamic I_e, with binomial intervals.
 
 :func:`run_validation` runs them all for a :class:`ValidationPlan` (``"quick"``, ``"full"``
 or the test-size ``"smoke"``), writes ``report.md`` with PNG figures and ``validation.json``.
@@ -34,6 +38,7 @@ module per study, :mod:`~spine_mj.validate.report` and :mod:`~spine_mj.validate.
 
 from spine_mj.presets import calibrated_mu
 from spine_mj.validate.boundary import BoundaryCurve, BoundaryResult, boundary
+from spine_mj.validate.fractal_lock import FractalLockResult, fractal_lock
 from spine_mj.validate.ie_star import (
     DEPARTURE,
     IE_STAR_CRITERIA,
@@ -86,6 +91,7 @@ __all__ = [
     "BoundaryCurve",
     "BoundaryResult",
     "FamilySpec",
+    "FractalLockResult",
     "IeStar",
     "LimitPath",
     "QuasistaticLimitResult",
@@ -102,6 +108,7 @@ __all__ = [
     "calibrated_mu",
     "departure_ie_star",
     "estimate_ie_star",
+    "fractal_lock",
     "ie_star_by_criterion",
     "path_metrics",
     "pilot_rig",

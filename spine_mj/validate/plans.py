@@ -1,6 +1,6 @@
 """Sizes and targets of a validation run: the plans, their surface families and engine variations.
 
-A :class:`ValidationPlan` fixes every grid of the five studies (planes, families, I_e
+A :class:`ValidationPlan` fixes every grid of the studies (planes, families, I_e
 values, stiffnesses, grits, bootstrap size, ramp caps); :data:`PLANS` holds the ``smoke``
 (test size), ``quick`` and ``full`` plans. The agreement targets and the physical
 constants every study shares (tip mass, gravity, the sandpaper mu) live here, so that the
@@ -134,6 +134,18 @@ class ValidationPlan:
         (the step of the paper's algorithm). The paper's dl = 0.01 sigma would need ~500
         cycles per path here; 0.1 L_c keeps a run affordable and is compared with the
         streamline stepped at its own, converged dl.
+    fractal_hursts : tuple of float
+        Hurst exponents of the fractal self-lock study (Figs. 7E and 9 in dynamics); the
+        default five lie in the preset's Fig. 9 list, so their surfaces are a Fig. 9 run's.
+    fractal_surfaces : int
+        Fractal surfaces per H (one start each): enough for a rate with a usable binomial
+        interval in the full plan (>= 30), fewer in the quick one.
+    fractal_dynamic_ie : float
+        The I_e of the study's dynamic MuJoCo series (its other one runs at ``lowest_ie``).
+    fractal_facets : bool
+        Also count the streamline traced on MuJoCo's facets (the ``compare`` analysis's
+        reference, ~1.4 s of CPU per surface measured on the fractal preset, twice the
+        MuJoCo runs' cost there).
     """
 
     name: str
@@ -156,6 +168,10 @@ class ValidationPlan:
     bootstrap: int = 200
     ramp_max_steps: int = 20000
     ramp_slide_lc: float = 0.1
+    fractal_hursts: tuple[float, ...] = (0.65, 0.75, 0.8, 0.85, 0.95)
+    fractal_surfaces: int = 30
+    fractal_dynamic_ie: float = 0.1
+    fractal_facets: bool = True
     extra: dict = field(default_factory=dict, compare=False)
 
 
@@ -212,6 +228,9 @@ PLANS: dict[str, ValidationPlan] = {
         sandpaper_grits=(),
         bootstrap=20,
         ramp_max_steps=2000,
+        fractal_hursts=(0.65, 0.95),
+        fractal_surfaces=1,
+        fractal_facets=False,
     ),
     "quick": ValidationPlan(
         name="quick",
@@ -238,6 +257,9 @@ PLANS: dict[str, ValidationPlan] = {
         sandpaper_starts=2,
         bootstrap=200,
         ramp_max_steps=60000,
+        fractal_surfaces=6,
+        # the facet streamline (~1.4 s per surface, measured) would double the study's time
+        fractal_facets=False,
     ),
     "full": ValidationPlan(
         name="full",

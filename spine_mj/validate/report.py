@@ -29,6 +29,7 @@ from spine_mj.presets import list_presets, make_surface
 from spine_mj.sweep.store import load_runs
 from spine_mj.templates import render
 from spine_mj.validate.boundary import BoundaryCurve, BoundaryResult
+from spine_mj.validate.fractal_lock import SERIES, FractalLockResult
 from spine_mj.validate.paths import stored_paths
 from spine_mj.validate.plans import FRECHET_TARGET, OUTCOME_TARGET, STATIC_TARGET
 from spine_mj.validate.quasistatic_limit import QuasistaticLimitResult
@@ -260,6 +261,45 @@ def _sand_figure(sp: SandpaperResult, path: Path) -> Path | None:
     return save_figure(fig, path)
 
 
+#: Legend labels of the fractal study's series (:data:`spine_mj.validate.fractal_lock.SERIES`).
+def _fractal_labels(fr: FractalLockResult) -> dict[str, str]:
+    return {
+        "streamline": "streamline (smooth surface, dilated by the tip)",
+        "facets": "streamline (MuJoCo's facets, dilated by the tip)",
+        "mujoco_corner": f"MuJoCo, spring, I_e = {sig(fr.corner_ie)}",
+        "mujoco_dynamic": f"MuJoCo, spring, I_e = {sig(fr.dynamic_ie)}",
+    }
+
+
+@styled
+def _fractal_figure(fr: FractalLockResult | None, path: Path) -> Path | None:
+    """Self-lock rate against H, one series per counter, Wilson intervals as error bars
+    (series side by side in H so that their bars do not hide each other)."""
+    if fr is None or not fr.rows:
+        return None
+    fig = new_figure(figsize=(6.4, 4.4), constrained_layout=True)
+    ax = fig.subplots()
+    labels = _fractal_labels(fr)
+    present = [s for s in SERIES if any(f"rate_{s}" in r for r in fr.rows)]
+    hs = np.array([r["hurst"] for r in fr.rows])
+    width = 0.006
+    for j, series in enumerate(present):
+        rate = np.array([r.get(f"rate_{series}", np.nan) for r in fr.rows], float)
+        lo = np.array([r.get(f"ci_low_{series}", np.nan) for r in fr.rows], float)
+        hi = np.array([r.get(f"ci_high_{series}", np.nan) for r in fr.rows], float)
+        x = hs + (j - (len(present) - 1) / 2) * width
+        ax.errorbar(x, rate, yerr=[rate - lo, hi - rate], fmt="o-", capsize=3, label=labels[series])
+    ax.set(
+        xlabel="Hurst exponent H [1]",
+        ylabel="self-locked runs [fraction]",
+        ylim=(-0.05, 1.05),
+        title=f"Self-lock rate against H, {fr.surfaces_per_hurst} fractal surfaces per H "
+        f"(bars: {sig(100 * fr.confidence)} % Wilson intervals)",
+    )
+    ax.legend(loc="upper left")
+    return save_figure(fig, path)
+
+
 #: What each plan is, for the report's first lines.
 PLAN_NOTES = {
     "smoke": "the seconds-long test plan: two planes, one family with two starts, two I_e values; "
@@ -279,6 +319,7 @@ def write_report(
     boundary: BoundaryResult,
     stick: StickSlipResult,
     sand: SandpaperResult,
+    fractal: FractalLockResult | None = None,
 ) -> Path:
     """Write the figures under ``out/figures`` and ``out/report.md``; returns the report path.
 
@@ -296,6 +337,7 @@ def write_report(
         "overlays": _overlay_figure(out, figs / "boundary_paths.png"),
         "stick": _stick_figure(stick, figs / "stick_slip.png"),
         "sand": _sand_figure(sand, figs / "sandpaper.png"),
+        "fractal": _fractal_figure(fractal, figs / "fractal_lock_rate.png"),
     }
     figures = {
         k: (p.relative_to(out).as_posix() if p is not None and p.is_file() else None)
@@ -314,6 +356,7 @@ def write_report(
         limit="\n".join(_limit_section(limit)),
         stick="\n".join(_stick_section(stick)),
         sand="\n".join(_sand_section(sand)),
+        fractal="\n".join(_fractal_section(fractal)),
         engine_settings=json.dumps(result["engine_settings"], indent=2, default=str),
         timings=", ".join(f"{k} {sig(v)}" for k, v in result["timings_s"].items()),
     )
@@ -662,3 +705,63 @@ def _sand_section(sand: SandpaperResult) -> list[str]:
         + ".",
         "",
     ]
+
+
+def _fractal_section(fr: FractalLockResult | None) -> list[str]:
+    """The fractal self-lock table (rate, Wilson interval, locked / ok runs, failed runs
+    per series and H) and one sentence on what it shows."""
+    if fr is None or not fr.rows:
+        return []
+    labels = _fractal_labels(fr)
+    present = [s for s in SERIES if any(f"rate_{s}" in r for r in fr.rows)]
+    rows = []
+    for r in fr.rows:
+        row = {"H": r["hurst"]}
+        for s in present:
+            row[s] = (
+                f"{_f(r[f'rate_{s}'], 2)} [{_f(r[f'ci_low_{s}'], 2)}, {_f(r[f'ci_high_{s}'], 2)}] "
+                f"({r[f'locked_{s}']}/{r[f'n_ok_{s}']}, failed {r[f'failed_runs_{s}']})"
+            )
+        rows.append(row)
+    return [
+        "## Self-lock rate against the Hurst exponent (fractal surfaces)",
+        "",
+        f"The paper's claim (Figs. 7E, 9) that self-lock becomes more frequent with H, checked "
+        f"in dynamics: {fr.surfaces_per_hurst} paper-fractal surfaces per H (the Fig. 9 "
+        f"height scale and seeds), one start each at mid height near the left edge, default "
+        f"spring drive (K = 30), mu = {sig(fr.mu)}, tip radius {sig(fr.tip_radius)} surface "
+        "units. Held = the lock rule or the shared force cap ended the path. Cells: rate [Wilson "
+        f"{sig(100 * fr.confidence)} % interval] (held / runs without engine trouble, runs "
+        "the engine stopped).",
+        "",
+        _table(rows, ["H", *present], ["H", *(labels[s] for s in present)]),
+        "",
+        _fractal_sentence(fr),
+        "",
+    ]
+
+
+def _fractal_sentence(fr: FractalLockResult) -> str:
+    """What the table shows, from its numbers: the streamline's and MuJoCo's rates at the
+    lowest and highest H, and whether their intervals overlap at every H."""
+    first, last = fr.rows[0], fr.rows[-1]
+
+    def ends(s):
+        return f"{_f(first.get(f'rate_{s}'), 2)} -> {_f(last.get(f'rate_{s}'), 2)}"
+
+    pairs = [
+        (r[f"ci_low_{s}"], r[f"ci_high_{s}"], r["ci_low_streamline"], r["ci_high_streamline"])
+        for r in fr.rows
+        for s in ("mujoco_corner", "mujoco_dynamic")
+        if np.isfinite(r.get(f"rate_{s}", np.nan)) and np.isfinite(r.get("rate_streamline", np.nan))
+    ]
+    if not pairs:
+        return "No H has both a streamline rate and a MuJoCo rate (every run stopped by the engine)."
+    overlap = all(max(a_lo, b_lo) <= min(a_hi, b_hi) for a_lo, a_hi, b_lo, b_hi in pairs)
+    return (
+        f"From H = {sig(first['hurst'])} to {sig(last['hurst'])} the streamline's rate goes "
+        f"{ends('streamline')}, MuJoCo's {ends('mujoco_corner')} at I_e = {sig(fr.corner_ie)} "
+        f"and {ends('mujoco_dynamic')} at I_e = {sig(fr.dynamic_ie)}; the MuJoCo intervals "
+        + ("overlap the streamline's at every H." if overlap else "miss the streamline's at some H.")
+        + " With this many surfaces per H, only differences larger than the intervals count."
+    )

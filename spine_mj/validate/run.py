@@ -1,4 +1,4 @@
-"""The validation suite: runs the five studies for a plan and writes ``validation.json`` and
+"""The validation suite: runs the studies for a plan and writes ``validation.json`` and
 ``report.md`` (with PNG figures) into one output folder.
 """
 
@@ -15,6 +15,7 @@ from spine_mj.errors import SpineInputError
 from spine_mj.jsonio import write_json
 from spine_mj.surfaces import single_gaussian
 from spine_mj.validate.boundary import BoundaryResult, boundary
+from spine_mj.validate.fractal_lock import FractalLockResult, fractal_lock
 from spine_mj.validate.plans import (
     FRECHET_TARGET,
     MASS_KG,
@@ -93,10 +94,11 @@ def run_validation(
         if plan.sandpaper_grits
         else SandpaperResult(rows=[], paths={}, mu=SANDPAPER_MU)
     )
+    fr = timed("fractal_lock", fractal_lock, plan, runner)
     runner.study = "report"
     runner.note("figures and report")
-    result = _summary(plan, st, lim, bnd, ss, sp, timings)
-    write_report(out, result, static=st, limit=lim, boundary=bnd, stick=ss, sand=sp)
+    result = _summary(plan, st, lim, bnd, ss, sp, timings, fr)
+    write_report(out, result, static=st, limit=lim, boundary=bnd, stick=ss, sand=sp, fractal=fr)
     result["timings_s"]["total"] = round(time.perf_counter() - t0, 2)
     write_json(out / "validation.json", result)
     return result
@@ -110,6 +112,7 @@ def _summary(
     ss: StickSlipResult,
     sp: SandpaperResult,
     timings: dict,
+    fr: FractalLockResult,
 ) -> dict:
     """The content of ``validation.json`` (``timings_s`` is ``timings``, not a copy)."""
     return {
@@ -128,6 +131,7 @@ def _summary(
         "trap_skip_rate": bnd.skip_rate,
         "stick_slip": ss.rows,
         "sandpaper": sp.rows,
+        "fractal_lock_rate": fr.as_dict(),
         "targets": {
             "outcome_agreement": OUTCOME_TARGET,
             "mean_frechet_lc": FRECHET_TARGET,
