@@ -1051,11 +1051,19 @@ def validate_cmd(out_dir, quick, plan_name, workers, quiet):
     click.echo(
         f"static kappa max rel. error (engaged, default settings): {result['static_kappa_max_rel_error']:.3g}"
     )
-    for fam, agree in result["outcome_agreement_at_lowest_ie"].items():
+    for fam, summ in result["limit_families"].items():
+        stops = ", ".join(f"{k} {n}" for k, n in summ["failed_runs"].items()) or "none"
         click.echo(
-            f"I_e = {result['lowest_ie']:g}, {fam}: outcome agreement {agree:.0%}, "
-            f"mean Frechet {result['mean_frechet_at_lowest_ie'][fam]:.3g} L_c"
+            f"I_e = {result['lowest_ie']:g}, {fam}: outcome agreement {summ['outcome_agreement']:.0%} "
+            f"of {summ['runs']}, median Frechet {summ['median_frechet']:.3g} L_c, engine stops: {stops}"
         )
+    for row in result.get("fractal_lock_rate", {}).get("rows", []):
+        rates = ", ".join(
+            f"{k} {row[f'rate_{k}']:.2f} ({row[f'locked_{k}']}/{row[f'n_ok_{k}']})"
+            for k in ("streamline", "mujoco_corner", "mujoco_dynamic")
+            if f"rate_{k}" in row
+        )
+        click.echo(f"fractal self-lock rate, H = {row['hurst']:g}: {rates}")
     for proto, s in result["ie_star"].items():
         if s.get("valid") is False:
             click.echo(f"I_e* ({proto}) {s['note']}")
