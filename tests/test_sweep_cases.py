@@ -53,3 +53,43 @@ def test_relative_and_random_starts():
     np.testing.assert_array_equal(pts, case.starts.resolve(bounds, case.seed))
     rel = sweep.StartsSpec(frame="relative", points=((0.0, 1.0), (0.5, 0.5)))
     np.testing.assert_allclose(rel.resolve((-5, 5, -2, 2), 0), [[-5, 2], [0, 0]])
+
+
+def test_config_hash_case_ids_and_seeds_are_pinned_so_existing_stores_resume():
+    """Values from the hand-written parser that the pydantic schema replaced: a store
+    resumes only while its config hash and case ids stay the same."""
+    doc = with_(grid__mu=[0.5, 1.0, 1.5], grid__tip_radius={"logspace": [0.01, 1.0], "num": 3})
+    doc["grid"]["trajectory"] = ["streamline", "ideal"]
+    doc["surfaces"] = [
+        {"preset": "paper-single-peak"},
+        {"preset": "paper-random-convex", "seeds": [3, 4]},
+        {"preset": "paper-random-concave", "n_seeds": 2},
+    ]
+    config = sweep.parse_config(doc)
+    cases = sweep.expand_cases(config)
+    assert config.hash == "9621a8c236b41bfd72d4d41fb8af91ff78810d755020a482827e59f5a05b9faa"
+    assert [c.case_id for c in cases[:2]] == ["cc97f990b04c338b", "34b54c8b15379690"]
+    assert (len(cases), cases[-1].case_id, cases[-1].surface.label) == (
+        90,
+        "53165dd5368af64b",
+        "paper-random-concave#2001798622",
+    )
+    assert cases[0].seed == 4076089954016632248
+    # starts per surface, the absolute frame, a bare analysis name, generator overrides
+    config = sweep.parse_config(
+        {
+            "sweep": {"analyses": "quasistatic"},
+            "surfaces": [
+                {"preset": "paper-single-peak", "starts": {"frame": "absolute", "x": -3, "y": [-1, -2]}},
+                {"preset": "paper-fractal", "seed": 5, "set": {"hurst": 0.6}, "starts": {"random": 3}},
+            ],
+            "grid": {"mu": {"linspace": [0.5, 1], "num": 3}, "max_steps": [10, 20]},
+        }
+    )
+    cases = sweep.expand_cases(config)
+    assert config.hash == "c9dde2304eea4caed2996631010e2bc751000fc049766e767dcacfab2762aa62"
+    assert [c.case_id for c in cases[:2]] + [cases[-1].case_id] == [
+        "8e9a571b02c22a69",
+        "2e7d7f0a83f55bae",
+        "fcff4bc40d98e50d",
+    ]

@@ -47,6 +47,10 @@ def test_cli_sweep_status_report(tmp_path):
         ),
         ("[sweep\n", "is not valid TOML"),
         (PEAK_QS.format(name="x", nmu=2, ny=2, dl=-1), "Error: config key grid.dl: must be"),
+        (
+            PEAK_QS.format(name="x", nmu=2, ny=2, dl=0.02).replace("num = 2 }", "num = 2, step = 1 }", 1),
+            "Error: config key starts.y.step: unknown key; allowed: linspace, logspace, num",
+        ),
     ],
 )
 def test_cli_bad_config_exits_2_with_one_line_and_writes_nothing(tmp_path, text, message):

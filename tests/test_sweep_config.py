@@ -11,13 +11,13 @@ from spine_mj.errors import SpineInputError
 @pytest.mark.parametrize(
     "doc, match",
     [
-        (with_(extra=1), r"config key extra: unknown; allowed keys: sweep, surfaces"),
+        (with_(extra=1), r"config key extra: unknown key; allowed: sweep, surfaces, starts, grid, drive"),
         (
             with_(sweep__analyses=["quasistatic", "nope"]),
             r"sweep.analyses: allowed values are .*'quasistatic'.*, got 'nope'",
         ),
         (with_(sweep__analyses=["compare"]), r"sweep.analyses: 'compare' needs"),
-        (with_(sweep__seed=-1), r"sweep.seed: must be a non-negative integer, got -1"),
+        (with_(sweep__seed=-1), r"sweep.seed: must be greater than or equal to 0, got -1"),
         (with_(grid__mu=-0.5), r"grid.mu: must be a finite number > 0 .*got -0.5"),
         (
             with_(grid__mu=None, surfaces=[{"preset": "sandpaper-P60"}]),
@@ -28,8 +28,8 @@ from spine_mj.errors import SpineInputError
         (with_(grid__trajectory="curvy"), r"grid.trajectory: must be one of 'streamline', 'ideal'"),
         (with_(grid__max_steps=1.5), r"grid.max_steps: must be an integer >= 1"),
         (with_(grid__mu={"logspace": [0, 1], "num": 3}), r"grid.mu.logspace: end values must be > 0"),
-        (with_(grid__mu={"linspace": [0.1, 1]}), r"grid.mu: a table must be \{linspace"),
-        (with_(surfaces=[]), r"config key surfaces: must be a non-empty array"),
+        (with_(grid__mu={"linspace": [0.1, 1]}), r"grid.mu.num: required"),
+        (with_(surfaces=[]), r"config key surfaces: must have at least 1 item\(s\), got \[\]"),
         (with_(surfaces__0__preset="nope"), r"surfaces\[0\].preset: allowed values are .*got 'nope'"),
         (with_(surfaces__0__seeds=[1, 2]), r"surfaces\[0\]: 'paper-single-peak' takes no seed"),
         (with_(surfaces__0__file="x.npz"), r"surfaces\[0\]: give exactly one of preset or file"),
@@ -37,7 +37,7 @@ from spine_mj.errors import SpineInputError
         (with_(starts=None), r"config key starts: required"),
         (with_(starts__points=[[1.5, 0.5]]), r"starts.points: coordinates must be numbers in \[0, 1\]"),
         (with_(starts__x=[0.5]), r"config key starts: give exactly one of points, x and y, or random"),
-        (with_(starts__frame="polar"), r"starts.frame: allowed values are 'relative', 'absolute'"),
+        (with_(starts__frame="polar"), r"starts.frame: must be 'relative' or 'absolute', got 'polar'"),
     ],
 )
 def test_config_errors_name_key_allowed_values_and_what_arrived(doc, match):
@@ -86,3 +86,68 @@ def test_mujoco_config_checks():
     doc = with_(sweep__analyses=["quasistatic"], drive__protocol="spring")
     with pytest.raises(SpineInputError, match=r"drive.protocol: unknown drive parameter"):
         sweep.parse_config(doc)
+
+
+@pytest.mark.parametrize(
+    "doc, message",
+    [
+        # an unknown key, however deep, is named by its path with the keys allowed there
+        (
+            with_(surfaces__0__starts={"points": [[0.5, 0.5]], "colour": 1}),
+            "config key surfaces[0].starts.colour: unknown key; allowed: frame, points, x, y, random",
+        ),
+        (
+            with_(grid__mu={"linspace": [0.1, 1.0], "num": 2, "step": 1}),
+            "config key grid.mu.step: unknown key; allowed: linspace, logspace, num",
+        ),
+        # a wrong type: what was expected and what arrived
+        (
+            with_(sweep__store_trajectories="yes"),
+            "config key sweep.store_trajectories: must be true or false, got 'yes'",
+        ),
+        (with_(sweep__seed=1.5), "config key sweep.seed: must be a valid integer, got 1.5"),
+        (with_(sweep="fast"), "config key sweep: must be a table, got 'fast'"),
+        (
+            with_(surfaces__0__starts=[0.5, 0.5]),
+            "config key surfaces[0].starts: must be a table, got [0.5, 0.5]",
+        ),
+        # out of range, with the index of the item in a list
+        (
+            with_(surfaces=[{"preset": "paper-fractal", "seeds": [1, -2]}]),
+            "config key surfaces[0].seeds[1]: must be greater than or equal to 0, got -2",
+        ),
+        (
+            with_(starts={"frame": "absolute", "points": [[0.5, 0.5], [0.5, float("inf")]]}),
+            "config key starts.points[1][1]: must be a finite number, got inf",
+        ),
+        (
+            with_(grid__mu={"linspace": [0.1, 1.0], "num": 0}),
+            "config key grid.mu.num: must be greater than or equal to 1, got 0",
+        ),
+        # a grid value is checked against its parameter's declaration, whole list or one value
+        (
+            with_(grid__tip_radius=[0.1, -1.0]),
+            "config key grid.tip_radius: must be a finite number >= 0 (or a list of them), got -1.0",
+        ),
+        # y without x ended in a KeyError
+        (
+            with_(starts={"y": [0.5]}),
+            "config key starts: give exactly one of points, x and y, or random, got ['y']",
+        ),
+        # several problems: the first one, and how many others
+        (
+            with_(sweep__name="", sweep__seed=-1, surfaces__0__preset=3),
+            "config key sweep.name: must be a non-empty string, got '' (and 2 other problems)",
+        ),
+    ],
+)
+def test_schema_errors_are_one_line_naming_the_key_path(doc, message):
+    with pytest.raises(SpineInputError) as err:
+        sweep.parse_config(doc)
+    assert str(err.value) == message
+
+
+def test_starts_spec_validates_when_made_directly():
+    assert sweep.StartsSpec(frame="absolute", x=-3, y=[-1, -2]).count == 2
+    with pytest.raises(ValueError, match=r"coordinates must be numbers in \[0, 1\] in the relative frame"):
+        sweep.StartsSpec(points=((2.0, 0.5),))

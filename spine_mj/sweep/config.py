@@ -1,12 +1,14 @@
 """The sweep config: its TOML schema, validation and normalized form.
 
 A config names surfaces (presets or files, with seeds), start points, a parameter grid and
-the analyses to run on every case (see :mod:`spine_mj.sweep` for the TOML form). The keys
-of the tables are declared here once; the parameters of [grid] and [drive], their types,
-bounds, defaults and the whole-config checks come from the analyses' declarations in
-:mod:`spine_mj.sweep.registry`. Every error is a SpineInputError naming the key, what is
-allowed and what arrived. The normalized config (:meth:`SweepConfig.as_dict`) is what the
-config hash, and so the resume of a store, covers.
+the analyses to run on every case (see :mod:`spine_mj.sweep` for the TOML form). Its shape
+is declared once, as frozen pydantic models that refuse undeclared keys: the tables here,
+and [grid] and [drive], built by :func:`_parameters_model` from the analyses' parameter
+declarations in :mod:`spine_mj.sweep.registry` (types, bounds, defaults). The checks that
+span tables (defaults, the size, the analyses' own config checks) follow in
+:func:`parse_config`. Every error is one SpineInputError line naming the key, what is
+allowed and what arrived (:func:`_validate`). The normalized config
+(:meth:`SweepConfig.as_dict`) is what the config hash, and so the resume of a store, covers.
 """
 
 from __future__ import annotations
@@ -23,30 +25,109 @@ import sys
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Annotated, Any, ClassVar, Literal
 
 import numpy as np
+from pydantic import (
+    AllowInfNan,
+    BaseModel,
+    ConfigDict,
+    Field,
+    PlainValidator,
+    Strict,
+    StrictBool,
+    StrictStr,
+    TypeAdapter,
+    ValidationError,
+    create_model,
+    field_validator,
+    model_validator,
+)
 
 from spine_mj import presets, surface_io
 from spine_mj.errors import SpineInputError
 from spine_mj.jsonio import to_jsonable
-from spine_mj.sweep.registry import ANALYSES, PRESET_MU, REQUIRED, param_specs
+from spine_mj.sweep.registry import ANALYSES, PRESET_MU, REQUIRED, ParamSpec, param_specs
 
 if sys.version_info >= (3, 11):
     import tomllib
 else:  # pragma: no cover
     import tomli as tomllib
 
-_TOP_KEYS = ("sweep", "surfaces", "starts", "grid", "drive")
-_SWEEP_KEYS = ("name", "seed", "analyses", "store_trajectories")
-_SURFACE_KEYS = ("preset", "file", "seed", "seeds", "n_seeds", "set", "starts")
-_STARTS_KEYS = ("frame", "points", "x", "y", "random")
-
 #: Most cases and runs one config may expand to (checked before anything is allocated).
 MAX_CASES = 1_000_000
 MAX_RUNS = 10_000_000
 #: Rough bytes of the run table per run, for the size in the message.
 _BYTES_PER_RUN = 300
+
+#: A finite number (an integer becomes a float; booleans and strings are refused).
+Finite = Annotated[float, Strict(), AllowInfNan(False)]
+#: A generator or master seed: an integer >= 0.
+Seed = Annotated[int, Strict(), Field(ge=0)]
+
+
+def _count(maximum: int) -> Any:
+    """The type of a count: an integer from 1 to ``maximum``."""
+    return Annotated[int, Strict(), Field(ge=1, le=maximum)]
+
+
+class _Table(BaseModel):
+    """A TOML table: frozen, and a key it does not declare is an error."""
+
+    model_config = ConfigDict(frozen=True, extra="forbid")
+    #: What its keys are, in the message for an unknown one.
+    noun: ClassVar[str] = "key"
+
+
+class _Span(_Table):
+    """``{linspace = [a, b], num = n}`` or ``{logspace = [a, b], num = n}``: ``n`` values from
+    ``a`` to ``b``, evenly or geometrically spaced."""
+
+    linspace: tuple[Finite, Finite] | None = None
+    logspace: tuple[Finite, Finite] | None = None
+    num: _count(MAX_CASES)
+
+    @field_validator("logspace")
+    def _positive_ends(cls, ends):
+        if min(ends) <= 0:
+            raise ValueError(f"end values must be > 0 (they are values, not exponents), got {list(ends)}")
+        return ends
+
+    @model_validator(mode="after")
+    def _one_spacing(self):
+        if (self.linspace is None) == (self.logspace is None):
+            both = "neither" if self.linspace is None else "both"
+            raise ValueError(f"give exactly one of linspace = [a, b] or logspace = [a, b], got {both}")
+        return self
+
+    def values(self) -> list[float]:
+        space = np.linspace if self.logspace is None else np.geomspace
+        return [float(v) for v in space(*(self.linspace or self.logspace), self.num)]
+
+
+def _values(item: Any, expected: str, *, distinct: bool = False) -> Any:
+    """The type of a key that takes a value, a non-empty list of them or a :class:`_Span`:
+    a tuple of values of the pydantic type ``item`` (``expected`` names it in the message);
+    with ``distinct``, none repeated."""
+    adapter = TypeAdapter(item)
+
+    def validate(value) -> tuple:
+        if isinstance(value, dict):
+            value = _Span.model_validate(value).values()
+        value = value if isinstance(value, list) else [value]
+        if not value:
+            raise ValueError("must be a value or a non-empty list, got []")
+        out = []
+        for v in value:
+            try:
+                out.append(adapter.validate_python(v))
+            except ValidationError:
+                raise ValueError(f"must be {expected} (or a list of them), got {v!r}") from None
+        if distinct and len(set(out)) != len(out):
+            raise ValueError(f"repeated value in {out!r}")
+        return tuple(out)
+
+    return Annotated[tuple, PlainValidator(validate)]
 
 
 @dataclass(frozen=True)
@@ -91,24 +172,48 @@ class SurfaceSpec:
         return _make_surface(self, stamp)
 
 
-@dataclass(frozen=True)
-class StartsSpec:
-    """Start points of every case.
+class StartsSpec(_Table):
+    """Start points of every case: the [starts] table, or a [[surfaces]] entry's ``starts``.
 
     Attributes
     ----------
     frame : {"relative", "absolute"}
-        Relative coordinates are fractions of the surface's bounds (0 = xmin, 1 = xmax).
+        Relative coordinates are fractions of the surface's bounds (0 = xmin, 1 = xmax);
+        absolute ones are in the surface's length unit.
     points : tuple of (x, y), optional
-        Explicit points; else the product of ``x`` and ``y``; else ``random`` uniform points
-        drawn from the case seed.
+        Explicit points; else the product of ``x`` and ``y`` (each a value, a list or a
+        linspace/logspace table); else ``random`` uniform points (relative frame) drawn
+        from the case seed. Exactly one of these is given.
     """
 
-    frame: str = "relative"
-    points: tuple[tuple[float, float], ...] | None = None
-    x: tuple[float, ...] | None = None
-    y: tuple[float, ...] | None = None
-    random: int | None = None
+    frame: Literal["relative", "absolute"] = "relative"
+    points: tuple[tuple[Finite, Finite], ...] | None = None
+    x: _values(Finite, "a finite number") | None = None
+    y: _values(Finite, "a finite number") | None = None
+    random: _count(MAX_RUNS) | None = None
+
+    @model_validator(mode="before")
+    def _one_kind(cls, data):
+        if isinstance(data, Mapping):
+            given = sorted(k for k, v in data.items() if v is not None)
+            if sum(k in given for k in ("points", "x", "random")) != 1 or ("x" in given) != ("y" in given):
+                raise ValueError(f"give exactly one of points, x and y, or random, got {given}")
+        return data
+
+    @field_validator("points", "x", "y")
+    def _in_frame(cls, value, info):
+        if not value:
+            raise ValueError("must be a non-empty list of [x, y] pairs, got []")
+        for c in np.ravel(value).tolist():
+            if info.data.get("frame") == "relative" and not 0 <= c <= 1:
+                raise ValueError(f"coordinates must be numbers in [0, 1] in the relative frame, got {c!r}")
+        return value
+
+    @field_validator("random")
+    def _relative(cls, n, info):
+        if info.data.get("frame") != "relative":
+            raise ValueError(f"random starts need frame = 'relative', got frame = {info.data.get('frame')!r}")
+        return n
 
     @property
     def count(self) -> int:
@@ -119,7 +224,7 @@ class StartsSpec:
         return len(self.x) * len(self.y)
 
     def as_dict(self) -> dict:
-        return {k: to_jsonable(v) for k, v in dataclasses.asdict(self).items() if v is not None}
+        return to_jsonable(self.model_dump(exclude_none=True))
 
     def resolve(self, bounds, seed: int) -> np.ndarray:
         """Start points ``(n_starts, 2)`` in the surface's length unit."""
@@ -127,15 +232,154 @@ class StartsSpec:
             pts = np.array(self.points, dtype=float)
         elif self.random is not None:
             pts = np.random.default_rng(seed).random((self.random, 2))
-            if self.frame == "absolute":
-                raise SpineInputError("random starts are drawn in the relative frame")
         else:
             gx, gy = np.meshgrid(self.x, self.y, indexing="ij")
             pts = np.column_stack([gx.ravel(), gy.ravel()])
-        if self.frame == "relative" or self.random is not None:
+        if self.frame == "relative":
             xmin, xmax, ymin, ymax = bounds
             pts = np.column_stack([xmin + pts[:, 0] * (xmax - xmin), ymin + pts[:, 1] * (ymax - ymin)])
         return pts
+
+
+class _SurfaceEntry(_Table):
+    """A [[surfaces]] entry: a preset, with one of ``seed``, ``seeds`` or ``n_seeds`` (that
+    many, derived from the master seed) if its generator takes one and generator overrides
+    ``set``; or a ``file`` (.npz or instrument), relative to the config. ``starts`` replaces
+    the [starts] table for it."""
+
+    preset: StrictStr | None = None
+    file: StrictStr | None = None
+    seed: Seed | None = None
+    seeds: list[Seed] | None = Field(None, min_length=1)
+    n_seeds: _count(MAX_CASES) | None = None
+    overrides: dict[str, Any] = Field({}, alias="set")
+    starts: StartsSpec | None = None
+
+    @model_validator(mode="before")
+    def _one_source_one_seed_key(cls, data):
+        if isinstance(data, Mapping):
+            if ("preset" in data) == ("file" in data):
+                raise ValueError(f"give exactly one of preset or file, got {sorted(data)}")
+            if sum(k in data for k in ("seed", "seeds", "n_seeds")) > 1:
+                raise ValueError(f"give at most one of seed, seeds, n_seeds, got {sorted(data)}")
+        return data
+
+    @field_validator("preset")
+    def _known_preset(cls, name):
+        if name not in presets.list_presets():
+            raise ValueError(f"allowed values are {', '.join(presets.list_presets())}, got {name!r}")
+        return name
+
+    @field_validator("file")
+    def _existing_file(cls, file, info):
+        path = (Path((info.context or {}).get("base_dir", ".")) / file).resolve()
+        if not path.is_file():
+            raise ValueError(f"no such file {str(path)!r}")
+        return str(path)
+
+    @field_validator("seeds")
+    def _distinct_seeds(cls, seeds):
+        if len(set(seeds)) != len(seeds):
+            raise ValueError(f"repeated seed in {seeds!r}")
+        return seeds
+
+    @field_validator("overrides")
+    def _generator_params(cls, overrides, info):
+        if info.data.get("preset") is not None:
+            generator = presets.load_preset(info.data["preset"]).generator
+            presets.check_generator_params(generator, overrides, f"preset {info.data['preset']!r}")
+        elif overrides:
+            raise ValueError(f"only presets take generator overrides, got {sorted(overrides)}")
+        return overrides
+
+    @model_validator(mode="after")
+    def _seed_only_if_taken(self):
+        given = [k for k in ("seed", "seeds", "n_seeds") if getattr(self, k) is not None]
+        generator = self.preset and presets.GENERATORS[presets.load_preset(self.preset).generator]
+        takes = generator and "rng" in inspect.signature(generator).parameters
+        if given and not takes:
+            raise ValueError(f"{self.preset or Path(self.file).name!r} takes no seed, got {given}")
+        return self
+
+    def instances(self, master_seed: int, index: int) -> list[SurfaceSpec]:
+        """One SurfaceSpec per seed (``n_seeds`` from ``master_seed`` and the entry's
+        ``index``; no seed key: ``None``, the preset's own)."""
+        if self.n_seeds is not None:
+            seeds = [
+                int(s) for s in np.random.SeedSequence([master_seed, index]).generate_state(self.n_seeds) >> 1
+            ]
+        else:
+            seeds = self.seeds or [self.seed]
+        kind, source = ("preset", self.preset) if self.preset is not None else ("file", self.file)
+        stem = source if kind == "preset" else Path(source).stem
+        overrides = tuple(sorted((k, _freeze(v)) for k, v in self.overrides.items()))
+        return [SurfaceSpec(kind, source, s, overrides, stem if s is None else f"{stem}#{s}") for s in seeds]
+
+
+class _Sweep(_Table):
+    """The [sweep] table: ``seed`` is the master seed (each case derives its own);
+    ``analyses``, a name or a list, run in the registry's order."""
+
+    name: StrictStr = Field("sweep", min_length=1)
+    seed: Seed = 0
+    analyses: tuple[StrictStr, ...] = ("quasistatic",)
+    store_trajectories: StrictBool = True
+
+    @field_validator("analyses", mode="before")
+    def _one_name_is_a_list(cls, analyses):
+        return [analyses] if isinstance(analyses, str) else analyses
+
+    @field_validator("analyses")
+    def _known_each_once_with_needs(cls, analyses):
+        names = ", ".join(repr(k) for k in sorted(ANALYSES))
+        if not analyses:
+            raise ValueError(f"must be a non-empty list of {names}, got []")
+        for a in analyses:
+            if a not in ANALYSES:
+                raise ValueError(f"allowed values are {names}, got {a!r}")
+            missing = [r for r in ANALYSES[a].requires if r not in analyses]
+            if missing:
+                raise ValueError(f"{a!r} needs {missing} as well, got {list(analyses)!r}")
+        if len(set(analyses)) != len(analyses):
+            raise ValueError(f"each analysis once, got {list(analyses)!r}")
+        return tuple(a for a in ANALYSES if a in analyses)
+
+
+class _Document(_Table):
+    """A whole config; [grid] and [drive] are checked by :func:`_parameters_model` once the
+    analyses are known."""
+
+    sweep: _Sweep = _Sweep()
+    surfaces: list[_SurfaceEntry] = Field(min_length=1)
+    starts: StartsSpec | None = Field(None, validate_default=True)
+    grid: dict[str, Any] = {}
+    drive: dict[str, Any] = {}
+
+    @field_validator("starts")
+    def _for_every_surface(cls, starts, info):
+        """[starts] may be left out when every [[surfaces]] entry has its own (a placeholder
+        then stands in the normalized config)."""
+        if starts is None and any(e.starts is None for e in info.data.get("surfaces", ())):
+            raise ValueError("required (a [starts] table, or starts in every [[surfaces]] entry)")
+        return starts or StartsSpec(points=((0.0, 0.0),))
+
+
+@functools.lru_cache(maxsize=16)
+def _parameters_model(analyses: tuple[str, ...], specs: tuple[ParamSpec, ...]) -> type[BaseModel]:
+    """The [grid] and [drive] tables of a config that runs ``analyses``, whose parameters are
+    ``specs``: a key per parameter, [drive] only those marked ``drive``; each optional here
+    (:func:`_grid` fills in the defaults)."""
+
+    def table(name: str, noun: str, keys) -> type[BaseModel]:
+        fields = {s.name: (_values(s.annotation, s.expected(), distinct=True), None) for s in keys}
+        model = create_model(name, __base__=_Table, **fields)
+        model.noun = f"{noun} for analyses {list(analyses)}"
+        return model
+
+    specs = sorted(specs, key=lambda s: s.name)
+    grid = table("grid", "parameter", specs)
+    drive = table("drive", "drive parameter", [s for s in specs if s.drive])
+    return create_model("parameters", __base__=_Table, grid=(grid, grid()), drive=(drive, drive()))
 
 
 @dataclass(frozen=True)
@@ -154,8 +398,8 @@ class SweepConfig:
     grid : tuple of (str, tuple of values)
         Every parameter of the chosen analyses with its value list (defaults filled in).
     store_trajectories : bool
-    starts_by_surface : tuple of (int, StartsSpec)
-        Per-surface starts replacing ``starts`` (index into ``surfaces`` before seeds).
+    surface_starts : tuple of (StartsSpec or None)
+        Per surface, the starts of its [[surfaces]] entry, replacing ``starts`` (None: none).
     source : str
         Path of the TOML file ("" when parsed from a dict).
     """
@@ -220,34 +464,54 @@ def load_config(path: str | os.PathLike) -> SweepConfig:
 def parse_config(doc: Mapping, *, base_dir: str | os.PathLike = ".") -> SweepConfig:
     """Validate a config given as a dict (the parsed TOML); relative file paths are taken
     from ``base_dir``. See :func:`load_config`."""
-    doc = dict(doc)
-    _allowed_keys(doc, "", _TOP_KEYS)
-    name, seed, store, order = _parse_sweep_table(_table(doc, "sweep"))
-    surfaces, per_surface = _parse_surfaces(doc.get("surfaces"), Path(base_dir), seed)
-    if "starts" not in doc and any(s is None for s in per_surface):
-        raise SpineInputError(
-            "config key starts: required (a [starts] table, or starts in every [[surfaces]] entry)"
-        )
-    starts = (
-        _parse_starts(doc["starts"], "starts")
-        if "starts" in doc
-        else StartsSpec(frame="relative", points=((0.0, 0.0),))
+    document = _validate(_Document, doc, context={"base_dir": Path(base_dir)})
+    sweep = document.sweep
+    specs = tuple(param_specs(sweep.analyses).values())
+    params = _validate(
+        _parameters_model(sweep.analyses, specs), {"grid": document.grid, "drive": document.drive}
     )
+    entries = [(e, spec) for i, e in enumerate(document.surfaces) for spec in e.instances(sweep.seed, i)]
+    surfaces = tuple(spec for _, spec in entries)
     config = SweepConfig(
-        name=name,
-        seed=seed,
-        analyses=order,
+        name=sweep.name,
+        seed=sweep.seed,
+        analyses=sweep.analyses,
         surfaces=surfaces,
-        starts=starts,
-        grid=_parse_grid(_table(doc, "grid"), _table(doc, "drive"), order, surfaces),
-        store_trajectories=store,
-        surface_starts=per_surface,
+        starts=document.starts,
+        grid=_grid(params, sweep.analyses, surfaces),
+        store_trajectories=sweep.store_trajectories,
+        surface_starts=tuple(e.starts for e, _ in entries),
     )
     check_size(config)
-    for a in order:
+    for a in sweep.analyses:
         if ANALYSES[a].check_config is not None:
             ANALYSES[a].check_config(config)
     return config
+
+
+def _grid(params, analyses: tuple[str, ...], surfaces) -> tuple[tuple[str, tuple], ...]:
+    """Every parameter of ``analyses`` with its values from [grid] or [drive], else its
+    default (None for :data:`PRESET_MU`: each case's preset's, filled in by
+    :func:`spine_mj.sweep.cases.expand_cases`)."""
+    given = {k: getattr(params.grid, k) for k in params.grid.model_fields_set}
+    for k in params.drive.model_fields_set:
+        if k in given:
+            raise SpineInputError(f"config key drive.{k}: also given as grid.{k}; give it once")
+        given[k] = getattr(params.drive, k)
+    grid = []
+    for pname, spec in param_specs(analyses).items():
+        if pname not in given and (spec.default is REQUIRED or spec.default is PRESET_MU):
+            lacking = spec.default is PRESET_MU and sorted(
+                {s.label for s in surfaces if s.kind != "preset" or presets.preset_mu(s.source) is None}
+            )
+            if spec.default is REQUIRED or lacking:
+                since = f" since {', '.join(lacking)} has no calibrated mu" if lacking else ""
+                raise SpineInputError(
+                    f"config key grid.{pname}: required by analyses {list(analyses)} ({spec.doc})"
+                    f"{since}; must be {spec.expected()}"
+                )
+        grid.append((pname, given.get(pname, (None if spec.default is PRESET_MU else spec.default,))))
+    return tuple(grid)
 
 
 def check_size(config: SweepConfig) -> None:
@@ -276,325 +540,67 @@ def _human_bytes(n: float) -> str:
     return f"{n:.3g} PB"
 
 
-def _parse_sweep_table(sweep: dict) -> tuple[str, int, bool, tuple[str, ...]]:
-    """``name, seed, store_trajectories, analyses`` (in run order) of the [sweep] table."""
-    _allowed_keys(sweep, "sweep", _SWEEP_KEYS)
-    name = sweep.get("name", "sweep")
-    if not isinstance(name, str) or not name:
-        raise SpineInputError(f"config key sweep.name: must be a non-empty string, got {name!r}")
-    seed = sweep.get("seed", 0)
-    _check_seed(seed, "sweep.seed")
-    store = sweep.get("store_trajectories", True)
-    if not isinstance(store, bool):
-        raise SpineInputError(f"config key sweep.store_trajectories: must be true or false, got {store!r}")
-    analyses = sweep.get("analyses", ["quasistatic"])
-    if isinstance(analyses, str):
-        analyses = [analyses]
-    if not isinstance(analyses, list) or not analyses:
-        raise SpineInputError(
-            f"config key sweep.analyses: must be a non-empty list of {_names(ANALYSES)}, got {analyses!r}"
+#: pydantic's words for the errors whose usual "Input should be ..." would not read well.
+_MESSAGES = {
+    "model_type": "must be a table",
+    "dict_type": "must be a table",
+    "list_type": "must be a list",
+    "tuple_type": "must be a list",
+    "bool_type": "must be true or false",
+    "too_short": "must have at least {min_length} item(s)",
+    "too_long": "must have at most {max_length} item(s)",
+    "string_too_short": "must be a non-empty string",
+}
+
+
+def _validate(model: type[BaseModel], data, context: dict | None = None):
+    """``model`` validated from ``data``, or a SpineInputError of one line: the first problem
+    (key path, what is expected, what arrived) and how many others there are."""
+    try:
+        return model.model_validate(data, context=context)
+    except ValidationError as exc:
+        errors = exc.errors()
+        n = len(errors) - 1
+        more = f" (and {n} other problem{'s' if n > 1 else ''})" if n else ""
+        raise SpineInputError(_describe(model, errors[0]) + more) from None
+
+
+def _describe(model: type[BaseModel], error: dict) -> str:
+    """A pydantic error as ``config key grid.ie[2]: must be ..., got ...``."""
+    loc, kind, ctx = error["loc"], error["type"], error.get("ctx", {})
+    if kind == "value_error":  # raised by the validators here, whose messages say what arrived
+        what = str(ctx["error"])
+    elif kind == "missing":
+        what = "required"
+    elif kind == "extra_forbidden":
+        table = _table_at(model, loc)
+        what = f"unknown {table.noun}; allowed: "
+        what += ", ".join(f.alias or n for n, f in table.model_fields.items()) or "none"
+    else:
+        what = (
+            _MESSAGES[kind].format(**ctx)
+            if kind in _MESSAGES
+            else error["msg"].replace("Input should", "must")
         )
-    for a in analyses:
-        if a not in ANALYSES:
-            raise SpineInputError(
-                f"config key sweep.analyses: allowed values are {_names(ANALYSES)}, got {a!r}"
-            )
-    if len(set(analyses)) != len(analyses):
-        raise SpineInputError(f"config key sweep.analyses: each analysis once, got {analyses!r}")
-    for a in analyses:
-        missing = [r for r in ANALYSES[a].requires if r not in analyses]
-        if missing:
-            raise SpineInputError(
-                f"config key sweep.analyses: {a!r} needs {missing} as well, got {analyses!r}"
-            )
-    return name, seed, store, tuple(a for a in ANALYSES if a in analyses)
+        what += f", got {error['input']!r}"
+    path = "".join(f"[{k}]" if isinstance(k, int) else f".{k}" for k in loc).lstrip(".")
+    return f"config key {path}: {what}" if path else f"config: {what}"
 
 
-def _parse_surfaces(
-    raw_surfaces, base_dir: Path, master_seed: int
-) -> tuple[tuple[SurfaceSpec, ...], tuple[StartsSpec | None, ...]]:
-    """The surface instances of the [[surfaces]] entries (one per seed) and the starts of
-    the entry each comes from (None: the [starts] table)."""
-    if not isinstance(raw_surfaces, list) or not raw_surfaces:
-        raise SpineInputError(
-            "config key surfaces: must be a non-empty array of tables "
-            "([[surfaces]] with preset = ... or file = ...), got "
-            f"{raw_surfaces!r}"
-        )
-    surfaces, per_surface = [], []
-    for i, entry in enumerate(raw_surfaces):
-        key = f"surfaces[{i}]"
-        if not isinstance(entry, dict):
-            raise SpineInputError(f"config key {key}: must be a table, got {entry!r}")
-        _allowed_keys(entry, key, _SURFACE_KEYS)
-        if ("preset" in entry) == ("file" in entry):
-            raise SpineInputError(
-                f"config key {key}: give exactly one of preset or file, got {sorted(entry)}"
-            )
-        n_seed_keys = sum(k in entry for k in ("seed", "seeds", "n_seeds"))
-        if n_seed_keys > 1:
-            raise SpineInputError(f"config key {key}: give at most one of seed, seeds, n_seeds")
-        overrides = entry.get("set", {})
-        if not isinstance(overrides, dict):
-            raise SpineInputError(
-                f"config key {key}.set: must be a table of generator parameters, got {overrides!r}"
-            )
-        kind, source, takes_seed = _surface_source(entry, key, overrides, base_dir)
-        if n_seed_keys and not takes_seed:
-            raise SpineInputError(
-                f"config key {key}: {source!r} takes no seed, got "
-                f"{[k for k in ('seed', 'seeds', 'n_seeds') if k in entry]}"
-            )
-        seeds = _surface_seeds(entry, key, master_seed, i)
-        starts_i = _parse_starts(entry["starts"], f"{key}.starts") if "starts" in entry else None
-        frozen = tuple(sorted((k, _freeze(v)) for k, v in overrides.items()))
-        stem = source if kind == "preset" else Path(source).stem
-        for s in seeds:
-            surfaces.append(
-                SurfaceSpec(
-                    kind=kind,
-                    source=source,
-                    seed=s,
-                    overrides=frozen,
-                    label=stem if s is None else f"{stem}#{s}",
-                )
-            )
-            per_surface.append(starts_i)
-    return tuple(surfaces), tuple(per_surface)
+def _table_at(model: type[BaseModel], loc: tuple) -> type[BaseModel]:
+    """The model of the table holding the key at ``loc`` (a table inside a value: a _Span)."""
+    for key in loc[:-1]:
+        if isinstance(key, str):
+            field = next((f for n, f in model.model_fields.items() if (f.alias or n) == key), None)
+            model = next(_models_in(getattr(field, "annotation", None)), _Span)
+    return model
 
 
-def _surface_source(entry: dict, key: str, overrides: dict, base_dir: Path) -> tuple[str, str, bool]:
-    """``kind, source, takes_seed`` of a [[surfaces]] entry (its preset or file checked)."""
-    if "preset" in entry:
-        preset_name = entry["preset"]
-        if not isinstance(preset_name, str) or preset_name not in presets.list_presets():
-            raise SpineInputError(
-                f"config key {key}.preset: allowed values are "
-                f"{', '.join(presets.list_presets())}, got {preset_name!r}"
-            )
-        preset = presets.load_preset(preset_name)
-        try:
-            presets.check_generator_params(preset.generator, overrides, f"config key {key}.set")
-        except SpineInputError as exc:
-            raise SpineInputError(str(exc)) from None
-        takes_seed = "rng" in inspect.signature(presets.GENERATORS[preset.generator]).parameters
-        return "preset", preset_name, takes_seed
-    if overrides:
-        raise SpineInputError(
-            f"config key {key}.set: only presets take generator overrides, got {sorted(overrides)}"
-        )
-    file = entry["file"]
-    if not isinstance(file, str):
-        raise SpineInputError(f"config key {key}.file: must be a path, got {file!r}")
-    path = (base_dir / file).resolve()
-    if not path.is_file():
-        raise SpineInputError(f"config key {key}.file: no such file {str(path)!r}")
-    return "file", str(path), False
-
-
-def _surface_seeds(entry: dict, key: str, master_seed: int, index: int) -> list[int | None]:
-    """The generator seeds of a [[surfaces]] entry (``n_seeds``: derived from the master
-    seed and the entry's index; none given: ``[None]``, the preset's own)."""
-    if "seed" in entry:
-        _check_seed(entry["seed"], f"{key}.seed")
-        return [entry["seed"]]
-    if "seeds" in entry:
-        seeds = entry["seeds"]
-        if not isinstance(seeds, list) or not seeds:
-            raise SpineInputError(
-                f"config key {key}.seeds: must be a non-empty list of non-negative integers, got {seeds!r}"
-            )
-        for s in seeds:
-            _check_seed(s, f"{key}.seeds")
-        if len(set(seeds)) != len(seeds):
-            raise SpineInputError(f"config key {key}.seeds: repeated seed in {seeds!r}")
-        return seeds
-    if "n_seeds" in entry:
-        n = entry["n_seeds"]
-        if not isinstance(n, int) or isinstance(n, bool) or not 1 <= n <= MAX_CASES:
-            raise SpineInputError(
-                f"config key {key}.n_seeds: must be an integer from 1 to {MAX_CASES:,}, got {n!r}"
-            )
-        return [int(s) for s in np.random.SeedSequence([master_seed, index]).generate_state(n) >> 1]
-    return [None]
-
-
-def _parse_grid(
-    grid_doc: dict, drive_doc: dict, order: tuple[str, ...], surfaces: tuple[SurfaceSpec, ...]
-) -> tuple[tuple[str, tuple], ...]:
-    """Every parameter of the analyses ``order`` with its values from [grid] or [drive]
-    (checked by its ParamSpec) or its default (None for :data:`PRESET_MU`: each case's
-    preset's, filled in by :func:`spine_mj.sweep.cases.expand_cases`)."""
-    specs = param_specs(order)
-    for key in grid_doc:
-        if key not in specs:
-            raise SpineInputError(
-                f"config key grid.{key}: unknown parameter for analyses "
-                f"{list(order)}; allowed: {', '.join(sorted(specs))}"
-            )
-    drive_keys = sorted(k for k, s in specs.items() if s.drive)
-    for key in drive_doc:
-        if key not in specs or not specs[key].drive:
-            raise SpineInputError(
-                f"config key drive.{key}: unknown drive parameter for "
-                f"analyses {list(order)}; allowed: "
-                f"{', '.join(drive_keys) or 'none'}"
-            )
-        if key in grid_doc:
-            raise SpineInputError(f"config key drive.{key}: also given as grid.{key}; give it once")
-    values = {**grid_doc, **drive_doc}
-    grid = []
-    for pname, spec in specs.items():
-        key = ("drive." if pname in drive_doc else "grid.") + pname
-        if pname in values:
-            vals = _expand_values(values[pname], key)
-            vals = tuple(spec.check(v, key) for v in vals)
-            if len(set(vals)) != len(vals):
-                raise SpineInputError(f"config key {key}: repeated value in {list(vals)!r}")
-        elif spec.default is REQUIRED:
-            raise SpineInputError(
-                f"config key grid.{pname}: required by analyses "
-                f"{list(order)} ({spec.doc}); must be {spec.expected()}"
-            )
-        elif spec.default is PRESET_MU:
-            _check_preset_mu(surfaces, pname, spec, order)
-            vals = (None,)
-        else:
-            vals = (spec.default,)
-        grid.append((pname, vals))
-    return tuple(grid)
-
-
-def _check_preset_mu(surfaces, pname: str, spec, order) -> None:
-    """Every surface must come from a preset with a calibrated mu when the config sets none."""
-    lacking = sorted({s.label for s in surfaces if s.kind != "preset" or presets.preset_mu(s.source) is None})
-    if lacking:
-        raise SpineInputError(
-            f"config key grid.{pname}: required by analyses {list(order)} ({spec.doc}) since "
-            f"{', '.join(lacking)} has no calibrated mu; must be {spec.expected()}"
-        )
-
-
-def _parse_starts(doc, key: str) -> StartsSpec:
-    if not isinstance(doc, dict):
-        raise SpineInputError(f"config key {key}: must be a table, got {doc!r}")
-    _allowed_keys(doc, key, _STARTS_KEYS)
-    frame = doc.get("frame", "relative")
-    if frame not in ("relative", "absolute"):
-        raise SpineInputError(
-            f"config key {key}.frame: allowed values are 'relative', 'absolute', got {frame!r}"
-        )
-    modes = [m for m in ("points", "x", "random") if m in doc]
-    if "y" in doc and "x" not in doc:
-        modes.append("y")
-    if len(modes) != 1:
-        raise SpineInputError(
-            f"config key {key}: give exactly one of points, x and y, or random, got {sorted(doc)}"
-        )
-    lo_hi = "in [0, 1]" if frame == "relative" else "finite"
-
-    def coord(v, k):
-        if (
-            isinstance(v, bool)
-            or not isinstance(v, (int, float))
-            or not math.isfinite(v)
-            or (frame == "relative" and not 0 <= v <= 1)
-        ):
-            raise SpineInputError(f"config key {k}: coordinates must be numbers {lo_hi}, got {v!r}")
-        return float(v)
-
-    if "points" in doc:
-        pts = doc["points"]
-        if not isinstance(pts, list) or not pts or not all(isinstance(p, list) and len(p) == 2 for p in pts):
-            raise SpineInputError(
-                f"config key {key}.points: must be a non-empty list of [x, y] pairs, got {pts!r}"
-            )
-        return StartsSpec(
-            frame=frame,
-            points=tuple((coord(p[0], f"{key}.points"), coord(p[1], f"{key}.points")) for p in pts),
-        )
-    if "random" in doc:
-        n = doc["random"]
-        if not isinstance(n, int) or isinstance(n, bool) or not 1 <= n <= MAX_RUNS:
-            raise SpineInputError(
-                f"config key {key}.random: must be an integer from 1 to {MAX_RUNS:,}, got {n!r}"
-            )
-        if frame != "relative":
-            raise SpineInputError(
-                f"config key {key}.frame: random starts need frame = 'relative', got {frame!r}"
-            )
-        return StartsSpec(frame=frame, random=n)
-    if "y" not in doc:
-        raise SpineInputError(f"config key {key}.y: required with {key}.x")
-    xs = tuple(coord(v, f"{key}.x") for v in _expand_values(doc["x"], f"{key}.x"))
-    ys = tuple(coord(v, f"{key}.y") for v in _expand_values(doc["y"], f"{key}.y"))
-    return StartsSpec(frame=frame, x=xs, y=ys)
-
-
-def _expand_values(value, key: str) -> list:
-    """A scalar, a list, or ``{linspace|logspace = [a, b], num = n}`` as a list."""
-    if isinstance(value, list):
-        if not value:
-            raise SpineInputError(f"config key {key}: empty list")
-        return value
-    if isinstance(value, dict):
-        kinds = [k for k in ("linspace", "logspace") if k in value]
-        extra = sorted(set(value) - {"linspace", "logspace", "num"})
-        if len(kinds) != 1 or extra or "num" not in value:
-            raise SpineInputError(
-                f"config key {key}: a table must be {{linspace = [a, b], "
-                f"num = n}} or {{logspace = [a, b], num = n}}, got {value!r}"
-            )
-        ends, num = value[kinds[0]], value["num"]
-        if (
-            not isinstance(ends, list)
-            or len(ends) != 2
-            or not all(
-                isinstance(e, (int, float)) and not isinstance(e, bool) and math.isfinite(e) for e in ends
-            )
-        ):
-            raise SpineInputError(
-                f"config key {key}.{kinds[0]}: must be [a, b] (finite end values), got {ends!r}"
-            )
-        if not isinstance(num, int) or isinstance(num, bool) or not 1 <= num <= MAX_CASES:
-            raise SpineInputError(
-                f"config key {key}.num: must be an integer from 1 to {MAX_CASES:,}, got {num!r}"
-            )
-        if kinds[0] == "logspace":
-            if min(ends) <= 0:
-                raise SpineInputError(
-                    f"config key {key}.logspace: end values must be > 0 "
-                    f"(they are values, not exponents), got {ends!r}"
-                )
-            return [float(v) for v in np.geomspace(ends[0], ends[1], num)]
-        return [float(v) for v in np.linspace(ends[0], ends[1], num)]
-    return [value]
-
-
-def _allowed_keys(doc: Mapping, where: str, allowed: tuple[str, ...]) -> None:
-    for key in doc:
-        if key not in allowed:
-            name = f"{where}.{key}" if where else key
-            raise SpineInputError(
-                f"config key {name}: unknown; allowed keys"
-                f"{' in ' + where if where else ''}: {', '.join(allowed)}"
-            )
-
-
-def _table(doc: Mapping, key: str) -> dict:
-    value = doc.get(key, {})
-    if not isinstance(value, dict):
-        raise SpineInputError(f"config key {key}: must be a table, got {value!r}")
-    return value
-
-
-def _check_seed(value, key: str) -> None:
-    if not isinstance(value, int) or isinstance(value, bool) or value < 0:
-        raise SpineInputError(f"config key {key}: must be a non-negative integer, got {value!r}")
-
-
-def _names(mapping) -> str:
-    return ", ".join(repr(k) for k in sorted(mapping))
+def _models_in(annotation):
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        yield annotation
+    for arg in getattr(annotation, "__args__", ()):
+        yield from _models_in(arg)
 
 
 def _freeze(value):

@@ -9,12 +9,13 @@ This module imports nothing else from :mod:`spine_mj.sweep`.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import Annotated, Any, Literal
 
 import numpy as np
+from annotated_types import Interval
+from pydantic import AllowInfNan, Strict
 
 from spine_mj.engagement import DEFAULT_KAPPA_CAP
 from spine_mj.errors import SpineInputError
@@ -100,27 +101,15 @@ class ParamSpec:
             what += f" and <= {self.maximum:g}"
         return what
 
-    def check(self, value, key: str):
-        """``value`` converted to the parameter's type, or SpineInputError naming ``key``."""
-        ok = False
-        if self.kind == "float":
-            ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
-            value = float(value) if ok else value
-        elif self.kind == "int":
-            ok = isinstance(value, int) and not isinstance(value, bool)
-        elif self.kind == "str":
-            ok = isinstance(value, str) and (not self.choices or value in self.choices)
-        elif self.kind == "bool":
-            ok = isinstance(value, bool)
-        if ok and self.minimum is not None:
-            ok = value > self.minimum if self.exclusive else value >= self.minimum
-        if ok and self.maximum is not None:
-            ok = value <= self.maximum
-        if not ok:
-            raise SpineInputError(
-                f"config key {key}: must be {self.expected()} (or a list of them), got {value!r}"
-            )
-        return value
+    @property
+    def annotation(self) -> Any:
+        """The pydantic type of one value: its kind, bounds and choices (:meth:`expected` in
+        words). Integers pass as floats; booleans and strings pass only as themselves."""
+        if self.choices:
+            return Literal[self.choices]
+        kinds = {"float": Annotated[float, AllowInfNan(False)], "int": int, "str": str, "bool": bool}
+        low = {"gt" if self.exclusive else "ge": self.minimum}
+        return Annotated[kinds[self.kind], Strict(), Interval(**low, le=self.maximum)]
 
 
 #: ``ParamSpec.default`` of a parameter that every config must set.
