@@ -1,7 +1,7 @@
 """Sizes and targets of a validation run: the plans, their surface families and engine variations.
 
-A :class:`ValidationPlan` fixes every grid of the five studies (planes, families, I_e
-values, stiffnesses, grits, bootstrap size, ramp caps); :data:`PLANS` holds the ``smoke``
+A :class:`ValidationPlan` fixes every grid of the six studies (planes, families, I_e
+values, stiffnesses, grits, bootstrap size, ramp caps, the (I_e, K) map); :data:`PLANS` holds the ``smoke``
 (test size), ``quick`` and ``full`` plans. The agreement targets and the physical
 constants every study shares (tip mass, gravity, the sandpaper mu) live here, so that the
 studies, the summary and the report read one value.
@@ -127,6 +127,13 @@ class ValidationPlan:
         (the step of the paper's algorithm). The paper's dl = 0.01 sigma would need ~500
         cycles per path here; 0.1 L_c keeps a run affordable and is compared with the
         streamline stepped at its own, converged dl.
+    stiffness_map_ie, stiffness_map_k : tuple of float
+        Grid of the (I_e, K) map of the spring drive, K = k l_s / F_p (empty: no map).
+    stiffness_map_families : tuple of str
+        Families (by name) of the map.
+    stiffness_map_starts : int
+        Starts per preset of the map (a subset of the family's): the lowest I_e and the
+        many K values make the map's expensive corner, so it runs from few starts.
     """
 
     name: str
@@ -149,6 +156,10 @@ class ValidationPlan:
     bootstrap: int = 200
     ramp_max_steps: int = 20000
     ramp_slide_lc: float = 0.1
+    stiffness_map_ie: tuple[float, ...] = ()
+    stiffness_map_k: tuple[float, ...] = ()
+    stiffness_map_families: tuple[str, ...] = ()
+    stiffness_map_starts: int = 2
     extra: dict = field(default_factory=dict, compare=False)
 
 
@@ -186,6 +197,10 @@ PLANS: dict[str, ValidationPlan] = {
         sandpaper_grits=(),
         bootstrap=20,
         ramp_max_steps=2000,
+        stiffness_map_ie=(1e-1, 1.0),
+        stiffness_map_k=(30.0,),
+        stiffness_map_families=("single_peak_valley",),
+        stiffness_map_starts=1,
     ),
     "quick": ValidationPlan(
         name="quick",
@@ -211,6 +226,10 @@ PLANS: dict[str, ValidationPlan] = {
         sandpaper_starts=2,
         bootstrap=200,
         ramp_max_steps=60000,
+        stiffness_map_ie=(1e-2, 1e-1, 1.0),
+        stiffness_map_k=(1.0, 10.0, 100.0),
+        stiffness_map_families=("single_peak_valley", "random_gaussian", "fractal"),
+        stiffness_map_starts=2,
     ),
     "full": ValidationPlan(
         name="full",
@@ -248,5 +267,9 @@ PLANS: dict[str, ValidationPlan] = {
         sandpaper_starts=4,
         bootstrap=500,
         ramp_max_steps=200_000,
+        stiffness_map_ie=(1e-4, 1e-3, 1e-2, 1e-1, 1.0),
+        stiffness_map_k=(1.0, 3.0, 10.0, 30.0, 100.0),
+        stiffness_map_families=("single_peak_valley", "random_gaussian", "fractal"),
+        stiffness_map_starts=3,
     ),
 }

@@ -25,7 +25,8 @@ class ValidationProgress:
     Attributes
     ----------
     study : str
-        ``static``, ``limit``, ``boundary``, ``stick_slip``, ``sandpaper`` or ``report``.
+        ``static``, ``limit``, ``boundary``, ``stick_slip``, ``sandpaper``, ``stiffness_map``
+        or ``report``.
     step : str
         What runs now (a sweep name or a phase).
     finished_cases, total_cases : int
