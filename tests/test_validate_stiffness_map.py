@@ -111,6 +111,10 @@ def test_slip_rows_count_skipped_traps_and_keep_slip_numbers_to_rough_families()
     assert np.isnan(rows[1e-3]["trap_skip_rate"])
     assert rows[1e-3]["slip_events_per_lc"] == pytest.approx(3.0)  # the peak/valley's 100 left out
     assert (rows[1e-3]["n_ok"], rows[1e-3]["n"]) == (2, 2)
+    # a run the engine lost (unlocked, against a streamline trap) is not a skipped trap
+    runs.loc[last & (runs["start"] == 1) & (runs["family"] == "fractal"), "engine_trouble"] = True
+    rows = {r["ie"]: r for r in slip_rows(runs)}
+    assert (rows[1.0]["traps"], rows[1.0]["skipped"]) == (2, 0) and rows[1.0]["n_ok"] == 1
 
 
 def test_subset_starts_keeps_ends_and_the_frame():

@@ -270,6 +270,6 @@ PLANS: dict[str, ValidationPlan] = {
         stiffness_map_ie=(1e-4, 1e-3, 1e-2, 1e-1, 1.0),
         stiffness_map_k=(1.0, 3.0, 10.0, 30.0, 100.0),
         stiffness_map_families=("single_peak_valley", "random_gaussian", "fractal"),
-        stiffness_map_starts=3,
+        stiffness_map_starts=2,
     ),
 }

@@ -365,8 +365,9 @@ def energy_rows(runs: pd.DataFrame) -> list[dict]:
 def slip_rows(runs: pd.DataFrame) -> list[dict]:
     """Per (I_e, K): slip events per L_c advanced and the fraction of time slipping over
     the :data:`SLIP_FAMILIES` runs without engine trouble (``n_ok`` / ``n``), and the
-    fraction of quasistatic traps MuJoCo skips over every family (``traps``: streamline
-    self-locks; ``skipped``: of those, runs where MuJoCo did not lock).
+    fraction of quasistatic traps MuJoCo skips over every family's runs without engine
+    trouble (``traps``: streamline self-locks; ``skipped``: of those, runs where MuJoCo did
+    not lock).
 
     ``runs`` has the columns of :func:`energy_rows` plus ``agree_lock`` and ``mj_locked``.
     """
@@ -374,8 +375,9 @@ def slip_rows(runs: pd.DataFrame) -> list[dict]:
         return []
     rows = []
     for (ie, k), g in _cells(runs, "ie", "K"):
-        qs_locked = quasistatic_locked(g["agree_lock"].to_numpy(), g["mj_locked"].to_numpy())
-        skipped = qs_locked & ~g["mj_locked"].astype(bool).to_numpy()
+        fine = g[~g["engine_trouble"].astype(bool)]  # a run the engine lost neither locks nor skips
+        qs_locked = quasistatic_locked(fine["agree_lock"].to_numpy(), fine["mj_locked"].to_numpy())
+        skipped = qs_locked & ~fine["mj_locked"].astype(bool).to_numpy()
         s = g[g["family"].isin(SLIP_FAMILIES)]
         ok = s[~s["engine_trouble"].astype(bool)]
         adv = ok["advance_lc"].clip(lower=0).sum()

@@ -157,6 +157,16 @@ def _table(rows: list[dict], cols: list[str], names: list[str], fmt) -> list[str
     return out
 
 
+def _bracket(star: dict, fmt) -> str:
+    """The I_e* bracket as text: ``low-high``, or ``< high`` / ``> low`` off the grid."""
+    kind = star.get("kind")
+    if kind == "below":
+        return f"< {fmt(star, 'high')}"
+    if kind == "above":
+        return f"> {fmt(star, 'low')}"
+    return f"{fmt(star, 'low')}-{fmt(star, 'high')}"
+
+
 def _ratio(row: dict) -> str:
     v = row.get("release_over_work")
     return sig(v) if v is not None and np.isfinite(v) else "- (no quasistatic work)"
@@ -177,7 +187,7 @@ def map_sections(km: StiffnessMapResult | None, fmt) -> dict[str, str]:
                     "family": fam,
                     "K": float(k),
                     "ie_star": s.get("value"),
-                    "bracket": f"{fmt(s, 'low')}-{fmt(s, 'high')}",
+                    "bracket": _bracket(s, fmt),
                     "ci": f"{fmt(s, 'ci_low')}-{fmt(s, 'ci_high')}",
                     "kind": s.get("kind"),
                     "runs": f"{min(cell['n_ok'])}-{max(cell['n_ok'])} ok / {max(cell['n'])}",
@@ -214,7 +224,9 @@ def map_sections(km: StiffnessMapResult | None, fmt) -> dict[str, str]:
             f"At the lowest I_e ({sig(km.energy[0]['ie'])}) of the map, pooled over the families: the "
             "spring energy released at breakaways (sum of (F_onset^2 - F_stop^2) / 2k over the slip "
             "events) per L_c the MuJoCo tip advanced, against the quasistatic work F_p integral kappa dx "
-            "per L_c along the streamline (both in F_p L_c per L_c, i.e. F_p).",
+            "per L_c along the streamline (both in F_p L_c per L_c, i.e. F_p). Runs that ended in "
+            "engine trouble are left out of the energies (ok / runs): at small K these are often the "
+            "runs a release threw into a hop, so the soft-spring rows understate the release.",
             "",
             *_table(
                 km.energy,
@@ -243,7 +255,8 @@ def map_sections(km: StiffnessMapResult | None, fmt) -> dict[str, str]:
             "",
             f"The released share of the quasistatic work goes from {_ratio(km.energy[0])} at K = "
             f"{sig(km.energy[0]['K'])} to {_ratio(km.energy[-1])} at K = {sig(km.energy[-1]['K'])}: where "
-            "it is large, each breakaway throws the tip however slowly the carriage moves.",
+            "it is large, each breakaway throws the tip however slowly the carriage moves. A stiff "
+            "spring stores little per event, but its many short events (slip events / L_c) add up.",
             "",
         ]
         if km.energy
@@ -254,9 +267,10 @@ def map_sections(km: StiffnessMapResult | None, fmt) -> dict[str, str]:
             "### Stick-slip across the map",
             "",
             f"Slip events on the {' and '.join(SLIP_FAMILIES)} runs (runs of slipping samples of at "
-            "least three steps), per L_c advanced and as the fraction of recorded time spent slipping; "
-            "trap skipping over every family: of the runs whose streamline self-locks (traps), those "
-            "where MuJoCo slides on (skipped).",
+            "least three steps), per L_c advanced and as the fraction of recorded time spent slipping "
+            "(near 1: steady sliding; well below 1: the tip sticks between events); "
+            "trap skipping over every family's runs without engine trouble: of the runs whose "
+            "streamline self-locks (traps), those where MuJoCo slides on (skipped).",
             "",
             *_table(
                 km.slip,
