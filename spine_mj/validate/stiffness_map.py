@@ -79,7 +79,8 @@ class StiffnessMapResult:
         Per (I_e, K) over :data:`SLIP_FAMILIES` (:func:`slip_rows`).
     slip_samples : dict
         ``(ie, K)`` -> ``{"jump_lc": ndarray, "force_drop_fp": ndarray}``: every slip event
-        of :data:`SLIP_FAMILIES`, for the CCDF figure (not in ``validation.json``).
+        of the :data:`SLIP_FAMILIES` runs without engine trouble, for the CCDF figure (not
+        in ``validation.json``).
     """
 
     ie: list[float]
@@ -170,8 +171,8 @@ def _length_m(preset: str) -> float:
 
 def _run_rows(df: pd.DataFrame, store, family: str, preset: str, samples: dict) -> pd.DataFrame:
     """One row per MuJoCo run of a preset's sweep: agreement, locks, energy and slip numbers
-    (energies in F_p L_c, lengths in L_c); slip events of :data:`SLIP_FAMILIES` go into
-    ``samples`` under ``(ie, K)``."""
+    (energies in F_p L_c, lengths in L_c); slip events of :data:`SLIP_FAMILIES` runs
+    without engine trouble go into ``samples`` under ``(ie, K)``."""
     fp = MASS_KG * GRAVITY
     unit_m = _length_m(preset)
     mj = df[df["analysis"] == "mujoco"]
@@ -199,7 +200,7 @@ def _run_rows(df: pd.DataFrame, store, family: str, preset: str, samples: dict) 
             }
             row.update(_energy_and_slip(traces.get(s), qs.get(s), lc, unit_m, fp, float(r["stiffness_n_m"])))
             ev = row.pop("events")
-            if family in SLIP_FAMILIES and ev is not None:
+            if family in SLIP_FAMILIES and ev is not None and not row["engine_trouble"]:
                 d = samples.setdefault((ie, k), {"jump_lc": [], "force_drop_fp": []})
                 d["jump_lc"].append(ev.jump_lengths)
                 d["force_drop_fp"].append(ev.force_drops)

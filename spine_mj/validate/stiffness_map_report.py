@@ -299,7 +299,8 @@ def map_sections(km: StiffnessMapResult | None, fmt) -> dict[str, str]:
                 fmt,
             ),
             "",
-            "The CCDFs show how slip sizes and force drops spread for a few (I_e, K); a straight tail on "
+            "The CCDFs (runs without engine trouble) show how slip sizes and force drops spread for a "
+            "few (I_e, K); a straight tail on "
             "log axes would be a power law, but with so few events per series it is only indicative.",
             "",
         ]
