@@ -319,7 +319,7 @@ def write_report(
         limit="\n".join(_limit_section(limit)),
         stick="\n".join(_stick_section(stick)),
         sand="\n".join(_sand_section(sand)),
-        kmap=map_sections(kmap, lambda row, col: _f(row.get(col))),
+        kmap=map_sections(kmap, _table, _f),
         engine_settings=json.dumps(result["engine_settings"], indent=2, default=str),
         timings=", ".join(f"{k} {sig(v)}" for k, v in result["timings_s"].items()),
     )

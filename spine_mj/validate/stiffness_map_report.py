@@ -151,20 +151,14 @@ def ccdf_figure(km: StiffnessMapResult, path: Path) -> Path | None:
     return save_figure(fig, path)
 
 
-def _table(rows: list[dict], cols: list[str], names: list[str], fmt) -> list[str]:
-    out = ["| " + " | ".join(names) + " |", "|" + "---|" * len(cols)]
-    out += ["| " + " | ".join(fmt(r, c) for c in cols) + " |" for r in rows]
-    return out
-
-
-def _bracket(star: dict, fmt) -> str:
+def _bracket(star: dict, cell) -> str:
     """The I_e* bracket as text: ``low-high``, or ``< high`` / ``> low`` off the grid."""
     kind = star.get("kind")
     if kind == "below":
-        return f"< {fmt(star, 'high')}"
+        return f"< {cell(star.get('high'))}"
     if kind == "above":
-        return f"> {fmt(star, 'low')}"
-    return f"{fmt(star, 'low')}-{fmt(star, 'high')}"
+        return f"> {cell(star.get('low'))}"
+    return f"{cell(star.get('low'))}-{cell(star.get('high'))}"
 
 
 def _ratio(row: dict) -> str:
@@ -172,25 +166,26 @@ def _ratio(row: dict) -> str:
     return sig(v) if v is not None and np.isfinite(v) else "- (no quasistatic work)"
 
 
-def map_sections(km: StiffnessMapResult | None, fmt) -> dict[str, str]:
+def map_sections(km: StiffnessMapResult | None, table, cell) -> dict[str, str]:
     """Report text of the map: ``map`` (I_e*(K) table), ``energy`` and ``slip`` (tables
-    with one sentence each); ``fmt(row, column)`` formats a cell. Empty strings without a
+    with one sentence each), drawn by the report's ``table(rows, columns, names)`` and
+    ``cell(value)`` so that every table of the report reads alike. Empty strings without a
     map (None or an empty grid)."""
     if km is None or not km.agreement:
         return {"map": "", "energy": "", "slip": ""}
     star_rows = []
     for fam, by_k in km.agreement.items():
-        for k, cell in by_k.items():
-            s = cell["ie_star"]
+        for k, grid_cell in by_k.items():
+            s = grid_cell["ie_star"]
             star_rows.append(
                 {
                     "family": fam,
                     "K": float(k),
                     "ie_star": s.get("value"),
-                    "bracket": _bracket(s, fmt),
-                    "ci": f"{fmt(s, 'ci_low')}-{fmt(s, 'ci_high')}",
+                    "bracket": _bracket(s, cell),
+                    "ci": f"{cell(s.get('ci_low'))}-{cell(s.get('ci_high'))}",
                     "kind": s.get("kind"),
-                    "runs": f"{min(cell['n_ok'])}-{max(cell['n_ok'])} ok / {max(cell['n'])}",
+                    "runs": f"{min(grid_cell['n_ok'])}-{max(grid_cell['n_ok'])} ok / {max(grid_cell['n'])}",
                 }
             )
     head = [
@@ -205,11 +200,10 @@ def map_sections(km: StiffnessMapResult | None, fmt) -> dict[str, str]:
         "interval over starts; `above`: it holds up to the largest I_e, `below`: it fails already "
         "at the smallest.",
         "",
-        *_table(
+        table(
             star_rows,
             ["family", "K", "ie_star", "bracket", "ci", "kind", "runs"],
             ["family", "K", "I_e*", "bracket", "bootstrap 16-84 %", "kind", "runs (ok / all, per I_e)"],
-            fmt,
         ),
         "",
         "The heat map shows the fraction of runs whose outcome agrees in each cell (crosses: the "
@@ -228,7 +222,7 @@ def map_sections(km: StiffnessMapResult | None, fmt) -> dict[str, str]:
             "engine trouble are left out of the energies (ok / runs): at small K these are often the "
             "runs a release threw into a hop, so the soft-spring rows understate the release.",
             "",
-            *_table(
+            table(
                 km.energy,
                 [
                     "K",
@@ -250,7 +244,6 @@ def map_sections(km: StiffnessMapResult | None, fmt) -> dict[str, str]:
                     "ok",
                     "runs",
                 ],
-                fmt,
             ),
             "",
             f"The released share of the quasistatic work goes from {_ratio(km.energy[0])} at K = "
@@ -272,7 +265,7 @@ def map_sections(km: StiffnessMapResult | None, fmt) -> dict[str, str]:
             "trap skipping over every family's runs without engine trouble: of the runs whose "
             "streamline self-locks (traps), those where MuJoCo slides on (skipped).",
             "",
-            *_table(
+            table(
                 km.slip,
                 [
                     "ie",
@@ -296,7 +289,6 @@ def map_sections(km: StiffnessMapResult | None, fmt) -> dict[str, str]:
                     "ok",
                     "runs",
                 ],
-                fmt,
             ),
             "",
             "The CCDFs (runs without engine trouble) show how slip sizes and force drops spread for a "
