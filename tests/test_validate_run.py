@@ -52,6 +52,16 @@ def test_smoke_validation_writes_report_and_json(tmp_path, monkeypatch):
     assert "fractal_lock" in doc["timings_s"]
     assert "Self-lock rate against the Hurst exponent" in report and "figures/fractal_lock_rate.png" in report
     assert (out / "figures" / "fractal_lock_rate.png").stat().st_size > 1000
+    # the (I_e, K) map: I_e* per family and K, its heat map, no CCDF without rough families
+    star = doc["ie_star_by_stiffness"]["single_peak_valley"]["30"]
+    assert {"value", "low", "high", "ci_low", "ci_high", "kind"} <= set(star)
+    cell = doc["stiffness_map"]["agreement"]["single_peak_valley"]["30"]
+    assert cell["ie"] == list(validate.PLANS["smoke"].stiffness_map_ie) and cell["n"] == [1, 1]
+    assert doc["stiffness_map"]["energy"][0]["K"] == 30.0
+    assert "stiffness_map" in doc["timings_s"]
+    assert "over (I_e, K)" in report and "figures/ie_k_map.png" in report
+    assert (out / "figures" / "ie_k_map.png").stat().st_size > 1000
+    assert "slip_ccdf.png" not in report and not (out / "figures" / "slip_ccdf.png").exists()
 
 
 def test_unknown_plan_is_rejected():

@@ -1,6 +1,6 @@
 """The validation harness: MuJoCo against the quasistatic streamline across inertia numbers.
 
-Six studies (1-5 from issue 6), each a function that runs its MuJoCo cases through the
+Seven studies, each a function that runs its MuJoCo cases through the
 sweep runner (:func:`spine_mj.sweep.run_sweep`, one resumable store per study under
 ``out/sweeps/``, so a killed validation resumes where it stopped) and returns a typed
 result with the numbers and the data of its figures (``as_dict()`` gives the keys of
@@ -10,9 +10,10 @@ result with the numbers and the data of its figures (``as_dict()`` gives the key
    planes over slope angle and azimuth (engaged, self-lock and slip regions), per engine
    setting.
 2. :func:`quasistatic_limit` - spring-drive paths at the lowest inertia number against the
-   streamline on the smooth surface and on MuJoCo's own triangulated hfield surface (which
-   separates the geometry error from the dynamics error), per surface family; the engine
-   settings that limit agreement varied one at a time.
+   streamline traced on the surface the tip touches (MuJoCo's facets dilated by the tip,
+   the like-for-like comparison) and on the smooth surface (the difference is the
+   geometry), per surface family; the engine settings that limit agreement varied one at
+   a time.
 3. :func:`boundary` - agreement against ``I_e`` for the spring and ramp drives and the
    ``I_e*`` where it breaks, with a bracketing interval and a bootstrap over starts.
 4. :func:`stick_slip` - drive-force curves, slip-event statistics and trap skipping against
@@ -22,6 +23,9 @@ result with the numbers and the data of its figures (``as_dict()`` gives the key
 6. :func:`fractal_lock` - the self-lock rate against the Hurst exponent H on fractal
    surfaces (the paper's Figs. 7E and 9), streamline beside MuJoCo at the quasistatic
    corner and at one dynamic I_e, with binomial intervals.
+7. :func:`stiffness_map` - the spring drive's agreement over (I_e, K), ``I_e*(K)`` per
+   family, the elastic energy released at breakaway against the quasistatic work, and
+   slip-size / force-drop distributions.
 
 :func:`run_validation` runs them all for a :class:`ValidationPlan` (``"quick"``, ``"full"``
 or the test-size ``"smoke"``), writes ``report.md`` with PNG figures and ``validation.json``.
@@ -75,6 +79,7 @@ from spine_mj.validate.runner import StudyRunner, ValidationProgress
 from spine_mj.validate.sandpaper import SandpaperResult, sandpaper
 from spine_mj.validate.static_map import PLANE_START, StaticMapResult, static_map
 from spine_mj.validate.stick_slip import SlipStats, StickSlipResult, slip_statistics, stick_slip
+from spine_mj.validate.stiffness_map import StiffnessMapResult, stiffness_map
 
 __all__ = [
     "DEPARTURE",
@@ -100,6 +105,7 @@ __all__ = [
     "SlipStats",
     "StaticMapResult",
     "StickSlipResult",
+    "StiffnessMapResult",
     "StudyRunner",
     "ValidationPlan",
     "ValidationProgress",
@@ -120,6 +126,7 @@ __all__ = [
     "slip_statistics",
     "static_map",
     "stick_slip",
+    "stiffness_map",
     "streamline_paths",
     "tip_radius",
     "triangulated_surface",

@@ -18,7 +18,7 @@ from spine_mj.validate.ramp_plan import pilot_rig, ramp_duration
 from spine_mj.validate.runner import StudyRunner
 from spine_mj.validate.sweep_docs import family_doc
 
-__all__ = ["BoundaryCurve", "BoundaryResult", "boundary"]
+__all__ = ["BoundaryCurve", "BoundaryResult", "boundary", "preset_grid", "quasistatic_locked"]
 
 
 @dataclass(frozen=True)
@@ -155,18 +155,33 @@ def boundary(plan: ValidationPlan, runner: StudyRunner) -> BoundaryResult:
     return BoundaryResult(curves=curves, ie_star=stars, skip_rate=skip, families=[f.name for f in fams])
 
 
-def _preset_runs(
-    plan: ValidationPlan, runner: StudyRunner, fam: FamilySpec, preset: str, proto: str, ramp_plans: dict
-) -> list[tuple[pd.DataFrame, pd.DataFrame]]:
-    """The (``compare``, ``mujoco``) rows of one preset's sweeps under ``proto``."""
-    mu = calibrated_mu(preset)
+def preset_grid(plan: ValidationPlan, fam: FamilySpec, preset: str) -> dict:
+    """Sweep grid keys of a boundary-type study on ``preset``: its calibrated mu, the rig's
+    tip radius (the streamline traces the same sphere), a step of half the tip, the plan's
+    hfield resolution."""
     tip = tip_radius(preset, fam.seeds, plan.hfield_resolution)
-    grid = {
-        "mu": mu,
+    return {
+        "mu": calibrated_mu(preset),
         "tip_radius": tip,
         "dl": tip / 2,
         "hfield_resolution": plan.hfield_resolution,
     }
+
+
+def quasistatic_locked(agree_lock, mj_locked) -> np.ndarray:
+    """Whether the streamline self-locked, per run: MuJoCo's lock where the two agree on
+    it (``agree_lock``, missing counted as disagreeing), its opposite where they do not."""
+    mj = np.asarray(mj_locked, dtype=bool)
+    agree = pd.Series(agree_lock).fillna(False).astype(bool).to_numpy()
+    return np.where(agree, mj, ~mj)
+
+
+def _preset_runs(
+    plan: ValidationPlan, runner: StudyRunner, fam: FamilySpec, preset: str, proto: str, ramp_plans: dict
+) -> list[tuple[pd.DataFrame, pd.DataFrame]]:
+    """The (``compare``, ``mujoco``) rows of one preset's sweeps under ``proto``."""
+    grid = preset_grid(plan, fam, preset)
+    mu, tip = grid["mu"], grid["tip_radius"]
     if proto == "ramp":
         return _ramp_runs(plan, runner, fam, preset, mu, tip, grid, ramp_plans)
     doc = family_doc(
@@ -270,8 +285,7 @@ def _curve(
         c = comp[np.isclose(comp["ie"], v)].sort_values(["surface", "case_id", "start"])
         m = mj[np.isclose(mj["ie"], v)].sort_values(["surface", "case_id", "start"])
         mj_locked = m["self_locked"].astype(bool).to_numpy()
-        agree_lock = c["agree_lock"].fillna(False).astype(bool).to_numpy()
-        qs_locked = np.where(agree_lock, mj_locked, ~mj_locked)
+        qs_locked = quasistatic_locked(c["agree_lock"].to_numpy(), mj_locked)
         if ramp:
             f_run = c["prefix_frechet"].to_numpy(dtype=float)
             ok = (m["end_reason"] != "engine_trouble").to_numpy()

@@ -28,6 +28,7 @@ __all__ = [
     "departure_ie_star",
     "estimate_ie_star",
     "ie_star_by_criterion",
+    "passes_criterion",
     "quiet_nan_warnings",
 ]
 
@@ -62,7 +63,11 @@ class IeStar:
         return dataclasses.asdict(self)
 
 
-def _passes(agree: float, frechet: float, *, agree_min: float, frechet_max: float) -> bool:
+def passes_criterion(
+    agree: float, frechet: float, *, agree_min: float = OUTCOME_TARGET, frechet_max: float = FRECHET_TARGET
+) -> bool:
+    """Whether agreement holds at one I_e: ``agree >= agree_min`` and a finite ``frechet``
+    (if any) ``<= frechet_max``; a NaN agreement fails."""
     return (
         bool(agree >= agree_min and (not np.isfinite(frechet) or frechet <= frechet_max))
         if np.isfinite(agree)
@@ -108,7 +113,9 @@ def estimate_ie_star(
         )
     if not (np.all(ie > 0) and np.all(np.diff(ie) > 0)):
         raise SpineInputError(f"ie must be positive and strictly increasing, got {ie.tolist()}")
-    ok = np.array([_passes(a, f, agree_min=agree_min, frechet_max=frechet_max) for a, f in zip(ag, fr)])
+    ok = np.array(
+        [passes_criterion(a, f, agree_min=agree_min, frechet_max=frechet_max) for a, f in zip(ag, fr)]
+    )
     if not ok[0]:
         return IeStar(float("nan"), float("nan"), float(ie[0]), "below")
     bad = np.flatnonzero(~ok)

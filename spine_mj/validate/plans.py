@@ -1,7 +1,8 @@
 """Sizes and targets of a validation run: the plans, their surface families and engine variations.
 
 A :class:`ValidationPlan` fixes every grid of the studies (planes, families, I_e
-values, stiffnesses, grits, bootstrap size, ramp caps); :data:`PLANS` holds the ``smoke``
+values, stiffnesses, grits, bootstrap size, ramp caps, the fractal self-lock study, the
+(I_e, K) map); :data:`PLANS` holds the ``smoke``
 (test size), ``quick`` and ``full`` plans. The agreement targets and the physical
 constants every study shares (tip mass, gravity, the sandpaper mu) live here, so that the
 studies, the summary and the report read one value.
@@ -146,6 +147,13 @@ class ValidationPlan:
         Also count the streamline traced on MuJoCo's facets (the ``compare`` analysis's
         reference, ~1.4 s of CPU per surface measured on the fractal preset, twice the
         MuJoCo runs' cost there).
+    stiffness_map_ie, stiffness_map_k : tuple of float
+        Grid of the (I_e, K) map of the spring drive, K = k l_s / F_p (empty: no map).
+    stiffness_map_families : tuple of str
+        Families (by name) of the map.
+    stiffness_map_starts : int
+        Starts per preset of the map (a subset of the family's): the lowest I_e and the
+        many K values make the map's expensive corner, so it runs from few starts.
     """
 
     name: str
@@ -172,6 +180,10 @@ class ValidationPlan:
     fractal_surfaces: int = 30
     fractal_dynamic_ie: float = 0.1
     fractal_facets: bool = True
+    stiffness_map_ie: tuple[float, ...] = ()
+    stiffness_map_k: tuple[float, ...] = ()
+    stiffness_map_families: tuple[str, ...] = ()
+    stiffness_map_starts: int = 2
     extra: dict = field(default_factory=dict, compare=False)
 
 
@@ -231,6 +243,10 @@ PLANS: dict[str, ValidationPlan] = {
         fractal_hursts=(0.65, 0.95),
         fractal_surfaces=1,
         fractal_facets=False,
+        stiffness_map_ie=(1e-1, 1.0),
+        stiffness_map_k=(30.0,),
+        stiffness_map_families=("single_peak_valley",),
+        stiffness_map_starts=1,
     ),
     "quick": ValidationPlan(
         name="quick",
@@ -260,6 +276,10 @@ PLANS: dict[str, ValidationPlan] = {
         fractal_surfaces=6,
         # the facet streamline (~1.4 s per surface, measured) would double the study's time
         fractal_facets=False,
+        stiffness_map_ie=(1e-2, 1e-1, 1.0),
+        stiffness_map_k=(1.0, 10.0, 100.0),
+        stiffness_map_families=("single_peak_valley", "random_gaussian", "fractal"),
+        stiffness_map_starts=2,
     ),
     "full": ValidationPlan(
         name="full",
@@ -298,5 +318,9 @@ PLANS: dict[str, ValidationPlan] = {
         sandpaper_starts=4,
         bootstrap=500,
         ramp_max_steps=200_000,
+        stiffness_map_ie=(1e-4, 1e-3, 1e-2, 1e-1, 1.0),
+        stiffness_map_k=(1.0, 3.0, 10.0, 30.0, 100.0),
+        stiffness_map_families=("single_peak_valley", "random_gaussian", "fractal"),
+        stiffness_map_starts=2,
     ),
 }

@@ -36,6 +36,8 @@ from spine_mj.validate.quasistatic_limit import QuasistaticLimitResult
 from spine_mj.validate.sandpaper import SandpaperResult
 from spine_mj.validate.static_map import StaticMapResult
 from spine_mj.validate.stick_slip import StickSlipResult
+from spine_mj.validate.stiffness_map import StiffnessMapResult
+from spine_mj.validate.stiffness_map_report import ccdf_figure, map_figure, map_sections
 
 __all__ = ["write_report"]
 
@@ -320,6 +322,7 @@ def write_report(
     stick: StickSlipResult,
     sand: SandpaperResult,
     fractal: FractalLockResult | None = None,
+    kmap: StiffnessMapResult | None = None,
 ) -> Path:
     """Write the figures under ``out/figures`` and ``out/report.md``; returns the report path.
 
@@ -338,6 +341,8 @@ def write_report(
         "stick": _stick_figure(stick, figs / "stick_slip.png"),
         "sand": _sand_figure(sand, figs / "sandpaper.png"),
         "fractal": _fractal_figure(fractal, figs / "fractal_lock_rate.png"),
+        "kmap": map_figure(kmap, figs / "ie_k_map.png") if kmap is not None else None,
+        "slip_ccdf": ccdf_figure(kmap, figs / "slip_ccdf.png") if kmap is not None else None,
     }
     figures = {
         k: (p.relative_to(out).as_posix() if p is not None and p.is_file() else None)
@@ -357,6 +362,7 @@ def write_report(
         stick="\n".join(_stick_section(stick)),
         sand="\n".join(_sand_section(sand)),
         fractal="\n".join(_fractal_section(fractal)),
+        kmap=map_sections(kmap, _table, _f),
         engine_settings=json.dumps(result["engine_settings"], indent=2, default=str),
         timings=", ".join(f"{k} {sig(v)}" for k, v in result["timings_s"].items()),
     )

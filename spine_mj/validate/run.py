@@ -31,6 +31,7 @@ from spine_mj.validate.runner import StudyRunner, ValidationProgress
 from spine_mj.validate.sandpaper import SandpaperResult, sandpaper
 from spine_mj.validate.static_map import StaticMapResult, static_map
 from spine_mj.validate.stick_slip import StickSlipResult, stick_slip
+from spine_mj.validate.stiffness_map import StiffnessMapResult, stiffness_map
 
 __all__ = ["run_validation"]
 
@@ -95,10 +96,12 @@ def run_validation(
         else SandpaperResult(rows=[], paths={}, mu=SANDPAPER_MU)
     )
     fr = timed("fractal_lock", fractal_lock, plan, runner)
+    km = timed("stiffness_map", stiffness_map, plan, runner)
     runner.study = "report"
     runner.note("figures and report")
     result = _summary(plan, st, lim, bnd, ss, sp, timings, fr)
-    write_report(out, result, static=st, limit=lim, boundary=bnd, stick=ss, sand=sp, fractal=fr)
+    result.update(_stiffness_map_summary(km))
+    write_report(out, result, static=st, limit=lim, boundary=bnd, stick=ss, sand=sp, fractal=fr, kmap=km)
     result["timings_s"]["total"] = round(time.perf_counter() - t0, 2)
     write_json(out / "validation.json", result)
     return result
@@ -140,6 +143,14 @@ def _summary(
         "engine_settings": _engine_settings(plan),
         "timings_s": timings,
     }
+
+
+def _stiffness_map_summary(km: StiffnessMapResult) -> dict:
+    """The map's ``validation.json`` keys: ``ie_star_by_stiffness`` (family -> K -> I_e*
+    with bracket ``low``/``high``, bootstrap ``ci_low``/``ci_high`` and ``kind``) and
+    ``stiffness_map`` (the agreement grid with n_ok / n per cell, the energy and slip
+    tables)."""
+    return {"ie_star_by_stiffness": km.ie_star(), "stiffness_map": km.as_dict()}
 
 
 def _engine_settings(plan: ValidationPlan) -> dict:

@@ -26,7 +26,7 @@ class ValidationProgress:
     ----------
     study : str
         ``static``, ``limit``, ``boundary``, ``stick_slip``, ``sandpaper``,
-        ``fractal_lock`` or ``report``.
+        ``fractal_lock``, ``stiffness_map`` or ``report``.
     step : str
         What runs now (a sweep name or a phase).
     finished_cases, total_cases : int

@@ -4,7 +4,7 @@ spring drive on a random concave surface, against I_e and spring stiffness.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -16,7 +16,7 @@ from spine_mj.validate.plans import GRAVITY, MASS_KG, FamilySpec, ValidationPlan
 from spine_mj.validate.runner import StudyRunner
 from spine_mj.validate.sweep_docs import family_doc
 
-__all__ = ["SlipStats", "StickSlipResult", "slip_statistics", "stick_slip"]
+__all__ = ["SlipStats", "StickSlipResult", "complementary_cdf", "slip_statistics", "stick_slip"]
 
 #: The surface of the study (seed 1).
 PRESET = "paper-random-concave"
@@ -37,12 +37,18 @@ class SlipStats:
         Drive force at the onset minus the force at the end of each event (same units as
         the force trace).
     durations : ndarray, shape (count,)
+    onset_indices, stop_indices : ndarray of int, shape (count,)
+        Trace samples at which each event's force drop is measured (the last stuck sample
+        before it and its last sample), so that the spring energy released over the same
+        events (:func:`spine_mj.energy.elastic_release_j`) is read at the same points.
     """
 
     count: int
     jump_lengths: np.ndarray
     force_drops: np.ndarray
     durations: np.ndarray
+    onset_indices: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    stop_indices: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
 
     def summary(self) -> dict:
         def stat(a):
@@ -85,7 +91,7 @@ def slip_statistics(time_s, x, y, force, slipping, *, min_samples: int = 1) -> S
     on, off = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)  # [on, off)
     keep = (off - on) >= min_samples
     on, off = on[keep], off[keep]
-    jumps, drops, durs = [], [], []
+    jumps, drops, durs, starts, ends = [], [], [], [], []
     for a, b in zip(on, off):
         end = min(b, t.size - 1)
         start = max(a - 1, 0)  # the last stuck sample before the slip
@@ -93,7 +99,28 @@ def slip_statistics(time_s, x, y, force, slipping, *, min_samples: int = 1) -> S
         jumps.append(float(np.linalg.norm(np.diff(seg, axis=0), axis=1).sum()))
         drops.append(float(f[start] - f[end]))
         durs.append(float(t[end] - t[start]))
-    return SlipStats(len(jumps), np.array(jumps), np.array(drops), np.array(durs))
+        starts.append(start)
+        ends.append(end)
+    return SlipStats(
+        len(jumps),
+        np.array(jumps),
+        np.array(drops),
+        np.array(durs),
+        np.array(starts, np.int64),
+        np.array(ends, np.int64),
+    )
+
+
+def complementary_cdf(samples) -> tuple[np.ndarray, np.ndarray]:
+    """The empirical complementary CDF of ``samples``: sorted finite values ``x`` and the
+    fraction ``P(X >= x)`` of samples at least as large (1 at the smallest, ``1/n`` at the
+    largest), the form in which heavy-tailed slip sizes are drawn on log axes."""
+    x = np.sort(np.asarray(samples, dtype=float).ravel())
+    x = x[np.isfinite(x)]
+    n = x.size
+    # ties share the fraction of their first occurrence: P(X >= x) counts them all
+    first = np.searchsorted(x, x, side="left")
+    return x, (n - first) / n if n else np.zeros(0)
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,403 @@
+"""Study 6: the quasistatic boundary as a map over (I_e, K) for the spring drive.
+
+A spring drive is quasistatic only when it is slow (I_e << 1) *and* stiff: a spring of
+stiffness ``k`` holding ``F`` stores ``F^2 / (2 k)``, released into the tip at every
+breakaway whatever the carriage speed (:mod:`spine_mj.energy`). The drive stiffness number
+``K = k l_s / F_p`` (``l_s``: the slope correlation length) measures that release against
+the work over one slope length. This study runs the spring drive on a grid of I_e x K for
+the plan's families and reports, from the same runs:
+
+- agreement per (family, K, I_e) by the boundary study's criterion (outcome agreement
+  >= 95 % and median Frechet <= 0.1 L_c) and I_e*(K) per family with its bracket and
+  bootstrap interval over starts (:func:`spine_mj.validate.ie_star.ie_star_by_criterion`);
+- per K, the spring energy released at breakaways against the quasistatic work of the
+  streamline (``F_p integral kappa dx``), both per L_c travelled;
+- slip events (:func:`spine_mj.validate.stick_slip.slip_statistics`): their sizes and force
+  drops, how often and how long the tip slips, and how many quasistatic traps MuJoCo skips.
+
+Each preset runs from few starts (``plan.stiffness_map_starts``): the lowest I_e and the
+many K values make the expensive corner (drive cost grows as I_e^-1/2).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from types import SimpleNamespace
+
+import numpy as np
+import pandas as pd
+
+from spine_mj import presets, sim, sweep
+from spine_mj.energy import elastic_release_j, quasistatic_work_j
+from spine_mj.errors import SpineInputError
+from spine_mj.validate.boundary import preset_grid, quasistatic_locked
+from spine_mj.validate.ie_star import ie_star_by_criterion, passes_criterion, quiet_nan_warnings
+from spine_mj.validate.paths import mujoco_traces
+from spine_mj.validate.plans import GRAVITY, MASS_KG, FamilySpec, ValidationPlan
+from spine_mj.validate.runner import StudyRunner
+from spine_mj.validate.stick_slip import slip_statistics
+from spine_mj.validate.sweep_docs import family_doc
+
+__all__ = [
+    "SLIP_FAMILIES",
+    "StiffnessMapResult",
+    "agreement_map",
+    "energy_rows",
+    "slip_rows",
+    "stiffness_map",
+    "subset_starts",
+]
+
+#: Families whose slip events the study collects (rough enough to stick and slip).
+SLIP_FAMILIES = ("random_gaussian", "fractal")
+
+#: Shorter runs of ``slipping`` samples are detector chatter (as in the stick-slip study).
+MIN_SLIP_SAMPLES = 3
+
+#: The agreement criterion of the map: the boundary study's headline one.
+CRITERION = "median_frechet"
+
+
+@dataclass(frozen=True)
+class StiffnessMapResult:
+    """Result of :func:`stiffness_map`.
+
+    Attributes
+    ----------
+    ie, stiffness_numbers : list of float
+        The grid: I_e values and K = k l_s / F_p values.
+    families : list of str
+    starts_per_preset : int
+    agreement : dict
+        family -> K (str) -> per-I_e lists (see :func:`agreement_map`): ``ie``,
+        ``agreement``, ``median_frechet``, ``passes``, ``n_ok``, ``n``, and ``ie_star``, the
+        I_e* of the criterion (:meth:`IeStar.as_dict` plus ``criterion``).
+    energy : list of dict
+        Per K at the lowest I_e (:func:`energy_rows`).
+    slip : list of dict
+        Per (I_e, K) over :data:`SLIP_FAMILIES` (:func:`slip_rows`).
+    slip_samples : dict
+        ``(ie, K)`` -> ``{"jump_lc": ndarray, "force_drop_fp": ndarray}``: every slip event
+        of the :data:`SLIP_FAMILIES` runs without engine trouble, for the CCDF figure (not
+        in ``validation.json``).
+    """
+
+    ie: list[float]
+    stiffness_numbers: list[float]
+    families: list[str]
+    starts_per_preset: int
+    agreement: dict
+    energy: list[dict]
+    slip: list[dict]
+    slip_samples: dict = dataclasses.field(default_factory=dict, compare=False)
+
+    def ie_star(self) -> dict:
+        """family -> K (str) -> I_e* (value, low, high, ci_low, ci_high, kind, criterion)."""
+        return {f: {k: cell["ie_star"] for k, cell in by_k.items()} for f, by_k in self.agreement.items()}
+
+    def as_dict(self) -> dict:
+        """The ``validation.json`` entry (the slip samples stay out: the figure holds them)."""
+        return {
+            "ie": self.ie,
+            "K": self.stiffness_numbers,
+            "families": self.families,
+            "starts_per_preset": self.starts_per_preset,
+            "agreement": self.agreement,
+            "energy": self.energy,
+            "slip": self.slip,
+        }
+
+
+def subset_starts(fam: FamilySpec, n: int) -> FamilySpec:
+    """``fam`` with at most ``n`` of its y starts, spread over its list (first and last kept),
+    on one surface per preset: its first seed and generator variant (the map's many cells
+    multiply every surface's cost)."""
+    if n < 1:
+        raise SpineInputError(f"starts must be >= 1, got {n}")
+    t = dict(fam.starts)
+    ys = tuple(t["y"])
+    if len(ys) > n:
+        idx = np.unique(np.linspace(0, len(ys) - 1, n).round().astype(int))
+        t["y"] = tuple(ys[i] for i in idx)
+    seeds = fam.seeds[:1] if fam.seeds else fam.seeds
+    return dataclasses.replace(fam, starts=tuple(t.items()), seeds=seeds, variants=fam.variants[:1])
+
+
+def stiffness_map(plan: ValidationPlan, runner: StudyRunner) -> StiffnessMapResult:
+    """Study 6: the spring drive over ``plan.stiffness_map_ie`` x ``plan.stiffness_map_k``
+    on ``plan.stiffness_map_families`` (an empty grid runs nothing).
+
+    Returns
+    -------
+    StiffnessMapResult
+    """
+    runner.study = "stiffness_map"
+    ies = [float(v) for v in plan.stiffness_map_ie]
+    ks = [float(v) for v in plan.stiffness_map_k]
+    fams = [f for f in plan.families if f.name in plan.stiffness_map_families]
+    empty = StiffnessMapResult(ies, ks, [f.name for f in fams], plan.stiffness_map_starts, {}, [], [])
+    if not ies or not ks or not fams:
+        return empty
+    runs, samples = [], {}
+    for fam in fams:
+        sub = subset_starts(fam, plan.stiffness_map_starts)
+        for preset in fam.presets:
+            doc = family_doc(
+                sub,
+                name=f"stiffness-map-{preset}",
+                preset=preset,
+                drive={"protocol": "spring", "ie": ies, "K": ks},
+                grid=preset_grid(plan, sub, preset),
+            )
+            df, store = runner(doc, f"stiffness_map/{preset}")
+            runner.note(f"slip events and energy on {preset}")
+            runs.append(_run_rows(df, store, fam.name, preset, samples))
+    table = pd.concat(runs, ignore_index=True)
+    return StiffnessMapResult(
+        ie=ies,
+        stiffness_numbers=ks,
+        families=[f.name for f in fams],
+        starts_per_preset=plan.stiffness_map_starts,
+        agreement=agreement_map(table, n_boot=plan.bootstrap),
+        energy=energy_rows(table),
+        slip=slip_rows(table),
+        slip_samples={k: {n: np.concatenate(v) for n, v in d.items()} for k, d in samples.items()},
+    )
+
+
+def _length_m(preset: str) -> float:
+    """Metres per surface unit of ``preset`` (the rig's scale of a dimensionless surface)."""
+    surface = presets.make_surface(preset)
+    return sim.DEFAULT_LENGTH_SCALE_M if surface.unit == "1" else 1.0
+
+
+def _run_rows(df: pd.DataFrame, store, family: str, preset: str, samples: dict) -> pd.DataFrame:
+    """One row per MuJoCo run of a preset's sweep: agreement, locks, energy and slip numbers
+    (energies in F_p L_c, lengths in L_c); slip events of :data:`SLIP_FAMILIES` runs
+    without engine trouble go into ``samples`` under ``(ie, K)``."""
+    fp = MASS_KG * GRAVITY
+    unit_m = _length_m(preset)
+    mj = df[df["analysis"] == "mujoco"]
+    comp = df[df["analysis"] == "compare"].set_index(["case_id", "start"])
+    rows = []
+    for case_id, grp in mj.groupby("case_id", sort=False):
+        traces = mujoco_traces(store, case_id)
+        qs = _streamline_traces(store, case_id)
+        for _, r in grp.iterrows():
+            s = int(r["start"])
+            c = comp.loc[(case_id, s)]
+            lc = float(r["char_length"])
+            ie, k = float(r["ie"]), float(r["K"])
+            row = {
+                "family": family,
+                "surface": r["surface"],
+                "ie": ie,
+                "K": k,
+                "start": s,
+                "agree": c["agree"],
+                "agree_lock": c["agree_lock"],
+                "frechet": float(c["frechet"]),
+                "engine_trouble": r["end_reason"] == "engine_trouble",
+                "mj_locked": bool(r["self_locked"]),
+            }
+            row.update(_energy_and_slip(traces.get(s), qs.get(s), lc, unit_m, fp, float(r["stiffness_n_m"])))
+            ev = row.pop("events")
+            if family in SLIP_FAMILIES and ev is not None and not row["engine_trouble"]:
+                d = samples.setdefault((ie, k), {"jump_lc": [], "force_drop_fp": []})
+                d["jump_lc"].append(ev.jump_lengths)
+                d["force_drop_fp"].append(ev.force_drops)
+            rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def _streamline_traces(store, case_id: str) -> dict[int, pd.DataFrame]:
+    """The stored streamlines of a case (start -> ``x``, ``kappa`` by step); empty without."""
+    try:
+        tr = sweep.load_trajectories(store, case_id, analysis="quasistatic", columns=["x", "kappa"])
+    except SpineInputError:
+        return {}
+    return {int(s): g.sort_values("step") for s, g in tr.groupby("start")}
+
+
+def _energy_and_slip(tr, qs, lc: float, unit_m: float, fp: float, k_n_m: float) -> dict:
+    """Energy and slip numbers of one run from its MuJoCo trace ``tr`` and streamline ``qs``
+    (NaN where either is missing): the spring energy released over the slip events and the
+    streamline's quasistatic work, in F_p L_c, with the x advance of each path in L_c."""
+    nan = float("nan")
+    out = {
+        "release_fplc": nan,
+        "advance_lc": nan,
+        "qs_work_fplc": nan,
+        "qs_advance_lc": nan,
+        "slip_events": nan,
+        "slip_time_fraction": nan,
+        "events": None,
+    }
+    lc_m = lc * unit_m
+    if tr is not None and len(tr) > 1:
+        force = tr["drive_force_n"].to_numpy(dtype=float)
+        ev = slip_statistics(
+            tr["time_s"],
+            tr["x"] / lc,
+            tr["y"] / lc,
+            force / fp,
+            tr["slipping"],
+            min_samples=MIN_SLIP_SAMPLES,
+        )
+        events = [SimpleNamespace(kind="slip_onset", index=int(i)) for i in ev.onset_indices] + [
+            SimpleNamespace(kind="slip_stop", index=int(i)) for i in ev.stop_indices
+        ]
+        x = tr["x"].to_numpy(dtype=float)
+        out.update(
+            release_fplc=elastic_release_j(force, k_n_m, events) / (fp * lc_m),
+            advance_lc=float(x[-1] - x[0]) / lc,
+            slip_events=float(ev.count),
+            slip_time_fraction=float(np.mean(tr["slipping"].to_numpy(dtype=bool))),
+            events=ev,
+        )
+    if qs is not None and len(qs) > 1:
+        xq = qs["x"].to_numpy(dtype=float)
+        out.update(
+            qs_work_fplc=quasistatic_work_j(qs["kappa"], xq * unit_m, fp) / (fp * lc_m),
+            qs_advance_lc=float(xq[-1] - xq[0]) / lc,
+        )
+    return out
+
+
+def _cells(runs: pd.DataFrame, *keys: str):
+    """Groups of ``runs`` by ``keys`` in sorted order, with float keys."""
+    for key, grp in runs.groupby(list(keys), sort=True):
+        yield key, grp.sort_values(["surface", "start"])
+
+
+def agreement_map(runs: pd.DataFrame, *, n_boot: int, rng=12345) -> dict:
+    """Agreement per (family, K, I_e) and I_e*(K) per family, from per-run rows.
+
+    Parameters
+    ----------
+    runs : DataFrame
+        One row per run: ``family``, ``K``, ``ie``, ``surface``, ``start``, ``agree``
+        (outcome agreement; missing counts as disagreeing), ``frechet`` (/ L_c) and
+        ``engine_trouble``.
+    n_boot : int
+        Bootstrap resamples of the starts for the I_e* interval.
+
+    Returns
+    -------
+    dict
+        family -> K (str, ``"%g"``) -> ``ie``, ``agreement`` (fraction of runs),
+        ``median_frechet``, ``passes`` (the :data:`CRITERION` at that I_e), ``n_ok`` (runs
+        without engine trouble), ``n`` (runs) per I_e, and ``ie_star``: the criterion's
+        :class:`~spine_mj.validate.ie_star.IeStar` dict with ``criterion`` (NaN, kind
+        ``"not measured"``, with fewer than two I_e values).
+    """
+    out: dict = {}
+    for (fam, k), grp in _cells(runs, "family", "K"):
+        ies, ag, med, n_ok, n, amat, fmat = [], [], [], [], [], [], []
+        for (ie,), cell in _cells(grp, "ie"):
+            a = cell["agree"].fillna(False).astype(bool).to_numpy(dtype=float)
+            f = cell["frechet"].to_numpy(dtype=float)
+            ies.append(float(ie))
+            ag.append(float(a.mean()))
+            with quiet_nan_warnings():
+                med.append(float(np.nanmedian(f)))
+            n_ok.append(int((~cell["engine_trouble"].astype(bool)).sum()))
+            n.append(len(cell))
+            amat.append(a)
+            fmat.append(f)
+        if len(ies) >= 2:
+            m = min(len(a) for a in amat)  # a resample needs one start set across I_e
+            by = ie_star_by_criterion(
+                np.array(ies),
+                np.array([a[:m] for a in amat]),
+                np.array([f[:m] for f in fmat]),
+                n_boot=n_boot,
+                rng=rng,
+            )
+            star = by[CRITERION]
+        else:
+            star = {"value": float("nan"), "kind": "not measured", "criterion": "fewer than two I_e values"}
+        passes = [passes_criterion(a_, f_) for a_, f_ in zip(ag, med)]
+        out.setdefault(fam, {})[f"{float(k):g}"] = {
+            "ie": ies,
+            "agreement": ag,
+            "median_frechet": med,
+            "passes": passes,
+            "n_ok": n_ok,
+            "n": n,
+            "ie_star": star,
+        }
+    return out
+
+
+def energy_rows(runs: pd.DataFrame) -> list[dict]:
+    """Per K at the lowest I_e of ``runs`` (where inertia plays no part), pooled over the
+    families: spring energy released at breakaways per L_c the MuJoCo tip advanced, the
+    streamline's quasistatic work per L_c it advanced (both in F_p), their ratio, slip
+    events per L_c, and outcome agreement, with ``n_ok`` / ``n`` runs.
+
+    ``runs`` has the per-run columns of :func:`agreement_map` plus ``release_fplc``,
+    ``advance_lc``, ``qs_work_fplc``, ``qs_advance_lc`` and ``slip_events``.
+    """
+    if runs.empty:
+        return []
+    low = runs[np.isclose(runs["ie"], runs["ie"].min())]
+    rows = []
+    for (k,), g in _cells(low, "K"):
+        ok = g[~g["engine_trouble"].astype(bool)]
+        adv = ok["advance_lc"].clip(lower=0).sum()
+        qadv = ok["qs_advance_lc"].clip(lower=0).sum()
+        release = ok["release_fplc"].sum() / adv if adv > 0 else float("nan")
+        work = ok["qs_work_fplc"].sum() / qadv if qadv > 0 else float("nan")
+        rows.append(
+            {
+                "K": float(k),
+                "ie": float(low["ie"].iloc[0]),
+                "n_ok": len(ok),
+                "n": len(g),
+                "release_per_lc": release,
+                "qs_work_per_lc": work,
+                "release_over_work": release / work if work > 0 else float("nan"),
+                "slip_events_per_lc": ok["slip_events"].sum() / adv if adv > 0 else float("nan"),
+                "agreement": float(g["agree"].fillna(False).astype(bool).mean()),
+            }
+        )
+    return rows
+
+
+def slip_rows(runs: pd.DataFrame) -> list[dict]:
+    """Per (I_e, K): slip events per L_c advanced and the fraction of time slipping over
+    the :data:`SLIP_FAMILIES` runs without engine trouble (``n_ok`` / ``n``), and the
+    fraction of quasistatic traps MuJoCo skips over every family's runs without engine
+    trouble (``traps``: streamline self-locks; ``skipped``: of those, runs where MuJoCo did
+    not lock).
+
+    ``runs`` has the columns of :func:`energy_rows` plus ``agree_lock`` and ``mj_locked``.
+    """
+    if runs.empty:
+        return []
+    rows = []
+    for (ie, k), g in _cells(runs, "ie", "K"):
+        fine = g[~g["engine_trouble"].astype(bool)]  # a run the engine lost neither locks nor skips
+        qs_locked = quasistatic_locked(fine["agree_lock"].to_numpy(), fine["mj_locked"].to_numpy())
+        skipped = qs_locked & ~fine["mj_locked"].astype(bool).to_numpy()
+        s = g[g["family"].isin(SLIP_FAMILIES)]
+        ok = s[~s["engine_trouble"].astype(bool)]
+        adv = ok["advance_lc"].clip(lower=0).sum()
+        with quiet_nan_warnings():
+            frac = float(np.nanmean(ok["slip_time_fraction"])) if len(ok) else float("nan")
+        rows.append(
+            {
+                "ie": float(ie),
+                "K": float(k),
+                "n_ok": len(ok),
+                "n": len(s),
+                "slip_events_per_lc": float(ok["slip_events"].sum() / adv) if adv > 0 else float("nan"),
+                "slip_time_fraction": frac,
+                "traps": int(qs_locked.sum()),
+                "skipped": int(skipped.sum()),
+                "trap_skip_rate": float(skipped.sum() / qs_locked.sum()) if qs_locked.sum() else float("nan"),
+            }
+        )
+    return rows

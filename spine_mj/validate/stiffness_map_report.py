@@ -1,0 +1,302 @@
+"""Figures and report text of the (I_e, K) map (:mod:`spine_mj.validate.stiffness_map`).
+
+:func:`map_figure` draws agreement as a heat map per family with I_e*(K) over it,
+:func:`ccdf_figure` the slip-size and force-drop CCDFs, and :func:`map_sections` the
+report's tables; :mod:`spine_mj.validate.report` puts them into ``report.md``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from spine_mj.plotting import SEQUENTIAL_CMAP, THRESHOLD_COLOR, new_figure, save_figure, sig, styled
+from spine_mj.validate.stick_slip import complementary_cdf
+from spine_mj.validate.stiffness_map import CRITERION, SLIP_FAMILIES, StiffnessMapResult
+
+__all__ = ["ccdf_figure", "map_figure", "map_sections"]
+
+#: At most this many (I_e, K) series in the CCDF figure.
+MAX_CCDF_SERIES = 5
+
+
+def _log_edges(values) -> np.ndarray:
+    """Cell edges of a log-spaced grid: geometric midpoints, the ends half a step out."""
+    v = np.log10(np.asarray(values, dtype=float))
+    step = np.diff(v) if v.size > 1 else np.array([1.0])
+    mid = (v[:-1] + v[1:]) / 2
+    return 10 ** np.r_[v[0] - step[0] / 2, mid, v[-1] + step[-1] / 2]
+
+
+def _star_point(star: dict) -> tuple[float, float, float] | None:
+    """(I_e*, lower error, upper error) to draw, or None: a bracketed I_e* with its bootstrap
+    interval; an unbracketed one at the grid edge it points at, without errors."""
+    kind = star.get("kind")
+    if kind == "bracketed" and np.isfinite(star.get("value", np.nan)):
+        v = star["value"]
+        lo = star.get("ci_low", np.nan)
+        hi = star.get("ci_high", np.nan)
+        return v, max(v - lo, 0.0) if np.isfinite(lo) else 0.0, max(hi - v, 0.0) if np.isfinite(hi) else 0.0
+    if kind == "above":
+        return star["low"], 0.0, 0.0
+    if kind == "below":
+        return star["high"], 0.0, 0.0
+    return None
+
+
+@styled
+def map_figure(km: StiffnessMapResult, path: Path) -> Path | None:
+    """Outcome agreement over (I_e, K) per family (``cividis``, 0..1), crosses on the cells
+    where the criterion fails (outcome or median Frechet) and I_e*(K) over it; None when
+    the map has fewer than two I_e values."""
+    if not km.agreement or len(km.ie) < 2:
+        return None
+    fams = [f for f in km.families if f in km.agreement]
+    fig = new_figure(figsize=(4.2 * len(fams) + 1.2, 3.8), constrained_layout=True)
+    axes = np.atleast_1d(fig.subplots(1, len(fams), sharey=True))
+    ie_e, k_e = _log_edges(km.ie), _log_edges(km.stiffness_numbers)
+    mesh = None
+    for ax, fam in zip(axes, fams):
+        grid = np.full((len(km.stiffness_numbers), len(km.ie)), np.nan)
+        xs, ys, lo, hi, open_x, open_y, fail_x, fail_y = [], [], [], [], [], [], [], []
+        for i, k in enumerate(km.stiffness_numbers):
+            cell = km.agreement[fam].get(f"{k:g}")
+            if cell is None:
+                continue
+            for ie, a, ok in zip(cell["ie"], cell["agreement"], cell["passes"]):
+                j = int(np.argmin(np.abs(np.log10(km.ie) - np.log10(ie))))
+                grid[i, j] = a
+                if not ok:
+                    fail_x.append(ie)
+                    fail_y.append(k)
+            p = _star_point(cell["ie_star"])
+            if p is not None and cell["ie_star"]["kind"] == "bracketed":
+                xs.append(p[0])
+                ys.append(k)
+                lo.append(p[1])
+                hi.append(p[2])
+            elif p is not None:
+                open_x.append(p[0])
+                open_y.append(k)
+        mesh = ax.pcolormesh(ie_e, k_e, grid, cmap=SEQUENTIAL_CMAP, vmin=0, vmax=1, shading="flat")
+        if fail_x:
+            ax.plot(fail_x, fail_y, ls="none", marker="x", color="#D55E00", label="criterion fails")
+        if xs:
+            ax.errorbar(
+                xs,
+                ys,
+                xerr=[lo, hi],
+                color=THRESHOLD_COLOR,
+                marker="o",
+                ms=5,
+                lw=1.5,
+                capsize=3,
+                label="I_e*(K) (68 % bootstrap)",
+            )
+        if open_x:
+            ax.plot(
+                open_x,
+                open_y,
+                ls="none",
+                marker="o",
+                mfc="white",
+                mec=THRESHOLD_COLOR,
+                label="I_e* outside the grid (edge shown)",
+            )
+        ax.set(xscale="log", yscale="log", xlabel="I_e", title=fam.replace("_", " "))
+        ax.grid(False)
+    axes[0].set_ylabel("K = k l_s / F_p")
+    fig.colorbar(mesh, ax=list(axes), label="outcome agreement [1]")
+    handles = {}
+    for ax in axes:  # one legend for the panels, below them: the cells stay visible
+        for h, lab in zip(*ax.get_legend_handles_labels()):
+            handles.setdefault(lab, h)
+    if handles:
+        fig.legend(handles.values(), handles.keys(), loc="outside lower center", ncols=len(handles))
+    fig.suptitle(f"Spring drive: agreement with the streamline (starts per preset: {km.starts_per_preset})")
+    return save_figure(fig, path)
+
+
+def _ccdf_series(km: StiffnessMapResult) -> list[tuple[float, float]]:
+    """Up to :data:`MAX_CCDF_SERIES` (I_e, K) keys with slip events: the extreme corners of
+    the map and its middle first."""
+    keys = sorted(k for k, v in km.slip_samples.items() if v["jump_lc"].size)
+    if len(keys) <= MAX_CCDF_SERIES:
+        return keys
+    idx = np.unique(np.linspace(0, len(keys) - 1, MAX_CCDF_SERIES).round().astype(int))
+    return [keys[i] for i in idx]
+
+
+@styled
+def ccdf_figure(km: StiffnessMapResult, path: Path) -> Path | None:
+    """CCDFs of slip size (L_c) and force drop (F_p) on log axes, a few (I_e, K) as series
+    with their event counts; None without slip events."""
+    keys = _ccdf_series(km)
+    if not keys:
+        return None
+    fig = new_figure(figsize=(10, 4), constrained_layout=True)
+    ax_j, ax_f = fig.subplots(1, 2)
+    for ie, k in keys:
+        d = km.slip_samples[(ie, k)]
+        label = f"I_e = {sig(ie)}, K = {sig(k)} ({d['jump_lc'].size} events)"
+        for ax, name in ((ax_j, "jump_lc"), (ax_f, "force_drop_fp")):
+            x, p = complementary_cdf(d[name][d[name] > 0])
+            if x.size:
+                ax.step(x, p, where="post", label=label)
+    ax_j.set(xscale="log", yscale="log", xlabel="slip size / L_c", ylabel="P(size >= x) [1]")
+    ax_f.set(xscale="log", yscale="log", xlabel="force drop / F_p", ylabel="P(drop >= x) [1]")
+    ax_j.legend(fontsize=7)
+    fig.suptitle(f"Slip events of the spring drive on the {' and '.join(SLIP_FAMILIES)} surfaces")
+    return save_figure(fig, path)
+
+
+def _bracket(star: dict, cell) -> str:
+    """The I_e* bracket as text: ``low-high``, or ``< high`` / ``> low`` off the grid."""
+    kind = star.get("kind")
+    if kind == "below":
+        return f"< {cell(star.get('high'))}"
+    if kind == "above":
+        return f"> {cell(star.get('low'))}"
+    return f"{cell(star.get('low'))}-{cell(star.get('high'))}"
+
+
+def _ratio(row: dict) -> str:
+    v = row.get("release_over_work")
+    return sig(v) if v is not None and np.isfinite(v) else "- (no quasistatic work)"
+
+
+def map_sections(km: StiffnessMapResult | None, table, cell) -> dict[str, str]:
+    """Report text of the map: ``map`` (I_e*(K) table), ``energy`` and ``slip`` (tables
+    with one sentence each), drawn by the report's ``table(rows, columns, names)`` and
+    ``cell(value)`` so that every table of the report reads alike. Empty strings without a
+    map (None or an empty grid)."""
+    if km is None or not km.agreement:
+        return {"map": "", "energy": "", "slip": ""}
+    star_rows = []
+    for fam, by_k in km.agreement.items():
+        for k, grid_cell in by_k.items():
+            s = grid_cell["ie_star"]
+            star_rows.append(
+                {
+                    "family": fam,
+                    "K": float(k),
+                    "ie_star": s.get("value"),
+                    "bracket": _bracket(s, cell),
+                    "ci": f"{cell(s.get('ci_low'))}-{cell(s.get('ci_high'))}",
+                    "kind": s.get("kind"),
+                    "runs": f"{min(grid_cell['n_ok'])}-{max(grid_cell['n_ok'])} ok / {max(grid_cell['n'])}",
+                }
+            )
+    head = [
+        "## The quasistatic boundary over (I_e, K)",
+        "",
+        f"Spring drive over I_e = {', '.join(sig(v) for v in km.ie)} and K = k l_s / F_p = "
+        f"{', '.join(sig(v) for v in km.stiffness_numbers)}, {km.starts_per_preset} starts per preset "
+        "(few: the lowest I_e and the many K are the expensive corner, so every cell's agreement "
+        "moves in steps of one run). A cell agrees when the boundary study's criterion holds "
+        f"({CRITERION.replace('_', ' ')}: outcome agreement >= 95 % and median Frechet <= 0.1 L_c); "
+        "I_e*(K) is where it first fails along I_e, with its bracket and the 16-84 % bootstrap "
+        "interval over starts; `above`: it holds up to the largest I_e, `below`: it fails already "
+        "at the smallest.",
+        "",
+        table(
+            star_rows,
+            ["family", "K", "ie_star", "bracket", "ci", "kind", "runs"],
+            ["family", "K", "I_e*", "bracket", "bootstrap 16-84 %", "kind", "runs (ok / all, per I_e)"],
+        ),
+        "",
+        "The heat map shows the fraction of runs whose outcome agrees in each cell (crosses: the "
+        "criterion fails there, by outcome or by median Frechet); the markers, I_e* against K "
+        "(hollow where it lies outside the grid).",
+        "",
+    ]
+    energy = (
+        [
+            "### Why a soft spring breaks quasistatics",
+            "",
+            f"At the lowest I_e ({sig(km.energy[0]['ie'])}) of the map, pooled over the families: the "
+            "spring energy released at breakaways (sum of (F_onset^2 - F_stop^2) / 2k over the slip "
+            "events) per L_c the MuJoCo tip advanced, against the quasistatic work F_p integral kappa dx "
+            "per L_c along the streamline (both in F_p L_c per L_c, i.e. F_p). Runs that ended in "
+            "engine trouble are left out of the energies (ok / runs): at small K these are often the "
+            "runs a release threw into a hop, so the soft-spring rows understate the release.",
+            "",
+            table(
+                km.energy,
+                [
+                    "K",
+                    "release_per_lc",
+                    "qs_work_per_lc",
+                    "release_over_work",
+                    "slip_events_per_lc",
+                    "agreement",
+                    "n_ok",
+                    "n",
+                ],
+                [
+                    "K",
+                    "released / L_c [F_p]",
+                    "W_qs / L_c [F_p]",
+                    "released / W_qs",
+                    "slip events / L_c",
+                    "outcome agreement",
+                    "ok",
+                    "runs",
+                ],
+            ),
+            "",
+            f"The released share of the quasistatic work goes from {_ratio(km.energy[0])} at K = "
+            f"{sig(km.energy[0]['K'])} to {_ratio(km.energy[-1])} at K = {sig(km.energy[-1]['K'])}: where "
+            "it is large, each breakaway throws the tip however slowly the carriage moves. A stiff "
+            "spring stores little per event, but its many short events (slip events / L_c) add up.",
+            "",
+        ]
+        if km.energy
+        else []
+    )
+    slip = (
+        [
+            "### Stick-slip across the map",
+            "",
+            f"Slip events on the {' and '.join(SLIP_FAMILIES)} runs (runs of slipping samples of at "
+            "least three steps), per L_c advanced and as the fraction of recorded time spent slipping "
+            "(near 1: steady sliding; well below 1: the tip sticks between events); "
+            "trap skipping over every family's runs without engine trouble: of the runs whose "
+            "streamline self-locks (traps), those where MuJoCo slides on (skipped).",
+            "",
+            table(
+                km.slip,
+                [
+                    "ie",
+                    "K",
+                    "slip_events_per_lc",
+                    "slip_time_fraction",
+                    "traps",
+                    "skipped",
+                    "trap_skip_rate",
+                    "n_ok",
+                    "n",
+                ],
+                [
+                    "I_e",
+                    "K",
+                    "slip events / L_c",
+                    "time slipping",
+                    "traps",
+                    "skipped",
+                    "skip rate",
+                    "ok",
+                    "runs",
+                ],
+            ),
+            "",
+            "The CCDFs (runs without engine trouble) show how slip sizes and force drops spread for a "
+            "few (I_e, K); a straight tail on "
+            "log axes would be a power law, but with so few events per series it is only indicative.",
+            "",
+        ]
+        if km.slip
+        else []
+    )
+    return {"map": "\n".join(head), "energy": "\n".join(energy), "slip": "\n".join(slip)}
