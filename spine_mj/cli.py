@@ -627,7 +627,7 @@ def sim_export(surface_spec, output, start, stiffness, **rig_opts):
     "--stiffness",
     type=float,
     default=None,
-    help="Spring stiffness [N/m] (instead of --K; default 10 F_p/L_c).",
+    help="Spring stiffness [N/m] (instead of --K; default K = 30).",
 )
 @click.option("--rate", type=float, default=None, help="Force rate [N/s] (ramp, static; instead of --ie).")
 @click.option(
