@@ -9,7 +9,7 @@ from sim_rigs import R_TIP, flat_rig
 
 from spine_mj.errors import SpineInputError
 from spine_mj.sim import EngineSettings, Rig, SpringDrive, StaticProbe, TipParams
-from spine_mj.surfaces import single_gaussian
+from spine_mj.surfaces import GridSurface, single_gaussian
 
 
 @pytest.mark.parametrize(
@@ -67,6 +67,32 @@ def test_scales_for_surface_are_the_rigs_scales_without_building_a_model():
     assert scales.hfield_spacing_m == pytest.approx(spacing_m, rel=1e-12)
     assert scales.tip_radius_m == pytest.approx(max(spacing_m, lc_m / 100), rel=1e-3)
     assert scales.inertia_number(scales.speed_for(3e-4)) == pytest.approx(3e-4, rel=1e-12)
+
+
+def test_a_surface_in_any_spelling_of_a_length_unit_is_scaled_by_that_unit():
+    """um is um however it is spelled (the micro sign SurfaceTopography writes, Greek mu);
+    a unit the rig does not know is refused with the list it knows."""
+    from spine_mj.sim import Scales
+    from spine_mj.surfaces import length_unit
+
+    assert [length_unit(u) for u in ("\u00b5m", "\u03bcm", "um", "nm", "1", "A", None)] == [
+        "um",
+        "um",
+        "um",
+        "nm",
+        None,
+        None,
+        None,
+    ]
+    grid = single_gaussian().sample(64)
+    for unit in ("\u00b5m", "\u03bcm", "um"):
+        surf = GridSurface(heights=grid.heights, x=grid.x, y=grid.y, unit=unit)
+        assert Scales.for_surface(surf).length_scale_m == 1e-6
+    bad = GridSurface(heights=grid.heights, x=grid.x, y=grid.y, unit="A")
+    with pytest.raises(
+        SpineInputError, match=r"surface unit must be .*\['m', 'mm', 'nm', 'pm', 'um'\], got 'A'"
+    ):
+        Scales.for_surface(bad)
 
 
 def test_a_fast_drive_shortens_the_step_so_impacts_stay_shallow():

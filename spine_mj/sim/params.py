@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 from spine_mj.errors import SpineInputError, check_positive
 from spine_mj.roughness import characteristic_length, slope_correlation_length
-from spine_mj.surfaces import GridSurface, HField, Surface, to_hfield
+from spine_mj.surfaces import LENGTH_UNITS_M, GridSurface, HField, Surface, length_unit, to_hfield
 
 DEFAULT_LENGTH_SCALE_M = 0.01
 _REST_PENETRATION_FRACTION = 0.005
@@ -39,11 +39,9 @@ _MIN_SPACING_PER_TIP_RADIUS = 0.25  # finer hfields exceed MuJoCo's 50 contacts 
 _SCAN_TIP_SPACINGS = 2.0  # default tip radius of a measured scan, in lateral spacings
 MAX_HFIELD_SIDE = 8192  # samples a side of an hfield (memory; MuJoCo's collision stays local)
 _MIN_ENGINE_RATIO = 1e-9  # smallest length ratio (tip / L_c, spacing / L_c) the engine resolves
-#: Metres per unit of the length units a surface may carry ("1": dimensionless, scaled).
 #: Physical range of lengths [m] and masses [kg] (outside it the model means nothing).
 PHYSICAL_LENGTH_M = (1e-12, 1e3)
 PHYSICAL_MASS_KG = (1e-24, 1e6)
-LENGTH_UNITS_M = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "µm": 1e-6, "nm": 1e-9, "pm": 1e-12}
 
 
 class Cone(enum.Enum):
@@ -390,14 +388,17 @@ class Scales:
 
 
 def surface_unit_m(surface: Surface, length_scale_m: float | None) -> float:
-    """Metres per surface length unit: ``length_scale_m``, else by the surface's unit."""
-    if surface.unit != "1" and surface.unit not in LENGTH_UNITS_M:
+    """Metres per surface length unit: ``length_scale_m``, else by the surface's unit
+    (:data:`~spine_mj.surfaces.LENGTH_UNITS_M`; "1", dimensionless, gives
+    :data:`DEFAULT_LENGTH_SCALE_M`)."""
+    unit = length_unit(surface.unit)
+    if surface.unit != "1" and unit is None:
         raise SpineInputError(
             f"surface unit must be '1' (dimensionless) or a length unit {sorted(LENGTH_UNITS_M)}, "
             f"got {surface.unit!r}"
         )
     if length_scale_m is None:
-        length_scale_m = DEFAULT_LENGTH_SCALE_M if surface.unit == "1" else LENGTH_UNITS_M[surface.unit]
+        length_scale_m = DEFAULT_LENGTH_SCALE_M if unit is None else LENGTH_UNITS_M[unit]
     return check_physical_length("length_scale_m", length_scale_m)
 
 

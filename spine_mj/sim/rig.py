@@ -33,7 +33,8 @@ class Rig(RigModel):
     engine : EngineSettings or None
         None: :func:`default_engine` of the scales.
     length_scale_m : float or None
-        Metres per surface unit; None gives 0.01 for ``unit == "1"`` and 1 for ``"m"``.
+        Metres per surface unit; None gives 0.01 for ``unit == "1"`` and the size of a
+        length unit otherwise (1e-6 for ``"um"``; :func:`~spine_mj.sim.params.surface_unit_m`).
     char_length_m : float or None
         L_c [m]; None: :func:`characteristic_length` times ``length_scale_m``.
 
