@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
 from sim_rigs import R_TIP, flat_rig
 
@@ -107,3 +108,29 @@ def test_a_fast_drive_shortens_the_step_so_impacts_stay_shallow():
     bound = 0.05 * math.e * scales.tip_radius_m / (2 * fast)
     assert dt < rest.timestep_s and dt <= bound * 1.05  # 2-digit rounding in engine units
     assert default_engine(scales, speed_m_s=fast).solref[0] == pytest.approx(2 * dt)
+
+
+def test_fall_height_is_the_landing_a_slip_can_make():
+    """Closed forms of :func:`fall_height`: a plane has none (no turn) whatever its slope;
+    a ramp steeper than friction (slope s > mu, run L) ending on a floor lands from
+    ``(s - mu) L sin^2(arctan s)``; one gentler than friction never gains speed; a cliff
+    of height H over one cell dx lands from ``(H - mu dx) sin^2`` of its turn."""
+    from spine_mj.sim.params import fall_height
+
+    x = np.arange(200.0)  # spacing 1
+    for slope in (0.0, 0.3, 2.0, -5.0):
+        plane = np.tile(slope * x, (8, 1))
+        assert fall_height(plane, (1.0, 1.0), mu=0.5, radius=1.0) < 1e-9
+    s, mu, run = 2.0, 0.5, 60.0
+    ramp = np.tile(np.clip(s * (100.0 - x), 0.0, s * run), (8, 1))  # descends from x = 40 to 100
+    expected = (s - mu) * run * s**2 / (1 + s**2)
+    assert fall_height(ramp, (1.0, 1.0), mu=mu, radius=1.0) == pytest.approx(expected, rel=1e-12)
+    gentle = np.tile(np.clip(0.4 * (100.0 - x), 0.0, 24.0), (8, 1))
+    assert fall_height(gentle, (1.0, 1.0), mu=0.5, radius=1.0) == 0.0
+    cliff_h = 50.0
+    cliff = np.tile(np.where(x < 100, cliff_h, 0.0), (8, 1)).T  # along y this time
+    expected = (cliff_h - mu) * cliff_h**2 / (cliff_h**2 + 1)
+    assert fall_height(cliff, (1.0, 1.0), mu=mu, radius=1.0) == pytest.approx(expected, rel=1e-12)
+    # the turn is what the tip feels over one radius: a wider tip on the same cliff
+    wide = (cliff_h - mu) * cliff_h**2 / (cliff_h**2 + 4**2)
+    assert fall_height(cliff, (1.0, 1.0), mu=mu, radius=4.0) == pytest.approx(wide, rel=1e-12)

@@ -25,6 +25,8 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+import numpy as np
+
 from spine_mj.errors import SpineInputError, check_positive
 from spine_mj.roughness import characteristic_length, slope_correlation_length
 from spine_mj.surfaces import LENGTH_UNITS_M, GridSurface, HField, Surface, length_unit, to_hfield
@@ -34,7 +36,7 @@ _REST_PENETRATION_FRACTION = 0.005
 #: Largest inertia number a drive may have: beyond it the quasistatic question is moot and
 #: the engine step (bounded by impacts at the drive speed) shrinks without end.
 MAX_INERTIA_NUMBER = 1e4
-_IMPACT_DEPTH_FRACTION = 0.05  # impact depth of a drive-speed arrival, in tip radii
+_IMPACT_DEPTH_OF_TOLERANCE = 0.5  # impact depth an arrival may reach, in penetration tolerances
 _MIN_SPACING_PER_TIP_RADIUS = 0.25  # finer hfields exceed MuJoCo's 50 contacts per geom pair
 _SCAN_TIP_SPACINGS = 2.0  # default tip radius of a measured scan, in lateral spacings
 MAX_HFIELD_SIDE = 8192  # samples a side of an hfield (memory; MuJoCo's collision stays local)
@@ -265,6 +267,11 @@ class Scales:
         the surface has none, a plane); the length of the drive stiffness number K.
     extent_m : float or None
         Diagonal of the surface's domain [m] (bounds the energy a run can gain).
+    fall_height_m : float
+        The height a slip can turn into an impact [m] (:func:`fall_height`: a fall down a
+        grit flank or a scan-line step onto the floor below); 0 on planes and on surfaces
+        no steeper than the friction angle. It bounds the engine step
+        (:func:`default_engine`).
     """
 
     length_scale_m: float
@@ -276,6 +283,7 @@ class Scales:
     hfield_resolution: int | None = None
     slope_length_m: float | None = None
     extent_m: float | None = None
+    fall_height_m: float = 0.0
 
     @classmethod
     def for_surface(
@@ -300,6 +308,7 @@ class Scales:
         * hfield resolution: an hfield finer than a quarter tip radius is coarsened to that
           (MuJoCo keeps at most 50 contacts per geom pair: a tip over too many cells loses
           its deepest contacts).
+        * fall height: :func:`fall_height` of that hfield with the tip's ``mu_s`` and radius.
 
         Raises
         ------
@@ -330,7 +339,15 @@ class Scales:
         if resolution is None and spacing < _MIN_SPACING_PER_TIP_RADIUS * radius:
             extent = 2 * max(hf.size[0], hf.size[1]) * length_scale_m
             resolution = math.ceil(extent / (_MIN_SPACING_PER_TIP_RADIUS * radius)) + 1
-            spacing = hfield_spacing(hfield_of(surface, resolution), length_scale_m)
+            hf = hfield_of(surface, resolution)
+            spacing = hfield_spacing(hf, length_scale_m)
+        rx, ry, elevation = hf.size[0], hf.size[1], hf.size[2]
+        fall = fall_height(
+            hf.data * (elevation * length_scale_m),
+            (2 * rx / (hf.ncol - 1) * length_scale_m, 2 * ry / (hf.nrow - 1) * length_scale_m),
+            mu=tip.mu_s,
+            radius=radius,
+        )
         return cls(
             length_scale_m=length_scale_m,
             char_length_m=char_length_m,
@@ -341,6 +358,7 @@ class Scales:
             hfield_resolution=resolution,
             slope_length_m=_slope_length(surface, length_scale_m, char_length_m),
             extent_m=math.hypot(xmax - xmin, ymax - ymin),
+            fall_height_m=fall,
         )
 
     @property
@@ -425,6 +443,50 @@ def default_tip_radius(surface: Surface, spacing_m: float, char_length_m: float)
     return float(f"{max(spacings * spacing_m, 0.01 * char_length_m):.3g}")
 
 
+def fall_height(
+    heights: np.ndarray, spacing: tuple[float, float], *, mu: float, radius: float, rows: int = 512
+) -> float:
+    """The height a slip can turn into an impact: the largest landing of a tip on ``heights``.
+
+    A tip that slips down a slope steeper than its friction angle gains speed; down a
+    cliff (a grit's overhang, an AFM scan-line step) it falls. Its speed is that of a fall
+    from ``H = drop - mu run``: the sliding friction takes ``mu`` times the weight per unit
+    of horizontal run (the work ``mu N ds`` with ``N = W cos(theta)``), nothing where the
+    tip is airborne or on a wall. Where the surface then turns up by ``theta`` (measured over
+    one tip radius, the scale the sphere feels), the part ``sin(theta)`` of that speed hits
+    the next facet: a landing like a fall from ``H sin^2(theta)``. The result is the largest
+    such height along every row and column of the grid, walked both ways: exact for the
+    straight falls of a quasistatic slip, 0 on a plane (no turn) and where no slope beats
+    friction (no drop). Pure numpy, ``rows`` lines at a time.
+
+    Parameters
+    ----------
+    heights : ndarray, shape (ny, nx)
+        ``heights[iy, ix]`` in some length unit (the result is in that unit).
+    spacing : (dx, dy)
+        Grid spacings in the same unit.
+    mu, radius : float
+        The tip's friction coefficient and radius (same unit).
+    """
+    heights = np.asarray(heights, dtype=float)
+    best = 0.0
+    for grid, step in ((heights, spacing[0]), (heights.T, spacing[1])):
+        m = max(1, round(radius / step))  # cells per tip radius
+        n = grid.shape[1]
+        if n <= 2 * m:
+            continue
+        run = mu * step * np.arange(n)
+        for lo in range(0, grid.shape[0], rows):
+            for a in (grid[lo : lo + rows], grid[lo : lo + rows, ::-1]):
+                g = a + run  # height plus the friction's toll: falling from i to j gains g_i - g_j
+                drop = np.maximum.accumulate(g, axis=1) - g
+                into = np.arctan((a[:, m : n - m] - a[:, : n - 2 * m]) / (m * step))
+                out = np.arctan((a[:, 2 * m :] - a[:, m : n - m]) / (m * step))
+                turn = np.clip(out - into, 0.0, math.pi / 2)
+                best = max(best, float((drop[:, m : n - m] * np.sin(turn) ** 2).max()))
+    return best
+
+
 def _check_sizes(radius: float, spacing: float, char_length: float, span: float) -> None:
     """Tip, hfield spacing and L_c against each other and the domain (all in metres)."""
     if 2 * radius >= span:
@@ -475,17 +537,23 @@ def default_engine(scales: Scales, *, speed_m_s: float | None = None, **override
     ``impratio = 1``. ``overrides`` replace fields (a ``timestep_s`` alone also sets
     ``solref = (2 timestep_s, 1)``).
 
-    A fast drive also limits the step: a tip arriving at speed ``v`` sinks about
-    ``v t_c / e`` into the soft contact (time constant ``t_c = 2 dt``) before it stops, so
-    with the drive's speed ``speed_m_s`` given, ``dt <= 0.05 e r_tip / (2 v)`` keeps that
-    impact depth at 5 % of the tip radius, half the penetration tolerance.
+    Impacts also limit the step: a tip arriving at speed ``v`` sinks about ``v t_c / e``
+    into the soft contact (time constant ``t_c = 2 dt``) before it stops, and one step
+    carries it up to ``v dt`` past the surface, so ``dt <= e d / (2 v)`` keeps the impact at
+    ``d``, half the penetration tolerance (:func:`penetration_tolerance_m`; ``d = 0.05
+    r_tip`` for tips up to ``L_c / 10``, ``0.005 L_c`` for larger ones). ``v`` is the larger
+    of the drive's speed ``speed_m_s`` (when given) and the landing speed of the surface's
+    fall, ``sqrt(2 a_p scales.fall_height_m)`` (:func:`fall_height`: falls off grit flanks
+    and scan-line steps land at many times a quasistatic drive's speed).
     """
     ratio = min(scales.tip_radius_m / scales.char_length_m, 1.0)
     dt_tau = math.sqrt(_REST_PENETRATION_FRACTION * ratio)
+    v = math.sqrt(2 * scales.fall_height_m / scales.char_length_m)  # engine units: a_p = 1
     if speed_m_s is not None:
-        v = check_positive("speed_m_s", speed_m_s) * scales.time_s / scales.char_length_m
-        r = scales.tip_radius_m / scales.char_length_m
-        dt_tau = min(dt_tau, _IMPACT_DEPTH_FRACTION * math.e * r / (2 * v))
+        v = max(v, check_positive("speed_m_s", speed_m_s) * scales.time_s / scales.char_length_m)
+    if v > 0:
+        depth = _IMPACT_DEPTH_OF_TOLERANCE * penetration_tolerance_m(scales) / scales.char_length_m
+        dt_tau = min(dt_tau, math.e * depth / (2 * v))
     dt = float(f"{dt_tau:.2g}") * scales.time_s
     base = {
         "timestep_s": dt,
