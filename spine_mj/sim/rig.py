@@ -47,7 +47,9 @@ class Rig(RigModel):
     Notes
     -----
     Default tip radius: ``surface.metadata["params"]["tip_radius_m"]`` if the surface has
-    one (sandpaper), else the larger of one hfield spacing and ``L_c / 100``.
+    one (sandpaper), the larger of two lateral spacings and ``L_c / 100`` for a measured
+    scan, else the larger of one hfield spacing and ``L_c / 100``
+    (:meth:`~spine_mj.sim.params.Scales.for_surface`).
     """
 
     def run(
