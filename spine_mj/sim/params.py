@@ -343,7 +343,7 @@ class Scales:
             spacing = hfield_spacing(hf, length_scale_m)
         rx, ry, elevation = hf.size[0], hf.size[1], hf.size[2]
         fall = fall_height(
-            hf.data * (elevation * length_scale_m),
+            hf.data.astype(float) * (elevation * length_scale_m),  # float64: the same at every scale
             (2 * rx / (hf.ncol - 1) * length_scale_m, 2 * ry / (hf.nrow - 1) * length_scale_m),
             mu=tip.mu_s,
             radius=radius,
