@@ -35,7 +35,7 @@ from spine_mj.sim.model import compile_spec
 from spine_mj.sim.render import FPS, choose_gl_backend, default_speed, render_frames
 from spine_mj.sim.replay import load_run, play_in_viewer, run_in_viewer
 from spine_mj.streamline import StreamlineParams, dilate, ideal_trajectories, streamlines
-from spine_mj.surfaces import to_hfield
+from spine_mj.surfaces import LENGTH_UNITS_M, length_unit, to_hfield
 
 INPUT_ERROR_EXIT = 2
 
@@ -261,8 +261,8 @@ def surface_info(surface_spec, output, as_json):
     "--stl-scale",
     type=float,
     default=None,
-    help="Multiply coordinates in the STL (default: metres to mm for physical "
-    "surfaces, 1 for dimensionless ones).",
+    help="Multiply coordinates in the STL (default: the surface's length unit to mm for "
+    "physical surfaces, 1 for dimensionless ones).",
 )
 @click.option(
     "--base",
@@ -294,7 +294,9 @@ def surface_export(surface_file, stl, stl_scale, base_thickness, hfield, resolut
     if hfield:
         _check_suffix(hfield, ".npz", "--hfield")
     surf = load_surface_arg(surface_file)
-    scale = stl_scale if stl_scale is not None else (1e3 if surf.unit == "m" else 1.0)
+    unit = length_unit(surf.unit)
+    mm_scale = 1.0 if unit is None else LENGTH_UNITS_M[unit] / LENGTH_UNITS_M["mm"]
+    scale = stl_scale if stl_scale is not None else mm_scale
     scale = check_positive("--stl-scale", scale)
     if base_thickness is not None:
         base_thickness = check_positive("--base", base_thickness)
@@ -627,7 +629,7 @@ def sim_export(surface_spec, output, start, stiffness, **rig_opts):
     "--stiffness",
     type=float,
     default=None,
-    help="Spring stiffness [N/m] (instead of --K; default 10 F_p/L_c).",
+    help="Spring stiffness [N/m] (instead of --K; default K = 30).",
 )
 @click.option("--rate", type=float, default=None, help="Force rate [N/s] (ramp, static; instead of --ie).")
 @click.option(

@@ -184,7 +184,7 @@ class Roughness:
     Attributes
     ----------
     unit : str
-        The surface's length unit ("m" or "1").
+        The surface's length unit (a key of :data:`~spine_mj.surfaces.LENGTH_UNITS_M`, or "1").
     rms_height, rms_slope, rms_curvature : float
         Sq, the rms gradient and the rms Laplacian / 2 (SurfaceTopography's definitions).
     char_length : float

@@ -1,8 +1,9 @@
 """Reading and writing surfaces: spine_mj's .npz format, measured instrument files, STL.
 
 * ``.npz``: every array plus a JSON metadata string; loads with ``allow_pickle=False``.
-* measured topographies (x3p, opd, datx, plu, di, sur, ...) through SurfaceTopography,
-  converted to metres, levelled, with missing points filled by a stated method or refused;
+* measured topographies (x3p, opd, datx, plu, di, sur, ...) through SurfaceTopography, in
+  the instrument's length unit, levelled, with missing points filled by a stated method or
+  refused;
 * a watertight STL solid (top surface, side walls, flat bottom) for 3-D printing.
 
 Writers go through :func:`spine_mj.errors.atomic_output`: a failure leaves no file behind.
@@ -22,7 +23,7 @@ from scipy import ndimage
 
 from spine_mj.errors import SpineInputError, atomic_output, check_positive
 from spine_mj.jsonio import to_jsonable
-from spine_mj.surfaces import GaussianSurface, GridSurface, Surface
+from spine_mj.surfaces import LENGTH_UNITS_M, GaussianSurface, GridSurface, Surface, length_unit
 
 __all__ = ["FILL_METHODS", "import_topography", "load_surface", "save_surface", "surface_mesh", "write_stl"]
 
@@ -145,7 +146,13 @@ def import_topography(
     level: bool = True,
     spacing_m: float | None = None,
 ) -> GridSurface:
-    """Read a measured topography through SurfaceTopography, in metres.
+    """Read a measured topography through SurfaceTopography, in the instrument's unit.
+
+    Heights and coordinates keep the length unit the file states, spelled as in
+    :data:`~spine_mj.surfaces.LENGTH_UNITS_M` ("µm" becomes "um"): an AFM scan stays in
+    nm, a profilometer's in um, and its numbers are the instrument's own (the rig and the
+    roughness analysis convert through the unit). A unit outside that table ("A", "km")
+    is converted to metres.
 
     Parameters
     ----------
@@ -161,8 +168,14 @@ def import_topography(
     level
         Remove the best-fit plane (tilt and offset) by least squares.
     spacing_m
-        Resample to this spacing (metres) with the C2 interpolant; None keeps the
+        Resample to this spacing, given in metres, with the C2 interpolant; None keeps the
         instrument's grid.
+
+    Raises
+    ------
+    SpineInputError
+        A missing or unreadable file, a channel out of range or without a length unit
+        (phase, amplitude), a non-uniform or 1-D scan, missing points with ``fill="refuse"``.
     """
     if fill not in FILL_METHODS:
         raise SpineInputError(f"fill must be one of {FILL_METHODS}, got {fill!r}")
@@ -178,9 +191,14 @@ def import_topography(
         if not (0 <= channel < n_channels):
             raise SpineInputError(f"channel must be in 0..{n_channels - 1} for {path.name}, got {channel}")
         topo = reader.topography(channel_index=channel)
-        if topo.unit is None:
-            raise SpineInputError(f"{path.name} states no length unit; cannot convert to metres")
-        topo = topo.to_unit("m")
+        unit = length_unit(topo.unit)
+        if unit is None:
+            if not _is_st_length_unit(topo.unit):
+                raise SpineInputError(
+                    f"channel {channel} of {path.name} must be heights in a length unit, "
+                    f"got unit {topo.unit!r}"
+                )
+            topo, unit = topo.to_unit("m"), "m"
     except SpineInputError:
         raise
     except Exception as exc:  # SurfaceTopography raises many types for bad files
@@ -217,9 +235,24 @@ def import_topography(
         "instrument": str(topo.info.get("instrument", {}).get("name", "")),
     }
     surface = GridSurface(
-        heights=heights.T, x=x - x.mean(), y=y - y.mean(), periodic=False, unit="m", metadata=meta
+        heights=heights.T, x=x - x.mean(), y=y - y.mean(), periodic=False, unit=unit, metadata=meta
     )
-    return surface if spacing_m is None else surface.resample(spacing_m)
+    if spacing_m is None:
+        return surface
+    spacing = check_positive("spacing_m", spacing_m) / LENGTH_UNITS_M[unit]
+    try:
+        return surface.resample(spacing)
+    except SpineInputError as exc:
+        raise SpineInputError(
+            f"spacing_m {spacing_m:g} m ({spacing:g} {unit}) on {path.name}: {exc}"
+        ) from None
+
+
+def _is_st_length_unit(unit) -> bool:
+    """Whether SurfaceTopography knows ``unit`` as a length (it can convert it to metres)."""
+    from SurfaceTopography.Support.UnitConversion import is_length_unit
+
+    return isinstance(unit, str) and is_length_unit(unit)
 
 
 def _fill_missing(heights, missing, method, topo):

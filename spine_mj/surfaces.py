@@ -15,7 +15,8 @@ column index is x, row 0 at the smallest y.
 Generators are pure functions with keyword-only options; randomness enters only through
 ``rng`` (an int seed or a :class:`numpy.random.Generator`), so a seed reproduces a surface
 bit for bit. Units: the paper's Gaussian surfaces are dimensionless (``unit="1"``, lengths
-in multiples of the paper's sigma units); sandpaper and measured surfaces are in metres.
+in multiples of the paper's sigma units); sandpaper is in metres and a measured surface in
+its instrument's length unit (:data:`LENGTH_UNITS_M`, spelled by :func:`length_unit`).
 """
 
 from __future__ import annotations
@@ -32,6 +33,7 @@ from spine_mj.errors import SpineInputError, check_positive
 
 __all__ = [
     "GRIT_PARTICLE_DIAMETER_M",
+    "LENGTH_UNITS_M",
     "BSplineGrid",
     "GaussianSurface",
     "GridSurface",
@@ -40,6 +42,7 @@ __all__ = [
     "TriangulatedSurface",
     "fractal_fbm",
     "from_hfield",
+    "length_unit",
     "random_gaussians",
     "sandpaper",
     "single_gaussian",
@@ -49,11 +52,24 @@ __all__ = [
 #: Mean particle sizes of the sandpapers in the paper's experiment (§3.3), metres.
 GRIT_PARTICLE_DIAMETER_M = {"P36": 538e-6, "P60": 269e-6, "P600": 25.8e-6}
 
+#: Metres per unit of the length units a surface may carry, one ASCII spelling each
+#: (:func:`length_unit` maps the others onto them); ``unit == "1"`` is dimensionless.
+LENGTH_UNITS_M = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "nm": 1e-9, "pm": 1e-12}
+#: Other spellings of those units: the micro sign (SurfaceTopography's "µm") and Greek mu.
+_UNIT_SPELLINGS = {"\u00b5m": "um", "\u03bcm": "um"}
+
 _MIN_POINTS_PER_SIDE = 4
 #: Most points a generated or resampled grid may have (512 MiB per float64 array).
 MAX_GRID_POINTS = 2**26
 _CHUNK = 1 << 15
 _NONPERIODIC_PAD = 8  # cells of odd reflection before the spline filter, see GridSurface
+
+
+def length_unit(unit: str) -> str | None:
+    """The spelling of :data:`LENGTH_UNITS_M` for the length unit ``unit`` ("µm" -> "um"),
+    or None when ``unit`` is not one of them (dimensionless "1", "A", "km", ...)."""
+    unit = _UNIT_SPELLINGS.get(unit, unit) if isinstance(unit, str) else None
+    return unit if unit in LENGTH_UNITS_M else None
 
 
 def _rng_and_seed(rng: int | np.random.Generator | None) -> tuple[np.random.Generator, Any]:

@@ -68,7 +68,18 @@ def test_import_from_file(tmp_path, topography_dir):
         "surface", "make", "--from-file", str(topography_dir / "di-1.di"), "--spacing", "4e-9", "-o", str(out)
     )
     assert result.exit_code == 0, result.output
-    assert load_surface(out).spacing[0] == pytest.approx(4e-9)
+    surf = load_surface(out)  # the AFM's nm kept; --spacing is in metres
+    assert surf.unit == "nm" and surf.spacing[0] == pytest.approx(4.0)
+    result = run("surface", "info", str(out), "-o", str(tmp_path / "psd.png"))
+    assert result.exit_code == 0, result.output
+    info = {line[:25].strip(): line[25:].split() for line in result.output.splitlines()[:6]}
+    value, unit = info["rms height"]
+    assert unit == "nm" and 5 < float(value) < 20  # Sq of this AFM scan: 9.8 nm
+    assert info["L_c (asperity length)"][1] == info["l_s (slope correlation)"][1] == "nm"
+    assert info["rms curvature"][1] == "1/nm" and len(info["rms slope"]) == 1
+    assert run("surface", "show", str(out), "-o", str(tmp_path / "s.png")).exit_code == 0
+    result = run("surface", "export", str(out), "--stl", str(tmp_path / "s.stl"))
+    assert result.exit_code == 0 and "scale 1e-06" in result.output  # nm -> mm
 
 
 @pytest.mark.parametrize(

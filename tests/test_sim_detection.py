@@ -21,6 +21,9 @@ def test_every_end_reason_is_reachable_and_recorded():
         detection=Detection(penetration_tol_m=1e-7),
     )
     assert "penetration" in res.end_detail
+    # the detail says what sank the tip: here its own weight, no landing
+    force = float(res.end_detail.split("pressed by a normal force of ")[1].split()[0])
+    assert 0.95 < force < 1.05
     reasons[res.end_reason] = res
     res = rig.run(
         SpringDrive(speed_m_s=0.01, stiffness_n_m=1e9, duration_s=0.05),

@@ -51,3 +51,42 @@ def test_an_absurd_inertia_number_is_refused_before_running(in_tmp):
     result = CliRunner().invoke(main, ["sweep", str(config), "--out", "sw", "--quiet"])
     assert result.exit_code == 2 and "grid.ie" in result.output and "<= 10000" in result.output
     assert not (in_tmp / "sw").exists()
+
+
+def test_a_fall_off_a_cliff_lands_within_the_tolerance_by_the_step_rule():
+    """A tip pulled off a 20-radius cliff lands at ~1.2 sqrt(F_p L_c / m), far faster than
+    the drive: the step the resting and drive-speed rules give (``fall_height_m`` zeroed)
+    lets it sink 0.1-0.3 tip radii on landing, depending on where the last step before
+    the floor falls, and stops most runs on penetration, which the detail calls a
+    landing. With the fall in the rule (sim.params.fall_height) every run lands within
+    the impact depth the rule aims at (5 % of the radius; measured up to 5.8 %)."""
+    import dataclasses
+
+    import numpy as np
+
+    from spine_mj import sim
+    from spine_mj.surfaces import GridSurface
+
+    x, y = np.linspace(-1e-3, 1e-3, 96), np.linspace(-0.5e-3, 0.5e-3, 48)
+    cliff_m = 0.4e-3
+    mesa = GridSurface(heights=np.tile(np.where(x < 0, cliff_m, 0.0), (y.size, 1)), x=x, y=y, unit="m")
+    tip = sim.TipParams(tip_radius_m=20e-6, mu_s=0.5)
+    scales = sim.Scales.for_surface(mesa, tip=tip)
+    dx = x[1] - x[0]
+    assert scales.fall_height_m == pytest.approx(
+        (cliff_m - 0.5 * dx) * cliff_m**2 / (cliff_m**2 + dx**2), rel=1e-6
+    )
+    speed = scales.speed_for(1e-2)
+    starts = [(-x0, 0.0) for x0 in np.linspace(0.05e-3, 0.3e-3, 8)]  # landings at 8 phases of the step
+    depth = {}
+    for name, sc in (("rule", scales), ("no fall", dataclasses.replace(scales, fall_height_m=0.0))):
+        rig = sim.Rig(mesa, tip=tip, engine=sim.default_engine(sc, speed_m_s=speed))
+        runs = rig.run_batch(sim.SpringDrive(speed_m_s=speed), starts)
+        depth[name] = np.array([r.penetration_m.max() for r in runs]) / tip.tip_radius_m
+        if name == "rule":
+            assert all(r.engine_trouble == "" for r in runs)
+        else:
+            stopped = [r for r in runs if r.engine_trouble == "penetration"]
+            assert len(stopped) >= 3 and all("landing at" in r.end_detail for r in stopped)
+    assert depth["rule"].max() < 0.07
+    assert depth["no fall"].max() > 0.2

@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
 from sim_rigs import R_TIP, flat_rig
 
 from spine_mj.errors import SpineInputError
 from spine_mj.sim import EngineSettings, Rig, SpringDrive, StaticProbe, TipParams
-from spine_mj.surfaces import single_gaussian
+from spine_mj.surfaces import GridSurface, single_gaussian
 
 
 @pytest.mark.parametrize(
@@ -69,6 +70,32 @@ def test_scales_for_surface_are_the_rigs_scales_without_building_a_model():
     assert scales.inertia_number(scales.speed_for(3e-4)) == pytest.approx(3e-4, rel=1e-12)
 
 
+def test_a_surface_in_any_spelling_of_a_length_unit_is_scaled_by_that_unit():
+    """um is um however it is spelled (the micro sign SurfaceTopography writes, Greek mu);
+    a unit the rig does not know is refused with the list it knows."""
+    from spine_mj.sim import Scales
+    from spine_mj.surfaces import length_unit
+
+    assert [length_unit(u) for u in ("\u00b5m", "\u03bcm", "um", "nm", "1", "A", None)] == [
+        "um",
+        "um",
+        "um",
+        "nm",
+        None,
+        None,
+        None,
+    ]
+    grid = single_gaussian().sample(64)
+    for unit in ("\u00b5m", "\u03bcm", "um"):
+        surf = GridSurface(heights=grid.heights, x=grid.x, y=grid.y, unit=unit)
+        assert Scales.for_surface(surf).length_scale_m == 1e-6
+    bad = GridSurface(heights=grid.heights, x=grid.x, y=grid.y, unit="A")
+    with pytest.raises(
+        SpineInputError, match=r"surface unit must be .*\['m', 'mm', 'nm', 'pm', 'um'\], got 'A'"
+    ):
+        Scales.for_surface(bad)
+
+
 def test_a_fast_drive_shortens_the_step_so_impacts_stay_shallow():
     """dt <= 0.05 e r / (2 v): an arrival at the drive's speed sinks at most ~5 % of r."""
     from spine_mj.sim import Scales, default_engine
@@ -81,3 +108,29 @@ def test_a_fast_drive_shortens_the_step_so_impacts_stay_shallow():
     bound = 0.05 * math.e * scales.tip_radius_m / (2 * fast)
     assert dt < rest.timestep_s and dt <= bound * 1.05  # 2-digit rounding in engine units
     assert default_engine(scales, speed_m_s=fast).solref[0] == pytest.approx(2 * dt)
+
+
+def test_fall_height_is_the_landing_a_slip_can_make():
+    """Closed forms of :func:`fall_height`: a plane has none (no turn) whatever its slope;
+    a ramp steeper than friction (slope s > mu, run L) ending on a floor lands from
+    ``(s - mu) L sin^2(arctan s)``; one gentler than friction never gains speed; a cliff
+    of height H over one cell dx lands from ``(H - mu dx) sin^2`` of its turn."""
+    from spine_mj.sim.params import fall_height
+
+    x = np.arange(200.0)  # spacing 1
+    for slope in (0.0, 0.3, 2.0, -5.0):
+        plane = np.tile(slope * x, (8, 1))
+        assert fall_height(plane, (1.0, 1.0), mu=0.5, radius=1.0) < 1e-9
+    s, mu, run = 2.0, 0.5, 60.0
+    ramp = np.tile(np.clip(s * (100.0 - x), 0.0, s * run), (8, 1))  # descends from x = 40 to 100
+    expected = (s - mu) * run * s**2 / (1 + s**2)
+    assert fall_height(ramp, (1.0, 1.0), mu=mu, radius=1.0) == pytest.approx(expected, rel=1e-12)
+    gentle = np.tile(np.clip(0.4 * (100.0 - x), 0.0, 24.0), (8, 1))
+    assert fall_height(gentle, (1.0, 1.0), mu=0.5, radius=1.0) == 0.0
+    cliff_h = 50.0
+    cliff = np.tile(np.where(x < 100, cliff_h, 0.0), (8, 1)).T  # along y this time
+    expected = (cliff_h - mu) * cliff_h**2 / (cliff_h**2 + 1)
+    assert fall_height(cliff, (1.0, 1.0), mu=mu, radius=1.0) == pytest.approx(expected, rel=1e-12)
+    # the turn is what the tip feels over one radius: a wider tip on the same cliff
+    wide = (cliff_h - mu) * cliff_h**2 / (cliff_h**2 + 4**2)
+    assert fall_height(cliff, (1.0, 1.0), mu=mu, radius=4.0) == pytest.approx(wide, rel=1e-12)

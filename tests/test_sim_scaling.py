@@ -10,7 +10,8 @@ import pytest
 from spine_mj.errors import SpineInputError
 from spine_mj.roughness import characteristic_length
 from spine_mj.sim import EndReason, Rig, SpringDrive, TipParams
-from spine_mj.surfaces import fractal_fbm, single_gaussian
+from spine_mj.surface_io import import_topography, load_surface, save_surface
+from spine_mj.surfaces import GridSurface, fractal_fbm, single_gaussian
 
 SCALES_M = (1e-6, 1e-3, 1.0)
 
@@ -101,3 +102,38 @@ def test_unphysical_sizes_are_rejected_clearly(kwargs, match):
         Rig(single_gaussian(), **kwargs)
     with pytest.raises(SpineInputError, match=r"mass_kg must lie in \[1e-24, 1e\+06\] kg, got 1e-30"):
         TipParams(mass_kg=1e-30)
+
+
+def test_a_scan_kept_in_its_instrument_unit_runs_as_the_scan_in_metres(tmp_path, topography_dir):
+    """The profilometer scan imported in its own um (through a saved .npz) and the same
+    heights converted to metres, as old .npz files hold them, are one dimensionless model:
+    the same engine numbers and the same SI trajectory. Both differ only by the rounding of
+    ``x * 1e-6`` (measured 2e-12 L_c over 5.6 L_c of travel), hence 1e-9 L_c."""
+    scan = import_topography(topography_dir / "plu-1.plu")
+    assert scan.unit == "um"
+    window = (slice(0, 64), slice(0, 64))  # 106 um a side: a fast run, still 5 L_c of path
+    um = load_surface(
+        save_surface(
+            GridSurface(heights=scan.heights[window], x=scan.x[:64], y=scan.y[:64], unit="um"),
+            tmp_path / "um.npz",
+        )
+    )
+    metres = GridSurface(heights=um.heights * 1e-6, x=um.x * 1e-6, y=um.y * 1e-6, unit="m")
+    runs = []
+    for surface, unit_m in ((um, 1e-6), (metres, 1.0)):
+        rig = Rig(surface)
+        assert rig.length_scale_m == unit_m
+        speed = rig.scales.speed_for(1e-2)
+        start = (surface.x[6], surface.y[32])  # surface units: the same point
+        runs.append((rig, rig.run(SpringDrive(speed_m_s=speed), start=start)))
+    (rig_um, res_um), (rig_m, res_m) = runs
+    lc = rig_um.scales.char_length_m
+    assert rig_m.scales.char_length_m == pytest.approx(lc, rel=1e-12)
+    assert rig_m.tip.tip_radius_m == rig_um.tip.tip_radius_m
+    assert rig_m.model.opt.timestep == pytest.approx(rig_um.model.opt.timestep, rel=1e-14)
+    assert res_um.end_reason is res_m.end_reason and res_um.n == res_m.n
+    assert np.ptp(res_um.position_m[:, 0]) > lc  # it went somewhere
+    table_um, table_m = res_um.table(), res_m.table()  # SI columns both
+    np.testing.assert_allclose(table_um["time_s"], table_m["time_s"], rtol=1e-12)
+    for col in ("position_x_m", "position_y_m", "position_z_m"):
+        np.testing.assert_allclose(table_um[col], table_m[col], rtol=0, atol=1e-9 * lc)

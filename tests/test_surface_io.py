@@ -62,10 +62,12 @@ def test_failed_save_leaves_nothing(tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
-@pytest.mark.parametrize("name, n_expected", [("plu-1.plu", (576, 768)), ("di-1.di", (512, 512))])
-def test_import_instrument_files(topography_dir, name, n_expected):
+@pytest.mark.parametrize(
+    "name, n_expected, unit", [("plu-1.plu", (576, 768), "um"), ("di-1.di", (512, 512), "nm")]
+)
+def test_import_instrument_files(topography_dir, name, n_expected, unit):
     surf = import_topography(topography_dir / name)
-    assert surf.unit == "m"
+    assert surf.unit == unit
     assert surf.shape == n_expected
     h = surf.heights
     assert np.isfinite(h).all()
@@ -73,19 +75,44 @@ def test_import_instrument_files(topography_dir, name, n_expected):
     yy, xx = np.meshgrid(surf.y, surf.x, indexing="ij")
     design = np.column_stack([np.ones(h.size), xx.ravel(), yy.ravel()])
     coef = np.linalg.lstsq(design, h.ravel(), rcond=None)[0]
-    assert np.abs(coef[1:]).max() < 1e-9 and abs(coef[0]) < 1e-3 * h.std()
-    # physical units: micrometre-scale heights on micrometre-to-millimetre fields
-    assert 1e-10 < h.std() < 1e-3
-    assert 1e-7 < surf.bounds[1] - surf.bounds[0] < 1e-2
+    assert np.abs(coef[1:]).max() < 1e-9 * h.std() and abs(coef[0]) < 1e-3 * h.std()
+    # the instrument's units: nanometre-to-micrometre heights on fields of 0.5 um (AFM)
+    # and 1.3 mm (profilometer)
+    assert 1e-2 < h.std() < 1e2
+    assert 1e2 < surf.bounds[1] - surf.bounds[0] < 2e3
     raw = import_topography(topography_dir / name, level=False)
     assert np.abs(raw.heights - h).max() > 0.01 * h.std()
 
 
+@pytest.mark.parametrize("name, st_unit", [("plu-1.plu", "\u00b5m"), ("di-1.di", "nm")])
+def test_import_keeps_the_numbers_surfacetopography_reads(tmp_path, topography_dir, name, st_unit):
+    """Heights and grid in the file's unit ("µm" spelled "um"), as SurfaceTopography reads
+    them, and through a saved .npz. Unlevelled they are the reader's float64 numbers
+    themselves (nothing is converted: tolerance 0); levelled, SurfaceTopography's own plane removal
+    (``detrend("height")``) agrees to round-off: the plu scan's tilt is 150 times its
+    roughness, so subtracting it costs ~150 ulp of the heights (measured 5e-12 of the rms
+    height), hence 1e-9."""
+    import SurfaceTopography as st
+
+    topo = st.open_topography(str(topography_dir / name)).topography()
+    assert topo.unit == st_unit
+    raw = import_topography(topography_dir / name, level=False)
+    np.testing.assert_array_equal(raw.heights, topo.heights().T)
+    spacing = np.asarray(topo.physical_sizes) / np.asarray(topo.nb_grid_pts)
+    np.testing.assert_allclose(raw.spacing, spacing, rtol=1e-12)
+    levelled = import_topography(topography_dir / name)
+    reference = topo.detrend("height").heights().T
+    np.testing.assert_allclose(levelled.heights, reference, rtol=0, atol=1e-9 * reference.std())
+    back = load_surface(save_surface(levelled, tmp_path / "scan.npz"))
+    assert back.unit == levelled.unit
+    np.testing.assert_array_equal(back.heights, levelled.heights)
+
+
 def test_import_resamples_to_spacing(topography_dir):
     surf = import_topography(topography_dir / "di-1.di")
-    dx = surf.spacing[0]
-    coarse = import_topography(topography_dir / "di-1.di", spacing_m=4 * dx)
-    assert coarse.spacing[0] == pytest.approx(4 * dx)
+    dx = surf.spacing[0]  # nm; spacing_m is in metres whatever the file's unit
+    coarse = import_topography(topography_dir / "di-1.di", spacing_m=4 * dx * 1e-9)
+    assert coarse.unit == "nm" and coarse.spacing[0] == pytest.approx(4 * dx)
     assert coarse.shape[1] == pytest.approx(surf.shape[1] / 4, abs=1)
     np.testing.assert_allclose(coarse.heights[::1, ::1][5, 5], surf.heights[20, 20], rtol=1e-6)
 
@@ -110,9 +137,10 @@ def test_missing_points_refused_or_filled(holey_x3p):
         surf = import_topography(holey_x3p, fill=method, level=False)
         assert np.isfinite(surf.heights).all()
         assert surf.metadata["missing_points"] == 12
-    # a harmonic fill of a smooth ramp stays on the ramp (um -> m)
+    # a harmonic fill of a smooth ramp stays on the ramp (x3p stores metres: the file's unit)
     harm = import_topography(holey_x3p, fill="harmonic", level=False)
     near = import_topography(holey_x3p, fill="nearest", level=False)
+    assert harm.unit == near.unit == "m"
     ramp_value = harm.heights[6, 11]
     assert abs(ramp_value - near.heights[6, 11]) < 0.2e-6
 

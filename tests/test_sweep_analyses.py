@@ -64,3 +64,23 @@ def test_mujoco_and_compare_runs_match_the_rig_run_directly(tmp_path):
     traj = sweep.load_trajectories(out, case_id, analysis="mujoco", start=1, columns=["x"])
     assert len(traj) == direct.n
     np.testing.assert_allclose(traj.x, direct.position_m[:, 0] / rig.length_scale_m)
+
+
+def test_a_scan_in_um_takes_its_tip_radius_in_um(tmp_path, topography_dir):
+    """A sweep's ``tip_radius`` is in the surface's length unit: 5 on a surface kept in
+    the instrument's um is a 5 um tip (the rule of ``sim.params.surface_unit_m``)."""
+    from spine_mj.surface_io import import_topography, save_surface
+    from spine_mj.sweep.analyses.mujoco import case_rig
+
+    save_surface(import_topography(topography_dir / "plu-1.plu"), tmp_path / "scan.npz")
+    doc = {
+        "sweep": {"analyses": ["mujoco"]},
+        "surfaces": [{"file": "scan.npz"}],
+        "starts": {"points": [[0.1, 0.5]]},
+        "drive": {"protocol": "spring", "ie": 1e-3},
+        "grid": {"tip_radius": 5.0, "mu": 0.5},
+    }
+    (case,) = sweep.expand_cases(sweep.parse_config(doc, base_dir=tmp_path))
+    rig = case_rig(case)
+    assert rig.surface.unit == "um" and rig.length_scale_m == 1e-6
+    assert rig.tip.tip_radius_m == pytest.approx(5e-6, rel=1e-12)

@@ -22,7 +22,10 @@ and ``L_c`` the surface's characteristic length (:func:`characteristic_length`):
   ``(1 - 0.99) a_p (2 dt)^2 = 0.04 a_p dt^2``, and the deepest contact seen while a drive
   loads the tip stays within a few ``a_p dt^2`` per preload of drive force;
 * ``dt = sqrt(0.005 min(r_tip, L_c) / L_c) tau`` (``a_p dt^2 = 0.005 min(r_tip, L_c)``),
-  rounded in engine units: resting penetration ``2e-4 min(r_tip, L_c)``;
+  rounded in engine units: resting penetration ``2e-4 min(r_tip, L_c)``; shorter where
+  impacts need it, so that a tip arriving at the drive's speed or landing from the
+  surface's fall (:func:`~spine_mj.sim.params.fall_height`: grit flanks, scan-line steps)
+  sinks at most half the penetration tolerance;
 * ``cone = elliptic`` with ``noslip_iterations = 3``: MuJoCo's friction is soft and creeps
   at any in-cone load without the noslip pass (docs/physics.md §5); ``impratio`` stays 1;
 * a run ends as engine trouble (:data:`~spine_mj.sim.detection.TROUBLES`) on a MuJoCo

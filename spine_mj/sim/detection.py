@@ -228,7 +228,10 @@ def end_candidates(
             detail = f"tip centre at z = {pos[k, 2]:.4g} m, {where} (diverged)"
             candidates.append(Ending(k, 1, trouble, detail, "diverged"))
     if (k := mark("deep")) is not None:
-        detail = f"penetration {rec.penetration_m[k]:.3g} m > tolerance {det.penetration_tol_m:.3g} m"
+        detail = (
+            f"penetration {rec.penetration_m[k]:.3g} m > tolerance {det.penetration_tol_m:.3g} m"
+            f" ({_penetration_cause(rec, k, preload_n)})"
+        )
         candidates.append(Ending(k, 1, trouble, detail, "penetration"))
     if (k := mark("out")) is not None:
         detail = f"tip at ({pos[k, 0]:.4g}, {pos[k, 1]:.4g}) m left the domain"
@@ -244,6 +247,17 @@ def end_candidates(
         detail = f"force cap: drive force reached kappa_cap * F_p = {cap:.4g} N without slip"
         candidates.append(Ending(k, 3, EndReason.SELF_LOCK, detail))
     return candidates
+
+
+def _penetration_cause(rec: Recording, k: int, preload_n: float) -> str:
+    """What sank the tip at step ``k``: a landing (the speed it arrived with, how long it
+    was airborne) or a contact pressed by a large force (the normal force in F_p)."""
+    touching = np.flatnonzero(rec.contact[:k])
+    airborne = k - 1 - int(touching[-1]) if touching.size else k
+    if airborne > 0:
+        speed = float(np.linalg.norm(rec.velocity_m_s[k - 1]))
+        return f"landing at {speed:.3g} m/s after {airborne} steps airborne"
+    return f"contact pressed by a normal force of {rec.normal_force_n[k] / preload_n:.3g} F_p"
 
 
 def probe_candidates(

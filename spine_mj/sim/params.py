@@ -25,16 +25,18 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+import numpy as np
+
 from spine_mj.errors import SpineInputError, check_positive
 from spine_mj.roughness import characteristic_length, slope_correlation_length
-from spine_mj.surfaces import GridSurface, HField, Surface, to_hfield
+from spine_mj.surfaces import LENGTH_UNITS_M, GridSurface, HField, Surface, length_unit, to_hfield
 
 DEFAULT_LENGTH_SCALE_M = 0.01
 _REST_PENETRATION_FRACTION = 0.005
 #: Largest inertia number a drive may have: beyond it the quasistatic question is moot and
 #: the engine step (bounded by impacts at the drive speed) shrinks without end.
 MAX_INERTIA_NUMBER = 1e4
-_IMPACT_DEPTH_FRACTION = 0.05  # impact depth of a drive-speed arrival, in tip radii
+_IMPACT_DEPTH_OF_TOLERANCE = 0.5  # impact depth an arrival may reach, in penetration tolerances
 #: Landing speed of a tip thrown off a crest, in drive speeds: the spring's release and the
 #: fall add to the carriage's speed. Measured on the single peak and valley with the default
 #: spring at I_e = 0.03-1: normal speeds at contact onset of 1.0-2.0 times the drive speed.
@@ -43,11 +45,9 @@ _MIN_SPACING_PER_TIP_RADIUS = 0.25  # finer hfields exceed MuJoCo's 50 contacts 
 _SCAN_TIP_SPACINGS = 2.0  # default tip radius of a measured scan, in lateral spacings
 MAX_HFIELD_SIDE = 8192  # samples a side of an hfield (memory; MuJoCo's collision stays local)
 _MIN_ENGINE_RATIO = 1e-9  # smallest length ratio (tip / L_c, spacing / L_c) the engine resolves
-#: Metres per unit of the length units a surface may carry ("1": dimensionless, scaled).
 #: Physical range of lengths [m] and masses [kg] (outside it the model means nothing).
 PHYSICAL_LENGTH_M = (1e-12, 1e3)
 PHYSICAL_MASS_KG = (1e-24, 1e6)
-LENGTH_UNITS_M = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "µm": 1e-6, "nm": 1e-9, "pm": 1e-12}
 
 
 class Cone(enum.Enum):
@@ -271,6 +271,11 @@ class Scales:
         the surface has none, a plane); the length of the drive stiffness number K.
     extent_m : float or None
         Diagonal of the surface's domain [m] (bounds the energy a run can gain).
+    fall_height_m : float
+        The height a slip can turn into an impact [m] (:func:`fall_height`: a fall down a
+        grit flank or a scan-line step onto the floor below); 0 on planes and on surfaces
+        no steeper than the friction angle. It bounds the engine step
+        (:func:`default_engine`).
     """
 
     length_scale_m: float
@@ -282,6 +287,7 @@ class Scales:
     hfield_resolution: int | None = None
     slope_length_m: float | None = None
     extent_m: float | None = None
+    fall_height_m: float = 0.0
 
     @classmethod
     def for_surface(
@@ -306,6 +312,7 @@ class Scales:
         * hfield resolution: an hfield finer than a quarter tip radius is coarsened to that
           (MuJoCo keeps at most 50 contacts per geom pair: a tip over too many cells loses
           its deepest contacts).
+        * fall height: :func:`fall_height` of that hfield with the tip's ``mu_s`` and radius.
 
         Raises
         ------
@@ -336,7 +343,15 @@ class Scales:
         if resolution is None and spacing < _MIN_SPACING_PER_TIP_RADIUS * radius:
             extent = 2 * max(hf.size[0], hf.size[1]) * length_scale_m
             resolution = math.ceil(extent / (_MIN_SPACING_PER_TIP_RADIUS * radius)) + 1
-            spacing = hfield_spacing(hfield_of(surface, resolution), length_scale_m)
+            hf = hfield_of(surface, resolution)
+            spacing = hfield_spacing(hf, length_scale_m)
+        rx, ry, elevation = hf.size[0], hf.size[1], hf.size[2]
+        fall = fall_height(
+            hf.data.astype(float) * (elevation * length_scale_m),  # float64: the same at every scale
+            (2 * rx / (hf.ncol - 1) * length_scale_m, 2 * ry / (hf.nrow - 1) * length_scale_m),
+            mu=tip.mu_s,
+            radius=radius,
+        )
         return cls(
             length_scale_m=length_scale_m,
             char_length_m=char_length_m,
@@ -347,6 +362,7 @@ class Scales:
             hfield_resolution=resolution,
             slope_length_m=_slope_length(surface, length_scale_m, char_length_m),
             extent_m=math.hypot(xmax - xmin, ymax - ymin),
+            fall_height_m=fall,
         )
 
     @property
@@ -394,14 +410,17 @@ class Scales:
 
 
 def surface_unit_m(surface: Surface, length_scale_m: float | None) -> float:
-    """Metres per surface length unit: ``length_scale_m``, else by the surface's unit."""
-    if surface.unit != "1" and surface.unit not in LENGTH_UNITS_M:
+    """Metres per surface length unit: ``length_scale_m``, else by the surface's unit
+    (:data:`~spine_mj.surfaces.LENGTH_UNITS_M`; "1", dimensionless, gives
+    :data:`DEFAULT_LENGTH_SCALE_M`)."""
+    unit = length_unit(surface.unit)
+    if surface.unit != "1" and unit is None:
         raise SpineInputError(
             f"surface unit must be '1' (dimensionless) or a length unit {sorted(LENGTH_UNITS_M)}, "
             f"got {surface.unit!r}"
         )
     if length_scale_m is None:
-        length_scale_m = DEFAULT_LENGTH_SCALE_M if surface.unit == "1" else LENGTH_UNITS_M[surface.unit]
+        length_scale_m = DEFAULT_LENGTH_SCALE_M if unit is None else LENGTH_UNITS_M[unit]
     return check_physical_length("length_scale_m", length_scale_m)
 
 
@@ -426,6 +445,50 @@ def default_tip_radius(surface: Surface, spacing_m: float, char_length_m: float)
     scan = isinstance(surface, GridSurface) and surface.unit != "1"
     spacings = _SCAN_TIP_SPACINGS if scan else 1.0
     return float(f"{max(spacings * spacing_m, 0.01 * char_length_m):.3g}")
+
+
+def fall_height(
+    heights: np.ndarray, spacing: tuple[float, float], *, mu: float, radius: float, rows: int = 512
+) -> float:
+    """The height a slip can turn into an impact: the largest landing of a tip on ``heights``.
+
+    A tip that slips down a slope steeper than its friction angle gains speed; down a
+    cliff (a grit's overhang, an AFM scan-line step) it falls. Its speed is that of a fall
+    from ``H = drop - mu run``: the sliding friction takes ``mu`` times the weight per unit
+    of horizontal run (the work ``mu N ds`` with ``N = W cos(theta)``), nothing where the
+    tip is airborne or on a wall. Where the surface then turns up by ``theta`` (measured over
+    one tip radius, the scale the sphere feels), the part ``sin(theta)`` of that speed hits
+    the next facet: a landing like a fall from ``H sin^2(theta)``. The result is the largest
+    such height along every row and column of the grid, walked both ways: exact for the
+    straight falls of a quasistatic slip, 0 on a plane (no turn) and where no slope beats
+    friction (no drop). Pure numpy, ``rows`` lines at a time.
+
+    Parameters
+    ----------
+    heights : ndarray, shape (ny, nx)
+        ``heights[iy, ix]`` in some length unit (the result is in that unit).
+    spacing : (dx, dy)
+        Grid spacings in the same unit.
+    mu, radius : float
+        The tip's friction coefficient and radius (same unit).
+    """
+    heights = np.asarray(heights, dtype=float)
+    best = 0.0
+    for grid, step in ((heights, spacing[0]), (heights.T, spacing[1])):
+        m = max(1, round(radius / step))  # cells per tip radius
+        n = grid.shape[1]
+        if n <= 2 * m:
+            continue
+        run = mu * step * np.arange(n)
+        for lo in range(0, grid.shape[0], rows):
+            for a in (grid[lo : lo + rows], grid[lo : lo + rows, ::-1]):
+                g = a + run  # height plus the friction's toll: falling from i to j gains g_i - g_j
+                drop = np.maximum.accumulate(g, axis=1) - g
+                into = np.arctan((a[:, m : n - m] - a[:, : n - 2 * m]) / (m * step))
+                out = np.arctan((a[:, 2 * m :] - a[:, m : n - m]) / (m * step))
+                turn = np.clip(out - into, 0.0, math.pi / 2)
+                best = max(best, float((drop[:, m : n - m] * np.sin(turn) ** 2).max()))
+    return best
 
 
 def _check_sizes(radius: float, spacing: float, char_length: float, span: float) -> None:
@@ -478,18 +541,25 @@ def default_engine(scales: Scales, *, speed_m_s: float | None = None, **override
     ``impratio = 1``. ``overrides`` replace fields (a ``timestep_s`` alone also sets
     ``solref = (2 timestep_s, 1)``).
 
-    A fast drive also limits the step: a tip arriving at speed ``v`` sinks about
-    ``v t_c / e`` into the soft contact (time constant ``t_c = 2 dt``) before it stops. A
-    tip thrown off a crest lands at up to twice the drive's speed ``speed_m_s``, so with
-    that speed given, ``dt <= 0.05 e r_tip / (2 * 2 v)`` keeps the impact depth at 5 % of
-    the tip radius, half the penetration tolerance.
+    Impacts also limit the step: a tip arriving at speed ``v`` sinks about ``v t_c / e``
+    into the soft contact (time constant ``t_c = 2 dt``) before it stops, and one step
+    carries it up to ``v dt`` past the surface, so ``dt <= e d / (2 v)`` keeps the impact at
+    ``d``, half the penetration tolerance (:func:`penetration_tolerance_m`; ``d = 0.05
+    r_tip`` for tips up to ``L_c / 10``, ``0.005 L_c`` for larger ones). ``v`` is the larger
+    of twice the drive's speed ``speed_m_s`` (when given: a tip thrown off a crest lands at
+    up to twice the carriage's speed) and the landing speed of the surface's fall,
+    ``sqrt(2 a_p scales.fall_height_m)`` (:func:`fall_height`: falls off grit flanks and
+    scan-line steps land at many times a quasistatic drive's speed).
     """
     ratio = min(scales.tip_radius_m / scales.char_length_m, 1.0)
     dt_tau = math.sqrt(_REST_PENETRATION_FRACTION * ratio)
+    v = math.sqrt(2 * scales.fall_height_m / scales.char_length_m)  # engine units: a_p = 1
     if speed_m_s is not None:
-        v = check_positive("speed_m_s", speed_m_s) * scales.time_s / scales.char_length_m
-        r = scales.tip_radius_m / scales.char_length_m
-        dt_tau = min(dt_tau, _IMPACT_DEPTH_FRACTION * math.e * r / (2 * _LANDING_SPEED_FACTOR * v))
+        drive = check_positive("speed_m_s", speed_m_s) * scales.time_s / scales.char_length_m
+        v = max(v, _LANDING_SPEED_FACTOR * drive)
+    if v > 0:
+        depth = _IMPACT_DEPTH_OF_TOLERANCE * penetration_tolerance_m(scales) / scales.char_length_m
+        dt_tau = min(dt_tau, math.e * depth / (2 * v))
     dt = float(f"{dt_tau:.2g}") * scales.time_s
     base = {
         "timestep_s": dt,

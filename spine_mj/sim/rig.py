@@ -33,7 +33,8 @@ class Rig(RigModel):
     engine : EngineSettings or None
         None: :func:`default_engine` of the scales.
     length_scale_m : float or None
-        Metres per surface unit; None gives 0.01 for ``unit == "1"`` and 1 for ``"m"``.
+        Metres per surface unit; None gives 0.01 for ``unit == "1"`` and the size of a
+        length unit otherwise (1e-6 for ``"um"``; :func:`~spine_mj.sim.params.surface_unit_m`).
     char_length_m : float or None
         L_c [m]; None: :func:`characteristic_length` times ``length_scale_m``.
 
@@ -46,7 +47,9 @@ class Rig(RigModel):
     Notes
     -----
     Default tip radius: ``surface.metadata["params"]["tip_radius_m"]`` if the surface has
-    one (sandpaper), else the larger of one hfield spacing and ``L_c / 100``.
+    one (sandpaper), the larger of two lateral spacings and ``L_c / 100`` for a measured
+    scan, else the larger of one hfield spacing and ``L_c / 100``
+    (:meth:`~spine_mj.sim.params.Scales.for_surface`).
     """
 
     def run(

@@ -13,6 +13,7 @@ import numpy as np
 
 from spine_mj import sim
 from spine_mj.errors import SpineInputError
+from spine_mj.sim.params import surface_unit_m
 from spine_mj.sim.ramp import nominal_time_s
 from spine_mj.surfaces import GridSurface
 from spine_mj.sweep.registry import (
@@ -235,11 +236,7 @@ _RIG_KEYS = (
 
 def _rig_key(p: dict, surface) -> tuple:
     """The parameters of a case that make its rig, as a hashable key of :func:`_rig`."""
-    unit_m = 1.0
-    if p["length_scale"] is not None:
-        unit_m = p["length_scale"]
-    elif surface.unit == "1":
-        unit_m = sim.DEFAULT_LENGTH_SCALE_M
+    unit_m = surface_unit_m(surface, p["length_scale"])
     tip_radius_m = p["tip_radius"] * unit_m if p["tip_radius"] > 0 else None
     return tuple(sorted({"tip_radius_m": tip_radius_m, **{k: p[k] for k in _RIG_KEYS}}.items()))
 
