@@ -138,7 +138,7 @@ def _validation_results():
     star |= {"criterion": "outcome agreement >= 95 %", "ie_used": [1e-4, 1.0]}
     star["by_criterion"] = {"outcome": dict(star)}
     fam = {"runs": 10, "ok_runs": 9, "outcome_agreement": 0.9, "mean_frechet": 0.05, "median_frechet": 0.04}
-    fam |= {"failed_runs": {"penetration": 1}}
+    fam |= {"failed_runs": {"penetration": 1}, "reference_stalled": 2}
     return {
         "static": StaticMapResult(rows=[], per_engine={}, mu=1.0, static_kappa_max_rel_error=0.01),
         "limit": QuasistaticLimitResult(
@@ -180,4 +180,5 @@ def test_validation_report_links_only_written_figures_and_names_its_plan(tmp_pat
     assert "sandpaper.png" not in text and not (tmp_path / "figures" / "sandpaper.png").exists()
     assert "9/10" in text  # agree / runs beside the agreement
     assert "penetration 1" in text  # the engine stops of a family, by kind
+    assert "stalled (single_peak_valley 2 of 10)" in text  # and the model's own stops
     assert "the issue" not in text

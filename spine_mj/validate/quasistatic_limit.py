@@ -67,7 +67,8 @@ class QuasistaticLimitResult:
         ``mean_frechet``, ``median_frechet``, ``mean_lateral_deviation`` (against the
         facet-traced streamline), ``outcome_agreement_smooth``, ``median_frechet_smooth``
         (against the smooth one), ``mean_geometry_frechet``, ``failed_runs`` (engine stops
-        by status), ``meets_target``.
+        by status), ``reference_stalled`` (reference streamlines stalled in a groove),
+        ``meets_target``.
     runs : list of dict
         Per-run rows (:data:`RUN_COLUMNS`).
     variations : dict
@@ -121,6 +122,10 @@ def quasistatic_limit(plan: ValidationPlan, runner: StudyRunner) -> QuasistaticL
                 "outcome_agreement_smooth": float(allc["agree_smooth"].fillna(False).astype(bool).mean()),
                 "mean_geometry_frechet": float(np.nanmean(allc["geometry_frechet"])),
                 "failed_runs": {str(k): int(v) for k, v in failed.items()},
+                # the single-contact streamline has no state for a tip resting in a groove
+                # between two flanks steeper than the friction angle: it falls to the bottom
+                # and steps back and forth across it (STALLED) where MuJoCo rests on both
+                "reference_stalled": int((allc["reference_outcome"] == "stalled").sum()),
                 "meets_target": bool(
                     summ["outcome_agreement"] >= OUTCOME_TARGET
                     and summ["median_frechet"] <= FRECHET_TARGET

@@ -466,6 +466,22 @@ def _static_section(static: StaticMapResult, result: dict) -> list[str]:
     ]
 
 
+def _stalled_note(limit: QuasistaticLimitResult) -> list[str]:
+    """A sentence on the reference streamlines that stalled in a groove, where there are any."""
+    stalled = {k: v["reference_stalled"] for k, v in limit.families.items() if v.get("reference_stalled")}
+    if not stalled:
+        return []
+    counts = ", ".join(f"{k} {n} of {limit.families[k]['runs']}" for k, n in stalled.items())
+    return [
+        f"Reference streamlines that stalled ({counts}): the single-contact streamline has no "
+        "state for a tip resting in a groove whose two flanks are steeper than the friction "
+        "angle. It slides to the bottom and steps back and forth across it (slip region, no "
+        "net progress), while MuJoCo's tip rests on both flanks and is pulled along the groove. "
+        "These runs count as disagreements; the quasistatic model, not the engine, stops there.",
+        "",
+    ]
+
+
 def _limit_section(limit: QuasistaticLimitResult) -> list[str]:
     families = [
         {
@@ -515,6 +531,7 @@ def _limit_section(limit: QuasistaticLimitResult) -> list[str]:
             ],
         ),
         "",
+        *_stalled_note(limit),
         "### What limits agreement: settings varied on the single peak",
         "",
         _table(
