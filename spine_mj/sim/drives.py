@@ -28,9 +28,9 @@ class SpringDrive:
     """Spring carriage: the carriage moves at ``speed_m_s`` in +x and pulls the tip through a
     spring of stiffness ``stiffness_n_m`` acting in x only.
 
-    ``stiffness_n_m`` None: :data:`DEFAULT_STIFFNESS_NUMBER` ``F_p / l_s``. ``duration_s`` None: the time the carriage
-    needs to cover 1.1 times the distance to the domain's +x edge plus the spring stretch
-    at ``(1 + mu_s) F_p``.
+    ``stiffness_n_m`` None: :data:`DEFAULT_STIFFNESS_NUMBER` ``F_p / l_s``. ``duration_s``
+    None: the time the carriage needs to cover 1.1 times the distance to the domain's +x
+    edge plus the spring stretch at ``(1 + mu_s) F_p``.
     """
 
     speed_m_s: float
