@@ -6,21 +6,17 @@ zero, and ramps again once the tip has been stuck for the settle time.
 :class:`ResetController` is that feedback; :func:`run_ramp` steps the model with it and
 analyses the run like any other, adding the resets to the events.
 
-Stick-phase fast-forward (``RampDrive.fast_forward``, on by default). At a low rate most
-steps integrate a tip that does not move while the force climbs. While the ramp is on,
-the noslip solver is on and the tip has been still for :data:`QUIET_STEPS` steps on one
-contact normal (tangential speed at most ``Detection.stick_speed_m_s``, the normal
-unchanged), :class:`StickFastForward` predicts the breakaway force
-``F_b = kappa_of_normal(n, mu) F_p`` (the lock rule the streamline uses; infinite in the
-self-lock region) and raises the force to ``min((1 - margin) F_b, F_b - NOMINAL_STEPS increments,
-kappa_cap F_p)`` in :data:`RISE_STEPS` steps, then hands back to the nominal rate, which carries the force
-through breakaway and the slip. A phase ends early when the contact normal changes; when
-the tip moves during a phase (tangential speed above the stick speed, or contact lost),
-the run is put back to the checkpoint taken 16 to 32 steps earlier (state, controller and
-recorded rows) and goes on at the nominal rate. A new phase needs the tip to have slipped
-since the last one. ``duration_s`` and ``time_s`` count engine time, so a fast-forwarded
-run covers more of the path in the same duration; :func:`nominal_time_s` gives the time
-the plain ramp would have taken.
+Stick-phase fast-forward (``RampDrive.fast_forward``, on by default; the rule is
+:class:`~spine_mj.sim.fastforward.StickFastForward`, shared with the static probe). While
+the ramp is on, every stick phase may climb fast to just below the breakaway force
+predicted from the contact normal, then the nominal rate carries the force through
+breakaway and the slip. A phase ends early when the contact normal changes; when the tip
+moves during a phase (tangential speed above the stick speed, or contact lost), the run is
+put back to the checkpoint taken 16 to 32 steps earlier (state, controller and recorded
+rows) and goes on at the nominal rate. A new phase needs the tip to have slipped since the
+last one. ``duration_s`` and ``time_s`` count engine time, so a fast-forwarded run covers
+more of the path in the same duration; :func:`nominal_time_s` gives the time the plain
+ramp would have taken.
 
 What the equivalence neglects. (1) Creep: noslip makes the stick rigid (a stuck tip moves
 ~1e-11 m/s), so the plain ramp's long stick moves the tip by nothing measurable; without
@@ -52,84 +48,17 @@ from collections.abc import Callable
 
 import numpy as np
 
-from spine_mj.engagement import SELF_LOCK, kappa_of_normal
 from spine_mj.sim.detection import Detection, Event
 from spine_mj.sim.drives import RampDrive, rate_n_s, settle_steps
+from spine_mj.sim.fastforward import StickFastForward, fast_forward_on
 from spine_mj.sim.model import RigModel
 from spine_mj.sim.results import RunResult, analyse, recorded_marks
 from spine_mj.sim.rollout import warning_text, warning_total
 
-#: Steps the tip must be still on one normal before a fast-forward phase starts.
-QUIET_STEPS = 8
-#: Steps over which a fast-forward phase raises the force (50 contact time constants).
-RISE_STEPS = 100
-#: Nominal-rate steps a phase leaves before the predicted breakaway, at least (50 contact
-#: time constants: at a fast rate the 3 % margin alone is a few steps, and the contact
-#: loaded by the rise breaks away late).
-NOMINAL_STEPS = 100
 #: Steps between checkpoints inside a phase (a rollback goes back 16 to 32 steps).
 CHECKPOINT_STEPS = 16
 #: Steps between two early-termination checks.
 END_CHECK_STEPS = 256
-#: Largest change of a unit normal (any component) that counts as the same normal.
-NORMAL_TOL = 1e-4
-
-
-class StickFastForward:
-    """Decides when the ramp may climb fast and how far (see the module docstring).
-
-    Parameters
-    ----------
-    mu : float
-        Friction coefficient of the contact.
-    preload_n, cap_n : float
-        F_p [N] and the largest force ``kappa_cap F_p`` [N].
-    margin : float
-        A phase stops at ``(1 - margin)`` of the predicted breakaway force.
-    stick_speed_m_s, slip_speed_m_s : float
-        Still below the first; a slip (which allows a new phase) above the second.
-    """
-
-    def __init__(self, *, mu, preload_n, cap_n, margin, stick_speed_m_s, slip_speed_m_s):
-        self.mu, self.preload_n, self.cap_n, self.margin = mu, preload_n, cap_n, margin
-        self.stick, self.slip = stick_speed_m_s, slip_speed_m_s
-        self.active, self.blocked, self.quiet = False, False, 0
-        self.target_n, self.step_n = 0.0, 0.0
-        self.normal0 = np.zeros(3)
-        self.prev = np.zeros(3)
-        self.phases = self.rollbacks = 0
-
-    def watch(self, vt: float, normal: np.ndarray, contact: bool, force: float, step_n: float) -> str:
-        """Verdict on one ramping step: ``"start"`` (a phase begins), ``"rollback"`` (the tip
-        moved during a phase), or ``""``. ``normal`` points out of the surface."""
-        same = contact and float(np.abs(normal - self.prev).max()) <= NORMAL_TOL
-        self.prev = normal.copy()
-        if self.active:
-            if not contact or vt > self.stick:
-                self.active, self.blocked, self.quiet = False, True, 0
-                self.rollbacks += 1
-                return "rollback"
-            if float(np.abs(normal - self.normal0).max()) > NORMAL_TOL or force >= self.target_n:
-                self.active, self.blocked, self.quiet = False, True, 0
-            return ""
-        if vt > self.slip:
-            self.blocked = False
-        self.quiet = self.quiet + 1 if (same and vt <= self.stick) else 0
-        if self.blocked or self.quiet < QUIET_STEPS:
-            return ""
-        k, region = kappa_of_normal(normal, self.mu)
-        f_b = math.inf if int(region) == SELF_LOCK else float(k) * self.preload_n
-        if not math.isfinite(f_b) and int(region) != SELF_LOCK:
-            return ""  # the slip region: no hold to predict
-        # leave the nominal ramp at least NOMINAL_STEPS before the predicted breakaway, so
-        # the contact loaded by the fast rise settles before it is tested
-        target = min((1 - self.margin) * f_b, f_b - NOMINAL_STEPS * step_n, self.cap_n)
-        if target - force <= 2 * RISE_STEPS * step_n:
-            return ""  # the nominal ramp gets there about as fast
-        self.active, self.target_n, self.normal0 = True, target, normal.copy()
-        self.step_n = (target - force) / RISE_STEPS
-        self.phases += 1
-        return "start"
 
 
 class ResetController:
@@ -319,7 +248,7 @@ def _controller(rig: RigModel, drive: RampDrive, det: Detection, n_settle: int) 
     dt = rig.engine.timestep_s
     cap = det.kappa_cap * rig.scales.preload_n / u.force_n
     ff = None
-    if drive.fast_forward and rig.engine.noslip_iterations > 0 and rig.tip.mu_s > 0:
+    if fast_forward_on(drive, rig.engine, rig.tip):
         ff = StickFastForward(
             mu=rig.tip.mu_s,
             preload_n=rig.scales.preload_n / u.force_n,
