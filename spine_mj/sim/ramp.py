@@ -199,6 +199,7 @@ class _Stepper:
         self.ctrl_log = np.zeros((nstep, 6))
         self.ck_size = mujoco.mj_stateSize(m, self.exact)
         self.checkpoints: list[tuple[int, np.ndarray, dict]] = []
+        self.steps = 0  # engine steps taken, rolled-back ones included
 
     def record(self, i: int, push_id: int) -> None:
         import mujoco
@@ -280,6 +281,7 @@ def _step_loop(rig, st: _Stepper, nstep: int, n_settle: int, det, stop_early: bo
         if i >= n_settle:
             d.ctrl[rig.act_push] = ctl.push()
         mujoco.mj_step(m, d)
+        st.steps += 1
         st.record(i, rig.act_push)
         if i % 64 == 63 and warning_total(d) != warn_total:
             return i + 1, (i, warning_text(d))
@@ -340,4 +342,4 @@ def run_ramp(
     result = analyse(rig, drive, start, state, sens, ctrl_log, det, warning or (None, ""))
     resets = tuple(Event("reset", i, float(state[i, 0])) for i in ctl.resets if i < result.n)
     events = sorted(result.events + resets, key=lambda e: (e.index, e.kind == result.end_reason.value))
-    return dataclasses.replace(result, events=tuple(events))
+    return dataclasses.replace(result, events=tuple(events), simulated_steps=st.steps)

@@ -73,9 +73,9 @@ class Recording:
         slipping = cols["tangential_speed_m_s"] > slip_speed_m_s
         return cls(**cols, carriage_x_m=carriage_x * units.length_m, slipping=slipping)
 
-    def run(self, r: int) -> Recording:
-        """Run ``r`` of a group (views of the group's columns)."""
-        return Recording(**{f.name: getattr(self, f.name)[r] for f in dataclasses.fields(self)})
+    def run(self, r: int, rows: int | None = None) -> Recording:
+        """Run ``r`` of a group, its first ``rows`` rows (all: None), as views of the group's columns."""
+        return Recording(**{k: getattr(self, k)[r, :rows] for k in COLUMNS})
 
     def cut(self, end: int) -> Recording:
         """Steps ``0..end`` of a run, as read-only views of its columns."""
@@ -85,7 +85,11 @@ class Recording:
             out.flags.writeable = False
             return out
 
-        return Recording(**{f.name: view(getattr(self, f.name)) for f in dataclasses.fields(self)})
+        return Recording(**{k: view(getattr(self, k)) for k in COLUMNS})
+
+
+#: The column names of a :class:`Recording`, in field order.
+COLUMNS = tuple(f.name for f in dataclasses.fields(Recording))
 
 
 def sensor_columns(sensor_adr: dict[str, int], state: np.ndarray, sens: np.ndarray) -> dict[str, np.ndarray]:
