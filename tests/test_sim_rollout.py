@@ -103,9 +103,10 @@ def test_stopping_decided_runs_early_changes_no_result():
             [
                 SpringDrive(speed_m_s=0.02, duration_s=1.0),  # runs off the +x edge
                 SpringDrive(speed_m_s=0.01, duration_s=0.1),  # completes
-                StaticProbe(rate_n_s=5 * fp),  # breaks away
+                StaticProbe(rate_n_s=5 * fp, fast_forward=False),  # breaks away
+                StaticProbe(rate_n_s=5 * fp),  # breaks away, fast-forwarded
             ],
-            [(0.04, 0.0), (-0.02, 0.0), (0.0, -0.01)],
+            [(0.04, 0.0), (-0.02, 0.0), (0.0, -0.01), (0.0, 0.01)],
             None,
         ),
         (flat, [SpringDrive(speed_m_s=0.01, duration_s=1.0)], [(-0.04, 0.0)], Detection(kappa_cap=0.3)),

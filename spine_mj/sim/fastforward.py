@@ -1,4 +1,4 @@
-"""Stick-phase fast-forward: the rule that lets a stuck tip's drive force climb fast.
+"""Stick-phase fast-forward: the rule the force ramp and the static probe share.
 
 At a low force rate most engine steps integrate a tip that does not move while the drive
 force climbs. Once the tip has been still for :data:`QUIET_STEPS` steps on one contact
@@ -11,8 +11,9 @@ kappa_cap F_p)`` in :data:`RISE_STEPS` steps; the nominal rate then carries the 
 through breakaway. A tip that moves during the climb (tangential speed above the stick
 speed, or contact lost) makes the caller go back to the nominal ramp from before the climb.
 
-User: :mod:`spine_mj.sim.ramp` (every stick phase of the ramp with reset, with
-checkpoints and rollback). What the equivalence neglects is written in the ramp's module
+Users: :mod:`spine_mj.sim.ramp` (every stick phase of the ramp with reset, with
+checkpoints and rollback) and :mod:`spine_mj.sim.rollout` (the static probe's one stick
+phase, after settling). What the equivalence neglects is written in the ramp's module
 docstring and the README.
 """
 

@@ -17,6 +17,13 @@ drifts by ~1e-5 L_c within a step). Each piece is one run on one ``MjData``, so 
 start is there to read; the pieces then give bit for bit the trajectory of one
 uninterrupted rollout (tested). :func:`python_steps` is the plain ``mj_step`` reference of
 a piece.
+
+A static probe with fast-forward (:class:`~spine_mj.sim.drives.StaticProbe`) is decided
+after its settle piece: :class:`~spine_mj.sim.fastforward.StickFastForward` reads the
+settled rows and, where it predicts a breakaway, the probe's remaining controls climb to
+just below it in :data:`~spine_mj.sim.fastforward.RISE_STEPS` steps, then go on at the
+nominal rate. That climb is its own piece; if the tip moved during it, the piece is
+dropped and the probe goes on from its settled state with the plain controls.
 """
 
 from __future__ import annotations
@@ -40,7 +47,9 @@ from spine_mj.sim.drives import (
     settle_steps,
     stiffness_n_m,
 )
+from spine_mj.sim.fastforward import QUIET_STEPS, RISE_STEPS, StickFastForward, fast_forward_on
 from spine_mj.sim.model import RigModel
+from spine_mj.sim.recording import Recording
 from spine_mj.sim.results import GroupAnalysis, RunResult
 
 BATCH_MEMORY_BYTES = 256 * 2**20
@@ -185,8 +194,8 @@ class _BatchRunner:
 
 
 class _Group:
-    """One group of runs of equal planned length: its arrays, each run's progress and the
-    analysis of its rows (``k`` below: a run's index in the group)."""
+    """One group of runs of equal planned length: its arrays, each run's progress, the
+    analysis of its rows and the probes' fast-forward (``k`` below: a run's index in the group)."""
 
     def __init__(self, runner: _BatchRunner, idx: list[int], stop_early: bool):
         rig = runner.rig
@@ -202,11 +211,12 @@ class _Group:
         self.init = np.zeros((g, runner.nstate))
         self.warm = np.zeros((g, rig.model.nv))  # the warm start each run goes on from
         self.done = np.zeros(g, dtype=int)  # rows simulated and analysed
-        self.pieces = np.zeros(g, dtype=int)  # pieces after the settle phase
-        self.end = np.full(g, n)  # rows planned
+        self.pieces = np.zeros(g, dtype=int)  # pieces after the settle phase (and a climb)
+        self.end = np.full(g, n)  # rows planned (a fast-forwarded probe plans fewer)
         self.live = np.ones(g, dtype=bool)
         self.warnings: list[tuple[int | None, str] | None] = [None] * g
         self.n_settle = [settle_steps(d, rig.engine.timestep_s) for d in self.drives]
+        self.climbs: dict[int, tuple[StickFastForward, np.ndarray, np.ndarray]] = {}
         self.analysis = GroupAnalysis(rig, self.drives, self.starts, self.det, self.ctrl[:, :, 3])
 
     def run(self, lanes) -> list[RunResult]:
@@ -234,13 +244,15 @@ class _Group:
             self.init[k, 1:4] = q
 
     def submit(self, ks: np.ndarray, lanes) -> list:
-        """Start the next piece of each run in ``ks``: its settle phase, or the next of the
-        pieces that double from :data:`FIRST_PIECE_STEPS` to :data:`PIECE_STEPS`."""
+        """Start the next piece of each run in ``ks``: its settle phase, a probe's climb, or
+        the next of the pieces that double from :data:`FIRST_PIECE_STEPS` to :data:`PIECE_STEPS`."""
         out = []
         for k in ks:
             a = int(self.done[k])
             if a < self.n_settle[k]:
                 b = self.n_settle[k]
+            elif k in self.climbs:
+                b = a + RISE_STEPS
             else:
                 b = a + min(PIECE_STEPS, FIRST_PIECE_STEPS << int(self.pieces[k]))
                 self.pieces[k] += 1
@@ -256,8 +268,8 @@ class _Group:
         return k, a, b, warm, warning
 
     def advance(self, done: list) -> None:
-        """Take finished pieces: analyse the new rows (runs with the same rows at once) and
-        stop decided runs."""
+        """Take finished pieces: check probes' climbs, analyse the new rows (runs with the
+        same rows at once), stop decided runs, decide probes' fast-forward after settling."""
         windows: dict[tuple[int, int], list[int]] = {}
         stop = set()
         for k, a, b, warm, warning in done:
@@ -273,6 +285,8 @@ class _Group:
             elif warning is not None:
                 self.warnings[k] = (a + warning[0], warning[1])
                 stop.add(k)
+            if k in self.climbs and not self.climb_held(k, a, b):
+                continue  # dropped: the probe goes on from its settled state
             windows.setdefault((a, b), []).append(k)
         for (a, b), ks in windows.items():
             ks = np.array(ks)
@@ -281,6 +295,69 @@ class _Group:
             for k, dec in zip(ks, decided):
                 if b >= self.end[k] or (self.stop_early and (dec or k in stop)):
                     self.live[k] = False
+                elif b == self.n_settle[k] and not dec:
+                    self.fast_forward(k)
+
+    def fast_forward(self, k: int) -> None:
+        """After settling: a probe whose tip is stuck on one normal gets controls that climb
+        to just below the breakaway force predicted from it (:class:`StickFastForward`)."""
+        rig, det, drive = self.rig, self.det, self.drives[k]
+        if not (isinstance(drive, StaticProbe) and fast_forward_on(drive, rig.engine, rig.tip)):
+            return
+        fp, cap = rig.scales.preload_n, det.kappa_cap * rig.scales.preload_n
+        ff = StickFastForward(
+            mu=rig.tip.mu_s,
+            preload_n=fp,
+            cap_n=cap * (1 + 1e-9),
+            margin=drive.fast_forward_margin,
+            stick_speed_m_s=det.stick_speed_m_s,
+            slip_speed_m_s=det.slip_speed_m_s,
+        )
+        step = rate_n_s(drive, rig.scales) * rig.engine.timestep_s
+        rec, ns = self.analysis.run(k), self.n_settle[k]
+        verdict = ""
+        for i in range(max(0, ns - QUIET_STEPS - 1), ns):
+            verdict = ff.watch(*_still(rec, i), float(rec.drive_force_n[i]), step)
+        if verdict != "start":
+            return
+        rise = drive.start_force_n + ff.step_n * np.arange(1, RISE_STEPS + 1)
+        rise[-1] = ff.target_n
+        nominal = ff.target_n + step * np.arange(1, int(math.ceil((cap - ff.target_n) / step)) + 3)
+        push = np.concatenate([rise, np.minimum(nominal, cap * (1 + 1e-9))]) / rig.units.force_n
+        if ns + push.size > self.n:
+            return
+        self.climbs[k] = (ff, self.warm[k].copy(), self.ctrl[k, ns:, 1].copy())
+        self.ctrl[k, ns : ns + push.size, 1] = push
+        self.end[k] = ns + push.size
+
+    def climb_held(self, k: int, a: int, b: int) -> bool:
+        """Whether probe ``k`` stayed stuck on its normal through its climb (rows a..b-1);
+        if not, its controls and warm start go back to the plain probe's after settling."""
+        ff, warm, plain = self.climbs.pop(k)
+        rig, det = self.rig, self.det
+        rec = Recording.from_sensors(
+            rig.sensor_adr,
+            self.state[k : k + 1, a:b],
+            self.sens[k : k + 1, a:b],
+            units=rig.units,
+            carriage_x=np.full((1, b - a), np.nan),
+            slip_speed_m_s=det.slip_speed_m_s,
+        ).run(0)
+        step = rate_n_s(self.drives[k], rig.scales) * rig.engine.timestep_s
+        for i in range(b - a):
+            verdict = ff.watch(*_still(rec, i), float(rec.drive_force_n[i]), step)
+            if verdict == "rollback" or (not ff.active and i < b - a - 1):
+                ns = self.n_settle[k]
+                self.ctrl[k, ns:, 1] = plain
+                self.end[k], self.warm[k] = self.n, warm
+                return False
+        return True
+
+
+def _still(rec: Recording, i: int) -> tuple[float, np.ndarray, bool]:
+    """Tangential speed, outward normal and contact of row ``i``: what
+    :meth:`StickFastForward.watch` reads."""
+    return float(rec.tangential_speed_m_s[i]), rec.normal[i], bool(rec.contact[i])
 
 
 class _NativeLanes:
