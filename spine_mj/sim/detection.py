@@ -143,6 +143,8 @@ def normal_lock_marks(
     region = np.zeros((g, n), np.int8)  # the rule is evaluated where the tip is stuck in contact
     region[candidate] = kappa_of_normal(rec.normal[candidate], mu)[1]
     held = candidate & (region == SELF_LOCK)
+    if not held.any():
+        return np.full(g, -1), np.full(g, np.nan)
     # first row of the held streak each row belongs to (0: since the window's first row)
     start = np.maximum.accumulate(np.where(held, 0, np.arange(1, n + 1)), axis=1)
     force = rec.drive_force_n

@@ -254,18 +254,21 @@ class GroupAnalysis:
         self.probe = [isinstance(d, StaticProbe) for d in self.drives]
         self.n_settle = [settle_steps(d, rig.engine.timestep_s) for d in self.drives]
         self.limits = np.array([det.speed_limit_m_s(rig.scales, rig.speed_of(d)) for d in self.drives])
-        self.cols: dict[str, np.ndarray] | None = None
+        self.cols = Recording.empty((self.g, self.n))
         self.marks: dict[str, np.ndarray] = {}
         self.held_from_n = np.full(self.g, np.nan)
         self.rows = np.zeros(self.g, dtype=int)
         self.simulated = np.zeros(self.g, dtype=int)
 
-    def add(self, runs: np.ndarray, a: int, b: int, state: np.ndarray, sens: np.ndarray) -> np.ndarray:
-        """Rows ``a..b-1`` of ``runs`` (``state`` ``(len(runs), b - a, nstate)``, ``sens``
-        likewise); returns, per run, whether it is decided (an ending at or before row b-1)."""
+    def add(
+        self, runs: np.ndarray | slice, a: int, b: int, state: np.ndarray, sens: np.ndarray
+    ) -> np.ndarray:
+        """Rows ``a..b-1`` of ``runs`` (indices, or a slice of the group; ``state``
+        ``(len(runs), b - a, nstate)``, ``sens`` likewise); returns, per run, whether it is
+        decided (an ending at or before row b-1)."""
         rig, det = self.rig, self.det
-        runs = np.asarray(runs)
         carriage = np.where(self.spring[runs, None], self.carriage[runs, a:b], np.nan)
+        block = isinstance(runs, slice)  # the window's columns are views of the group's: written in place
         rec = Recording.from_sensors(
             rig.sensor_adr,
             state,
@@ -273,11 +276,11 @@ class GroupAnalysis:
             units=rig.units,
             carriage_x=carriage,
             slip_speed_m_s=det.slip_speed_m_s,
+            out=Recording(**{k: getattr(self.cols, k)[runs, a:b] for k in COLUMNS}) if block else None,
         )
-        if self.cols is None:
-            self.cols = {k: np.empty((self.g, self.n, *c.shape[2:]), c.dtype) for k, c in _items(rec)}
-        for k, c in _items(rec):
-            self.cols[k][runs, a:b] = c
+        if not block:
+            for k in COLUMNS:
+                getattr(self.cols, k)[runs, a:b] = getattr(rec, k)
         marks = end_marks(
             rec,
             state,
@@ -292,14 +295,14 @@ class GroupAnalysis:
         marks["lock_rule"], self.held_from_n[runs] = normal_lock_marks(
             rec, rig.tip.mu_s, rig.scales.preload_n, self.held_from_n[runs]
         )
-        decided = np.zeros(runs.size, bool)
+        decided = np.zeros(state.shape[0], bool)
         for k, m in marks.items():
             old = self.marks.setdefault(k, np.full(self.g, -1))[runs]
             merged = np.where((old < 0) & (m >= 0), m + a, old)
             self.marks[k][runs] = merged
             decided |= merged >= 0
         self.rows[runs] = b
-        for i, r in enumerate(runs):
+        for i, r in enumerate(np.arange(self.g)[runs]):
             if self.probe[r] and not decided[i]:
                 decided[i] = bool(
                     probe_candidates(self.run(r), self.n_settle[r], det, rig.scales.preload_n)[0]
@@ -308,7 +311,7 @@ class GroupAnalysis:
 
     def run(self, r: int) -> Recording:
         """The recorded rows of run ``r`` (views of the group's columns)."""
-        return Recording(**{k: self.cols[k][r, : self.rows[r]] for k in COLUMNS})
+        return self.cols.run(r, self.rows[r])
 
     def results(self, warnings: Sequence[tuple[int | None, str] | None]) -> list[RunResult]:
         """Each run's ending and result; a run without an ending completed its recorded rows.
@@ -342,10 +345,6 @@ class GroupAnalysis:
                 )
             )
         return out
-
-
-def _items(rec: Recording):
-    return ((k, getattr(rec, k)) for k in COLUMNS)
 
 
 def _run_result(
