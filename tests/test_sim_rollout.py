@@ -54,7 +54,7 @@ def test_pieces_continue_bit_for_bit_as_one_uninterrupted_rollout():
     starts = [(-3.0, -1.0), (-3.0, -2.0), (-2.5, 0.3)]
     runs = rig.run_batch(drive, starts, nthread=2, stop_early=False)
     for start, res in zip(starts, runs):
-        # settle, then pieces of 128, 256 and 216 steps: continued from the saved state and
+        # pieces of 328 (the settle phase and 128), 256 and 216 steps: continued from the saved state and
         # warm start, the trajectory is the uninterrupted one to the last bit
         assert res.simulated_steps == 800 and res.n > 700
         np.testing.assert_array_equal(res.position_m, _one_rollout(rig, drive, start)[: res.n])

@@ -217,13 +217,18 @@ class _Group:
         self.warnings: list[tuple[int | None, str] | None] = [None] * g
         self.n_settle = [settle_steps(d, rig.engine.timestep_s) for d in self.drives]
         self.climbs: dict[int, tuple[StickFastForward, np.ndarray, np.ndarray]] = {}
+        # a probe that may fast-forward is decided from its settled rows: its settle phase is a piece
+        self.settle_apart = [
+            isinstance(d, StaticProbe) and fast_forward_on(d, rig.engine, rig.tip) for d in self.drives
+        ]
         self.analysis = GroupAnalysis(rig, self.drives, self.starts, self.det, self.ctrl[:, :, 3])
 
     def run(self, lanes) -> list[RunResult]:
         """Simulate the group piece by piece in two halves (one is simulated while the
         other is analysed); the results in group order."""
         g = len(self.drives)
-        halves = [np.arange(h, g, 2) for h in range(min(2, g))]
+        cut = (g + 1) // 2
+        halves = [np.arange(0, cut), np.arange(cut, g)] if g > 1 else [np.arange(g)]
         pending = []
         for half in halves:
             self.prepare(half)
@@ -231,30 +236,30 @@ class _Group:
         while any(pending):
             for h, half in enumerate(halves):
                 if pending[h]:
-                    self.advance([f.result() for f in pending[h]])
+                    self.advance(lanes.wait(pending[h]))
                     pending[h] = self.submit(half[self.live[half]], lanes)
         return self.analysis.results(self.warnings)
 
     def prepare(self, ks: np.ndarray) -> None:
         """Place the tips of runs ``ks``; their controls and initial states."""
         rig = self.rig
-        for k in ks:
-            q = rig.place(*self.starts[k])
+        for k, q in zip(ks, rig.place_many([self.starts[k] for k in ks])):
             self.ctrl[k] = controls(rig, self.drives[k], q, self.det)
             self.init[k, 1:4] = q
 
     def submit(self, ks: np.ndarray, lanes) -> list:
-        """Start the next piece of each run in ``ks``: its settle phase, a probe's climb, or
-        the next of the pieces that double from :data:`FIRST_PIECE_STEPS` to :data:`PIECE_STEPS`."""
+        """Start the next piece of each run in ``ks``: a fast-forwarding probe's settle phase
+        or climb, or the next of the pieces that double from :data:`FIRST_PIECE_STEPS` to
+        :data:`PIECE_STEPS` (the first with the settle phase)."""
         out = []
         for k in ks:
             a = int(self.done[k])
-            if a < self.n_settle[k]:
+            if a < self.n_settle[k] and self.settle_apart[k]:
                 b = self.n_settle[k]
             elif k in self.climbs:
                 b = a + RISE_STEPS
             else:
-                b = a + min(PIECE_STEPS, FIRST_PIECE_STEPS << int(self.pieces[k]))
+                b = max(a, self.n_settle[k]) + min(PIECE_STEPS, FIRST_PIECE_STEPS << int(self.pieces[k]))
                 self.pieces[k] += 1
             out.append(lanes.submit(self.piece, lanes, k, a, min(b, int(self.end[k]))))
         return out
@@ -290,7 +295,8 @@ class _Group:
             windows.setdefault((a, b), []).append(k)
         for (a, b), ks in windows.items():
             ks = np.array(ks)
-            decided = self.analysis.add(ks, a, b, self.state[ks, a:b], self.sens[ks, a:b])
+            rows = _as_slice(ks)  # runs of a half: usually a block, read without a copy
+            decided = self.analysis.add(rows, a, b, self.state[rows, a:b], self.sens[rows, a:b])
             self.done[ks] = b
             for k, dec in zip(ks, decided):
                 if b >= self.end[k] or (self.stop_early and (dec or k in stop)):
@@ -302,7 +308,7 @@ class _Group:
         """After settling: a probe whose tip is stuck on one normal gets controls that climb
         to just below the breakaway force predicted from it (:class:`StickFastForward`)."""
         rig, det, drive = self.rig, self.det, self.drives[k]
-        if not (isinstance(drive, StaticProbe) and fast_forward_on(drive, rig.engine, rig.tip)):
+        if not self.settle_apart[k]:
             return
         fp, cap = rig.scales.preload_n, det.kappa_cap * rig.scales.preload_n
         ff = StickFastForward(
@@ -354,6 +360,13 @@ class _Group:
         return True
 
 
+def _as_slice(ks: np.ndarray) -> slice | np.ndarray:
+    """Sorted run indices as a slice where they form a block, else as they are."""
+    if ks.size and ks[-1] - ks[0] + 1 == ks.size and (np.diff(ks) == 1).all():
+        return slice(int(ks[0]), int(ks[-1]) + 1)
+    return ks
+
+
 def _still(rec: Recording, i: int) -> tuple[float, np.ndarray, bool]:
     """Tangential speed, outward normal and contact of row ``i``: what
     :meth:`StickFastForward.watch` reads."""
@@ -373,6 +386,9 @@ class _NativeLanes:
 
     def submit(self, fn, *args) -> cf.Future:
         return self.pool.submit(fn, *args)
+
+    def wait(self, futures: list[cf.Future]) -> list:
+        return [f.result() for f in futures]
 
     def step(self, model, init, warm, ctrl, state, sens):
         """Rows ``ctrl.shape[0]`` of one run from full physics state ``init`` and warm start
@@ -404,16 +420,25 @@ class _NativeLanes:
         self.pool.shutdown(wait=True, cancel_futures=True)
 
 
+def _run(future: cf.Future, fn, args) -> None:
+    """Run one queued piece into its future."""
+    if future.set_running_or_notify_cancel():
+        try:
+            future.set_result(fn(*args))
+        except BaseException as exc:  # handed to the caller by future.result()
+            future.set_exception(exc)
+
+
 class _PythonLane:
     """The reference backend: every piece stepped by :func:`python_steps` on the calling thread."""
 
     def submit(self, fn, *args) -> cf.Future:
         future: cf.Future = cf.Future()
-        try:
-            future.set_result(fn(*args))
-        except BaseException as exc:  # handed to the caller by future.result()
-            future.set_exception(exc)
+        _run(future, fn, args)
         return future
+
+    def wait(self, futures: list[cf.Future]) -> list:
+        return [f.result() for f in futures]
 
     def step(self, model, init, warm, ctrl, state, sens):
         return python_steps(model, init, warm, ctrl, state, sens)
@@ -423,8 +448,9 @@ class _PythonLane:
 
 
 def warning_total(d) -> int:
-    """The number of MuJoCo warnings ``d`` (an ``MjData``) has seen."""
-    return int(sum(w.number for w in d.warning))
+    """The number of MuJoCo warnings ``d`` (an ``MjData``) has seen (read as one array: a
+    loop over the warning structs costs 100 us)."""
+    return int(d.warning.number.sum())
 
 
 def warning_text(d) -> str:
