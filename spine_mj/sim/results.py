@@ -313,15 +313,17 @@ class GroupAnalysis:
         """The recorded rows of run ``r`` (views of the group's columns)."""
         return self.cols.run(r, self.rows[r])
 
-    def results(self, warnings: Sequence[tuple[int | None, str] | None]) -> list[RunResult]:
-        """Each run's ending and result; a run without an ending completed its recorded rows.
+    def results(self, warnings: Sequence[tuple[int | None, str] | None], runs=None) -> list[RunResult]:
+        """The ending and result of each run (of ``runs``, indices; None: all); a run without
+        an ending completed its recorded rows.
 
-        ``warnings``: per run ``(first step with a MuJoCo warning or None, its text)`` or None.
+        ``warnings``: per run of the group ``(first step with a MuJoCo warning or None, its
+        text)`` or None.
         """
         fp = self.rig.scales.preload_n
         out = []
-        for r, drive in enumerate(self.drives):
-            rec = self.run(r)
+        for r in range(self.g) if runs is None else runs:
+            drive, rec = self.drives[r], self.run(r)
             candidates = end_candidates(self.marks, r, rec, warnings[r], self.det, fp)
             kappa = math.nan
             if self.probe[r]:

@@ -54,11 +54,14 @@ from spine_mj.sim.results import GroupAnalysis, RunResult
 
 BATCH_MEMORY_BYTES = 256 * 2**20
 #: Steps of a run's first piece after its settle phase; each next piece is twice as long,
-#: up to :data:`PIECE_STEPS`: a run is not simulated past its end by more than it had
-#: run before it, nor by more than :data:`PIECE_STEPS`.
+#: up to :data:`PIECE_STEPS` (a last piece under half that joins the one before): a run is
+#: not simulated past its end by much more than it had run before it, nor by more than
+#: 1.5 :data:`PIECE_STEPS`.
 FIRST_PIECE_STEPS = 128
 #: Longest piece: the most steps a run is simulated between two looks at its end conditions.
 PIECE_STEPS = 1024
+#: Tips placed before their first pieces are handed to the workers.
+PLACE_CHUNK = 4
 
 
 def drive_steps(rig: RigModel, drive: Drive, x0_m: float, detection: Detection) -> int:
@@ -229,16 +232,21 @@ class _Group:
         g = len(self.drives)
         cut = (g + 1) // 2
         halves = [np.arange(0, cut), np.arange(cut, g)] if g > 1 else [np.arange(g)]
-        pending = []
-        for half in halves:
-            self.prepare(half)
-            pending.append(self.submit(half, lanes))
+        pending: list[list] = [[] for _ in halves]
+        for h, half in enumerate(halves):
+            for i in range(0, half.size, PLACE_CHUNK):  # the workers start on the first tips placed
+                self.prepare(half[i : i + PLACE_CHUNK])
+                pending[h] += self.submit(half[i : i + PLACE_CHUNK], lanes)
+        results: list[RunResult | None] = [None] * g
         while any(pending):
             for h, half in enumerate(halves):
                 if pending[h]:
                     self.advance(lanes.wait(pending[h]))
                     pending[h] = self.submit(half[self.live[half]], lanes)
-        return self.analysis.results(self.warnings)
+                    if not pending[h]:  # the half is done: its results while the other runs
+                        for k, res in zip(half, self.analysis.results(self.warnings, half)):
+                            results[k] = res
+        return results
 
     def prepare(self, ks: np.ndarray) -> None:
         """Place the tips of runs ``ks``; their controls and initial states."""
@@ -259,7 +267,10 @@ class _Group:
             elif k in self.climbs:
                 b = a + RISE_STEPS
             else:
-                b = max(a, self.n_settle[k]) + min(PIECE_STEPS, FIRST_PIECE_STEPS << int(self.pieces[k]))
+                size = min(PIECE_STEPS, FIRST_PIECE_STEPS << int(self.pieces[k]))
+                b = max(a, self.n_settle[k]) + size
+                if self.end[k] - b < size // 2:  # no short last piece: it joins this one
+                    b = int(self.end[k])
                 self.pieces[k] += 1
             out.append(lanes.submit(self.piece, lanes, k, a, min(b, int(self.end[k]))))
         return out
