@@ -7,14 +7,24 @@ within :data:`NORMAL_TOL`) with the noslip solver on, :class:`StickFastForward` 
 the breakaway force ``F_b = kappa_of_normal(n, mu) F_p`` (the lock rule the streamline
 uses, :func:`spine_mj.engagement.kappa_of_normal`; infinite in the self-lock region) and
 lets the force climb to ``min((1 - margin) F_b, F_b - NOMINAL_STEPS increments,
-kappa_cap F_p)`` in :data:`RISE_STEPS` steps; the nominal rate then carries the force
-through breakaway. A tip that moves during the climb (tangential speed above the stick
-speed, or contact lost) makes the caller go back to the nominal ramp from before the climb.
+kappa_cap F_p)`` in :data:`RISE_STEPS` steps. A tip that moves during the climb
+(tangential speed above the stick speed, or contact lost) makes the caller go back to
+before the motion and on at the nominal rate.
 
-Users: :mod:`spine_mj.sim.ramp` (every stick phase of the ramp with reset, with
-checkpoints and rollback) and :mod:`spine_mj.sim.rollout` (the static probe's one stick
-phase, after settling). What the equivalence neglects is written in the ramp's module
-docstring and the README.
+After the climb, the static probe goes on at the nominal rate through breakaway. The
+ramp, which keeps checkpoints every :data:`CHECKPOINT_STEPS` steps, goes on in an
+approach stage at :data:`APPROACH_RATE` nominal increments per step up to the cap: the
+breakaway happens in it, the tip's motion sends the run back 8 to 16 steps (64 to 128
+nominal increments below the breakaway force) and the nominal rate takes it through the
+breakaway from there. A stuck tip gets an approach alone where the climb would not help:
+held beyond the predicted breakaway (wedged between hfield facets, whose deepest normal
+predicts too little), or more than a rollback's worth of increments below it. Stepping
+the margin at the nominal rate cost ~1000 steps per ramp cycle at kappa ~ 5 and I_e =
+1e-4; the approach and its rollback cost ~250.
+
+Users: :mod:`spine_mj.sim.ramp` (every stick phase of the ramp with reset) and
+:mod:`spine_mj.sim.rollout` (the static probe's one stick phase, after settling). What the
+equivalence neglects is written in the ramp's module docstring and the README.
 """
 
 from __future__ import annotations
@@ -35,6 +45,10 @@ RISE_STEPS = 100
 NOMINAL_STEPS = 100
 #: Largest change of a unit normal (any component) that counts as the same normal.
 NORMAL_TOL = 1e-4
+#: Rate of the approach stage, in nominal increments per step (see :class:`StickFastForward`).
+APPROACH_RATE = 8.0
+#: Steps between checkpoints inside a phase (a rollback goes back 8 to 16 steps).
+CHECKPOINT_STEPS = 8
 
 
 class StickFastForward:
@@ -47,16 +61,28 @@ class StickFastForward:
     preload_n, cap_n : float
         F_p [N] and the largest force ``kappa_cap F_p`` [N].
     margin : float
-        A phase stops at ``(1 - margin)`` of the predicted breakaway force.
+        The climb stops at ``(1 - margin)`` of the predicted breakaway force.
     stick_speed_m_s, slip_speed_m_s : float
         Still below the first; a slip (which allows a new phase) above the second.
+    approach_rate : float or None
+        For a caller that rolls back to checkpoints (the ramp): after the climb the phase
+        goes on at ``approach_rate`` nominal increments per step up to the cap, so that the
+        breakaway itself happens in it and is rolled back (8 to 16 steps, a force
+        ``approach_rate`` times that many increments lower) to be taken at the nominal
+        rate, instead of covering the whole margin at that rate. A stuck tip that the
+        climb would not help gets such an approach alone: where it holds beyond the
+        predicted breakaway (wedged between facets, whose deepest normal predicts too little)
+        or lies more than a rollback's worth of increments below it. None: the nominal
+        rate takes over after the climb.
     """
 
-    def __init__(self, *, mu, preload_n, cap_n, margin, stick_speed_m_s, slip_speed_m_s):
+    def __init__(self, *, mu, preload_n, cap_n, margin, stick_speed_m_s, slip_speed_m_s, approach_rate=None):
         self.mu, self.preload_n, self.cap_n, self.margin = mu, preload_n, cap_n, margin
         self.stick, self.slip = stick_speed_m_s, slip_speed_m_s
+        self.approach_rate = approach_rate
         self.active, self.blocked, self.quiet = False, False, 0
-        self.target_n, self.step_n = 0.0, 0.0
+        self.target_n, self.step_n, self.approach_to_n = 0.0, 0.0, 0.0
+        self.blocked_to_n = 0.0  # force at which the last phase ended
         self.normal0 = np.zeros(3)
         self.prev = np.zeros(3)
         self.phases = self.rollbacks = 0
@@ -68,13 +94,20 @@ class StickFastForward:
         self.prev = normal.copy()
         if self.active:
             if not contact or vt > self.stick:
-                self.active, self.blocked, self.quiet = False, True, 0
+                self._end(force)
                 self.rollbacks += 1
                 return "rollback"
-            if float(np.abs(normal - self.normal0).max()) > NORMAL_TOL or force >= self.target_n:
-                self.active, self.blocked, self.quiet = False, True, 0
+            if float(np.abs(normal - self.normal0).max()) > NORMAL_TOL:
+                self._end(force)
+            elif force >= self.target_n:
+                if self.approach_rate is not None and self.approach_to_n > self.target_n:
+                    self.target_n, self.step_n = self.approach_to_n, self.approach_rate * step_n
+                else:
+                    self._end(force)
             return ""
-        if vt > self.slip:
+        # a new phase once the tip has slipped, or once the nominal ramp has carried the
+        # force past where the last phase ended (the tip moved there without slipping)
+        if vt > self.slip or force > self.blocked_to_n:
             self.blocked = False
         self.quiet = self.quiet + 1 if (same and vt <= self.stick) else 0
         if self.blocked or self.quiet < QUIET_STEPS:
@@ -86,12 +119,23 @@ class StickFastForward:
         # leave the nominal ramp at least NOMINAL_STEPS before the predicted breakaway, so
         # the contact loaded by the fast rise settles before it is tested
         target = min((1 - self.margin) * f_b, f_b - NOMINAL_STEPS * step_n, self.cap_n)
-        if target - force <= 2 * RISE_STEPS * step_n:
+        self.approach_to_n = self.cap_n
+        if target - force > 2 * RISE_STEPS * step_n:
+            self.step_n = (target - force) / RISE_STEPS
+        elif (
+            self.approach_rate is not None
+            and force < self.cap_n
+            and (force >= f_b or f_b - force > 2 * CHECKPOINT_STEPS * self.approach_rate * step_n)
+        ):
+            target, self.step_n = self.cap_n, self.approach_rate * step_n
+        else:
             return ""  # the nominal ramp gets there about as fast
         self.active, self.target_n, self.normal0 = True, target, normal.copy()
-        self.step_n = (target - force) / RISE_STEPS
         self.phases += 1
         return "start"
+
+    def _end(self, force: float) -> None:
+        self.active, self.blocked, self.quiet, self.blocked_to_n = False, True, 0, force
 
 
 def fast_forward_on(drive, engine, tip) -> bool:

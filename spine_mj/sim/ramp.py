@@ -9,25 +9,26 @@ analyses the run like any other, adding the resets to the events.
 Stick-phase fast-forward (``RampDrive.fast_forward``, on by default; the rule is
 :class:`~spine_mj.sim.fastforward.StickFastForward`, shared with the static probe). While
 the ramp is on, every stick phase may climb fast to just below the breakaway force
-predicted from the contact normal, then the nominal rate carries the force through
-breakaway and the slip. A phase ends early when the contact normal changes; when the tip
-moves during a phase (tangential speed above the stick speed, or contact lost), the run is
-put back to the checkpoint taken 16 to 32 steps earlier (state, controller and recorded
-rows) and goes on at the nominal rate. A new phase needs the tip to have slipped since the
-last one. ``duration_s`` and ``time_s`` count engine time, so a fast-forwarded run covers
-more of the path in the same duration; :func:`nominal_time_s` gives the time the plain
-ramp would have taken.
+predicted from the contact normal and approach it at a few times the nominal rate; the
+tip's motion at breakaway puts the run back to the checkpoint taken 8 to 16 steps earlier
+(state, controller and recorded rows), and the nominal rate carries the force through
+breakaway and the slip. A phase ends early when the contact normal changes. A new phase
+needs the tip to have slipped since the last one, or the nominal ramp to have carried
+the force past where the last one ended. ``duration_s`` and ``time_s`` count engine
+time, so a fast-forwarded run covers more of the path in the same duration;
+:func:`nominal_time_s` gives the time the plain ramp would have taken.
 
 What the equivalence neglects. (1) Creep: noslip makes the stick rigid (a stuck tip moves
 ~1e-11 m/s), so the plain ramp's long stick moves the tip by nothing measurable; without
 noslip friction creeps at any load and fast-forward is off. (2) The soft normal contact:
 the faster rise loads the contact within ``RISE_STEPS = 50`` contact time constants, far
-slower than its response, and the nominal ramp that follows lasts many time constants
-before breakaway, so the breakaway starts from the same quasistatic contact. (3) The
-margin: the prediction uses the deepest contact's normal; where two facets share the load
+slower than its response, and the nominal ramp after a rollback lasts 32 to 64 time
+constants before breakaway, so the breakaway starts from the same quasistatic contact.
+(3) The prediction: it uses the deepest contact's normal; where two facets share the load
 (an hfield edge) the breakaway can lie below it by a few per cent (measured up to 1.5 %
-on the single peak), inside the default 3 % margin; a larger error is caught by the
-rollback. On the cases of ``tests/test_sim_fastforward.py`` and
+on the single peak), inside the default 3 % margin of the climb, or above it (a wedge),
+where the approach goes on to the cap; either way the breakaway itself is taken at the
+nominal rate. On the cases of ``tests/test_sim_fastforward.py`` and
 ``benchmarks/bench_fastforward.py`` the breakaway forces agree with the plain ramp's within
 0.5 % and the outcomes and paths agree (Frechet <= 0.01 L_c).
 
@@ -50,13 +51,11 @@ import numpy as np
 
 from spine_mj.sim.detection import Detection, Event
 from spine_mj.sim.drives import RampDrive, rate_n_s, settle_steps
-from spine_mj.sim.fastforward import StickFastForward, fast_forward_on
+from spine_mj.sim.fastforward import APPROACH_RATE, CHECKPOINT_STEPS, StickFastForward, fast_forward_on
 from spine_mj.sim.model import RigModel
 from spine_mj.sim.results import RunResult, analyse, recorded_marks
 from spine_mj.sim.rollout import warning_text, warning_total
 
-#: Steps between checkpoints inside a phase (a rollback goes back 16 to 32 steps).
-CHECKPOINT_STEPS = 16
 #: Steps between two early-termination checks.
 END_CHECK_STEPS = 256
 
@@ -257,6 +256,7 @@ def _controller(rig: RigModel, drive: RampDrive, det: Detection, n_settle: int) 
             margin=drive.fast_forward_margin,
             stick_speed_m_s=det.stick_speed_m_s / u.speed_m_s,
             slip_speed_m_s=det.slip_speed_m_s / u.speed_m_s,
+            approach_rate=APPROACH_RATE,
         )
     slide = drive.slide_distance_m
     return ResetController(
