@@ -301,8 +301,10 @@ class _Group:
             elif warning is not None:
                 self.warnings[k] = (a + warning[0], warning[1])
                 stop.add(k)
-            if k in self.climbs and not self.climb_held(k, a, b):
-                continue  # dropped: the probe goes on from its settled state
+            if k in self.climbs:
+                if not self.climb_held(k, a, b):
+                    continue  # dropped: the probe goes on from its settled state
+                self.pieces[k] = 1  # the breakaway is expected within ~2 NOMINAL_STEPS: a 256-step piece
             windows.setdefault((a, b), []).append(k)
         for (a, b), ks in windows.items():
             ks = np.array(ks)
