@@ -91,38 +91,54 @@ def probe_rows(res: int, ie: float) -> list[dict]:
     return rows
 
 
-def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--ie", type=float, default=1e-2)
-    ap.add_argument("--cycles", type=int, default=2)
-    ap.add_argument("--res", type=int, default=61)
-    args = ap.parse_args()
-    for name, rig, start in _cases(args.res):
+def ramp_rows(res: int, ie: float, cycles: int) -> list[dict]:
+    """Plain and fast-forwarded ramps for ``cycles`` cycles on every case: breakaway forces,
+    Frechet distance of the paths, rows to the last reset of each."""
+    rows = []
+    for name, rig, start in _cases(res):
         sc = rig.scales
-        rate = math.sqrt(args.ie) * sc.preload_n / sc.time_s
+        rate = math.sqrt(ie) * sc.preload_n / sc.time_s
         per_cycle = 5 * sc.preload_n / rate + 400 * rig.engine.timestep_s
         drive = sim.RampDrive(
-            rate_n_s=rate, duration_s=args.cycles * per_cycle, slide_distance_m=0.05 * sc.char_length_m
+            rate_n_s=rate, duration_s=cycles * per_cycle, slide_distance_m=0.05 * sc.char_length_m
         )
         t0 = time.perf_counter()
         plain = rig.run(dataclasses.replace(drive, fast_forward=False), start=start)
         t1 = time.perf_counter()
         fast = rig.run(drive, start=start)
         t2 = time.perf_counter()
-        kp, kf = cycle_breakaways(plain, args.cycles), cycle_breakaways(fast, args.cycles)
+        kp, kf = cycle_breakaways(plain, cycles), cycle_breakaways(fast, cycles)
         k = min(kp.size, kf.size)
-        dk = float(np.max(np.abs(kf[:k] / kp[:k] - 1))) if k else math.nan
-        a, b = (
-            plain.position_m[: rows_to_reset(plain, args.cycles), :2],
-            fast.position_m[: rows_to_reset(fast, args.cycles), :2],
+        n_p, n_f = rows_to_reset(plain, cycles), rows_to_reset(fast, cycles)
+        rows.append(
+            {
+                "case": name,
+                "breakaways": f"{k}/{kp.size}",
+                "max_rel_diff": float(np.max(np.abs(kf[:k] / kp[:k] - 1))) if k else math.nan,
+                "frechet_lc": compare.path_frechet(
+                    fast.position_m[:n_f, :2], plain.position_m[:n_p, :2], length_scale=sc.char_length_m
+                ),
+                "end": f"{plain.end_reason.value}/{fast.end_reason.value}",
+                "steps_plain": n_p,
+                "steps_fast": n_f,
+                "wall_s": (t1 - t0, t2 - t1),
+            }
         )
-        fr = compare.path_frechet(b, a, length_scale=sc.char_length_m)
-        n_p, n_f = rows_to_reset(plain, args.cycles), rows_to_reset(fast, args.cycles)
+    return rows
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--ie", type=float, default=1e-2)
+    ap.add_argument("--cycles", type=int, default=2)
+    ap.add_argument("--res", type=int, default=61)
+    args = ap.parse_args()
+    for r in ramp_rows(args.res, args.ie, args.cycles):
         print(
-            f"{name:32s} breakaways {k}/{kp.size} max rel diff {dk:.2e}  Frechet/L_c {fr:.2e}  "
-            f"end {plain.end_reason.value}/{fast.end_reason.value}  "
-            f"steps {n_p}/{n_f} = {n_p / max(n_f, 1):.1f}x  "
-            f"wall {t1 - t0:.1f}/{t2 - t1:.1f} s  load {os.getloadavg()[0]:.1f}"
+            f"{r['case']:32s} breakaways {r['breakaways']} max rel diff {r['max_rel_diff']:.2e}  "
+            f"Frechet/L_c {r['frechet_lc']:.2e}  end {r['end']}  "
+            f"steps {r['steps_plain']}/{r['steps_fast']} = {r['steps_plain'] / r['steps_fast']:.1f}x  "
+            f"wall {r['wall_s'][0]:.1f}/{r['wall_s'][1]:.1f} s  load {os.getloadavg()[0]:.1f}"
         )
     for r in probe_rows(args.res, args.ie):
         print(
