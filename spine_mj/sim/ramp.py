@@ -33,10 +33,10 @@ nominal rate. On the cases of ``tests/test_sim_fastforward.py`` and
 0.5 % and the outcomes and paths agree (Frechet <= 0.01 L_c).
 
 Early termination (``RampDrive.stop_early``): every :data:`END_CHECK_STEPS` steps outside
-a fast-forward phase the new rows are run through the same end rules as the analysis
-(:func:`~spine_mj.sim.detection.end_marks`: deep penetration, leaving the domain, the force
-at ``kappa_cap F_p`` while stuck); at the first one the run stops, so the recorded
-trajectory and end reason are those of the full run up to its end. With fast-forward a
+a fast-forward phase the new rows go into the run's analysis
+(:class:`~spine_mj.sim.results.GroupAnalysis`, the one the result comes from); at the
+first ending the run stops, so the recorded trajectory and end reason are those of the
+full run up to its end. With fast-forward a
 tip on a self-locking normal reaches the cap within a phase instead of after
 ``kappa_cap F_p / rate``.
 """
@@ -53,7 +53,7 @@ from spine_mj.sim.detection import Detection, Event
 from spine_mj.sim.drives import RampDrive, rate_n_s, settle_steps
 from spine_mj.sim.fastforward import APPROACH_RATE, CHECKPOINT_STEPS, StickFastForward, fast_forward_on
 from spine_mj.sim.model import RigModel
-from spine_mj.sim.results import RunResult, analyse, recorded_marks
+from spine_mj.sim.results import GroupAnalysis, RunResult
 from spine_mj.sim.rollout import warning_text, warning_total
 
 #: Steps between two early-termination checks.
@@ -185,12 +185,14 @@ def nominal_time_s(result: RunResult) -> np.ndarray:
 
 
 class _Stepper:
-    """The stepping loop's arrays and checkpoints: one row per engine step."""
+    """The stepping loop's arrays, checkpoints and the analysis of its rows: one row per
+    engine step."""
 
-    def __init__(self, m, d, nstep: int, ctl: ResetController):
+    def __init__(self, m, d, nstep: int, ctl: ResetController, analysis: GroupAnalysis):
         import mujoco
 
         self.m, self.d, self.ctl = m, d, ctl
+        self.analysis, self.analysed = analysis, 0  # rows 0..analysed-1 are in the analysis
         self.full = mujoco.mjtState.mjSTATE_FULLPHYSICS
         self.exact = mujoco.mjtState.mjSTATE_INTEGRATION  # warm start included: an exact restart
         self.state = np.empty((nstep, mujoco.mj_stateSize(m, self.full)))
@@ -227,15 +229,14 @@ class _Stepper:
         self.checkpoints = []
         return row
 
-
-def _first_end(rig: RigModel, st: _Stepper, a: int, b: int, det: Detection) -> int | None:
-    """The first row in ``a..b-1`` at which the analysis would end the run (deep
-    penetration, left the domain, self-lock), or None."""
-    state, sens = st.state[None, a:b], st.sens[None, a:b]
-    # only deep, out and the locks are read here: no speed limit
-    _, marks = recorded_marks(rig, state, sens, np.full((1, b - a), np.nan), det, np.array([np.inf]))
-    found = [int(marks[k][0]) for k in ("deep", "out", "lock", "lock_rule") if marks[k][0] >= 0]
-    return a + min(found) if found else None
+    def analyse_to(self, b: int) -> bool:
+        """Add rows ``analysed..b-1`` to the run's analysis (they are final: a rollback never
+        reaches back before the phase, and rows are added outside phases); whether the run
+        has an ending by row b-1."""
+        a, self.analysed = self.analysed, max(b, self.analysed)
+        if b <= a:
+            return False
+        return bool(self.analysis.add(slice(0, 1), a, b, self.state[None, a:b], self.sens[None, a:b])[0])
 
 
 def _controller(rig: RigModel, drive: RampDrive, det: Detection, n_settle: int) -> ResetController:
@@ -270,13 +271,13 @@ def _controller(rig: RigModel, drive: RampDrive, det: Detection, n_settle: int) 
     )
 
 
-def _step_loop(rig, st: _Stepper, nstep: int, n_settle: int, det, stop_early: bool, progress):
+def _step_loop(rig, st: _Stepper, nstep: int, n_settle: int, stop_early: bool, progress):
     """Step until ``nstep`` rows, an early end or engine trouble; returns (rows, warning)."""
     import mujoco
 
     m, d, ctl = st.m, st.d, st.ctl
     ff = ctl.ff
-    warn_total, checked, i = warning_total(d), n_settle, 0
+    warn_total, i = warning_total(d), 0
     while i < nstep:
         if i >= n_settle:
             d.ctrl[rig.act_push] = ctl.push()
@@ -297,12 +298,10 @@ def _step_loop(rig, st: _Stepper, nstep: int, n_settle: int, det, stop_early: bo
         if (
             stop_early
             and not (ff is not None and ff.active)
-            and (i - checked >= END_CHECK_STEPS or i == nstep)
+            and (i - st.analysed >= END_CHECK_STEPS or i == nstep)
+            and st.analyse_to(i)
         ):
-            end = _first_end(rig, st, checked, i, det)
-            if end is not None:
-                return end + 1, None
-            checked = i
+            return i, None
         if progress is not None and i % 2000 == 0:
             progress(i / nstep)
     return nstep, None
@@ -336,10 +335,10 @@ def run_ramp(
         )
     nstep = n_settle + int(math.ceil(duration / dt))
     ctl = _controller(rig, drive, det, n_settle)
-    st = _Stepper(m, d, nstep, ctl)
-    stop, warning = _step_loop(rig, st, nstep, n_settle, det, drive.stop_early, progress)
-    state, sens, ctrl_log = st.state[:stop], st.sens[:stop], st.ctrl_log[:stop]
-    result = analyse(rig, drive, start, state, sens, ctrl_log, det, warning or (None, ""))
-    resets = tuple(Event("reset", i, float(state[i, 0])) for i in ctl.resets if i < result.n)
+    st = _Stepper(m, d, nstep, ctl, GroupAnalysis(rig, [drive], [start], det, np.full((1, nstep), np.nan)))
+    stop, warning = _step_loop(rig, st, nstep, n_settle, drive.stop_early, progress)
+    st.analyse_to(stop)
+    result = st.analysis.results([warning or (None, "")])[0]
+    resets = tuple(Event("reset", i, float(st.state[i, 0])) for i in ctl.resets if i < result.n)
     events = sorted(result.events + resets, key=lambda e: (e.index, e.kind == result.end_reason.value))
     return dataclasses.replace(result, events=tuple(events), simulated_steps=st.steps)

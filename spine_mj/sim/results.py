@@ -176,30 +176,6 @@ class RunResult:
         }
 
 
-def analyse(rig: RigModel, drive: Drive, start, state, sens, ctrl, det: Detection, warning) -> RunResult:
-    """:func:`analyse_group` of one run (``state`` ``(n, nstate)``, ``sens`` ``(n, nsensordata)``)."""
-    return analyse_group(rig, [drive], [start], state[None], sens[None], [ctrl], det, [warning])[0]
-
-
-def recorded_marks(rig: RigModel, state, sens, carriage_x, det: Detection, speed_limit_m_s):
-    """A group's SI :class:`Recording` and its end marks (:func:`end_marks`) on ``rig``."""
-    group = Recording.from_sensors(
-        rig.sensor_adr, state, sens, units=rig.units, carriage_x=carriage_x, slip_speed_m_s=det.slip_speed_m_s
-    )
-    marks = end_marks(
-        group,
-        state,
-        sens,
-        timestep_s=rig.engine.timestep_s,
-        bounds_m=(*rig.bounds_m, *rig.z_range_m),
-        det=det,
-        preload_n=rig.scales.preload_n,
-        speed_limit_m_s=speed_limit_m_s,
-        mu=rig.tip.mu_s,
-    )
-    return group, marks
-
-
 def analyse_group(
     rig: RigModel,
     drives: Sequence[Drive],
