@@ -8,7 +8,11 @@ Sections (each records the machine's load average before and after it):
 * ``streamline``: steps/s of the compiled kernel (analytic single Gaussian, gridded
   fractal) and of the plain numpy reference (``backend="numpy"``) on the same starts.
 * ``rollout``: ``Rig.run_batch`` against bare ``mujoco.rollout`` (same model, controls and
-  recording), paired runs in alternating order; the median of the per-pair ratios.
+  recording, runs that do not end early), paired runs in alternating order; the median of
+  the per-pair ratios. And the steps and time ``Rig.run_batch`` saves by stopping decided
+  runs (``stop_early``) on a fractal where most runs self-lock.
+* ``fastforward``: the static probe and the force ramp with and without stick-phase
+  fast-forward (``benchmarks/bench_fastforward.py``): breakaway forces, steps.
 * ``sweep``: the one-worker sweep against bare rollout, and its two-worker efficiency.
 * ``cost``: steps per spring-drive run against I_e and the spring stiffness K on the single
   peak and on a fractal, with a fitted cost model (see :func:`fit_cost`).
@@ -131,7 +135,50 @@ def bench_rollout(quick: bool) -> dict:
         "ratios": ratios,
         "ratio_median": statistics.median(ratios),
         "target": 0.95,
+        "early": early_stop(quick, nthread),
     }
+
+
+def early_stop(quick: bool, nthread: int) -> dict:
+    """``Rig.run_batch`` on ``paper-fractal`` (preset mu, I_e 1e-3, default K), where most
+    runs self-lock early: simulated steps and wall time with and without ``stop_early``."""
+    from spine_mj import presets
+    from spine_mj.sim import Rig, SpringDrive, TipParams
+
+    surface = presets.make_surface("paper-fractal")
+    rig = Rig(surface, tip=TipParams(mu_s=presets.calibrated_mu("paper-fractal")))
+    xmin, xmax, ymin, ymax = surface.bounds
+    n = 4 if quick else 8
+    starts = [
+        (xmin + 0.05 * (xmax - xmin), float(y))
+        for y in np.linspace(ymin + 0.2 * (ymax - ymin), ymax - 0.2 * (ymax - ymin), n)
+    ]
+    drive = SpringDrive(speed_m_s=rig.scales.speed_for(1e-3))
+    out = {"preset": "paper-fractal", "mu": rig.tip.mu_s, "ie": 1e-3, "runs": n}
+    for stop in (False, True):
+        t0 = time.perf_counter()
+        res = rig.run_batch(drive, starts, nthread=nthread, stop_early=stop)
+        out["early" if stop else "plain"] = {
+            "wall_s": time.perf_counter() - t0,
+            "simulated_steps": int(sum(r.simulated_steps for r in res)),
+            "recorded_steps": int(sum(r.n for r in res)),
+            "end_reasons": sorted({r.end_reason.value for r in res}),
+        }
+    return out
+
+
+# ----------------------------------------------------------------------------- fast-forward
+
+
+def bench_fastforward_section(quick: bool) -> dict:
+    """The static probe at I_e 1e-3 and 1e-2 and the ramp at I_e 1e-2 (2 cycles), plain and
+    fast-forwarded (see bench_fastforward.py)."""
+    from bench_fastforward import probe_rows, ramp_rows
+
+    out = {"probe": {str(ie): probe_rows(61, ie) for ie in (1e-3, 1e-2)}}
+    if not quick:
+        out["ramp"] = ramp_rows(61, 1e-2, 2)
+    return out
 
 
 # ----------------------------------------------------------------------------- sweep
@@ -205,6 +252,7 @@ def bench_cost(quick: bool) -> dict:
                         "ie": ie,
                         "k_factor": kf,
                         "planned_steps": planned,
+                        "simulated_steps_mean": float(np.mean([r.simulated_steps for r in res])),
                         "recorded_steps_mean": float(np.mean([r.n for r in res])),
                         "end_reasons": sorted({r.end_reason.value for r in res}),
                         "wall_s_per_run": wall / len(starts),
@@ -385,6 +433,17 @@ def markdown(res: dict) -> str:
             f"(range {min(ro['ratios']):.3f}-{max(ro['ratios']):.3f}) | "
             f"{ro['ratio_median']:.3f} | >= 0.95 | {ld} |",
         ]
+        e = ro.get("early")
+        if e:
+            p, q = e["plain"], e["early"]
+            lines.append(
+                f"| `Rig.run_batch` stopping decided runs, {e['preset']} (mu {e['mu']:g}, I_e {e['ie']:g}, "
+                f"{e['runs']} runs, ends: {', '.join(q['end_reasons'])}): simulated steps, wall | "
+                f"{q['simulated_steps']} instead of {p['simulated_steps']} "
+                f"({p['simulated_steps'] / q['simulated_steps']:.1f}x fewer; "
+                f"recorded {q['recorded_steps']}), "
+                f"{q['wall_s']:.2f} s instead of {p['wall_s']:.2f} s | | {ld} |"
+            )
     sw = res.get("sweep")
     if sw:
         ld = f"{sw['load_before']}-{sw['load_after']}"
@@ -395,6 +454,7 @@ def markdown(res: dict) -> str:
             f"{sw['parallel_efficiency']:.3f} | >= 0.85 | {ld} |",
         ]
     lines += _cost_markdown(res.get("cost"))
+    lines += _fastforward_markdown(res.get("fastforward"))
     lines += _gpu_markdown(res.get("gpu"))
     return "\n".join(lines) + "\n"
 
@@ -404,10 +464,11 @@ def _cost_markdown(cost) -> list[str]:
         return []
     out = [
         "",
-        "**Cost model** (spring drive, steps per run; rollout simulates every planned step, a "
-        "run's recording is then cut at its end event). A run lasts (path + spring stretch) / "
+        "**Cost model** (spring drive, planned steps per run: the most a run can take; a run "
+        "whose outcome is decided earlier stops within a piece of its end, see the simulated "
+        "steps). A run lasts (path + spring stretch) / "
         "speed with speed = sqrt(I_e) v_c and dt fixed by the contact, so "
-        "`steps = s0 + I_e^-1/2 (A + B / k)` with `k = K L_c / F_p`. Size a sweep as "
+        "`steps = s0 + I_e^-1/2 (A + B / k)` with `k = K L_c / F_p`. Size a sweep as at most "
         "runs x steps / (steps/s of `Rig.run_batch` above).",
         "",
         "| surface | dt [s] | s0 | A | B | R^2 | max rel. err | power law a I_e^b: b (R^2) |",
@@ -422,17 +483,52 @@ def _cost_markdown(cost) -> list[str]:
         )
     out += [
         "",
-        "| surface | I_e | K [F_p/L_c] | planned steps | recorded steps (mean) | wall s / run | end |",
-        "| --- | --- | --- | --- | --- | --- | --- |",
+        "| surface | I_e | K [F_p/L_c] | planned steps | simulated steps (mean) | recorded steps (mean) "
+        "| wall s / run | end |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- |",
     ]
     for fam, f in cost["families"].items():
         for r in f["rows"]:
+            sim_steps = r.get("simulated_steps_mean", float(r["planned_steps"]))
             out.append(
-                f"| {fam} | {r['ie']:g} | {r['k_factor']:g} | {r['planned_steps']} | "
+                f"| {fam} | {r['ie']:g} | {r['k_factor']:g} | {r['planned_steps']} | {sim_steps:.0f} | "
                 f"{r['recorded_steps_mean']:.0f} | {r['wall_s_per_run']:.3f} | "
                 f"{', '.join(r['end_reasons'])} |"
             )
     out.append(f"\nLoad during the cost runs: {cost['load_before']}-{cost['load_after']}.")
+    return out
+
+
+def _fastforward_markdown(ff) -> list[str]:
+    if not ff:
+        return []
+    out = [
+        "",
+        "**Stick-phase fast-forward** (`benchmarks/bench_fastforward.py`; plain = `fast_forward=False`). "
+        "Static probe, the static map's probe on inclined planes (mu 0.5) and on the single peak "
+        "(hfield 61, mu 1.23):",
+        "",
+        "| I_e | case | end | kappa_mj plain / fast-forwarded | rel. diff | rows | simulated steps |",
+        "| --- | --- | --- | --- | --- | --- | --- |",
+    ]
+    for ie, rows in ff["probe"].items():
+        for r in rows:
+            out.append(
+                f"| {float(ie):g} | {r['case']} | {r['end']} | "
+                f"{r['kappa_plain']:.4f} / {r['kappa_fast']:.4f} | "
+                f"{r['rel_diff']:+.1e} | {r['rows_plain']} / {r['rows_fast']} | "
+                f"{r['steps_plain']} / {r['steps_fast']} |"
+            )
+    if ff.get("ramp"):
+        rows = ff["ramp"]
+        out.append(
+            f"\nForce ramp, I_e 1e-2, 2 cycles, {len(rows)} cases (planes -15...25 deg, single peak and "
+            f"valley from 4 starts each): breakaway forces within "
+            f"{max(r['max_rel_diff'] for r in rows):.2%} of the plain ramp's, paths within Frechet "
+            f"{max(r['frechet_lc'] for r in rows):.1e} L_c, steps to the second reset "
+            f"{sum(r['steps_plain'] for r in rows)} plain against {sum(r['steps_fast'] for r in rows)}."
+        )
+    out.append(f"\nLoad: {ff['load_before']}-{ff['load_after']}.")
     return out
 
 
@@ -505,6 +601,7 @@ def main(argv=None) -> None:
         res = {"quick": args.quick, "machine": machine()}
         sections = {"streamline": bench_streamline, "rollout": bench_rollout, "sweep": bench_sweep}
         sections["cost"] = bench_cost
+        sections["fastforward"] = bench_fastforward_section
         if args.gpu:
             sections["gpu"] = bench_gpu
         for name, fn in sections.items():

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import pytest
@@ -25,13 +26,12 @@ def test_static_probe_matches_closed_form(slope_deg):
 
 def test_static_probe_self_locks_beyond_90_degrees():
     rig = plane_rig(70.0)  # theta + arctan(mu) = 96.6 deg
-    res = rig.run(
-        StaticProbe(
-            start_force_n=1.5 * math.tan(math.radians(70) - PHI) * rig.scales.preload_n,
-            rate_n_s=20 * rig.scales.preload_n,
-        ),
-        start=START,
+    probe = StaticProbe(
+        start_force_n=1.5 * math.tan(math.radians(70) - PHI) * rig.scales.preload_n,
+        rate_n_s=20 * rig.scales.preload_n,
+        fast_forward=False,
     )
+    res = rig.run(probe, start=START)
     assert res.end_reason is EndReason.SELF_LOCK
     # the shared lock rule ends it (the force cap is only the safety net): stuck on a
     # self-locking normal while the force rose one preload, the streamline's verdict too
@@ -42,6 +42,10 @@ def test_static_probe_self_locks_beyond_90_degrees():
     assert res.drive_force_n[-1] < res.detection.kappa_cap * fp
     assert int(kappa(math.tan(math.radians(70)), 0.0, MU)[1]) == SELF_LOCK
     assert math.isnan(res.kappa_mj)
+    # fast-forwarded, the force climbs toward the cap at once and the same rule ends it
+    fast = rig.run(dataclasses.replace(probe, fast_forward=True), start=START)
+    assert fast.end_reason is EndReason.SELF_LOCK and fast.end_detail.startswith("lock rule")
+    assert fast.n < res.n
 
 
 @pytest.mark.parametrize(("slope_deg", "locks"), [(55.0, False), (70.0, True)])

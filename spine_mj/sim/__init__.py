@@ -42,15 +42,18 @@ equivalent speed ``v_eq = L_c (dF/dt) / F_p`` (the speed at which the tip would 
 feature in the time the force takes to rise by one preload).
 
 Spring drives and static probes run open loop through :func:`mujoco.rollout.rollout` on
-native threads (a batch of starts or parameter sets at once); the force ramp with reset
-needs feedback and steps in Python. Every run ends with a recorded :class:`EndReason`,
-never with an exception from the engine.
+worker threads (a batch of starts or parameter sets at once, each run in pieces continued
+from its exact state and stopped once its outcome is decided); the force ramp with reset
+needs feedback and steps in Python. The ramp and the static probe fast-forward their
+stick phases (:mod:`~spine_mj.sim.fastforward`). Every run ends with a recorded
+:class:`EndReason`, never with an exception from the engine.
 
 Modules: :mod:`~spine_mj.sim.params` (tip, engine, scales and their rules),
 :mod:`~spine_mj.sim.drives`, :mod:`~spine_mj.sim.model` (building the MuJoCo model),
 :mod:`~spine_mj.sim.placement`, :mod:`~spine_mj.sim.recording` (per-step columns),
 :mod:`~spine_mj.sim.detection` (events, end reasons), :mod:`~spine_mj.sim.results`,
 :mod:`~spine_mj.sim.rollout` (open-loop batches), :mod:`~spine_mj.sim.ramp` (closed loop),
+:mod:`~spine_mj.sim.fastforward` (the stick-phase fast-forward rule both use),
 :mod:`~spine_mj.sim.render`, :mod:`~spine_mj.sim.planes` and :mod:`~spine_mj.sim.rig`
 (:class:`Rig`, the object users hold).
 """

@@ -122,27 +122,38 @@ def first_indices(mask: np.ndarray) -> np.ndarray:
 LOCK_RISE_FP = 1.0
 
 
-def normal_lock_marks(rec: Recording, mu: float, preload_n: float) -> np.ndarray:
-    """First step of each run at which the shared lock rule holds, or -1.
+def normal_lock_marks(
+    rec: Recording, mu: float, preload_n: float, held_from_n: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """First step of each run at which the shared lock rule holds (or -1), and the carry.
 
     The rule the streamline uses (:func:`spine_mj.engagement.kappa_of_normal`, paper
     Fig. 2C), made sustained for a dynamic run: the tip is stuck in contact, the normal of
     its deepest contact lies in the self-lock region, and while both hold without a break
     the drive force has risen by :data:`LOCK_RISE_FP` preloads (the drive pushes into the
     surface and the contact holds, as the theory says it must at any force).
+
+    ``rec`` may be a window of the runs (rows a..b-1): ``held_from_n`` ``(g,)`` is then the
+    drive force at the start of a held streak still going on at row a-1 (NaN: none), and
+    the second result is the same for row b-1, to pass with the next window; the marks
+    are window rows. Windows passed in order give the marks of the whole run.
     """
-    _, region = kappa_of_normal(np.nan_to_num(rec.normal), mu)
-    held = rec.contact & ~rec.slipping & (region == SELF_LOCK)
-    g, n = held.shape
-    out = np.full(g, -1)
-    for r in range(g):
-        if not held[r].any():
-            continue
-        run_start = np.maximum.accumulate(np.where(~held[r], np.arange(n) + 1, 0))
-        rise = rec.drive_force_n[r] - rec.drive_force_n[r, np.minimum(run_start, n - 1)]
-        hit = np.flatnonzero(held[r] & (rise >= LOCK_RISE_FP * preload_n))
-        out[r] = hit[0] if hit.size else -1
-    return out
+    g, n = rec.contact.shape
+    candidate = rec.contact & ~rec.slipping
+    region = np.zeros((g, n), np.int8)  # the rule is evaluated where the tip is stuck in contact
+    region[candidate] = kappa_of_normal(rec.normal[candidate], mu)[1]
+    held = candidate & (region == SELF_LOCK)
+    if not held.any():
+        return np.full(g, -1), np.full(g, np.nan)
+    # first row of the held streak each row belongs to (0: since the window's first row)
+    start = np.maximum.accumulate(np.where(held, 0, np.arange(1, n + 1)), axis=1)
+    force = rec.drive_force_n
+    base = np.take_along_axis(force, np.minimum(start, n - 1), axis=1)
+    if held_from_n is not None:
+        base = np.where((start == 0) & np.isfinite(held_from_n)[:, None], held_from_n[:, None], base)
+    hit = held & (force - base >= LOCK_RISE_FP * preload_n)
+    carry = np.where(held[:, -1], base[:, -1], np.nan) if n else np.full(g, np.nan)
+    return first_indices(hit), carry
 
 
 def end_marks(
@@ -156,6 +167,7 @@ def end_marks(
     preload_n: float,
     speed_limit_m_s: np.ndarray,
     mu: float | None = None,
+    first_step: int = 0,
 ) -> dict[str, np.ndarray]:
     """First step of each end condition for each run of a group (``rec`` ``(g, n, ...)``), or -1.
 
@@ -166,6 +178,8 @@ def end_marks(
     zmin, zmax)``), ``deep`` (penetration above tolerance), ``out`` (the tip left the
     domain), ``lock_rule`` (the shared lock rule, :func:`normal_lock_marks`; needs ``mu``)
     and ``lock`` (the safety net: the drive force reached ``kappa_cap F_p`` while stuck).
+    ``first_step``: the run step of the rows' first row (a window of a run; the marks are
+    window rows, and the lock rule sees the window alone).
     """
     g, n = state.shape[:2]
     dt = timestep_s
@@ -173,7 +187,7 @@ def end_marks(
         nonfinite = np.full(g, -1)
     else:
         nonfinite = first_indices(~(np.isfinite(state).all(axis=2) & np.isfinite(sens).all(axis=2)))
-    expected = dt * np.arange(1, n + 1)
+    expected = dt * np.arange(first_step + 1, first_step + n + 1)
     xmin, xmax, ymin, ymax, zmin, zmax = bounds_m
     mg = det.domain_margin_m
     px, py, pz = rec.position_m[:, :, 0], rec.position_m[:, :, 1], rec.position_m[:, :, 2]
@@ -190,7 +204,7 @@ def end_marks(
         "deep": first_indices(rec.penetration_m > det.penetration_tol_m),
         "out": first_indices((px < xmin + mg) | (px > xmax - mg) | (py < ymin + mg) | (py > ymax - mg)),
         "lock": first_indices((rec.drive_force_n >= cap * (1 - 1e-9)) & ~rec.slipping),
-        "lock_rule": np.full(g, -1) if mu is None else normal_lock_marks(rec, mu, preload_n),
+        "lock_rule": np.full(g, -1) if mu is None else normal_lock_marks(rec, mu, preload_n)[0],
     }
 
 

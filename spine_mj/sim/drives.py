@@ -74,10 +74,7 @@ class RampDrive:
     def __post_init__(self):
         check_optional(self, ["rate_n_s", "duration_s"])
         check_optional(self, ["settle_time_s", "slide_distance_m"], allow_zero=True)
-        m = check_positive("fast_forward_margin", self.fast_forward_margin)
-        if m >= 1:
-            raise SpineInputError(f"fast_forward_margin must be < 1, got {m!r}")
-        object.__setattr__(self, "fast_forward_margin", m)
+        _check_margin(self)
 
 
 @dataclass(frozen=True)
@@ -88,11 +85,19 @@ class StaticProbe:
     A start force is needed where gravity alone would slide the tip (a slope steeper than
     arctan mu): the tip is held by friction at ``start_force_n``. ``rate_n_s`` None:
     ``0.1 F_p / tau`` (``I_e = 0.01``).
+
+    ``fast_forward``: when the tip has settled stuck on one contact normal (noslip on), the
+    force climbs quickly from ``start_force_n`` to ``1 - fast_forward_margin`` of the
+    breakaway force predicted from that normal, then at ``rate_n_s`` through breakaway
+    (:mod:`spine_mj.sim.fastforward`, the rule the ramp uses); a tip that moves during the
+    climb is run again from the settled state at the nominal rate.
     """
 
     rate_n_s: float | None = None
     start_force_n: float = 0.0
     settle_time_s: float | None = None
+    fast_forward: bool = True
+    fast_forward_margin: float = 0.03
 
     def __post_init__(self):
         check_optional(self, ["rate_n_s"])
@@ -100,9 +105,19 @@ class StaticProbe:
         object.__setattr__(
             self, "start_force_n", check_positive("start_force_n", self.start_force_n, allow_zero=True)
         )
+        _check_margin(self)
 
 
 Drive = SpringDrive | RampDrive | StaticProbe
+
+
+def _check_margin(drive: RampDrive | StaticProbe) -> None:
+    """``fast_forward_margin`` must lie in (0, 1): the fast climb stops that fraction below
+    the predicted breakaway force."""
+    m = check_positive("fast_forward_margin", drive.fast_forward_margin)
+    if m >= 1:
+        raise SpineInputError(f"fast_forward_margin must be < 1, got {m!r}")
+    object.__setattr__(drive, "fast_forward_margin", m)
 
 
 def stiffness_n_m(drive: SpringDrive, scales: Scales) -> float:

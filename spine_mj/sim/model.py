@@ -300,8 +300,13 @@ class RigModel:
         ``(1 - dmax) (F_p / m) (timeconst dampratio)^2``: it starts at rest and in
         contact, never dropped (a start just above the surface falls for one step).
         """
-        x0, y0 = float(x0), float(y0)
-        self.check_start(x0, y0)
+        return self.place_many([(x0, y0)])[0]
+
+    def place_many(self, starts) -> np.ndarray:
+        """:meth:`place` of many starts (surface units): qpos ``(k, 3)`` in engine units."""
+        starts = [(float(x0), float(y0)) for x0, y0 in starts]
+        for x0, y0 in starts:
+            self.check_start(x0, y0)
         if self._placer is None or self._placer.model is not self.model:
             u = self.units
             tc, dr = self.engine.solref
@@ -315,7 +320,7 @@ class RigModel:
                 tip_radius=self.tip.tip_radius_m / u.length_m,
                 rest_depth=(1 - self.engine.solimp[1]) * a_p * (tc * dr) ** 2 / u.length_m,
             )
-        return self._placer.place(x0, y0)
+        return self._placer.place_many(starts)
 
     def check_start(self, x0: float, y0: float) -> None:
         """Raise :class:`SpineInputError` unless ``(x0, y0)`` (surface units) lies on the surface."""

@@ -57,16 +57,23 @@ class Placer:
 
     def place(self, x0: float, y0: float) -> np.ndarray:
         """qpos ``(3,)`` (engine units) with the tip resting on the hfield at ``(x0, y0)`` (surface units)."""
-        placed = self._placed
-        if (x0, y0) in placed:  # the search is deterministic: a start seen before is reused
-            return placed[(x0, y0)].copy()
-        s = self._s
-        z = self._touching_z(x0, y0) - self._rest_depth
-        qpos = np.array([x0 * s, y0 * s, z])
-        if len(placed) >= PLACE_CACHE_SIZE:
-            placed.pop(next(iter(placed)))
-        placed[(x0, y0)] = qpos
-        return qpos.copy()
+        return self.place_many([(x0, y0)])[0]
+
+    def place_many(self, points) -> np.ndarray:
+        """qpos ``(k, 3)`` of :meth:`place` for ``k`` points; the surface heights that start
+        the searches are evaluated in one call."""
+        placed, s = self._placed, self._s
+        got = {p: placed[p] for p in points if p in placed}  # the search is deterministic: reuse
+        new = [p for p in dict.fromkeys(points) if p not in got]
+        if new:
+            lo = self._surface.height(np.array([p[0] for p in new]), np.array([p[1] for p in new]))
+            for (x0, y0), z_lo in zip(new, np.atleast_1d(lo)):
+                z = self._touching_z(x0, y0, float(z_lo) * s) - self._rest_depth
+                got[(x0, y0)] = np.array([x0 * s, y0 * s, z])
+                if len(placed) >= PLACE_CACHE_SIZE:
+                    placed.pop(next(iter(placed)))
+                placed[(x0, y0)] = got[(x0, y0)]
+        return np.array([got[p] for p in points])
 
     def _probe(self, x0: float, y0: float, z: float) -> tuple[float | None, float]:
         """Signed distance of the deepest contact at height ``z`` (None: none) and |n_z|."""
@@ -81,13 +88,14 @@ class Placer:
         k = int(np.argmin(d.contact.dist[: d.ncon]))
         return float(d.contact.dist[k]), abs(float(d.contact.frame[k, 2]))
 
-    def _touching_z(self, x0: float, y0: float) -> float:
-        """Height (engine units) of the sphere centre touching the hfield (distance within 1e-7 radii)."""
+    def _touching_z(self, x0: float, y0: float, lo: float) -> float:
+        """Height (engine units) of the sphere centre touching the hfield (distance within 1e-7
+        radii), searched from ``lo``, the surface's height there (engine units)."""
         s, r = self._s, self._r
         _, _, elev, _ = self._hfield.size
+        # 2 r above the hfield's top the sphere (contact margin 0.2 r) touches nothing
         hi = (self._hfield.pos[2] + elev) * s + 2 * r
-        lo = float(self._surface.height(x0, y0)) * s
-        if not (self._probe(x0, y0, hi)[0] is None and (self._probe(x0, y0, lo)[0] or 0.0) < 0):
+        if not (self._probe(x0, y0, lo)[0] or 0.0) < 0:
             raise SpineInputError(f"could not place the tip on the surface at ({x0:g}, {y0:g})")
         z = lo + r
         for _ in range(100):  # Newton on the engine's distance, safeguarded by [lo, hi]

@@ -6,40 +6,37 @@ zero, and ramps again once the tip has been stuck for the settle time.
 :class:`ResetController` is that feedback; :func:`run_ramp` steps the model with it and
 analyses the run like any other, adding the resets to the events.
 
-Stick-phase fast-forward (``RampDrive.fast_forward``, on by default). At a low rate most
-steps integrate a tip that does not move while the force climbs. While the ramp is on,
-the noslip solver is on and the tip has been still for :data:`QUIET_STEPS` steps on one
-contact normal (tangential speed at most ``Detection.stick_speed_m_s``, the normal
-unchanged), :class:`StickFastForward` predicts the breakaway force
-``F_b = kappa_of_normal(n, mu) F_p`` (the lock rule the streamline uses; infinite in the
-self-lock region) and raises the force to ``min((1 - margin) F_b, F_b - NOMINAL_STEPS increments,
-kappa_cap F_p)`` in :data:`RISE_STEPS` steps, then hands back to the nominal rate, which carries the force
-through breakaway and the slip. A phase ends early when the contact normal changes; when
-the tip moves during a phase (tangential speed above the stick speed, or contact lost),
-the run is put back to the checkpoint taken 16 to 32 steps earlier (state, controller and
-recorded rows) and goes on at the nominal rate. A new phase needs the tip to have slipped
-since the last one. ``duration_s`` and ``time_s`` count engine time, so a fast-forwarded
-run covers more of the path in the same duration; :func:`nominal_time_s` gives the time
-the plain ramp would have taken.
+Stick-phase fast-forward (``RampDrive.fast_forward``, on by default; the rule is
+:class:`~spine_mj.sim.fastforward.StickFastForward`, shared with the static probe). While
+the ramp is on, every stick phase may climb fast to just below the breakaway force
+predicted from the contact normal and approach it at a few times the nominal rate; the
+tip's motion at breakaway puts the run back to the checkpoint taken 8 to 16 steps earlier
+(state, controller and recorded rows), and the nominal rate carries the force through
+breakaway and the slip. A phase ends early when the contact normal changes. A new phase
+needs the tip to have slipped since the last one, or the nominal ramp to have carried
+the force past where the last one ended. ``duration_s`` and ``time_s`` count engine
+time, so a fast-forwarded run covers more of the path in the same duration;
+:func:`nominal_time_s` gives the time the plain ramp would have taken.
 
 What the equivalence neglects. (1) Creep: noslip makes the stick rigid (a stuck tip moves
 ~1e-11 m/s), so the plain ramp's long stick moves the tip by nothing measurable; without
 noslip friction creeps at any load and fast-forward is off. (2) The soft normal contact:
 the faster rise loads the contact within ``RISE_STEPS = 50`` contact time constants, far
-slower than its response, and the nominal ramp that follows lasts many time constants
-before breakaway, so the breakaway starts from the same quasistatic contact. (3) The
-margin: the prediction uses the deepest contact's normal; where two facets share the load
+slower than its response, and the nominal ramp after a rollback lasts 32 to 64 time
+constants before breakaway, so the breakaway starts from the same quasistatic contact.
+(3) The prediction: it uses the deepest contact's normal; where two facets share the load
 (an hfield edge) the breakaway can lie below it by a few per cent (measured up to 1.5 %
-on the single peak), inside the default 3 % margin; a larger error is caught by the
-rollback. On the cases of ``tests/test_sim_fastforward.py`` and
+on the single peak), inside the default 3 % margin of the climb, or above it (a wedge),
+where the approach goes on to the cap; either way the breakaway itself is taken at the
+nominal rate. On the cases of ``tests/test_sim_fastforward.py`` and
 ``benchmarks/bench_fastforward.py`` the breakaway forces agree with the plain ramp's within
 0.5 % and the outcomes and paths agree (Frechet <= 0.01 L_c).
 
 Early termination (``RampDrive.stop_early``): every :data:`END_CHECK_STEPS` steps outside
-a fast-forward phase the new rows are run through the same end rules as the analysis
-(:func:`~spine_mj.sim.detection.end_marks`: deep penetration, leaving the domain, the force
-at ``kappa_cap F_p`` while stuck); at the first one the run stops, so the recorded
-trajectory and end reason are those of the full run up to its end. With fast-forward a
+a fast-forward phase the new rows go into the run's analysis
+(:class:`~spine_mj.sim.results.GroupAnalysis`, the one the result comes from); at the
+first ending the run stops, so the recorded trajectory and end reason are those of the
+full run up to its end. With fast-forward a
 tip on a self-locking normal reaches the cap within a phase instead of after
 ``kappa_cap F_p / rate``.
 """
@@ -52,84 +49,15 @@ from collections.abc import Callable
 
 import numpy as np
 
-from spine_mj.engagement import SELF_LOCK, kappa_of_normal
 from spine_mj.sim.detection import Detection, Event
 from spine_mj.sim.drives import RampDrive, rate_n_s, settle_steps
+from spine_mj.sim.fastforward import APPROACH_RATE, CHECKPOINT_STEPS, StickFastForward, fast_forward_on
 from spine_mj.sim.model import RigModel
-from spine_mj.sim.results import RunResult, analyse, recorded_marks
+from spine_mj.sim.results import GroupAnalysis, RunResult
 from spine_mj.sim.rollout import warning_text, warning_total
 
-#: Steps the tip must be still on one normal before a fast-forward phase starts.
-QUIET_STEPS = 8
-#: Steps over which a fast-forward phase raises the force (50 contact time constants).
-RISE_STEPS = 100
-#: Nominal-rate steps a phase leaves before the predicted breakaway, at least (50 contact
-#: time constants: at a fast rate the 3 % margin alone is a few steps, and the contact
-#: loaded by the rise breaks away late).
-NOMINAL_STEPS = 100
-#: Steps between checkpoints inside a phase (a rollback goes back 16 to 32 steps).
-CHECKPOINT_STEPS = 16
 #: Steps between two early-termination checks.
 END_CHECK_STEPS = 256
-#: Largest change of a unit normal (any component) that counts as the same normal.
-NORMAL_TOL = 1e-4
-
-
-class StickFastForward:
-    """Decides when the ramp may climb fast and how far (see the module docstring).
-
-    Parameters
-    ----------
-    mu : float
-        Friction coefficient of the contact.
-    preload_n, cap_n : float
-        F_p [N] and the largest force ``kappa_cap F_p`` [N].
-    margin : float
-        A phase stops at ``(1 - margin)`` of the predicted breakaway force.
-    stick_speed_m_s, slip_speed_m_s : float
-        Still below the first; a slip (which allows a new phase) above the second.
-    """
-
-    def __init__(self, *, mu, preload_n, cap_n, margin, stick_speed_m_s, slip_speed_m_s):
-        self.mu, self.preload_n, self.cap_n, self.margin = mu, preload_n, cap_n, margin
-        self.stick, self.slip = stick_speed_m_s, slip_speed_m_s
-        self.active, self.blocked, self.quiet = False, False, 0
-        self.target_n, self.step_n = 0.0, 0.0
-        self.normal0 = np.zeros(3)
-        self.prev = np.zeros(3)
-        self.phases = self.rollbacks = 0
-
-    def watch(self, vt: float, normal: np.ndarray, contact: bool, force: float, step_n: float) -> str:
-        """Verdict on one ramping step: ``"start"`` (a phase begins), ``"rollback"`` (the tip
-        moved during a phase), or ``""``. ``normal`` points out of the surface."""
-        same = contact and float(np.abs(normal - self.prev).max()) <= NORMAL_TOL
-        self.prev = normal.copy()
-        if self.active:
-            if not contact or vt > self.stick:
-                self.active, self.blocked, self.quiet = False, True, 0
-                self.rollbacks += 1
-                return "rollback"
-            if float(np.abs(normal - self.normal0).max()) > NORMAL_TOL or force >= self.target_n:
-                self.active, self.blocked, self.quiet = False, True, 0
-            return ""
-        if vt > self.slip:
-            self.blocked = False
-        self.quiet = self.quiet + 1 if (same and vt <= self.stick) else 0
-        if self.blocked or self.quiet < QUIET_STEPS:
-            return ""
-        k, region = kappa_of_normal(normal, self.mu)
-        f_b = math.inf if int(region) == SELF_LOCK else float(k) * self.preload_n
-        if not math.isfinite(f_b) and int(region) != SELF_LOCK:
-            return ""  # the slip region: no hold to predict
-        # leave the nominal ramp at least NOMINAL_STEPS before the predicted breakaway, so
-        # the contact loaded by the fast rise settles before it is tested
-        target = min((1 - self.margin) * f_b, f_b - NOMINAL_STEPS * step_n, self.cap_n)
-        if target - force <= 2 * RISE_STEPS * step_n:
-            return ""  # the nominal ramp gets there about as fast
-        self.active, self.target_n, self.normal0 = True, target, normal.copy()
-        self.step_n = (target - force) / RISE_STEPS
-        self.phases += 1
-        return "start"
 
 
 class ResetController:
@@ -257,12 +185,14 @@ def nominal_time_s(result: RunResult) -> np.ndarray:
 
 
 class _Stepper:
-    """The stepping loop's arrays and checkpoints: one row per engine step."""
+    """The stepping loop's arrays, checkpoints and the analysis of its rows: one row per
+    engine step."""
 
-    def __init__(self, m, d, nstep: int, ctl: ResetController):
+    def __init__(self, m, d, nstep: int, ctl: ResetController, analysis: GroupAnalysis):
         import mujoco
 
         self.m, self.d, self.ctl = m, d, ctl
+        self.analysis, self.analysed = analysis, 0  # rows 0..analysed-1 are in the analysis
         self.full = mujoco.mjtState.mjSTATE_FULLPHYSICS
         self.exact = mujoco.mjtState.mjSTATE_INTEGRATION  # warm start included: an exact restart
         self.state = np.empty((nstep, mujoco.mj_stateSize(m, self.full)))
@@ -270,6 +200,7 @@ class _Stepper:
         self.ctrl_log = np.zeros((nstep, 6))
         self.ck_size = mujoco.mj_stateSize(m, self.exact)
         self.checkpoints: list[tuple[int, np.ndarray, dict]] = []
+        self.steps = 0  # engine steps taken, rolled-back ones included
 
     def record(self, i: int, push_id: int) -> None:
         import mujoco
@@ -298,15 +229,14 @@ class _Stepper:
         self.checkpoints = []
         return row
 
-
-def _first_end(rig: RigModel, st: _Stepper, a: int, b: int, det: Detection) -> int | None:
-    """The first row in ``a..b-1`` at which the analysis would end the run (deep
-    penetration, left the domain, self-lock), or None."""
-    state, sens = st.state[None, a:b], st.sens[None, a:b]
-    # only deep, out and the locks are read here: no speed limit
-    _, marks = recorded_marks(rig, state, sens, np.full((1, b - a), np.nan), det, np.array([np.inf]))
-    found = [int(marks[k][0]) for k in ("deep", "out", "lock", "lock_rule") if marks[k][0] >= 0]
-    return a + min(found) if found else None
+    def analyse_to(self, b: int) -> bool:
+        """Add rows ``analysed..b-1`` to the run's analysis (they are final: a rollback never
+        reaches back before the phase, and rows are added outside phases); whether the run
+        has an ending by row b-1."""
+        a, self.analysed = self.analysed, max(b, self.analysed)
+        if b <= a:
+            return False
+        return bool(self.analysis.add(slice(0, 1), a, b, self.state[None, a:b], self.sens[None, a:b])[0])
 
 
 def _controller(rig: RigModel, drive: RampDrive, det: Detection, n_settle: int) -> ResetController:
@@ -319,7 +249,7 @@ def _controller(rig: RigModel, drive: RampDrive, det: Detection, n_settle: int) 
     dt = rig.engine.timestep_s
     cap = det.kappa_cap * rig.scales.preload_n / u.force_n
     ff = None
-    if drive.fast_forward and rig.engine.noslip_iterations > 0 and rig.tip.mu_s > 0:
+    if fast_forward_on(drive, rig.engine, rig.tip):
         ff = StickFastForward(
             mu=rig.tip.mu_s,
             preload_n=rig.scales.preload_n / u.force_n,
@@ -327,6 +257,7 @@ def _controller(rig: RigModel, drive: RampDrive, det: Detection, n_settle: int) 
             margin=drive.fast_forward_margin,
             stick_speed_m_s=det.stick_speed_m_s / u.speed_m_s,
             slip_speed_m_s=det.slip_speed_m_s / u.speed_m_s,
+            approach_rate=APPROACH_RATE,
         )
     slide = drive.slide_distance_m
     return ResetController(
@@ -340,17 +271,18 @@ def _controller(rig: RigModel, drive: RampDrive, det: Detection, n_settle: int) 
     )
 
 
-def _step_loop(rig, st: _Stepper, nstep: int, n_settle: int, det, stop_early: bool, progress):
+def _step_loop(rig, st: _Stepper, nstep: int, n_settle: int, stop_early: bool, progress):
     """Step until ``nstep`` rows, an early end or engine trouble; returns (rows, warning)."""
     import mujoco
 
     m, d, ctl = st.m, st.d, st.ctl
     ff = ctl.ff
-    warn_total, checked, i = warning_total(d), n_settle, 0
+    warn_total, i = warning_total(d), 0
     while i < nstep:
         if i >= n_settle:
             d.ctrl[rig.act_push] = ctl.push()
         mujoco.mj_step(m, d)
+        st.steps += 1
         st.record(i, rig.act_push)
         if i % 64 == 63 and warning_total(d) != warn_total:
             return i + 1, (i, warning_text(d))
@@ -366,12 +298,10 @@ def _step_loop(rig, st: _Stepper, nstep: int, n_settle: int, det, stop_early: bo
         if (
             stop_early
             and not (ff is not None and ff.active)
-            and (i - checked >= END_CHECK_STEPS or i == nstep)
+            and (i - st.analysed >= END_CHECK_STEPS or i == nstep)
+            and st.analyse_to(i)
         ):
-            end = _first_end(rig, st, checked, i, det)
-            if end is not None:
-                return end + 1, None
-            checked = i
+            return i, None
         if progress is not None and i % 2000 == 0:
             progress(i / nstep)
     return nstep, None
@@ -405,10 +335,10 @@ def run_ramp(
         )
     nstep = n_settle + int(math.ceil(duration / dt))
     ctl = _controller(rig, drive, det, n_settle)
-    st = _Stepper(m, d, nstep, ctl)
-    stop, warning = _step_loop(rig, st, nstep, n_settle, det, drive.stop_early, progress)
-    state, sens, ctrl_log = st.state[:stop], st.sens[:stop], st.ctrl_log[:stop]
-    result = analyse(rig, drive, start, state, sens, ctrl_log, det, warning or (None, ""))
-    resets = tuple(Event("reset", i, float(state[i, 0])) for i in ctl.resets if i < result.n)
+    st = _Stepper(m, d, nstep, ctl, GroupAnalysis(rig, [drive], [start], det, np.full((1, nstep), np.nan)))
+    stop, warning = _step_loop(rig, st, nstep, n_settle, drive.stop_early, progress)
+    st.analyse_to(stop)
+    result = st.analysis.results([warning or (None, "")])[0]
+    resets = tuple(Event("reset", i, float(st.state[i, 0])) for i in ctl.resets if i < result.n)
     events = sorted(result.events + resets, key=lambda e: (e.index, e.kind == result.end_reason.value))
-    return dataclasses.replace(result, events=tuple(events))
+    return dataclasses.replace(result, events=tuple(events), simulated_steps=st.steps)

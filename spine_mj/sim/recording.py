@@ -50,6 +50,11 @@ class Recording:
     slipping: np.ndarray
 
     @classmethod
+    def empty(cls, shape: tuple[int, ...]) -> Recording:
+        """Uninitialised columns with leading shape ``shape`` (``(n,)`` or ``(g, n)``)."""
+        return cls(**{k: np.empty(shape + tail, dtype) for k, (tail, dtype) in _LAYOUT.items()})
+
+    @classmethod
     def from_sensors(
         cls,
         sensor_adr: dict[str, int],
@@ -59,23 +64,25 @@ class Recording:
         units: EngineUnits,
         carriage_x: np.ndarray,
         slip_speed_m_s: float,
+        out: Recording | None = None,
     ) -> Recording:
         """The recording of a group in SI: ``state`` ``(g, n, nstate)``, ``sens`` ``(g, n,
         nsensordata)`` and the carriage ``carriage_x`` ``(g, n)`` in engine ``units``.
 
         The columns are computed for the whole group in one pass (the same arithmetic per
         row as one run at a time); a step slips when its tangential speed exceeds
-        ``slip_speed_m_s``.
+        ``slip_speed_m_s``. ``out``: columns of that shape (views into larger ones are
+        fine) to write into and return, instead of new arrays.
         """
-        g, n = state.shape[:2]
-        cols = sensor_columns(sensor_adr, state.reshape(g * n, -1), sens.reshape(g * n, -1))
-        cols = {k: to_si(k, c, units).reshape(g, n, *c.shape[1:]) for k, c in cols.items()}
-        slipping = cols["tangential_speed_m_s"] > slip_speed_m_s
-        return cls(**cols, carriage_x_m=carriage_x * units.length_m, slipping=slipping)
+        rec = cls.empty(state.shape[:-1]) if out is None else out
+        sensor_columns(sensor_adr, state, sens, units, rec)
+        np.multiply(carriage_x, units.length_m, out=rec.carriage_x_m)
+        np.greater(rec.tangential_speed_m_s, slip_speed_m_s, out=rec.slipping)
+        return rec
 
-    def run(self, r: int) -> Recording:
-        """Run ``r`` of a group (views of the group's columns)."""
-        return Recording(**{f.name: getattr(self, f.name)[r] for f in dataclasses.fields(self)})
+    def run(self, r: int, rows: int | None = None) -> Recording:
+        """Run ``r`` of a group, its first ``rows`` rows (all: None), as views of the group's columns."""
+        return Recording(**{k: getattr(self, k)[r, :rows] for k in COLUMNS})
 
     def cut(self, end: int) -> Recording:
         """Steps ``0..end`` of a run, as read-only views of its columns."""
@@ -85,66 +92,71 @@ class Recording:
             out.flags.writeable = False
             return out
 
-        return Recording(**{f.name: view(getattr(self, f.name)) for f in dataclasses.fields(self)})
+        return Recording(**{k: view(getattr(self, k)) for k in COLUMNS})
 
 
-def sensor_columns(sensor_adr: dict[str, int], state: np.ndarray, sens: np.ndarray) -> dict[str, np.ndarray]:
-    """Per-step columns of ``N`` steps (``state`` ``(N, nstate)``, ``sens`` ``(N, nsensordata)``).
+#: The column names of a :class:`Recording`, in field order.
+COLUMNS = tuple(f.name for f in dataclasses.fields(Recording))
+#: Each column's trailing shape and dtype.
+_LAYOUT = {
+    k: ((3,) if k in ("position_m", "velocity_m_s", "normal", "contact_point_m") else (), float)
+    for k in COLUMNS
+}
+_LAYOUT["contact"] = _LAYOUT["slipping"] = ((), bool)
 
-    Every column is a fresh C-contiguous array: the strided sensor slices are copied
-    once, so the arithmetic reads contiguous memory (the row-wise operations, einsum
-    and norm included, are those of a plain per-row evaluation: same results).
+
+def sensor_columns(
+    sensor_adr: dict[str, int], state: np.ndarray, sens: np.ndarray, units: EngineUnits, out: Recording
+) -> None:
+    """Write the per-step columns of steps ``state`` ``(..., nstate)`` and ``sens`` ``(...,
+    nsensordata)`` (engine ``units``) into ``out`` in SI (all but the carriage and slipping).
+
+    The arithmetic runs on component arrays of the leading shape (numpy's loops over a
+    length-3 axis cost more than the arithmetic), row by row the operations of a plain
+    per-row evaluation; each column is computed in engine units and multiplied by its
+    unit last.
     """
     a = sensor_adr
-    cn, cd = a["contact_net"], a["contact_deepest"]
-    t = state[:, 0].copy()
-    pos = sens[:, a["tip_pos"] : a["tip_pos"] + 3].copy()
-    vel = sens[:, a["tip_vel"] : a["tip_vel"] + 3].copy()
-    contact = sens[:, cd] > 0
-    no_contact = ~contact[:, None]
-    force = np.negative(sens[:, cn + 1 : cn + 4])  # the sensor reports the tip's force on the surface
-    normal = sens[:, cd + 5 : cd + 8].copy()
-    np.negative(normal, out=normal, where=normal[:, 2:3] < 0)  # point out of the surface
-    np.copyto(normal, np.nan, where=no_contact)
-    point = sens[:, cd + 2 : cd + 5].copy()
-    np.copyto(point, np.nan, where=no_contact)
-    pen = np.where(contact, np.maximum(-sens[:, cd + 1], 0.0), 0.0)
-    nn = np.nan_to_num(normal)
-    fn = np.where(contact, np.einsum("ij,ij->i", nn, force), 0.0)
-    ft = np.where(contact, _norm3(force - fn[:, None] * nn), 0.0)
-    drive_f = sens[:, a["spring_force"]] + sens[:, a["push_force"]]
-    vt = vel - np.einsum("ij,ij->i", vel, nn)[:, None] * nn
-    return {
-        "time_s": t,
-        "position_m": pos,
-        "velocity_m_s": vel,
-        "contact": contact,
-        "normal": normal,
-        "contact_point_m": point,
-        "penetration_m": pen,
-        "normal_force_n": fn,
-        "tangential_force_n": ft,
-        "drive_force_n": drive_f,
-        "tangential_speed_m_s": _norm3(vt),
-    }
+    cn, cd, v, p = a["contact_net"], a["contact_deepest"], a["tip_vel"], a["tip_pos"]
+    length, force_n, speed = units.length_m, units.force_n, units.speed_m_s
+    col = np.moveaxis(sens, -1, 0).copy()  # one pass over the rows; then every sensor is contiguous
+    contact = np.greater(col[cd], 0, out=out.contact)
+    no_contact = ~contact
+    flip = col[cd + 7] < 0  # the sensor's normal, turned to point out of the surface
+    normal = [np.where(flip, np.negative(col[cd + 5 + j]), col[cd + 5 + j]) for j in range(3)]
+    nn = [np.where(contact, c, 0.0) for c in normal]  # the normal, 0 without contact
+    if not all(np.isfinite(c).all() for c in nn):  # engine trouble: keep the arithmetic finite
+        nn = [np.nan_to_num(c) for c in nn]
+    force = [np.negative(col[cn + 1 + j]) for j in range(3)]  # the sensor: the tip's force on the surface
+    fn = np.where(contact, _dot3(nn, force), 0.0)
+    ft = np.where(contact, _norm3([force[j] - fn * nn[j] for j in range(3)]), 0.0)
+    vel = [col[v + j] for j in range(3)]
+    vn = _dot3(vel, nn)
+    np.multiply(_norm3([vel[j] - vn * nn[j] for j in range(3)]), speed, out=out.tangential_speed_m_s)
+    pen = np.where(contact, np.maximum(np.negative(col[cd + 1]), 0.0), 0.0)
+    np.multiply(pen, length, out=out.penetration_m)
+    np.multiply(fn, force_n, out=out.normal_force_n)
+    np.multiply(ft, force_n, out=out.tangential_force_n)
+    np.multiply(state[..., 0], units.time_s, out=out.time_s)
+    np.add(col[a["spring_force"]], col[a["push_force"]], out=out.drive_force_n)
+    np.multiply(out.drive_force_n, force_n, out=out.drive_force_n)
+    for j in range(3):
+        np.multiply(col[p + j], length, out=out.position_m[..., j])
+        np.multiply(vel[j], speed, out=out.velocity_m_s[..., j])
+        np.copyto(out.normal[..., j], normal[j])
+        np.copyto(out.normal[..., j], np.nan, where=no_contact)
+        np.multiply(col[cd + 2 + j], length, out=out.contact_point_m[..., j])
+        np.copyto(out.contact_point_m[..., j], np.nan, where=no_contact)
 
 
-def to_si(name: str, column: np.ndarray, units: EngineUnits) -> np.ndarray:
-    """A column of :func:`sensor_columns` converted from engine units to SI, by its name's unit."""
-    unit = {
-        "_s": units.time_s,
-        "_m": units.length_m,
-        "_m_s": units.speed_m_s,
-        "_n": units.force_n,
-    }
-    for suffix in ("_m_s", "_s", "_m", "_n"):
-        if name.endswith(suffix):
-            return column * unit[suffix] if column.dtype.kind == "f" else column
-    return column
+def _dot3(u: list[np.ndarray], v: list[np.ndarray]) -> np.ndarray:
+    """Row-wise dot product of two vectors given by components, summed as numpy's einsum
+    ``"ij,ij->i"`` sums three terms: ``(u0 v0 + u2 v2) + u1 v1``."""
+    return (u[0] * v[0] + u[2] * v[2]) + u[1] * v[1]
 
 
-def _norm3(v: np.ndarray) -> np.ndarray:
-    """``np.linalg.norm(v, axis=1)`` of ``(N, 3)`` rows, bit for bit (numpy sums fewer than 8
-    terms in order: ``(x^2 + y^2) + z^2``), without the slow reduction over a short axis."""
-    x, y, z = v[:, 0], v[:, 1], v[:, 2]
+def _norm3(c: list[np.ndarray]) -> np.ndarray:
+    """Row-wise length of a vector given by components, summed as ``np.linalg.norm(v,
+    axis=1)`` of ``(N, 3)`` rows sums (fewer than 8 terms, in order): ``(x^2 + y^2) + z^2``."""
+    x, y, z = c
     return np.sqrt(x * x + y * y + z * z)

@@ -1,9 +1,12 @@
 """The result of a run, and the analysis that turns a rollout into results.
 
-:class:`RunResult` is what every drive returns. :func:`analyse_group` reads a group of
-runs of equal length at once: the per-step :class:`~spine_mj.sim.recording.Recording` and
-the end conditions for the whole group in one pass, then per run its ending, its slip
-events and its result, a cut of the group's columns.
+:class:`RunResult` is what every drive returns. :class:`GroupAnalysis` reads a group of
+runs of equal planned length, window by window (rows a..b-1 of some of its runs, as the
+batch runner simulates them): the per-step :class:`~spine_mj.sim.recording.Recording` and
+the end conditions of a window are computed for its runs at once and merged with the
+earlier windows, so the runner knows after every window which runs are decided; at the end
+each run gets its ending, its slip events and its result, a cut of the group's columns.
+:func:`analyse_group` is the same analysis of whole runs in one window.
 """
 
 from __future__ import annotations
@@ -24,13 +27,14 @@ from spine_mj.sim.detection import (
     decide_end,
     end_candidates,
     end_marks,
+    normal_lock_marks,
     probe_candidates,
     slip_events,
 )
 from spine_mj.sim.drives import Drive, SpringDrive, StaticProbe, settle_steps, stiffness_n_m
 from spine_mj.sim.model import RigModel
 from spine_mj.sim.params import EndReason, EngineSettings, Scales, TipParams
-from spine_mj.sim.recording import Recording
+from spine_mj.sim.recording import COLUMNS, Recording
 
 
 @dataclass(frozen=True, eq=False)
@@ -75,6 +79,10 @@ class RunResult:
         I_e and the speed (or equivalent speed) it uses.
     stiffness_number, stiffness_n_m : float
         K = k l_s / F_p and the spring's stiffness k (0 for force drives).
+    simulated_steps : int
+        Engine steps simulated for the run: ``n`` plus the steps after its end that were
+        simulated before the end was seen (up to one piece of a batch), plus steps a
+        fast-forward rolled back.
     start : (x0, y0)
         Start in surface units.
     """
@@ -102,6 +110,7 @@ class RunResult:
     speed_m_s: float
     stiffness_number: float
     stiffness_n_m: float
+    simulated_steps: int
     start: tuple[float, float]
     drive: Drive
     tip: TipParams
@@ -162,32 +171,9 @@ class RunResult:
             "char_length_m": self.scales.char_length_m,
             "engine_units": enc(self.scales.units),
             "n_slip_onsets": sum(e.kind == "slip_onset" for e in self.events),
+            "simulated_steps": self.simulated_steps,
             "max_penetration_m": float(self.penetration_m.max()) if self.n else 0.0,
         }
-
-
-def analyse(rig: RigModel, drive: Drive, start, state, sens, ctrl, det: Detection, warning) -> RunResult:
-    """:func:`analyse_group` of one run (``state`` ``(n, nstate)``, ``sens`` ``(n, nsensordata)``)."""
-    return analyse_group(rig, [drive], [start], state[None], sens[None], [ctrl], det, [warning])[0]
-
-
-def recorded_marks(rig: RigModel, state, sens, carriage_x, det: Detection, speed_limit_m_s):
-    """A group's SI :class:`Recording` and its end marks (:func:`end_marks`) on ``rig``."""
-    group = Recording.from_sensors(
-        rig.sensor_adr, state, sens, units=rig.units, carriage_x=carriage_x, slip_speed_m_s=det.slip_speed_m_s
-    )
-    marks = end_marks(
-        group,
-        state,
-        sens,
-        timestep_s=rig.engine.timestep_s,
-        bounds_m=(*rig.bounds_m, *rig.z_range_m),
-        det=det,
-        preload_n=rig.scales.preload_n,
-        speed_limit_m_s=speed_limit_m_s,
-        mu=rig.tip.mu_s,
-    )
-    return group, marks
 
 
 def analyse_group(
@@ -200,40 +186,143 @@ def analyse_group(
     det: Detection,
     warnings: Sequence[tuple[int | None, str] | None],
 ) -> list[RunResult]:
-    """The results of a group of runs of equal length on ``rig``.
+    """The results of a group of whole runs of equal length on ``rig`` (one window of a
+    :class:`GroupAnalysis`).
 
-    ``state`` ``(g, n, nstate)`` and ``sens`` ``(g, n, nsensordata)``: the per-step
-    columns and the event masks are computed for the whole group in one pass (the same
-    arithmetic per row as one run at a time); only the events of each run are read
-    per run. ``ctrls`` are the runs' controls (the carriage is column 3), ``warnings``
-    per run ``(first step with a MuJoCo warning or None, its text)`` or None.
+    ``state`` ``(g, n, nstate)`` and ``sens`` ``(g, n, nsensordata)``; ``ctrls`` are the
+    runs' controls (the carriage is column 3), ``warnings`` per run ``(first step with a
+    MuJoCo warning or None, its text)`` or None.
     """
-    n = state.shape[1]
-    fp = rig.scales.preload_n
-    carriage = np.stack(
-        [
-            ctrl[:, 3].copy() if isinstance(d, SpringDrive) else np.full(n, np.nan)
-            for d, ctrl in zip(drives, ctrls)
-        ]
-    )
-    limits = np.array([det.speed_limit_m_s(rig.scales, rig.speed_of(d)) for d in drives])
-    group, marks = recorded_marks(rig, state, sens, carriage, det, limits)
-    results = []
-    for r, drive in enumerate(drives):
-        rec = group.run(r)
-        n_settle = settle_steps(drive, rig.engine.timestep_s)
-        candidates = end_candidates(marks, r, rec, warnings[r], det, fp)
-        kappa = math.nan
-        if isinstance(drive, StaticProbe):
-            probe, kappa = probe_candidates(rec, n_settle, det, fp)
-            candidates += probe
-        ending = decide_end(candidates, n)
-        if ending.reason is not EndReason.BREAKAWAY:
-            kappa = math.nan
-        results.append(
-            _run_result(rig, drive, starts[r], det, rec.cut(ending.index), ending, n_settle, kappa)
+    g, n = state.shape[:2]
+    group = GroupAnalysis(rig, drives, starts, det, np.stack([c[:, 3] for c in ctrls]))
+    group.add(np.arange(g), 0, n, state, sens)
+    return group.results(warnings)
+
+
+class GroupAnalysis:
+    """The recording and end marks of a group of runs on ``rig``, filled window by window.
+
+    Parameters
+    ----------
+    rig, drives, starts, det
+        The runs (``det`` resolved).
+    carriage : (g, n) array
+        The carriage x of each run and step in engine units (read for spring drives only);
+        ``n`` is the group's planned length.
+
+    Notes
+    -----
+    :meth:`add` takes rows a..b-1 of some runs; windows of a run must come in order and
+    without gaps. Every end mark is the first row of a condition (:func:`end_marks`) and the
+    lock rule carries its held streak from one window to the next
+    (:func:`~spine_mj.sim.detection.normal_lock_marks`), so after any window a run's marks
+    and its probe endings are those of its whole run's analysis up to that row: a run with
+    an ending there is decided, and cutting it there changes neither its recording nor its
+    ending (except that engine trouble after the ending is never seen, which a whole run
+    would report instead of the ending). Columns hold only the rows added.
+    """
+
+    def __init__(self, rig: RigModel, drives, starts, det: Detection, carriage: np.ndarray):
+        self.rig, self.drives, self.starts, self.det = rig, list(drives), list(starts), det
+        self.g, self.n = carriage.shape
+        self.carriage = carriage
+        self.spring = np.array([isinstance(d, SpringDrive) for d in self.drives])
+        self.probe = [isinstance(d, StaticProbe) for d in self.drives]
+        self.n_settle = [settle_steps(d, rig.engine.timestep_s) for d in self.drives]
+        self.limits = np.array([det.speed_limit_m_s(rig.scales, rig.speed_of(d)) for d in self.drives])
+        self.cols = Recording.empty((self.g, self.n))
+        self.marks: dict[str, np.ndarray] = {}
+        self.held_from_n = np.full(self.g, np.nan)
+        self.rows = np.zeros(self.g, dtype=int)
+        self.simulated = np.zeros(self.g, dtype=int)
+
+    def add(
+        self, runs: np.ndarray | slice, a: int, b: int, state: np.ndarray, sens: np.ndarray
+    ) -> np.ndarray:
+        """Rows ``a..b-1`` of ``runs`` (indices, or a slice of the group; ``state``
+        ``(len(runs), b - a, nstate)``, ``sens`` likewise); returns, per run, whether it is
+        decided (an ending at or before row b-1)."""
+        rig, det = self.rig, self.det
+        carriage = np.where(self.spring[runs, None], self.carriage[runs, a:b], np.nan)
+        block = isinstance(runs, slice)  # the window's columns are views of the group's: written in place
+        rec = Recording.from_sensors(
+            rig.sensor_adr,
+            state,
+            sens,
+            units=rig.units,
+            carriage_x=carriage,
+            slip_speed_m_s=det.slip_speed_m_s,
+            out=Recording(**{k: getattr(self.cols, k)[runs, a:b] for k in COLUMNS}) if block else None,
         )
-    return results
+        if not block:
+            for k in COLUMNS:
+                getattr(self.cols, k)[runs, a:b] = getattr(rec, k)
+        marks = end_marks(
+            rec,
+            state,
+            sens,
+            timestep_s=rig.engine.timestep_s,
+            bounds_m=(*rig.bounds_m, *rig.z_range_m),
+            det=det,
+            preload_n=rig.scales.preload_n,
+            speed_limit_m_s=self.limits[runs],
+            first_step=a,
+        )
+        marks["lock_rule"], self.held_from_n[runs] = normal_lock_marks(
+            rec, rig.tip.mu_s, rig.scales.preload_n, self.held_from_n[runs]
+        )
+        decided = np.zeros(state.shape[0], bool)
+        for k, m in marks.items():
+            old = self.marks.setdefault(k, np.full(self.g, -1))[runs]
+            merged = np.where((old < 0) & (m >= 0), m + a, old)
+            self.marks[k][runs] = merged
+            decided |= merged >= 0
+        self.rows[runs] = b
+        for i, r in enumerate(np.arange(self.g)[runs]):
+            if self.probe[r] and not decided[i]:
+                decided[i] = bool(
+                    probe_candidates(self.run(r), self.n_settle[r], det, rig.scales.preload_n)[0]
+                )
+        return decided
+
+    def run(self, r: int) -> Recording:
+        """The recorded rows of run ``r`` (views of the group's columns)."""
+        return self.cols.run(r, self.rows[r])
+
+    def results(self, warnings: Sequence[tuple[int | None, str] | None], runs=None) -> list[RunResult]:
+        """The ending and result of each run (of ``runs``, indices; None: all); a run without
+        an ending completed its recorded rows.
+
+        ``warnings``: per run of the group ``(first step with a MuJoCo warning or None, its
+        text)`` or None.
+        """
+        fp = self.rig.scales.preload_n
+        out = []
+        for r in range(self.g) if runs is None else runs:
+            drive, rec = self.drives[r], self.run(r)
+            candidates = end_candidates(self.marks, r, rec, warnings[r], self.det, fp)
+            kappa = math.nan
+            if self.probe[r]:
+                probe, kappa = probe_candidates(rec, self.n_settle[r], self.det, fp)
+                candidates += probe
+            ending = decide_end(candidates, int(self.rows[r]))
+            if ending.reason is not EndReason.BREAKAWAY:
+                kappa = math.nan
+            steps = max(int(self.simulated[r]), int(self.rows[r]))
+            out.append(
+                _run_result(
+                    self.rig,
+                    drive,
+                    self.starts[r],
+                    self.det,
+                    rec.cut(ending.index),
+                    ending,
+                    self.n_settle[r],
+                    kappa,
+                    steps,
+                )
+            )
+        return out
 
 
 def _run_result(
@@ -245,14 +334,13 @@ def _run_result(
     ending: Ending,
     n_settle: int,
     kappa_mj: float,
+    simulated_steps: int,
 ) -> RunResult:
     """The result of one run, its recording cut at its ending."""
     events = slip_events(rec.slipping, rec.time_s, n_settle)
     events.append(Event(ending.reason.value, ending.index, float(rec.time_s[ending.index])))
     onsets = [e.index for e in events if e.kind == "slip_onset"]
-    arrays = {
-        f.name: getattr(rec, f.name) for f in dataclasses.fields(rec) if f.name != "tangential_speed_m_s"
-    }
+    arrays = {k: getattr(rec, k) for k in COLUMNS if k != "tangential_speed_m_s"}
     speed = rig.speed_of(drive)
     k = stiffness_n_m(drive, rig.scales) if isinstance(drive, SpringDrive) else 0.0
     return RunResult(
@@ -268,6 +356,7 @@ def _run_result(
         speed_m_s=speed,
         stiffness_number=rig.scales.stiffness_number(k),
         stiffness_n_m=k,
+        simulated_steps=simulated_steps,
         start=tuple(start),
         drive=drive,
         tip=rig.tip,

@@ -79,17 +79,22 @@ class Rig(RigModel):
         detection: Detection | None = None,
         backend: str = "rollout",
         nthread: int | None = None,
+        stop_early: bool = True,
     ) -> list[RunResult]:
         """Run many starts and/or drive parameter sets of this model.
 
         ``drives`` is one drive for all starts or one per start (SpringDrive or StaticProbe;
         mixed kinds are allowed). Runs go through :func:`mujoco.rollout.rollout` on
-        ``nthread`` native threads (default: CPU count), in groups sized to stay within
-        256 MiB of output; each run is then cut at its first end event. A group runs in up
-        to 4 pieces, pipelined: while the native threads simulate one piece, the calling
-        thread analyses the previous one and places the next (``rollout`` releases the GIL);
-        the results are those of one run at a time. The arrays of a result are read-only
-        views of its group's columns.
+        ``nthread`` worker threads (default: CPU count), in groups of equal planned length
+        sized to stay within 256 MiB of output, each run in pieces continued from its exact
+        state (:mod:`spine_mj.sim.rollout`); each run is cut at its first end event.
+        ``stop_early``: a run is not simulated past the piece in which its outcome was
+        decided (self-lock, left the domain, engine trouble, a probe's breakaway or slide);
+        its recording and ending are those of the whole run, except that engine trouble
+        after the ending goes unseen. False simulates every planned step (the reference).
+        While the worker threads simulate, the calling thread analyses and places tips; the
+        results are those of one run at a time. The arrays of a result are read-only views
+        of its group's columns.
 
         ``backend``: ``"rollout"`` (native CPU threads), ``"python"`` (the plain reference
         loop), ``"gpu"`` (MuJoCo Warp on a CUDA device, :mod:`spine_mj.sim.gpu`; the
@@ -97,7 +102,9 @@ class Rig(RigModel):
         """
         if backend in ("gpu", "auto"):
             return run_batch_gpu(self, drives, starts, detection=detection, backend=backend, nthread=nthread)
-        return run_batch(self, drives, starts, detection=detection, backend=backend, nthread=nthread)
+        return run_batch(
+            self, drives, starts, detection=detection, backend=backend, nthread=nthread, stop_early=stop_early
+        )
 
     def controls(self, drive: Drive, qpos0: np.ndarray, detection: Detection) -> np.ndarray:
         """Open-loop controls ``(nstep, 6)`` of a run from the placed start ``qpos0``.

@@ -1,12 +1,29 @@
-"""Open-loop runs in batches: controls, grouping, and the pipelined native rollout.
+"""Open-loop runs in batches: controls, grouping, and the pieced native rollout.
 
 Spring drives and static probes need no feedback: their controls are known in advance
-(:func:`controls`), so many runs go through :func:`mujoco.rollout.rollout` on native
-threads at once. Runs of equal length are grouped (rollout takes one ``nstep`` a call),
-groups are cut to stay within 256 MiB of output and simulated in up to 4 pieces,
-pipelined: while the native threads simulate one piece, the calling thread analyses the
-previous one and places the next (``rollout`` releases the GIL). :func:`python_rollout`
-is the plain ``mj_step`` reference of the same call.
+(:func:`controls`), so they go through :func:`mujoco.rollout.rollout` on worker threads
+(``rollout`` releases the GIL). Runs of equal planned length form a group (within 256 MiB
+of output); each run is simulated in pieces (its settle phase, then :data:`PIECE_STEPS`
+steps at a time), and after each piece its new rows are analysed
+(:class:`~spine_mj.sim.results.GroupAnalysis`): a run whose outcome is decided (self-lock,
+left the domain, engine trouble, a probe's breakaway or slide) is not simulated further.
+The group's runs are split in two halves: while the worker threads simulate one half's
+pieces, the calling thread analyses the other's and places tips.
+
+A run is continued from its exact state: the full physics state of its last row and the
+warm start (``qacc_warmstart``) its worker's ``MjData`` holds after the piece, which the
+recorded state lacks (without it the constraint solver starts elsewhere and the trajectory
+drifts by ~1e-5 L_c within a step). Each piece is one run on one ``MjData``, so that warm
+start is there to read; the pieces then give bit for bit the trajectory of one
+uninterrupted rollout (tested). :func:`python_steps` is the plain ``mj_step`` reference of
+a piece.
+
+A static probe with fast-forward (:class:`~spine_mj.sim.drives.StaticProbe`) is decided
+after its settle piece: :class:`~spine_mj.sim.fastforward.StickFastForward` reads the
+settled rows and, where it predicts a breakaway, the probe's remaining controls climb to
+just below it in :data:`~spine_mj.sim.fastforward.RISE_STEPS` steps, then go on at the
+nominal rate. That climb is its own piece; if the tip moved during it, the piece is
+dropped and the probe goes on from its settled state with the plain controls.
 """
 
 from __future__ import annotations
@@ -14,6 +31,7 @@ from __future__ import annotations
 import concurrent.futures as cf
 import math
 import os
+import threading
 from collections.abc import Sequence
 
 import numpy as np
@@ -29,11 +47,21 @@ from spine_mj.sim.drives import (
     settle_steps,
     stiffness_n_m,
 )
+from spine_mj.sim.fastforward import QUIET_STEPS, RISE_STEPS, StickFastForward, fast_forward_on
 from spine_mj.sim.model import RigModel
-from spine_mj.sim.results import RunResult, analyse_group
+from spine_mj.sim.recording import Recording
+from spine_mj.sim.results import GroupAnalysis, RunResult
 
 BATCH_MEMORY_BYTES = 256 * 2**20
-PIPELINE_PIECES = 4  # a batch group is simulated in up to this many pieces
+#: Steps of a run's first piece after its settle phase; each next piece is twice as long,
+#: up to :data:`PIECE_STEPS` (a last piece under half that joins the one before): a run is
+#: not simulated past its end by much more than it had run before it, nor by more than
+#: 1.5 :data:`PIECE_STEPS`.
+FIRST_PIECE_STEPS = 128
+#: Longest piece: the most steps a run is simulated between two looks at its end conditions.
+PIECE_STEPS = 1024
+#: Tips placed before their first pieces are handed to the workers.
+PLACE_CHUNK = 4
 
 
 def drive_steps(rig: RigModel, drive: Drive, x0_m: float, detection: Detection) -> int:
@@ -84,15 +112,11 @@ def controls(rig: RigModel, drive: Drive, qpos0: np.ndarray, detection: Detectio
     return ctrl
 
 
-def plan_batches(lengths: Sequence[int], bytes_per_step: int, nthread: int) -> list[list[int]]:
-    """Run indices in pieces of equal length, each within :data:`BATCH_MEMORY_BYTES` of output.
-
-    Runs are grouped by length (shortest first); a group is cut into up to
-    :data:`PIPELINE_PIECES` pieces of at least ``nthread`` runs, so one piece can be
-    simulated while the previous one is analysed (and the next one placed).
-    """
+def plan_groups(lengths: Sequence[int], bytes_per_step: int) -> list[list[int]]:
+    """Run indices in groups of equal planned length (shortest first), each within
+    :data:`BATCH_MEMORY_BYTES` of output."""
     order = sorted(range(len(lengths)), key=lambda i: lengths[i])
-    batches = []
+    groups = []
     i = 0
     while i < len(order):
         nstep = lengths[order[i]]
@@ -101,9 +125,8 @@ def plan_batches(lengths: Sequence[int], bytes_per_step: int, nthread: int) -> l
         while i + len(group) < len(order) and len(group) < limit and lengths[order[i + len(group)]] == nstep:
             group.append(order[i + len(group)])
         i += len(group)
-        size = max(nthread, -(-len(group) // PIPELINE_PIECES))
-        batches += [group[k : k + size] for k in range(0, len(group), size)]
-    return batches
+        groups.append(group)
+    return groups
 
 
 def batch_drives(drives, starts) -> tuple[list[Drive], list[tuple[float, float]]]:
@@ -128,6 +151,7 @@ def run_batch(
     detection: Detection | None = None,
     backend: str = "rollout",
     nthread: int | None = None,
+    stop_early: bool = True,
 ) -> list[RunResult]:
     """Run many starts and/or drive parameter sets of ``rig``'s model (see :meth:`Rig.run_batch`)."""
     drives, starts = batch_drives(drives, starts)
@@ -137,20 +161,20 @@ def run_batch(
     for x0, y0 in starts:
         rig.check_start(x0, y0)
     runner = _BatchRunner(rig, drives, starts, det)
-    nthread = os.cpu_count() or 1 if nthread is None else int(nthread)
-    batches = plan_batches(runner.lengths, 8 * (runner.nstate + rig.model.nsensordata), nthread)
-    if backend == "python":
-        for batch in batches:
-            batch, ctrls, init, ctrl = runner.prepare(batch)
-            state, sens, warn = python_rollout([runner.models[j] for j in batch], init, ctrl)
-            runner.analyse(batch, ctrls, state, sens, warn)
-    else:
-        runner.pipeline(batches, nthread)
+    nthread = (os.cpu_count() or 1) if nthread is None else max(1, int(nthread))
+    lanes = _NativeLanes(nthread) if backend == "rollout" else _PythonLane()
+    try:
+        for idx in plan_groups(runner.lengths, 8 * (runner.nstate + rig.model.nsensordata)):
+            group = _Group(runner, idx, stop_early)
+            for j, res in zip(idx, group.run(lanes)):
+                runner.results[j] = res
+    finally:
+        lanes.close()
     return runner.results
 
 
 class _BatchRunner:
-    """The runs of one :func:`run_batch` call: their models, lengths, preparation and analysis."""
+    """The runs of one :func:`run_batch` call: their drives, starts, models and lengths."""
 
     def __init__(self, rig: RigModel, drives: list[Drive], starts: list[tuple[float, float]], det: Detection):
         import mujoco
@@ -171,61 +195,275 @@ class _BatchRunner:
         self.nstate = mujoco.mj_stateSize(rig.model, mujoco.mjtState.mjSTATE_FULLPHYSICS)
         self.results: list[RunResult | None] = [None] * len(starts)
 
-    def prepare(self, batch):
-        """Place the batch's tips; their controls, initial states and stacked controls."""
-        qpos0 = [self.rig.place(*self.starts[j]) for j in batch]
-        ctrls = [controls(self.rig, self.drives[j], q, self.det) for j, q in zip(batch, qpos0)]
-        init = np.zeros((len(batch), self.nstate))
-        init[:, 1:4] = qpos0
-        return batch, ctrls, init, np.stack(ctrls)
 
-    def analyse(self, batch, ctrls, state, sens, warn) -> None:
-        """Store the results of a simulated batch."""
-        drives, starts = [self.drives[j] for j in batch], [self.starts[j] for j in batch]
-        for j, res in zip(batch, analyse_group(self.rig, drives, starts, state, sens, ctrls, self.det, warn)):
-            self.results[j] = res
+class _Group:
+    """One group of runs of equal planned length: its arrays, each run's progress, the
+    analysis of its rows and the probes' fast-forward (``k`` below: a run's index in the group)."""
 
-    def pipeline(self, batches: list[list[int]], nthread: int) -> None:
-        """Simulate the batches natively, one piece at a time on a helper thread, while the
-        calling thread analyses the previous piece and prepares the next."""
+    def __init__(self, runner: _BatchRunner, idx: list[int], stop_early: bool):
+        rig = runner.rig
+        self.rig, self.det, self.stop_early = rig, runner.det, stop_early
+        self.drives = [runner.drives[j] for j in idx]
+        self.starts = [runner.starts[j] for j in idx]
+        self.models = [runner.models[j] for j in idx]
+        g, n = len(idx), runner.lengths[idx[0]]
+        self.n = n
+        self.ctrl = np.empty((g, n, 6))
+        self.state = np.empty((g, n, runner.nstate))
+        self.sens = np.empty((g, n, rig.model.nsensordata))
+        self.init = np.zeros((g, runner.nstate))
+        self.warm = np.zeros((g, rig.model.nv))  # the warm start each run goes on from
+        self.done = np.zeros(g, dtype=int)  # rows simulated and analysed
+        self.pieces = np.zeros(g, dtype=int)  # pieces after the settle phase (and a climb)
+        self.end = np.full(g, n)  # rows planned (a fast-forwarded probe plans fewer)
+        self.live = np.ones(g, dtype=bool)
+        self.warnings: list[tuple[int | None, str] | None] = [None] * g
+        self.n_settle = [settle_steps(d, rig.engine.timestep_s) for d in self.drives]
+        self.climbs: dict[int, tuple[StickFastForward, np.ndarray, np.ndarray]] = {}
+        # a probe that may fast-forward is decided from its settled rows: its settle phase is a piece
+        self.settle_apart = [
+            isinstance(d, StaticProbe) and fast_forward_on(d, rig.engine, rig.tip) for d in self.drives
+        ]
+        self.analysis = GroupAnalysis(rig, self.drives, self.starts, self.det, self.ctrl[:, :, 3])
+
+    def run(self, lanes) -> list[RunResult]:
+        """Simulate the group piece by piece in two halves (one is simulated while the
+        other is analysed); the results in group order."""
+        g = len(self.drives)
+        cut = (g + 1) // 2
+        halves = [np.arange(0, cut), np.arange(cut, g)] if g > 1 else [np.arange(g)]
+        pending: list[list] = [[] for _ in halves]
+        for h, half in enumerate(halves):
+            for i in range(0, half.size, PLACE_CHUNK):  # the workers start on the first tips placed
+                self.prepare(half[i : i + PLACE_CHUNK])
+                pending[h] += self.submit(half[i : i + PLACE_CHUNK], lanes)
+        results: list[RunResult | None] = [None] * g
+        while any(pending):
+            for h, half in enumerate(halves):
+                if pending[h]:
+                    self.advance(lanes.wait(pending[h]))
+                    pending[h] = self.submit(half[self.live[half]], lanes)
+                    if not pending[h]:  # the half is done: its results while the other runs
+                        for k, res in zip(half, self.analysis.results(self.warnings, half)):
+                            results[k] = res
+        return results
+
+    def prepare(self, ks: np.ndarray) -> None:
+        """Place the tips of runs ``ks``; their controls and initial states."""
+        rig = self.rig
+        for k, q in zip(ks, rig.place_many([self.starts[k] for k in ks])):
+            self.ctrl[k] = controls(rig, self.drives[k], q, self.det)
+            self.init[k, 1:4] = q
+
+    def submit(self, ks: np.ndarray, lanes) -> list:
+        """Start the next piece of each run in ``ks``: a fast-forwarding probe's settle phase
+        or climb, or the next of the pieces that double from :data:`FIRST_PIECE_STEPS` to
+        :data:`PIECE_STEPS` (the first with the settle phase)."""
+        out = []
+        for k in ks:
+            a = int(self.done[k])
+            if a < self.n_settle[k] and self.settle_apart[k]:
+                b = self.n_settle[k]
+            elif k in self.climbs:
+                b = a + RISE_STEPS
+            else:
+                size = min(PIECE_STEPS, FIRST_PIECE_STEPS << int(self.pieces[k]))
+                b = max(a, self.n_settle[k]) + size
+                if self.end[k] - b < size // 2:  # no short last piece: it joins this one
+                    b = int(self.end[k])
+                self.pieces[k] += 1
+            out.append(lanes.submit(self.piece, lanes, k, a, min(b, int(self.end[k]))))
+        return out
+
+    def piece(self, lanes, k: int, a: int, b: int):
+        """Simulate rows ``a..b-1`` of run ``k`` from its exact state (a worker thread's job)."""
+        init = self.init[k] if a == 0 else self.state[k, a - 1]
+        warm, warning = lanes.step(
+            self.models[k], init, self.warm[k], self.ctrl[k, a:b], self.state[k, a:b], self.sens[k, a:b]
+        )
+        return k, a, b, warm, warning
+
+    def advance(self, done: list) -> None:
+        """Take finished pieces: check probes' climbs, analyse the new rows (runs with the
+        same rows at once), stop decided runs, decide probes' fast-forward after settling."""
+        windows: dict[tuple[int, int], list[int]] = {}
+        stop = set()
+        for k, a, b, warm, warning in done:
+            self.analysis.simulated[k] += b - a
+            self.warm[k] = warm
+            if warning == "frozen":
+                # the native rollout stops a run at a MuJoCo warning and repeats its last row
+                # to the end of the call: the rows a whole-run rollout would have recorded
+                self.state[k, b : self.end[k]] = self.state[k, b - 1]
+                self.sens[k, b : self.end[k]] = self.sens[k, b - 1]
+                b = int(self.end[k])
+                stop.add(k)
+            elif warning is not None:
+                self.warnings[k] = (a + warning[0], warning[1])
+                stop.add(k)
+            if k in self.climbs:
+                if not self.climb_held(k, a, b):
+                    continue  # dropped: the probe goes on from its settled state
+                self.pieces[k] = 1  # the breakaway is expected within ~2 NOMINAL_STEPS: a 256-step piece
+            windows.setdefault((a, b), []).append(k)
+        for (a, b), ks in windows.items():
+            ks = np.array(ks)
+            rows = _as_slice(ks)  # runs of a half: usually a block, read without a copy
+            decided = self.analysis.add(rows, a, b, self.state[rows, a:b], self.sens[rows, a:b])
+            self.done[ks] = b
+            for k, dec in zip(ks, decided):
+                if b >= self.end[k] or (self.stop_early and (dec or k in stop)):
+                    self.live[k] = False
+                elif b == self.n_settle[k] and not dec:
+                    self.fast_forward(k)
+
+    def fast_forward(self, k: int) -> None:
+        """After settling: a probe whose tip is stuck on one normal gets controls that climb
+        to just below the breakaway force predicted from it (:class:`StickFastForward`)."""
+        rig, det, drive = self.rig, self.det, self.drives[k]
+        if not self.settle_apart[k]:
+            return
+        fp, cap = rig.scales.preload_n, det.kappa_cap * rig.scales.preload_n
+        ff = StickFastForward(
+            mu=rig.tip.mu_s,
+            preload_n=fp,
+            cap_n=cap * (1 + 1e-9),
+            margin=drive.fast_forward_margin,
+            stick_speed_m_s=det.stick_speed_m_s,
+            slip_speed_m_s=det.slip_speed_m_s,
+        )
+        step = rate_n_s(drive, rig.scales) * rig.engine.timestep_s
+        rec, ns = self.analysis.run(k), self.n_settle[k]
+        verdict = ""
+        for i in range(max(0, ns - QUIET_STEPS - 1), ns):
+            verdict = ff.watch(*_still(rec, i), float(rec.drive_force_n[i]), step)
+        if verdict != "start":
+            return
+        rise = drive.start_force_n + ff.step_n * np.arange(1, RISE_STEPS + 1)
+        rise[-1] = ff.target_n
+        nominal = ff.target_n + step * np.arange(1, int(math.ceil((cap - ff.target_n) / step)) + 3)
+        push = np.concatenate([rise, np.minimum(nominal, cap * (1 + 1e-9))]) / rig.units.force_n
+        if ns + push.size > self.n:
+            return
+        self.climbs[k] = (ff, self.warm[k].copy(), self.ctrl[k, ns:, 1].copy())
+        self.ctrl[k, ns : ns + push.size, 1] = push
+        self.end[k] = ns + push.size
+
+    def climb_held(self, k: int, a: int, b: int) -> bool:
+        """Whether probe ``k`` stayed stuck on its normal through its climb (rows a..b-1);
+        if not, its controls and warm start go back to the plain probe's after settling."""
+        ff, warm, plain = self.climbs.pop(k)
+        rig, det = self.rig, self.det
+        rec = Recording.from_sensors(
+            rig.sensor_adr,
+            self.state[k : k + 1, a:b],
+            self.sens[k : k + 1, a:b],
+            units=rig.units,
+            carriage_x=np.full((1, b - a), np.nan),
+            slip_speed_m_s=det.slip_speed_m_s,
+        ).run(0)
+        step = rate_n_s(self.drives[k], rig.scales) * rig.engine.timestep_s
+        for i in range(b - a):
+            verdict = ff.watch(*_still(rec, i), float(rec.drive_force_n[i]), step)
+            if verdict == "rollback" or (not ff.active and i < b - a - 1):
+                ns = self.n_settle[k]
+                self.ctrl[k, ns:, 1] = plain
+                self.end[k], self.warm[k] = self.n, warm
+                return False
+        return True
+
+
+def _as_slice(ks: np.ndarray) -> slice | np.ndarray:
+    """Sorted run indices as a slice where they form a block, else as they are."""
+    if ks.size and ks[-1] - ks[0] + 1 == ks.size and (np.diff(ks) == 1).all():
+        return slice(int(ks[0]), int(ks[-1]) + 1)
+    return ks
+
+
+def _still(rec: Recording, i: int) -> tuple[float, np.ndarray, bool]:
+    """Tangential speed, outward normal and contact of row ``i``: what
+    :meth:`StickFastForward.watch` reads."""
+    return float(rec.tangential_speed_m_s[i]), rec.normal[i], bool(rec.contact[i])
+
+
+class _NativeLanes:
+    """Worker threads, each stepping one run's piece at a time through
+    :func:`mujoco.rollout.rollout` on its own ``MjData`` (whose warm start the run goes on from)."""
+
+    def __init__(self, nthread: int):
+        import mujoco
+
+        self.spec = int(mujoco.mjtState.mjSTATE_CTRL) | int(mujoco.mjtState.mjSTATE_MOCAP_POS)
+        self.pool = cf.ThreadPoolExecutor(max_workers=nthread)
+        self.local = threading.local()
+
+    def submit(self, fn, *args) -> cf.Future:
+        return self.pool.submit(fn, *args)
+
+    def wait(self, futures: list[cf.Future]) -> list:
+        return [f.result() for f in futures]
+
+    def step(self, model, init, warm, ctrl, state, sens):
+        """Rows ``ctrl.shape[0]`` of one run from full physics state ``init`` and warm start
+        ``warm`` into ``state`` and ``sens`` (C-contiguous views); returns the warm start
+        after the last row and ``"frozen"`` if MuJoCo warned (the rollout then repeated the
+        row of the warning), else None."""
         import mujoco
         from mujoco import rollout
 
-        model = self.rig.model
-        spec = int(mujoco.mjtState.mjSTATE_CTRL) | int(mujoco.mjtState.mjSTATE_MOCAP_POS)
-        pool = rollout.Rollout(nthread=nthread)
-        datas = [mujoco.MjData(model) for _ in range(max(1, nthread))]
+        lane = getattr(self.local, "lane", None)
+        if lane is None:  # the rig's models differ in the spring's stiffness only: one MjData fits all
+            lane = self.local.lane = (mujoco.MjData(model), rollout.Rollout(nthread=0))
+        data, pool = lane
+        pool.rollout(
+            [model],
+            [data],
+            init[None],
+            ctrl[None],
+            control_spec=self.spec,
+            skip_checks=True,
+            nstep=ctrl.shape[0],
+            initial_warmstart=warm[None],
+            state=state[None],
+            sensordata=sens[None],
+        )
+        return data.qacc_warmstart.copy(), ("frozen" if warning_total(data) else None)
 
-        def simulate(batch, init, ctrl):
-            return pool.rollout(
-                [self.models[j] for j in batch],
-                datas,
-                init,
-                ctrl,
-                control_spec=spec,
-                initial_warmstart=np.zeros((len(batch), model.nv)),
-            )
+    def close(self) -> None:
+        self.pool.shutdown(wait=True, cancel_futures=True)
 
+
+def _run(future: cf.Future, fn, args) -> None:
+    """Run one queued piece into its future."""
+    if future.set_running_or_notify_cancel():
         try:
-            with cf.ThreadPoolExecutor(max_workers=1) as sim_thread:
-                running = None
-                ready = self.prepare(batches[0]) if batches else None
-                for k in range(len(batches)):
-                    batch, ctrls, init, ctrl = ready
-                    future = sim_thread.submit(simulate, batch, init, ctrl)
-                    if running is not None:
-                        self.analyse(*running)
-                    ready = self.prepare(batches[k + 1]) if k + 1 < len(batches) else None
-                    running = (batch, ctrls, *future.result(), [None] * len(batch))
-                if running is not None:
-                    self.analyse(*running)
-        finally:
-            pool.close()
+            future.set_result(fn(*args))
+        except BaseException as exc:  # handed to the caller by future.result()
+            future.set_exception(exc)
+
+
+class _PythonLane:
+    """The reference backend: every piece stepped by :func:`python_steps` on the calling thread."""
+
+    def submit(self, fn, *args) -> cf.Future:
+        future: cf.Future = cf.Future()
+        _run(future, fn, args)
+        return future
+
+    def wait(self, futures: list[cf.Future]) -> list:
+        return [f.result() for f in futures]
+
+    def step(self, model, init, warm, ctrl, state, sens):
+        return python_steps(model, init, warm, ctrl, state, sens)
+
+    def close(self) -> None:
+        pass
 
 
 def warning_total(d) -> int:
-    """The number of MuJoCo warnings ``d`` (an ``MjData``) has seen."""
-    return int(sum(w.number for w in d.warning))
+    """The number of MuJoCo warnings ``d`` (an ``MjData``) has seen (read as one array: a
+    loop over the warning structs costs 100 us)."""
+    return int(d.warning.number.sum())
 
 
 def warning_text(d) -> str:
@@ -237,33 +475,27 @@ def warning_text(d) -> str:
     return ", ".join(h.removeprefix("mjWARN_") for h in hit) or "unknown"
 
 
-def python_rollout(models, init, ctrl):
-    """Reference for :func:`mujoco.rollout.rollout`: a plain ``mj_step`` loop per run.
+def python_steps(model, init, warm, ctrl, state, sens):
+    """Reference for one run's piece of :func:`mujoco.rollout.rollout`: a plain ``mj_step``
+    loop from full physics state ``init`` and warm start ``warm``, filling ``state``
+    ``(nstep, nstate)`` and ``sens`` ``(nstep, nsensordata)``.
 
-    Returns state ``(nbatch, nstep, nstate)``, sensordata ``(nbatch, nstep, nsensordata)``
-    and per run ``(first step with a new MuJoCo warning or None, warning names)``.
+    Returns the warm start after the last step and ``(first step with a new MuJoCo warning,
+    warning names)`` or None (the loop steps on after a warning).
     """
     import mujoco
 
-    nbatch, nstep, _ = ctrl.shape
-    m0 = models[0]
-    nstate = mujoco.mj_stateSize(m0, mujoco.mjtState.mjSTATE_FULLPHYSICS)
-    state = np.empty((nbatch, nstep, nstate))
-    sens = np.empty((nbatch, nstep, m0.nsensordata))
-    warns = []
     full = mujoco.mjtState.mjSTATE_FULLPHYSICS
-    for b, m in enumerate(models):
-        d = mujoco.MjData(m)
-        mujoco.mj_setState(m, d, init[b], full)
-        d.qacc_warmstart[:] = 0
-        first_warn = None
-        for i in range(nstep):
-            d.ctrl[:] = ctrl[b, i, :3]
-            d.mocap_pos[0] = ctrl[b, i, 3:6]
-            mujoco.mj_step(m, d)
-            mujoco.mj_getState(m, d, state[b, i], full)
-            sens[b, i] = d.sensordata
-            if first_warn is None and warning_total(d):
-                first_warn = (i, warning_text(d))
-        warns.append(first_warn if first_warn is not None else (None, ""))
-    return state, sens, warns
+    d = mujoco.MjData(model)
+    mujoco.mj_setState(model, d, init, full)
+    d.qacc_warmstart[:] = warm
+    first_warn = None
+    for i in range(ctrl.shape[0]):
+        d.ctrl[:] = ctrl[i, :3]
+        d.mocap_pos[0] = ctrl[i, 3:6]
+        mujoco.mj_step(model, d)
+        mujoco.mj_getState(model, d, state[i], full)
+        sens[i] = d.sensordata
+        if first_warn is None and warning_total(d):
+            first_warn = (i, warning_text(d))
+    return d.qacc_warmstart.copy(), first_warn
