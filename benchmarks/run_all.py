@@ -225,24 +225,24 @@ def bench_sweep(quick: bool) -> dict:
 def bench_cost(quick: bool) -> dict:
     """Steps per spring-drive run against I_e and K on two surface families, and fits."""
     from spine_mj import presets
-    from spine_mj.sim import Rig, SpringDrive
+    from spine_mj.sim import Rig, SpringDrive, TipParams
 
-    ies = [1e-3, 1e-2, 1e-1] if quick else [1e-3, 3e-3, 1e-2, 3e-2, 1e-1]
-    kfactors = [3.0, 10.0, 30.0]  # K in F_p / L_c
+    # I_e where the contact sets the step; above ~0.008 (peak) the impact rule shortens it as
+    # I_e^-1/2, so the steps grow as 1 / I_e there (sim.default_engine)
+    ies = [3e-4, 1e-3, 3e-3] if quick else [1e-4, 3e-4, 1e-3, 3e-3]
+    stiffness_numbers = [3.0, 10.0, 30.0]  # K = k l_s / F_p (30: the default)
     n_starts = 2 if quick else 4
     families = {}
     for family, preset in (("single peak", "paper-single-peak"), ("fractal", "paper-fractal")):
         surface = presets.make_surface(preset)
-        rig = Rig(surface)
+        rig = Rig(surface, tip=TipParams(mu_s=presets.calibrated_mu(preset)))
         sc = rig.scales
         xmin, _, ymin, ymax = surface.bounds
         starts = [(0.9 * xmin, float(y)) for y in np.linspace(0.8 * ymin, 0.8 * ymax, n_starts)]
         rows = []
         for ie in ies:
-            for kf in kfactors:
-                drive = SpringDrive(
-                    speed_m_s=sc.speed_for(ie), stiffness_n_m=kf * sc.preload_n / sc.char_length_m
-                )
+            for kf in stiffness_numbers:
+                drive = SpringDrive(speed_m_s=sc.speed_for(ie), stiffness_n_m=sc.stiffness_for(kf))
                 t0 = time.perf_counter()
                 res = rig.run_batch(drive, starts, nthread=1)
                 wall = time.perf_counter() - t0
@@ -250,7 +250,7 @@ def bench_cost(quick: bool) -> dict:
                 rows.append(
                     {
                         "ie": ie,
-                        "k_factor": kf,
+                        "K": kf,
                         "planned_steps": planned,
                         "simulated_steps_mean": float(np.mean([r.simulated_steps for r in res])),
                         "recorded_steps_mean": float(np.mean([r.n for r in res])),
@@ -276,13 +276,13 @@ def rig_detection(rig):
 def fit_cost(rows: list[dict]) -> dict:
     """Fit the simulated steps per run (``planned_steps``: rollout steps every planned step).
 
-    Model: ``steps = s0 + I_e^-1/2 (A + B / k)`` with ``k = K L_c / F_p``: a run lasts
+    Model: ``steps = s0 + I_e^-1/2 (A + B / K)`` with ``K = k l_s / F_p``: a run lasts
     (path + spring stretch) / speed, the speed is ``sqrt(I_e) v_c`` and dt is fixed by the
     contact. Also the plain power law ``steps = a I_e^b`` (b should be ~ -1/2).
     Quality: R^2 and the largest relative error of each fit.
     """
     ie = np.array([r["ie"] for r in rows])
-    kf = np.array([r["k_factor"] for r in rows])
+    kf = np.array([r["K"] for r in rows])
     y = np.array([r["planned_steps"] for r in rows], dtype=float)
     design = np.c_[np.ones_like(ie), ie**-0.5, ie**-0.5 / kf]
     coef, *_ = np.linalg.lstsq(design, y, rcond=None)
@@ -297,7 +297,7 @@ def fit_cost(rows: list[dict]) -> dict:
     r2, err = quality(pred)
     r2p, errp = quality(pred_pow)
     return {
-        "model": "steps = s0 + I_e^-1/2 (A + B / k), k = K L_c / F_p",
+        "model": "steps = s0 + I_e^-1/2 (A + B / K), K = k l_s / F_p",
         "s0": float(coef[0]),
         "A": float(coef[1]),
         "B": float(coef[2]),
@@ -468,7 +468,9 @@ def _cost_markdown(cost) -> list[str]:
         "whose outcome is decided earlier stops within a piece of its end, see the simulated "
         "steps). A run lasts (path + spring stretch) / "
         "speed with speed = sqrt(I_e) v_c and dt fixed by the contact, so "
-        "`steps = s0 + I_e^-1/2 (A + B / k)` with `k = K L_c / F_p`. Size a sweep as at most "
+        "`steps = s0 + I_e^-1/2 (A + B / K)` with `K = k l_s / F_p` (the spring's stretch "
+        "`(1 + mu) l_s / K`), up to I_e ~ 0.008 (single peak), where the impact rule starts "
+        "to shorten the step as I_e^-1/2. Size a sweep as at most "
         "runs x steps / (steps/s of `Rig.run_batch` above).",
         "",
         "| surface | dt [s] | s0 | A | B | R^2 | max rel. err | power law a I_e^b: b (R^2) |",
@@ -483,7 +485,7 @@ def _cost_markdown(cost) -> list[str]:
         )
     out += [
         "",
-        "| surface | I_e | K [F_p/L_c] | planned steps | simulated steps (mean) | recorded steps (mean) "
+        "| surface | I_e | K = k l_s / F_p | planned steps | simulated steps (mean) | recorded steps (mean) "
         "| wall s / run | end |",
         "| --- | --- | --- | --- | --- | --- | --- | --- |",
     ]
@@ -491,7 +493,7 @@ def _cost_markdown(cost) -> list[str]:
         for r in f["rows"]:
             sim_steps = r.get("simulated_steps_mean", float(r["planned_steps"]))
             out.append(
-                f"| {fam} | {r['ie']:g} | {r['k_factor']:g} | {r['planned_steps']} | {sim_steps:.0f} | "
+                f"| {fam} | {r['ie']:g} | {r['K']:g} | {r['planned_steps']} | {sim_steps:.0f} | "
                 f"{r['recorded_steps_mean']:.0f} | {r['wall_s_per_run']:.3f} | "
                 f"{', '.join(r['end_reasons'])} |"
             )

@@ -3,6 +3,7 @@
 import json
 import os
 
+import numpy as np
 import pytest
 from click.testing import CliRunner
 
@@ -81,7 +82,7 @@ def test_a_fall_off_a_cliff_lands_within_the_tolerance_by_the_step_rule():
     depth = {}
     for name, sc in (("rule", scales), ("no fall", dataclasses.replace(scales, fall_height_m=0.0))):
         rig = sim.Rig(mesa, tip=tip, engine=sim.default_engine(sc, speed_m_s=speed))
-        runs = rig.run_batch(sim.SpringDrive(speed_m_s=speed), starts)
+        runs = rig.run_batch(sim.SpringDrive(speed_m_s=speed), starts, refine=False)
         depth[name] = np.array([r.penetration_m.max() for r in runs]) / tip.tip_radius_m
         if name == "rule":
             assert all(r.engine_trouble == "" for r in runs)
@@ -90,3 +91,30 @@ def test_a_fall_off_a_cliff_lands_within_the_tolerance_by_the_step_rule():
             assert len(stopped) >= 3 and all("landing at" in r.end_detail for r in stopped)
     assert depth["rule"].max() < 0.07
     assert depth["no fall"].max() > 0.2
+
+
+def test_a_penetration_stop_is_run_again_at_a_quarter_of_the_step(monkeypatch):
+    """The engine rule made too coarse on purpose (impacts allowed twice the tolerance
+    deep): landings on the peak's fast runs then sink too far; run_batch runs each such run
+    once more at a quarter of the step, and the result carries the step it ran at."""
+    from spine_mj import presets, sim
+    from spine_mj.sim import params
+
+    monkeypatch.setattr(params, "_IMPACT_DEPTH_OF_TOLERANCE", 2.0)
+    monkeypatch.setattr(params, "_LANDING_SPEED_FACTOR", 1.0)
+    surface, tip = presets.make_surface("paper-single-peak"), sim.TipParams(mu_s=1.23)
+    scales = sim.Scales.for_surface(surface, tip=tip)
+    speed = scales.speed_for(0.1)
+    rig = sim.Rig(surface, tip=tip, engine=sim.default_engine(scales, speed_m_s=speed))
+    starts = [(-3.0, -1.0), (-3.0, -2.0)]
+    drive = sim.SpringDrive(speed_m_s=speed)
+    coarse = rig.run_batch(drive, starts, nthread=1, refine=False)
+    stopped = [r.engine_trouble == "penetration" for r in coarse]
+    assert any(stopped)
+    runs = rig.run_batch(drive, starts, nthread=1)
+    dt = rig.engine.timestep_s
+    for run, was_stopped, before in zip(runs, stopped, coarse):
+        assert run.engine.timestep_s == pytest.approx(dt * sim.REFINE_TIMESTEP if was_stopped else dt)
+        assert run.engine_trouble == ""
+        if not was_stopped:  # a run that was fine is the same run
+            np.testing.assert_array_equal(run.position_m, before.position_m)

@@ -84,34 +84,3 @@ def test_a_scan_in_um_takes_its_tip_radius_in_um(tmp_path, topography_dir):
     rig = case_rig(case)
     assert rig.surface.unit == "um" and rig.length_scale_m == 1e-6
     assert rig.tip.tip_radius_m == pytest.approx(5e-6, rel=1e-12)
-
-
-def test_a_penetration_stop_is_run_again_at_a_quarter_of_the_step(monkeypatch):
-    """The engine rule made too coarse on purpose (impacts allowed twice the tolerance
-    deep): the landings of the peak's fast runs then sink too far; each such run is run once
-    more at a quarter of the step, and its row says so."""
-    from spine_mj.sim import params
-    from spine_mj.sweep.analyses import mujoco as mj
-
-    monkeypatch.setattr(params, "_IMPACT_DEPTH_OF_TOLERANCE", 2.0)
-    monkeypatch.setattr(params, "_LANDING_SPEED_FACTOR", 1.0)
-    mj.case_rig.cache_clear()
-    doc = {
-        "sweep": {"name": "refine", "analyses": ["mujoco"]},
-        "surfaces": [{"preset": "paper-single-peak"}],
-        "starts": {"frame": "absolute", "x": [-3.0], "y": [-1.0, -2.0]},
-        "drive": {"protocol": "spring", "ie": [0.1]},
-    }
-    case = sweep.expand_cases(sweep.parse_config(doc))[0]
-    surface = case.surface.make()
-    starts = np.array([[-3.0, -1.0], [-3.0, -2.0]])
-    coarse = mj._runs(mj.case_rig(case, surface), case.params, starts)
-    stopped = [r.engine_trouble == "penetration" for r in coarse]
-    assert any(stopped)
-    res = mj._mujoco(case, surface, starts, {})
-    mj.case_rig.cache_clear()
-    dt = coarse[0].engine.timestep_s
-    for i, was_stopped in enumerate(stopped):
-        expected = dt * mj.REFINE_TIMESTEP if was_stopped else dt
-        assert res.metrics["timestep_s"][i] == pytest.approx(expected)
-    assert (res.status == "ok").all()

@@ -80,13 +80,14 @@ from spine_mj.sim.params import (
 )
 from spine_mj.sim.planes import inclined_plane
 from spine_mj.sim.results import RunResult
-from spine_mj.sim.rig import Rig
+from spine_mj.sim.rig import REFINE_TIMESTEP, Rig
 
 __all__ = [
     "DEFAULT_LENGTH_SCALE_M",
     "LENGTH_UNITS_M",
     "MAX_INERTIA_NUMBER",
     "MODEL_PATH",
+    "REFINE_TIMESTEP",
     "Cone",
     "Detection",
     "Drive",

@@ -202,37 +202,10 @@ def case_rig(case, surface=None):
 case_rig.cache_clear = _rig.cache_clear
 
 
-#: A run stopped on penetration is run once more at this fraction of its time step and
-#: contact time constant. The engine rule bounds the landings it can foresee (the drive's
-#: speed, falls off the surface's steps); a hop thrown by the spring's release at a
-#: breakaway can land faster (measured: a fractal run at I_e = 1e-4 landing at 0.19 m/s,
-#: 1.14 times the tolerance deep). The row's ``timestep_s`` says which step a run used.
-REFINE_TIMESTEP = 0.25
-
-
-def _refine_penetration(case, surface, p: dict, starts, runs: list) -> list:
-    """``runs`` with each penetration stop replaced by its run at :data:`REFINE_TIMESTEP`
-    of the step (once; a step the config sets is kept as given)."""
-    redo = [i for i, r in enumerate(runs) if r.engine_trouble == "penetration"]
-    if not redo or p["timestep"] is not None:
-        return runs
-    engine = runs[redo[0]].engine
-    finer = dict(
-        p,
-        timestep=REFINE_TIMESTEP * engine.timestep_s,
-        solref_timeconst=REFINE_TIMESTEP * engine.solref[0],
-    )
-    again = _runs(_rig(case.surface, _rig_key(finer, surface)), finer, [starts[i] for i in redo])
-    out = list(runs)
-    for i, run in zip(redo, again):
-        out[i] = run
-    return out
-
-
 def _mujoco(case, surface, starts, upstream):
     p = case.params
     rig = case_rig(case, surface)
-    runs = _refine_penetration(case, surface, p, starts, _runs(rig, p, starts))
+    runs = _runs(rig, p, starts)
     # engine trouble is named by its kind: nan, engine_warning, penetration or diverged
     status = np.array([r.engine_trouble or "ok" for r in runs], dtype=object)
     reason = np.array([r.end_detail for r in runs], dtype=object)
