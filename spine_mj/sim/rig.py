@@ -20,7 +20,7 @@ from spine_mj.sim.model import RigModel
 from spine_mj.sim.ramp import run_ramp
 from spine_mj.sim.render import render_frames
 from spine_mj.sim.results import RunResult
-from spine_mj.sim.rollout import controls, run_batch
+from spine_mj.sim.rollout import batch_drives, controls, run_batch
 
 #: A run stopped on penetration is run once more at this fraction of the time step and
 #: contact time constant (``Rig.run_batch``, ``refine``). The engine rule bounds the
@@ -122,10 +122,10 @@ class Rig(RigModel):
         redo = [i for i, r in enumerate(runs) if r.engine_trouble == "penetration"]
         if not refine or not redo:
             return runs
-        drive_list = [drives] * len(runs) if not isinstance(drives, Sequence) else list(drives)
+        drive_list, start_list = batch_drives(drives, starts)
         again = self.refined().run_batch(
             [drive_list[i] for i in redo],
-            [starts[i] for i in redo],
+            [start_list[i] for i in redo],
             detection=detection,
             backend=backend,
             nthread=nthread,

@@ -23,15 +23,20 @@ from spine_mj.sweep.analyses.quasistatic import path_table
 from spine_mj.sweep.registry import Analysis, AnalysisResult, register_analysis
 
 
+def _xy(res: sl.StreamlineResult, i: int) -> np.ndarray:
+    """Path ``i`` of ``res`` as ``(n, 2)`` x, y."""
+    q = res.path(i)
+    return np.column_stack([q["x"], q["y"]])
+
+
 def _deviations(mpaths, qs: sl.StreamlineResult, lc: float) -> tuple[np.ndarray, np.ndarray]:
     """Frechet and mean lateral deviation of each MuJoCo path from the streamline of its start."""
     frechet = np.full(len(mpaths), np.nan)
     lateral = np.full(len(mpaths), np.nan)
     for i, mpath in enumerate(mpaths):
-        q = qs.path(i)
-        qpath = np.column_stack([q["x"], q["y"]])
         if mpath.shape[0] == 0:
             continue
+        qpath = _xy(qs, i)
         frechet[i] = compare.path_frechet(mpath, qpath, length_scale=lc)
         lateral[i] = compare.mean_lateral_deviation(mpath, qpath, length_scale=lc)
     return frechet, lateral
@@ -59,14 +64,7 @@ def _compare(case, surface, starts, upstream):
     frechet, lateral = _deviations(mpaths, facets, lc)
     frechet_smooth, _ = _deviations(mpaths, smooth, lc)
     geometry = np.array(
-        [
-            compare.path_frechet(
-                np.column_stack([facets.path(i)["x"], facets.path(i)["y"]]),
-                np.column_stack([smooth.path(i)["x"], smooth.path(i)["y"]]),
-                length_scale=lc,
-            )
-            for i in range(len(facets))
-        ]
+        [compare.path_frechet(_xy(facets, i), _xy(smooth, i), length_scale=lc) for i in range(len(facets))]
     )
     mj_locked = np.array([r.end_reason.value == "self_lock" for r in runs])
     mj_end = np.array([r.position_m[-1, :2] / s for r in runs])
