@@ -83,10 +83,13 @@ class Placer:
         d.qpos[:] = (x0 * s, y0 * s, z)
         mujoco.mj_kinematics(m, d)  # positions and contacts only: no dynamics needed
         mujoco.mj_collision(m, d)
-        if not d.ncon:
+        n = d.ncon
+        if not n:
             return None, 1.0
-        k = int(np.argmin(d.contact.dist[: d.ncon]))
-        return float(d.contact.dist[k]), abs(float(d.contact.frame[k, 2]))
+        contacts = d.contact
+        dist = contacts.dist
+        k = int(dist[:n].argmin())
+        return float(dist[k]), abs(float(contacts.frame[k, 2]))
 
     def _touching_z(self, x0: float, y0: float, lo: float) -> float:
         """Height (engine units) of the sphere centre touching the hfield (distance within 1e-7
@@ -95,10 +98,10 @@ class Placer:
         _, _, elev, _ = self._hfield.size
         # 2 r above the hfield's top the sphere (contact margin 0.2 r) touches nothing
         hi = (self._hfield.pos[2] + elev) * s + 2 * r
-        if not (self._probe(x0, y0, lo)[0] or 0.0) < 0:
-            raise SpineInputError(f"could not place the tip on the surface at ({x0:g}, {y0:g})")
         z = lo + r
-        for _ in range(100):  # Newton on the engine's distance, safeguarded by [lo, hi]
+        # Newton on the engine's distance, safeguarded by [lo, hi]: the sphere centred at the
+        # surface's height cuts the hfield; where it would not, the search fails to converge
+        for _ in range(100):
             g, nz = self._probe(x0, y0, z)
             if g is None:
                 hi, z = z, 0.5 * (z + lo)

@@ -20,7 +20,9 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from spine_mj.engagement import DEFAULT_TOL
 from spine_mj.sim.detection import (
+    LOCK_RISE_FP,
     Detection,
     Ending,
     Event,
@@ -34,7 +36,7 @@ from spine_mj.sim.detection import (
 from spine_mj.sim.drives import Drive, SpringDrive, StaticProbe, settle_steps, stiffness_n_m
 from spine_mj.sim.model import RigModel
 from spine_mj.sim.params import EndReason, EngineSettings, Scales, TipParams
-from spine_mj.sim.recording import COLUMNS, Recording
+from spine_mj.sim.recording import COLUMNS, SENSOR_NAMES, Recording
 
 
 @dataclass(frozen=True, eq=False)
@@ -209,6 +211,9 @@ class GroupAnalysis:
     carriage : (g, n) array
         The carriage x of each run and step in engine units (read for spring drives only);
         ``n`` is the group's planned length.
+    compiled : bool
+        Analyse each window in one compiled pass (:mod:`~spine_mj.sim._window_kernel`);
+        False: by the numpy reference it is tested against (the same numbers, bit for bit).
 
     Notes
     -----
@@ -222,8 +227,11 @@ class GroupAnalysis:
     would report instead of the ending). Columns hold only the rows added.
     """
 
-    def __init__(self, rig: RigModel, drives, starts, det: Detection, carriage: np.ndarray):
+    def __init__(
+        self, rig: RigModel, drives, starts, det: Detection, carriage: np.ndarray, *, compiled: bool = True
+    ):
         self.rig, self.drives, self.starts, self.det = rig, list(drives), list(starts), det
+        self.compiled = compiled
         self.g, self.n = carriage.shape
         self.carriage = carriage
         self.spring = np.array([isinstance(d, SpringDrive) for d in self.drives])
@@ -233,6 +241,24 @@ class GroupAnalysis:
         self.cols = Recording.empty((self.g, self.n))
         self.marks: dict[str, np.ndarray] = {}
         self.held_from_n = np.full(self.g, np.nan)
+        a, u, e = rig.sensor_adr, rig.units, (*rig.bounds_m, *rig.z_range_m)
+        self._adr = np.array([a[k] for k in SENSOR_NAMES], dtype=np.int64)
+        self._units = np.array([u.length_m, u.force_n, u.speed_m_s, u.time_s])
+        span = max(e[1] - e[0], e[3] - e[2])
+        self._prm = np.array(
+            [
+                rig.engine.timestep_s,
+                *e[:5],
+                e[5] + span,
+                det.domain_margin_m,
+                det.slip_speed_m_s,
+                det.penetration_tol_m,
+                det.kappa_cap * rig.scales.preload_n * (1 - 1e-9),
+                rig.tip.mu_s,
+                DEFAULT_TOL,
+                LOCK_RISE_FP * rig.scales.preload_n,
+            ]
+        )
         self.rows = np.zeros(self.g, dtype=int)
         self.simulated = np.zeros(self.g, dtype=int)
 
@@ -243,20 +269,46 @@ class GroupAnalysis:
         ``(len(runs), b - a, nstate)``, ``sens`` likewise); returns, per run, whether it is
         decided (an ending at or before row b-1)."""
         rig, det = self.rig, self.det
-        carriage = np.where(self.spring[runs, None], self.carriage[runs, a:b], np.nan)
         block = isinstance(runs, slice)  # the window's columns are views of the group's: written in place
-        rec = Recording.from_sensors(
+        if block:
+            rec = Recording(**{k: getattr(self.cols, k)[runs, a:b] for k in COLUMNS})
+        else:
+            rec = Recording.empty(state.shape[:2])
+        if self.compiled:
+            marks = self._marks_compiled(runs, a, state, sens, rec)
+        else:
+            marks = self._marks_reference(runs, a, b, state, sens, rec)
+        if not block:
+            for k in COLUMNS:
+                getattr(self.cols, k)[runs, a:b] = getattr(rec, k)
+        decided = np.zeros(state.shape[0], bool)
+        for k, m in marks.items():
+            old = self.marks.setdefault(k, np.full(self.g, -1))[runs]
+            merged = np.where((old < 0) & (m >= 0), m + a, old)
+            self.marks[k][runs] = merged
+            decided |= merged >= 0
+        self.rows[runs] = b
+        for i, r in enumerate(np.arange(self.g)[runs]):
+            if self.probe[r] and not decided[i]:
+                decided[i] = bool(
+                    probe_candidates(self.run(r), self.n_settle[r], det, rig.scales.preload_n)[0]
+                )
+        return decided
+
+    def _marks_reference(self, runs, a: int, b: int, state, sens, rec: Recording) -> dict[str, np.ndarray]:
+        """The window's columns (into ``rec``) and end marks by the numpy reference:
+        :meth:`Recording.from_sensors`, :func:`end_marks`, :func:`normal_lock_marks`."""
+        rig, det = self.rig, self.det
+        carriage = np.where(self.spring[runs, None], self.carriage[runs, a:b], np.nan)
+        Recording.from_sensors(
             rig.sensor_adr,
             state,
             sens,
             units=rig.units,
             carriage_x=carriage,
             slip_speed_m_s=det.slip_speed_m_s,
-            out=Recording(**{k: getattr(self.cols, k)[runs, a:b] for k in COLUMNS}) if block else None,
+            out=rec,
         )
-        if not block:
-            for k in COLUMNS:
-                getattr(self.cols, k)[runs, a:b] = getattr(rec, k)
         marks = end_marks(
             rec,
             state,
@@ -271,19 +323,32 @@ class GroupAnalysis:
         marks["lock_rule"], self.held_from_n[runs] = normal_lock_marks(
             rec, rig.tip.mu_s, rig.scales.preload_n, self.held_from_n[runs]
         )
-        decided = np.zeros(state.shape[0], bool)
-        for k, m in marks.items():
-            old = self.marks.setdefault(k, np.full(self.g, -1))[runs]
-            merged = np.where((old < 0) & (m >= 0), m + a, old)
-            self.marks[k][runs] = merged
-            decided |= merged >= 0
-        self.rows[runs] = b
-        for i, r in enumerate(np.arange(self.g)[runs]):
-            if self.probe[r] and not decided[i]:
-                decided[i] = bool(
-                    probe_candidates(self.run(r), self.n_settle[r], det, rig.scales.preload_n)[0]
-                )
-        return decided
+        return marks
+
+    def _marks_compiled(self, runs, a: int, state, sens, rec: Recording) -> dict[str, np.ndarray]:
+        """:meth:`_marks_reference` in one compiled pass (:mod:`~spine_mj.sim._window_kernel`)."""
+        from spine_mj.sim._window_kernel import MARK_KEYS, analyse_window
+
+        g = state.shape[0]
+        marks = np.empty((g, len(MARK_KEYS)), dtype=np.int64)
+        held = np.empty(g)
+        analyse_window(
+            state,
+            sens,
+            self.carriage[runs, a : a + state.shape[1]],
+            self.spring[runs],
+            self._adr,
+            self._units,
+            self._prm,
+            self.limits[runs] ** 2,
+            a,
+            self.held_from_n[runs],
+            *(getattr(rec, k) for k in COLUMNS),
+            marks,
+            held,
+        )
+        self.held_from_n[runs] = held
+        return {k: marks[:, j] for j, k in enumerate(MARK_KEYS)}
 
     def run(self, r: int) -> Recording:
         """The recorded rows of run ``r`` (views of the group's columns)."""

@@ -82,11 +82,14 @@ def drive_steps(rig: RigModel, drive: Drive, x0_m: float, detection: Detection) 
     )
 
 
-def controls(rig: RigModel, drive: Drive, qpos0: np.ndarray, detection: Detection) -> np.ndarray:
+def controls(
+    rig: RigModel, drive: Drive, qpos0: np.ndarray, detection: Detection, out: np.ndarray | None = None
+) -> np.ndarray:
     """Open-loop controls ``(nstep, 6)`` in engine units: ctrl (spring, push, preload) then mocap xyz.
 
     ``qpos0`` is the placed start (:meth:`RigModel.place`, engine units), ``detection``
     resolved (:meth:`Detection.resolve`): its ``kappa_cap`` bounds a probe's force.
+    ``out``: an array of that shape to fill and return (a batch's row) instead of a new one.
     """
     u = rig.units
     dt = rig.engine.timestep_s
@@ -94,7 +97,10 @@ def controls(rig: RigModel, drive: Drive, qpos0: np.ndarray, detection: Detectio
     cap = detection.kappa_cap * rig.scales.preload_n / u.force_n
     n_drive = drive_steps(rig, drive, qpos0[0] * u.length_m, detection)
     n = n_settle + n_drive
-    ctrl = np.zeros((n, 6))
+    if out is not None and out.shape != (n, 6):
+        raise ValueError(f"out must have shape {(n, 6)}, got {out.shape}")
+    ctrl = np.empty((n, 6)) if out is None else out
+    ctrl[:, :2] = 0.0
     ctrl[:, 2] = -rig.tip.preload_n / u.force_n
     ctrl[:, 3] = qpos0[0]
     ctrl[:, 4] = qpos0[1]
@@ -252,7 +258,7 @@ class _Group:
         """Place the tips of runs ``ks``; their controls and initial states."""
         rig = self.rig
         for k, q in zip(ks, rig.place_many([self.starts[k] for k in ks])):
-            self.ctrl[k] = controls(rig, self.drives[k], q, self.det)
+            controls(rig, self.drives[k], q, self.det, out=self.ctrl[k])
             self.init[k, 1:4] = q
 
     def submit(self, ks: np.ndarray, lanes) -> list:
