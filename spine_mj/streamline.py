@@ -75,6 +75,11 @@ class StreamlineParams:
         (:class:`spine_mj.sim.Detection`, the same default
         :data:`spine_mj.engagement.DEFAULT_KAPPA_CAP` in a comparison). ``inf``, the
         paper's theory: only the self-lock region stops a path.
+    edge_margin : float
+        A path ends ``LEFT_DOMAIN`` where its next step would come closer than this to
+        the surface's edges (surface length unit; 0: at the edges). A comparison with the
+        engine passes the MuJoCo run's domain margin (the tip radius,
+        :class:`spine_mj.sim.Detection`), so that both sides end at the same place.
     """
 
     mu: float
@@ -84,6 +89,7 @@ class StreamlineParams:
     stall_distance: float | None = None
     tol: float = 1e-12
     kappa_cap: float = math.inf
+    edge_margin: float = 0.0
 
     def __post_init__(self):
         for name in ("mu", "dl"):
@@ -100,6 +106,16 @@ class StreamlineParams:
             raise SpineInputError(f"tol must be >= 0, got {self.tol!r}")
         if not (self.kappa_cap > 0):
             raise SpineInputError(f"kappa_cap must be > 0 (inf: no cap), got {self.kappa_cap!r}")
+        m = self.edge_margin
+        if not (isinstance(m, (int, float, np.floating)) and math.isfinite(m) and m >= 0):
+            raise SpineInputError(f"edge_margin must be a finite number >= 0, got {self.edge_margin!r}")
+
+    def domain(self, surface: Surface) -> tuple[float, float, float, float]:
+        """``(xmin, xmax, ymin, ymax)`` a path on ``surface`` stays within: its bounds
+        less ``edge_margin``."""
+        xmin, xmax, ymin, ymax = surface.bounds
+        m = float(self.edge_margin)
+        return xmin + m, xmax - m, ymin + m, ymax - m
 
     @property
     def stall_distance_value(self) -> float:
@@ -282,7 +298,7 @@ def _trajectories(surface, starts, params, *, ideal, store_paths, backend):
             g,
             coef,
             sp,
-            np.asarray(surface.bounds, dtype=float),
+            np.asarray(params.domain(surface), dtype=float),
             xs,
             ys,
             bool(ideal),
@@ -362,7 +378,7 @@ def ideal_trajectories(
 def _run_numpy(surface, xs, ys, params, *, ideal, store):
     """The obvious reference: one vectorized step for all active starts per iteration."""
     n = xs.size
-    xmin, xmax, ymin, ymax = surface.bounds
+    xmin, xmax, ymin, ymax = params.domain(surface)
     x, y = xs.copy(), ys.copy()
     cx, cy = x.copy(), y.copy()
     outcome = np.zeros(n, np.int8)

@@ -163,6 +163,24 @@ def test_regions_along_path_are_consistent():
     assert np.any(r.region == ENGAGED)
 
 
+@pytest.mark.parametrize("backend", ["numba", "numpy"])
+def test_edge_margin_ends_the_path_that_far_from_the_edge(backend):
+    """Flat ground, +x: with a margin m the path ends LEFT_DOMAIN at its last step before
+    x = xmax - m (within one step), the same path as without it up to there."""
+    surf = _plane(0.0)
+    p = StreamlineParams(mu=0.6, dl=0.01)
+    full = streamlines(surf, [(-1.5, 0.3)], p, backend=backend)
+    cut = streamlines(
+        surf, [(-1.5, 0.3)], StreamlineParams(mu=0.6, dl=0.01, edge_margin=0.25), backend=backend
+    )
+    assert cut.outcome[0] == Outcome.LEFT_DOMAIN
+    assert 2.0 - 0.25 - 0.01 < cut.end_x[0] <= 2.0 - 0.25
+    n = cut.path(0)["x"].size
+    np.testing.assert_array_equal(cut.path(0)["x"], full.path(0)["x"][:n])
+    with pytest.raises(SpineInputError, match="edge_margin"):
+        StreamlineParams(mu=0.6, edge_margin=-1.0)
+
+
 def test_bad_input_names_the_argument():
     surf = single_gaussian()
     with pytest.raises(SpineInputError, match="starts must lie inside"):

@@ -51,6 +51,14 @@ def test_mujoco_and_compare_runs_match_the_rig_run_directly(tmp_path):
     assert (cmp_.status == np.where(mjs.status.loc[cmp_.index] == "ok", "ok", "dependency_failed")).all()
     ran = mjs.status.loc[cmp_.index] == "ok"
     assert cmp_.frechet[ran].notna().all() and (cmp_.frechet[ran] >= 0).all()
+    # both sides end at the engine's domain margin: at the lower I_e, runs that leave the
+    # domain end together
+    left = (
+        (cmp_.reference_outcome == "left_domain")
+        & (mjs.end_reason.loc[cmp_.index] == "left_domain")
+        & (mjs.ie.loc[cmp_.index] == 0.01)
+    )
+    assert left.any() and (cmp_.end_distance[left] < 0.05).all(), cmp_.end_distance[left]
     # the stored run is the rig's own run at that speed
     case_id = mj.case_id[mj.ie == 0.01].iloc[0]
     # the engine's step follows the drive speed (impacts): the rule of sim.default_engine
@@ -64,6 +72,11 @@ def test_mujoco_and_compare_runs_match_the_rig_run_directly(tmp_path):
     traj = sweep.load_trajectories(out, case_id, analysis="mujoco", start=1, columns=["x"])
     assert len(traj) == direct.n
     np.testing.assert_allclose(traj.x, direct.position_m[:, 0] / rig.length_scale_m)
+    # the reference ends where the run does: the tip radius (the domain margin) from the edge
+    edge = surface.bounds[1] - rig.tip.tip_radius_m / rig.length_scale_m
+    ref = sweep.load_trajectories(out, case_id, analysis="compare", start=1, columns=["x"])
+    assert direct.end_reason.value == "left_domain" and row.end_x > edge
+    assert edge - 2 * 0.02 < ref.x.max() <= edge  # within a step (dl 0.02) of it
 
 
 def test_a_scan_in_um_takes_its_tip_radius_in_um(tmp_path, topography_dir):

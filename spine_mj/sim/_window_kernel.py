@@ -36,7 +36,7 @@ def _finite_or_clipped(x):
     return x
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)  # the worker threads go on stepping meanwhile
 def analyse_window(
     state,
     sens,

@@ -3,10 +3,11 @@
 Like for like (docs/physics.md §4): the reference streamline is traced on the surface the
 MuJoCo tip touches, the rig's hfield facets dilated by its tip radius
 (:meth:`spine_mj.sim.Rig.contact_surface`), with the quasistatic analysis's mu_s, step and
-force cap, so both sides share the geometry and the lock test. The comparison with the
-quasistatic analysis's own path (the smooth surface, or whatever it traced) is kept beside
-it (``*_smooth``), and the gap between the two streamlines is the geometry part
-(``geometry_frechet``). Touches the API of :mod:`spine_mj.compare` here only; needs the
+force cap, and it ends where the engine's run ends (the domain margin from the edges), so
+both sides share the geometry, the lock test and the domain. The comparison with the
+quasistatic analysis's path (the smooth surface, or whatever it traced; retraced within
+the same domain) is kept beside it (``*_smooth``), and the gap between the two streamlines
+is the geometry part (``geometry_frechet``). Touches the API of :mod:`spine_mj.compare` here only; needs the
 results of the ``quasistatic`` and ``mujoco`` analyses of the same case.
 """
 
@@ -19,7 +20,7 @@ import numpy as np
 from spine_mj import compare
 from spine_mj import streamline as sl
 from spine_mj.sweep.analyses.mujoco import peak_drive_over_fp
-from spine_mj.sweep.analyses.quasistatic import path_table
+from spine_mj.sweep.analyses.quasistatic import path_table, traced_surface
 from spine_mj.sweep.registry import Analysis, AnalysisResult, register_analysis
 
 
@@ -49,16 +50,21 @@ def _outcomes(qs: sl.StreamlineResult, mj_locked, mj_end, lc: float) -> dict[str
 
 
 def _compare(case, surface, starts, upstream):
-    smooth = upstream["quasistatic"].data
+    quasistatic = upstream["quasistatic"].data
     rig, runs = upstream["mujoco"].data
-    trace = sl.ideal_trajectories if smooth.ideal else sl.streamlines
+    trace = sl.ideal_trajectories if quasistatic.ideal else sl.streamlines
+    s = rig.length_scale_m
+    # both sides end where the engine's run ends, its domain margin from the edges (a path
+    # traced to the very edge is a tip radius longer: measured on the random Gaussian, that
+    # tail alone made the Frechet distance 0.12 L_c where the paths were 0.01-0.03 apart)
+    margin = dataclasses.replace(quasistatic.params, edge_margin=runs[0].detection.domain_margin_m / s)
+    smooth = trace(traced_surface(case, surface), starts, margin, store_paths=True)
     contact = rig.contact_surface()
     # steps no longer than the contact surface's samples: a longer step can jump a crease
     # between facets where the engine's tip wedges (measured on a fractal: dl = 4 samples
     # passed a crease of kappa > 20 where MuJoCo held; 1 sample held within 0.003 L_c)
-    params = dataclasses.replace(smooth.params, dl=min(smooth.params.dl, *contact.spacing))
+    params = dataclasses.replace(margin, dl=min(margin.dl, *contact.spacing))
     facets = trace(contact, starts, params, store_paths=True)
-    s = rig.length_scale_m
     lc = rig.scales.char_length_m / s
     mpaths = [r.position_m[r.drive_start_index :, :2] / s for r in runs]
     frechet, lateral = _deviations(mpaths, facets, lc)

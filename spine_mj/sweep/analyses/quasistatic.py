@@ -47,10 +47,16 @@ def clear_cache() -> None:
     _dilated.cache_clear()
 
 
+def traced_surface(case, surface):
+    """The surface the quasistatic analysis traces on for ``case``: ``surface`` dilated by
+    the case's tip radius (when it has one)."""
+    r = case.params["tip_radius"]
+    return _dilated(case.surface, r) if r > 0 else surface
+
+
 def _quasistatic(case, surface, starts, upstream):
     p = case.params
-    if p["tip_radius"] > 0:
-        surface = _dilated(case.surface, p["tip_radius"])
+    surface = traced_surface(case, surface)
     xmin, xmax, ymin, ymax = surface.bounds
     dl = p["dl"] if p["dl"] is not None else 0.0015 * min(xmax - xmin, ymax - ymin)
     params = sl.StreamlineParams(mu=p["mu"], dl=dl, max_steps=p["max_steps"], kappa_cap=p["kappa_cap"])
