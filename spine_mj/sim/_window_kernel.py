@@ -91,15 +91,18 @@ def analyse_window(
         for i in range(w):
             s = sens[r, i]
             if marks[r, 0] < 0:
-                finite = True
+                total = 0.0  # finite unless a number is not (or the sum overflows: then look closer)
                 for j in range(nstate):
-                    if not math.isfinite(state[r, i, j]):
-                        finite = False
+                    total += state[r, i, j]
                 for j in range(nsens):
-                    if not math.isfinite(s[j]):
-                        finite = False
-                if not finite:
-                    marks[r, 0] = i
+                    total += s[j]
+                if not math.isfinite(total):
+                    for j in range(nstate):
+                        if not math.isfinite(state[r, i, j]):
+                            marks[r, 0] = i
+                    for j in range(nsens):
+                        if not math.isfinite(s[j]):
+                            marks[r, 0] = i
             touching = s[cd] > 0
             contact[r, i] = touching
             flip = s[cd + 7] < 0
