@@ -111,7 +111,7 @@ def bench_rollout(quick: bool) -> dict:
     """Paired timings of ``Rig.run_batch`` and bare ``mujoco.rollout`` (see bench_rollout.py)."""
     from bench_rollout import paired_setup
 
-    runs, duration, pairs = (16, 0.2, 5) if quick else (64, 0.5, 7)
+    runs, duration, pairs = (16, 0.2, 5) if quick else (64, 0.5, 11)
     nthread = os.cpu_count() or 1
     bare, ours, nstep = paired_setup(runs, duration, nthread)
     ours()
