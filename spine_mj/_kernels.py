@@ -3,7 +3,9 @@
 ``run_trajectories`` steps ``lanes`` starts together on one core (a finished lane takes the
 next start): per iteration every lane gets its height and slopes, then kappa, region and
 slip direction in branch-free loops over the lanes that LLVM vectorizes (AVX2: 4 lanes per
-instruction), then a scalar pass records, stops and steps. The trajectories are independent
+instruction), then a scalar pass controls the step (a point where the slip direction
+reverses is rejected and the step halves; see :class:`spine_mj.streamline.StreamlineParams`
+``max_halvings``), records, stops and steps. The trajectories are independent
 and each is computed with the same operations as one at a time, so the result does not
 depend on ``lanes``. A single Gaussian has its own path (exp through libm, the rest
 vectorized); Gaussian sums and grids evaluate lane by lane. ``kind`` 0
@@ -124,6 +126,7 @@ def run_trajectories(
     store,
     lanes,
     kappa_cap,
+    max_halvings,
 ):
     n = xs.size
     outcome = np.zeros(n, np.int8)
@@ -158,6 +161,20 @@ def run_trajectories(
     lmoved = np.empty(L, np.bool_)  # stepped to a new point, not yet evaluated
     levent = np.empty(L, np.bool_)
     lstall = np.zeros(L, np.bool_)  # no progress over a window: ends after its next evaluation
+    # step-size control: the step that produced the lane's point (then the next one), the
+    # last accepted point with its horizontal slip direction, the path walked since the
+    # last progress check
+    lh = np.empty(L)
+    lpx = np.empty(L)
+    lpy = np.empty(L)
+    lpvx = np.empty(L)
+    lpvy = np.empty(L)
+    lhp = np.zeros(L, np.bool_)
+    larc = np.zeros(L)
+    lrev = np.empty(L, np.bool_)
+    lrej = np.empty(L, np.bool_)
+    h_min = dl / 2.0**max_halvings
+    arc_norm = 1.0 / (stall_window * dl)
     # path points in the order they are produced, tagged with their start
     cap = 1024 if store else 1
     bx = np.empty(cap)
@@ -168,7 +185,6 @@ def run_trajectories(
     bi = np.empty(cap, np.int64)
     pos = 0
     xmin, xmax, ymin, ymax = bounds[0], bounds[1], bounds[2], bounds[3]
-    sd2 = stall_dist * stall_dist
     m2 = mu * mu
     single = kind == 0 and g.shape[1] == 1
     amp = g[0, 0] if single else 0.0
@@ -182,7 +198,26 @@ def run_trajectories(
         lx[j] = xs[0]  # idle lanes compute on a valid point, results unused
         ly[j] = ys[0]
         if nxt < n:
-            _load_lane(j, nxt, xs, ys, stall_window, lidx, lx, ly, lcx, lcy, lmk, lstep, luntil, lstall)
+            _load_lane(
+                j,
+                nxt,
+                xs,
+                ys,
+                stall_window,
+                dl,
+                lidx,
+                lx,
+                ly,
+                lcx,
+                lcy,
+                lmk,
+                lstep,
+                luntil,
+                lstall,
+                lh,
+                lhp,
+                larc,
+            )
             nxt += 1
             nact += 1
     while nact > 0:
@@ -248,7 +283,15 @@ def run_trajectories(
                 lvx[j] = tx * inv
                 lvy[j] = ty * inv
                 lok[j] = tn2 > 0.0
-        # 3. record the points, then move every lane that goes on (branch-free)
+        # 3. step-size control: a point where the horizontal slip direction reverses against
+        # the last accepted point's is rejected (the step halves and is retried from there)
+        # unless the step is already the shortest; a self-locked point has no direction
+        for j in range(L):
+            turned = lvx[j] * lpvx[j] + lvy[j] * lpvy[j] < 0.0
+            rev = lhp[j] & (lreg[j] != 2) & lok[j] & turned
+            lrev[j] = rev
+            lrej[j] = rev & (lh[j] > h_min) & (lidx[j] >= 0)
+        # 4. record the accepted points, then move every lane that goes on (branch-free)
         if store:
             if pos + L > cap:
                 cap *= 2
@@ -259,7 +302,7 @@ def run_trajectories(
                 br = _grow(br, pos, cap)
                 bi = _grow(bi, pos, cap)
             for j in range(L):
-                if lidx[j] >= 0:
+                if lidx[j] >= 0 and not lrej[j]:
                     bx[pos] = lx[j]
                     by[pos] = ly[j]
                     bz[pos] = lf[j]
@@ -268,13 +311,23 @@ def run_trajectories(
                     bi[pos] = lidx[j]
                     pos += 1
         for j in range(L):
+            if lrej[j]:
+                h = 0.5 * lh[j]
+                lh[j] = h
+                lx[j] = lpx[j] + h * lpvx[j]
+                ly[j] = lpy[j] + h * lpvy[j]
+                lmoved[j] = False
+                levent[j] = False
+                continue
             k = lk[j]
             mk = lmk[j]
             lmk[j] = k if ((k > mk) | (mk != mk)) & (k == k) else mk
             x = lx[j]
             y = ly[j]
-            xn = x + dl * lvx[j]
-            yn = y + dl * lvy[j]
+            # an accepted point reached without a reversal lets the step grow back
+            h = lh[j] if lrev[j] else min(2.0 * lh[j], dl)
+            xn = x + h * lvx[j]
+            yn = y + h * lvy[j]
             inside = (xn >= xmin) & (xn <= xmax) & (yn >= ymin) & (yn <= ymax)
             go = (
                 (lreg[j] != 2)
@@ -284,14 +337,22 @@ def run_trajectories(
                 & inside
                 & (not lstall[j])
             )
-            lx[j] = xn if go else x
-            ly[j] = yn if go else y
+            if go:
+                lpx[j] = x
+                lpy[j] = y
+                lpvx[j] = lvx[j]
+                lpvy[j] = lvy[j]
+                lhp[j] = True
+                lh[j] = h
+                larc[j] += h
+                lx[j] = xn
+                ly[j] = yn
             lstep[j] += go
             u = luntil[j] - go
             luntil[j] = u
             lmoved[j] = go
             levent[j] = (not go) | (u == 0)
-        # 4. the rare events: a trajectory ends (the lane takes the next start), stall checks.
+        # 5. the rare events: a trajectory ends (the lane takes the next start), stall checks.
         # A lane that moved is on a point not evaluated yet: it only gets its progress check
         # here (a stall or the step cap ends it after the next pass has recorded that point).
         # A lane that did not move ends now, on the point just recorded. Deciding an end for
@@ -310,10 +371,13 @@ def run_trajectories(
                 luntil[j] = stall_window
                 dxs = x - lcx[j]
                 dys = y - lcy[j]
-                if dxs * dxs + dys * dys < sd2:
+                # progress asked for in proportion to the path walked (full steps: stall_dist)
+                need = stall_dist * (larc[j] * arc_norm)
+                if dxs * dxs + dys * dys < need * need:
                     lstall[j] = True
                 lcx[j] = x
                 lcy[j] = y
+                larc[j] = 0.0
             elif lreg[j] == 2:
                 code = 1
             elif lk[j] > kappa_cap:
@@ -335,7 +399,24 @@ def run_trajectories(
                 ez[i] = lf[j]
                 if nxt < n:
                     _load_lane(
-                        j, nxt, xs, ys, stall_window, lidx, lx, ly, lcx, lcy, lmk, lstep, luntil, lstall
+                        j,
+                        nxt,
+                        xs,
+                        ys,
+                        stall_window,
+                        dl,
+                        lidx,
+                        lx,
+                        ly,
+                        lcx,
+                        lcy,
+                        lmk,
+                        lstep,
+                        luntil,
+                        lstall,
+                        lh,
+                        lhp,
+                        larc,
                     )
                     nxt += 1
                 else:
@@ -368,8 +449,10 @@ def run_trajectories(
 
 
 @njit(cache=True, inline="always")
-def _load_lane(j, i, xs, ys, stall_window, lidx, lx, ly, lcx, lcy, lmk, lstep, luntil, lstall):
-    """Put start ``i`` into lane ``j``: position, progress anchor, fresh counters."""
+def _load_lane(
+    j, i, xs, ys, stall_window, dl, lidx, lx, ly, lcx, lcy, lmk, lstep, luntil, lstall, lh, lhp, larc
+):
+    """Put start ``i`` into lane ``j``: position, progress anchor, fresh counters, a full step."""
     lidx[j] = i
     lx[j] = xs[i]
     ly[j] = ys[i]
@@ -379,6 +462,9 @@ def _load_lane(j, i, xs, ys, stall_window, lidx, lx, ly, lcx, lcy, lmk, lstep, l
     lstep[j] = 0
     luntil[j] = stall_window
     lstall[j] = False
+    lh[j] = dl
+    lhp[j] = False
+    larc[j] = 0.0
 
 
 @njit(cache=True)

@@ -7,6 +7,11 @@ back on the surface vertically::
 
     A_{k+1} = A_k + dl v_k,    B_{k+1} = (A_{k+1,x}, A_{k+1,y}, f(A_{k+1,x}, A_{k+1,y}))
 
+The step is controlled: a step after which the horizontal slip direction reverses is
+rejected and retried at half the length (the path crossed a groove floor or a crease
+narrower than the step, across which fixed steps zig-zag and stall), and the step grows
+back once the path goes on (``StreamlineParams.max_halvings``).
+
 The ideal trajectory keeps ``y = y0`` and walks in +x with arc-length steps ``dl`` along
 the section; kappa is evaluated on it and it stops on self-lock as well.
 
@@ -43,7 +48,7 @@ class Outcome(enum.IntEnum):
 
     SELF_LOCKED = 1  #: entered the self-lock region (kappa = inf)
     LEFT_DOMAIN = 2  #: the next step would leave the surface's bounds
-    STALLED = 3  #: no net progress (|T| = 0, or moved < stall_distance in stall_window steps)
+    STALLED = 3  #: no net progress (|T| = 0, or too little progress over stall_window steps)
     STEP_CAP = 4  #: max_steps taken without any of the above
     FORCE_CAP = 5  #: the drive force needed, kappa W, exceeds ``kappa_cap`` W (held by the cap)
 
@@ -64,10 +69,20 @@ class StreamlineParams:
     stall_window : int
         Steps between progress checks.
     stall_distance : float or None
-        Minimum horizontal net displacement per ``stall_window`` steps (surface length
-        unit); less is ``STALLED``. None means ``dl``.
+        Minimum horizontal net displacement per ``stall_window`` steps of length ``dl``
+        (surface length unit); less is ``STALLED``. Shorter steps ask for proportionally
+        less (the progress asked for is ``stall_distance`` times the path walked over the
+        window divided by ``stall_window dl``). None means ``dl``.
     tol : float
         Tolerance on the scaled self-lock coefficient A' (see :func:`~spine_mj.engagement.kappa`).
+    max_halvings : int
+        Step-size control: a step after which the horizontal slip direction reverses (turns
+        by more than 90 degrees) has crossed something it did not resolve, such as the floor
+        of a groove narrower than the step, across which a fixed step would zig-zag and
+        stall while the path itself follows the floor. Such a step is rejected and retried
+        at half the length, at most ``max_halvings`` times (down to ``dl / 2**max_halvings``,
+        where it is taken as it is); each accepted step lets the next one grow back by a
+        factor 2, up to ``dl``. 0: fixed steps ``dl``.
     kappa_cap : float
         The force cap, the safety net a comparison with the engine shares: a point whose
         kappa exceeds it ends the path as ``FORCE_CAP`` (held: no drive up to ``kappa_cap W``
@@ -88,6 +103,7 @@ class StreamlineParams:
     stall_window: int = 64
     stall_distance: float | None = None
     tol: float = 1e-12
+    max_halvings: int = 10
     kappa_cap: float = math.inf
     edge_margin: float = 0.0
 
@@ -100,6 +116,9 @@ class StreamlineParams:
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 1:
                 raise SpineInputError(f"{name} must be an integer >= 1, got {v!r}")
+        v = self.max_halvings
+        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or not (0 <= v <= 60):
+            raise SpineInputError(f"max_halvings must be an integer in [0, 60], got {v!r}")
         if self.stall_distance is not None and not (self.stall_distance >= 0):
             raise SpineInputError(f"stall_distance must be >= 0 or None, got {self.stall_distance!r}")
         if not (self.tol >= 0):
@@ -311,6 +330,7 @@ def _trajectories(surface, starts, params, *, ideal, store_paths, backend):
             bool(store_paths),
             min(_LANES, xs.size),
             float(params.kappa_cap),
+            int(params.max_halvings),
         )
     outcome, n_steps, max_k, ex, ey, ez, offsets, px, py, pz, pk, pr = out
     if not store_paths:
@@ -376,11 +396,26 @@ def ideal_trajectories(
 
 
 def _run_numpy(surface, xs, ys, params, *, ideal, store):
-    """The obvious reference: one vectorized step for all active starts per iteration."""
+    """The obvious reference: one vectorized evaluation for all active starts per iteration.
+
+    Each start holds a candidate point reached from its last accepted point by a step ``h``;
+    a candidate where the horizontal slip direction reverses against the accepted point's
+    is rejected (``h`` halves, down to ``dl / 2**max_halvings``) and the step is retried;
+    an accepted candidate lets ``h`` grow back (doubling, up to ``dl``). See
+    :class:`StreamlineParams`.
+    """
     n = xs.size
     xmin, xmax, ymin, ymax = params.domain(surface)
+    dl = float(params.dl)
+    h_min = dl / 2.0**params.max_halvings
     x, y = xs.copy(), ys.copy()
     cx, cy = x.copy(), y.copy()
+    h = np.full(n, dl)  # the step that produced the current point, then the next one
+    px, py = x.copy(), y.copy()  # last accepted point and its horizontal slip direction
+    pvx, pvy = np.zeros(n), np.zeros(n)
+    has_prev = np.zeros(n, bool)
+    arc = np.zeros(n)  # step lengths since the last progress check
+    until = np.full(n, params.stall_window, np.int64)
     outcome = np.zeros(n, np.int8)
     n_steps = np.zeros(n, np.int64)
     max_k = np.full(n, np.nan)
@@ -388,19 +423,36 @@ def _run_numpy(surface, xs, ys, params, *, ideal, store):
     paths = [[] for _ in range(n)]
     active = np.arange(n)
     stall_pending = np.zeros(n, bool)  # no progress over a window: ends at the next evaluation
-    step = 0
     stall_dist = params.stall_distance_value
     while active.size:
         xa, ya = x[active], y[active]
         f, fx, fy = surface.evaluate(xa, ya, order=1)
         k, reg = kappa(fx, fy, params.mu, tol=params.tol)
+        locked = reg == SELF_LOCK
+        if ideal:
+            vx, vy = 1.0 / np.sqrt(1.0 + fx * fx), np.zeros_like(fx)
+        else:
+            vx, vy, _ = slip_direction(fx, fy, k, np.where(locked, SLIP, reg))
+        finite = np.isfinite(vx) & np.isfinite(vy)
+        with np.errstate(invalid="ignore"):
+            turned = vx * pvx[active] + vy * pvy[active] < 0.0
+        reversed_ = has_prev[active] & ~locked & finite & turned
+        rejected = reversed_ & (h[active] > h_min)
+        back = active[rejected]  # evaluated again next iteration, at the shorter step
+        if back.size:
+            h[back] *= 0.5
+            x[back] = px[back] + h[back] * pvx[back]
+            y[back] = py[back] + h[back] * pvy[back]
+        keep = ~rejected
+        active, xa, ya = active[keep], xa[keep], ya[keep]
+        f, fx, fy, k, reg, locked = f[keep], fx[keep], fy[keep], k[keep], reg[keep], locked[keep]
+        vx, vy, finite, reversed_ = vx[keep], vy[keep], finite[keep], reversed_[keep]
         ez[active] = f
         max_k[active] = np.fmax(max_k[active], k)
         if store:
             for j, idx in enumerate(active):
                 paths[idx].append((xa[j], ya[j], f[j], k[j], reg[j]))
         done = np.zeros(active.size, bool)
-        locked = reg == SELF_LOCK
         outcome[active[locked]] = Outcome.SELF_LOCKED
         done |= locked
         held = ~done & (k > params.kappa_cap)
@@ -409,40 +461,49 @@ def _run_numpy(surface, xs, ys, params, *, ideal, store):
         stalled = ~done & stall_pending[active]
         outcome[active[stalled]] = Outcome.STALLED
         done |= stalled
-        capped = ~done & (step >= params.max_steps)
+        capped = ~done & (n_steps[active] >= params.max_steps)
         outcome[active[capped]] = Outcome.STEP_CAP
         done |= capped
-        if ideal:
-            vx, vy = 1.0 / np.sqrt(1.0 + fx * fx), np.zeros_like(fx)
-        else:
-            vx, vy, _ = slip_direction(fx, fy, k, np.where(locked, SLIP, reg))
-        still = ~done & ~(np.isfinite(vx) & np.isfinite(vy))
+        still = ~done & ~finite
         outcome[active[still]] = Outcome.STALLED
         done |= still
-        xn = xa + params.dl * np.where(done, 0.0, vx)
-        yn = ya + params.dl * np.where(done, 0.0, vy)
+        # an accepted point reached without a reversal lets the step grow back
+        hn = np.where(reversed_, h[active], np.minimum(2.0 * h[active], dl))
+        xn = xa + hn * np.where(done, 0.0, vx)
+        yn = ya + hn * np.where(done, 0.0, vy)
         out = ~done & ~((xn >= xmin) & (xn <= xmax) & (yn >= ymin) & (yn <= ymax))
         outcome[active[out]] = Outcome.LEFT_DOMAIN
         done |= out
-        move = active[~done]
-        x[move], y[move] = xn[~done], yn[~done]
+        go = ~done
+        move = active[go]
+        px[move], py[move] = xa[go], ya[go]
+        pvx[move], pvy[move] = vx[go], vy[go]
+        has_prev[move] = True
+        h[move] = hn[go]
+        x[move], y[move] = xn[go], yn[go]
         n_steps[move] += 1
-        step += 1
-        if step % params.stall_window == 0 and move.size:
-            stuck = np.hypot(x[move] - cx[move], y[move] - cy[move]) < stall_dist
-            stall_pending[move[stuck]] = True
-            cx[move], cy[move] = x[move], y[move]
-        active = active[~done]
+        arc[move] += hn[go]
+        until[move] -= 1
+        check = move[until[move] == 0]
+        if check.size:
+            # progress asked for in proportion to the path walked (all full steps: stall_distance)
+            need = stall_dist * (arc[check] * (1.0 / (params.stall_window * dl)))
+            stuck = (x[check] - cx[check]) ** 2 + (y[check] - cy[check]) ** 2 < need * need
+            stall_pending[check[stuck]] = True
+            cx[check], cy[check] = x[check], y[check]
+            arc[check] = 0.0
+            until[check] = params.stall_window
+        active = np.sort(np.concatenate([back, move]))
     offsets = np.zeros(n + 1, np.int64)
     if store:
         offsets[1:] = np.cumsum([len(p) for p in paths])
         flat = np.array([pt for p in paths for pt in p], dtype=float).reshape(-1, 5)
-        px, py, pz, pk = (np.ascontiguousarray(flat[:, c]) for c in range(4))
-        pr = flat[:, 4].astype(np.int8)
+        ppx, ppy, ppz, ppk = (np.ascontiguousarray(flat[:, c]) for c in range(4))
+        ppr = flat[:, 4].astype(np.int8)
     else:
-        px = py = pz = pk = np.empty(0)
-        pr = np.empty(0, np.int8)
-    return outcome, n_steps, max_k, x.copy(), y.copy(), ez, offsets, px, py, pz, pk, pr
+        ppx = ppy = ppz = ppk = np.empty(0)
+        ppr = np.empty(0, np.int8)
+    return outcome, n_steps, max_k, x.copy(), y.copy(), ez, offsets, ppx, ppy, ppz, ppk, ppr
 
 
 # --------------------------------------------------------------------------- finite tip

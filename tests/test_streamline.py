@@ -1,3 +1,4 @@
+import itertools
 import math
 
 import numpy as np
@@ -193,6 +194,83 @@ def test_bad_input_names_the_argument():
         StreamlineParams(mu=0.0)
     with pytest.raises(SpineInputError, match="radius"):
         dilate(surf, -1.0)
+    with pytest.raises(SpineInputError, match="max_halvings"):
+        StreamlineParams(mu=1.0, max_halvings=-1)
+
+
+# --------------------------------------------------------------------------- step control
+
+
+def _groove(width=0.1, depth=0.25, descent=0.02):
+    """A Gaussian groove along x whose floor descends gently in +x (slope ``descent``,
+    engaged with mu = 0.5) between flanks steeper than the friction angle (up to 1.52)."""
+    x = np.linspace(-2.0, 2.0, 401)
+    heights = -descent * x[None, :] - depth * np.exp(-0.5 * (x[:, None] / width) ** 2)
+    return GridSurface(heights=heights, x=x, y=x.copy())
+
+
+def test_step_control_follows_a_groove_floor_that_fixed_steps_stall_in():
+    """A step three groove widths long overshoots the floor from one flank to the other
+    and back (gravity alone slides the tip down either flank, almost across the drive), so
+    fixed steps stall where the path itself reaches the floor, is driven along it (engaged,
+    kappa ~ mu) and leaves the domain. The controlled step follows the floor like a step
+    shorter than the groove does."""
+    surf, width = _groove(), 0.1
+    start = [(-1.5, 0.25)]
+    fixed = streamlines(surf, start, StreamlineParams(mu=0.5, dl=3 * width, max_halvings=0))
+    assert fixed.outcome[0] == Outcome.STALLED and fixed.end_x[0] < 0
+    resolved = streamlines(surf, start, StreamlineParams(mu=0.5, dl=0.2 * width, max_halvings=0))
+    assert resolved.outcome[0] == Outcome.LEFT_DOMAIN
+    p = StreamlineParams(mu=0.5, dl=3 * width)
+    for backend in ("numba", "numpy"):
+        res = streamlines(surf, start, p, backend=backend)
+        assert res.outcome[0] == Outcome.LEFT_DOMAIN
+        assert res.end_x[0] > 2.0 - 3 * width
+        path = res.path(0)
+        on_floor = path["x"] > -1.0  # past the slide down the first flank
+        assert np.abs(path["y"][on_floor]).max() < 0.2 * width
+    _same(streamlines(surf, start, p, backend="numba"), streamlines(surf, start, p, backend="numpy"), 1e-9)
+
+
+def test_step_controlled_groove_path_converges_as_dl_shrinks():
+    """Past the slide down the first flank the resolved path (steps a tenth of the groove
+    width, none reversing) runs on the floor, y = 0; the controlled path's largest distance
+    from it falls as dl shrinks, with the same outcome."""
+    surf, width = _groove(), 0.1
+    start = [(-1.5, 0.25)]
+
+    def offset(res):
+        path = res.path(0)
+        return np.abs(path["y"][path["x"] > -1.0]).max()
+
+    fine = streamlines(surf, start, StreamlineParams(mu=0.5, dl=0.1 * width))
+    assert fine.outcome[0] == Outcome.LEFT_DOMAIN and offset(fine) < 1e-6 * width
+    gaps = []
+    for dl in (3 * width, 1.5 * width, 0.5 * width, 0.2 * width):
+        res = streamlines(surf, start, StreamlineParams(mu=0.5, dl=dl))
+        assert res.outcome[0] == Outcome.LEFT_DOMAIN
+        gaps.append(offset(res))
+    assert all(b <= a for a, b in itertools.pairwise(gaps)), gaps
+    assert gaps[0] < 0.2 * width and gaps[-1] < 1e-6 * width
+
+
+def test_step_controlled_kernel_matches_reference_with_more_starts_than_lanes():
+    """Rejected steps, halvings and regrowth in the kernel's lanes (refilled as paths end)
+    give the reference's paths point for point."""
+    surf = _groove()
+    starts = np.c_[np.full(40, -1.5), np.linspace(-0.6, 0.6, 40)]
+    p = StreamlineParams(mu=0.5, dl=0.3, stall_window=16)
+    _same(streamlines(surf, starts, p, backend="numba"), streamlines(surf, starts, p, backend="numpy"), 1e-9)
+
+
+@pytest.mark.parametrize("sign", [1, -1])
+def test_step_control_leaves_resolved_paths_alone(sign):
+    """On the paper's single peak and valley at the paper's step no slip direction
+    reverses: the controlled paths are the fixed-step ones, point for point."""
+    surf = single_gaussian(sign=sign)
+    controlled = streamlines(surf, FIVE_STARTS, StreamlineParams(mu=MU, dl=0.015))
+    fixed = streamlines(surf, FIVE_STARTS, StreamlineParams(mu=MU, dl=0.015, max_halvings=0))
+    _same(controlled, fixed, 0.0)
 
 
 # --------------------------------------------------------------------------- finite tip

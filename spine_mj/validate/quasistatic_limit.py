@@ -122,9 +122,9 @@ def quasistatic_limit(plan: ValidationPlan, runner: StudyRunner) -> QuasistaticL
                 "outcome_agreement_smooth": float(allc["agree_smooth"].fillna(False).astype(bool).mean()),
                 "mean_geometry_frechet": float(np.nanmean(allc["geometry_frechet"])),
                 "failed_runs": {str(k): int(v) for k, v in failed.items()},
-                # the single-contact streamline has no state for a tip resting in a groove
-                # between two flanks steeper than the friction angle: it falls to the bottom
-                # and steps back and forth across it (STALLED) where MuJoCo rests on both
+                # no progress even with the step cut to dl / 2**max_halvings (a fixed step
+                # once zig-zagged across grit valleys narrower than itself and stalled
+                # there: docs/physics.md §2)
                 "reference_stalled": int((allc["reference_outcome"] == "stalled").sum()),
                 "meets_target": bool(
                     summ["outcome_agreement"] >= OUTCOME_TARGET

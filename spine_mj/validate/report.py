@@ -473,11 +473,9 @@ def _stalled_note(limit: QuasistaticLimitResult) -> list[str]:
         return []
     counts = ", ".join(f"{k} {n} of {limit.families[k]['runs']}" for k, n in stalled.items())
     return [
-        f"Reference streamlines that stalled ({counts}): the single-contact streamline has no "
-        "state for a tip resting in a groove whose two flanks are steeper than the friction "
-        "angle. It slides to the bottom and steps back and forth across it (slip region, no "
-        "net progress), while MuJoCo's tip rests on both flanks and is pulled along the groove. "
-        "These runs count as disagreements; the quasistatic model, not the engine, stops there.",
+        f"Reference streamlines that stalled ({counts}): no net progress even with the step "
+        "cut to 1/1024 of dl (the step control of docs/physics.md §2), a point the "
+        "single-contact rule can neither leave nor rest on. These runs count as disagreements.",
         "",
     ]
 
