@@ -1,10 +1,11 @@
 """Why the sandpaper and fractal runs of the quasistatic corner disagree (issue 11).
 
 Rebuilds, for the full plan's sandpaper and fractal families at the lowest I_e, what the
-sweep's ``compare`` analysis compares (:mod:`spine_mj.sweep.analyses.compare`): the MuJoCo
-runs (the ``mujoco`` analysis of each case, about a minute for both families) and the
-reference streamline traced on the rig's contact surface with the same mu_s, step and force
-cap. Then, per run that disagrees or whose reference stalls or holds:
+sweep's ``compare`` analysis compared before its contact surface became exact
+(:class:`spine_mj.surfaces.BallOnFacets`): the MuJoCo runs (the ``mujoco`` analysis of each
+case, about a minute for both families) and the reference streamline traced on the facets
+dilated by the tip and sampled at R/8 under a spline (``spine_mj.streamline.dilate``), with
+the same mu_s, step and force cap. Then, per run that disagrees or whose reference stalls or holds:
 
 * the reference with fixed steps (``max_halvings = 0``, the integrator before the step
   control) and with the step control, and with fixed steps of dl / 2, dl / 4;
@@ -67,7 +68,8 @@ def _case(case):
     rig = case_rig(case, surface)
     runs = ANALYSES["mujoco"].func(case, surface, starts, {}).data[1]
     s = rig.length_scale_m
-    contact = rig.contact_surface()
+    facets = TriangulatedSurface.from_grid(from_hfield(rig.hfield, unit=surface.unit))
+    contact = sl.dilate(facets, rig.tip.tip_radius_m / s)  # the spline surface compare used to trace on
     p = case.params
     return {
         "tag": f"{case.surface.label} {dict(case.surface.overrides) or ''}".strip(),
@@ -77,7 +79,7 @@ def _case(case):
         "held": np.array([r.end_reason.value == "self_lock" for r in runs]),
         "end": np.array([r.position_m[-1, :2] / s for r in runs]),
         "contact": contact,
-        "facets": TriangulatedSurface.from_grid(from_hfield(rig.hfield, unit=surface.unit)),
+        "facets": facets,
         "radius": rig.tip.tip_radius_m / s,
         "params": sl.StreamlineParams(
             mu=p["mu"], dl=min(p["dl"], *contact.spacing), kappa_cap=p["kappa_cap"]

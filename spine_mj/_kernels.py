@@ -344,7 +344,7 @@ def run_trajectories(
                 lpvy[j] = lvy[j]
                 lhp[j] = True
                 lh[j] = h
-                larc[j] += h
+                larc[j] += dl if lrev[j] else h  # a forced step across a crease: judged as a full one
                 lx[j] = xn
                 ly[j] = yn
             lstep[j] += go

@@ -72,7 +72,10 @@ class StreamlineParams:
         Minimum horizontal net displacement per ``stall_window`` steps of length ``dl``
         (surface length unit); less is ``STALLED``. Shorter steps ask for proportionally
         less (the progress asked for is ``stall_distance`` times the path walked over the
-        window divided by ``stall_window dl``). None means ``dl``.
+        window divided by ``stall_window dl``), except a step taken across a reversal at
+        the shortest length, which counts as a full one: a path zig-zagging across a
+        concave crease (two contacts, which a single-contact path cannot rest on) stalls
+        within a window instead of creeping until the step cap. None means ``dl``.
     tol : float
         Tolerance on the scaled self-lock coefficient A' (see :func:`~spine_mj.engagement.kappa`).
     max_halvings : int
@@ -482,7 +485,7 @@ def _run_numpy(surface, xs, ys, params, *, ideal, store):
         h[move] = hn[go]
         x[move], y[move] = xn[go], yn[go]
         n_steps[move] += 1
-        arc[move] += hn[go]
+        arc[move] += np.where(reversed_[go], dl, hn[go])  # a forced step across a crease: a full one
         until[move] -= 1
         check = move[until[move] == 0]
         if check.size:

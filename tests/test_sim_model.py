@@ -74,6 +74,30 @@ def test_triangulated_surface_matches_mujoco_facets():
     assert n_alt_mismatch >= 3
 
 
+def test_contact_surface_is_where_the_engine_rests_the_tip_and_its_normal():
+    """The rig's contact surface against MuJoCo: a tip placed by the engine's own distance
+    sits at its height (plus the radius, less the soft contact's rest depth) and, where one
+    contact holds it, that contact's normal gives the contact surface's slopes."""
+    rng = np.random.default_rng(3)
+    x = np.linspace(-0.02, 0.02, 11)
+    h = rng.uniform(0, 0.004, (11, 11))
+    h[4:6, :] += 0.008  # a steep wall, as grit has
+    rig = Rig(GridSurface(heights=h, x=x, y=x.copy(), unit="m"), tip=TipParams(tip_radius_m=3e-3))
+    contact = rig.contact_surface()
+    r = rig.tip.tip_radius_m
+    single = 0
+    for x0, y0 in rng.uniform(-0.012, 0.012, (40, 2)):
+        q = rig.place(x0, y0) * rig.units.length_m
+        f, fx, fy = contact.evaluate(x0, y0, order=1)
+        assert q[2] == pytest.approx(float(f) + r, abs=2e-4 * r)
+        contacts = deepest_contacts(rig, rig.place(x0, y0))
+        if len(contacts) == 1:
+            n = contacts[0][1]
+            np.testing.assert_allclose([fx, fy], [-n[0] / n[2], -n[1] / n[2]], rtol=1e-4, atol=1e-5)
+            single += 1
+    assert single >= 10
+
+
 def test_triangulated_surface_interpolates_nodes_and_is_linear_per_facet():
     x = np.array([0.0, 1.0, 2.0, 3.0])
     h = np.arange(16.0).reshape(4, 4) ** 1.5

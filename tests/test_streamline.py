@@ -438,3 +438,22 @@ def test_force_cap_kernel_matches_numpy_reference():
     a, b = streamlines(grid, starts, p, backend="numba"), streamlines(grid, starts, p, backend="numpy")
     _same(a, b, 1e-8)
     assert (a.outcome == Outcome.FORCE_CAP).any()
+
+
+def test_a_crease_two_contacts_hold_stalls_within_a_window():
+    """A ball in a V-groove whose flanks are steeper than the friction angle: on either flank
+    the slip direction points across the crease, so the single-contact path zig-zags at its
+    shortest step, creeping down the floor. It ends STALLED within a few windows, not at the
+    step cap."""
+    from spine_mj.surfaces import BallOnFacets, TriangulatedSurface
+
+    x = np.linspace(0.0, 1.0, 21)
+    y = np.linspace(-0.5, 0.5, 21)
+    floor = -0.1 * x[None, :]  # descends gently along the drive: the zig-zag creeps along it
+    groove = TriangulatedSurface(heights=2.0 * np.abs(y)[:, None] + floor, x=x, y=y)
+    ball = BallOnFacets(groove, 0.05)
+    params = StreamlineParams(mu=0.5, dl=0.01, max_steps=100_000)
+    res = streamlines(ball, [(0.3, 0.12)], params)
+    assert res.outcome[0] == Outcome.STALLED
+    assert res.n_steps[0] < 10 * params.stall_window
+    assert abs(res.end_y[0]) < 0.01  # at the crease

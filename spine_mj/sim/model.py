@@ -31,8 +31,7 @@ from spine_mj.sim.drives import stiffness_n_m as spring_stiffness_n_m
 from spine_mj.sim.params import EngineSettings, Scales, TipParams, default_engine, hfield_of
 from spine_mj.sim.placement import Placer
 from spine_mj.sim.recording import SENSOR_NAMES
-from spine_mj.streamline import dilate
-from spine_mj.surfaces import Surface, TriangulatedSurface, from_hfield
+from spine_mj.surfaces import BallOnFacets, Surface, TriangulatedSurface, from_hfield
 
 MODEL_PATH = model_path()
 #: MuJoCo's latest warning messages (the engine's own text), newest last.
@@ -203,16 +202,17 @@ class RigModel:
         self.z_range_m = self._z_range_m()
         self._ids()
 
-    def contact_surface(self):
+    def contact_surface(self) -> BallOnFacets:
         """The surface the tip's centre rides on, in surface units and shifted down by the
         tip radius: MuJoCo's hfield facets (the float32 samples the engine collides with,
-        triangulated as MuJoCo does) dilated by the tip (:func:`spine_mj.streamline.dilate`,
-        sampled at ``r / 8``, finer than the hfield). A streamline traced on it is the fair
-        reference for this rig (docs/physics.md §4); built once per hfield."""
+        triangulated as MuJoCo does) under a ball of the tip's radius, with the height and
+        the contact's slopes computed exactly (:class:`~spine_mj.surfaces.BallOnFacets`).
+        A streamline traced on it is the fair reference for this rig (docs/physics.md §4);
+        built once per hfield."""
         cached = self._contact
         if cached is None or cached[0] is not self.hfield:
             facets = TriangulatedSurface.from_grid(from_hfield(self.hfield, unit=self.surface.unit))
-            cached = (self.hfield, dilate(facets, self.tip.tip_radius_m / self.length_scale_m))
+            cached = (self.hfield, BallOnFacets(facets, self.tip.tip_radius_m / self.length_scale_m))
             self._contact = cached
         return cached[1]
 

@@ -1,7 +1,7 @@
 """The ``compare`` analysis: the streamline against MuJoCo per start, lengths over L_c.
 
 Like for like (docs/physics.md §4): the reference streamline is traced on the surface the
-MuJoCo tip touches, the rig's hfield facets dilated by its tip radius
+MuJoCo tip touches, the rig's hfield facets under a ball of its tip radius, exactly
 (:meth:`spine_mj.sim.Rig.contact_surface`), with the quasistatic analysis's mu_s, step and
 force cap, and it ends where the engine's run ends (the domain margin from the edges), so
 both sides share the geometry, the lock test and the domain. The comparison with the
@@ -60,10 +60,10 @@ def _compare(case, surface, starts, upstream):
     margin = dataclasses.replace(quasistatic.params, edge_margin=runs[0].detection.domain_margin_m / s)
     smooth = trace(traced_surface(case, surface), starts, margin, store_paths=True)
     contact = rig.contact_surface()
-    # steps no longer than the contact surface's samples: a longer step can jump a crease
-    # between facets where the engine's tip wedges (measured on a fractal: dl = 4 samples
-    # passed a crease of kappa > 20 where MuJoCo held; 1 sample held within 0.003 L_c)
-    params = dataclasses.replace(margin, dl=min(margin.dl, *contact.spacing))
+    # steps no longer than an eighth of the tip radius: a longer step can jump a crease
+    # between facets where the engine's tip wedges (measured on a fractal: dl = R/2 passed
+    # a crease of kappa > 20 where MuJoCo held; R/8 held within 0.003 L_c)
+    params = dataclasses.replace(margin, dl=min(margin.dl, contact.radius / 8))
     facets = trace(contact, starts, params, store_paths=True)
     lc = rig.scales.char_length_m / s
     mpaths = [r.position_m[r.drive_start_index :, :2] / s for r in runs]
