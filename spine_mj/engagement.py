@@ -37,6 +37,7 @@ __all__ = [
     "REGION_NAMES",
     "SELF_LOCK",
     "SLIP",
+    "crease_engagement",
     "kappa",
     "kappa_of_normal",
     "quadratic_coefficients",
@@ -190,6 +191,65 @@ def kappa_of_normal(normal, mu, *, tol: float = DEFAULT_TOL) -> tuple[np.ndarray
     region = np.where(up, region, np.where(wall_lock, SELF_LOCK, SLIP)).astype(np.int8)
     k = np.where(up, k, np.where(wall_lock, np.inf, np.nan))
     return k, region
+
+
+def crease_engagement(fx_a, fy_a, fx_b, fy_b, mu, *, tol: float = DEFAULT_TOL):
+    """Engagement of a tip resting on two contacts at once, in a concave crease between
+    surfaces of slopes ``(fx_a, fy_a)`` and ``(fx_b, fy_b)``: what the single-contact
+    :func:`kappa` cannot describe (beyond the paper, docs/physics.md §2).
+
+    The tip can only move along the crease, ``c = n_a x n_b`` (unit, turned to the drive:
+    ``c_x >= 0``). Under ``F = W (kappa e_x - e_z)`` the normal forces balance the part of
+    F across the crease, ``N_a n_a + N_b n_b = -(F - (F.c) c)``, each linear in kappa; the
+    friction of both contacts, at most ``mu (N_a + N_b)``, opposes the part along it,
+    ``F.c = W (kappa c_x - c_z)``. A V-groove of flank angle theta along the drive gives
+    the wedge's ``kappa = mu / cos(theta)``.
+
+    Returns
+    -------
+    kappa : ndarray
+        The drive at which the tip slides along the crease (``ENGAGED``); ``+inf`` where no
+        drive can (``SELF_LOCK``); NaN where gravity alone slides it along (``SLIP``) or
+        where the two-contact state does not hold (a normal force would be negative, the
+        crease is vertical or the contacts are parallel: ``region`` -1).
+    region : ndarray of int8
+        ``SLIP``, ``ENGAGED``, ``SELF_LOCK``, or -1 (no two-contact state).
+    vx, vy : ndarray
+        Unit horizontal direction of motion along the crease (NaN where held or none).
+    """
+    mu = _check_mu(mu)
+
+    def unit_normal(fx, fy):
+        fx, fy = np.asarray(fx, dtype=float), np.asarray(fy, dtype=float)
+        s = np.sqrt(1.0 + fx * fx + fy * fy)
+        return -fx / s, -fy / s, 1.0 / s
+
+    ax, ay, az = unit_normal(fx_a, fy_a)
+    bx, by, bz = unit_normal(fx_b, fy_b)
+    cx, cy, cz = ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
+    with np.errstate(divide="ignore", invalid="ignore"):
+        norm = np.sqrt(cx * cx + cy * cy + cz * cz)
+        turn = np.where((cx < 0) | ((cx == 0) & (cy < 0)), -1.0, 1.0) / norm
+        cx, cy, cz = cx * turn, cy * turn, cz * turn
+        d = ax * bx + ay * by + az * bz
+        den = 1.0 - d * d
+        a0, a1 = (az - d * bz) / den, (-ax + d * bx) / den
+        b0, b1 = (bz - d * az) / den, (-bx + d * ax) / den
+        s0, s1 = a0 + b0, a1 + b1
+        slides = np.abs(cz) > mu * s0  # gravity alone, downhill along the crease
+        lock = ~slides & (cx - mu * s1 < tol)
+        k = np.where(slides | lock, np.nan, (cz + mu * s0) / (cx - mu * s1))
+        k_at = np.where(np.isfinite(k), k, 0.0)
+        pressed = (a0 + k_at * a1 >= 0) & (b0 + k_at * b1 >= 0) & (a0 >= 0) & (b0 >= 0)
+        h = np.hypot(cx, cy)
+        sign = np.where(slides, -np.sign(cz), 1.0)
+        vx, vy = sign * cx / h, sign * cy / h
+        valid = pressed & np.isfinite(norm) & (norm > tol) & (h > tol) & (den > tol)
+    region = np.where(slides, SLIP, np.where(lock, SELF_LOCK, ENGAGED)).astype(np.int8)
+    region = np.where(valid, region, -1).astype(np.int8)
+    k = np.where(valid & lock, np.inf, np.where(valid, k, np.nan))
+    moving = valid & ~lock
+    return k, region, np.where(moving, vx, np.nan), np.where(moving, vy, np.nan)
 
 
 def slip_direction(fx, fy, kappa_value, region) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

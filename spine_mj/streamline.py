@@ -36,7 +36,15 @@ import pandas as pd
 from scipy import ndimage
 
 from spine_mj._kernels import run_trajectories
-from spine_mj.engagement import ENGAGED, REGION_NAMES, SELF_LOCK, SLIP, kappa, slip_direction
+from spine_mj.engagement import (
+    ENGAGED,
+    REGION_NAMES,
+    SELF_LOCK,
+    SLIP,
+    crease_engagement,
+    kappa,
+    slip_direction,
+)
 from spine_mj.errors import SpineInputError
 from spine_mj.surfaces import GaussianSurface, GridSurface, Surface, TriangulatedSurface
 
@@ -401,6 +409,12 @@ def ideal_trajectories(
 def _run_numpy(surface, xs, ys, params, *, ideal, store):
     """The obvious reference: one vectorized evaluation for all active starts per iteration.
 
+    A reversal at the shortest step (or on a crease already followed) is a tip resting in a
+    concave crease on two contacts: the path follows the crease at the two-contact kappa of
+    its sides (:func:`spine_mj.engagement.crease_engagement`) with whole steps. Only this
+    backend has the crease state; the compiled kernel traces smooth surfaces (Gaussian sums,
+    splines) and takes such a reversal as it is.
+
     Each start holds a candidate point reached from its last accepted point by a step ``h``;
     a candidate where the horizontal slip direction reverses against the accepted point's
     is rejected (``h`` halves, down to ``dl / 2**max_halvings``) and the step is retried;
@@ -416,6 +430,9 @@ def _run_numpy(surface, xs, ys, params, *, ideal, store):
     h = np.full(n, dl)  # the step that produced the current point, then the next one
     px, py = x.copy(), y.copy()  # last accepted point and its horizontal slip direction
     pvx, pvy = np.zeros(n), np.zeros(n)
+    pfx, pfy = np.zeros(n), np.zeros(n)  # and its slopes (the other side of a crease)
+    sides = np.full((n, 4), np.nan)  # the two sides' slopes of the last crease the path met
+    in_crease = np.zeros(n, bool)  # the last accepted point was on a crease
     has_prev = np.zeros(n, bool)
     arc = np.zeros(n)  # step lengths since the last progress check
     until = np.full(n, params.stall_window, np.int64)
@@ -440,7 +457,28 @@ def _run_numpy(surface, xs, ys, params, *, ideal, store):
         with np.errstate(invalid="ignore"):
             turned = vx * pvx[active] + vy * pvy[active] < 0.0
         reversed_ = has_prev[active] & ~locked & finite & turned
-        rejected = reversed_ & (h[active] > h_min)
+        crease = np.zeros(active.size, bool)
+        if not ideal:
+            # reversed at the shortest step, or on a crease already followed: the tip rests in
+            # a concave crease, on two contacts (crease_engagement)
+            r = np.flatnonzero(reversed_ & ((h[active] <= h_min) | in_crease[active]))
+            other = np.column_stack([pfx[active[r]], pfy[active[r]]])
+            got = crease_engagement(other[:, 0], other[:, 1], fx[r], fy[r], params.mu)
+            for c in (0, 2):  # on the same side as the last point: the crease's other side
+                again = got[1] < 0
+                retry = sides[active[r], c : c + 2]
+                alt = crease_engagement(retry[:, 0], retry[:, 1], fx[r], fy[r], params.mu)
+                got = tuple(np.where(again, b, a) for a, b in zip(got, alt))
+                other = np.where(again[:, None], retry, other)
+            kc, rc, cvx, cvy = got
+            two = rc >= 0
+            r = r[two]
+            sides[active[r]] = np.column_stack([other[two], fx[r], fy[r]])
+            crease[r] = True
+            k[r], reg[r], locked[r] = kc[two], rc[two], rc[two] == SELF_LOCK
+            vx[r], vy[r] = cvx[two], cvy[two]
+            finite[r] = locked[r] | (np.isfinite(vx[r]) & np.isfinite(vy[r]))
+        rejected = reversed_ & (h[active] > h_min) & ~crease
         back = active[rejected]  # evaluated again next iteration, at the shorter step
         if back.size:
             h[back] *= 0.5
@@ -450,6 +488,7 @@ def _run_numpy(surface, xs, ys, params, *, ideal, store):
         active, xa, ya = active[keep], xa[keep], ya[keep]
         f, fx, fy, k, reg, locked = f[keep], fx[keep], fy[keep], k[keep], reg[keep], locked[keep]
         vx, vy, finite, reversed_ = vx[keep], vy[keep], finite[keep], reversed_[keep]
+        crease = crease[keep]
         ez[active] = f
         max_k[active] = np.fmax(max_k[active], k)
         if store:
@@ -470,8 +509,9 @@ def _run_numpy(surface, xs, ys, params, *, ideal, store):
         still = ~done & ~finite
         outcome[active[still]] = Outcome.STALLED
         done |= still
-        # an accepted point reached without a reversal lets the step grow back
-        hn = np.where(reversed_, h[active], np.minimum(2.0 * h[active], dl))
+        # an accepted point reached without a reversal lets the step grow back; along a
+        # crease the path steps a whole dl
+        hn = np.where(crease, dl, np.where(reversed_, h[active], np.minimum(2.0 * h[active], dl)))
         xn = xa + hn * np.where(done, 0.0, vx)
         yn = ya + hn * np.where(done, 0.0, vy)
         out = ~done & ~((xn >= xmin) & (xn <= xmax) & (yn >= ymin) & (yn <= ymax))
@@ -481,6 +521,8 @@ def _run_numpy(surface, xs, ys, params, *, ideal, store):
         move = active[go]
         px[move], py[move] = xa[go], ya[go]
         pvx[move], pvy[move] = vx[go], vy[go]
+        pfx[move], pfy[move] = fx[go], fy[go]
+        in_crease[move] = crease[go]
         has_prev[move] = True
         h[move] = hn[go]
         x[move], y[move] = xn[go], yn[go]

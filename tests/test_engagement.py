@@ -143,3 +143,18 @@ def test_kappa_of_normal_handles_walls_and_batches():
     assert k[0] == np.inf and np.isnan(k[1]) and k[2] == pytest.approx(mu)
     with pytest.raises(SpineInputError, match=r"shape \(\.\.\., 3\)"):
         kappa_of_normal([1.0, 0.0], mu)
+
+
+def test_crease_engagement_of_a_v_groove_is_the_wedge():
+    """A V-groove along the drive with flanks of angle theta: the wedge's kappa = mu / cos(theta),
+    sliding along +x; symmetric in the order of the sides."""
+    from spine_mj.engagement import crease_engagement
+
+    t = 2.0  # tan(theta)
+    for a, b in (((0.0, t), (0.0, -t)), ((0.0, -t), (0.0, t))):
+        k, region, vx, vy = crease_engagement(*a, *b, 0.5)
+        assert region == ENGAGED
+        assert float(k) == pytest.approx(0.5 * math.sqrt(1 + t * t))
+        assert (float(vx), float(vy)) == pytest.approx((1.0, 0.0))
+    # parallel contacts are no crease
+    assert crease_engagement(0.3, 0.1, 0.3, 0.1, 0.5)[1] == -1

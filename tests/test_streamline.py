@@ -440,20 +440,32 @@ def test_force_cap_kernel_matches_numpy_reference():
     assert (a.outcome == Outcome.FORCE_CAP).any()
 
 
-def test_a_crease_two_contacts_hold_stalls_within_a_window():
-    """A ball in a V-groove whose flanks are steeper than the friction angle: on either flank
-    the slip direction points across the crease, so the single-contact path zig-zags at its
-    shortest step, creeping down the floor. It ends STALLED within a few windows, not at the
-    step cap."""
+def test_a_crease_descending_along_the_drive_is_followed_at_its_two_contact_kappa():
+    """A V-groove whose floor descends gently along the drive: on either flank the slip
+    direction points across the crease (a single-contact path would zig-zag there); the path
+    follows the crease at the two-contact kappa of its flanks (crease_engagement)."""
+    from spine_mj.engagement import crease_engagement
     from spine_mj.surfaces import BallOnFacets, TriangulatedSurface
 
     x = np.linspace(0.0, 1.0, 21)
     y = np.linspace(-0.5, 0.5, 21)
-    floor = -0.1 * x[None, :]  # descends gently along the drive: the zig-zag creeps along it
-    groove = TriangulatedSurface(heights=2.0 * np.abs(y)[:, None] + floor, x=x, y=y)
-    ball = BallOnFacets(groove, 0.05)
+    groove = TriangulatedSurface(heights=2.0 * np.abs(y)[:, None] - 0.1 * x[None, :], x=x, y=y)
     params = StreamlineParams(mu=0.5, dl=0.01, max_steps=100_000)
-    res = streamlines(ball, [(0.3, 0.12)], params)
-    assert res.outcome[0] == Outcome.STALLED
-    assert res.n_steps[0] < 10 * params.stall_window
-    assert abs(res.end_y[0]) < 0.01  # at the crease
+    res = streamlines(BallOnFacets(groove, 0.05), [(0.3, 0.12)], params)
+    assert res.outcome[0] == Outcome.LEFT_DOMAIN and res.n_steps[0] < 1000
+    k = float(crease_engagement(-0.1, 2.0, -0.1, -2.0, 0.5)[0])
+    assert res.max_kappa[0] == pytest.approx(k, rel=1e-9)
+
+
+def test_a_ball_slides_along_a_v_groove_at_the_wedge_kappa():
+    """Flanks steeper than the friction angle and a flat floor along the drive: the path
+    follows the crease on two contacts to the edge, at kappa = mu / cos(theta)."""
+    from spine_mj.surfaces import BallOnFacets, TriangulatedSurface
+
+    x = np.linspace(0.0, 1.0, 21)
+    y = np.linspace(-0.5, 0.5, 21)
+    groove = TriangulatedSurface(heights=np.broadcast_to(2.0 * np.abs(y)[:, None], (21, 21)), x=x, y=y)
+    res = streamlines(BallOnFacets(groove, 0.05), [(0.3, 0.12)], StreamlineParams(mu=0.5, dl=0.01))
+    assert res.outcome[0] == Outcome.LEFT_DOMAIN
+    assert res.end_x[0] > 0.98 and abs(res.end_y[0]) < 1e-3
+    assert res.max_kappa[0] == pytest.approx(0.5 * math.sqrt(5.0), rel=1e-9)
