@@ -106,7 +106,12 @@ def run_pool(todo: list, n_workers: int, ctx, work, on_death, handle, *, parent_
             while len(workers) < min(n_workers, busy + len(queue)):
                 workers.append(_start(ctx, work, parent_pid))
             if not state["ready"] and queue and not wait([w.conn for w in workers], timeout=0):
-                handle(work(queue.pop()))
+                case = queue.pop()
+                try:
+                    result = work(case)
+                except Exception as exc:  # as a worker reports it: the case's failure
+                    result = on_death(case, f"{type(exc).__name__}: {exc}"[:500])
+                handle(result)
                 continue
             objs = [w.conn for w in workers] + [w.process.sentinel for w in workers]
             ready = set(wait(objs, timeout=1.0))
