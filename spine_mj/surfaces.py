@@ -1081,11 +1081,11 @@ class BallOnFacets(Surface):
                 contact[better, c] = p[np.arange(x.size), k][better]
 
         ax, ay, az, aok = node(ii, jj)
+        ahead = {step: node(ii + step[0], jj + step[1]) for step in ((1, 0), (0, 1), (1, 1))}
         with np.errstate(invalid="ignore"):
             d2 = (cx - ax) ** 2 + (cy - ay) ** 2  # vertices: the sphere around each
             keep(az + np.sqrt(r * r - d2), ax, ay, az, aok & (d2 <= r * r))
-            for di, dj in ((1, 0), (0, 1), (1, 1)):  # edges: the cylinder around each
-                bx, by, bz, bok = node(ii + di, jj + dj)
+            for bx, by, bz, bok in ahead.values():  # edges: the cylinder around each
                 ex, ey, ez = bx - ax, by - ay, bz - az
                 ll = ex * ex + ey * ey + ez * ez
                 wd = (cx - ax) * ex + (cy - ay) * ey
@@ -1096,10 +1096,10 @@ class BallOnFacets(Surface):
                 t = (wd + e * ez) / ll
                 ok = aok & bok & (t >= 0) & (t <= 1) & np.isfinite(e)
                 keep(az + e, ax + t * ex, ay + t * ey, az + t * ez, ok)
+            _, _, bz, bok = ahead[(1, 1)]
+            _, _, h10, ok10 = ahead[(1, 0)]
+            _, _, h01, ok01 = ahead[(0, 1)]
             for lower in (True, False):  # faces: the plane lifted along its normal
-                bx, by, bz, bok = node(ii + 1, jj + 1)
-                _, _, h10, ok10 = node(ii + 1, jj)
-                _, _, h01, ok01 = node(ii, jj + 1)
                 gx = np.where(lower, h10 - az, bz - h01) / dx
                 gy = np.where(lower, bz - h10, h01 - az) / dy
                 norm = np.sqrt(1.0 + gx * gx + gy * gy)
