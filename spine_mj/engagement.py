@@ -239,8 +239,12 @@ def crease_engagement(fx_a, fy_a, fx_b, fy_b, mu, *, tol: float = DEFAULT_TOL):
         slides = np.abs(cz) > mu * s0  # gravity alone, downhill along the crease
         lock = ~slides & (cx - mu * s1 < tol)
         k = np.where(slides | lock, np.nan, (cz + mu * s0) / (cx - mu * s1))
+        # both contacts pressed where the tip slides (a contact that gravity alone leaves
+        # unloaded, a wall beside a flat floor, is pressed by the drive); held or sliding
+        # under gravity alone: pressed without drive
         k_at = np.where(np.isfinite(k), k, 0.0)
-        pressed = (a0 + k_at * a1 >= 0) & (b0 + k_at * b1 >= 0) & (a0 >= 0) & (b0 >= 0)
+        pressed = (a0 + k_at * a1 >= 0) & (b0 + k_at * b1 >= 0)
+        pressed &= np.isfinite(k) | ((a0 >= 0) & (b0 >= 0))
         h = np.hypot(cx, cy)
         sign = np.where(slides, -np.sign(cz), 1.0)
         vx, vy = sign * cx / h, sign * cy / h

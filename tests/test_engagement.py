@@ -158,3 +158,25 @@ def test_crease_engagement_of_a_v_groove_is_the_wedge():
         assert (float(vx), float(vy)) == pytest.approx((1.0, 0.0))
     # parallel contacts are no crease
     assert crease_engagement(0.3, 0.1, 0.3, 0.1, 0.5)[1] == -1
+
+
+@pytest.mark.parametrize("floor_fy", [0.0, 1e-4, -1e-4])
+def test_crease_engagement_of_a_floor_beside_a_wall(floor_fy):
+    """A flat floor meeting a steep wall the drive pushes into: gravity alone leaves the wall
+    unloaded, the drive presses it. Force balance on the floor (load W) and the wall (normal
+    n_b, horizontal part h_b) gives ``kappa = mu / (c_x - mu |c_y| (1 - n_bz) / h_b)`` along
+    the foot ``c``; a floor tilted by 1e-4 either way changes it by about that much (it was
+    rejected as no two-contact state when the tilt left the wall's load at zero drive < 0)."""
+    from spine_mj.engagement import crease_engagement
+
+    mu, wall = 0.5, (5.0, -4.0)
+    s = math.sqrt(1.0 + wall[0] ** 2 + wall[1] ** 2)
+    nbx, nby, nbz = -wall[0] / s, -wall[1] / s, 1.0 / s
+    hb = math.hypot(nbx, nby)
+    cx, cy = abs(nby) / hb, nbx / hb  # the foot, horizontal, turned to the drive
+    expected = mu / (cx - mu * abs(cy) * (1.0 - nbz) / hb)
+    for a, b in (((0.0, floor_fy), wall), (wall, (0.0, floor_fy))):
+        k, region, vx, vy = crease_engagement(*a, *b, mu)
+        assert region == ENGAGED
+        assert float(k) == pytest.approx(expected, rel=1e-3)
+        assert (float(vx), abs(float(vy))) == pytest.approx((cx, abs(cy)), abs=1e-3)
