@@ -11,7 +11,9 @@ stated in units of ``L_c``).
 * :func:`outcome_agreement`: both self-lock or neither, end points within a tolerance,
   same trap;
 * :func:`kappa_agreement`: quasistatic max kappa against the dynamic peak drive force / W;
-* :func:`capture_rate`: the fraction of runs that end self-locked (trapped).
+* :func:`capture_rate`: the fraction of runs that end self-locked (trapped);
+* :func:`miss_reason`: why a run and its reference disagree, from the reference restarted
+  along the run's path.
 """
 
 from __future__ import annotations
@@ -28,14 +30,19 @@ from spine_mj.errors import SpineInputError
 OUTCOME_TARGET = 0.95
 FRECHET_TARGET = 0.1
 
+#: The kinds :func:`miss_reason` tells apart, in the order reports list them.
+MISS_REASONS = ("separatrix", "diverged", "engine_held", "engine_passed")
+
 __all__ = [
     "FRECHET_TARGET",
+    "MISS_REASONS",
     "OUTCOME_TARGET",
     "capture_rate",
     "frechet_distance",
     "frechet_distance_reference",
     "kappa_agreement",
     "mean_lateral_deviation",
+    "miss_reason",
     "outcome_agreement",
     "path_frechet",
     "resample_by_arclength",
@@ -234,6 +241,62 @@ def outcome_agreement(
     same_trap = la & lb & end
     agree = lock & (~la | same_trap)
     return {"lock": lock, "end": end, "same_trap": same_trap, "agree": agree}
+
+
+def miss_reason(
+    checkpoints, reference, reaches, mj_locked: bool, *, length_scale: float, separatrix_offset: float
+) -> tuple[str, float]:
+    """Why a run disagrees with its reference, read from the reference restarted at
+    checkpoints along the run's own path (the first at its start, the last at its end).
+
+    Parameters
+    ----------
+    checkpoints : array_like, shape (k, 2)
+        Points of the run's path, in order.
+    reference : array_like, shape (n, 2)
+        The reference path of the run's start.
+    reaches : array_like of bool, shape (k,)
+        Whether the reference restarted at each checkpoint ends as the run did
+        (:func:`outcome_agreement`).
+    mj_locked : bool
+        Whether the run ended held.
+    length_scale
+        L_c, in the unit of the paths.
+    separatrix_offset
+        Distance from the reference (over L_c) up to which the run cannot follow it: a facet.
+
+    Returns
+    -------
+    reason : str
+        One of :data:`MISS_REASONS`. ``separatrix``: a restart from a checkpoint within
+        ``separatrix_offset`` of the reference ends as the run did, so the reference's own
+        outcome flips closer to its path than the engine resolves (the two sides agree on
+        the flow; the start is ill-conditioned). ``diverged``: the first such checkpoint is
+        farther; the run left the reference's path by ``offset`` before its outcome parted
+        (inertia, a hop). ``engine_held``: no restart ends as the run did, and the run ended
+        held where the reference, restarted there, moves on (a lock the reference does not
+        see). ``engine_passed``: the run ended free where every restart holds.
+    offset : float
+        Distance over L_c from the reference of the first checkpoint that reaches the run's
+        outcome; NaN for the engine_* reasons.
+    """
+    lc = _length_scale(length_scale)
+    pts = _path("checkpoints", checkpoints)[:, :2]
+    ref = _path("reference", reference)[:, :2]
+    hit = np.asarray(reaches, dtype=bool).ravel()
+    if hit.shape != (pts.shape[0],):
+        raise SpineInputError(f"reaches must have one flag per checkpoint ({pts.shape[0]}), got {hit.shape}")
+    if not (separatrix_offset >= 0):
+        raise SpineInputError(f"separatrix_offset must be >= 0, got {separatrix_offset!r}")
+    first = np.flatnonzero(hit)
+    if first.size == 0:
+        return ("engine_held" if mj_locked else "engine_passed"), math.nan
+    point = pts[first[:1]]
+    if ref.shape[0] == 1:
+        offset = float(np.linalg.norm(point[0] - ref[0]) / lc)
+    else:
+        offset = float(_point_segment_distance(point, ref[:-1], ref[1:])[0] / lc)
+    return ("separatrix" if offset <= separatrix_offset else "diverged"), offset
 
 
 def kappa_agreement(

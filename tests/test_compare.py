@@ -14,6 +14,7 @@ from spine_mj.compare import (
     frechet_distance_reference,
     kappa_agreement,
     mean_lateral_deviation,
+    miss_reason,
     outcome_agreement,
     resample_by_arclength,
 )
@@ -114,3 +115,28 @@ def test_bad_input_is_named():
         outcome_agreement([True], [[0, 0]], [True, False], [[0, 0], [1, 1]])
     with pytest.raises(SpineInputError, match="kappa_cap"):
         kappa_agreement([1.0], [1.0], kappa_cap=np.inf)
+
+
+def test_miss_reason_reads_where_the_restarted_reference_first_ends_as_the_run():
+    """The reference is the line y = 0; the run leaves it towards y = 1. Its outcome is
+    reached first from the checkpoint at y = 0.001 (within a facet of 0.01: a separatrix),
+    or first from y = 0.5 (diverged by 0.5 L_c); never reached: the engine held or passed."""
+    ref = line(0.0)
+    run = np.column_stack([np.linspace(0.0, 5.0, 5), [0.0, 0.001, 0.2, 0.5, 1.0]])
+    reaches = np.array([False, True, True, True, True])
+    assert miss_reason(run, ref, reaches, True, length_scale=1.0, separatrix_offset=0.01) == (
+        "separatrix",
+        pytest.approx(0.001),
+    )
+    reaches[1:3] = False
+    reason, offset = miss_reason(run, ref, reaches, True, length_scale=2.0, separatrix_offset=0.01)
+    assert reason == "diverged" and offset == pytest.approx(0.25)  # 0.5 over L_c = 2
+    for locked, expected in ((True, "engine_held"), (False, "engine_passed")):
+        reason, offset = miss_reason(
+            run, ref, np.zeros(5, bool), locked, length_scale=1.0, separatrix_offset=0.01
+        )
+        assert reason == expected and math.isnan(offset)
+    with pytest.raises(SpineInputError, match="one flag per checkpoint"):
+        miss_reason(run, ref, reaches[:3], True, length_scale=1.0, separatrix_offset=0.01)
+    with pytest.raises(SpineInputError, match="separatrix_offset"):
+        miss_reason(run, ref, reaches, True, length_scale=1.0, separatrix_offset=-1.0)

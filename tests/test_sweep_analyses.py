@@ -51,6 +51,12 @@ def test_mujoco_and_compare_runs_match_the_rig_run_directly(tmp_path):
     assert (cmp_.status == np.where(mjs.status.loc[cmp_.index] == "ok", "ok", "dependency_failed")).all()
     ran = mjs.status.loc[cmp_.index] == "ok"
     assert cmp_.frechet[ran].notna().all() and (cmp_.frechet[ran] >= 0).all()
+    # a run that agrees has no miss reason; one the engine finished and that disagrees has one
+    agree = cmp_.agree.astype(bool)
+    assert (cmp_.miss_reason[agree] == "").all()
+    assert (
+        cmp_.miss_reason[~agree & ran].isin(["separatrix", "diverged", "engine_held", "engine_passed"]).all()
+    )
     # both sides end at the engine's domain margin: at the lower I_e, runs that leave the
     # domain end together
     left = (

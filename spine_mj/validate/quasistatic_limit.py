@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from spine_mj.compare import MISS_REASONS
 from spine_mj.presets import calibrated_mu
 from spine_mj.validate.paths import stored_paths, tip_radius
 from spine_mj.validate.plans import FRECHET_TARGET, OUTCOME_TARGET, RECOMMENDED, FamilySpec, ValidationPlan
@@ -40,6 +41,8 @@ RUN_COLUMNS = (
     "agree_smooth",
     "frechet_smooth",
     "geometry_frechet",
+    "miss_reason",
+    "miss_offset",
 )
 
 
@@ -68,6 +71,8 @@ class QuasistaticLimitResult:
         facet-traced streamline), ``outcome_agreement_smooth``, ``median_frechet_smooth``
         (against the smooth one), ``mean_geometry_frechet``, ``failed_runs`` (engine stops
         by status), ``reference_stalled`` (reference streamlines stalled in a groove),
+        ``misses`` (disagreeing runs the engine finished, by
+        :func:`spine_mj.compare.miss_reason`, each with its offsets over L_c),
         ``meets_target``.
     runs : list of dict
         Per-run rows (:data:`RUN_COLUMNS`).
@@ -126,6 +131,7 @@ def quasistatic_limit(plan: ValidationPlan, runner: StudyRunner) -> QuasistaticL
                 # once zig-zagged across grit valleys narrower than itself and stalled
                 # there: docs/physics.md §2)
                 "reference_stalled": int((allc["reference_outcome"] == "stalled").sum()),
+                "misses": _misses(allc),
                 "meets_target": bool(
                     summ["outcome_agreement"] >= OUTCOME_TARGET
                     and summ["median_frechet"] <= FRECHET_TARGET
@@ -211,6 +217,17 @@ def _variations(plan: ValidationPlan, runner: StudyRunner, runs_rows: list[dict]
         },
         **variations,
     }
+
+
+def _misses(comp) -> dict[str, dict]:
+    """Disagreeing runs by miss reason: count and offsets over L_c (separatrix, diverged)."""
+    out = {}
+    for reason in MISS_REASONS:
+        rows = comp[comp["miss_reason"] == reason] if "miss_reason" in comp else comp.iloc[:0]
+        if len(rows):
+            offsets = [float(v) for v in rows["miss_offset"] if np.isfinite(v)]
+            out[reason] = {"runs": int(len(rows)), "offsets": sorted(offsets)}
+    return out
 
 
 def _family_summary(comp) -> dict:

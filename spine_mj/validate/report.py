@@ -26,6 +26,7 @@ from spine_mj.plotting import (
     styled,
 )
 from spine_mj.presets import list_presets, make_surface
+from spine_mj.sweep.analyses.compare import MISS_CHECKPOINTS
 from spine_mj.sweep.store import load_runs
 from spine_mj.templates import render
 from spine_mj.validate.boundary import BoundaryCurve, BoundaryResult
@@ -480,6 +481,40 @@ def _stalled_note(limit: QuasistaticLimitResult) -> list[str]:
     ]
 
 
+#: What each miss reason means, for the report (spine_mj.compare.miss_reason).
+_MISS_MEANING = {
+    "separatrix": "the reference restarted from a point of MuJoCo's path within one hfield "
+    "spacing of its own path ends where MuJoCo ended: the reference's outcome flips closer "
+    "to its path than the engine's tip can follow it",
+    "diverged": "MuJoCo left the reference's path by more than a spacing (the offset) before "
+    "the outcomes parted",
+    "engine_held": "MuJoCo held where the reference, restarted at MuJoCo's end, moves on",
+    "engine_passed": "MuJoCo ended free where every restart of the reference holds",
+}
+
+
+def _misses_note(limit: QuasistaticLimitResult) -> list[str]:
+    """Why the runs that the engine finished disagree, per family, where any do."""
+    lines = []
+    for fam, v in limit.families.items():
+        parts = []
+        for reason, m in v.get("misses", {}).items():
+            offs = ", ".join(f"{o:.3g}" for o in m["offsets"])
+            parts.append(f"{reason} {m['runs']}" + (f" (offsets {offs} L_c)" if offs else ""))
+        if parts:
+            lines.append(f"* {fam}: " + "; ".join(parts))
+    if not lines:
+        return []
+    meaning = "; ".join(f"*{k}*: {v}" for k, v in _MISS_MEANING.items())
+    return [
+        "Why the runs the engine finished disagree (the reference restarted from "
+        f"{MISS_CHECKPOINTS} points along each MuJoCo path, `compare.miss_reason`): {meaning}.",
+        "",
+        *lines,
+        "",
+    ]
+
+
 def _limit_section(limit: QuasistaticLimitResult) -> list[str]:
     families = [
         {
@@ -530,6 +565,7 @@ def _limit_section(limit: QuasistaticLimitResult) -> list[str]:
         ),
         "",
         *_stalled_note(limit),
+        *_misses_note(limit),
         "### What limits agreement: settings varied on the single peak",
         "",
         _table(
@@ -557,6 +593,8 @@ def _limit_section(limit: QuasistaticLimitResult) -> list[str]:
                 "reference_outcome",
                 "end_reason",
                 "end_detail",
+                "miss_reason",
+                "miss_offset",
                 "agree_smooth",
                 "frechet_smooth",
                 "geometry_frechet",

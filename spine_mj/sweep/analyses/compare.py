@@ -7,7 +7,8 @@ force cap, and it ends where the engine's run ends (the domain margin from the e
 both sides share the geometry, the lock test and the domain. The comparison with the
 quasistatic analysis's path (the smooth surface, or whatever it traced; retraced within
 the same domain) is kept beside it (``*_smooth``), and the gap between the two streamlines
-is the geometry part (``geometry_frechet``). Touches the API of :mod:`spine_mj.compare` here only; needs the
+is the geometry part (``geometry_frechet``). A run that disagrees gets a ``miss_reason``
+(:func:`spine_mj.compare.miss_reason`: the reference restarted along its path). Touches the API of :mod:`spine_mj.compare` here only; needs the
 results of the ``quasistatic`` and ``mujoco`` analyses of the same case.
 """
 
@@ -43,6 +44,47 @@ def _deviations(mpaths, qs: sl.StreamlineResult, lc: float) -> tuple[np.ndarray,
     return frechet, lateral
 
 
+#: Checkpoints along a disagreeing MuJoCo path from which the reference is restarted to
+#: tell why it disagrees (:func:`spine_mj.compare.miss_reason`): evenly spaced in arc
+#: length, the first at the path's start, the last at its end.
+MISS_CHECKPOINTS = 32
+
+
+def _miss_reasons(contact, params, trace, mpaths, facets, mj_locked, mj_end, lc, miss):
+    """``miss_reason`` and ``miss_offset`` of each run; empty and NaN where it agrees.
+
+    The separatrix offset is one facet (the hfield spacing): closer to the reference than
+    that, the engine's tip cannot follow it."""
+    reason = np.full(len(mpaths), "", dtype=object)
+    offset = np.full(len(mpaths), np.nan)
+    runs = [i for i in np.flatnonzero(miss) if mpaths[i].shape[0] > 0]
+    if not runs:
+        return reason, offset
+    k = MISS_CHECKPOINTS
+    points = []
+    for i in runs:
+        path = mpaths[i]
+        arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(path, axis=0), axis=1))])
+        at = np.minimum(np.searchsorted(arc, np.linspace(0.0, arc[-1], k)), len(path) - 1)
+        points.append(path[at])
+    restarts = trace(contact, np.vstack(points), params, store_paths=False)
+    ends = np.column_stack([restarts.end_x, restarts.end_y])
+    facet = float(contact.facets.x[1] - contact.facets.x[0]) / lc
+    for n, i in enumerate(runs):
+        part = slice(n * k, (n + 1) * k)
+        reaches = compare.outcome_agreement(
+            restarts.self_locked[part],
+            ends[part],
+            np.full(k, mj_locked[i]),
+            np.tile(mj_end[i], (k, 1)),
+            length_scale=lc,
+        )["agree"]
+        reason[i], offset[i] = compare.miss_reason(
+            points[n], _xy(facets, i), reaches, bool(mj_locked[i]), length_scale=lc, separatrix_offset=facet
+        )
+    return reason, offset
+
+
 def _outcomes(qs: sl.StreamlineResult, mj_locked, mj_end, lc: float) -> dict[str, np.ndarray]:
     return compare.outcome_agreement(
         qs.self_locked, np.column_stack([qs.end_x, qs.end_y]), mj_locked, mj_end, length_scale=lc
@@ -76,6 +118,13 @@ def _compare(case, surface, starts, upstream):
     mj_end = np.array([r.position_m[-1, :2] / s for r in runs])
     agree = _outcomes(facets, mj_locked, mj_end, lc)
     agree_smooth = _outcomes(smooth, mj_locked, mj_end, lc)
+    status = np.array(
+        upstream["mujoco"].status if upstream["mujoco"].status is not None else np.full(len(runs), "ok"),
+        dtype=object,
+    )
+    miss_reason, miss_offset = _miss_reasons(
+        contact, params, trace, mpaths, facets, mj_locked, mj_end, lc, ~agree["agree"] & (status == "ok")
+    )
     peak = np.array([peak_drive_over_fp(r, rig.scales.preload_n) for r in runs])
     kap = compare.kappa_agreement(facets.max_kappa, peak, kappa_cap=runs[0].detection.kappa_cap)
     metrics = {
@@ -86,6 +135,8 @@ def _compare(case, surface, starts, upstream):
         "agree_end": agree["end"],
         "same_trap": agree["same_trap"],
         "agree": agree["agree"],
+        "miss_reason": miss_reason,
+        "miss_offset": miss_offset,
         "reference_outcome": np.array(facets.outcome_names, dtype=object),
         "reference_max_kappa": facets.max_kappa,
         "frechet_smooth": frechet_smooth,
@@ -94,10 +145,6 @@ def _compare(case, surface, starts, upstream):
         "kappa_ratio": kap["ratio"],
         "inertia_number": np.array([r.inertia_number for r in runs]),
     }
-    status = np.array(
-        upstream["mujoco"].status if upstream["mujoco"].status is not None else np.full(len(runs), "ok"),
-        dtype=object,
-    )
     reason = np.where(
         status == "ok", "", "mujoco run: " + np.asarray(upstream["mujoco"].reason, dtype=object)
     ).astype(object)
@@ -114,6 +161,7 @@ register_analysis(
         requires=("quasistatic", "mujoco"),
         doc="MuJoCo against the streamline traced on the rig's facets dilated by its tip "
         "(like for like), and against the quasistatic analysis's own path (*_smooth); "
+        "why a run disagrees (miss_reason, miss_offset); "
         "lengths over L_c: spine_mj.compare",
     )
 )
