@@ -8,8 +8,9 @@ both sides share the geometry, the lock test and the domain. The comparison with
 quasistatic analysis's path (the smooth surface, or whatever it traced; retraced within
 the same domain) is kept beside it (``*_smooth``), and the gap between the two streamlines
 is the geometry part (``geometry_frechet``). A run that disagrees gets a ``miss_reason``
-(:func:`spine_mj.compare.miss_reason`: the reference restarted along its path). Touches the API of :mod:`spine_mj.compare` here only; needs the
-results of the ``quasistatic`` and ``mujoco`` analyses of the same case.
+(:func:`spine_mj.compare.miss_reason`: the reference restarted along its path). Touches
+the API of :mod:`spine_mj.compare` here only; needs the results of the ``quasistatic`` and
+``mujoco`` analyses of the same case.
 """
 
 from __future__ import annotations
