@@ -202,7 +202,11 @@ def fractal_lock(plan: ValidationPlan, runner: StudyRunner) -> FractalLockResult
             "surfaces": surfaces,
             "starts": starts,
             "drive": {"protocol": "spring", "ie": ie},
-            "grid": {**grid, **({"dl": tip / 2} if "quasistatic" in analyses else {})},
+            "grid": {
+                **grid,
+                **({"dl": tip / 2} if "quasistatic" in analyses else {}),
+                **({"miss_reasons": False} if "compare" in analyses else {}),
+            },
         }
         df, _ = runner(doc, f"fractal-lock/{label}")
         records += _records(df, label, seed_hurst)

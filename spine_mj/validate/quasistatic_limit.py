@@ -163,7 +163,12 @@ def _limit_doc(plan: ValidationPlan, fam: FamilySpec, preset: str, name: str, ov
         **engine_grid(plan, overrides, preset, fam.seeds, tip),
     }
     return family_doc(
-        fam, name=name, preset=preset, drive={"protocol": "spring", "ie": plan.lowest_ie}, grid=grid
+        fam,
+        name=name,
+        preset=preset,
+        drive={"protocol": "spring", "ie": plan.lowest_ie},
+        grid=grid,
+        miss_reasons=not overrides,
     )
 
 

@@ -39,8 +39,14 @@ def family_doc(
     drive: dict,
     grid: dict,
     analyses=("quasistatic", "mujoco", "compare"),
+    miss_reasons: bool = False,
 ) -> dict:
-    """The sweep config of one preset of ``fam`` with its starts, ``drive`` and ``grid``."""
+    """The sweep config of one preset of ``fam`` with its starts, ``drive`` and ``grid``;
+    ``compare`` tells why runs disagree only where ``miss_reasons`` (a trace per checkpoint
+    of each miss: the studies away from the quasistatic corner, where most runs disagree by
+    design, skip it)."""
+    if "compare" in analyses:
+        grid = {**grid, "miss_reasons": miss_reasons}
     return {
         "sweep": {"name": name, "seed": 11, "analyses": list(analyses)},
         "surfaces": surfaces_table([preset], fam.seeds, fam.variants),

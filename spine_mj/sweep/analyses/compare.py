@@ -23,7 +23,7 @@ from spine_mj import compare
 from spine_mj import streamline as sl
 from spine_mj.sweep.analyses.mujoco import peak_drive_over_fp
 from spine_mj.sweep.analyses.quasistatic import path_table, traced_surface
-from spine_mj.sweep.registry import Analysis, AnalysisResult, register_analysis
+from spine_mj.sweep.registry import Analysis, AnalysisResult, ParamSpec, register_analysis
 
 
 def _xy(res: sl.StreamlineResult, i: int) -> np.ndarray:
@@ -48,7 +48,7 @@ def _deviations(mpaths, qs: sl.StreamlineResult, lc: float) -> tuple[np.ndarray,
 #: Checkpoints along a disagreeing MuJoCo path from which the reference is restarted to
 #: tell why it disagrees (:func:`spine_mj.compare.miss_reason`): evenly spaced in arc
 #: length, the first at the path's start, the last at its end.
-MISS_CHECKPOINTS = 32
+MISS_CHECKPOINTS = 16
 
 
 def _miss_reasons(contact, params, trace, mpaths, facets, mj_locked, mj_end, lc, miss):
@@ -123,8 +123,9 @@ def _compare(case, surface, starts, upstream):
         upstream["mujoco"].status if upstream["mujoco"].status is not None else np.full(len(runs), "ok"),
         dtype=object,
     )
+    explain = ~agree["agree"] & (status == "ok") & bool(case.params["miss_reasons"])
     miss_reason, miss_offset = _miss_reasons(
-        contact, params, trace, mpaths, facets, mj_locked, mj_end, lc, ~agree["agree"] & (status == "ok")
+        contact, params, trace, mpaths, facets, mj_locked, mj_end, lc, explain
     )
     peak = np.array([peak_drive_over_fp(r, rig.scales.preload_n) for r in runs])
     kap = compare.kappa_agreement(facets.max_kappa, peak, kappa_cap=runs[0].detection.kappa_cap)
@@ -158,7 +159,15 @@ register_analysis(
     Analysis(
         "compare",
         _compare,
-        (),
+        (
+            ParamSpec(
+                "miss_reasons",
+                "bool",
+                "tell why each disagreeing run disagrees (miss_reason): the reference restarted "
+                f"from {MISS_CHECKPOINTS} points of its MuJoCo path, a trace each",
+                True,
+            ),
+        ),
         requires=("quasistatic", "mujoco"),
         doc="MuJoCo against the streamline traced on the rig's facets dilated by its tip "
         "(like for like), and against the quasistatic analysis's own path (*_smooth); "
