@@ -221,6 +221,33 @@ class GaussianSurface(Surface):
     def n_gaussians(self) -> int:
         return self.amplitude.size
 
+    def _eval_shaped(self, x, y, order: int) -> tuple[np.ndarray, ...]:
+        x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+        if x.ndim == 2 and y.ndim == 2 and x.shape[0] == 1 and y.shape[1] == 1:
+            return self._on_grid(x[0], y[:, 0], order)
+        return super()._eval_shaped(x, y, order)
+
+    def _on_grid(self, x, y, order):
+        """Values on the tensor grid ``x (nx,)`` by ``y (ny,)``, shape ``(ny, nx)``: each
+        Gaussian is a product of one factor in x and one in y, so every sum is a matrix
+        product (K Gaussians: K (nx + ny) exponentials instead of K nx ny). Sampling and
+        dilating a surface of 100 Gaussians on a 3201^2 grid: 47 s pointwise."""
+        dx = (x[None, :] - self.center_x[:, None]) / self.sigma_x[:, None]  # (K, nx)
+        dy = (y[None, :] - self.center_y[:, None]) / self.sigma_y[:, None]  # (K, ny)
+        ex, ey = np.exp(-0.5 * dx * dx), np.exp(-0.5 * dy * dy)
+        ay = self.amplitude[:, None] * ey
+        out = [ay.T @ ex]
+        if order >= 1:
+            gx, gy = -dx / self.sigma_x[:, None], -dy / self.sigma_y[:, None]
+            out += [ay.T @ (ex * gx), (ay * gy).T @ ex]
+        if order >= 2:
+            out += [
+                ay.T @ (ex * (gx * gx - 1.0 / self.sigma_x[:, None] ** 2)),
+                (ay * gy).T @ (ex * gx),
+                (ay * (gy * gy - 1.0 / self.sigma_y[:, None] ** 2)).T @ ex,
+            ]
+        return tuple(out)
+
     def _evaluate(self, x, y, order):
         dx = (x[:, None] - self.center_x) / self.sigma_x
         dy = (y[:, None] - self.center_y) / self.sigma_y
@@ -1023,10 +1050,14 @@ class BallOnFacets(Surface):
     facets : TriangulatedSurface
     radius : float
         Ball radius in the surface's length unit, > 0.
+    compiled : bool
+        Evaluate with the compiled kernel (:mod:`spine_mj._contact_kernel`, the default) or
+        with the numpy reference it is tested against (same numbers; about 1 ms per call).
     """
 
     facets: TriangulatedSurface
     radius: float
+    compiled: bool = True
     unit: str = field(init=False)
     metadata: dict = field(init=False)
     bounds: tuple[float, float, float, float] = field(init=False)
@@ -1043,12 +1074,31 @@ class BallOnFacets(Surface):
     def _evaluate(self, x, y, order):
         if order > 1:
             raise SpineInputError("BallOnFacets has no Hessian (order 2): its facets are flat")
-        parts = [self._contact(x[s : s + 1024], y[s : s + 1024]) for s in range(0, x.size, 1024)]
-        f, fx, fy = (np.concatenate([p[k] for p in parts]) for k in range(3))
+        if self.compiled:
+            from spine_mj._contact_kernel import ball_on_facets
+
+            fac = self.facets
+            ny, nx = fac.heights.shape
+            dx = (fac.x[-1] - fac.x[0]) / (nx - 1)
+            dy = (fac.y[-1] - fac.y[0]) / (ny - 1)
+            f, fx, fy = ball_on_facets(
+                np.ascontiguousarray(x, dtype=float),
+                np.ascontiguousarray(y, dtype=float),
+                np.ascontiguousarray(fac.heights, dtype=float),
+                float(fac.x[0]),
+                float(fac.y[0]),
+                float(dx),
+                float(dy),
+                float(self.radius),
+            )
+        else:
+            parts = [self._contact(x[s : s + 1024], y[s : s + 1024]) for s in range(0, x.size, 1024)]
+            f, fx, fy = (np.concatenate([p[k] for p in parts]) for k in range(3))
         return (f,) if order == 0 else (f, fx, fy)
 
     def _contact(self, x, y):
-        """Centre height less the radius and the contact's slopes at points ``x``, ``y``."""
+        """Centre height less the radius and the contact's slopes at points ``x``, ``y``
+        (the numpy reference of the compiled kernel)."""
         fac, r = self.facets, self.radius
         h = fac.heights
         ny, nx = h.shape

@@ -439,6 +439,26 @@ def test_ball_on_facets_against_brute_force_over_the_footprint():
             np.testing.assert_allclose([fx[k], fy[k]], slope, atol=0.02)
 
 
+@pytest.mark.parametrize("radius", [0.02, 0.05, 0.16])
+def test_ball_on_facets_compiled_matches_the_numpy_reference(radius):
+    """The compiled contact against the array reference, on rough facets with a wall, a flat
+    patch (ties between features) and points past the edges (the ball sees only the facets
+    inside; no contact at all gives -inf)."""
+    x = np.linspace(0.0, 1.0, 26)
+    y = np.linspace(-0.5, 0.5, 21)
+    h = RNG.normal(0.0, 0.05, (21, 26))
+    h[8:10, :] += 0.3
+    h[:, :6] = 0.0
+    tri = TriangulatedSurface(heights=h, x=x, y=y)
+    px = np.concatenate([RNG.uniform(-0.1, 1.1, 300), [0.1, 0.12, 1.0, 2.0]])
+    py = np.concatenate([RNG.uniform(-0.6, 0.6, 300), [0.0, -0.2, 0.5, 2.0]])
+    fast = BallOnFacets(tri, radius).evaluate(px, py, order=1)
+    slow = BallOnFacets(tri, radius, compiled=False).evaluate(px, py, order=1)
+    for a, b in zip(fast, slow):
+        np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-12)
+    assert fast[0][-1] == -np.inf
+
+
 def test_ball_on_facets_rejects_bad_input():
     x = np.linspace(0.0, 1.0, 5)
     tri = TriangulatedSurface(heights=np.zeros((5, 5)), x=x, y=x.copy())
@@ -448,3 +468,25 @@ def test_ball_on_facets_rejects_bad_input():
         BallOnFacets(single_gaussian(), 0.1)
     with pytest.raises(SpineInputError, match="Hessian"):
         BallOnFacets(tri, 0.1).hessian(0.5, 0.5)
+
+
+def test_gaussian_sum_on_a_grid_equals_its_pointwise_values():
+    """The separable grid path (x a row, y a column) against the pointwise sum, orders 0-2."""
+    from spine_mj.surfaces import GaussianSurface
+
+    k = 30
+    surf = GaussianSurface(
+        amplitude=RNG.normal(0.0, 1.0, k),
+        center_x=RNG.uniform(-2, 2, k),
+        center_y=RNG.uniform(-2, 2, k),
+        sigma_x=RNG.uniform(0.2, 1.0, k),
+        sigma_y=RNG.uniform(0.2, 1.0, k),
+        bounds=(-2, 2, -2, 2),
+    )
+    x, y = np.linspace(-2, 2, 37), np.linspace(-2.5, 2, 23)
+    grid = surf.evaluate(x[None, :], y[:, None], order=2)
+    X, Y = np.meshgrid(x, y)
+    points = surf.evaluate(X, Y, order=2)
+    for a, b in zip(grid, points):
+        assert a.shape == (23, 37)
+        np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-12)
