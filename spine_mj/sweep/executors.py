@@ -20,6 +20,7 @@ from distributed import Client, as_completed
 
 from spine_mj.sweep.cases import Case
 from spine_mj.sweep.pool import run_pool
+from spine_mj.sweep.registry import CASE_THREADS
 from spine_mj.sweep.runner import failed_rows, run_case
 from spine_mj.sweep.store import encode_case
 
@@ -32,7 +33,16 @@ def encoded_case(case: Case) -> tuple:
 def run_here(todo: list[Case], handle) -> None:
     """One worker: the cases run in this process, in order; each case's store files are
     encoded and written on a helper thread while the next case runs (pyarrow releases the
-    GIL), and handled here in order as they complete."""
+    GIL), and handled here in order as they complete. Each case's engine batch uses every
+    core (:data:`~spine_mj.sweep.registry.CASE_THREADS`)."""
+    token = CASE_THREADS.set(os.cpu_count() or 1)
+    try:
+        _run_in_order(todo, handle)
+    finally:
+        CASE_THREADS.reset(token)
+
+
+def _run_in_order(todo: list[Case], handle) -> None:
     with cf.ThreadPoolExecutor(max_workers=1) as writer:
         pending = None
         for case in todo:

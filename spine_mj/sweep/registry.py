@@ -9,6 +9,7 @@ This module imports nothing else from :mod:`spine_mj.sweep`.
 
 from __future__ import annotations
 
+import contextvars
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Annotated, Any, Literal
@@ -19,6 +20,12 @@ from pydantic import AllowInfNan, Strict
 
 from spine_mj.engagement import DEFAULT_KAPPA_CAP
 from spine_mj.errors import SpineInputError
+
+#: Threads a case's engine batch may use: 1 where cases run side by side in worker
+#: processes, every core where they run one at a time in the sweep's own process
+#: (:func:`spine_mj.sweep.executors.run_here`: a sweep of one case, or ``workers = 1``).
+#: Read by the analyses that step MuJoCo; a run's result does not depend on it.
+CASE_THREADS: contextvars.ContextVar[int] = contextvars.ContextVar("case_threads", default=1)
 
 #: Row statuses. ``ok``; ``failed`` (an exception in the analysis); ``bad_surface`` (the
 #: surface could not be made or loaded); MuJoCo trouble by kind: ``nan`` (a non-finite

@@ -17,6 +17,7 @@ from spine_mj.sim.params import surface_unit_m
 from spine_mj.sim.ramp import nominal_time_s
 from spine_mj.surfaces import GridSurface
 from spine_mj.sweep.registry import (
+    CASE_THREADS,
     KAPPA_CAP_PARAM,
     MU_PARAM,
     Analysis,
@@ -264,10 +265,10 @@ def _runs(rig, p: dict, starts) -> list:
             duration_s=p["duration"],
             settle_time_s=p["settle_time"],
         )
-        return rig.run_batch(drive, pts, detection=det, nthread=1)
+        return rig.run_batch(drive, pts, detection=det, nthread=CASE_THREADS.get())
     if p["protocol"] == "static":
         drive = sim.StaticProbe(rate_n_s=rate, start_force_n=p["start_force"], settle_time_s=p["settle_time"])
-        return rig.run_batch(drive, pts, detection=det, nthread=1)
+        return rig.run_batch(drive, pts, detection=det, nthread=CASE_THREADS.get())
     drive = sim.RampDrive(
         rate_n_s=rate,
         duration_s=p["duration"],
