@@ -196,7 +196,7 @@ def kappa_of_normal(normal, mu, *, tol: float = DEFAULT_TOL) -> tuple[np.ndarray
 def crease_engagement(fx_a, fy_a, fx_b, fy_b, mu, *, tol: float = DEFAULT_TOL):
     """Engagement of a tip resting on two contacts at once, in a concave crease between
     surfaces of slopes ``(fx_a, fy_a)`` and ``(fx_b, fy_b)``: what the single-contact
-    :func:`kappa` cannot describe (beyond the paper, docs/physics.md §2).
+    :func:`kappa` cannot describe (beyond the paper, docs/physics.md §4, Creases).
 
     The tip can only move along the crease, ``c = n_a x n_b`` (unit, turned to the drive:
     ``c_x >= 0``). Under ``F = W (kappa e_x - e_z)`` the normal forces balance the part of
