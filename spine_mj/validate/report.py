@@ -475,8 +475,9 @@ def _stalled_note(limit: QuasistaticLimitResult) -> list[str]:
     counts = ", ".join(f"{k} {n} of {limit.families[k]['runs']}" for k, n in stalled.items())
     return [
         f"Reference streamlines that stalled ({counts}): no net progress even with the step "
-        "cut to 1/1024 of dl (the step control of docs/physics.md §2), a point the "
-        "single-contact rule can neither leave nor rest on. These runs count as disagreements.",
+        "cut to 1/1024 of dl (the step control of docs/physics.md §2), a point that neither "
+        "one contact nor two (the crease rule, §4) can leave or rest on. These runs count as "
+        "disagreements.",
         "",
     ]
 
@@ -530,9 +531,10 @@ def _limit_section(limit: QuasistaticLimitResult) -> list[str]:
         "",
         f"I_e = {limit.lowest_ie:g}, default drive (K = k l_s / F_p = 30) and engine. Like for "
         "like: each MuJoCo path is compared with the streamline traced on the surface its tip "
-        "touches (MuJoCo's hfield facets dilated by the tip radius, sampled at an eighth of the "
-        "radius), with the same force cap on both sides (a path needing more than the cap times "
-        "F_p is held). A run the engine stopped counts as a disagreement. Beside it: the "
+        "touches (a ball of the tip's radius on MuJoCo's hfield facets, exactly: "
+        "`surfaces.BallOnFacets`), ending where the engine's run ends, with the same force "
+        "cap on both sides (a path needing more than the cap times F_p is held). A run the "
+        "engine stopped, or whose reference stalled, counts as a disagreement. Beside it: the "
         "comparison with the streamline on the smooth surface and the geometry part (smooth vs "
         "facet streamline).",
         "",

@@ -87,9 +87,12 @@ def _miss_reasons(contact, params, trace, mpaths, facets, mj_locked, mj_end, lc,
 
 
 def _outcomes(qs: sl.StreamlineResult, mj_locked, mj_end, lc: float) -> dict[str, np.ndarray]:
-    return compare.outcome_agreement(
+    """Outcome agreement; a reference that stalled decided nothing, so its run disagrees."""
+    out = compare.outcome_agreement(
         qs.self_locked, np.column_stack([qs.end_x, qs.end_y]), mj_locked, mj_end, length_scale=lc
     )
+    out["agree"] = out["agree"] & (qs.outcome != sl.Outcome.STALLED)
+    return out
 
 
 def _compare(case, surface, starts, upstream):
