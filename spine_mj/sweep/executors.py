@@ -30,12 +30,12 @@ def encoded_case(case: Case) -> tuple:
     return encode_case(case.case_id, *run_case(case))
 
 
-def run_here(todo: list[Case], handle) -> None:
+def run_here(todo: list[Case], handle, *, threads: int = 1) -> None:
     """One worker: the cases run in this process, in order; each case's store files are
     encoded and written on a helper thread while the next case runs (pyarrow releases the
-    GIL), and handled here in order as they complete. Each case's engine batch uses every
-    core (:data:`~spine_mj.sweep.registry.CASE_THREADS`)."""
-    token = CASE_THREADS.set(os.cpu_count() or 1)
+    GIL), and handled here in order as they complete. Each case's engine batch steps on
+    ``threads`` threads (:data:`~spine_mj.sweep.registry.CASE_THREADS`)."""
+    token = CASE_THREADS.set(max(1, int(threads)))
     try:
         _run_in_order(todo, handle)
     finally:

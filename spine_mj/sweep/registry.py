@@ -22,8 +22,8 @@ from spine_mj.engagement import DEFAULT_KAPPA_CAP
 from spine_mj.errors import SpineInputError
 
 #: Threads a case's engine batch may use: 1 where cases run side by side in worker
-#: processes, every core where they run one at a time in the sweep's own process
-#: (:func:`spine_mj.sweep.executors.run_here`: a sweep of one case, or ``workers = 1``).
+#: processes or one at a time with ``workers = 1``; the sweep's workers where a single case
+#: is left to run (:func:`spine_mj.sweep.executors.run_here`).
 #: Read by the analyses that step MuJoCo; a run's result does not depend on it.
 CASE_THREADS: contextvars.ContextVar[int] = contextvars.ContextVar("case_threads", default=1)
 

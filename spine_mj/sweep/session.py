@@ -261,8 +261,9 @@ def _run_locked(
     if todo:
         if scheduler is not None:
             run_dask(longest_first(todo), scheduler, handle)
-        elif n_workers == 1:
-            run_here(todo, handle)
+        elif n_workers == 1 or len(todo) == 1:
+            # one case left: no processes to start; its engine batch gets the workers' threads
+            run_here(todo, handle, threads=n_workers)
         else:
             run_processes(longest_first(todo), n_workers, handle)
     status_counts = _status_counts(consolidate(out_dir))

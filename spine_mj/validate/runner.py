@@ -50,7 +50,8 @@ class StudyRunner:
     out_dir : Path
         The validation's output folder (absolute: the stores refer to files under it).
     workers : int or None
-        Worker processes per sweep (None: all cores), capped at the sweep's case count.
+        Worker processes per sweep (None: all cores); a sweep of one case steps its engine
+        batch on that many threads.
     progress : callable or None
         Called with :class:`ValidationProgress`.
     t0 : float
@@ -103,8 +104,9 @@ class StudyRunner:
                     )
                 )
 
-        n_cases = len(sweep.expand_cases(config))
+        # not capped at the case count: a sweep of one case steps its engine batch on the
+        # workers' threads instead of starting processes
         w = workers if workers is not None else self.workers
-        w = max(1, min(w or os.cpu_count() or 1, n_cases))
+        w = w or os.cpu_count() or 1
         sweep.run_sweep(config, store, workers=w, overwrite=True, progress=cb)
         return sweep.load_runs(store), store
