@@ -9,7 +9,8 @@ Sections (each records the machine's load average before and after it):
   fractal) and of the plain numpy reference (``backend="numpy"``) on the same starts.
 * ``rollout``: ``Rig.run_batch`` against bare ``mujoco.rollout`` (same model, controls and
   recording, runs that do not end early), paired runs in alternating order; the median of
-  the per-pair ratios. And the steps and time ``Rig.run_batch`` saves by stopping decided
+  the per-pair ratios; the calling thread's own CPU per batch (less sensitive to a shared
+  machine than the ratio). And the steps and time ``Rig.run_batch`` saves by stopping decided
   runs (``stop_early``) on a fractal where most runs self-lock.
 * ``fastforward``: the static probe and the force ramp with and without stick-phase
   fast-forward (``benchmarks/bench_fastforward.py``): breakaway forces, steps.
@@ -116,13 +117,15 @@ def bench_rollout(quick: bool) -> dict:
     bare, ours, nstep = paired_setup(runs, duration, nthread)
     ours()
     bare()  # warm-up
-    t_bare, t_ours = [], []
+    t_bare, t_ours, cpu_main = [], [], []
     for k in range(pairs):
         order = ((t_bare, bare), (t_ours, ours)) if k % 2 == 0 else ((t_ours, ours), (t_bare, bare))
         for times, fn in order:
-            t0 = time.perf_counter()
+            t0, c0 = time.perf_counter(), time.thread_time()
             fn()
             times.append(time.perf_counter() - t0)
+            if fn is ours:  # the calling thread's own CPU: it competes with the worker threads
+                cpu_main.append(time.thread_time() - c0)
     ratios = [b / o for b, o in zip(t_bare, t_ours)]
     steps = runs * nstep
     return {
@@ -134,6 +137,8 @@ def bench_rollout(quick: bool) -> dict:
         "run_batch_steps_s": steps / statistics.median(t_ours),
         "ratios": ratios,
         "ratio_median": statistics.median(ratios),
+        "calling_thread_cpu_s": statistics.median(cpu_main),
+        "bare_wall_s": statistics.median(t_bare),
         "target": 0.95,
         "early": early_stop(quick, nthread),
     }
@@ -433,6 +438,14 @@ def markdown(res: dict) -> str:
             f"(range {min(ro['ratios']):.3f}-{max(ro['ratios']):.3f}) | "
             f"{ro['ratio_median']:.3f} | >= 0.95 | {ld} |",
         ]
+        if "calling_thread_cpu_s" in ro:  # results from before it was measured lack it
+            lines.append(
+                "| `Rig.run_batch`: the calling thread's CPU per batch (placement, controls, "
+                "analysis, results; it competes with the worker threads), median | "
+                f"{1000 * ro['calling_thread_cpu_s']:.1f} ms, "
+                f"{100 * ro['calling_thread_cpu_s'] / ro['bare_wall_s']:.1f} % of a bare batch's "
+                f"wall | | {ld} |"
+            )
         e = ro.get("early")
         if e:
             p, q = e["plain"], e["early"]
