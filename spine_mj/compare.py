@@ -30,8 +30,19 @@ from spine_mj.errors import SpineInputError
 OUTCOME_TARGET = 0.95
 FRECHET_TARGET = 0.1
 
-#: The kinds :func:`miss_reason` tells apart, in the order reports list them.
-MISS_REASONS = ("separatrix", "diverged", "engine_held", "engine_passed")
+#: The kinds :func:`miss_reason` tells apart, in the order reports list them, and what each
+#: means (the report prints these).
+MISS_REASONS = {
+    "separatrix": "the reference restarted from a point of MuJoCo's path within one hfield "
+    "spacing of its own path ends where MuJoCo ended: the reference's outcome flips closer "
+    "to its path than the engine's tip can follow it (the two sides agree on the flow; the "
+    "start is ill-conditioned)",
+    "diverged": "the first such point is farther: MuJoCo left the reference's path by the "
+    "offset before the outcomes parted (inertia, a hop)",
+    "engine_held": "no restart ends as MuJoCo did, and MuJoCo held where the reference, "
+    "restarted at MuJoCo's end, moves on (a lock the reference does not see)",
+    "engine_passed": "MuJoCo ended free where every restart of the reference holds",
+}
 
 __all__ = [
     "FRECHET_TARGET",
@@ -268,14 +279,11 @@ def miss_reason(
     Returns
     -------
     reason : str
-        One of :data:`MISS_REASONS`. ``separatrix``: a restart from a checkpoint within
-        ``separatrix_offset`` of the reference ends as the run did, so the reference's own
-        outcome flips closer to its path than the engine resolves (the two sides agree on
-        the flow; the start is ill-conditioned). ``diverged``: the first such checkpoint is
-        farther; the run left the reference's path by ``offset`` before its outcome parted
-        (inertia, a hop). ``engine_held``: no restart ends as the run did, and the run ended
-        held where the reference, restarted there, moves on (a lock the reference does not
-        see). ``engine_passed``: the run ended free where every restart holds.
+        A key of :data:`MISS_REASONS`, which says what each means: ``separatrix`` where the
+        first checkpoint whose restart ends as the run did lies within
+        ``separatrix_offset`` of the reference, ``diverged`` where it lies farther,
+        ``engine_held`` / ``engine_passed`` where no restart ends as the run did and the
+        run ended held / free.
     offset : float
         Distance over L_c from the reference of the first checkpoint that reaches the run's
         outcome; NaN for the engine_* reasons.

@@ -37,21 +37,17 @@ def run_here(todo: list[Case], handle, *, threads: int = 1) -> None:
     ``threads`` threads (:data:`~spine_mj.sweep.registry.CASE_THREADS`)."""
     token = CASE_THREADS.set(max(1, int(threads)))
     try:
-        _run_in_order(todo, handle)
-    finally:
-        CASE_THREADS.reset(token)
-
-
-def _run_in_order(todo: list[Case], handle) -> None:
-    with cf.ThreadPoolExecutor(max_workers=1) as writer:
-        pending = None
-        for case in todo:
-            rows, traj = run_case(case)
+        with cf.ThreadPoolExecutor(max_workers=1) as writer:
+            pending = None
+            for case in todo:
+                rows, traj = run_case(case)
+                if pending is not None:
+                    handle(pending.result())
+                pending = writer.submit(encode_case, case.case_id, rows, traj)
             if pending is not None:
                 handle(pending.result())
-            pending = writer.submit(encode_case, case.case_id, rows, traj)
-        if pending is not None:
-            handle(pending.result())
+    finally:
+        CASE_THREADS.reset(token)
 
 
 def run_processes(todo: list[Case], n_workers: int, handle) -> None:

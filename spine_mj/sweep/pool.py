@@ -63,7 +63,7 @@ def _worker_main(conn, parent_pid, work) -> None:
         try:
             result = ("done", work(case))
         except Exception as exc:  # recorded as the case's failure; the worker goes on
-            result = ("error", f"{type(exc).__name__}: {exc}"[:500])
+            result = ("error", failure_text(exc))
         conn.send(result)
 
 
@@ -74,6 +74,11 @@ class _Worker:
     case: object = None
     ready: bool = False
     sent: list = field(default_factory=list)
+
+
+def failure_text(exc: BaseException) -> str:
+    """How a case's exception is reported, by a worker or by this process alike."""
+    return f"{type(exc).__name__}: {exc}"[:500]
 
 
 def death_reason(exitcode: int | None) -> str:
@@ -110,7 +115,7 @@ def run_pool(todo: list, n_workers: int, ctx, work, on_death, handle, *, parent_
                 try:
                     result = work(case)
                 except Exception as exc:  # as a worker reports it: the case's failure
-                    result = on_death(case, f"{type(exc).__name__}: {exc}"[:500])
+                    result = on_death(case, failure_text(exc))
                 handle(result)
                 continue
             objs = [w.conn for w in workers] + [w.process.sentinel for w in workers]

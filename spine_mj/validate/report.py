@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
+from spine_mj.compare import MISS_REASONS
 from spine_mj.errors import atomic_output
 from spine_mj.plotting import (
     DIVERGING_CMAP,
@@ -482,18 +483,6 @@ def _stalled_note(limit: QuasistaticLimitResult) -> list[str]:
     ]
 
 
-#: What each miss reason means, for the report (spine_mj.compare.miss_reason).
-_MISS_MEANING = {
-    "separatrix": "the reference restarted from a point of MuJoCo's path within one hfield "
-    "spacing of its own path ends where MuJoCo ended: the reference's outcome flips closer "
-    "to its path than the engine's tip can follow it",
-    "diverged": "MuJoCo left the reference's path by more than a spacing (the offset) before "
-    "the outcomes parted",
-    "engine_held": "MuJoCo held where the reference, restarted at MuJoCo's end, moves on",
-    "engine_passed": "MuJoCo ended free where every restart of the reference holds",
-}
-
-
 def _misses_note(limit: QuasistaticLimitResult) -> list[str]:
     """Why the runs that the engine finished disagree, per family, where any do."""
     lines = []
@@ -506,7 +495,7 @@ def _misses_note(limit: QuasistaticLimitResult) -> list[str]:
             lines.append(f"* {fam}: " + "; ".join(parts))
     if not lines:
         return []
-    meaning = "; ".join(f"*{k}*: {v}" for k, v in _MISS_MEANING.items())
+    meaning = "; ".join(f"*{k}*: {v}" for k, v in MISS_REASONS.items())
     return [
         "Why the runs the engine finished disagree (the reference restarted from "
         f"{MISS_CHECKPOINTS} points along each MuJoCo path, `compare.miss_reason`): {meaning}.",
