@@ -42,6 +42,8 @@ MISS_REASONS = {
     "engine_held": "no restart ends as MuJoCo did, and MuJoCo held where the reference, "
     "restarted at MuJoCo's end, moves on (a lock the reference does not see)",
     "engine_passed": "MuJoCo ended free where every restart of the reference holds",
+    "reference_stalled": "the reference made no progress even at its shortest step: it "
+    "decided nothing (no restart is traced)",
 }
 
 __all__ = [
@@ -283,7 +285,8 @@ def miss_reason(
         first checkpoint whose restart ends as the run did lies within
         ``separatrix_offset`` of the reference, ``diverged`` where it lies farther,
         ``engine_held`` / ``engine_passed`` where no restart ends as the run did and the
-        run ended held / free.
+        run ended held / free. (``reference_stalled`` is the caller's to tell: a stalled
+        reference has no outcome to read restarts against.)
     offset : float
         Distance over L_c from the reference of the first checkpoint that reaches the run's
         outcome; NaN for the engine_* reasons.

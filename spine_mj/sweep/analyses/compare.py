@@ -45,6 +45,15 @@ def _deviations(mpaths, qs: sl.StreamlineResult, lc: float) -> tuple[np.ndarray,
     return frechet, lateral
 
 
+def _outcomes(qs: sl.StreamlineResult, mj_locked, mj_end, lc: float) -> dict[str, np.ndarray]:
+    """Outcome agreement; a reference that stalled decided nothing, so its run disagrees."""
+    out = compare.outcome_agreement(
+        qs.self_locked, np.column_stack([qs.end_x, qs.end_y]), mj_locked, mj_end, length_scale=lc
+    )
+    out["agree"] = out["agree"] & (qs.outcome != sl.Outcome.STALLED)
+    return out
+
+
 #: Checkpoints along a disagreeing MuJoCo path from which the reference is restarted to
 #: tell why it disagrees (:func:`spine_mj.compare.miss_reason`): evenly spaced in arc
 #: length, the first at the path's start, the last at its end.
@@ -58,7 +67,9 @@ def _miss_reasons(contact, params, trace, mpaths, facets, mj_locked, mj_end, lc,
     that, the engine's tip cannot follow it."""
     reason = np.full(len(mpaths), "", dtype=object)
     offset = np.full(len(mpaths), np.nan)
-    runs = [i for i in np.flatnonzero(miss) if mpaths[i].shape[0] > 0]
+    stalled = miss & (facets.outcome == sl.Outcome.STALLED)
+    reason[stalled] = "reference_stalled"
+    runs = [i for i in np.flatnonzero(miss & ~stalled) if mpaths[i].shape[0] > 0]
     if not runs:
         return reason, offset
     k = MISS_CHECKPOINTS
@@ -69,30 +80,21 @@ def _miss_reasons(contact, params, trace, mpaths, facets, mj_locked, mj_end, lc,
         at = np.minimum(np.searchsorted(arc, np.linspace(0.0, arc[-1], k)), len(path) - 1)
         points.append(path[at])
     restarts = trace(contact, np.vstack(points), params, store_paths=False)
-    ends = np.column_stack([restarts.end_x, restarts.end_y])
+    # a restart reaches the run's outcome as the reference agrees with it: a stall reaches none
+    reaches = _outcomes(restarts, np.repeat(mj_locked[runs], k), np.repeat(mj_end[runs], k, axis=0), lc)[
+        "agree"
+    ]
     facet = float(contact.facets.x[1] - contact.facets.x[0]) / lc
     for n, i in enumerate(runs):
-        part = slice(n * k, (n + 1) * k)
-        reaches = compare.outcome_agreement(
-            restarts.self_locked[part],
-            ends[part],
-            np.full(k, mj_locked[i]),
-            np.tile(mj_end[i], (k, 1)),
-            length_scale=lc,
-        )["agree"]
         reason[i], offset[i] = compare.miss_reason(
-            points[n], _xy(facets, i), reaches, bool(mj_locked[i]), length_scale=lc, separatrix_offset=facet
+            points[n],
+            _xy(facets, i),
+            reaches[n * k : (n + 1) * k],
+            bool(mj_locked[i]),
+            length_scale=lc,
+            separatrix_offset=facet,
         )
     return reason, offset
-
-
-def _outcomes(qs: sl.StreamlineResult, mj_locked, mj_end, lc: float) -> dict[str, np.ndarray]:
-    """Outcome agreement; a reference that stalled decided nothing, so its run disagrees."""
-    out = compare.outcome_agreement(
-        qs.self_locked, np.column_stack([qs.end_x, qs.end_y]), mj_locked, mj_end, length_scale=lc
-    )
-    out["agree"] = out["agree"] & (qs.outcome != sl.Outcome.STALLED)
-    return out
 
 
 def _compare(case, surface, starts, upstream):
