@@ -136,3 +136,43 @@ def test_stopping_decided_runs_early_changes_no_result():
         (EndReason.ENGINE_TROUBLE, ""),
     }
     assert steps[0] < 0.5 * steps[1]
+
+
+def test_worker_lanes_hand_back_a_pieces_exception_and_close_with_pieces_queued():
+    import threading
+
+    from spine_mj.sim.rollout import _NativeLanes
+
+    lanes = _NativeLanes(2)
+    release = threading.Event()
+    ran = []
+
+    def piece(i):
+        release.wait(5)
+        ran.append(i)
+        if i == 1:
+            raise ValueError("piece 1 failed")
+        return i
+
+    try:
+        for i in range(2):
+            lanes.put(piece, (i,))
+        release.set()
+        try:
+            lanes.take(2)
+        except ValueError as exc:
+            assert "piece 1" in str(exc)
+        else:
+            raise AssertionError("the worker's exception was not handed back")
+        release.clear()
+        for i in range(2, 40):  # two block in the workers, the rest wait in the queue
+            lanes.put(piece, (i,))
+        closing = threading.Thread(target=lanes.close)
+        closing.start()
+        while not lanes.cancelled:
+            closing.join(0.001)
+    finally:
+        release.set()
+    closing.join(10)
+    assert not closing.is_alive() and not any(t.is_alive() for t in lanes.threads)
+    assert set(ran) <= {0, 1, 2, 3}  # at most the two pieces under way finished; the queued ones were dropped

@@ -40,7 +40,7 @@ def _both(rig, drive, starts, det, state, sens, carriage, windows, runs=None):
         decided = []
         for a, b in windows:
             rows = slice(None) if runs is None else runs
-            decided.append(ga.add(rows, a, b, state[rows, a:b], sens[rows, a:b]))
+            decided.append(ga.add(rows, a, b, state, sens))
         out.append((ga, decided))
     return out
 

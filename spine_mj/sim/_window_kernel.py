@@ -20,9 +20,6 @@ import math
 import numpy as np
 from numba import njit
 
-#: The end conditions, in the order of the kernel's ``marks`` columns (the keys of
-#: :func:`~spine_mj.sim.detection.end_marks`).
-MARK_KEYS = ("nonfinite", "reset", "fast", "sank", "flew", "deep", "out", "lock", "lock_rule")
 _MAX = np.finfo(np.float64).max
 
 
@@ -36,10 +33,31 @@ def _finite_or_clipped(x):
     return x
 
 
+@njit(cache=True, inline="always")
+def _finite_sum(x):
+    """Whether the sum of ``x`` is finite: it is when every number is (it may not be when
+    the sum overflows; the caller then looks closer). Four partial sums, so that the adds
+    do not wait on one another."""
+    t0 = t1 = t2 = t3 = 0.0
+    n = x.size
+    j = 0
+    while j + 4 <= n:
+        t0 += x[j]
+        t1 += x[j + 1]
+        t2 += x[j + 2]
+        t3 += x[j + 3]
+        j += 4
+    while j < n:
+        t0 += x[j]
+        j += 1
+    return math.isfinite((t0 + t1) + (t2 + t3))
+
+
 @njit(cache=True, nogil=True)  # the worker threads go on stepping meanwhile
 def analyse_window(
     state,
     sens,
+    w,
     carriage,
     spring,
     adr,
@@ -48,6 +66,7 @@ def analyse_window(
     speed_limit2,
     first_step,
     held_from,
+    out_rows,
     time_s,
     position,
     velocity,
@@ -64,7 +83,9 @@ def analyse_window(
     marks,
     held_out,
 ):
-    """Columns, end marks and lock-rule carry of rows ``(g, w)``.
+    """Columns, end marks and lock-rule carry of ``w`` rows from ``first_step`` on of the
+    group's runs ``out_rows`` (g,): ``state``, ``sens``, ``carriage`` and the columns are
+    the group's arrays; the marks and the per-run inputs are in ``out_rows`` order.
 
     ``adr``: sensor addresses (tip_pos, tip_vel, contact_net, contact_deepest,
     spring_force, push_force). ``units``: metres, newtons, m/s and seconds per engine unit.
@@ -73,9 +94,9 @@ def analyse_window(
     mu_s, the self-lock tolerance, the lock rule's rise [N]. ``spring`` (g,)
     marks the runs whose carriage is recorded; ``speed_limit2`` (g,) the squared speed
     limits; ``held_from`` (g,) the lock rule's carry (NaN: none). Writes the columns,
-    ``marks`` (g, 9) in :data:`MARK_KEYS` order (-1: none) and ``held_out`` (g,).
+    ``marks`` (g, 9) in :data:`~spine_mj.sim.detection.MARK_KEYS` order (-1: none) and ``held_out`` (g,).
     """
-    g, w = state.shape[0], state.shape[1]
+    g = out_rows.size
     p, v, cn, cd, sp, pu = adr[0], adr[1], adr[2], adr[3], adr[4], adr[5]
     length, force_n, speed, time_u = units[0], units[1], units[2], units[3]
     dt, xmin, xmax, ymin, ymax, zmin, ztop = prm[0], prm[1], prm[2], prm[3], prm[4], prm[5], prm[6]
@@ -86,25 +107,22 @@ def analyse_window(
     for r in range(g):
         for k in range(9):
             marks[r, k] = -1
+        o = out_rows[r]
         streak = not math.isnan(held_from[r])
         base = held_from[r]
         for i in range(w):
-            s = sens[r, i]
+            c = first_step + i
+            s = sens[o, c]
             if marks[r, 0] < 0:
-                total = 0.0  # finite unless a number is not (or the sum overflows: then look closer)
-                for j in range(nstate):
-                    total += state[r, i, j]
-                for j in range(nsens):
-                    total += s[j]
-                if not math.isfinite(total):
+                if not (_finite_sum(state[o, c]) and _finite_sum(s)):
                     for j in range(nstate):
-                        if not math.isfinite(state[r, i, j]):
+                        if not math.isfinite(state[o, c, j]):
                             marks[r, 0] = i
                     for j in range(nsens):
                         if not math.isfinite(s[j]):
                             marks[r, 0] = i
             touching = s[cd] > 0
-            contact[r, i] = touching
+            contact[o, c] = touching
             flip = s[cd + 7] < 0
             n0 = -s[cd + 5] if flip else s[cd + 5]
             n1 = -s[cd + 6] if flip else s[cd + 6]
@@ -123,35 +141,35 @@ def analyse_window(
             vn = (v0 * c0 + v2 * c2) + v1 * c1
             u0, u1, u2 = v0 - vn * c0, v1 - vn * c1, v2 - vn * c2
             vt = math.sqrt(u0 * u0 + u1 * u1 + u2 * u2) * speed
-            tangential_speed[r, i] = vt
+            tangential_speed[o, c] = vt
             depth = -s[cd + 1]
             if touching:
                 pen = depth if (depth >= 0.0 or math.isnan(depth)) else 0.0  # np.maximum
             else:
                 pen = 0.0
             pen_m = pen * length
-            penetration[r, i] = pen_m
-            normal_force[r, i] = fn * force_n
-            tangential_force[r, i] = ft * force_n
-            t = state[r, i, 0] * time_u
-            time_s[r, i] = t
+            penetration[o, c] = pen_m
+            normal_force[o, c] = fn * force_n
+            tangential_force[o, c] = ft * force_n
+            t = state[o, c, 0] * time_u
+            time_s[o, c] = t
             fd = (s[sp] + s[pu]) * force_n
-            drive_force[r, i] = fd
+            drive_force[o, c] = fd
             px, py, pz = s[p] * length, s[p + 1] * length, s[p + 2] * length
-            position[r, i, 0], position[r, i, 1], position[r, i, 2] = px, py, pz
+            position[o, c, 0], position[o, c, 1], position[o, c, 2] = px, py, pz
             w0, w1, w2 = v0 * speed, v1 * speed, v2 * speed
-            velocity[r, i, 0], velocity[r, i, 1], velocity[r, i, 2] = w0, w1, w2
+            velocity[o, c, 0], velocity[o, c, 1], velocity[o, c, 2] = w0, w1, w2
             if touching:
-                normal[r, i, 0], normal[r, i, 1], normal[r, i, 2] = n0, n1, n2
-                contact_point[r, i, 0] = s[cd + 2] * length
-                contact_point[r, i, 1] = s[cd + 3] * length
-                contact_point[r, i, 2] = s[cd + 4] * length
+                normal[o, c, 0], normal[o, c, 1], normal[o, c, 2] = n0, n1, n2
+                contact_point[o, c, 0] = s[cd + 2] * length
+                contact_point[o, c, 1] = s[cd + 3] * length
+                contact_point[o, c, 2] = s[cd + 4] * length
             else:
-                normal[r, i, 0] = normal[r, i, 1] = normal[r, i, 2] = np.nan
-                contact_point[r, i, 0] = contact_point[r, i, 1] = contact_point[r, i, 2] = np.nan
-            carriage_x[r, i] = carriage[r, i] * length if spring[r] else np.nan
+                normal[o, c, 0] = normal[o, c, 1] = normal[o, c, 2] = np.nan
+                contact_point[o, c, 0] = contact_point[o, c, 1] = contact_point[o, c, 2] = np.nan
+            carriage_x[o, c] = carriage[o, c] * length if spring[r] else np.nan
             slips = vt > slip_speed
-            slipping[r, i] = slips
+            slipping[o, c] = slips
 
             if marks[r, 1] < 0 and not (abs(t - dt * float(first_step + i + 1)) <= 0.5 * dt):
                 marks[r, 1] = i

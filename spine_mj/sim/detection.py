@@ -156,6 +156,10 @@ def normal_lock_marks(
     return first_indices(hit), carry
 
 
+#: The end conditions, in the order of a group's mark columns (the keys of :func:`end_marks`).
+MARK_KEYS = ("nonfinite", "reset", "fast", "sank", "flew", "deep", "out", "lock", "lock_rule")
+
+
 def end_marks(
     rec: Recording,
     state: np.ndarray,

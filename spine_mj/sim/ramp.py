@@ -236,7 +236,7 @@ class _Stepper:
         a, self.analysed = self.analysed, max(b, self.analysed)
         if b <= a:
             return False
-        return bool(self.analysis.add(slice(0, 1), a, b, self.state[None, a:b], self.sens[None, a:b])[0])
+        return bool(self.analysis.add(slice(0, 1), a, b, self.state[None], self.sens[None])[0])
 
 
 def _controller(rig: RigModel, drive: RampDrive, det: Detection, n_settle: int) -> ResetController:

@@ -23,6 +23,7 @@ import pandas as pd
 from spine_mj.engagement import DEFAULT_TOL
 from spine_mj.sim.detection import (
     LOCK_RISE_FP,
+    MARK_KEYS,
     Detection,
     Ending,
     Event,
@@ -239,7 +240,8 @@ class GroupAnalysis:
         self.n_settle = [settle_steps(d, rig.engine.timestep_s) for d in self.drives]
         self.limits = np.array([det.speed_limit_m_s(rig.scales, rig.speed_of(d)) for d in self.drives])
         self.cols = Recording.empty((self.g, self.n))
-        self.marks: dict[str, np.ndarray] = {}
+        self._mark_rows = np.full((self.g, len(MARK_KEYS)), -1)  # first run row of each end mark
+        self.marks = {k: self._mark_rows[:, j] for j, k in enumerate(MARK_KEYS)}
         self.held_from_n = np.full(self.g, np.nan)
         a, u, e = rig.sensor_adr, rig.units, (*rig.bounds_m, *rig.z_range_m)
         self._adr = np.array([a[k] for k in SENSOR_NAMES], dtype=np.int64)
@@ -265,28 +267,18 @@ class GroupAnalysis:
     def add(
         self, runs: np.ndarray | slice, a: int, b: int, state: np.ndarray, sens: np.ndarray
     ) -> np.ndarray:
-        """Rows ``a..b-1`` of ``runs`` (indices, or a slice of the group; ``state``
-        ``(len(runs), b - a, nstate)``, ``sens`` likewise); returns, per run, whether it is
-        decided (an ending at or before row b-1)."""
+        """Rows ``a..b-1`` of ``runs`` (indices, or a slice of the group) from the group's
+        ``state`` ``(g, n, nstate)`` and ``sens`` ``(g, n, nsensordata)`` (the rows, read in
+        place); returns, per run, whether it is decided (an ending at or before row b-1)."""
         rig, det = self.rig, self.det
-        block = isinstance(runs, slice)  # the window's columns are views of the group's: written in place
-        if block:
-            rec = Recording(**{k: getattr(self.cols, k)[runs, a:b] for k in COLUMNS})
-        else:
-            rec = Recording.empty(state.shape[:2])
         if self.compiled:
-            marks = self._marks_compiled(runs, a, state, sens, rec)
+            marks = self._marks_compiled(runs, a, b, state, sens)
         else:
-            marks = self._marks_reference(runs, a, b, state, sens, rec)
-        if not block:
-            for k in COLUMNS:
-                getattr(self.cols, k)[runs, a:b] = getattr(rec, k)
-        decided = np.zeros(state.shape[0], bool)
-        for k, m in marks.items():
-            old = self.marks.setdefault(k, np.full(self.g, -1))[runs]
-            merged = np.where((old < 0) & (m >= 0), m + a, old)
-            self.marks[k][runs] = merged
-            decided |= merged >= 0
+            marks = self._marks_reference(runs, a, b, state[runs, a:b], sens[runs, a:b])
+        old = self._mark_rows[runs]
+        merged = np.where((old < 0) & (marks >= 0), marks + a, old)
+        self._mark_rows[runs] = merged
+        decided = (merged >= 0).any(axis=1)
         self.rows[runs] = b
         for i, r in enumerate(np.arange(self.g)[runs]):
             if self.probe[r] and not decided[i]:
@@ -295,10 +287,16 @@ class GroupAnalysis:
                 )
         return decided
 
-    def _marks_reference(self, runs, a: int, b: int, state, sens, rec: Recording) -> dict[str, np.ndarray]:
-        """The window's columns (into ``rec``) and end marks by the numpy reference:
+    def _marks_reference(self, runs, a: int, b: int, state, sens) -> np.ndarray:
+        """The window's columns (into the group's) and end marks ``(runs, len(MARK_KEYS))``
+        (window rows, -1: none) by the numpy reference:
         :meth:`Recording.from_sensors`, :func:`end_marks`, :func:`normal_lock_marks`."""
         rig, det = self.rig, self.det
+        block = isinstance(runs, slice)  # the window's columns are views of the group's: written in place
+        if block:
+            rec = Recording(**{k: getattr(self.cols, k)[runs, a:b] for k in COLUMNS})
+        else:
+            rec = Recording.empty(state.shape[:2])
         carriage = np.where(self.spring[runs, None], self.carriage[runs, a:b], np.nan)
         Recording.from_sensors(
             rig.sensor_adr,
@@ -323,19 +321,24 @@ class GroupAnalysis:
         marks["lock_rule"], self.held_from_n[runs] = normal_lock_marks(
             rec, rig.tip.mu_s, rig.scales.preload_n, self.held_from_n[runs]
         )
-        return marks
+        if not block:
+            for k in COLUMNS:
+                getattr(self.cols, k)[runs, a:b] = getattr(rec, k)
+        return np.stack([marks[k] for k in MARK_KEYS], axis=1)
 
-    def _marks_compiled(self, runs, a: int, state, sens, rec: Recording) -> dict[str, np.ndarray]:
-        """:meth:`_marks_reference` in one compiled pass (:mod:`~spine_mj.sim._window_kernel`)."""
-        from spine_mj.sim._window_kernel import MARK_KEYS, analyse_window
+    def _marks_compiled(self, runs, a: int, b: int, state, sens) -> np.ndarray:
+        """:meth:`_marks_reference` in one compiled pass (:mod:`~spine_mj.sim._window_kernel`),
+        writing the group's columns in place."""
+        from spine_mj.sim._window_kernel import analyse_window
 
-        g = state.shape[0]
-        marks = np.empty((g, len(MARK_KEYS)), dtype=np.int64)
-        held = np.empty(g)
+        out_rows = np.arange(self.g)[runs]
+        marks = np.empty((out_rows.size, len(MARK_KEYS)), dtype=np.int64)
+        held = np.empty(out_rows.size)
         analyse_window(
             state,
             sens,
-            self.carriage[runs, a : a + state.shape[1]],
+            b - a,
+            self.carriage,
             self.spring[runs],
             self._adr,
             self._units,
@@ -343,12 +346,13 @@ class GroupAnalysis:
             self.limits[runs] ** 2,
             a,
             self.held_from_n[runs],
-            *(getattr(rec, k) for k in COLUMNS),
+            out_rows,
+            *(getattr(self.cols, k) for k in COLUMNS),
             marks,
             held,
         )
         self.held_from_n[runs] = held
-        return {k: marks[:, j] for j, k in enumerate(MARK_KEYS)}
+        return marks
 
     def run(self, r: int) -> Recording:
         """The recorded rows of run ``r`` (views of the group's columns)."""

@@ -7,8 +7,9 @@ of output); each run is simulated in pieces (its settle phase, then :data:`PIECE
 steps at a time), and after each piece its new rows are analysed
 (:class:`~spine_mj.sim.results.GroupAnalysis`): a run whose outcome is decided (self-lock,
 left the domain, engine trouble, a probe's breakaway or slide) is not simulated further.
-The group's runs are split in two halves: while the worker threads simulate one half's
-pieces, the calling thread analyses the other's and places tips.
+The pieces stream: worker threads take them from one queue, and the calling thread takes
+finished ones in small batches, analyses them and queues each live run's next piece while
+the workers still have queued pieces to simulate (no round waits for its slowest piece).
 
 A run is continued from its exact state: the full physics state of its last row and the
 warm start (``qacc_warmstart``) its worker's ``MjData`` holds after the piece, which the
@@ -28,7 +29,6 @@ dropped and the probe goes on from its settled state with the plain controls.
 
 from __future__ import annotations
 
-import concurrent.futures as cf
 import math
 import os
 import threading
@@ -233,25 +233,28 @@ class _Group:
         self.analysis = GroupAnalysis(rig, self.drives, self.starts, self.det, self.ctrl[:, :, 3])
 
     def run(self, lanes) -> list[RunResult]:
-        """Simulate the group piece by piece in two halves (one is simulated while the
-        other is analysed); the results in group order."""
+        """Simulate the group piece by piece; the results in group order.
+
+        The calling thread takes finished pieces as a batch once it can do so and still leave
+        each worker a queued piece (``batch`` at most, at least one), analyses them, queues
+        the live runs' next pieces and makes the results of the runs that ended."""
         g = len(self.drives)
-        cut = (g + 1) // 2
-        halves = [np.arange(0, cut), np.arange(cut, g)] if g > 1 else [np.arange(g)]
-        pending: list[list] = [[] for _ in halves]
-        for h, half in enumerate(halves):
-            for i in range(0, half.size, PLACE_CHUNK):  # the workers start on the first tips placed
-                self.prepare(half[i : i + PLACE_CHUNK])
-                pending[h] += self.submit(half[i : i + PLACE_CHUNK], lanes)
+        out = 0  # pieces queued or being simulated
+        for i in range(0, g, PLACE_CHUNK):  # the workers start on the first tips placed
+            ks = np.arange(i, min(g, i + PLACE_CHUNK))
+            self.prepare(ks)
+            out += self.submit(ks, lanes)
+        batch = max(lanes.nthread, g // 4)
         results: list[RunResult | None] = [None] * g
-        while any(pending):
-            for h, half in enumerate(halves):
-                if pending[h]:
-                    self.advance(sorted(p for job in lanes.wait(pending[h]) for p in job))
-                    pending[h] = self.submit(half[self.live[half]], lanes)
-                    if not pending[h]:  # the half is done: its results while the other runs
-                        for k, res in zip(half, self.analysis.results(self.warnings, half)):
-                            results[k] = res
+        while out:
+            done = lanes.take(max(1, min(batch, out - 2 * lanes.nthread)))
+            out -= len(done)
+            self.advance(sorted(done))
+            ks = np.array(sorted({d[0] for d in done}), dtype=int)
+            out += self.submit(ks[self.live[ks]], lanes)
+            ended = ks[~self.live[ks]]
+            for k, res in zip(ended, self.analysis.results(self.warnings, ended)):
+                results[k] = res
         return results
 
     def prepare(self, ks: np.ndarray) -> None:
@@ -261,12 +264,11 @@ class _Group:
             controls(rig, self.drives[k], q, self.det, out=self.ctrl[k])
             self.init[k, 1:4] = q
 
-    def submit(self, ks: np.ndarray, lanes) -> list:
-        """Start the next piece of each run in ``ks``: a fast-forwarding probe's settle phase
-        or climb, or the next of the pieces that double from :data:`FIRST_PIECE_STEPS` to
-        :data:`PIECE_STEPS` (the first with the settle phase). The pieces go to the lanes in
-        one job per lane, of about equal steps (a future per piece cost the calling thread
-        more CPU than the analysis: about 590 of them per 64-run benchmark batch)."""
+    def submit(self, ks: np.ndarray, lanes) -> int:
+        """Queue the next piece of each run in ``ks`` (longest first): a fast-forwarding
+        probe's settle phase or climb, or the next of the pieces that double from
+        :data:`FIRST_PIECE_STEPS` to :data:`PIECE_STEPS` (the first with the settle phase).
+        Returns the number queued."""
         todo = []
         for k in ks:
             a = int(self.done[k])
@@ -281,17 +283,9 @@ class _Group:
                     b = int(self.end[k])
                 self.pieces[k] += 1
             todo.append((int(k), a, min(b, int(self.end[k]))))
-        jobs = [[] for _ in range(min(lanes.nthread, len(todo)))]
-        load = [0] * len(jobs)
-        for k, a, b in sorted(todo, key=lambda t: t[1] - t[2]):  # longest first, to the lightest job
-            j = load.index(min(load))
-            jobs[j].append((k, a, b))
-            load[j] += b - a
-        return [lanes.submit(self.pieces_of, lanes, job) for job in jobs]
-
-    def pieces_of(self, lanes, job: list[tuple[int, int, int]]) -> list:
-        """Simulate the pieces ``(k, a, b)`` of ``job`` one after another (a worker thread's job)."""
-        return [self.piece(lanes, k, a, b) for k, a, b in job]
+        for k, a, b in sorted(todo, key=lambda t: t[1] - t[2]):
+            lanes.put(self.piece, (lanes, k, a, b))
+        return len(todo)
 
     def piece(self, lanes, k: int, a: int, b: int):
         """Simulate rows ``a..b-1`` of run ``k`` from its exact state (a worker thread's job)."""
@@ -327,7 +321,7 @@ class _Group:
         for (a, b), ks in windows.items():
             ks = np.array(ks)
             rows = _as_slice(ks)  # runs of a half: usually a block, read without a copy
-            decided = self.analysis.add(rows, a, b, self.state[rows, a:b], self.sens[rows, a:b])
+            decided = self.analysis.add(rows, a, b, self.state, self.sens)
             self.done[ks] = b
             for k, dec in zip(ks, decided):
                 if b >= self.end[k] or (self.stop_early and (dec or k in stop)):
@@ -405,22 +399,54 @@ def _still(rec: Recording, i: int) -> tuple[float, np.ndarray, bool]:
 
 
 class _NativeLanes:
-    """Worker threads, each stepping one run's piece at a time through
-    :func:`mujoco.rollout.rollout` on its own ``MjData`` (whose warm start the run goes on from)."""
+    """Worker threads, each taking pieces from one queue and stepping them through
+    :func:`mujoco.rollout.rollout` on its own ``MjData`` (whose warm start the run goes on
+    from); finished pieces go to a second queue, in the order they finish."""
 
     def __init__(self, nthread: int):
+        import queue
+
         import mujoco
 
         self.spec = int(mujoco.mjtState.mjSTATE_CTRL) | int(mujoco.mjtState.mjSTATE_MOCAP_POS)
         self.nthread = nthread
-        self.pool = cf.ThreadPoolExecutor(max_workers=nthread)
         self.local = threading.local()
+        self.jobs: queue.SimpleQueue = queue.SimpleQueue()
+        self.finished: list = []  # (ok, result or exception), under ``ready``
+        self.ready = threading.Condition()
+        self.wanted = 0  # take() waits for this many: the workers wake it once, not per piece
+        self.cancelled = False
+        self.threads = [threading.Thread(target=self._work, daemon=True) for _ in range(nthread)]
+        for t in self.threads:
+            t.start()
 
-    def submit(self, fn, *args) -> cf.Future:
-        return self.pool.submit(fn, *args)
+    def _work(self) -> None:
+        while (job := self.jobs.get()) is not None:
+            if not self.cancelled:
+                fn, args = job
+                try:
+                    item = (True, fn(*args))
+                except BaseException as exc:  # raised again by take(), on the calling thread
+                    item = (False, exc)
+                with self.ready:
+                    self.finished.append(item)
+                    if len(self.finished) == self.wanted or not item[0]:
+                        self.ready.notify()
 
-    def wait(self, futures: list[cf.Future]) -> list:
-        return [f.result() for f in futures]
+    def put(self, fn, args: tuple) -> None:
+        """Queue ``fn(*args)``."""
+        self.jobs.put((fn, args))
+
+    def take(self, n: int) -> list:
+        """At least ``n`` finished pieces (waiting for them) and any others finished by then."""
+        with self.ready:
+            self.wanted = n
+            self.ready.wait_for(lambda: len(self.finished) >= n or not all(ok for ok, _ in self.finished))
+            got, self.finished, self.wanted = self.finished, [], 0
+        for ok, value in got:
+            if not ok:
+                raise value
+        return [value for _, value in got]
 
     def step(self, model, init, warm, ctrl, state, sens):
         """Rows ``ctrl.shape[0]`` of one run from full physics state ``init`` and warm start
@@ -449,30 +475,29 @@ class _NativeLanes:
         return data.qacc_warmstart.copy(), ("frozen" if warning_total(data) else None)
 
     def close(self) -> None:
-        self.pool.shutdown(wait=True, cancel_futures=True)
-
-
-def _run(future: cf.Future, fn, args) -> None:
-    """Run one queued piece into its future."""
-    if future.set_running_or_notify_cancel():
-        try:
-            future.set_result(fn(*args))
-        except BaseException as exc:  # handed to the caller by future.result()
-            future.set_exception(exc)
+        """Stop the workers (pieces still queued are dropped) and wait for them."""
+        self.cancelled = True
+        for _ in self.threads:
+            self.jobs.put(None)
+        for t in self.threads:
+            t.join()
 
 
 class _PythonLane:
-    """The reference backend: every piece stepped by :func:`python_steps` on the calling thread."""
+    """The reference backend: every piece stepped by :func:`python_steps` on the calling
+    thread, when it is queued."""
 
     nthread = 1
 
-    def submit(self, fn, *args) -> cf.Future:
-        future: cf.Future = cf.Future()
-        _run(future, fn, args)
-        return future
+    def __init__(self):
+        self.finished: list = []
 
-    def wait(self, futures: list[cf.Future]) -> list:
-        return [f.result() for f in futures]
+    def put(self, fn, args: tuple) -> None:
+        self.finished.append(fn(*args))
+
+    def take(self, n: int) -> list:
+        got, self.finished = self.finished, []
+        return got
 
     def step(self, model, init, warm, ctrl, state, sens):
         return python_steps(model, init, warm, ctrl, state, sens)
