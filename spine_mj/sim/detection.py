@@ -329,12 +329,11 @@ def decide_end(candidates: Sequence[Ending], n: int) -> Ending:
 
 
 def slip_events(slipping: np.ndarray, t: np.ndarray, start: int) -> list[Event]:
-    """Slip onsets and stops from step ``start`` on (the settle phase ignored)."""
-    s = slipping.copy()
-    s[:start] = False
-    change = np.flatnonzero(np.diff(s.astype(np.int8)))
-    events = []
-    for k in change:
-        i = int(k) + 1
-        events.append(Event("slip_onset" if s[i] else "slip_stop", i, float(t[i])))
-    return events
+    """Slip onsets and stops from step ``start`` on, the settle phase taken as stuck: an
+    onset at ``start`` if the tip slips there (``start`` >= 1), then every change of
+    ``slipping`` after it."""
+    seg = slipping[start:]
+    changes = np.flatnonzero(seg[1:] != seg[:-1]) + (start + 1)
+    if start >= 1 and seg.size and seg[0]:
+        changes = np.concatenate([[start], changes])
+    return [Event("slip_onset" if slipping[i] else "slip_stop", i, float(t[i])) for i in changes.tolist()]

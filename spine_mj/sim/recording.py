@@ -84,11 +84,11 @@ class Recording:
         """Run ``r`` of a group, its first ``rows`` rows (all: None), as views of the group's columns."""
         return Recording(**{k: getattr(self, k)[r, :rows] for k in COLUMNS})
 
-    def cut(self, end: int) -> Recording:
-        """Steps ``0..end`` of a run, as read-only views of its columns."""
+    def read_only(self) -> Recording:
+        """The same columns as read-only views (slices of them are read-only too)."""
 
         def view(a):
-            out = a[: end + 1]  # a view of the group's column (C-contiguous rows), read-only
+            out = a.view()
             out.flags.writeable = False
             return out
 

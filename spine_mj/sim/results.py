@@ -240,6 +240,7 @@ class GroupAnalysis:
         self.n_settle = [settle_steps(d, rig.engine.timestep_s) for d in self.drives]
         self.limits = np.array([det.speed_limit_m_s(rig.scales, rig.speed_of(d)) for d in self.drives])
         self.cols = Recording.empty((self.g, self.n))
+        self._results_view = self.cols.read_only()  # a RunResult cannot write the group's columns
         self._mark_rows = np.full((self.g, len(MARK_KEYS)), -1)  # first run row of each end mark
         self.marks = {k: self._mark_rows[:, j] for j, k in enumerate(MARK_KEYS)}
         self.held_from_n = np.full(self.g, np.nan)
@@ -368,7 +369,7 @@ class GroupAnalysis:
         fp = self.rig.scales.preload_n
         out = []
         for r in range(self.g) if runs is None else runs:
-            drive, rec = self.drives[r], self.run(r)
+            drive, rec = self.drives[r], self._results_view.run(r, self.rows[r])
             candidates = end_candidates(self.marks, r, rec, warnings[r], self.det, fp)
             kappa = math.nan
             if self.probe[r]:
@@ -384,7 +385,7 @@ class GroupAnalysis:
                     drive,
                     self.starts[r],
                     self.det,
-                    rec.cut(ending.index),
+                    self._results_view.run(r, ending.index + 1),
                     ending,
                     self.n_settle[r],
                     kappa,

@@ -230,7 +230,7 @@ class _Group:
         self.settle_apart = [
             isinstance(d, StaticProbe) and fast_forward_on(d, rig.engine, rig.tip) for d in self.drives
         ]
-        self.analysis = GroupAnalysis(rig, self.drives, self.starts, self.det, self.ctrl[:, :, 3])
+        self.analysis: GroupAnalysis | None = None  # built once the workers have pieces
 
     def run(self, lanes) -> list[RunResult]:
         """Simulate the group piece by piece; the results in group order.
@@ -244,6 +244,9 @@ class _Group:
             ks = np.arange(i, min(g, i + PLACE_CHUNK))
             self.prepare(ks)
             out += self.submit(ks, lanes)
+            if self.analysis is None:
+                carriage = self.ctrl[:, :, 3]
+                self.analysis = GroupAnalysis(self.rig, self.drives, self.starts, self.det, carriage)
         batch = max(lanes.nthread, g // 4)
         results: list[RunResult | None] = [None] * g
         while out:
