@@ -13,7 +13,10 @@ stated in units of ``L_c``).
 * :func:`kappa_agreement`: quasistatic max kappa against the dynamic peak drive force / W;
 * :func:`capture_rate`: the fraction of runs that end self-locked (trapped);
 * :func:`miss_reason`: why a run and its reference disagree, from the reference restarted
-  along the run's path.
+  along the run's path;
+* :func:`slide_fraction` and :func:`peak_speed`: how much of a path gravity alone moves
+  (where the quasistatic model has no drive, hence no rate) and how fast the engine's tip
+  actually went: the evidence that a path is quasistatic at all, whatever the drive speed.
 """
 
 from __future__ import annotations
@@ -58,7 +61,9 @@ __all__ = [
     "miss_reason",
     "outcome_agreement",
     "path_frechet",
+    "peak_speed",
     "resample_by_arclength",
+    "slide_fraction",
 ]
 
 
@@ -337,3 +342,34 @@ def capture_rate(locked) -> float:
     """Fraction of runs that ended self-locked; NaN for no runs."""
     arr = np.asarray(locked, dtype=bool)
     return float(arr.mean()) if arr.size else float("nan")
+
+
+def slide_fraction(path, region) -> float:
+    """Share of a streamline's arc length traced in the slip region (``region`` per point,
+    :data:`spine_mj.engagement.SLIP`; a segment counts by its first point), where gravity
+    alone slides the tip (docs/physics.md §2).
+
+    There the quasistatic model has no drive force and no rate: the engine's tip falls at
+    the speed gravity gives it, not at the drive's, so a path with slides is not
+    quasistatic at any drive speed (:func:`peak_speed` measures how fast it went). NaN for
+    a path of fewer than two points or of zero length.
+    """
+    from spine_mj.engagement import SLIP
+
+    p = _path("path", path)
+    reg = np.asarray(region).reshape(-1)
+    if reg.size != p.shape[0]:
+        raise SpineInputError(f"region must have one entry per path point ({p.shape[0]}), got {reg.size}")
+    seg = np.linalg.norm(np.diff(p[:, :2], axis=0), axis=1)
+    total = float(seg.sum())
+    if not total > 0:
+        return float("nan")
+    return float(seg[reg[:-1] == SLIP].sum() / total)
+
+
+def peak_speed(velocity) -> float:
+    """The largest speed ``|v|`` of velocity rows ``(n, 3)`` (NaN for none). Over L_c per
+    time it is the inertia number the tip itself reached, ``m v_max^2 / (F_p L_c)``
+    (:meth:`spine_mj.sim.Scales.inertia_number`), to set against the drive's and I_e*."""
+    v = np.asarray(velocity, dtype=float).reshape(-1, 3)
+    return float(np.sqrt((v * v).sum(axis=1)).max()) if v.shape[0] else float("nan")

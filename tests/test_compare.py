@@ -16,7 +16,9 @@ from spine_mj.compare import (
     mean_lateral_deviation,
     miss_reason,
     outcome_agreement,
+    peak_speed,
     resample_by_arclength,
+    slide_fraction,
 )
 
 
@@ -140,3 +142,21 @@ def test_miss_reason_reads_where_the_restarted_reference_first_ends_as_the_run()
         miss_reason(run, ref, reaches[:3], True, length_scale=1.0, separatrix_offset=0.01)
     with pytest.raises(SpineInputError, match="separatrix_offset"):
         miss_reason(run, ref, reaches, True, length_scale=1.0, separatrix_offset=-1.0)
+
+
+def test_slide_fraction_counts_the_arc_length_of_slip_segments():
+    from spine_mj.engagement import ENGAGED, SELF_LOCK, SLIP
+
+    path = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 3.0], [1.0, 4.0]])
+    region = [ENGAGED, SLIP, SLIP, SELF_LOCK]  # the last point's region starts no segment
+    assert slide_fraction(path, region) == pytest.approx(4.0 / 5.0)
+    assert slide_fraction(path, [ENGAGED] * 4) == 0.0
+    assert np.isnan(slide_fraction(path[:1], [SLIP]))
+    with pytest.raises(SpineInputError, match="region must have one entry per path point"):
+        slide_fraction(path, [SLIP])
+
+
+def test_peak_speed_is_the_largest_row_norm():
+    v = np.array([[3.0, 4.0, 0.0], [0.0, 0.0, -6.0], [1.0, 1.0, 1.0]])
+    assert peak_speed(v) == pytest.approx(6.0)
+    assert np.isnan(peak_speed(np.zeros((0, 3))))

@@ -47,9 +47,13 @@ def test_mujoco_and_compare_runs_match_the_rig_run_directly(tmp_path):
     smooth_lock_differs = qs.self_locked.astype(bool) != mjs.self_locked.astype(bool)
     assert not cmp_.agree_smooth.astype(bool)[smooth_lock_differs.loc[cmp_.index]].any()
     assert (cmp_.geometry_frechet >= 0).all()
+    # the peak's flanks are gentler than mu_s's friction angle: no gravity slides; the tip
+    # moves on average with the carriage, so its peak speed is at least the drive's
+    assert (cmp_.reference_slide_fraction == 0).all()
+    ran = mjs.status.loc[cmp_.index] == "ok"
+    assert (cmp_.tip_peak_ie[ran] >= 0.5 * mjs.ie.loc[cmp_.index][ran]).all()
     assert mjs.end_detail[mjs.self_locked.astype(bool)].str.match("lock rule|force cap").all()
     assert (cmp_.status == np.where(mjs.status.loc[cmp_.index] == "ok", "ok", "dependency_failed")).all()
-    ran = mjs.status.loc[cmp_.index] == "ok"
     assert cmp_.frechet[ran].notna().all() and (cmp_.frechet[ran] >= 0).all()
     # a run that agrees has no miss reason; one the engine finished and that disagrees has one
     agree = cmp_.agree.astype(bool)

@@ -25,6 +25,7 @@ __all__ = ["LimitPath", "QuasistaticLimitResult", "quasistatic_limit"]
 
 #: Columns of the per-run rows.
 RUN_COLUMNS = (
+    "family",
     "preset",
     "surface",
     "start",
@@ -43,6 +44,8 @@ RUN_COLUMNS = (
     "geometry_frechet",
     "miss_reason",
     "miss_offset",
+    "reference_slide_fraction",
+    "tip_peak_ie",
 )
 
 
@@ -73,7 +76,9 @@ class QuasistaticLimitResult:
         by status), ``reference_stalled`` (reference streamlines stalled in a groove),
         ``misses`` (disagreeing runs the engine finished, by
         :func:`spine_mj.compare.miss_reason`, each with its offsets over L_c),
-        ``meets_target``.
+        ``slide_runs`` (runs whose reference slides under gravity somewhere:
+        :func:`spine_mj.compare.slide_fraction` > 0), ``median_tip_peak_ie`` (the engine
+        tip's own peak speed as an inertia number), ``meets_target``.
     runs : list of dict
         Per-run rows (:data:`RUN_COLUMNS`).
     variations : dict
@@ -132,6 +137,8 @@ def quasistatic_limit(plan: ValidationPlan, runner: StudyRunner) -> QuasistaticL
                 # there: docs/physics.md §2)
                 "reference_stalled": int((allc["reference_outcome"] == "stalled").sum()),
                 "misses": _misses(allc),
+                "slide_runs": int((allc["reference_slide_fraction"] > 0).sum()),
+                "median_tip_peak_ie": float(np.nanmedian(allc["tip_peak_ie"])),
                 "meets_target": bool(
                     summ["outcome_agreement"] >= OUTCOME_TARGET
                     and summ["median_frechet"] <= FRECHET_TARGET
@@ -181,6 +188,7 @@ def _preset_comparison(
     comp = df[df["analysis"] == "compare"].copy()
     mj = df[df["analysis"] == "mujoco"].set_index(["case_id", "start"])
     key = list(zip(comp["case_id"], comp["start"].astype(int)))
+    comp["family"] = fam.name
     comp["preset"] = preset
     comp["end_reason"] = [mj.loc[k, "end_reason"] for k in key]
     comp["end_detail"] = [mj.loc[k, "end_detail"] for k in key]

@@ -360,7 +360,7 @@ def write_report(
         targets={"outcome": OUTCOME_TARGET, "frechet": FRECHET_TARGET, "static": STATIC_TARGET},
         boundary="\n".join(_boundary_section(boundary)),
         static="\n".join(_static_section(static, result)),
-        limit="\n".join(_limit_section(limit)),
+        limit="\n".join(_limit_section(limit, boundary)),
         stick="\n".join(_stick_section(stick)),
         sand="\n".join(_sand_section(sand)),
         fractal="\n".join(_fractal_section(fractal)),
@@ -505,7 +505,62 @@ def _misses_note(limit: QuasistaticLimitResult) -> list[str]:
     ]
 
 
-def _limit_section(limit: QuasistaticLimitResult) -> list[str]:
+def _falls_note(limit: QuasistaticLimitResult, boundary: BoundaryResult) -> list[str]:
+    """Whether the runs were quasistatic at all: gravity slides on the reference and the
+    engine tip's own peak inertia number, with agreement split at the spring drive's I_e*
+    (the boundary study's bracket: below its lower end a drive is quasistatic)."""
+    star = _star_for_figure(boundary.ie_star.get("spring", {})) if boundary.ie_star else None
+    if star is None:
+        return []
+    cut = float(star["low"])
+    rows = []
+    for fam, v in limit.families.items():
+        runs = [r for r in limit.runs if r.get("family") == fam]
+        peak = np.array([r.get("tip_peak_ie", np.nan) for r in runs], dtype=float)
+        if not np.isfinite(peak).any():
+            continue
+        row = {
+            "family": fam,
+            "slides": f"{v.get('slide_runs', 0)}/{len(runs)}",
+            "peak": f"{_f(np.nanmedian(peak))} ({_f(np.nanmin(peak))}-{_f(np.nanmax(peak))})",
+        }
+        for side, keep in (("slow", peak <= cut), ("fast", peak > cut)):
+            sel = [r for r, k in zip(runs, keep) if k]
+            agree = sum(bool(r["agree"]) for r in sel)
+            frechet = np.nanmedian([r["frechet"] for r in sel]) if sel else np.nan
+            row[side] = f"{agree}/{len(sel)}, {_f(frechet)}" if sel else "-"
+        rows.append(row)
+    if not rows:
+        return []
+    return [
+        "### Was the path quasistatic? Gravity slides and the tip's own speed",
+        "",
+        "A slow, stiff drive makes a path quasistatic only where the drive moves the tip. Where "
+        "a descent is steeper than the friction angle (the slip region, docs/physics.md §2) "
+        "gravity alone slides the tip: the quasistatic model has no rate there, and the "
+        "engine's tip falls at the speed gravity gives it, whatever the drive's. Per run, the "
+        "share of the reference's arc length in the slip region (`compare.slide_fraction`) "
+        "and the tip's peak speed as an inertia number, m v_max^2 / (F_p L_c) "
+        f"(`compare.peak_speed`), split at the lower end of the spring drive's I_e* bracket "
+        f"({_f(cut)}): a tip that went faster than that, somewhere, left the quasistatic "
+        "regime there.",
+        "",
+        _table(
+            rows,
+            ["family", "slides", "peak", "slow", "fast"],
+            [
+                "family",
+                "runs with gravity slides",
+                "tip peak I_e: median (range)",
+                f"peak I_e <= {_f(cut)}: agree, median Frechet",
+                f"peak I_e > {_f(cut)}: agree, median Frechet",
+            ],
+        ),
+        "",
+    ]
+
+
+def _limit_section(limit: QuasistaticLimitResult, boundary: BoundaryResult) -> list[str]:
     families = [
         {
             "family": k,
@@ -557,6 +612,7 @@ def _limit_section(limit: QuasistaticLimitResult) -> list[str]:
         "",
         *_stalled_note(limit),
         *_misses_note(limit),
+        *_falls_note(limit, boundary),
         "### What limits agreement: settings varied on the single peak",
         "",
         _table(
