@@ -323,7 +323,7 @@ class _Group:
             windows.setdefault((a, b), []).append(k)
         for (a, b), ks in windows.items():
             ks = np.array(ks)
-            rows = _as_slice(ks)  # runs of a half: usually a block, read without a copy
+            rows = _as_slice(ks)  # neighbours in the queue: often a block, read as a slice
             decided = self.analysis.add(rows, a, b, self.state, self.sens)
             self.done[ks] = b
             for k, dec in zip(ks, decided):
@@ -404,7 +404,7 @@ def _still(rec: Recording, i: int) -> tuple[float, np.ndarray, bool]:
 class _NativeLanes:
     """Worker threads, each taking pieces from one queue and stepping them through
     :func:`mujoco.rollout.rollout` on its own ``MjData`` (whose warm start the run goes on
-    from); finished pieces go to a second queue, in the order they finish."""
+    from); :meth:`take` hands finished pieces back in the order they finished."""
 
     def __init__(self, nthread: int):
         import queue
