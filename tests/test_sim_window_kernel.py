@@ -85,6 +85,37 @@ def test_runs_added_by_index_arrays(peak_runs):
     _assert_same(fast, ref, runs)
 
 
+def test_runs_each_with_its_own_window_in_one_call(peak_runs):
+    """As the batch runner adds them: every run its own rows in one call (one compiled
+    pass; the reference one window at a time), the same as adding them window by window."""
+    rig, drive, starts, det, state, sens, carriage = peak_runs
+    n = state.shape[1]
+    runs = np.arange(len(starts))
+    steps = [(np.array([0, 0, 0, 0]), np.array([37, 120, 37, 800])), (None, np.array([800, 801, n, n]))]
+    out = []
+    for compiled in (True, False):
+        ga = GroupAnalysis(rig, [drive] * len(starts), starts, det, carriage, compiled=compiled)
+        decided = []
+        for a, b in steps:
+            a = ga.rows[runs].copy() if a is None else a
+            decided.append(ga.add(runs, a, b, state, sens))
+        out.append((ga, decided))
+    (fast, dec_fast), (ref, dec_ref) = out
+    np.testing.assert_array_equal(fast.rows, ref.rows)
+    for r in runs:  # each run's own rows (the columns beyond them were never written)
+        for k in COLUMNS:
+            np.testing.assert_array_equal(getattr(fast.run(r), k), getattr(ref.run(r), k), err_msg=k)
+    for k in fast.marks:
+        np.testing.assert_array_equal(fast.marks[k], ref.marks[k], err_msg=k)
+    np.testing.assert_array_equal(fast.held_from_n, ref.held_from_n)
+    np.testing.assert_array_equal(dec_fast, dec_ref)
+    by_window = _both(
+        rig, drive, starts, det, state, sens, carriage, [(0, 800), (800, n)], runs=np.array([3])
+    )
+    for k in COLUMNS:
+        np.testing.assert_array_equal(getattr(out[0][0].cols, k)[3], getattr(by_window[0][0].cols, k)[3])
+
+
 def test_rows_with_engine_trouble(peak_runs):
     """NaN and inf in the sensors and the state, a time reset, a deep contact, a flipped
     normal, a tip far outside the domain and far too fast: every mark and column agrees."""

@@ -57,14 +57,14 @@ def _finite_sum(x):
 def analyse_window(
     state,
     sens,
-    w,
+    widths,
     carriage,
     spring,
     adr,
     units,
     prm,
     speed_limit2,
-    first_step,
+    firsts,
     held_from,
     out_rows,
     time_s,
@@ -83,9 +83,10 @@ def analyse_window(
     marks,
     held_out,
 ):
-    """Columns, end marks and lock-rule carry of ``w`` rows from ``first_step`` on of the
-    group's runs ``out_rows`` (g,): ``state``, ``sens``, ``carriage`` and the columns are
-    the group's arrays; the marks and the per-run inputs are in ``out_rows`` order.
+    """Columns, end marks and lock-rule carry of the group's runs ``out_rows`` (g,), run
+    ``r`` from its row ``firsts[r]`` on for ``widths[r]`` rows: ``state``, ``sens``,
+    ``carriage`` and the columns are the group's arrays; the marks (window rows) and the
+    per-run inputs are in ``out_rows`` order.
 
     ``adr``: sensor addresses (tip_pos, tip_vel, contact_net, contact_deepest,
     spring_force, push_force). ``units``: metres, newtons, m/s and seconds per engine unit.
@@ -110,8 +111,9 @@ def analyse_window(
         o = out_rows[r]
         streak = not math.isnan(held_from[r])
         base = held_from[r]
-        for i in range(w):
-            c = first_step + i
+        first = firsts[r]
+        for i in range(widths[r]):
+            c = first + i
             s = sens[o, c]
             if marks[r, 0] < 0:
                 if not (_finite_sum(state[o, c]) and _finite_sum(s)):
@@ -171,7 +173,7 @@ def analyse_window(
             slips = vt > slip_speed
             slipping[o, c] = slips
 
-            if marks[r, 1] < 0 and not (abs(t - dt * float(first_step + i + 1)) <= 0.5 * dt):
+            if marks[r, 1] < 0 and not (abs(t - dt * float(first + i + 1)) <= 0.5 * dt):
                 marks[r, 1] = i
             if marks[r, 2] < 0 and not ((w0 * w0 + w1 * w1) + w2 * w2 <= speed_limit2[r]):
                 marks[r, 2] = i

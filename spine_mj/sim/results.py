@@ -265,23 +265,29 @@ class GroupAnalysis:
         self.rows = np.zeros(self.g, dtype=int)
         self.simulated = np.zeros(self.g, dtype=int)
 
-    def add(
-        self, runs: np.ndarray | slice, a: int, b: int, state: np.ndarray, sens: np.ndarray
-    ) -> np.ndarray:
-        """Rows ``a..b-1`` of ``runs`` (indices, or a slice of the group) from the group's
-        ``state`` ``(g, n, nstate)`` and ``sens`` ``(g, n, nsensordata)`` (the rows, read in
-        place); returns, per run, whether it is decided (an ending at or before row b-1)."""
+    def add(self, runs: np.ndarray | slice, a, b, state: np.ndarray, sens: np.ndarray) -> np.ndarray:
+        """Rows ``a..b-1`` of ``runs`` (indices, or a slice of the group; ``a`` and ``b``
+        one window for all or one per run) from the group's ``state`` ``(g, n, nstate)``
+        and ``sens`` ``(g, n, nsensordata)`` (the rows, read in place); returns, per run,
+        whether it is decided (an ending at or before its row b-1)."""
         rig, det = self.rig, self.det
+        index = np.arange(self.g)[runs]
+        a = np.broadcast_to(np.asarray(a, dtype=np.int64), index.shape)
+        b = np.broadcast_to(np.asarray(b, dtype=np.int64), index.shape)
         if self.compiled:
-            marks = self._marks_compiled(runs, a, b, state, sens)
+            marks = self._marks_compiled(index, a, b, state, sens)
         else:
-            marks = self._marks_reference(runs, a, b, state[runs, a:b], sens[runs, a:b])
+            marks = np.empty((index.size, len(MARK_KEYS)), dtype=np.int64)
+            for aw, bw in sorted(set(zip(a.tolist(), b.tolist()))):
+                sel = np.flatnonzero((a == aw) & (b == bw))
+                window = _as_block(index[sel])
+                marks[sel] = self._marks_reference(window, aw, bw, state[window, aw:bw], sens[window, aw:bw])
         old = self._mark_rows[runs]
-        merged = np.where((old < 0) & (marks >= 0), marks + a, old)
+        merged = np.where((old < 0) & (marks >= 0), marks + a[:, None], old)
         self._mark_rows[runs] = merged
         decided = (merged >= 0).any(axis=1)
         self.rows[runs] = b
-        for i, r in enumerate(np.arange(self.g)[runs]):
+        for i, r in enumerate(index):
             if self.probe[r] and not decided[i]:
                 decided[i] = bool(
                     probe_candidates(self.run(r), self.n_settle[r], det, rig.scales.preload_n)[0]
@@ -327,27 +333,27 @@ class GroupAnalysis:
                 getattr(self.cols, k)[runs, a:b] = getattr(rec, k)
         return np.stack([marks[k] for k in MARK_KEYS], axis=1)
 
-    def _marks_compiled(self, runs, a: int, b: int, state, sens) -> np.ndarray:
-        """:meth:`_marks_reference` in one compiled pass (:mod:`~spine_mj.sim._window_kernel`),
-        writing the group's columns in place."""
+    def _marks_compiled(self, runs: np.ndarray, a: np.ndarray, b: np.ndarray, state, sens) -> np.ndarray:
+        """:meth:`_marks_reference` of every run's own window ``a..b-1`` (run indices
+        ``runs``) in one compiled pass (:mod:`~spine_mj.sim._window_kernel`), writing the
+        group's columns in place."""
         from spine_mj.sim._window_kernel import analyse_window
 
-        out_rows = np.arange(self.g)[runs]
-        marks = np.empty((out_rows.size, len(MARK_KEYS)), dtype=np.int64)
-        held = np.empty(out_rows.size)
+        marks = np.empty((runs.size, len(MARK_KEYS)), dtype=np.int64)
+        held = np.empty(runs.size)
         analyse_window(
             state,
             sens,
-            b - a,
+            np.ascontiguousarray(b - a),
             self.carriage,
             self.spring[runs],
             self._adr,
             self._units,
             self._prm,
             self.limits[runs] ** 2,
-            a,
+            np.ascontiguousarray(a),
             self.held_from_n[runs],
-            out_rows,
+            runs,
             *(getattr(self.cols, k) for k in COLUMNS),
             marks,
             held,
@@ -434,3 +440,11 @@ def _run_result(
         scales=rig.scales,
         detection=det,
     )
+
+
+def _as_block(ks: np.ndarray) -> slice | np.ndarray:
+    """Sorted run indices as a slice where they form a block (the reference then writes the
+    group's columns through views), else as they are."""
+    if ks.size and ks[-1] - ks[0] + 1 == ks.size and (np.diff(ks) == 1).all():
+        return slice(int(ks[0]), int(ks[-1]) + 1)
+    return ks

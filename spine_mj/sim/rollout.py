@@ -299,9 +299,9 @@ class _Group:
         return k, a, b, warm, warning
 
     def advance(self, done: list) -> None:
-        """Take finished pieces: check probes' climbs, analyse the new rows (runs with the
-        same rows at once), stop decided runs, decide probes' fast-forward after settling."""
-        windows: dict[tuple[int, int], list[int]] = {}
+        """Take finished pieces: check probes' climbs, analyse the new rows (all at once),
+        stop decided runs, decide probes' fast-forward after settling."""
+        new = []
         stop = set()
         for k, a, b, warm, warning in done:
             self.analysis.simulated[k] += b - a
@@ -320,17 +320,17 @@ class _Group:
                 if not self.climb_held(k, a, b):
                     continue  # dropped: the probe goes on from its settled state
                 self.pieces[k] = 1  # the breakaway is expected within ~2 NOMINAL_STEPS: a 256-step piece
-            windows.setdefault((a, b), []).append(k)
-        for (a, b), ks in windows.items():
-            ks = np.array(ks)
-            rows = _as_slice(ks)  # neighbours in the queue: often a block, read as a slice
-            decided = self.analysis.add(rows, a, b, self.state, self.sens)
-            self.done[ks] = b
-            for k, dec in zip(ks, decided):
-                if b >= self.end[k] or (self.stop_early and (dec or k in stop)):
-                    self.live[k] = False
-                elif b == self.n_settle[k] and not dec:
-                    self.fast_forward(k)
+            new.append((k, a, b))
+        if not new:
+            return
+        ks, a, b = (np.array(col, dtype=np.int64) for col in zip(*new))
+        decided = self.analysis.add(ks, a, b, self.state, self.sens)
+        self.done[ks] = b
+        for k, bk, dec in zip(ks.tolist(), b.tolist(), decided):
+            if bk >= self.end[k] or (self.stop_early and (dec or k in stop)):
+                self.live[k] = False
+            elif bk == self.n_settle[k] and not dec:
+                self.fast_forward(k)
 
     def fast_forward(self, k: int) -> None:
         """After settling: a probe whose tip is stuck on one normal gets controls that climb
@@ -386,13 +386,6 @@ class _Group:
                 self.end[k], self.warm[k] = self.n, warm
                 return False
         return True
-
-
-def _as_slice(ks: np.ndarray) -> slice | np.ndarray:
-    """Sorted run indices as a slice where they form a block, else as they are."""
-    if ks.size and ks[-1] - ks[0] + 1 == ks.size and (np.diff(ks) == 1).all():
-        return slice(int(ks[0]), int(ks[-1]) + 1)
-    return ks
 
 
 def _still(rec: Recording, i: int) -> tuple[float, np.ndarray, bool]:
