@@ -26,6 +26,7 @@ import math
 import numpy as np
 from numba import njit
 
+from spine_mj.engagement import SLIP
 from spine_mj.errors import SpineInputError
 
 #: What "agree" means at the quasistatic corner, for sweeps and validation alike: outcome
@@ -354,8 +355,6 @@ def slide_fraction(path, region) -> float:
     quasistatic at any drive speed (:func:`peak_speed` measures how fast it went). NaN for
     a path of fewer than two points or of zero length.
     """
-    from spine_mj.engagement import SLIP
-
     p = _path("path", path)
     reg = np.asarray(region).reshape(-1)
     if reg.size != p.shape[0]:
@@ -368,8 +367,8 @@ def slide_fraction(path, region) -> float:
 
 
 def peak_speed(velocity) -> float:
-    """The largest speed ``|v|`` of velocity rows ``(n, 3)`` (NaN for none). Over L_c per
-    time it is the inertia number the tip itself reached, ``m v_max^2 / (F_p L_c)``
-    (:meth:`spine_mj.sim.Scales.inertia_number`), to set against the drive's and I_e*."""
+    """The largest speed ``|v|`` of velocity rows ``(n, 3)`` (NaN for none). Through
+    :meth:`spine_mj.sim.Scales.inertia_number` it gives the inertia number the tip itself
+    reached, ``m v_max^2 / (F_p L_c)``, to set against the drive's and against I_e*."""
     v = np.asarray(velocity, dtype=float).reshape(-1, 3)
     return float(np.sqrt((v * v).sum(axis=1)).max()) if v.shape[0] else float("nan")

@@ -509,7 +509,7 @@ def _falls_note(limit: QuasistaticLimitResult, boundary: BoundaryResult) -> list
     """Whether the runs were quasistatic at all: gravity slides on the reference and the
     engine tip's own peak inertia number, with agreement split at the spring drive's I_e*
     (the boundary study's bracket: below its lower end a drive is quasistatic)."""
-    star = _star_for_figure(boundary.ie_star.get("spring", {})) if boundary.ie_star else None
+    star = _star_for_figure(boundary.ie_star.get("spring", {}))
     if star is None:
         return []
     cut = float(star["low"])
