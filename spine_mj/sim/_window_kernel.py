@@ -33,26 +33,6 @@ def _finite_or_clipped(x):
     return x
 
 
-@njit(cache=True, inline="always")
-def _finite_sum(x):
-    """Whether the sum of ``x`` is finite: it is when every number is (it may not be when
-    the sum overflows; the caller then looks closer). Four partial sums, so that the adds
-    do not wait on one another."""
-    t0 = t1 = t2 = t3 = 0.0
-    n = x.size
-    j = 0
-    while j + 4 <= n:
-        t0 += x[j]
-        t1 += x[j + 1]
-        t2 += x[j + 2]
-        t3 += x[j + 3]
-        j += 4
-    while j < n:
-        t0 += x[j]
-        j += 1
-    return math.isfinite((t0 + t1) + (t2 + t3))
-
-
 @njit(cache=True, nogil=True)  # the worker threads go on stepping meanwhile
 def analyse_window(
     state,
@@ -116,7 +96,12 @@ def analyse_window(
             c = first + i
             s = sens[o, c]
             if marks[r, 0] < 0:
-                if not (_finite_sum(state[o, c]) and _finite_sum(s)):
+                total = 0.0  # finite unless a number is not (or the sum overflows: then look closer)
+                for j in range(nstate):
+                    total += state[o, c, j]
+                for j in range(nsens):
+                    total += s[j]
+                if not math.isfinite(total):
                     for j in range(nstate):
                         if not math.isfinite(state[o, c, j]):
                             marks[r, 0] = i
