@@ -153,8 +153,7 @@ def run_batch_gpu(
     wp, mjw = require_packages()
     drives, starts = batch_drives(drives, starts)
     det = (Detection() if detection is None else detection).resolve(rig.scales)
-    for x0, y0 in starts:
-        rig.check_start(x0, y0)
+    rig.check_starts(starts)
     dev = device or "cuda:0"
     dt, s = rig.engine.timestep_s, rig.length_scale_m
     lengths = [settle_steps(d, dt) + drive_steps(rig, d, x0 * s, det) for d, (x0, _) in zip(drives, starts)]

@@ -305,8 +305,7 @@ class RigModel:
     def place_many(self, starts) -> np.ndarray:
         """:meth:`place` of many starts (surface units): qpos ``(k, 3)`` in engine units."""
         starts = [(float(x0), float(y0)) for x0, y0 in starts]
-        for x0, y0 in starts:
-            self.check_start(x0, y0)
+        self.check_starts(starts)
         if self._placer is None or self._placer.model is not self.model:
             u = self.units
             tc, dr = self.engine.solref
@@ -324,7 +323,14 @@ class RigModel:
 
     def check_start(self, x0: float, y0: float) -> None:
         """Raise :class:`SpineInputError` unless ``(x0, y0)`` (surface units) lies on the surface."""
-        if not bool(self.surface.contains(x0, y0)):
+        self.check_starts([(x0, y0)])
+
+    def check_starts(self, starts) -> None:
+        """:meth:`check_start` of many ``(x0, y0)`` at once (the first outside is named)."""
+        xy = np.asarray(starts, dtype=float).reshape(-1, 2)
+        inside = self.surface.contains(xy[:, 0], xy[:, 1])
+        if not inside.all():
+            x0, y0 = xy[int(np.argmin(inside))]
             raise SpineInputError(
                 f"start ({x0:g}, {y0:g}) lies outside the surface bounds {self.surface.bounds}"
             )
