@@ -96,18 +96,13 @@ def analyse_window(
             c = first + i
             s = sens[o, c]
             if marks[r, 0] < 0:
-                total = 0.0  # finite unless a number is not (or the sum overflows: then look closer)
+                bad = False  # independent tests, not a sum: no chain of dependent additions
                 for j in range(nstate):
-                    total += state[o, c, j]
+                    bad |= not math.isfinite(state[o, c, j])
                 for j in range(nsens):
-                    total += s[j]
-                if not math.isfinite(total):
-                    for j in range(nstate):
-                        if not math.isfinite(state[o, c, j]):
-                            marks[r, 0] = i
-                    for j in range(nsens):
-                        if not math.isfinite(s[j]):
-                            marks[r, 0] = i
+                    bad |= not math.isfinite(s[j])
+                if bad:
+                    marks[r, 0] = i
             touching = s[cd] > 0
             contact[o, c] = touching
             flip = s[cd + 7] < 0

@@ -213,19 +213,19 @@ def end_marks(
 
 
 def end_candidates(
-    marks: dict[str, np.ndarray],
-    r: int,
+    marks: dict[str, int],
     rec: Recording,
     warning: tuple[int | None, str] | None,
     det: Detection,
     preload_n: float,
 ) -> list[Ending]:
-    """The endings run ``r`` of a group reached (``rec`` is that run's recording)."""
+    """The endings a run reached: ``marks`` its row of each of :data:`MARK_KEYS` (-1: none),
+    ``rec`` its recording."""
     trouble = EndReason.ENGINE_TROUBLE
     candidates = []
 
     def mark(key):
-        return int(marks[key][r]) if marks[key][r] >= 0 else None
+        return marks[key] if marks[key] >= 0 else None
 
     if (k := mark("nonfinite")) is not None:
         candidates.append(Ending(k, 0, trouble, f"non-finite state at t = {rec.time_s[k]:.4g} s", "nan"))

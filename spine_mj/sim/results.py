@@ -39,6 +39,9 @@ from spine_mj.sim.model import RigModel
 from spine_mj.sim.params import EndReason, EngineSettings, Scales, TipParams
 from spine_mj.sim.recording import COLUMNS, SENSOR_NAMES, Recording
 
+#: The recording's columns a :class:`RunResult` carries (the tangential speed stays behind).
+RESULT_COLUMNS = tuple(k for k in COLUMNS if k != "tangential_speed_m_s")
+
 
 @dataclass(frozen=True, eq=False)
 class RunResult:
@@ -264,6 +267,7 @@ class GroupAnalysis:
         )
         self.rows = np.zeros(self.g, dtype=int)
         self.simulated = np.zeros(self.g, dtype=int)
+        self._numbers: dict[int, tuple[float, float, float, float]] = {}  # see _drive_numbers
 
     def add(self, runs: np.ndarray | slice, a, b, state: np.ndarray, sens: np.ndarray) -> np.ndarray:
         """Rows ``a..b-1`` of ``runs`` (indices, or a slice of the group; ``a`` and ``b``
@@ -373,73 +377,64 @@ class GroupAnalysis:
         text)`` or None.
         """
         fp = self.rig.scales.preload_n
+        view = self._results_view
         out = []
         for r in range(self.g) if runs is None else runs:
-            drive, rec = self.drives[r], self._results_view.run(r, self.rows[r])
-            candidates = end_candidates(self.marks, r, rec, warnings[r], self.det, fp)
+            rows = int(self.rows[r])
+            rec = view.run(r, rows)
+            marks = dict(zip(MARK_KEYS, self._mark_rows[r].tolist()))
+            candidates = end_candidates(marks, rec, warnings[r], self.det, fp)
             kappa = math.nan
             if self.probe[r]:
                 probe, kappa = probe_candidates(rec, self.n_settle[r], self.det, fp)
                 candidates += probe
-            ending = decide_end(candidates, int(self.rows[r]))
+            ending = decide_end(candidates, rows)
             if ending.reason is not EndReason.BREAKAWAY:
                 kappa = math.nan
-            steps = max(int(self.simulated[r]), int(self.rows[r]))
-            out.append(
-                _run_result(
-                    self.rig,
-                    drive,
-                    self.starts[r],
-                    self.det,
-                    self._results_view.run(r, ending.index + 1),
-                    ending,
-                    self.n_settle[r],
-                    kappa,
-                    steps,
-                )
-            )
+            cut = rec if ending.index + 1 == rows else view.run(r, ending.index + 1)
+            out.append(self._result(r, cut, ending, kappa, max(int(self.simulated[r]), rows)))
         return out
 
+    def _result(
+        self, r: int, rec: Recording, ending: Ending, kappa_mj: float, simulated_steps: int
+    ) -> RunResult:
+        """The result of run ``r``, its recording ``rec`` cut at its ``ending``."""
+        rig, drive, n_settle = self.rig, self.drives[r], self.n_settle[r]
+        events = slip_events(rec.slipping, rec.time_s, n_settle)
+        events.append(Event(ending.reason.value, ending.index, float(rec.time_s[ending.index])))
+        onsets = [e.index for e in events if e.kind == "slip_onset"]
+        speed, ie, k, kn = self._drive_numbers(drive)
+        return RunResult(
+            **{name: getattr(rec, name) for name in RESULT_COLUMNS},
+            events=tuple(events),
+            end_reason=ending.reason,
+            end_detail=ending.detail,
+            engine_trouble=ending.trouble,
+            drive_start_index=n_settle,
+            kappa_mj=kappa_mj,
+            slip_kappas=rec.drive_force_n[onsets] / rig.scales.preload_n,
+            inertia_number=ie,
+            speed_m_s=speed,
+            stiffness_number=kn,
+            stiffness_n_m=k,
+            simulated_steps=simulated_steps,
+            start=tuple(self.starts[r]),
+            drive=drive,
+            tip=rig.tip,
+            engine=rig.engine,
+            scales=rig.scales,
+            detection=self.det,
+        )
 
-def _run_result(
-    rig: RigModel,
-    drive: Drive,
-    start,
-    det: Detection,
-    rec: Recording,
-    ending: Ending,
-    n_settle: int,
-    kappa_mj: float,
-    simulated_steps: int,
-) -> RunResult:
-    """The result of one run, its recording cut at its ending."""
-    events = slip_events(rec.slipping, rec.time_s, n_settle)
-    events.append(Event(ending.reason.value, ending.index, float(rec.time_s[ending.index])))
-    onsets = [e.index for e in events if e.kind == "slip_onset"]
-    arrays = {k: getattr(rec, k) for k in COLUMNS if k != "tangential_speed_m_s"}
-    speed = rig.speed_of(drive)
-    k = stiffness_n_m(drive, rig.scales) if isinstance(drive, SpringDrive) else 0.0
-    return RunResult(
-        **arrays,
-        events=tuple(events),
-        end_reason=ending.reason,
-        end_detail=ending.detail,
-        engine_trouble=ending.trouble,
-        drive_start_index=n_settle,
-        kappa_mj=kappa_mj,
-        slip_kappas=np.array([rec.drive_force_n[i] / rig.scales.preload_n for i in onsets]),
-        inertia_number=rig.scales.inertia_number(speed),
-        speed_m_s=speed,
-        stiffness_number=rig.scales.stiffness_number(k),
-        stiffness_n_m=k,
-        simulated_steps=simulated_steps,
-        start=tuple(start),
-        drive=drive,
-        tip=rig.tip,
-        engine=rig.engine,
-        scales=rig.scales,
-        detection=det,
-    )
+    def _drive_numbers(self, drive: Drive) -> tuple[float, float, float, float]:
+        """Speed [m/s], I_e, spring stiffness [N/m] (0: none) and K of ``drive`` (once per drive)."""
+        key = id(drive)  # the group holds its drives: an id is not reused while it lives
+        if key not in self._numbers:
+            scales = self.rig.scales
+            speed = self.rig.speed_of(drive)
+            k = stiffness_n_m(drive, scales) if isinstance(drive, SpringDrive) else 0.0
+            self._numbers[key] = (speed, scales.inertia_number(speed), k, scales.stiffness_number(k))
+        return self._numbers[key]
 
 
 def _as_block(ks: np.ndarray) -> slice | np.ndarray:
