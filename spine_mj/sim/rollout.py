@@ -282,7 +282,7 @@ class _Group:
         :data:`FIRST_PIECE_STEPS` to :data:`PIECE_STEPS` (the first with the settle phase).
         Returns the number queued."""
         todo = []
-        for k in ks:
+        for k in ks.tolist():
             a = int(self.done[k])
             if a < self.n_settle[k] and self.settle_apart[k]:
                 b = self.n_settle[k]
@@ -294,7 +294,7 @@ class _Group:
                 if self.end[k] - b < size // 2:  # no short last piece: it joins this one
                     b = int(self.end[k])
                 self.pieces[k] += 1
-            todo.append((int(k), a, min(b, int(self.end[k]))))
+            todo.append((k, a, min(b, int(self.end[k]))))
         for k, a, b in sorted(todo, key=lambda t: t[1] - t[2]):
             lanes.put(self.piece, (lanes, k, a, b))
         return len(todo)
@@ -313,9 +313,10 @@ class _Group:
         stop decided runs, decide probes' fast-forward after settling."""
         new = []
         stop = set()
-        for k, a, b, warm, warning in done:
-            self.analysis.simulated[k] += b - a
-            self.warm[k] = warm
+        runs = [piece[0] for piece in done]  # a run has one piece out at a time: no repeats
+        self.analysis.simulated[runs] += [b - a for _, a, b, _, _ in done]
+        self.warm[runs] = [piece[3] for piece in done]
+        for k, a, b, _, warning in done:
             if warning == "frozen":
                 # the native rollout stops a run at a MuJoCo warning and repeats its last row
                 # to the end of the call: the rows a whole-run rollout would have recorded
