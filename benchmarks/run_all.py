@@ -9,8 +9,8 @@ Sections (each records the machine's load average before and after it):
   fractal) and of the plain numpy reference (``backend="numpy"``) on the same starts.
 * ``rollout``: ``Rig.run_batch`` against bare ``mujoco.rollout`` (same model, controls and
   recording, runs that do not end early), paired runs in alternating order; the median of
-  the per-pair ratios; the calling thread's own CPU per batch (less sensitive to a shared
-  machine than the ratio). And the steps and time ``Rig.run_batch`` saves by stopping decided
+  the per-pair ratios of wall time (the target) and of the process's CPU time; the calling
+  thread's own CPU per batch (both less sensitive to a shared machine than the wall ratio). And the steps and time ``Rig.run_batch`` saves by stopping decided
   runs (``stop_early``) on a fractal where most runs self-lock.
 * ``fastforward``: the static probe and the force ramp with and without stick-phase
   fast-forward (``benchmarks/bench_fastforward.py``): breakaway forces, steps.
@@ -112,21 +112,24 @@ def bench_rollout(quick: bool) -> dict:
     """Paired timings of ``Rig.run_batch`` and bare ``mujoco.rollout`` (see bench_rollout.py)."""
     from bench_rollout import paired_setup
 
-    runs, duration, pairs = (16, 0.2, 5) if quick else (64, 0.5, 11)
+    runs, duration, pairs = (16, 0.2, 5) if quick else (64, 0.5, 21)
     nthread = os.cpu_count() or 1
     bare, ours, nstep = paired_setup(runs, duration, nthread)
     ours()
     bare()  # warm-up
     t_bare, t_ours, cpu_main = [], [], []
+    cpu = {bare: [], ours: []}  # the process's CPU per batch, all threads
     for k in range(pairs):
         order = ((t_bare, bare), (t_ours, ours)) if k % 2 == 0 else ((t_ours, ours), (t_bare, bare))
         for times, fn in order:
-            t0, c0 = time.perf_counter(), time.thread_time()
+            t0, c0, p0 = time.perf_counter(), time.thread_time(), time.process_time()
             fn()
             times.append(time.perf_counter() - t0)
+            cpu[fn].append(time.process_time() - p0)
             if fn is ours:  # the calling thread's own CPU: it competes with the worker threads
                 cpu_main.append(time.thread_time() - c0)
     ratios = [b / o for b, o in zip(t_bare, t_ours)]
+    cpu_ratios = [b / o for b, o in zip(cpu[bare], cpu[ours])]
     steps = runs * nstep
     return {
         "runs": runs,
@@ -137,6 +140,8 @@ def bench_rollout(quick: bool) -> dict:
         "run_batch_steps_s": steps / statistics.median(t_ours),
         "ratios": ratios,
         "ratio_median": statistics.median(ratios),
+        "cpu_ratios": cpu_ratios,
+        "cpu_ratio_median": statistics.median(cpu_ratios),
         "calling_thread_cpu_s": statistics.median(cpu_main),
         "bare_wall_s": statistics.median(t_bare),
         "target": 0.95,
@@ -438,6 +443,13 @@ def markdown(res: dict) -> str:
             f"(range {min(ro['ratios']):.3f}-{max(ro['ratios']):.3f}) | "
             f"{ro['ratio_median']:.3f} | >= 0.95 | {ld} |",
         ]
+        if "cpu_ratio_median" in ro:  # results from before it was measured lack it
+            lines.append(
+                f"| `Rig.run_batch` / bare rollout in CPU time (all threads; a shared machine's "
+                f"noise moves it less than the wall ratio), median of the same pairs "
+                f"(range {min(ro['cpu_ratios']):.3f}-{max(ro['cpu_ratios']):.3f}) | "
+                f"{ro['cpu_ratio_median']:.3f} | | {ld} |"
+            )
         if "calling_thread_cpu_s" in ro:  # results from before it was measured lack it
             lines.append(
                 "| `Rig.run_batch`: the calling thread's CPU per batch (placement, controls, "
