@@ -29,6 +29,10 @@ from spine_mj.surfaces import GridSurface, single_gaussian
             r"surface too coarse for the tip: hfield spacing 0\.0005 m > 2 x tip_radius_m",
         ),
         (lambda: flat_rig().run(StaticProbe(), start=(1.0, 0.0)), r"start \(1, 0\) lies outside"),
+        (  # a batch's starts are checked at once; the first bad one is named
+            lambda: flat_rig().run_batch(StaticProbe(), [(0.0, 0.0), (0.0, math.nan), (1.0, 0.0)]),
+            r"start \(0, nan\) lies outside",
+        ),
     ],
 )
 def test_bad_parameters_are_rejected_clearly(make, match):

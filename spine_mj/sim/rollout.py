@@ -61,7 +61,8 @@ BATCH_MEMORY_BYTES = 256 * 2**20
 FIRST_PIECE_STEPS = 128
 #: Longest piece: the most steps a run is simulated between two looks at its end conditions.
 PIECE_STEPS = 1024
-#: Tips placed before their first pieces are handed to the workers.
+#: Tips placed at a time, their first pieces then handed to the workers (the very first
+#: chunk is one tip per worker, so that each starts as soon as it can).
 PLACE_CHUNK = 4
 
 
