@@ -10,8 +10,9 @@ Sections (each records the machine's load average before and after it):
 * ``rollout``: ``Rig.run_batch`` against bare ``mujoco.rollout`` (same model, controls and
   recording, runs that do not end early), paired runs in alternating order; the median of
   the per-pair ratios of wall time (the target) and of the process's CPU time; the calling
-  thread's own CPU per batch (both less sensitive to a shared machine than the wall ratio). And the steps and time ``Rig.run_batch`` saves by stopping decided
-  runs (``stop_early``) on a fractal where most runs self-lock.
+  thread's own CPU per batch (both less sensitive to a shared machine than the wall
+  ratio). And the steps and time ``Rig.run_batch`` saves by stopping decided runs
+  (``stop_early``) on a fractal where most runs self-lock.
 * ``fastforward``: the static probe and the force ramp with and without stick-phase
   fast-forward (``benchmarks/bench_fastforward.py``): breakaway forces, steps.
 * ``sweep``: the one-worker sweep against bare rollout, and its two-worker efficiency.
