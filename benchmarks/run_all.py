@@ -490,9 +490,11 @@ def _cost_markdown(cost) -> list[str]:
         return []
     out = [
         "",
-        "**Cost model** (spring drive, planned steps per run: the most a run can take; a run "
-        "whose outcome is decided earlier stops within a piece of its end, see the simulated "
-        "steps). A run lasts (path + spring stretch) / "
+        "**Cost model** (spring drive, planned steps per run: what a run takes at most at its "
+        "step; a run whose outcome is decided earlier stops within a piece of its end, and a "
+        "run stopped on penetration runs once more at a quarter of the step (`Rig.run_batch`'s "
+        "`refine`), up to 4x its planned steps more: see the simulated steps). "
+        "A run lasts (path + spring stretch) / "
         "speed with speed = sqrt(I_e) v_c and dt fixed by the contact, so "
         "`steps = s0 + I_e^-1/2 (A + B / K)` with `K = k l_s / F_p` (the spring's stretch "
         "`(1 + mu) l_s / K`), up to I_e ~ 0.008 (single peak), where the impact rule starts "
