@@ -9,7 +9,7 @@ import pytest
 from sim_rigs import R_TIP, flat_rig
 
 from spine_mj.errors import SpineInputError
-from spine_mj.sim import EngineSettings, Rig, SpringDrive, StaticProbe, TipParams
+from spine_mj.sim import EngineSettings, RampDrive, Rig, SpringDrive, StaticProbe, TipParams
 from spine_mj.surfaces import GridSurface, single_gaussian
 
 
@@ -32,6 +32,18 @@ from spine_mj.surfaces import GridSurface, single_gaussian
         (  # a batch's starts are checked at once; the first bad one is named
             lambda: flat_rig().run_batch(StaticProbe(), [(0.0, 0.0), (0.0, math.nan), (1.0, 0.0)]),
             r"start \(0, nan\) lies outside",
+        ),
+        (
+            lambda: flat_rig().run_batch(StaticProbe(), [(0.0, 0.0), (0.0, 0.0, 1.0)]),
+            r"each start must be a pair \(x0, y0\) of numbers, got \(0\.0, 0\.0, 1\.0\)",
+        ),
+        (
+            lambda: flat_rig().run(RampDrive(), start=(0.0, 0.0, 1.0)),
+            r"each start must be a pair \(x0, y0\) of numbers",
+        ),
+        (
+            lambda: flat_rig().run_batch(StaticProbe(), [("a", 0.0)]),
+            r"each start must be a pair \(x0, y0\) of numbers, got \('a', 0\.0\)",
         ),
     ],
 )

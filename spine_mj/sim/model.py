@@ -67,6 +67,15 @@ def _follow_camera(distance: float) -> dict:
     return {"pos": list(-distance * ahead), "xyaxes": [*right, *up]}
 
 
+def start_pair(start) -> tuple[float, float]:
+    """``start`` as ``(x0, y0)`` floats, or :class:`SpineInputError` naming what arrived."""
+    try:
+        x0, y0 = (float(v) for v in start)
+    except (TypeError, ValueError):
+        raise SpineInputError(f"each start must be a pair (x0, y0) of numbers, got {start!r}") from None
+    return x0, y0
+
+
 class RigModel:
     """The MuJoCo model of one surface and one tip (parameters as for :class:`~spine_mj.sim.Rig`)."""
 

@@ -49,7 +49,7 @@ from spine_mj.sim.drives import (
     stiffness_n_m,
 )
 from spine_mj.sim.fastforward import QUIET_STEPS, RISE_STEPS, StickFastForward, fast_forward_on
-from spine_mj.sim.model import RigModel
+from spine_mj.sim.model import RigModel, start_pair
 from spine_mj.sim.recording import Recording
 from spine_mj.sim.results import GroupAnalysis, RunResult
 
@@ -144,9 +144,10 @@ def plan_groups(lengths: Sequence[int], bytes_per_step: int) -> list[list[int]]:
 
 
 def batch_drives(drives, starts) -> tuple[list[Drive], list[tuple[float, float]]]:
-    """``drives`` as one drive per start (one drive is shared by all), checked: an open-loop
-    batch takes spring drives and static probes only."""
-    starts = [tuple(float(v) for v in s) for s in starts]
+    """``drives`` as one drive per start (one drive is shared by all) and ``starts`` as
+    ``(x0, y0)`` float pairs, checked: an open-loop batch takes spring drives and static
+    probes only."""
+    starts = [start_pair(s) for s in starts]
     if isinstance(drives, (SpringDrive, StaticProbe, RampDrive)):
         drives = [drives] * len(starts)
     drives = list(drives)
