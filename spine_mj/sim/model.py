@@ -336,7 +336,11 @@ class RigModel:
 
     def check_starts(self, starts) -> None:
         """:meth:`check_start` of many ``(x0, y0)`` at once (the first outside is named)."""
-        xy = np.asarray(starts, dtype=float).reshape(-1, 2)
+        xy = np.asarray(starts, dtype=float)
+        if xy.size == 0:
+            return
+        if xy.ndim != 2 or xy.shape[1] != 2:
+            raise SpineInputError(f"starts must be (x0, y0) pairs, got an array of shape {xy.shape}")
         inside = self.surface.contains(xy[:, 0], xy[:, 1])
         if not inside.all():
             x0, y0 = xy[int(np.argmin(inside))]
