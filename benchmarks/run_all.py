@@ -52,6 +52,19 @@ def load() -> float:
     return round(os.getloadavg()[0], 2)
 
 
+def median_interval(values, confidence: float = 0.95) -> tuple[float, float] | None:
+    """A distribution-free confidence interval of the median: the order statistics
+    ``x_(k)`` and ``x_(n+1-k)`` with the largest ``k`` for which a Binomial(n, 1/2) count
+    falls below ``k`` with probability at most ``(1 - confidence) / 2``. It tells how far a
+    median of so many noisy pairs can be trusted. None when ``n`` is too small (under 6)."""
+    x, n = sorted(values), len(values)
+    tail, k, below = (1 - confidence) / 2, 0, 0.0
+    while k < n // 2 and below + math.comb(n, k) / 2**n <= tail:
+        below += math.comb(n, k) / 2**n
+        k += 1
+    return (x[k - 1], x[n - k]) if k else None
+
+
 def section(fn, *args):
     """Run one benchmark section; its dict gains the load average before and after it."""
     before, t0 = load(), time.perf_counter()
@@ -141,6 +154,7 @@ def bench_rollout(quick: bool) -> dict:
         "run_batch_steps_s": steps / statistics.median(t_ours),
         "ratios": ratios,
         "ratio_median": statistics.median(ratios),
+        "ratio_median_ci95": median_interval(ratios),
         "cpu_ratios": cpu_ratios,
         "cpu_ratio_median": statistics.median(cpu_ratios),
         "calling_thread_cpu_s": statistics.median(cpu_main),
@@ -441,7 +455,7 @@ def markdown(res: dict) -> str:
             f"| `Rig.run_batch`, same runs (tips placed afresh, analysis included) | "
             f"{_fmt(ro['run_batch_steps_s'])} steps/s | | {ld} |",
             f"| `Rig.run_batch` / bare rollout, median of {ro['pairs']} paired runs "
-            f"(range {min(ro['ratios']):.3f}-{max(ro['ratios']):.3f}) | "
+            f"(range {min(ro['ratios']):.3f}-{max(ro['ratios']):.3f}{_ci_text(ro)}) | "
             f"{ro['ratio_median']:.3f} | >= 0.95 | {ld} |",
         ]
         if "cpu_ratio_median" in ro:  # results from before it was measured lack it
@@ -483,6 +497,12 @@ def markdown(res: dict) -> str:
     lines += _fastforward_markdown(res.get("fastforward"))
     lines += _gpu_markdown(res.get("gpu"))
     return "\n".join(lines) + "\n"
+
+
+def _ci_text(ro: dict) -> str:
+    """``; 95 % CI of the median a-b`` where the results have it (older ones do not)."""
+    ci = ro.get("ratio_median_ci95")
+    return f"; 95 % CI of the median {ci[0]:.3f}-{ci[1]:.3f}" if ci else ""
 
 
 def _cost_markdown(cost) -> list[str]:
