@@ -241,7 +241,11 @@ class GroupAnalysis:
         self.spring = np.array([isinstance(d, SpringDrive) for d in self.drives])
         self.probe = [isinstance(d, StaticProbe) for d in self.drives]
         self.n_settle = [settle_steps(d, rig.engine.timestep_s) for d in self.drives]
-        self.limits = np.array([det.speed_limit_m_s(rig.scales, rig.speed_of(d)) for d in self.drives])
+        self.speeds = [rig.speed_of(d) for d in self.drives]  # [m/s]
+        self.stiffness = [  # [N/m], 0 for force drives
+            stiffness_n_m(d, rig.scales) if sp else 0.0 for d, sp in zip(self.drives, self.spring)
+        ]
+        self.limits = np.array([det.speed_limit_m_s(rig.scales, v) for v in self.speeds])
         self.cols = Recording.empty((self.g, self.n))
         self._results_view = self.cols.read_only()  # a RunResult cannot write the group's columns
         self._mark_rows = np.full((self.g, len(MARK_KEYS)), -1)  # first run row of each end mark
@@ -267,7 +271,6 @@ class GroupAnalysis:
         )
         self.rows = np.zeros(self.g, dtype=int)
         self.simulated = np.zeros(self.g, dtype=int)
-        self._numbers: dict[int, tuple[float, float, float, float]] = {}  # see _drive_numbers
 
     def add(self, runs: np.ndarray | slice, a, b, state: np.ndarray, sens: np.ndarray) -> np.ndarray:
         """Rows ``a..b-1`` of ``runs`` (indices, or a slice of the group; ``a`` and ``b``
@@ -403,7 +406,7 @@ class GroupAnalysis:
         events = slip_events(rec.slipping, rec.time_s, n_settle)
         events.append(Event(ending.reason.value, ending.index, float(rec.time_s[ending.index])))
         onsets = [e.index for e in events if e.kind == "slip_onset"]
-        speed, ie, k, kn = self._drive_numbers(drive)
+        speed, k = self.speeds[r], self.stiffness[r]
         return RunResult(
             **{name: getattr(rec, name) for name in RESULT_COLUMNS},
             events=tuple(events),
@@ -413,9 +416,9 @@ class GroupAnalysis:
             drive_start_index=n_settle,
             kappa_mj=kappa_mj,
             slip_kappas=rec.drive_force_n[onsets] / rig.scales.preload_n,
-            inertia_number=ie,
+            inertia_number=rig.scales.inertia_number(speed),
             speed_m_s=speed,
-            stiffness_number=kn,
+            stiffness_number=rig.scales.stiffness_number(k),
             stiffness_n_m=k,
             simulated_steps=simulated_steps,
             start=tuple(self.starts[r]),
@@ -425,16 +428,6 @@ class GroupAnalysis:
             scales=rig.scales,
             detection=self.det,
         )
-
-    def _drive_numbers(self, drive: Drive) -> tuple[float, float, float, float]:
-        """Speed [m/s], I_e, spring stiffness [N/m] (0: none) and K of ``drive`` (once per drive)."""
-        key = id(drive)  # the group holds its drives: an id is not reused while it lives
-        if key not in self._numbers:
-            scales = self.rig.scales
-            speed = self.rig.speed_of(drive)
-            k = stiffness_n_m(drive, scales) if isinstance(drive, SpringDrive) else 0.0
-            self._numbers[key] = (speed, scales.inertia_number(speed), k, scales.stiffness_number(k))
-        return self._numbers[key]
 
 
 def _as_block(ks: np.ndarray) -> slice | np.ndarray:

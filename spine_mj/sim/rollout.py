@@ -196,18 +196,17 @@ class _BatchRunner:
         self.rig, self.drives, self.starts, self.det = rig, drives, starts, det
         s, dt = rig.length_scale_m, rig.engine.timestep_s
         by_stiffness: dict[float, object] = {}
-        per_drive: dict[int, tuple] = {}  # a batch shares few drive objects: their numbers once each
+        lengths: dict[object, int] = {}  # by drive object, and by start where the length depends on it
         self.models, self.lengths = [], []
         for d, (x0, _) in zip(drives, starts):
-            if id(d) not in per_drive:
-                k = stiffness_n_m(d, rig.scales) if isinstance(d, SpringDrive) else 0.0
-                if k not in by_stiffness:
-                    by_stiffness[k] = rig.model_for(d)
-                n = None if length_from_start(d) else settle_steps(d, dt) + drive_steps(rig, d, 0.0, det)
-                per_drive[id(d)] = (by_stiffness[k], n)
-            model, n = per_drive[id(d)]
-            self.models.append(model)
-            self.lengths.append(settle_steps(d, dt) + drive_steps(rig, d, x0 * s, det) if n is None else n)
+            k = stiffness_n_m(d, rig.scales) if isinstance(d, SpringDrive) else 0.0
+            if k not in by_stiffness:
+                by_stiffness[k] = rig.model_for(d)
+            self.models.append(by_stiffness[k])
+            key = (id(d), x0) if length_from_start(d) else id(d)
+            if key not in lengths:
+                lengths[key] = settle_steps(d, dt) + drive_steps(rig, d, x0 * s, det)
+            self.lengths.append(lengths[key])
         self.nstate = mujoco.mj_stateSize(rig.model, mujoco.mjtState.mjSTATE_FULLPHYSICS)
         self.results: list[RunResult | None] = [None] * len(starts)
 
