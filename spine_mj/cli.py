@@ -10,7 +10,9 @@ from __future__ import annotations
 
 import json
 import os
+import signal
 import sys
+import threading
 from pathlib import Path
 
 import click
@@ -35,7 +37,7 @@ from spine_mj.sim.model import compile_spec
 from spine_mj.sim.render import FPS, choose_gl_backend, default_speed, render_frames
 from spine_mj.sim.replay import load_run, play_in_viewer, run_in_viewer
 from spine_mj.streamline import StreamlineParams, dilate, ideal_trajectories, streamlines
-from spine_mj.surfaces import LENGTH_UNITS_M, length_unit, to_hfield
+from spine_mj.surfaces import LENGTH_UNITS_M, check_grid_size, length_unit, to_hfield
 
 INPUT_ERROR_EXIT = 2
 
@@ -85,11 +87,16 @@ class InputError(click.ClickException):
 
 
 class _Group(click.Group):
-    """Turns the library's input errors into :class:`InputError` for every subcommand."""
+    """Turns the library's input errors into :class:`InputError` for every subcommand, and
+    so too a request too large for memory or out of floating-point range that no check at
+    the boundary caught (one line still, not a traceback)."""
 
     def invoke(self, ctx):
         try:
-            return super().invoke(ctx)
+            # numpy's overflow and invalid-value warnings would print lines before the one
+            # error line; results are checked for finiteness where it matters
+            with np.errstate(all="ignore"):
+                return super().invoke(ctx)
         except SpineInputError as exc:
             root = ctx.find_root()
             if exc.details and root.params.get("verbose"):
@@ -97,6 +104,15 @@ class _Group(click.Group):
             raise InputError(str(exc)) from None
         except OSError as exc:
             raise InputError(f"{exc.strerror or exc}: {exc.filename}") from None
+        except MemoryError as exc:  # the checks at the boundary missed a size: still one line
+            raise InputError(
+                f"not enough memory for this request ({exc or 'MemoryError'}): a size, resolution or "
+                "duration is too large, or a length too small for the surface"
+            ) from None
+        except (OverflowError, RecursionError) as exc:
+            raise InputError(
+                f"a value is out of range ({type(exc).__name__}: {exc}); check the parameters given"
+            ) from None
 
 
 @click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})
@@ -105,6 +121,13 @@ class _Group(click.Group):
 def main(verbose):
     """spine_mj: streamline theory and MuJoCo dynamics of bio-inspired spines on rough
     surfaces."""
+    if threading.current_thread() is threading.main_thread():
+        # a SIGTERM (kill, timeout, a scheduler) unwinds like Ctrl-C: temporary outputs are removed
+        signal.signal(signal.SIGTERM, _exit_on_sigterm)
+
+
+def _exit_on_sigterm(signum, frame):
+    raise SystemExit(128 + signum)
 
 
 # --------------------------------------------------------------------------- surface
@@ -770,6 +793,8 @@ def replay(run_dir, speed, duration, mp4):
         sys.platform.startswith("linux")
         and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
     )
+    if duration is not None:
+        check_positive("--duration", duration)
     if headless:
         choose_gl_backend()
     rig, track = load_run(run_dir)
@@ -805,6 +830,8 @@ def view(surface_spec, start, duration, **rig_opts):
     To watch a recorded run instead, use `spine-mj replay RUN_DIR`.
     """
 
+    if duration is not None:
+        check_positive("--duration", duration)
     if sys.platform.startswith("linux") and not (
         os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
     ):
@@ -856,6 +883,7 @@ def kappa_cmd(surface_spec, mu, output, resolution):
     """
 
     _check_suffix(output, ".png", "-o/--output")
+    check_grid_size(resolution, resolution, where="kappa --resolution")
     surf = load_surface_arg(surface_spec)
     mu = _engagement_mu(surf, mu)
     xmin, xmax, ymin, ymax = surf.bounds

@@ -46,7 +46,7 @@ from spine_mj.engagement import (
     slip_direction,
 )
 from spine_mj.errors import SpineInputError
-from spine_mj.surfaces import GaussianSurface, GridSurface, Surface, TriangulatedSurface
+from spine_mj.surfaces import GaussianSurface, GridSurface, Surface, TriangulatedSurface, check_grid_size
 
 __all__ = ["Outcome", "StreamlineParams", "StreamlineResult", "dilate", "ideal_trajectories", "streamlines"]
 
@@ -596,6 +596,11 @@ def dilate(surface: Surface, radius: float, *, spacing: float | None = None) -> 
         if isinstance(surface, GridSurface) and surface.periodic:
             grid = surface.resample(h)
         else:
+            check_grid_size(
+                (xmax - xmin) / h + 1,
+                (ymax - ymin) / h + 1,
+                where=f"dilating by the tip radius {radius:g} at spacing {h:g} (surface units)",
+            )
             nx = int(math.ceil((xmax - xmin) / h)) + 1
             ny = int(math.ceil((ymax - ymin) / h)) + 1
             x, y = np.linspace(xmin, xmax, nx), np.linspace(ymin, ymax, ny)
@@ -609,6 +614,11 @@ def dilate(surface: Surface, radius: float, *, spacing: float | None = None) -> 
     if radius == 0:
         return grid
     dx, dy = grid.spacing
+    check_grid_size(
+        2 * radius / dx + 1,
+        2 * radius / dy + 1,
+        where=f"the tip's footprint (radius {radius:g} on a grid of spacing {dx:g} x {dy:g} surface units)",
+    )
     rx, ry = int(math.floor(radius / dx)), int(math.floor(radius / dy))
     u = dx * np.arange(-rx, rx + 1)
     v = dy * np.arange(-ry, ry + 1)

@@ -12,6 +12,7 @@ Writers go through :func:`spine_mj.errors.atomic_output`: a failure leaves no fi
 from __future__ import annotations
 
 import json
+import math
 import os
 import re
 import zipfile
@@ -23,7 +24,14 @@ from scipy import ndimage
 
 from spine_mj.errors import SpineInputError, atomic_output, check_positive
 from spine_mj.jsonio import to_jsonable
-from spine_mj.surfaces import LENGTH_UNITS_M, GaussianSurface, GridSurface, Surface, length_unit
+from spine_mj.surfaces import (
+    LENGTH_UNITS_M,
+    MAX_GRID_POINTS,
+    GaussianSurface,
+    GridSurface,
+    Surface,
+    length_unit,
+)
 
 __all__ = ["FILL_METHODS", "import_topography", "load_surface", "save_surface", "surface_mesh", "write_stl"]
 
@@ -67,6 +75,15 @@ def save_surface(surface: Surface, path: str | os.PathLike) -> Path:
 _NUMERIC_KEYS = {"heights", "x", "y", "bounds", *_GAUSS_KEYS}
 
 
+def _npz_member_shape(npz, name: str) -> tuple[int, ...]:
+    """The shape of array ``name`` of an open .npz, read from its .npy header."""
+    with npz.zip.open(f"{name}.npy") as f:
+        version = np.lib.format.read_magic(f)
+        if version == (1, 0):
+            return np.lib.format.read_array_header_1_0(f)[0]
+        return np.lib.format.read_array_header_2_0(f)[0]
+
+
 def load_surface(path: str | os.PathLike) -> Surface:
     """Read a surface written by :func:`save_surface`.
 
@@ -81,8 +98,16 @@ def load_surface(path: str | os.PathLike) -> Surface:
         raise SpineInputError(f"surface file not found: {path}")
     try:
         with np.load(path, allow_pickle=False) as npz:
+            for name in npz.files:  # sizes from the headers, before a compressed array is inflated
+                shape = _npz_member_shape(npz, name)
+                if math.prod(shape) > MAX_GRID_POINTS:
+                    raise SpineInputError(
+                        f"{path}: array {name!r} has shape {shape}, more than {MAX_GRID_POINTS} values"
+                    )
             data = {k: npz[k] for k in npz.files}
     except (zipfile.BadZipFile, ValueError, OSError, EOFError) as exc:
+        if isinstance(exc, SpineInputError):
+            raise
         raise SpineInputError(f"{path} is not a readable spine_mj .npz surface ({exc})") from None
     if str(data.get("format", "")) != FORMAT:
         raise SpineInputError(f"{path} is not a spine_mj surface file (no format tag {FORMAT!r})")
@@ -96,11 +121,16 @@ def load_surface(path: str | os.PathLike) -> Surface:
         kind = str(data["kind"])
         unit = str(data["unit"])
         if kind == "grid":
+            periodic = data["periodic"]
+            if periodic.shape != () or periodic.dtype.kind not in "bi" or periodic not in (0, 1):
+                raise SpineInputError(
+                    f"array 'periodic' must be one boolean, got {periodic.dtype} of shape {periodic.shape}"
+                )
             return GridSurface(
                 heights=data["heights"],
                 x=data["x"],
                 y=data["y"],
-                periodic=bool(data["periodic"]),
+                periodic=bool(periodic),
                 unit=unit,
                 metadata=metadata,
             )
@@ -115,6 +145,8 @@ def load_surface(path: str | os.PathLike) -> Surface:
         raise SpineInputError(f"{path} is missing the array {exc.args[0]!r}") from None
     except json.JSONDecodeError as exc:
         raise SpineInputError(f"{path} has corrupt metadata ({exc})") from None
+    except RecursionError:
+        raise SpineInputError(f"{path} has metadata nested too deep to read") from None
     except SpineInputError as exc:
         raise SpineInputError(f"{path}: {exc}") from None
     raise SpineInputError(f"{path} has unknown surface kind {kind!r}; expected 'grid' or 'gaussian'")
@@ -330,6 +362,10 @@ def write_stl(surface: Surface, path: str | os.PathLike, **mesh_options) -> Path
     if path.suffix.lower() != ".stl":
         raise SpineInputError(f"STL output must end in .stl, got {path.name!r}")
     mesh = surface_mesh(surface, **mesh_options)
+    if not np.isfinite(np.asarray(mesh.vertices, dtype=np.float32)).all():  # STL stores float32
+        raise SpineInputError(
+            "the mesh's coordinates overflow the STL's 32-bit floats: use a smaller --stl-scale or --base"
+        )
     if not mesh.is_watertight:
         raise SpineInputError("internal mesh is not watertight; refusing to write an STL")
     with atomic_output(path) as tmp:

@@ -62,6 +62,8 @@ _UNIT_SPELLINGS = {"\u00b5m": "um", "\u03bcm": "um"}
 _MIN_POINTS_PER_SIDE = 4
 #: Most points a generated or resampled grid may have (512 MiB per float64 array).
 MAX_GRID_POINTS = 2**26
+#: Most Gaussians of a random surface: every height costs one exponential per Gaussian.
+MAX_PEAKS = 100_000
 _CHUNK = 1 << 15
 _NONPERIODIC_PAD = 8  # cells of odd reflection before the spline filter, see GridSurface
 
@@ -83,6 +85,17 @@ def _rng_and_seed(rng: int | np.random.Generator | None) -> tuple[np.random.Gene
     raise SpineInputError(f"rng must be a non-negative int seed or a numpy Generator, got {rng!r}")
 
 
+def _pair(name: str, value) -> tuple[float, float]:
+    """``value`` as two finite floats, or a :class:`SpineInputError` naming ``name``."""
+    try:
+        a, b = (float(v) for v in value)
+    except (TypeError, ValueError):
+        raise SpineInputError(f"{name} must be a pair of numbers, got {value!r}") from None
+    if not (math.isfinite(a) and math.isfinite(b)):
+        raise SpineInputError(f"{name} must be finite, got {value!r}")
+    return a, b
+
+
 def _range(name: str, value, *, positive: bool = True) -> tuple[float, float]:
     try:
         lo, hi = (float(v) for v in value)
@@ -100,8 +113,8 @@ def _bounds(value) -> tuple[float, float, float, float]:
         xmin, xmax, ymin, ymax = (float(v) for v in value)
     except (TypeError, ValueError):
         raise SpineInputError(f"bounds must be (xmin, xmax, ymin, ymax), got {value!r}") from None
-    if not all(math.isfinite(v) for v in (xmin, xmax, ymin, ymax)):
-        raise SpineInputError(f"bounds must be finite, got {value!r}")
+    if not all(math.isfinite(v) for v in (xmin, xmax, ymin, ymax, xmax - xmin, ymax - ymin)):
+        raise SpineInputError(f"bounds and their extents must be finite, got {value!r}")
     if not (xmin < xmax and ymin < ymax):
         raise SpineInputError(f"bounds must satisfy xmin < xmax and ymin < ymax, got {value!r}")
     return xmin, xmax, ymin, ymax
@@ -359,6 +372,11 @@ class GridSurface(Surface):
             d = np.diff(c)
             if np.any(d <= 0):
                 raise SpineInputError(f"{name} coordinates must be strictly increasing")
+            if not (np.isfinite(1.0 / d.min()) and np.isfinite(c[-1] - c[0])):
+                raise SpineInputError(
+                    f"{name} spacing {d.min():.3g} and extent {c[-1] - c[0]:.3g} must be finite and normal "
+                    "floating-point numbers"
+                )
             if np.ptp(d) > 1e-6 * abs(d.mean()):
                 raise SpineInputError(
                     f"{name} coordinates must be uniformly spaced (spacing varies by "
@@ -460,6 +478,9 @@ class GridSurface(Surface):
         sx, sy = (spacing, spacing) if np.isscalar(spacing) else spacing
         sx, sy = check_positive("spacing x", sx), check_positive("spacing y", sy)
         xmin, xmax, ymin, ymax = self.bounds
+        check_grid_size(
+            (xmax - xmin) / sx + 1, (ymax - ymin) / sy + 1, where=f"resampling to spacing {sx:g} x {sy:g}"
+        )
         if self.periodic:
             nx, ny = max(1, round((xmax - xmin) / sx)), max(1, round((ymax - ymin) / sy))
             sx, sy = (xmax - xmin) / nx, (ymax - ymin) / ny
@@ -504,7 +525,7 @@ def single_gaussian(
         raise SpineInputError(f"sign must be +1 (peak) or -1 (valley), got {sign!r}")
     k = check_positive("k", k)
     sx, sy = check_positive("sigma_x", sigma_x), check_positive("sigma_y", sigma_y)
-    mx, my = (float(c) for c in center)
+    mx, my = _pair("center", center)
     amplitude = sign * k / (2 * math.pi * sx * sy)
     return GaussianSurface(
         amplitude=[amplitude],
@@ -554,8 +575,8 @@ def random_gaussians(
     The draws happen in a fixed order (centres, widths, amplitudes), so one seed gives the
     same surface on every machine.
     """
-    if isinstance(n_peaks, bool) or int(n_peaks) != n_peaks or n_peaks <= 0:
-        raise SpineInputError(f"n_peaks must be a positive integer, got {n_peaks!r}")
+    if isinstance(n_peaks, bool) or int(n_peaks) != n_peaks or not 0 < n_peaks <= MAX_PEAKS:
+        raise SpineInputError(f"n_peaks must be an integer in 1..{MAX_PEAKS}, got {n_peaks!r}")
     n_peaks = int(n_peaks)
     if sign not in (1, -1):
         raise SpineInputError(f"sign must be +1 (convex peaks) or -1 (concave valleys), got {sign!r}")
@@ -661,7 +682,7 @@ def fractal_fbm(
     nx = _grid_count("nx", nx)
     ny = nx if ny is None else _grid_count("ny", ny)
     check_grid_size((1 if periodic else 2) * nx, (1 if periodic else 2) * ny, where="fractal_fbm")
-    lx, ly = (size, size) if np.isscalar(size) else size
+    lx, ly = (size, size) if np.isscalar(size) else _pair("size", size)
     lx, ly = check_positive("size x", lx), check_positive("size y", ly)
     hurst = float(hurst)
     if not (0.0 < hurst < 1.0):
@@ -745,13 +766,19 @@ def check_grid_size(nx: int, ny: int, *, where: str) -> None:
         Naming ``where``, the grid's shape, the limit and the memory one height array
         of that shape would take.
     """
-    points = int(nx) * int(ny)
-    if points > MAX_GRID_POINTS:
+    points = float(nx) * float(ny)  # counts may come as floats, before rounding: inf is refused too
+    if not points <= MAX_GRID_POINTS:
         gib = points * 8 / 2**30
         raise SpineInputError(
-            f"{where}: a {int(ny)} x {int(nx)} grid has {points:.3g} points, more than the limit "
+            f"{where}: a {_count(ny)} x {_count(nx)} grid has {points:.3g} points, more than the limit "
             f"{MAX_GRID_POINTS:.3g} ({gib:.3g} GiB per height array); use fewer points or a coarser spacing"
         )
+
+
+def _count(n) -> str:
+    """A point count for a message: whole numbers as integers, others as floats."""
+    n = float(n)
+    return str(int(n)) if math.isfinite(n) and n == int(n) and abs(n) < 1e15 else f"{n:.4g}"
 
 
 def _particle_envelope(n, spacing, diam, px, py, embed) -> np.ndarray:
@@ -829,6 +856,9 @@ def sandpaper(
     e_lo, e_hi = _range("embed_range", embed_range, positive=False)
     if not (0 <= e_lo and e_hi < 1):
         raise SpineInputError(f"embed_range must lie within [0, 1), got {embed_range!r}")
+    check_grid_size(
+        size_m / spacing_m, size_m / spacing_m, where="sandpaper (size_m / spacing_m points a side)"
+    )
     n = math.ceil(size_m / spacing_m - 1e-9)
     if n < _MIN_POINTS_PER_SIDE:
         raise SpineInputError(f"size_m / spacing_m gives {n} points; need at least 4")

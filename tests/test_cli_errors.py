@@ -104,3 +104,131 @@ def test_reproduce_json_is_valid_json(tmp_path):
     result = run("reproduce", "single-peak", "--quick", "--out", tmp_path)
     assert result.exit_code == 0, result.output
     json.loads((tmp_path / "single-peak.json").read_text())
+
+
+def test_a_run_too_long_to_record_is_refused_before_allocating(tmp_path):
+    out = tmp_path / "run"
+    for extra in (
+        ["--duration", "1e6"],
+        ["--duration", "1e308"],
+        ["--duration", "0.05", "--timestep", "1e-320"],
+    ):
+        result = run(
+            "simulate", "paper-single-peak", "--start", "-3,-1", "--resolution", "41", "--out", out, *extra
+        )
+        assert_one_error_line(result, "a spring run of", "more than the limit")
+    assert not out.exists()
+
+
+def test_a_tip_radius_far_below_the_surface_scale_is_refused_before_dilating(tmp_path):
+    # metres given for a dimensionless preset: 1e-6 would need a 8e7 x 8e7 dilation grid
+    result = run(
+        "streamline", "paper-single-peak", "--start", "0,0", "--tip-radius", "1e-6", "--out", tmp_path / "o"
+    )
+    assert_one_error_line(result, "dilating by the tip radius 1e-06", "more than the limit")
+    result = run(
+        "streamline", "paper-single-peak", "--start", "0,0", "--tip-radius", "1e308", "--out", tmp_path / "o"
+    )
+    assert_one_error_line(result, "the tip's footprint")
+    assert not (tmp_path / "o").exists()
+
+
+def test_kappa_resolution_too_large_is_refused(tmp_path):
+    out = tmp_path / "k.png"
+    assert_one_error_line(
+        run("kappa", "paper-single-peak", "-o", out, "--resolution", "100000000"), "kappa --resolution"
+    )
+    assert not out.exists()
+
+
+def test_preset_pairs_of_the_wrong_length_are_named(tmp_path):
+    out = tmp_path / "f.npz"
+    assert_one_error_line(
+        run("surface", "make", "paper-single-peak", "--set", "center=[0]", "-o", out), "center must be a pair"
+    )
+    assert_one_error_line(
+        run("surface", "make", "paper-fractal", "--set", "size=[1,2,3]", "-o", out), "size must be a pair"
+    )
+    assert not out.exists()
+
+
+def _npz_with_header_only(path, shape):
+    """An .npz whose 'heights' header claims ``shape`` (no data follows): a decompression
+    bomb's size, read without inflating anything."""
+    import io
+    import zipfile
+
+    buf = io.BytesIO()
+    np.lib.format.write_array_header_1_0(buf, {"descr": "<f8", "fortran_order": False, "shape": shape})
+    with zipfile.ZipFile(path, "w") as zf:
+        zf.writestr("heights.npy", buf.getvalue())
+
+
+def test_surface_files_too_large_deep_or_malformed_are_refused(tmp_path):
+    bomb = tmp_path / "bomb.npz"
+    _npz_with_header_only(bomb, (20000, 20000))
+    assert_one_error_line(run("surface", "info", bomb), "array 'heights' has shape (20000, 20000)")
+
+    good = tmp_path / "p.npz"
+    assert run("surface", "make", "paper-fractal", "--set", "nx=16", "-o", good).exit_code == 0
+    with np.load(good) as npz:
+        arrays = {k: npz[k] for k in npz.files}
+    for change, fragment in [
+        ({"metadata_json": np.array("[" * 100_000 + "]" * 100_000)}, "nested too deep"),
+        ({"periodic": np.array([True, False, True])}, "'periodic' must be one boolean"),
+        ({"periodic": np.array("no")}, "'periodic' must be one boolean"),
+        ({"x": np.arange(16) * 1e-320}, "x spacing"),
+    ]:
+        bad = tmp_path / "bad.npz"
+        np.savez(bad, **{**arrays, **change})
+        assert_one_error_line(run("surface", "info", bad), fragment)
+
+
+def test_replay_of_a_corrupt_run_folder_is_one_error_line(tmp_path):
+    run_dir = tmp_path / "run"
+    result = run(
+        "simulate",
+        "paper-single-peak",
+        "--start",
+        "-3,-1",
+        "--resolution",
+        "41",
+        "--duration",
+        "0.01",
+        "--out",
+        run_dir,
+    )
+    assert result.exit_code == 0, result.output
+    (run_dir / "summary.json").write_text("{bad")
+    assert_one_error_line(
+        run("replay", run_dir, "--mp4", tmp_path / "x.mp4"), "summary.json is not readable JSON"
+    )
+    assert not (tmp_path / "x.mp4").exists()
+
+
+def test_sigterm_removes_a_temporary_output(tmp_path):
+    import subprocess
+    import sys
+
+    script = f"""
+import os, signal, time
+from pathlib import Path
+from spine_mj.cli import _exit_on_sigterm
+from spine_mj.errors import atomic_output
+signal.signal(signal.SIGTERM, _exit_on_sigterm)
+with atomic_output(Path({str(tmp_path / "out.txt")!r})) as tmp:
+    tmp.write_text("half")
+    os.kill(os.getpid(), signal.SIGTERM)
+    time.sleep(30)
+"""
+    proc = subprocess.run([sys.executable, "-c", script], timeout=60)
+    assert proc.returncode == 128 + 15
+    assert list(tmp_path.iterdir()) == [], "the temporary file outlived the SIGTERM"
+
+
+def test_an_stl_whose_coordinates_overflow_float32_is_refused(tmp_path):
+    surf = tmp_path / "p.npz"
+    assert run("surface", "make", "paper-single-peak", "-o", surf).exit_code == 0
+    stl = tmp_path / "s.stl"
+    assert_one_error_line(run("surface", "export", surf, "--stl", stl, "--base", "1e308"), "32-bit floats")
+    assert not stl.exists()

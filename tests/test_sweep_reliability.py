@@ -34,6 +34,7 @@ def test_overwrite_refuses_a_folder_that_is_not_a_store_and_removes_only_store_f
     with pytest.raises(SpineInputError, match=r"holds no sweep manifest.*--overwrite replaces only"):
         sweep.run_sweep(cfg, mine, workers=1, overwrite=True)
     assert all((mine / n).read_text() == "keep me" for n in (".bashrc", "report.html", "runs/notes.txt"))
+    assert not (mine / ".sweep.lock").exists(), "a refused folder is left as it was"
 
     out = tmp_path / "out"
     sweep.run_sweep(cfg, out, workers=1)

@@ -43,7 +43,10 @@ def load_run(run_dir: str | Path) -> tuple[RigModel, Track]:
             f"{run_dir} is not a replayable run folder: {', '.join(missing)} missing "
             "(written by `spine-mj simulate`; older runs lack surface.npz)"
         )
-    summary = json.loads((run_dir / "summary.json").read_text())
+    try:
+        summary = json.loads((run_dir / "summary.json").read_text())
+    except (UnicodeDecodeError, json.JSONDecodeError, RecursionError) as exc:
+        raise SpineInputError(f"{run_dir / 'summary.json'} is not readable JSON ({exc})") from None
     try:
         sc = summary["scales"]
         rig = RigModel(
@@ -57,15 +60,20 @@ def load_run(run_dir: str | Path) -> tuple[RigModel, Track]:
         start = tuple(summary["start"])
     except (KeyError, TypeError) as exc:
         raise SpineInputError(f"{run_dir / 'summary.json'} does not describe a run: {exc!r}") from None
-    table = pd.read_parquet(run_dir / "trajectory.parquet")
-    track = Track(
-        time_s=table["time_s"].to_numpy(),
-        position_m=table[["position_x_m", "position_y_m", "position_z_m"]].to_numpy(),
-        carriage_x_m=table["carriage_x_m"].to_numpy(),
-        drive_force_n=table["drive_force_n"].to_numpy(),
-        start=start,
-        drive=drive,
-    )
+    import pyarrow
+
+    try:
+        table = pd.read_parquet(run_dir / "trajectory.parquet")
+        track = Track(
+            time_s=table["time_s"].to_numpy(),
+            position_m=table[["position_x_m", "position_y_m", "position_z_m"]].to_numpy(),
+            carriage_x_m=table["carriage_x_m"].to_numpy(),
+            drive_force_n=table["drive_force_n"].to_numpy(),
+            start=start,
+            drive=drive,
+        )
+    except (pyarrow.ArrowException, KeyError) as exc:
+        raise SpineInputError(f"{run_dir / 'trajectory.parquet'} is not a run's trajectory ({exc})") from None
     return rig, track
 
 

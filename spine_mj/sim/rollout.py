@@ -61,6 +61,8 @@ BATCH_MEMORY_BYTES = 256 * 2**20
 FIRST_PIECE_STEPS = 128
 #: Longest piece: the most steps a run is simulated between two looks at its end conditions.
 PIECE_STEPS = 1024
+#: Most steps an open-loop run may plan: its recording (~0.5 kB a step) stays within ~2 GiB.
+MAX_RUN_STEPS = 2**22
 #: Tips placed at a time, their first pieces then handed to the workers (the very first
 #: chunk is one tip per worker, so that each starts as soon as it can).
 PLACE_CHUNK = 4
@@ -80,11 +82,24 @@ def drive_steps(rig: RigModel, drive: Drive, x0_m: float, detection: Detection) 
         if length_from_start(drive):
             stretch = (1 + rig.tip.mu_s) * rig.scales.preload_n / stiffness_n_m(drive, rig.scales)
             duration = (1.1 * max(rig.bounds_m[1] - x0_m, 0.0) + stretch) / drive.speed_m_s
-        return max(1, int(math.ceil(duration / dt)))
+        steps = duration / dt
+        if not steps <= MAX_RUN_STEPS:
+            raise SpineInputError(
+                f"a spring run of {duration:.3g} s would take {steps:.3g} steps of {dt:.3g} s, more than "
+                f"the limit {MAX_RUN_STEPS}: shorten duration_s, or raise the speed (I_e) or the timestep"
+            )
+        return max(1, int(math.ceil(steps)))
     if isinstance(drive, StaticProbe):
         cap = detection.kappa_cap * rig.scales.preload_n
         rate = rate_n_s(drive, rig.scales)
-        return max(1, int(math.ceil((cap - drive.start_force_n) / rate / dt)) + 2)
+        steps = (cap - drive.start_force_n) / rate / dt
+        if not (math.isfinite(steps) and steps <= MAX_RUN_STEPS):
+            raise SpineInputError(
+                f"a static probe from {drive.start_force_n:.3g} N to the force cap {cap:.3g} N at "
+                f"{rate:.3g} N/s would take {steps:.3g} steps of {dt:.3g} s, more than the limit "
+                f"{MAX_RUN_STEPS}: raise the rate or lower kappa_cap"
+            )
+        return max(1, int(math.ceil(steps)) + 2)
     raise SpineInputError(
         f"open-loop controls exist for SpringDrive and StaticProbe, got {type(drive).__name__}"
     )

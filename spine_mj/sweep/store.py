@@ -294,6 +294,7 @@ def store_lock(out_dir: Path):
         if key in _HELD:
             raise busy
         _HELD.add(key)
+    created = not (out_dir / LOCK).exists()
     try:
         with open(out_dir / LOCK, "a") as fh:
             try:
@@ -303,6 +304,8 @@ def store_lock(out_dir: Path):
             try:
                 yield
             finally:
+                if created and not (out_dir / MANIFEST).exists():  # refused: leave the folder as it was
+                    (out_dir / LOCK).unlink(missing_ok=True)
                 fcntl.lockf(fh, fcntl.LOCK_UN)
     finally:
         with _HELD_GUARD:
