@@ -705,6 +705,14 @@ def simulate(
         choose_gl_backend()
 
     x0, y0 = _parse_start(start)
+    _refuse_options_not_for(
+        f"--drive {drive}",
+        {
+            "spring": ["rate", "start_force"],
+            "ramp": ["speed", "stiffness_number", "stiffness", "start_force"],
+            "static": ["speed", "stiffness_number", "stiffness", "duration"],
+        }[drive],
+    )
     for a, b, names in ((ie, speed, "--ie or --speed"), (ie, rate, "--ie or --rate")):
         if a is not None and b is not None:
             raise SpineInputError(f"give one of {names}, got both")
@@ -744,6 +752,21 @@ def simulate(
         + (f", K = {result.stiffness_number:.3g}" if drive == "spring" else "")
     )
     click.echo(f"wrote {', '.join(str(out / w) for w in written)}")
+
+
+def _refuse_options_not_for(what: str, params: list[str]) -> None:
+    """A :class:`SpineInputError` if any of the current command's ``params`` was given on
+    the command line: options that ``what`` would ignore."""
+    ctx = click.get_current_context()
+    given = [
+        opt.opts[0]
+        for opt in ctx.command.params
+        if opt.name in params and ctx.get_parameter_source(opt.name) is click.core.ParameterSource.COMMANDLINE
+    ]
+    if given:
+        raise SpineInputError(
+            f"{what} does not use {', '.join(given)}; leave {'it' if len(given) == 1 else 'them'} out"
+        )
 
 
 def _render_mp4(rig, run, path: Path, *, speed: float | None = None) -> None:

@@ -232,3 +232,20 @@ def test_an_stl_whose_coordinates_overflow_float32_is_refused(tmp_path):
     stl = tmp_path / "s.stl"
     assert_one_error_line(run("surface", "export", surf, "--stl", stl, "--base", "1e308"), "32-bit floats")
     assert not stl.exists()
+
+
+@pytest.mark.parametrize(
+    ("options", "fragment"),
+    [
+        (["--drive", "spring", "--rate", "1"], "--drive spring does not use --rate; leave it out"),
+        (["--drive", "ramp", "--K", "5"], "--drive ramp does not use --K"),
+        (["--drive", "static", "--duration", "1", "--speed", "0.1"], "does not use --speed, --duration"),
+    ],
+)
+def test_simulate_refuses_options_its_drive_would_ignore(tmp_path, options, fragment):
+    out = tmp_path / "run"
+    result = run(
+        "simulate", "paper-single-peak", "--start", "-3,-1", "--resolution", "41", "--out", out, *options
+    )
+    assert_one_error_line(result, fragment)
+    assert not out.exists()
