@@ -724,6 +724,11 @@ def fractal_fbm(
         heights *= rms_slope / current
     else:
         heights *= rms_height / heights.std()
+    if not np.isfinite(heights).all():
+        raise SpineInputError(
+            f"fractal_fbm: size {lx:g} x {ly:g} with rms_height {rms_height} and rms_slope {rms_slope} "
+            "gives heights beyond floating-point range; use sizes and RMS values nearer 1"
+        )
     x = -lx / 2 + dx * np.arange(nx)
     y = -ly / 2 + dy * np.arange(ny)
     return GridSurface(

@@ -249,3 +249,50 @@ def test_simulate_refuses_options_its_drive_would_ignore(tmp_path, options, frag
     )
     assert_one_error_line(result, fragment)
     assert not out.exists()
+
+
+def test_fractal_sizes_beyond_floating_point_range_are_named(tmp_path):
+    out = tmp_path / "f.npz"
+    for setting in ("size=1e308", "rms_slope=1e308"):
+        result = run("surface", "make", "paper-fractal", "--set", setting, "-o", out)
+        assert_one_error_line(result, "fractal_fbm: size", "beyond floating-point range")
+    assert not out.exists()
+
+
+def test_a_drive_speed_no_time_step_can_resolve_names_the_speed(tmp_path):
+    result = run(
+        "simulate",
+        "paper-single-peak",
+        "--start",
+        "-3,-1",
+        "--resolution",
+        "41",
+        "--speed",
+        "1e308",
+        "--out",
+        tmp_path / "r",
+    )
+    assert_one_error_line(result, "drive speed 1e+308", "lower the speed")
+
+
+def test_replay_at_a_speed_that_would_need_endless_frames_is_refused(tmp_path):
+    run_dir = tmp_path / "run"
+    result = run(
+        "simulate",
+        "paper-single-peak",
+        "--start",
+        "-3,-1",
+        "--resolution",
+        "41",
+        "--duration",
+        "0.01",
+        "--out",
+        run_dir,
+    )
+    assert result.exit_code == 0, result.output
+    mp4 = tmp_path / "x.mp4"
+    assert_one_error_line(
+        run("replay", run_dir, "--speed", "1e-320", "--mp4", mp4), "frames", "raise the speed"
+    )
+    assert_one_error_line(run("replay", run_dir, "--duration", "-1", "--mp4", mp4), "--duration")
+    assert not mp4.exists()

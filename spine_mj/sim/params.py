@@ -561,6 +561,11 @@ def default_engine(scales: Scales, *, speed_m_s: float | None = None, **override
         depth = _IMPACT_DEPTH_OF_TOLERANCE * penetration_tolerance_m(scales) / scales.char_length_m
         dt_tau = min(dt_tau, math.e * depth / (2 * v))
     dt = float(f"{dt_tau:.2g}") * scales.time_s
+    if not dt > 0 and "timestep_s" not in overrides:
+        raise SpineInputError(
+            f"impacts at {v:.3g} L_c/tau (drive speed {speed_m_s!r} m/s, or a fall down the surface) "
+            f"would need a time step of {dt_tau * scales.time_s:.3g} s: lower the speed (I_e)"
+        )
     base = {
         "timestep_s": dt,
         "solref": (2 * dt, 1.0),

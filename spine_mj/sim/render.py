@@ -27,6 +27,7 @@ TRAIL_RGBA = (1.0, 0.55, 0.0, 1.0)
 STREAMLINE_RGBA = (0.0, 0.8, 0.9, 0.9)
 MAX_SEGMENTS = 300  # per polyline
 FPS = 30.0  # of the MP4
+MAX_FRAMES = 100_000  # about an hour of video at FPS
 _ZERO3, _EYE9 = np.zeros(3), np.eye(3).ravel()
 
 
@@ -153,6 +154,14 @@ def render_frames(
     import mujoco
 
     track = Track.of(run)
+    t = track.time_s
+    speed = default_speed(t) if speed is None else speed
+    frames = (t[-1] - t[0]) * fps / speed
+    if not frames <= MAX_FRAMES:
+        raise SpineInputError(
+            f"speed {speed:.3g} makes a video of {frames:.3g} frames at {fps:g} fps, more than "
+            f"{MAX_FRAMES}: raise the speed"
+        )
     m = rig.model_for(track.drive)
     d = mujoco.MjData(m)
     renderer = mujoco.Renderer(m, height=height, width=width, max_geom=2 * MAX_SEGMENTS + 100)
@@ -166,8 +175,6 @@ def render_frames(
     cam.type = mujoco.mjtCamera.mjCAMERA_FREE
     cam.distance, cam.elevation, cam.azimuth = 80 * r, -30.0, 20.0
     f_p = rig.scales.preload_n
-    t = track.time_s
-    speed = default_speed(t) if speed is None else speed
     rows = np.unique(np.searchsorted(t, np.arange(t[0], t[-1], speed / fps)).clip(0, len(t) - 1))
     rows = np.append(rows, len(t) - 1) if rows[-1] != len(t) - 1 else rows
     try:
