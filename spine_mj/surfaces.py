@@ -85,6 +85,13 @@ def _rng_and_seed(rng: int | np.random.Generator | None) -> tuple[np.random.Gene
     raise SpineInputError(f"rng must be a non-negative int seed or a numpy Generator, got {rng!r}")
 
 
+def _flag(name: str, value) -> bool:
+    """``value`` as a bool: True, False, their numpy forms, 1 or 0; not 3 or "no"."""
+    if isinstance(value, str) or value not in (True, False):
+        raise SpineInputError(f"{name} must be true or false, got {value!r}")
+    return bool(value)
+
+
 def _pair(name: str, value) -> tuple[float, float]:
     """``value`` as two finite floats, or a :class:`SpineInputError` naming ``name``."""
     try:
@@ -387,7 +394,7 @@ class GridSurface(Surface):
         heights.flags.writeable = False
         x, y = coords["x"], coords["y"]
         dx, dy = (x[-1] - x[0]) / (nx - 1), (y[-1] - y[0]) / (ny - 1)
-        periodic = bool(self.periodic)
+        periodic = _flag("periodic", self.periodic)
         if periodic:
             coef = np.pad(ndimage.spline_filter(heights, order=3, mode="grid-wrap"), 2, mode="wrap")
             offset = 2
@@ -679,6 +686,7 @@ def fractal_fbm(
         If False, a surface twice as large is synthesized and one quadrant kept, so the
         result does not wrap around.
     """
+    periodic = _flag("periodic", periodic)
     nx = _grid_count("nx", nx)
     ny = nx if ny is None else _grid_count("ny", ny)
     check_grid_size((1 if periodic else 2) * nx, (1 if periodic else 2) * ny, where="fractal_fbm")

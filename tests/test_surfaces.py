@@ -342,6 +342,8 @@ def test_grid_surface_rejects_bad_data(kwargs, match):
         (fractal_fbm, dict(hurst=0.0), "hurst"),
         (fractal_fbm, dict(hurst=0.5, nx=3), "nx must be an integer >= 4"),
         (fractal_fbm, dict(rms_height=1, rms_slope=1), "not both"),
+        (fractal_fbm, dict(periodic=3), "periodic must be true or false, got 3"),
+        (fractal_fbm, dict(periodic="no"), "periodic must be true or false"),
         (random_gaussians, dict(n_peaks=0), "n_peaks must be an integer in 1..100000"),
         (random_gaussians, dict(n_peaks=10**8), "n_peaks must be an integer in 1..100000"),
         (random_gaussians, dict(n_peaks=-5), "n_peaks"),
