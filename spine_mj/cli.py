@@ -775,16 +775,7 @@ def _render_mp4(rig, run, path: Path, *, speed: float | None = None) -> None:
 
     with Progress("rendering MP4", unit="frame") as bar:
         frames = render_frames(rig, run, speed=speed, progress=bar.update)
-        try:
-            first = next(frames)
-        except SpineInputError:
-            raise
-        except Exception as exc:  # a missing GL backend surfaces as many exception types
-            backend = os.environ.get("MUJOCO_GL", "")
-            raise SpineInputError(
-                f"no headless renderer (MUJOCO_GL={backend!r}: {type(exc).__name__}: {exc}); "
-                "install EGL (libegl1) or OSMesa (libosmesa6), or run without --render"
-            ) from None
+        first = next(frames)  # a missing renderer fails here, before the file is opened
         with atomic_output(path) as tmp:
             with imageio.get_writer(tmp, fps=FPS, codec="libx264", format="FFMPEG") as writer:
                 writer.append_data(first)

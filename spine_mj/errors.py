@@ -76,6 +76,16 @@ def atomic_output(path: str | os.PathLike, *, suffix: str | None = None) -> Iter
             tmp.unlink()
 
 
+def _missing_folders(path: Path) -> list[Path]:
+    """The folders above ``path`` that do not exist yet."""
+    missing = []
+    folder = path.parent
+    while not folder.exists() and folder != folder.parent:
+        missing.append(folder)
+        folder = folder.parent
+    return missing
+
+
 def writable_path(path: str | os.PathLike) -> Path:
     """``path`` as a :class:`Path` whose folder exists (created if missing) and takes files.
 
@@ -107,8 +117,10 @@ def all_or_none(*paths: str | os.PathLike | None) -> Iterator[None]:
     Every path is checked for writability on entry (:func:`writable_path`), so a bad
     second output fails before the first is written. Files that existed are kept aside
     (a hard link) and restored if the block raises; files the block created are removed.
-    ``None`` entries are skipped, so optional outputs can be passed as they are.
+    ``None`` entries are skipped, so optional outputs can be passed as they are. Folders
+    made for the outputs are removed again if the block raises.
     """
+    new_dirs = {d for p in paths if p is not None for d in _missing_folders(Path(p))}
     dests = [writable_path(p) for p in paths if p is not None]
     backups: dict[Path, Path] = {}
     try:
@@ -127,6 +139,9 @@ def all_or_none(*paths: str | os.PathLike | None) -> Iterator[None]:
                 os.replace(backups.pop(dest), dest)
             elif dest.exists():
                 dest.unlink()
+        for folder in sorted(new_dirs, key=lambda d: len(d.parts), reverse=True):
+            with contextlib.suppress(OSError):  # not empty: something else was put there
+                folder.rmdir()
         raise
     finally:
         for backup in backups.values():

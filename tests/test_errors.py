@@ -41,6 +41,19 @@ def test_all_or_none_restores_what_existed_and_removes_what_it_made(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["kept.txt"]
 
 
+def test_all_or_none_removes_the_folders_it_made_for_outputs_that_failed(tmp_path):
+    out = tmp_path / "runs" / "one"
+    with pytest.raises(RuntimeError), all_or_none(out / "a.txt", out / "sub" / "b.txt"):
+        (out / "a.txt").write_text("new")
+        raise RuntimeError("the second output failed")
+    assert list(tmp_path.iterdir()) == []
+
+    (tmp_path / "mine").mkdir()
+    with pytest.raises(RuntimeError), all_or_none(tmp_path / "mine" / "a.txt"):
+        raise RuntimeError("failed")
+    assert (tmp_path / "mine").is_dir(), "a folder that was there stays"
+
+
 def test_all_or_none_keeps_every_output_on_success(tmp_path):
     a, b = tmp_path / "a.txt", tmp_path / "b.txt"
     a.write_text("old")

@@ -40,3 +40,24 @@ def test_cli_simulate_export_and_view(tmp_path, monkeypatch):
     monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
     res = runner.invoke(main, ["view", "paper-single-peak"])
     assert res.exit_code != 0 and "no display" in res.output and "Traceback" not in res.output
+
+
+def test_a_missing_gl_backend_is_one_error_line_naming_it(tmp_path, monkeypatch):
+    from click.testing import CliRunner
+
+    from spine_mj.cli import main
+
+    def no_gl(*args, **kwargs):
+        raise mujoco.FatalError("an OpenGL platform library has not been loaded")
+
+    monkeypatch.setattr(mujoco, "Renderer", no_gl)
+    res = CliRunner().invoke(
+        main,
+        [
+            *("simulate", "paper-single-peak", "--start", "-3,-1", "--resolution", "41"),
+            *("--duration", "0.01", "--render", "--out", str(tmp_path / "run")),
+        ],
+    )
+    assert res.exit_code == 2, res.output
+    assert res.output.strip().startswith("Error: no headless renderer") and "OpenGL platform" in res.output
+    assert not (tmp_path / "run").exists()

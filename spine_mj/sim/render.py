@@ -164,7 +164,15 @@ def render_frames(
         )
     m = rig.model_for(track.drive)
     d = mujoco.MjData(m)
-    renderer = mujoco.Renderer(m, height=height, width=width, max_geom=2 * MAX_SEGMENTS + 100)
+    try:
+        renderer = mujoco.Renderer(m, height=height, width=width, max_geom=2 * MAX_SEGMENTS + 100)
+        renderer.render()  # some backends fail only on the first frame
+    except Exception as exc:  # a missing GL backend surfaces as many exception types
+        raise SpineInputError(
+            f"no headless renderer (MUJOCO_GL={os.environ.get('MUJOCO_GL', '')!r}: "
+            f"{type(exc).__name__}: {exc}); install EGL (libegl1) or OSMesa (libosmesa6), or run "
+            "without --render"
+        ) from None
     to_engine = 1.0 / rig.units.length_m
     r = rig.tip.tip_radius_m * to_engine
     ref = streamline_path_m(rig, track.start) * to_engine if streamline else np.empty((0, 3))
