@@ -22,6 +22,18 @@ def assert_one_error_line(result, *fragments):
         assert fragment in lines[0], lines[0]
 
 
+#: A quick simulate on the single peak; the tests add the options they probe.
+SIMULATE = ("simulate", "paper-single-peak", "--start", "-3,-1", "--resolution", "41")
+
+
+def recorded_run(tmp_path):
+    """A run folder written by a 0.01 s simulate."""
+    run_dir = tmp_path / "run"
+    result = run(*SIMULATE, "--duration", "0.01", "--out", run_dir)
+    assert result.exit_code == 0, result.output
+    return run_dir
+
+
 @pytest.mark.parametrize(
     ("value", "fragment"),
     [("nan", "nx must be an integer >= 4, got nan"), ("abc", "got 'abc'"), ("3.5", "got 3.5")],
@@ -113,9 +125,7 @@ def test_a_run_too_long_to_record_is_refused_before_allocating(tmp_path):
         ["--duration", "1e308"],
         ["--duration", "0.05", "--timestep", "1e-320"],
     ):
-        result = run(
-            "simulate", "paper-single-peak", "--start", "-3,-1", "--resolution", "41", "--out", out, *extra
-        )
+        result = run(*SIMULATE, "--out", out, *extra)
         assert_one_error_line(result, "a spring run of", "more than the limit")
     assert not out.exists()
 
@@ -185,20 +195,7 @@ def test_surface_files_too_large_deep_or_malformed_are_refused(tmp_path):
 
 
 def test_replay_of_a_corrupt_run_folder_is_one_error_line(tmp_path):
-    run_dir = tmp_path / "run"
-    result = run(
-        "simulate",
-        "paper-single-peak",
-        "--start",
-        "-3,-1",
-        "--resolution",
-        "41",
-        "--duration",
-        "0.01",
-        "--out",
-        run_dir,
-    )
-    assert result.exit_code == 0, result.output
+    run_dir = recorded_run(tmp_path)
     (run_dir / "summary.json").write_text("{bad")
     assert_one_error_line(
         run("replay", run_dir, "--mp4", tmp_path / "x.mp4"), "summary.json is not readable JSON"
@@ -244,9 +241,7 @@ def test_an_stl_whose_coordinates_overflow_float32_is_refused(tmp_path):
 )
 def test_simulate_refuses_options_its_drive_would_ignore(tmp_path, options, fragment):
     out = tmp_path / "run"
-    result = run(
-        "simulate", "paper-single-peak", "--start", "-3,-1", "--resolution", "41", "--out", out, *options
-    )
+    result = run(*SIMULATE, "--out", out, *options)
     assert_one_error_line(result, fragment)
     assert not out.exists()
 
@@ -260,36 +255,12 @@ def test_fractal_sizes_beyond_floating_point_range_are_named(tmp_path):
 
 
 def test_a_drive_speed_no_time_step_can_resolve_names_the_speed(tmp_path):
-    result = run(
-        "simulate",
-        "paper-single-peak",
-        "--start",
-        "-3,-1",
-        "--resolution",
-        "41",
-        "--speed",
-        "1e308",
-        "--out",
-        tmp_path / "r",
-    )
+    result = run(*SIMULATE, "--speed", "1e308", "--out", tmp_path / "r")
     assert_one_error_line(result, "drive speed 1e+308", "lower the speed")
 
 
 def test_replay_at_a_speed_that_would_need_endless_frames_is_refused(tmp_path):
-    run_dir = tmp_path / "run"
-    result = run(
-        "simulate",
-        "paper-single-peak",
-        "--start",
-        "-3,-1",
-        "--resolution",
-        "41",
-        "--duration",
-        "0.01",
-        "--out",
-        run_dir,
-    )
-    assert result.exit_code == 0, result.output
+    run_dir = recorded_run(tmp_path)
     mp4 = tmp_path / "x.mp4"
     assert_one_error_line(
         run("replay", run_dir, "--speed", "1e-320", "--mp4", mp4), "frames", "raise the speed"
