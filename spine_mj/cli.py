@@ -127,6 +127,7 @@ def main(verbose):
 
 
 def _exit_on_sigterm(signum, frame):
+    """SIGTERM's handler: exit as a kill would (128 + signal), through every ``finally``."""
     raise SystemExit(128 + signum)
 
 

@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+import pyarrow
 
 from spine_mj import surface_io
 from spine_mj.errors import SpineInputError
@@ -60,8 +61,6 @@ def load_run(run_dir: str | Path) -> tuple[RigModel, Track]:
         start = tuple(summary["start"])
     except (KeyError, TypeError) as exc:
         raise SpineInputError(f"{run_dir / 'summary.json'} does not describe a run: {exc!r}") from None
-    import pyarrow
-
     try:
         table = pd.read_parquet(run_dir / "trajectory.parquet")
         track = Track(
