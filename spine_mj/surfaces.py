@@ -355,6 +355,8 @@ class GridSurface(Surface):
     bounds: tuple[float, float, float, float] = field(init=False)
 
     def __post_init__(self):
+        if np.iscomplexobj(self.heights):  # a cast would drop the imaginary part with a warning
+            raise SpineInputError("heights must be real numbers, got complex values")
         heights = np.array(self.heights, dtype=float)
         if heights.ndim != 2:
             raise SpineInputError(f"heights must be a 2-D array (ny, nx), got shape {heights.shape}")

@@ -188,6 +188,7 @@ def test_surface_files_too_large_deep_or_malformed_are_refused(tmp_path):
         ({"periodic": np.array([True, False, True])}, "'periodic' must be one boolean"),
         ({"periodic": np.array("no")}, "'periodic' must be one boolean"),
         ({"x": np.arange(16) * 1e-320}, "x spacing"),
+        ({"heights": arrays["heights"] + 1j}, "heights must be real numbers"),
     ]:
         bad = tmp_path / "bad.npz"
         np.savez(bad, **{**arrays, **change})
