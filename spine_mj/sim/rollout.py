@@ -192,15 +192,13 @@ def run_batch(
     runner = _BatchRunner(rig, drives, starts, det)
     nthread = (os.cpu_count() or 1) if nthread is None else max(1, int(nthread))
     lanes = _NativeLanes(nthread) if backend == "rollout" else _PythonLane()
-    finished = False
     try:
         for idx in plan_groups(runner.lengths, 8 * (runner.nstate + rig.model.nsensordata)):
             group = _Group(runner, idx, stop_early)
             for j, res in zip(idx, group.run(lanes)):
                 runner.results[j] = res
-        finished = True
     finally:
-        lanes.close(wait=not finished)
+        lanes.close()
     return runner.results
 
 
@@ -505,17 +503,13 @@ class _NativeLanes:
         )
         return warm_out.tolist(), ("frozen" if any(warned) else None)
 
-    def close(self, wait: bool = True) -> None:
-        """Stop the workers (pieces still queued are dropped) and, if ``wait``, wait for
-        them: after an error, so that no piece writes into a batch's arrays once the batch
-        is gone. After a batch that finished the workers are idle and are left to exit on
-        their own (joining them took 0.7 ms of the batch's wall time, measured)."""
+    def close(self) -> None:
+        """Stop the workers (pieces still queued are dropped) and wait for them."""
         self.cancelled = True
         for _ in self.threads:
             self.jobs.put(None)
-        if wait:
-            for t in self.threads:
-                t.join()
+        for t in self.threads:
+            t.join()
 
 
 class _PythonLane:
@@ -537,7 +531,7 @@ class _PythonLane:
     def step(self, model, init, warm, ctrl, state, sens):
         return python_steps(model, init[0], warm[0], ctrl[0], state[0], sens[0])
 
-    def close(self, wait: bool = True) -> None:
+    def close(self) -> None:
         pass
 
 
