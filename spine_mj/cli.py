@@ -12,7 +12,6 @@ import json
 import os
 import signal
 import sys
-import threading
 from pathlib import Path
 
 import click
@@ -121,9 +120,14 @@ class _Group(click.Group):
 def main(verbose):
     """spine_mj: streamline theory and MuJoCo dynamics of bio-inspired spines on rough
     surfaces."""
-    if threading.current_thread() is threading.main_thread():
-        # a SIGTERM (kill, timeout, a scheduler) unwinds like Ctrl-C: temporary outputs are removed
-        signal.signal(signal.SIGTERM, _exit_on_sigterm)
+
+
+def run() -> None:
+    """The ``spine-mj`` program: :func:`main`, with a SIGTERM (kill, timeout, a scheduler)
+    unwinding like Ctrl-C so that temporary outputs are removed. Callers of :func:`main`
+    in their own process (tests, notebooks) keep their signal handling."""
+    signal.signal(signal.SIGTERM, _exit_on_sigterm)
+    main()
 
 
 def _exit_on_sigterm(signum, frame):
@@ -1132,4 +1136,4 @@ def validate_cmd(out_dir, quick, plan_name, workers, quiet):
 
 
 if __name__ == "__main__":  # pragma: no cover
-    main()
+    run()
