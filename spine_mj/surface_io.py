@@ -105,9 +105,9 @@ def load_surface(path: str | os.PathLike) -> Surface:
                         f"{path}: array {name!r} has shape {shape}, more than {MAX_GRID_POINTS} values"
                     )
             data = {k: npz[k] for k in npz.files}
+    except SpineInputError:
+        raise
     except (zipfile.BadZipFile, ValueError, OSError, EOFError) as exc:
-        if isinstance(exc, SpineInputError):
-            raise
         raise SpineInputError(f"{path} is not a readable spine_mj .npz surface ({exc})") from None
     if str(data.get("format", "")) != FORMAT:
         raise SpineInputError(f"{path} is not a spine_mj surface file (no format tag {FORMAT!r})")

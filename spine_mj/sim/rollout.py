@@ -83,26 +83,34 @@ def drive_steps(rig: RigModel, drive: Drive, x0_m: float, detection: Detection) 
             stretch = (1 + rig.tip.mu_s) * rig.scales.preload_n / stiffness_n_m(drive, rig.scales)
             duration = (1.1 * max(rig.bounds_m[1] - x0_m, 0.0) + stretch) / drive.speed_m_s
         steps = duration / dt
-        if not steps <= MAX_RUN_STEPS:
-            raise SpineInputError(
-                f"a spring run of {duration:.3g} s would take {steps:.3g} steps of {dt:.3g} s, more than "
-                f"the limit {MAX_RUN_STEPS}: shorten duration_s, or raise the speed (I_e) or the timestep"
-            )
+        _check_run_steps(
+            steps,
+            dt,
+            f"a spring run of {duration:.3g} s",
+            "shorten duration_s, or raise the speed (I_e) or the timestep",
+        )
         return max(1, int(math.ceil(steps)))
     if isinstance(drive, StaticProbe):
         cap = detection.kappa_cap * rig.scales.preload_n
         rate = rate_n_s(drive, rig.scales)
         steps = (cap - drive.start_force_n) / rate / dt
-        if not (math.isfinite(steps) and steps <= MAX_RUN_STEPS):
-            raise SpineInputError(
-                f"a static probe from {drive.start_force_n:.3g} N to the force cap {cap:.3g} N at "
-                f"{rate:.3g} N/s would take {steps:.3g} steps of {dt:.3g} s, more than the limit "
-                f"{MAX_RUN_STEPS}: raise the rate or lower kappa_cap"
-            )
+        what = (
+            f"a static probe from {drive.start_force_n:.3g} N to the force cap {cap:.3g} N at {rate:.3g} N/s"
+        )
+        _check_run_steps(steps, dt, what, "raise the rate or lower kappa_cap")
         return max(1, int(math.ceil(steps)) + 2)
     raise SpineInputError(
         f"open-loop controls exist for SpringDrive and StaticProbe, got {type(drive).__name__}"
     )
+
+
+def _check_run_steps(steps: float, dt: float, what: str, remedy: str) -> None:
+    """Refuse a run of ``steps`` (a float, before rounding) beyond :data:`MAX_RUN_STEPS`."""
+    if not (math.isfinite(steps) and steps <= MAX_RUN_STEPS):
+        raise SpineInputError(
+            f"{what} would take {steps:.3g} steps of {dt:.3g} s, more than the limit "
+            f"{MAX_RUN_STEPS}: {remedy}"
+        )
 
 
 def controls(
