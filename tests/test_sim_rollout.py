@@ -10,6 +10,7 @@ from sim_rigs import flat_rig, plane_rig
 
 from spine_mj import presets, sim
 from spine_mj.sim import Detection, EndReason, SpringDrive, StaticProbe
+from spine_mj.sim.drives import settle_steps
 from spine_mj.validate.ramp_plan import pilot_rig
 
 
@@ -29,6 +30,41 @@ def test_batch_equals_one_at_a_time_and_python_reference():
             assert other.end_reason is b.end_reason and other.n == b.n
             np.testing.assert_allclose(other.position_m, b.position_m, rtol=0, atol=1e-12)
             np.testing.assert_allclose(other.drive_force_n, b.drive_force_n, rtol=1e-9, atol=1e-12)
+
+
+def test_controls_are_the_drives_profile_shifted_by_the_start():
+    """Spring: the anchor and carriage sit at the start through the settle phase, then move
+    at the drive's speed; probe: the push climbs from its start force at its rate to the
+    force cap.
+    Every start of one drive adds its position to the same profile (a batch computes it once)."""
+    rig = flat_rig()
+    det = Detection().resolve(rig.scales)
+    u, dt = rig.units, rig.engine.timestep_s
+    spring = SpringDrive(speed_m_s=0.01, duration_s=0.05)
+    probe = StaticProbe(rate_n_s=5 * rig.scales.preload_n, start_force_n=0.1 * rig.scales.preload_n)
+    qs = [rig.place(*s) for s in [(-0.02, 0.0), (0.01, 0.013)]]
+    for drive in (spring, probe):
+        ns = settle_steps(drive, dt)
+        for q in qs:
+            c = rig.controls(drive, q, det)
+            t = dt * np.arange(1, c.shape[0] - ns + 1)  # [s] since the drive started
+            np.testing.assert_array_equal(c[:, 4], q[1])
+            np.testing.assert_allclose(c[:, 5], q[2] + 2 * rig.tip.tip_radius_m / u.length_m, rtol=1e-15)
+            np.testing.assert_allclose(c[:, 2], -rig.tip.preload_n / u.force_n, rtol=1e-15)
+            if drive is spring:
+                np.testing.assert_array_equal(c[:, 0], c[:, 3])
+                np.testing.assert_array_equal(c[:ns, 0], q[0])
+                np.testing.assert_allclose(c[ns:, 0] * u.length_m, q[0] * u.length_m + 0.01 * t, rtol=1e-12)
+                np.testing.assert_array_equal(c[:, 1], 0.0)
+            else:
+                np.testing.assert_array_equal(c[:, 0], 0.0)
+                np.testing.assert_array_equal(c[:, 3], q[0])
+                cap = det.kappa_cap * rig.scales.preload_n * (1 + 1e-9)  # just past: the cap rule sees it
+                force = np.minimum(probe.start_force_n + probe.rate_n_s * t, cap)
+                np.testing.assert_allclose(c[ns:, 1] * u.force_n, force, rtol=1e-9)
+                np.testing.assert_allclose(c[:ns, 1] * u.force_n, probe.start_force_n, rtol=1e-12)
+        a, b = (rig.controls(drive, q, det) for q in qs)
+        np.testing.assert_allclose(b - a, np.broadcast_to(b[0] - a[0], a.shape), rtol=0, atol=1e-12)
 
 
 def _one_rollout(rig, drive, start):

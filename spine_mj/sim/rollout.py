@@ -121,32 +121,51 @@ def controls(
     ``qpos0`` is the placed start (:meth:`RigModel.place`, engine units), ``detection``
     resolved (:meth:`Detection.resolve`): its ``kappa_cap`` bounds a probe's force.
     ``out``: an array of that shape to fill and return (a batch's row) instead of a new one.
+    The controls are the drive's :func:`control_profile` shifted by the start
+    (:func:`start_offsets`).
     """
+    profile = control_profile(rig, drive, qpos0[0] * rig.units.length_m, detection)
+    if out is not None and out.shape != profile.shape:
+        raise ValueError(f"out must have shape {profile.shape}, got {out.shape}")
+    return np.add(profile, start_offsets(drive, qpos0), out=out)
+
+
+def control_profile(rig: RigModel, drive: Drive, x0_m: float, detection: Detection) -> np.ndarray:
+    """The controls of :func:`controls` for a start at the origin ``(nstep, 6)``, engine
+    units (``x0_m`` [m] sets only the length of a spring run without a duration): what
+    every start of one drive shares, so that a batch computes it once per drive."""
     u = rig.units
     dt = rig.engine.timestep_s
     n_settle = settle_steps(drive, dt)
-    cap = detection.kappa_cap * rig.scales.preload_n / u.force_n
-    n_drive = drive_steps(rig, drive, qpos0[0] * u.length_m, detection)
-    n = n_settle + n_drive
-    if out is not None and out.shape != (n, 6):
-        raise ValueError(f"out must have shape {(n, 6)}, got {out.shape}")
-    ctrl = np.empty((n, 6)) if out is None else out
-    ctrl[:, :2] = 0.0
+    n_drive = drive_steps(rig, drive, x0_m, detection)
+    ctrl = np.zeros((n_settle + n_drive, 6))
     ctrl[:, 2] = -rig.tip.preload_n / u.force_n
-    ctrl[:, 3] = qpos0[0]
-    ctrl[:, 4] = qpos0[1]
-    ctrl[:, 5] = qpos0[2] + 2 * rig.tip.tip_radius_m / u.length_m
+    ctrl[:, 5] = 2 * rig.tip.tip_radius_m / u.length_m
     ramp_t = (dt / u.time_s) * np.arange(1, n_drive + 1)
     if isinstance(drive, SpringDrive):
-        ctrl[:, 0] = qpos0[0]
-        ctrl[n_settle:, 0] = qpos0[0] + (drive.speed_m_s / u.speed_m_s) * ramp_t
+        ctrl[n_settle:, 0] = (drive.speed_m_s / u.speed_m_s) * ramp_t
         ctrl[:, 3] = ctrl[:, 0]
     else:
+        cap = detection.kappa_cap * rig.scales.preload_n / u.force_n
         f0 = drive.start_force_n / u.force_n
         ctrl[:, 1] = f0
         rate = rate_n_s(drive, rig.scales) * u.time_s / u.force_n
         ctrl[n_settle:, 1] = np.minimum(f0 + rate * ramp_t, cap * (1 + 1e-9))
     return ctrl
+
+
+def start_offsets(drive: Drive, qpos0: np.ndarray) -> np.ndarray:
+    """What a placed start ``qpos0`` (engine units) adds to each row of its drive's
+    :func:`control_profile` ``(6,)``: the spring's anchor and the mocap carriage follow the
+    start (the anchor only for a spring drive)."""
+    x0, y0, z0 = (float(c) for c in qpos0)
+    return np.array([x0 if isinstance(drive, SpringDrive) else 0.0, 0.0, 0.0, x0, y0, z0])
+
+
+def profile_key(drive: Drive, x0: float):
+    """What a run's :func:`control_profile` (and length) depends on: the drive, and the
+    start ``x0`` where the length does (:func:`length_from_start`)."""
+    return (id(drive), x0) if length_from_start(drive) else id(drive)
 
 
 def plan_groups(lengths: Sequence[int], bytes_per_step: int) -> list[list[int]]:
@@ -226,7 +245,7 @@ class _BatchRunner:
             if k not in by_stiffness:
                 by_stiffness[k] = rig.model_for(d)
             self.models.append(by_stiffness[k])
-            key = (id(d), x0) if length_from_start(d) else id(d)
+            key = profile_key(d, x0)
             if key not in lengths:
                 lengths[key] = settle_steps(d, dt) + drive_steps(rig, d, x0 * s, det)
             self.lengths.append(lengths[key])
@@ -263,6 +282,7 @@ class _Group:
             isinstance(d, StaticProbe) and fast_forward_on(d, rig.engine, rig.tip) for d in self.drives
         ]
         self.analysis: GroupAnalysis | None = None  # built once the workers have pieces
+        self.profiles: dict[object, np.ndarray] = {}  # control profiles shared by starts (profile_key)
 
     def run(self, lanes) -> list[RunResult]:
         """Simulate the group piece by piece; the results in group order.
@@ -295,10 +315,21 @@ class _Group:
 
     def prepare(self, ks: np.ndarray) -> None:
         """Place the tips of runs ``ks``; their controls and initial states."""
-        rig = self.rig
-        for k, q in zip(ks, rig.place_many([self.starts[k] for k in ks])):
-            controls(rig, self.drives[k], q, self.det, out=self.ctrl[k])
+        for k, q in zip(ks, self.rig.place_many([self.starts[k] for k in ks])):
+            np.add(self.profile(k), start_offsets(self.drives[k], q), out=self.ctrl[k])
             self.init[k, 1:4] = q
+
+    def profile(self, k: int) -> np.ndarray:
+        """The :func:`control_profile` of run ``k``, computed once per drive (once per run
+        where its length depends on its start)."""
+        drive, x0 = self.drives[k], self.starts[k][0]
+        key = profile_key(drive, x0)
+        profile = self.profiles.get(key)
+        if profile is None:
+            profile = control_profile(self.rig, drive, x0 * self.rig.length_scale_m, self.det)
+            if not length_from_start(drive):
+                self.profiles[key] = profile
+        return profile
 
     def submit(self, ks: np.ndarray, lanes) -> int:
         """Queue the next piece of each run in ``ks`` (longest first): a fast-forwarding
