@@ -289,7 +289,12 @@ class _Group:
 
         The calling thread takes finished pieces as a batch once it can do so and still leave
         each worker a queued piece (``batch`` at most, at least one), analyses them, queues
-        the live runs' next pieces and makes the results of the runs that ended."""
+        the live runs' next pieces and makes the results of the runs that ended. Each wake
+        costs more than its pieces (the thread's code and data are cold after the workers
+        ran), so a batch is up to half the group: per 64-run batch of 3 pieces a run, that
+        took 2.4 ms less of the calling thread's CPU than a quarter (21.1 against 23.5 ms,
+        medians of 30) and the wall time fell by 1.1 %. The pieces and so the results do
+        not depend on it."""
         g = len(self.drives)
         out = 0  # pieces queued or being simulated
         edges = [0, *range(min(lanes.nthread, g), g, PLACE_CHUNK), g]  # one tip per worker first
@@ -300,7 +305,7 @@ class _Group:
             if self.analysis is None:
                 carriage = self.ctrl[:, :, 3]
                 self.analysis = GroupAnalysis(self.rig, self.drives, self.starts, self.det, carriage)
-        batch = max(lanes.nthread, g // 4)
+        batch = max(lanes.nthread, g // 2)
         results: list[RunResult | None] = [None] * g
         while out:
             done = lanes.take(max(1, min(batch, out - 2 * lanes.nthread)))
