@@ -64,8 +64,10 @@ PIECE_STEPS = 1024
 #: Most steps an open-loop run may plan: its recording (~0.5 kB a step) stays within ~2 GiB.
 MAX_RUN_STEPS = 2**22
 #: Tips placed at a time, their first pieces then handed to the workers (the very first
-#: chunk is one tip per worker, so that each starts as soon as it can).
-PLACE_CHUNK = 4
+#: chunk is one tip per worker, so that each starts as soon as it can). Placing 16 tips
+#: (~1 ms) takes less than a first piece (~2.5 ms on the single peak), and a 64-run batch
+#: spends 1.3 ms less of its calling thread's CPU than with chunks of 4 (fewer cold calls).
+PLACE_CHUNK = 16
 
 
 def length_from_start(drive: Drive) -> bool:
