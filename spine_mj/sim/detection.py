@@ -336,4 +336,5 @@ def slip_events(slipping: np.ndarray, t: np.ndarray, start: int) -> list[Event]:
     changes = np.flatnonzero(seg[1:] != seg[:-1]) + (start + 1)
     if start >= 1 and seg.size and seg[0]:
         changes = np.concatenate([[start], changes])
-    return [Event("slip_onset" if slipping[i] else "slip_stop", i, float(t[i])) for i in changes.tolist()]
+    rows = zip(changes.tolist(), slipping[changes].tolist(), t[changes].tolist())
+    return [Event("slip_onset" if slips else "slip_stop", i, ti) for i, slips, ti in rows]

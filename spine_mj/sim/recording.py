@@ -82,7 +82,7 @@ class Recording:
 
     def run(self, r: int, rows: int | None = None) -> Recording:
         """Run ``r`` of a group, its first ``rows`` rows (all: None), as views of the group's columns."""
-        return Recording(**{k: getattr(self, k)[r, :rows] for k in COLUMNS})
+        return Recording(*[getattr(self, k)[r, :rows] for k in COLUMNS])  # fields in COLUMNS order
 
     def read_only(self) -> Recording:
         """The same columns as read-only views (slices of them are read-only too)."""
