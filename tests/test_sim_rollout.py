@@ -35,8 +35,8 @@ def test_batch_equals_one_at_a_time_and_python_reference():
 def test_controls_are_the_drives_profile_shifted_by_the_start():
     """Spring: the anchor and carriage sit at the start through the settle phase, then move
     at the drive's speed; probe: the push climbs from its start force at its rate to the
-    force cap.
-    Every start of one drive adds its position to the same profile (a batch computes it once)."""
+    force cap. Every start of one drive adds its position to the same profile (a batch
+    computes the profile once)."""
     rig = flat_rig()
     det = Detection().resolve(rig.scales)
     u, dt = rig.units, rig.engine.timestep_s
