@@ -104,12 +104,10 @@ def _pair(name: str, value) -> tuple[float, float]:
 
 
 def _range(name: str, value, *, positive: bool = True) -> tuple[float, float]:
-    try:
-        lo, hi = (float(v) for v in value)
-    except (TypeError, ValueError):
-        raise SpineInputError(f"{name} must be a pair (low, high), got {value!r}") from None
-    if not (math.isfinite(lo) and math.isfinite(hi) and lo <= hi):
-        raise SpineInputError(f"{name} must be a finite pair with low <= high, got {value!r}")
+    """``value`` as a finite pair ``(low, high)`` with low <= high (and low > 0 if ``positive``)."""
+    lo, hi = _pair(name, value)
+    if not lo <= hi:
+        raise SpineInputError(f"{name} must be a pair (low, high) with low <= high, got {value!r}")
     if positive and lo <= 0:
         raise SpineInputError(f"{name} must be > 0, got {value!r}")
     return lo, hi

@@ -221,6 +221,8 @@ def end_candidates(
 ) -> list[Ending]:
     """The endings a run reached: ``marks`` its row of each of :data:`MARK_KEYS` (-1: none),
     ``rec`` its recording."""
+    if warning is None and max(marks.values()) < 0:
+        return []  # most runs: nothing to look up
     trouble = EndReason.ENGINE_TROUBLE
     candidates = []
 

@@ -385,11 +385,8 @@ class GroupAnalysis:
         for r in range(self.g) if runs is None else runs:
             rows = int(self.rows[r])
             rec = view.run(r, rows)
-            marks = self._mark_rows[r].tolist()
-            if max(marks) < 0 and warnings[r] is None:
-                candidates = []  # most runs: what end_candidates would find, without its cost
-            else:
-                candidates = end_candidates(dict(zip(MARK_KEYS, marks)), rec, warnings[r], self.det, fp)
+            marks = dict(zip(MARK_KEYS, self._mark_rows[r].tolist()))
+            candidates = end_candidates(marks, rec, warnings[r], self.det, fp)
             kappa = math.nan
             if self.probe[r]:
                 probe, kappa = probe_candidates(rec, self.n_settle[r], self.det, fp)
