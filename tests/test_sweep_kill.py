@@ -117,13 +117,16 @@ def test_killing_one_worker_fails_its_case_and_the_sweep_goes_on(tmp_path):
     assert failed.reason.str.contains("SIGKILL").all()
 
 
+TEST_PROCESS = os.getpid()
+
+
 def crash_on_three(case):
-    if case == 3:
+    if case == 3 and os.getpid() != TEST_PROCESS:
         faulthandler.disable()  # no stack dump on stderr: the crash is the point
         os.kill(os.getpid(), signal.SIGSEGV)
     if case == 5:
         raise ValueError("five is bad")
-    return ("ok", case)
+    return ("ok", case, os.getpid())
 
 
 def test_pool_records_a_segfault_and_an_exception_as_the_case_failure_and_finishes():
@@ -138,6 +141,7 @@ def test_pool_records_a_segfault_and_an_exception_as_the_case_failure_and_finish
         parent_pid=os.getpid(),
     )
     assert sorted(r[1] for r in results) == list(range(8))
+    assert all(r[2] != TEST_PROCESS for r in results if r[0] == "ok"), "a case ran in the pool's own process"
     failed = {r[1]: r[2] for r in results if r[0] == "failed"}
     assert set(failed) == {3, 5}
     assert "SIGSEGV" in failed[3] and failed[5] == "ValueError: five is bad"

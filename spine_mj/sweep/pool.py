@@ -77,7 +77,7 @@ class _Worker:
 
 
 def failure_text(exc: BaseException) -> str:
-    """How a case's exception is reported, by a worker or by this process alike."""
+    """How a worker reports the exception of a case."""
     return f"{type(exc).__name__}: {exc}"[:500]
 
 
@@ -96,28 +96,20 @@ def death_reason(exitcode: int | None) -> str:
 def run_pool(todo: list, n_workers: int, ctx, work, on_death, handle, *, parent_pid=None) -> None:
     """Run ``work(case)`` for every case of ``todo`` in ``n_workers`` processes of ``ctx``.
 
-    Cases go to the workers from the front of ``todo``; until the first worker is up, this
-    process runs cases from the back itself (the shortest, when ``todo`` is longest first).
-    ``handle`` gets each result in this process; ``on_death(case, reason)`` gives the result
-    of a case whose worker died. ``parent_pid``: this process's pid where workers are its
-    own children (fork), None where a fork server starts them.
+    Cases go to the workers in the order of ``todo``; none runs in this process, so no case
+    can take the sweep down with it. ``handle`` gets each result in this process;
+    ``on_death(case, reason)`` gives the result of a case whose worker died. ``parent_pid``:
+    this process's pid where workers are its own children (fork), None where a fork server
+    starts them.
     """
     queue = collections.deque(todo)
     workers: list[_Worker] = []
-    state = {"ready": False, "startup_deaths": 0}
+    state = {"startup_deaths": 0}
     try:
         while queue or any(w.case is not None for w in workers):
             busy = sum(w.case is not None for w in workers)
             while len(workers) < min(n_workers, busy + len(queue)):
                 workers.append(_start(ctx, work, parent_pid))
-            if not state["ready"] and queue and not wait([w.conn for w in workers], timeout=0):
-                case = queue.pop()
-                try:
-                    result = work(case)
-                except Exception as exc:  # as a worker reports it: the case's failure
-                    result = on_death(case, failure_text(exc))
-                handle(result)
-                continue
             objs = [w.conn for w in workers] + [w.process.sentinel for w in workers]
             ready = set(wait(objs, timeout=1.0))
             for w in list(workers):
@@ -161,7 +153,7 @@ def _serve(w: _Worker, workers, queue, state, handle, on_death) -> None:
         return
     kind, payload = msg
     if kind == "ready":
-        w.ready = state["ready"] = True
+        w.ready = True
         state["startup_deaths"] = 0
     else:
         case, w.case = w.case, None
