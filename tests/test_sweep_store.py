@@ -154,3 +154,28 @@ def test_failing_runs_are_recorded_and_the_sweep_goes_on(tmp_path):
     # a finished store with failures is not re-run unless asked
     assert sweep.run_sweep(cfg, out, workers=1).run_cases == 0
     assert sweep.run_sweep(cfg, out, workers=1, retry_failed=True).run_cases == 4
+
+
+def test_a_store_held_by_a_running_sweep_is_refused_at_once_and_free_when_it_ends(tmp_path):
+    cfg = peak_config(tmp_path, nmu=2, ny=2)
+    out = tmp_path / "out"
+    sweep.run_sweep(cfg, out, workers=1)
+    holder = subprocess.Popen(
+        [
+            sys.executable,
+            "-c",
+            "import sys, time; from pathlib import Path; from spine_mj.sweep.store import store_lock\n"
+            f"with store_lock(Path({str(out)!r})):\n"
+            "    print('held', flush=True); time.sleep(120)",
+        ],
+        stdout=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert holder.stdout.readline().strip() == "held"
+        with pytest.raises(SpineInputError, match="another sweep is writing to it"):
+            sweep.run_sweep(cfg, out, workers=1)
+    finally:
+        holder.kill()
+        holder.wait()
+    assert sweep.run_sweep(cfg, out, workers=1).skipped_cases == 2
