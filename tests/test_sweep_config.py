@@ -34,6 +34,11 @@ from spine_mj.errors import SpineInputError
         (with_(surfaces__0__seeds=[1, 2]), r"surfaces\[0\]: 'paper-single-peak' takes no seed"),
         (with_(surfaces__0__file="x.npz"), r"surfaces\[0\]: give exactly one of preset or file"),
         (with_(surfaces__0__set={"nope": 1}), r"unknown parameter\(s\) \['nope'\]"),
+        (with_(surfaces__0__set={"k": "abc"}), r"surfaces\[0\].set: k must be a number, got 'abc'"),
+        (
+            with_(surfaces__0__set={"sigma_x": -1.0}),
+            r"surfaces\[0\].set: sigma_x must be a finite number > 0",
+        ),
         (with_(starts=None), r"config key starts: required"),
         (with_(starts__points=[[1.5, 0.5]]), r"starts.points: coordinates must be numbers in \[0, 1\]"),
         (with_(starts__x=[0.5]), r"config key starts: give exactly one of points, x and y, or random"),

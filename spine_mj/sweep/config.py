@@ -285,9 +285,13 @@ class _SurfaceEntry(_Table):
 
     @field_validator("overrides")
     def _generator_params(cls, overrides, info):
+        """Names the generator takes, and values it accepts: the preset is made once here
+        (with its own seed), so a bad value ends the config, not every case at run time."""
         if info.data.get("preset") is not None:
             generator = presets.load_preset(info.data["preset"]).generator
             presets.check_generator_params(generator, overrides, f"preset {info.data['preset']!r}")
+            if overrides:
+                presets.make_surface(info.data["preset"], **overrides)
         elif overrides:
             raise ValueError(f"only presets take generator overrides, got {sorted(overrides)}")
         return overrides
