@@ -2,6 +2,7 @@
 
 import json
 import os
+import re
 
 import numpy as np
 import pytest
@@ -20,23 +21,36 @@ def simulate(*args):
     return CliRunner().invoke(main, ["simulate", "paper-single-peak", "--start", "-3,-1", *map(str, args)])
 
 
-@pytest.mark.parametrize(
-    ("args", "detail"),
-    [
-        # a 1 s step at 1e6 m/s: the tip is flung through the surface
-        (["--timestep", 1, "--speed", 1e6], "below the surface"),
-        # a 1e12 N/m spring with a 10 ms step: MuJoCo's "Nan, Inf or huge value in QACC"
-        (["--stiffness", 1e12, "--timestep", 0.01], "MuJoCo warning"),
-    ],
-)
-def test_engine_blow_ups_end_as_engine_trouble_and_leave_no_mujoco_log(in_tmp, args, detail):
-    result = simulate(*args, "--out", "run")
+def test_engine_blow_ups_end_as_engine_trouble_and_leave_no_mujoco_log(in_tmp):
+    # a 1e12 N/m spring with a 10 ms step: MuJoCo's "Nan, Inf or huge value in QACC"
+    result = simulate("--stiffness", 1e12, "--timestep", 0.01, "--out", "run")
     assert result.exit_code == 0, result.output
     summary = json.loads((in_tmp / "run" / "summary.json").read_text())
     assert summary["end_reason"] == "engine_trouble"
-    assert detail in summary["end_detail"]
+    assert "MuJoCo warning" in summary["end_detail"]
     assert not (in_tmp / "MUJOCO_LOG.TXT").exists()
     assert sorted(os.listdir(in_tmp)) == ["run"]
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        # a speed beyond the largest inertia number, given as a speed rather than an I_e
+        (["--speed", 1e6], r"the drive's inertia number I_e \(speed 1e\+06 m/s\) must be <= 10000"),
+        # a step so coarse that the contact rests the tip deeper than the tolerance
+        (["--timestep", 1], r"rests the tip 0\.392 m deep .* at most 0\.0113 s"),
+        # the carriage crossing a quarter of an asperity per step
+        (["--timestep", 0.01, "--ie", 1], r"the drive advances 0\.256 L_c in one time step"),
+        (["--timestep", 1e-12], r"timestep_s must be at least 1e-09 of the time scale tau"),
+    ],
+)
+def test_a_drive_or_step_the_engine_cannot_resolve_is_refused_before_running(in_tmp, args, message):
+    """Before these were refused, a 1 s step at 1e6 m/s sank the tip through the surface and
+    a 10 ms step at I_e = 1e4 'self-locked' at the force cap in its first step."""
+    result = simulate(*args, "--out", "run")
+    assert result.exit_code == 2 and re.search(message, result.output), result.output
+    assert len(result.output.strip().splitlines()) == 1
+    assert not (in_tmp / "run").exists()
 
 
 def test_an_absurd_inertia_number_is_refused_before_running(in_tmp):

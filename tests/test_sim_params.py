@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 import pytest
-from sim_rigs import R_TIP, flat_rig
+from sim_rigs import R_TIP, START, flat_rig
 
 from spine_mj.errors import SpineInputError
 from spine_mj.sim import EngineSettings, RampDrive, Rig, SpringDrive, StaticProbe, TipParams
@@ -150,3 +150,36 @@ def test_fall_height_is_the_landing_a_slip_can_make():
     # the turn is what the tip feels over one radius: a wider tip on the same cliff
     wide = (cliff_h - mu) * cliff_h**2 / (cliff_h**2 + 4**2)
     assert fall_height(cliff, (1.0, 1.0), mu=mu, radius=4.0) == pytest.approx(wide, rel=1e-12)
+
+
+def test_a_time_step_whose_contact_rests_the_tip_too_deep_is_refused_with_the_largest_that_fits():
+    """rest_depth_m is MuJoCo's for one contact: a flat rig at 0.8 of the largest time step
+    the refusal names rests the tip 0.64 of the penetration tolerance deep, divided among
+    the contacts that carry it; 1.1 of it is refused, and so is a step below
+    MIN_TIMESTEP_TAU."""
+    import re
+
+    import mujoco
+
+    from spine_mj.sim.params import MIN_TIMESTEP_TAU, penetration_tolerance_m, rest_depth_m
+
+    base = flat_rig()
+    surface, tip = base.surface, base.tip
+    with pytest.raises(SpineInputError, match=r"rests the tip .* deep in the surface") as refused:
+        Rig(surface, tip=tip, engine=EngineSettings(timestep_s=1.0, solref=(2.0, 1.0)))
+    most = float(re.search(r"at most ([0-9.e+-]+) s", str(refused.value)).group(1))
+    near = Rig(surface, tip=tip, engine=EngineSettings(timestep_s=0.8 * most, solref=(1.6 * most, 1.0)))
+    tol = penetration_tolerance_m(near.scales)
+    assert rest_depth_m(near.engine, near.scales) == pytest.approx(0.64 * tol, rel=0.01)
+    data = mujoco.MjData(near.model)
+    data.qpos[:] = near.place(*START)
+    mujoco.mj_step(near.model, data, 400)
+    depths = np.array([-c.dist for c in data.contact[: data.ncon]]) * near.units.length_m
+    # the contacts of the hfield's triangles under the tip share the preload, each pushing
+    # in proportion to its depth
+    assert data.ncon >= 1 and depths.sum() == pytest.approx(0.64 * tol, rel=0.02)
+    with pytest.raises(SpineInputError, match="rests the tip"):
+        Rig(surface, tip=tip, engine=EngineSettings(timestep_s=1.1 * most, solref=(2.2 * most, 1.0)))
+    tiny = 0.5 * MIN_TIMESTEP_TAU * base.scales.time_s
+    with pytest.raises(SpineInputError, match=r"timestep_s must be at least 1e-09 of the time scale"):
+        Rig(surface, tip=tip, engine=EngineSettings(timestep_s=tiny, solref=(2 * tiny, 1.0)))

@@ -28,7 +28,17 @@ from spine_mj.errors import SpineInputError, atomic_output
 from spine_mj.resources import model_path
 from spine_mj.sim.drives import Drive, SpringDrive, speed_m_s, stiffness_n_m
 from spine_mj.sim.drives import stiffness_n_m as spring_stiffness_n_m
-from spine_mj.sim.params import EngineSettings, Scales, TipParams, default_engine, hfield_of
+from spine_mj.sim.params import (
+    MAX_DRIVE_ADVANCE_PER_STEP,
+    EngineSettings,
+    Scales,
+    TipParams,
+    check_drive_speed,
+    check_engine_for,
+    default_engine,
+    hfield_of,
+    rest_depth_m,
+)
 from spine_mj.sim.placement import Placer
 from spine_mj.sim.recording import SENSOR_NAMES
 from spine_mj.surfaces import BallOnFacets, Surface, TriangulatedSurface, from_hfield
@@ -109,6 +119,7 @@ class RigModel:
         self.length_scale_m = length_scale_m = self.scales.length_scale_m
         self.units = self.scales.units
         self.engine = default_engine(self.scales) if engine is None else engine
+        check_engine_for(self.engine, self.scales)
         self.hfield = hfield_of(surface, resolution)
         xmin, xmax, ymin, ymax = surface.bounds
         self.bounds_m = tuple(length_scale_m * b for b in (xmin, xmax, ymin, ymax))
@@ -317,8 +328,6 @@ class RigModel:
         self.check_starts(starts)
         if self._placer is None or self._placer.model is not self.model:
             u = self.units
-            tc, dr = self.engine.solref
-            a_p = self.scales.preload_n / self.tip.mass_kg
             self._placer = Placer(
                 self.model,
                 geom_tip=self.geom_tip,
@@ -326,7 +335,7 @@ class RigModel:
                 hfield=self.hfield,
                 length_scale=self.length_scale_m / u.length_m,
                 tip_radius=self.tip.tip_radius_m / u.length_m,
-                rest_depth=(1 - self.engine.solimp[1]) * a_p * (tc * dr) ** 2 / u.length_m,
+                rest_depth=rest_depth_m(self.engine, self.scales) / u.length_m,
             )
         return self._placer.place_many(starts)
 
@@ -357,3 +366,16 @@ class RigModel:
     def inertia_number(self, drive: Drive) -> float:
         """I_e = m v^2 / (F_p L_c) of a drive (equivalent speed for force drives)."""
         return self.scales.inertia_number(self.speed_of(drive))
+
+    def check_drive(self, drive: Drive) -> None:
+        """Refuse a drive whose inertia number is beyond :data:`MAX_INERTIA_NUMBER`, however it
+        was given (an I_e, a speed or a force rate), or that advances more than
+        :data:`MAX_DRIVE_ADVANCE_PER_STEP` L_c in one time step of this rig."""
+        speed = check_drive_speed(self.scales, self.speed_of(drive))
+        dt, lc = self.engine.timestep_s, self.scales.char_length_m
+        if speed * dt > MAX_DRIVE_ADVANCE_PER_STEP * lc:
+            raise SpineInputError(
+                f"the drive advances {speed * dt / lc:.3g} L_c in one time step of {dt:.3g} s (speed "
+                f"{speed:.3g} m/s), more than {MAX_DRIVE_ADVANCE_PER_STEP:g}: use a time step of at most "
+                f"{MAX_DRIVE_ADVANCE_PER_STEP * lc / speed:.3g} s, or none (derived)"
+            )

@@ -36,6 +36,11 @@ _REST_PENETRATION_FRACTION = 0.005
 #: Largest inertia number a drive may have: beyond it the quasistatic question is moot and
 #: the engine step (bounded by impacts at the drive speed) shrinks without end.
 MAX_INERTIA_NUMBER = 1e4
+#: Most a drive may advance in one time step, in L_c of carriage travel (for a force drive,
+#: F_p of force rise: the same number at its equivalent speed). Beyond it an asperity is
+#: crossed in a few steps and a run's ending tells of the step, not the surface; the step
+#: rule (:func:`default_engine`) keeps it below ~0.004.
+MAX_DRIVE_ADVANCE_PER_STEP = 0.1
 _IMPACT_DEPTH_OF_TOLERANCE = 0.5  # impact depth an arrival may reach, in penetration tolerances
 #: Landing speed of a tip thrown off a crest, in drive speeds: the spring's release and the
 #: fall add to the carriage's speed. Measured on the single peak and valley with the default
@@ -382,7 +387,7 @@ class Scales:
 
     def inertia_number(self, speed_m_s: float) -> float:
         """I_e = m v^2 / (F_p L_c) (paper §2.2)."""
-        return self.mass_kg * speed_m_s**2 / (self.preload_n * self.char_length_m)
+        return self.mass_kg * speed_m_s * speed_m_s / (self.preload_n * self.char_length_m)
 
     def speed_for(self, inertia_number: float) -> float:
         """The drive speed [m/s] of inertia number ``inertia_number`` (inverse of I_e).
@@ -392,13 +397,7 @@ class Scales:
         SpineInputError
             Unless ``0 < I_e <= MAX_INERTIA_NUMBER``.
         """
-        ie = check_positive("inertia number I_e", inertia_number)
-        if ie > MAX_INERTIA_NUMBER:
-            raise SpineInputError(
-                f"inertia number I_e must be <= {MAX_INERTIA_NUMBER:g} (the tip crosses an asperity "
-                f"{math.sqrt(MAX_INERTIA_NUMBER):g} times faster than the preload can move it), got {ie:g}"
-            )
-        return math.sqrt(ie) * self.speed_m_s
+        return math.sqrt(check_inertia_number(inertia_number)) * self.speed_m_s
 
     def stiffness_number(self, stiffness_n_m: float) -> float:
         """K = k l_s / F_p (docs/physics.md §4), l_s the slope correlation length."""
@@ -555,7 +554,7 @@ def default_engine(scales: Scales, *, speed_m_s: float | None = None, **override
     dt_tau = math.sqrt(_REST_PENETRATION_FRACTION * ratio)
     v = math.sqrt(2 * scales.fall_height_m / scales.char_length_m)  # engine units: a_p = 1
     if speed_m_s is not None:
-        drive = check_positive("speed_m_s", speed_m_s) * scales.time_s / scales.char_length_m
+        drive = check_drive_speed(scales, speed_m_s) * scales.time_s / scales.char_length_m
         v = max(v, _LANDING_SPEED_FACTOR * drive)
     if v > 0:
         depth = _IMPACT_DEPTH_OF_TOLERANCE * penetration_tolerance_m(scales) / scales.char_length_m
@@ -576,6 +575,61 @@ def default_engine(scales: Scales, *, speed_m_s: float | None = None, **override
         base["solref"] = (2 * float(overrides["timestep_s"]), 1.0)
     base.update(overrides)
     return EngineSettings(**base)
+
+
+def check_inertia_number(inertia_number: float, what: str = "inertia number I_e") -> float:
+    """``inertia_number`` if ``0 < I_e <= MAX_INERTIA_NUMBER``, else SpineInputError naming ``what``."""
+    if isinstance(inertia_number, (int, float)) and inertia_number > MAX_INERTIA_NUMBER * (1 + 1e-12):
+        raise SpineInputError(  # (1 + 1e-12): the limit itself, through a speed and back
+            f"{what} must be <= {MAX_INERTIA_NUMBER:g} (the tip crosses an asperity "
+            f"{math.sqrt(MAX_INERTIA_NUMBER):g} times faster than the preload can move it), "
+            f"got {inertia_number:g}"
+        )
+    return check_positive(what, inertia_number)
+
+
+def check_drive_speed(scales: Scales, speed_m_s: float) -> float:
+    """``speed_m_s`` if its inertia number is within :data:`MAX_INERTIA_NUMBER` (a speed,
+    or a force drive's equivalent speed)."""
+    speed = check_positive("speed_m_s", speed_m_s)
+    check_inertia_number(
+        scales.inertia_number(speed), f"the drive's inertia number I_e (speed {speed:.3g} m/s)"
+    )
+    return speed
+
+
+def rest_depth_m(engine: EngineSettings, scales: Scales) -> float:
+    """How deep the soft contact lets the tip rest under its preload [m]:
+    ``(1 - dmax) a_p (timeconst dampratio)^2`` with ``a_p = F_p / m`` (MuJoCo's reference
+    acceleration balancing the preload; 2e-4 min(r_tip, L_c) with :func:`default_engine`)."""
+    tc, dr = engine.solref
+    return (1 - engine.solimp[1]) * scales.preload_n / scales.mass_kg * (tc * dr) ** 2
+
+
+#: Shortest time step, in time scales tau: a tip moving L_c per tau then advances by less
+#: than 1e-9 L_c a step, of which float64 keeps only ~7 digits.
+MIN_TIMESTEP_TAU = 1e-9
+
+
+def check_engine_for(engine: EngineSettings, scales: Scales) -> None:
+    """Refuse engine settings whose contact rests the tip deeper than the penetration
+    tolerance (every run on them would end as engine trouble, and an exported model would
+    show a tip sunk into the surface; the message gives the largest time step that fits),
+    or whose step is below :data:`MIN_TIMESTEP_TAU`."""
+    if engine.timestep_s < MIN_TIMESTEP_TAU * scales.time_s:
+        raise SpineInputError(
+            f"timestep_s must be at least {MIN_TIMESTEP_TAU:g} of the time scale tau = "
+            f"{scales.time_s:.3g} s, or none (derived), got {engine.timestep_s:.3g}"
+        )
+    depth, tol = rest_depth_m(engine, scales), penetration_tolerance_m(scales)
+    if depth > tol:
+        tc, dr = engine.solref
+        most_dt = math.sqrt(tol / ((1 - engine.solimp[1]) * scales.preload_n / scales.mass_kg)) / (2 * dr)
+        raise SpineInputError(
+            f"timestep_s {engine.timestep_s:.3g} s (contact time constant {tc:.3g} s) rests the "
+            f"tip {depth:.3g} m deep in the surface, beyond the penetration tolerance "
+            f"{tol:.3g} m: use a time step of at most {most_dt:.3g} s, or none (derived)"
+        )
 
 
 def penetration_tolerance_m(scales: Scales) -> float:

@@ -317,6 +317,7 @@ def run_ramp(
     """Run the force ramp with reset from ``start`` (surface units); see :meth:`Rig.run`."""
     import mujoco
 
+    rig.check_drive(drive)
     det = (Detection() if detection is None else detection).resolve(rig.scales)
     start = start_pair(start)
     u = rig.units  # the model is in engine units (spine_mj.sim.params.EngineUnits)

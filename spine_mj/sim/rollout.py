@@ -78,6 +78,7 @@ def length_from_start(drive: Drive) -> bool:
 
 def drive_steps(rig: RigModel, drive: Drive, x0_m: float, detection: Detection) -> int:
     """Steps of the drive phase of an open-loop run starting at ``x0_m`` [m]."""
+    rig.check_drive(drive)
     dt = rig.engine.timestep_s
     if isinstance(drive, SpringDrive):
         duration = drive.duration_s
