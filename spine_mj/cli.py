@@ -85,10 +85,14 @@ class InputError(click.ClickException):
     exit_code = INPUT_ERROR_EXIT
 
 
+#: The usage error by which a group given no arguments shows its help (click >= 8.2).
+_SHOWS_HELP = tuple(e for e in [getattr(click.exceptions, "NoArgsIsHelpError", None)] if e)
+
+
 class _Group(click.Group):
-    """Turns the library's input errors into :class:`InputError` for every subcommand, and
-    so too a request too large for memory or out of floating-point range that no check at
-    the boundary caught (one line still, not a traceback)."""
+    """Turns the library's input errors and click's usage errors into :class:`InputError`
+    (one line) for every subcommand, and so too a request too large for memory or out of
+    floating-point range that no check at the boundary caught (not a traceback)."""
 
     def invoke(self, ctx):
         try:
@@ -96,6 +100,11 @@ class _Group(click.Group):
             # error line; results are checked for finiteness where it matters
             with np.errstate(all="ignore"):
                 return super().invoke(ctx)
+        except _SHOWS_HELP:
+            raise
+        except click.UsageError as exc:  # click's own: usage, hint and error in one line
+            hint = f" (see '{exc.ctx.command_path} --help')" if exc.ctx is not None else ""
+            raise InputError(exc.format_message() + hint) from None
         except SpineInputError as exc:
             root = ctx.find_root()
             if exc.details and root.params.get("verbose"):

@@ -270,3 +270,17 @@ def test_replay_at_a_speed_that_would_need_endless_frames_is_refused(tmp_path):
     )
     assert_one_error_line(run("replay", run_dir, "--duration", "-1", "--mp4", mp4), "--duration")
     assert not mp4.exists()
+
+
+@pytest.mark.parametrize(
+    ("args", "fragments"),
+    [
+        (("simulate", "paper-single-peak"), ("Missing option '--start'", "(see 'main simulate --help')")),
+        (("simulate", "paper-single-peak", "--start", "0,0", "--ie", "abc"), ("'abc' is not a valid float",)),
+        (("simulate", "paper-single-peak", "--start", "0,0", "--bogus"), ("No such option '--bogus'",)),
+        (("nosuch",), ("No such command 'nosuch'", "(see 'main --help')")),
+        (("surface", "make", "--set"), ("Option '--set' requires an argument",)),
+    ],
+)
+def test_usage_errors_are_one_line_too(args, fragments):
+    assert_one_error_line(run(*args), *fragments)
