@@ -1037,8 +1037,8 @@ def reproduce_cmd(name, out_dir, quick, surfaces, workers):
         options = {"workers": workers}
         if surfaces is not None:
             options["surfaces"] = surfaces
-    elif surfaces is not None:
-        raise SpineInputError(f"--surfaces applies to fractal-hurst only, got NAME {name!r}")
+    else:
+        _refuse_options_not_for(f"reproduce {name}", ["surfaces", "workers"])
     with Progress(name) as bar:
         numbers, fig = reproduce.run(name, quick=quick, progress=bar.update, **options)
     out = Path(out_dir)

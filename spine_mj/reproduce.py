@@ -480,9 +480,9 @@ def fractal_hurst(
     """Figs. 7E and 9: self-lock rate and concave / convex (sectional, Eq. 6) and concave /
     saddle / convex (Hessian, Eqs. 8-10) shares of self-lock points against H.
 
-    For each H, ``surfaces`` fractal surfaces (default 300, in 3 groups) get one streamline
-    each from the middle of the left edge; shares are among self-locked streamlines of a
-    group; mean and sd over the groups. The height scale follows the paper's unnormalized
+    For each H, ``surfaces`` fractal surfaces (default 300, 30 when ``quick``; in 3 groups)
+    get one streamline each from the middle of the left edge; shares are among self-locked
+    streamlines of a group; mean and sd over the groups. The height scale follows the paper's unnormalized
     synthesis (:func:`raw_rms_height`) times ``scale`` from the preset: a fixed spectral
     prefactor, so roughness grows with H when frequencies are in cycles per pixel
     (``frequency_unit = "pixel"``) and barely changes with ``"length"``.
@@ -497,9 +497,10 @@ def fractal_hurst(
     hursts = list(
         hursts if hursts is not None else rep.get("hursts", [0.65, 0.7, 0.75, 0.8, 0.85, 0.9, 0.95])
     )
-    n = int(surfaces if surfaces is not None else rep.get("surfaces", 300))
-    if quick:
-        n = min(n, 30)
+    if surfaces is not None:  # given, it is what runs, quick or not
+        n = int(surfaces)
+    else:
+        n = min(int(rep.get("surfaces", 300)), 30) if quick else int(rep.get("surfaces", 300))
     groups = int(rep.get("groups", 3))
     if n < groups:
         raise SpineInputError(f"surfaces must be >= groups ({groups}), got {n}")

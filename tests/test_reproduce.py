@@ -103,3 +103,16 @@ def test_random_surface_single_peak_normalization_and_finite_max_kappa():
     ok = np.isfinite(fin)
     assert np.all(fin[ok] <= inf[ok]) and not np.isposinf(fin).any()
     assert np.array_equal(np.isposinf(inf), res.self_locked)
+
+
+def test_options_are_used_or_refused_never_ignored(tmp_path):
+    """--surfaces given with --quick is what runs (quick only sets the default); --workers
+    and --surfaces of a figure that takes neither are refused."""
+    from spine_mj.reproduce import fractal_hurst
+
+    numbers, _ = fractal_hurst(quick=True, surfaces=36, hursts=[0.8], workers=1)
+    assert numbers["surfaces_per_hurst"] == 36 and numbers["by_hurst"][0]["surfaces"] == 36
+    for option in (["--workers", "4"], ["--surfaces", "10"]):
+        res = CliRunner().invoke(main, ["reproduce", "kappa-map", "--out", str(tmp_path), *option])
+        assert res.exit_code == 2 and f"reproduce kappa-map does not use {option[0]}" in res.output
+    assert list(tmp_path.iterdir()) == []
