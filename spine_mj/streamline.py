@@ -306,6 +306,29 @@ def _starts(surface: Surface, starts) -> tuple[np.ndarray, np.ndarray]:
     return np.ascontiguousarray(arr[:, 0]), np.ascontiguousarray(arr[:, 1])
 
 
+#: Smallest step length, relative to the largest coordinate of the surface's bounds: below
+#: it, ``x + dl`` keeps too few of dl's digits (float64) for a path to advance truly.
+MIN_STEP_OF_COORDINATES = 1e-9
+
+
+def _check_step(surface: Surface, dl: float) -> None:
+    """Refuse a step length ``dl`` no path can use on ``surface``: not smaller than the
+    domain (every path leaves at its first step) or lost in the rounding of a position."""
+    xmin, xmax, ymin, ymax = surface.bounds
+    size = min(xmax - xmin, ymax - ymin)
+    if dl >= size:
+        raise SpineInputError(
+            f"dl must be smaller than the surface's domain ({size:g} across), got {dl:g}: "
+            "every path would leave it at its first step"
+        )
+    scale = max(abs(xmin), abs(xmax), abs(ymin), abs(ymax), size)
+    if dl < MIN_STEP_OF_COORDINATES * scale:
+        raise SpineInputError(
+            f"dl must be at least {MIN_STEP_OF_COORDINATES:g} of the surface's coordinates "
+            f"(up to {scale:g}), got {dl:g}: a step would be lost in rounding"
+        )
+
+
 def _trajectories(surface, starts, params, *, ideal, store_paths, backend):
     if not isinstance(surface, Surface):
         raise SpineInputError(f"surface must be a spine_mj Surface, got {type(surface).__name__}")
@@ -314,6 +337,7 @@ def _trajectories(surface, starts, params, *, ideal, store_paths, backend):
     if backend not in ("numba", "numpy", "auto"):
         raise SpineInputError(f"backend must be 'numba', 'numpy' or 'auto', got {backend!r}")
     xs, ys = _starts(surface, starts)
+    _check_step(surface, params.dl)
     data = _surface_data(surface)
     if backend == "numba" and data is None:
         raise SpineInputError(

@@ -190,6 +190,11 @@ def test_bad_input_names_the_argument():
         streamlines(surf, [[1.0, 2.0, 3.0]], StreamlineParams(mu=1.0))
     with pytest.raises(SpineInputError, match="dl"):
         StreamlineParams(mu=1.0, dl=-0.1)
+    # steps no path can use: across the whole domain (10 wide), or lost in x + dl
+    with pytest.raises(SpineInputError, match=r"dl must be smaller than the surface's domain \(10 across\)"):
+        streamlines(surf, [(0.0, 0.0)], StreamlineParams(mu=1.0, dl=10.0))
+    with pytest.raises(SpineInputError, match="dl must be at least 1e-09 of the surface's coordinates"):
+        ideal_trajectories(surf, [(0.0, 0.0)], StreamlineParams(mu=1.0, dl=1e-12))
     with pytest.raises(SpineInputError, match="mu"):
         StreamlineParams(mu=0.0)
     with pytest.raises(SpineInputError, match="radius"):
