@@ -482,10 +482,10 @@ def fractal_hurst(
 
     For each H, ``surfaces`` fractal surfaces (default 300, 30 when ``quick``; in 3 groups)
     get one streamline each from the middle of the left edge; shares are among self-locked
-    streamlines of a group; mean and sd over the groups. The height scale follows the paper's unnormalized
-    synthesis (:func:`raw_rms_height`) times ``scale`` from the preset: a fixed spectral
-    prefactor, so roughness grows with H when frequencies are in cycles per pixel
-    (``frequency_unit = "pixel"``) and barely changes with ``"length"``.
+    streamlines of a group; mean and sd over the groups. The height scale follows the
+    paper's unnormalized synthesis (:func:`raw_rms_height`) times ``scale`` from the
+    preset: a fixed spectral prefactor, so roughness grows with H when frequencies are in
+    cycles per pixel (``frequency_unit = "pixel"``) and barely changes with ``"length"``.
 
     ``lock_point`` (preset ``[reproduce] lock_point``): ``"lock"`` classifies the first
     self-lock point the trajectory reaches, ``"before"`` the engaged point one step
@@ -497,10 +497,8 @@ def fractal_hurst(
     hursts = list(
         hursts if hursts is not None else rep.get("hursts", [0.65, 0.7, 0.75, 0.8, 0.85, 0.9, 0.95])
     )
-    if surfaces is not None:  # given, it is what runs, quick or not
-        n = int(surfaces)
-    else:
-        n = min(int(rep.get("surfaces", 300)), 30) if quick else int(rep.get("surfaces", 300))
+    default = int(rep.get("surfaces", 300))
+    n = int(surfaces) if surfaces is not None else (min(default, 30) if quick else default)
     groups = int(rep.get("groups", 3))
     if n < groups:
         raise SpineInputError(f"surfaces must be >= groups ({groups}), got {n}")
