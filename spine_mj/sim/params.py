@@ -387,7 +387,7 @@ class Scales:
 
     def inertia_number(self, speed_m_s: float) -> float:
         """I_e = m v^2 / (F_p L_c) (paper §2.2)."""
-        return self.mass_kg * speed_m_s * speed_m_s / (self.preload_n * self.char_length_m)
+        return self.mass_kg * speed_m_s**2 / (self.preload_n * self.char_length_m)
 
     def speed_for(self, inertia_number: float) -> float:
         """The drive speed [m/s] of inertia number ``inertia_number`` (inverse of I_e).
@@ -592,9 +592,11 @@ def check_drive_speed(scales: Scales, speed_m_s: float) -> float:
     """``speed_m_s`` if its inertia number is within :data:`MAX_INERTIA_NUMBER` (a speed,
     or a force drive's equivalent speed)."""
     speed = check_positive("speed_m_s", speed_m_s)
-    check_inertia_number(
-        scales.inertia_number(speed), f"the drive's inertia number I_e (speed {speed:.3g} m/s)"
-    )
+    try:
+        ie = scales.inertia_number(speed)
+    except OverflowError:  # speed**2 beyond float range
+        ie = math.inf
+    check_inertia_number(ie, f"the drive's inertia number I_e (speed {speed:.3g} m/s)")
     return speed
 
 
