@@ -429,17 +429,20 @@ def sweep_run(config, out_dir, workers, scheduler, overwrite, retry_failed, quie
 
     cfg = sw.load_config(config)
     with Progress(cfg.name, unit="case", quiet=quiet) as bar:
-        summary = sw.run_sweep(
-            cfg,
-            out_dir,
-            workers=workers,
-            scheduler=scheduler,
-            overwrite=overwrite,
-            retry_failed=retry_failed,
-            progress=lambda p: bar.update(
-                p.finished_cases + p.skipped_cases, p.total_cases, ok=p.ok_runs, failed=p.failed_runs
-            ),
-        )
+        try:
+            summary = sw.run_sweep(
+                cfg,
+                out_dir,
+                workers=workers,
+                scheduler=scheduler,
+                overwrite=overwrite,
+                retry_failed=retry_failed,
+                progress=lambda p: bar.update(
+                    p.finished_cases + p.skipped_cases, p.total_cases, ok=p.ok_runs, failed=p.failed_runs
+                ),
+            )
+        except sw.WorkersCannotStart as exc:  # the environment, not the input: exit code 1
+            raise click.ClickException(f"{exc}; the finished cases are kept, a re-run resumes") from None
     if summary.rerun_corrupt:
         click.echo(
             f"ran again {len(summary.rerun_corrupt)} case(s) whose stored rows could not be read: "

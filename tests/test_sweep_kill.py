@@ -143,3 +143,64 @@ def test_pool_records_a_segfault_and_an_exception_as_the_case_failure_and_finish
     failed = {r[1]: r[2] for r in results if r[0] == "failed"}
     assert set(failed) == {3, 5}
     assert "SIGSEGV" in failed[3] and failed[5] == "ValueError: five is bad"
+
+
+class _StartsInstead:
+    """A multiprocessing context whose processes run ``target(*args)`` instead of the pool's
+    worker loop: real processes that die or hang before their first case."""
+
+    def __init__(self, target, args=()):
+        self._ctx, self._target, self._args = multiprocessing.get_context("fork"), target, args
+
+    def Pipe(self):
+        return self._ctx.Pipe()
+
+    def Process(self, *, target, args, daemon):
+        return self._ctx.Process(target=self._target, args=self._args, daemon=daemon)
+
+
+@pytest.mark.parametrize(
+    ("start", "what"),
+    [((os._exit, (3,)), "exited with code 3"), ((time.sleep, (600,)), "ended by SIGKILL")],
+    ids=["dies", "hangs"],
+)
+def test_workers_that_die_or_hang_before_their_first_case_end_the_pool_with_the_cause(
+    monkeypatch, start, what
+):
+    import spine_mj.sweep.pool as pool
+
+    monkeypatch.setattr(pool, "STARTUP_TIMEOUT_S", 0.5)
+    with pytest.raises(pool.WorkersCannotStart, match=f"die \\(or hang\\) before their first case .*{what}"):
+        run_pool(
+            list(range(4)), 2, _StartsInstead(*start), crash_on_three, None, None, parent_pid=os.getpid()
+        )
+
+
+def test_a_sweep_whose_workers_cannot_start_ends_in_one_line_and_resumes(tmp_path, monkeypatch):
+    from click.testing import CliRunner
+
+    from spine_mj.cli import main
+    from spine_mj.sweep import executors
+
+    def dying_pool(todo, n_workers, handle):  # workers that exit before their first case
+        run_pool(
+            todo,
+            n_workers,
+            _StartsInstead(os._exit, (3,)),
+            executors.encoded_case,
+            executors.dead_worker_case,
+            handle,
+            parent_pid=os.getpid(),
+        )
+
+    cfg = peak_config(tmp_path, nmu=4, ny=2)
+    out = tmp_path / "out"
+    monkeypatch.setattr(executors, "_run_pool", dying_pool)
+    result = CliRunner().invoke(main, ["sweep", str(cfg), "--out", str(out), "--workers", "2", "--quiet"])
+    lines = [line for line in result.output.splitlines() if line.strip()]
+    assert result.exit_code == 1 and len(lines) == 1, result.output
+    assert lines[0].startswith("Error: sweep worker processes die (or hang) before their first case")
+    assert "a re-run resumes" in lines[0]
+    monkeypatch.undo()
+    summary = sweep.run_sweep(cfg, out, workers=2)
+    assert summary.run_cases == 4 and set(sweep.load_runs(out).status) == {"ok"}

@@ -54,6 +54,7 @@ and :mod:`~spine_mj.sweep.analyses` (the built-in analyses, registered on import
 from spine_mj.sweep.analyses import MUJOCO_PARAMS, QUASISTATIC_PARAMS
 from spine_mj.sweep.cases import Case, expand_cases
 from spine_mj.sweep.config import StartsSpec, SurfaceSpec, SweepConfig, load_config, parse_config
+from spine_mj.sweep.pool import WorkersCannotStart
 from spine_mj.sweep.registry import (
     ANALYSES,
     REQUIRED,
@@ -84,6 +85,7 @@ __all__ = [
     "SurfaceSpec",
     "SweepConfig",
     "SweepSummary",
+    "WorkersCannotStart",
     "consolidate",
     "expand_cases",
     "load_config",

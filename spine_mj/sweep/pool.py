@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import collections
 import ctypes
-import ctypes.util
 import os
 import signal
 import sys
@@ -26,6 +25,15 @@ from multiprocessing.connection import wait
 WATCHDOG_PERIOD_S = 0.5
 #: Workers that die before their first case, in a row, before the pool gives up.
 MAX_STARTUP_DEATHS = 3
+#: Seconds a worker may take to report ready (a fork takes milliseconds, a fork server's
+#: first start its imports, ~1-2 s); one that takes longer is hung, is killed and counts
+#: as a death before its first case.
+STARTUP_TIMEOUT_S = 120.0
+
+
+class WorkersCannotStart(RuntimeError):
+    """Worker processes die or hang before their first case, :data:`MAX_STARTUP_DEATHS` in
+    a row: something in the environment (memory, a broken install), not in a case."""
 
 
 def die_with_parent(parent_pid: int | None) -> None:
@@ -35,7 +43,9 @@ def die_with_parent(parent_pid: int | None) -> None:
     ``os.getppid()`` now); a parent already gone ends this process at once.
     """
     if sys.platform.startswith("linux"):
-        libc = ctypes.CDLL(ctypes.util.find_library("c") or None, use_errno=True)
+        # the running program's own symbols (libc's among them): find_library would start a
+        # subprocess, which a child forked from a threaded process must not
+        libc = ctypes.CDLL(None, use_errno=True)
         libc.prctl(1, int(signal.SIGKILL), 0, 0, 0)  # PR_SET_PDEATHSIG
     expected = os.getppid() if parent_pid is None else parent_pid
     if os.getppid() != expected:
@@ -73,7 +83,7 @@ class _Worker:
     conn: object
     case: object = None
     ready: bool = False
-    sent: list = field(default_factory=list)
+    started: float = field(default_factory=time.monotonic)
 
 
 def failure_text(exc: BaseException) -> str:
@@ -112,6 +122,9 @@ def run_pool(todo: list, n_workers: int, ctx, work, on_death, handle, *, parent_
                 workers.append(_start(ctx, work, parent_pid))
             objs = [w.conn for w in workers] + [w.process.sentinel for w in workers]
             ready = set(wait(objs, timeout=1.0))
+            for w in workers:
+                if not w.ready and time.monotonic() - w.started > STARTUP_TIMEOUT_S:
+                    w.process.kill()  # hung before its first case: its death is seen next
             for w in list(workers):
                 if w.conn in ready or w.process.sentinel in ready:
                     _serve(w, workers, queue, state, handle, on_death)
@@ -146,8 +159,8 @@ def _serve(w: _Worker, workers, queue, state, handle, on_death) -> None:
         elif not w.ready:
             state["startup_deaths"] += 1
             if state["startup_deaths"] >= MAX_STARTUP_DEATHS:
-                raise RuntimeError(
-                    f"sweep worker processes die before their first case "
+                raise WorkersCannotStart(
+                    f"sweep worker processes die (or hang) before their first case "
                     f"({death_reason(w.process.exitcode)}); run with --workers 1 to see why"
                 )
         return

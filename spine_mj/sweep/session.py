@@ -136,6 +136,14 @@ def run_sweep(
     Returns
     -------
     SweepSummary
+
+    Raises
+    ------
+    SpineInputError
+        A bad config, store, worker count or scheduler address.
+    WorkersCannotStart
+        Local worker processes die or hang before their first case (the finished cases
+        are kept; a re-run resumes).
     """
     if not isinstance(config, SweepConfig):
         config = load_config(config)
