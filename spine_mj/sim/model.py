@@ -317,7 +317,7 @@ class RigModel:
 
         The sphere centre is found by a safeguarded Newton search in z on the engine's own
         sphere-hfield distance (to 1e-7 tip radii), then lowered by the soft contact's resting depth
-        ``(1 - dmax) (F_p / m) (timeconst dampratio)^2``: it starts at rest and in
+        under one contact (:func:`~spine_mj.sim.params.rest_depth_m`): it starts at rest and in
         contact, never dropped (a start just above the surface falls for one step).
         """
         return self.place_many([(x0, y0)])[0]
