@@ -41,6 +41,7 @@ __all__ = [
     "HField",
     "Surface",
     "TriangulatedSurface",
+    "corrugation",
     "fractal_fbm",
     "from_hfield",
     "length_unit",
@@ -555,6 +556,56 @@ def single_gaussian(
     )
 
 
+def corrugation(
+    *,
+    wavelength: float = 1.0,
+    slope_amplitude: float = 0.3,
+    n_waves: int = 8,
+    width: float = 1.0,
+    points_per_wave: int = 32,
+) -> GridSurface:
+    """A sinusoidal corrugation ``z = h sin(2 pi x / lambda)``, uniform in y: the
+    Prandtl-Tomlinson profile, a surface whose dynamics have closed forms (docs/physics.md).
+
+    ``h = slope_amplitude * wavelength / (2 pi)``, so the steepest slope is
+    ``slope_amplitude``; ``L_c = wavelength`` (rms height over rms slope times 2 pi) and the
+    slope correlation length is ``0.190 wavelength``. The grid is periodic in x over
+    ``n_waves`` whole wavelengths starting at x = 0 (a crest's rising flank begins there)
+    and spans ``width`` in y, centred on y = 0. Dimensionless.
+    """
+    lam = check_positive("wavelength", wavelength)
+    s = float(slope_amplitude)
+    if not (math.isfinite(s) and 0.0 <= s <= 10.0):
+        raise SpineInputError(f"slope_amplitude must lie in [0, 10], got {slope_amplitude!r}")
+    waves = _count_at_least("n_waves", n_waves, 1)
+    per_wave = _count_at_least("points_per_wave", points_per_wave, 8)
+    w = check_positive("width", width)
+    nx = waves * per_wave
+    dx = lam / per_wave
+    ny = max(_MIN_POINTS_PER_SIDE, int(math.ceil(w / dx)))
+    check_grid_size(nx, ny, where="corrugation")
+    x = np.arange(nx) * dx
+    y = -w / 2 + np.arange(ny) * (w / ny)
+    h = s * lam / (2 * math.pi)
+    heights = np.broadcast_to(h * np.sin(2 * math.pi * x / lam), (ny, nx)).copy()
+    return GridSurface(
+        heights=heights,
+        x=x,
+        y=y,
+        periodic=True,
+        unit="1",
+        metadata=_meta(
+            "corrugation",
+            None,
+            wavelength=lam,
+            slope_amplitude=s,
+            n_waves=waves,
+            width=w,
+            points_per_wave=per_wave,
+        ),
+    )
+
+
 def random_gaussians(
     *,
     n_peaks: int = 100,
@@ -767,6 +818,14 @@ def _grid_count(name: str, n) -> int:
     ok = isinstance(n, (int, np.integer, float, np.floating)) and not isinstance(n, (bool, np.bool_))
     if not ok or not math.isfinite(n) or int(n) != n or n < _MIN_POINTS_PER_SIDE:
         raise SpineInputError(f"{name} must be an integer >= {_MIN_POINTS_PER_SIDE}, got {n!r}")
+    return int(n)
+
+
+def _count_at_least(name: str, n, least: int) -> int:
+    """``n`` as an integer count of at least ``least``."""
+    ok = isinstance(n, (int, np.integer, float, np.floating)) and not isinstance(n, (bool, np.bool_))
+    if not ok or not math.isfinite(n) or int(n) != n or n < least or n > MAX_GRID_POINTS:
+        raise SpineInputError(f"{name} must be an integer in [{least}, {MAX_GRID_POINTS}], got {n!r}")
     return int(n)
 
 
