@@ -58,8 +58,10 @@ Modules: :mod:`~spine_mj.sim.params` (tip, engine, scales and their rules),
 (:class:`Rig`, the object users hold).
 """
 
+from spine_mj.sim.array import ArrayResult, ArrayRig, ForcePull
 from spine_mj.sim.detection import Detection, Event
 from spine_mj.sim.drives import Drive, RampDrive, SpringDrive, StaticProbe
+from spine_mj.sim.layout import Layout, LayoutKind
 from spine_mj.sim.model import MODEL_PATH
 from spine_mj.sim.params import (
     DEFAULT_LENGTH_SCALE_M,
@@ -88,6 +90,8 @@ __all__ = [
     "MAX_INERTIA_NUMBER",
     "MODEL_PATH",
     "REFINE_TIMESTEP",
+    "ArrayResult",
+    "ArrayRig",
     "Cone",
     "Detection",
     "Drive",
@@ -95,7 +99,10 @@ __all__ = [
     "EngineSettings",
     "EngineUnits",
     "Event",
+    "ForcePull",
     "Integrator",
+    "Layout",
+    "LayoutKind",
     "RampDrive",
     "Rig",
     "RunResult",
