@@ -27,7 +27,7 @@ LET_GO_TRAVEL_LC = 2.0
 
 #: Steps of each piece of an array run between two looks at its end conditions.
 ARRAY_PIECE_STEPS = 1024
-#: Most rows an array run keeps (every ``stride``-th step is recorded; maxima and the
+#: Rows an array run keeps before it thins them to every other (maxima and the
 #: end conditions read every step).
 MAX_RECORDED_ROWS = 2000
 #: A force-controlled run holds its full pull this long, in ramp steps, before it counts as held.
@@ -73,7 +73,7 @@ ArrayDrive = SpringDrive | ForcePull
 
 @dataclass(frozen=True, eq=False)
 class ArrayResult:
-    """One array run (SI units). ``m`` recorded rows (every ``stride``-th step), ``N`` spines.
+    """One array run (SI units). ``m`` recorded rows (``step_index``), ``N`` spines.
 
     Attributes
     ----------
@@ -101,7 +101,10 @@ class ArrayResult:
         ``completed``, ``left_domain`` (a tip reached the domain's edge), ``locked`` (every
         spine self-locked), ``held`` (force control: the full pull held) or ``engine_trouble``.
     end_detail : str
-    simulated_steps, stride : int
+    simulated_steps : int
+    step_index : (m,) int
+        The step each recorded row is the state after (0: the first step); every
+        ``2^j``-th step is kept, at most ~2 :data:`MAX_RECORDED_ROWS` rows, plus the last.
     """
 
     time_s: np.ndarray
@@ -118,7 +121,7 @@ class ArrayResult:
     end_reason: str
     end_detail: str
     simulated_steps: int
-    stride: int
+    step_index: np.ndarray
 
     @property
     def n_spines(self) -> int:
@@ -141,8 +144,18 @@ class _Run:
         self.locked = np.zeros(n_spines, dtype=bool)
         self.hold = -np.inf  # largest total spring force so far (engine units)
         self.held_x = init[0, 1 + 3 * n_spines] if init.shape[1] > 1 + 3 * n_spines else 0.0
-        self.rows: list[tuple] = []
+        self.rows: list[tuple] = []  # kept rows: (time, X, forces, positions, pull, step index)
+        self.stride, self.kept = 1, 0
         self.end: tuple[str, str] | None = None
+
+    def thin(self) -> None:
+        """Keep every other kept row (and the last): the stride doubles."""
+        cols = [np.concatenate(c) for c in zip(*self.rows)]
+        steps = cols[-1]
+        self.stride *= 2
+        keep = ((steps + 1) % self.stride == 0) | (np.arange(steps.size) == steps.size - 1)
+        self.rows = [tuple(c[keep] for c in cols)]
+        self.kept = int(keep.sum())
 
 
 class ArrayBatch:
@@ -294,8 +307,7 @@ class ArrayBatch:
         else:
             run.hold = max(run.hold, float(f[keep].sum(axis=1).max()))
         run.locked = locked_by_row[last - 1]
-        stride = self.stride(k)
-        pick = np.flatnonzero(((rows[keep] + 1) % stride == 0) | (np.arange(last) == last - 1))
+        pick = np.flatnonzero(((rows[keep] + 1) % run.stride == 0) | (np.arange(last) == last - 1))
         u = self.u
         pull = self.pull(k, rows[pick]) * u.force_n if self.force else np.full(pick.size, np.nan)
         run.rows.append(
@@ -305,8 +317,12 @@ class ArrayBatch:
                 f[pick] * u.force_n,
                 pos[pick] * u.length_m,
                 pull,
+                rows[pick],
             )
         )
+        run.kept += pick.size
+        if run.kept > 2 * MAX_RECORDED_ROWS:
+            run.thin()
         run.last = st[last - 1 : last].copy()
         run.done = a + last
 
@@ -319,12 +335,9 @@ class ArrayBatch:
                 return "held", f"the full pull {self.n * self.cap:g} F_p held"
         return "completed", "the drive's duration elapsed"
 
-    def stride(self, k: int) -> int:
-        return max(1, -(-self.plans[k][1] // MAX_RECORDED_ROWS))
-
     def result(self, k: int) -> ArrayResult:
         run, u = self.runs[k], self.u
-        t, X, f, pos, pull = (np.concatenate(c) for c in zip(*run.rows))
+        t, X, f, pos, pull, steps = (np.concatenate(c) for c in zip(*run.rows))
         fp = self.arr.rig.scales.preload_n
         total_f = f.sum(axis=1)
         hold = run.hold * u.force_n
@@ -343,7 +356,7 @@ class ArrayBatch:
             end_reason=run.end[0] if run.end else "completed",
             end_detail=run.end[1] if run.end else "",
             simulated_steps=int(run.done),
-            stride=self.stride(k),
+            step_index=steps,
         )
 
 
