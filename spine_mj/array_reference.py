@@ -150,3 +150,57 @@ def force_control_release(carriage: np.ndarray, total: np.ndarray, *, rel_tol: f
     first = float(total[j_first])
     caught = float(total[j_best]) > first * (1 + rel_tol)
     return Release(first, float(total[j_best]), caught, float(carriage[j_first]), float(carriage[j_best]))
+
+
+#: Outcomes of a compliant path that hold the spine where it ended (its spring then
+#: stretches to the cap): the self-lock region, the force cap, and a stall (a tip wedged in
+#: a crease, which a single-contact path cannot leave; docs/physics.md §6, the V-groove).
+_HELD = ("SELF_LOCKED", "FORCE_CAP", "STALLED")
+
+
+def compliant_spine_curves(
+    result, carriage: np.ndarray, *, kappa_cap: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """Each spine's quasistatic force over preload at carriage displacements ``carriage``
+    from a :class:`~spine_mj.compliant.CompliantResult` (one path per spine, spring relaxed
+    at the start).
+
+    The spring stretches with the tip stuck until the first path point (``F = c X``),
+    follows the path's carriage and force (a slip, the carriage still, drops the force to
+    the landing's), and past the path's end either keeps stretching up to ``kappa_cap``
+    (a held spine: self-locked, capped or stalled) or is NaN (it left the domain).
+
+    Returns
+    -------
+    forces : (N, m) array
+    locked : (N,) bool
+        Spines that reach ``kappa_cap`` within ``carriage``.
+    """
+    from spine_mj.streamline import Outcome
+
+    carriage = np.asarray(carriage, dtype=float)
+    c = float(result.stiffness)
+    held_codes = [int(getattr(Outcome, name)) for name in _HELD]
+    n = len(result)
+    forces = np.full((n, carriage.size), np.nan)
+    locked = np.zeros(n, dtype=bool)
+    for i in range(n):
+        p = result.path(i)
+        x0 = float(result.start_x[i])
+        car = np.concatenate([[x0], p["carriage"]]) - x0
+        frc = np.concatenate([[0.0], p["force"]])
+        ok = np.isfinite(car) & np.isfinite(frc)
+        car, frc = np.maximum.accumulate(car[ok]), frc[ok]
+        j = np.clip(np.searchsorted(car, carriage, side="right") - 1, 0, car.size - 1)
+        nxt = np.minimum(j + 1, car.size - 1)
+        span = car[nxt] - car[j]
+        w = np.where(span > 0, (carriage - car[j]) / np.where(span > 0, span, 1.0), 0.0)
+        f = frc[j] + np.clip(w, 0, 1) * (frc[nxt] - frc[j])
+        beyond = carriage > car[-1]
+        if int(result.outcome[i]) in held_codes:
+            f = np.where(beyond, np.minimum(frc[-1] + c * (carriage - car[-1]), kappa_cap), f)
+            locked[i] = bool(np.any(f >= kappa_cap * (1 - 1e-9)))
+        else:
+            f = np.where(beyond, np.nan, f)
+        forces[i] = np.minimum(f, kappa_cap)
+    return forces, locked

@@ -124,7 +124,7 @@ class Layout:
         rng = np.random.default_rng(self.seed)
         lx, ly = self.footprint(s)
         n = self.n_spines
-        if gap > 0 and n * math.pi * (gap / 2) ** 2 > 0.5 * lx * ly:
+        if gap > 0 and n > 1 and n * math.pi * (gap / 2) ** 2 > 0.5 * lx * ly:
             raise SpineInputError(
                 f"spacing {s:g} is too small for {n} random spines {gap:g} apart: raise the spacing"
             )

@@ -325,6 +325,7 @@ def write_report(
     sand: SandpaperResult,
     fractal: FractalLockResult | None = None,
     kmap: StiffnessMapResult | None = None,
+    arrays=None,
 ) -> Path:
     """Write the figures under ``out/figures`` and ``out/report.md``; returns the report path.
 
@@ -368,6 +369,15 @@ def write_report(
         engine_settings=json.dumps(result["engine_settings"], indent=2, default=str),
         timings=", ".join(f"{k} {sig(v)}" for k, v in result["timings_s"].items()),
     )
+    if arrays is not None:  # the array study (issue 27)
+        from spine_mj.validate.array_report import array_figure, array_section
+
+        fig = array_figure(arrays, figs / "arrays.png")
+        text = (
+            text.rstrip("\n")
+            + "\n\n"
+            + array_section(arrays, fig.relative_to(out).as_posix() if fig else None)
+        )
     path = out / "report.md"
     with atomic_output(path) as tmp:
         tmp.write_text(text)

@@ -14,6 +14,7 @@ from spine_mj import sim
 from spine_mj.errors import SpineInputError
 from spine_mj.jsonio import write_json
 from spine_mj.surfaces import single_gaussian
+from spine_mj.validate.array_study import array_study
 from spine_mj.validate.boundary import BoundaryResult, boundary
 from spine_mj.validate.fractal_lock import FractalLockResult, fractal_lock
 from spine_mj.validate.plans import (
@@ -97,11 +98,16 @@ def run_validation(
     )
     fr = timed("fractal_lock", fractal_lock, plan, runner)
     km = timed("stiffness_map", stiffness_map, plan, runner)
+    runner.study = "arrays"
+    arrays = timed("arrays", array_study, plan, runner)
     runner.study = "report"
     runner.note("figures and report")
     result = _summary(plan, st, lim, bnd, ss, sp, timings, fr)
     result.update(_stiffness_map_summary(km))
-    write_report(out, result, static=st, limit=lim, boundary=bnd, stick=ss, sand=sp, fractal=fr, kmap=km)
+    result["arrays"] = arrays.as_dict()
+    write_report(
+        out, result, static=st, limit=lim, boundary=bnd, stick=ss, sand=sp, fractal=fr, kmap=km, arrays=arrays
+    )
     result["timings_s"]["total"] = round(time.perf_counter() - t0, 2)
     write_json(out / "validation.json", result)
     return result
