@@ -9,6 +9,7 @@ from pathlib import Path
 import click
 
 from spine_mj import presets, sim, surface_io
+from spine_mj.atomic import all_or_none, atomic_output
 from spine_mj.cli.app import (
     InputError,
     Progress,
@@ -19,7 +20,7 @@ from spine_mj.cli.app import (
     parse_start,
     refuse_options_not_for,
 )
-from spine_mj.errors import SpineInputError, all_or_none, atomic_output, check_positive
+from spine_mj.errors import SpineInputError, check_positive
 from spine_mj.jsonio import write_json
 from spine_mj.plotting import (
     save_figure,

@@ -8,13 +8,14 @@ import click
 import numpy as np
 
 from spine_mj import presets, roughness, surface_io
+from spine_mj.atomic import all_or_none, atomic_output
 from spine_mj.cli.app import (
     _Group,
     check_suffix,
     load_surface_arg,
     main,
 )
-from spine_mj.errors import SpineInputError, all_or_none, atomic_output, check_positive
+from spine_mj.errors import SpineInputError, check_positive
 from spine_mj.jsonio import to_jsonable
 from spine_mj.plotting import (
     roughness_figure,

@@ -9,6 +9,7 @@ import numpy as np
 import pandas as pd
 
 from spine_mj import engagement, presets, reproduce
+from spine_mj.atomic import all_or_none, atomic_output
 from spine_mj.cli.app import (
     Progress,
     check_suffix,
@@ -18,7 +19,7 @@ from spine_mj.cli.app import (
     refuse_options_not_for,
 )
 from spine_mj.engagement import kappa
-from spine_mj.errors import SpineInputError, all_or_none, atomic_output
+from spine_mj.errors import SpineInputError
 from spine_mj.jsonio import write_json
 from spine_mj.plotting import (
     kappa_map_figure,

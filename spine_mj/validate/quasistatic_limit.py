@@ -18,8 +18,8 @@ from spine_mj.compare import MISS_REASONS
 from spine_mj.presets import calibrated_mu
 from spine_mj.validate.paths import stored_paths, tip_radius
 from spine_mj.validate.plans import FRECHET_TARGET, OUTCOME_TARGET, RECOMMENDED, FamilySpec, ValidationPlan
-from spine_mj.validate.runner import StudyRunner
-from spine_mj.validate.sweep_docs import engine_grid, family_doc
+from spine_mj.validate.study_runner import StudyRunner
+from spine_mj.validate.sweep_configs import engine_grid, family_doc
 
 __all__ = ["LimitPath", "QuasistaticLimitResult", "quasistatic_limit"]
 

@@ -11,8 +11,8 @@ from pathlib import Path
 
 import numpy as np
 
+from spine_mj.atomic import atomic_output
 from spine_mj.compare import MISS_REASONS
-from spine_mj.errors import atomic_output
 from spine_mj.plotting import (
     DIVERGING_CMAP,
     PATH_COLORS,

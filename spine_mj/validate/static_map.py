@@ -13,8 +13,8 @@ import numpy as np
 
 from spine_mj import engagement, sim, surface_io
 from spine_mj.validate.plans import GRAVITY, MASS_KG, ValidationPlan
-from spine_mj.validate.runner import StudyRunner
-from spine_mj.validate.sweep_docs import engine_default
+from spine_mj.validate.study_runner import StudyRunner
+from spine_mj.validate.sweep_configs import engine_default
 
 __all__ = ["PLANE_START", "StaticMapResult", "static_map"]
 

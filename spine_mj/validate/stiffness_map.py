@@ -1,4 +1,4 @@
-"""Study 6: the quasistatic boundary as a map over (I_e, K) for the spring drive.
+"""Study 7: the quasistatic boundary as a map over (I_e, K) for the spring drive.
 
 A spring drive is quasistatic only when it is slow (I_e << 1) *and* stiff: a spring of
 stiffness ``k`` holding ``F`` stores ``F^2 / (2 k)``, released into the tip at every
@@ -35,9 +35,9 @@ from spine_mj.validate.boundary import preset_grid, quasistatic_locked
 from spine_mj.validate.ie_star import ie_star_by_criterion, passes_criterion, quiet_nan_warnings
 from spine_mj.validate.paths import mujoco_traces
 from spine_mj.validate.plans import GRAVITY, MASS_KG, FamilySpec, ValidationPlan
-from spine_mj.validate.runner import StudyRunner
 from spine_mj.validate.stick_slip import slip_statistics
-from spine_mj.validate.sweep_docs import family_doc
+from spine_mj.validate.study_runner import StudyRunner
+from spine_mj.validate.sweep_configs import family_doc
 
 __all__ = [
     "SLIP_FAMILIES",
@@ -125,7 +125,7 @@ def subset_starts(fam: FamilySpec, n: int) -> FamilySpec:
 
 
 def stiffness_map(plan: ValidationPlan, runner: StudyRunner) -> StiffnessMapResult:
-    """Study 6: the spring drive over ``plan.stiffness_map_ie`` x ``plan.stiffness_map_k``
+    """Study 7: the spring drive over ``plan.stiffness_map_ie`` x ``plan.stiffness_map_k``
     on ``plan.stiffness_map_families`` (an empty grid runs nothing).
 
     Returns

@@ -27,11 +27,11 @@ from spine_mj.validate.plans import (
 )
 from spine_mj.validate.quasistatic_limit import QuasistaticLimitResult, quasistatic_limit
 from spine_mj.validate.report import write_report
-from spine_mj.validate.runner import StudyRunner, ValidationProgress
 from spine_mj.validate.sandpaper import SandpaperResult, sandpaper
 from spine_mj.validate.static_map import StaticMapResult, static_map
 from spine_mj.validate.stick_slip import StickSlipResult, stick_slip
 from spine_mj.validate.stiffness_map import StiffnessMapResult, stiffness_map
+from spine_mj.validate.study_runner import StudyRunner, ValidationProgress
 
 __all__ = ["run_validation"]
 
