@@ -109,6 +109,14 @@ class BoundaryResult:
     skip_rate: dict[str, list[float]]
     families: list[str]
 
+    def validation_keys(self) -> dict:
+        """This study's keys of ``validation.json``."""
+        return {
+            "ie_star": self.ie_star,
+            "ie_curves": {k: c.as_dict() for k, c in self.curves.items()},
+            "trap_skip_rate": self.skip_rate,
+        }
+
     def as_dict(self) -> dict:
         return {
             "curves": {k: c.as_dict() for k, c in self.curves.items()},

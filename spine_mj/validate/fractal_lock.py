@@ -133,6 +133,10 @@ class FractalLockResult:
     tip_radius: float
     runs: list[dict]
 
+    def validation_keys(self) -> dict:
+        """This study's keys of ``validation.json``."""
+        return {"fractal_lock_rate": self.as_dict()}
+
     def as_dict(self) -> dict:
         return {
             "rows": self.rows,

@@ -94,6 +94,19 @@ class QuasistaticLimitResult:
     paths: dict[str, list[LimitPath]]
     lowest_ie: float
 
+    def validation_keys(self) -> dict:
+        """This study's keys of ``validation.json``."""
+        fams = self.families
+        return {
+            "lowest_ie": self.lowest_ie,
+            "outcome_agreement_at_lowest_ie": {k: v["outcome_agreement"] for k, v in fams.items()},
+            "mean_frechet_at_lowest_ie": {k: v["mean_frechet"] for k, v in fams.items()},
+            "median_frechet_at_lowest_ie": {k: v["median_frechet"] for k, v in fams.items()},
+            "failed_runs": {k: v["failed_runs"] for k, v in fams.items()},
+            "limit_families": fams,
+            "limit_variations": self.variations,
+        }
+
     def as_dict(self) -> dict:
         return {
             "families": self.families,

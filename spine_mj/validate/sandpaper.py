@@ -37,6 +37,10 @@ class SandpaperResult:
     paths: dict[str, list[tuple]]
     mu: float
 
+    def validation_keys(self) -> dict:
+        """This study's keys of ``validation.json``."""
+        return {"sandpaper": self.rows}
+
     def as_dict(self) -> dict:
         return {"rows": self.rows, "paths": self.paths, "mu": self.mu}
 

@@ -47,6 +47,13 @@ class StaticMapResult:
     mu: float
     static_kappa_max_rel_error: float
 
+    def validation_keys(self) -> dict:
+        """This study's keys of ``validation.json``."""
+        return {
+            "static_kappa_max_rel_error": self.static_kappa_max_rel_error,
+            "static_by_engine": self.per_engine,
+        }
+
     def as_dict(self) -> dict:
         return {
             "rows": self.rows,

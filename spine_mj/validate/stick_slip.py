@@ -143,6 +143,10 @@ class StickSlipResult:
     traces: dict[tuple[float, float], tuple[np.ndarray, np.ndarray]]
     surface: str
 
+    def validation_keys(self) -> dict:
+        """This study's keys of ``validation.json``."""
+        return {"stick_slip": self.rows}
+
     def as_dict(self) -> dict:
         return {"rows": self.rows, "traces": self.traces, "surface": self.surface}
 

@@ -96,6 +96,13 @@ class StiffnessMapResult:
         """family -> K (str) -> I_e* (value, low, high, ci_low, ci_high, kind, criterion)."""
         return {f: {k: cell["ie_star"] for k, cell in by_k.items()} for f, by_k in self.agreement.items()}
 
+    def validation_keys(self) -> dict:
+        """This study's keys of ``validation.json``: ``ie_star_by_stiffness`` (family -> K ->
+        I_e* with bracket ``low``/``high``, bootstrap ``ci_low``/``ci_high`` and ``kind``) and
+        ``stiffness_map`` (the agreement grid with n_ok / n per cell, the energy and slip
+        tables)."""
+        return {"ie_star_by_stiffness": self.ie_star(), "stiffness_map": self.as_dict()}
+
     def as_dict(self) -> dict:
         """The ``validation.json`` entry (the slip samples stay out: the figure holds them)."""
         return {
