@@ -19,7 +19,7 @@ class TriangulatedSurface(Surface):
 
     Each grid cell ``[x_i, x_i+1] x [y_j, y_j+1]`` is split into two triangles along the
     diagonal from its ``(x_min, y_min)`` corner to its ``(x_max, y_max)`` corner, as in
-    MuJoCo's hfield (``tests/test_sim.py`` checks the facet normals against MuJoCo's
+    MuJoCo's hfield (``tests/sim/test_sim_model.py`` checks the facet normals against MuJoCo's
     contacts). Height and gradient are exact per facet; the Hessian is zero. On a cell
     edge or diagonal the facet with the smaller index wins (lower triangle, then the cell
     with the smaller i, j). Points outside the grid evaluate to NaN.

@@ -228,7 +228,7 @@ class GridSurface(Surface):
     -----
     The interpolant passes through every sample and is twice continuously differentiable.
     Its error for a smooth surface is O(h^4) in height, O(h^3) in slope and O(h^2) in
-    curvature (h the spacing; ``tests/test_surfaces.py`` measures the orders). A
+    curvature (h the spacing; ``tests/surfaces/test_surfaces.py`` measures the orders). A
     non-periodic grid is extended by 8 cells of odd reflection, ``f(-k) = 2 f(0) - f(k)``,
     before the spline is fitted: slopes stay continuous across the edge and the implied
     curvature there is zero, so within about two cells of an edge the curvature error is
