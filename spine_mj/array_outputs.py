@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from spine_mj.errors import all_or_none, atomic_output
+from spine_mj.atomic import all_or_none, atomic_output
 from spine_mj.jsonio import write_json
 
 #: The files :func:`write_array_outputs` writes.

@@ -90,6 +90,10 @@ class ArrayStudyResult:
     pooled: dict = field(default_factory=dict)
     plan: dict = field(default_factory=dict)
 
+    def validation_keys(self) -> dict:
+        """This study's keys of ``validation.json``."""
+        return {"arrays": self.as_dict()}
+
     def as_dict(self) -> dict:
         return {"rows": self.rows, "conjecture": self.conjecture, "pooled": self.pooled, "plan": self.plan}
 

@@ -4,10 +4,10 @@ import math
 
 import pytest
 
-from spine_mj.validate.array_report import array_figure, array_section
 from spine_mj.validate.array_study import array_study, newcombe_difference
 from spine_mj.validate.fractal_lock import lock_rate
 from spine_mj.validate.plans import PLANS
+from spine_mj.validate.report.array_study import array_figure, array_section
 
 
 def test_newcombe_difference_is_zero_centred_for_equal_rates_and_inside_minus_one_one():

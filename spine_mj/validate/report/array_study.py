@@ -1,4 +1,6 @@
-"""Figure and report section of the array study (:mod:`spine_mj.validate.array_study`)."""
+"""The report of the array study (:mod:`spine_mj.validate.array_study`): holding per spine
+and P(at least one spine self-locks) against N per layout, and the staggered-array conjecture.
+"""
 
 from __future__ import annotations
 
@@ -9,8 +11,9 @@ import numpy as np
 
 from spine_mj.plotting import new_figure, save_figure, sig, styled
 from spine_mj.validate.array_study import ArrayStudyResult
+from spine_mj.validate.report.common import ReportContext
 
-__all__ = ["array_figure", "array_section"]
+__all__ = ["array_figure", "array_section", "headline", "section"]
 
 _COLORS = {"grid": "#1f77b4", "staggered": "#d62728", "random": "#2ca02c"}
 
@@ -151,3 +154,11 @@ def _verdict(res: ArrayStudyResult) -> str:
             else "."
         )
     )
+
+
+def headline(res: ArrayStudyResult) -> list[str]:
+    return []
+
+
+def section(res: ArrayStudyResult, ctx: ReportContext) -> str:
+    return array_section(res, ctx.draw(array_figure, res, "arrays.png"))
