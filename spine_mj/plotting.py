@@ -575,10 +575,15 @@ def array_figure(res, arr):
         ax.plot(p[:, 0], p[:, 1], lw=0.9, color="white")
     x0, y0 = res.start_xy.T * lf
     ax.scatter(x0, y0, s=12, color="black", zorder=3, label="start")
+    end = res.position_m[-1] / s * lf
     if res.locked.any():
-        ax.scatter(
-            x0[res.locked], y0[res.locked], s=40, marker="x", color="red", zorder=4, label="self-locked"
-        )
+        xe, ye = end[res.locked, 0], end[res.locked, 1]
+        ax.scatter(xe, ye, s=40, marker="x", color="red", zorder=4, label="self-locked (where it ended)")
+    seen = np.concatenate([res.start_xy * lf, res.position_m[:, :, :2].reshape(-1, 2) / s * lf])
+    lo, hi = np.nanmin(seen, axis=0), np.nanmax(seen, axis=0)
+    pad = 0.15 * max(hi - lo) + 1e-12
+    ax.set_xlim(lo[0] - pad, hi[0] + pad)
+    ax.set_ylim(lo[1] - pad, hi[1] + pad)
     ax.legend(loc="upper right", fontsize=7)
     lay = arr.layout
     ax.set_title(

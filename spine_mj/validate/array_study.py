@@ -36,7 +36,7 @@ from spine_mj.array_reference import compliant_spine_curves
 from spine_mj.compare import OUTCOME_TARGET
 from spine_mj.compliant import compliant_streamlines
 from spine_mj.sim.drives import stiffness_n_m
-from spine_mj.streamline import StreamlineParams
+from spine_mj.streamline import StreamlineParams, dilate
 from spine_mj.validate.fractal_lock import CONFIDENCE, lock_rate
 from spine_mj.validate.plans import SANDPAPER_MU, ValidationPlan
 
@@ -57,6 +57,9 @@ LAYOUTS = ("grid", "staggered", "random")
 #: fractal, l_s is 1.6 tip radii: its spacings are this, reported in l_s as run; a random
 #: pattern of 1-diameter gaps then covers 35 % of its footprint, below the 55 % jamming limit).
 MIN_SPACING_TIP_RADII = 3.0
+#: The reference's step cap, in steps of dl per unit of carriage travel (the tip moves less
+#: than the carriage; halved steps at creases and grit edges need the margin).
+REFERENCE_STEPS_PER_TRAVEL = 4
 #: Streamline step, in l_s.
 DL_LS = 0.01
 
@@ -152,9 +155,12 @@ def _centres(
 
 
 def _reference(rig, drive, groups: list[list], travel: float, det) -> list[tuple[np.ndarray, np.ndarray]]:
-    """Quasistatic holding ratio ``(P,)`` and per-spine locks ``(P, N)`` of each group of
-    runs: every spine of every group on its compliant-drive streamline, in one call (the
-    streamline is vectorized over starts: one call costs about as much as one path)."""
+    """Quasistatic holding ratio ``(P,)``, per-spine locks ``(P, N)`` and paths that ended
+    before the travel ``(P, N)`` of each group of runs: every spine of every group on its
+    compliant-drive streamline over the surface dilated by the tip (what its centre rides
+    on), in one call (the streamline is vectorized over starts: one call costs about as
+    much as one path). A path that ended early (the domain's edge, the step cap) adds
+    nothing past its end."""
     s = rig.length_scale_m
     c = stiffness_n_m(drive, rig.scales) * s / rig.scales.preload_n
     ls = rig.scales.slope_length_m / s
@@ -163,16 +169,19 @@ def _reference(rig, drive, groups: list[list], travel: float, det) -> list[tuple
         dl=DL_LS * ls,
         kappa_cap=det.kappa_cap,
         edge_margin=det.domain_margin_m / s,
-        max_steps=int(2 * travel / (DL_LS * ls)) + 100,
+        max_steps=int(REFERENCE_STEPS_PER_TRAVEL * travel / (DL_LS * ls)) + 100,
     )
     starts = np.concatenate([r.start_xy for runs in groups for r in runs])
-    paths = compliant_streamlines(rig.surface, starts, params, stiffness=c)
+    traced = dilate(rig.surface, rig.tip.tip_radius_m / s)  # the surface the tip's centre rides on
+    paths = compliant_streamlines(traced, starts, params, stiffness=c)
     forces, locked = compliant_spine_curves(paths, np.linspace(0.0, travel, 400), kappa_cap=det.kappa_cap)
+    short = np.isnan(forces[:, -1])  # the path ended (domain edge, step cap) before the travel did
     out, at = [], 0
     for runs in groups:
         n, p = runs[0].n_spines, len(runs)
         f = forces[at : at + n * p].reshape(p, n, -1)
-        out.append((np.nanmax(f.sum(axis=1), axis=1) / n, locked[at : at + n * p].reshape(p, n)))
+        hold = np.array([np.nanmax(np.nansum(g, axis=0)) / n for g in f])
+        out.append((hold, locked[at : at + n * p].reshape(p, n), short[at : at + n * p].reshape(p, n)))
         at += n * p
     return out
 
@@ -206,7 +215,7 @@ def _surface_runs(rig, speed, plan: ArrayPlan):
 def _row(config, runs, reference, plan: ArrayPlan) -> dict:
     """One configuration's row, with the per-placement numbers kept for the paired comparisons."""
     side, nominal, spacing, kind, seed = config
-    qs_hold, qs_lock = reference
+    qs_hold, qs_lock, qs_short = reference
     ok = np.array([r.end_reason != "engine_trouble" for r in runs])
     mj_hold = np.array([r.holding_ratio for r in runs])
     mj_lock = np.array([r.locked for r in runs])
@@ -231,6 +240,7 @@ def _row(config, runs, reference, plan: ArrayPlan) -> dict:
         "lock_agreement": float(agree.mean()) if agree.size else math.nan,
         "meets_outcome_target": bool(agree.size and agree.mean() >= OUTCOME_TARGET),
         "failed_runs": int((~ok).sum()),
+        "reference_short_spines": int(qs_short.sum()),
         "_hold": mj_hold.tolist(),
         "_ok": ok.tolist(),
     }

@@ -88,8 +88,8 @@ def array_section(res: ArrayStudyResult | None, figure: str | None = None) -> st
         "spring-block swing past breakaway, K_c = k L_c / F_p); the sum over spines smooths it.",
         "",
         "| surface | N | spacing [l_s] | layout | holding (MuJoCo) | 95 % CI | holding (QS) | "
-        "P(lock) MuJoCo | 95 % CI | P(lock) QS | lock agreement | failed |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|",
+        "P(lock) MuJoCo | 95 % CI | P(lock) QS | lock agreement | failed | QS paths short |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in res.rows:
         pl, pq = r["p_lock"], r["p_lock_qs"]
@@ -98,7 +98,7 @@ def array_section(res: ArrayStudyResult | None, figure: str | None = None) -> st
             f"{sig(r['holding_per_spine'])} | {_ci(*r['holding_ci'])} | {sig(r['holding_per_spine_qs'])} | "
             f"{pl['locked']}/{pl['n_ok']} | {_ci(pl['ci_low'], pl['ci_high'])} | "
             f"{pq['locked']}/{pq['n_ok']} | "
-            f"{sig(r['lock_agreement'])} | {r['failed_runs']} |"
+            f"{sig(r['lock_agreement'])} | {r['failed_runs']} | {r['reference_short_spines']} |"
         )
     if figure:
         lines += ["", f"![Holding per spine and P(lock) against N per layout]({figure})"]
