@@ -89,3 +89,24 @@ def test_bad_layouts_are_refused():
         Layout(rows=0)
     with pytest.raises(SpineInputError, match="spacing"):
         Layout(spacing=float("nan"))
+
+
+def test_compliant_spine_curves_follow_the_prandtl_tomlinson_curve_on_a_corrugation():
+    from spine_mj.array_reference import compliant_spine_curves
+    from spine_mj.compliant import compliant_streamlines
+    from spine_mj.streamline import StreamlineParams
+    from spine_mj.surfaces import corrugation
+
+    surf = corrugation(n_waves=4, width=0.5, points_per_wave=64)
+    starts = np.array([[1.1, 0.0], [1.4, 0.0]])
+    c = 150.0  # K = c l_s = 28.5 > K* = 0.47: smooth
+    X = np.linspace(0.0, 1.0, 201)
+    params = StreamlineParams(mu=0.5, dl=0.005)
+    # two steps of margin: the last point, where the carriage stops mid-step, is off the curve
+    paths = compliant_streamlines(surf, starts, params, stiffness=c, carriage_end=starts[:, 0] + 1.01)
+    forces, locked = compliant_spine_curves(paths, X, kappa_cap=20.0)
+    slope = lambda u: 0.3 * np.cos(2 * math.pi * u)  # noqa: E731
+    for f, x0 in zip(forces, starts[:, 0]):
+        pt = profile_spine_curve(X, x0=x0, slope=slope, mu=0.5, spring_per_preload=c)
+        assert np.max(np.abs(f - pt)) < 0.02
+    assert not locked.any()

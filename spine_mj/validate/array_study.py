@@ -159,8 +159,8 @@ def _reference(rig, drive, groups: list[list], travel: float, det) -> list[tuple
     before the travel ``(P, N)`` of each group of runs: every spine of every group on its
     compliant-drive streamline over the surface dilated by the tip (what its centre rides
     on), in one call (the streamline is vectorized over starts: one call costs about as
-    much as one path). A path that ended early (the domain's edge, the step cap) adds
-    nothing past its end."""
+    much as one path), each stopped where its carriage's travel ends (``carriage_end``). A
+    path that ended earlier (the domain's edge, the step cap) adds nothing past its end."""
     s = rig.length_scale_m
     c = stiffness_n_m(drive, rig.scales) * s / rig.scales.preload_n
     ls = rig.scales.slope_length_m / s
@@ -173,7 +173,10 @@ def _reference(rig, drive, groups: list[list], travel: float, det) -> list[tuple
     )
     starts = np.concatenate([r.start_xy for runs in groups for r in runs])
     traced = dilate(rig.surface, rig.tip.tip_radius_m / s)  # the surface the tip's centre rides on
-    paths = compliant_streamlines(traced, starts, params, stiffness=c)
+    # the carriage runs two steps past the travel: a path's last point, where the carriage
+    # stops mid-step, is not on the curve (the tip is left a step ahead of its equilibrium)
+    end = starts[:, 0] + travel + 2 * params.dl
+    paths = compliant_streamlines(traced, starts, params, stiffness=c, carriage_end=end)
     forces, locked = compliant_spine_curves(paths, np.linspace(0.0, travel, 400), kappa_cap=det.kappa_cap)
     short = np.isnan(forces[:, -1])  # the path ended (domain edge, step cap) before the travel did
     out, at = [], 0
