@@ -133,9 +133,11 @@ class Release:
     holding_x: float
 
 
-def force_control_release(carriage: np.ndarray, total: np.ndarray, *, rel_tol: float = 1e-9) -> Release:
+def force_control_release(carriage: np.ndarray, total: np.ndarray, *, rel_tol: float = 1e-6) -> Release:
     """:class:`Release` of a force-controlled array from its forward curve ``total`` at
-    carriage positions ``carriage`` (increasing)."""
+    carriage positions ``carriage`` (increasing). A drop or a later peak counts when it
+    exceeds ``rel_tol`` of the curve's largest magnitude (equal peaks of a periodic
+    profile are not a catch)."""
     total = np.asarray(total, dtype=float)
     carriage = np.asarray(carriage, dtype=float)
     if total.shape != carriage.shape or total.ndim != 1 or total.size == 0:

@@ -11,7 +11,7 @@ import pytest
 from sim_rigs import MU, R_TIP
 
 from spine_mj import sim, surfaces
-from spine_mj.array_reference import profile_spine_curve, summed_curve
+from spine_mj.array_reference import force_control_release, profile_spine_curve, summed_curve
 from spine_mj.errors import SpineInputError
 from spine_mj.sim.array import ArrayRig, ForcePull
 from spine_mj.sim.drives import stiffness_n_m
@@ -160,3 +160,24 @@ def test_batched_runs_equal_runs_one_at_a_time():
     for c, b in zip(centres, batch):
         one = arr.run(drive, centre=c, nthread=1)
         assert np.array_equal(one.position_m, b.position_m)
+
+
+def test_force_controlled_spines_on_a_corrugation_let_go_where_the_summed_curve_peaks():
+    # three spines at 0.3 wavelength offsets: the summed forward curve peaks once per
+    # wavelength at one height, so a catch after the first let-go holds no more
+    rig = _corrugation_rig()
+    fp, tau, s = rig.scales.preload_n, rig.scales.time_s, rig.length_scale_m
+    arr = ArrayRig(rig, Layout(rows=1, cols=3, spacing=0.3, spacing_unit="surface"), force_control=True)
+    res = arr.run(ForcePull(rate_n_s=3e-3 * fp / tau), centre=(1.0, 0.0))
+    assert res.end_reason == "let_go"
+    kk = stiffness_n_m(ForcePull(), rig.scales) * s / fp
+    x = np.linspace(0.0, 3.0, 6001)
+    slope = lambda u: 0.3 * np.cos(2 * math.pi * u)  # noqa: E731
+    r = rig.tip.tip_radius_m / s
+    curves = [
+        profile_spine_curve(x, x0=x0, slope=slope, mu=MU, spring_per_preload=kk, tip_radius=r)
+        for x0 in res.start_xy[:, 0]
+    ]
+    rel = force_control_release(x, summed_curve(curves))
+    assert rel.holding == pytest.approx(rel.first_let_go, rel=1e-3)
+    assert res.holding_ratio == pytest.approx(rel.holding / 3, rel=0.03)
