@@ -53,9 +53,10 @@ SURFACES = (
     ("sandpaper", "sandpaper-P60", SANDPAPER_MU),
 )
 LAYOUTS = ("grid", "staggered", "random")
-#: Closest spacing, in tip radii: spines never stand closer than 1.5 tip diameters (on the
-#: fractal, l_s is 1.6 tip radii: its spacings are this, reported in l_s as run; a random
-#: pattern of 1-diameter gaps then covers 35 % of its footprint, below the 55 % jamming limit).
+#: The spacing unit is l_s, or this many tip radii where the tip is wider (the fractal's
+#: l_s is 1.6 tip radii, the sandpaper's 0.66): spines never stand closer than 1.5 tip
+#: diameters, and a random pattern of 1-diameter gaps covers at most 35 % of its footprint,
+#: below the 55 % jamming limit. Spacings are reported in l_s as run.
 MIN_SPACING_TIP_RADII = 3.0
 #: The reference's step cap, in steps of dl per unit of carriage travel (the tip moves less
 #: than the carriage; halved steps at creases and grit edges need the margin).
@@ -66,8 +67,9 @@ DL_LS = 0.01
 
 @dataclass(frozen=True)
 class ArrayPlan:
-    """The study's size: array sides (``N = side^2``), spacings [l_s], placements per
-    configuration, surfaces and bootstrap resamples."""
+    """The study's size: array sides (``N = side^2``), spacings (in units of
+    ``max(l_s, MIN_SPACING_TIP_RADII r_tip)``), placements per configuration, surfaces and
+    bootstrap resamples."""
 
     sides: tuple[int, ...]
     spacings_ls: tuple[float, ...]
@@ -80,7 +82,7 @@ class ArrayPlan:
 ARRAY_PLANS = {
     "smoke": ArrayPlan(sides=(1, 2), spacings_ls=(1.0,), placements=3, surfaces=("fractal",), bootstrap=50),
     "quick": ArrayPlan(sides=(1, 2, 4), spacings_ls=(1.0,), placements=6, bootstrap=300),
-    "full": ArrayPlan(sides=(1, 2, 4, 8), spacings_ls=(0.5, 1.0), placements=6, bootstrap=1000),
+    "full": ArrayPlan(sides=(1, 2, 4, 8), spacings_ls=(1.0, 1.5), placements=6, bootstrap=1000),
 }
 
 
@@ -198,7 +200,7 @@ def _surface_runs(rig, speed, plan: ArrayPlan):
     done = []
     for side in plan.sides:
         for nominal in plan.spacings_ls:
-            spacing = max(nominal, MIN_SPACING_TIP_RADII * r_tip / ls)  # in l_s
+            spacing = nominal * max(1.0, MIN_SPACING_TIP_RADII * r_tip / ls)  # in l_s
             seed = 1000 * side + int(100 * nominal)
             centres = _centres(rig, side, spacing * ls, TRAVEL_LS * ls, plan.placements, seed)
             if not centres:

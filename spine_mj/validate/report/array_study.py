@@ -56,7 +56,7 @@ def array_figure(res: ArrayStudyResult, path: Path) -> Path | None:
                 n, p, yerr=[p - plo, phi - p], color=color, marker="o", ms=4, capsize=2, label=kind
             )
             axes[1, j].plot(n, [r["p_lock_qs"]["rate"] for r in rows], color=color, ls="--", lw=0.8)
-        axes[0, j].set_title(f"{surf} (spacing {sig(first)} l_s nominal)")
+        axes[0, j].set_title(f"{surf} (spacing {sig(first)} x max(l_s, 3 r_tip))")
         for ax in axes[:, j]:
             ax.set_xscale("log", base=2)
             ax.set_xlabel("spines N")
@@ -76,8 +76,8 @@ def array_section(res: ArrayStudyResult | None, figure: str | None = None) -> st
         "## Spine arrays and the staggered-layout conjecture",
         "",
         f"Arrays of N = {', '.join(str(s * s) for s in p['sides'])} spines (aligned grid, staggered grid, "
-        "random pattern of one footprint; nominal spacings "
-        f"{', '.join(sig(v) for v in p['spacings_ls'])} l_s, at least 3 tip radii) dragged under "
+        "random pattern of one footprint; spacings "
+        f"{', '.join(sig(v) for v in p['spacings_ls'])} x max(l_s, 3 tip radii)) dragged under "
         f"displacement control at I_e = {sig(p['ie'])}, K = 30 per spine, "
         f"over {sig(p['travel_ls'])} l_s; {p['placements']} placements per configuration, the same for every "
         f"layout; {p['array_runs']} array runs. Holding = the largest total spring force over N F_p (mean, "
