@@ -54,13 +54,13 @@ def _probe_cases(res: int, ie: float):
         k, low, _ = _hold_force(t * math.cos(math.radians(az)), t * math.sin(math.radians(az)), 0.5)
         sc = rig.scales
         probe = sim.StaticProbe(
-            rate_n_s=sc.speed_for(ie) * sc.preload_n / sc.char_length_m,
+            rate_n_s=sc.force_rate_for(sc.speed_for(ie)),
             start_force_n=(0.5 * (low + k) if low > 0 else 0.0) * sc.preload_n,
         )
         yield f"plane {slope:g} deg, azimuth {az:g}", rig, (0.0, 0.0), probe
     rig, _ = pilot_rig("paper-single-peak", None, 1.23, 0.1, res)
     sc = rig.scales
-    probe = sim.StaticProbe(rate_n_s=sc.speed_for(ie) * sc.preload_n / sc.char_length_m)
+    probe = sim.StaticProbe(rate_n_s=sc.force_rate_for(sc.speed_for(ie)))
     for start in PROBE_PEAK_STARTS:
         yield f"single peak {start}", rig, start, probe
 
@@ -97,7 +97,7 @@ def ramp_rows(res: int, ie: float, cycles: int) -> list[dict]:
     rows = []
     for name, rig, start in _cases(res):
         sc = rig.scales
-        rate = math.sqrt(ie) * sc.preload_n / sc.time_s
+        rate = sc.force_rate_for(sc.speed_for(ie))
         per_cycle = 5 * sc.preload_n / rate + 400 * rig.engine.timestep_s
         drive = sim.RampDrive(
             rate_n_s=rate, duration_s=cycles * per_cycle, slide_distance_m=0.05 * sc.char_length_m
