@@ -28,7 +28,7 @@ import numpy as np
 from spine_mj import compare, sim
 from spine_mj.sim.ramp import cycle_breakaways, rows_to_reset
 from spine_mj.validate.ramp_pilot import pilot_rig
-from spine_mj.validate.static_map import _hold_force
+from spine_mj.validate.static_map import hold_force
 
 #: (slope, azimuth) of the probe's planes [deg]: engaged planes of the static map.
 PROBE_PLANES = ((0.0, 0.0), (15.0, 0.0), (30.0, 0.0), (45.0, 0.0), (52.5, 0.0), (30.0, 30.0), (30.0, 60.0))
@@ -51,7 +51,7 @@ def _probe_cases(res: int, ie: float):
     for slope, az in PROBE_PLANES:
         rig = sim.Rig(sim.inclined_plane(slope_deg=slope, azimuth_deg=az), tip=sim.TipParams(mu_s=0.5))
         t = math.tan(math.radians(slope))
-        k, low, _ = _hold_force(t * math.cos(math.radians(az)), t * math.sin(math.radians(az)), 0.5)
+        k, low, _ = hold_force(t * math.cos(math.radians(az)), t * math.sin(math.radians(az)), 0.5)
         sc = rig.scales
         probe = sim.StaticProbe(
             rate_n_s=sc.force_rate_for(sc.speed_for(ie)),

@@ -37,7 +37,6 @@ from scipy import ndimage
 
 from spine_mj._kernels import run_trajectories
 from spine_mj.engagement import (
-    ENGAGED,
     REGION_NAMES,
     SELF_LOCK,
     SLIP,
@@ -665,7 +664,3 @@ def dilate(surface: Surface, radius: float, *, spacing: float | None = None) -> 
     return GridSurface(
         heights=heights, x=grid.x, y=grid.y, periodic=grid.periodic, unit=surface.unit, metadata=meta
     )
-
-
-# keep the region constants importable from here for convenience
-REGIONS = (SLIP, ENGAGED, SELF_LOCK)
