@@ -34,7 +34,13 @@ from spine_mj.surfaces.base import (
     length_unit,
 )
 from spine_mj.surfaces.facets import BallOnFacets, TriangulatedSurface
-from spine_mj.surfaces.generators import fractal_fbm, random_gaussians, sandpaper, single_gaussian
+from spine_mj.surfaces.generators import (
+    corrugation,
+    fractal_fbm,
+    random_gaussians,
+    sandpaper,
+    single_gaussian,
+)
 from spine_mj.surfaces.hfield import HField, from_hfield, to_hfield
 from spine_mj.surfaces.types import BSplineGrid, GaussianSurface, GridSurface, Surface
 
@@ -51,6 +57,7 @@ __all__ = [
     "Surface",
     "TriangulatedSurface",
     "check_grid_size",
+    "corrugation",
     "fractal_fbm",
     "from_hfield",
     "length_unit",

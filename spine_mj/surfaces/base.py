@@ -98,6 +98,14 @@ def _grid_count(name: str, n) -> int:
     return int(n)
 
 
+def _count_at_least(name: str, n, least: int) -> int:
+    """``n`` as an integer count of at least ``least``."""
+    ok = isinstance(n, (int, np.integer, float, np.floating)) and not isinstance(n, (bool, np.bool_))
+    if not ok or not math.isfinite(n) or int(n) != n or n < least or n > MAX_GRID_POINTS:
+        raise SpineInputError(f"{name} must be an integer in [{least}, {MAX_GRID_POINTS}], got {n!r}")
+    return int(n)
+
+
 def check_grid_size(nx: int, ny: int, *, where: str) -> None:
     """Refuse a grid of more than :data:`MAX_GRID_POINTS` points before allocating it.
 

@@ -15,6 +15,7 @@ from spine_mj.surfaces.base import (
     GRIT_PARTICLE_DIAMETER_M,
     MAX_PEAKS,
     _bounds,
+    _count_at_least,
     _flag,
     _grid_count,
     _pair,
@@ -68,6 +69,56 @@ def single_gaussian(
             sigma_y=sy,
             center=(mx, my),
             bounds=tuple(bounds),
+        ),
+    )
+
+
+def corrugation(
+    *,
+    wavelength: float = 1.0,
+    slope_amplitude: float = 0.3,
+    n_waves: int = 8,
+    width: float = 1.0,
+    points_per_wave: int = 32,
+) -> GridSurface:
+    """A sinusoidal corrugation ``z = h sin(2 pi x / lambda)``, uniform in y: the
+    Prandtl-Tomlinson profile, a surface whose dynamics have closed forms (docs/physics.md).
+
+    ``h = slope_amplitude * wavelength / (2 pi)``, so the steepest slope is
+    ``slope_amplitude``; ``L_c = wavelength`` (rms height over rms slope times 2 pi) and the
+    slope correlation length is ``0.190 wavelength``. The grid is periodic in x over
+    ``n_waves`` whole wavelengths starting at x = 0 (a crest's rising flank begins there)
+    and spans ``width`` in y, centred on y = 0. Dimensionless.
+    """
+    lam = check_positive("wavelength", wavelength)
+    s = float(slope_amplitude)
+    if not (math.isfinite(s) and 0.0 <= s <= 10.0):
+        raise SpineInputError(f"slope_amplitude must lie in [0, 10], got {slope_amplitude!r}")
+    waves = _count_at_least("n_waves", n_waves, 1)
+    per_wave = _count_at_least("points_per_wave", points_per_wave, 8)
+    w = check_positive("width", width)
+    nx = waves * per_wave
+    dx = lam / per_wave
+    ny = max(_MIN_POINTS_PER_SIDE, int(math.ceil(w / dx)))
+    check_grid_size(nx, ny, where="corrugation")
+    x = np.arange(nx) * dx
+    y = -w / 2 + np.arange(ny) * (w / ny)
+    h = s * lam / (2 * math.pi)
+    heights = np.broadcast_to(h * np.sin(2 * math.pi * x / lam), (ny, nx)).copy()
+    return GridSurface(
+        heights=heights,
+        x=x,
+        y=y,
+        periodic=True,
+        unit="1",
+        metadata=_meta(
+            "corrugation",
+            None,
+            wavelength=lam,
+            slope_amplitude=s,
+            n_waves=waves,
+            width=w,
+            points_per_wave=per_wave,
         ),
     )
 
