@@ -606,34 +606,9 @@ def dilate(surface: Surface, radius: float, *, spacing: float | None = None) -> 
     radius = float(radius)
     if not (math.isfinite(radius) and radius >= 0):
         raise SpineInputError(f"radius (tip radius) must be finite and >= 0, got {radius!r}")
-    xmin, xmax, ymin, ymax = surface.bounds
     if spacing is not None and not (math.isfinite(spacing) and spacing > 0):
         raise SpineInputError(f"spacing must be finite and > 0, got {spacing!r}")
-    if isinstance(surface, GridSurface) and spacing is None:
-        grid = surface
-    else:
-        h = spacing
-        if h is None:
-            extent = max(xmax - xmin, ymax - ymin)
-            h = min(radius / 8, extent / 400) if radius > 0 else extent / 400
-        if isinstance(surface, GridSurface) and surface.periodic:
-            grid = surface.resample(h)
-        else:
-            check_grid_size(
-                (xmax - xmin) / h + 1,
-                (ymax - ymin) / h + 1,
-                where=f"dilating by the tip radius {radius:g} at spacing {h:g} (surface units)",
-            )
-            nx = int(math.ceil((xmax - xmin) / h)) + 1
-            ny = int(math.ceil((ymax - ymin) / h)) + 1
-            x, y = np.linspace(xmin, xmax, nx), np.linspace(ymin, ymax, ny)
-            grid = GridSurface(
-                heights=surface.height(x[None, :], y[:, None]),
-                x=x,
-                y=y,
-                unit=surface.unit,
-                metadata=dict(surface.metadata),
-            )
+    grid = _dilation_grid(surface, radius, spacing)
     if radius == 0:
         return grid
     dx, dy = grid.spacing
@@ -663,4 +638,33 @@ def dilate(surface: Surface, radius: float, *, spacing: float | None = None) -> 
     meta = dict(surface.metadata, tip_radius=radius)
     return GridSurface(
         heights=heights, x=grid.x, y=grid.y, periodic=grid.periodic, unit=surface.unit, metadata=meta
+    )
+
+
+def _dilation_grid(surface: Surface, radius: float, spacing: float | None) -> GridSurface:
+    """The samples :func:`dilate` dilates: a grid's own (or resampled to ``spacing``), an
+    analytic surface's on its bounds at ``spacing`` (default ``min(R / 8, extent / 400)``)."""
+    if isinstance(surface, GridSurface) and spacing is None:
+        return surface
+    xmin, xmax, ymin, ymax = surface.bounds
+    h = spacing
+    if h is None:
+        extent = max(xmax - xmin, ymax - ymin)
+        h = min(radius / 8, extent / 400) if radius > 0 else extent / 400
+    if isinstance(surface, GridSurface) and surface.periodic:
+        return surface.resample(h)
+    check_grid_size(
+        (xmax - xmin) / h + 1,
+        (ymax - ymin) / h + 1,
+        where=f"dilating by the tip radius {radius:g} at spacing {h:g} (surface units)",
+    )
+    nx = int(math.ceil((xmax - xmin) / h)) + 1
+    ny = int(math.ceil((ymax - ymin) / h)) + 1
+    x, y = np.linspace(xmin, xmax, nx), np.linspace(ymin, ymax, ny)
+    return GridSurface(
+        heights=surface.height(x[None, :], y[:, None]),
+        x=x,
+        y=y,
+        unit=surface.unit,
+        metadata=dict(surface.metadata),
     )
