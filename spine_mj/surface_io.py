@@ -30,11 +30,21 @@ from spine_mj.surfaces import (
     MAX_GRID_POINTS,
     GaussianSurface,
     GridSurface,
+    HField,
     Surface,
     length_unit,
+    to_hfield,
 )
 
-__all__ = ["FILL_METHODS", "import_topography", "load_surface", "save_surface", "surface_mesh", "write_stl"]
+__all__ = [
+    "FILL_METHODS",
+    "import_topography",
+    "load_surface",
+    "save_surface",
+    "surface_mesh",
+    "write_hfield",
+    "write_stl",
+]
 
 FORMAT = "spine_mj.surface/1"
 _GAUSS_KEYS = ("amplitude", "center_x", "center_y", "sigma_x", "sigma_y")
@@ -384,3 +394,15 @@ def write_stl(surface: Surface, path: str | os.PathLike, **mesh_options) -> Path
     with atomic_output(path) as tmp:
         mesh.export(tmp, file_type="stl")
     return path
+
+
+def write_hfield(surface: Surface, path: str | os.PathLike, *, resolution: int | None = None) -> HField:
+    """Write the surface as MuJoCo hfield data (:func:`~spine_mj.surfaces.to_hfield`;
+    ``resolution`` samples a side, else a grid's own or 201) to an ``.npz`` with ``data``,
+    ``size``, ``pos`` and ``unit``, atomically. Returns the hfield."""
+    hf = to_hfield(surface, ncol=resolution, nrow=resolution) if resolution else to_hfield(surface)
+    with atomic_output(path) as tmp, open(tmp, "wb") as fh:
+        np.savez(
+            fh, data=hf.data, size=np.asarray(hf.size), pos=np.asarray(hf.pos), unit=np.array(surface.unit)
+        )
+    return hf
