@@ -72,14 +72,14 @@ class EnergyBudget:
 def elastic_release_j(drive_force_n, stiffness_n_m: float, events) -> float:
     """Spring energy released over the slip events of a run [J].
 
-    For each ``slip_onset`` the release is ``(F_onset^2 - F_stop^2) / (2 k)`` with
-    ``F_stop`` the force at the next ``slip_stop`` (or the last sample); increases of the
+    For each ``move_onset`` the release is ``(F_onset^2 - F_stop^2) / (2 k)`` with
+    ``F_stop`` the force at the next ``move_stop`` (or the last sample); increases of the
     stored energy are not counted.
     """
     k = check_positive("stiffness_n_m", stiffness_n_m)
     force = np.asarray(drive_force_n, dtype=float)
-    onsets = [e.index for e in events if e.kind == "slip_onset"]
-    stops = sorted(e.index for e in events if e.kind == "slip_stop")
+    onsets = [e.index for e in events if e.kind == "move_onset"]
+    stops = sorted(e.index for e in events if e.kind == "move_stop")
     total = 0.0
     for i in onsets:
         j = next((s for s in stops if s > i), force.size - 1)

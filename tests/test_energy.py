@@ -30,13 +30,13 @@ def test_spring_on_a_flat_plane_accounts_for_the_carriage_work():
     # what a breakaway releases is bounded by the largest energy the spring ever held
     k = stiffness_n_m(drive, rig.scales)
     held = (res.drive_force_n[i0:] ** 2).max() / (2 * k)
-    n_slips = sum(e.kind == "slip_onset" for e in res.events if e.index >= i0)
+    n_slips = sum(e.kind == "move_onset" for e in res.events if e.index >= i0)
     assert 0 <= budget.elastic_release_j <= n_slips * held * (1 + 1e-12)
 
 
 def test_elastic_release_closed_form():
     force = np.array([0.0, 2.0, 4.0, 3.0, 1.0, 1.0, 3.0, 2.0])
-    events = [Event("slip_onset", 2, 0.2), Event("slip_stop", 4, 0.4), Event("slip_onset", 6, 0.6)]
+    events = [Event("move_onset", 2, 0.2), Event("move_stop", 4, 0.4), Event("move_onset", 6, 0.6)]
     k = 5.0
     # (4^2 - 1^2) / 2k for the first slip; the second runs to the last sample (3 -> 2)
     expected = (16 - 1) / (2 * k) + (9 - 4) / (2 * k)

@@ -61,6 +61,7 @@ Modules: :mod:`~spine_mj.sim.params` (tip, engine, scales and their rules),
 from spine_mj.sim.detection import Detection, Event
 from spine_mj.sim.drives import Drive, RampDrive, SpringDrive, StaticProbe
 from spine_mj.sim.model import MODEL_PATH
+from spine_mj.sim.motion import MOTION_NAMES, SLIDING, SLIPPING, STUCK, SlipEvent
 from spine_mj.sim.params import (
     DEFAULT_LENGTH_SCALE_M,
     LENGTH_UNITS_M,
@@ -87,7 +88,11 @@ __all__ = [
     "LENGTH_UNITS_M",
     "MAX_INERTIA_NUMBER",
     "MODEL_PATH",
+    "MOTION_NAMES",
     "REFINE_TIMESTEP",
+    "SLIDING",
+    "SLIPPING",
+    "STUCK",
     "Cone",
     "Detection",
     "Drive",
@@ -100,6 +105,7 @@ __all__ = [
     "Rig",
     "RunResult",
     "Scales",
+    "SlipEvent",
     "SpringDrive",
     "StaticProbe",
     "TipParams",

@@ -29,7 +29,7 @@ class SlipStats:
     Attributes
     ----------
     count : int
-        Slip events (a run of ``slipping`` samples, counted once it has ended or the trace
+        Slip events (a run of ``moving`` samples, counted once it has ended or the trace
         ends).
     jump_lengths : ndarray, shape (count,)
         Distance travelled in x-y during each event.
@@ -63,15 +63,15 @@ class SlipStats:
         }
 
 
-def slip_statistics(time_s, x, y, force, slipping, *, min_samples: int = 1) -> SlipStats:
-    """Slip events (runs of ``slipping``) of a trace, with jump length and force drop.
+def slip_statistics(time_s, x, y, force, moving, *, min_samples: int = 1) -> SlipStats:
+    """Slip events (runs of ``moving``) of a trace, with jump length and force drop.
 
     Parameters
     ----------
     time_s, x, y, force : array_like, shape (n,)
-    slipping : array_like of bool, shape (n,)
+    moving : array_like of bool, shape (n,)
     min_samples : int
-        Shorter runs of ``slipping`` are ignored (detector chatter).
+        Shorter runs of ``moving`` are ignored (detector chatter).
 
     Returns
     -------
@@ -81,10 +81,10 @@ def slip_statistics(time_s, x, y, force, slipping, *, min_samples: int = 1) -> S
     x = np.asarray(x, float)
     y = np.asarray(y, float)
     f = np.asarray(force, float)
-    s = np.asarray(slipping, bool)
+    s = np.asarray(moving, bool)
     if not (t.shape == x.shape == y.shape == f.shape == s.shape) or t.ndim != 1:
         raise SpineInputError(
-            f"time_s, x, y, force and slipping must be 1-D of one length, "
+            f"time_s, x, y, force and moving must be 1-D of one length, "
             f"got {t.shape}, {x.shape}, {y.shape}, {f.shape}, {s.shape}"
         )
     edges = np.diff(np.r_[0, s.astype(np.int8), 0])
@@ -189,7 +189,7 @@ def stick_slip(plan: ValidationPlan, runner: StudyRunner) -> StickSlipResult:
                     tr["x"] / lc_units,
                     tr["y"] / lc_units,
                     tr["drive_force_n"] / fp,
-                    tr["slipping"],
+                    tr["moving"],
                     min_samples=3,
                 )
             )

@@ -52,7 +52,7 @@ __all__ = [
 #: Families whose slip events the study collects (rough enough to stick and slip).
 SLIP_FAMILIES = ("random_gaussian", "fractal")
 
-#: Shorter runs of ``slipping`` samples are detector chatter (as in the stick-slip study).
+#: Shorter runs of ``moving`` samples are detector chatter (as in the stick-slip study).
 MIN_SLIP_SAMPLES = 3
 
 #: The agreement criterion of the map: the boundary study's headline one.
@@ -242,18 +242,18 @@ def _energy_and_slip(tr, qs, lc: float, unit_m: float, fp: float, k_n_m: float) 
             tr["x"] / lc,
             tr["y"] / lc,
             force / fp,
-            tr["slipping"],
+            tr["moving"],
             min_samples=MIN_SLIP_SAMPLES,
         )
-        events = [SimpleNamespace(kind="slip_onset", index=int(i)) for i in ev.onset_indices] + [
-            SimpleNamespace(kind="slip_stop", index=int(i)) for i in ev.stop_indices
+        events = [SimpleNamespace(kind="move_onset", index=int(i)) for i in ev.onset_indices] + [
+            SimpleNamespace(kind="move_stop", index=int(i)) for i in ev.stop_indices
         ]
         x = tr["x"].to_numpy(dtype=float)
         out.update(
             release_fplc=elastic_release_j(force, k_n_m, events) / (fp * lc_m),
             advance_lc=float(x[-1] - x[0]) / lc,
             slip_events=float(ev.count),
-            slip_time_fraction=float(np.mean(tr["slipping"].to_numpy(dtype=bool))),
+            slip_time_fraction=float(np.mean(tr["moving"].to_numpy(dtype=bool))),
             events=ev,
         )
     if qs is not None and len(qs) > 1:
@@ -367,7 +367,7 @@ def energy_rows(runs: pd.DataFrame) -> list[dict]:
 
 
 def slip_rows(runs: pd.DataFrame) -> list[dict]:
-    """Per (I_e, K): slip events per L_c advanced and the fraction of time slipping over
+    """Per (I_e, K): slip events per L_c advanced and the fraction of time moving over
     the :data:`SLIP_FAMILIES` runs without engine trouble (``n_ok`` / ``n``), and the
     fraction of quasistatic traps MuJoCo skips over every family's runs without engine
     trouble (``traps``: streamline self-locks; ``skipped``: of those, runs where MuJoCo did
