@@ -11,6 +11,7 @@ import numpy as np
 from spine_mj import presets, sim
 from spine_mj.errors import SpineInputError
 from spine_mj.presets import calibrated_mu
+from spine_mj.sim.motion import slip_events
 from spine_mj.validate.paths import mujoco_traces, tip_radius
 from spine_mj.validate.plans import GRAVITY, MASS_KG, FamilySpec, ValidationPlan, relative_starts
 from spine_mj.validate.runner import StudyRunner
@@ -29,17 +30,16 @@ class SlipStats:
     Attributes
     ----------
     count : int
-        Slip events (a run of ``moving`` samples, counted once it has ended or the trace
-        ends).
+        Slip events (runs of ``slipping`` motion states).
     jump_lengths : ndarray, shape (count,)
         Distance travelled in x-y during each event.
     force_drops : ndarray, shape (count,)
-        Drive force at the onset minus the force at the end of each event (same units as
-        the force trace).
+        Peak drive force of each event minus the lowest force after it within the event
+        (same units as the force trace; >= 0).
     durations : ndarray, shape (count,)
     onset_indices, stop_indices : ndarray of int, shape (count,)
-        Trace samples at which each event's force drop is measured (the last stuck sample
-        before it and its last sample), so that the spring energy released over the same
+        Trace samples at which each event begins (the last loading sample before it) and
+        ends, so that the spring energy released over the same
         events (:func:`spine_mj.energy.elastic_release_j`) is read at the same points.
     """
 
@@ -63,51 +63,49 @@ class SlipStats:
         }
 
 
-def slip_statistics(time_s, x, y, force, moving, *, min_samples: int = 1) -> SlipStats:
-    """Slip events (runs of ``moving``) of a trace, with jump length and force drop.
+def slip_statistics(time_s, x, y, force, motion) -> SlipStats:
+    """Slip events of a trace (its runs of ``slipping`` motion states,
+    :func:`spine_mj.sim.motion.slip_events`), with jump length and force drop.
 
     Parameters
     ----------
     time_s, x, y, force : array_like, shape (n,)
-    moving : array_like of bool, shape (n,)
-    min_samples : int
-        Shorter runs of ``moving`` are ignored (detector chatter).
+    motion : array_like of int, shape (n,)
+        Motion state codes (:data:`spine_mj.sim.motion.MOTION_NAMES`), as recorded.
 
     Returns
     -------
     SlipStats
+        Jump lengths along the x-y path from the onset (the last loading sample) to the
+        event's last sample; force drops from the event's peak force to the lowest force
+        after it (never negative).
     """
     t = np.asarray(time_s, float)
     x = np.asarray(x, float)
     y = np.asarray(y, float)
     f = np.asarray(force, float)
-    s = np.asarray(moving, bool)
-    if not (t.shape == x.shape == y.shape == f.shape == s.shape) or t.ndim != 1:
+    m = np.asarray(motion)
+    if not (t.shape == x.shape == y.shape == f.shape == m.shape) or t.ndim != 1:
         raise SpineInputError(
-            f"time_s, x, y, force and moving must be 1-D of one length, "
-            f"got {t.shape}, {x.shape}, {y.shape}, {f.shape}, {s.shape}"
+            f"time_s, x, y, force and motion must be 1-D of one length, "
+            f"got {t.shape}, {x.shape}, {y.shape}, {f.shape}, {m.shape}"
         )
-    edges = np.diff(np.r_[0, s.astype(np.int8), 0])
-    on, off = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)  # [on, off)
-    keep = (off - on) >= min_samples
-    on, off = on[keep], off[keep]
-    jumps, drops, durs, starts, ends = [], [], [], [], []
-    for a, b in zip(on, off):
-        end = min(b, t.size - 1)
-        start = max(a - 1, 0)  # the last stuck sample before the slip
-        seg = np.column_stack([x[start : end + 1], y[start : end + 1]])
-        jumps.append(float(np.linalg.norm(np.diff(seg, axis=0), axis=1).sum()))
-        drops.append(float(f[start] - f[end]))
-        durs.append(float(t[end] - t[start]))
-        starts.append(start)
-        ends.append(end)
+    events = slip_events(m, t, x, f)
+    jumps = [
+        float(
+            np.linalg.norm(
+                np.diff(np.column_stack([x[e.onset : e.stop + 1], y[e.onset : e.stop + 1]]), axis=0), axis=1
+            ).sum()
+        )
+        for e in events
+    ]
     return SlipStats(
-        len(jumps),
+        len(events),
         np.array(jumps),
-        np.array(drops),
-        np.array(durs),
-        np.array(starts, np.int64),
-        np.array(ends, np.int64),
+        np.array([e.force_drop_n for e in events]),
+        np.array([e.duration_s for e in events]),
+        np.array([e.onset for e in events], np.int64),
+        np.array([e.stop for e in events], np.int64),
     )
 
 
@@ -189,8 +187,7 @@ def stick_slip(plan: ValidationPlan, runner: StudyRunner) -> StickSlipResult:
                     tr["x"] / lc_units,
                     tr["y"] / lc_units,
                     tr["drive_force_n"] / fp,
-                    tr["moving"],
-                    min_samples=3,
+                    tr["motion"],
                 )
             )
             if s == 0:

@@ -31,6 +31,7 @@ import pandas as pd
 from spine_mj import presets, sim, sweep
 from spine_mj.energy import elastic_release_j, quasistatic_work_j
 from spine_mj.errors import SpineInputError
+from spine_mj.sim.motion import SLIPPING
 from spine_mj.validate.boundary import preset_grid, quasistatic_locked
 from spine_mj.validate.ie_star import ie_star_by_criterion, passes_criterion, quiet_nan_warnings
 from spine_mj.validate.paths import mujoco_traces
@@ -52,8 +53,6 @@ __all__ = [
 #: Families whose slip events the study collects (rough enough to stick and slip).
 SLIP_FAMILIES = ("random_gaussian", "fractal")
 
-#: Shorter runs of ``moving`` samples are detector chatter (as in the stick-slip study).
-MIN_SLIP_SAMPLES = 3
 
 #: The agreement criterion of the map: the boundary study's headline one.
 CRITERION = "median_frechet"
@@ -242,8 +241,7 @@ def _energy_and_slip(tr, qs, lc: float, unit_m: float, fp: float, k_n_m: float) 
             tr["x"] / lc,
             tr["y"] / lc,
             force / fp,
-            tr["moving"],
-            min_samples=MIN_SLIP_SAMPLES,
+            tr["motion"],
         )
         events = [SimpleNamespace(kind="move_onset", index=int(i)) for i in ev.onset_indices] + [
             SimpleNamespace(kind="move_stop", index=int(i)) for i in ev.stop_indices
@@ -253,7 +251,7 @@ def _energy_and_slip(tr, qs, lc: float, unit_m: float, fp: float, k_n_m: float) 
             release_fplc=elastic_release_j(force, k_n_m, events) / (fp * lc_m),
             advance_lc=float(x[-1] - x[0]) / lc,
             slip_events=float(ev.count),
-            slip_time_fraction=float(np.mean(tr["moving"].to_numpy(dtype=bool))),
+            slip_time_fraction=float(np.mean(tr["motion"].to_numpy() == SLIPPING)),
             events=ev,
         )
     if qs is not None and len(qs) > 1:
@@ -367,7 +365,7 @@ def energy_rows(runs: pd.DataFrame) -> list[dict]:
 
 
 def slip_rows(runs: pd.DataFrame) -> list[dict]:
-    """Per (I_e, K): slip events per L_c advanced and the fraction of time moving over
+    """Per (I_e, K): slip events per L_c advanced and the fraction of time slipping over
     the :data:`SLIP_FAMILIES` runs without engine trouble (``n_ok`` / ``n``), and the
     fraction of quasistatic traps MuJoCo skips over every family's runs without engine
     trouble (``traps``: streamline self-locks; ``skipped``: of those, runs where MuJoCo did
