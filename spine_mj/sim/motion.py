@@ -12,14 +12,15 @@ thresholds:
   interval reaches :data:`SLIP_SPEED_FACTOR` ``V``. A stable quasistatic slide moves at
   ``V / (1 + (W/k) dkappa/dx)``, at most 2 V for ``K >= 2 K*``, and a spring-block on a
   flat plane swings between 0 and 2 V; a jump's speed is set by ``w = sqrt(k/m)`` and the
-  force drop (``~ dF / sqrt(k m)``), not by V, and exceeds 3 V by far at small I_e.
+  force drop (``~ dF / sqrt(k m)``), not by V, and exceeds 5 V by far at small I_e.
 * otherwise a step is *stuck* when the tip's speed is below :data:`STUCK_SPEED_FRACTION`
   ``V`` (the spring takes at least 90 % of the carriage's advance), else *sliding*.
 
 A slip event is one slipping interval: its onset is the step before the interval (the last
 step at which the spring was still loading, where its force peaks), and it carries the
 onset force, the force drop (peak minus the lowest force after it within the event, never
-negative by construction), the jump length along x and the duration.
+negative by construction), the jump length along x and the duration. A slip still going
+on at the run's last row (a run cut by its end) is not an event: its drop is unknown.
 """
 
 from __future__ import annotations
@@ -34,9 +35,11 @@ MOTION_NAMES = ("stuck", "sliding", "slipping")
 
 #: A step is stuck when the tip's speed is below this fraction of the drive's speed V.
 STUCK_SPEED_FRACTION = 0.1
-#: An interval of the tip outrunning the drive is a slip when its x-speed reaches this many V
-#: (above the 2 V of a spring-block's swing and of any stable slide at K >= 2 K*).
-SLIP_SPEED_FACTOR = 3.0
+#: An interval of the tip outrunning the drive is a slip when its x-speed reaches this many V:
+#: above the 2 V of a spring-block's swing and of any stable slide at K >= 2 K*, plus the
+#: bursts of up to ~2 V the hfield's facet kinks add (measured on a corrugation at 128 points
+#: per wavelength, K = 2 K*, I_e = 1e-4); a jump there reaches 50-80 V (docs/physics.md).
+SLIP_SPEED_FACTOR = 5.0
 
 
 @dataclass(frozen=True)
@@ -109,7 +112,10 @@ def slip_events(
     """The slip events of a run from its motion ``states`` (one per run of SLIPPING rows)
     and its time, tip x and drive force (and x-speed, for the peak speed) per row."""
     out = []
+    n = len(states)
     for a, b in _runs(np.asarray(states) == SLIPPING):
+        if b == n - 1:  # cut by the end of the run
+            continue
         o = max(a - 1, 0)
         f = force_n[o : b + 1]
         p = int(np.argmax(f))
