@@ -1,6 +1,5 @@
 """Motion states relative to the drive, against the closed forms (spine_mj.tomlinson)."""
 
-
 import numpy as np
 import pytest
 from sim_rigs import MU, flat_rig

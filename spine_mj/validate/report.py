@@ -32,6 +32,8 @@ from spine_mj.sweep.store import load_runs
 from spine_mj.templates import render
 from spine_mj.validate.boundary import BoundaryCurve, BoundaryResult
 from spine_mj.validate.fractal_lock import SERIES, FractalLockResult
+from spine_mj.validate.ground_truth import GroundTruthResult
+from spine_mj.validate.ground_truth_report import ground_truth_section
 from spine_mj.validate.paths import stored_paths
 from spine_mj.validate.plans import FRECHET_TARGET, OUTCOME_TARGET, STATIC_TARGET
 from spine_mj.validate.quasistatic_limit import QuasistaticLimitResult
@@ -325,6 +327,7 @@ def write_report(
     sand: SandpaperResult,
     fractal: FractalLockResult | None = None,
     kmap: StiffnessMapResult | None = None,
+    ground: GroundTruthResult | None = None,
 ) -> Path:
     """Write the figures under ``out/figures`` and ``out/report.md``; returns the report path.
 
@@ -365,6 +368,7 @@ def write_report(
         sand="\n".join(_sand_section(sand)),
         fractal="\n".join(_fractal_section(fractal)),
         kmap=map_sections(kmap, _table, _f),
+        ground=ground_truth_section(ground, _table, _f),
         engine_settings=json.dumps(result["engine_settings"], indent=2, default=str),
         timings=", ".join(f"{k} {sig(v)}" for k, v in result["timings_s"].items()),
     )

@@ -16,6 +16,7 @@ from spine_mj.jsonio import write_json
 from spine_mj.surfaces import single_gaussian
 from spine_mj.validate.boundary import BoundaryResult, boundary
 from spine_mj.validate.fractal_lock import FractalLockResult, fractal_lock
+from spine_mj.validate.ground_truth import ground_truth
 from spine_mj.validate.plans import (
     FRECHET_TARGET,
     MASS_KG,
@@ -97,11 +98,15 @@ def run_validation(
     )
     fr = timed("fractal_lock", fractal_lock, plan, runner)
     km = timed("stiffness_map", stiffness_map, plan, runner)
+    gt = timed("ground_truth", ground_truth, plan, runner)
     runner.study = "report"
     runner.note("figures and report")
     result = _summary(plan, st, lim, bnd, ss, sp, timings, fr)
     result.update(_stiffness_map_summary(km))
-    write_report(out, result, static=st, limit=lim, boundary=bnd, stick=ss, sand=sp, fractal=fr, kmap=km)
+    result["ground_truth"] = gt.as_dict()
+    write_report(
+        out, result, static=st, limit=lim, boundary=bnd, stick=ss, sand=sp, fractal=fr, kmap=km, ground=gt
+    )
     result["timings_s"]["total"] = round(time.perf_counter() - t0, 2)
     write_json(out / "validation.json", result)
     return result
