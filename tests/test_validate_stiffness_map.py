@@ -139,9 +139,9 @@ def test_complementary_cdf_of_known_samples():
 
 
 def test_slip_statistics_marks_where_each_drop_is_read():
-    t = np.arange(8, dtype=float)
-    s = np.array([0, 0, 1, 1, 0, 0, 1, 1], bool)
-    f = np.array([0.0, 1.0, 0.5, 0.2, 0.3, 0.8, 0.4, 0.1])
+    t = np.arange(9, dtype=float)
+    s = np.array([0, 0, 1, 1, 0, 0, 1, 1, 0], bool)
+    f = np.array([0.0, 1.0, 0.5, 0.2, 0.3, 0.8, 0.4, 0.1, 0.2])
     st = slip_statistics(t, t, 0 * t, f, np.where(s, 2, 0))
     np.testing.assert_array_equal(st.onset_indices, [1, 5])
     np.testing.assert_array_equal(st.stop_indices, [3, 7])

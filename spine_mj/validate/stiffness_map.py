@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
-from types import SimpleNamespace
 
 import numpy as np
 import pandas as pd
@@ -243,12 +242,10 @@ def _energy_and_slip(tr, qs, lc: float, unit_m: float, fp: float, k_n_m: float) 
             force / fp,
             tr["motion"],
         )
-        events = [SimpleNamespace(kind="move_onset", index=int(i)) for i in ev.onset_indices] + [
-            SimpleNamespace(kind="move_stop", index=int(i)) for i in ev.stop_indices
-        ]
+        spans = list(zip(ev.onset_indices.tolist(), ev.stop_indices.tolist()))
         x = tr["x"].to_numpy(dtype=float)
         out.update(
-            release_fplc=elastic_release_j(force, k_n_m, events) / (fp * lc_m),
+            release_fplc=elastic_release_j(force, k_n_m, spans) / (fp * lc_m),
             advance_lc=float(x[-1] - x[0]) / lc,
             slip_events=float(ev.count),
             slip_time_fraction=float(np.mean(tr["motion"].to_numpy() == SLIPPING)),
