@@ -135,28 +135,13 @@ def _tomlinson(plan: ValidationPlan, runner: StudyRunner, s: float, mu: float) -
     c = Corrugation(s, mu, tip_radius=TOMLINSON_TIP)
     k_star = c.critical_stiffness()
     ks = [float(f"{f * k_star:.6g}") for f in plan.ground_truth_k_factors]
-    start = 0.75
-    doc = {
-        "sweep": {"name": f"pt-s{s:g}-mu{mu:g}", "seed": 1, "analyses": ["mujoco"]},
-        "surfaces": [
-            {
-                "preset": "corrugation",
-                "set": {
-                    "slope_amplitude": s,
-                    "points_per_wave": POINTS_PER_WAVE,
-                    "n_waves": plan.ground_truth_waves,
-                },
-            }
-        ],
-        "starts": {"frame": "absolute", "x": [start], "y": [0.0]},
-        "drive": {"protocol": "spring", "ie": TOMLINSON_IE, "K": ks},
-        "grid": {"mu": mu, "tip_radius": TOMLINSON_TIP, "record_every": 50},
-    }
-    df, _ = runner(doc, f"ground-truth/pt-s{s:g}-mu{mu:g}")
+    df = corrugation_runs(
+        runner, f"ground-truth/pt-s{s:g}-mu{mu:g}", s, mu, ks, TOMLINSON_IE, plan.ground_truth_waves
+    )
     rows = []
-    for _, r in df[df["analysis"] == "mujoco"].sort_values("K").iterrows():
+    for _, r in df.sort_values("K").iterrows():
         k = float(r["K"])
-        travel = float(r["end_x"]) - start
+        travel = float(r["end_x"]) - CORRUGATION_START
         row = {
             "slope_amplitude": s,
             "mu": mu,
@@ -182,6 +167,31 @@ def _tomlinson(plan: ValidationPlan, runner: StudyRunner, s: float, mu: float) -
             )
         rows.append(row)
     return rows
+
+
+#: Where the corrugation runs start (x over the wavelength; y = 0): a quarter wavelength
+#: before a crest's steepest rising point.
+CORRUGATION_START = 0.75
+
+
+def corrugation_runs(runner: StudyRunner, name: str, s: float, mu: float, ks, ie, waves: int):
+    """The ``mujoco`` rows of the spring drive on a corrugation (slope amplitude ``s``,
+    unit wavelength, :data:`POINTS_PER_WAVE`, ``waves`` wavelengths) at stiffness numbers
+    ``ks`` and I_e ``ie`` (one or a list), from :data:`CORRUGATION_START`."""
+    doc = {
+        "sweep": {"name": name.replace("/", "-"), "seed": 1, "analyses": ["mujoco"]},
+        "surfaces": [
+            {
+                "preset": "corrugation",
+                "set": {"slope_amplitude": s, "points_per_wave": POINTS_PER_WAVE, "n_waves": waves},
+            }
+        ],
+        "starts": {"frame": "absolute", "x": [CORRUGATION_START], "y": [0.0]},
+        "drive": {"protocol": "spring", "ie": ie, "K": list(ks)},
+        "grid": {"mu": mu, "tip_radius": TOMLINSON_TIP, "record_every": 50},
+    }
+    df, _ = runner(doc, name)
+    return df[df["analysis"] == "mujoco"]
 
 
 def ridge(width: float, height: float = RIDGE_HEIGHT) -> GridSurface:

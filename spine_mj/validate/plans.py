@@ -154,6 +154,8 @@ class ValidationPlan:
     stiffness_map_starts : int
         Starts per preset of the map (a subset of the family's): the lowest I_e and the
         many K values make the map's expensive corner, so it runs from few starts.
+    stick_slip_k_ie, stick_slip_k_factors : tuple of float
+        The stick-slip study's K scan on a corrugation: I_e values and K in units of K*.
     ground_truth_slopes, ground_truth_mus : tuple of float
         Corrugations of the ground-truth study's Prandtl-Tomlinson check (slope amplitude
         x mu, each slope below each mu).
@@ -195,6 +197,8 @@ class ValidationPlan:
     stiffness_map_k: tuple[float, ...] = ()
     stiffness_map_families: tuple[str, ...] = ()
     stiffness_map_starts: int = 2
+    stick_slip_k_ie: tuple[float, ...] = (1e-4, 1e-2)
+    stick_slip_k_factors: tuple[float, ...] = (0.125, 0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 4.0, 8.0)
     ground_truth_slopes: tuple[float, ...] = (0.1, 0.2, 0.3)
     ground_truth_mus: tuple[float, ...] = (0.5, 0.8)
     ground_truth_k_factors: tuple[float, ...] = (0.25, 0.5, 2.0, 4.0)
@@ -264,6 +268,8 @@ PLANS: dict[str, ValidationPlan] = {
         stiffness_map_k=(30.0,),
         stiffness_map_families=("single_peak_valley",),
         stiffness_map_starts=1,
+        stick_slip_k_ie=(1e-2,),
+        stick_slip_k_factors=(0.25, 4.0),
         ground_truth_slopes=(0.3,),
         ground_truth_mus=(0.5,),
         ground_truth_k_factors=(0.25, 4.0),
@@ -303,6 +309,8 @@ PLANS: dict[str, ValidationPlan] = {
         stiffness_map_k=(1.0, 10.0, 100.0),
         stiffness_map_families=("single_peak_valley", "random_gaussian", "fractal"),
         stiffness_map_starts=2,
+        stick_slip_k_ie=(1e-4,),
+        stick_slip_k_factors=(0.25, 0.5, 1.0, 2.0, 4.0),
         ground_truth_k_factors=(0.25, 4.0),
         ground_truth_waves=4,
         ground_truth_ridge_widths=(0.35, 0.5),

@@ -40,6 +40,7 @@ from spine_mj.validate.quasistatic_limit import QuasistaticLimitResult
 from spine_mj.validate.sandpaper import SandpaperResult
 from spine_mj.validate.static_map import StaticMapResult
 from spine_mj.validate.stick_slip import StickSlipResult
+from spine_mj.validate.stick_slip_report import k_scan_section
 from spine_mj.validate.stiffness_map import StiffnessMapResult
 from spine_mj.validate.stiffness_map_report import ccdf_figure, map_figure, map_sections
 
@@ -782,6 +783,7 @@ def _stick_section(stick: StickSlipResult) -> list[str]:
             ],
         ),
         "",
+        *k_scan_section(stick, _table, _f),
     ]
 
 
