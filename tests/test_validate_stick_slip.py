@@ -39,3 +39,15 @@ def test_slip_statistics_on_a_constructed_stick_slip_trace():
 def test_slip_statistics_rejects_mismatched_arrays():
     with pytest.raises(SpineInputError, match="one length"):
         validate.slip_statistics([0, 1], [0, 1], [0, 1], [0, 1], [2])
+
+
+def test_k_scan_transition_lies_between_the_last_slipping_and_the_first_sliding_k():
+    from spine_mj.validate.stick_slip import transitions
+
+    scan = [
+        {"ie": 1e-4, "K": k, "events_per_wave": e}
+        for k, e in ((0.1, 1.0), (0.2, 0.9), (0.4, 0.0), (0.8, 0.0))
+    ]
+    (t,) = transitions(scan, k_star=0.3)
+    assert (t["k_low"], t["k_high"]) == (0.2, 0.4)
+    assert t["over_k_star"] == pytest.approx(np.sqrt(0.08) / 0.3)
