@@ -29,7 +29,7 @@ from spine_mj.tomlinson import (
     spring_block_period_s,
 )
 from spine_mj.validate.plans import MASS_KG, ValidationPlan
-from spine_mj.validate.runner import StudyRunner
+from spine_mj.validate.study_runner import StudyRunner
 
 __all__ = ["GroundTruthResult", "ground_truth", "spring_block_check"]
 
@@ -81,6 +81,10 @@ class GroundTruthResult:
 
     def as_dict(self) -> dict:
         return {"spring_block": self.spring_block, "tomlinson": self.tomlinson, "liftoff": self.liftoff}
+
+    def validation_keys(self) -> dict:
+        """This study's key of ``validation.json``."""
+        return {"ground_truth": self.as_dict()}
 
 
 def ground_truth(plan: ValidationPlan, runner: StudyRunner) -> GroundTruthResult:

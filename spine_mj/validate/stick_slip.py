@@ -16,8 +16,8 @@ from spine_mj.tomlinson import Corrugation
 from spine_mj.validate.ground_truth import CORRUGATION_START, TOMLINSON_TIP, corrugation_runs
 from spine_mj.validate.paths import mujoco_traces, tip_radius
 from spine_mj.validate.plans import GRAVITY, MASS_KG, FamilySpec, ValidationPlan, relative_starts
-from spine_mj.validate.runner import StudyRunner
-from spine_mj.validate.sweep_docs import family_doc
+from spine_mj.validate.study_runner import StudyRunner
+from spine_mj.validate.sweep_configs import family_doc
 
 __all__ = ["SlipStats", "StickSlipResult", "complementary_cdf", "slip_statistics", "stick_slip"]
 
@@ -158,6 +158,10 @@ class StickSlipResult:
     k_scan: list[dict] = field(default_factory=list)
     k_star: float = float("nan")
     transitions: list[dict] = field(default_factory=list)
+
+    def validation_keys(self) -> dict:
+        """This study's keys of ``validation.json``."""
+        return {"stick_slip": self.rows}
 
     def as_dict(self) -> dict:
         return {

@@ -1,4 +1,4 @@
-"""Report text of the ground-truth study (:mod:`spine_mj.validate.ground_truth`): the
+"""The report of the ground-truth study (:mod:`spine_mj.validate.ground_truth`): the
 "Ground truth" section, each closed form beside what MuJoCo measured and its error.
 """
 
@@ -10,19 +10,28 @@ import numpy as np
 
 from spine_mj.sim.motion import SLIP_SPEED_FACTOR, STUCK_SPEED_FRACTION
 from spine_mj.validate.ground_truth import LIFTOFF_GAP_RADII, POINTS_PER_WAVE, TOMLINSON_IE, GroundTruthResult
+from spine_mj.validate.report.common import ReportContext, cell, table
 
-__all__ = ["ground_truth_section"]
+__all__ = ["ground_truth_section", "headline", "section"]
 
 
 def _pct(v: float) -> str:
     return "n/a" if v is None or not math.isfinite(v) else f"{100 * v:+.1f} %"
 
 
-def ground_truth_section(gt: GroundTruthResult | None, table, f) -> str:
-    """The section's Markdown ("" without a result); ``table(rows, cols, names)`` and
-    ``f(value)`` are the report's table and number formatters."""
+def headline(gt: GroundTruthResult) -> list[str]:
+    return []
+
+
+def section(gt: GroundTruthResult, ctx: ReportContext) -> str:
+    return ground_truth_section(gt)
+
+
+def ground_truth_section(gt: GroundTruthResult | None) -> str:
+    """The section's Markdown ("" without a result)."""
     if gt is None:
         return ""
+    f = cell
     b = gt.spring_block
     lines = [
         "## Ground truth for the dynamics",
@@ -39,12 +48,13 @@ def ground_truth_section(gt: GroundTruthResult | None, table, f) -> str:
         f"slip events {b['slip_events']} (the swing is no slip).",
         "",
     ]
-    lines += _tomlinson(gt.tomlinson, table, f)
-    lines += _liftoff(gt.liftoff, table, f)
+    lines += _tomlinson(gt.tomlinson)
+    lines += _liftoff(gt.liftoff)
     return "\n".join(lines)
 
 
-def _tomlinson(rows: list[dict], table, f) -> list[str]:
+def _tomlinson(rows: list[dict]) -> list[str]:
+    f = cell
     if not rows:
         return []
     below = [r for r in rows if r["k_over_k_star"] < 1]
@@ -99,7 +109,8 @@ def _tomlinson(rows: list[dict], table, f) -> list[str]:
     return out
 
 
-def _liftoff(rows: list[dict], table, f) -> list[str]:
+def _liftoff(rows: list[dict]) -> list[str]:
+    f = cell
     if not rows:
         return []
     out = [

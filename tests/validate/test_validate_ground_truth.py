@@ -5,10 +5,9 @@ import math
 import pytest
 
 from spine_mj.validate.ground_truth import ground_truth
-from spine_mj.validate.ground_truth_report import ground_truth_section
 from spine_mj.validate.plans import PLANS
-from spine_mj.validate.report import _f, _table
-from spine_mj.validate.runner import StudyRunner
+from spine_mj.validate.report.ground_truth import ground_truth_section
+from spine_mj.validate.study_runner import StudyRunner
 
 
 @pytest.fixture(scope="module")
@@ -32,6 +31,6 @@ def test_ground_truth_errors_are_small_at_smoke_size(smoke):
 
 
 def test_ground_truth_section_names_each_check(smoke):
-    text = ground_truth_section(smoke, _table, _f)
+    text = ground_truth_section(smoke)
     assert "Spring-block" in text and "Prandtl-Tomlinson" in text and "Lift-off" in text
-    assert ground_truth_section(None, _table, _f) == ""
+    assert ground_truth_section(None) == ""
