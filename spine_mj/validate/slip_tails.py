@@ -47,7 +47,7 @@ def fit_tail(samples) -> dict:
         fit = powerlaw.Fit(x, verbose=False)
         pl = fit.power_law
         ratio, p = fit.distribution_compare("power_law", "exponential", normalized_ratio=True)
-    alpha, sigma = float(pl.alpha), float(pl.sigma)
+    alpha, sigma = float(pl.alpha), float(pl.standard_err)
     out.update(
         fitted=math.isfinite(alpha),
         alpha=alpha,
