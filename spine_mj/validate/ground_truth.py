@@ -249,10 +249,11 @@ def _liftoff(plan: ValidationPlan, runner: StudyRunner, width: float) -> dict:
         approach = float(((z[flat] - tip) / tip).max()) if flat.any() else math.nan
         runs.append((ie, ie * (v / float(r["speed_m_s"])) ** 2, _crest_gap(x, z, width, tip), approach))
     runs.sort()
-    lifted = [run for run in runs if run[2] > LIFTOFF_GAP_RADII]
-    held = [run for run in runs if run[2] <= LIFTOFF_GAP_RADII and (not lifted or run[0] < lifted[0][0])]
-    first = lifted[0][1] if lifted else math.nan
-    last_held = held[-1][1] if held else math.nan
+    # the bracket in the I_e of the speed at the crest (what the criterion reads; a spring
+    # run's crest speed need not rise with the carriage's)
+    first = min((run[1] for run in runs if run[2] > LIFTOFF_GAP_RADII), default=math.nan)
+    held = [run[1] for run in runs if run[2] <= LIFTOFF_GAP_RADII and not run[1] > first]
+    last_held = max(held, default=math.nan)
     return {
         "width": width,
         "height": RIDGE_HEIGHT,
