@@ -154,6 +154,19 @@ class ValidationPlan:
     stiffness_map_starts : int
         Starts per preset of the map (a subset of the family's): the lowest I_e and the
         many K values make the map's expensive corner, so it runs from few starts.
+    stick_slip_k_ie, stick_slip_k_factors : tuple of float
+        The stick-slip study's K scan on a corrugation: I_e values and K in units of K*.
+    ground_truth_slopes, ground_truth_mus : tuple of float
+        Corrugations of the ground-truth study's Prandtl-Tomlinson check (slope amplitude
+        x mu, each slope below each mu).
+    ground_truth_k_factors : tuple of float
+        Stiffness numbers of that check in units of each corrugation's K*.
+    ground_truth_waves : int
+        Wavelengths of those corrugations.
+    ground_truth_ridge_widths : tuple of float
+        Gaussian ridge widths (height 0.5) of the lift-off check.
+    ground_truth_liftoff_factors : tuple of float
+        I_e of the lift-off scans in units of each ridge's predicted I_e*.
     """
 
     name: str
@@ -184,6 +197,14 @@ class ValidationPlan:
     stiffness_map_k: tuple[float, ...] = ()
     stiffness_map_families: tuple[str, ...] = ()
     stiffness_map_starts: int = 2
+    stick_slip_k_ie: tuple[float, ...] = (1e-4, 1e-2)
+    stick_slip_k_factors: tuple[float, ...] = (0.125, 0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 4.0, 8.0)
+    ground_truth_slopes: tuple[float, ...] = (0.1, 0.2, 0.3)
+    ground_truth_mus: tuple[float, ...] = (0.5, 0.8)
+    ground_truth_k_factors: tuple[float, ...] = (0.25, 0.5, 2.0, 4.0)
+    ground_truth_waves: int = 6
+    ground_truth_ridge_widths: tuple[float, ...] = (0.35, 0.5, 0.7)
+    ground_truth_liftoff_factors: tuple[float, ...] = (0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1.2, 1.5)
     extra: dict = field(default_factory=dict, compare=False)
 
 
@@ -247,6 +268,14 @@ PLANS: dict[str, ValidationPlan] = {
         stiffness_map_k=(30.0,),
         stiffness_map_families=("single_peak_valley",),
         stiffness_map_starts=1,
+        stick_slip_k_ie=(1e-2,),
+        stick_slip_k_factors=(0.25, 4.0),
+        ground_truth_slopes=(0.3,),
+        ground_truth_mus=(0.5,),
+        ground_truth_k_factors=(0.25, 4.0),
+        ground_truth_waves=3,
+        ground_truth_ridge_widths=(0.5,),
+        ground_truth_liftoff_factors=(0.5, 1.5),
     ),
     "quick": ValidationPlan(
         name="quick",
@@ -280,6 +309,12 @@ PLANS: dict[str, ValidationPlan] = {
         stiffness_map_k=(1.0, 10.0, 100.0),
         stiffness_map_families=("single_peak_valley", "random_gaussian", "fractal"),
         stiffness_map_starts=2,
+        stick_slip_k_ie=(1e-4,),
+        stick_slip_k_factors=(0.25, 0.5, 1.0, 2.0, 4.0),
+        ground_truth_k_factors=(0.25, 4.0),
+        ground_truth_waves=4,
+        ground_truth_ridge_widths=(0.35, 0.5),
+        ground_truth_liftoff_factors=(0.5, 0.8, 1.1, 1.5),
     ),
     "full": ValidationPlan(
         name="full",
