@@ -193,7 +193,7 @@ def kappa_of_normal(normal, mu, *, tol: float = DEFAULT_TOL) -> tuple[np.ndarray
     return k, region
 
 
-def crease_engagement(fx_a, fy_a, fx_b, fy_b, mu, *, tol: float = DEFAULT_TOL, lock_first: bool = False):
+def crease_engagement(fx_a, fy_a, fx_b, fy_b, mu, *, tol: float = DEFAULT_TOL):
     """Engagement of a tip resting on two contacts at once, in a concave crease between
     surfaces of slopes ``(fx_a, fy_a)`` and ``(fx_b, fy_b)``: what the single-contact
     :func:`kappa` cannot describe (beyond the paper, docs/physics.md §4, Creases).
@@ -204,11 +204,6 @@ def crease_engagement(fx_a, fy_a, fx_b, fy_b, mu, *, tol: float = DEFAULT_TOL, l
     friction of both contacts, at most ``mu (N_a + N_b)``, opposes the part along it,
     ``F.c = W (kappa c_x - c_z)``. A V-groove of flank angle theta along the drive gives
     the wedge's ``kappa = mu / cos(theta)``.
-
-    ``lock_first``: a crease no drive moves forward is ``SELF_LOCK`` even where gravity
-    alone would slide the tip back down it (the precedence of :func:`kappa`, whose steep
-    wall self-locks: the drive that brought the tip there presses it in); by default
-    gravity's slide comes first.
 
     Returns
     -------
@@ -242,8 +237,7 @@ def crease_engagement(fx_a, fy_a, fx_b, fy_b, mu, *, tol: float = DEFAULT_TOL, l
         b0, b1 = (bz - d * az) / den, (-bx + d * ax) / den
         s0, s1 = a0 + b0, a1 + b1
         slides = np.abs(cz) > mu * s0  # gravity alone, downhill along the crease
-        lock = (~slides | lock_first) & (cx - mu * s1 < tol)
-        slides &= ~lock
+        lock = ~slides & (cx - mu * s1 < tol)
         k = np.where(slides | lock, np.nan, (cz + mu * s0) / (cx - mu * s1))
         # both contacts pressed where the tip slides (a contact that gravity alone leaves
         # unloaded, a wall beside a flat floor, is pressed by the drive); held or sliding

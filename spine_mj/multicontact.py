@@ -162,7 +162,10 @@ def two_contact_kappa(fx_a, fy_a, fx_b, fy_b, mu) -> tuple[np.ndarray, np.ndarra
     of theta 0.3, alpha 0.8, mu 0.7, MuJoCo's static probe broke away at 1.906 F_p, the
     closed form gives 1.907, the feasibility 3.18). Where no motion counts at its onset, the
     feasibility's kappa is the bound: the tip holds at least up to the smallest onset drive,
-    and at most up to that bound.
+    and at most up to that bound. Where gravity alone slides the tip down the crease, that
+    comes first (slip), as in :func:`~spine_mj.engagement.crease_engagement`: measured on
+    sandpaper P36 and P60 grit walls, a crease taken as locked there (the drive's precedence
+    of the single-contact rule) held the reference where MuJoCo's tip moves on.
 
     Parameters
     ----------
@@ -181,7 +184,7 @@ def two_contact_kappa(fx_a, fy_a, fx_b, fy_b, mu) -> tuple[np.ndarray, np.ndarra
     """
     fx_a, fy_a, fx_b, fy_b = np.broadcast_arrays(*(np.asarray(v, float) for v in (fx_a, fy_a, fx_b, fy_b)))
     na, nb = normals_of_slopes(fx_a, fy_a), normals_of_slopes(fx_b, fy_b)
-    kc, rc, _, _ = crease_engagement(fx_a, fy_a, fx_b, fy_b, mu, lock_first=True)
+    kc, rc, _, _ = crease_engagement(fx_a, fy_a, fx_b, fy_b, mu)
     slides = rc == SLIP
     onset = np.where(rc >= 0, np.where(rc == SELF_LOCK, np.inf, kc), np.nan)
     counts = rc >= 0

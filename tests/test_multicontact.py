@@ -48,8 +48,11 @@ def test_two_contacts_in_a_v_groove_hold_like_one_of_friction_mu_over_cos_alpha(
 
 
 def test_a_v_groove_self_locks_once_theta_plus_the_wedge_friction_angle_reaches_90_degrees():
-    mu, alpha = 0.5, 0.6
+    """Where gravity alone does not slide the tip back down the groove (theta below the wedge's
+    friction angle, so that angle above 45 deg); steeper, the preload slides it (slip)."""
+    mu, alpha = 0.8, 0.8
     phi = math.atan(mu / math.cos(alpha))
+    assert phi > math.pi / 4
     for theta, locked in ((math.pi / 2 - phi - 0.02, False), (math.pi / 2 - phi + 0.02, True)):
         fx, fy = _slopes(wedge_normals(theta, alpha))
         k, region = two_contact_kappa(fx[0], fy[0], fx[1], fy[1], mu)

@@ -154,6 +154,10 @@ class ValidationPlan:
     stiffness_map_starts : int
         Starts per preset of the map (a subset of the family's): the lowest I_e and the
         many K values make the map's expensive corner, so it runs from few starts.
+    ensemble_members : int
+        Runs per start of the quasistatic-limit study, on each side: the start and
+        ``ensemble_members - 1`` starts around it (:mod:`spine_mj.validate.ensembles`);
+        1: no ensembles (no start is found ill-conditioned).
     """
 
     name: str
@@ -184,6 +188,7 @@ class ValidationPlan:
     stiffness_map_k: tuple[float, ...] = ()
     stiffness_map_families: tuple[str, ...] = ()
     stiffness_map_starts: int = 2
+    ensemble_members: int = 1
     extra: dict = field(default_factory=dict, compare=False)
 
 

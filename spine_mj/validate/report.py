@@ -40,6 +40,7 @@ from spine_mj.validate.static_map import StaticMapResult
 from spine_mj.validate.stick_slip import StickSlipResult
 from spine_mj.validate.stiffness_map import StiffnessMapResult
 from spine_mj.validate.stiffness_map_report import ccdf_figure, map_figure, map_sections
+from spine_mj.validate.verdicts_report import platform_line, verdicts_section
 
 __all__ = ["write_report"]
 
@@ -360,7 +361,7 @@ def write_report(
         targets={"outcome": OUTCOME_TARGET, "frechet": FRECHET_TARGET, "static": STATIC_TARGET},
         boundary="\n".join(_boundary_section(boundary)),
         static="\n".join(_static_section(static, result)),
-        limit="\n".join(_limit_section(limit, boundary)),
+        limit="\n".join([*_limit_section(limit, boundary), *platform_line(result.get("platform"))]),
         stick="\n".join(_stick_section(stick)),
         sand="\n".join(_sand_section(sand)),
         fractal="\n".join(_fractal_section(fractal)),
@@ -610,6 +611,7 @@ def _limit_section(limit: QuasistaticLimitResult, boundary: BoundaryResult) -> l
             ],
         ),
         "",
+        *verdicts_section(limit.families),
         *_stalled_note(limit),
         *_misses_note(limit),
         *_falls_note(limit, boundary),

@@ -16,6 +16,7 @@ from spine_mj.jsonio import write_json
 from spine_mj.surfaces import single_gaussian
 from spine_mj.validate.boundary import BoundaryResult, boundary
 from spine_mj.validate.fractal_lock import FractalLockResult, fractal_lock
+from spine_mj.validate.intervals import TARGET_RULE
 from spine_mj.validate.plans import (
     FRECHET_TARGET,
     MASS_KG,
@@ -25,6 +26,7 @@ from spine_mj.validate.plans import (
     STATIC_TARGET,
     ValidationPlan,
 )
+from spine_mj.validate.platform import platform_info
 from spine_mj.validate.quasistatic_limit import QuasistaticLimitResult, quasistatic_limit
 from spine_mj.validate.report import write_report
 from spine_mj.validate.runner import StudyRunner, ValidationProgress
@@ -139,8 +141,10 @@ def _summary(
             "outcome_agreement": OUTCOME_TARGET,
             "mean_frechet_lc": FRECHET_TARGET,
             "static_kappa_rel_error": STATIC_TARGET,
+            "rule": TARGET_RULE,
         },
         "engine_settings": _engine_settings(plan),
+        "platform": platform_info(),
         "timings_s": timings,
     }
 
