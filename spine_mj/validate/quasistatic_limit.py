@@ -125,6 +125,7 @@ def quasistatic_limit(plan: ValidationPlan, runner: StudyRunner) -> QuasistaticL
     runner.study = "limit"
     families, runs_rows, paths = {}, [], {}
     for fam in plan.families:
+        fam = plan.corner_family(fam)
         groups: list[dict] = []
         comps = [_preset_comparison(plan, runner, fam, preset, paths, groups) for preset in fam.presets]
         allc = pd.concat(comps, ignore_index=True)
