@@ -20,8 +20,8 @@ from spine_mj.validate.ensembles import ensemble_family, ensemble_groups, ensemb
 from spine_mj.validate.intervals import bootstrap, meets_target, wilson
 from spine_mj.validate.paths import stored_paths, tip_radius
 from spine_mj.validate.plans import FRECHET_TARGET, OUTCOME_TARGET, RECOMMENDED, FamilySpec, ValidationPlan
-from spine_mj.validate.runner import StudyRunner
-from spine_mj.validate.sweep_docs import engine_grid, family_doc
+from spine_mj.validate.study_runner import StudyRunner
+from spine_mj.validate.sweep_configs import engine_grid, family_doc
 
 __all__ = ["LimitPath", "QuasistaticLimitResult", "quasistatic_limit"]
 
@@ -96,6 +96,19 @@ class QuasistaticLimitResult:
     variations: dict[str, dict]
     paths: dict[str, list[LimitPath]]
     lowest_ie: float
+
+    def validation_keys(self) -> dict:
+        """This study's keys of ``validation.json``."""
+        fams = self.families
+        return {
+            "lowest_ie": self.lowest_ie,
+            "outcome_agreement_at_lowest_ie": {k: v["outcome_agreement"] for k, v in fams.items()},
+            "mean_frechet_at_lowest_ie": {k: v["mean_frechet"] for k, v in fams.items()},
+            "median_frechet_at_lowest_ie": {k: v["median_frechet"] for k, v in fams.items()},
+            "failed_runs": {k: v["failed_runs"] for k, v in fams.items()},
+            "limit_families": fams,
+            "limit_variations": self.variations,
+        }
 
     def as_dict(self) -> dict:
         return {
@@ -235,7 +248,7 @@ def _variations(plan: ValidationPlan, runner: StudyRunner, runs_rows: list[dict]
     """The plan's engine variations on the first family's first preset, after the
     recommended settings (summarised from ``runs_rows``)."""
     variations = {}
-    fam0 = plan.families[0]
+    fam0 = plan.corner_family(plan.families[0])
     preset = fam0.presets[0]
     for label, ov in plan.limit_variations:
         tag = "-".join(f"{k}{v}" for k, v in ov)

@@ -14,26 +14,19 @@ from spine_mj import sim
 from spine_mj.errors import SpineInputError
 from spine_mj.jsonio import write_json
 from spine_mj.surfaces import single_gaussian
-from spine_mj.validate.boundary import BoundaryResult, boundary
-from spine_mj.validate.fractal_lock import FractalLockResult, fractal_lock
 from spine_mj.validate.intervals import TARGET_RULE
 from spine_mj.validate.plans import (
     FRECHET_TARGET,
     MASS_KG,
     OUTCOME_TARGET,
     PLANS,
-    SANDPAPER_MU,
     STATIC_TARGET,
     ValidationPlan,
 )
 from spine_mj.validate.platform import platform_info
-from spine_mj.validate.quasistatic_limit import QuasistaticLimitResult, quasistatic_limit
-from spine_mj.validate.report import write_report
-from spine_mj.validate.runner import StudyRunner, ValidationProgress
-from spine_mj.validate.sandpaper import SandpaperResult, sandpaper
-from spine_mj.validate.static_map import StaticMapResult, static_map
-from spine_mj.validate.stick_slip import StickSlipResult, stick_slip
-from spine_mj.validate.stiffness_map import StiffnessMapResult, stiffness_map
+from spine_mj.validate.report.document import write_report
+from spine_mj.validate.studies import STUDIES
+from spine_mj.validate.study_runner import StudyRunner, ValidationProgress
 
 __all__ = ["run_validation"]
 
@@ -81,80 +74,37 @@ def run_validation(
     t0 = time.perf_counter()
     runner = StudyRunner(out, workers, progress, t0)
     timings = {}
-
-    def timed(name, func, *args, **kw):
+    results = []
+    for study in STUDIES:
         t = time.perf_counter()
-        res = func(*args, **kw)
-        timings[name] = round(time.perf_counter() - t, 2)
-        return res
-
-    st = timed("static", static_map, plan, runner)
-    lim = timed("limit", quasistatic_limit, plan, runner)
-    bnd = timed("boundary", boundary, plan, runner)
-    ss = timed("stick_slip", stick_slip, plan, runner)
-    sp = (
-        timed("sandpaper", sandpaper, plan, runner)
-        if plan.sandpaper_grits
-        else SandpaperResult(rows=[], paths={}, mu=SANDPAPER_MU)
-    )
-    fr = timed("fractal_lock", fractal_lock, plan, runner)
-    km = timed("stiffness_map", stiffness_map, plan, runner)
+        results.append(study.run(plan, runner))
+        timings[study.name] = round(time.perf_counter() - t, 2)
     runner.study = "report"
     runner.note("figures and report")
-    result = _summary(plan, st, lim, bnd, ss, sp, timings, fr)
-    result.update(_stiffness_map_summary(km))
-    write_report(out, result, static=st, limit=lim, boundary=bnd, stick=ss, sand=sp, fractal=fr, kmap=km)
+    result = _summary(plan, results, timings)
+    write_report(out, result, results)
     result["timings_s"]["total"] = round(time.perf_counter() - t0, 2)
     write_json(out / "validation.json", result)
     return result
 
 
-def _summary(
-    plan: ValidationPlan,
-    st: StaticMapResult,
-    lim: QuasistaticLimitResult,
-    bnd: BoundaryResult,
-    ss: StickSlipResult,
-    sp: SandpaperResult,
-    timings: dict,
-    fr: FractalLockResult,
-) -> dict:
-    """The content of ``validation.json`` (``timings_s`` is ``timings``, not a copy)."""
-    return {
-        "plan": plan.name,
-        "static_kappa_max_rel_error": st.static_kappa_max_rel_error,
-        "static_by_engine": st.per_engine,
-        "lowest_ie": plan.lowest_ie,
-        "outcome_agreement_at_lowest_ie": {k: v["outcome_agreement"] for k, v in lim.families.items()},
-        "mean_frechet_at_lowest_ie": {k: v["mean_frechet"] for k, v in lim.families.items()},
-        "median_frechet_at_lowest_ie": {k: v["median_frechet"] for k, v in lim.families.items()},
-        "failed_runs": {k: v["failed_runs"] for k, v in lim.families.items()},
-        "limit_families": lim.families,
-        "limit_variations": lim.variations,
-        "ie_star": bnd.ie_star,
-        "ie_curves": {k: c.as_dict() for k, c in bnd.curves.items()},
-        "trap_skip_rate": bnd.skip_rate,
-        "stick_slip": ss.rows,
-        "sandpaper": sp.rows,
-        "fractal_lock_rate": fr.as_dict(),
-        "targets": {
-            "outcome_agreement": OUTCOME_TARGET,
-            "mean_frechet_lc": FRECHET_TARGET,
-            "static_kappa_rel_error": STATIC_TARGET,
-            "rule": TARGET_RULE,
-        },
-        "engine_settings": _engine_settings(plan),
-        "platform": platform_info(),
-        "timings_s": timings,
+def _summary(plan: ValidationPlan, results: list, timings: dict) -> dict:
+    """The content of ``validation.json``: the plan, every study's keys
+    (``validation_keys()``), the targets and engine settings (``timings_s`` is
+    ``timings``, not a copy)."""
+    summary = {"plan": plan.name}
+    for res in results:
+        summary.update(res.validation_keys())
+    summary["targets"] = {
+        "outcome_agreement": OUTCOME_TARGET,
+        "mean_frechet_lc": FRECHET_TARGET,
+        "static_kappa_rel_error": STATIC_TARGET,
+        "rule": TARGET_RULE,
     }
-
-
-def _stiffness_map_summary(km: StiffnessMapResult) -> dict:
-    """The map's ``validation.json`` keys: ``ie_star_by_stiffness`` (family -> K -> I_e*
-    with bracket ``low``/``high``, bootstrap ``ci_low``/``ci_high`` and ``kind``) and
-    ``stiffness_map`` (the agreement grid with n_ok / n per cell, the energy and slip
-    tables)."""
-    return {"ie_star_by_stiffness": km.ie_star(), "stiffness_map": km.as_dict()}
+    summary["engine_settings"] = _engine_settings(plan)
+    summary["platform"] = platform_info()
+    summary["timings_s"] = timings
+    return summary
 
 
 def _engine_settings(plan: ValidationPlan) -> dict:

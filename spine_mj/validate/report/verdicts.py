@@ -1,6 +1,6 @@
-"""The report's verdicts on the quasistatic limit: every headline number with its 95 %
-interval, the target rule, and the platform that made them (a section of the validation
-report, :mod:`spine_mj.validate.report`)."""
+"""The quasistatic limit's verdicts (part of :mod:`spine_mj.validate.report.quasistatic_limit`):
+every headline number with its 95 % interval, the target rule, and the platform that made
+them."""
 
 from __future__ import annotations
 

@@ -81,7 +81,7 @@ def test_the_limit_study_runs_each_start_as_an_ensemble_on_both_sides(tmp_path):
 
     from spine_mj.validate.plans import PLANS, FamilySpec, paper_starts
     from spine_mj.validate.quasistatic_limit import quasistatic_limit
-    from spine_mj.validate.runner import StudyRunner
+    from spine_mj.validate.study_runner import StudyRunner
 
     fam = FamilySpec("single_peak_valley", ("paper-single-peak",), None, paper_starts([-2.0, -4.0]))
     plan = dataclasses.replace(PLANS["smoke"], families=(fam,), ensemble_members=3)
