@@ -17,7 +17,15 @@ from collections.abc import Callable, Sequence
 import numpy as np
 from scipy import stats
 
-__all__ = ["CONFIDENCE", "TARGET_RULE", "TARGET_SLACK", "bootstrap", "meets_target", "wilson"]
+__all__ = [
+    "CONFIDENCE",
+    "TARGET_RULE",
+    "TARGET_SLACK",
+    "bootstrap",
+    "meets_target",
+    "runs_to_meet",
+    "wilson",
+]
 
 #: Confidence level of every interval on a headline number.
 CONFIDENCE = 0.95
@@ -86,3 +94,13 @@ def meets_target(point: float, interval: Sequence[float], target: float, *, high
     if higher_is_better:
         return point >= target and low >= target - TARGET_SLACK
     return point <= target and high <= target * (1.0 + TARGET_SLACK)
+
+
+def runs_to_meet(target: float) -> int:
+    """The fewest runs with which a rate can meet ``target`` under :func:`meets_target`: all
+    of them agreeing, the Wilson interval's low end reaching ``target - TARGET_SLACK`` (35
+    for 0.95: a plan of 30 runs a family cannot meet it, whatever it measures)."""
+    n = 1
+    while wilson(n, n)[0] < target - TARGET_SLACK:
+        n += 1
+    return n

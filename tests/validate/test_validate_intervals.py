@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from scipy.stats import norm
 
-from spine_mj.validate.intervals import TARGET_SLACK, bootstrap, meets_target, wilson
+from spine_mj.validate.intervals import TARGET_SLACK, bootstrap, meets_target, runs_to_meet, wilson
 from spine_mj.validate.platform import platform_info
 
 
@@ -68,3 +68,10 @@ def test_platform_names_the_cpu_and_the_versions():
     assert info["numpy"] == np.__version__
     assert isinstance(info["vector_instruction_sets"], list)
     assert info["mujoco"]
+
+
+def test_the_fewest_runs_that_can_meet_a_rate_target():
+    n = runs_to_meet(0.95)
+    assert meets_target(1.0, wilson(n, n), 0.95, higher_is_better=True)
+    assert not meets_target(1.0, wilson(n - 1, n - 1), 0.95, higher_is_better=True)
+    assert n == 35  # z^2 (1 - 0.9) / 0.1 rounded up: 30 all-agreeing runs are not enough

@@ -6,8 +6,9 @@ from __future__ import annotations
 
 import math
 
+from spine_mj.compare import OUTCOME_TARGET
 from spine_mj.validate.ensembles import ENSEMBLE_RADIUS_LC
-from spine_mj.validate.intervals import TARGET_RULE
+from spine_mj.validate.intervals import TARGET_RULE, runs_to_meet
 
 __all__ = ["platform_line", "verdicts_section"]
 
@@ -63,11 +64,14 @@ def verdicts_section(families: dict) -> list[str]:
         if m > 1
         else "Each start ran once (no ensembles: no start is found ill-conditioned)."
     )
+    least = runs_to_meet(OUTCOME_TARGET)
     return [
         "### Verdicts with their intervals",
         "",
         f"{how} Each headline number with its 95 % interval (Wilson for agreements, percentile "
-        f"bootstrap over runs for medians); a target is {TARGET_RULE}.",
+        f"bootstrap over runs for medians); a target is {TARGET_RULE}. An agreement of "
+        f"{OUTCOME_TARGET:g} needs at least {least} well-conditioned starts to be met, all agreeing: "
+        "a family with fewer cannot meet it whatever it measures.",
         "",
         *table,
         "",
