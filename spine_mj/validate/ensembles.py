@@ -111,6 +111,7 @@ def ensemble_verdicts(groups: Sequence[dict]) -> dict:
         ``starts``, ``members``, ``ill_conditioned_share`` ({``mujoco``, ``reference``}: the
         share of starts whose ensemble splits there), ``ill_conditioned_starts`` (either
         side), ``well_conditioned_runs`` (starts one outcome on both sides, none stopped),
+        ``stopped_starts`` (a member stopped by the engine or stalled on the reference),
         ``agreement_well_conditioned`` (the share of those where the outcomes agree) with
         its Wilson ``agreement_ci``, and ``distribution_agreement`` (over all starts, the
         mean share of MuJoCo-reference member pairs that agree); ``ill_conditioned``: the
@@ -142,6 +143,7 @@ def ensemble_verdicts(groups: Sequence[dict]) -> dict:
         },
         "ill_conditioned_starts": int((mj_split | ref_split).sum()),
         "well_conditioned_runs": n_well,
+        "stopped_starts": int((~ok).sum()),
         "agreement_well_conditioned": n_agree / n_well if n_well else math.nan,
         "agreement_ci": list(wilson(n_agree, n_well)),
         "distribution_agreement": float(np.mean(overlap)) if n else math.nan,

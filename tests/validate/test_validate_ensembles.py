@@ -62,7 +62,7 @@ def test_a_start_whose_members_end_in_different_traps_is_ill_conditioned_on_that
     assert v["starts"] == 6 and v["members"] == 3
     assert v["ill_conditioned_share"] == {"mujoco": pytest.approx(1 / 6), "reference": pytest.approx(1 / 6)}
     assert v["ill_conditioned_starts"] == 2
-    assert v["well_conditioned_runs"] == 3
+    assert v["well_conditioned_runs"] == 3 and v["stopped_starts"] == 1
     assert v["agreement_well_conditioned"] == pytest.approx(2 / 3)
     assert v["agreement_ci"] == pytest.approx(list(wilson(2, 3)))
     # pairs that agree: 1, 1, 0, 6/9, 6/9 and 0 for the stopped start

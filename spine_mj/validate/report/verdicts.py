@@ -34,7 +34,7 @@ def verdicts_section(families: dict) -> list[str]:
     head = [
         "family",
         "agreement, well-conditioned [95 % CI]",
-        "well-conditioned / starts",
+        "well-conditioned / starts (a member stopped)",
         "ill-conditioned: MuJoCo / reference",
         "agreement, all starts [95 % CI]",
         "median Frechet / L_c [95 % CI]",
@@ -48,7 +48,8 @@ def verdicts_section(families: dict) -> list[str]:
         row = [
             name,
             f"{_num(f.get('agreement_well_conditioned'))} {_ci(f.get('agreement_ci'))}",
-            f"{f.get('well_conditioned_runs', '-')} / {f.get('starts', f['runs'])}",
+            f"{f.get('well_conditioned_runs', '-')} / {f.get('starts', f['runs'])} "
+            f"({f.get('stopped_starts', 0)})",
             f"{_num(ill.get('mujoco'))} / {_num(ill.get('reference'))}",
             f"{_num(f['outcome_agreement'])} {_ci(f.get('outcome_agreement_ci'))}",
             f"{_num(f['median_frechet'])} {_ci(f.get('median_frechet_ci'))}",
