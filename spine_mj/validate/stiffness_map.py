@@ -158,7 +158,7 @@ def stiffness_map(plan: ValidationPlan, runner: StudyRunner) -> StiffnessMapResu
         return empty
     runs, samples = [], {}
     for fam in fams:
-        sub = subset_starts(fam, plan.stiffness_map_starts)
+        sub = subset_starts(plan.map_family(fam), plan.stiffness_map_starts)
         for preset in fam.presets:
             doc = family_doc(
                 sub,
