@@ -96,9 +96,9 @@ def array_cmd(
     where = arr.default_centre() if centre is None else parse_start(centre)
     arr.starts(where)  # spines off the surface: refused before anything runs or is written
     if drive == "speed":
-        drv = sim.SpringDrive(speed_m_s=speed, stiffness_n_m=k, duration_s=duration)
+        drv = sim.build_drive(sc, "spring", ie=ie, stiffness_n_m=k, duration_s=duration)
     else:
-        drv = sim.ForcePull(rate_n_s=speed * sc.preload_n / sc.char_length_m, stiffness_n_m=k)
+        drv = sim.ForcePull(rate_n_s=sc.force_rate_for(speed), stiffness_n_m=k)
     click.echo(f"{layout.n_spines} spines, {drive} drive, I_e = {ie:g}: simulating ...")
     res = arr.run(drv, centre=where)
     written = write_array_outputs(res, arr, out_dir)

@@ -171,7 +171,7 @@ class ArrayBatch:
         self.k = stiffness_n_m(drive, rig.scales) / u.stiffness_n_m  # each spring, engine units
         self.cap = det.kappa_cap * rig.scales.preload_n / u.force_n
         self.dt = rig.engine.timestep_s / u.time_s
-        self.slip = det.slip_speed_m_s / u.speed_m_s
+        self.slip = det.move_speed_m_s / u.speed_m_s
         margin = det.domain_margin_m / u.length_m
         xmin, xmax, ymin, ymax = (b / u.length_m for b in rig.bounds_m)
         self.box = (xmin + margin, xmax - margin, ymin + margin, ymax - margin)

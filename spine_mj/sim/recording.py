@@ -21,19 +21,10 @@ from spine_mj.sim.params import EngineUnits
 SENSOR_NAMES = ("tip_pos", "tip_vel", "contact_net", "contact_deepest", "spring_force", "push_force")
 
 
-@dataclass(frozen=True)
-class Recording:
-    """Per-step arrays of a run ``(n, ...)`` or of a group of runs ``(g, n, ...)``.
-
-    Attributes
-    ----------
-    time_s, position_m, velocity_m_s, contact, normal, contact_point_m, penetration_m,
-    normal_force_n, tangential_force_n, drive_force_n, carriage_x_m, slipping
-        As in :class:`~spine_mj.sim.RunResult`.
-    tangential_speed_m_s
-        Tip speed in the tangent plane of the deepest contact [m/s] (the full speed
-        without contact).
-    """
+@dataclass(frozen=True, eq=False)
+class RunColumns:
+    """The per-step arrays every run records, declared once: the fields that
+    :class:`Recording` and :class:`~spine_mj.sim.RunResult` share (documented there)."""
 
     time_s: np.ndarray
     position_m: np.ndarray
@@ -45,9 +36,25 @@ class Recording:
     normal_force_n: np.ndarray
     tangential_force_n: np.ndarray
     drive_force_n: np.ndarray
-    tangential_speed_m_s: np.ndarray
     carriage_x_m: np.ndarray
-    slipping: np.ndarray
+    moving: np.ndarray
+
+
+@dataclass(frozen=True)
+class Recording(RunColumns):
+    """Per-step arrays of a run ``(n, ...)`` or of a group of runs ``(g, n, ...)``.
+
+    Attributes
+    ----------
+    time_s, position_m, velocity_m_s, contact, normal, contact_point_m, penetration_m,
+    normal_force_n, tangential_force_n, drive_force_n, carriage_x_m, moving
+        As in :class:`~spine_mj.sim.RunResult` (:class:`RunColumns`).
+    tangential_speed_m_s
+        Tip speed in the tangent plane of the deepest contact [m/s] (the full speed
+        without contact).
+    """
+
+    tangential_speed_m_s: np.ndarray
 
     @classmethod
     def empty(cls, shape: tuple[int, ...]) -> Recording:
@@ -63,7 +70,7 @@ class Recording:
         *,
         units: EngineUnits,
         carriage_x: np.ndarray,
-        slip_speed_m_s: float,
+        move_speed_m_s: float,
         out: Recording | None = None,
     ) -> Recording:
         """The recording of a group in SI: ``state`` ``(g, n, nstate)``, ``sens`` ``(g, n,
@@ -71,13 +78,13 @@ class Recording:
 
         The columns are computed for the whole group in one pass (the same arithmetic per
         row as one run at a time); a step slips when its tangential speed exceeds
-        ``slip_speed_m_s``. ``out``: columns of that shape (views into larger ones are
+        ``move_speed_m_s``. ``out``: columns of that shape (views into larger ones are
         fine) to write into and return, instead of new arrays.
         """
         rec = cls.empty(state.shape[:-1]) if out is None else out
         sensor_columns(sensor_adr, state, sens, units, rec)
         np.multiply(carriage_x, units.length_m, out=rec.carriage_x_m)
-        np.greater(rec.tangential_speed_m_s, slip_speed_m_s, out=rec.slipping)
+        np.greater(rec.tangential_speed_m_s, move_speed_m_s, out=rec.moving)
         return rec
 
     def run(self, r: int, rows: int | None = None) -> Recording:
@@ -95,21 +102,24 @@ class Recording:
         return Recording(**{k: view(getattr(self, k)) for k in COLUMNS})
 
 
-#: The column names of a :class:`Recording`, in field order.
+#: The column names of a :class:`Recording`, in field order (the order the compiled
+#: window kernel takes them in, :mod:`~spine_mj.sim._window_kernel`).
 COLUMNS = tuple(f.name for f in dataclasses.fields(Recording))
+#: The columns a :class:`~spine_mj.sim.RunResult` carries (the tangential speed stays behind).
+RESULT_COLUMNS = tuple(f.name for f in dataclasses.fields(RunColumns))
 #: Each column's trailing shape and dtype.
 _LAYOUT = {
     k: ((3,) if k in ("position_m", "velocity_m_s", "normal", "contact_point_m") else (), float)
     for k in COLUMNS
 }
-_LAYOUT["contact"] = _LAYOUT["slipping"] = ((), bool)
+_LAYOUT["contact"] = _LAYOUT["moving"] = ((), bool)
 
 
 def sensor_columns(
     sensor_adr: dict[str, int], state: np.ndarray, sens: np.ndarray, units: EngineUnits, out: Recording
 ) -> None:
     """Write the per-step columns of steps ``state`` ``(..., nstate)`` and ``sens`` ``(...,
-    nsensordata)`` (engine ``units``) into ``out`` in SI (all but the carriage and slipping).
+    nsensordata)`` (engine ``units``) into ``out`` in SI (all but the carriage and moving).
 
     The arithmetic runs on component arrays of the leading shape (numpy's loops over a
     length-3 axis cost more than the arithmetic), row by row the operations of a plain

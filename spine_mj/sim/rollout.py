@@ -32,6 +32,7 @@ from __future__ import annotations
 import itertools
 import math
 import os
+import queue
 import threading
 from collections.abc import Sequence
 
@@ -419,7 +420,7 @@ class _Group:
             cap_n=cap * (1 + 1e-9),
             margin=drive.fast_forward_margin,
             stick_speed_m_s=det.stick_speed_m_s,
-            slip_speed_m_s=det.slip_speed_m_s,
+            move_speed_m_s=det.move_speed_m_s,
         )
         step = rate_n_s(drive, rig.scales) * rig.engine.timestep_s
         rec, ns = self.analysis.run(k), self.n_settle[k]
@@ -449,7 +450,7 @@ class _Group:
             self.sens[k : k + 1, a:b],
             units=rig.units,
             carriage_x=np.full((1, b - a), np.nan),
-            slip_speed_m_s=det.slip_speed_m_s,
+            move_speed_m_s=det.move_speed_m_s,
         ).run(0)
         step = rate_n_s(self.drives[k], rig.scales) * rig.engine.timestep_s
         for i in range(b - a):
@@ -474,8 +475,6 @@ class _NativeLanes:
     from); :meth:`take` hands finished pieces back in the order they finished."""
 
     def __init__(self, nthread: int):
-        import queue
-
         import mujoco
 
         self.spec = int(mujoco.mjtState.mjSTATE_CTRL) | int(mujoco.mjtState.mjSTATE_MOCAP_POS)

@@ -16,12 +16,14 @@ import pandas as pd
 
 from spine_mj.compare import MISS_REASONS
 from spine_mj.presets import calibrated_mu
+from spine_mj.validate.ensembles import ensemble_family, ensemble_groups, ensemble_verdicts
+from spine_mj.validate.intervals import bootstrap, meets_target, wilson
 from spine_mj.validate.paths import stored_paths, tip_radius
 from spine_mj.validate.plans import FRECHET_TARGET, OUTCOME_TARGET, RECOMMENDED, FamilySpec, ValidationPlan
 from spine_mj.validate.study_runner import StudyRunner
 from spine_mj.validate.sweep_configs import engine_grid, family_doc
 
-__all__ = ["LimitPath", "QuasistaticLimitResult", "quasistatic_limit"]
+__all__ = ["LimitPath", "QuasistaticLimitResult", "limit_doc", "quasistatic_limit"]
 
 #: Columns of the per-run rows.
 RUN_COLUMNS = (
@@ -46,6 +48,7 @@ RUN_COLUMNS = (
     "miss_offset",
     "reference_slide_fraction",
     "tip_peak_ie",
+    "ill_conditioned",
 )
 
 
@@ -135,9 +138,12 @@ def quasistatic_limit(plan: ValidationPlan, runner: StudyRunner) -> QuasistaticL
     runner.study = "limit"
     families, runs_rows, paths = {}, [], {}
     for fam in plan.families:
-        comps = [_preset_comparison(plan, runner, fam, preset, paths) for preset in fam.presets]
+        fam = plan.corner_family(fam)
+        groups: list[dict] = []
+        comps = [_preset_comparison(plan, runner, fam, preset, paths, groups) for preset in fam.presets]
         allc = pd.concat(comps, ignore_index=True)
         summ = _family_summary(allc)
+        summ.update(ensemble_verdicts(groups))
         failed = allc.loc[allc["mujoco_status"] != "ok", "mujoco_status"].value_counts()
         summ.update(
             {
@@ -152,16 +158,27 @@ def quasistatic_limit(plan: ValidationPlan, runner: StudyRunner) -> QuasistaticL
                 "misses": _misses(allc),
                 "slide_runs": int((allc["reference_slide_fraction"] > 0).sum()),
                 "median_tip_peak_ie": float(np.nanmedian(allc["tip_peak_ie"])),
-                "meets_target": bool(
-                    summ["outcome_agreement"] >= OUTCOME_TARGET
-                    and summ["median_frechet"] <= FRECHET_TARGET
-                    and "penetration" not in failed
-                ),
             }
         )
+        summ.update(_intervals(allc, summ))
+        summ["meets_target"] = bool(
+            meets_target(
+                summ["agreement_well_conditioned"],
+                summ["agreement_ci"],
+                OUTCOME_TARGET,
+                higher_is_better=True,
+            )
+            and meets_target(
+                summ["median_frechet"], summ["median_frechet_ci"], FRECHET_TARGET, higher_is_better=False
+            )
+            and "penetration" not in failed
+        )
+        ill = summ.pop("ill_conditioned")
         families[fam.name] = summ
         for _, r in allc.iterrows():
-            runs_rows.append({k: _plain(r[k]) for k in RUN_COLUMNS})
+            row = {k: _plain(r[k]) for k in RUN_COLUMNS if k != "ill_conditioned"}
+            row["ill_conditioned"] = ill.get(f"{r['case_id']}/{int(r['start'])}", "")
+            runs_rows.append(row)
     return QuasistaticLimitResult(
         families=families,
         runs=runs_rows,
@@ -171,7 +188,7 @@ def quasistatic_limit(plan: ValidationPlan, runner: StudyRunner) -> QuasistaticL
     )
 
 
-def _limit_doc(plan: ValidationPlan, fam: FamilySpec, preset: str, name: str, overrides=()) -> dict:
+def limit_doc(plan: ValidationPlan, fam: FamilySpec, preset: str, name: str, overrides=()) -> dict:
     """The sweep config of one preset of ``fam`` at the lowest I_e with the rig's tip on
     both sides (``overrides``: an engine variation)."""
     res = dict(overrides).get("hfield_resolution", plan.hfield_resolution)
@@ -182,6 +199,8 @@ def _limit_doc(plan: ValidationPlan, fam: FamilySpec, preset: str, name: str, ov
         "dl": tip / 2,
         **engine_grid(plan, overrides, preset, fam.seeds, tip),
     }
+    if plan.ensemble_members > 1 and not overrides:
+        fam = ensemble_family(fam, preset, plan.ensemble_members)
     return family_doc(
         fam,
         name=name,
@@ -193,11 +212,17 @@ def _limit_doc(plan: ValidationPlan, fam: FamilySpec, preset: str, name: str, ov
 
 
 def _preset_comparison(
-    plan: ValidationPlan, runner: StudyRunner, fam: FamilySpec, preset: str, paths: dict
+    plan: ValidationPlan, runner: StudyRunner, fam: FamilySpec, preset: str, paths: dict, groups: list
 ) -> pd.DataFrame:
-    """The ``compare`` rows of one preset's sweep with the MuJoCo row's end and status; the
-    single peak/valley family's paths go into ``paths``."""
-    df, store = runner(_limit_doc(plan, fam, preset, f"limit-{preset}"), f"limit/{preset}")
+    """The ``compare`` rows of one preset's sweep (each ensemble's own start) with the MuJoCo
+    row's end and status; the ensembles' outcomes go into ``groups``
+    (:func:`~spine_mj.validate.ensembles.ensemble_verdicts`), the single peak/valley
+    family's paths into ``paths``."""
+    df, store = runner(limit_doc(plan, fam, preset, f"limit-{preset}"), f"limit/{preset}")
+    members = max(int(plan.ensemble_members), 1)
+    groups.extend(ensemble_groups(df, store, members))
+    df = df[df["start"].astype(int) % members == 0].copy()  # the runs: each ensemble's own start
+    df["start"] = df["start"].astype(int) // members
     comp = df[df["analysis"] == "compare"].copy()
     mj = df[df["analysis"] == "mujoco"].set_index(["case_id", "start"])
     key = list(zip(comp["case_id"], comp["start"].astype(int)))
@@ -211,7 +236,7 @@ def _preset_comparison(
             smooth = stored_paths(store, case_id, "quasistatic")
             facets = stored_paths(store, case_id, "compare")
             mpaths = stored_paths(store, case_id, "mujoco")
-            for s, x0, y0 in zip(grp["start"].astype(int), grp["start_x"], grp["start_y"]):
+            for s, x0, y0 in zip(grp["start"].astype(int) * members, grp["start_x"], grp["start_y"]):
                 empty = np.zeros((0, 2))
                 paths.setdefault(preset, []).append(
                     LimitPath(smooth[s], facets.get(s, empty), mpaths.get(s, empty), (x0, y0))
@@ -223,11 +248,11 @@ def _variations(plan: ValidationPlan, runner: StudyRunner, runs_rows: list[dict]
     """The plan's engine variations on the first family's first preset, after the
     recommended settings (summarised from ``runs_rows``)."""
     variations = {}
-    fam0 = plan.families[0]
+    fam0 = plan.corner_family(plan.families[0])
     preset = fam0.presets[0]
     for label, ov in plan.limit_variations:
         tag = "-".join(f"{k}{v}" for k, v in ov)
-        df, _ = runner(_limit_doc(plan, fam0, preset, f"limit-var-{label}", ov), f"limit-var/{preset}-{tag}")
+        df, _ = runner(limit_doc(plan, fam0, preset, f"limit-var-{label}", ov), f"limit-var/{preset}-{tag}")
         comp = df[df["analysis"] == "compare"]
         variations[label] = {**_family_summary(comp), "settings": dict(ov), "surface": preset}
     base = [r for r in runs_rows if r["preset"] == preset]
@@ -242,6 +267,18 @@ def _variations(plan: ValidationPlan, runner: StudyRunner, runs_rows: list[dict]
             "surface": preset,
         },
         **variations,
+    }
+
+
+def _intervals(comp, summ: dict) -> dict:
+    """The family's 95 % intervals: Wilson on the outcome agreement (``outcome_agreement_ci``, over
+    all runs, a stopped run disagreeing), percentile bootstrap over runs on the median
+    Frechet distance (``median_frechet_ci``)."""
+    n = summ["runs"]
+    agree = int(round(summ["outcome_agreement"] * n)) if n else 0
+    return {
+        "outcome_agreement_ci": list(wilson(agree, n)),
+        "median_frechet_ci": list(bootstrap(comp["frechet"].to_numpy(float))),
     }
 
 

@@ -139,10 +139,22 @@ def test_complementary_cdf_of_known_samples():
 
 
 def test_slip_statistics_marks_where_each_drop_is_read():
-    t = np.arange(8, dtype=float)
-    s = np.array([0, 0, 1, 1, 0, 0, 1, 1], bool)
-    f = np.array([0.0, 1.0, 0.5, 0.2, 0.3, 0.8, 0.4, 0.1])
-    st = slip_statistics(t, t, 0 * t, f, s)
+    t = np.arange(9, dtype=float)
+    s = np.array([0, 0, 1, 1, 0, 0, 1, 1, 0], bool)
+    f = np.array([0.0, 1.0, 0.5, 0.2, 0.3, 0.8, 0.4, 0.1, 0.2])
+    st = slip_statistics(t, t, 0 * t, f, np.where(s, 2, 0))
     np.testing.assert_array_equal(st.onset_indices, [1, 5])
-    np.testing.assert_array_equal(st.stop_indices, [4, 7])
+    np.testing.assert_array_equal(st.stop_indices, [3, 7])
     np.testing.assert_allclose(st.force_drops, f[st.onset_indices] - f[st.stop_indices])
+
+
+def test_slip_transition_brackets_where_slips_stop_along_k():
+    from spine_mj.validate.stiffness_map import SLIPS_PER_LC, slip_transitions
+
+    rate = {1.0: 3.0, 3.0: 1.0, 10.0: 0.1 * SLIPS_PER_LC, 30.0: 0.0}
+    slip = [{"ie": 1e-4, "K": k, "slip_events_per_lc": r} for k, r in rate.items()]
+    slip += [{"ie": 1e-2, "K": k, "slip_events_per_lc": 0.0} for k in rate]
+    low, high = slip_transitions(slip)
+    assert (low["k_low"], low["k_high"]) == (3.0, 10.0)
+    assert low["k_transition"] == pytest.approx(np.sqrt(30.0))
+    assert np.isnan(high["k_low"]) and high["k_high"] == 1.0 and np.isnan(high["k_transition"])

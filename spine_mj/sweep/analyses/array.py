@@ -15,7 +15,7 @@ import numpy as np
 
 from spine_mj import sim
 from spine_mj.sim.layout import MAX_SPINES
-from spine_mj.sweep.analyses.mujoco import MUJOCO_PARAMS, case_rig, drive_speed_m_s
+from spine_mj.sweep.analyses.mujoco import MUJOCO_PARAMS, case_drive, case_rig
 from spine_mj.sweep.registry import CASE_THREADS, Analysis, AnalysisResult, ParamSpec, register_analysis
 
 ARRAY_PARAMS = (
@@ -53,18 +53,14 @@ def _array(case, surface, starts, upstream):
     )
     force = p["array_drive"] == "force"
     arr = sim.ArrayRig(rig, layout, force_control=force)
-    speed = drive_speed_m_s(p, sc)
-    stiffness = p["stiffness"] if p["K"] is None else sc.stiffness_for(p["K"])
     if force:
+        speed = sim.drive_speed_m_s(sc, ie=p["ie"], speed_m_s=p["speed"])
+        stiffness = p["stiffness"] if p["K"] is None else sc.stiffness_for(p["K"])
         drive = sim.ForcePull(
-            rate_n_s=speed * sc.preload_n / sc.char_length_m,
-            stiffness_n_m=stiffness,
-            settle_time_s=p["settle_time"],
+            rate_n_s=sc.force_rate_for(speed), stiffness_n_m=stiffness, settle_time_s=p["settle_time"]
         )
     else:
-        drive = sim.SpringDrive(
-            speed_m_s=speed, stiffness_n_m=stiffness, duration_s=p["duration"], settle_time_s=p["settle_time"]
-        )
+        drive = case_drive(rig, {**p, "protocol": "spring"})
     det = sim.Detection(kappa_cap=p["kappa_cap"])
     runs = arr.run_batch(drive, [tuple(s) for s in starts], detection=det, nthread=CASE_THREADS.get())
     trouble = np.array([r.end_reason == "engine_trouble" for r in runs])

@@ -22,9 +22,11 @@ from spine_mj.plotting import (
 from spine_mj.presets import make_surface
 from spine_mj.sweep.analyses.compare import MISS_CHECKPOINTS
 from spine_mj.validate.boundary import BoundaryResult
+from spine_mj.validate.platform import platform_info
 from spine_mj.validate.quasistatic_limit import QuasistaticLimitResult
 from spine_mj.validate.report.boundary import star_to_draw
 from spine_mj.validate.report.common import ReportContext, assemble, cell, image, table
+from spine_mj.validate.report.verdicts import platform_line, verdicts_section
 
 
 @styled
@@ -219,9 +221,18 @@ def _lines(limit: QuasistaticLimitResult, boundary: BoundaryResult) -> list[str]
             ],
         ),
         "",
+        *verdicts_section(limit.families),
+        *platform_line(platform_info()),
         *_stalled_note(limit),
         *_misses_note(limit),
         *falls_note(limit, boundary),
+        *_variations_and_runs(limit),
+    ]
+
+
+def _variations_and_runs(limit: QuasistaticLimitResult) -> list[str]:
+    """The settings varied on the single peak, and the per-run table (folded)."""
+    return [
         "### What limits agreement: settings varied on the single peak",
         "",
         table(
@@ -254,6 +265,7 @@ def _lines(limit: QuasistaticLimitResult, boundary: BoundaryResult) -> list[str]
                 "agree_smooth",
                 "frechet_smooth",
                 "geometry_frechet",
+                "ill_conditioned",
             ],
         ),
         "",

@@ -18,8 +18,9 @@ from spine_mj.plotting import (
     styled,
 )
 from spine_mj.validate.report.common import ReportContext, assemble, cell, image, table
+from spine_mj.validate.slip_tails import MIN_EVENTS
 from spine_mj.validate.stick_slip import complementary_cdf
-from spine_mj.validate.stiffness_map import CRITERION, SLIP_FAMILIES, StiffnessMapResult
+from spine_mj.validate.stiffness_map import CRITERION, SLIP_FAMILIES, SLIPS_PER_LC, StiffnessMapResult
 
 #: At most this many (I_e, K) series in the CCDF figure.
 MAX_CCDF_SERIES = 5
@@ -170,13 +171,71 @@ def _ratio(row: dict) -> str:
     return sig(v) if v is not None and np.isfinite(v) else "- (no quasistatic work)"
 
 
+def _transition_lines(km: StiffnessMapResult) -> list[str]:
+    """Where stick-slip gives way to steady sliding along K at each I_e ([] without)."""
+    if not km.transitions:
+        return []
+    return [
+        f"Where stick-slip (at least {SLIPS_PER_LC:g} slip events per L_c) gives way to steady "
+        "sliding along K, per I_e. The predicted K* of these families comes from their geometry "
+        "(the quasistatic-boundary prediction, not part of this study); on a corrugation, where "
+        "K* is exact, the stick-slip study's K scan sets the measured transition beside it.",
+        "",
+        table(
+            km.transitions,
+            ["ie", "k_low", "k_high", "k_transition"],
+            ["I_e", "last K with stick-slip", "first K below the rate", "transition K"],
+        ),
+        "",
+    ]
+
+
+def _tail_lines(km: StiffnessMapResult) -> list[str]:
+    """The maximum-likelihood tail fits of slip size and force drop ([] without)."""
+    if not km.tails:
+        return []
+    rows = [
+        {
+            **t,
+            "alpha_ci": f"{cell(t['alpha'])} ({cell(t['ci_low'])}-{cell(t['ci_high'])})"
+            if t["fitted"]
+            else "-",
+            "vs_exp": f"{cell(t['loglik_ratio_vs_exponential'])} (p {cell(t['p_vs_exponential'])})"
+            if t["fitted"]
+            else "-",
+        }
+        for t in km.tails
+    ]
+    return [
+        f"Tails fitted by maximum likelihood (`powerlaw`; density p(S) ~ S^-alpha above xmin, 95 % "
+        f"interval; series of fewer than {MIN_EVENTS} events are counted, not fitted). The "
+        "likelihood ratio against an exponential tail is positive where the power law fits better. "
+        "The ABBM model (a random-walk force landscape) gives alpha = 3/2; short-range correlated "
+        "slopes have no universal exponent.",
+        "",
+        table(
+            rows,
+            ["ie", "K", "quantity", "n", "alpha_ci", "xmin", "n_tail", "vs_exp"],
+            ["I_e", "K", "quantity", "events", "alpha (95 %)", "xmin", "in tail", "log-lik. ratio vs exp."],
+        ),
+        "",
+    ]
+
+
 def map_sections(km: StiffnessMapResult) -> dict[str, str]:
     """Report text of the map: ``map`` (I_e*(K) table), ``energy`` and ``slip`` (tables
-    with one sentence each), drawn by the report's ``table(rows, columns, names)`` and
-    ``cell(value)`` so that every table of the report reads alike. Empty strings without a
-    map (None or an empty grid)."""
-    if km is None or not km.agreement:
+    with one sentence each); empty strings without a map (an empty grid)."""
+    if not km.agreement:
         return {"map": "", "energy": "", "slip": ""}
+    return {
+        "map": "\n".join(_map_lines(km)),
+        "energy": "\n".join(_energy_lines(km)),
+        "slip": "\n".join(_slip_lines(km)),
+    }
+
+
+def _map_lines(km: StiffnessMapResult) -> list[str]:
+    """The I_e*(K) table per family and K, with what its columns mean."""
     star_rows = []
     for fam, by_k in km.agreement.items():
         for k, grid_cell in by_k.items():
@@ -215,7 +274,12 @@ def map_sections(km: StiffnessMapResult) -> dict[str, str]:
         "(hollow where it lies outside the grid).",
         "",
     ]
-    energy = (
+    return head
+
+
+def _energy_lines(km: StiffnessMapResult) -> list[str]:
+    """The spring energy released at breakaways against the quasistatic work, per K."""
+    return (
         [
             "### Why a soft spring breaks quasistatics",
             "",
@@ -259,13 +323,18 @@ def map_sections(km: StiffnessMapResult) -> dict[str, str]:
         if km.energy
         else []
     )
-    slip = (
+
+
+def _slip_lines(km: StiffnessMapResult) -> list[str]:
+    """Slip events and trap skipping over the map."""
+    return (
         [
             "### Stick-slip across the map",
             "",
-            f"Slip events on the {' and '.join(SLIP_FAMILIES)} runs (runs of slipping samples of at "
-            "least three steps), per L_c advanced and as the fraction of recorded time spent slipping "
-            "(near 1: steady sliding; well below 1: the tip sticks between events); "
+            f"Slip events on the {' and '.join(SLIP_FAMILIES)} runs (stretches where the tip outruns "
+            "the carriage while the spring unloads and reaches 5 times its speed: steady sliding is "
+            "no slip; docs/physics.md §6), per L_c advanced and as the fraction of recorded time "
+            "spent slipping; "
             "trap skipping over every family's runs without engine trouble: of the runs whose "
             "streamline self-locks (traps), those where MuJoCo slides on (skipped).",
             "",
@@ -295,15 +364,12 @@ def map_sections(km: StiffnessMapResult) -> dict[str, str]:
                 ],
             ),
             "",
-            "The CCDFs (runs without engine trouble) show how slip sizes and force drops spread for a "
-            "few (I_e, K); a straight tail on "
-            "log axes would be a power law, but with so few events per series it is only indicative.",
-            "",
+            *_transition_lines(km),
+            *_tail_lines(km),
         ]
         if km.slip
         else []
     )
-    return {"map": "\n".join(head), "energy": "\n".join(energy), "slip": "\n".join(slip)}
 
 
 def headline(km: StiffnessMapResult) -> list[str]:
