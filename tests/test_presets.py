@@ -47,7 +47,7 @@ def test_overrides_and_seed():
 
 
 def test_bad_presets_and_overrides(tmp_path):
-    with pytest.raises(SpineInputError, match="unknown preset 'nope'; known presets: .*paper-single-peak"):
+    with pytest.raises(SpineInputError, match=r"unknown preset 'nope'; known presets: .*paper-single-peak"):
         load_preset("nope")
     with pytest.raises(SpineInputError, match=r"unknown parameter\(s\) \['colour'\]"):
         make_surface("paper-fractal", colour="red")
