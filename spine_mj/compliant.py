@@ -33,7 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from spine_mj.engagement import ENGAGED, SELF_LOCK, kappa, quadratic_coefficients
+from spine_mj.engagement import DEFAULT_TOL, ENGAGED, SELF_LOCK, SLIP, quadratic_coefficients
 from spine_mj.errors import SpineInputError
 from spine_mj.streamline import Outcome, StreamlineParams, _check_step, _starts
 from spine_mj.surfaces import Surface
@@ -49,27 +49,27 @@ class MotionState(enum.IntEnum):
     SLIP = 2  #: moves with the carriage still, the spring force above the hold (a jump)
 
 
-def hold_force(fx, fy, mu, *, tol: float = 1e-12) -> tuple[np.ndarray, np.ndarray]:
+def hold_force(fx, fy, mu, *, tol: float = DEFAULT_TOL) -> tuple[np.ndarray, np.ndarray]:
     """Largest drive per unit preload ``H`` (any sign) that holds the tip, and the region.
 
-    ``H = kappa`` where engaged (:func:`spine_mj.engagement.kappa`), ``+inf`` where
-    self-locked; in the slip region the largest root of Eq. 2 with ``N > 0`` when one
-    exists (a backward pull that holds: negative), else NaN (nothing holds). A tip held by
-    a spring force ``F`` sticks while ``F <= H``.
+    ``H = kappa`` where engaged (:func:`spine_mj.engagement.kappa`, the same roots of Eq. 2
+    by the same cancellation-free formula), ``+inf`` where self-locked; in the slip region
+    the largest root of Eq. 2 with ``N > 0`` when one exists (a backward pull that holds:
+    negative), else NaN (nothing holds). A tip held by a spring force ``F`` sticks while
+    ``F <= H``.
     """
-    k, region = kappa(fx, fy, mu, tol=tol)
+    fx, fy = np.broadcast_arrays(np.asarray(fx, dtype=float), np.asarray(fy, dtype=float))
     a, b, c = quadratic_coefficients(fx, fy, mu)
-    fx = np.broadcast_to(np.asarray(fx, dtype=float), k.shape)
     with np.errstate(invalid="ignore", divide="ignore"):
         disc = b * b - 4.0 * a * c
         q = -0.5 * (b + np.where(b >= 0, 1.0, -1.0) * np.sqrt(np.where(disc >= 0, disc, np.nan)))
         big = np.abs(a) >= tol
         r1 = np.where(big & (q != 0), q / np.where(big, a, 1.0), np.nan)
-        r2 = np.where(q != 0, c / q, np.where(b != 0, -c / np.where(b != 0, b, 1.0), np.nan))
-        ok1, ok2 = 1.0 + r1 * fx > 0, 1.0 + r2 * fx > 0
-        slip_hold = np.fmax(np.where(ok1, r1, np.nan), np.where(ok2, r2, np.nan))
-    hold = np.where(region == ENGAGED, k, np.where(region == SELF_LOCK, np.inf, slip_hold))
-    return hold, region
+        r2 = np.where(q != 0, c / q, np.nan)
+        hold = np.fmax(np.where(1.0 + r1 * fx > 0, r1, np.nan), np.where(1.0 + r2 * fx > 0, r2, np.nan))
+    lock = (a < tol) & (fx > 0)
+    region = np.where(lock, SELF_LOCK, np.where(hold > 0, ENGAGED, SLIP)).astype(np.int8)
+    return np.where(lock, np.inf, hold), region
 
 
 @dataclass(frozen=True)
@@ -178,6 +178,10 @@ class CompliantResult:
         return Fold(**{k: getattr(self.folds, k)[sel] for k in Fold.__dataclass_fields__})
 
 
+#: Golden-section steps locating a fold: the bracket shrinks to 0.618**60 ~ 3e-13 of a step.
+_GOLDEN_ITERATIONS = 60
+#: Bisections locating a landing: 2**-52 of a step, round-off.
+_BISECTIONS = 52
 #: Where the probe sits along a slide step, from its end, as a fraction of the step.
 _PROBE = 1e-6
 
@@ -211,7 +215,7 @@ def _fold_along(surface, px, py, vx, vy, h, c, mu, tol):
     a, b = np.zeros_like(h), h.copy()
     s1, s2 = b - g * (b - a), a + g * (b - a)
     x1, x2 = carriage(s1), carriage(s2)
-    for _ in range(90):
+    for _ in range(_GOLDEN_ITERATIONS):
         left = x1 >= x2  # the maximum lies in [a, s2]
         b = np.where(left, s2, b)
         a = np.where(left, a, s1)
@@ -239,7 +243,7 @@ def _landing_along(surface, px, py, vx, vy, h, carriage, c, mu, tol):
         return ~(c * (carriage - (px + s * vx)) <= hx)
 
     lo, hi = np.zeros_like(h), h.copy()
-    for _ in range(64):
+    for _ in range(_BISECTIONS):
         mid = 0.5 * (lo + hi)
         slip = slipping(mid)
         lo, hi = np.where(slip, mid, lo), np.where(slip, hi, mid)
@@ -446,8 +450,8 @@ def _run(surface, xs, ys, params, c):
         z, fx, fy = surface.evaluate(np.r_[L.x[a], qx], np.r_[L.y[a], qy], order=1)
         hold_q = hold_force(fx[a.size :], fy[a.size :], params.mu, tol=params.tol)[0]
         z, fx, fy = z[: a.size], fx[: a.size], fy[: a.size]
-        kap, region = kappa(fx, fy, params.mu, tol=params.tol)
-        hold, _ = hold_force(fx, fy, params.mu, tol=params.tol)
+        hold, region = hold_force(fx, fy, params.mu, tol=params.tol)
+        kap = np.where(region == SLIP, np.nan, hold)
         slip, drive = _classify(L, a, hold, region, c)
         at = np.searchsorted(a, probe)
         with np.errstate(invalid="ignore"):
