@@ -274,7 +274,7 @@ class _Lanes:
 
 
 def compliant_streamlines(
-    surface: Surface, starts, params: StreamlineParams, *, stiffness: float
+    surface: Surface, starts, params: StreamlineParams, *, stiffness: float, carriage_end=None
 ) -> CompliantResult:
     """Quasistatic paths of a tip pulled through a spring of stiffness ``k = stiffness W``.
 
@@ -288,6 +288,10 @@ def compliant_streamlines(
         Friction, step, caps, stall test and step control, as for the rigid streamline.
     stiffness : float
         ``k / W`` in 1 / surface length, finite and > 0 (``K / l_s``).
+    carriage_end : float or array_like, shape (n,), optional
+        Where the carriage stops (surface units, >= the start's x): a path whose hold
+        needs the carriage further ends there (``Outcome.DRIVE_END``), the tip held short
+        of its hold, as a run whose drive ends does. None: the carriage goes on.
 
     Returns
     -------
@@ -303,7 +307,12 @@ def compliant_streamlines(
         raise SpineInputError(f"stiffness (k / W, 1 / length) must be a finite number > 0, got {stiffness!r}")
     xs, ys = _starts(surface, starts)
     _check_step(surface, params.dl)
-    return _run(surface, xs, ys, params, float(c))
+    end = np.broadcast_to(np.asarray(np.inf if carriage_end is None else carriage_end, float), xs.shape)
+    if np.isnan(end).any() or (end < xs).any():
+        raise SpineInputError(
+            "carriage_end must be >= each start's x (or None: no end), got " + repr(carriage_end)
+        )
+    return _run(surface, xs, ys, params, float(c), np.array(end))
 
 
 class _Record:
@@ -364,7 +373,7 @@ def _search(surface, L, lanes, kind, c, params):
     L.pending[lanes] = kind
 
 
-def _accept(L, rec, a, z, kap, hold, slip, c):
+def _accept(L, rec, a, z, kap, hold, slip, c, carriage_end):
     """Record the accepted points of lanes ``a``; open and close jumps; move the carriage."""
     x, y = L.x[a], L.y[a]
     arrived_slipping = L.slipping[a] & L.has_prev[a]
@@ -384,11 +393,14 @@ def _accept(L, rec, a, z, kap, hold, slip, c):
     with np.errstate(invalid="ignore"):
         follow = ~slip & np.isfinite(hold)
         L.X[a] = np.where(follow, np.maximum(L.X[a], x + hold / c), L.X[a])
+    stopped = L.X[a] > carriage_end[a]  # the carriage stops short of the hold: the tip stays
+    L.X[a] = np.where(stopped, carriage_end[a], L.X[a])
     state = np.where(slip, MotionState.SLIP, np.where(stick, MotionState.STICK, MotionState.SLIDE))
     force = c * (L.X[a] - x)
     rec.add(a, x=x, y=y, z=z, kappa=kap, carriage=L.X[a].copy(), force=force, state=state.astype(np.int8))
     L.max_k[a] = np.fmax(L.max_k[a], kap)
     L.pending[a] = 0
+    return stopped
 
 
 def _end(L, rec, a, done_code):
@@ -432,7 +444,7 @@ def _stalled(L, a, params):
     return check[stuck]
 
 
-def _run(surface, xs, ys, params, c):
+def _run(surface, xs, ys, params, c, carriage_end):
     """The vectorized loop: one surface evaluation for all active lanes per iteration."""
     n = xs.size
     L = _Lanes(xs, ys, params.dl, params.stall_window)
@@ -476,9 +488,10 @@ def _run(surface, xs, ys, params, c):
         ok = ~(reject | fold | land)
         a, z, kap, hold, slip = a[ok], z[ok], kap[ok], hold[ok], slip[ok]
         vx, vy, locked, finite, reversed_ = vx[ok], vy[ok], locked[ok], finite[ok], reversed_[ok]
-        _accept(L, rec, a, z, kap, hold, slip, c)
+        stopped = _accept(L, rec, a, z, kap, hold, slip, c, carriage_end)
         ended = np.zeros(a.size, bool)
         for mask, code in (
+            (stopped, Outcome.DRIVE_END),
             (locked, Outcome.SELF_LOCKED),
             (~locked & (hold > params.kappa_cap), Outcome.FORCE_CAP),
             (L.n_steps[a] >= params.max_steps, Outcome.STEP_CAP),

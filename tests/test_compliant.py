@@ -204,3 +204,22 @@ def test_many_starts_equal_one_at_a_time():
 def test_stiffness_is_validated(bad):
     with pytest.raises(SpineInputError, match="stiffness"):
         compliant_streamlines(corrugation(), [(0.1, 0.0)], StreamlineParams(mu=0.5), stiffness=bad)
+
+
+def test_a_carriage_that_stops_leaves_the_tip_short_of_its_hold():
+    c, end = 3.0, -0.5
+    r = compliant_streamlines(
+        Plane(0.4),
+        [(-1.5, 0.0), (-1.0, 0.5)],
+        StreamlineParams(mu=0.5, dl=0.05),
+        stiffness=c,
+        carriage_end=[end, 10.0],
+    )
+    assert r.outcome[0] == Outcome.DRIVE_END and r.outcome[1] == Outcome.LEFT_DOMAIN
+    q = r.path(0)
+    assert q["carriage"][-1] == end and q["force"][-1] <= math.tan(math.atan(0.4) + math.atan(0.5))
+    assert end - q["x"][-1] == pytest.approx(q["force"][-1] / c)
+    with pytest.raises(SpineInputError, match="carriage_end"):
+        compliant_streamlines(
+            Plane(0.4), [(-1.5, 0.0)], StreamlineParams(mu=0.5), stiffness=c, carriage_end=-2.0
+        )
