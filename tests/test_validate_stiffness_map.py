@@ -146,3 +146,27 @@ def test_slip_statistics_marks_where_each_drop_is_read():
     np.testing.assert_array_equal(st.onset_indices, [1, 5])
     np.testing.assert_array_equal(st.stop_indices, [4, 7])
     np.testing.assert_allclose(st.force_drops, f[st.onset_indices] - f[st.stop_indices])
+
+
+def test_measured_k_star_brackets_the_first_passing_stiffness():
+    from spine_mj.validate.stiffness_map_report import measured_k_star
+
+    def cells(passes):
+        return {k: {"passes": [p, False]} for k, p in passes.items()}
+
+    assert measured_k_star(cells({"1": False, "3": False, "10": True, "30": True})) == "3-10"
+    assert measured_k_star(cells({"1": True, "3": True})) == "< 1"
+    assert measured_k_star(cells({"1": False, "3": False})) == "> 3"
+    assert measured_k_star(cells({"1": True, "3": False, "10": True})) == "3-10"
+
+
+def test_family_limits_predict_on_the_maps_surfaces():
+    from spine_mj.validate.plans import PLANS
+    from spine_mj.validate.predicted_limits import family_limits
+
+    plan = PLANS["smoke"]
+    got = family_limits(plan, plan.families[0])
+    assert set(got["presets"]) == {"paper-single-peak"}
+    one = got["presets"]["paper-single-peak"]
+    assert got["k_star"] == one["k_star"] > 0 and got["ie_star"] == one["ie_star"] > 0
+    assert one["tip_radius"] > 0 and one["mu"] == pytest.approx(1.23, abs=0.05)

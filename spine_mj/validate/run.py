@@ -147,10 +147,20 @@ def _summary(
 
 def _stiffness_map_summary(km: StiffnessMapResult) -> dict:
     """The map's ``validation.json`` keys: ``ie_star_by_stiffness`` (family -> K -> I_e*
-    with bracket ``low``/``high``, bootstrap ``ci_low``/``ci_high`` and ``kind``) and
+    with bracket ``low``/``high``, bootstrap ``ci_low``/``ci_high`` and ``kind``), the same
+    against the compliant-drive reference (``ie_star_by_stiffness_compliant``), the
+    geometry's prediction (``predicted_drive_limits``: family -> ``k_star``, ``ie_star``,
+    ``limit``) and
     ``stiffness_map`` (the agreement grid with n_ok / n per cell, the energy and slip
     tables)."""
-    return {"ie_star_by_stiffness": km.ie_star(), "stiffness_map": km.as_dict()}
+    return {
+        "ie_star_by_stiffness": km.ie_star(),
+        "ie_star_by_stiffness_compliant": km.ie_star_compliant(),
+        "predicted_drive_limits": {
+            f: {k: d[k] for k in ("k_star", "ie_star", "limit")} for f, d in km.predicted.items()
+        },
+        "stiffness_map": km.as_dict(),
+    }
 
 
 def _engine_settings(plan: ValidationPlan) -> dict:

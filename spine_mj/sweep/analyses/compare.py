@@ -105,14 +105,19 @@ def _compliant(contact, params, starts, runs, preload_n, s, mpaths, facets, mj_l
     (:mod:`spine_mj.compliant`, ``k / W`` from the run), traced like the rigid reference:
     what stiffness does is predicted there, what is left over is inertia. NaN for drives
     without a spring. ``stiffness_frechet`` is the compliant reference's distance from the
-    rigid one, ``compliant_jumps`` its folds."""
+    rigid one, ``compliant_jumps`` its folds. The reference's carriage stops where the run's
+    does (``carriage_end``)."""
     n = len(runs)
     nan = np.full(n, np.nan)
     out = {"compliant_frechet": nan, "agree_compliant": nan, "compliant_jumps": nan, "stiffness_frechet": nan}
     k = runs[0].stiffness_n_m if n else 0.0
     if not (k > 0):
         return out
-    ref = compliant_streamlines(contact, starts, params, stiffness=k * s / preload_n)
+    # the carriage stops where the run's does: a soft spring's reference is not held at a
+    # force cap the engine's carriage never reached
+    travel = np.array([(r.carriage_x_m[-1] - r.carriage_x_m[r.drive_start_index]) / s for r in runs])
+    end = np.asarray(starts, float)[:, 0] + np.where(np.isfinite(travel), np.maximum(travel, 0.0), np.inf)
+    ref = compliant_streamlines(contact, starts, params, stiffness=k * s / preload_n, carriage_end=end)
     frechet, _ = _deviations(mpaths, ref, lc)
     agree = _outcomes(ref, mj_locked, mj_end, lc)["agree"]
     return {
