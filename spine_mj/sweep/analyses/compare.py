@@ -113,9 +113,17 @@ def _compliant(contact, params, starts, runs, preload_n, s, mpaths, facets, mj_l
     k = runs[0].stiffness_n_m if n else 0.0
     if not (k > 0):
         return out
-    # the carriage stops where the run's does: a soft spring's reference is not held at a
-    # force cap the engine's carriage never reached
-    travel = np.array([(r.carriage_x_m[-1] - r.carriage_x_m[r.drive_start_index]) / s for r in runs])
+    # where the run's drive ran out, the carriage stops where the run's did: a soft spring's
+    # reference is not held at a force cap the engine's carriage never reached (a run that
+    # ended on an event, a lock or the edge, has its own outcome to compare)
+    travel = np.array(
+        [
+            (r.carriage_x_m[-1] - r.carriage_x_m[r.drive_start_index]) / s
+            if r.end_reason.value == "completed"
+            else np.inf
+            for r in runs
+        ]
+    )
     end = np.asarray(starts, float)[:, 0] + np.where(np.isfinite(travel), np.maximum(travel, 0.0), np.inf)
     ref = compliant_streamlines(contact, starts, params, stiffness=k * s / preload_n, carriage_end=end)
     frechet, _ = _deviations(mpaths, ref, lc)
