@@ -5,7 +5,8 @@ import stat
 
 import pytest
 
-from spine_mj.errors import SpineInputError, all_or_none, atomic_output, writable_path
+from spine_mj.atomic import all_or_none, atomic_output, writable_path
+from spine_mj.errors import SpineInputError
 
 
 def test_atomic_output_writes_on_success_with_umask_permissions(tmp_path):

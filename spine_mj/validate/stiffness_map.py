@@ -1,4 +1,4 @@
-"""Study 6: the quasistatic boundary as a map over (I_e, K) for the spring drive.
+"""Study 7: the quasistatic boundary as a map over (I_e, K) for the spring drive.
 
 A spring drive is quasistatic only when it is slow (I_e << 1) *and* stiff: a spring of
 stiffness ``k`` holding ``F`` stores ``F^2 / (2 k)``, released into the tip at every
@@ -40,9 +40,9 @@ from spine_mj.validate.ie_star import ie_star_by_criterion, passes_criterion, qu
 from spine_mj.validate.paths import mujoco_traces
 from spine_mj.validate.plans import GRAVITY, MASS_KG, FamilySpec, ValidationPlan
 from spine_mj.validate.predicted_limits import family_limits
-from spine_mj.validate.runner import StudyRunner
 from spine_mj.validate.stick_slip import slip_statistics
-from spine_mj.validate.sweep_docs import family_doc
+from spine_mj.validate.study_runner import StudyRunner
+from spine_mj.validate.sweep_configs import family_doc
 
 __all__ = [
     "SLIP_FAMILIES",
@@ -103,6 +103,22 @@ class StiffnessMapResult:
         """family -> K (str) -> I_e* (value, low, high, ci_low, ci_high, kind, criterion)."""
         return {f: {k: cell["ie_star"] for k, cell in by_k.items()} for f, by_k in self.agreement.items()}
 
+    def validation_keys(self) -> dict:
+        """This study's keys of ``validation.json``: ``ie_star_by_stiffness`` (family -> K ->
+        I_e* with bracket ``low``/``high``, bootstrap ``ci_low``/``ci_high`` and ``kind``), the
+        same against the compliant-drive reference (``ie_star_by_stiffness_compliant``), the
+        geometry's prediction (``predicted_drive_limits``: family -> ``k_star``, ``ie_star``,
+        ``limit``) and ``stiffness_map`` (the agreement grid with n_ok / n per cell, the
+        energy and slip tables)."""
+        return {
+            "ie_star_by_stiffness": self.ie_star(),
+            "ie_star_by_stiffness_compliant": self.ie_star_compliant(),
+            "predicted_drive_limits": {
+                f: {k: d[k] for k in ("k_star", "ie_star", "limit")} for f, d in self.predicted.items()
+            },
+            "stiffness_map": self.as_dict(),
+        }
+
     def as_dict(self) -> dict:
         """The ``validation.json`` entry (the slip samples stay out: the figure holds them)."""
         return {
@@ -141,7 +157,7 @@ def subset_starts(fam: FamilySpec, n: int) -> FamilySpec:
 
 
 def stiffness_map(plan: ValidationPlan, runner: StudyRunner) -> StiffnessMapResult:
-    """Study 6: the spring drive over ``plan.stiffness_map_ie`` x ``plan.stiffness_map_k``
+    """Study 7: the spring drive over ``plan.stiffness_map_ie`` x ``plan.stiffness_map_k``
     on ``plan.stiffness_map_families`` (an empty grid runs nothing).
 
     Returns

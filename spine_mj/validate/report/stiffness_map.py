@@ -1,8 +1,6 @@
-"""Figures and report text of the (I_e, K) map (:mod:`spine_mj.validate.stiffness_map`).
-
-:func:`map_figure` draws agreement as a heat map per family with I_e*(K) over it,
-:func:`ccdf_figure` the slip-size and force-drop CCDFs, and :func:`map_sections` the
-report's tables; :mod:`spine_mj.validate.report` puts them into ``report.md``.
+"""The report of the (I_e, K) map (:mod:`spine_mj.validate.stiffness_map`): agreement as a heat
+map per family with I_e*(K) over it, the elastic energy released at breakaway, and the
+slip-size and force-drop CCDFs.
 """
 
 from __future__ import annotations
@@ -11,11 +9,17 @@ from pathlib import Path
 
 import numpy as np
 
-from spine_mj.plotting import SEQUENTIAL_CMAP, THRESHOLD_COLOR, new_figure, save_figure, sig, styled
+from spine_mj.plotting import (
+    SEQUENTIAL_CMAP,
+    THRESHOLD_COLOR,
+    new_figure,
+    save_figure,
+    sig,
+    styled,
+)
+from spine_mj.validate.report.common import ReportContext, assemble, cell, image, table
 from spine_mj.validate.stick_slip import complementary_cdf
 from spine_mj.validate.stiffness_map import CRITERION, SLIP_FAMILIES, StiffnessMapResult
-
-__all__ = ["ccdf_figure", "map_figure", "map_sections"]
 
 #: At most this many (I_e, K) series in the CCDF figure.
 MAX_CCDF_SERIES = 5
@@ -150,7 +154,7 @@ def measured_k_star(cells: dict) -> str:
     return f"{sig(float(ks[last_fail]))}-{sig(float(ks[last_fail + 1]))}"
 
 
-def _prediction_rows(km: StiffnessMapResult, cell) -> list[dict]:
+def _prediction_rows(km: StiffnessMapResult) -> list[dict]:
     """Per family: predicted K* and I_e* (and which mechanism), the measured K boundary at
     the lowest I_e and I_e* at the largest K (rigid and compliant references)."""
     rows = []
@@ -166,10 +170,8 @@ def _prediction_rows(km: StiffnessMapResult, cell) -> list[dict]:
                 "k_measured_compliant": measured_k_star(comp) if comp else "-",
                 "ie_star": pred["ie_star"],
                 "limit": pred["limit"],
-                "ie_measured": _bracket(rigid[k_top]["ie_star"], cell) if k_top else "-",
-                "ie_measured_compliant": _bracket(comp[k_top]["ie_star"], cell)
-                if k_top and k_top in comp
-                else "-",
+                "ie_measured": _bracket(rigid[k_top]["ie_star"]) if k_top else "-",
+                "ie_measured_compliant": _bracket(comp[k_top]["ie_star"]) if k_top and k_top in comp else "-",
                 "at_k": float(k_top) if k_top else np.nan,
             }
         )
@@ -209,7 +211,7 @@ def ccdf_figure(km: StiffnessMapResult, path: Path) -> Path | None:
     return save_figure(fig, path)
 
 
-def _bracket(star: dict, cell) -> str:
+def _bracket(star: dict) -> str:
     """The I_e* bracket as text: ``low-high``, or ``< high`` / ``> low`` off the grid."""
     kind = star.get("kind")
     if kind == "below":
@@ -224,7 +226,7 @@ def _ratio(row: dict) -> str:
     return sig(v) if v is not None and np.isfinite(v) else "- (no quasistatic work)"
 
 
-def map_sections(km: StiffnessMapResult | None, table, cell) -> dict[str, str]:
+def map_sections(km: StiffnessMapResult) -> dict[str, str]:
     """Report text of the map: ``map`` (I_e*(K) table), ``energy`` and ``slip`` (tables
     with one sentence each), drawn by the report's ``table(rows, columns, names)`` and
     ``cell(value)`` so that every table of the report reads alike. Empty strings without a
@@ -240,7 +242,7 @@ def map_sections(km: StiffnessMapResult | None, table, cell) -> dict[str, str]:
                     "family": fam,
                     "K": float(k),
                     "ie_star": s.get("value"),
-                    "bracket": _bracket(s, cell),
+                    "bracket": _bracket(s),
                     "ci": f"{cell(s.get('ci_low'))}-{cell(s.get('ci_high'))}",
                     "kind": s.get("kind"),
                     "runs": f"{min(grid_cell['n_ok'])}-{max(grid_cell['n_ok'])} ok / {max(grid_cell['n'])}",
@@ -269,7 +271,7 @@ def map_sections(km: StiffnessMapResult | None, table, cell) -> dict[str, str]:
         "(hollow where it lies outside the grid).",
         "",
     ]
-    head += _prediction_text(km, table, cell)
+    head += _prediction_text(km)
     energy = (
         [
             "### Why a soft spring breaks quasistatics",
@@ -361,7 +363,7 @@ def map_sections(km: StiffnessMapResult | None, table, cell) -> dict[str, str]:
     return {"map": "\n".join(head), "energy": "\n".join(energy), "slip": "\n".join(slip)}
 
 
-def _prediction_text(km: StiffnessMapResult, table, cell) -> list[str]:
+def _prediction_text(km: StiffnessMapResult) -> list[str]:
     """The predicted boundary against the measured one, and the compliant reference's
     agreement (lines of the map section; empty without predictions)."""
     if not km.predicted:
@@ -379,7 +381,7 @@ def _prediction_text(km: StiffnessMapResult, table, cell) -> list[str]:
                     if rigid
                     else "-",
                     "compliant": f"{cell(c['agreement'][0])} / {cell(c['median_frechet'][0])}",
-                    "star": _bracket(c["ie_star"], cell),
+                    "star": _bracket(c["ie_star"]),
                 }
             )
     return [
@@ -394,7 +396,7 @@ def _prediction_text(km: StiffnessMapResult, table, cell) -> list[str]:
         "streamline of each run's spring. Dashed and dotted lines on the map.",
         "",
         table(
-            _prediction_rows(km, cell),
+            _prediction_rows(km),
             [
                 "family",
                 "k_star",
@@ -430,3 +432,23 @@ def _prediction_text(km: StiffnessMapResult, table, cell) -> list[str]:
         ),
         "",
     ]
+
+
+def headline(km: StiffnessMapResult) -> list[str]:
+    return []
+
+
+def section(km: StiffnessMapResult, ctx: ReportContext) -> str | None:
+    """The map's sections (I_e*(K), energy, slip), or None without a map."""
+    if not km.agreement:
+        return None
+    text = map_sections(km)
+    heat = ctx.draw(map_figure, km, "ie_k_map.png")
+    ccdf = ctx.draw(ccdf_figure, km, "slip_ccdf.png")
+    return assemble(
+        text["map"],
+        image("Outcome agreement over (I_e, K) per family with I_e*(K)", heat),
+        text["energy"],
+        text["slip"],
+        image("Complementary CDFs of slip size and force drop", ccdf),
+    )

@@ -149,7 +149,7 @@ def test_slip_statistics_marks_where_each_drop_is_read():
 
 
 def test_measured_k_star_brackets_the_first_passing_stiffness():
-    from spine_mj.validate.stiffness_map_report import measured_k_star
+    from spine_mj.validate.report.stiffness_map import measured_k_star
 
     def cells(passes):
         return {k: {"passes": [p, False]} for k, p in passes.items()}
