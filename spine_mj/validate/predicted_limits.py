@@ -18,9 +18,10 @@ from spine_mj.validate.plans import FamilySpec, ValidationPlan
 __all__ = ["family_limits"]
 
 
-def family_limits(plan: ValidationPlan, fam: FamilySpec) -> dict:
+def family_limits(plan: ValidationPlan, fam: FamilySpec, *, n_starts: int = 8) -> dict:
     """``{"k_star", "ie_star", "limit", "presets": {preset: DriveLimits.as_dict()}}`` of
-    ``fam`` on its first seed and variant (see module)."""
+    ``fam`` on its first seed and variant (see module), from ``n_starts x n_starts`` paths
+    per surface."""
     seed = fam.seeds[0] if fam.seeds else None
     variant = dict(fam.variants[0]) if fam.variants else {}
     per = {}
@@ -29,7 +30,7 @@ def family_limits(plan: ValidationPlan, fam: FamilySpec) -> dict:
         surface = presets.make_surface(preset, **overrides)
         mu = fam.mu if fam.mu is not None else presets.calibrated_mu(preset)
         tip = tip_radius(preset, None if seed is None else (seed,), plan.hfield_resolution)
-        per[preset] = dict(drive_limits(surface, mu, tip_radius=tip).as_dict(), tip_radius=tip)
+        per[preset] = dict(drive_limits(surface, mu, tip_radius=tip, n_starts=n_starts).as_dict(), tip_radius=tip)
     worst = min(per.values(), key=lambda d: d["ie_star"])
     return {
         "k_star": max(d["k_star"] for d in per.values()),

@@ -165,7 +165,7 @@ def test_family_limits_predict_on_the_maps_surfaces():
     from spine_mj.validate.predicted_limits import family_limits
 
     plan = PLANS["smoke"]
-    got = family_limits(plan, plan.families[0])
+    got = family_limits(plan, plan.families[0], n_starts=2)
     assert set(got["presets"]) == {"paper-single-peak"}
     one = got["presets"]["paper-single-peak"]
     assert got["k_star"] == one["k_star"] > 0 and got["ie_star"] == one["ie_star"] > 0
