@@ -30,7 +30,8 @@ def family_limits(plan: ValidationPlan, fam: FamilySpec, *, n_starts: int = 8) -
         surface = presets.make_surface(preset, **overrides)
         mu = fam.mu if fam.mu is not None else presets.calibrated_mu(preset)
         tip = tip_radius(preset, None if seed is None else (seed,), plan.hfield_resolution)
-        per[preset] = dict(drive_limits(surface, mu, tip_radius=tip, n_starts=n_starts).as_dict(), tip_radius=tip)
+        limits = drive_limits(surface, mu, tip_radius=tip, n_starts=n_starts)
+        per[preset] = dict(limits.as_dict(), tip_radius=tip)
     worst = min(per.values(), key=lambda d: d["ie_star"])
     return {
         "k_star": max(d["k_star"] for d in per.values()),
