@@ -135,6 +135,17 @@ def _draw_prediction(ax, pred: dict | None) -> None:
         ax.axhline(k, color=THRESHOLD_COLOR, ls="--", lw=1.2, label="predicted K*")
     if np.isfinite(ie) and lo < ie < hi:
         ax.axvline(ie, color=THRESHOLD_COLOR, ls=":", lw=1.5, label="predicted I_e*")
+    off = [f"K* = {sig(k)}" for v, a, b in [(k, klo, khi)] if np.isfinite(v) and not a < v < b]
+    off += [f"I_e* = {sig(ie)}" for v, a, b in [(ie, lo, hi)] if np.isfinite(v) and not a < v < b]
+    if off:  # a prediction beyond the grid: named in the panel
+        ax.text(
+            0.02,
+            0.02,
+            "predicted, off the grid: " + ", ".join(off),
+            transform=ax.transAxes,
+            fontsize=7,
+            bbox={"facecolor": "white", "alpha": 0.85, "lw": 0},
+        )
     ax.set(xlim=(lo, hi), ylim=(klo, khi))
 
 
