@@ -170,3 +170,32 @@ def test_family_limits_predict_on_the_maps_surfaces():
     one = got["presets"]["paper-single-peak"]
     assert got["k_star"] == one["k_star"] > 0 and got["ie_star"] == one["ie_star"] > 0
     assert one["tip_radius"] > 0 and one["mu"] == pytest.approx(1.23, abs=0.05)
+
+
+def test_the_report_sets_the_prediction_beside_the_measured_boundary(tmp_path):
+    from spine_mj.validate.report.stiffness_map import map_figure, map_sections
+    from spine_mj.validate.stiffness_map import StiffnessMapResult
+
+    rigid = agreement_map(_runs({1.0: 0, 10.0: 2, 100.0: 3}), n_boot=20)
+    compliant = agreement_map(_runs({1.0: 2, 10.0: 2, 100.0: 3}), n_boot=20)
+    km = StiffnessMapResult(
+        ie=IE,
+        stiffness_numbers=[1.0, 10.0, 100.0],
+        families=["fractal"],
+        starts_per_preset=4,
+        agreement=rigid,
+        energy=[],
+        slip=[],
+        agreement_compliant=compliant,
+        predicted={"fractal": {"k_star": 5.0, "ie_star": 0.02, "limit": "trap", "presets": {}}},
+    )
+    text = map_sections(km)["map"]
+    row = next(line for line in text.splitlines() if line.startswith("| fractal | 5 |"))
+    # measured K boundary at the lowest I_e: rigid fails at K = 1 only, the compliant
+    # reference passes from K = 1; I_e* at the stiffest K from both
+    assert "| 1-10 | < 1 | 0.02 | trap | 100 | 0.1-1 | 0.1-1 |" in row
+    assert "| fractal | 1 | 0.001 | 0 / 0.01 | 1 / 0.01 |" in text
+    assert map_figure(km, tmp_path / "map.png").is_file()
+    assert km.validation_keys()["predicted_drive_limits"] == {
+        "fractal": {"k_star": 5.0, "ie_star": 0.02, "limit": "trap"}
+    }
