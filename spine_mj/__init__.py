@@ -23,7 +23,7 @@ from spine_mj.compare import (
 )
 from spine_mj.compliant import CompliantResult, compliant_streamlines
 from spine_mj.convexity import classify_points, hessian_class, sectional_class
-from spine_mj.drive_limits import DriveLimits, drive_limits
+from spine_mj.drive_limits import DriveLimits
 from spine_mj.engagement import ENGAGED, SELF_LOCK, SLIP, kappa
 from spine_mj.errors import SpineInputError
 from spine_mj.presets import list_presets, load_preset, make_surface
@@ -96,7 +96,6 @@ __all__ = [
     "classify_points",
     "compliant_streamlines",
     "dilate",
-    "drive_limits",
     "fractal_fbm",
     "frechet_distance",
     "from_hfield",
