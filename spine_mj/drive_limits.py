@@ -141,6 +141,24 @@ def trap_depths(surface: Surface, x, y, f_arrival, mu: float, *, step: float, ka
     return np.where(np.isfinite(x), dz + mu * dx + f * (mu * dz - dx), np.inf)
 
 
+def _path_statistics(surface: Surface, res, mu: float, kappa_cap: float) -> tuple[float, float, np.ndarray]:
+    """Over the paths of ``res``: the steepest fall of the hold force ``max(-dH/dx)``, the
+    sharpest crest ``max(-z'')``, and per path the last finite hold force (a trap's
+    arrival drive)."""
+    fall, curv, arrival = [], [], np.full(len(res), np.nan)
+    for i in range(len(res)):
+        p = res.path(i)
+        _, fx, fy = surface.evaluate(p["x"], p["y"], order=1)
+        hold, _ = hold_force(fx, fy, mu)
+        hold = np.where(hold > kappa_cap, np.nan, hold)
+        fall.append(kappa_fall(p["x"], hold))
+        curv.append(crest_curvature(p["x"], p["y"], p["z"]))
+        finite = hold[np.isfinite(hold)]
+        arrival[i] = finite[-1] if finite.size else 0.0
+    max_fall = float(np.nanmax(np.concatenate(fall), initial=0.0))
+    return max_fall, float(np.nanmax(np.concatenate(curv), initial=0.0)), arrival
+
+
 def _grid_starts(surface: Surface, n: int, margin: float) -> np.ndarray:
     xmin, xmax, ymin, ymax = surface.bounds
     mx, my = margin * (xmax - xmin), margin * (ymax - ymin)
@@ -189,18 +207,7 @@ def drive_limits(
     pts = _grid_starts(traced, int(n_starts), 0.05) if starts is None else starts
     params = sl.StreamlineParams(mu=mu, dl=l_s / 40 if dl is None else dl, kappa_cap=kappa_cap)
     res = sl.streamlines(traced, pts, params, store_paths=True)
-    fall, curv, arrival = [], [], np.full(len(res), np.nan)
-    for i in range(len(res)):
-        p = res.path(i)
-        _, fx, fy = traced.evaluate(p["x"], p["y"], order=1)
-        hold, _ = hold_force(fx, fy, mu)
-        hold = np.where(hold > kappa_cap, np.nan, hold)
-        fall.append(kappa_fall(p["x"], hold))
-        curv.append(crest_curvature(p["x"], p["y"], p["z"]))
-        finite = hold[np.isfinite(hold)]
-        arrival[i] = finite[-1] if finite.size else 0.0
-    max_fall = float(np.nanmax(np.concatenate(fall), initial=0.0))
-    max_curv = float(np.nanmax(np.concatenate(curv), initial=0.0))
+    max_fall, max_curv, arrival = _path_statistics(traced, res, mu, kappa_cap)
     trapped = res.self_locked
     depth = trap_depths(
         traced,
