@@ -10,7 +10,7 @@ surface, pure numpy on the analytic side:
   position that holds the tip, ``X = x + (W / k) H``, falls somewhere along a path, a fold
   of the compliant-drive streamline (:mod:`spine_mj.compliant`). On a corrugation this is
   the Prandtl-Tomlinson ``K* = l_s max(-d kappa / dx)``.
-* ``I_e*`` the lower of two thresholds. *Lift-off*: a tip carried at horizontal speed
+* ``I_e*`` the lowest of three thresholds. *Lift-off*: a tip carried at horizontal speed
   ``v`` over a profile ``z(h)`` (h: horizontal arc length along the path) needs the
   vertical acceleration ``z'' v^2``; preload and gravity give at most ``F_p / m``, so it
   leaves the surface where ``-z'' v^2 > F_p / m``: ``I_e > 1 / (L_c max(-z''))``.
@@ -21,6 +21,10 @@ surface, pure numpy on the analytic side:
   ``dz / dx`` pushed by ``F``), less the drive's ``F dx``, with ``F`` the hold force the
   path had on arrival: ``I_e > 2 D / L_c``, ``D = dz + mu dx + f (mu dz - dx)``,
   ``f = F / W``, the shallowest trap first.
+  *Lag*: where the quasistatic path turns, a sliding tip carries its momentum on until
+  friction (``mu F_p`` at most) has taken its kinetic energy: over ``m v^2 / (2 mu F_p) =
+  I_e L_c / (2 mu)``. The path lags the streamline by that much; it stays within a path
+  tolerance ``t L_c`` while ``I_e < 2 mu t``.
 """
 
 from __future__ import annotations
@@ -32,6 +36,7 @@ import numpy as np
 
 from spine_mj import roughness
 from spine_mj import streamline as sl
+from spine_mj.compare import FRECHET_TARGET
 from spine_mj.compliant import hold_force
 from spine_mj.engagement import DEFAULT_KAPPA_CAP, SELF_LOCK
 from spine_mj.errors import SpineInputError
@@ -52,8 +57,11 @@ class DriveLimits:
         ``min(ie_lift, ie_trap)``: the quasistatic picture breaks above it.
     ie_lift, ie_trap : float
         The lift-off and trap-skipping thresholds (inf: no crest, no trap).
+    ie_lag : float
+        Where the tip's lag behind a turn of the path, ``I_e L_c / (2 mu)``, reaches the
+        path tolerance: ``2 mu tolerance / L_c``.
     limit : str
-        Which of the two sets ``ie_star``: ``"lift-off"`` or ``"trap"``.
+        Which of the three sets ``ie_star``: ``"lift-off"``, ``"trap"`` or ``"lag"``.
     mu : float
     slope_length, char_length : float
         ``l_s`` and ``L_c`` (surface length unit).
@@ -70,6 +78,7 @@ class DriveLimits:
     ie_star: float
     ie_lift: float
     ie_trap: float
+    ie_lag: float
     limit: str
     mu: float
     slope_length: float
@@ -87,7 +96,8 @@ class DriveLimits:
         """``"quasistatic needs K > ... and I_e < ..."``."""
         return (
             f"quasistatic needs K > {self.k_star:.3g} and I_e < {self.ie_star:.3g} "
-            f"(set by {self.limit}; lift-off {self.ie_lift:.3g}, trap {self.ie_trap:.3g})"
+            f"(set by {self.limit}; lift-off {self.ie_lift:.3g}, trap {self.ie_trap:.3g}, "
+            f"lag {self.ie_lag:.3g})"
         )
 
 
@@ -176,6 +186,7 @@ def drive_limits(
     dl: float | None = None,
     tip_radius: float = 0.0,
     kappa_cap: float = DEFAULT_KAPPA_CAP,
+    path_tolerance: float = FRECHET_TARGET,
 ) -> DriveLimits:
     """Predict ``K*`` and ``I_e*`` of ``surface`` from its quasistatic paths (module doc).
 
@@ -192,6 +203,9 @@ def drive_limits(
         Trace on the surface dilated by a ball of this radius (the MuJoCo tip's centre).
     kappa_cap : float
         Hold forces above it count as held (the comparison's force cap).
+    path_tolerance : float
+        How far (in ``L_c``) a path may lag the streamline, for ``ie_lag``; default the
+        comparison's Frechet target (:data:`spine_mj.compare.FRECHET_TARGET`, 0.1).
 
     Returns
     -------
@@ -221,12 +235,16 @@ def drive_limits(
     min_depth = float(depth.min()) if depth.size else math.inf
     ie_lift = 1.0 / (l_c * max_curv) if max_curv > 0 else math.inf
     ie_trap = 2.0 * max(min_depth, 0.0) / l_c
+    ie_lag = 2.0 * float(mu) * float(path_tolerance)
+    limits = {"lift-off": ie_lift, "trap": ie_trap, "lag": ie_lag}
+    limit = min(limits, key=limits.get)
     return DriveLimits(
-        k_star=l_s * max(max_fall, 0.0),
-        ie_star=min(ie_lift, ie_trap),
+        k_star=l_s * max(0.0, max_fall),
+        ie_star=limits[limit],
         ie_lift=ie_lift,
         ie_trap=ie_trap,
-        limit="lift-off" if ie_lift <= ie_trap else "trap",
+        ie_lag=ie_lag,
+        limit=limit,
         mu=float(mu),
         slope_length=l_s,
         char_length=l_c,

@@ -18,10 +18,11 @@ def test_surface_info_prints_the_drive_limits_of_a_corrugation():
     result = run("surface", "info", "corrugation")
     assert result.exit_code == 0, result.output
     line = next(s for s in result.output.splitlines() if s.startswith("drive limits"))
-    assert "quasistatic needs K > 0.467 and I_e < 0.529" in line  # Prandtl-Tomlinson K*, lift-off
+    # Prandtl-Tomlinson K*; I_e* set by the lag 2 mu 0.1 before lift-off at 0.529
+    assert "quasistatic needs K > 0.467 and I_e < 0.1 (set by lag; lift-off 0.529" in line
     doc = json.loads(run("surface", "info", "corrugation", "--json").output)
     assert doc["drive_limits"]["k_star"] == pytest.approx(0.467, abs=0.002)
-    assert doc["drive_limits"]["limit"] == "lift-off"
+    assert doc["drive_limits"]["limit"] == "lag"
 
 
 def test_a_file_without_preset_needs_mu(tmp_path):

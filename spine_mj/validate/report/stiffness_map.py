@@ -401,7 +401,8 @@ def _prediction_text(km: StiffnessMapResult) -> list[str]:
         "Predicted from each family's geometry alone (docs/physics.md §8, `spine-mj surface info`), on "
         "the surfaces the map runs traced under the rig's tip: K* = l_s max(-dH/dx) along the "
         "streamlines (below it the compliant-drive streamline folds: stick-slip at vanishing speed), "
-        "and I_e* the lower of lift-off over crests and skipping the shallowest trap. Measured: the K "
+        "and I_e* the lowest of lift-off over crests, skipping the shallowest trap and the lag "
+        "behind turns (I_e < 2 mu 0.1). Measured: the K "
         "boundary is where the criterion first holds at the lowest I_e as K grows; I_e* is the map's "
         "at its stiffest K; both against the rigid streamline and against the compliant-drive "
         "streamline of each run's spring. Dashed and dotted lines on the map.",
