@@ -3,12 +3,12 @@
 from __future__ import annotations
 
 import json
+import math
 
 import click
-import numpy as np
 
 from spine_mj import presets, roughness, surface_io
-from spine_mj.atomic import all_or_none, atomic_output
+from spine_mj.atomic import all_or_none
 from spine_mj.cli.app import (
     _Group,
     check_suffix,
@@ -23,7 +23,7 @@ from spine_mj.plotting import (
     save_figure,
     surface_preview,
 )
-from spine_mj.surfaces import LENGTH_UNITS_M, length_unit, to_hfield
+from spine_mj.surfaces import LENGTH_UNITS_M, length_unit
 
 
 @main.group(cls=_Group)
@@ -162,13 +162,13 @@ def surface_info(surface_spec, output, as_json, mu, tip_radius):
 
 
 def _drive_limits(surf, mu, tip_radius):
-    """:func:`spine_mj.drive_limits.drive_limits` of ``surf`` (None without a mu_s)."""
-    mu = presets.preset_mu(surf) if mu is None else mu
-    if mu is None:
+    """:func:`spine_mj.drive_limits.drive_limits` of ``surf`` with the one mu rule
+    (:func:`spine_mj.presets.resolve_mu`); None without a mu_s (info still reports the
+    roughness)."""
+    if mu is None and presets.preset_mu(surf) is None:
         return None
-    if not (np.isfinite(mu) and mu > 0):
-        raise SpineInputError(f"--mu must be a finite number > 0, got {mu!r}")
-    if not (np.isfinite(tip_radius) and tip_radius >= 0):
+    mu = presets.resolve_mu(surf, mu, name="--mu")
+    if not (math.isfinite(tip_radius) and tip_radius >= 0):
         raise SpineInputError(f"--tip-radius must be a finite number >= 0, got {tip_radius!r}")
     return drive_limits(surf, mu, tip_radius=tip_radius)
 
@@ -228,14 +228,6 @@ def surface_export(surface_file, stl, stl_scale, base_thickness, hfield, resolut
             surface_io.write_stl(surf, stl, **mesh_opts)
             written.append(f"wrote {stl} (scale {scale:g})")
         if hfield:
-            hf = to_hfield(surf, ncol=resolution, nrow=resolution) if resolution else to_hfield(surf)
-            with atomic_output(hfield) as tmp, open(tmp, "wb") as fh:
-                np.savez(
-                    fh,
-                    data=hf.data,
-                    size=np.asarray(hf.size),
-                    pos=np.asarray(hf.pos),
-                    unit=np.array(surf.unit),
-                )
+            hf = surface_io.write_hfield(surf, hfield, resolution=resolution)
             written.append(f"wrote {hfield} ({hf.nrow} x {hf.ncol}, size {json.dumps(hf.size)})")
     click.echo("\n".join(written))
