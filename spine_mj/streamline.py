@@ -66,6 +66,7 @@ class Outcome(enum.IntEnum):
     STALLED = 3  #: no net progress (|T| = 0, or too little progress over stall_window steps)
     STEP_CAP = 4  #: max_steps taken without any of the above
     FORCE_CAP = 5  #: the drive force needed, kappa W, exceeds ``kappa_cap`` W (held by the cap)
+    DRIVE_END = 6  #: the carriage reached the end of its travel (compliant drive, :mod:`spine_mj.compliant`)
 
 
 @dataclass(frozen=True)
