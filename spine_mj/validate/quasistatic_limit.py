@@ -74,7 +74,9 @@ class QuasistaticLimitResult:
     families : dict
         Family name -> summary: ``runs``, ``ok_runs``, ``outcome_agreement``,
         ``mean_frechet``, ``median_frechet``, ``mean_lateral_deviation`` (against the
-        facet-traced streamline), ``outcome_agreement_smooth``, ``median_frechet_smooth``
+        facet-traced streamline), ``outcome_agreement_compliant`` and
+        ``median_frechet_compliant`` (against the compliant-drive streamline of the run's
+        spring), ``outcome_agreement_smooth``, ``median_frechet_smooth``
         (against the smooth one), ``mean_geometry_frechet``, ``failed_runs`` (engine stops
         by status), ``reference_stalled`` (reference streamlines stalled in a groove),
         ``misses`` (disagreeing runs the engine finished, by
@@ -150,6 +152,9 @@ def quasistatic_limit(plan: ValidationPlan, runner: StudyRunner) -> QuasistaticL
                 "median_frechet_smooth": float(np.nanmedian(allc["frechet_smooth"])),
                 "outcome_agreement_smooth": float(allc["agree_smooth"].fillna(False).astype(bool).mean()),
                 "mean_geometry_frechet": float(np.nanmean(allc["geometry_frechet"])),
+                # against the compliant-drive streamline of the run's own spring (NaN in a
+                # store written before compare had it)
+                **_compliant_summary(allc),
                 "failed_runs": {str(k): int(v) for k, v in failed.items()},
                 # no progress even with the step cut to dl / 2**max_halvings (a fixed step
                 # once zig-zagged across grit valleys narrower than itself and stalled
@@ -291,6 +296,17 @@ def _misses(comp) -> dict[str, dict]:
             offsets = [float(v) for v in rows["miss_offset"] if np.isfinite(v)]
             out[reason] = {"runs": int(len(rows)), "offsets": sorted(offsets)}
     return out
+
+
+def _compliant_summary(comp) -> dict:
+    """Outcome agreement and median Frechet of ``compare`` rows against the compliant-drive
+    reference (``agree_compliant``, ``compliant_frechet``; NaN without those columns)."""
+    if "agree_compliant" not in comp or not comp["agree_compliant"].notna().any():
+        return {"outcome_agreement_compliant": float("nan"), "median_frechet_compliant": float("nan")}
+    return {
+        "outcome_agreement_compliant": float((comp["agree_compliant"] == 1).mean()),
+        "median_frechet_compliant": float(np.nanmedian(comp["compliant_frechet"])),
+    }
 
 
 def _family_summary(comp) -> dict:

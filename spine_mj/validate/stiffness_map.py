@@ -13,7 +13,11 @@ the plan's families and reports, from the same runs:
 - per K, the spring energy released at breakaways against the quasistatic work of the
   streamline (``F_p integral kappa dx``), both per L_c travelled;
 - slip events (:func:`spine_mj.validate.stick_slip.slip_statistics`): their sizes and force
-  drops, how often and how long the tip slips, and how many quasistatic traps MuJoCo skips.
+  drops, how often and how long the tip slips, and how many quasistatic traps MuJoCo skips;
+- the same agreement against the compliant-drive streamline of each run's spring
+  (``agreement_compliant``: what the spring does predicted, inertia left over), and the
+  drive limits predicted from each family's geometry (``predicted``,
+  :mod:`spine_mj.validate.predicted_limits`) beside the measured boundary.
 
 Each preset runs from few starts (``plan.stiffness_map_starts``): the lowest I_e and the
 many K values make the expensive corner (drive cost grows as I_e^-1/2).
@@ -35,6 +39,7 @@ from spine_mj.validate.boundary import preset_grid, quasistatic_locked
 from spine_mj.validate.ie_star import ie_star_by_criterion, passes_criterion, quiet_nan_warnings
 from spine_mj.validate.paths import mujoco_traces
 from spine_mj.validate.plans import GRAVITY, MASS_KG, FamilySpec, ValidationPlan
+from spine_mj.validate.predicted_limits import family_limits
 from spine_mj.validate.slip_tails import fit_tail
 from spine_mj.validate.stick_slip import slip_statistics
 from spine_mj.validate.study_runner import StudyRunner
@@ -99,6 +104,8 @@ class StiffnessMapResult:
     slip_samples: dict = dataclasses.field(default_factory=dict, compare=False)
     tails: list = dataclasses.field(default_factory=list)
     transitions: list = dataclasses.field(default_factory=list)
+    agreement_compliant: dict = dataclasses.field(default_factory=dict)
+    predicted: dict = dataclasses.field(default_factory=dict)
 
     def ie_star(self) -> dict:
         """family -> K (str) -> I_e* (value, low, high, ci_low, ci_high, kind, criterion)."""
@@ -106,10 +113,19 @@ class StiffnessMapResult:
 
     def validation_keys(self) -> dict:
         """This study's keys of ``validation.json``: ``ie_star_by_stiffness`` (family -> K ->
-        I_e* with bracket ``low``/``high``, bootstrap ``ci_low``/``ci_high`` and ``kind``) and
-        ``stiffness_map`` (the agreement grid with n_ok / n per cell, the energy and slip
-        tables)."""
-        return {"ie_star_by_stiffness": self.ie_star(), "stiffness_map": self.as_dict()}
+        I_e* with bracket ``low``/``high``, bootstrap ``ci_low``/``ci_high`` and ``kind``), the
+        same against the compliant-drive reference (``ie_star_by_stiffness_compliant``), the
+        geometry's prediction (``predicted_drive_limits``: family -> ``k_star``, ``ie_star``,
+        ``limit``) and ``stiffness_map`` (the agreement grid with n_ok / n per cell, the
+        energy and slip tables)."""
+        return {
+            "ie_star_by_stiffness": self.ie_star(),
+            "ie_star_by_stiffness_compliant": self.ie_star_compliant(),
+            "predicted_drive_limits": {
+                f: {k: d[k] for k in ("k_star", "ie_star", "limit")} for f, d in self.predicted.items()
+            },
+            "stiffness_map": self.as_dict(),
+        }
 
     def as_dict(self) -> dict:
         """The ``validation.json`` entry (the slip samples stay out: the figure holds them)."""
@@ -123,6 +139,15 @@ class StiffnessMapResult:
             "slip": self.slip,
             "tails": self.tails,
             "transitions": self.transitions,
+            "agreement_compliant": self.agreement_compliant,
+            "predicted": self.predicted,
+        }
+
+    def ie_star_compliant(self) -> dict:
+        """:meth:`ie_star` against the compliant-drive reference (``agreement_compliant``)."""
+        return {
+            f: {k: cell["ie_star"] for k, cell in by_k.items()}
+            for f, by_k in self.agreement_compliant.items()
         }
 
 
@@ -156,9 +181,11 @@ def stiffness_map(plan: ValidationPlan, runner: StudyRunner) -> StiffnessMapResu
     empty = StiffnessMapResult(ies, ks, [f.name for f in fams], plan.stiffness_map_starts, {}, [], [])
     if not ies or not ks or not fams:
         return empty
-    runs, samples = [], {}
+    runs, samples, predicted = [], {}, {}
     for fam in fams:
         sub = subset_starts(plan.map_family(fam), plan.stiffness_map_starts)
+        runner.note(f"predicted drive limits of {fam.name}")
+        predicted[fam.name] = family_limits(plan, sub)
         for preset in fam.presets:
             doc = family_doc(
                 sub,
@@ -184,6 +211,11 @@ def stiffness_map(plan: ValidationPlan, runner: StudyRunner) -> StiffnessMapResu
         slip_samples=pooled,
         tails=tail_rows(pooled),
         transitions=slip_transitions(slip),
+        agreement_compliant=agreement_map(
+            table.assign(agree=table["agree_compliant"], frechet=table["frechet_compliant"]),
+            n_boot=plan.bootstrap,
+        ),
+        predicted=predicted,
     )
 
 
@@ -251,6 +283,8 @@ def _run_rows(df: pd.DataFrame, store, family: str, preset: str, samples: dict) 
                 "agree": c["agree"],
                 "agree_lock": c["agree_lock"],
                 "frechet": float(c["frechet"]),
+                "agree_compliant": c.get("agree_compliant", np.nan),
+                "frechet_compliant": float(c.get("compliant_frechet", np.nan)),
                 "engine_trouble": r["end_reason"] == "engine_trouble",
                 "mj_locked": bool(r["self_locked"]),
             }

@@ -190,8 +190,9 @@ def _lines(limit: QuasistaticLimitResult, boundary: BoundaryResult) -> list[str]
         "`surfaces.BallOnFacets`), ending where the engine's run ends, with the same force "
         "cap on both sides (a path needing more than the cap times F_p is held). A run the "
         "engine stopped, or whose reference stalled, counts as a disagreement. Beside it: the "
-        "comparison with the streamline on the smooth surface and the geometry part (smooth vs "
-        "facet streamline).",
+        "comparison with the compliant-drive streamline of the run's spring on the same facets "
+        "(docs/physics.md §7: what the spring itself does, jumps at folds, predicted), with the "
+        "streamline on the smooth surface, and the geometry part (smooth vs facet streamline).",
         "",
         table(
             families,
@@ -202,6 +203,8 @@ def _lines(limit: QuasistaticLimitResult, boundary: BoundaryResult) -> list[str]
                 "outcome_agreement",
                 "median_frechet",
                 "mean_frechet",
+                "outcome_agreement_compliant",
+                "median_frechet_compliant",
                 "outcome_agreement_smooth",
                 "median_frechet_smooth",
                 "mean_geometry_frechet",
@@ -214,6 +217,8 @@ def _lines(limit: QuasistaticLimitResult, boundary: BoundaryResult) -> list[str]
                 "outcome agr.",
                 "median Frechet",
                 "mean Frechet",
+                "outcome agr. (compliant ref.)",
+                "median Frechet (compliant ref.)",
                 "outcome agr. (smooth)",
                 "median Frechet (smooth)",
                 "geometry Frechet",
