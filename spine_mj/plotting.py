@@ -555,3 +555,44 @@ def shared_height_norm(panels: list[dict]):
             xs, ys = np.linspace(x0, x1, 81), np.linspace(y0, y1, 81)
             top = max(top, float(np.abs(panel["surface"].height(xs[None, :], ys[:, None])).max()))
     return mcolors.TwoSlopeNorm(0.0, -top, top) if top > 0 else None
+
+
+@styled
+def array_figure(res, arr):
+    """An array run (:class:`~spine_mj.sim.ArrayResult` of ``arr``, an
+    :class:`~spine_mj.sim.ArrayRig`): the layout on the surface's height map with each
+    spine's path (self-locked spines marked), beside the array's force-displacement curve."""
+    rig = arr.rig
+    s = rig.length_scale_m
+    fig = new_figure(figsize=(12, 4.6), layout="constrained")
+    ax, ax2 = fig.subplots(1, 2, gridspec_kw={"width_ratios": [1.4, 1]})
+    grid = _display_grid(rig.surface, 300)
+    units = _axes_units(rig.surface, grid)
+    lf = units[0]
+    _height_map(fig, ax, grid, units)
+    for i in range(res.n_spines):
+        p = res.position_m[:, i] / s * lf
+        ax.plot(p[:, 0], p[:, 1], lw=0.9, color="white")
+    x0, y0 = res.start_xy.T * lf
+    ax.scatter(x0, y0, s=12, color="black", zorder=3, label="start")
+    end = res.position_m[-1] / s * lf
+    if res.locked.any():
+        xe, ye = end[res.locked, 0], end[res.locked, 1]
+        ax.scatter(xe, ye, s=40, marker="x", color="red", zorder=4, label="self-locked (where it ended)")
+    seen = np.concatenate([res.start_xy * lf, res.position_m[:, :, :2].reshape(-1, 2) / s * lf])
+    lo, hi = np.nanmin(seen, axis=0), np.nanmax(seen, axis=0)
+    pad = 0.15 * max(hi - lo) + 1e-12
+    ax.set_xlim(lo[0] - pad, hi[0] + pad)
+    ax.set_ylim(lo[1] - pad, hi[1] + pad)
+    ax.legend(loc="upper right", fontsize=7)
+    lay = arr.layout
+    ax.set_title(
+        f"{lay.kind.value} {lay.rows} x {lay.cols}, spacing {lay.spacing:g} {lay.spacing_unit.value}"
+    )
+    fp = rig.scales.preload_n
+    ax2.plot(res.carriage_x_m / rig.scales.char_length_m, res.total_force_n / (res.n_spines * fp), lw=1)
+    ax2.axhline(res.holding_ratio, color="gray", lw=0.8, ls="--")
+    ax2.set_xlabel("carriage displacement [L_c]")
+    ax2.set_ylabel("array force / (N F_p)")
+    ax2.set_title(f"holding ratio {sig(res.holding_ratio)}, {res.locked_spines} locked ({res.end_reason})")
+    return fig

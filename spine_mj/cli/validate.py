@@ -82,6 +82,14 @@ def validate_cmd(out_dir, quick, plan_name, workers, quiet):
             if f"rate_{k}" in row
         )
         click.echo(f"fractal self-lock rate, H = {row['hurst']:g}: {rates}")
+    for kind, pool in result.get("arrays", {}).get("pooled", {}).items():
+        if pool.get("diff"):
+            d = pool["diff"]
+            click.echo(
+                f"arrays: P(at least one spine locks), {kind} - aligned = {d['diff']:+.3f} "
+                f"[{d['ci_low']:+.3f}, {d['ci_high']:+.3f}] ({pool['locked']}/{pool['n_ok']} against "
+                f"{pool['locked_grid']}/{pool['n_ok_grid']})"
+            )
     for proto, s in result["ie_star"].items():
         if s.get("valid") is False:
             click.echo(f"I_e* ({proto}) {s['note']}")

@@ -59,9 +59,11 @@ Modules: :mod:`~spine_mj.sim.params` (tip, engine, scales and their rules),
 :func:`build_drive`: a rig and a drive from dimensionless or SI inputs).
 """
 
+from spine_mj.sim.array import ArrayResult, ArrayRig, ForcePull
 from spine_mj.sim.build import DEFAULT_INERTIA_NUMBER, PROTOCOLS, build_drive, build_rig, drive_speed_m_s
 from spine_mj.sim.detection import Detection, Event
 from spine_mj.sim.drives import Drive, RampDrive, SpringDrive, StaticProbe
+from spine_mj.sim.layout import Layout, LayoutKind
 from spine_mj.sim.model import MODEL_PATH
 from spine_mj.sim.motion import MOTION_NAMES, SLIDING, SLIPPING, STUCK, SlipEvent
 from spine_mj.sim.params import (
@@ -97,6 +99,8 @@ __all__ = [
     "SLIDING",
     "SLIPPING",
     "STUCK",
+    "ArrayResult",
+    "ArrayRig",
     "Cone",
     "Detection",
     "Drive",
@@ -104,7 +108,10 @@ __all__ = [
     "EngineSettings",
     "EngineUnits",
     "Event",
+    "ForcePull",
     "Integrator",
+    "Layout",
+    "LayoutKind",
     "RampDrive",
     "Rig",
     "RunResult",

@@ -612,8 +612,8 @@ def python_steps(model, init, warm, ctrl, state, sens):
     d.qacc_warmstart[:] = warm
     first_warn = None
     for i in range(ctrl.shape[0]):
-        d.ctrl[:] = ctrl[i, :3]
-        d.mocap_pos[0] = ctrl[i, 3:6]
+        d.ctrl[:] = ctrl[i, : model.nu]
+        d.mocap_pos[:] = ctrl[i, model.nu :].reshape(-1, 3)
         mujoco.mj_step(model, d)
         mujoco.mj_getState(model, d, state[i], full)
         sens[i] = d.sensordata

@@ -3,12 +3,13 @@
 A config names surfaces (presets or files, with seeds), start points, a parameter grid and
 the analyses to run on every case (see :mod:`spine_mj.sweep` for the TOML form). Its shape
 is declared once, as frozen pydantic models that refuse undeclared keys: the tables here,
-and [grid] and [drive], built by :func:`_parameters_model` from the analyses' parameter
-declarations in :mod:`spine_mj.sweep.registry` (types, bounds, defaults). The checks that
-span tables (defaults, the size, the analyses' own config checks) follow in
-:func:`parse_config`. Every error is one SpineInputError line naming the key, what is
-allowed and what arrived (:func:`_validate`). The normalized config
-(:meth:`SweepConfig.as_dict`) is what the config hash, and so the resume of a store, covers.
+and [grid], [drive] and [array] (the array analysis's layout), built by
+:func:`_parameters_model` from the analyses' parameter declarations in
+:mod:`spine_mj.sweep.registry` (types, bounds, defaults). The checks that span tables
+(defaults, the size, the analyses' own config checks) follow in :func:`parse_config`.
+Every error is one SpineInputError line naming the key, what is allowed and what arrived
+(:func:`_validate`). The normalized config (:meth:`SweepConfig.as_dict`) is what the
+config hash, and so the resume of a store, covers.
 """
 
 from __future__ import annotations
@@ -358,6 +359,7 @@ class _Document(_Table):
     starts: StartsSpec | None = Field(None, validate_default=True)
     grid: dict[str, Any] = {}
     drive: dict[str, Any] = {}
+    array: dict[str, Any] = {}
 
     @field_validator("starts")
     def _for_every_surface(cls, starts, info):
@@ -383,7 +385,10 @@ def _parameters_model(analyses: tuple[str, ...], specs: tuple[ParamSpec, ...]) -
     specs = sorted(specs, key=lambda s: s.name)
     grid = table("grid", "parameter", specs)
     drive = table("drive", "drive parameter", [s for s in specs if s.drive])
-    return create_model("parameters", __base__=_Table, grid=(grid, grid()), drive=(drive, drive()))
+    array = table("array", "array parameter", [s for s in specs if s.array])
+    return create_model(
+        "parameters", __base__=_Table, grid=(grid, grid()), drive=(drive, drive()), array=(array, array())
+    )
 
 
 @dataclass(frozen=True)
@@ -472,7 +477,8 @@ def parse_config(doc: Mapping, *, base_dir: str | os.PathLike = ".") -> SweepCon
     sweep = document.sweep
     specs = tuple(param_specs(sweep.analyses).values())
     params = _validate(
-        _parameters_model(sweep.analyses, specs), {"grid": document.grid, "drive": document.drive}
+        _parameters_model(sweep.analyses, specs),
+        {"grid": document.grid, "drive": document.drive, "array": document.array},
     )
     entries = [(e, spec) for i, e in enumerate(document.surfaces) for spec in e.instances(sweep.seed, i)]
     surfaces = tuple(spec for _, spec in entries)
@@ -498,10 +504,11 @@ def _grid(params, analyses: tuple[str, ...], surfaces) -> tuple[tuple[str, tuple
     default (None for :data:`PRESET_MU`: each case's preset's, filled in by
     :func:`spine_mj.sweep.cases.expand_cases`)."""
     given = {k: getattr(params.grid, k) for k in params.grid.model_fields_set}
-    for k in params.drive.model_fields_set:
-        if k in given:
-            raise SpineInputError(f"config key drive.{k}: also given as grid.{k}; give it once")
-        given[k] = getattr(params.drive, k)
+    for table in ("drive", "array"):
+        for k in getattr(params, table).model_fields_set:
+            if k in given:
+                raise SpineInputError(f"config key {table}.{k}: also given as grid.{k}; give it once")
+            given[k] = getattr(getattr(params, table), k)
     grid = []
     for pname, spec in param_specs(analyses).items():
         if pname not in given and (spec.default is REQUIRED or spec.default is PRESET_MU):

@@ -84,6 +84,8 @@ class ParamSpec:
         Allowed values of a ``str`` parameter.
     drive : bool
         May also be given in the ``[drive]`` table.
+    array : bool
+        May also be given in the ``[array]`` table (the layout of the ``array`` analysis).
     """
 
     name: str
@@ -95,6 +97,7 @@ class ParamSpec:
     choices: tuple[str, ...] | None = None
     drive: bool = False
     maximum: float | None = None
+    array: bool = False
 
     def expected(self) -> str:
         if self.choices:

@@ -1,4 +1,4 @@
-"""The built-in sweep analyses: ``quasistatic``, ``mujoco`` and ``compare``.
+"""The built-in sweep analyses: ``quasistatic``, ``mujoco``, ``compare`` and ``array``.
 
 Each analysis touches the API of its module in one place (``quasistatic`` ->
 :mod:`spine_mj.streamline`, ``mujoco`` -> :mod:`spine_mj.sim`, ``compare`` ->
@@ -9,7 +9,8 @@ this package registers them, in this order (the run order: dependencies first).
 from spine_mj.sweep.analyses import quasistatic  # noqa: I001  (registration order is run order)
 from spine_mj.sweep.analyses import mujoco
 from spine_mj.sweep.analyses import compare
+from spine_mj.sweep.analyses import array
 from spine_mj.sweep.analyses.mujoco import MUJOCO_PARAMS
 from spine_mj.sweep.analyses.quasistatic import QUASISTATIC_PARAMS
 
-__all__ = ["MUJOCO_PARAMS", "QUASISTATIC_PARAMS", "compare", "mujoco", "quasistatic"]
+__all__ = ["MUJOCO_PARAMS", "QUASISTATIC_PARAMS", "array", "compare", "mujoco", "quasistatic"]

@@ -1,0 +1,89 @@
+"""The ``array`` analysis: an array of spines on one carriage, centred at every start.
+
+Its layout and drive are read from the config's ``[array]`` table (or ``[grid]``): the
+keys of ``spine-mj array`` (``layout``, ``rows``, ``cols``, ``spacing``, ``spacing_unit``,
+``layout_seed``, ``array_drive``); the tip, engine and drive speed are the ``mujoco``
+analysis's parameters (:data:`~spine_mj.sweep.analyses.mujoco.MUJOCO_PARAMS`, one rig per
+case: :func:`~spine_mj.sweep.analyses.mujoco.case_rig`). Per start it records the keys of
+the command's ``summary.json``: ``n_spines``, ``holding_force_n``, ``holding_ratio`` and
+``locked_spines``. Touches the API of :mod:`spine_mj.sim`'s arrays here only.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from spine_mj import sim
+from spine_mj.sim.layout import MAX_SPINES
+from spine_mj.sweep.analyses.mujoco import MUJOCO_PARAMS, case_drive, case_rig
+from spine_mj.sweep.registry import CASE_THREADS, Analysis, AnalysisResult, ParamSpec, register_analysis
+
+ARRAY_PARAMS = (
+    *MUJOCO_PARAMS,
+    ParamSpec("layout", "str", "array layout", "grid", choices=("grid", "staggered", "random"), array=True),
+    ParamSpec("rows", "int", "spines across the drive (y)", 2, 1, maximum=MAX_SPINES, array=True),
+    ParamSpec("cols", "int", "spines along the drive (x)", 2, 1, maximum=MAX_SPINES, array=True),
+    ParamSpec(
+        "spacing", "float", "distance between neighbouring spines", 1.0, 0.0, exclusive=True, array=True
+    ),
+    ParamSpec("spacing_unit", "str", "unit of spacing", "L_c", choices=("surface", "l_s", "L_c"), array=True),
+    ParamSpec("layout_seed", "int", "seed of the random layout", 0, 0, array=True),
+    ParamSpec(
+        "array_drive",
+        "str",
+        "speed: the carriage moves at the drive speed; force: a free carriage pulled by a rising force",
+        "speed",
+        choices=("speed", "force"),
+        array=True,
+    ),
+)
+
+
+def _array(case, surface, starts, upstream):
+    p = case.params
+    rig = case_rig(case, surface)
+    sc = rig.scales
+    layout = sim.Layout(
+        kind=p["layout"],
+        rows=p["rows"],
+        cols=p["cols"],
+        spacing=p["spacing"],
+        spacing_unit=p["spacing_unit"],
+        seed=p["layout_seed"],
+    )
+    force = p["array_drive"] == "force"
+    arr = sim.ArrayRig(rig, layout, force_control=force)
+    if force:
+        speed = sim.drive_speed_m_s(sc, ie=p["ie"], speed_m_s=p["speed"])
+        stiffness = p["stiffness"] if p["K"] is None else sc.stiffness_for(p["K"])
+        drive = sim.ForcePull(
+            rate_n_s=sc.force_rate_for(speed), stiffness_n_m=stiffness, settle_time_s=p["settle_time"]
+        )
+    else:
+        drive = case_drive(rig, {**p, "protocol": "spring"})
+    det = sim.Detection(kappa_cap=p["kappa_cap"])
+    runs = arr.run_batch(drive, [tuple(s) for s in starts], detection=det, nthread=CASE_THREADS.get())
+    trouble = np.array([r.end_reason == "engine_trouble" for r in runs])
+    status = np.where(
+        trouble, ["engine_warning" if "warned" in r.end_detail else "nan" for r in runs], "ok"
+    ).astype(object)
+    metrics = {
+        "n_spines": np.array([r.n_spines for r in runs]),
+        "holding_force_n": np.array([r.holding_force_n for r in runs]),
+        "holding_ratio": np.array([r.holding_ratio for r in runs]),
+        "locked_spines": np.array([r.locked_spines for r in runs]),
+        "end_reason": np.array([r.end_reason for r in runs], dtype=object),
+        "simulated_steps": np.array([r.simulated_steps for r in runs]),
+    }
+    reason = np.array([r.end_detail for r in runs], dtype=object)
+    return AnalysisResult(metrics=metrics, status=status, reason=reason)
+
+
+register_analysis(
+    Analysis(
+        "array",
+        _array,
+        ARRAY_PARAMS,
+        doc="an array of spines on one carriage centred at every start ([array] table): sim.ArrayRig",
+    )
+)

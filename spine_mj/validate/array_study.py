@@ -1,0 +1,326 @@
+"""Study: spine arrays, and the paper's staggered-array conjecture in dynamics.
+
+The paper ends on arrays: "multi-spine arrays with staggered spatial layouts may increase
+the probability that at least one spine samples a favorable concave region". On a random
+Gaussian (paper-random-concave), a fractal (paper-fractal) and a sandpaper (P60) surface,
+arrays of ``N = side^2`` spines (side 1 to 8) are dragged under displacement control
+(the spring drive at :data:`ARRAY_IE`, ``K = 30`` per spine) over :data:`TRAVEL_LS` slope
+lengths, laid out as an aligned grid, a staggered grid and a random pattern of one
+footprint at spacings in multiples of ``l_s``. Each (surface, N, spacing) draws
+``placements`` array centres once (seeded) and runs every layout at the same centres, so
+the layouts are compared pairwise on the same patches of surface.
+
+Per configuration it reports the holding force per spine (holding force over ``N F_p``:
+the largest total spring force, mean over placements with a 95 % bootstrap interval) and
+the probability that at least one spine self-locks (its spring at ``kappa_cap F_p`` while
+stuck; Wilson interval, :func:`~spine_mj.validate.fractal_lock.lock_rate`), from MuJoCo
+and from the quasistatic reference: each spine on its own compliant-drive streamline
+(:func:`~spine_mj.compliant.compliant_streamlines`, same friction, spring, force cap and
+domain margin), the array's curve their sum (:mod:`spine_mj.array_reference`). Like the
+single spine's comparison, agreement is the share of spines whose lock verdict matches
+(target :data:`~spine_mj.compare.OUTCOME_TARGET`). The conjecture is answered by the
+difference staggered - aligned (and random - aligned) in the lock probability (Newcombe's
+interval from the two Wilson intervals) and in holding per spine (paired bootstrap).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.stats import bootstrap
+
+from spine_mj import presets, sim
+from spine_mj.array_reference import compliant_spine_curves
+from spine_mj.compare import OUTCOME_TARGET
+from spine_mj.compliant import compliant_streamlines
+from spine_mj.sim.drives import stiffness_n_m
+from spine_mj.streamline import StreamlineParams, dilate
+from spine_mj.validate.fractal_lock import CONFIDENCE, lock_rate
+from spine_mj.validate.plans import SANDPAPER_MU, ValidationPlan
+
+__all__ = ["ARRAY_PLANS", "ArrayPlan", "ArrayStudyResult", "array_study", "newcombe_difference"]
+
+#: Inertia number of the arrays' carriage (per spine, as the single rig's I_e).
+ARRAY_IE = 1e-3
+#: Carriage travel of each run, in slope lengths l_s.
+TRAVEL_LS = 3.0
+#: The study's surfaces: (key, preset, mu or None for the preset's own).
+SURFACES = (
+    ("random_gaussian", "paper-random-concave", None),
+    ("fractal", "paper-fractal", None),
+    ("sandpaper", "sandpaper-P60", SANDPAPER_MU),
+)
+LAYOUTS = ("grid", "staggered", "random")
+#: The spacing unit is l_s, or this many tip radii where the tip is wider (the fractal's
+#: l_s is 1.6 tip radii, the sandpaper's 0.66): spines never stand closer than 1.5 tip
+#: diameters, and a random pattern of 1-diameter gaps covers at most 35 % of its footprint,
+#: below the 55 % jamming limit. Spacings are reported in l_s as run.
+MIN_SPACING_TIP_RADII = 3.0
+#: The reference's step cap, in steps of dl per unit of carriage travel (the tip moves less
+#: than the carriage; halved steps at creases and grit edges need the margin).
+REFERENCE_STEPS_PER_TRAVEL = 4
+#: Streamline step, in l_s.
+DL_LS = 0.01
+
+
+@dataclass(frozen=True)
+class ArrayPlan:
+    """The study's size: array sides (``N = side^2``), spacings (in units of
+    ``max(l_s, MIN_SPACING_TIP_RADII r_tip)``), placements per configuration, surfaces and
+    bootstrap resamples."""
+
+    sides: tuple[int, ...]
+    spacings_ls: tuple[float, ...]
+    placements: int
+    surfaces: tuple[str, ...] = tuple(s[0] for s in SURFACES)
+    bootstrap: int = 500
+    hfield_resolution: int | None = 151
+
+
+ARRAY_PLANS = {
+    "smoke": ArrayPlan(sides=(1, 2), spacings_ls=(1.0,), placements=3, surfaces=("fractal",), bootstrap=50),
+    "quick": ArrayPlan(sides=(1, 2, 4), spacings_ls=(1.0,), placements=6, bootstrap=300),
+    "full": ArrayPlan(sides=(1, 2, 4, 8), spacings_ls=(1.0, 1.5), placements=6, bootstrap=1000),
+}
+
+
+@dataclass
+class ArrayStudyResult:
+    """Rows per (surface, N, spacing, layout), the conjecture's differences and the plan."""
+
+    rows: list[dict] = field(default_factory=list)
+    conjecture: list[dict] = field(default_factory=list)
+    pooled: dict = field(default_factory=dict)
+    plan: dict = field(default_factory=dict)
+
+    def validation_keys(self) -> dict:
+        """This study's keys of ``validation.json``."""
+        return {"arrays": self.as_dict()}
+
+    def as_dict(self) -> dict:
+        return {"rows": self.rows, "conjecture": self.conjecture, "pooled": self.pooled, "plan": self.plan}
+
+
+def newcombe_difference(a: dict, b: dict) -> dict:
+    """``a["rate"] - b["rate"]`` of two :func:`lock_rate` records with Newcombe's hybrid
+    score interval (method 10) built from their Wilson intervals."""
+    pa, pb = a["rate"], b["rate"]
+    d = pa - pb
+    lo = d - math.sqrt((pa - a["ci_low"]) ** 2 + (b["ci_high"] - pb) ** 2)
+    hi = d + math.sqrt((a["ci_high"] - pa) ** 2 + (pb - b["ci_low"]) ** 2)
+    return {"diff": d, "ci_low": lo, "ci_high": hi}
+
+
+def _mean_ci(values, n_resamples: int, seed: int) -> tuple[float, float, float]:
+    v = np.asarray(values, dtype=float)
+    v = v[np.isfinite(v)]
+    if v.size == 0:
+        return math.nan, math.nan, math.nan
+    if v.size < 2 or np.ptp(v) == 0:
+        return float(v.mean()), float(v.mean()), float(v.mean())
+    ci = bootstrap(
+        (v,),
+        np.mean,
+        n_resamples=n_resamples,
+        confidence_level=CONFIDENCE,
+        method="percentile",
+        random_state=seed,
+    ).confidence_interval
+    return float(v.mean()), float(ci.low), float(ci.high)
+
+
+def _rig(preset: str, mu: float | None, plan: ArrayPlan):
+    surf = presets.make_surface(preset)
+    mu = mu if mu is not None else (presets.preset_mu(surf) or 0.5)
+    tip = sim.TipParams(mu_s=mu)
+    res = plan.hfield_resolution if surf.unit == "1" else None
+    sc = sim.Scales.for_surface(surf, tip=tip, hfield_resolution=res)
+    speed = sc.speed_for(ARRAY_IE)
+    return sim.Rig(surf, tip=tip, engine=sim.default_engine(sc, speed_m_s=speed)), speed
+
+
+def _centres(
+    rig, side: int, spacing: float, travel: float, count: int, seed: int
+) -> list[tuple[float, float]]:
+    """``count`` centres (surface units) where a ``side x side`` footprint of ``spacing``
+    and the travel after it stay on the surface (two tip radii in)."""
+    xmin, xmax, ymin, ymax = rig.surface.bounds
+    half = side * spacing / 2 + 2 * rig.tip.tip_radius_m / rig.length_scale_m
+    lo_x, hi_x = xmin + half, xmax - half - travel
+    lo_y, hi_y = ymin + half, ymax - half
+    if hi_x <= lo_x or hi_y <= lo_y:
+        return []
+    rng = np.random.default_rng(seed)
+    return list(zip(rng.uniform(lo_x, hi_x, count), rng.uniform(lo_y, hi_y, count)))
+
+
+def _reference(rig, drive, groups: list[list], travel: float, det) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Quasistatic holding ratio ``(P,)``, per-spine locks ``(P, N)`` and paths that ended
+    before the travel ``(P, N)`` of each group of runs: every spine of every group on its
+    compliant-drive streamline over the surface dilated by the tip (what its centre rides
+    on), in one call (the streamline is vectorized over starts: one call costs about as
+    much as one path), each stopped where its carriage's travel ends (``carriage_end``). A
+    path that ended earlier (the domain's edge, the step cap) adds nothing past its end."""
+    s = rig.length_scale_m
+    c = stiffness_n_m(drive, rig.scales) * s / rig.scales.preload_n
+    ls = rig.scales.slope_length_m / s
+    params = StreamlineParams(
+        mu=rig.tip.mu_s,
+        dl=DL_LS * ls,
+        kappa_cap=det.kappa_cap,
+        edge_margin=det.domain_margin_m / s,
+        max_steps=int(REFERENCE_STEPS_PER_TRAVEL * travel / (DL_LS * ls)) + 100,
+    )
+    starts = np.concatenate([r.start_xy for runs in groups for r in runs])
+    traced = dilate(rig.surface, rig.tip.tip_radius_m / s)  # the surface the tip's centre rides on
+    # the carriage runs two steps past the travel: a path's last point, where the carriage
+    # stops mid-step, is not on the curve (the tip is left a step ahead of its equilibrium)
+    end = starts[:, 0] + travel + 2 * params.dl
+    paths = compliant_streamlines(traced, starts, params, stiffness=c, carriage_end=end)
+    forces, locked = compliant_spine_curves(paths, np.linspace(0.0, travel, 400), kappa_cap=det.kappa_cap)
+    short = np.isnan(forces[:, -1])  # the path ended (domain edge, step cap) before the travel did
+    out, at = [], 0
+    for runs in groups:
+        n, p = runs[0].n_spines, len(runs)
+        f = forces[at : at + n * p].reshape(p, n, -1)
+        hold = np.array([np.nanmax(np.nansum(g, axis=0)) / n for g in f])
+        out.append((hold, locked[at : at + n * p].reshape(p, n), short[at : at + n * p].reshape(p, n)))
+        at += n * p
+    return out
+
+
+def _surface_runs(rig, speed, plan: ArrayPlan):
+    """Every MuJoCo array run on one surface: ``[(config, runs)]`` with ``config`` the
+    (side, nominal spacing, spacing [l_s], layout, seed) and ``runs`` its placements."""
+    ls = rig.scales.slope_length_m / rig.length_scale_m
+    r_tip = rig.tip.tip_radius_m / rig.length_scale_m
+    drive = sim.SpringDrive(speed_m_s=speed, duration_s=TRAVEL_LS * rig.scales.slope_length_m / speed)
+    done = []
+    for side in plan.sides:
+        for nominal in plan.spacings_ls:
+            spacing = nominal * max(1.0, MIN_SPACING_TIP_RADII * r_tip / ls)  # in l_s
+            seed = 1000 * side + int(100 * nominal)
+            centres = _centres(rig, side, spacing * ls, TRAVEL_LS * ls, plan.placements, seed)
+            if not centres:
+                continue
+            for kind in LAYOUTS:
+                if side == 1 and kind == "staggered":  # one spine: the staggered grid is the grid
+                    done.append(((side, nominal, spacing, kind, seed), done[-1][1]))
+                    continue
+                lay = sim.Layout(
+                    kind=kind, rows=side, cols=side, spacing=spacing, spacing_unit="l_s", seed=seed
+                )
+                runs = sim.ArrayRig(rig, lay).run_batch(drive, centres)
+                done.append(((side, nominal, spacing, kind, seed), runs))
+    return drive, done
+
+
+def _row(config, runs, reference, plan: ArrayPlan) -> dict:
+    """One configuration's row, with the per-placement numbers kept for the paired comparisons."""
+    side, nominal, spacing, kind, seed = config
+    qs_hold, qs_lock, qs_short = reference
+    ok = np.array([r.end_reason != "engine_trouble" for r in runs])
+    mj_hold = np.array([r.holding_ratio for r in runs])
+    mj_lock = np.array([r.locked for r in runs])
+    agree = (mj_lock == qs_lock)[ok]
+    m, lo, hi = _mean_ci(mj_hold[ok], plan.bootstrap, seed)
+    qm, qlo, qhi = _mean_ci(qs_hold, plan.bootstrap, seed)
+    return {
+        "layout": kind,
+        "n_spines": side * side,
+        "spacing_nominal_ls": nominal,
+        "spacing_ls": spacing,
+        "placements": len(runs),
+        "holding_per_spine": m,
+        "holding_ci": [lo, hi],
+        "holding_per_spine_qs": qm,
+        "holding_qs_ci": [qlo, qhi],
+        "holding_rel_error_median": float(np.nanmedian(np.abs(mj_hold[ok] / qs_hold[ok] - 1)))
+        if ok.any()
+        else math.nan,
+        "p_lock": lock_rate(mj_lock.any(axis=1), ok),
+        "p_lock_qs": lock_rate(qs_lock.any(axis=1)),
+        "lock_agreement": float(agree.mean()) if agree.size else math.nan,
+        "meets_outcome_target": bool(agree.size and agree.mean() >= OUTCOME_TARGET),
+        "failed_runs": int((~ok).sum()),
+        "reference_short_spines": int(qs_short.sum()),
+        "_hold": mj_hold.tolist(),
+        "_ok": ok.tolist(),
+    }
+
+
+def _paired(a: dict, b: dict, n_resamples: int, seed: int) -> dict:
+    """Holding per spine ``a - b`` over the placements both ran cleanly (paired bootstrap)."""
+    ok = np.array(a["_ok"]) & np.array(b["_ok"])
+    d = (np.array(a["_hold"]) - np.array(b["_hold"]))[ok]
+    m, lo, hi = _mean_ci(d, n_resamples, seed)
+    return {"diff": m, "ci_low": lo, "ci_high": hi}
+
+
+def _conjecture(rows: list[dict], plan: ArrayPlan) -> tuple[list[dict], dict]:
+    """Staggered - grid and random - grid per (surface, N > 1, spacing), and pooled counts."""
+    out = []
+    pooled: dict = {}
+    keyed = {(r["surface"], r["n_spines"], r["spacing_nominal_ls"], r["layout"]): r for r in rows}
+    for (surf, n, sp, kind), base in keyed.items():
+        if kind != "grid" or n == 1:
+            continue
+        for other in ("staggered", "random"):
+            r = keyed[(surf, n, sp, other)]
+            out.append(
+                {
+                    "surface": surf,
+                    "n_spines": n,
+                    "spacing_ls": sp,
+                    "layout": other,
+                    "p_lock_diff": newcombe_difference(r["p_lock"], base["p_lock"]),
+                    "holding_diff": _paired(r, base, plan.bootstrap, n),
+                }
+            )
+            pool = pooled.setdefault(other, {"locked": 0, "n_ok": 0, "locked_grid": 0, "n_ok_grid": 0})
+            pool["locked"] += r["p_lock"]["locked"]
+            pool["n_ok"] += r["p_lock"]["n_ok"]
+            pool["locked_grid"] += base["p_lock"]["locked"]
+            pool["n_ok_grid"] += base["p_lock"]["n_ok"]
+    for pool in pooled.values():
+        a = lock_rate([True] * pool["locked"] + [False] * (pool["n_ok"] - pool["locked"]))
+        b = lock_rate([True] * pool["locked_grid"] + [False] * (pool["n_ok_grid"] - pool["locked_grid"]))
+        pool.update(
+            p_lock=a, p_lock_grid=b, diff=newcombe_difference(a, b) if a["n_ok"] and b["n_ok"] else None
+        )
+    return out, pooled
+
+
+def array_study(plan: ValidationPlan, runner=None) -> ArrayStudyResult:
+    """Run the array study at the size of ``plan`` (:data:`ARRAY_PLANS` by its name)."""
+    ap = ARRAY_PLANS.get(plan.name, ARRAY_PLANS["quick"])
+    rows = []
+    for key, preset, mu in SURFACES:
+        if key not in ap.surfaces:
+            continue
+        if runner is not None:
+            runner.note(f"arrays on {key}")
+        rig, speed = _rig(preset, mu, ap)
+        drive, done = _surface_runs(rig, speed, ap)
+        if not done:
+            continue
+        det = sim.Detection().resolve(rig.scales)
+        travel = TRAVEL_LS * rig.scales.slope_length_m / rig.length_scale_m
+        refs = _reference(rig, drive, [runs for _, runs in done], travel, det)
+        rows += [{"surface": key, **_row(cfg, runs, ref, ap)} for (cfg, runs), ref in zip(done, refs)]
+    conj, pooled = _conjecture(rows, ap)
+    for r in rows:
+        r.pop("_hold"), r.pop("_ok")
+    plan_info = {
+        "name": plan.name,
+        "sides": list(ap.sides),
+        "spacings_ls": list(ap.spacings_ls),
+        "placements": ap.placements,
+        "surfaces": list(ap.surfaces),
+        "ie": ARRAY_IE,
+        "travel_ls": TRAVEL_LS,
+        "array_runs": sum(r["placements"] for r in rows),
+    }
+    return ArrayStudyResult(rows=rows, conjecture=conj, pooled=pooled, plan=plan_info)

@@ -1,0 +1,164 @@
+"""The report of the array study (:mod:`spine_mj.validate.array_study`): holding per spine
+and P(at least one spine self-locks) against N per layout, and the staggered-array conjecture.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from spine_mj.plotting import new_figure, save_figure, sig, styled
+from spine_mj.validate.array_study import ArrayStudyResult
+from spine_mj.validate.report.common import ReportContext
+
+__all__ = ["array_figure", "array_section", "headline", "section"]
+
+_COLORS = {"grid": "#1f77b4", "staggered": "#d62728", "random": "#2ca02c"}
+
+
+def _ci(lo, hi) -> str:
+    return f"[{sig(lo)}, {sig(hi)}]" if np.isfinite(lo) and np.isfinite(hi) else "-"
+
+
+@styled
+def array_figure(res: ArrayStudyResult, path: Path) -> Path | None:
+    """Holding per spine and P(at least one spine self-locks) against N per surface and
+    layout (MuJoCo with 95 % intervals, the quasistatic reference dashed), at the plan's
+    first spacing; None without rows."""
+    if not res.rows:
+        return None
+    surfaces = list(dict.fromkeys(r["surface"] for r in res.rows))
+    first = min(r["spacing_nominal_ls"] for r in res.rows)
+    fig = new_figure(figsize=(4.0 * len(surfaces), 6.4), constrained_layout=True)
+    axes = np.atleast_2d(fig.subplots(2, len(surfaces), squeeze=False))
+    for j, surf in enumerate(surfaces):
+        for kind, color in _COLORS.items():
+            rows = [
+                r
+                for r in res.rows
+                if r["surface"] == surf and r["layout"] == kind and r["spacing_nominal_ls"] == first
+            ]
+            if not rows:
+                continue
+            n = np.array([r["n_spines"] for r in rows]) * (1 + 0.04 * (list(_COLORS).index(kind) - 1))
+            h = np.array([r["holding_per_spine"] for r in rows])
+            lo, hi = np.array([r["holding_ci"] for r in rows]).T
+            axes[0, j].errorbar(
+                n, h, yerr=[h - lo, hi - h], color=color, marker="o", ms=4, capsize=2, label=kind
+            )
+            axes[0, j].plot(n, [r["holding_per_spine_qs"] for r in rows], color=color, ls="--", lw=0.8)
+            p = np.array([r["p_lock"]["rate"] for r in rows])
+            plo = np.array([r["p_lock"]["ci_low"] for r in rows])
+            phi = np.array([r["p_lock"]["ci_high"] for r in rows])
+            axes[1, j].errorbar(
+                n, p, yerr=[p - plo, phi - p], color=color, marker="o", ms=4, capsize=2, label=kind
+            )
+            axes[1, j].plot(n, [r["p_lock_qs"]["rate"] for r in rows], color=color, ls="--", lw=0.8)
+        axes[0, j].set_title(f"{surf} (spacing {sig(first)} x max(l_s, 3 r_tip))")
+        for ax in axes[:, j]:
+            ax.set_xscale("log", base=2)
+            ax.set_xlabel("spines N")
+        axes[0, j].set_ylabel("holding force / (N F_p)")
+        axes[1, j].set_ylabel("P(at least one spine self-locks)")
+        axes[1, j].set_ylim(-0.05, 1.05)
+    axes[0, 0].legend(fontsize=7, title="MuJoCo (dashed: quasistatic)", title_fontsize=7)
+    return save_figure(fig, path)
+
+
+def array_section(res: ArrayStudyResult | None, figure: str | None = None) -> str:
+    """The report's Markdown section on arrays ("" when the study did not run)."""
+    if res is None or not res.rows:
+        return ""
+    p = res.plan
+    lines = [
+        "## Spine arrays and the staggered-layout conjecture",
+        "",
+        f"Arrays of N = {', '.join(str(s * s) for s in p['sides'])} spines (aligned grid, staggered grid, "
+        "random pattern of one footprint; spacings "
+        f"{', '.join(sig(v) for v in p['spacings_ls'])} x max(l_s, 3 tip radii)) dragged under "
+        f"displacement control at I_e = {sig(p['ie'])}, K = 30 per spine, "
+        f"over {sig(p['travel_ls'])} l_s; {p['placements']} placements per configuration, the same for every "
+        f"layout; {p['array_runs']} array runs. Holding = the largest total spring force over N F_p (mean, "
+        "95 % bootstrap interval); P(lock) = share of placements where at least one spine self-locked "
+        "(Wilson 95 %). The quasistatic reference puts each spine on its own compliant-drive streamline and "
+        "sums them; agreement = share of spines whose lock verdict matches (single-spine target "
+        "95 %). A spine's peak force overshoots the quasistatic one by about sqrt(I_e K_c) F_p (the "
+        "spring-block swing past breakaway, K_c = k L_c / F_p); the sum over spines smooths it.",
+        "",
+        "| surface | N | spacing [l_s] | layout | holding (MuJoCo) | 95 % CI | holding (QS) | "
+        "P(lock) MuJoCo | 95 % CI | P(lock) QS | lock agreement | failed | QS paths short |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for r in res.rows:
+        pl, pq = r["p_lock"], r["p_lock_qs"]
+        lines.append(
+            f"| {r['surface']} | {r['n_spines']} | {sig(r['spacing_ls'])} | {r['layout']} | "
+            f"{sig(r['holding_per_spine'])} | {_ci(*r['holding_ci'])} | {sig(r['holding_per_spine_qs'])} | "
+            f"{pl['locked']}/{pl['n_ok']} | {_ci(pl['ci_low'], pl['ci_high'])} | "
+            f"{pq['locked']}/{pq['n_ok']} | "
+            f"{sig(r['lock_agreement'])} | {r['failed_runs']} | {r['reference_short_spines']} |"
+        )
+    if figure:
+        lines += ["", f"![Holding per spine and P(lock) against N per layout]({figure})"]
+    lines += ["", "### The conjecture: staggered (and random) against aligned, same placements", ""]
+    lines += [
+        "| surface | N | spacing [l_s] | layout | P(lock) - P(lock, grid) | 95 % CI | "
+        "holding - holding(grid) | 95 % CI |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for c in res.conjecture:
+        d, h = c["p_lock_diff"], c["holding_diff"]
+        lines.append(
+            f"| {c['surface']} | {c['n_spines']} | {sig(c['spacing_ls'])} | {c['layout']} | "
+            f"{sig(d['diff'])} | "
+            f"{_ci(d['ci_low'], d['ci_high'])} | {sig(h['diff'])} | {_ci(h['ci_low'], h['ci_high'])} |"
+        )
+    lines += ["", _verdict(res)]
+    return "\n".join(lines) + "\n"
+
+
+def _verdict(res: ArrayStudyResult) -> str:
+    """One paragraph: the pooled lock-probability differences and what they say."""
+    parts = []
+    for kind, pool in res.pooled.items():
+        d = pool.get("diff")
+        if not d:
+            continue
+        a, b = pool["p_lock"], pool["p_lock_grid"]
+        verdict = (
+            "higher"
+            if d["ci_low"] > 0
+            else "lower"
+            if d["ci_high"] < 0
+            else "not distinguishable from aligned"
+        )
+        parts.append(
+            f"{kind}: P(lock) {sig(a['rate'])} ({a['locked']}/{a['n_ok']}) against aligned {sig(b['rate'])} "
+            f"({b['locked']}/{b['n_ok']}), difference {sig(d['diff'])} "
+            f"{_ci(d['ci_low'], d['ci_high'])}: {verdict}"
+        )
+    if not parts:
+        return "No N > 1 configuration ran: the conjecture is not tested at this size."
+    width = max(
+        (p["ci_high"] - p["ci_low"]) for p in (v["diff"] for v in res.pooled.values() if v.get("diff"))
+    )
+    return (
+        "**Answer (pooled over surfaces, N > 1 and spacings, paired placements):** "
+        + "; ".join(parts)
+        + f". The pooled interval is {sig(width)} wide"
+        + (
+            ", so a difference smaller than that is not resolved at this size."
+            if math.isfinite(width)
+            else "."
+        )
+    )
+
+
+def headline(res: ArrayStudyResult) -> list[str]:
+    return []
+
+
+def section(res: ArrayStudyResult, ctx: ReportContext) -> str:
+    return array_section(res, ctx.draw(array_figure, res, "arrays.png"))

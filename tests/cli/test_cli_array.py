@@ -1,0 +1,62 @@
+"""`spine-mj array`: the designer's outputs, and bad input refused with nothing written."""
+
+import json
+
+import pandas as pd
+import pytest
+from click.testing import CliRunner
+
+from spine_mj.cli import main
+
+ARRAY = (
+    "array",
+    "corrugation",
+    "--rows",
+    "1",
+    "--cols",
+    "2",
+    "--spacing",
+    "0.3",
+    "--spacing-unit",
+    "surface",
+)
+
+
+def run(*args):
+    return CliRunner().invoke(main, [str(a) for a in args])
+
+
+def test_array_writes_curve_spines_summary_and_figure(tmp_path):
+    out = tmp_path / "arr"
+    result = run(*ARRAY, "--ie", "1e-2", "--duration", "0.02", "--out", out)
+    assert result.exit_code == 0, result.output
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["n_spines"] == 2 and summary["locked_spines"] == 0
+    assert summary["holding_ratio"] == pytest.approx(
+        summary["holding_force_n"] / (2 * summary["preload_per_spine_n"])
+    )
+    spines = pd.read_csv(out / "spines.csv")
+    assert len(spines) == 2 and spines["x0"].diff().iloc[1] == pytest.approx(0.3)
+    curve = pd.read_csv(out / "curve.csv")
+    assert curve["total_force_n"].max() == pytest.approx(summary["holding_force_n"], rel=1e-9)
+    assert (out / "layout.png").stat().st_size > 10_000
+
+
+@pytest.mark.parametrize(
+    ("args", "fragment"),
+    [
+        (("--spacing", "20", "--spacing-unit", "L_c"), "puts spine"),
+        (("--rows", "20", "--cols", "20"), "at most 256 spines"),
+        (("--rows", "0"), "rows must be an integer >= 1"),
+        (("--spacing", "nan"), "spacing"),
+        (("--drive", "force", "--duration", "1"), "--duration is for --drive speed"),
+        (("--centre", "100,0"), "puts spine"),
+    ],
+)
+def test_bad_array_input_is_one_error_line_and_writes_nothing(tmp_path, args, fragment):
+    out = tmp_path / "arr"
+    result = run(*ARRAY, *args, "--out", out)
+    assert result.exit_code == 2, result.output
+    lines = [line for line in result.output.splitlines() if line.strip()]
+    assert len(lines) == 1 and lines[0].startswith("Error: ") and fragment in lines[0], result.output
+    assert not out.exists()

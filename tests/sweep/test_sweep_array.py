@@ -1,0 +1,57 @@
+"""The ``array`` analysis: an ``[array]`` table in a sweep gives the command's summary keys."""
+
+import numpy as np
+import pytest
+from sweep_support import write_config
+
+from spine_mj import sweep
+from spine_mj.errors import SpineInputError
+
+ARRAY = """
+[sweep]
+name = "arrays"
+analyses = ["array"]
+[[surfaces]]
+preset = "corrugation"
+[starts]
+frame = "absolute"
+points = [[1.0, 0.0], [2.3, 0.0]]
+[drive]
+ie = 1e-2
+duration = 0.02
+[array]
+layout = ["grid", "staggered"]
+rows = 2
+cols = 2
+spacing = 0.15
+spacing_unit = "surface"
+"""
+
+
+def test_array_sweep_records_the_summary_keys_per_layout_and_centre(tmp_path):
+    from spine_mj import sim
+
+    out = tmp_path / "out"
+    summary = sweep.run_sweep(write_config(tmp_path, ARRAY), out, workers=1)
+    assert summary.total_runs == 4
+    runs = sweep.load_runs(out)
+    assert (runs.status == "ok").all() and (runs.n_spines == 4).all()
+    assert set(runs.layout) == {"grid", "staggered"}
+    np.testing.assert_allclose(runs.holding_ratio * 4 * 0.01 * 9.81, runs.holding_force_n, rtol=1e-9)
+    # the grid case's rows are the ArrayRig's own runs on the case's rig
+    from spine_mj.sweep.analyses.mujoco import case_rig
+
+    cases = sweep.expand_cases(sweep.load_config(write_config(tmp_path, ARRAY)))
+    case = next(c for c in cases if c.params["layout"] == "grid")
+    rig = case_rig(case)
+    arr = sim.ArrayRig(rig, sim.Layout(rows=2, cols=2, spacing=0.15, spacing_unit="surface"))
+    v = rig.scales.speed_for(1e-2)
+    direct = arr.run_batch(sim.SpringDrive(speed_m_s=v, duration_s=0.02), [(1.0, 0.0), (2.3, 0.0)], nthread=1)
+    grid = runs[runs.layout == "grid"].sort_values("start")
+    np.testing.assert_allclose(grid.holding_force_n, [r.holding_force_n for r in direct], rtol=1e-9)
+
+
+def test_array_key_given_twice_is_refused(tmp_path):
+    doc = ARRAY + "[grid]\nrows = 3\n"
+    with pytest.raises(SpineInputError, match=r"array\.rows: also given as grid\.rows"):
+        sweep.load_config(write_config(tmp_path, doc))
