@@ -286,7 +286,8 @@ def surface_info(surface_spec, output, as_json):
     click.echo(f"rms curvature            {rough.rms_curvature:.4g}{'' if not unit else ' 1/' + surf.unit}")
     click.echo(f"L_c (asperity length)    {rough.char_length:.4g}{unit}")
     click.echo(f"l_s (slope correlation)  {rough.slope_correlation_length:.4g}{unit}")
-    click.echo(f"Hurst estimate (PSD fit) {rough.hurst:.3g}")
+    hurst = f"{rough.hurst:.3g}" if np.isfinite(rough.hurst) else "not estimated (the PSD is no power law)"
+    click.echo(f"Hurst estimate (PSD fit) {hurst}")
     if output:
         click.echo(f"wrote {output}")
 

@@ -143,13 +143,33 @@ MUJOCO_PARAMS = (
 )
 
 
+#: The drive keys each protocol reads (the others, ie, speed and settle_time, every one).
+PROTOCOL_KEYS = {
+    "K": ("spring",),
+    "stiffness": ("spring",),
+    "duration": ("spring", "ramp"),
+    "start_force": ("static",),
+    "slide_distance": ("ramp",),
+}
+
+
 def _check_speed(config) -> None:
+    """One of ie/speed and K/stiffness; no drive key that a chosen protocol would ignore."""
     grid = dict(config.grid)
     for a, b, what in (("ie", "speed", "the inertia number or the speed"), ("K", "stiffness", "K or k")):
         if grid[a] != (None,) and grid[b] != (None,):
             raise SpineInputError(
                 f"config keys grid.{a} and grid.{b}: give one of them ({what}), got "
                 f"{a} = {list(grid[a])} and {b} = {list(grid[b])}"
+            )
+    defaults = {s.name: s.default for s in MUJOCO_PARAMS}
+    protocols = grid["protocol"]
+    for key, readers in PROTOCOL_KEYS.items():
+        ignoring = [p for p in protocols if p not in readers]
+        if grid[key] != (defaults[key],) and ignoring:
+            raise SpineInputError(
+                f"config key {key} = {list(grid[key])}: the {' and '.join(ignoring)} drive ignores it "
+                f"(read only by {' and '.join(readers)}); remove it, or sweep that protocol separately"
             )
 
 
