@@ -194,7 +194,7 @@ def test_load_refuses_a_surface_whose_unit_is_no_length_unit(tmp_path, unit):
     data = dict(np.load(path))
     data["unit"] = np.array(unit)
     np.savez(path, **data)
-    with pytest.raises(SpineInputError, match=f"s.npz: unit must be '1' .* got '{unit}'"):
+    with pytest.raises(SpineInputError, match=rf"s\.npz: unit must be '1' .* got '{unit}'"):
         load_surface(path)
 
 
@@ -204,5 +204,5 @@ def test_load_refuses_a_zip_that_is_not_an_npz_of_arrays(tmp_path):
     path = tmp_path / "z.npz"
     with zipfile.ZipFile(path, "w") as z:
         z.writestr("hello.txt", "hello")
-    with pytest.raises(SpineInputError, match="z.npz is not a spine_mj .npz surface: member 'hello.txt'"):
+    with pytest.raises(SpineInputError, match=r"z\.npz is not a spine_mj \.npz surface: member 'hello\.txt'"):
         load_surface(path)

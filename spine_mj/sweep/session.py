@@ -26,6 +26,7 @@ from spine_mj.sweep.analyses.mujoco import case_rig
 from spine_mj.sweep.cases import expand_cases, longest_first
 from spine_mj.sweep.config import SweepConfig, _make_surface, load_config
 from spine_mj.sweep.executors import run_dask, run_here, run_processes
+from spine_mj.sweep.preflight import check_cases
 from spine_mj.sweep.store import (
     consolidate,
     corrupt_cases,
@@ -161,8 +162,9 @@ def run_sweep(
         "versions": versions(),
         "git": git_commit(),
     }
-    client = None if scheduler is None else connect(scheduler)  # before anything is written
     clear_caches()
+    check_cases(cases, config.swept)  # an input error refuses the config, not every run
+    client = None if scheduler is None else connect(scheduler)  # before anything is written
     try:
         out_dir.mkdir(parents=True, exist_ok=True)
         with store_lock(out_dir):

@@ -15,6 +15,7 @@ from spine_mj import sim
 from spine_mj.errors import SpineInputError
 from spine_mj.sim.params import surface_unit_m
 from spine_mj.sim.ramp import nominal_time_s
+from spine_mj.sim.rollout import drive_steps
 from spine_mj.surfaces import GridSurface
 from spine_mj.sweep.registry import (
     CASE_THREADS,
@@ -269,33 +270,50 @@ def drive_speed_m_s(p: dict, scales) -> float:
     return scales.speed_for(1e-3 if p["ie"] is None else p["ie"])
 
 
-def _runs(rig, p: dict, starts) -> list:
-    """The runs of ``rig`` from every start with the case's drive (speed from ``ie`` unless
-    given; the ramp and static rates from the speed)."""
+def _drive(rig, p: dict):
+    """The case's drive on ``rig`` (speed from ``ie`` unless given; the ramp and static
+    rates from the speed)."""
     sc = rig.scales
     speed = drive_speed_m_s(p, sc)
     rate = speed * sc.preload_n / sc.char_length_m
-    det = sim.Detection(kappa_cap=p["kappa_cap"])
-    pts = [tuple(s) for s in starts]
-    stiffness = p["stiffness"] if p["K"] is None else sc.stiffness_for(p["K"])
     if p["protocol"] == "spring":
-        drive = sim.SpringDrive(
+        stiffness = p["stiffness"] if p["K"] is None else sc.stiffness_for(p["K"])
+        return sim.SpringDrive(
             speed_m_s=speed,
             stiffness_n_m=stiffness,
             duration_s=p["duration"],
             settle_time_s=p["settle_time"],
         )
-        return rig.run_batch(drive, pts, detection=det, nthread=CASE_THREADS.get())
     if p["protocol"] == "static":
-        drive = sim.StaticProbe(rate_n_s=rate, start_force_n=p["start_force"], settle_time_s=p["settle_time"])
-        return rig.run_batch(drive, pts, detection=det, nthread=CASE_THREADS.get())
-    drive = sim.RampDrive(
+        return sim.StaticProbe(rate_n_s=rate, start_force_n=p["start_force"], settle_time_s=p["settle_time"])
+    return sim.RampDrive(
         rate_n_s=rate,
         duration_s=p["duration"],
         settle_time_s=p["settle_time"],
         slide_distance_m=p["slide_distance"],
     )
-    return [rig.run(drive, start=s, detection=det) for s in pts]
+
+
+def _runs(rig, p: dict, starts) -> list:
+    """The runs of ``rig`` from every start with the case's drive."""
+    drive = _drive(rig, p)
+    det = sim.Detection(kappa_cap=p["kappa_cap"])
+    pts = [tuple(s) for s in starts]
+    if isinstance(drive, sim.RampDrive):
+        return [rig.run(drive, start=s, detection=det) for s in pts]
+    return rig.run_batch(drive, pts, detection=det, nthread=CASE_THREADS.get())
+
+
+def _check_case(case, surface, starts) -> None:
+    """The inputs' errors a run would meet, without running: the rig (tip, scales, engine),
+    the drive and, for the open-loop drives, the length of the run from the first start."""
+    rig = case_rig(case, surface)
+    drive = _drive(rig, case.params)
+    rig.check_drive(drive)
+    if not isinstance(drive, sim.RampDrive) and len(starts):
+        det = sim.Detection(kappa_cap=case.params["kappa_cap"]).resolve(rig.scales)
+        x0 = float(min(s[0] for s in starts)) * rig.length_scale_m
+        drive_steps(rig, drive, x0, det)
 
 
 def peak_drive_over_fp(run, preload_n: float) -> float:
@@ -391,5 +409,6 @@ register_analysis(
         MUJOCO_PARAMS,
         doc="MuJoCo rig run from every start with the chosen drive: spine_mj.sim",
         check_config=_check_speed,
+        check_case=_check_case,
     )
 )
