@@ -19,7 +19,7 @@ import numpy as np
 import pandas as pd
 from tqdm import tqdm
 
-from spine_mj import engagement, presets, reproduce, roughness, sim, surface_io, validate
+from spine_mj import engagement, extras, presets, reproduce, roughness, sim, surface_io, validate
 from spine_mj import sweep as sw
 from spine_mj.engagement import kappa
 from spine_mj.errors import SpineInputError, all_or_none, atomic_output, check_positive
@@ -720,6 +720,7 @@ def simulate(
     """
 
     if render:
+        extras.require("video", "--render")
         choose_gl_backend()
 
     x0, y0 = _parse_start(start)
@@ -828,6 +829,7 @@ def replay(run_dir, speed, duration, mp4):
     if duration is not None:
         check_positive("--duration", duration)
     if headless:
+        extras.require("video", "replay without a display (an MP4)" if mp4 is None else "--mp4")
         choose_gl_backend()
     rig, track = load_run(run_dir)
     span = float(track.time_s[-1] - track.time_s[0])

@@ -263,6 +263,7 @@ def test_a_drive_speed_no_time_step_can_resolve_names_the_speed(tmp_path):
 
 
 def test_replay_at_a_speed_that_would_need_endless_frames_is_refused(tmp_path):
+    pytest.importorskip("imageio", reason="needs the optional extra 'video': pip install 'spine-mj[video]'")
     run_dir = recorded_run(tmp_path)
     mp4 = tmp_path / "x.mp4"
     assert_one_error_line(
