@@ -419,8 +419,16 @@ def sweep():
     "inputs (removes only the files the store wrote).",
 )
 @click.option("--retry-failed", is_flag=True, help="Run again the cases with failed runs.")
+@click.option(
+    "--worker-wait",
+    type=float,
+    default=sw.DEFAULT_WORKER_WAIT_S,
+    show_default=True,
+    metavar="SECONDS",
+    help="With --scheduler: how long to wait for its first worker before giving up.",
+)
 @click.option("--quiet", is_flag=True, help="No progress bar.")
-def sweep_run(config, out_dir, workers, scheduler, overwrite, retry_failed, quiet):
+def sweep_run(config, out_dir, workers, scheduler, overwrite, retry_failed, worker_wait, quiet):
     """Run the sweep CONFIG (TOML) into --out; re-running resumes and skips finished runs.
 
     \b
@@ -428,6 +436,8 @@ def sweep_run(config, out_dir, workers, scheduler, overwrite, retry_failed, quie
       spine-mj sweep analysis/sweeps/paper-quasistatic.toml --out runs/qs --workers 4
     """
 
+    if scheduler is None:
+        _refuse_options_not_for("a sweep without --scheduler", ["worker_wait"])
     cfg = sw.load_config(config)
     with Progress(cfg.name, unit="case", quiet=quiet) as bar:
         try:
@@ -441,7 +451,11 @@ def sweep_run(config, out_dir, workers, scheduler, overwrite, retry_failed, quie
                 progress=lambda p: bar.update(
                     p.finished_cases + p.skipped_cases, p.total_cases, ok=p.ok_runs, failed=p.failed_runs
                 ),
+                worker_wait_s=worker_wait,
+                notice=lambda text: click.echo(text, err=True),
             )
+        except sw.SchedulerUnavailable as exc:  # the environment: exit code 1
+            raise click.ClickException(str(exc)) from None
         except sw.WorkersCannotStart as exc:  # the environment, not the input: exit code 1
             raise click.ClickException(f"{exc}; the finished cases are kept, a re-run resumes") from None
     if summary.rerun_corrupt:

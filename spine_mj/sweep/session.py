@@ -9,6 +9,7 @@ at the end. Killed at any moment, the next session resumes where it stopped.
 from __future__ import annotations
 
 import datetime
+import math
 import os
 import re
 import time
@@ -25,7 +26,7 @@ from spine_mj.sweep.analyses import quasistatic
 from spine_mj.sweep.analyses.mujoco import case_rig
 from spine_mj.sweep.cases import expand_cases, longest_first
 from spine_mj.sweep.config import SweepConfig, _make_surface, load_config
-from spine_mj.sweep.executors import run_dask, run_here, run_processes
+from spine_mj.sweep.executors import DEFAULT_WORKER_WAIT_S, run_dask, run_here, run_processes
 from spine_mj.sweep.preflight import check_cases
 from spine_mj.sweep.store import (
     consolidate,
@@ -108,6 +109,8 @@ def run_sweep(
     overwrite: bool = False,
     retry_failed: bool = False,
     progress: Callable[[Progress], None] | None = None,
+    worker_wait_s: float = DEFAULT_WORKER_WAIT_S,
+    notice: Callable[[str], None] | None = None,
 ) -> SweepSummary:
     """Run (or resume) a sweep into ``out_dir``.
 
@@ -133,6 +136,10 @@ def run_sweep(
     progress : callable, optional
         Called with a :class:`Progress` once after the skipped cases are counted and after
         every finished case.
+    worker_wait_s : float
+        With ``scheduler``: seconds to wait for its first worker before giving up.
+    notice : callable, optional
+        Called with a line of text on what the sweep waits for (a scheduler's workers).
 
     Returns
     -------
@@ -145,7 +152,12 @@ def run_sweep(
     WorkersCannotStart
         Local worker processes die or hang before their first case (the finished cases
         are kept; a re-run resumes).
+    SchedulerUnavailable
+        The Dask scheduler had no worker within ``worker_wait_s`` or was lost (the
+        finished cases are kept; a re-run resumes).
     """
+    if not (math.isfinite(worker_wait_s) and worker_wait_s > 0):
+        raise SpineInputError(f"--worker-wait must be a number of seconds > 0, got {worker_wait_s!r}")
     if not isinstance(config, SweepConfig):
         config = load_config(config)
     if workers is not None:
@@ -178,6 +190,8 @@ def run_sweep(
                 overwrite=overwrite,
                 retry_failed=retry_failed,
                 progress=progress,
+                worker_wait_s=worker_wait_s,
+                notice=notice,
             )
     finally:
         if client is not None and client is not scheduler:
@@ -231,7 +245,18 @@ CONNECT_TIMEOUT_S = 10
 
 
 def _run_locked(
-    config, cases, out_dir, session, *, n_workers, scheduler, overwrite, retry_failed, progress
+    config,
+    cases,
+    out_dir,
+    session,
+    *,
+    n_workers,
+    scheduler,
+    overwrite,
+    retry_failed,
+    progress,
+    worker_wait_s=DEFAULT_WORKER_WAIT_S,
+    notice=None,
 ) -> SweepSummary:
     prepare_store(config, cases, out_dir, overwrite=overwrite, session=session)
     remove_temporaries(out_dir)
@@ -270,7 +295,7 @@ def _run_locked(
     report(None)
     if todo:
         if scheduler is not None:
-            run_dask(longest_first(todo), scheduler, handle)
+            run_dask(longest_first(todo), scheduler, handle, worker_wait_s=worker_wait_s, notice=notice)
         elif n_workers == 1 or len(todo) == 1:
             # one case left: no processes to start; its engine batch gets the workers' threads
             run_here(todo, handle, threads=n_workers)
