@@ -843,9 +843,10 @@ def replay(run_dir, speed, duration, mp4):
     if duration is not None:
         check_positive("--duration", duration)
     if headless:
-        extras.require("video", "replay without a display (an MP4)" if mp4 is None else "--mp4")
         choose_gl_backend()
     rig, track = load_run(run_dir)
+    if headless:
+        extras.require("video", "replay without a display (an MP4)" if mp4 is None else "--mp4")
     span = float(track.time_s[-1] - track.time_s[0])
     speed = check_positive("--speed", speed) if speed is not None else default_speed(track.time_s)
     if headless:

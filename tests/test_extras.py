@@ -28,8 +28,8 @@ def _without(monkeypatch, *modules):
 
 def test_require_names_the_extra_and_the_missing_modules(monkeypatch):
     _without(monkeypatch, "imageio")
-    assert extras.missing("video") == ["imageio"]
-    with pytest.raises(SpineInputError, match=r"--render needs the optional extra 'video' \(imageio not"):
+    assert "imageio" in extras.missing("video")
+    with pytest.raises(SpineInputError, match=r"--render needs the optional extra 'video' \(imageio"):
         extras.require("video", "--render")
 
 
