@@ -111,7 +111,8 @@ class _Group(click.Group):
                 click.echo(exc.details, err=True)
             raise InputError(str(exc)) from None
         except OSError as exc:
-            raise InputError(f"{exc.strerror or exc}: {exc.filename}") from None
+            where = f": {exc.filename}" if exc.filename is not None else " (the system named no file)"
+            raise InputError(f"{exc.strerror or exc}{where}") from None
         except MemoryError as exc:  # the checks at the boundary missed a size: still one line
             raise InputError(
                 f"not enough memory for this request ({exc or 'MemoryError'}): a size, resolution or "

@@ -66,7 +66,12 @@ def atomic_output(path: str | os.PathLike, *, suffix: str | None = None) -> Iter
     os.close(fd)
     tmp = Path(tmp_name)
     try:
-        yield tmp
+        try:
+            yield tmp
+        except OSError as exc:  # a writer's error without its file (a full disk): name it
+            if exc.filename is not None:
+                raise
+            raise SpineInputError(f"cannot write {dest}: {exc.strerror or exc}") from None
         umask = os.umask(0)
         os.umask(umask)
         os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; give the usual permissions

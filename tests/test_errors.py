@@ -70,3 +70,17 @@ def test_an_unwritable_path_is_refused_before_any_work(tmp_path):
         writable_path(tmp_path / "file" / "out.txt")
     with pytest.raises(SpineInputError, match="it is a folder"):
         writable_path(tmp_path)
+
+
+def test_a_full_disk_names_the_file_being_written(tmp_path):
+    """pyarrow and numpy raise ENOSPC without a file name: the error names the output."""
+    import errno
+
+    dest = tmp_path / "runs.parquet"
+    with pytest.raises(SpineInputError, match=r"cannot write .*runs\.parquet: No space left on device"):
+        with atomic_output(dest):
+            raise OSError(errno.ENOSPC, "No space left on device")
+    assert list(tmp_path.iterdir()) == []
+    with pytest.raises(FileNotFoundError):  # an error that names its own file is left as it is
+        with atomic_output(dest):
+            open(tmp_path / "missing.txt")
