@@ -10,6 +10,7 @@ from __future__ import annotations
 import contextlib
 import math
 import os
+import re
 import shutil
 import tempfile
 from collections.abc import Iterator
@@ -79,6 +80,27 @@ def atomic_output(path: str | os.PathLike, *, suffix: str | None = None) -> Iter
     finally:
         if tmp.exists():
             tmp.unlink()
+
+
+#: The temporary files of :func:`atomic_output` (``.NAME.XXXXXXXX.SUFFIX``, mkstemp's 8
+#: random characters) and :func:`all_or_none` (``.NAME.PID.keep``).
+_TEMPORARY = re.compile(r"^\.(?P<name>.+)\.(?:[a-z0-9_]{8}(?P<suffix>\.[^.]+)?|\d+\.keep)$")
+
+
+def remove_temporaries(folder: str | os.PathLike) -> list[Path]:
+    """Delete, under ``folder`` (recursively), the temporary files that :func:`atomic_output`
+    and :func:`all_or_none` leave when their process is killed; a resumed run calls this for
+    the run it replaces. Returns the files removed."""
+    removed = []
+    for path in Path(folder).rglob(".*"):
+        m = _TEMPORARY.match(path.name)
+        if not (m and path.is_file()):
+            continue
+        if m["suffix"] is not None and Path(m["name"]).suffix != m["suffix"]:
+            continue  # not one of ours: the suffix is the destination's
+        path.unlink(missing_ok=True)
+        removed.append(path)
+    return removed
 
 
 def _missing_folders(path: Path) -> list[Path]:

@@ -11,7 +11,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from spine_mj import sim
-from spine_mj.errors import SpineInputError
+from spine_mj.errors import SpineInputError, remove_temporaries
 from spine_mj.jsonio import write_json
 from spine_mj.surfaces import single_gaussian
 from spine_mj.validate.boundary import BoundaryResult, boundary
@@ -76,6 +76,7 @@ def run_validation(
     if out.exists() and not out.is_dir():
         raise SpineInputError(f"--out {out} exists and is not a folder")
     out.mkdir(parents=True, exist_ok=True)
+    remove_temporaries(out)  # of a killed run this one resumes
     t0 = time.perf_counter()
     runner = StudyRunner(out, workers, progress, t0)
     timings = {}
