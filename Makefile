@@ -24,7 +24,8 @@ lint: $(STAMP)
 	$(BIN)/ruff check .
 	$(BIN)/ruff format --check .
 
-# make bench BENCH_ARGS="--quick --readme": CI-size runs, README Performance section rewritten
+# make bench: results in benchmarks/out/ (untracked), each missed target marked;
+# make bench BENCH_ARGS="--update --readme": the committed results and README section rewritten
 bench: $(STAMP)
 	$(BIN)/python benchmarks/run_all.py $(BENCH_ARGS)
 
