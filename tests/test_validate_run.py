@@ -87,3 +87,10 @@ def test_cli_bad_input_is_one_line_exit_2_and_writes_nothing(tmp_path, args, mat
     lines = res.output.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("Error:") and match in lines[0]
     assert sorted(p.name for p in tmp_path.iterdir()) == before
+
+
+def test_too_many_workers_are_refused_before_anything_is_written(tmp_path):
+    out = tmp_path / "v"
+    result = CliRunner().invoke(main, ["validate", "--quick", "--workers", "100000", "--out", str(out)])
+    assert result.exit_code == 2 and "--workers: must be an integer from 1 to" in result.output, result.output
+    assert not out.exists()

@@ -40,6 +40,7 @@ from spine_mj.sweep.store import (
     store_lock,
     versions,
 )
+from spine_mj.workers import MAX_WORKERS_PER_CORE, check_workers  # noqa: F401 (re-exported)
 
 
 @dataclass(frozen=True)
@@ -204,22 +205,6 @@ def clear_caches() -> None:
     _make_surface.cache_clear()
     quasistatic.clear_cache()
     case_rig.cache_clear()
-
-
-#: Local worker processes allowed per core (more only cost memory: ~300 MB each).
-MAX_WORKERS_PER_CORE = 4
-
-
-def check_workers(workers) -> int:
-    """``workers`` if it is an integer from 1 to :data:`MAX_WORKERS_PER_CORE` per core."""
-    cores = os.cpu_count() or 1
-    limit = MAX_WORKERS_PER_CORE * cores
-    if isinstance(workers, bool) or not isinstance(workers, int) or not 1 <= workers <= limit:
-        raise SpineInputError(
-            f"--workers: must be an integer from 1 to {limit} ({MAX_WORKERS_PER_CORE} per core "
-            f"on {cores} cores), got {workers!r}"
-        )
-    return workers
 
 
 _ADDRESS = re.compile(r"^((tcp|tls|ucx|ws|wss)://)?[A-Za-z0-9._-]+(:[0-9]{1,5})?$|^inproc://\S+$")

@@ -32,6 +32,7 @@ from spine_mj.validate.sandpaper import SandpaperResult, sandpaper
 from spine_mj.validate.static_map import StaticMapResult, static_map
 from spine_mj.validate.stick_slip import StickSlipResult, stick_slip
 from spine_mj.validate.stiffness_map import StiffnessMapResult, stiffness_map
+from spine_mj.workers import check_workers
 
 __all__ = ["run_validation"]
 
@@ -70,8 +71,8 @@ def run_validation(
         if plan not in PLANS:
             raise SpineInputError(f"plan must be one of {sorted(PLANS)}, got {plan!r}")
         plan = PLANS[plan]
-    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
-        raise SpineInputError(f"workers must be an integer >= 1, got {workers!r}")
+    if workers is not None:
+        check_workers(workers)  # before anything is written
     out = Path(out_dir).resolve()  # stores refer to files under it: one absolute root
     if out.exists() and not out.is_dir():
         raise SpineInputError(f"--out {out} exists and is not a folder")
