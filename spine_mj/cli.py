@@ -769,6 +769,7 @@ def simulate(
         drv = sim.StaticProbe(rate_n_s=rate, start_force_n=start_force)
     with Progress("simulating", unit="%") as bar:
         result = rig.run(drv, start=(x0, y0), progress=lambda frac: bar.update(round(100 * frac, 1), 100))
+        bar.update(100, 100)  # a run that ends early (a breakaway, a lock) is done too
     out = Path(out_dir)
     written = ["trajectory.parquet", "summary.json", "surface.npz", "run.png"] + (
         ["run.mp4"] if render else []

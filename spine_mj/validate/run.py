@@ -100,10 +100,10 @@ def run_validation(
     fr = timed("fractal_lock", fractal_lock, plan, runner)
     km = timed("stiffness_map", stiffness_map, plan, runner)
     runner.study = "report"
-    runner.note("figures and report")
-    result = _summary(plan, st, lim, bnd, ss, sp, timings, fr)
-    result.update(_stiffness_map_summary(km))
-    write_report(out, result, static=st, limit=lim, boundary=bnd, stick=ss, sand=sp, fractal=fr, kmap=km)
+    with runner.phase("figures and report"):
+        result = _summary(plan, st, lim, bnd, ss, sp, timings, fr)
+        result.update(_stiffness_map_summary(km))
+        write_report(out, result, static=st, limit=lim, boundary=bnd, stick=ss, sand=sp, fractal=fr, kmap=km)
     result["timings_s"]["total"] = round(time.perf_counter() - t0, 2)
     write_json(out / "validation.json", result)
     return result

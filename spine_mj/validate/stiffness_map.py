@@ -151,8 +151,8 @@ def stiffness_map(plan: ValidationPlan, runner: StudyRunner) -> StiffnessMapResu
                 grid=preset_grid(plan, sub, preset),
             )
             df, store = runner(doc, f"stiffness_map/{preset}")
-            runner.note(f"slip events and energy on {preset}")
-            runs.append(_run_rows(df, store, fam.name, preset, samples))
+            with runner.phase(f"slip events and energy on {preset}"):
+                runs.append(_run_rows(df, store, fam.name, preset, samples))
     table = pd.concat(runs, ignore_index=True)
     return StiffnessMapResult(
         ie=ies,
