@@ -27,7 +27,7 @@ import numpy as np
 
 from spine_mj import compare, sim
 from spine_mj.sim.ramp import cycle_breakaways, rows_to_reset
-from spine_mj.validate.ramp_plan import pilot_rig
+from spine_mj.validate.ramp_pilot import pilot_rig
 from spine_mj.validate.static_map import _hold_force
 
 #: (slope, azimuth) of the probe's planes [deg]: engaged planes of the static map.

@@ -624,7 +624,8 @@ def _gpu_markdown(g) -> list[str]:
 
 def rewrite_readme(text: str, readme: Path = README) -> None:
     """Replace the README's text between the bench markers with ``text``."""
-    from spine_mj.errors import SpineInputError, atomic_output
+    from spine_mj.atomic import atomic_output
+    from spine_mj.errors import SpineInputError
 
     doc = readme.read_text()
     if BEGIN not in doc or END not in doc:
@@ -690,7 +691,7 @@ def main(argv=None) -> None:
     text = markdown(res)
     if args.from_json is None:
         md = args.out.with_suffix(".md")
-        from spine_mj.errors import atomic_output
+        from spine_mj.atomic import atomic_output
 
         with atomic_output(md) as tmp:
             tmp.write_text(text)

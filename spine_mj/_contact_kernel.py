@@ -7,7 +7,7 @@ centre rests at on that feature; the highest wins (the first of equal heights, i
 reference's order: vertices, the three edge kinds, lower then upper triangles, each by row
 then column). Its value is the centre height less ``r`` and the slopes of the contact
 normal. The streamline traces a few points per call, where the array version's per-call
-overhead (about 1 ms) was most of the facet reference's cost. ``tests/test_surfaces.py``
+overhead (about 1 ms) was most of the facet reference's cost. ``tests/surfaces/test_surfaces.py``
 checks the two against each other.
 """
 

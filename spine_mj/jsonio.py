@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from spine_mj.errors import atomic_output
+from spine_mj.atomic import atomic_output
 
 __all__ = ["to_jsonable", "write_json"]
 

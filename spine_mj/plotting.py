@@ -27,7 +27,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
-from spine_mj.errors import atomic_output
+from spine_mj.atomic import atomic_output
 from spine_mj.surfaces import GridSurface, Surface
 
 __all__ = [

@@ -60,6 +60,7 @@ def _measured(*, file: str, **options):
 #: Generator names usable in a preset, and the functions they call.
 GENERATORS = {
     "single_gaussian": surfaces.single_gaussian,
+    "corrugation": surfaces.corrugation,
     "random_gaussians": surfaces.random_gaussians,
     "fractal_fbm": surfaces.fractal_fbm,
     "sandpaper": surfaces.sandpaper,

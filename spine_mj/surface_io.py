@@ -22,7 +22,8 @@ import numpy as np
 import trimesh
 from scipy import ndimage
 
-from spine_mj.errors import SpineInputError, atomic_output, check_positive
+from spine_mj.atomic import atomic_output
+from spine_mj.errors import SpineInputError, check_positive
 from spine_mj.jsonio import to_jsonable
 from spine_mj.surfaces import (
     LENGTH_UNITS_M,

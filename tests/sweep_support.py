@@ -1,4 +1,4 @@
-"""Shared by the sweep tests (tests/test_sweep_*.py): small configs and their helpers."""
+"""Shared by the sweep tests (tests/sweep/test_sweep_*.py): small configs and their helpers."""
 
 import json
 import textwrap

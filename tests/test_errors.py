@@ -5,7 +5,8 @@ import stat
 
 import pytest
 
-from spine_mj.errors import SpineInputError, all_or_none, atomic_output, writable_path
+from spine_mj.atomic import all_or_none, atomic_output, writable_path
+from spine_mj.errors import SpineInputError
 
 
 def test_atomic_output_writes_on_success_with_umask_permissions(tmp_path):
@@ -87,7 +88,7 @@ def test_a_full_disk_names_the_file_being_written(tmp_path):
 
 
 def test_remove_temporaries_removes_what_a_killed_writer_left_and_nothing_else(tmp_path):
-    from spine_mj.errors import remove_temporaries
+    from spine_mj.atomic import remove_temporaries
 
     figures = tmp_path / "figures"
     figures.mkdir()
@@ -102,7 +103,7 @@ def test_remove_temporaries_removes_what_a_killed_writer_left_and_nothing_else(t
 
 def test_atomic_output_temporaries_are_what_remove_temporaries_removes(tmp_path):
     """A writer killed inside the block leaves its temporary; the pattern must know its name."""
-    from spine_mj.errors import remove_temporaries
+    from spine_mj.atomic import remove_temporaries
 
     dest = tmp_path / "fig.png"
     writer = atomic_output(dest)  # entered and never left, as in a killed process

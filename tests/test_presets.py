@@ -47,7 +47,7 @@ def test_overrides_and_seed():
 
 
 def test_bad_presets_and_overrides(tmp_path):
-    with pytest.raises(SpineInputError, match="unknown preset 'nope'; known presets: paper-"):
+    with pytest.raises(SpineInputError, match=r"unknown preset 'nope'; known presets: .*paper-single-peak"):
         load_preset("nope")
     with pytest.raises(SpineInputError, match=r"unknown parameter\(s\) \['colour'\]"):
         make_surface("paper-fractal", colour="red")
@@ -68,3 +68,30 @@ def test_parse_override():
     assert parse_override("grit=P36") == ("grit", "P36")
     with pytest.raises(SpineInputError, match="key=value"):
         parse_override("hurst")
+
+
+def test_corrugation_preset_is_the_prandtl_tomlinson_profile():
+    # z = h sin(2 pi x / lambda), slope amplitude s: f_x = s cos(2 pi x / lambda), f_y = 0;
+    # L_c = lambda and l_s = 0.190 lambda (docs/physics.md), the numbers K* is quoted with
+    from spine_mj import roughness
+
+    surf = make_surface("corrugation")
+    lam, s = surf.metadata["params"]["wavelength"], surf.metadata["params"]["slope_amplitude"]
+    x = np.linspace(0.1, 7.3, 41)
+    y = np.full_like(x, 0.2)
+    fx, fy = surf.gradient(x, y)
+    np.testing.assert_allclose(fx, s * np.cos(2 * np.pi * x / lam), atol=1e-4)
+    np.testing.assert_allclose(fy, 0.0, atol=1e-12)
+    np.testing.assert_allclose(
+        surf.height(x, y), s * lam / (2 * np.pi) * np.sin(2 * np.pi * x / lam), atol=1e-5
+    )
+    assert roughness.characteristic_length(surf) == pytest.approx(lam, rel=1e-3)
+    assert roughness.slope_correlation_length(surf) == pytest.approx(0.190 * lam, rel=0.01)
+
+
+@pytest.mark.parametrize(
+    "bad", [{"n_waves": 0}, {"n_waves": 2.5}, {"points_per_wave": 4}, {"slope_amplitude": float("nan")}]
+)
+def test_corrugation_refuses_nonsense(bad):
+    with pytest.raises(SpineInputError, match=next(iter(bad))):
+        make_surface("corrugation", **bad)

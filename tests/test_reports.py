@@ -20,7 +20,7 @@ from spine_mj.validate import (
     StaticMapResult,
     StickSlipResult,
 )
-from spine_mj.validate.report import write_report as write_validation_report
+from spine_mj.validate import write_report as write_validation_report
 
 
 @pytest.mark.parametrize(
@@ -171,7 +171,7 @@ def _validation_results():
 def test_validation_report_links_only_written_figures_and_names_its_plan(tmp_path):
     result = {"plan": "quick", "static_kappa_max_rel_error": 0.01, "engine_settings": {"dt": 1e-3}}
     result["timings_s"] = {"static": 1.23456}
-    path = write_validation_report(tmp_path, result, **_validation_results())
+    path = write_validation_report(tmp_path, result, _validation_results().values())
     text = path.read_text()
     assert text.startswith("# Validation") and "(quick plan)" in text and "full plan" in text
     assert "{{" not in text and "{%" not in text
@@ -185,7 +185,7 @@ def test_validation_report_links_only_written_figures_and_names_its_plan(tmp_pat
 
 
 def test_falls_note_splits_the_runs_at_the_lower_end_of_the_ie_star_bracket():
-    from spine_mj.validate.report import _falls_note
+    from spine_mj.validate.report.quasistatic_limit import falls_note as _falls_note
 
     res = _validation_results()
     runs = [

@@ -5,7 +5,7 @@ One pass over the rows does what three numpy functions do in some seventy passes
 :func:`~spine_mj.sim.recording.sensor_columns` (the SI columns),
 :func:`~spine_mj.sim.detection.end_marks` (the first row of each end condition) and
 :func:`~spine_mj.sim.detection.normal_lock_marks` (the shared lock rule, carried from one
-window to the next). Those stay the reference: ``tests/test_sim_window_kernel.py`` checks
+window to the next). Those stay the reference: ``tests/sim/test_sim_window_kernel.py`` checks
 this kernel against them, value for value, on recorded runs and on rows with engine trouble.
 Every number is computed with the same floating-point operations in the same order as the
 reference (no fast-math), so the two agree to the last bit.

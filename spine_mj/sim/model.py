@@ -24,7 +24,8 @@ from pathlib import Path
 
 import numpy as np
 
-from spine_mj.errors import SpineInputError, atomic_output
+from spine_mj.atomic import atomic_output
+from spine_mj.errors import SpineInputError
 from spine_mj.resources import model_path
 from spine_mj.sim.drives import Drive, SpringDrive, speed_m_s, stiffness_n_m
 from spine_mj.sim.drives import stiffness_n_m as spring_stiffness_n_m

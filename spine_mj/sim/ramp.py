@@ -28,7 +28,7 @@ constants before breakaway, so the breakaway starts from the same quasistatic co
 (an hfield edge) the breakaway can lie below it by a few per cent (measured up to 1.5 %
 on the single peak), inside the default 3 % margin of the climb, or above it (a wedge),
 where the approach goes on to the cap; either way the breakaway itself is taken at the
-nominal rate. On the cases of ``tests/test_sim_fastforward.py`` and
+nominal rate. On the cases of ``tests/sim/test_sim_fastforward.py`` and
 ``benchmarks/bench_fastforward.py`` the breakaway forces agree with the plain ramp's within
 0.5 % and the outcomes and paths agree (Frechet <= 0.01 L_c).
 

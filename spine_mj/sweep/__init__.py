@@ -43,7 +43,7 @@ the end of every sweep.
 
 Modules, each importing only those above it: :mod:`~spine_mj.sweep.registry` (analyses and
 their parameters), :mod:`~spine_mj.sweep.config` (the TOML schema),
-:mod:`~spine_mj.sweep.cases` (expansion, ids, seeds), :mod:`~spine_mj.sweep.runner` (one
+:mod:`~spine_mj.sweep.cases` (expansion, ids, seeds), :mod:`~spine_mj.sweep.case_runs` (one
 case), :mod:`~spine_mj.sweep.store` (the result store and its readers),
 :mod:`~spine_mj.sweep.pool` (local worker processes that die with their parent),
 :mod:`~spine_mj.sweep.executors` (in-process, local processes, Dask),
@@ -52,6 +52,7 @@ and :mod:`~spine_mj.sweep.analyses` (the built-in analyses, registered on import
 """
 
 from spine_mj.sweep.analyses import MUJOCO_PARAMS, QUASISTATIC_PARAMS
+from spine_mj.sweep.case_runs import run_case
 from spine_mj.sweep.cases import Case, expand_cases
 from spine_mj.sweep.config import StartsSpec, SurfaceSpec, SweepConfig, load_config, parse_config
 from spine_mj.sweep.executors import DEFAULT_WORKER_WAIT_S, SchedulerUnavailable
@@ -66,7 +67,6 @@ from spine_mj.sweep.registry import (
     register_analysis,
 )
 from spine_mj.sweep.report import write_report
-from spine_mj.sweep.runner import run_case
 from spine_mj.sweep.session import Progress, SweepSummary, run_sweep
 from spine_mj.sweep.store import StoreStatus, consolidate, load_runs, load_trajectories, store_status
 

@@ -20,10 +20,10 @@ from collections.abc import Callable
 from distributed import Client, as_completed
 from distributed.comm.core import CommClosedError
 
+from spine_mj.sweep.case_runs import failed_rows, run_case
 from spine_mj.sweep.cases import Case
 from spine_mj.sweep.pool import run_pool
 from spine_mj.sweep.registry import CASE_THREADS
-from spine_mj.sweep.runner import failed_rows, run_case
 from spine_mj.sweep.store import encode_case
 
 

@@ -19,8 +19,8 @@ import numpy as np
 import pandas as pd
 from pandas.api.types import is_bool_dtype, is_numeric_dtype
 
+from spine_mj.atomic import atomic_output
 from spine_mj.compare import FRECHET_TARGET, OUTCOME_TARGET
-from spine_mj.errors import atomic_output
 from spine_mj.plotting import (
     THRESHOLD_COLOR,
     house_style,

@@ -32,7 +32,8 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from spine_mj.errors import SpineInputError, atomic_output
+from spine_mj.atomic import atomic_output
+from spine_mj.errors import SpineInputError
 from spine_mj.jsonio import write_json
 from spine_mj.sweep.cases import Case
 from spine_mj.sweep.config import SweepConfig, input_digests

@@ -34,10 +34,14 @@ Lengths in the metrics are in units of the surface's characteristic length ``L_c
 (:func:`spine_mj.sim.characteristic_length`), forces in units of the preload ``F_p``.
 
 Modules: :mod:`~spine_mj.validate.plans` (plans, targets, constants),
-:mod:`~spine_mj.validate.runner` (the sweep runner), :mod:`~spine_mj.validate.sweep_docs`
-(sweep configs), :mod:`~spine_mj.validate.paths` (streamlines on the tip-dilated surface,
-path metrics), :mod:`~spine_mj.validate.ie_star`, :mod:`~spine_mj.validate.ramp_plan`, one
-module per study, :mod:`~spine_mj.validate.report` and :mod:`~spine_mj.validate.run`.
+:mod:`~spine_mj.validate.study_runner` (runs a study's sweep configs into resumable
+stores), :mod:`~spine_mj.validate.sweep_configs` (the sweep configs the studies share),
+:mod:`~spine_mj.validate.paths` (streamlines on the tip-dilated surface, path metrics),
+:mod:`~spine_mj.validate.ie_star` (I_e* estimators and bootstrap),
+:mod:`~spine_mj.validate.ramp_pilot` (a ramp's duration from a pilot run), one module per
+study, :mod:`~spine_mj.validate.report` (one report module per study, named like it),
+:mod:`~spine_mj.validate.studies` (the registry: name, run function, result type, report
+module) and :mod:`~spine_mj.validate.suite` (:func:`run_validation`).
 """
 
 from spine_mj.presets import calibrated_mu
@@ -72,14 +76,15 @@ from spine_mj.validate.plans import (
     ValidationPlan,
 )
 from spine_mj.validate.quasistatic_limit import LimitPath, QuasistaticLimitResult, quasistatic_limit
-from spine_mj.validate.ramp_plan import RampPlan, pilot_rig, ramp_duration
-from spine_mj.validate.report import write_report
-from spine_mj.validate.run import run_validation
-from spine_mj.validate.runner import StudyRunner, ValidationProgress
+from spine_mj.validate.ramp_pilot import RampPlan, pilot_rig, ramp_duration
+from spine_mj.validate.report.document import write_report
 from spine_mj.validate.sandpaper import SandpaperResult, sandpaper
 from spine_mj.validate.static_map import PLANE_START, StaticMapResult, static_map
 from spine_mj.validate.stick_slip import SlipStats, StickSlipResult, slip_statistics, stick_slip
 from spine_mj.validate.stiffness_map import StiffnessMapResult, stiffness_map
+from spine_mj.validate.studies import STUDIES, Study
+from spine_mj.validate.study_runner import StudyRunner, ValidationProgress
+from spine_mj.validate.suite import run_validation
 
 __all__ = [
     "DEPARTURE",
@@ -93,6 +98,7 @@ __all__ = [
     "RAMP_MIN_COVERAGE",
     "SANDPAPER_MU",
     "STATIC_TARGET",
+    "STUDIES",
     "BoundaryCurve",
     "BoundaryResult",
     "FamilySpec",
@@ -106,6 +112,7 @@ __all__ = [
     "StaticMapResult",
     "StickSlipResult",
     "StiffnessMapResult",
+    "Study",
     "StudyRunner",
     "ValidationPlan",
     "ValidationProgress",

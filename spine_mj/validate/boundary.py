@@ -14,9 +14,9 @@ from spine_mj.presets import calibrated_mu
 from spine_mj.validate.ie_star import ie_star_by_criterion, quiet_nan_warnings
 from spine_mj.validate.paths import prefix_frechet, stored_paths, tip_radius
 from spine_mj.validate.plans import FRECHET_TARGET, RAMP_MIN_COVERAGE, FamilySpec, ValidationPlan
-from spine_mj.validate.ramp_plan import pilot_rig, ramp_duration
-from spine_mj.validate.runner import StudyRunner
-from spine_mj.validate.sweep_docs import family_doc
+from spine_mj.validate.ramp_pilot import pilot_rig, ramp_duration
+from spine_mj.validate.study_runner import StudyRunner
+from spine_mj.validate.sweep_configs import family_doc
 
 __all__ = ["BoundaryCurve", "BoundaryResult", "boundary", "preset_grid", "quasistatic_locked"]
 
@@ -108,6 +108,14 @@ class BoundaryResult:
     ie_star: dict[str, dict]
     skip_rate: dict[str, list[float]]
     families: list[str]
+
+    def validation_keys(self) -> dict:
+        """This study's keys of ``validation.json``."""
+        return {
+            "ie_star": self.ie_star,
+            "ie_curves": {k: c.as_dict() for k, c in self.curves.items()},
+            "trap_skip_rate": self.skip_rate,
+        }
 
     def as_dict(self) -> dict:
         return {

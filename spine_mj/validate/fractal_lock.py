@@ -29,7 +29,7 @@ from spine_mj.presets import calibrated_mu, load_preset
 from spine_mj.reproduce import fig9_rms_height, fig9_seeds
 from spine_mj.validate.paths import tip_radius
 from spine_mj.validate.plans import ValidationPlan
-from spine_mj.validate.runner import StudyRunner
+from spine_mj.validate.study_runner import StudyRunner
 
 __all__ = ["SERIES", "FractalLockResult", "fractal_lock", "hurst_rows", "lock_rate"]
 
@@ -132,6 +132,10 @@ class FractalLockResult:
     mu: float
     tip_radius: float
     runs: list[dict]
+
+    def validation_keys(self) -> dict:
+        """This study's keys of ``validation.json``."""
+        return {"fractal_lock_rate": self.as_dict()}
 
     def as_dict(self) -> dict:
         return {

@@ -18,8 +18,8 @@ from spine_mj.compare import MISS_REASONS
 from spine_mj.presets import calibrated_mu
 from spine_mj.validate.paths import stored_paths, tip_radius
 from spine_mj.validate.plans import FRECHET_TARGET, OUTCOME_TARGET, RECOMMENDED, FamilySpec, ValidationPlan
-from spine_mj.validate.runner import StudyRunner
-from spine_mj.validate.sweep_docs import engine_grid, family_doc
+from spine_mj.validate.study_runner import StudyRunner
+from spine_mj.validate.sweep_configs import engine_grid, family_doc
 
 __all__ = ["LimitPath", "QuasistaticLimitResult", "quasistatic_limit"]
 
@@ -93,6 +93,19 @@ class QuasistaticLimitResult:
     variations: dict[str, dict]
     paths: dict[str, list[LimitPath]]
     lowest_ie: float
+
+    def validation_keys(self) -> dict:
+        """This study's keys of ``validation.json``."""
+        fams = self.families
+        return {
+            "lowest_ie": self.lowest_ie,
+            "outcome_agreement_at_lowest_ie": {k: v["outcome_agreement"] for k, v in fams.items()},
+            "mean_frechet_at_lowest_ie": {k: v["mean_frechet"] for k, v in fams.items()},
+            "median_frechet_at_lowest_ie": {k: v["median_frechet"] for k, v in fams.items()},
+            "failed_runs": {k: v["failed_runs"] for k, v in fams.items()},
+            "limit_families": fams,
+            "limit_variations": self.variations,
+        }
 
     def as_dict(self) -> dict:
         return {

@@ -12,7 +12,7 @@ from scipy.signal import find_peaks
 from spine_mj import presets
 from spine_mj.validate.paths import mujoco_traces
 from spine_mj.validate.plans import GRAVITY, MASS_KG, SANDPAPER_MU, ValidationPlan
-from spine_mj.validate.runner import StudyRunner
+from spine_mj.validate.study_runner import StudyRunner
 
 __all__ = ["SandpaperResult", "sandpaper"]
 
@@ -36,6 +36,10 @@ class SandpaperResult:
     rows: list[dict]
     paths: dict[str, list[tuple]]
     mu: float
+
+    def validation_keys(self) -> dict:
+        """This study's keys of ``validation.json``."""
+        return {"sandpaper": self.rows}
 
     def as_dict(self) -> dict:
         return {"rows": self.rows, "paths": self.paths, "mu": self.mu}

@@ -13,8 +13,8 @@ import numpy as np
 
 from spine_mj import engagement, sim, surface_io
 from spine_mj.validate.plans import GRAVITY, MASS_KG, ValidationPlan
-from spine_mj.validate.runner import StudyRunner
-from spine_mj.validate.sweep_docs import engine_default
+from spine_mj.validate.study_runner import StudyRunner
+from spine_mj.validate.sweep_configs import engine_default
 
 __all__ = ["PLANE_START", "StaticMapResult", "static_map"]
 
@@ -46,6 +46,13 @@ class StaticMapResult:
     per_engine: dict[str, dict]
     mu: float
     static_kappa_max_rel_error: float
+
+    def validation_keys(self) -> dict:
+        """This study's keys of ``validation.json``."""
+        return {
+            "static_kappa_max_rel_error": self.static_kappa_max_rel_error,
+            "static_by_engine": self.per_engine,
+        }
 
     def as_dict(self) -> dict:
         return {

@@ -13,8 +13,8 @@ from spine_mj.errors import SpineInputError
 from spine_mj.presets import calibrated_mu
 from spine_mj.validate.paths import mujoco_traces, tip_radius
 from spine_mj.validate.plans import GRAVITY, MASS_KG, FamilySpec, ValidationPlan, relative_starts
-from spine_mj.validate.runner import StudyRunner
-from spine_mj.validate.sweep_docs import family_doc
+from spine_mj.validate.study_runner import StudyRunner
+from spine_mj.validate.sweep_configs import family_doc
 
 __all__ = ["SlipStats", "StickSlipResult", "complementary_cdf", "slip_statistics", "stick_slip"]
 
@@ -142,6 +142,10 @@ class StickSlipResult:
     rows: list[dict]
     traces: dict[tuple[float, float], tuple[np.ndarray, np.ndarray]]
     surface: str
+
+    def validation_keys(self) -> dict:
+        """This study's keys of ``validation.json``."""
+        return {"stick_slip": self.rows}
 
     def as_dict(self) -> dict:
         return {"rows": self.rows, "traces": self.traces, "surface": self.surface}

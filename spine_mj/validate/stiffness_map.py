@@ -1,4 +1,4 @@
-"""Study 6: the quasistatic boundary as a map over (I_e, K) for the spring drive.
+"""Study 7: the quasistatic boundary as a map over (I_e, K) for the spring drive.
 
 A spring drive is quasistatic only when it is slow (I_e << 1) *and* stiff: a spring of
 stiffness ``k`` holding ``F`` stores ``F^2 / (2 k)``, released into the tip at every
@@ -35,9 +35,9 @@ from spine_mj.validate.boundary import preset_grid, quasistatic_locked
 from spine_mj.validate.ie_star import ie_star_by_criterion, passes_criterion, quiet_nan_warnings
 from spine_mj.validate.paths import mujoco_traces
 from spine_mj.validate.plans import GRAVITY, MASS_KG, FamilySpec, ValidationPlan
-from spine_mj.validate.runner import StudyRunner
 from spine_mj.validate.stick_slip import slip_statistics
-from spine_mj.validate.sweep_docs import family_doc
+from spine_mj.validate.study_runner import StudyRunner
+from spine_mj.validate.sweep_configs import family_doc
 
 __all__ = [
     "SLIP_FAMILIES",
@@ -96,6 +96,13 @@ class StiffnessMapResult:
         """family -> K (str) -> I_e* (value, low, high, ci_low, ci_high, kind, criterion)."""
         return {f: {k: cell["ie_star"] for k, cell in by_k.items()} for f, by_k in self.agreement.items()}
 
+    def validation_keys(self) -> dict:
+        """This study's keys of ``validation.json``: ``ie_star_by_stiffness`` (family -> K ->
+        I_e* with bracket ``low``/``high``, bootstrap ``ci_low``/``ci_high`` and ``kind``) and
+        ``stiffness_map`` (the agreement grid with n_ok / n per cell, the energy and slip
+        tables)."""
+        return {"ie_star_by_stiffness": self.ie_star(), "stiffness_map": self.as_dict()}
+
     def as_dict(self) -> dict:
         """The ``validation.json`` entry (the slip samples stay out: the figure holds them)."""
         return {
@@ -125,7 +132,7 @@ def subset_starts(fam: FamilySpec, n: int) -> FamilySpec:
 
 
 def stiffness_map(plan: ValidationPlan, runner: StudyRunner) -> StiffnessMapResult:
-    """Study 6: the spring drive over ``plan.stiffness_map_ie`` x ``plan.stiffness_map_k``
+    """Study 7: the spring drive over ``plan.stiffness_map_ie`` x ``plan.stiffness_map_k``
     on ``plan.stiffness_map_families`` (an empty grid runs nothing).
 
     Returns

@@ -97,7 +97,7 @@ def test_too_many_workers_are_refused_before_anything_is_written(tmp_path):
 
 
 def test_a_phase_without_a_sweep_ends_its_progress_at_100_percent(tmp_path):
-    from spine_mj.validate.runner import StudyRunner
+    from spine_mj.validate.study_runner import StudyRunner
 
     seen = []
     runner = StudyRunner(tmp_path, 1, seen.append, 0.0)

@@ -25,7 +25,7 @@ KEYS = st.one_of(
     st.sampled_from(["hurst", "size", "n_peaks", "seed", "rms", "height", "spacing", "resolution", "file"]),
     st.text(alphabet="abcdefghij_", min_size=1, max_size=8),
 )
-#: More examples for a longer search: SPINE_MJ_PROPERTY_SCALE=10 pytest tests/test_cli_property.py
+#: More examples for a longer search: SPINE_MJ_PROPERTY_SCALE=10 pytest tests/cli/test_cli_property.py
 SCALE = int(os.environ.get("SPINE_MJ_PROPERTY_SCALE", "1"))
 SETTINGS = settings(
     max_examples=12 * SCALE,

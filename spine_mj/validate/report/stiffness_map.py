@@ -1,8 +1,6 @@
-"""Figures and report text of the (I_e, K) map (:mod:`spine_mj.validate.stiffness_map`).
-
-:func:`map_figure` draws agreement as a heat map per family with I_e*(K) over it,
-:func:`ccdf_figure` the slip-size and force-drop CCDFs, and :func:`map_sections` the
-report's tables; :mod:`spine_mj.validate.report` puts them into ``report.md``.
+"""The report of the (I_e, K) map (:mod:`spine_mj.validate.stiffness_map`): agreement as a heat
+map per family with I_e*(K) over it, the elastic energy released at breakaway, and the
+slip-size and force-drop CCDFs.
 """
 
 from __future__ import annotations
@@ -11,11 +9,17 @@ from pathlib import Path
 
 import numpy as np
 
-from spine_mj.plotting import SEQUENTIAL_CMAP, THRESHOLD_COLOR, new_figure, save_figure, sig, styled
+from spine_mj.plotting import (
+    SEQUENTIAL_CMAP,
+    THRESHOLD_COLOR,
+    new_figure,
+    save_figure,
+    sig,
+    styled,
+)
+from spine_mj.validate.report.common import ReportContext, assemble, cell, image, table
 from spine_mj.validate.stick_slip import complementary_cdf
 from spine_mj.validate.stiffness_map import CRITERION, SLIP_FAMILIES, StiffnessMapResult
-
-__all__ = ["ccdf_figure", "map_figure", "map_sections"]
 
 #: At most this many (I_e, K) series in the CCDF figure.
 MAX_CCDF_SERIES = 5
@@ -151,7 +155,7 @@ def ccdf_figure(km: StiffnessMapResult, path: Path) -> Path | None:
     return save_figure(fig, path)
 
 
-def _bracket(star: dict, cell) -> str:
+def _bracket(star: dict) -> str:
     """The I_e* bracket as text: ``low-high``, or ``< high`` / ``> low`` off the grid."""
     kind = star.get("kind")
     if kind == "below":
@@ -166,7 +170,7 @@ def _ratio(row: dict) -> str:
     return sig(v) if v is not None and np.isfinite(v) else "- (no quasistatic work)"
 
 
-def map_sections(km: StiffnessMapResult | None, table, cell) -> dict[str, str]:
+def map_sections(km: StiffnessMapResult) -> dict[str, str]:
     """Report text of the map: ``map`` (I_e*(K) table), ``energy`` and ``slip`` (tables
     with one sentence each), drawn by the report's ``table(rows, columns, names)`` and
     ``cell(value)`` so that every table of the report reads alike. Empty strings without a
@@ -182,7 +186,7 @@ def map_sections(km: StiffnessMapResult | None, table, cell) -> dict[str, str]:
                     "family": fam,
                     "K": float(k),
                     "ie_star": s.get("value"),
-                    "bracket": _bracket(s, cell),
+                    "bracket": _bracket(s),
                     "ci": f"{cell(s.get('ci_low'))}-{cell(s.get('ci_high'))}",
                     "kind": s.get("kind"),
                     "runs": f"{min(grid_cell['n_ok'])}-{max(grid_cell['n_ok'])} ok / {max(grid_cell['n'])}",
@@ -300,3 +304,23 @@ def map_sections(km: StiffnessMapResult | None, table, cell) -> dict[str, str]:
         else []
     )
     return {"map": "\n".join(head), "energy": "\n".join(energy), "slip": "\n".join(slip)}
+
+
+def headline(km: StiffnessMapResult) -> list[str]:
+    return []
+
+
+def section(km: StiffnessMapResult, ctx: ReportContext) -> str | None:
+    """The map's sections (I_e*(K), energy, slip), or None without a map."""
+    if not km.agreement:
+        return None
+    text = map_sections(km)
+    heat = ctx.draw(map_figure, km, "ie_k_map.png")
+    ccdf = ctx.draw(ccdf_figure, km, "slip_ccdf.png")
+    return assemble(
+        text["map"],
+        image("Outcome agreement over (I_e, K) per family with I_e*(K)", heat),
+        text["energy"],
+        text["slip"],
+        image("Complementary CDFs of slip size and force drop", ccdf),
+    )

@@ -56,7 +56,7 @@ def test_fast_forward_breaks_away_where_the_plain_ramp_does_on_planes(slope):
 
 @pytest.mark.parametrize("y0", [-1.0, -2.0])
 def test_fast_forward_breaks_away_where_the_plain_ramp_does_on_the_single_peak(y0):
-    from spine_mj.validate.ramp_plan import pilot_rig
+    from spine_mj.validate.ramp_pilot import pilot_rig
 
     rig, _ = pilot_rig("paper-single-peak", None, 1.23, 0.1, 61)  # coarse hfield: fast
     rate = 0.1 * rig.scales.preload_n / rig.scales.time_s  # I_e = 1e-2
@@ -92,7 +92,7 @@ def test_a_tip_wedged_in_the_valley_reaches_the_cap_with_the_plain_ramps_verdict
     breakaway its deepest normal predicts, so only the force cap ends the run. The
     fast-forward's approach takes it there at 8 times the nominal rate: the same verdict,
     the same place (0.006 L_c apart after 20 cycles), in under half the steps."""
-    from spine_mj.validate.ramp_plan import pilot_rig
+    from spine_mj.validate.ramp_pilot import pilot_rig
 
     rig, _ = pilot_rig("paper-single-valley", None, 1.23, 0.1, 61)
     sc = rig.scales
@@ -189,7 +189,7 @@ def test_probe_fast_forward_breaks_away_where_the_plain_probe_does_on_planes(slo
     ],
 )
 def test_probe_fast_forward_breaks_away_where_the_plain_probe_does_on_the_single_peak(start, end):
-    from spine_mj.validate.ramp_plan import pilot_rig
+    from spine_mj.validate.ramp_pilot import pilot_rig
 
     rig, _ = pilot_rig("paper-single-peak", None, 1.23, 0.1, 61)
     sc = rig.scales

@@ -11,7 +11,7 @@ from sim_rigs import flat_rig, plane_rig
 from spine_mj import presets, sim
 from spine_mj.sim import Detection, EndReason, SpringDrive, StaticProbe
 from spine_mj.sim.drives import settle_steps
-from spine_mj.validate.ramp_plan import pilot_rig
+from spine_mj.validate.ramp_pilot import pilot_rig
 
 
 def test_batch_equals_one_at_a_time_and_python_reference():

@@ -14,7 +14,7 @@ from sim_rigs import plane_rig
 from spine_mj.sim import Detection, SpringDrive
 from spine_mj.sim.recording import COLUMNS
 from spine_mj.sim.results import GroupAnalysis
-from spine_mj.validate.ramp_plan import pilot_rig
+from spine_mj.validate.ramp_pilot import pilot_rig
 
 
 def _recorded(rig, drive, starts):

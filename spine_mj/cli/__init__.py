@@ -1,0 +1,28 @@
+"""The ``spine-mj`` command line (click).
+
+Modules: :mod:`~spine_mj.cli.app` (the root group :func:`main`, the program :func:`run`,
+one-line errors, progress and shared argument parsing), and one module per family of
+commands: :mod:`~spine_mj.cli.surface` (``surface make/show/info/export``),
+:mod:`~spine_mj.cli.theory` (``kappa``, ``streamline``, ``reproduce``),
+:mod:`~spine_mj.cli.sim` (``simulate``, ``replay``, ``view``, ``sim export``),
+:mod:`~spine_mj.cli.sweep` (``sweep run/status``, ``report``) and
+:mod:`~spine_mj.cli.validate` (``validate``). Importing this package registers every
+command on :func:`main`.
+"""
+
+from spine_mj.cli import sim, surface, sweep, theory, validate
+from spine_mj.cli.app import INPUT_ERROR_EXIT, InputError, Progress, _exit_on_sigterm, main, run
+
+__all__ = [
+    "INPUT_ERROR_EXIT",
+    "InputError",
+    "Progress",
+    "_exit_on_sigterm",
+    "main",
+    "run",
+    "sim",
+    "surface",
+    "sweep",
+    "theory",
+    "validate",
+]

@@ -1,0 +1,177 @@
+"""The command line's shared plumbing: the root group ``main``, the program ``run``, one-line
+errors (:class:`InputError`, exit code 2), the progress display and the argument parsers the
+command modules share.
+
+Bad input ends in one line ``Error: ...`` on stderr and exit code 2, never a traceback;
+outputs are written atomically, so a failed command leaves nothing half-written.
+Printing and progress bars live in the CLI; the library reports through return values and
+callbacks.
+"""
+
+from __future__ import annotations
+
+import signal
+import sys
+from pathlib import Path
+
+import click
+import numpy as np
+from tqdm import tqdm
+
+from spine_mj import presets, surface_io
+from spine_mj.errors import SpineInputError
+
+INPUT_ERROR_EXIT = 2
+
+
+class Progress:
+    """The CLI's one progress display: a tqdm bar on stderr, or nothing with ``quiet``.
+
+    ``update(done, total, desc=None, **postfix)`` moves the bar to ``done`` of ``total``
+    (a new ``desc`` starts a fresh bar); used as a context manager it closes the bar.
+    """
+
+    def __init__(self, desc: str, *, unit: str = "it", quiet: bool = False):
+        self.desc, self.unit, self.quiet, self.bar = desc, unit, quiet, None
+
+    def update(self, done: float, total: float, desc: str | None = None, **postfix) -> None:
+        if self.quiet:
+            return
+        if self.bar is not None and desc is not None and desc != self.bar.desc:
+            self.close()
+        if self.bar is None:
+            tqdm.monitor_interval = 0  # no monitor thread: a single-threaded CLI forks its workers
+            self.bar = tqdm(
+                total=total, desc=desc or self.desc, unit=self.unit, dynamic_ncols=True, file=sys.stderr
+            )
+        self.bar.total = total
+        self.bar.n = done
+        if postfix:
+            self.bar.set_postfix(postfix, refresh=False)
+        self.bar.refresh()
+
+    def complete(self) -> None:
+        """Move an open bar to its total: a job that ended early (a breakaway) is done too."""
+        if self.bar is not None:
+            self.update(self.bar.total, self.bar.total)
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
+            self.bar = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+
+class InputError(click.ClickException):
+    """A :class:`SpineInputError` (or unreadable file) shown as one line, exit code 2."""
+
+    exit_code = INPUT_ERROR_EXIT
+
+
+#: The usage error by which a group given no arguments shows its help (click >= 8.2).
+_SHOWS_HELP = tuple(e for e in [getattr(click.exceptions, "NoArgsIsHelpError", None)] if e)
+
+
+class _Group(click.Group):
+    """Turns the library's input errors and click's usage errors into :class:`InputError`
+    (one line) for every subcommand, and so too a request too large for memory or out of
+    floating-point range that no check at the boundary caught (not a traceback)."""
+
+    def invoke(self, ctx):
+        try:
+            # numpy's overflow and invalid-value warnings would print lines before the one
+            # error line; results are checked for finiteness where it matters
+            with np.errstate(all="ignore"):
+                return super().invoke(ctx)
+        except _SHOWS_HELP:
+            raise
+        except click.UsageError as exc:  # click's own: usage, hint and error in one line
+            hint = f" (see '{exc.ctx.command_path} --help')" if exc.ctx is not None else ""
+            raise InputError(exc.format_message() + hint) from None
+        except SpineInputError as exc:
+            root = ctx.find_root()
+            if exc.details and root.params.get("verbose"):
+                click.echo(exc.details, err=True)
+            raise InputError(str(exc)) from None
+        except OSError as exc:
+            where = f": {exc.filename}" if exc.filename is not None else " (the system named no file)"
+            raise InputError(f"{exc.strerror or exc}{where}") from None
+        except MemoryError as exc:  # the checks at the boundary missed a size: still one line
+            raise InputError(
+                f"not enough memory for this request ({exc or 'MemoryError'}): a size, resolution or "
+                "duration is too large, or a length too small for the surface"
+            ) from None
+        except (OverflowError, RecursionError) as exc:
+            raise InputError(
+                f"a value is out of range ({type(exc).__name__}: {exc}); check the parameters given"
+            ) from None
+
+
+@click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(package_name="spine_mj")
+@click.option("-v", "--verbose", is_flag=True, help="Show the full text behind an error (e.g. a reader's).")
+def main(verbose):
+    """spine_mj: streamline theory and MuJoCo dynamics of bio-inspired spines on rough
+    surfaces."""
+
+
+def run() -> None:
+    """The ``spine-mj`` program: :func:`main`, with a SIGTERM (kill, timeout, a scheduler)
+    unwinding like Ctrl-C so that temporary outputs are removed. Callers of :func:`main`
+    in their own process (tests, notebooks) keep their signal handling."""
+    signal.signal(signal.SIGTERM, _exit_on_sigterm)
+    main()
+
+
+def _exit_on_sigterm(signum, frame):
+    """SIGTERM's handler: exit as a kill would (128 + signal), through every ``finally``."""
+    raise SystemExit(128 + signum)
+
+
+def load_surface_arg(spec: str):
+    """A SURFACE argument: a saved .npz, a preset name, or an instrument file."""
+
+    path = Path(spec)
+    if path.suffix == ".npz":
+        return surface_io.load_surface(path)
+    if spec in presets.list_presets() or path.suffix == ".toml":
+        return presets.make_surface(spec)
+    if path.is_file():
+        return surface_io.import_topography(path)
+    raise SpineInputError(
+        f"SURFACE must be a .npz file, a preset ({', '.join(presets.list_presets())}) or an "
+        f"instrument file, got {spec!r}"
+    )
+
+
+def check_suffix(path: str, suffix: str, option: str) -> None:
+    if Path(path).suffix.lower() != suffix:
+        raise SpineInputError(f"{option} must name a {suffix} file, got {path!r}")
+
+
+def parse_start(text: str) -> tuple[float, float]:
+    try:
+        x, y = (float(v) for v in text.split(","))
+    except ValueError:
+        raise SpineInputError(f"--start must look like X,Y (e.g. -3,-1), got {text!r}") from None
+    return x, y
+
+
+def refuse_options_not_for(what: str, params: list[str]) -> None:
+    """A :class:`SpineInputError` if any of the current command's ``params`` was given on
+    the command line: options that ``what`` would ignore."""
+    ctx = click.get_current_context()
+    given = [
+        opt.opts[0]
+        for opt in ctx.command.params
+        if opt.name in params and ctx.get_parameter_source(opt.name) is click.core.ParameterSource.COMMANDLINE
+    ]
+    if given:
+        raise SpineInputError(
+            f"{what} does not use {', '.join(given)}; leave {'it' if len(given) == 1 else 'them'} out"
+        )

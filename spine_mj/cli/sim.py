@@ -1,0 +1,374 @@
+"""The MuJoCo rig's commands: ``simulate``, ``replay``, ``view`` and ``sim export``."""
+
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+
+import click
+
+from spine_mj import extras, presets, sim, surface_io
+from spine_mj.atomic import all_or_none, atomic_output
+from spine_mj.cli.app import (
+    InputError,
+    Progress,
+    _Group,
+    check_suffix,
+    load_surface_arg,
+    main,
+    parse_start,
+    refuse_options_not_for,
+)
+from spine_mj.errors import SpineInputError, check_positive
+from spine_mj.jsonio import write_json
+from spine_mj.plotting import (
+    save_figure,
+    sim_run_figure,
+)
+from spine_mj.sim.model import compile_spec
+from spine_mj.sim.render import FPS, choose_gl_backend, default_speed, render_frames
+from spine_mj.sim.replay import load_run, play_in_viewer, run_in_viewer
+
+
+def _rig_options(f):
+    """Options shared by `sim export`, `simulate` and `view` (tip, scale, engine)."""
+    opts = [
+        click.option(
+            "--tip-radius",
+            type=float,
+            default=None,
+            help="Tip radius [m] (default: the surface's own, 2 spacings for a scan, else "
+            "max(1 spacing, L_c / 100)).",
+        ),
+        click.option("--mass", type=float, default=0.01, show_default=True, help="m_eff [kg]."),
+        click.option(
+            "--mu",
+            type=float,
+            default=None,
+            help="Friction coefficient mu_s (default: the preset's [engagement] mu, else 0.5).",
+        ),
+        click.option(
+            "--preload", type=float, default=0.0, show_default=True, help="Extra downward preload [N]."
+        ),
+        click.option(
+            "--length-scale",
+            type=float,
+            default=None,
+            help="Metres per unit of a dimensionless surface (default 0.01).",
+        ),
+        click.option(
+            "--resolution",
+            type=int,
+            default=None,
+            help="hfield samples a side for analytic surfaces (default 201).",
+        ),
+        click.option("--timestep", type=float, default=None, help="Time step [s] (default: derived)."),
+        click.option("--noslip", type=int, default=None, help="noslip_iterations (default 3)."),
+        click.option("--impratio", type=float, default=None, help="impratio (default 1)."),
+    ]
+    for opt in reversed(opts):
+        f = opt(f)
+    return f
+
+
+def _build_rig(
+    surface_spec,
+    tip_radius,
+    mass,
+    mu,
+    preload,
+    length_scale,
+    resolution,
+    timestep,
+    noslip,
+    impratio,
+    *,
+    ie=None,
+    speed=None,
+):
+    """The rig of the shared rig options; ``ie`` or ``speed`` (the drive's) bound the engine
+    step for impacts (:func:`spine_mj.sim.default_engine`)."""
+
+    surf = load_surface_arg(surface_spec)
+    mu = presets.preset_mu(surf) if mu is None else mu
+    tip = sim.TipParams(
+        tip_radius_m=tip_radius, mass_kg=mass, preload_n=preload, **({} if mu is None else {"mu_s": mu})
+    )
+    overrides = {
+        k: v
+        for k, v in (
+            ("timestep_s", timestep),
+            ("noslip_iterations", noslip),
+            ("impratio", impratio),
+            ("hfield_resolution", resolution),
+        )
+        if v is not None
+    }
+    scales = sim.Scales.for_surface(surf, tip=tip, length_scale_m=length_scale, hfield_resolution=resolution)
+    if ie is not None:
+        speed = scales.speed_for(check_positive("--ie", ie))
+    engine = sim.default_engine(scales, speed_m_s=speed, **overrides)
+    return sim.Rig(surf, tip=tip, length_scale_m=length_scale, engine=engine)
+
+
+@main.group("sim", cls=_Group)
+def sim_group():
+    """The MuJoCo rig: export the model of a surface."""
+
+
+@sim_group.command("export")
+@click.argument("surface_spec", metavar="SURFACE")
+@click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="Output .xml.")
+@click.option(
+    "--start",
+    default=None,
+    help="Where the tip rests, 'x0,y0' in surface units (default: a tenth in from the -x edge, mid y).",
+)
+@click.option("--stiffness", type=float, default=None, help="Spring stiffness [N/m] (default K = 30).")
+@_rig_options
+def sim_export(surface_spec, output, start, stiffness, **rig_opts):
+    """Write a self-contained MJCF of the rig on SURFACE, ready for MuJoCo's viewer.
+
+    The tip rests on the surface at --start (keyframe 'home', also the initial state),
+    the spring is on with its target at the tip. Plain MJCF has no controller, so
+    nothing moves by itself: in the viewer's Control panel move the 'spring' slider (the
+    carriage's x, engine units) to pull the tip in x, or 'push' (a force, +-2 F_p).
+    Press Backspace (reset) to return to the start. The camera 'follow' tracks the tip.
+    Units are engine units: length L_c, force F_p, mass m (printed below).
+
+    \b
+    Example:
+      spine-mj sim export paper-single-peak -o rig.xml && python -m mujoco.viewer --mjcf rig.xml
+    """
+    check_suffix(output, ".xml", "-o/--output")
+    rig = _build_rig(surface_spec, **rig_opts)
+    xy = None if start is None else parse_start(start)
+    if stiffness is not None:
+        check_positive("--stiffness", stiffness)
+    rig.export_xml(output, start=xy, stiffness_n_m=stiffness)
+    u = rig.units
+    click.echo(
+        f"wrote {output} (hfield {rig.hfield.nrow} x {rig.hfield.ncol}, "
+        f"dt {rig.engine.timestep_s:g} s, tip radius {rig.tip.tip_radius_m:g} m; "
+        f"engine units: L_c = {u.length_m:g} m, F_p = {u.force_n:g} N, m = {u.mass_kg:g} kg)"
+    )
+    click.echo("in the viewer: Control panel, move 'spring' (carriage x) or 'push' to drive the tip")
+
+
+@main.command("simulate")
+@click.argument("surface_spec", metavar="SURFACE")
+@click.option("--start", required=True, help="Start 'x0,y0' in surface units, e.g. -3,-1.")
+@click.option("--drive", type=click.Choice(["spring", "ramp", "static"]), default="spring", show_default=True)
+@click.option(
+    "--ie",
+    type=float,
+    default=None,
+    help="Inertia number I_e = m v^2 / (F_p L_c): sets the carriage speed (spring) or the "
+    "force rate (ramp, static); default 1e-3 unless --speed or --rate is given.",
+)
+@click.option("--speed", type=float, default=None, help="Carriage speed [m/s] (spring; instead of --ie).")
+@click.option(
+    "--K",
+    "stiffness_number",
+    type=float,
+    default=None,
+    help="Drive stiffness number K = k l_s / F_p (l_s: slope correlation length; spring).",
+)
+@click.option(
+    "--stiffness",
+    type=float,
+    default=None,
+    help="Spring stiffness [N/m] (instead of --K; default K = 30).",
+)
+@click.option("--rate", type=float, default=None, help="Force rate [N/s] (ramp, static; instead of --ie).")
+@click.option(
+    "--start-force",
+    type=float,
+    default=0.0,
+    show_default=True,
+    help="Static probe: force [N] applied while the tip settles.",
+)
+@click.option("--duration", type=float, default=None, help="Run time [s] (spring, ramp).")
+@click.option(
+    "--render",
+    is_flag=True,
+    help="Also write run.mp4 (headless: MUJOCO_GL=egl, else osmesa) with the tip's path, the "
+    "streamline from the same start and the drive force.",
+)
+@click.option(
+    "--out",
+    "out_dir",
+    required=True,
+    type=click.Path(file_okay=False),
+    help="Output folder (trajectory.parquet, summary.json, surface.npz, run.png, run.mp4).",
+)
+@_rig_options
+def simulate(
+    surface_spec,
+    start,
+    drive,
+    ie,
+    speed,
+    stiffness_number,
+    stiffness,
+    rate,
+    start_force,
+    duration,
+    render,
+    out_dir,
+    **rig_opts,
+):
+    """Run one drive on SURFACE: writes trajectory.parquet, run.png, summary.json (and run.mp4).
+
+    Lengths, forces and times are SI; --ie and --K give the drive in dimensionless terms.
+
+    \b
+    Example:
+      spine-mj simulate paper-single-peak --start -3,-1 --drive spring --ie 1e-3 --K 10 --out out/
+    """
+
+    if render:
+        extras.require("video", "--render")
+        choose_gl_backend()
+
+    x0, y0 = parse_start(start)
+    refuse_options_not_for(
+        f"--drive {drive}",
+        {
+            "spring": ["rate", "start_force"],
+            "ramp": ["speed", "stiffness_number", "stiffness", "start_force"],
+            "static": ["speed", "stiffness_number", "stiffness", "duration"],
+        }[drive],
+    )
+    for a, b, names in ((ie, speed, "--ie or --speed"), (ie, rate, "--ie or --rate")):
+        if a is not None and b is not None:
+            raise SpineInputError(f"give one of {names}, got both")
+    if stiffness_number is not None and stiffness is not None:
+        raise SpineInputError("give one of --K or --stiffness, got both")
+    if ie is None and speed is None and rate is None:
+        ie = 1e-3
+    rig = _build_rig(surface_spec, **rig_opts, ie=ie, speed=speed)
+    sc = rig.scales
+    if ie is not None:
+        speed = sc.speed_for(check_positive("--ie", ie))
+        rate = speed * sc.preload_n / sc.char_length_m
+    if stiffness_number is not None:
+        stiffness = sc.stiffness_for(check_positive("--K", stiffness_number))
+    if drive == "spring":
+        drv = sim.SpringDrive(speed_m_s=speed, stiffness_n_m=stiffness, duration_s=duration)
+    elif drive == "ramp":
+        drv = sim.RampDrive(rate_n_s=rate, duration_s=duration)
+    else:
+        drv = sim.StaticProbe(rate_n_s=rate, start_force_n=start_force)
+    with Progress("simulating", unit="%") as bar:
+        result = rig.run(drv, start=(x0, y0), progress=lambda frac: bar.update(round(100 * frac, 1), 100))
+        bar.complete()
+    out = Path(out_dir)
+    written = ["trajectory.parquet", "summary.json", "surface.npz", "run.png"] + (
+        ["run.mp4"] if render else []
+    )
+    with all_or_none(*(out / name for name in written)):
+        with atomic_output(out / "trajectory.parquet") as tmp:
+            result.table().to_parquet(tmp, index=False)
+        write_json(out / "summary.json", result.summary())
+        surface_io.save_surface(rig.surface, out / "surface.npz")  # for `spine-mj replay`
+        save_figure(sim_run_figure(result, rig.surface, length_scale_m=rig.length_scale_m), out / "run.png")
+        if render:
+            _render_mp4(rig, result, out / "run.mp4")
+    click.echo(
+        f"end: {result.end_reason.value} ({result.end_detail}); I_e = {result.inertia_number:.3g}"
+        + (f", K = {result.stiffness_number:.3g}" if drive == "spring" else "")
+    )
+    click.echo(f"wrote {', '.join(str(out / w) for w in written)}")
+
+
+def _render_mp4(rig, run, path: Path, *, speed: float | None = None) -> None:
+    """Write the MP4 of a run (a RunResult or a replay Track), with a progress bar."""
+    import imageio.v2 as imageio
+
+    with Progress("rendering MP4", unit="frame") as bar:
+        frames = render_frames(rig, run, speed=speed, progress=bar.update)
+        first = next(frames)  # a missing renderer fails here, before the file is opened
+        with atomic_output(path) as tmp:
+            with imageio.get_writer(tmp, fps=FPS, codec="libx264", format="FFMPEG") as writer:
+                writer.append_data(first)
+                for frame in frames:
+                    writer.append_data(frame)
+
+
+@main.command("replay")
+@click.argument("run_dir", type=click.Path(file_okay=False, exists=True))
+@click.option(
+    "--speed", type=float, default=None, help="Playback speed, times real time (default: the run in ~10 s)."
+)
+@click.option("--duration", type=float, default=None, help="Close the viewer after this many seconds.")
+@click.option(
+    "--mp4", type=click.Path(dir_okay=False), default=None, help="Write this MP4 instead (headless)."
+)
+def replay(run_dir, speed, duration, mp4):
+    """Play a run recorded by `spine-mj simulate` in MuJoCo's viewer (RUN_DIR: its --out-dir).
+
+    The tip moves through its recorded positions at the recorded times (times --speed),
+    with its path so far (orange) and the streamline from the same start (cyan). Without a
+    display, or with --mp4, it writes an MP4 instead (RUN_DIR/replay.mp4 by default).
+
+    \b
+    Example:
+      spine-mj simulate paper-single-peak --start -3,-1 --out run/ && spine-mj replay run/
+    """
+    headless = mp4 is not None or (
+        sys.platform.startswith("linux")
+        and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+    )
+    if duration is not None:
+        check_positive("--duration", duration)
+    if headless:
+        choose_gl_backend()
+    rig, track = load_run(run_dir)
+    if headless:
+        extras.require("video", "replay without a display (an MP4)" if mp4 is None else "--mp4")
+    span = float(track.time_s[-1] - track.time_s[0])
+    speed = check_positive("--speed", speed) if speed is not None else default_speed(track.time_s)
+    if headless:
+        path = Path(mp4) if mp4 is not None else Path(run_dir) / "replay.mp4"
+        check_suffix(str(path), ".mp4", "--mp4")
+        if mp4 is None:
+            click.echo("no display: writing an MP4 instead of opening the viewer", err=True)
+        _render_mp4(rig, track, path, speed=speed)
+        click.echo(f"wrote {path}")
+        return
+    click.echo(f"replaying {span:g} s of run at {speed:g}x; close the window to stop", err=True)
+    play_in_viewer(rig, track, speed=speed, duration_s=duration)
+
+
+@main.command("view")
+@click.argument("surface_spec", metavar="SURFACE")
+@click.option(
+    "--start",
+    default=None,
+    help="Where the tip rests, 'x0,y0' in surface units (default: a tenth in from the -x edge, mid y).",
+)
+@click.option("--duration", type=float, default=None, help="Close the viewer after this many seconds.")
+@_rig_options
+def view(surface_spec, start, duration, **rig_opts):
+    """Open the rig on SURFACE in MuJoCo's interactive viewer (needs a display).
+
+    The model is the one `sim export` writes: the tip rests at --start with the spring on;
+    drive it with the 'spring' (carriage x) or 'push' slider in the Control panel. It
+    runs in physical real time, seen from the camera 'follow' (Esc: the free camera).
+    To watch a recorded run instead, use `spine-mj replay RUN_DIR`.
+    """
+
+    if duration is not None:
+        check_positive("--duration", duration)
+    if sys.platform.startswith("linux") and not (
+        os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
+    ):
+        raise InputError(
+            "no display (DISPLAY and WAYLAND_DISPLAY are unset): the viewer "
+            "needs one; use `spine-mj sim export`, `simulate --render` or `replay --mp4`"
+        )
+    rig = _build_rig(surface_spec, **rig_opts)
+    model = compile_spec(rig.export_spec(None if start is None else parse_start(start)))
+    run_in_viewer(model, time_scale=1.0 / rig.units.time_s, duration_s=duration)

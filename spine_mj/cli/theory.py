@@ -1,0 +1,192 @@
+"""The engagement theory's commands: ``kappa``, ``streamline`` and ``reproduce`` (the paper's figures)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+import numpy as np
+import pandas as pd
+
+from spine_mj import engagement, presets, reproduce
+from spine_mj.atomic import all_or_none, atomic_output
+from spine_mj.cli.app import (
+    Progress,
+    check_suffix,
+    load_surface_arg,
+    main,
+    parse_start,
+    refuse_options_not_for,
+)
+from spine_mj.engagement import kappa
+from spine_mj.errors import SpineInputError
+from spine_mj.jsonio import write_json
+from spine_mj.plotting import (
+    kappa_map_figure,
+    save_figure,
+    streamline_figure,
+)
+from spine_mj.streamline import StreamlineParams, dilate, ideal_trajectories, streamlines
+from spine_mj.surfaces import check_grid_size
+
+
+def _engagement_mu(surf, mu):
+    if mu is None:
+        mu = presets.preset_mu(surf)
+    if mu is None:
+        raise SpineInputError("--mu is required for a surface whose preset has no [engagement] mu")
+    return mu
+
+
+@main.command("kappa")
+@click.argument("surface_spec", metavar="SURFACE")
+@click.option("--mu", type=float, help="Static friction coefficient mu_s (default: the preset's).")
+@click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="Output PNG.")
+@click.option(
+    "--resolution", type=click.IntRange(min=8), default=301, show_default=True, help="Samples a side."
+)
+def kappa_cmd(surface_spec, mu, output, resolution):
+    """Map the engagement ratio kappa over SURFACE (paper Fig. 2B): slip blank, self-lock
+    dark red.
+
+    \b
+    Example:
+      spine-mj kappa paper-single-peak --mu 1.2 -o map.png
+    """
+
+    check_suffix(output, ".png", "-o/--output")
+    check_grid_size(resolution, resolution, where="kappa --resolution")
+    surf = load_surface_arg(surface_spec)
+    mu = _engagement_mu(surf, mu)
+    xmin, xmax, ymin, ymax = surf.bounds
+    xs = np.linspace(xmin, xmax, resolution)
+    ys = np.linspace(ymin, ymax, resolution)
+    _, fx, fy = surf.evaluate(xs[None, :], ys[:, None], order=1)
+    k, region = kappa(fx, fy, mu)
+    heights = surf.height(xs[None, :], ys[:, None])
+    fig = kappa_map_figure({surf.metadata.get("preset", "surface"): (xs, heights, k, region)}, mu)
+    save_figure(fig, output)
+    shares = ", ".join(f"{n} {100 * np.mean(region == c):.1f} %" for c, n in engagement.REGION_NAMES.items())
+    click.echo(f"wrote {output} ({shares})")
+
+
+@main.command("streamline")
+@click.argument("surface_spec", metavar="SURFACE")
+@click.option("--mu", type=float, help="Static friction coefficient mu_s (default: the preset's).")
+@click.option(
+    "--start", "starts", multiple=True, required=True, metavar="X,Y", help="Start point, repeatable."
+)
+@click.option("--dl", type=float, default=None, help="Step length (default: 1/1000 of the domain).")
+@click.option(
+    "--tip-radius",
+    type=float,
+    default=0.0,
+    show_default=True,
+    help="Spherical tip radius R; the tip centre rides the surface dilated by R.",
+)
+@click.option(
+    "--format",
+    "fmt",
+    type=click.Choice(["parquet", "csv"]),
+    default="parquet",
+    show_default=True,
+    help="Table format.",
+)
+@click.option(
+    "--out",
+    "out_dir",
+    required=True,
+    type=click.Path(file_okay=False),
+    help="Output folder (streamlines.parquet|csv and streamlines.png).",
+)
+def streamline_cmd(surface_spec, mu, starts, dl, tip_radius, fmt, out_dir):
+    """Quasistatic streamlines and ideal trajectories from each --start (paper Eq. 4):
+    a table (one row per path point) and a PNG (3-D view and kappa along the paths).
+
+    \b
+    Example:
+      spine-mj streamline paper-single-valley --mu 1.2 --start -3,-1 --start -3,-2 -o out/
+    """
+
+    pts = [parse_start(s) for s in starts]
+    surf = load_surface_arg(surface_spec)
+    mu = _engagement_mu(surf, mu)
+    xmin, xmax, ymin, ymax = surf.bounds
+    params = StreamlineParams(mu=mu, dl=dl if dl is not None else max(xmax - xmin, ymax - ymin) / 1000)
+    if tip_radius:
+        surf = dilate(surf, tip_radius)
+    stream = streamlines(surf, pts, params)
+    ideal = ideal_trajectories(surf, pts, params)
+    table = pd.concat([stream.to_frame(), ideal.to_frame()], ignore_index=True)
+    table["mu"] = mu
+    table["tip_radius"] = tip_radius
+    out = Path(out_dir)
+    path = out / f"streamlines.{fmt}"
+    with all_or_none(path, out / "streamlines.png"):
+        with atomic_output(path) as tmp:
+            if fmt == "parquet":
+                table.to_parquet(tmp, index=False)
+            else:
+                table.to_csv(tmp, index=False)
+        save_figure(streamline_figure(surf, stream, ideal, title=f"mu_s = {mu:g}"), out / "streamlines.png")
+    for i, (x, y) in enumerate(pts):
+        click.echo(
+            f"start ({x:g}, {y:g}): streamline {stream.outcome_names[i]} at "
+            f"({stream.end_x[i]:.3f}, {stream.end_y[i]:.3f}), max kappa "
+            f"{stream.max_kappa[i]:.3g}; ideal {ideal.outcome_names[i]}, max kappa "
+            f"{ideal.max_kappa[i]:.3g}"
+        )
+    click.echo(f"wrote {path} and {out / 'streamlines.png'}")
+
+
+@main.command("reproduce")
+@click.argument("name", type=click.Choice(["single-peak", "random-gaussian", "fractal-hurst", "kappa-map"]))
+@click.option(
+    "--out",
+    "out_dir",
+    required=True,
+    type=click.Path(file_okay=False),
+    help="Output folder for NAME.png and NAME.json.",
+)
+@click.option("--quick", is_flag=True, help="Reduced run (fewer surfaces and starts).")
+@click.option(
+    "--surfaces",
+    type=click.IntRange(min=3),
+    default=None,
+    help="fractal-hurst: surfaces per H (default 300).",
+)
+@click.option(
+    "--workers",
+    type=click.IntRange(min=1),
+    default=2,
+    show_default=True,
+    help="fractal-hurst: worker processes.",
+)
+def reproduce_cmd(name, out_dir, quick, surfaces, workers):
+    """Reproduce a figure of the paper: writes DIR/NAME.png and DIR/NAME.json.
+
+    \b
+    single-peak      Figs. 3-4: five starts, self-lock start-range ratios
+    random-gaussian  Fig. 5: medians of max kappa, bypass / trap changes
+    fractal-hurst    Figs. 7E, 9: self-lock rate and concavity shares vs H
+    kappa-map        Fig. 2B: kappa over the single peak and valley
+
+    \b
+    Example:
+      spine-mj reproduce single-peak --out repro/
+    """
+
+    options = {}
+    if name == "fractal-hurst":
+        options = {"workers": workers}
+        if surfaces is not None:
+            options["surfaces"] = surfaces
+    else:
+        refuse_options_not_for(f"reproduce {name}", ["surfaces", "workers"])
+    with Progress(name) as bar:
+        numbers, fig = reproduce.run(name, quick=quick, progress=bar.update, **options)
+    out = Path(out_dir)
+    with all_or_none(out / f"{name}.json", out / f"{name}.png"):
+        write_json(out / f"{name}.json", numbers)
+        save_figure(fig, out / f"{name}.png")
+    click.echo(f"wrote {out / name}.json and {out / name}.png")

@@ -1,0 +1,101 @@
+"""``spine-mj validate``: the validation suite, MuJoCo against the quasistatic streamline."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+from spine_mj import validate
+from spine_mj.cli.app import (
+    Progress,
+    main,
+)
+from spine_mj.errors import SpineInputError
+
+
+@main.command("validate")
+@click.option(
+    "--out",
+    "out_dir",
+    required=True,
+    type=click.Path(),
+    help="Output folder: report.md, validation.json, figures/, sweeps/ (resumable).",
+)
+@click.option(
+    "--quick",
+    is_flag=True,
+    help="The quick plan (<= 5 min on 2 cores): fewer starts and I_e values, coarser hfields.",
+)
+@click.option(
+    "--plan",
+    "plan_name",
+    type=click.Choice(["smoke", "quick", "full"]),
+    default=None,
+    hidden=True,
+    help="Plan by name (smoke: a seconds-long test size).",
+)
+@click.option(
+    "--workers",
+    type=click.IntRange(min=1),
+    default=None,
+    help="Worker processes for the sweeps (default: all cores).",
+)
+@click.option("--quiet", is_flag=True, help="No progress lines.")
+def validate_cmd(out_dir, quick, plan_name, workers, quiet):
+    """Run the validation suite (MuJoCo against the quasistatic streamline across inertia
+    numbers) and write --out/report.md and --out/validation.json.
+
+    \b
+    Example:
+      spine-mj validate --quick --out demo-out
+    """
+
+    if plan_name is not None and quick and plan_name != "quick":
+        raise SpineInputError(f"--quick and --plan {plan_name}: give one of them")
+    plan = plan_name or ("quick" if quick else "full")
+    out = Path(out_dir)
+    if out.exists() and not out.is_dir():
+        raise SpineInputError(f"--out {out} exists and is not a folder")
+    with Progress("validate", unit="case", quiet=quiet) as bar:
+        result = validate.run_validation(
+            out,
+            plan=plan,
+            workers=workers,
+            progress=lambda p: bar.update(
+                p.finished_cases, max(p.total_cases, 1), desc=f"{p.study}: {p.step}"
+            ),
+        )
+    click.echo(
+        f"static kappa max rel. error (engaged, default settings): {result['static_kappa_max_rel_error']:.3g}"
+    )
+    for fam, summ in result["limit_families"].items():
+        stops = ", ".join(f"{k} {n}" for k, n in summ["failed_runs"].items()) or "none"
+        click.echo(
+            f"I_e = {result['lowest_ie']:g}, {fam}: outcome agreement {summ['outcome_agreement']:.0%} "
+            f"of {summ['runs']}, median Frechet {summ['median_frechet']:.3g} L_c, engine stops: {stops}"
+        )
+    for row in result.get("fractal_lock_rate", {}).get("rows", []):
+        rates = ", ".join(
+            f"{k} {row[f'rate_{k}']:.2f} ({row[f'locked_{k}']}/{row[f'n_ok_{k}']})"
+            for k in ("streamline", "mujoco_corner", "mujoco_dynamic")
+            if f"rate_{k}" in row
+        )
+        click.echo(f"fractal self-lock rate, H = {row['hurst']:g}: {rates}")
+    for proto, s in result["ie_star"].items():
+        if s.get("valid") is False:
+            click.echo(f"I_e* ({proto}) {s['note']}")
+            continue
+        for star in (s, s["by_criterion"].get("departure")):
+            if star is None:
+                continue
+            click.echo(f"I_e* ({proto}) criterion: {star['criterion']}")
+            if star["kind"] == "bracketed":
+                click.echo(f"  I_e* = {star['value']:.3g} in [{star['low']:.3g}, {star['high']:.3g}]")
+            elif star["kind"] == "above":
+                click.echo(f"  I_e* > {star['low']:.3g} (agreement holds on the whole grid)")
+            else:
+                click.echo(f"  I_e* < {star['high']:.3g} (no agreement at the lowest I_e)")
+    click.echo(
+        f"wrote {out / 'report.md'} and {out / 'validation.json'} ({result['timings_s']['total']:.0f} s)"
+    )

@@ -1,0 +1,130 @@
+"""The surfaces' shared rules: length units, size limits (a grid's point count, a random
+surface's peak count) and the checks of generator arguments."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from spine_mj.errors import SpineInputError
+
+#: Mean particle sizes of the sandpapers in the paper's experiment (§3.3), metres.
+GRIT_PARTICLE_DIAMETER_M = {"P36": 538e-6, "P60": 269e-6, "P600": 25.8e-6}
+
+#: Metres per unit of the length units a surface may carry, one ASCII spelling each
+#: (:func:`length_unit` maps the others onto them); ``unit == "1"`` is dimensionless.
+LENGTH_UNITS_M = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "nm": 1e-9, "pm": 1e-12}
+#: Other spellings of those units: the micro sign (SurfaceTopography's "µm") and Greek mu.
+_UNIT_SPELLINGS = {"\u00b5m": "um", "\u03bcm": "um"}
+
+_MIN_POINTS_PER_SIDE = 4
+#: Most points a generated or resampled grid may have (512 MiB per float64 array).
+MAX_GRID_POINTS = 2**26
+#: Most Gaussians of a random surface: every height costs one exponential per Gaussian.
+MAX_PEAKS = 100_000
+_CHUNK = 1 << 15
+_NONPERIODIC_PAD = 8  # cells of odd reflection before the spline filter, see GridSurface
+
+
+def length_unit(unit: str) -> str | None:
+    """The spelling of :data:`LENGTH_UNITS_M` for the length unit ``unit`` ("µm" -> "um"),
+    or None when ``unit`` is not one of them (dimensionless "1", "A", "km", ...)."""
+    unit = _UNIT_SPELLINGS.get(unit, unit) if isinstance(unit, str) else None
+    return unit if unit in LENGTH_UNITS_M else None
+
+
+def _rng_and_seed(rng: int | np.random.Generator | None) -> tuple[np.random.Generator, Any]:
+    if isinstance(rng, np.random.Generator):
+        return rng, None
+    if rng is None:
+        return np.random.default_rng(), None
+    if isinstance(rng, (int, np.integer)) and not isinstance(rng, bool) and rng >= 0:
+        return np.random.default_rng(int(rng)), int(rng)
+    raise SpineInputError(f"rng must be a non-negative int seed or a numpy Generator, got {rng!r}")
+
+
+def _flag(name: str, value) -> bool:
+    """``value`` as a bool: True, False, their numpy forms, 1 or 0; not 3 or "no"."""
+    if isinstance(value, str) or value not in (True, False):
+        raise SpineInputError(f"{name} must be true or false, got {value!r}")
+    return bool(value)
+
+
+def _pair(name: str, value) -> tuple[float, float]:
+    """``value`` as two finite floats, or a :class:`SpineInputError` naming ``name``."""
+    try:
+        a, b = (float(v) for v in value)
+    except (TypeError, ValueError):
+        raise SpineInputError(f"{name} must be a pair of numbers, got {value!r}") from None
+    if not (math.isfinite(a) and math.isfinite(b)):
+        raise SpineInputError(f"{name} must be finite, got {value!r}")
+    return a, b
+
+
+def _range(name: str, value, *, positive: bool = True) -> tuple[float, float]:
+    """``value`` as a finite pair ``(low, high)`` with low <= high (and low > 0 if ``positive``)."""
+    lo, hi = _pair(name, value)
+    if not lo <= hi:
+        raise SpineInputError(f"{name} must be a pair (low, high) with low <= high, got {value!r}")
+    if positive and lo <= 0:
+        raise SpineInputError(f"{name} must be > 0, got {value!r}")
+    return lo, hi
+
+
+def _bounds(value) -> tuple[float, float, float, float]:
+    try:
+        xmin, xmax, ymin, ymax = (float(v) for v in value)
+    except (TypeError, ValueError):
+        raise SpineInputError(f"bounds must be (xmin, xmax, ymin, ymax), got {value!r}") from None
+    if not all(math.isfinite(v) for v in (xmin, xmax, ymin, ymax, xmax - xmin, ymax - ymin)):
+        raise SpineInputError(f"bounds and their extents must be finite, got {value!r}")
+    if not (xmin < xmax and ymin < ymax):
+        raise SpineInputError(f"bounds must satisfy xmin < xmax and ymin < ymax, got {value!r}")
+    return xmin, xmax, ymin, ymax
+
+
+def _broadcast_points(x, y) -> tuple[np.ndarray, np.ndarray, tuple[int, ...]]:
+    x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
+    return x.ravel(), y.ravel(), x.shape
+
+
+def _grid_count(name: str, n) -> int:
+    """``n`` as a number of grid points a side: an integer in [4, MAX_GRID_POINTS]."""
+    ok = isinstance(n, (int, np.integer, float, np.floating)) and not isinstance(n, (bool, np.bool_))
+    if not ok or not math.isfinite(n) or int(n) != n or n < _MIN_POINTS_PER_SIDE:
+        raise SpineInputError(f"{name} must be an integer >= {_MIN_POINTS_PER_SIDE}, got {n!r}")
+    return int(n)
+
+
+def _count_at_least(name: str, n, least: int) -> int:
+    """``n`` as an integer count of at least ``least``."""
+    ok = isinstance(n, (int, np.integer, float, np.floating)) and not isinstance(n, (bool, np.bool_))
+    if not ok or not math.isfinite(n) or int(n) != n or n < least or n > MAX_GRID_POINTS:
+        raise SpineInputError(f"{name} must be an integer in [{least}, {MAX_GRID_POINTS}], got {n!r}")
+    return int(n)
+
+
+def check_grid_size(nx: int, ny: int, *, where: str) -> None:
+    """Refuse a grid of more than :data:`MAX_GRID_POINTS` points before allocating it.
+
+    Raises
+    ------
+    SpineInputError
+        Naming ``where``, the grid's shape, the limit and the memory one height array
+        of that shape would take.
+    """
+    points = float(nx) * float(ny)  # counts may come as floats, before rounding: inf is refused too
+    if not points <= MAX_GRID_POINTS:
+        gib = points * 8 / 2**30
+        raise SpineInputError(
+            f"{where}: a {_count(ny)} x {_count(nx)} grid has {points:.3g} points, more than the limit "
+            f"{MAX_GRID_POINTS:.3g} ({gib:.3g} GiB per height array); use fewer points or a coarser spacing"
+        )
+
+
+def _count(n) -> str:
+    """A point count for a message: whole numbers as integers, others as floats."""
+    n = float(n)
+    return str(int(n)) if math.isfinite(n) and n == int(n) and abs(n) < 1e15 else f"{n:.4g}"

@@ -1,0 +1,451 @@
+"""Surface generators: the paper's single Gaussian and random Gaussian surfaces (§3.1-3.2),
+fractal fBm surfaces and sandpaper analogs (§3.3). Pure functions with keyword-only
+options; randomness enters only through ``rng``, so a seed reproduces a surface bit for bit."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from spine_mj._version import __version__
+from spine_mj.errors import SpineInputError, check_positive
+from spine_mj.surfaces.base import (
+    _MIN_POINTS_PER_SIDE,
+    GRIT_PARTICLE_DIAMETER_M,
+    MAX_PEAKS,
+    _bounds,
+    _count_at_least,
+    _flag,
+    _grid_count,
+    _pair,
+    _range,
+    _rng_and_seed,
+    check_grid_size,
+)
+from spine_mj.surfaces.types import GaussianSurface, GridSurface
+
+
+def _meta(generator: str, seed, **params) -> dict:
+    clean = {k: (list(v) if isinstance(v, tuple) else v) for k, v in params.items()}
+    return {"generator": generator, "seed": seed, "params": clean, "spine_mj_version": __version__}
+
+
+def single_gaussian(
+    *,
+    sign: int = 1,
+    k: float = 10 * math.pi,
+    sigma_x: float = 1.5,
+    sigma_y: float = 1.5,
+    center: tuple[float, float] = (0.0, 0.0),
+    bounds: tuple[float, float, float, float] = (-5.0, 5.0, -5.0, 5.0),
+) -> GaussianSurface:
+    """The paper's single Gaussian peak (``sign=+1``) or valley (``sign=-1``), §3.1.
+
+    ``f = sign * k / (2 pi sx sy) * exp(-(x-mx)^2/(2 sx^2) - (y-my)^2/(2 sy^2))``; with the
+    paper's ``k = 10 pi`` and ``sx = sy = 1.5`` the amplitude is 2.22 and the steepest
+    slope 0.90 (docs/physics.md §3). Dimensionless.
+    """
+    if sign not in (1, -1):
+        raise SpineInputError(f"sign must be +1 (peak) or -1 (valley), got {sign!r}")
+    k = check_positive("k", k)
+    sx, sy = check_positive("sigma_x", sigma_x), check_positive("sigma_y", sigma_y)
+    mx, my = _pair("center", center)
+    amplitude = sign * k / (2 * math.pi * sx * sy)
+    return GaussianSurface(
+        amplitude=[amplitude],
+        center_x=[mx],
+        center_y=[my],
+        sigma_x=[sx],
+        sigma_y=[sy],
+        bounds=_bounds(bounds),
+        unit="1",
+        metadata=_meta(
+            "single_gaussian",
+            None,
+            sign=sign,
+            k=k,
+            sigma_x=sx,
+            sigma_y=sy,
+            center=(mx, my),
+            bounds=tuple(bounds),
+        ),
+    )
+
+
+def corrugation(
+    *,
+    wavelength: float = 1.0,
+    slope_amplitude: float = 0.3,
+    n_waves: int = 8,
+    width: float = 1.0,
+    points_per_wave: int = 32,
+) -> GridSurface:
+    """A sinusoidal corrugation ``z = h sin(2 pi x / lambda)``, uniform in y: the
+    Prandtl-Tomlinson profile, a surface whose dynamics have closed forms (docs/physics.md).
+
+    ``h = slope_amplitude * wavelength / (2 pi)``, so the steepest slope is
+    ``slope_amplitude``; ``L_c = wavelength`` (rms height over rms slope times 2 pi) and the
+    slope correlation length is ``0.190 wavelength``. The grid is periodic in x over
+    ``n_waves`` whole wavelengths starting at x = 0 (a crest's rising flank begins there)
+    and spans ``width`` in y, centred on y = 0. Dimensionless.
+    """
+    lam = check_positive("wavelength", wavelength)
+    s = float(slope_amplitude)
+    if not (math.isfinite(s) and 0.0 <= s <= 10.0):
+        raise SpineInputError(f"slope_amplitude must lie in [0, 10], got {slope_amplitude!r}")
+    waves = _count_at_least("n_waves", n_waves, 1)
+    per_wave = _count_at_least("points_per_wave", points_per_wave, 8)
+    w = check_positive("width", width)
+    nx = waves * per_wave
+    dx = lam / per_wave
+    ny = max(_MIN_POINTS_PER_SIDE, int(math.ceil(w / dx)))
+    check_grid_size(nx, ny, where="corrugation")
+    x = np.arange(nx) * dx
+    y = -w / 2 + np.arange(ny) * (w / ny)
+    h = s * lam / (2 * math.pi)
+    heights = np.broadcast_to(h * np.sin(2 * math.pi * x / lam), (ny, nx)).copy()
+    return GridSurface(
+        heights=heights,
+        x=x,
+        y=y,
+        periodic=True,
+        unit="1",
+        metadata=_meta(
+            "corrugation",
+            None,
+            wavelength=lam,
+            slope_amplitude=s,
+            n_waves=waves,
+            width=w,
+            points_per_wave=per_wave,
+        ),
+    )
+
+
+def random_gaussians(
+    *,
+    n_peaks: int = 100,
+    sign: int = 1,
+    bounds: tuple[float, float, float, float] = (-10.0, 10.0, -10.0, 10.0),
+    sigma_range: tuple[float, float] = (0.5, 1.5),
+    amplitude_range: tuple[float, float] = (0.5, 1.5),
+    anisotropic: bool = False,
+    overlap: bool = True,
+    min_separation: float = 2.0,
+    rng: int | np.random.Generator | None = None,
+) -> GaussianSurface:
+    """Random Gaussian surface of §3.2: ``n_peaks`` Gaussians scattered over ``bounds``.
+
+    Distributions (the paper gives none; the defaults are calibrated in ``analysis/``):
+
+    * centres: uniform over ``bounds``;
+    * widths: ``sigma`` uniform on ``sigma_range``; ``sigma_x = sigma_y`` unless
+      ``anisotropic``, when both are drawn independently;
+    * heights: amplitude ``|a|`` uniform on ``amplitude_range``, sign ``sign`` (+1 convex
+      peaks, -1 concave valleys);
+    * ``overlap=False`` rejects centres closer than ``min_separation * (sigma_i + sigma_j)``
+      (drawn in sequence), and fails clearly when they cannot all be placed.
+
+    The draws happen in a fixed order (centres, widths, amplitudes), so one seed gives the
+    same surface on every machine.
+    """
+    if isinstance(n_peaks, bool) or int(n_peaks) != n_peaks or not 0 < n_peaks <= MAX_PEAKS:
+        raise SpineInputError(f"n_peaks must be an integer in 1..{MAX_PEAKS}, got {n_peaks!r}")
+    n_peaks = int(n_peaks)
+    if sign not in (1, -1):
+        raise SpineInputError(f"sign must be +1 (convex peaks) or -1 (concave valleys), got {sign!r}")
+    anisotropic, overlap = _flag("anisotropic", anisotropic), _flag("overlap", overlap)
+    xmin, xmax, ymin, ymax = _bounds(bounds)
+    s_lo, s_hi = _range("sigma_range (widths)", sigma_range)
+    a_lo, a_hi = _range("amplitude_range (heights)", amplitude_range)
+    min_separation = float(min_separation)
+    if not overlap and not (min_separation > 0):
+        raise SpineInputError(f"min_separation must be > 0, got {min_separation!r}")
+    gen, seed = _rng_and_seed(rng)
+
+    sigma_x = gen.uniform(s_lo, s_hi, n_peaks)
+    sigma_y = gen.uniform(s_lo, s_hi, n_peaks) if anisotropic else sigma_x.copy()
+    amplitude = sign * gen.uniform(a_lo, a_hi, n_peaks)
+    if overlap:
+        cx = gen.uniform(xmin, xmax, n_peaks)
+        cy = gen.uniform(ymin, ymax, n_peaks)
+    else:
+        radius = 0.5 * (sigma_x + sigma_y)
+        cx, cy = np.empty(n_peaks), np.empty(n_peaks)
+        for i in range(n_peaks):
+            for _ in range(10_000):
+                px, py = gen.uniform(xmin, xmax), gen.uniform(ymin, ymax)
+                d = np.hypot(cx[:i] - px, cy[:i] - py)
+                if np.all(d >= min_separation * (radius[:i] + radius[i])):
+                    cx[i], cy[i] = px, py
+                    break
+            else:
+                raise SpineInputError(
+                    f"overlap=False: could not place peak {i + 1} of {n_peaks} with "
+                    f"min_separation={min_separation}; lower n_peaks, the widths or "
+                    "min_separation, or allow overlap"
+                )
+    return GaussianSurface(
+        amplitude=amplitude,
+        center_x=cx,
+        center_y=cy,
+        sigma_x=sigma_x,
+        sigma_y=sigma_y,
+        bounds=(xmin, xmax, ymin, ymax),
+        unit="1",
+        metadata=_meta(
+            "random_gaussians",
+            seed,
+            n_peaks=n_peaks,
+            sign=sign,
+            bounds=(xmin, xmax, ymin, ymax),
+            sigma_range=(s_lo, s_hi),
+            amplitude_range=(a_lo, a_hi),
+            anisotropic=bool(anisotropic),
+            overlap=bool(overlap),
+            min_separation=min_separation,
+        ),
+    )
+
+
+def _spectral_rms_slope(heights: np.ndarray, dx: float, dy: float) -> float:
+    """``sqrt(<|grad f|^2>)`` of a periodic grid by Parseval: ``sum q^2 |F(q)|^2 / N^2``."""
+    ny, nx = heights.shape
+    power = np.abs(np.fft.fft2(heights)) ** 2 / heights.size**2
+    q2 = (2 * np.pi) ** 2 * (np.fft.fftfreq(nx, dx)[None, :] ** 2 + np.fft.fftfreq(ny, dy)[:, None] ** 2)
+    return float(np.sqrt(np.sum(q2 * power)))
+
+
+def fractal_fbm(
+    *,
+    nx: int = 256,
+    ny: int | None = None,
+    size: float | tuple[float, float] = 20.0,
+    hurst: float = 0.8,
+    rms_height: float | None = None,
+    rms_slope: float | None = None,
+    periodic: bool = True,
+    long_cutoff: float | None = None,
+    short_cutoff: float | None = None,
+    unit: str = "1",
+    rng: int | np.random.Generator | None = None,
+) -> GridSurface:
+    """Fractal (fBm) surface by spectral synthesis, paper Eq. 5 and Fig. 7A-C.
+
+    White Gaussian noise is Fourier transformed (a complex Gaussian field with Hermitian
+    symmetry), filtered by ``A(f) = sqrt(P(f)) = |f|^-(H+1)`` so that the 2-D PSD is
+    ``P(f) ~ |f|^-(2H+2)``, and transformed back. ``f`` is spatial frequency in cycles per
+    unit length. Below ``1/long_cutoff`` the filter is flat (roll-off); above
+    ``1/short_cutoff`` it is zero. The mean height is removed.
+
+    Parameters
+    ----------
+    nx, ny
+        Grid points per side (``ny`` defaults to ``nx``); spacing is ``size / n``.
+    size
+        Physical side lengths ``(Lx, Ly)`` or one value for both; the grid is centred at 0.
+    hurst
+        Hurst index H, 0 < H < 1.
+    rms_height, rms_slope
+        Normalization: exactly one may be given (neither gives ``rms_height=1``). RMS slope
+        is ``sqrt(<|grad f|^2>)``, evaluated spectrally on a periodic surface and by
+        central differences on a non-periodic one.
+    periodic
+        If False, a surface twice as large is synthesized and one quadrant kept, so the
+        result does not wrap around.
+    """
+    periodic = _flag("periodic", periodic)
+    nx = _grid_count("nx", nx)
+    ny = nx if ny is None else _grid_count("ny", ny)
+    check_grid_size((1 if periodic else 2) * nx, (1 if periodic else 2) * ny, where="fractal_fbm")
+    lx, ly = (size, size) if np.isscalar(size) else _pair("size", size)
+    lx, ly = check_positive("size x", lx), check_positive("size y", ly)
+    hurst = float(hurst)
+    if not (0.0 < hurst < 1.0):
+        raise SpineInputError(f"hurst must lie in the open interval (0, 1), got {hurst!r}")
+    if rms_height is not None and rms_slope is not None:
+        raise SpineInputError("give rms_height or rms_slope, not both")
+    if rms_slope is not None:
+        rms_slope = check_positive("rms_slope", rms_slope)
+    else:
+        rms_height = 1.0 if rms_height is None else check_positive("rms_height", rms_height)
+    if long_cutoff is not None:
+        long_cutoff = check_positive("long_cutoff", long_cutoff)
+    if short_cutoff is not None:
+        short_cutoff = check_positive("short_cutoff", short_cutoff)
+    gen, seed = _rng_and_seed(rng)
+
+    dx, dy = lx / nx, ly / ny
+    fac = 1 if periodic else 2
+    mx, my = fac * nx, fac * ny
+    fx = np.fft.fftfreq(mx, dx)[None, :]
+    fy = np.fft.fftfreq(my, dy)[:, None]
+    freq = np.hypot(fx, fy)
+    if long_cutoff is not None:
+        freq = np.maximum(freq, 1.0 / long_cutoff)
+    with np.errstate(divide="ignore"):
+        amp = np.where(freq > 0, freq ** -(hurst + 1.0), 0.0)
+    if short_cutoff is not None:
+        amp[np.hypot(fx, fy) > 1.0 / short_cutoff] = 0.0
+    amp[0, 0] = 0.0
+    noise = gen.standard_normal((my, mx))
+    heights = np.fft.ifft2(np.fft.fft2(noise) * amp).real[:ny, :nx]
+    heights -= heights.mean()
+    if rms_slope is not None:
+        if periodic:
+            current = _spectral_rms_slope(heights, dx, dy)
+        else:
+            gy, gx = np.gradient(heights, dy, dx)
+            current = float(np.sqrt(np.mean(gx * gx + gy * gy)))
+        heights *= rms_slope / current
+    else:
+        heights *= rms_height / heights.std()
+    if not np.isfinite(heights).all():
+        raise SpineInputError(
+            f"fractal_fbm: size {lx:g} x {ly:g} with rms_height {rms_height} and rms_slope {rms_slope} "
+            "gives heights beyond floating-point range; use sizes and RMS values nearer 1"
+        )
+    x = -lx / 2 + dx * np.arange(nx)
+    y = -ly / 2 + dy * np.arange(ny)
+    return GridSurface(
+        heights=heights,
+        x=x,
+        y=y,
+        periodic=bool(periodic),
+        unit=unit,
+        metadata=_meta(
+            "fractal_fbm",
+            seed,
+            nx=nx,
+            ny=ny,
+            size=(lx, ly),
+            hurst=hurst,
+            rms_height=rms_height,
+            rms_slope=rms_slope,
+            periodic=bool(periodic),
+            long_cutoff=long_cutoff,
+            short_cutoff=short_cutoff,
+            unit=unit,
+        ),
+    )
+
+
+def _particle_envelope(n, spacing, diam, px, py, embed) -> np.ndarray:
+    """Upper envelope ``(n, n)`` of the base z = 0 and spheres of diameters ``diam`` at
+    ``(px, py)``, each sunk by ``embed`` times its diameter, on a periodic grid."""
+    heights = np.zeros((n, n))
+    grid = np.arange(n)
+    for d, cx, cy, e in zip(diam, px, py, embed):
+        r = d / 2
+        zc = r - e * d
+        half = int(math.ceil(r / spacing)) + 1
+        ix0, iy0 = int(round(cx / spacing)), int(round(cy / spacing))
+        ix = np.arange(ix0 - half, ix0 + half + 1)
+        iy = np.arange(iy0 - half, iy0 + half + 1)
+        ddx = ix * spacing - cx
+        ddy = iy * spacing - cy
+        rho2 = ddy[:, None] ** 2 + ddx[None, :] ** 2
+        cap = zc + np.sqrt(np.clip(r * r - rho2, 0, None))
+        cap[rho2 >= r * r] = 0.0
+        rows, cols = grid[np.mod(iy, n)], grid[np.mod(ix, n)]
+        block = heights[np.ix_(rows, cols)]
+        heights[np.ix_(rows, cols)] = np.maximum(block, cap)
+    return heights
+
+
+def sandpaper(
+    *,
+    grit: str | None = None,
+    particle_diameter_m: float | None = None,
+    size_m: float = 4e-3,
+    tip_radius_m: float = 25e-6,
+    spacing_m: float | None = None,
+    coverage: float = 0.6,
+    size_cv: float = 0.25,
+    embed_range: tuple[float, float] = (0.3, 0.6),
+    rng: int | np.random.Generator | None = None,
+) -> GridSurface:
+    """Sandpaper analog: partly embedded spherical grit particles on a flat base (§3.3).
+
+    Particles are placed uniformly at random (overlaps allowed) on a square periodic
+    patch; diameters are log-normal with mean ``particle_diameter_m`` and coefficient of
+    variation ``size_cv``; each sphere is sunk into the base by a fraction of its diameter
+    drawn uniformly from ``embed_range``. The height is the upper envelope of the exposed
+    caps and the base (z = 0). Their number fills ``coverage`` of the base area with
+    particle cross-sections (counting overlaps).
+
+    The default spacing, ``min(tip_radius_m / 5, particle_diameter_m / 10)``, resolves both
+    a tip of radius ``tip_radius_m`` and the particles (P600's 25.8 um grains included).
+
+    Parameters
+    ----------
+    grit
+        One of ``P36``, ``P60``, ``P600`` (mean particle size from the paper), or None
+        when ``particle_diameter_m`` is given.
+    size_m
+        Side of the square patch, metres.
+    """
+    if grit is not None:
+        if grit not in GRIT_PARTICLE_DIAMETER_M:
+            raise SpineInputError(f"grit must be one of {sorted(GRIT_PARTICLE_DIAMETER_M)}, got {grit!r}")
+        if particle_diameter_m is None:
+            particle_diameter_m = GRIT_PARTICLE_DIAMETER_M[grit]
+    if particle_diameter_m is None:
+        raise SpineInputError("give grit (P36, P60, P600) or particle_diameter_m")
+    d_mean = check_positive("particle_diameter_m", particle_diameter_m)
+    size_m = check_positive("size_m", size_m)
+    tip_radius_m = check_positive("tip_radius_m", tip_radius_m)
+    spacing_m = (
+        min(tip_radius_m / 5, d_mean / 10) if spacing_m is None else check_positive("spacing_m", spacing_m)
+    )
+    coverage = check_positive("coverage", coverage)
+    size_cv = float(size_cv)
+    if not (0 <= size_cv < 2):
+        raise SpineInputError(f"size_cv must be in [0, 2), got {size_cv!r}")
+    e_lo, e_hi = _range("embed_range", embed_range, positive=False)
+    if not (0 <= e_lo and e_hi < 1):
+        raise SpineInputError(f"embed_range must lie within [0, 1), got {embed_range!r}")
+    check_grid_size(
+        size_m / spacing_m, size_m / spacing_m, where="sandpaper (size_m / spacing_m points a side)"
+    )
+    n = math.ceil(size_m / spacing_m - 1e-9)
+    if n < _MIN_POINTS_PER_SIDE:
+        raise SpineInputError(f"size_m / spacing_m gives {n} points; need at least 4")
+    if size_m < 2 * d_mean:
+        raise SpineInputError(
+            f"size_m ({size_m:g}) must be at least twice the particle diameter ({d_mean:g})"
+        )
+    gen, seed = _rng_and_seed(rng)
+    spacing = size_m / n
+    mean_area = math.pi * (d_mean / 2) ** 2 * (1 + size_cv**2)
+    n_particles = max(1, round(coverage * size_m**2 / mean_area))
+
+    sig_ln = math.sqrt(math.log1p(size_cv**2))
+    diam = d_mean * np.exp(gen.normal(-0.5 * sig_ln**2, sig_ln, n_particles))
+    px = gen.uniform(0, size_m, n_particles)
+    py = gen.uniform(0, size_m, n_particles)
+    embed = gen.uniform(e_lo, e_hi, n_particles)
+
+    heights = _particle_envelope(n, spacing, diam, px, py, embed)
+    coords = spacing * np.arange(n) - size_m / 2
+    return GridSurface(
+        heights=heights,
+        x=coords,
+        y=coords.copy(),
+        periodic=True,
+        unit="m",
+        metadata=_meta(
+            "sandpaper",
+            seed,
+            grit=grit,
+            particle_diameter_m=d_mean,
+            size_m=size_m,
+            tip_radius_m=tip_radius_m,
+            spacing_m=spacing,
+            coverage=coverage,
+            size_cv=size_cv,
+            embed_range=(e_lo, e_hi),
+            n_particles=n_particles,
+        ),
+    )

@@ -1,0 +1,79 @@
+"""What every study's report module shares: table cells, Markdown tables and figure links,
+and the :class:`ReportContext` a module gets (the output folder and every study's result).
+
+A study's report module (:mod:`spine_mj.validate.report`) defines two functions, which
+:func:`~spine_mj.validate.report.document.write_report` calls in the order of the
+registry (:data:`spine_mj.validate.studies.STUDIES`):
+
+* ``headline(result) -> list[str]``: lines for the report's headline list (most give none);
+* ``section(result, ctx) -> str | None``: its Markdown section with the figures it drew
+  under ``ctx.figures`` (:func:`assemble`), or None for no section at all.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from spine_mj.plotting import sig
+
+__all__ = ["ReportContext", "assemble", "cell", "image", "table"]
+
+
+@dataclass(frozen=True)
+class ReportContext:
+    """What a study's report module may read besides its own result.
+
+    Attributes
+    ----------
+    out : Path
+        The validation's output folder (``out/sweeps`` holds the studies' stores).
+    figures : Path
+        ``out/figures``, where the modules write their PNGs.
+    results : mapping
+        Study name (:data:`spine_mj.validate.studies.STUDIES`) -> the result of every
+        study given to the report, for a section that cites another study's numbers.
+    """
+
+    out: Path
+    figures: Path
+    results: Mapping[str, Any]
+
+    def draw(self, drawer: Callable[[Any, Path], Path | None], result, name: str) -> str | None:
+        """``drawer(result, figures/name)``; the link to the PNG relative to ``out``, or
+        None when nothing was drawn."""
+        return self.link(drawer(result, self.figures / name))
+
+    def link(self, path: Path | None) -> str | None:
+        """``path`` relative to ``out`` if it is a file, else None."""
+        return path.relative_to(self.out).as_posix() if path is not None and path.is_file() else None
+
+
+def cell(v, digits=3) -> str:
+    """A table cell: numbers to ``digits`` significant digits, NaN and None as ``-``."""
+    try:
+        text = sig(v, digits)
+    except (TypeError, ValueError):
+        return str(v)
+    return "-" if text in ("nan", "-") else text
+
+
+def table(rows: list[dict], cols: list[str], names: list[str] | None = None) -> str:
+    """A Markdown table of ``rows`` (dicts), columns ``cols`` headed ``names``."""
+    names = names or cols
+    out = ["| " + " | ".join(names) + " |", "|" + "---|" * len(cols)]
+    for r in rows:
+        out.append("| " + " | ".join(cell(r.get(c)) for c in cols) + " |")
+    return "\n".join(out)
+
+
+def image(alt: str, link: str | None, before: str = "") -> str | None:
+    """A figure's Markdown (``before`` it, a paragraph), or None without a ``link``."""
+    return None if link is None else f"{before}![{alt}]({link})\n"
+
+
+def assemble(text: str, *figures: str | None) -> str:
+    """A section: its text, then each figure that was drawn, a blank line between them."""
+    return "\n".join([text, *(f for f in figures if f is not None)])

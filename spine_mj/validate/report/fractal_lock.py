@@ -1,0 +1,131 @@
+"""The report of the fractal self-lock study (:mod:`spine_mj.validate.fractal_lock`): the
+self-lock rate against the Hurst exponent, streamline beside MuJoCo.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from spine_mj.plotting import (
+    new_figure,
+    save_figure,
+    sig,
+    styled,
+)
+from spine_mj.validate.fractal_lock import SERIES, FractalLockResult
+from spine_mj.validate.report.common import ReportContext, assemble, cell, image, table
+
+
+#: Legend labels of the fractal study's series (:data:`spine_mj.validate.fractal_lock.SERIES`).
+def _fractal_labels(fr: FractalLockResult) -> dict[str, str]:
+    return {
+        "streamline": "streamline (smooth surface, dilated by the tip)",
+        "facets": "streamline (MuJoCo's facets, dilated by the tip)",
+        "mujoco_corner": f"MuJoCo, spring, I_e = {sig(fr.corner_ie)}",
+        "mujoco_dynamic": f"MuJoCo, spring, I_e = {sig(fr.dynamic_ie)}",
+    }
+
+
+@styled
+def _fractal_figure(fr: FractalLockResult, path: Path) -> Path | None:
+    """Self-lock rate against H, one series per counter, Wilson intervals as error bars
+    (series side by side in H so that their bars do not hide each other)."""
+    if not fr.rows:
+        return None
+    fig = new_figure(figsize=(6.4, 4.4), constrained_layout=True)
+    ax = fig.subplots()
+    labels = _fractal_labels(fr)
+    present = [s for s in SERIES if any(f"rate_{s}" in r for r in fr.rows)]
+    hs = np.array([r["hurst"] for r in fr.rows])
+    width = 0.006
+    for j, series in enumerate(present):
+        rate = np.array([r.get(f"rate_{series}", np.nan) for r in fr.rows], float)
+        lo = np.array([r.get(f"ci_low_{series}", np.nan) for r in fr.rows], float)
+        hi = np.array([r.get(f"ci_high_{series}", np.nan) for r in fr.rows], float)
+        x = hs + (j - (len(present) - 1) / 2) * width
+        ax.errorbar(x, rate, yerr=[rate - lo, hi - rate], fmt="o-", capsize=3, label=labels[series])
+    ax.set(
+        xlabel="Hurst exponent H [1]",
+        ylabel="self-locked runs [fraction]",
+        ylim=(-0.05, 1.05),
+        title=f"Self-lock rate against H, {fr.surfaces_per_hurst} fractal surfaces per H "
+        f"(bars: {sig(100 * fr.confidence)} % Wilson intervals)",
+    )
+    ax.legend(loc="upper left")
+    return save_figure(fig, path)
+
+
+def _lines(fr: FractalLockResult) -> list[str]:
+    """The fractal self-lock table (rate, Wilson interval, locked / ok runs, failed runs
+    per series and H) and one sentence on what it shows."""
+    if not fr.rows:
+        return []
+    labels = _fractal_labels(fr)
+    present = [s for s in SERIES if any(f"rate_{s}" in r for r in fr.rows)]
+    rows = []
+    for r in fr.rows:
+        row = {"H": r["hurst"]}
+        for s in present:
+            row[s] = (
+                f"{cell(r[f'rate_{s}'], 2)} [{cell(r[f'ci_low_{s}'], 2)}, {cell(r[f'ci_high_{s}'], 2)}] "
+                f"({r[f'locked_{s}']}/{r[f'n_ok_{s}']}, failed {r[f'failed_runs_{s}']})"
+            )
+        rows.append(row)
+    return [
+        "## Self-lock rate against the Hurst exponent (fractal surfaces)",
+        "",
+        f"The paper's claim (Figs. 7E, 9) that self-lock becomes more frequent with H, checked "
+        f"in dynamics: {fr.surfaces_per_hurst} paper-fractal surfaces per H (the Fig. 9 "
+        f"height scale and seeds), one start each at mid height near the left edge, default "
+        f"spring drive (K = 30), mu = {sig(fr.mu)}, tip radius {sig(fr.tip_radius)} surface "
+        "units. Held = the lock rule or the shared force cap ended the path. Cells: rate [Wilson "
+        f"{sig(100 * fr.confidence)} % interval] (held / runs without engine trouble, runs "
+        "the engine stopped).",
+        "",
+        table(rows, ["H", *present], ["H", *(labels[s] for s in present)]),
+        "",
+        _fractal_sentence(fr),
+        "",
+    ]
+
+
+def _fractal_sentence(fr: FractalLockResult) -> str:
+    """What the table shows, from its numbers: the streamline's and MuJoCo's rates at the
+    lowest and highest H, and whether their intervals overlap at every H."""
+    first, last = fr.rows[0], fr.rows[-1]
+
+    def ends(s):
+        return f"{cell(first.get(f'rate_{s}'), 2)} -> {cell(last.get(f'rate_{s}'), 2)}"
+
+    pairs = [
+        (r[f"ci_low_{s}"], r[f"ci_high_{s}"], r["ci_low_streamline"], r["ci_high_streamline"])
+        for r in fr.rows
+        for s in ("mujoco_corner", "mujoco_dynamic")
+        if np.isfinite(r.get(f"rate_{s}", np.nan)) and np.isfinite(r.get("rate_streamline", np.nan))
+    ]
+    if not pairs:
+        return "No H has both a streamline rate and a MuJoCo rate (every run stopped by the engine)."
+    overlap = all(max(a_lo, b_lo) <= min(a_hi, b_hi) for a_lo, a_hi, b_lo, b_hi in pairs)
+    return (
+        f"From H = {sig(first['hurst'])} to {sig(last['hurst'])} the streamline's rate goes "
+        f"{ends('streamline')}, MuJoCo's {ends('mujoco_corner')} at I_e = {sig(fr.corner_ie)} "
+        f"and {ends('mujoco_dynamic')} at I_e = {sig(fr.dynamic_ie)}; the MuJoCo intervals "
+        + ("overlap the streamline's at every H." if overlap else "miss the streamline's at some H.")
+        + " With this many surfaces per H, only differences larger than the intervals count."
+    )
+
+
+def headline(fr: FractalLockResult) -> list[str]:
+    return []
+
+
+def section(fr: FractalLockResult, ctx: ReportContext) -> str:
+    fig = ctx.draw(_fractal_figure, fr, "fractal_lock_rate.png")
+    return assemble(
+        "\n".join(_lines(fr)),
+        image(
+            "Self-lock rate against the Hurst exponent H, streamline and MuJoCo, with Wilson intervals", fig
+        ),
+    )

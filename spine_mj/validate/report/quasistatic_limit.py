@@ -1,0 +1,277 @@
+"""The report of the quasistatic limit (:mod:`spine_mj.validate.quasistatic_limit`): paths at
+the lowest I_e against the streamline, per family, and the settings that limit agreement.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from spine_mj.compare import MISS_REASONS
+from spine_mj.plotting import (
+    DIVERGING_CMAP,
+    PATH_COLORS,
+    height_mappable,
+    new_figure,
+    save_figure,
+    shared_height_norm,
+    sig,
+    styled,
+)
+from spine_mj.presets import make_surface
+from spine_mj.sweep.analyses.compare import MISS_CHECKPOINTS
+from spine_mj.validate.boundary import BoundaryResult
+from spine_mj.validate.quasistatic_limit import QuasistaticLimitResult
+from spine_mj.validate.report.boundary import star_to_draw
+from spine_mj.validate.report.common import ReportContext, assemble, cell, image, table
+
+
+@styled
+def _paths_figure(lim: QuasistaticLimitResult, path: Path) -> Path | None:
+    """Paths at the lowest I_e over the peak / valley (shared diverging height scale)."""
+    presets = list(lim.paths)
+    if not presets:
+        return None
+    surfaces = {p: make_surface(p) for p in presets}
+    norm = shared_height_norm([{"surface": s} for s in surfaces.values()])
+    fig = new_figure(figsize=(5.4 * len(presets) + 0.8, 5), constrained_layout=True)
+    axes = fig.subplots(1, len(presets), squeeze=False)[0]
+    field = None
+    for ax, preset in zip(axes, presets):
+        x0, x1, y0, y1 = surfaces[preset].bounds
+        xs, ys = np.linspace(x0, x1, 161), np.linspace(y0, y1, 161)
+        field = ax.contourf(
+            xs, ys, surfaces[preset].height(xs[None, :], ys[:, None]), 15, cmap=DIVERGING_CMAP, norm=norm
+        )
+        for i, p in enumerate(lim.paths[preset]):
+            first = i == 0
+            ax.plot(
+                *p.smooth.T,
+                color=PATH_COLORS["streamline"],
+                lw=1.5,
+                label="streamline (smooth surface)" if first else None,
+            )
+            ax.plot(
+                *p.tri.T,
+                color=PATH_COLORS["facets"],
+                ls="--",
+                lw=1,
+                label="streamline (MuJoCo's hfield facets)" if first else None,
+            )
+            if p.mujoco.shape[0]:
+                ax.plot(
+                    *p.mujoco.T,
+                    color=PATH_COLORS["mujoco"],
+                    lw=0.9,
+                    label="MuJoCo (spring drive)" if first else None,
+                )
+        ax.set(xlim=(x0, x1), ylim=(y0, y1), xlabel="x [surface units]", ylabel="y [surface units]")
+        ax.set(aspect="equal", title=f"{preset}, I_e = {sig(lim.lowest_ie)}")
+        ax.legend(loc="upper left")
+    fig.colorbar(
+        height_mappable(field),
+        ax=list(axes),
+        label="surface height [surface units] (peak red, valley blue)",
+    )
+    return save_figure(fig, path)
+
+
+def _stalled_note(limit: QuasistaticLimitResult) -> list[str]:
+    """A sentence on the reference streamlines that stalled in a groove, where there are any."""
+    stalled = {k: v["reference_stalled"] for k, v in limit.families.items() if v.get("reference_stalled")}
+    if not stalled:
+        return []
+    counts = ", ".join(f"{k} {n} of {limit.families[k]['runs']}" for k, n in stalled.items())
+    return [
+        f"Reference streamlines that stalled ({counts}): no net progress even with the step "
+        "cut to 1/1024 of dl (the step control of docs/physics.md §2), a point that neither "
+        "one contact nor two (the crease rule, §4) can leave or rest on. These runs count as "
+        "disagreements.",
+        "",
+    ]
+
+
+def _misses_note(limit: QuasistaticLimitResult) -> list[str]:
+    """Why the runs that the engine finished disagree, per family, where any do."""
+    lines = []
+    for fam, v in limit.families.items():
+        parts = []
+        for reason, m in v.get("misses", {}).items():
+            offs = ", ".join(f"{o:.3g}" for o in m["offsets"])
+            parts.append(f"{reason} {m['runs']}" + (f" (offsets {offs} L_c)" if offs else ""))
+        if parts:
+            lines.append(f"* {fam}: " + "; ".join(parts))
+    if not lines:
+        return []
+    meaning = "; ".join(f"*{k}*: {v}" for k, v in MISS_REASONS.items())
+    return [
+        "Why the runs the engine finished disagree (the reference restarted from "
+        f"{MISS_CHECKPOINTS} points along each MuJoCo path, `compare.miss_reason`): {meaning}.",
+        "",
+        *lines,
+        "",
+    ]
+
+
+def falls_note(limit: QuasistaticLimitResult, boundary: BoundaryResult) -> list[str]:
+    """Whether the runs were quasistatic at all: gravity slides on the reference and the
+    engine tip's own peak inertia number, with agreement split at the spring drive's I_e*
+    (the boundary study's bracket: below its lower end a drive is quasistatic)."""
+    star = star_to_draw(boundary.ie_star.get("spring", {}))
+    if star is None:
+        return []
+    cut = float(star["low"])
+    rows = []
+    for fam, v in limit.families.items():
+        runs = [r for r in limit.runs if r.get("family") == fam]
+        peak = np.array([r.get("tip_peak_ie", np.nan) for r in runs], dtype=float)
+        if not np.isfinite(peak).any():
+            continue
+        row = {
+            "family": fam,
+            "slides": f"{v.get('slide_runs', 0)}/{len(runs)}",
+            "peak": f"{cell(np.nanmedian(peak))} ({cell(np.nanmin(peak))}-{cell(np.nanmax(peak))})",
+        }
+        for side, keep in (("slow", peak <= cut), ("fast", peak > cut)):
+            sel = [r for r, k in zip(runs, keep) if k]
+            agree = sum(bool(r["agree"]) for r in sel)
+            frechet = np.nanmedian([r["frechet"] for r in sel]) if sel else np.nan
+            row[side] = f"{agree}/{len(sel)}, {cell(frechet)}" if sel else "-"
+        rows.append(row)
+    if not rows:
+        return []
+    return [
+        "### Was the path quasistatic? Gravity slides and the tip's own speed",
+        "",
+        "A slow, stiff drive makes a path quasistatic only where the drive moves the tip. Where "
+        "a descent is steeper than the friction angle (the slip region, docs/physics.md §2) "
+        "gravity alone slides the tip: the quasistatic model has no rate there, and the "
+        "engine's tip falls at the speed gravity gives it, whatever the drive's. Per run, the "
+        "share of the reference's arc length in the slip region (`compare.slide_fraction`) "
+        "and the tip's peak speed as an inertia number, m v_max^2 / (F_p L_c) "
+        f"(`compare.peak_speed`), split at the lower end of the spring drive's I_e* bracket "
+        f"({cell(cut)}): a tip that went faster than that, somewhere, left the quasistatic "
+        "regime there.",
+        "",
+        table(
+            rows,
+            ["family", "slides", "peak", "slow", "fast"],
+            [
+                "family",
+                "runs with gravity slides",
+                "tip peak I_e: median (range)",
+                f"peak I_e <= {cell(cut)}: agree, median Frechet",
+                f"peak I_e > {cell(cut)}: agree, median Frechet",
+            ],
+        ),
+        "",
+    ]
+
+
+def _lines(limit: QuasistaticLimitResult, boundary: BoundaryResult) -> list[str]:
+    families = [
+        {
+            "family": k,
+            "ok_n": f"{v['ok_runs']}/{v['runs']}",
+            "stopped": ", ".join(f"{s} {n}" for s, n in v["failed_runs"].items()) or "none",
+            **v,
+        }
+        for k, v in limit.families.items()
+    ]
+    return [
+        "## Quasistatic limit (spring drive, lowest I_e)",
+        "",
+        f"I_e = {limit.lowest_ie:g}, default drive (K = k l_s / F_p = 30) and engine. Like for "
+        "like: each MuJoCo path is compared with the streamline traced on the surface its tip "
+        "touches (a ball of the tip's radius on MuJoCo's hfield facets, exactly: "
+        "`surfaces.BallOnFacets`), ending where the engine's run ends, with the same force "
+        "cap on both sides (a path needing more than the cap times F_p is held). A run the "
+        "engine stopped, or whose reference stalled, counts as a disagreement. Beside it: the "
+        "comparison with the streamline on the smooth surface and the geometry part (smooth vs "
+        "facet streamline).",
+        "",
+        table(
+            families,
+            [
+                "family",
+                "ok_n",
+                "stopped",
+                "outcome_agreement",
+                "median_frechet",
+                "mean_frechet",
+                "outcome_agreement_smooth",
+                "median_frechet_smooth",
+                "mean_geometry_frechet",
+                "meets_target",
+            ],
+            [
+                "family",
+                "ok/runs",
+                "engine stops",
+                "outcome agr.",
+                "median Frechet",
+                "mean Frechet",
+                "outcome agr. (smooth)",
+                "median Frechet (smooth)",
+                "geometry Frechet",
+                "target met (this plan)",
+            ],
+        ),
+        "",
+        *_stalled_note(limit),
+        *_misses_note(limit),
+        *falls_note(limit, boundary),
+        "### What limits agreement: settings varied on the single peak",
+        "",
+        table(
+            [{"setting": k, **v} for k, v in limit.variations.items()],
+            [
+                "setting",
+                "runs",
+                "outcome_agreement",
+                "median_frechet",
+                "mean_frechet",
+                "mean_lateral_deviation",
+            ],
+        ),
+        "",
+        "<details><summary>per run</summary>",
+        "",
+        table(
+            limit.runs,
+            [
+                "surface",
+                "start_x",
+                "start_y",
+                "agree",
+                "frechet",
+                "reference_outcome",
+                "end_reason",
+                "end_detail",
+                "miss_reason",
+                "miss_offset",
+                "agree_smooth",
+                "frechet_smooth",
+                "geometry_frechet",
+            ],
+        ),
+        "",
+        "</details>",
+        "",
+    ]
+
+
+def headline(limit: QuasistaticLimitResult) -> list[str]:
+    return []
+
+
+def section(limit: QuasistaticLimitResult, ctx: ReportContext) -> str:
+    """The section; the note on gravity slides cites the boundary study's I_e* (none
+    without that study's result)."""
+    boundary = ctx.results.get("boundary", BoundaryResult(curves={}, ie_star={}, skip_rate={}, families=[]))
+    fig = ctx.draw(_paths_figure, limit, "limit_paths.png")
+    return assemble(
+        "\n".join(_lines(limit, boundary)),
+        image("Paths at the lowest I_e over the single peak and valley", fig),
+    )

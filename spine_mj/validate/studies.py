@@ -1,0 +1,69 @@
+"""The registry of the validation's studies: what runs, in which order, and who reports it.
+
+Each :class:`Study` names its run function (``(plan, runner) -> result``), the type of
+its result (whose ``validation_keys()`` are its keys of ``validation.json``) and its
+report module (:mod:`spine_mj.validate.report`). :func:`spine_mj.validate.run_validation`
+runs the studies in this order and :func:`spine_mj.validate.write_report` puts their
+sections into ``report.md`` in the same order. A new study is one study module, one report
+module and one line here.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from types import ModuleType
+from typing import Any
+
+from spine_mj.validate.boundary import BoundaryResult, boundary
+from spine_mj.validate.fractal_lock import FractalLockResult, fractal_lock
+from spine_mj.validate.plans import ValidationPlan
+from spine_mj.validate.quasistatic_limit import QuasistaticLimitResult, quasistatic_limit
+from spine_mj.validate.report import boundary as boundary_report
+from spine_mj.validate.report import fractal_lock as fractal_lock_report
+from spine_mj.validate.report import quasistatic_limit as quasistatic_limit_report
+from spine_mj.validate.report import sandpaper as sandpaper_report
+from spine_mj.validate.report import static_map as static_map_report
+from spine_mj.validate.report import stick_slip as stick_slip_report
+from spine_mj.validate.report import stiffness_map as stiffness_map_report
+from spine_mj.validate.sandpaper import SandpaperResult, sandpaper
+from spine_mj.validate.static_map import StaticMapResult, static_map
+from spine_mj.validate.stick_slip import StickSlipResult, stick_slip
+from spine_mj.validate.stiffness_map import StiffnessMapResult, stiffness_map
+from spine_mj.validate.study_runner import StudyRunner
+
+__all__ = ["STUDIES", "Study"]
+
+
+@dataclass(frozen=True)
+class Study:
+    """One study of the validation.
+
+    Attributes
+    ----------
+    name : str
+        Its key in ``validation.json``'s ``timings_s`` and in the progress reports.
+    run : callable
+        ``run(plan, runner) -> result``.
+    result : type
+        The type of its result.
+    report : module
+        Its report module: ``headline(result)`` and ``section(result, ctx)``.
+    """
+
+    name: str
+    run: Callable[[ValidationPlan, StudyRunner], Any]
+    result: type
+    report: ModuleType
+
+
+#: The studies, in the order they run and appear in the report (the I_e* headline first).
+STUDIES: tuple[Study, ...] = (
+    Study("boundary", boundary, BoundaryResult, boundary_report),
+    Study("limit", quasistatic_limit, QuasistaticLimitResult, quasistatic_limit_report),
+    Study("static", static_map, StaticMapResult, static_map_report),
+    Study("stick_slip", stick_slip, StickSlipResult, stick_slip_report),
+    Study("sandpaper", sandpaper, SandpaperResult, sandpaper_report),
+    Study("fractal_lock", fractal_lock, FractalLockResult, fractal_lock_report),
+    Study("stiffness_map", stiffness_map, StiffnessMapResult, stiffness_map_report),
+)
