@@ -77,10 +77,25 @@ class InputError(click.ClickException):
 _SHOWS_HELP = tuple(e for e in [getattr(click.exceptions, "NoArgsIsHelpError", None)] if e)
 
 
+def _one_line(exc: click.UsageError) -> str:
+    """A usage error's message (a choice list spans lines) and its help hint, on one line."""
+    hint = f" (see '{exc.ctx.command_path} --help')" if exc.ctx is not None else ""
+    return " ".join(exc.format_message().split()) + hint
+
+
 class _Group(click.Group):
     """Turns the library's input errors and click's usage errors into :class:`InputError`
     (one line) for every subcommand, and so too a request too large for memory or out of
     floating-point range that no check at the boundary caught (not a traceback)."""
+
+    def parse_args(self, ctx, args):
+        """The root's own options (``spine-mj --bogus``) fail here, before :meth:`invoke`."""
+        try:
+            return super().parse_args(ctx, args)
+        except _SHOWS_HELP:
+            raise
+        except click.UsageError as exc:
+            raise InputError(_one_line(exc)) from None
 
     def invoke(self, ctx):
         try:
@@ -91,8 +106,7 @@ class _Group(click.Group):
         except _SHOWS_HELP:
             raise
         except click.UsageError as exc:  # click's own: usage, hint and error in one line
-            hint = f" (see '{exc.ctx.command_path} --help')" if exc.ctx is not None else ""
-            raise InputError(exc.format_message() + hint) from None
+            raise InputError(_one_line(exc)) from None
         except SpineInputError as exc:
             root = ctx.find_root()
             if exc.details and root.params.get("verbose"):

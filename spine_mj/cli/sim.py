@@ -321,6 +321,8 @@ def replay(run_dir, speed, duration, mp4):
         sys.platform.startswith("linux")
         and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
     )
+    if headless:  # --duration closes the viewer; an MP4 has the run's length at --speed
+        refuse_options_not_for("replay to an MP4 (no display, or --mp4)", ["duration"])
     if duration is not None:
         check_positive("--duration", duration)
     if headless:

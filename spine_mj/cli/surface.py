@@ -14,6 +14,7 @@ from spine_mj.cli.app import (
     check_suffix,
     load_surface_arg,
     main,
+    refuse_options_not_for,
 )
 from spine_mj.errors import SpineInputError, check_positive
 from spine_mj.jsonio import to_jsonable
@@ -79,6 +80,12 @@ def surface_make(preset, from_file, output, seed, hurst, sets, fill, no_level, s
 
     if (preset is None) == (from_file is None):
         raise SpineInputError("give exactly one of PRESET or --from-file")
+    if from_file is None:
+        refuse_options_not_for(
+            f"preset {preset!r} (not a file import)", ["fill", "no_level", "spacing", "channel"]
+        )
+    else:
+        refuse_options_not_for("--from-file (an import, not a generator)", ["seed", "hurst", "sets"])
     if from_file is not None:
         surf = surface_io.import_topography(
             from_file, channel=channel, fill=fill, level=not no_level, spacing_m=spacing
