@@ -5,12 +5,12 @@ one-line errors, progress and shared argument parsing), and one module per famil
 commands: :mod:`~spine_mj.cli.surface` (``surface make/show/info/export``),
 :mod:`~spine_mj.cli.theory` (``kappa``, ``streamline``, ``reproduce``),
 :mod:`~spine_mj.cli.sim` (``simulate``, ``replay``, ``view``, ``sim export``),
-:mod:`~spine_mj.cli.sweep` (``sweep run/status``, ``report``) and
-:mod:`~spine_mj.cli.validate` (``validate``). Importing this package registers every
-command on :func:`main`.
+:mod:`~spine_mj.cli.sweep` (``sweep run/status``, ``report``),
+:mod:`~spine_mj.cli.validate` (``validate``) and :mod:`~spine_mj.cli.examples`
+(``examples``). Importing this package registers every command on :func:`main`.
 """
 
-from spine_mj.cli import sim, surface, sweep, theory, validate
+from spine_mj.cli import examples, sim, surface, sweep, theory, validate
 from spine_mj.cli.app import INPUT_ERROR_EXIT, InputError, Progress, _exit_on_sigterm, main, run
 
 __all__ = [
@@ -18,6 +18,7 @@ __all__ = [
     "InputError",
     "Progress",
     "_exit_on_sigterm",
+    "examples",
     "main",
     "run",
     "sim",

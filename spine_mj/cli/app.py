@@ -18,7 +18,7 @@ import click
 import numpy as np
 from tqdm import tqdm
 
-from spine_mj import presets, surface_io
+from spine_mj import examples, presets, surface_io
 from spine_mj.errors import SpineInputError
 
 INPUT_ERROR_EXIT = 2
@@ -148,8 +148,10 @@ def _exit_on_sigterm(signum, frame):
 
 
 def load_surface_arg(spec: str):
-    """A SURFACE argument: a saved .npz, a preset name, or an instrument file."""
+    """A SURFACE argument: a saved .npz, a preset name, an instrument file, or a shipped
+    example (``example:plu-1.plu``)."""
 
+    spec = examples.resolve(spec)
     path = Path(spec)
     if path.suffix == ".npz":
         return surface_io.load_surface(path)
@@ -158,8 +160,8 @@ def load_surface_arg(spec: str):
     if path.is_file():
         return surface_io.import_topography(path)
     raise SpineInputError(
-        f"SURFACE must be a .npz file, a preset ({', '.join(presets.list_presets())}) or an "
-        f"instrument file, got {spec!r}"
+        f"SURFACE must be a .npz file, a preset ({', '.join(presets.list_presets())}), an "
+        f"instrument file or an example (spine-mj examples), got {spec!r}"
     )
 
 

@@ -7,7 +7,7 @@ import json
 import click
 import numpy as np
 
-from spine_mj import presets, roughness, surface_io
+from spine_mj import examples, presets, roughness, surface_io
 from spine_mj.atomic import all_or_none, atomic_output
 from spine_mj.cli.app import (
     _Group,
@@ -45,7 +45,7 @@ def surface_list():
     "--from-file",
     "from_file",
     type=click.Path(dir_okay=False),
-    help="Import a measured topography (x3p, opd, datx, plu, di, sur, ...).",
+    help="Import a measured topography (x3p, opd, datx, plu, di, sur, ...; or example:plu-1.plu).",
 )
 @click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="Output .npz file.")
 @click.option("--seed", type=click.IntRange(min=0), help="Override the preset's seed.")
@@ -88,7 +88,7 @@ def surface_make(preset, from_file, output, seed, hurst, sets, fill, no_level, s
         refuse_options_not_for("--from-file (an import, not a generator)", ["seed", "hurst", "sets"])
     if from_file is not None:
         surf = surface_io.import_topography(
-            from_file, channel=channel, fill=fill, level=not no_level, spacing_m=spacing
+            examples.resolve(from_file), channel=channel, fill=fill, level=not no_level, spacing_m=spacing
         )
     else:
         overrides = dict(presets.parse_override(s) for s in sets)

@@ -6,6 +6,7 @@ from pathlib import Path
 
 import click
 
+from spine_mj import examples
 from spine_mj import sweep as sw
 from spine_mj.cli.app import (
     Progress,
@@ -41,7 +42,7 @@ def sweep():
 
     \b
     Examples:
-      spine-mj sweep analysis/sweeps/paper-quasistatic.toml --out runs/qs
+      spine-mj sweep example:paper-quasistatic.toml --out runs/qs
       spine-mj sweep config.toml --out runs/x --scheduler tcp://head:8786
       spine-mj sweep status runs/qs
     """
@@ -86,12 +87,12 @@ def sweep_run(config, out_dir, workers, scheduler, overwrite, retry_failed, work
 
     \b
     Example:
-      spine-mj sweep analysis/sweeps/paper-quasistatic.toml --out runs/qs --workers 4
+      spine-mj sweep example:paper-quasistatic.toml --out runs/qs --workers 4
     """
 
     if scheduler is None:
         refuse_options_not_for("a sweep without --scheduler", ["worker_wait"])
-    cfg = sw.load_config(config)
+    cfg = sw.load_config(examples.resolve(config))
     with Progress(cfg.name, unit="case", quiet=quiet) as bar:
         try:
             summary = sw.run_sweep(
