@@ -133,7 +133,7 @@ def surface_info(surface_spec, output, as_json):
 
     \b
     Example:
-      spine-mj surface info tests/data/plu-1.plu -o psd.png
+      spine-mj surface info example:plu-1.plu -o psd.png
     """
     if output:
         check_suffix(output, ".png", "-o/--output")
