@@ -3,9 +3,10 @@
 ``models/`` and ``surfaces/`` stay at the repository's top level and ship inside the
 package as ``spine_mj._data.models`` and ``spine_mj._data.surfaces``, the example scans of
 ``tests/data/`` and sweep configs of ``analysis/sweeps/`` as ``spine_mj._data.scans`` and
-``spine_mj._data.sweeps`` (read through ``spine_mj.resources``). pyproject's ``packages.find`` cannot rename folders, so the
-package list is built here: every package under ``spine_mj/`` that has an ``__init__.py``
-(new subpackages are picked up automatically) plus the two mapped data packages.
+``spine_mj._data.sweeps`` (read through ``spine_mj.resources``). pyproject's
+``packages.find`` cannot rename folders, so the package list is built here: every package
+under ``spine_mj/`` that has an ``__init__.py`` (new subpackages are picked up
+automatically) plus the mapped data packages.
 """
 
 from setuptools import find_packages, setup

@@ -33,7 +33,7 @@ from spine_mj.surfaces import TriangulatedSurface
 from spine_mj.sweep import ANALYSES, expand_cases, parse_config
 from spine_mj.sweep.analyses.mujoco import case_rig
 from spine_mj.validate.plans import FRACTAL, PLANS, SANDPAPER
-from spine_mj.validate.quasistatic_limit import _limit_doc
+from spine_mj.validate.quasistatic_limit import limit_doc
 
 
 def exact_contact(facets, c, radius, n=321):
@@ -122,7 +122,7 @@ def _finer_sampling(d, i):
 def _family(plan, fam):
     counts = {"fixed": [], "controlled": []}
     for preset in fam.presets:
-        for case in expand_cases(parse_config(_limit_doc(plan, fam, preset, f"limit-{preset}"))):
+        for case in expand_cases(parse_config(limit_doc(plan, fam, preset, f"limit-{preset}"))):
             d = _case(case)
             contact, starts, params, lc = d["contact"], d["starts"], d["params"], d["lc"]
             refs = {

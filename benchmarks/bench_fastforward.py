@@ -28,7 +28,7 @@ import numpy as np
 from spine_mj import compare, sim
 from spine_mj.sim.ramp import cycle_breakaways, rows_to_reset
 from spine_mj.validate.ramp_pilot import pilot_rig
-from spine_mj.validate.static_map import _hold_force
+from spine_mj.validate.static_map import hold_force
 
 #: (slope, azimuth) of the probe's planes [deg]: engaged planes of the static map.
 PROBE_PLANES = ((0.0, 0.0), (15.0, 0.0), (30.0, 0.0), (45.0, 0.0), (52.5, 0.0), (30.0, 30.0), (30.0, 60.0))
@@ -51,16 +51,16 @@ def _probe_cases(res: int, ie: float):
     for slope, az in PROBE_PLANES:
         rig = sim.Rig(sim.inclined_plane(slope_deg=slope, azimuth_deg=az), tip=sim.TipParams(mu_s=0.5))
         t = math.tan(math.radians(slope))
-        k, low, _ = _hold_force(t * math.cos(math.radians(az)), t * math.sin(math.radians(az)), 0.5)
+        k, low, _ = hold_force(t * math.cos(math.radians(az)), t * math.sin(math.radians(az)), 0.5)
         sc = rig.scales
         probe = sim.StaticProbe(
-            rate_n_s=sc.speed_for(ie) * sc.preload_n / sc.char_length_m,
+            rate_n_s=sc.force_rate_for(sc.speed_for(ie)),
             start_force_n=(0.5 * (low + k) if low > 0 else 0.0) * sc.preload_n,
         )
         yield f"plane {slope:g} deg, azimuth {az:g}", rig, (0.0, 0.0), probe
     rig, _ = pilot_rig("paper-single-peak", None, 1.23, 0.1, res)
     sc = rig.scales
-    probe = sim.StaticProbe(rate_n_s=sc.speed_for(ie) * sc.preload_n / sc.char_length_m)
+    probe = sim.StaticProbe(rate_n_s=sc.force_rate_for(sc.speed_for(ie)))
     for start in PROBE_PEAK_STARTS:
         yield f"single peak {start}", rig, start, probe
 
@@ -97,7 +97,7 @@ def ramp_rows(res: int, ie: float, cycles: int) -> list[dict]:
     rows = []
     for name, rig, start in _cases(res):
         sc = rig.scales
-        rate = math.sqrt(ie) * sc.preload_n / sc.time_s
+        rate = sc.force_rate_for(sc.speed_for(ie))
         per_cycle = 5 * sc.preload_n / rate + 400 * rig.engine.timestep_s
         drive = sim.RampDrive(
             rate_n_s=rate, duration_s=cycles * per_cycle, slide_distance_m=0.05 * sc.char_length_m

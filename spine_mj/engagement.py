@@ -39,6 +39,7 @@ __all__ = [
     "SLIP",
     "crease_engagement",
     "kappa",
+    "kappa_grid",
     "kappa_of_normal",
     "quadratic_coefficients",
     "slip_direction",
@@ -164,6 +165,24 @@ def kappa(fx, fy, mu, *, tol: float = DEFAULT_TOL) -> tuple[np.ndarray, np.ndarr
     region = np.where(lock, SELF_LOCK, np.where(engaged, ENGAGED, SLIP)).astype(np.int8)
     k = np.where(lock, np.inf, k)
     return k, region
+
+
+def kappa_grid(surface, mu, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """kappa and the region over ``n x n`` points spanning ``surface.bounds`` (Fig. 2B).
+
+    Returns
+    -------
+    xs, ys : ndarray, shape (n,)
+        The grid's x and y.
+    heights, kappa, region : ndarray, shape (n, n)
+        Indexed ``[iy, ix]``, as :func:`kappa` gives them from the surface's gradient.
+    """
+    xmin, xmax, ymin, ymax = surface.bounds
+    xs = np.linspace(xmin, xmax, n)
+    ys = np.linspace(ymin, ymax, n)
+    _, fx, fy = surface.evaluate(xs[None, :], ys[:, None], order=1)
+    k, region = kappa(fx, fy, mu)
+    return xs, ys, surface.height(xs[None, :], ys[:, None]), k, region
 
 
 def kappa_of_normal(normal, mu, *, tol: float = DEFAULT_TOL) -> tuple[np.ndarray, np.ndarray]:

@@ -20,6 +20,7 @@ calibrated defaults live in the presets, not in code.
 from __future__ import annotations
 
 import inspect
+import math
 import os
 import sys
 from dataclasses import dataclass, field
@@ -46,6 +47,7 @@ __all__ = [
     "parse_override",
     "preset_mu",
     "presets_dir",
+    "resolve_mu",
 ]
 
 
@@ -158,6 +160,48 @@ def calibrated_mu(preset: Preset | str) -> float:
         name = preset if isinstance(preset, str) else preset.name
         raise SpineInputError(f"preset {name!r} has no [engagement] mu; a calibrated mu_s is needed here")
     return mu
+
+
+def resolve_mu(
+    source: Preset | str | surfaces.Surface | None, mu: float | None = None, *, name: str = "mu"
+) -> float:
+    """The friction coefficient mu_s a command runs with: the one rule of ``kappa``,
+    ``streamline``, ``simulate``, ``sim export``, ``view``, ``reproduce`` and sweep configs.
+
+    ``mu`` when given, else the calibrated ``[engagement] mu`` of ``source``'s preset
+    (:func:`preset_mu`: a preset, its name, or a surface made from one). There is no
+    fallback value: a surface without a calibrated mu needs one given.
+
+    mu_s must be finite and > 0. mu_s = 0 is refused, not taken as frictionless: the
+    engagement condition ``|T| <= mu N`` (Eqs. 1-3) then admits no tangential force, so no
+    drive force holds the tip anywhere but on a level floor (kappa = mu = 0 there), every
+    slope is a slip region, and the streamline, which follows the engaged direction, is
+    undefined; a spine holds by friction, and the harness compares engagement. The
+    library's :class:`~spine_mj.sim.TipParams` still takes ``mu_s = 0`` for engine
+    experiments.
+
+    Raises
+    ------
+    SpineInputError
+        ``mu`` not a finite number > 0, or none given and ``source`` has no calibrated mu
+        (named as ``name``, e.g. ``--mu``).
+    """
+    if mu is None:
+        mu = preset_mu(source)
+        if mu is None:
+            raise SpineInputError(f"{name} is required for a surface whose preset has no [engagement] mu")
+    try:
+        value = float(mu)
+    except (TypeError, ValueError):
+        raise SpineInputError(
+            f"{name} (static friction coefficient mu_s) must be a number, got {mu!r}"
+        ) from None
+    if not (math.isfinite(value) and value > 0):
+        raise SpineInputError(
+            f"{name} (static friction coefficient mu_s) must be finite and > 0 (mu_s = 0 leaves no "
+            f"friction cone to engage in), got {mu!r}"
+        )
+    return value
 
 
 def check_generator_params(generator: str, params: dict, where: str) -> None:

@@ -17,7 +17,7 @@ from concurrent.futures import ProcessPoolExecutor
 import numpy as np
 
 from spine_mj.convexity import CONCAVE, CONVEX, SADDLE, hessian_class, sectional_class
-from spine_mj.engagement import ENGAGED, REGION_NAMES, SLIP, kappa
+from spine_mj.engagement import ENGAGED, REGION_NAMES, SLIP, kappa, kappa_grid
 from spine_mj.errors import SpineInputError
 from spine_mj.plotting import (
     fractal_hurst_figure,
@@ -25,7 +25,7 @@ from spine_mj.plotting import (
     random_gaussian_figure,
     single_peak_figure,
 )
-from spine_mj.presets import calibrated_mu, load_preset
+from spine_mj.presets import load_preset, resolve_mu
 from spine_mj.streamline import Outcome, StreamlineParams, ideal_trajectories, streamlines
 from spine_mj.surfaces import GaussianSurface, fractal_fbm, random_gaussians, single_gaussian
 from spine_mj.workers import check_workers
@@ -46,10 +46,11 @@ Progress = Callable[[int, int], None] | None
 FIVE_Y0 = (-0.5, -1.0, -2.0, -3.0, -4.0)
 
 
-def _settings(preset: str) -> tuple[float, dict, object]:
-    """The preset's calibrated mu_s, its ``[reproduce]`` table and the preset itself."""
+def _settings(preset: str, mu: float | None) -> tuple[float, dict, object]:
+    """mu_s (``mu``, else the preset's calibrated one: :func:`~spine_mj.presets.resolve_mu`),
+    the preset's ``[reproduce]`` table and the preset itself."""
     p = load_preset(preset)
-    return calibrated_mu(p), dict(p.extras.get("reproduce", {})), p
+    return resolve_mu(p, mu), dict(p.extras.get("reproduce", {})), p
 
 
 def _outcome_name(code: int) -> str:
@@ -160,8 +161,7 @@ def single_peak(
     paper 0.833 and 5.667), the ranges, their ``*_coarse`` counterparts, and per-start
     outcomes and max kappa.
     """
-    preset_mu_s, rep, _ = _settings("paper-single-peak")
-    mu = float(mu if mu is not None else preset_mu_s)
+    mu, rep, _ = _settings("paper-single-peak", mu)
     dl = float(dl if dl is not None else rep.get("dl", 0.015))
     y0_step = float(y0_step if y0_step is not None else rep.get("y0_step", 0.1))
     lo, hi = (float(v) for v in (y0_range if y0_range is not None else rep.get("y0_range", (-5.0, 0.0))))
@@ -209,17 +209,13 @@ def kappa_map(
 ):
     """Fig. 2B: kappa over the single convex peak and concave valley (slip blank, self-lock
     marked). Numbers: area fractions of the regions and the kappa range."""
-    preset_mu_s, _, _ = _settings("paper-single-peak")
-    mu = float(mu if mu is not None else preset_mu_s)
+    mu, _, _ = _settings("paper-single-peak", mu)
     n = int(n if n is not None else (101 if quick else 301))
-    xs = np.linspace(-5, 5, n)
     numbers = {"mu": mu, "n": n}
     maps = {}
     for name, sign in (("convex", 1), ("concave", -1)):
-        surf = single_gaussian(sign=sign)
-        _, fx, fy = surf.evaluate(xs[None, :], xs[:, None], order=1)
-        k, region = kappa(fx, fy, mu)
-        maps[name] = (xs, surf.height(xs[None, :], xs[:, None]), k, region)
+        xs, _, heights, k, region = kappa_grid(single_gaussian(sign=sign), mu, n)
+        maps[name] = (xs, heights, k, region)
         for code, label in REGION_NAMES.items():
             numbers[f"{name}_{label}_fraction"] = float(np.mean(region == code))
     if progress:
@@ -347,8 +343,7 @@ def _random_family(
 ) -> tuple[dict, tuple[np.ndarray, np.ndarray]]:
     """One family of :func:`random_gaussian`: its numbers (keys without the family
     prefix) and the (ideal, streamline) max-kappa scatter."""
-    preset_mu_s, rep, pre = _settings(preset)
-    m = float(mu if mu is not None else preset_mu_s)
+    m, rep, pre = _settings(preset, mu)
     runs = int(n_runs if n_runs is not None else rep.get("n_runs", 100))
     mode = str(starts if starts is not None else rep.get("starts", "surfaces"))
     cap = kappa_cap if kappa_cap is not None else rep.get("kappa_cap")
@@ -498,8 +493,7 @@ def fractal_hurst(
     earlier. ``trajectory``: ``"streamline"`` (the paper's Fig. 9) or ``"ideal"`` (the
     same statistics for ideal trajectories, for comparison).
     """
-    preset_mu_s, rep, pre = _settings("paper-fractal")
-    mu = float(mu if mu is not None else preset_mu_s)
+    mu, rep, pre = _settings("paper-fractal", mu)
     hursts = list(
         hursts if hursts is not None else rep.get("hursts", [0.65, 0.7, 0.75, 0.8, 0.85, 0.9, 0.95])
     )

@@ -37,7 +37,6 @@ from scipy import ndimage
 
 from spine_mj._kernels import run_trajectories
 from spine_mj.engagement import (
-    ENGAGED,
     REGION_NAMES,
     SELF_LOCK,
     SLIP,
@@ -453,6 +452,9 @@ def _run_numpy(surface, xs, ys, params, *, ideal, store):
     an accepted candidate lets ``h`` grow back (doubling, up to ``dl``). See
     :class:`StreamlineParams`.
     """
+    # One state machine over per-start arrays (point, step, last accepted point, its
+    # direction and slopes, crease sides, stall window), kept whole where its steps share
+    # them; the crease rule, the endings and the path packing are split out.
     n = xs.size
     xmin, xmax, ymin, ymax = params.domain(surface)
     dl = float(params.dl)
@@ -494,22 +496,9 @@ def _run_numpy(surface, xs, ys, params, *, ideal, store):
             # reversed at the shortest step, or on a crease already followed: the tip rests in
             # a concave crease, on two contacts (crease_engagement)
             r = np.flatnonzero(reversed_ & ((h[active] <= h_min) | in_crease[active]))
-            other = np.column_stack([pfx[active[r]], pfy[active[r]]])
-            got = crease_engagement(other[:, 0], other[:, 1], fx[r], fy[r], params.mu)
-            for c in (0, 2):  # on the same side as the last point: the crease's other side
-                again = got[1] < 0
-                retry = sides[active[r], c : c + 2]
-                alt = crease_engagement(retry[:, 0], retry[:, 1], fx[r], fy[r], params.mu)
-                got = tuple(np.where(again, b, a) for a, b in zip(got, alt))
-                other = np.where(again[:, None], retry, other)
-            kc, rc, cvx, cvy = got
-            two = rc >= 0
-            r = r[two]
-            sides[active[r]] = np.column_stack([other[two], fx[r], fy[r]])
-            crease[r] = True
-            k[r], reg[r], locked[r] = kc[two], rc[two], rc[two] == SELF_LOCK
-            vx[r], vy[r] = cvx[two], cvy[two]
-            finite[r] = locked[r] | (np.isfinite(vx[r]) & np.isfinite(vy[r]))
+            _on_crease(
+                r, active, (pfx, pfy), sides, params.mu, (fx, fy, k, reg, locked, vx, vy, finite), crease
+            )
         rejected = reversed_ & (h[active] > h_min) & ~crease
         back = active[rejected]  # evaluated again next iteration, at the shorter step
         if back.size:
@@ -526,21 +515,15 @@ def _run_numpy(surface, xs, ys, params, *, ideal, store):
         if store:
             for j, idx in enumerate(active):
                 paths[idx].append((xa[j], ya[j], f[j], k[j], reg[j]))
-        done = np.zeros(active.size, bool)
-        outcome[active[locked]] = Outcome.SELF_LOCKED
-        done |= locked
-        held = ~done & (k > params.kappa_cap)
-        outcome[active[held]] = Outcome.FORCE_CAP
-        done |= held
-        stalled = ~done & stall_pending[active]
-        outcome[active[stalled]] = Outcome.STALLED
-        done |= stalled
-        capped = ~done & (n_steps[active] >= params.max_steps)
-        outcome[active[capped]] = Outcome.STEP_CAP
-        done |= capped
-        still = ~done & ~finite
-        outcome[active[still]] = Outcome.STALLED
-        done |= still
+        done = _endings(
+            outcome,
+            active,
+            locked,
+            k > params.kappa_cap,
+            stall_pending[active],
+            n_steps[active] >= params.max_steps,
+            ~finite,
+        )
         # an accepted point reached without a reversal lets the step grow back; along a
         # crease the path steps a whole dl
         hn = np.where(crease, dl, np.where(reversed_, h[active], np.minimum(2.0 * h[active], dl)))
@@ -567,20 +550,64 @@ def _run_numpy(surface, xs, ys, params, *, ideal, store):
             need = stall_dist * (arc[check] * (1.0 / (params.stall_window * dl)))
             stuck = (x[check] - cx[check]) ** 2 + (y[check] - cy[check]) ** 2 < need * need
             stall_pending[check[stuck]] = True
-            cx[check], cy[check] = x[check], y[check]
-            arc[check] = 0.0
-            until[check] = params.stall_window
+            cx[check], cy[check], arc[check], until[check] = x[check], y[check], 0.0, params.stall_window
         active = np.sort(np.concatenate([back, move]))
-    offsets = np.zeros(n + 1, np.int64)
-    if store:
-        offsets[1:] = np.cumsum([len(p) for p in paths])
-        flat = np.array([pt for p in paths for pt in p], dtype=float).reshape(-1, 5)
-        ppx, ppy, ppz, ppk = (np.ascontiguousarray(flat[:, c]) for c in range(4))
-        ppr = flat[:, 4].astype(np.int8)
-    else:
-        ppx = ppy = ppz = ppk = np.empty(0)
-        ppr = np.empty(0, np.int8)
-    return outcome, n_steps, max_k, x.copy(), y.copy(), ez, offsets, ppx, ppy, ppz, ppk, ppr
+    return outcome, n_steps, max_k, x.copy(), y.copy(), ez, *_packed(paths, store)
+
+
+def _on_crease(r, active, prev_slopes, sides, mu, point, crease) -> None:
+    """Where the tip rests in a concave crease (rows ``r`` of the ``active`` starts): the
+    two-contact kappa, region and direction of its sides (:func:`crease_engagement`), the
+    last point's slopes ``prev_slopes`` and the current ones, else the crease's other side
+    from ``sides``; written into ``point`` = (fx, fy, k, reg, locked, vx, vy, finite),
+    ``sides`` and ``crease`` where two contacts hold (:func:`_run_numpy`)."""
+    pfx, pfy = prev_slopes
+    fx, fy, k, reg, locked, vx, vy, finite = point
+    other = np.column_stack([pfx[active[r]], pfy[active[r]]])
+    got = crease_engagement(other[:, 0], other[:, 1], fx[r], fy[r], mu)
+    for c in (0, 2):  # on the same side as the last point: the crease's other side
+        again = got[1] < 0
+        retry = sides[active[r], c : c + 2]
+        alt = crease_engagement(retry[:, 0], retry[:, 1], fx[r], fy[r], mu)
+        got = tuple(np.where(again, b, a) for a, b in zip(got, alt))
+        other = np.where(again[:, None], retry, other)
+    kc, rc, cvx, cvy = got
+    two = rc >= 0
+    r = r[two]
+    sides[active[r]] = np.column_stack([other[two], fx[r], fy[r]])
+    crease[r] = True
+    k[r], reg[r], locked[r] = kc[two], rc[two], rc[two] == SELF_LOCK
+    vx[r], vy[r] = cvx[two], cvy[two]
+    finite[r] = locked[r] | (np.isfinite(vx[r]) & np.isfinite(vy[r]))
+
+
+def _endings(outcome, active, locked, held, stalled, capped, still) -> np.ndarray:
+    """Which ``active`` starts end here, the first reason in this order winning: self-lock,
+    the force cap, a stall, the step cap, no finite direction (a stall); their outcomes
+    are written into ``outcome``."""
+    done = np.zeros(active.size, bool)
+    for mask, code in (
+        (locked, Outcome.SELF_LOCKED),
+        (held, Outcome.FORCE_CAP),
+        (stalled, Outcome.STALLED),
+        (capped, Outcome.STEP_CAP),
+        (still, Outcome.STALLED),
+    ):
+        new = ~done & mask
+        outcome[active[new]] = code
+        done |= new
+    return done
+
+
+def _packed(paths: list, store: bool) -> tuple:
+    """Per-start paths as ``offsets`` and flat ``x, y, z, kappa, region`` arrays."""
+    offsets = np.zeros(len(paths) + 1, np.int64)
+    if not store:
+        return offsets, np.empty(0), np.empty(0), np.empty(0), np.empty(0), np.empty(0, np.int8)
+    offsets[1:] = np.cumsum([len(p) for p in paths])
+    flat = np.array([pt for p in paths for pt in p], dtype=float).reshape(-1, 5)
+    ppx, ppy, ppz, ppk = (np.ascontiguousarray(flat[:, c]) for c in range(4))
+    return offsets, ppx, ppy, ppz, ppk, flat[:, 4].astype(np.int8)
 
 
 # --------------------------------------------------------------------------- finite tip
@@ -615,34 +642,9 @@ def dilate(surface: Surface, radius: float, *, spacing: float | None = None) -> 
     radius = float(radius)
     if not (math.isfinite(radius) and radius >= 0):
         raise SpineInputError(f"radius (tip radius) must be finite and >= 0, got {radius!r}")
-    xmin, xmax, ymin, ymax = surface.bounds
     if spacing is not None and not (math.isfinite(spacing) and spacing > 0):
         raise SpineInputError(f"spacing must be finite and > 0, got {spacing!r}")
-    if isinstance(surface, GridSurface) and spacing is None:
-        grid = surface
-    else:
-        h = spacing
-        if h is None:
-            extent = max(xmax - xmin, ymax - ymin)
-            h = min(radius / 8, extent / 400) if radius > 0 else extent / 400
-        if isinstance(surface, GridSurface) and surface.periodic:
-            grid = surface.resample(h)
-        else:
-            check_grid_size(
-                (xmax - xmin) / h + 1,
-                (ymax - ymin) / h + 1,
-                where=f"dilating by the tip radius {radius:g} at spacing {h:g} (surface units)",
-            )
-            nx = int(math.ceil((xmax - xmin) / h)) + 1
-            ny = int(math.ceil((ymax - ymin) / h)) + 1
-            x, y = np.linspace(xmin, xmax, nx), np.linspace(ymin, ymax, ny)
-            grid = GridSurface(
-                heights=surface.height(x[None, :], y[:, None]),
-                x=x,
-                y=y,
-                unit=surface.unit,
-                metadata=dict(surface.metadata),
-            )
+    grid = _dilation_grid(surface, radius, spacing)
     if radius == 0:
         return grid
     dx, dy = grid.spacing
@@ -675,5 +677,30 @@ def dilate(surface: Surface, radius: float, *, spacing: float | None = None) -> 
     )
 
 
-# keep the region constants importable from here for convenience
-REGIONS = (SLIP, ENGAGED, SELF_LOCK)
+def _dilation_grid(surface: Surface, radius: float, spacing: float | None) -> GridSurface:
+    """The samples :func:`dilate` dilates: a grid's own (or resampled to ``spacing``), an
+    analytic surface's on its bounds at ``spacing`` (default ``min(R / 8, extent / 400)``)."""
+    if isinstance(surface, GridSurface) and spacing is None:
+        return surface
+    xmin, xmax, ymin, ymax = surface.bounds
+    h = spacing
+    if h is None:
+        extent = max(xmax - xmin, ymax - ymin)
+        h = min(radius / 8, extent / 400) if radius > 0 else extent / 400
+    if isinstance(surface, GridSurface) and surface.periodic:
+        return surface.resample(h)
+    check_grid_size(
+        (xmax - xmin) / h + 1,
+        (ymax - ymin) / h + 1,
+        where=f"dilating by the tip radius {radius:g} at spacing {h:g} (surface units)",
+    )
+    nx = int(math.ceil((xmax - xmin) / h)) + 1
+    ny = int(math.ceil((ymax - ymin) / h)) + 1
+    x, y = np.linspace(xmin, xmax, nx), np.linspace(ymin, ymax, ny)
+    return GridSurface(
+        heights=surface.height(x[None, :], y[:, None]),
+        x=x,
+        y=y,
+        unit=surface.unit,
+        metadata=dict(surface.metadata),
+    )

@@ -30,11 +30,21 @@ from spine_mj.surfaces import (
     MAX_GRID_POINTS,
     GaussianSurface,
     GridSurface,
+    HField,
     Surface,
     length_unit,
+    to_hfield,
 )
 
-__all__ = ["FILL_METHODS", "import_topography", "load_surface", "save_surface", "surface_mesh", "write_stl"]
+__all__ = [
+    "FILL_METHODS",
+    "import_topography",
+    "load_surface",
+    "save_surface",
+    "surface_mesh",
+    "write_hfield",
+    "write_stl",
+]
 
 FORMAT = "spine_mj.surface/1"
 _GAUSS_KEYS = ("amplitude", "center_x", "center_y", "sigma_x", "sigma_y")
@@ -224,41 +234,12 @@ def import_topography(
     if not path.is_file():
         raise SpineInputError(f"topography file not found: {path}")
 
-    import SurfaceTopography as st  # lazy like mujoco: 1.7 s to import, needed only for instrument files
-
-    try:
-        reader = st.open_topography(str(path))
-        n_channels = len(reader.channels)
-        if not (0 <= channel < n_channels):
-            raise SpineInputError(f"channel must be in 0..{n_channels - 1} for {path.name}, got {channel}")
-        topo = reader.topography(channel_index=channel)
-        unit = length_unit(topo.unit)
-        if unit is None:
-            if not _is_st_length_unit(topo.unit):
-                raise SpineInputError(
-                    f"channel {channel} of {path.name} must be heights in a length unit, "
-                    f"got unit {topo.unit!r}"
-                )
-            topo, unit = topo.to_unit("m"), "m"
-    except SpineInputError:
-        raise
-    except Exception as exc:  # SurfaceTopography raises many types for bad files
-        raise _unreadable(path, exc) from None
-    if topo.dim != 2 or not topo.is_uniform:
-        raise SpineInputError(f"{path.name} is not a uniform 2-D area scan")
-
+    topo, unit = _read_channel(path, channel)
     heights = np.ma.filled(np.ma.masked_invalid(topo.heights()).astype(float), np.nan)
     missing = ~np.isfinite(heights)
     n_missing = int(missing.sum())
     if n_missing:
-        if fill == "refuse":
-            raise SpineInputError(
-                f"{path.name} has {n_missing} missing points ({100 * n_missing / heights.size:.2f} %);"
-                " choose a fill method (harmonic, nearest, mean)"
-            )
-        if n_missing == heights.size:
-            raise SpineInputError(f"{path.name} has no valid height at all")
-        heights = _fill_missing(heights, missing, fill, topo)
+        heights = _filled(heights, missing, fill, topo, path)
     if level:
         heights = _remove_plane(heights)
 
@@ -287,6 +268,47 @@ def import_topography(
         raise SpineInputError(
             f"spacing_m {spacing_m:g} m ({spacing:g} {unit}) on {path.name}: {exc}"
         ) from None
+
+
+def _read_channel(path: Path, channel: int):
+    """SurfaceTopography's topography of ``channel`` in ``path`` and its length unit (a unit
+    outside :data:`LENGTH_UNITS_M` converted to metres); one-line errors for bad files."""
+    import SurfaceTopography as st  # lazy like mujoco: 1.7 s to import, needed only for instrument files
+
+    try:
+        reader = st.open_topography(str(path))
+        n_channels = len(reader.channels)
+        if not (0 <= channel < n_channels):
+            raise SpineInputError(f"channel must be in 0..{n_channels - 1} for {path.name}, got {channel}")
+        topo = reader.topography(channel_index=channel)
+        unit = length_unit(topo.unit)
+        if unit is None:
+            if not _is_st_length_unit(topo.unit):
+                raise SpineInputError(
+                    f"channel {channel} of {path.name} must be heights in a length unit, "
+                    f"got unit {topo.unit!r}"
+                )
+            topo, unit = topo.to_unit("m"), "m"
+    except SpineInputError:
+        raise
+    except Exception as exc:  # SurfaceTopography raises many types for bad files
+        raise _unreadable(path, exc) from None
+    if topo.dim != 2 or not topo.is_uniform:
+        raise SpineInputError(f"{path.name} is not a uniform 2-D area scan")
+    return topo, unit
+
+
+def _filled(heights: np.ndarray, missing: np.ndarray, fill: str, topo, path: Path) -> np.ndarray:
+    """``heights`` with its ``missing`` points filled by ``fill``, or refused."""
+    n_missing = int(missing.sum())
+    if fill == "refuse":
+        raise SpineInputError(
+            f"{path.name} has {n_missing} missing points ({100 * n_missing / heights.size:.2f} %);"
+            " choose a fill method (harmonic, nearest, mean)"
+        )
+    if n_missing == heights.size:
+        raise SpineInputError(f"{path.name} has no valid height at all")
+    return _fill_missing(heights, missing, fill, topo)
 
 
 def _is_st_length_unit(unit) -> bool:
@@ -380,3 +402,15 @@ def write_stl(surface: Surface, path: str | os.PathLike, **mesh_options) -> Path
     with atomic_output(path) as tmp:
         mesh.export(tmp, file_type="stl")
     return path
+
+
+def write_hfield(surface: Surface, path: str | os.PathLike, *, resolution: int | None = None) -> HField:
+    """Write the surface as MuJoCo hfield data (:func:`~spine_mj.surfaces.to_hfield`;
+    ``resolution`` samples a side, else a grid's own or 201) to an ``.npz`` with ``data``,
+    ``size``, ``pos`` and ``unit``, atomically. Returns the hfield."""
+    hf = to_hfield(surface, ncol=resolution, nrow=resolution) if resolution else to_hfield(surface)
+    with atomic_output(path) as tmp, open(tmp, "wb") as fh:
+        np.savez(
+            fh, data=hf.data, size=np.asarray(hf.size), pos=np.asarray(hf.pos), unit=np.array(surface.unit)
+        )
+    return hf

@@ -8,8 +8,7 @@ from pathlib import Path
 
 import click
 
-from spine_mj import extras, presets, sim, surface_io
-from spine_mj.atomic import all_or_none, atomic_output
+from spine_mj import extras, presets, sim
 from spine_mj.cli.app import (
     InputError,
     Progress,
@@ -21,14 +20,10 @@ from spine_mj.cli.app import (
     refuse_options_not_for,
 )
 from spine_mj.errors import SpineInputError, check_positive
-from spine_mj.jsonio import write_json
-from spine_mj.plotting import (
-    save_figure,
-    sim_run_figure,
-)
 from spine_mj.sim.model import compile_spec
-from spine_mj.sim.render import FPS, choose_gl_backend, default_speed, render_frames
-from spine_mj.sim.replay import load_run, play_in_viewer, run_in_viewer
+from spine_mj.sim.render import choose_gl_backend, default_speed, write_mp4
+from spine_mj.sim.replay import play_in_viewer, run_in_viewer
+from spine_mj.sim.run_folder import load_run, write_run
 
 
 def _rig_options(f):
@@ -46,7 +41,8 @@ def _rig_options(f):
             "--mu",
             type=float,
             default=None,
-            help="Friction coefficient mu_s (default: the preset's [engagement] mu, else 0.5).",
+            help="Friction coefficient mu_s > 0 (default: the preset's [engagement] mu; required "
+            "for other surfaces).",
         ),
         click.option(
             "--preload", type=float, default=0.0, show_default=True, help="Extra downward preload [N]."
@@ -61,7 +57,8 @@ def _rig_options(f):
             "--resolution",
             type=int,
             default=None,
-            help="hfield samples a side for analytic surfaces (default 201).",
+            help="hfield samples a side for analytic surfaces (default 201); a gridded surface "
+            "keeps its own samples.",
         ),
         click.option("--timestep", type=float, default=None, help="Time step [s] (default: derived)."),
         click.option("--noslip", type=int, default=None, help="noslip_iterations (default 3)."),
@@ -86,30 +83,28 @@ def _build_rig(
     *,
     ie=None,
     speed=None,
+    rate=None,
+    driven=True,
 ):
-    """The rig of the shared rig options; ``ie`` or ``speed`` (the drive's) bound the engine
-    step for impacts (:func:`spine_mj.sim.default_engine`)."""
-
+    """The rig of the shared rig options (:func:`spine_mj.sim.build_rig`); the drive's pace
+    (``ie``, ``speed`` or ``rate``) bounds the engine step for impacts (``driven``)."""
     surf = load_surface_arg(surface_spec)
-    mu = presets.preset_mu(surf) if mu is None else mu
-    tip = sim.TipParams(
-        tip_radius_m=tip_radius, mass_kg=mass, preload_n=preload, **({} if mu is None else {"mu_s": mu})
+    return sim.build_rig(
+        surf,
+        mu=presets.resolve_mu(surf, mu, name="--mu"),
+        tip_radius_m=tip_radius,
+        mass_kg=mass,
+        preload_n=preload,
+        length_scale_m=length_scale,
+        hfield_resolution=resolution,
+        timestep_s=timestep,
+        noslip_iterations=noslip,
+        impratio=impratio,
+        ie=ie,
+        speed_m_s=speed,
+        rate_n_s=rate,
+        driven=driven,
     )
-    overrides = {
-        k: v
-        for k, v in (
-            ("timestep_s", timestep),
-            ("noslip_iterations", noslip),
-            ("impratio", impratio),
-            ("hfield_resolution", resolution),
-        )
-        if v is not None
-    }
-    scales = sim.Scales.for_surface(surf, tip=tip, length_scale_m=length_scale, hfield_resolution=resolution)
-    if ie is not None:
-        speed = scales.speed_for(check_positive("--ie", ie))
-    engine = sim.default_engine(scales, speed_m_s=speed, **overrides)
-    return sim.Rig(surf, tip=tip, length_scale_m=length_scale, engine=engine)
 
 
 @main.group("sim", cls=_Group)
@@ -142,7 +137,7 @@ def sim_export(surface_spec, output, start, stiffness, **rig_opts):
       spine-mj sim export paper-single-peak -o rig.xml && python -m mujoco.viewer --mjcf rig.xml
     """
     check_suffix(output, ".xml", "-o/--output")
-    rig = _build_rig(surface_spec, **rig_opts)
+    rig = _build_rig(surface_spec, **rig_opts, driven=False)
     xy = None if start is None else parse_start(start)
     if stiffness is not None:
         check_positive("--stiffness", stiffness)
@@ -246,55 +241,36 @@ def simulate(
             raise SpineInputError(f"give one of {names}, got both")
     if stiffness_number is not None and stiffness is not None:
         raise SpineInputError("give one of --K or --stiffness, got both")
-    if ie is None and speed is None and rate is None:
-        ie = 1e-3
-    rig = _build_rig(surface_spec, **rig_opts, ie=ie, speed=speed)
-    sc = rig.scales
     if ie is not None:
-        speed = sc.speed_for(check_positive("--ie", ie))
-        rate = speed * sc.preload_n / sc.char_length_m
-    if stiffness_number is not None:
-        stiffness = sc.stiffness_for(check_positive("--K", stiffness_number))
-    if drive == "spring":
-        drv = sim.SpringDrive(speed_m_s=speed, stiffness_n_m=stiffness, duration_s=duration)
-    elif drive == "ramp":
-        drv = sim.RampDrive(rate_n_s=rate, duration_s=duration)
-    else:
-        drv = sim.StaticProbe(rate_n_s=rate, start_force_n=start_force)
+        check_positive("--ie", ie)
+    rig = _build_rig(surface_spec, **rig_opts, ie=ie, speed=speed, rate=rate)
+    drv = sim.build_drive(
+        rig.scales,
+        drive,
+        ie=ie,
+        speed_m_s=speed,
+        rate_n_s=rate,
+        stiffness_number=stiffness_number,
+        stiffness_n_m=stiffness,
+        duration_s=duration,
+        start_force_n=start_force,
+    )
     with Progress("simulating", unit="%") as bar:
         result = rig.run(drv, start=(x0, y0), progress=lambda frac: bar.update(round(100 * frac, 1), 100))
         bar.complete()
-    out = Path(out_dir)
-    written = ["trajectory.parquet", "summary.json", "surface.npz", "run.png"] + (
-        ["run.mp4"] if render else []
-    )
-    with all_or_none(*(out / name for name in written)):
-        with atomic_output(out / "trajectory.parquet") as tmp:
-            result.table().to_parquet(tmp, index=False)
-        write_json(out / "summary.json", result.summary())
-        surface_io.save_surface(rig.surface, out / "surface.npz")  # for `spine-mj replay`
-        save_figure(sim_run_figure(result, rig.surface, length_scale_m=rig.length_scale_m), out / "run.png")
-        if render:
-            _render_mp4(rig, result, out / "run.mp4")
+    with Progress("rendering MP4", unit="frame", quiet=not render) as bar:
+        written = write_run(out_dir, rig, result, mp4=render, progress=bar.update)
     click.echo(
         f"end: {result.end_reason.value} ({result.end_detail}); I_e = {result.inertia_number:.3g}"
         + (f", K = {result.stiffness_number:.3g}" if drive == "spring" else "")
     )
-    click.echo(f"wrote {', '.join(str(out / w) for w in written)}")
+    click.echo(f"wrote {', '.join(str(w) for w in written)}")
 
 
 def _render_mp4(rig, run, path: Path, *, speed: float | None = None) -> None:
     """Write the MP4 of a run (a RunResult or a replay Track), with a progress bar."""
-    import imageio.v2 as imageio
-
     with Progress("rendering MP4", unit="frame") as bar:
-        frames = render_frames(rig, run, speed=speed, progress=bar.update)
-        first = next(frames)  # a missing renderer fails here, before the file is opened
-        with atomic_output(path) as tmp:
-            with imageio.get_writer(tmp, fps=FPS, codec="libx264", format="FFMPEG") as writer:
-                writer.append_data(first)
-                for frame in frames:
-                    writer.append_data(frame)
+        write_mp4(rig, run, path, speed=speed, progress=bar.update)
 
 
 @main.command("replay")
@@ -371,6 +347,6 @@ def view(surface_spec, start, duration, **rig_opts):
             "no display (DISPLAY and WAYLAND_DISPLAY are unset): the viewer "
             "needs one; use `spine-mj sim export`, `simulate --render` or `replay --mp4`"
         )
-    rig = _build_rig(surface_spec, **rig_opts)
+    rig = _build_rig(surface_spec, **rig_opts, driven=False)
     model = compile_spec(rig.export_spec(None if start is None else parse_start(start)))
     run_in_viewer(model, time_scale=1.0 / rig.units.time_s, duration_s=duration)

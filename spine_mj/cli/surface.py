@@ -3,12 +3,12 @@
 from __future__ import annotations
 
 import json
+import math
 
 import click
-import numpy as np
 
 from spine_mj import examples, presets, roughness, surface_io
-from spine_mj.atomic import all_or_none, atomic_output
+from spine_mj.atomic import all_or_none
 from spine_mj.cli.app import (
     _Group,
     check_suffix,
@@ -23,7 +23,7 @@ from spine_mj.plotting import (
     save_figure,
     surface_preview,
 )
-from spine_mj.surfaces import LENGTH_UNITS_M, length_unit, to_hfield
+from spine_mj.surfaces import LENGTH_UNITS_M, length_unit
 
 
 @main.group(cls=_Group)
@@ -150,7 +150,7 @@ def surface_info(surface_spec, output, as_json):
     click.echo(f"rms curvature            {rough.rms_curvature:.4g}{'' if not unit else ' 1/' + surf.unit}")
     click.echo(f"L_c (asperity length)    {rough.char_length:.4g}{unit}")
     click.echo(f"l_s (slope correlation)  {rough.slope_correlation_length:.4g}{unit}")
-    hurst = f"{rough.hurst:.3g}" if np.isfinite(rough.hurst) else "not estimated (the PSD is no power law)"
+    hurst = f"{rough.hurst:.3g}" if math.isfinite(rough.hurst) else "not estimated (the PSD is no power law)"
     click.echo(f"Hurst estimate (PSD fit) {hurst}")
     if output:
         click.echo(f"wrote {output}")
@@ -211,14 +211,6 @@ def surface_export(surface_file, stl, stl_scale, base_thickness, hfield, resolut
             surface_io.write_stl(surf, stl, **mesh_opts)
             written.append(f"wrote {stl} (scale {scale:g})")
         if hfield:
-            hf = to_hfield(surf, ncol=resolution, nrow=resolution) if resolution else to_hfield(surf)
-            with atomic_output(hfield) as tmp, open(tmp, "wb") as fh:
-                np.savez(
-                    fh,
-                    data=hf.data,
-                    size=np.asarray(hf.size),
-                    pos=np.asarray(hf.pos),
-                    unit=np.array(surf.unit),
-                )
+            hf = surface_io.write_hfield(surf, hfield, resolution=resolution)
             written.append(f"wrote {hfield} ({hf.nrow} x {hf.ncol}, size {json.dumps(hf.size)})")
     click.echo("\n".join(written))

@@ -18,8 +18,6 @@ from spine_mj.cli.app import (
     parse_start,
     refuse_options_not_for,
 )
-from spine_mj.engagement import kappa
-from spine_mj.errors import SpineInputError
 from spine_mj.jsonio import write_json
 from spine_mj.plotting import (
     kappa_map_figure,
@@ -28,14 +26,6 @@ from spine_mj.plotting import (
 )
 from spine_mj.streamline import StreamlineParams, dilate, ideal_trajectories, streamlines
 from spine_mj.surfaces import check_grid_size
-
-
-def _engagement_mu(surf, mu):
-    if mu is None:
-        mu = presets.preset_mu(surf)
-    if mu is None:
-        raise SpineInputError("--mu is required for a surface whose preset has no [engagement] mu")
-    return mu
 
 
 @main.command("kappa")
@@ -57,13 +47,8 @@ def kappa_cmd(surface_spec, mu, output, resolution):
     check_suffix(output, ".png", "-o/--output")
     check_grid_size(resolution, resolution, where="kappa --resolution")
     surf = load_surface_arg(surface_spec)
-    mu = _engagement_mu(surf, mu)
-    xmin, xmax, ymin, ymax = surf.bounds
-    xs = np.linspace(xmin, xmax, resolution)
-    ys = np.linspace(ymin, ymax, resolution)
-    _, fx, fy = surf.evaluate(xs[None, :], ys[:, None], order=1)
-    k, region = kappa(fx, fy, mu)
-    heights = surf.height(xs[None, :], ys[:, None])
+    mu = presets.resolve_mu(surf, mu, name="--mu")
+    xs, _, heights, k, region = engagement.kappa_grid(surf, mu, resolution)
     fig = kappa_map_figure({surf.metadata.get("preset", "surface"): (xs, heights, k, region)}, mu)
     save_figure(fig, output)
     shares = ", ".join(f"{n} {100 * np.mean(region == c):.1f} %" for c, n in engagement.REGION_NAMES.items())
@@ -110,7 +95,7 @@ def streamline_cmd(surface_spec, mu, starts, dl, tip_radius, fmt, out_dir):
 
     pts = [parse_start(s) for s in starts]
     surf = load_surface_arg(surface_spec)
-    mu = _engagement_mu(surf, mu)
+    mu = presets.resolve_mu(surf, mu, name="--mu")
     xmin, xmax, ymin, ymax = surf.bounds
     params = StreamlineParams(mu=mu, dl=dl if dl is not None else max(xmax - xmin, ymax - ymin) / 1000)
     if tip_radius:

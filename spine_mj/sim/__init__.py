@@ -54,10 +54,12 @@ Modules: :mod:`~spine_mj.sim.params` (tip, engine, scales and their rules),
 :mod:`~spine_mj.sim.detection` (events, end reasons), :mod:`~spine_mj.sim.results`,
 :mod:`~spine_mj.sim.rollout` (open-loop batches), :mod:`~spine_mj.sim.ramp` (closed loop),
 :mod:`~spine_mj.sim.fastforward` (the stick-phase fast-forward rule both use),
-:mod:`~spine_mj.sim.render`, :mod:`~spine_mj.sim.planes` and :mod:`~spine_mj.sim.rig`
-(:class:`Rig`, the object users hold).
+:mod:`~spine_mj.sim.render`, :mod:`~spine_mj.sim.planes`, :mod:`~spine_mj.sim.rig`
+(:class:`Rig`, the object users hold) and :mod:`~spine_mj.sim.build` (:func:`build_rig` and
+:func:`build_drive`: a rig and a drive from dimensionless or SI inputs).
 """
 
+from spine_mj.sim.build import DEFAULT_INERTIA_NUMBER, PROTOCOLS, build_drive, build_rig, drive_speed_m_s
 from spine_mj.sim.detection import Detection, Event
 from spine_mj.sim.drives import Drive, RampDrive, SpringDrive, StaticProbe
 from spine_mj.sim.model import MODEL_PATH
@@ -83,10 +85,12 @@ from spine_mj.sim.results import RunResult
 from spine_mj.sim.rig import REFINE_TIMESTEP, Rig
 
 __all__ = [
+    "DEFAULT_INERTIA_NUMBER",
     "DEFAULT_LENGTH_SCALE_M",
     "LENGTH_UNITS_M",
     "MAX_INERTIA_NUMBER",
     "MODEL_PATH",
+    "PROTOCOLS",
     "REFINE_TIMESTEP",
     "Cone",
     "Detection",
@@ -103,8 +107,11 @@ __all__ = [
     "SpringDrive",
     "StaticProbe",
     "TipParams",
+    "build_drive",
+    "build_rig",
     "characteristic_length",
     "default_engine",
+    "drive_speed_m_s",
     "hfield_of",
     "hfield_spacing",
     "inclined_plane",

@@ -57,9 +57,9 @@ def analyse_window(
     normal_force,
     tangential_force,
     drive_force,
-    tangential_speed,
     carriage_x,
     slipping,
+    tangential_speed,
     marks,
     held_out,
 ):

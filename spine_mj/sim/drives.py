@@ -147,4 +147,4 @@ def speed_m_s(drive: Drive, scales: Scales) -> float:
     """The drive's speed [m/s]: carriage speed, or ``L_c rate / F_p`` for force drives."""
     if isinstance(drive, SpringDrive):
         return drive.speed_m_s
-    return scales.char_length_m * rate_n_s(drive, scales) / scales.preload_n
+    return scales.equivalent_speed(rate_n_s(drive, scales))

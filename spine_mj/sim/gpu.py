@@ -38,7 +38,7 @@ from spine_mj.sim.detection import Detection
 from spine_mj.sim.drives import Drive, SpringDrive, settle_steps, stiffness_n_m
 from spine_mj.sim.model import RigModel
 from spine_mj.sim.results import RunResult, analyse_group
-from spine_mj.sim.rollout import batch_drives, controls, drive_steps
+from spine_mj.sim.rollout import batch_drives, controls, drive_steps, run_batch
 
 # import name -> the PyPI package that provides it
 GPU_PACKAGES = {"warp": "warp-lang", "mujoco_warp": "mujoco-warp"}
@@ -147,8 +147,6 @@ def run_batch_gpu(
     if device is None or backend != "gpu":
         backend = resolve_backend(backend)
     if backend != "gpu":
-        from spine_mj.sim.rollout import run_batch
-
         return run_batch(rig, drives, starts, detection=detection, backend=backend, nthread=nthread)
     wp, mjw = require_packages()
     drives, starts = batch_drives(drives, starts)

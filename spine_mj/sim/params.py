@@ -410,6 +410,17 @@ class Scales:
         """
         return math.sqrt(check_inertia_number(inertia_number)) * self.speed_m_s
 
+    def force_rate_for(self, speed_m_s: float) -> float:
+        """The force rate [N/s] of a force drive (ramp, static probe) at equivalent speed
+        ``speed_m_s``: ``v F_p / L_c``, the rate at which the force rises by one preload in
+        the time the tip would cross one feature at that speed (inverse of
+        :meth:`equivalent_speed`)."""
+        return speed_m_s * self.preload_n / self.char_length_m
+
+    def equivalent_speed(self, rate_n_s: float) -> float:
+        """A force drive's equivalent speed [m/s], ``v_eq = L_c rate / F_p``."""
+        return self.char_length_m * rate_n_s / self.preload_n
+
     def stiffness_number(self, stiffness_n_m: float) -> float:
         """K = k l_s / F_p (docs/physics.md §4), l_s the slope correlation length."""
         return stiffness_n_m * self.slope_length_m / self.preload_n

@@ -21,19 +21,10 @@ from spine_mj.sim.params import EngineUnits
 SENSOR_NAMES = ("tip_pos", "tip_vel", "contact_net", "contact_deepest", "spring_force", "push_force")
 
 
-@dataclass(frozen=True)
-class Recording:
-    """Per-step arrays of a run ``(n, ...)`` or of a group of runs ``(g, n, ...)``.
-
-    Attributes
-    ----------
-    time_s, position_m, velocity_m_s, contact, normal, contact_point_m, penetration_m,
-    normal_force_n, tangential_force_n, drive_force_n, carriage_x_m, slipping
-        As in :class:`~spine_mj.sim.RunResult`.
-    tangential_speed_m_s
-        Tip speed in the tangent plane of the deepest contact [m/s] (the full speed
-        without contact).
-    """
+@dataclass(frozen=True, eq=False)
+class RunColumns:
+    """The per-step arrays every run records, declared once: the fields that
+    :class:`Recording` and :class:`~spine_mj.sim.RunResult` share (documented there)."""
 
     time_s: np.ndarray
     position_m: np.ndarray
@@ -45,9 +36,25 @@ class Recording:
     normal_force_n: np.ndarray
     tangential_force_n: np.ndarray
     drive_force_n: np.ndarray
-    tangential_speed_m_s: np.ndarray
     carriage_x_m: np.ndarray
     slipping: np.ndarray
+
+
+@dataclass(frozen=True)
+class Recording(RunColumns):
+    """Per-step arrays of a run ``(n, ...)`` or of a group of runs ``(g, n, ...)``.
+
+    Attributes
+    ----------
+    time_s, position_m, velocity_m_s, contact, normal, contact_point_m, penetration_m,
+    normal_force_n, tangential_force_n, drive_force_n, carriage_x_m, slipping
+        As in :class:`~spine_mj.sim.RunResult` (:class:`RunColumns`).
+    tangential_speed_m_s
+        Tip speed in the tangent plane of the deepest contact [m/s] (the full speed
+        without contact).
+    """
+
+    tangential_speed_m_s: np.ndarray
 
     @classmethod
     def empty(cls, shape: tuple[int, ...]) -> Recording:
@@ -95,8 +102,11 @@ class Recording:
         return Recording(**{k: view(getattr(self, k)) for k in COLUMNS})
 
 
-#: The column names of a :class:`Recording`, in field order.
+#: The column names of a :class:`Recording`, in field order (the order the compiled
+#: window kernel takes them in, :mod:`~spine_mj.sim._window_kernel`).
 COLUMNS = tuple(f.name for f in dataclasses.fields(Recording))
+#: The columns a :class:`~spine_mj.sim.RunResult` carries (the tangential speed stays behind).
+RESULT_COLUMNS = tuple(f.name for f in dataclasses.fields(RunColumns))
 #: Each column's trailing shape and dtype.
 _LAYOUT = {
     k: ((3,) if k in ("position_m", "velocity_m_s", "normal", "contact_point_m") else (), float)

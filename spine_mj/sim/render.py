@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from spine_mj import streamline as sl
+from spine_mj.atomic import atomic_output
 from spine_mj.errors import SpineInputError
 from spine_mj.sim.drives import Drive
 from spine_mj.sim.model import RigModel
@@ -219,3 +220,27 @@ def render_frames(
             yield frame
     finally:
         renderer.close()
+
+
+def write_mp4(
+    rig: RigModel,
+    run,
+    path,
+    *,
+    speed: float | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> None:
+    """Write the MP4 of a run (a RunResult or :class:`Track`) to ``path``, atomically.
+
+    Frames as :func:`render_frames` draws them; a missing renderer fails before the file
+    is opened. Needs the ``[video]`` extra (imageio with ffmpeg).
+    """
+    import imageio.v2 as imageio  # the optional [video] extra: imported only to write a video
+
+    frames = render_frames(rig, run, speed=speed, progress=progress)
+    first = next(frames)
+    with atomic_output(path) as tmp:
+        with imageio.get_writer(tmp, fps=FPS, codec="libx264", format="FFMPEG") as writer:
+            writer.append_data(first)
+            for frame in frames:
+                writer.append_data(frame)

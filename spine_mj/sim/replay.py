@@ -1,27 +1,17 @@
-"""Replaying a recorded ``simulate`` run: rebuilding its rig from the run folder and
-playing the recorded tip positions in MuJoCo's interactive viewer.
-
-The run folder holds ``summary.json`` (tip, engine, scales, drive), ``surface.npz`` and
-``trajectory.parquet``; the rig is rebuilt from them, so the replay shows the same model.
+"""MuJoCo's interactive viewer: a rig simulated live (:func:`run_in_viewer`) and a recorded
+run played back (:func:`play_in_viewer`, the rig and track of
+:func:`spine_mj.sim.run_folder.load_run`).
 """
 
 from __future__ import annotations
 
-import json
 import threading
 import time
 from collections.abc import Callable
-from pathlib import Path
 
 import numpy as np
-import pandas as pd
-import pyarrow
 
-from spine_mj import surface_io
-from spine_mj.errors import SpineInputError
-from spine_mj.sim.drives import RampDrive, SpringDrive, StaticProbe
 from spine_mj.sim.model import RigModel
-from spine_mj.sim.params import EngineSettings, TipParams
 from spine_mj.sim.render import (
     STREAMLINE_RGBA,
     TRAIL_RGBA,
@@ -30,50 +20,6 @@ from spine_mj.sim.render import (
     decimate,
     streamline_path_m,
 )
-
-RUN_FILES = ("summary.json", "surface.npz", "trajectory.parquet")
-_DRIVES = {cls.__name__: cls for cls in (SpringDrive, RampDrive, StaticProbe)}
-
-
-def load_run(run_dir: str | Path) -> tuple[RigModel, Track]:
-    """The rig and the track of the run recorded in ``run_dir`` by ``spine-mj simulate``."""
-    run_dir = Path(run_dir)
-    missing = [name for name in RUN_FILES if not (run_dir / name).is_file()]
-    if missing:
-        raise SpineInputError(
-            f"{run_dir} is not a replayable run folder: {', '.join(missing)} missing "
-            "(written by `spine-mj simulate`; older runs lack surface.npz)"
-        )
-    try:
-        summary = json.loads((run_dir / "summary.json").read_text())
-    except (UnicodeDecodeError, json.JSONDecodeError, RecursionError) as exc:
-        raise SpineInputError(f"{run_dir / 'summary.json'} is not readable JSON ({exc})") from None
-    try:
-        sc = summary["scales"]
-        rig = RigModel(
-            surface_io.load_surface(run_dir / "surface.npz"),
-            tip=TipParams(**summary["tip"]),
-            engine=EngineSettings(**summary["engine"]),
-            length_scale_m=sc["length_scale_m"],
-            char_length_m=sc["char_length_m"],
-        )
-        drive = _DRIVES[summary["drive"]](**summary["drive_params"])
-        start = tuple(summary["start"])
-    except (KeyError, TypeError) as exc:
-        raise SpineInputError(f"{run_dir / 'summary.json'} does not describe a run: {exc!r}") from None
-    try:
-        table = pd.read_parquet(run_dir / "trajectory.parquet")
-        track = Track(
-            time_s=table["time_s"].to_numpy(),
-            position_m=table[["position_x_m", "position_y_m", "position_z_m"]].to_numpy(),
-            carriage_x_m=table["carriage_x_m"].to_numpy(),
-            drive_force_n=table["drive_force_n"].to_numpy(),
-            start=start,
-            drive=drive,
-        )
-    except (pyarrow.ArrowException, KeyError) as exc:
-        raise SpineInputError(f"{run_dir / 'trajectory.parquet'} is not a run's trajectory ({exc})") from None
-    return rig, track
 
 
 def run_in_viewer(model, *, time_scale: float = 1.0, duration_s: float | None = None) -> None:

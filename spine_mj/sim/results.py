@@ -37,14 +37,11 @@ from spine_mj.sim.detection import (
 from spine_mj.sim.drives import Drive, SpringDrive, StaticProbe, settle_steps, stiffness_n_m
 from spine_mj.sim.model import RigModel
 from spine_mj.sim.params import EndReason, EngineSettings, Scales, TipParams
-from spine_mj.sim.recording import COLUMNS, SENSOR_NAMES, Recording
-
-#: The recording's columns a :class:`RunResult` carries (the tangential speed stays behind).
-RESULT_COLUMNS = tuple(k for k in COLUMNS if k != "tangential_speed_m_s")
+from spine_mj.sim.recording import COLUMNS, RESULT_COLUMNS, SENSOR_NAMES, Recording, RunColumns
 
 
 @dataclass(frozen=True, eq=False)
-class RunResult:
+class RunResult(RunColumns):
     """One run. Arrays have ``n`` rows, one per recorded step (the settle phase included).
 
     Attributes
@@ -93,18 +90,6 @@ class RunResult:
         Start in surface units.
     """
 
-    time_s: np.ndarray
-    position_m: np.ndarray
-    velocity_m_s: np.ndarray
-    contact: np.ndarray
-    normal: np.ndarray
-    contact_point_m: np.ndarray
-    penetration_m: np.ndarray
-    normal_force_n: np.ndarray
-    tangential_force_n: np.ndarray
-    drive_force_n: np.ndarray
-    carriage_x_m: np.ndarray
-    slipping: np.ndarray
     events: tuple[Event, ...]
     end_reason: EndReason
     end_detail: str

@@ -32,6 +32,7 @@ from __future__ import annotations
 import itertools
 import math
 import os
+import queue
 import threading
 from collections.abc import Sequence
 
@@ -474,8 +475,6 @@ class _NativeLanes:
     from); :meth:`take` hands finished pieces back in the order they finished."""
 
     def __init__(self, nthread: int):
-        import queue
-
         import mujoco
 
         self.spec = int(mujoco.mjtState.mjSTATE_CTRL) | int(mujoco.mjtState.mjSTATE_MOCAP_POS)

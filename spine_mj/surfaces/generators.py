@@ -171,21 +171,7 @@ def random_gaussians(
         cx = gen.uniform(xmin, xmax, n_peaks)
         cy = gen.uniform(ymin, ymax, n_peaks)
     else:
-        radius = 0.5 * (sigma_x + sigma_y)
-        cx, cy = np.empty(n_peaks), np.empty(n_peaks)
-        for i in range(n_peaks):
-            for _ in range(10_000):
-                px, py = gen.uniform(xmin, xmax), gen.uniform(ymin, ymax)
-                d = np.hypot(cx[:i] - px, cy[:i] - py)
-                if np.all(d >= min_separation * (radius[:i] + radius[i])):
-                    cx[i], cy[i] = px, py
-                    break
-            else:
-                raise SpineInputError(
-                    f"overlap=False: could not place peak {i + 1} of {n_peaks} with "
-                    f"min_separation={min_separation}; lower n_peaks, the widths or "
-                    "min_separation, or allow overlap"
-                )
+        cx, cy = _separated_centres(gen, (xmin, xmax, ymin, ymax), 0.5 * (sigma_x + sigma_y), min_separation)
     return GaussianSurface(
         amplitude=amplitude,
         center_x=cx,
@@ -207,6 +193,28 @@ def random_gaussians(
             min_separation=min_separation,
         ),
     )
+
+
+def _separated_centres(gen, bounds, radius: np.ndarray, min_separation: float):
+    """Centres drawn one at a time, uniform over ``bounds``, each at least ``min_separation``
+    times the sum of two radii from those before it (10 000 tries each)."""
+    xmin, xmax, ymin, ymax = bounds
+    n_peaks = radius.size
+    cx, cy = np.empty(n_peaks), np.empty(n_peaks)
+    for i in range(n_peaks):
+        for _ in range(10_000):
+            px, py = gen.uniform(xmin, xmax), gen.uniform(ymin, ymax)
+            d = np.hypot(cx[:i] - px, cy[:i] - py)
+            if np.all(d >= min_separation * (radius[:i] + radius[i])):
+                cx[i], cy[i] = px, py
+                break
+        else:
+            raise SpineInputError(
+                f"overlap=False: could not place peak {i + 1} of {n_peaks} with "
+                f"min_separation={min_separation}; lower n_peaks, the widths or "
+                "min_separation, or allow overlap"
+            )
+    return cx, cy
 
 
 def _spectral_rms_slope(heights: np.ndarray, dx: float, dy: float) -> float:
@@ -256,49 +264,19 @@ def fractal_fbm(
         result does not wrap around.
     """
     periodic = _flag("periodic", periodic)
-    nx = _grid_count("nx", nx)
-    ny = nx if ny is None else _grid_count("ny", ny)
-    check_grid_size((1 if periodic else 2) * nx, (1 if periodic else 2) * ny, where="fractal_fbm")
-    lx, ly = (size, size) if np.isscalar(size) else _pair("size", size)
-    lx, ly = check_positive("size x", lx), check_positive("size y", ly)
+    nx, ny, lx, ly = _fbm_grid(nx, ny, size, periodic)
     hurst = float(hurst)
     if not (0.0 < hurst < 1.0):
         raise SpineInputError(f"hurst must lie in the open interval (0, 1), got {hurst!r}")
-    if rms_height is not None and rms_slope is not None:
-        raise SpineInputError("give rms_height or rms_slope, not both")
-    if rms_slope is not None:
-        rms_slope = check_positive("rms_slope", rms_slope)
-    else:
-        rms_height = 1.0 if rms_height is None else check_positive("rms_height", rms_height)
-    if long_cutoff is not None:
-        long_cutoff = check_positive("long_cutoff", long_cutoff)
-    if short_cutoff is not None:
-        short_cutoff = check_positive("short_cutoff", short_cutoff)
+    rms_height, rms_slope = _fbm_normalization(rms_height, rms_slope)
+    long_cutoff = None if long_cutoff is None else check_positive("long_cutoff", long_cutoff)
+    short_cutoff = None if short_cutoff is None else check_positive("short_cutoff", short_cutoff)
     gen, seed = _rng_and_seed(rng)
 
     dx, dy = lx / nx, ly / ny
-    fac = 1 if periodic else 2
-    mx, my = fac * nx, fac * ny
-    fx = np.fft.fftfreq(mx, dx)[None, :]
-    fy = np.fft.fftfreq(my, dy)[:, None]
-    freq = np.hypot(fx, fy)
-    if long_cutoff is not None:
-        freq = np.maximum(freq, 1.0 / long_cutoff)
-    with np.errstate(divide="ignore"):
-        amp = np.where(freq > 0, freq ** -(hurst + 1.0), 0.0)
-    if short_cutoff is not None:
-        amp[np.hypot(fx, fy) > 1.0 / short_cutoff] = 0.0
-    amp[0, 0] = 0.0
-    noise = gen.standard_normal((my, mx))
-    heights = np.fft.ifft2(np.fft.fft2(noise) * amp).real[:ny, :nx]
-    heights -= heights.mean()
+    heights = _fbm_heights(gen, (nx, ny), (dx, dy), hurst, periodic, long_cutoff, short_cutoff)
     if rms_slope is not None:
-        if periodic:
-            current = _spectral_rms_slope(heights, dx, dy)
-        else:
-            gy, gx = np.gradient(heights, dy, dx)
-            current = float(np.sqrt(np.mean(gx * gx + gy * gy)))
-        heights *= rms_slope / current
+        heights *= rms_slope / _rms_slope(heights, dx, dy, periodic)
     else:
         heights *= rms_height / heights.std()
     if not np.isfinite(heights).all():
@@ -329,6 +307,56 @@ def fractal_fbm(
             unit=unit,
         ),
     )
+
+
+def _fbm_grid(nx, ny, size, periodic: bool) -> tuple[int, int, float, float]:
+    """Points and side lengths of a :func:`fractal_fbm` grid, checked (a non-periodic one
+    is synthesized twice as large)."""
+    nx = _grid_count("nx", nx)
+    ny = nx if ny is None else _grid_count("ny", ny)
+    check_grid_size((1 if periodic else 2) * nx, (1 if periodic else 2) * ny, where="fractal_fbm")
+    lx, ly = (size, size) if np.isscalar(size) else _pair("size", size)
+    return nx, ny, check_positive("size x", lx), check_positive("size y", ly)
+
+
+def _fbm_normalization(rms_height, rms_slope) -> tuple[float | None, float | None]:
+    """``(rms_height, rms_slope)`` checked: one of them (neither: ``rms_height = 1``)."""
+    if rms_height is not None and rms_slope is not None:
+        raise SpineInputError("give rms_height or rms_slope, not both")
+    if rms_slope is not None:
+        return None, check_positive("rms_slope", rms_slope)
+    return (1.0 if rms_height is None else check_positive("rms_height", rms_height)), None
+
+
+def _rms_slope(heights: np.ndarray, dx: float, dy: float, periodic: bool) -> float:
+    """``sqrt(<|grad f|^2>)``: spectral on a periodic grid, central differences otherwise."""
+    if periodic:
+        return _spectral_rms_slope(heights, dx, dy)
+    gy, gx = np.gradient(heights, dy, dx)
+    return float(np.sqrt(np.mean(gx * gx + gy * gy)))
+
+
+def _fbm_heights(gen, shape, spacing, hurst, periodic, long_cutoff, short_cutoff) -> np.ndarray:
+    """Zero-mean fBm heights ``(ny, nx)`` before normalization (:func:`fractal_fbm`): white
+    noise filtered by ``|f|^-(H+1)``, flat below ``1/long_cutoff``, zero above
+    ``1/short_cutoff``; a non-periodic surface is one quadrant of one twice as large."""
+    (nx, ny), (dx, dy) = shape, spacing
+    fac = 1 if periodic else 2
+    mx, my = fac * nx, fac * ny
+    fx = np.fft.fftfreq(mx, dx)[None, :]
+    fy = np.fft.fftfreq(my, dy)[:, None]
+    freq = np.hypot(fx, fy)
+    if long_cutoff is not None:
+        freq = np.maximum(freq, 1.0 / long_cutoff)
+    with np.errstate(divide="ignore"):
+        amp = np.where(freq > 0, freq ** -(hurst + 1.0), 0.0)
+    if short_cutoff is not None:
+        amp[np.hypot(fx, fy) > 1.0 / short_cutoff] = 0.0
+    amp[0, 0] = 0.0
+    noise = gen.standard_normal((my, mx))
+    heights = np.fft.ifft2(np.fft.fft2(noise) * amp).real[:ny, :nx]
+    heights -= heights.mean()
+    return heights
 
 
 def _particle_envelope(n, spacing, diam, px, py, embed) -> np.ndarray:
@@ -386,14 +414,7 @@ def sandpaper(
     size_m
         Side of the square patch, metres.
     """
-    if grit is not None:
-        if grit not in GRIT_PARTICLE_DIAMETER_M:
-            raise SpineInputError(f"grit must be one of {sorted(GRIT_PARTICLE_DIAMETER_M)}, got {grit!r}")
-        if particle_diameter_m is None:
-            particle_diameter_m = GRIT_PARTICLE_DIAMETER_M[grit]
-    if particle_diameter_m is None:
-        raise SpineInputError("give grit (P36, P60, P600) or particle_diameter_m")
-    d_mean = check_positive("particle_diameter_m", particle_diameter_m)
+    d_mean = _grit_diameter(grit, particle_diameter_m)
     size_m = check_positive("size_m", size_m)
     tip_radius_m = check_positive("tip_radius_m", tip_radius_m)
     spacing_m = (
@@ -406,28 +427,15 @@ def sandpaper(
     e_lo, e_hi = _range("embed_range", embed_range, positive=False)
     if not (0 <= e_lo and e_hi < 1):
         raise SpineInputError(f"embed_range must lie within [0, 1), got {embed_range!r}")
-    check_grid_size(
-        size_m / spacing_m, size_m / spacing_m, where="sandpaper (size_m / spacing_m points a side)"
-    )
-    n = math.ceil(size_m / spacing_m - 1e-9)
-    if n < _MIN_POINTS_PER_SIDE:
-        raise SpineInputError(f"size_m / spacing_m gives {n} points; need at least 4")
-    if size_m < 2 * d_mean:
-        raise SpineInputError(
-            f"size_m ({size_m:g}) must be at least twice the particle diameter ({d_mean:g})"
-        )
+    n = _patch_points(size_m, spacing_m, d_mean)
     gen, seed = _rng_and_seed(rng)
     spacing = size_m / n
     mean_area = math.pi * (d_mean / 2) ** 2 * (1 + size_cv**2)
     n_particles = max(1, round(coverage * size_m**2 / mean_area))
 
-    sig_ln = math.sqrt(math.log1p(size_cv**2))
-    diam = d_mean * np.exp(gen.normal(-0.5 * sig_ln**2, sig_ln, n_particles))
-    px = gen.uniform(0, size_m, n_particles)
-    py = gen.uniform(0, size_m, n_particles)
-    embed = gen.uniform(e_lo, e_hi, n_particles)
-
-    heights = _particle_envelope(n, spacing, diam, px, py, embed)
+    heights = _particle_envelope(
+        n, spacing, *_particles(gen, n_particles, d_mean, size_cv, size_m, (e_lo, e_hi))
+    )
     coords = spacing * np.arange(n) - size_m / 2
     return GridSurface(
         heights=heights,
@@ -449,3 +457,42 @@ def sandpaper(
             n_particles=n_particles,
         ),
     )
+
+
+def _grit_diameter(grit: str | None, particle_diameter_m: float | None) -> float:
+    """The mean particle diameter [m]: ``particle_diameter_m``, else the grit's."""
+    if grit is not None:
+        if grit not in GRIT_PARTICLE_DIAMETER_M:
+            raise SpineInputError(f"grit must be one of {sorted(GRIT_PARTICLE_DIAMETER_M)}, got {grit!r}")
+        if particle_diameter_m is None:
+            particle_diameter_m = GRIT_PARTICLE_DIAMETER_M[grit]
+    if particle_diameter_m is None:
+        raise SpineInputError("give grit (P36, P60, P600) or particle_diameter_m")
+    return check_positive("particle_diameter_m", particle_diameter_m)
+
+
+def _patch_points(size_m: float, spacing_m: float, d_mean: float) -> int:
+    """Grid points a side of a sandpaper patch, refused when too many or too few, or when the
+    patch is smaller than two particles."""
+    check_grid_size(
+        size_m / spacing_m, size_m / spacing_m, where="sandpaper (size_m / spacing_m points a side)"
+    )
+    n = math.ceil(size_m / spacing_m - 1e-9)
+    if n < _MIN_POINTS_PER_SIDE:
+        raise SpineInputError(f"size_m / spacing_m gives {n} points; need at least 4")
+    if size_m < 2 * d_mean:
+        raise SpineInputError(
+            f"size_m ({size_m:g}) must be at least twice the particle diameter ({d_mean:g})"
+        )
+    return n
+
+
+def _particles(gen, n_particles: int, d_mean: float, size_cv: float, size_m: float, embed_range):
+    """Diameters (log-normal, mean ``d_mean``, variation ``size_cv``), centres (uniform on the
+    patch) and embedding fractions (uniform on ``embed_range``), drawn in that order."""
+    sig_ln = math.sqrt(math.log1p(size_cv**2))
+    diam = d_mean * np.exp(gen.normal(-0.5 * sig_ln**2, sig_ln, n_particles))
+    px = gen.uniform(0, size_m, n_particles)
+    py = gen.uniform(0, size_m, n_particles)
+    embed = gen.uniform(*embed_range, n_particles)
+    return diam, px, py, embed

@@ -124,7 +124,8 @@ REQUIRED = object()
 
 #: ``ParamSpec.default`` of ``mu``: each case takes the calibrated mu_s of its surface's
 #: preset (``[engagement] mu``, :func:`spine_mj.presets.preset_mu`); a config must set it
-#: when a surface has none (a file, a preset without a calibration).
+#: when a surface has none (a file, a preset without a calibration), and mu_s <= 0 is
+#: refused: the rule of every command (:func:`spine_mj.presets.resolve_mu`).
 PRESET_MU = object()
 
 #: The friction coefficient, shared by every analysis that needs one (declared once).

@@ -168,13 +168,7 @@ def run_sweep(
         raise SpineInputError(f"--out {out_dir} exists and is not a folder")
     cases = expand_cases(config)
     n_workers = None if scheduler is not None else (workers or os.cpu_count() or 1)
-    session = {
-        "started": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
-        "workers": n_workers,
-        "scheduler": None if scheduler is None else str(getattr(scheduler, "scheduler", scheduler)),
-        "versions": versions(),
-        "git": git_commit(),
-    }
+    session = _session_record(n_workers, scheduler)
     clear_caches()
     check_cases(cases, config.swept)  # an input error refuses the config, not every run
     client = None if scheduler is None else connect(scheduler)  # before anything is written
@@ -197,6 +191,17 @@ def run_sweep(
     finally:
         if client is not None and client is not scheduler:
             client.close()
+
+
+def _session_record(n_workers: int | None, scheduler) -> dict:
+    """What the manifest records of this session: start time, workers, scheduler, versions."""
+    return {
+        "started": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+        "workers": n_workers,
+        "scheduler": None if scheduler is None else str(getattr(scheduler, "scheduler", scheduler)),
+        "versions": versions(),
+        "git": git_commit(),
+    }
 
 
 def clear_caches() -> None:

@@ -276,6 +276,3 @@ def departure_ie_star(ie, agree_matrix, *, n_boot: int, rng=12345) -> IeStar:
         return star
     lo, hi = _log_interval(lambda idx: estimate(a[:, idx]), n, n_boot, rng)
     return dataclasses.replace(star, ci_low=lo, ci_high=hi)
-
-
-# --------------------------------------------------------------------------- ramp duration

@@ -21,7 +21,7 @@ from spine_mj.validate.plans import FRECHET_TARGET, OUTCOME_TARGET, RECOMMENDED,
 from spine_mj.validate.study_runner import StudyRunner
 from spine_mj.validate.sweep_configs import engine_grid, family_doc
 
-__all__ = ["LimitPath", "QuasistaticLimitResult", "quasistatic_limit"]
+__all__ = ["LimitPath", "QuasistaticLimitResult", "limit_doc", "quasistatic_limit"]
 
 #: Columns of the per-run rows.
 RUN_COLUMNS = (
@@ -171,7 +171,7 @@ def quasistatic_limit(plan: ValidationPlan, runner: StudyRunner) -> QuasistaticL
     )
 
 
-def _limit_doc(plan: ValidationPlan, fam: FamilySpec, preset: str, name: str, overrides=()) -> dict:
+def limit_doc(plan: ValidationPlan, fam: FamilySpec, preset: str, name: str, overrides=()) -> dict:
     """The sweep config of one preset of ``fam`` at the lowest I_e with the rig's tip on
     both sides (``overrides``: an engine variation)."""
     res = dict(overrides).get("hfield_resolution", plan.hfield_resolution)
@@ -197,7 +197,7 @@ def _preset_comparison(
 ) -> pd.DataFrame:
     """The ``compare`` rows of one preset's sweep with the MuJoCo row's end and status; the
     single peak/valley family's paths go into ``paths``."""
-    df, store = runner(_limit_doc(plan, fam, preset, f"limit-{preset}"), f"limit/{preset}")
+    df, store = runner(limit_doc(plan, fam, preset, f"limit-{preset}"), f"limit/{preset}")
     comp = df[df["analysis"] == "compare"].copy()
     mj = df[df["analysis"] == "mujoco"].set_index(["case_id", "start"])
     key = list(zip(comp["case_id"], comp["start"].astype(int)))
@@ -227,7 +227,7 @@ def _variations(plan: ValidationPlan, runner: StudyRunner, runs_rows: list[dict]
     preset = fam0.presets[0]
     for label, ov in plan.limit_variations:
         tag = "-".join(f"{k}{v}" for k, v in ov)
-        df, _ = runner(_limit_doc(plan, fam0, preset, f"limit-var-{label}", ov), f"limit-var/{preset}-{tag}")
+        df, _ = runner(limit_doc(plan, fam0, preset, f"limit-var-{label}", ov), f"limit-var/{preset}-{tag}")
         comp = df[df["analysis"] == "compare"]
         variations[label] = {**_family_summary(comp), "settings": dict(ov), "surface": preset}
     base = [r for r in runs_rows if r["preset"] == preset]

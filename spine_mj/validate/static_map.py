@@ -16,7 +16,7 @@ from spine_mj.validate.plans import GRAVITY, MASS_KG, ValidationPlan
 from spine_mj.validate.study_runner import StudyRunner
 from spine_mj.validate.sweep_configs import engine_default
 
-__all__ = ["PLANE_START", "StaticMapResult", "static_map"]
+__all__ = ["PLANE_START", "StaticMapResult", "hold_force", "static_map"]
 
 #: Where the probe starts on every plane (metres).
 PLANE_START = (3.1e-4, 2.7e-4)
@@ -63,7 +63,7 @@ class StaticMapResult:
         }
 
 
-def _hold_force(fx: float, fy: float, mu: float) -> tuple[float, float, int]:
+def hold_force(fx: float, fy: float, mu: float) -> tuple[float, float, int]:
     """Analytic kappa, the smallest drive force / W that holds the tip, and the region."""
     k, region = engagement.kappa(fx, fy, mu)
     a, b, c = (float(v) for v in engagement.quadratic_coefficients(fx, fy, mu))
@@ -111,7 +111,7 @@ def _plane_rows(plan: ValidationPlan, runner: StudyRunner, slope: float, az: flo
     engines = plan.static_engines
     t = math.tan(math.radians(slope))
     fx, fy = t * math.cos(math.radians(az)), t * math.sin(math.radians(az))
-    k, low, region = _hold_force(fx, fy, mu)
+    k, low, region = hold_force(fx, fy, mu)
     hold = 0.5 * (low + k) if (low > 0 and np.isfinite(k)) else (1.5 * low if low > 0 else 0.0)
     path = runner.out_dir / "surfaces" / f"plane_s{slope:g}_a{az:g}.npz"
     if not path.is_file():

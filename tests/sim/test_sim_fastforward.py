@@ -141,9 +141,9 @@ def _probe(rig, ie, fx, fy):
     """The static map's probe (validate.static_map) at ``I_e = ie`` on a plane of slopes
     (fx, fy): it starts holding the smallest force that keeps the tip put plus half the gap
     to the breakaway force."""
-    from spine_mj.validate.static_map import _hold_force
+    from spine_mj.validate.static_map import hold_force
 
-    k, low, _ = _hold_force(fx, fy, rig.tip.mu_s)
+    k, low, _ = hold_force(fx, fy, rig.tip.mu_s)
     hold = 0.5 * (low + k) if low > 0 else 0.0
     sc = rig.scales
     return sim.StaticProbe(

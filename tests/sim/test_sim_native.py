@@ -18,7 +18,7 @@ from spine_mj.cli import main
 from spine_mj.errors import SpineInputError
 from spine_mj.sim import Rig
 from spine_mj.sim.render import choose_gl_backend, streamline_path_m
-from spine_mj.sim.replay import load_run
+from spine_mj.sim.run_folder import load_run
 
 
 def _surface_height_m(rig, x_m, y_m):

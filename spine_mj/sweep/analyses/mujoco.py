@@ -1,7 +1,8 @@
 """The ``mujoco`` analysis: a run of the MuJoCo rig from every start with the chosen drive.
 
-Touches the API of :mod:`spine_mj.sim` here only. The rig of a case is built from
-:meth:`spine_mj.sim.Scales.for_surface` and cached per process, so cases that differ only
+Touches the API of :mod:`spine_mj.sim` here only. The rig and drive of a case come from
+:func:`spine_mj.sim.build_rig` and :func:`spine_mj.sim.build_drive` (the builder
+``spine-mj simulate`` uses too); the rig is cached per process, so cases that differ only
 in the drive share it.
 """
 
@@ -16,7 +17,6 @@ from spine_mj.errors import SpineInputError
 from spine_mj.sim.params import surface_unit_m
 from spine_mj.sim.ramp import nominal_time_s
 from spine_mj.sim.rollout import drive_steps
-from spine_mj.surfaces import GridSurface
 from spine_mj.sweep.registry import (
     CASE_THREADS,
     KAPPA_CAP_PARAM,
@@ -179,37 +179,25 @@ def _rig(spec, key):
     """The rig of a surface and tip/engine parameters (cached: cases differing only in the
     drive's stiffness or protocol share it; the speed sets the engine step)."""
     p = dict(key)
-    surface = spec.make()
-    tip = sim.TipParams(
+    return sim.build_rig(
+        spec.make(),
+        mu=p["mu"],
         tip_radius_m=p["tip_radius_m"],
         mass_kg=p["mass"],
-        mu_s=p["mu"],
         preload_n=p["preload"],
         gravity_m_s2=p["gravity"],
+        length_scale_m=p["length_scale"],
+        hfield_resolution=p["hfield_resolution"],
+        timestep_s=p["timestep"],
+        integrator=p["integrator"],
+        cone=p["cone"],
+        impratio=p["impratio"],
+        noslip_iterations=p["noslip_iterations"],
+        solref_timeconst_s=p["solref_timeconst"],
+        solref_dampratio=p["solref_dampratio"],
+        ie=p["ie"],
+        speed_m_s=p["speed"],
     )
-    # a gridded surface (fractal, sandpaper, scan) keeps its own samples: resampling a
-    # sandpaper to an analytic surface's 151 a side left 33 um facets under a 25 um tip
-    resolution = None if isinstance(surface, GridSurface) else p["hfield_resolution"]
-    scales = sim.Scales.for_surface(
-        surface, tip=tip, length_scale_m=p["length_scale"], hfield_resolution=resolution
-    )
-    overrides = {
-        "integrator": p["integrator"],
-        "cone": p["cone"],
-        "impratio": p["impratio"],
-        "noslip_iterations": p["noslip_iterations"],
-        "hfield_resolution": resolution,
-    }
-    if p["timestep"] is not None:
-        overrides["timestep_s"] = p["timestep"]
-    speed = drive_speed_m_s(p, scales)
-    dt = (
-        p["timestep"] if p["timestep"] is not None else sim.default_engine(scales, speed_m_s=speed).timestep_s
-    )
-    tc = p["solref_timeconst"] if p["solref_timeconst"] is not None else 2 * dt
-    overrides["solref"] = (tc, p["solref_dampratio"])
-    engine = sim.default_engine(scales, speed_m_s=speed, **overrides)
-    return sim.Rig(surface, tip=tip, engine=engine, length_scale_m=p["length_scale"])
 
 
 def case_rig(case, surface=None):
@@ -263,43 +251,28 @@ def _rig_key(p: dict, surface) -> tuple:
     return tuple(sorted({"tip_radius_m": tip_radius_m, **{k: p[k] for k in _RIG_KEYS}}.items()))
 
 
-def drive_speed_m_s(p: dict, scales) -> float:
-    """A case's drive speed: ``speed`` when given, else from ``ie`` (default 1e-3)."""
-    if p["speed"] is not None:
-        return p["speed"]
-    return scales.speed_for(1e-3 if p["ie"] is None else p["ie"])
-
-
-def _drive(rig, p: dict):
-    """The case's drive on ``rig`` (speed from ``ie`` unless given; the ramp and static
-    rates from the speed)."""
-    sc = rig.scales
-    speed = drive_speed_m_s(p, sc)
-    rate = speed * sc.preload_n / sc.char_length_m
-    if p["protocol"] == "spring":
-        stiffness = p["stiffness"] if p["K"] is None else sc.stiffness_for(p["K"])
-        return sim.SpringDrive(
-            speed_m_s=speed,
-            stiffness_n_m=stiffness,
-            duration_s=p["duration"],
-            settle_time_s=p["settle_time"],
-        )
-    if p["protocol"] == "static":
-        return sim.StaticProbe(rate_n_s=rate, start_force_n=p["start_force"], settle_time_s=p["settle_time"])
-    return sim.RampDrive(
-        rate_n_s=rate,
+def case_drive(rig, p: dict):
+    """The drive of a case's parameters ``p`` on ``rig`` (:func:`spine_mj.sim.build_drive`)."""
+    return sim.build_drive(
+        rig.scales,
+        p["protocol"],
+        ie=p["ie"],
+        speed_m_s=p["speed"],
+        stiffness_number=p["K"],
+        stiffness_n_m=p["stiffness"],
         duration_s=p["duration"],
         settle_time_s=p["settle_time"],
+        start_force_n=p["start_force"],
         slide_distance_m=p["slide_distance"],
     )
 
 
 def _runs(rig, p: dict, starts) -> list:
     """The runs of ``rig`` from every start with the case's drive."""
-    drive = _drive(rig, p)
+    drive = case_drive(rig, p)
     det = sim.Detection(kappa_cap=p["kappa_cap"])
     pts = [tuple(s) for s in starts]
-    if isinstance(drive, sim.RampDrive):
+    if p["protocol"] == "ramp":
         return [rig.run(drive, start=s, detection=det) for s in pts]
     return rig.run_batch(drive, pts, detection=det, nthread=CASE_THREADS.get())
 
@@ -308,9 +281,9 @@ def _check_case(case, surface, starts) -> None:
     """The inputs' errors a run would meet, without running: the rig (tip, scales, engine),
     the drive and, for the open-loop drives, the length of the run from the first start."""
     rig = case_rig(case, surface)
-    drive = _drive(rig, case.params)
+    drive = case_drive(rig, case.params)
     rig.check_drive(drive)
-    if not isinstance(drive, sim.RampDrive) and len(starts):
+    if case.params["protocol"] != "ramp" and len(starts):
         det = sim.Detection(kappa_cap=case.params["kappa_cap"]).resolve(rig.scales)
         x0 = float(min(s[0] for s in starts)) * rig.length_scale_m
         drive_steps(rig, drive, x0, det)

@@ -222,6 +222,13 @@ def _lines(limit: QuasistaticLimitResult, boundary: BoundaryResult) -> list[str]
         *_stalled_note(limit),
         *_misses_note(limit),
         *falls_note(limit, boundary),
+        *_variations_and_runs(limit),
+    ]
+
+
+def _variations_and_runs(limit: QuasistaticLimitResult) -> list[str]:
+    """The settings varied on the single peak, and the per-run table (folded)."""
+    return [
         "### What limits agreement: settings varied on the single peak",
         "",
         table(

@@ -172,11 +172,18 @@ def _ratio(row: dict) -> str:
 
 def map_sections(km: StiffnessMapResult) -> dict[str, str]:
     """Report text of the map: ``map`` (I_e*(K) table), ``energy`` and ``slip`` (tables
-    with one sentence each), drawn by the report's ``table(rows, columns, names)`` and
-    ``cell(value)`` so that every table of the report reads alike. Empty strings without a
-    map (None or an empty grid)."""
-    if km is None or not km.agreement:
+    with one sentence each); empty strings without a map (an empty grid)."""
+    if not km.agreement:
         return {"map": "", "energy": "", "slip": ""}
+    return {
+        "map": "\n".join(_map_lines(km)),
+        "energy": "\n".join(_energy_lines(km)),
+        "slip": "\n".join(_slip_lines(km)),
+    }
+
+
+def _map_lines(km: StiffnessMapResult) -> list[str]:
+    """The I_e*(K) table per family and K, with what its columns mean."""
     star_rows = []
     for fam, by_k in km.agreement.items():
         for k, grid_cell in by_k.items():
@@ -215,7 +222,12 @@ def map_sections(km: StiffnessMapResult) -> dict[str, str]:
         "(hollow where it lies outside the grid).",
         "",
     ]
-    energy = (
+    return head
+
+
+def _energy_lines(km: StiffnessMapResult) -> list[str]:
+    """The spring energy released at breakaways against the quasistatic work, per K."""
+    return (
         [
             "### Why a soft spring breaks quasistatics",
             "",
@@ -259,7 +271,11 @@ def map_sections(km: StiffnessMapResult) -> dict[str, str]:
         if km.energy
         else []
     )
-    slip = (
+
+
+def _slip_lines(km: StiffnessMapResult) -> list[str]:
+    """Slip events and trap skipping over the map."""
+    return (
         [
             "### Stick-slip across the map",
             "",
@@ -303,7 +319,6 @@ def map_sections(km: StiffnessMapResult) -> dict[str, str]:
         if km.slip
         else []
     )
-    return {"map": "\n".join(head), "energy": "\n".join(energy), "slip": "\n".join(slip)}
 
 
 def headline(km: StiffnessMapResult) -> list[str]:

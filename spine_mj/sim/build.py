@@ -1,0 +1,186 @@
+"""The one way from a problem's inputs to a rig and a drive.
+
+Users, the sweep's ``mujoco`` analysis, the validation and the benchmarks give the same
+things: a surface, a friction coefficient, a tip (radius, mass, preload), a length scale
+and hfield resolution, engine overrides, and a drive either dimensionless (inertia number
+``I_e``, stiffness number ``K``) or in SI (speed [m/s], stiffness [N/m], force rate
+[N/s]). :func:`build_rig` and :func:`build_drive` turn them into a :class:`Rig` and a
+drive by the rules of :class:`~spine_mj.sim.params.Scales`, so that ``spine-mj simulate``
+and a sweep case with the same inputs run the same model (tested).
+
+Two rules live here:
+
+* a gridded surface (fractal, sandpaper, measured scan, a saved grid) keeps its own
+  samples as the hfield: ``hfield_resolution`` resamples analytic surfaces only. MuJoCo
+  then collides with the heights the streamline reads, and a resampling cannot leave
+  facets coarser than a small tip (a sandpaper resampled to an analytic surface's 151 a
+  side left 33 um facets under a 25 um tip). The rig still coarsens a grid finer than a
+  quarter tip radius (:meth:`Scales.for_surface`).
+* a drive given neither an inertia number, nor a speed, nor a force rate runs at
+  ``I_e = DEFAULT_INERTIA_NUMBER`` (slow: quasistatic on the paper's surfaces).
+"""
+
+from __future__ import annotations
+
+from spine_mj.errors import SpineInputError, check_positive
+from spine_mj.sim.drives import Drive, RampDrive, SpringDrive, StaticProbe
+from spine_mj.sim.params import Cone, Integrator, Scales, TipParams, default_engine
+from spine_mj.sim.rig import Rig
+from spine_mj.surfaces import GridSurface, Surface
+
+__all__ = ["DEFAULT_INERTIA_NUMBER", "PROTOCOLS", "build_drive", "build_rig", "drive_speed_m_s"]
+
+#: The inertia number of a drive given no speed, rate or I_e.
+DEFAULT_INERTIA_NUMBER = 1e-3
+
+#: The drive protocols, by the names the CLI and sweep configs use.
+PROTOCOLS = ("spring", "ramp", "static")
+
+
+def drive_speed_m_s(
+    scales: Scales,
+    *,
+    ie: float | None = None,
+    speed_m_s: float | None = None,
+    rate_n_s: float | None = None,
+) -> float:
+    """The drive's speed [m/s]: ``speed_m_s`` when given, else a force rate's equivalent
+    speed (:meth:`Scales.equivalent_speed`), else the speed of ``ie`` (default
+    :data:`DEFAULT_INERTIA_NUMBER`)."""
+    if speed_m_s is not None:
+        return speed_m_s
+    if rate_n_s is not None:
+        return scales.equivalent_speed(check_positive("rate_n_s", rate_n_s))
+    return scales.speed_for(DEFAULT_INERTIA_NUMBER if ie is None else check_positive("I_e", ie))
+
+
+def build_rig(
+    surface: Surface,
+    *,
+    mu: float,
+    tip_radius_m: float | None = None,
+    mass_kg: float | None = None,
+    preload_n: float | None = None,
+    gravity_m_s2: float | None = None,
+    length_scale_m: float | None = None,
+    hfield_resolution: int | None = None,
+    timestep_s: float | None = None,
+    integrator: str | Integrator | None = None,
+    cone: str | Cone | None = None,
+    impratio: float | None = None,
+    noslip_iterations: int | None = None,
+    solref_timeconst_s: float | None = None,
+    solref_dampratio: float | None = None,
+    ie: float | None = None,
+    speed_m_s: float | None = None,
+    rate_n_s: float | None = None,
+    driven: bool = True,
+) -> Rig:
+    """The rig of ``surface`` and a tip of friction ``mu`` (resolve it with
+    :func:`spine_mj.presets.friction_coefficient`); None leaves a parameter to its rule.
+
+    Parameters
+    ----------
+    tip_radius_m, mass_kg, preload_n, gravity_m_s2
+        The tip (:class:`TipParams`; None: its default, the radius from the surface).
+    length_scale_m : float or None
+        Metres per surface unit (None: 0.01 for dimensionless surfaces, else the unit's).
+    hfield_resolution : int or None
+        Samples a side of the hfield of an analytic surface; ignored for a gridded one,
+        which keeps its own samples (module docstring).
+    timestep_s, integrator, cone, impratio, noslip_iterations
+        Engine overrides of :func:`default_engine`.
+    solref_timeconst_s, solref_dampratio
+        The contact's time constant (None: twice the step) and damping ratio (None: 1).
+    ie, speed_m_s, rate_n_s
+        The drive's pace, as for :func:`build_drive`: its speed (:func:`drive_speed_m_s`)
+        bounds the engine step for impacts.
+    driven : bool
+        False for a model no drive of ours runs (``sim export``, the viewer: the user's
+        sliders drive it): then only the surface's falls bound the step.
+
+    Raises
+    ------
+    SpineInputError
+        Any parameter out of range (named), or a drive the engine cannot resolve.
+    """
+    tip = TipParams(
+        tip_radius_m=tip_radius_m,
+        mu_s=mu,
+        **_given(mass_kg=mass_kg, preload_n=preload_n, gravity_m_s2=gravity_m_s2),
+    )
+    resolution = None if isinstance(surface, GridSurface) else hfield_resolution
+    scales = Scales.for_surface(surface, tip=tip, length_scale_m=length_scale_m, hfield_resolution=resolution)
+    speed = drive_speed_m_s(scales, ie=ie, speed_m_s=speed_m_s, rate_n_s=rate_n_s) if driven else None
+    overrides = _given(
+        timestep_s=timestep_s,
+        integrator=integrator,
+        cone=cone,
+        impratio=impratio,
+        noslip_iterations=noslip_iterations,
+    )
+    overrides["hfield_resolution"] = resolution  # None: the rig's own rule (a grid's samples)
+    if solref_timeconst_s is not None or solref_dampratio is not None:
+        dt = timestep_s if timestep_s is not None else default_engine(scales, speed_m_s=speed).timestep_s
+        overrides["solref"] = (
+            2 * dt if solref_timeconst_s is None else solref_timeconst_s,
+            1.0 if solref_dampratio is None else solref_dampratio,
+        )
+    engine = default_engine(scales, speed_m_s=speed, **overrides)
+    return Rig(surface, tip=tip, engine=engine, length_scale_m=length_scale_m)
+
+
+def build_drive(
+    scales: Scales,
+    protocol: str = "spring",
+    *,
+    ie: float | None = None,
+    speed_m_s: float | None = None,
+    rate_n_s: float | None = None,
+    stiffness_number: float | None = None,
+    stiffness_n_m: float | None = None,
+    duration_s: float | None = None,
+    settle_time_s: float | None = None,
+    start_force_n: float = 0.0,
+    slide_distance_m: float | None = None,
+) -> Drive:
+    """The drive ``protocol`` ("spring", "ramp" or "static") on a rig of ``scales``.
+
+    Parameters
+    ----------
+    ie, speed_m_s, rate_n_s
+        Its pace: an inertia number, a carriage speed [m/s] (spring) or a force rate
+        [N/s] (ramp, static), at most one of them; none: ``I_e =``
+        :data:`DEFAULT_INERTIA_NUMBER`. A force drive's rate at a speed is
+        :meth:`Scales.force_rate_for` (its equivalent speed ``L_c rate / F_p``).
+    stiffness_number, stiffness_n_m
+        The spring's stiffness as ``K = k l_s / F_p`` or in N/m (none: K = 30).
+    duration_s, settle_time_s, start_force_n, slide_distance_m
+        As the drives take them (:class:`SpringDrive`, :class:`RampDrive`, :class:`StaticProbe`).
+    """
+    if rate_n_s is None:
+        rate_n_s = scales.force_rate_for(drive_speed_m_s(scales, ie=ie, speed_m_s=speed_m_s))
+    if stiffness_number is not None:
+        stiffness_n_m = scales.stiffness_for(check_positive("K", stiffness_number))
+    if protocol == "spring":
+        return SpringDrive(
+            speed_m_s=drive_speed_m_s(scales, ie=ie, speed_m_s=speed_m_s),
+            stiffness_n_m=stiffness_n_m,
+            duration_s=duration_s,
+            settle_time_s=settle_time_s,
+        )
+    if protocol == "static":
+        return StaticProbe(rate_n_s=rate_n_s, start_force_n=start_force_n, settle_time_s=settle_time_s)
+    if protocol == "ramp":
+        return RampDrive(
+            rate_n_s=rate_n_s,
+            duration_s=duration_s,
+            settle_time_s=settle_time_s,
+            slide_distance_m=slide_distance_m,
+        )
+    raise SpineInputError(f"protocol must be one of {', '.join(PROTOCOLS)}, got {protocol!r}")
+
+
+def _given(**values) -> dict:
+    """The ``values`` that are not None."""
+    return {k: v for k, v in values.items() if v is not None}

@@ -1,0 +1,113 @@
+"""The one rig builder: ``spine-mj simulate`` and a sweep case given the same inputs build
+the same model and drive, and the drive-rate rule inverts the equivalent speed."""
+
+import dataclasses
+import enum
+import json
+
+import pytest
+from click.testing import CliRunner
+
+from spine_mj import sim, sweep
+from spine_mj.cli import main
+from spine_mj.surface_io import save_surface
+from spine_mj.surfaces import fractal_fbm, single_gaussian
+from spine_mj.sweep.analyses.mujoco import case_drive, case_rig
+
+
+def _enc(obj) -> dict:
+    d = dataclasses.asdict(obj)
+    return {k: (v.value if isinstance(v, enum.Enum) else v) for k, v in d.items()}
+
+
+def _cli_summary(tmp_path, surface: str, start, args) -> dict:
+    out = tmp_path / "cli-run"
+    cmd = ["simulate", surface, "--start", f"{start[0]},{start[1]}", "--duration", "0.002", "--out", str(out)]
+    res = CliRunner().invoke(main, [*cmd, *map(str, args)])
+    assert res.exit_code == 0, res.output
+    return json.loads((out / "summary.json").read_text())
+
+
+def _sweep_case(tmp_path, surface: dict, start, drive: dict, grid: dict):
+    doc = {
+        "sweep": {"analyses": ["mujoco"]},
+        "surfaces": [surface],
+        "starts": {"frame": "absolute", "points": [list(start)]},
+        "drive": {"protocol": "spring", **drive},
+        "grid": grid,
+    }
+    (case,) = sweep.expand_cases(sweep.parse_config(doc, base_dir=tmp_path))
+    rig = case_rig(case)
+    return rig, case_drive(rig, case.params)
+
+
+def _flat(d: dict) -> dict:
+    """``d`` with list values spread into ``key[i]`` entries (for pytest.approx)."""
+    out = {}
+    for k, v in d.items():
+        for i, x in enumerate(v) if isinstance(v, (list, tuple)) else [(None, v)]:
+            out[k if i is None else f"{k}[{i}]"] = x
+    return out
+
+
+def _assert_same_model(summary: dict, rig, drive) -> None:
+    """Equal settings; floats to 1e-12 (a tip radius in surface units times 0.01 m)."""
+    for got, want in [
+        (summary["engine"], json.loads(json.dumps(rig.engine.to_dict()))),
+        (summary["tip"], _enc(rig.tip)),
+        (summary["scales"], _enc(rig.scales)),
+        (summary["drive_params"], _enc(drive)),
+    ]:
+        got, want = _flat(got), _flat(want)
+        assert set(got) == set(want)
+        for k, v in want.items():
+            same = (
+                got[k] == v
+                if isinstance(v, (str, bool)) or v is None
+                else got[k] == pytest.approx(v, rel=1e-12)
+            )
+            assert same, (k, got[k], v)
+    assert summary["drive"] == type(drive).__name__
+
+
+def test_cli_and_sweep_build_the_same_model_on_an_analytic_surface(tmp_path):
+    start = (-3.0, -1.0)
+    summary = _cli_summary(
+        tmp_path,
+        "paper-single-peak",
+        start,
+        ["--ie", 1e-3, "--K", 10, "--mu", 1.2, "--tip-radius", 2e-3, "--resolution", 41],
+    )
+    rig, drive = _sweep_case(
+        tmp_path,
+        {"preset": "paper-single-peak"},
+        start,
+        {"ie": 1e-3, "K": 10.0, "duration": 0.002},
+        {"mu": 1.2, "tip_radius": 0.2, "hfield_resolution": 41},
+    )
+    _assert_same_model(summary, rig, drive)
+    assert rig.hfield.ncol == 41 and summary["engine"]["hfield_resolution"] == 41
+
+
+def test_cli_and_sweep_keep_a_grids_own_samples(tmp_path):
+    """A gridded surface is not resampled by --resolution / hfield_resolution: MuJoCo
+    collides with the heights the streamline reads."""
+    surface = fractal_fbm(nx=48, size=10.0, hurst=0.8, rms_height=0.3, rng=3)
+    save_surface(surface, tmp_path / "f.npz")
+    start = (-2.0, 0.0)
+    summary = _cli_summary(tmp_path, str(tmp_path / "f.npz"), start, ["--mu", 0.8, "--resolution", 41])
+    rig, drive = _sweep_case(
+        tmp_path, {"file": "f.npz"}, start, {"duration": 0.002}, {"mu": 0.8, "hfield_resolution": 41}
+    )
+    _assert_same_model(summary, rig, drive)
+    assert (rig.hfield.nrow, rig.hfield.ncol) == surface.heights.shape
+
+
+def test_force_rate_is_the_inverse_of_the_equivalent_speed():
+    rig = sim.Rig(single_gaussian(), tip=sim.TipParams(mu_s=1.0))
+    sc = rig.scales
+    v = sc.speed_for(1e-3)
+    assert sc.force_rate_for(v) == pytest.approx(v * sc.preload_n / sc.char_length_m, rel=1e-15)
+    assert sc.equivalent_speed(sc.force_rate_for(v)) == pytest.approx(v, rel=1e-12)
+    ramp = sim.build_drive(sc, "ramp", ie=1e-3)
+    assert sc.inertia_number(sc.equivalent_speed(ramp.rate_n_s)) == pytest.approx(1e-3, rel=1e-12)
