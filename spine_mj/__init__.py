@@ -6,6 +6,7 @@ imports without MuJoCo; the MuJoCo rig (:mod:`spine_mj.sim`) and the sweep runne
 
 Modules: :mod:`~spine_mj.surfaces`, :mod:`~spine_mj.surface_io`,
 :mod:`~spine_mj.presets`, :mod:`~spine_mj.engagement`, :mod:`~spine_mj.streamline`,
+:mod:`~spine_mj.compliant`, :mod:`~spine_mj.drive_limits`,
 :mod:`~spine_mj.convexity`, :mod:`~spine_mj.compare`, :mod:`~spine_mj.sim`,
 :mod:`~spine_mj.sweep`, :mod:`~spine_mj.reproduce`, :mod:`~spine_mj.cli`.
 """
@@ -20,7 +21,9 @@ from spine_mj.compare import (
     mean_lateral_deviation,
     outcome_agreement,
 )
+from spine_mj.compliant import CompliantResult, compliant_streamlines
 from spine_mj.convexity import classify_points, hessian_class, sectional_class
+from spine_mj.drive_limits import DriveLimits
 from spine_mj.engagement import ENGAGED, SELF_LOCK, SLIP, kappa
 from spine_mj.errors import SpineInputError
 from spine_mj.presets import list_presets, load_preset, make_surface
@@ -77,6 +80,8 @@ __all__ = [
     "ENGAGED",
     "SELF_LOCK",
     "SLIP",
+    "CompliantResult",
+    "DriveLimits",
     "GaussianSurface",
     "GridSurface",
     "HField",
@@ -89,6 +94,7 @@ __all__ = [
     "__version__",
     "capture_rate",
     "classify_points",
+    "compliant_streamlines",
     "dilate",
     "fractal_fbm",
     "frechet_distance",

@@ -69,22 +69,16 @@ class EnergyBudget:
         return self.carriage_work_j - self.spring_energy_change_j - self.drive_work_j
 
 
-def elastic_release_j(drive_force_n, stiffness_n_m: float, events) -> float:
+def elastic_release_j(drive_force_n, stiffness_n_m: float, spans) -> float:
     """Spring energy released over the slip events of a run [J].
 
-    For each ``slip_onset`` the release is ``(F_onset^2 - F_stop^2) / (2 k)`` with
-    ``F_stop`` the force at the next ``slip_stop`` (or the last sample); increases of the
-    stored energy are not counted.
+    ``spans``: ``(onset, stop)`` rows of each slip (:class:`spine_mj.sim.SlipEvent`'s
+    ``onset`` and ``stop``); each releases ``(F_onset^2 - F_stop^2) / (2 k)``, an increase
+    of the stored energy counting 0.
     """
     k = check_positive("stiffness_n_m", stiffness_n_m)
     force = np.asarray(drive_force_n, dtype=float)
-    onsets = [e.index for e in events if e.kind == "slip_onset"]
-    stops = sorted(e.index for e in events if e.kind == "slip_stop")
-    total = 0.0
-    for i in onsets:
-        j = next((s for s in stops if s > i), force.size - 1)
-        total += max(0.0, (force[i] ** 2 - force[j] ** 2) / (2 * k))
-    return total
+    return float(sum(max(0.0, (force[i] ** 2 - force[j] ** 2) / (2 * k)) for i, j in spans))
 
 
 def quasistatic_work_j(kappa_along_path, x_m, preload_n: float) -> float:
@@ -114,7 +108,8 @@ def energy_budget(result, *, stiffness_n_m: float | None = None) -> EnergyBudget
         k = check_positive("stiffness_n_m", stiffness_n_m)
         carriage = _integral(force * np.gradient(result.carriage_x_m[i0:], t), t) if t.size > 1 else 0.0
         spring = float((force[-1] ** 2 - force[0] ** 2) / (2 * k)) if t.size else 0.0
-        release = elastic_release_j(result.drive_force_n, k, [e for e in result.events if e.index >= i0])
+        spans = [(e.onset, e.stop) for e in result.slip_events if e.onset >= i0]
+        release = elastic_release_j(result.drive_force_n, k, spans)
     return EnergyBudget(
         drive_work_j=_integral(force * v[:, 0], t),
         carriage_work_j=carriage,

@@ -45,7 +45,15 @@ from spine_mj.engagement import (
     slip_direction,
 )
 from spine_mj.errors import SpineInputError
-from spine_mj.surfaces import GaussianSurface, GridSurface, Surface, TriangulatedSurface, check_grid_size
+from spine_mj.multicontact import two_contact_kappa
+from spine_mj.surfaces import (
+    BallOnFacets,
+    GaussianSurface,
+    GridSurface,
+    Surface,
+    TriangulatedSurface,
+    check_grid_size,
+)
 
 __all__ = [
     "Outcome",
@@ -66,6 +74,7 @@ class Outcome(enum.IntEnum):
     STALLED = 3  #: no net progress (|T| = 0, or too little progress over stall_window steps)
     STEP_CAP = 4  #: max_steps taken without any of the above
     FORCE_CAP = 5  #: the drive force needed, kappa W, exceeds ``kappa_cap`` W (held by the cap)
+    DRIVE_END = 6  #: the carriage reached the end of its travel (compliant drive, :mod:`spine_mj.compliant`)
 
 
 @dataclass(frozen=True)
@@ -437,6 +446,39 @@ def ideal_trajectories(
     return _trajectories(surface, starts, params, ideal=True, store_paths=store_paths, backend=backend)
 
 
+#: A step across which the slope along the step grows by more than this crossed a concave
+#: crease (a kink of the height's slopes, not a smooth valley: on MuJoCo's facets under a ball
+#: every smooth piece curves down, so only creases make the slope grow along a step).
+CREASE_KINK = 1e-6
+
+
+def _wedged(xa, ya, fx, fy, prev, params) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Points that crossed a concave crease from the last accepted point and rest there on
+    both sides, held: by the two-contact rule
+    (:func:`spine_mj.multicontact.two_contact_kappa`) beyond the force cap or for every
+    drive. A path that crosses such a crease without turning back (its two sides' slip
+    directions less than 90 deg apart, each pressing into the other side) would zig-zag
+    across it on single contacts and pass where the tip wedges.
+
+    ``prev``: ``(px, py, pfx, pfy, ok)`` of the last accepted points (``ok``: it exists).
+    Returns the held mask, and kappa and region of the held points."""
+    px, py, pfx, pfy, ok = prev
+    dx, dy = xa - px, ya - py
+    step = np.hypot(dx, dy)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        kink = ok & (((fx - pfx) * dx + (fy - pfy) * dy) > CREASE_KINK * step)
+    i = np.flatnonzero(kink)
+    held = np.zeros(xa.size, bool)
+    kt = np.full(i.size, np.nan)
+    rt = np.zeros(i.size, np.int8)
+    if i.size:
+        kt, rt = two_contact_kappa(pfx[i], pfy[i], fx[i], fy[i], params.mu)
+        hold = (rt == SELF_LOCK) | (kt > params.kappa_cap)
+        held[i[hold]] = True
+        kt, rt = kt[hold], rt[hold]
+    return held, kt, rt
+
+
 def _run_numpy(surface, xs, ys, params, *, ideal, store):
     """The obvious reference: one vectorized evaluation for all active starts per iteration.
 
@@ -444,7 +486,11 @@ def _run_numpy(surface, xs, ys, params, *, ideal, store):
     concave crease on two contacts: the path follows the crease at the two-contact kappa of
     its sides (:func:`spine_mj.engagement.crease_engagement`) with whole steps. Only this
     backend has the crease state; the compiled kernel traces smooth surfaces (Gaussian sums,
-    splines) and takes such a reversal as it is.
+    splines) and takes such a reversal as it is. On facets (a ball on them or bare), a step
+    that crosses a concave crease tests the two contacts' hold there
+    (:func:`spine_mj.multicontact.two_contact_kappa`, :func:`_wedged`): a tip wedged beyond
+    the force cap, or for every drive, is held where a path on single contacts would
+    zig-zag across the crease and go on.
 
     Each start holds a candidate point reached from its last accepted point by a step ``h``;
     a candidate where the horizontal slip direction reverses against the accepted point's
@@ -456,6 +502,7 @@ def _run_numpy(surface, xs, ys, params, *, ideal, store):
     # direction and slopes, crease sides, stall window), kept whole where its steps share
     # them; the crease rule, the endings and the path packing are split out.
     n = xs.size
+    creased = isinstance(surface, (BallOnFacets, TriangulatedSurface))  # creases between facets
     xmin, xmax, ymin, ymax = params.domain(surface)
     dl = float(params.dl)
     h_min = dl / 2.0**params.max_halvings
@@ -492,6 +539,12 @@ def _run_numpy(surface, xs, ys, params, *, ideal, store):
             turned = vx * pvx[active] + vy * pvy[active] < 0.0
         reversed_ = has_prev[active] & ~locked & finite & turned
         crease = np.zeros(active.size, bool)
+        if not ideal and creased:
+            prev = (px[active], py[active], pfx[active], pfy[active], has_prev[active] & ~locked)
+            wedged, kw, rw = _wedged(xa, ya, fx, fy, prev, params)
+            k[wedged], reg[wedged], locked[wedged] = kw, rw, rw == SELF_LOCK
+            crease |= wedged
+            reversed_ &= ~wedged
         if not ideal:
             # reversed at the shortest step, or on a crease already followed: the tip rests in
             # a concave crease, on two contacts (crease_engagement)

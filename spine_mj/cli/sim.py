@@ -264,7 +264,18 @@ def simulate(
         f"end: {result.end_reason.value} ({result.end_detail}); I_e = {result.inertia_number:.3g}"
         + (f", K = {result.stiffness_number:.3g}" if drive == "spring" else "")
     )
+    click.echo(_motion_line(result))
     click.echo(f"wrote {', '.join(str(w) for w in written)}")
+
+
+def _motion_line(result) -> str:
+    """One line on the run's motion relative to the drive: the time stuck, sliding and
+    slipping, the slip events and the largest speed over the drive's."""
+    s = result.slip_summary()
+    frac = ", ".join(f"{k} {100 * v:.0f} %" for k, v in s["motion_fractions"].items())
+    onsets = s["slip_onset_forces_fp"]
+    slips = f"{s['slip_events']} slip events" + (f" (onset up to {max(onsets):.3g} F_p)" if onsets else "")
+    return f"motion: {frac}; {slips}; largest speed {s['max_speed_over_drive']:.3g} V"
 
 
 def _render_mp4(rig, run, path: Path, *, speed: float | None = None) -> None:

@@ -16,6 +16,7 @@ from spine_mj.cli.app import (
     main,
     refuse_options_not_for,
 )
+from spine_mj.drive_limits import drive_limits
 from spine_mj.errors import SpineInputError, check_positive
 from spine_mj.jsonio import to_jsonable
 from spine_mj.plotting import (
@@ -127,22 +128,30 @@ def surface_show(surface_file, output):
 @click.argument("surface_spec", metavar="SURFACE")
 @click.option("-o", "--output", type=click.Path(dir_okay=False), help="Also write the PSD plot (.png).")
 @click.option("--json", "as_json", is_flag=True, help="Print the numbers as JSON.")
-def surface_info(surface_spec, output, as_json):
+@click.option("--mu", type=float, help="mu_s for the drive limits (default: the preset's).")
+@click.option(
+    "--tip-radius", type=float, default=0.0, show_default=True, help="Tip radius for the drive limits."
+)
+def surface_info(surface_spec, output, as_json, mu, tip_radius):
     """Roughness of SURFACE (preset, .npz or instrument file): rms height, slope and
-    curvature, L_c, the slope correlation length l_s, a Hurst estimate and the PSD.
+    curvature, L_c, the slope correlation length l_s, a Hurst estimate and the PSD; and
+    the predicted drive limits, "quasistatic needs K > ... and I_e < ..." (docs/physics.md
+    §8), where mu_s is known (--mu or the preset's).
 
     \b
     Example:
-      spine-mj surface info example:plu-1.plu -o psd.png
+      spine-mj surface info example:plu-1.plu --mu 0.5 -o psd.png
     """
     if output:
         check_suffix(output, ".png", "-o/--output")
     surf = load_surface_arg(surface_spec)
     rough = roughness.summarize(surf)
+    limits = _drive_limits(surf, mu, tip_radius)
     if output:
         save_figure(roughness_figure(rough), output)
     if as_json:
-        click.echo(json.dumps(to_jsonable(rough.as_dict()), indent=2))
+        doc = dict(rough.as_dict(), drive_limits=None if limits is None else limits.as_dict())
+        click.echo(json.dumps(to_jsonable(doc), indent=2))
         return
     unit = "" if surf.unit == "1" else f" {surf.unit}"
     click.echo(f"rms height               {rough.rms_height:.4g}{unit}")
@@ -152,8 +161,24 @@ def surface_info(surface_spec, output, as_json):
     click.echo(f"l_s (slope correlation)  {rough.slope_correlation_length:.4g}{unit}")
     hurst = f"{rough.hurst:.3g}" if math.isfinite(rough.hurst) else "not estimated (the PSD is no power law)"
     click.echo(f"Hurst estimate (PSD fit) {hurst}")
+    if limits is None:
+        click.echo("drive limits             give --mu (no preset mu_s)")
+    else:
+        click.echo(f"drive limits (mu_s {limits.mu:g})  {limits.sentence()}")
     if output:
         click.echo(f"wrote {output}")
+
+
+def _drive_limits(surf, mu, tip_radius):
+    """:func:`spine_mj.drive_limits.drive_limits` of ``surf`` with the one mu rule
+    (:func:`spine_mj.presets.resolve_mu`); None without a mu_s (info still reports the
+    roughness)."""
+    if mu is None and presets.preset_mu(surf) is None:
+        return None
+    mu = presets.resolve_mu(surf, mu, name="--mu")
+    if not (math.isfinite(tip_radius) and tip_radius >= 0):
+        raise SpineInputError(f"--tip-radius must be a finite number >= 0, got {tip_radius!r}")
+    return drive_limits(surf, mu, tip_radius=tip_radius)
 
 
 @surface.command("export")

@@ -63,6 +63,7 @@ from spine_mj.sim.build import DEFAULT_INERTIA_NUMBER, PROTOCOLS, build_drive, b
 from spine_mj.sim.detection import Detection, Event
 from spine_mj.sim.drives import Drive, RampDrive, SpringDrive, StaticProbe
 from spine_mj.sim.model import MODEL_PATH
+from spine_mj.sim.motion import MOTION_NAMES, SLIDING, SLIPPING, STUCK, SlipEvent
 from spine_mj.sim.params import (
     DEFAULT_LENGTH_SCALE_M,
     LENGTH_UNITS_M,
@@ -90,8 +91,12 @@ __all__ = [
     "LENGTH_UNITS_M",
     "MAX_INERTIA_NUMBER",
     "MODEL_PATH",
+    "MOTION_NAMES",
     "PROTOCOLS",
     "REFINE_TIMESTEP",
+    "SLIDING",
+    "SLIPPING",
+    "STUCK",
     "Cone",
     "Detection",
     "Drive",
@@ -104,6 +109,7 @@ __all__ = [
     "Rig",
     "RunResult",
     "Scales",
+    "SlipEvent",
     "SpringDrive",
     "StaticProbe",
     "TipParams",

@@ -58,7 +58,7 @@ def analyse_window(
     tangential_force,
     drive_force,
     carriage_x,
-    slipping,
+    moving,
     tangential_speed,
     marks,
     held_out,
@@ -151,7 +151,7 @@ def analyse_window(
                 contact_point[o, c, 0] = contact_point[o, c, 1] = contact_point[o, c, 2] = np.nan
             carriage_x[o, c] = carriage[o, c] * length if spring[r] else np.nan
             slips = vt > slip_speed
-            slipping[o, c] = slips
+            moving[o, c] = slips
 
             if marks[r, 1] < 0 and not (abs(t - dt * float(first + i + 1)) <= 0.5 * dt):
                 marks[r, 1] = i

@@ -39,7 +39,7 @@ class Detection:
 
     Attributes
     ----------
-    slip_speed_m_s : float or None
+    move_speed_m_s : float or None
         Tangential speed above which the tip slips (default ``1e-3 v_c``).
     stick_speed_m_s : float or None
         Tangential speed below which the tip counts as stuck when the breakaway force is
@@ -56,7 +56,7 @@ class Detection:
         (default: the tip radius).
     """
 
-    slip_speed_m_s: float | None = None
+    move_speed_m_s: float | None = None
     stick_speed_m_s: float | None = None
     breakaway_distance_m: float | None = None
     kappa_cap: float = DEFAULT_KAPPA_CAP
@@ -65,7 +65,7 @@ class Detection:
 
     def __post_init__(self):
         check_optional(
-            self, ["slip_speed_m_s", "stick_speed_m_s", "breakaway_distance_m", "penetration_tol_m"]
+            self, ["move_speed_m_s", "stick_speed_m_s", "breakaway_distance_m", "penetration_tol_m"]
         )
         check_optional(self, ["domain_margin_m"], allow_zero=True)
         object.__setattr__(self, "kappa_cap", check_positive("kappa_cap", self.kappa_cap))
@@ -74,7 +74,7 @@ class Detection:
         v_c = scales.speed_m_s
         small = min(0.1 * scales.tip_radius_m, 0.01 * scales.char_length_m)
         defaults = {
-            "slip_speed_m_s": 1e-3 * v_c,
+            "move_speed_m_s": 1e-3 * v_c,
             "stick_speed_m_s": 1e-5 * v_c,
             "breakaway_distance_m": small,
             "penetration_tol_m": penetration_tolerance_m(scales),
@@ -93,7 +93,7 @@ class Detection:
 
 @dataclass(frozen=True)
 class Event:
-    """One event in a run: ``kind`` in {"slip_onset", "slip_stop", "reset"} or an end reason."""
+    """One event in a run: ``kind`` in {"move_onset", "move_stop", "reset"} or an end reason."""
 
     kind: str
     index: int
@@ -139,7 +139,7 @@ def normal_lock_marks(
     are window rows. Windows passed in order give the marks of the whole run.
     """
     g, n = rec.contact.shape
-    candidate = rec.contact & ~rec.slipping
+    candidate = rec.contact & ~rec.moving
     region = np.zeros((g, n), np.int8)  # the rule is evaluated where the tip is stuck in contact
     region[candidate] = kappa_of_normal(rec.normal[candidate], mu)[1]
     held = candidate & (region == SELF_LOCK)
@@ -207,7 +207,7 @@ def end_marks(
         "flew": first_indices(pz > zmax + span),
         "deep": first_indices(rec.penetration_m > det.penetration_tol_m),
         "out": first_indices((px < xmin + mg) | (px > xmax - mg) | (py < ymin + mg) | (py > ymax - mg)),
-        "lock": first_indices((rec.drive_force_n >= cap * (1 - 1e-9)) & ~rec.slipping),
+        "lock": first_indices((rec.drive_force_n >= cap * (1 - 1e-9)) & ~rec.moving),
         "lock_rule": np.full(g, -1) if mu is None else normal_lock_marks(rec, mu, preload_n)[0],
     }
 
@@ -330,13 +330,13 @@ def decide_end(candidates: Sequence[Ending], n: int) -> Ending:
     return min(candidates, key=lambda c: (c.index, c.rank))
 
 
-def slip_events(slipping: np.ndarray, t: np.ndarray, start: int) -> list[Event]:
+def move_events(moving: np.ndarray, t: np.ndarray, start: int) -> list[Event]:
     """Slip onsets and stops from step ``start`` on, the settle phase taken as stuck: an
     onset at ``start`` if the tip slips there (``start`` >= 1), then every change of
-    ``slipping`` after it."""
-    seg = slipping[start:]
+    ``moving`` after it."""
+    seg = moving[start:]
     changes = np.flatnonzero(seg[1:] != seg[:-1]) + (start + 1)
     if start >= 1 and seg.size and seg[0]:
         changes = np.concatenate([[start], changes])
-    rows = zip(changes.tolist(), slipping[changes].tolist(), t[changes].tolist())
-    return [Event("slip_onset" if slips else "slip_stop", i, ti) for i, slips, ti in rows]
+    rows = zip(changes.tolist(), moving[changes].tolist(), t[changes].tolist())
+    return [Event("move_onset" if slips else "move_stop", i, ti) for i, slips, ti in rows]

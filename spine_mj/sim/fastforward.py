@@ -62,7 +62,7 @@ class StickFastForward:
         F_p [N] and the largest force ``kappa_cap F_p`` [N].
     margin : float
         The climb stops at ``(1 - margin)`` of the predicted breakaway force.
-    stick_speed_m_s, slip_speed_m_s : float
+    stick_speed_m_s, move_speed_m_s : float
         Still below the first; a slip (which allows a new phase) above the second.
     approach_rate : float or None
         For a caller that rolls back to checkpoints (the ramp): after the climb the phase
@@ -76,9 +76,9 @@ class StickFastForward:
         rate takes over after the climb.
     """
 
-    def __init__(self, *, mu, preload_n, cap_n, margin, stick_speed_m_s, slip_speed_m_s, approach_rate=None):
+    def __init__(self, *, mu, preload_n, cap_n, margin, stick_speed_m_s, move_speed_m_s, approach_rate=None):
         self.mu, self.preload_n, self.cap_n, self.margin = mu, preload_n, cap_n, margin
-        self.stick, self.slip = stick_speed_m_s, slip_speed_m_s
+        self.stick, self.slip = stick_speed_m_s, move_speed_m_s
         self.approach_rate = approach_rate
         self.active, self.blocked, self.quiet = False, False, 0
         self.target_n, self.step_n, self.approach_to_n = 0.0, 0.0, 0.0

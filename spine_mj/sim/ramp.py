@@ -73,7 +73,7 @@ class ResetController:
         Horizontal slide after slip onset at which the force drops to 0 [m].
     settle_steps : int
         Steps the tip must stay stuck before the ramp starts again.
-    slip_speed_m_s : float
+    move_speed_m_s : float
         Tangential speed above which the tip slips.
     sensor_adr : dict
         Sensor addresses of the rig (:attr:`RigModel.sensor_adr`).
@@ -84,10 +84,10 @@ class ResetController:
     _SNAPSHOT = ("force", "ramping", "stuck_steps", "slip_from", "normal", "resets")
 
     def __init__(
-        self, *, step_n, cap_n, slide_distance_m, settle_steps, slip_speed_m_s, sensor_adr, fast_forward=None
+        self, *, step_n, cap_n, slide_distance_m, settle_steps, move_speed_m_s, sensor_adr, fast_forward=None
     ):
         self.step_n, self.cap_n, self.slide_distance_m = step_n, cap_n, slide_distance_m
-        self.settle_steps, self.slip_speed_m_s, self.adr = settle_steps, slip_speed_m_s, sensor_adr
+        self.settle_steps, self.move_speed_m_s, self.adr = settle_steps, move_speed_m_s, sensor_adr
         self.ff = fast_forward
         self.force, self.ramping, self.stuck_steps = 0.0, True, 0
         self.slip_from = None  # (x, y) where the current slip began, while the force still acts
@@ -133,7 +133,7 @@ class ResetController:
             verdict = self.ff.watch(vt, out, contact, self.force, self.step_n)
             if verdict == "rollback":
                 return verdict
-        if self.ramping and self.slip_from is None and vt > self.slip_speed_m_s:
+        if self.ramping and self.slip_from is None and vt > self.move_speed_m_s:
             self.slip_from = sens[a["tip_pos"] : a["tip_pos"] + 2].copy()
         if self.ramping and self.slip_from is not None:
             moved = sens[a["tip_pos"] : a["tip_pos"] + 2] - self.slip_from
@@ -143,7 +143,7 @@ class ResetController:
                 if self.ff is not None:
                     self.ff.active = False
         elif not self.ramping:
-            self.stuck_steps = self.stuck_steps + 1 if vt <= self.slip_speed_m_s else 0
+            self.stuck_steps = self.stuck_steps + 1 if vt <= self.move_speed_m_s else 0
             if self.stuck_steps >= self.settle_steps:
                 self.ramping = True
                 self.resets.append(i)
@@ -163,7 +163,7 @@ def cycle_breakaways(result: RunResult, cycles: int) -> np.ndarray:
     for e in result.events:
         if e.kind == "reset":
             armed = True
-        elif e.kind == "slip_onset" and armed:
+        elif e.kind == "move_onset" and armed:
             out.append(result.drive_force_n[e.index] / result.scales.preload_n)
             armed = False
     return np.array(out[:cycles])
@@ -256,7 +256,7 @@ def _controller(rig: RigModel, drive: RampDrive, det: Detection, n_settle: int) 
             cap_n=cap * (1 + 1e-9),
             margin=drive.fast_forward_margin,
             stick_speed_m_s=det.stick_speed_m_s / u.speed_m_s,
-            slip_speed_m_s=det.slip_speed_m_s / u.speed_m_s,
+            move_speed_m_s=det.move_speed_m_s / u.speed_m_s,
             approach_rate=APPROACH_RATE,
         )
     slide = drive.slide_distance_m
@@ -265,7 +265,7 @@ def _controller(rig: RigModel, drive: RampDrive, det: Detection, n_settle: int) 
         cap_n=cap * (1 + 1e-9),
         slide_distance_m=(0.01 * rig.scales.char_length_m if slide is None else slide) / u.length_m,
         settle_steps=n_settle,
-        slip_speed_m_s=det.slip_speed_m_s / u.speed_m_s,
+        move_speed_m_s=det.move_speed_m_s / u.speed_m_s,
         sensor_adr=rig.sensor_adr,
         fast_forward=ff,
     )

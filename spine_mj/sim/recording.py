@@ -37,7 +37,7 @@ class RunColumns:
     tangential_force_n: np.ndarray
     drive_force_n: np.ndarray
     carriage_x_m: np.ndarray
-    slipping: np.ndarray
+    moving: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -47,7 +47,7 @@ class Recording(RunColumns):
     Attributes
     ----------
     time_s, position_m, velocity_m_s, contact, normal, contact_point_m, penetration_m,
-    normal_force_n, tangential_force_n, drive_force_n, carriage_x_m, slipping
+    normal_force_n, tangential_force_n, drive_force_n, carriage_x_m, moving
         As in :class:`~spine_mj.sim.RunResult` (:class:`RunColumns`).
     tangential_speed_m_s
         Tip speed in the tangent plane of the deepest contact [m/s] (the full speed
@@ -70,7 +70,7 @@ class Recording(RunColumns):
         *,
         units: EngineUnits,
         carriage_x: np.ndarray,
-        slip_speed_m_s: float,
+        move_speed_m_s: float,
         out: Recording | None = None,
     ) -> Recording:
         """The recording of a group in SI: ``state`` ``(g, n, nstate)``, ``sens`` ``(g, n,
@@ -78,13 +78,13 @@ class Recording(RunColumns):
 
         The columns are computed for the whole group in one pass (the same arithmetic per
         row as one run at a time); a step slips when its tangential speed exceeds
-        ``slip_speed_m_s``. ``out``: columns of that shape (views into larger ones are
+        ``move_speed_m_s``. ``out``: columns of that shape (views into larger ones are
         fine) to write into and return, instead of new arrays.
         """
         rec = cls.empty(state.shape[:-1]) if out is None else out
         sensor_columns(sensor_adr, state, sens, units, rec)
         np.multiply(carriage_x, units.length_m, out=rec.carriage_x_m)
-        np.greater(rec.tangential_speed_m_s, slip_speed_m_s, out=rec.slipping)
+        np.greater(rec.tangential_speed_m_s, move_speed_m_s, out=rec.moving)
         return rec
 
     def run(self, r: int, rows: int | None = None) -> Recording:
@@ -112,14 +112,14 @@ _LAYOUT = {
     k: ((3,) if k in ("position_m", "velocity_m_s", "normal", "contact_point_m") else (), float)
     for k in COLUMNS
 }
-_LAYOUT["contact"] = _LAYOUT["slipping"] = ((), bool)
+_LAYOUT["contact"] = _LAYOUT["moving"] = ((), bool)
 
 
 def sensor_columns(
     sensor_adr: dict[str, int], state: np.ndarray, sens: np.ndarray, units: EngineUnits, out: Recording
 ) -> None:
     """Write the per-step columns of steps ``state`` ``(..., nstate)`` and ``sens`` ``(...,
-    nsensordata)`` (engine ``units``) into ``out`` in SI (all but the carriage and slipping).
+    nsensordata)`` (engine ``units``) into ``out`` in SI (all but the carriage and moving).
 
     The arithmetic runs on component arrays of the leading shape (numpy's loops over a
     length-3 axis cost more than the arithmetic), row by row the operations of a plain

@@ -30,12 +30,13 @@ from spine_mj.sim.detection import (
     decide_end,
     end_candidates,
     end_marks,
+    move_events,
     normal_lock_marks,
     probe_candidates,
-    slip_events,
 )
 from spine_mj.sim.drives import Drive, SpringDrive, StaticProbe, settle_steps, stiffness_n_m
 from spine_mj.sim.model import RigModel
+from spine_mj.sim.motion import MOTION_NAMES, SlipEvent, motion_fractions, motion_states, slip_events
 from spine_mj.sim.params import EndReason, EngineSettings, Scales, TipParams
 from spine_mj.sim.recording import COLUMNS, RESULT_COLUMNS, SENSOR_NAMES, Recording, RunColumns
 
@@ -63,8 +64,15 @@ class RunResult(RunColumns):
         Force of the drive on the tip in +x [N].
     carriage_x_m : (n,)
         Carriage position (spring drive; NaN otherwise).
-    slipping : (n,) bool
-        Tangential speed above ``detection.slip_speed_m_s``.
+    moving : (n,) bool
+        Tangential speed above ``detection.move_speed_m_s`` (the engine side's "not stuck",
+        read by the lock rule and the fast-forward; not a slip).
+    motion : (n,) int8
+        Motion state relative to the drive, :data:`~spine_mj.sim.motion.STUCK`,
+        ``SLIDING`` or ``SLIPPING`` (:func:`~spine_mj.sim.motion.motion_states`).
+    slip_events : tuple of SlipEvent
+        The slips (:func:`~spine_mj.sim.motion.slip_events`): onset force, force drop,
+        jump length and duration of each.
     events : tuple of Event
     end_reason : EndReason
     end_detail : str
@@ -76,8 +84,9 @@ class RunResult(RunColumns):
         First row after the settle phase.
     kappa_mj : float
         Static probe: F_breakaway / F_p (NaN unless ``end_reason`` is BREAKAWAY).
-    slip_kappas : (k,)
-        Drive force / F_p at each slip onset after the settle phase.
+    breakaway_kappas : (k,)
+        Drive force / F_p at each ``move_onset`` after the settle phase (the tip starting
+        to move: a force ramp's breakaway per cycle).
     inertia_number, speed_m_s : float
         I_e and the speed (or equivalent speed) it uses.
     stiffness_number, stiffness_n_m : float
@@ -90,13 +99,15 @@ class RunResult(RunColumns):
         Start in surface units.
     """
 
+    motion: np.ndarray
+    slip_events: tuple[SlipEvent, ...]
     events: tuple[Event, ...]
     end_reason: EndReason
     end_detail: str
     engine_trouble: str
     drive_start_index: int
     kappa_mj: float
-    slip_kappas: np.ndarray
+    breakaway_kappas: np.ndarray
     inertia_number: float
     speed_m_s: float
     stiffness_number: float
@@ -128,9 +139,10 @@ class RunResult(RunColumns):
             "tangential_force_n",
             "drive_force_n",
             "carriage_x_m",
-            "slipping",
+            "moving",
         ):
             cols[name] = getattr(self, name)
+        cols["motion"] = pd.Categorical.from_codes(self.motion, MOTION_NAMES)
         return pd.DataFrame(cols)
 
     def summary(self) -> dict:
@@ -153,7 +165,7 @@ class RunResult(RunColumns):
             "engine_trouble": self.engine_trouble,
             "end_time_s": float(self.time_s[-1]) if self.n else 0.0,
             "kappa_mj": None if math.isnan(self.kappa_mj) else self.kappa_mj,
-            "slip_kappas": self.slip_kappas.tolist(),
+            "breakaway_kappas": self.breakaway_kappas.tolist(),
             "inertia_number": self.inertia_number,
             "speed_m_s": self.speed_m_s,
             "stiffness_number_K": self.stiffness_number,
@@ -161,9 +173,28 @@ class RunResult(RunColumns):
             "slope_length_m": self.scales.slope_length_m,
             "char_length_m": self.scales.char_length_m,
             "engine_units": enc(self.scales.units),
-            "n_slip_onsets": sum(e.kind == "slip_onset" for e in self.events),
+            "n_move_onsets": sum(e.kind == "move_onset" for e in self.events),
+            **self.slip_summary(),
             "simulated_steps": self.simulated_steps,
             "max_penetration_m": float(self.penetration_m.max()) if self.n else 0.0,
+        }
+
+    def slip_summary(self) -> dict:
+        """The slip events and motion states of the run, JSON-ready: ``slip_events``
+        (count), ``slip_onset_forces_fp``, ``slip_force_drops_fp``, ``slip_jump_lengths_m``,
+        ``slip_durations_s``, ``motion_fractions`` (over the drive phase) and
+        ``max_speed_over_drive`` (the tip's largest x-speed after the settle phase over
+        the drive's speed)."""
+        fp, ev = self.scales.preload_n, self.slip_events
+        vx = self.velocity_m_s[self.drive_start_index :, 0]
+        return {
+            "slip_events": len(ev),
+            "slip_onset_forces_fp": [e.onset_force_n / fp for e in ev],
+            "slip_force_drops_fp": [e.force_drop_n / fp for e in ev],
+            "slip_jump_lengths_m": [e.jump_length_m for e in ev],
+            "slip_durations_s": [e.duration_s for e in ev],
+            "motion_fractions": motion_fractions(self.motion, self.drive_start_index),
+            "max_speed_over_drive": float(vx.max() / self.speed_m_s) if vx.size else 0.0,
         }
 
 
@@ -246,7 +277,7 @@ class GroupAnalysis:
                 *e[:5],
                 e[5] + span,
                 det.domain_margin_m,
-                det.slip_speed_m_s,
+                det.move_speed_m_s,
                 det.penetration_tol_m,
                 det.kappa_cap * rig.scales.preload_n * (1 - 1e-9),
                 rig.tip.mu_s,
@@ -303,7 +334,7 @@ class GroupAnalysis:
             sens,
             units=rig.units,
             carriage_x=carriage,
-            slip_speed_m_s=det.slip_speed_m_s,
+            move_speed_m_s=det.move_speed_m_s,
             out=rec,
         )
         marks = end_marks(
@@ -388,19 +419,25 @@ class GroupAnalysis:
     ) -> RunResult:
         """The result of run ``r``, its recording ``rec`` cut at its ``ending``."""
         rig, drive, n_settle = self.rig, self.drives[r], self.n_settle[r]
-        events = slip_events(rec.slipping, rec.time_s, n_settle)
+        events = move_events(rec.moving, rec.time_s, n_settle)
         events.append(Event(ending.reason.value, ending.index, float(rec.time_s[ending.index])))
-        onsets = [e.index for e in events if e.kind == "slip_onset"]
+        onsets = [e.index for e in events if e.kind == "move_onset"]
         speed, k = self.speeds[r], self.stiffness[r]
+        motion = motion_states(rec.velocity_m_s, speed, n_settle)
+        slips = slip_events(
+            motion, rec.time_s, rec.position_m[:, 0], rec.drive_force_n, rec.velocity_m_s[:, 0]
+        )
         return RunResult(
             **{name: getattr(rec, name) for name in RESULT_COLUMNS},
+            motion=motion,
+            slip_events=tuple(slips),
             events=tuple(events),
             end_reason=ending.reason,
             end_detail=ending.detail,
             engine_trouble=ending.trouble,
             drive_start_index=n_settle,
             kappa_mj=kappa_mj,
-            slip_kappas=rec.drive_force_n[onsets] / rig.scales.preload_n,
+            breakaway_kappas=rec.drive_force_n[onsets] / rig.scales.preload_n,
             inertia_number=rig.scales.inertia_number(speed),
             speed_m_s=speed,
             stiffness_number=rig.scales.stiffness_number(k),

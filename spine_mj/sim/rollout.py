@@ -420,7 +420,7 @@ class _Group:
             cap_n=cap * (1 + 1e-9),
             margin=drive.fast_forward_margin,
             stick_speed_m_s=det.stick_speed_m_s,
-            slip_speed_m_s=det.slip_speed_m_s,
+            move_speed_m_s=det.move_speed_m_s,
         )
         step = rate_n_s(drive, rig.scales) * rig.engine.timestep_s
         rec, ns = self.analysis.run(k), self.n_settle[k]
@@ -450,7 +450,7 @@ class _Group:
             self.sens[k : k + 1, a:b],
             units=rig.units,
             carriage_x=np.full((1, b - a), np.nan),
-            slip_speed_m_s=det.slip_speed_m_s,
+            move_speed_m_s=det.move_speed_m_s,
         ).run(0)
         step = rate_n_s(self.drives[k], rig.scales) * rig.engine.timestep_s
         for i in range(b - a):

@@ -23,10 +23,10 @@ from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
-from scipy.stats import binomtest
 
 from spine_mj.presets import calibrated_mu, load_preset
 from spine_mj.reproduce import fig9_rms_height, fig9_seeds
+from spine_mj.validate.intervals import CONFIDENCE, wilson
 from spine_mj.validate.paths import tip_radius
 from spine_mj.validate.plans import ValidationPlan
 from spine_mj.validate.study_runner import StudyRunner
@@ -35,8 +35,6 @@ __all__ = ["SERIES", "FractalLockResult", "fractal_lock", "hurst_rows", "lock_ra
 
 #: The study's surface preset.
 PRESET = "paper-fractal"
-#: Confidence level of the rates' Wilson intervals.
-CONFIDENCE = 0.95
 #: The rate series, in the order of the table and the figure.
 SERIES = ("streamline", "facets", "mujoco_corner", "mujoco_dynamic")
 #: Outcomes of the streamline that hold the tip (the self-lock region or the force cap).
@@ -68,8 +66,8 @@ def lock_rate(locked: Sequence[bool], ok: Sequence[bool] | None = None) -> dict:
     n, n_ok, k = int(locked.size), int(ok.sum()), int((locked & ok).sum())
     rate = lo = hi = float("nan")
     if n_ok:
-        ci = binomtest(k, n_ok).proportion_ci(confidence_level=CONFIDENCE, method="wilson")
-        rate, lo, hi = k / n_ok, float(ci.low), float(ci.high)
+        lo, hi = wilson(k, n_ok, confidence=CONFIDENCE)
+        rate = k / n_ok
     return {
         "n": n,
         "n_ok": n_ok,

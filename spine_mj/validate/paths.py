@@ -95,10 +95,10 @@ def prefix_frechet(mpath: np.ndarray, qpath: np.ndarray, lc: float) -> float:
 
 def mujoco_traces(store: Path, case_id: str) -> dict:
     """MuJoCo trajectories of a stored case: start -> DataFrame (``x``, ``y``,
-    ``drive_force_n``, ``time_s``, ``slipping``) sorted by step; empty without any."""
+    ``drive_force_n``, ``time_s``, ``motion``) sorted by step; empty without any."""
     try:
         tr = sweep.load_trajectories(
-            store, case_id, analysis="mujoco", columns=["x", "y", "drive_force_n", "time_s", "slipping"]
+            store, case_id, analysis="mujoco", columns=["x", "y", "drive_force_n", "time_s", "motion"]
         )
     except SpineInputError:
         return {}

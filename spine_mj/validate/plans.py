@@ -10,6 +10,7 @@ studies, the summary and the report read one value.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -154,6 +155,30 @@ class ValidationPlan:
     stiffness_map_starts : int
         Starts per preset of the map (a subset of the family's): the lowest I_e and the
         many K values make the map's expensive corner, so it runs from few starts.
+    stick_slip_k_ie, stick_slip_k_factors : tuple of float
+        The stick-slip study's K scan on a corrugation: I_e values and K in units of K*.
+    ground_truth_slopes, ground_truth_mus : tuple of float
+        Corrugations of the ground-truth study's Prandtl-Tomlinson check (slope amplitude
+        x mu, each slope below each mu).
+    ground_truth_k_factors : tuple of float
+        Stiffness numbers of that check in units of each corrugation's K*.
+    ground_truth_waves : int
+        Wavelengths of those corrugations.
+    ground_truth_ridge_widths : tuple of float
+        Gaussian ridge widths (height 0.5) of the lift-off check.
+    ground_truth_liftoff_factors : tuple of float
+        I_e of the lift-off scans in units of each ridge's predicted I_e*.
+    stiffness_map_runs : int
+        Runs per (I_e, K) point and family the map needs at least (0: the family's own
+        starts, ``stiffness_map_starts`` of them; :meth:`map_family`).
+    ensemble_members : int
+        Runs per start of the quasistatic-limit study, on each side: the start and
+        ``ensemble_members - 1`` starts around it (:mod:`spine_mj.validate.ensembles`);
+        1: no ensembles (no start is found ill-conditioned).
+    corner : tuple of (family name, seeds, starts)
+        The quasistatic-limit study's own seeds and starts table per family (the corner's
+        sample size), where they differ from the family's (which the boundary study and the
+        (I_e, K) map draw on); :meth:`corner_family`.
     """
 
     name: str
@@ -184,7 +209,38 @@ class ValidationPlan:
     stiffness_map_k: tuple[float, ...] = ()
     stiffness_map_families: tuple[str, ...] = ()
     stiffness_map_starts: int = 2
+    stick_slip_k_ie: tuple[float, ...] = (1e-4, 1e-2)
+    stick_slip_k_factors: tuple[float, ...] = (0.125, 0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 4.0, 8.0)
+    ground_truth_slopes: tuple[float, ...] = (0.1, 0.2, 0.3)
+    ground_truth_mus: tuple[float, ...] = (0.5, 0.8)
+    ground_truth_k_factors: tuple[float, ...] = (0.25, 0.5, 2.0, 4.0)
+    ground_truth_waves: int = 6
+    ground_truth_ridge_widths: tuple[float, ...] = (0.35, 0.5, 0.7)
+    ground_truth_liftoff_factors: tuple[float, ...] = (0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1.2, 1.5)
+    stiffness_map_runs: int = 0
+    ensemble_members: int = 1
+    corner: tuple[tuple[str, Any, tuple], ...] = ()
     extra: dict = field(default_factory=dict, compare=False)
+
+    def map_family(self, fam: FamilySpec) -> FamilySpec:
+        """``fam`` for the (I_e, K) map: with ``stiffness_map_runs`` > 0, its y starts
+        respread over the same range, as many as that many runs per (I_e, K) point need on
+        the map's one surface per preset (``stiffness_map_starts``, at least as many, then
+        keeps them all)."""
+        if self.stiffness_map_runs <= 0:
+            return fam
+        t = dict(fam.starts)
+        ys = [float(v) for v in t["y"]]
+        n = -(-self.stiffness_map_runs // len(fam.presets))
+        t["y"] = tuple(float(v) for v in np.linspace(min(ys), max(ys), n).round(4))
+        return dataclasses.replace(fam, starts=tuple(t.items()))
+
+    def corner_family(self, fam: FamilySpec) -> FamilySpec:
+        """``fam`` with the seeds and starts of the quasistatic-limit corner (``corner``)."""
+        for name, seeds, starts in self.corner:
+            if name == fam.name:
+                return dataclasses.replace(fam, seeds=seeds, starts=starts)
+        return fam
 
 
 #: Engine variations: (label, sweep grid overrides); the first is the rig's default.
@@ -247,6 +303,14 @@ PLANS: dict[str, ValidationPlan] = {
         stiffness_map_k=(30.0,),
         stiffness_map_families=("single_peak_valley",),
         stiffness_map_starts=1,
+        stick_slip_k_ie=(1e-2,),
+        stick_slip_k_factors=(0.25, 4.0),
+        ground_truth_slopes=(0.3,),
+        ground_truth_mus=(0.5,),
+        ground_truth_k_factors=(0.25, 4.0),
+        ground_truth_waves=3,
+        ground_truth_ridge_widths=(0.5,),
+        ground_truth_liftoff_factors=(0.5, 1.5),
     ),
     "quick": ValidationPlan(
         name="quick",
@@ -276,10 +340,22 @@ PLANS: dict[str, ValidationPlan] = {
         fractal_surfaces=6,
         # the facet streamline (~1.4 s per surface, measured) would double the study's time
         fractal_facets=False,
+        ensemble_members=3,
+        corner=(
+            ("single_peak_valley", None, paper_starts(np.linspace(-0.5, -4.0, 15).round(4))),
+            ("random_gaussian", (1,), relative_starts(15)),
+            ("sandpaper", None, relative_starts(10, 0.25)),
+        ),
         stiffness_map_ie=(1e-2, 1.0),
         stiffness_map_k=(1.0, 10.0, 100.0),
         stiffness_map_families=("single_peak_valley", "random_gaussian", "fractal"),
         stiffness_map_starts=2,
+        stick_slip_k_ie=(1e-4,),
+        stick_slip_k_factors=(0.25, 0.5, 1.0, 2.0, 4.0),
+        ground_truth_k_factors=(0.25, 4.0),
+        ground_truth_waves=4,
+        ground_truth_ridge_widths=(0.35, 0.5),
+        ground_truth_liftoff_factors=(0.5, 0.8, 1.1, 1.5),
     ),
     "full": ValidationPlan(
         name="full",
@@ -321,6 +397,16 @@ PLANS: dict[str, ValidationPlan] = {
         stiffness_map_ie=(1e-4, 1e-3, 1e-2, 1e-1, 1.0),
         stiffness_map_k=(1.0, 3.0, 10.0, 30.0, 100.0),
         stiffness_map_families=("single_peak_valley", "random_gaussian", "fractal"),
-        stiffness_map_starts=2,
+        # at least 30 runs per (I_e, K) point and family (map_family)
+        stiffness_map_starts=30,
+        stiffness_map_runs=30,
+        ensemble_members=3,
+        # at least 100 well-conditioned starts per family, the fractal over 5 seeds x 2 H
+        corner=(
+            ("single_peak_valley", None, paper_starts(np.linspace(-0.25, -5.0, 55).round(4))),
+            ("random_gaussian", (1, 2), relative_starts(28)),
+            ("fractal", (1, 2, 3, 4, 5), relative_starts(12)),
+            ("sandpaper", None, relative_starts(12, 0.25)),
+        ),
     ),
 }

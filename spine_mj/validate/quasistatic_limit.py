@@ -16,6 +16,8 @@ import pandas as pd
 
 from spine_mj.compare import MISS_REASONS
 from spine_mj.presets import calibrated_mu
+from spine_mj.validate.ensembles import ensemble_family, ensemble_groups, ensemble_verdicts
+from spine_mj.validate.intervals import bootstrap, meets_target, wilson
 from spine_mj.validate.paths import stored_paths, tip_radius
 from spine_mj.validate.plans import FRECHET_TARGET, OUTCOME_TARGET, RECOMMENDED, FamilySpec, ValidationPlan
 from spine_mj.validate.study_runner import StudyRunner
@@ -46,6 +48,7 @@ RUN_COLUMNS = (
     "miss_offset",
     "reference_slide_fraction",
     "tip_peak_ie",
+    "ill_conditioned",
 )
 
 
@@ -71,7 +74,9 @@ class QuasistaticLimitResult:
     families : dict
         Family name -> summary: ``runs``, ``ok_runs``, ``outcome_agreement``,
         ``mean_frechet``, ``median_frechet``, ``mean_lateral_deviation`` (against the
-        facet-traced streamline), ``outcome_agreement_smooth``, ``median_frechet_smooth``
+        facet-traced streamline), ``outcome_agreement_compliant`` and
+        ``median_frechet_compliant`` (against the compliant-drive streamline of the run's
+        spring), ``outcome_agreement_smooth``, ``median_frechet_smooth``
         (against the smooth one), ``mean_geometry_frechet``, ``failed_runs`` (engine stops
         by status), ``reference_stalled`` (reference streamlines stalled in a groove),
         ``misses`` (disagreeing runs the engine finished, by
@@ -135,15 +140,21 @@ def quasistatic_limit(plan: ValidationPlan, runner: StudyRunner) -> QuasistaticL
     runner.study = "limit"
     families, runs_rows, paths = {}, [], {}
     for fam in plan.families:
-        comps = [_preset_comparison(plan, runner, fam, preset, paths) for preset in fam.presets]
+        fam = plan.corner_family(fam)
+        groups: list[dict] = []
+        comps = [_preset_comparison(plan, runner, fam, preset, paths, groups) for preset in fam.presets]
         allc = pd.concat(comps, ignore_index=True)
         summ = _family_summary(allc)
+        summ.update(ensemble_verdicts(groups))
         failed = allc.loc[allc["mujoco_status"] != "ok", "mujoco_status"].value_counts()
         summ.update(
             {
                 "median_frechet_smooth": float(np.nanmedian(allc["frechet_smooth"])),
                 "outcome_agreement_smooth": float(allc["agree_smooth"].fillna(False).astype(bool).mean()),
                 "mean_geometry_frechet": float(np.nanmean(allc["geometry_frechet"])),
+                # against the compliant-drive streamline of the run's own spring (NaN in a
+                # store written before compare had it)
+                **_compliant_summary(allc),
                 "failed_runs": {str(k): int(v) for k, v in failed.items()},
                 # no progress even with the step cut to dl / 2**max_halvings (a fixed step
                 # once zig-zagged across grit valleys narrower than itself and stalled
@@ -152,16 +163,27 @@ def quasistatic_limit(plan: ValidationPlan, runner: StudyRunner) -> QuasistaticL
                 "misses": _misses(allc),
                 "slide_runs": int((allc["reference_slide_fraction"] > 0).sum()),
                 "median_tip_peak_ie": float(np.nanmedian(allc["tip_peak_ie"])),
-                "meets_target": bool(
-                    summ["outcome_agreement"] >= OUTCOME_TARGET
-                    and summ["median_frechet"] <= FRECHET_TARGET
-                    and "penetration" not in failed
-                ),
             }
         )
+        summ.update(_intervals(allc, summ))
+        summ["meets_target"] = bool(
+            meets_target(
+                summ["agreement_well_conditioned"],
+                summ["agreement_ci"],
+                OUTCOME_TARGET,
+                higher_is_better=True,
+            )
+            and meets_target(
+                summ["median_frechet"], summ["median_frechet_ci"], FRECHET_TARGET, higher_is_better=False
+            )
+            and "penetration" not in failed
+        )
+        ill = summ.pop("ill_conditioned")
         families[fam.name] = summ
         for _, r in allc.iterrows():
-            runs_rows.append({k: _plain(r[k]) for k in RUN_COLUMNS})
+            row = {k: _plain(r[k]) for k in RUN_COLUMNS if k != "ill_conditioned"}
+            row["ill_conditioned"] = ill.get(f"{r['case_id']}/{int(r['start'])}", "")
+            runs_rows.append(row)
     return QuasistaticLimitResult(
         families=families,
         runs=runs_rows,
@@ -182,6 +204,8 @@ def limit_doc(plan: ValidationPlan, fam: FamilySpec, preset: str, name: str, ove
         "dl": tip / 2,
         **engine_grid(plan, overrides, preset, fam.seeds, tip),
     }
+    if plan.ensemble_members > 1 and not overrides:
+        fam = ensemble_family(fam, preset, plan.ensemble_members)
     return family_doc(
         fam,
         name=name,
@@ -193,11 +217,17 @@ def limit_doc(plan: ValidationPlan, fam: FamilySpec, preset: str, name: str, ove
 
 
 def _preset_comparison(
-    plan: ValidationPlan, runner: StudyRunner, fam: FamilySpec, preset: str, paths: dict
+    plan: ValidationPlan, runner: StudyRunner, fam: FamilySpec, preset: str, paths: dict, groups: list
 ) -> pd.DataFrame:
-    """The ``compare`` rows of one preset's sweep with the MuJoCo row's end and status; the
-    single peak/valley family's paths go into ``paths``."""
+    """The ``compare`` rows of one preset's sweep (each ensemble's own start) with the MuJoCo
+    row's end and status; the ensembles' outcomes go into ``groups``
+    (:func:`~spine_mj.validate.ensembles.ensemble_verdicts`), the single peak/valley
+    family's paths into ``paths``."""
     df, store = runner(limit_doc(plan, fam, preset, f"limit-{preset}"), f"limit/{preset}")
+    members = max(int(plan.ensemble_members), 1)
+    groups.extend(ensemble_groups(df, store, members))
+    df = df[df["start"].astype(int) % members == 0].copy()  # the runs: each ensemble's own start
+    df["start"] = df["start"].astype(int) // members
     comp = df[df["analysis"] == "compare"].copy()
     mj = df[df["analysis"] == "mujoco"].set_index(["case_id", "start"])
     key = list(zip(comp["case_id"], comp["start"].astype(int)))
@@ -211,7 +241,7 @@ def _preset_comparison(
             smooth = stored_paths(store, case_id, "quasistatic")
             facets = stored_paths(store, case_id, "compare")
             mpaths = stored_paths(store, case_id, "mujoco")
-            for s, x0, y0 in zip(grp["start"].astype(int), grp["start_x"], grp["start_y"]):
+            for s, x0, y0 in zip(grp["start"].astype(int) * members, grp["start_x"], grp["start_y"]):
                 empty = np.zeros((0, 2))
                 paths.setdefault(preset, []).append(
                     LimitPath(smooth[s], facets.get(s, empty), mpaths.get(s, empty), (x0, y0))
@@ -223,7 +253,7 @@ def _variations(plan: ValidationPlan, runner: StudyRunner, runs_rows: list[dict]
     """The plan's engine variations on the first family's first preset, after the
     recommended settings (summarised from ``runs_rows``)."""
     variations = {}
-    fam0 = plan.families[0]
+    fam0 = plan.corner_family(plan.families[0])
     preset = fam0.presets[0]
     for label, ov in plan.limit_variations:
         tag = "-".join(f"{k}{v}" for k, v in ov)
@@ -245,6 +275,18 @@ def _variations(plan: ValidationPlan, runner: StudyRunner, runs_rows: list[dict]
     }
 
 
+def _intervals(comp, summ: dict) -> dict:
+    """The family's 95 % intervals: Wilson on the outcome agreement (``outcome_agreement_ci``, over
+    all runs, a stopped run disagreeing), percentile bootstrap over runs on the median
+    Frechet distance (``median_frechet_ci``)."""
+    n = summ["runs"]
+    agree = int(round(summ["outcome_agreement"] * n)) if n else 0
+    return {
+        "outcome_agreement_ci": list(wilson(agree, n)),
+        "median_frechet_ci": list(bootstrap(comp["frechet"].to_numpy(float))),
+    }
+
+
 def _misses(comp) -> dict[str, dict]:
     """Disagreeing runs by miss reason: count and offsets over L_c (separatrix, diverged)."""
     out = {}
@@ -254,6 +296,17 @@ def _misses(comp) -> dict[str, dict]:
             offsets = [float(v) for v in rows["miss_offset"] if np.isfinite(v)]
             out[reason] = {"runs": int(len(rows)), "offsets": sorted(offsets)}
     return out
+
+
+def _compliant_summary(comp) -> dict:
+    """Outcome agreement and median Frechet of ``compare`` rows against the compliant-drive
+    reference (``agree_compliant``, ``compliant_frechet``; NaN without those columns)."""
+    if "agree_compliant" not in comp or not comp["agree_compliant"].notna().any():
+        return {"outcome_agreement_compliant": float("nan"), "median_frechet_compliant": float("nan")}
+    return {
+        "outcome_agreement_compliant": float((comp["agree_compliant"] == 1).mean()),
+        "median_frechet_compliant": float(np.nanmedian(comp["compliant_frechet"])),
+    }
 
 
 def _family_summary(comp) -> dict:

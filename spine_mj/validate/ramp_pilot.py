@@ -107,7 +107,7 @@ def ramp_duration(
         start=start,
     )
     i0 = r.drive_start_index
-    onsets = [e for e in r.events if e.kind == "slip_onset"]
+    onsets = [e for e in r.events if e.kind == "move_onset"]
     resets = [e for e in r.events if e.kind == "reset"]
     dx = (r.position_m[-1, 0] - r.position_m[i0, 0]) / sc.char_length_m
     cap = max_steps * dt

@@ -11,6 +11,9 @@ import numpy as np
 from spine_mj import presets, sim
 from spine_mj.errors import SpineInputError
 from spine_mj.presets import calibrated_mu
+from spine_mj.sim.motion import slip_events
+from spine_mj.tomlinson import Corrugation
+from spine_mj.validate.ground_truth import CORRUGATION_START, TOMLINSON_TIP, corrugation_runs
 from spine_mj.validate.paths import mujoco_traces, tip_radius
 from spine_mj.validate.plans import GRAVITY, MASS_KG, FamilySpec, ValidationPlan, relative_starts
 from spine_mj.validate.study_runner import StudyRunner
@@ -20,6 +23,10 @@ __all__ = ["SlipStats", "StickSlipResult", "complementary_cdf", "slip_statistics
 
 #: The surface of the study (seed 1).
 PRESET = "paper-random-concave"
+#: The corrugation of the K scan: slope amplitude and mu (K* = 0.46 with a tip of lambda / 100).
+K_SCAN_SURFACE = (0.3, 0.5)
+#: A corrugation run is stick-slip when it slips at least this often per wavelength.
+SLIPS_PER_WAVE = 0.5
 
 
 @dataclass(frozen=True)
@@ -29,17 +36,16 @@ class SlipStats:
     Attributes
     ----------
     count : int
-        Slip events (a run of ``slipping`` samples, counted once it has ended or the trace
-        ends).
+        Slip events (runs of ``slipping`` motion states).
     jump_lengths : ndarray, shape (count,)
         Distance travelled in x-y during each event.
     force_drops : ndarray, shape (count,)
-        Drive force at the onset minus the force at the end of each event (same units as
-        the force trace).
+        Peak drive force of each event minus the lowest force after it within the event
+        (same units as the force trace; >= 0).
     durations : ndarray, shape (count,)
     onset_indices, stop_indices : ndarray of int, shape (count,)
-        Trace samples at which each event's force drop is measured (the last stuck sample
-        before it and its last sample), so that the spring energy released over the same
+        Trace samples at which each event begins (the last loading sample before it) and
+        ends, so that the spring energy released over the same
         events (:func:`spine_mj.energy.elastic_release_j`) is read at the same points.
     """
 
@@ -63,51 +69,49 @@ class SlipStats:
         }
 
 
-def slip_statistics(time_s, x, y, force, slipping, *, min_samples: int = 1) -> SlipStats:
-    """Slip events (runs of ``slipping``) of a trace, with jump length and force drop.
+def slip_statistics(time_s, x, y, force, motion) -> SlipStats:
+    """Slip events of a trace (its runs of ``slipping`` motion states,
+    :func:`spine_mj.sim.motion.slip_events`), with jump length and force drop.
 
     Parameters
     ----------
     time_s, x, y, force : array_like, shape (n,)
-    slipping : array_like of bool, shape (n,)
-    min_samples : int
-        Shorter runs of ``slipping`` are ignored (detector chatter).
+    motion : array_like of int, shape (n,)
+        Motion state codes (:data:`spine_mj.sim.motion.MOTION_NAMES`), as recorded.
 
     Returns
     -------
     SlipStats
+        Jump lengths along the x-y path from the onset (the last loading sample) to the
+        event's last sample; force drops from the event's peak force to the lowest force
+        after it (never negative).
     """
     t = np.asarray(time_s, float)
     x = np.asarray(x, float)
     y = np.asarray(y, float)
     f = np.asarray(force, float)
-    s = np.asarray(slipping, bool)
-    if not (t.shape == x.shape == y.shape == f.shape == s.shape) or t.ndim != 1:
+    m = np.asarray(motion)
+    if not (t.shape == x.shape == y.shape == f.shape == m.shape) or t.ndim != 1:
         raise SpineInputError(
-            f"time_s, x, y, force and slipping must be 1-D of one length, "
-            f"got {t.shape}, {x.shape}, {y.shape}, {f.shape}, {s.shape}"
+            f"time_s, x, y, force and motion must be 1-D of one length, "
+            f"got {t.shape}, {x.shape}, {y.shape}, {f.shape}, {m.shape}"
         )
-    edges = np.diff(np.r_[0, s.astype(np.int8), 0])
-    on, off = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)  # [on, off)
-    keep = (off - on) >= min_samples
-    on, off = on[keep], off[keep]
-    jumps, drops, durs, starts, ends = [], [], [], [], []
-    for a, b in zip(on, off):
-        end = min(b, t.size - 1)
-        start = max(a - 1, 0)  # the last stuck sample before the slip
-        seg = np.column_stack([x[start : end + 1], y[start : end + 1]])
-        jumps.append(float(np.linalg.norm(np.diff(seg, axis=0), axis=1).sum()))
-        drops.append(float(f[start] - f[end]))
-        durs.append(float(t[end] - t[start]))
-        starts.append(start)
-        ends.append(end)
+    events = slip_events(m, t, x, f)
+    jumps = [
+        float(
+            np.linalg.norm(
+                np.diff(np.column_stack([x[e.onset : e.stop + 1], y[e.onset : e.stop + 1]]), axis=0), axis=1
+            ).sum()
+        )
+        for e in events
+    ]
     return SlipStats(
-        len(jumps),
+        len(events),
         np.array(jumps),
-        np.array(drops),
-        np.array(durs),
-        np.array(starts, np.int64),
-        np.array(ends, np.int64),
+        np.array([e.force_drop_n for e in events]),
+        np.array([e.duration_s for e in events]),
+        np.array([e.onset for e in events], np.int64),
+        np.array([e.stop for e in events], np.int64),
     )
 
 
@@ -137,18 +141,37 @@ class StickSlipResult:
     traces : dict
         ``(ie, stiffness_n_m)`` -> (time_s, drive force / F_p) of the first start.
     surface : str
+    k_scan : list of dict
+        The spring drive on the corrugation :data:`K_SCAN_SURFACE` per (I_e, K): slip
+        events, events per wavelength, motion fractions, the largest speed [V].
+    k_star : float
+        That corrugation's K* (:meth:`spine_mj.tomlinson.Corrugation.critical_stiffness`).
+    transitions : list of dict
+        Per I_e of the scan: where stick-slip gives way to steady sliding (the bracket of K
+        between the last K with at least :data:`SLIPS_PER_WAVE` slips per wavelength and the
+        next) against K*.
     """
 
     rows: list[dict]
     traces: dict[tuple[float, float], tuple[np.ndarray, np.ndarray]]
     surface: str
+    k_scan: list[dict] = field(default_factory=list)
+    k_star: float = float("nan")
+    transitions: list[dict] = field(default_factory=list)
 
     def validation_keys(self) -> dict:
         """This study's keys of ``validation.json``."""
         return {"stick_slip": self.rows}
 
     def as_dict(self) -> dict:
-        return {"rows": self.rows, "traces": self.traces, "surface": self.surface}
+        return {
+            "rows": self.rows,
+            "traces": self.traces,
+            "surface": self.surface,
+            "k_scan": self.k_scan,
+            "k_star": self.k_star,
+            "transitions": self.transitions,
+        }
 
 
 def stick_slip(plan: ValidationPlan, runner: StudyRunner) -> StickSlipResult:
@@ -193,8 +216,7 @@ def stick_slip(plan: ValidationPlan, runner: StudyRunner) -> StickSlipResult:
                     tr["x"] / lc_units,
                     tr["y"] / lc_units,
                     tr["drive_force_n"] / fp,
-                    tr["slipping"],
-                    min_samples=3,
+                    tr["motion"],
                 )
             )
             if s == 0:
@@ -204,7 +226,58 @@ def stick_slip(plan: ValidationPlan, runner: StudyRunner) -> StickSlipResult:
         qs_locked = np.where(agree_lock, locked_mj, ~locked_mj)  # agree_lock: same as qs
         rows.append(_row(float(ie), float(k) * lc_m / fp, stats, qs_locked, locked_mj))
     rows.sort(key=lambda r: (r["ie"], r["stiffness_fp_per_lc"]))
-    return StickSlipResult(rows=rows, traces=traces, surface=f"{PRESET}#1")
+    scan, k_star = k_scan(plan, runner)
+    return StickSlipResult(
+        rows=rows,
+        traces=traces,
+        surface=f"{PRESET}#1",
+        k_scan=scan,
+        k_star=k_star,
+        transitions=transitions(scan, k_star),
+    )
+
+
+def k_scan(plan: ValidationPlan, runner: StudyRunner) -> tuple[list[dict], float]:
+    """The spring drive on the corrugation :data:`K_SCAN_SURFACE` over ``plan.stick_slip_k_ie``
+    x ``plan.stick_slip_k_factors`` K*: one row per run, and K*."""
+    s, mu = K_SCAN_SURFACE
+    k_star = Corrugation(s, mu, tip_radius=TOMLINSON_TIP).critical_stiffness()
+    ks = [float(f"{f * k_star:.6g}") for f in plan.stick_slip_k_factors]
+    mj = corrugation_runs(runner, "stick-slip/corrugation", s, mu, ks, list(plan.stick_slip_k_ie), 4)
+    rows = []
+    for _, r in mj.sort_values(["ie", "K"]).iterrows():
+        travel = float(r["end_x"]) - CORRUGATION_START
+        rows.append(
+            {
+                "ie": float(r["ie"]),
+                "K": float(r["K"]),
+                "k_over_k_star": float(r["K"]) / k_star,
+                "slip_events": int(r["slip_events"]),
+                "events_per_wave": int(r["slip_events"]) / travel if travel > 0 else float("nan"),
+                "onset_mean_fp": float(r["slip_onset_fp_mean"]),
+                "stuck": float(r["stuck_fraction"]),
+                "sliding": float(r["sliding_fraction"]),
+                "slipping": float(r["slipping_fraction"]),
+                "max_speed_v": float(r["max_speed_over_drive"]),
+                "status": str(r["status"]),
+            }
+        )
+    return rows, k_star
+
+
+def transitions(scan: list[dict], k_star: float) -> list[dict]:
+    """Per I_e of ``scan``: the K bracket where stick-slip (at least :data:`SLIPS_PER_WAVE`
+    slips per wavelength) gives way to steady sliding, and its geometric mean over K*."""
+    out = []
+    for ie in sorted({r["ie"] for r in scan}):
+        rows = sorted((r for r in scan if r["ie"] == ie), key=lambda r: r["K"])
+        slips = [r["K"] for r in rows if r["events_per_wave"] >= SLIPS_PER_WAVE]
+        low = max(slips) if slips else float("nan")
+        above = [r["K"] for r in rows if not slips or r["K"] > low]
+        high = min(above) if above else float("nan")
+        mid = float(np.sqrt(low * high)) if slips and above else float("nan")
+        out.append({"ie": ie, "k_low": low, "k_high": high, "k_transition": mid, "over_k_star": mid / k_star})
+    return out
 
 
 def _row(

@@ -13,7 +13,11 @@ the plan's families and reports, from the same runs:
 - per K, the spring energy released at breakaways against the quasistatic work of the
   streamline (``F_p integral kappa dx``), both per L_c travelled;
 - slip events (:func:`spine_mj.validate.stick_slip.slip_statistics`): their sizes and force
-  drops, how often and how long the tip slips, and how many quasistatic traps MuJoCo skips.
+  drops, how often and how long the tip slips, and how many quasistatic traps MuJoCo skips;
+- the same agreement against the compliant-drive streamline of each run's spring
+  (``agreement_compliant``: what the spring does predicted, inertia left over), and the
+  drive limits predicted from each family's geometry (``predicted``,
+  :mod:`spine_mj.validate.predicted_limits`) beside the measured boundary.
 
 Each preset runs from few starts (``plan.stiffness_map_starts``): the lowest I_e and the
 many K values make the expensive corner (drive cost grows as I_e^-1/2).
@@ -23,7 +27,6 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
-from types import SimpleNamespace
 
 import numpy as np
 import pandas as pd
@@ -31,10 +34,13 @@ import pandas as pd
 from spine_mj import presets, sim, sweep
 from spine_mj.energy import elastic_release_j, quasistatic_work_j
 from spine_mj.errors import SpineInputError
+from spine_mj.sim.motion import SLIPPING
 from spine_mj.validate.boundary import preset_grid, quasistatic_locked
 from spine_mj.validate.ie_star import ie_star_by_criterion, passes_criterion, quiet_nan_warnings
 from spine_mj.validate.paths import mujoco_traces
 from spine_mj.validate.plans import GRAVITY, MASS_KG, FamilySpec, ValidationPlan
+from spine_mj.validate.predicted_limits import family_limits
+from spine_mj.validate.slip_tails import fit_tail
 from spine_mj.validate.stick_slip import slip_statistics
 from spine_mj.validate.study_runner import StudyRunner
 from spine_mj.validate.sweep_configs import family_doc
@@ -52,8 +58,6 @@ __all__ = [
 #: Families whose slip events the study collects (rough enough to stick and slip).
 SLIP_FAMILIES = ("random_gaussian", "fractal")
 
-#: Shorter runs of ``slipping`` samples are detector chatter (as in the stick-slip study).
-MIN_SLIP_SAMPLES = 3
 
 #: The agreement criterion of the map: the boundary study's headline one.
 CRITERION = "median_frechet"
@@ -81,6 +85,13 @@ class StiffnessMapResult:
         ``(ie, K)`` -> ``{"jump_lc": ndarray, "force_drop_fp": ndarray}``: every slip event
         of the :data:`SLIP_FAMILIES` runs without engine trouble, for the CCDF figure (not
         in ``validation.json``).
+    tails : list of dict
+        Per (I_e, K) and quantity (``jump_lc``, ``force_drop_fp``): the maximum-likelihood
+        tail fit (:func:`spine_mj.validate.slip_tails.fit_tail`; series of fewer than 200
+        events are counted, not fitted).
+    transitions : list of dict
+        Per I_e: the K bracket where stick-slip (at least :data:`SLIPS_PER_LC` slip events
+        per L_c) gives way to steady sliding on the :data:`SLIP_FAMILIES` runs.
     """
 
     ie: list[float]
@@ -91,6 +102,10 @@ class StiffnessMapResult:
     energy: list[dict]
     slip: list[dict]
     slip_samples: dict = dataclasses.field(default_factory=dict, compare=False)
+    tails: list = dataclasses.field(default_factory=list)
+    transitions: list = dataclasses.field(default_factory=list)
+    agreement_compliant: dict = dataclasses.field(default_factory=dict)
+    predicted: dict = dataclasses.field(default_factory=dict)
 
     def ie_star(self) -> dict:
         """family -> K (str) -> I_e* (value, low, high, ci_low, ci_high, kind, criterion)."""
@@ -98,10 +113,19 @@ class StiffnessMapResult:
 
     def validation_keys(self) -> dict:
         """This study's keys of ``validation.json``: ``ie_star_by_stiffness`` (family -> K ->
-        I_e* with bracket ``low``/``high``, bootstrap ``ci_low``/``ci_high`` and ``kind``) and
-        ``stiffness_map`` (the agreement grid with n_ok / n per cell, the energy and slip
-        tables)."""
-        return {"ie_star_by_stiffness": self.ie_star(), "stiffness_map": self.as_dict()}
+        I_e* with bracket ``low``/``high``, bootstrap ``ci_low``/``ci_high`` and ``kind``), the
+        same against the compliant-drive reference (``ie_star_by_stiffness_compliant``), the
+        geometry's prediction (``predicted_drive_limits``: family -> ``k_star``, ``ie_star``,
+        ``limit``) and ``stiffness_map`` (the agreement grid with n_ok / n per cell, the
+        energy and slip tables)."""
+        return {
+            "ie_star_by_stiffness": self.ie_star(),
+            "ie_star_by_stiffness_compliant": self.ie_star_compliant(),
+            "predicted_drive_limits": {
+                f: {k: d[k] for k in ("k_star", "ie_star", "limit")} for f, d in self.predicted.items()
+            },
+            "stiffness_map": self.as_dict(),
+        }
 
     def as_dict(self) -> dict:
         """The ``validation.json`` entry (the slip samples stay out: the figure holds them)."""
@@ -113,6 +137,17 @@ class StiffnessMapResult:
             "agreement": self.agreement,
             "energy": self.energy,
             "slip": self.slip,
+            "tails": self.tails,
+            "transitions": self.transitions,
+            "agreement_compliant": self.agreement_compliant,
+            "predicted": self.predicted,
+        }
+
+    def ie_star_compliant(self) -> dict:
+        """:meth:`ie_star` against the compliant-drive reference (``agreement_compliant``)."""
+        return {
+            f: {k: cell["ie_star"] for k, cell in by_k.items()}
+            for f, by_k in self.agreement_compliant.items()
         }
 
 
@@ -146,9 +181,11 @@ def stiffness_map(plan: ValidationPlan, runner: StudyRunner) -> StiffnessMapResu
     empty = StiffnessMapResult(ies, ks, [f.name for f in fams], plan.stiffness_map_starts, {}, [], [])
     if not ies or not ks or not fams:
         return empty
-    runs, samples = [], {}
+    runs, samples, predicted = [], {}, {}
     for fam in fams:
-        sub = subset_starts(fam, plan.stiffness_map_starts)
+        sub = subset_starts(plan.map_family(fam), plan.stiffness_map_starts)
+        runner.note(f"predicted drive limits of {fam.name}")
+        predicted[fam.name] = family_limits(plan, sub)
         for preset in fam.presets:
             doc = family_doc(
                 sub,
@@ -161,6 +198,8 @@ def stiffness_map(plan: ValidationPlan, runner: StudyRunner) -> StiffnessMapResu
             with runner.phase(f"slip events and energy on {preset}"):
                 runs.append(_run_rows(df, store, fam.name, preset, samples))
     table = pd.concat(runs, ignore_index=True)
+    pooled = {k: {n: np.concatenate(v) for n, v in d.items()} for k, d in samples.items()}
+    slip = slip_rows(table)
     return StiffnessMapResult(
         ie=ies,
         stiffness_numbers=ks,
@@ -168,9 +207,48 @@ def stiffness_map(plan: ValidationPlan, runner: StudyRunner) -> StiffnessMapResu
         starts_per_preset=plan.stiffness_map_starts,
         agreement=agreement_map(table, n_boot=plan.bootstrap),
         energy=energy_rows(table),
-        slip=slip_rows(table),
-        slip_samples={k: {n: np.concatenate(v) for n, v in d.items()} for k, d in samples.items()},
+        slip=slip,
+        slip_samples=pooled,
+        tails=tail_rows(pooled),
+        transitions=slip_transitions(slip),
+        agreement_compliant=agreement_map(
+            table.assign(agree=table["agree_compliant"], frechet=table["frechet_compliant"]),
+            n_boot=plan.bootstrap,
+        ),
+        predicted=predicted,
     )
+
+
+#: A cell of the map is stick-slip when its runs slip at least this often per L_c advanced.
+SLIPS_PER_LC = 0.5
+
+
+def tail_rows(samples: dict) -> list[dict]:
+    """The tail fit of each series of ``samples`` (``(ie, K)`` -> quantity -> values)."""
+    rows = []
+    for (ie, k), d in sorted(samples.items()):
+        for name, values in d.items():
+            rows.append({"ie": float(ie), "K": float(k), "quantity": name, **fit_tail(values)})
+    return rows
+
+
+def slip_transitions(slip: list[dict]) -> list[dict]:
+    """Per I_e of the map's ``slip`` rows: the largest K with at least :data:`SLIPS_PER_LC`
+    slip events per L_c, the next K of the grid (NaN where none), and their geometric mean."""
+    out = []
+    for ie in sorted({r["ie"] for r in slip}):
+        rows = sorted((r for r in slip if r["ie"] == ie), key=lambda r: r["K"])
+        slips = [
+            r["K"]
+            for r in rows
+            if np.isfinite(r["slip_events_per_lc"]) and r["slip_events_per_lc"] >= SLIPS_PER_LC
+        ]
+        low = max(slips) if slips else float("nan")
+        above = [r["K"] for r in rows if not slips or r["K"] > low]
+        high = min(above) if above else float("nan")
+        mid = float(np.sqrt(low * high)) if slips and above else float("nan")
+        out.append({"ie": float(ie), "k_low": low, "k_high": high, "k_transition": mid})
+    return out
 
 
 def _length_m(preset: str) -> float:
@@ -205,6 +283,8 @@ def _run_rows(df: pd.DataFrame, store, family: str, preset: str, samples: dict) 
                 "agree": c["agree"],
                 "agree_lock": c["agree_lock"],
                 "frechet": float(c["frechet"]),
+                "agree_compliant": c.get("agree_compliant", np.nan),
+                "frechet_compliant": float(c.get("compliant_frechet", np.nan)),
                 "engine_trouble": r["end_reason"] == "engine_trouble",
                 "mj_locked": bool(r["self_locked"]),
             }
@@ -249,18 +329,15 @@ def _energy_and_slip(tr, qs, lc: float, unit_m: float, fp: float, k_n_m: float) 
             tr["x"] / lc,
             tr["y"] / lc,
             force / fp,
-            tr["slipping"],
-            min_samples=MIN_SLIP_SAMPLES,
+            tr["motion"],
         )
-        events = [SimpleNamespace(kind="slip_onset", index=int(i)) for i in ev.onset_indices] + [
-            SimpleNamespace(kind="slip_stop", index=int(i)) for i in ev.stop_indices
-        ]
+        spans = list(zip(ev.onset_indices.tolist(), ev.stop_indices.tolist()))
         x = tr["x"].to_numpy(dtype=float)
         out.update(
-            release_fplc=elastic_release_j(force, k_n_m, events) / (fp * lc_m),
+            release_fplc=elastic_release_j(force, k_n_m, spans) / (fp * lc_m),
             advance_lc=float(x[-1] - x[0]) / lc,
             slip_events=float(ev.count),
-            slip_time_fraction=float(np.mean(tr["slipping"].to_numpy(dtype=bool))),
+            slip_time_fraction=float(np.mean(tr["motion"].to_numpy() == SLIPPING)),
             events=ev,
         )
     if qs is not None and len(qs) > 1:

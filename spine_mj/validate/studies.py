@@ -17,10 +17,12 @@ from typing import Any
 
 from spine_mj.validate.boundary import BoundaryResult, boundary
 from spine_mj.validate.fractal_lock import FractalLockResult, fractal_lock
+from spine_mj.validate.ground_truth import GroundTruthResult, ground_truth
 from spine_mj.validate.plans import ValidationPlan
 from spine_mj.validate.quasistatic_limit import QuasistaticLimitResult, quasistatic_limit
 from spine_mj.validate.report import boundary as boundary_report
 from spine_mj.validate.report import fractal_lock as fractal_lock_report
+from spine_mj.validate.report import ground_truth as ground_truth_report
 from spine_mj.validate.report import quasistatic_limit as quasistatic_limit_report
 from spine_mj.validate.report import sandpaper as sandpaper_report
 from spine_mj.validate.report import static_map as static_map_report
@@ -62,6 +64,7 @@ STUDIES: tuple[Study, ...] = (
     Study("boundary", boundary, BoundaryResult, boundary_report),
     Study("limit", quasistatic_limit, QuasistaticLimitResult, quasistatic_limit_report),
     Study("static", static_map, StaticMapResult, static_map_report),
+    Study("ground_truth", ground_truth, GroundTruthResult, ground_truth_report),
     Study("stick_slip", stick_slip, StickSlipResult, stick_slip_report),
     Study("sandpaper", sandpaper, SandpaperResult, sandpaper_report),
     Study("fractal_lock", fractal_lock, FractalLockResult, fractal_lock_report),

@@ -15,6 +15,7 @@ from spine_mj.atomic import remove_temporaries
 from spine_mj.errors import SpineInputError
 from spine_mj.jsonio import write_json
 from spine_mj.surfaces import single_gaussian
+from spine_mj.validate.intervals import TARGET_RULE
 from spine_mj.validate.plans import (
     FRECHET_TARGET,
     MASS_KG,
@@ -23,6 +24,7 @@ from spine_mj.validate.plans import (
     STATIC_TARGET,
     ValidationPlan,
 )
+from spine_mj.validate.platform import platform_info
 from spine_mj.validate.report.document import write_report
 from spine_mj.validate.studies import STUDIES
 from spine_mj.validate.study_runner import StudyRunner, ValidationProgress
@@ -100,8 +102,10 @@ def _summary(plan: ValidationPlan, results: list, timings: dict) -> dict:
         "outcome_agreement": OUTCOME_TARGET,
         "mean_frechet_lc": FRECHET_TARGET,
         "static_kappa_rel_error": STATIC_TARGET,
+        "rule": TARGET_RULE,
     }
     summary["engine_settings"] = _engine_settings(plan)
+    summary["platform"] = platform_info()
     summary["timings_s"] = timings
     return summary
 

@@ -49,24 +49,24 @@ def test_every_end_reason_is_reachable_and_recorded():
         assert res.summary()["end_reason"] == reason.value and res.end_detail
 
 
-def _slip_events_reference(slipping, t, start):
+def _move_events_reference(moving, t, start):
     """The obvious form: the settle phase set to stuck, then every change of the flag."""
-    s = slipping.copy()
+    s = moving.copy()
     s[:start] = False
     return [
-        ("slip_onset" if s[i] else "slip_stop", int(i), float(t[i]))
+        ("move_onset" if s[i] else "move_stop", int(i), float(t[i]))
         for i in np.flatnonzero(np.diff(s.astype(np.int8))) + 1
     ]
 
 
-def test_slip_events_match_the_reference_on_random_flags():
-    from spine_mj.sim.detection import slip_events
+def test_move_events_match_the_reference_on_random_flags():
+    from spine_mj.sim.detection import move_events
 
     rng = np.random.default_rng(3)
     for n in (0, 1, 2, 7, 300):
         t = np.arange(n) * 1e-3
         for p in (0.0, 0.1, 0.5, 1.0):
-            slipping = rng.random(n) < p
+            moving = rng.random(n) < p
             for start in sorted({0, 1, n // 3, n, n + 2}):
-                got = [(e.kind, e.index, e.time_s) for e in slip_events(slipping, t, start)]
-                assert got == _slip_events_reference(slipping, t, start), (n, p, start)
+                got = [(e.kind, e.index, e.time_s) for e in move_events(moving, t, start)]
+                assert got == _move_events_reference(moving, t, start), (n, p, start)

@@ -74,11 +74,11 @@ def test_flat_ground_spring_drive_pulls_with_mu_w():
     half = res.n // 2
     force = res.drive_force_n[half:].mean()
     assert force == pytest.approx(MU * rig.scales.preload_n, rel=0.02)
-    assert res.slipping[half:].mean() > 0.5
+    assert res.moving[half:].mean() > 0.5
     assert res.inertia_number == pytest.approx(
         rig.tip.mass_kg * 0.005**2 / (rig.scales.preload_n * rig.scales.char_length_m)
     )
     # cell edges give two contacts: a few um of drift over 80 mm, no more
     assert abs(res.position_m[-1, 1] - res.position_m[0, 1]) < 1e-5
     table = res.table()
-    assert len(table) == res.n and {"position_x_m", "drive_force_n", "slipping"} <= set(table)
+    assert len(table) == res.n and {"position_x_m", "drive_force_n", "moving"} <= set(table)

@@ -83,11 +83,11 @@ def test_warp_on_cpu_matches_the_cpu_engine(rig):
     ref = rig.run_batch(DRIVE, STARTS)
     for a, b in zip(got, ref):
         assert a.n == b.n and a.end_reason is b.end_reason
-        stuck = np.flatnonzero(b.slipping[b.drive_start_index :])[0] + b.drive_start_index
+        stuck = np.flatnonzero(b.moving[b.drive_start_index :])[0] + b.drive_start_index
         np.testing.assert_allclose(a.position_m[:stuck], b.position_m[:stuck], rtol=0, atol=1e-7)
         np.testing.assert_allclose(a.position_m, b.position_m, rtol=0, atol=5e-5)
         for r in (a, b):
-            sliding = r.slipping & r.contact & (np.arange(r.n) > r.drive_start_index)
-            assert r.slipping[-50:].all() and sliding.sum() > 100
+            sliding = r.moving & r.contact & (np.arange(r.n) > r.drive_start_index)
+            assert r.moving[-50:].all() and sliding.sum() > 100
             ratio = r.tangential_force_n[sliding] / r.normal_force_n[sliding]
             assert np.median(ratio) == pytest.approx(MU, rel=0.03)

@@ -13,10 +13,10 @@ def test_ramp_with_reset_slips_at_mu_and_ramps_again():
     rig = flat_rig()
     res = rig.run(RampDrive(rate_n_s=2 * rig.scales.preload_n, duration_s=1.2), start=(-0.04, 0.0))
     assert res.end_reason is EndReason.COMPLETED
-    assert len(res.slip_kappas) >= 2
-    np.testing.assert_allclose(res.slip_kappas, MU, rtol=0.05)
+    assert len(res.breakaway_kappas) >= 2
+    np.testing.assert_allclose(res.breakaway_kappas, MU, rtol=0.05)
     kinds = [e.kind for e in res.events]
-    assert "reset" in kinds and kinds.index("reset") > kinds.index("slip_onset")
+    assert "reset" in kinds and kinds.index("reset") > kinds.index("move_onset")
     assert res.speed_m_s == pytest.approx(rig.scales.char_length_m * 2)
 
 
@@ -33,7 +33,7 @@ def test_ramp_slides_the_set_distance_per_cycle():
     assert len(resets) >= 2
     steps = np.diff(res.position_m[resets, 0])
     assert np.all(steps >= slide) and np.all(steps < 3 * slide)
-    np.testing.assert_allclose(res.slip_kappas, MU, rtol=0.05)
+    np.testing.assert_allclose(res.breakaway_kappas, MU, rtol=0.05)
     short = rig.run(
         RampDrive(rate_n_s=2 * rig.scales.preload_n, duration_s=1.2, slide_distance_m=0.0), start=(-0.04, 0.0)
     )

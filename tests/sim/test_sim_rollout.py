@@ -113,7 +113,7 @@ def _same_run(a, b):
         "normal",
         "drive_force_n",
         "normal_force_n",
-        "slipping",
+        "moving",
     ):
         np.testing.assert_array_equal(getattr(a, name), getattr(b, name))
 

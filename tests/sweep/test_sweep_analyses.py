@@ -55,6 +55,9 @@ def test_mujoco_and_compare_runs_match_the_rig_run_directly(tmp_path):
     assert mjs.end_detail[mjs.self_locked.astype(bool)].str.match("lock rule|force cap").all()
     assert (cmp_.status == np.where(mjs.status.loc[cmp_.index] == "ok", "ok", "dependency_failed")).all()
     assert cmp_.frechet[ran].notna().all() and (cmp_.frechet[ran] >= 0).all()
+    # the spring drive is also set against the compliant streamline of its own spring
+    assert (cmp_.compliant_frechet[ran] >= 0).all() and (cmp_.stiffness_frechet >= 0).all()
+    assert cmp_.agree_compliant.isin([0.0, 1.0]).all() and (cmp_.compliant_jumps >= 0).all()
     # a run that agrees has no miss reason; one the engine finished and that disagrees has one
     agree = cmp_.agree.astype(bool)
     assert (cmp_.miss_reason[agree] == "").all()

@@ -139,10 +139,75 @@ def test_complementary_cdf_of_known_samples():
 
 
 def test_slip_statistics_marks_where_each_drop_is_read():
-    t = np.arange(8, dtype=float)
-    s = np.array([0, 0, 1, 1, 0, 0, 1, 1], bool)
-    f = np.array([0.0, 1.0, 0.5, 0.2, 0.3, 0.8, 0.4, 0.1])
-    st = slip_statistics(t, t, 0 * t, f, s)
+    t = np.arange(9, dtype=float)
+    s = np.array([0, 0, 1, 1, 0, 0, 1, 1, 0], bool)
+    f = np.array([0.0, 1.0, 0.5, 0.2, 0.3, 0.8, 0.4, 0.1, 0.2])
+    st = slip_statistics(t, t, 0 * t, f, np.where(s, 2, 0))
     np.testing.assert_array_equal(st.onset_indices, [1, 5])
-    np.testing.assert_array_equal(st.stop_indices, [4, 7])
+    np.testing.assert_array_equal(st.stop_indices, [3, 7])
     np.testing.assert_allclose(st.force_drops, f[st.onset_indices] - f[st.stop_indices])
+
+
+def test_slip_transition_brackets_where_slips_stop_along_k():
+    from spine_mj.validate.stiffness_map import SLIPS_PER_LC, slip_transitions
+
+    rate = {1.0: 3.0, 3.0: 1.0, 10.0: 0.1 * SLIPS_PER_LC, 30.0: 0.0}
+    slip = [{"ie": 1e-4, "K": k, "slip_events_per_lc": r} for k, r in rate.items()]
+    slip += [{"ie": 1e-2, "K": k, "slip_events_per_lc": 0.0} for k in rate]
+    low, high = slip_transitions(slip)
+    assert (low["k_low"], low["k_high"]) == (3.0, 10.0)
+    assert low["k_transition"] == pytest.approx(np.sqrt(30.0))
+    assert np.isnan(high["k_low"]) and high["k_high"] == 1.0 and np.isnan(high["k_transition"])
+
+
+def test_measured_k_star_brackets_the_first_passing_stiffness():
+    from spine_mj.validate.report.stiffness_map import measured_k_star
+
+    def cells(passes):
+        return {k: {"passes": [p, False]} for k, p in passes.items()}
+
+    assert measured_k_star(cells({"1": False, "3": False, "10": True, "30": True})) == "3-10"
+    assert measured_k_star(cells({"1": True, "3": True})) == "< 1"
+    assert measured_k_star(cells({"1": False, "3": False})) == "> 3"
+    assert measured_k_star(cells({"1": True, "3": False, "10": True})) == "3-10"
+
+
+def test_family_limits_predict_on_the_maps_surfaces():
+    from spine_mj.validate.plans import PLANS
+    from spine_mj.validate.predicted_limits import family_limits
+
+    plan = PLANS["smoke"]
+    got = family_limits(plan, plan.families[0], n_starts=2)
+    assert set(got["presets"]) == {"paper-single-peak"}
+    one = got["presets"]["paper-single-peak"]
+    assert got["k_star"] == one["k_star"] > 0 and got["ie_star"] == one["ie_star"] > 0
+    assert one["tip_radius"] > 0 and one["mu"] == pytest.approx(1.23, abs=0.05)
+
+
+def test_the_report_sets_the_prediction_beside_the_measured_boundary(tmp_path):
+    from spine_mj.validate.report.stiffness_map import map_figure, map_sections
+    from spine_mj.validate.stiffness_map import StiffnessMapResult
+
+    rigid = agreement_map(_runs({1.0: 0, 10.0: 2, 100.0: 3}), n_boot=20)
+    compliant = agreement_map(_runs({1.0: 2, 10.0: 2, 100.0: 3}), n_boot=20)
+    km = StiffnessMapResult(
+        ie=IE,
+        stiffness_numbers=[1.0, 10.0, 100.0],
+        families=["fractal"],
+        starts_per_preset=4,
+        agreement=rigid,
+        energy=[],
+        slip=[],
+        agreement_compliant=compliant,
+        predicted={"fractal": {"k_star": 5.0, "ie_star": 0.02, "limit": "trap", "presets": {}}},
+    )
+    text = map_sections(km)["map"]
+    row = next(line for line in text.splitlines() if line.startswith("| fractal | 5 |"))
+    # measured K boundary at the lowest I_e: rigid fails at K = 1 only, the compliant
+    # reference passes from K = 1; I_e* at the stiffest K from both
+    assert "| 1-10 | < 1 | 0.02 | trap | 100 | 0.1-1 | 0.1-1 |" in row
+    assert "| fractal | 1 | 0.001 | 0 / 0.01 | 1 / 0.01 |" in text
+    assert map_figure(km, tmp_path / "map.png").is_file()
+    assert km.validation_keys()["predicted_drive_limits"] == {
+        "fractal": {"k_star": 5.0, "ie_star": 0.02, "limit": "trap"}
+    }

@@ -32,11 +32,19 @@ def test_smoke_validation_writes_report_and_json(tmp_path, monkeypatch):
     assert 0.0 <= doc["outcome_agreement_at_lowest_ie"]["single_peak_valley"] <= 1.0
     # runs the engine stopped, by status, per family (none expected on the smoke plan's peak)
     assert doc["failed_runs"] == {"single_peak_valley": {}}
+    # every headline number with its 95 % interval, and the machine that made them
+    fam = doc["limit_families"]["single_peak_valley"]
+    lo, hi = fam["agreement_ci"]
+    assert lo <= fam["outcome_agreement"] <= hi
+    assert len(fam["median_frechet_ci"]) == 2
+    assert {"cpu", "vector_instruction_sets", "python", "numpy", "mujoco", "os"} <= set(doc["platform"])
+    assert "interval" in doc["targets"]["rule"]
     assert {"value", "low", "high", "kind"} <= set(doc["ie_star"]["spring"])
     # the static probe on a 20 deg plane (engaged) matches tan(theta + arctan mu) closely
     assert doc["static_kappa_max_rel_error"] < 0.05
     report = (out / "report.md").read_text()
     assert "Quasistatic limit" in report and "figures/boundary.png" in report
+    assert "Verdicts with their intervals" in report and doc["platform"]["cpu"] in report
     assert (out / "figures" / "boundary.png").stat().st_size > 1000
     assert (out / "sweeps" / "boundary" / "spring-paper-single-peak" / "runs.parquet").is_file()
     assert "outcome agreement" in res.output

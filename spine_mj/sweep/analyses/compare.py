@@ -8,7 +8,9 @@ both sides share the geometry, the lock test and the domain. The comparison with
 quasistatic analysis's path (the smooth surface, or whatever it traced; retraced within
 the same domain) is kept beside it (``*_smooth``), and the gap between the two streamlines
 is the geometry part (``geometry_frechet``). A run that disagrees gets a ``miss_reason``
-(:func:`spine_mj.compare.miss_reason`: the reference restarted along its path). Touches
+(:func:`spine_mj.compare.miss_reason`: the reference restarted along its path). A spring
+drive is also compared with the compliant-drive streamline of its own spring
+(``compliant_frechet``, ``agree_compliant``; :mod:`spine_mj.compliant`). Touches
 the API of :mod:`spine_mj.compare` here only; needs the results of the ``quasistatic`` and
 ``mujoco`` analyses of the same case.
 """
@@ -21,6 +23,7 @@ import numpy as np
 
 from spine_mj import compare
 from spine_mj import streamline as sl
+from spine_mj.compliant import compliant_streamlines
 from spine_mj.sweep.analyses.mujoco import peak_drive_over_fp
 from spine_mj.sweep.analyses.quasistatic import path_table, traced_surface
 from spine_mj.sweep.registry import Analysis, AnalysisResult, ParamSpec, register_analysis
@@ -97,6 +100,44 @@ def _miss_reasons(contact, params, trace, mpaths, facets, mj_locked, mj_end, lc,
     return reason, offset
 
 
+def _compliant(contact, params, starts, runs, preload_n, s, mpaths, facets, mj_locked, mj_end, lc) -> dict:
+    """MuJoCo against the compliant-drive streamline of the run's own spring
+    (:mod:`spine_mj.compliant`, ``k / W`` from the run), traced like the rigid reference:
+    what stiffness does is predicted there, what is left over is inertia. NaN for drives
+    without a spring. ``stiffness_frechet`` is the compliant reference's distance from the
+    rigid one, ``compliant_jumps`` its folds. The reference's carriage stops where the run's
+    does (``carriage_end``)."""
+    n = len(runs)
+    nan = np.full(n, np.nan)
+    out = {"compliant_frechet": nan, "agree_compliant": nan, "compliant_jumps": nan, "stiffness_frechet": nan}
+    k = runs[0].stiffness_n_m if n else 0.0
+    if not (k > 0):
+        return out
+    # where the run's drive ran out, the carriage stops where the run's did: a soft spring's
+    # reference is not held at a force cap the engine's carriage never reached (a run that
+    # ended on an event, a lock or the edge, has its own outcome to compare)
+    travel = np.array(
+        [
+            (r.carriage_x_m[-1] - r.carriage_x_m[r.drive_start_index]) / s
+            if r.end_reason.value == "completed"
+            else np.inf
+            for r in runs
+        ]
+    )
+    end = np.asarray(starts, float)[:, 0] + np.where(np.isfinite(travel), np.maximum(travel, 0.0), np.inf)
+    ref = compliant_streamlines(contact, starts, params, stiffness=k * s / preload_n, carriage_end=end)
+    frechet, _ = _deviations(mpaths, ref, lc)
+    agree = _outcomes(ref, mj_locked, mj_end, lc)["agree"]
+    return {
+        "compliant_frechet": frechet,
+        "agree_compliant": agree.astype(float),
+        "compliant_jumps": np.bincount(ref.folds.start, minlength=n).astype(float),
+        "stiffness_frechet": np.array(
+            [compare.path_frechet(_xy(ref, i), _xy(facets, i), length_scale=lc) for i in range(n)]
+        ),
+    }
+
+
 def _compare(case, surface, starts, upstream):
     quasistatic = upstream["quasistatic"].data
     rig, runs = upstream["mujoco"].data
@@ -132,6 +173,9 @@ def _compare(case, surface, starts, upstream):
     miss_reason, miss_offset = _miss_reasons(
         contact, params, trace, mpaths, facets, mj_locked, mj_end, lc, explain
     )
+    compliant = _compliant(
+        contact, params, starts, runs, rig.scales.preload_n, s, mpaths, facets, mj_locked, mj_end, lc
+    )
     peak = np.array([peak_drive_over_fp(r, rig.scales.preload_n) for r in runs])
     kap = compare.kappa_agreement(facets.max_kappa, peak, kappa_cap=runs[0].detection.kappa_cap)
     metrics = {
@@ -149,6 +193,7 @@ def _compare(case, surface, starts, upstream):
         "frechet_smooth": frechet_smooth,
         "agree_smooth": agree_smooth["agree"],
         "geometry_frechet": geometry,
+        **compliant,
         "kappa_ratio": kap["ratio"],
         "inertia_number": np.array([r.inertia_number for r in runs]),
         # whether the paths are quasistatic at all: gravity slides on the reference, and the

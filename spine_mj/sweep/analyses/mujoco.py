@@ -335,15 +335,37 @@ def _metrics(rig, runs) -> dict[str, np.ndarray]:
         "stiffness_n_m": np.array([r.stiffness_n_m for r in runs]),
         "slope_length": np.full(n, sc.slope_length_m / s),
         "max_drive_over_fp": np.array([peak_drive_over_fp(r, sc.preload_n) for r in runs]),
-        "n_slip_onsets": np.array(
-            [sum(e.kind == "slip_onset" for e in r.events) for r in runs], dtype=np.int64
+        "n_move_onsets": np.array(
+            [sum(e.kind == "move_onset" for e in r.events) for r in runs], dtype=np.int64
         ),
+        **_slip_metrics(runs),
         "max_penetration_m": np.array([r.penetration_m.max() for r in runs]),
         "kappa_mj": np.array([r.kappa_mj for r in runs]),
         "timestep_s": np.array([r.engine.timestep_s for r in runs]),
         "char_length": np.full(n, sc.char_length_m / s),
         "tip_radius_m": np.full(n, rig.tip.tip_radius_m),
     }
+
+
+def _slip_metrics(runs) -> dict[str, np.ndarray]:
+    """The runs' slip events and motion states (:meth:`spine_mj.sim.RunResult.slip_summary`)
+    as columns: ``slip_events``, the mean and largest onset force (F_p; NaN without a
+    slip), the fraction of the drive phase ``stuck``, ``sliding`` and ``slipping``, and the
+    largest x-speed over the drive's speed."""
+    sums = [r.slip_summary() for r in runs]
+
+    def onset(f):
+        return np.array([f(d["slip_onset_forces_fp"]) if d["slip_events"] else np.nan for d in sums])
+
+    cols = {
+        "slip_events": np.array([d["slip_events"] for d in sums], dtype=np.int64),
+        "slip_onset_fp_mean": onset(np.mean),
+        "slip_onset_fp_max": onset(np.max),
+    }
+    for name in sim.MOTION_NAMES:
+        cols[f"{name}_fraction"] = np.array([d["motion_fractions"][name] for d in sums])
+    cols["max_speed_over_drive"] = np.array([d["max_speed_over_drive"] for d in sums])
+    return cols
 
 
 def _trajectories(runs, s: float, k: int) -> dict[str, np.ndarray]:
@@ -368,7 +390,8 @@ def _trajectories(runs, s: float, k: int) -> dict[str, np.ndarray]:
                 "drive_force_n": r.drive_force_n[rows],
                 "normal_force_n": r.normal_force_n[rows],
                 "tangential_force_n": r.tangential_force_n[rows],
-                "slipping": r.slipping[rows],
+                "moving": r.moving[rows],
+                "motion": r.motion[rows],
                 "contact": r.contact[rows],
             }
         )

@@ -22,9 +22,11 @@ from spine_mj.plotting import (
 from spine_mj.presets import make_surface
 from spine_mj.sweep.analyses.compare import MISS_CHECKPOINTS
 from spine_mj.validate.boundary import BoundaryResult
+from spine_mj.validate.platform import platform_info
 from spine_mj.validate.quasistatic_limit import QuasistaticLimitResult
 from spine_mj.validate.report.boundary import star_to_draw
 from spine_mj.validate.report.common import ReportContext, assemble, cell, image, table
+from spine_mj.validate.report.verdicts import platform_line, verdicts_section
 
 
 @styled
@@ -188,8 +190,9 @@ def _lines(limit: QuasistaticLimitResult, boundary: BoundaryResult) -> list[str]
         "`surfaces.BallOnFacets`), ending where the engine's run ends, with the same force "
         "cap on both sides (a path needing more than the cap times F_p is held). A run the "
         "engine stopped, or whose reference stalled, counts as a disagreement. Beside it: the "
-        "comparison with the streamline on the smooth surface and the geometry part (smooth vs "
-        "facet streamline).",
+        "comparison with the compliant-drive streamline of the run's spring on the same facets "
+        "(docs/physics.md §7: what the spring itself does, jumps at folds, predicted), with the "
+        "streamline on the smooth surface, and the geometry part (smooth vs facet streamline).",
         "",
         table(
             families,
@@ -200,6 +203,8 @@ def _lines(limit: QuasistaticLimitResult, boundary: BoundaryResult) -> list[str]
                 "outcome_agreement",
                 "median_frechet",
                 "mean_frechet",
+                "outcome_agreement_compliant",
+                "median_frechet_compliant",
                 "outcome_agreement_smooth",
                 "median_frechet_smooth",
                 "mean_geometry_frechet",
@@ -212,6 +217,8 @@ def _lines(limit: QuasistaticLimitResult, boundary: BoundaryResult) -> list[str]
                 "outcome agr.",
                 "median Frechet",
                 "mean Frechet",
+                "outcome agr. (compliant ref.)",
+                "median Frechet (compliant ref.)",
                 "outcome agr. (smooth)",
                 "median Frechet (smooth)",
                 "geometry Frechet",
@@ -219,6 +226,8 @@ def _lines(limit: QuasistaticLimitResult, boundary: BoundaryResult) -> list[str]
             ],
         ),
         "",
+        *verdicts_section(limit.families),
+        *platform_line(platform_info()),
         *_stalled_note(limit),
         *_misses_note(limit),
         *falls_note(limit, boundary),
@@ -261,6 +270,7 @@ def _variations_and_runs(limit: QuasistaticLimitResult) -> list[str]:
                 "agree_smooth",
                 "frechet_smooth",
                 "geometry_frechet",
+                "ill_conditioned",
             ],
         ),
         "",

@@ -18,8 +18,9 @@ from spine_mj.plotting import (
     styled,
 )
 from spine_mj.validate.report.common import ReportContext, assemble, cell, image, table
+from spine_mj.validate.slip_tails import MIN_EVENTS
 from spine_mj.validate.stick_slip import complementary_cdf
-from spine_mj.validate.stiffness_map import CRITERION, SLIP_FAMILIES, StiffnessMapResult
+from spine_mj.validate.stiffness_map import CRITERION, SLIP_FAMILIES, SLIPS_PER_LC, StiffnessMapResult
 
 #: At most this many (I_e, K) series in the CCDF figure.
 MAX_CCDF_SERIES = 5
@@ -108,6 +109,7 @@ def map_figure(km: StiffnessMapResult, path: Path) -> Path | None:
                 mec=THRESHOLD_COLOR,
                 label="I_e* outside the grid (edge shown)",
             )
+        _draw_prediction(ax, km.predicted.get(fam))
         ax.set(xscale="log", yscale="log", xlabel="I_e", title=fam.replace("_", " "))
         ax.grid(False)
     axes[0].set_ylabel("K = k l_s / F_p")
@@ -120,6 +122,72 @@ def map_figure(km: StiffnessMapResult, path: Path) -> Path | None:
         fig.legend(handles.values(), handles.keys(), loc="outside lower center", ncols=len(handles))
     fig.suptitle(f"Spring drive: agreement with the streamline (starts per preset: {km.starts_per_preset})")
     return save_figure(fig, path)
+
+
+def _draw_prediction(ax, pred: dict | None) -> None:
+    """The geometry's prediction (docs/physics.md §8): dashed K* and I_e* lines, quasistatic
+    to their lower right (K > K*, I_e < I_e*), inside the axes' current limits."""
+    if not pred:
+        return
+    lo, hi = ax.get_xlim()
+    klo, khi = ax.get_ylim()
+    k, ie = pred.get("k_star", np.nan), pred.get("ie_star", np.nan)
+    if np.isfinite(k) and klo < k < khi:
+        ax.axhline(k, color=THRESHOLD_COLOR, ls="--", lw=1.2, label="predicted K*")
+    if np.isfinite(ie) and lo < ie < hi:
+        ax.axvline(ie, color=THRESHOLD_COLOR, ls=":", lw=1.5, label="predicted I_e*")
+    off = [f"K* = {sig(k)}" for v, a, b in [(k, klo, khi)] if np.isfinite(v) and not a < v < b]
+    off += [f"I_e* = {sig(ie)}" for v, a, b in [(ie, lo, hi)] if np.isfinite(v) and not a < v < b]
+    if off:  # a prediction beyond the grid: named in the panel
+        ax.text(
+            0.02,
+            0.02,
+            "predicted, off the grid: " + ", ".join(off),
+            transform=ax.transAxes,
+            fontsize=7,
+            bbox={"facecolor": "white", "alpha": 0.85, "lw": 0},
+        )
+    ax.set(xlim=(lo, hi), ylim=(klo, khi))
+
+
+def measured_k_star(cells: dict) -> str:
+    """The measured K boundary at the lowest I_e of a family's map (``K`` -> agreement
+    cell): ``low-high`` between the largest K that fails and the next that passes, ``< K``
+    when the smallest passes, ``> K`` when none does."""
+    ks = sorted(cells, key=float)
+    passes = [bool(cells[k]["passes"][0]) for k in ks]
+    if all(passes):
+        return f"< {sig(float(ks[0]))}"
+    if not any(passes):
+        return f"> {sig(float(ks[-1]))}"
+    last_fail = max(i for i, p in enumerate(passes) if not p)
+    if last_fail + 1 >= len(ks):
+        return f"> {sig(float(ks[-1]))}"
+    return f"{sig(float(ks[last_fail]))}-{sig(float(ks[last_fail + 1]))}"
+
+
+def _prediction_rows(km: StiffnessMapResult) -> list[dict]:
+    """Per family: predicted K* and I_e* (and which mechanism), the measured K boundary at
+    the lowest I_e and I_e* at the largest K (rigid and compliant references)."""
+    rows = []
+    for fam, pred in km.predicted.items():
+        rigid = km.agreement.get(fam, {})
+        comp = km.agreement_compliant.get(fam, {})
+        k_top = max(rigid, key=float) if rigid else None
+        rows.append(
+            {
+                "family": fam,
+                "k_star": pred["k_star"],
+                "k_measured": measured_k_star(rigid) if rigid else "-",
+                "k_measured_compliant": measured_k_star(comp) if comp else "-",
+                "ie_star": pred["ie_star"],
+                "limit": pred["limit"],
+                "ie_measured": _bracket(rigid[k_top]["ie_star"]) if k_top else "-",
+                "ie_measured_compliant": _bracket(comp[k_top]["ie_star"]) if k_top and k_top in comp else "-",
+                "at_k": float(k_top) if k_top else np.nan,
+            }
+        )
+    return rows
 
 
 def _ccdf_series(km: StiffnessMapResult) -> list[tuple[float, float]]:
@@ -168,6 +236,57 @@ def _bracket(star: dict) -> str:
 def _ratio(row: dict) -> str:
     v = row.get("release_over_work")
     return sig(v) if v is not None and np.isfinite(v) else "- (no quasistatic work)"
+
+
+def _transition_lines(km: StiffnessMapResult) -> list[str]:
+    """Where stick-slip gives way to steady sliding along K at each I_e ([] without)."""
+    if not km.transitions:
+        return []
+    return [
+        f"Where stick-slip (at least {SLIPS_PER_LC:g} slip events per L_c) gives way to steady "
+        "sliding along K, per I_e. The predicted K* of these families comes from their geometry "
+        "(the quasistatic-boundary prediction, not part of this study); on a corrugation, where "
+        "K* is exact, the stick-slip study's K scan sets the measured transition beside it.",
+        "",
+        table(
+            km.transitions,
+            ["ie", "k_low", "k_high", "k_transition"],
+            ["I_e", "last K with stick-slip", "first K below the rate", "transition K"],
+        ),
+        "",
+    ]
+
+
+def _tail_lines(km: StiffnessMapResult) -> list[str]:
+    """The maximum-likelihood tail fits of slip size and force drop ([] without)."""
+    if not km.tails:
+        return []
+    rows = [
+        {
+            **t,
+            "alpha_ci": f"{cell(t['alpha'])} ({cell(t['ci_low'])}-{cell(t['ci_high'])})"
+            if t["fitted"]
+            else "-",
+            "vs_exp": f"{cell(t['loglik_ratio_vs_exponential'])} (p {cell(t['p_vs_exponential'])})"
+            if t["fitted"]
+            else "-",
+        }
+        for t in km.tails
+    ]
+    return [
+        f"Tails fitted by maximum likelihood (`powerlaw`; density p(S) ~ S^-alpha above xmin, 95 % "
+        f"interval; series of fewer than {MIN_EVENTS} events are counted, not fitted). The "
+        "likelihood ratio against an exponential tail is positive where the power law fits better. "
+        "The ABBM model (a random-walk force landscape) gives alpha = 3/2; short-range correlated "
+        "slopes have no universal exponent.",
+        "",
+        table(
+            rows,
+            ["ie", "K", "quantity", "n", "alpha_ci", "xmin", "n_tail", "vs_exp"],
+            ["I_e", "K", "quantity", "events", "alpha (95 %)", "xmin", "in tail", "log-lik. ratio vs exp."],
+        ),
+        "",
+    ]
 
 
 def map_sections(km: StiffnessMapResult) -> dict[str, str]:
@@ -222,7 +341,7 @@ def _map_lines(km: StiffnessMapResult) -> list[str]:
         "(hollow where it lies outside the grid).",
         "",
     ]
-    return head
+    return head + _prediction_text(km)
 
 
 def _energy_lines(km: StiffnessMapResult) -> list[str]:
@@ -279,9 +398,10 @@ def _slip_lines(km: StiffnessMapResult) -> list[str]:
         [
             "### Stick-slip across the map",
             "",
-            f"Slip events on the {' and '.join(SLIP_FAMILIES)} runs (runs of slipping samples of at "
-            "least three steps), per L_c advanced and as the fraction of recorded time spent slipping "
-            "(near 1: steady sliding; well below 1: the tip sticks between events); "
+            f"Slip events on the {' and '.join(SLIP_FAMILIES)} runs (stretches where the tip outruns "
+            "the carriage while the spring unloads and reaches 5 times its speed: steady sliding is "
+            "no slip; docs/physics.md §6), per L_c advanced and as the fraction of recorded time "
+            "spent slipping; "
             "trap skipping over every family's runs without engine trouble: of the runs whose "
             "streamline self-locks (traps), those where MuJoCo slides on (skipped).",
             "",
@@ -311,14 +431,84 @@ def _slip_lines(km: StiffnessMapResult) -> list[str]:
                 ],
             ),
             "",
-            "The CCDFs (runs without engine trouble) show how slip sizes and force drops spread for a "
-            "few (I_e, K); a straight tail on "
-            "log axes would be a power law, but with so few events per series it is only indicative.",
-            "",
+            *_transition_lines(km),
+            *_tail_lines(km),
         ]
         if km.slip
         else []
     )
+
+
+def _prediction_text(km: StiffnessMapResult) -> list[str]:
+    """The predicted boundary against the measured one, and the compliant reference's
+    agreement (lines of the map section; empty without predictions)."""
+    if not km.predicted:
+        return []
+    comp_rows = []
+    for fam, by_k in km.agreement_compliant.items():
+        for k, c in by_k.items():
+            rigid = km.agreement.get(fam, {}).get(k)
+            comp_rows.append(
+                {
+                    "family": fam,
+                    "K": float(k),
+                    "ie": float(c["ie"][0]),
+                    "rigid": f"{cell(rigid['agreement'][0])} / {cell(rigid['median_frechet'][0])}"
+                    if rigid
+                    else "-",
+                    "compliant": f"{cell(c['agreement'][0])} / {cell(c['median_frechet'][0])}",
+                    "star": _bracket(c["ie_star"]),
+                }
+            )
+    return [
+        "### The predicted boundary",
+        "",
+        "Predicted from each family's geometry alone (docs/physics.md §8, `spine-mj surface info`), on "
+        "the surfaces the map runs traced under the rig's tip: K* = l_s max(-dH/dx) along the "
+        "streamlines (below it the compliant-drive streamline folds: stick-slip at vanishing speed), "
+        "and I_e* the lowest of lift-off over crests, skipping the shallowest trap and the lag "
+        "behind turns (I_e < 2 mu 0.1). Measured: the K "
+        "boundary is where the criterion first holds at the lowest I_e as K grows; I_e* is the map's "
+        "at its stiffest K; both against the rigid streamline and against the compliant-drive "
+        "streamline of each run's spring. Dashed and dotted lines on the map.",
+        "",
+        table(
+            _prediction_rows(km),
+            [
+                "family",
+                "k_star",
+                "k_measured",
+                "k_measured_compliant",
+                "ie_star",
+                "limit",
+                "at_k",
+                "ie_measured",
+                "ie_measured_compliant",
+            ],
+            [
+                "family",
+                "K* predicted",
+                "K boundary (rigid ref.)",
+                "(compliant ref.)",
+                "I_e* predicted",
+                "set by",
+                "at K",
+                "I_e* measured (rigid ref.)",
+                "(compliant ref.)",
+            ],
+        ),
+        "",
+        "What the compliant reference changes at the lowest I_e (outcome agreement / median Frechet "
+        "in L_c against each reference; what stiffness does is in the compliant one, what is left "
+        "over is inertia):",
+        "",
+        table(
+            comp_rows,
+            ["family", "K", "ie", "rigid", "compliant", "star"],
+            ["family", "K", "I_e", "rigid reference", "compliant reference", "I_e* (compliant)"],
+        ),
+        "",
+    ]
 
 
 def headline(km: StiffnessMapResult) -> list[str]:

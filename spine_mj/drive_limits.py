@@ -1,0 +1,256 @@
+"""The drive limits a surface sets before any run: the stiffness ``K*`` below which a
+spring drive stick-slips at vanishing speed, and the inertia number ``I_e*`` above which the
+quasistatic picture breaks (docs/physics.md §8).
+
+Both come from the rigid streamlines (paper Eq. 4) traced from a grid of starts over the
+surface, pure numpy on the analytic side:
+
+* ``K* = l_s max(-dH/dx)`` along the paths, ``H`` the hold force per unit preload
+  (:func:`spine_mj.compliant.hold_force`, kappa where engaged): below it the carriage
+  position that holds the tip, ``X = x + (W / k) H``, falls somewhere along a path, a fold
+  of the compliant-drive streamline (:mod:`spine_mj.compliant`). On a corrugation this is
+  the Prandtl-Tomlinson ``K* = l_s max(-d kappa / dx)``.
+* ``I_e*`` the lowest of three thresholds. *Lift-off*: a tip carried at horizontal speed
+  ``v`` over a profile ``z(h)`` (h: horizontal arc length along the path) needs the
+  vertical acceleration ``z'' v^2``; preload and gravity give at most ``F_p / m``, so it
+  leaves the surface where ``-z'' v^2 > F_p / m``: ``I_e > 1 / (L_c max(-z''))``.
+  *Trap skipping*: a path that self-locks does so on a wall the drive cannot climb; a tip
+  arriving at the carriage speed climbs it anyway if its kinetic energy covers the work
+  to the wall's end (where the region stops being self-locked, along +x): against the
+  preload ``W dz``, against friction ``mu (W dx + F dz)`` (the normal load on a slope of
+  ``dz / dx`` pushed by ``F``), less the drive's ``F dx``, with ``F`` the hold force the
+  path had on arrival: ``I_e > 2 D / L_c``, ``D = dz + mu dx + f (mu dz - dx)``,
+  ``f = F / W``, the shallowest trap first.
+  *Lag*: where the quasistatic path turns, a sliding tip carries its momentum on until
+  friction (``mu F_p`` at most) has taken its kinetic energy: over ``m v^2 / (2 mu F_p) =
+  I_e L_c / (2 mu)``. The path lags the streamline by that much; it stays within a path
+  tolerance ``t L_c`` while ``I_e < 2 mu t``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from spine_mj import roughness
+from spine_mj import streamline as sl
+from spine_mj.compare import FRECHET_TARGET
+from spine_mj.compliant import hold_force
+from spine_mj.engagement import DEFAULT_KAPPA_CAP, SELF_LOCK
+from spine_mj.errors import SpineInputError
+from spine_mj.surfaces import Surface
+
+__all__ = ["DriveLimits", "crest_curvature", "drive_limits", "kappa_fall", "trap_depths"]
+
+
+@dataclass(frozen=True)
+class DriveLimits:
+    """Predicted drive limits of a surface (dimensionless unless a unit is named).
+
+    Attributes
+    ----------
+    k_star : float
+        ``K*``: stick-slip at vanishing speed below it (0: no fold anywhere).
+    ie_star : float
+        ``min(ie_lift, ie_trap)``: the quasistatic picture breaks above it.
+    ie_lift, ie_trap : float
+        The lift-off and trap-skipping thresholds (inf: no crest, no trap).
+    ie_lag : float
+        Where the tip's lag behind a turn of the path, ``I_e L_c / (2 mu)``, reaches the
+        path tolerance: ``2 mu tolerance / L_c``.
+    limit : str
+        Which of the three sets ``ie_star``: ``"lift-off"``, ``"trap"`` or ``"lag"``.
+    mu : float
+    slope_length, char_length : float
+        ``l_s`` and ``L_c`` (surface length unit).
+    max_fall : float
+        ``max(-dH/dx)`` along the paths (1 / length).
+    max_crest_curvature : float
+        ``max(-z'')`` along the paths (1 / length).
+    min_trap_depth : float
+        The shallowest trap's ``D`` (length; inf without traps).
+    n_paths, n_traps : int
+    """
+
+    k_star: float
+    ie_star: float
+    ie_lift: float
+    ie_trap: float
+    ie_lag: float
+    limit: str
+    mu: float
+    slope_length: float
+    char_length: float
+    max_fall: float
+    max_crest_curvature: float
+    min_trap_depth: float
+    n_paths: int
+    n_traps: int
+
+    def as_dict(self) -> dict:
+        return asdict(self)
+
+    def sentence(self) -> str:
+        """``"quasistatic needs K > ... and I_e < ..."``."""
+        return (
+            f"quasistatic needs K > {self.k_star:.3g} and I_e < {self.ie_star:.3g} "
+            f"(set by {self.limit}; lift-off {self.ie_lift:.3g}, trap {self.ie_trap:.3g}, "
+            f"lag {self.ie_lag:.3g})"
+        )
+
+
+def kappa_fall(x, hold) -> np.ndarray:
+    """``-dH/dx`` between consecutive points of one path (shape ``(n - 1,)``); NaN where
+    ``x`` does not advance or either hold is not finite."""
+    x, hold = np.asarray(x, float), np.asarray(hold, float)
+    dx, dh = np.diff(x), np.diff(hold)
+    ok = (dx > 1e-12 * max(1.0, float(np.abs(x).max(initial=0.0)))) & np.isfinite(dh)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(ok, -dh / np.where(ok, dx, 1.0), np.nan)
+
+
+def crest_curvature(x, y, z) -> np.ndarray:
+    """``-d^2 z / dh^2`` at the inner points of one path (shape ``(n - 2,)``), ``h`` its
+    horizontal arc length (three-point formula on uneven steps); NaN at repeated points."""
+    x, y, z = (np.asarray(a, float) for a in (x, y, z))
+    h = np.hypot(np.diff(x), np.diff(y))
+    h1, h2 = h[:-1], h[1:]
+    ok = (h1 > 0) & (h2 > 0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        d2 = 2.0 * (h1 * z[2:] - (h1 + h2) * z[1:-1] + h2 * z[:-2]) / (h1 * h2 * (h1 + h2))
+    return np.where(ok, -d2, np.nan)
+
+
+def trap_depths(surface: Surface, x, y, f_arrival, mu: float, *, step: float, kappa_cap: float) -> np.ndarray:
+    """``D = dz + mu dx + f (mu dz - dx)`` of traps at ``(x, y)`` (shape ``(m,)``): the
+    work per unit preload that takes a tip arriving with drive ``f W`` along +x to the end
+    of the self-locked wall (held: self-locked, or a hold force above ``kappa_cap``),
+    marched in steps ``step``; ``inf`` where the wall reaches the domain's edge."""
+    x = np.asarray(x, float).copy()
+    y = np.asarray(y, float)
+    f = np.asarray(f_arrival, float)
+    x0 = x.copy()
+    z0 = surface.height(x, y)
+    xmax = surface.bounds[1]
+    held = np.ones(x.size, bool)
+    while held.any():
+        x = np.where(held, x + step, x)
+        beyond = held & (x > xmax)
+        x = np.where(beyond, xmax, x)
+        _, fx, fy = surface.evaluate(x, y, order=1)
+        hold, region = hold_force(fx, fy, mu)
+        still = (region == SELF_LOCK) | (hold > kappa_cap)
+        held &= still & ~beyond
+        if beyond.any():
+            held[beyond] = False
+            x[beyond] = np.inf
+    dz = surface.height(np.where(np.isfinite(x), x, x0), y) - z0
+    dx = x - x0
+    return np.where(np.isfinite(x), dz + mu * dx + f * (mu * dz - dx), np.inf)
+
+
+def _path_statistics(surface: Surface, res, mu: float, kappa_cap: float) -> tuple[float, float, np.ndarray]:
+    """Over the paths of ``res``: the steepest fall of the hold force ``max(-dH/dx)``, the
+    sharpest crest ``max(-z'')``, and per path the last finite hold force (a trap's
+    arrival drive)."""
+    fall, curv, arrival = [], [], np.full(len(res), np.nan)
+    for i in range(len(res)):
+        p = res.path(i)
+        _, fx, fy = surface.evaluate(p["x"], p["y"], order=1)
+        hold, _ = hold_force(fx, fy, mu)
+        hold = np.where(hold > kappa_cap, np.nan, hold)
+        fall.append(kappa_fall(p["x"], hold))
+        curv.append(crest_curvature(p["x"], p["y"], p["z"]))
+        finite = hold[np.isfinite(hold)]
+        arrival[i] = finite[-1] if finite.size else 0.0
+    max_fall = float(np.nanmax(np.concatenate(fall), initial=0.0))
+    return max_fall, float(np.nanmax(np.concatenate(curv), initial=0.0)), arrival
+
+
+def _grid_starts(surface: Surface, n: int, margin: float) -> np.ndarray:
+    xmin, xmax, ymin, ymax = surface.bounds
+    mx, my = margin * (xmax - xmin), margin * (ymax - ymin)
+    xs = np.linspace(xmin + mx, xmax - mx, n)
+    ys = np.linspace(ymin + my, ymax - my, n)
+    return np.array([(a, b) for b in ys for a in xs])
+
+
+def drive_limits(
+    surface: Surface,
+    mu: float,
+    *,
+    starts=None,
+    n_starts: int = 8,
+    dl: float | None = None,
+    tip_radius: float = 0.0,
+    kappa_cap: float = DEFAULT_KAPPA_CAP,
+    path_tolerance: float = FRECHET_TARGET,
+) -> DriveLimits:
+    """Predict ``K*`` and ``I_e*`` of ``surface`` from its quasistatic paths (module doc).
+
+    Parameters
+    ----------
+    surface : Surface
+    mu : float
+        Static friction coefficient mu_s.
+    starts : array_like, shape (n, 2), optional
+        Path starts; default an ``n_starts x n_starts`` grid over the domain (5 % margin).
+    dl : float, optional
+        Streamline step (default ``l_s / 40``).
+    tip_radius : float
+        Trace on the surface dilated by a ball of this radius (the MuJoCo tip's centre).
+    kappa_cap : float
+        Hold forces above it count as held (the comparison's force cap).
+    path_tolerance : float
+        How far (in ``L_c``) a path may lag the streamline, for ``ie_lag``; default the
+        comparison's Frechet target (:data:`spine_mj.compare.FRECHET_TARGET`, 0.1).
+
+    Returns
+    -------
+    DriveLimits
+    """
+    if not isinstance(surface, Surface):
+        raise SpineInputError(f"surface must be a spine_mj Surface, got {type(surface).__name__}")
+    if isinstance(n_starts, bool) or not isinstance(n_starts, (int, np.integer)) or n_starts < 1:
+        raise SpineInputError(f"n_starts must be an integer >= 1, got {n_starts!r}")
+    l_s = float(roughness.slope_correlation_length(surface))
+    l_c = float(roughness.characteristic_length(surface))
+    traced = sl.dilate(surface, tip_radius) if tip_radius > 0 else surface
+    pts = _grid_starts(traced, int(n_starts), 0.05) if starts is None else starts
+    params = sl.StreamlineParams(mu=mu, dl=l_s / 40 if dl is None else dl, kappa_cap=kappa_cap)
+    res = sl.streamlines(traced, pts, params, store_paths=True)
+    max_fall, max_curv, arrival = _path_statistics(traced, res, mu, kappa_cap)
+    trapped = res.self_locked
+    depth = trap_depths(
+        traced,
+        res.end_x[trapped],
+        res.end_y[trapped],
+        arrival[trapped],
+        mu,
+        step=params.dl / 4,
+        kappa_cap=kappa_cap,
+    )
+    min_depth = float(depth.min()) if depth.size else math.inf
+    ie_lift = 1.0 / (l_c * max_curv) if max_curv > 0 else math.inf
+    ie_trap = 2.0 * max(min_depth, 0.0) / l_c
+    ie_lag = 2.0 * float(mu) * float(path_tolerance)
+    limits = {"lift-off": ie_lift, "trap": ie_trap, "lag": ie_lag}
+    limit = min(limits, key=limits.get)
+    return DriveLimits(
+        k_star=l_s * max(0.0, max_fall),
+        ie_star=limits[limit],
+        ie_lift=ie_lift,
+        ie_trap=ie_trap,
+        ie_lag=ie_lag,
+        limit=limit,
+        mu=float(mu),
+        slope_length=l_s,
+        char_length=l_c,
+        max_fall=max_fall,
+        max_crest_curvature=max_curv,
+        min_trap_depth=min_depth,
+        n_paths=len(res),
+        n_traps=int(trapped.sum()),
+    )

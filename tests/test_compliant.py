@@ -1,0 +1,225 @@
+"""The compliant-drive streamline against closed forms (docs/physics.md §6)."""
+
+import itertools
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+from spine_mj.compare import path_frechet
+from spine_mj.compliant import MotionState, compliant_streamlines, hold_force
+from spine_mj.engagement import kappa
+from spine_mj.errors import SpineInputError
+from spine_mj.streamline import Outcome, StreamlineParams, streamlines
+from spine_mj.surfaces import (
+    BallOnFacets,
+    Surface,
+    TriangulatedSurface,
+    corrugation,
+    single_gaussian,
+)
+
+L_S = 0.190  # slope correlation length of a corrugation, in wavelengths
+
+
+@dataclass(frozen=True, eq=False)
+class Sine(Surface):
+    """z = s / (2 pi) sin(2 pi x), uniform in y, exactly (the corrugation of wavelength 1)."""
+
+    s: float
+    bounds: tuple = (0.0, 6.0, -0.5, 0.5)
+    unit: str = "1"
+    metadata: dict = field(default_factory=dict)
+
+    def _evaluate(self, x, y, order):
+        u = 2 * np.pi * x
+        out = (self.s / (2 * np.pi) * np.sin(u), self.s * np.cos(u), np.zeros_like(x))
+        return out[:1] if order == 0 else out
+
+
+@dataclass(frozen=True, eq=False)
+class Plane(Surface):
+    """z = slope x, exactly."""
+
+    slope: float
+    bounds: tuple = (-2.0, 2.0, -2.0, 2.0)
+    unit: str = "1"
+    metadata: dict = field(default_factory=dict)
+
+    def _evaluate(self, x, y, order):
+        out = (self.slope * x, np.full_like(x, self.slope), np.zeros_like(x))
+        return out[:1] if order == 0 else out
+
+
+def _distance(a, b, i, length=1.0):
+    """Frechet distance between path ``i`` of two results, over ``length``."""
+    pa, pb = a.path(i), b.path(i)
+    return path_frechet(np.c_[pa["x"], pa["y"]], np.c_[pb["x"], pb["y"]], length_scale=length)
+
+
+def _pt(s, mu):
+    """Prandtl-Tomlinson closed form on z = h sin(2 pi x): kappa(x), -dkappa/dx and K*."""
+
+    def kap(x):
+        t = s * np.cos(2 * np.pi * x)
+        return (t + mu) / (1 - mu * t)
+
+    def fall(x):
+        t = s * np.cos(2 * np.pi * x)
+        return (1 + mu * mu) * s * 2 * np.pi * np.sin(2 * np.pi * x) / (1 - mu * t) ** 2
+
+    x = np.linspace(0, 1, 200_001)
+    return kap, fall, L_S * fall(x).max()
+
+
+def _fold_closed_form(s, mu, c):
+    """First fold after x = 0 where -dkappa/dx = c on the falling flank, its onset force,
+    carriage position and where the tip lands (c (X - x) = kappa(x) further on)."""
+    kap, fall, _ = _pt(s, mu)
+    x = np.linspace(0, 0.5, 100_001)
+    steep = x[np.argmax(fall(x))]
+    xf = brentq(lambda u: fall(u) - c, 1e-9, steep)
+    X = xf + kap(xf) / c
+    xl = brentq(lambda u: c * (X - u) - kap(u), steep + 1e-9, 1.5)
+    return xf, kap(xf), X, xl
+
+
+def test_hold_force_is_kappa_where_engaged_and_holds_in_slip_region():
+    fx = np.array([0.0, 0.3, -0.3, -0.7, -0.9, 3.0])
+    hold, _ = hold_force(fx, 0.0, 0.5)
+    k, _ = kappa(fx, 0.0, 0.5)
+    engaged = np.isfinite(k) & (k < np.inf)
+    np.testing.assert_allclose(hold[engaged], k[engaged])
+    assert hold[-1] == np.inf  # slope 3 > 1/mu: self-locked
+    # a slope steeper than the friction angle downhill: a backward pull of
+    # tan(theta + phi) < 0 holds it
+    for i in (3, 4):
+        assert hold[i] == pytest.approx(math.tan(math.atan(fx[i]) + math.atan(0.5)), rel=1e-12)
+
+
+@pytest.mark.parametrize("s, mu", [(0.3, 0.5), (0.5, 0.3)])
+def test_corrugation_smooth_iff_stiffer_than_prandtl_tomlinson_k_star(s, mu):
+    surf = Sine(s)
+    p = StreamlineParams(mu=mu, dl=0.02)
+    _, _, k_star = _pt(s, mu)
+    if (s, mu) == (0.3, 0.5):
+        assert k_star == pytest.approx(0.47, abs=0.005)
+    starts = [(0.02, 0.0), (0.6, 0.1)]
+    rigid = streamlines(surf, starts, p)
+    for ratio in (1.05, 2.0):
+        r = compliant_streamlines(surf, starts, p, stiffness=ratio * k_star / L_S)
+        # no jump (the start's own, from a relaxed spring on a flank steeper than phi, aside)
+        assert not np.any(r.folds.x > r.start_x[r.folds.start] + 1e-9)
+        for i in range(2):  # no jump: the rigid streamline's path (its last step may differ)
+            assert _distance(r, rigid, i) < p.dl
+            assert abs(r.end_x[i] - rigid.end_x[i]) < p.dl
+    for ratio in (0.25, 0.5, 0.95):
+        c = ratio * k_star / L_S
+        r = compliant_streamlines(surf, starts, p, stiffness=c)
+        xf, onset, X, xl = _fold_closed_form(s, mu, c)
+        for i, x0 in enumerate((0.02, 0.6)):
+            folds = r.folds_of(i)
+            inner = (folds.x > x0 + 1e-9) & np.isfinite(folds.land_x)  # not the start's own jump
+            frac = np.mod(folds.x[inner], 1.0)
+            assert np.all(np.diff(np.floor(folds.x[inner])) == 1)  # one jump per wavelength
+            assert inner.sum() >= 4
+            np.testing.assert_allclose(frac, xf, atol=1e-6)
+            np.testing.assert_allclose(folds.onset_force[inner], onset, rtol=1e-6)
+            np.testing.assert_allclose(np.mod(folds.carriage[inner], 1.0), X % 1.0, atol=1e-6)
+            np.testing.assert_allclose(folds.jump_length[inner], xl - xf, rtol=1e-6)
+            assert np.all(folds.force_drop[inner] > 0)
+
+
+def test_folds_do_not_depend_on_the_step():
+    surf = corrugation(slope_amplitude=0.3, n_waves=3)
+    out = []
+    for dl in (0.04, 0.013, 0.005):
+        r = compliant_streamlines(surf, [(0.3, 0.0)], StreamlineParams(mu=0.5, dl=dl), stiffness=0.3 / L_S)
+        f = r.folds
+        out.append(np.c_[f.x, f.onset_force, f.carriage, f.jump_length][:3])
+    for o in out[1:]:
+        np.testing.assert_allclose(o, out[0], atol=1e-6)
+
+
+@pytest.mark.parametrize("slope", [0.0, 0.4])
+def test_inclined_plane_force_is_tan_theta_plus_phi_once_stretched(slope):
+    plane = Plane(slope)
+    c = 3.0
+    r = compliant_streamlines(plane, [(-1.5, 0.0)], StreamlineParams(mu=0.5, dl=0.05), stiffness=c)
+    q = r.path(0)
+    expect = math.tan(math.atan(slope) + math.atan(0.5))
+    assert q["state"][0] == MotionState.STICK
+    assert np.all(q["state"][1:] == MotionState.SLIDE)
+    np.testing.assert_allclose(q["force"], expect, rtol=1e-12)
+    np.testing.assert_allclose(q["carriage"] - q["x"], expect / c, rtol=1e-12)
+    assert r.outcome[0] == Outcome.LEFT_DOMAIN
+
+
+def test_reduces_to_the_rigid_streamline_as_stiffness_grows():
+    surf = single_gaussian(sign=-1)
+    starts = [(-3.0, y) for y in (-4.0, -3.0, -2.0, -1.0)]
+    p = StreamlineParams(mu=1.25, dl=0.02)
+    rigid = streamlines(surf, starts, p)
+    dist = []
+    for c in (0.1, 1.0, 10.0, 100.0):
+        r = compliant_streamlines(surf, starts, p, stiffness=c)
+        np.testing.assert_array_equal(r.self_locked[1:], rigid.self_locked[1:]) if c >= 10 else None
+        dist.append(max(_distance(r, rigid, i, 1.5) for i in range(len(starts))))
+    assert dist[0] > 0.05  # a soft spring jumps off the rigid path
+    assert dist[-1] < 1e-3
+    assert all(b <= a + 1e-9 for a, b in itertools.pairwise(dist))
+
+
+def test_ball_on_facets_like_the_rigid_reference():
+    grid = corrugation(slope_amplitude=0.3, n_waves=4, points_per_wave=24)
+    contact = BallOnFacets(TriangulatedSurface.from_grid(grid), 0.04)
+    p = StreamlineParams(mu=0.5, dl=0.005)
+    starts = [(0.3, 0.0), (0.5, 0.2)]
+    rigid = streamlines(contact, starts, p)
+    stiff = compliant_streamlines(contact, starts, p, stiffness=20.0 / L_S)
+    for i in range(2):
+        assert _distance(stiff, rigid, i) < 1e-3
+    soft = compliant_streamlines(contact, starts, p, stiffness=0.1 / L_S)
+    for i in range(2):
+        f = soft.folds_of(i)
+        landed = np.isfinite(f.land_x)
+        assert np.all(np.diff(np.floor(f.x[landed & (f.x > starts[i][0] + 1e-9)])) == 1)
+
+
+def test_many_starts_equal_one_at_a_time():
+    surf = single_gaussian(sign=1)
+    starts = [(-3.0, y) for y in (-3.0, -1.0, -0.5)]
+    p = StreamlineParams(mu=1.25, dl=0.03)
+    both = compliant_streamlines(surf, starts, p, stiffness=0.5)
+    for i, st in enumerate(starts):
+        one = compliant_streamlines(surf, [st], p, stiffness=0.5)
+        for key in ("x", "y", "carriage", "force", "state"):
+            np.testing.assert_allclose(both.path(i)[key], one.path(0)[key], rtol=1e-12, atol=1e-12)
+        assert len(one.folds) == len(both.folds_of(i))
+
+
+@pytest.mark.parametrize("bad", [0.0, -1.0, math.nan, math.inf, True, "1"])
+def test_stiffness_is_validated(bad):
+    with pytest.raises(SpineInputError, match="stiffness"):
+        compliant_streamlines(corrugation(), [(0.1, 0.0)], StreamlineParams(mu=0.5), stiffness=bad)
+
+
+def test_a_carriage_that_stops_leaves_the_tip_short_of_its_hold():
+    c, end = 3.0, -0.5
+    r = compliant_streamlines(
+        Plane(0.4),
+        [(-1.5, 0.0), (-1.0, 0.5)],
+        StreamlineParams(mu=0.5, dl=0.05),
+        stiffness=c,
+        carriage_end=[end, 10.0],
+    )
+    assert r.outcome[0] == Outcome.DRIVE_END and r.outcome[1] == Outcome.LEFT_DOMAIN
+    q = r.path(0)
+    assert q["carriage"][-1] == end and q["force"][-1] <= math.tan(math.atan(0.4) + math.atan(0.5))
+    assert end - q["x"][-1] == pytest.approx(q["force"][-1] / c)
+    with pytest.raises(SpineInputError, match="carriage_end"):
+        compliant_streamlines(
+            Plane(0.4), [(-1.5, 0.0)], StreamlineParams(mu=0.5), stiffness=c, carriage_end=-2.0
+        )

@@ -1,0 +1,92 @@
+"""Predicted drive limits against closed forms (docs/physics.md §8)."""
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import pytest
+
+from spine_mj.drive_limits import crest_curvature, drive_limits, kappa_fall, trap_depths
+from spine_mj.errors import SpineInputError
+from spine_mj.surfaces import GaussianSurface, Surface, corrugation
+
+
+@dataclass(frozen=True, eq=False)
+class Wall(Surface):
+    """Flat, then a wall of slope ``t`` from x = 0 to x = w, then flat again."""
+
+    t: float
+    w: float
+    bounds: tuple = (-1.0, 2.0, -0.5, 0.5)
+    unit: str = "1"
+    metadata: dict = field(default_factory=dict)
+
+    def _evaluate(self, x, y, order):
+        on = (x > 0) & (x < self.w)
+        out = (self.t * np.clip(x, 0, self.w), np.where(on, self.t, 0.0), np.zeros_like(x))
+        return out[:1] if order == 0 else out
+
+
+@pytest.mark.parametrize("s, mu", [(0.3, 0.5), (0.5, 0.8)])
+def test_corrugation_k_star_is_prandtl_tomlinson(s, mu):
+    surf = corrugation(slope_amplitude=s, n_waves=4, points_per_wave=64)
+    d = drive_limits(surf, mu, n_starts=3)
+    u = np.linspace(0, 2 * np.pi, 100_001)
+    t = s * np.cos(u)
+    fall = ((1 + mu * mu) * s * 2 * np.pi * np.sin(u) / (1 - mu * t) ** 2).max()
+    assert d.max_fall == pytest.approx(fall, rel=5e-3)
+    assert d.slope_length == pytest.approx(0.190, rel=0.01)
+    assert d.k_star == pytest.approx(d.slope_length * fall, rel=5e-3)
+    if (s, mu) == (0.3, 0.5):
+        assert d.k_star == pytest.approx(0.47, abs=0.01)
+    # crests: -f'' = s 2 pi / lambda, lift-off at I_e = 1 / (L_c s 2 pi)
+    assert d.max_crest_curvature == pytest.approx(2 * np.pi * s, rel=5e-3)
+    assert d.ie_lift == pytest.approx(1 / (d.char_length * 2 * np.pi * s), rel=5e-3)
+    assert d.n_traps == 0 and d.ie_trap == math.inf
+    assert d.ie_lag == pytest.approx(2 * mu * 0.1)  # stopping distance I_e L_c / (2 mu) = 0.1 L_c
+    assert d.ie_star == min(d.ie_lift, d.ie_lag) and d.limit == (
+        "lag" if d.ie_lag < d.ie_lift else "lift-off"
+    )
+    assert "quasistatic needs K > " in d.sentence()
+
+
+@pytest.mark.parametrize("amp, sigma", [(0.5, 1.0), (0.3, 0.6)])
+def test_gaussian_ridge_lift_off(amp, sigma):
+    ridge = GaussianSurface(
+        amplitude=np.array([amp]),
+        center_x=np.array([0.0]),
+        center_y=np.array([0.0]),
+        sigma_x=np.array([sigma]),
+        sigma_y=np.array([1e6]),
+        bounds=(-5.0, 5.0, -1.0, 1.0),
+    )
+    d = drive_limits(ridge, 1.0, n_starts=3, dl=0.01)
+    assert d.max_crest_curvature == pytest.approx(amp / sigma**2, rel=1e-3)
+    assert d.ie_lift == pytest.approx(1.0 / (d.char_length * amp / sigma**2), rel=1e-3)
+
+
+def test_trap_depth_of_a_wall_is_the_work_to_its_top():
+    mu, t, w = 0.5, 3.0, 0.4  # slope 3 > 1 / mu: self-locked
+    wall = Wall(t, w)
+    got = trap_depths(wall, [0.001], [0.0], [mu], mu, step=1e-4, kappa_cap=20.0)
+    dz, dx = t * (w - 0.001), w - 0.001
+    assert got[0] == pytest.approx(dz + mu * dx + mu * (mu * dz - dx), abs=2e-3)
+    d = drive_limits(wall, mu, starts=[(-0.5, 0.0), (-0.5, 0.2)], dl=0.01, path_tolerance=10.0)
+    assert d.n_traps == 2 and d.ie_star == d.ie_trap and d.limit == "trap"
+    assert d.min_trap_depth == pytest.approx(t * w + mu * w + mu * (mu * t * w - w), rel=0.05)
+    assert d.ie_trap == pytest.approx(2 * d.min_trap_depth / d.char_length)
+
+
+def test_finite_differences_on_closed_forms():
+    x = np.linspace(0, 1, 11)
+    np.testing.assert_allclose(kappa_fall(x, 2 - 3 * x), 3.0)
+    assert np.isnan(kappa_fall([0.0, 0.0], [1.0, 0.0])[0])
+    xs = np.sort(np.random.default_rng(0).uniform(0, 1, 30))
+    np.testing.assert_allclose(crest_curvature(xs, 0 * xs, -2.5 * xs**2), 5.0, rtol=1e-9)
+
+
+def test_bad_input():
+    with pytest.raises(SpineInputError, match="n_starts"):
+        drive_limits(corrugation(), 0.5, n_starts=0)
+    with pytest.raises(SpineInputError, match="surface"):
+        drive_limits("corrugation", 0.5)

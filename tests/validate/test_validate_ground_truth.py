@@ -1,0 +1,36 @@
+"""The ground-truth study at smoke size: each closed form against MuJoCo, and its report."""
+
+import math
+
+import pytest
+
+from spine_mj.validate.ground_truth import ground_truth
+from spine_mj.validate.plans import PLANS
+from spine_mj.validate.report.ground_truth import ground_truth_section
+from spine_mj.validate.study_runner import StudyRunner
+
+
+@pytest.fixture(scope="module")
+def smoke(tmp_path_factory):
+    out = tmp_path_factory.mktemp("gt")
+    return ground_truth(PLANS["smoke"], StudyRunner(out, 1, None, 0.0))
+
+
+def test_ground_truth_errors_are_small_at_smoke_size(smoke):
+    b = smoke.spring_block
+    assert (
+        abs(b["period_rel_error"]) < 0.03 and abs(b["peak_speed_rel_error"]) < 0.15 and b["slip_events"] == 0
+    )
+    below, above = sorted(smoke.tomlinson, key=lambda r: r["K"])
+    assert above["slip_events"] == 0 and above["max_speed_v"] < 5
+    assert below["slip_events"] >= 1 and abs(below["onset_max_rel_error"]) < 0.05
+    assert abs(below["slope_length_rel_error"]) < 0.01
+    (lift,) = smoke.liftoff
+    assert lift["ie_star_predicted"] == pytest.approx(0.55)
+    assert len(lift["crest_gap_radii"]) == 2 and math.isfinite(lift["crest_gap_radii"][0])
+
+
+def test_ground_truth_section_names_each_check(smoke):
+    text = ground_truth_section(smoke)
+    assert "Spring-block" in text and "Prandtl-Tomlinson" in text and "Lift-off" in text
+    assert ground_truth_section(None) == ""

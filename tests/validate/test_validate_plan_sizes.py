@@ -1,0 +1,42 @@
+"""The plans' sample sizes: enough runs that the intervals on the verdicts are narrow."""
+
+from __future__ import annotations
+
+import pytest
+
+from spine_mj.validate.plans import PLANS
+from spine_mj.validate.stiffness_map import subset_starts
+
+
+def _corner_starts(plan, fam) -> int:
+    c = plan.corner_family(fam)
+    t = c.starts_table()
+    per_surface = len(t["points"]) if "points" in t else len(t["x"]) * len(t["y"])
+    return per_surface * len(c.presets) * len(c.variants) * (len(c.seeds) if c.seeds else 1)
+
+
+@pytest.mark.parametrize(("plan", "least"), [("quick", 30), ("full", 100)])
+def test_every_family_has_enough_starts_at_the_corner_each_an_ensemble(plan, least):
+    p = PLANS[plan]
+    assert p.ensemble_members >= 3
+    for fam in p.families:
+        need = 30 if (plan == "full" and fam.name == "sandpaper") else least
+        assert _corner_starts(p, fam) >= need, fam.name
+    if plan == "full":
+        fractal = p.corner_family(next(f for f in p.families if f.name == "fractal"))
+        assert len(fractal.seeds) >= 5 and len(fractal.variants) >= 2
+
+
+def test_the_full_maps_every_ie_k_point_has_30_runs_per_family():
+    p = PLANS["full"]
+    for fam in p.families:
+        if fam.name in p.stiffness_map_families:
+            sub = subset_starts(p.map_family(fam), p.stiffness_map_starts)
+            assert len(sub.starts_table()["y"]) * len(sub.presets) * len(sub.variants) >= 30, fam.name
+
+
+def test_the_corner_and_the_map_leave_the_family_for_the_other_studies():
+    p = PLANS["quick"]
+    for fam in p.families:
+        assert p.map_family(fam) == fam  # no map sample size asked for: the family's own
+    assert PLANS["smoke"].corner_family(PLANS["smoke"].families[0]) == PLANS["smoke"].families[0]
