@@ -184,8 +184,8 @@ def stiffness_map(plan: ValidationPlan, runner: StudyRunner) -> StiffnessMapResu
     runs, samples, predicted = [], {}, {}
     for fam in fams:
         sub = subset_starts(plan.map_family(fam), plan.stiffness_map_starts)
-        runner.note(f"predicted drive limits of {fam.name}")
-        predicted[fam.name] = family_limits(plan, sub)
+        with runner.phase(f"predicted drive limits of {fam.name}"):
+            predicted[fam.name] = family_limits(plan, sub)
         for preset in fam.presets:
             doc = family_doc(
                 sub,
