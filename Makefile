@@ -24,12 +24,14 @@ lint: $(STAMP)
 	$(BIN)/ruff check .
 	$(BIN)/ruff format --check .
 
-# make bench BENCH_ARGS="--quick --readme": CI-size runs, README Performance section rewritten
+# make bench: results in benchmarks/out/ (untracked), each missed target marked;
+# make bench BENCH_ARGS="--update --readme": the committed results and README section rewritten
 bench: $(STAMP)
 	$(BIN)/python benchmarks/run_all.py $(BENCH_ARGS)
 
 # Build the wheel, install it (not editable) into a fresh venv and use it from a folder
-# outside the repository: presets and the MuJoCo rig must come from the installed package.
+# outside the repository: presets, the MuJoCo rig and the README's examples (example:NAME,
+# shipped scans and sweep configs) must come from the installed package.
 wheel-check: $(STAMP)
 	@set -e; tmp=$$(mktemp -d); trap 'rm -rf "$$tmp"' EXIT; \
 	$(BIN)/python -m pip wheel --quiet --no-deps --wheel-dir "$$tmp/dist" . ; rm -rf build; \
@@ -42,6 +44,15 @@ wheel-check: $(STAMP)
 	m = mujoco.MjModel.from_xml_path(str(model_path())); print('rig compiles:', model_path(), m.nbody, 'bodies')"; \
 	"$$tmp/venv/bin/spine-mj" simulate paper-single-peak --start -3,-1 --duration 0.05 --resolution 41 --out sim; \
 	"$$tmp/venv/bin/spine-mj" reproduce single-peak --quick --out repro; \
+	"$$tmp/venv/bin/spine-mj" examples; \
+	"$$tmp/venv/bin/spine-mj" surface make paper-fractal --hurst 0.7 --seed 3 -o fractal.npz --png fractal.png; \
+	"$$tmp/venv/bin/spine-mj" surface make --from-file example:plu-1.plu --fill harmonic --spacing 2e-6 -o scan.npz; \
+	"$$tmp/venv/bin/spine-mj" surface show scan.npz -o scan.png; \
+	"$$tmp/venv/bin/spine-mj" surface info example:plu-1.plu -o psd.png; \
+	"$$tmp/venv/bin/python" -c "from spine_mj import examples, sweep; \
+	[sweep.load_config(examples.resolve('example:' + n)) for n, (k, _) in examples.list_examples().items() if k == 'sweep']; \
+	print('every shipped sweep config reads, its example scans found')"; \
+	"$$tmp/venv/bin/spine-mj" sweep example:paper-quasistatic.toml --out runs/qs --quiet; \
 	echo "wheel-check: OK"
 
 clean:

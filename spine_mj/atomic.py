@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import re
 import shutil
 import tempfile
 from collections.abc import Iterator
@@ -17,7 +18,7 @@ from pathlib import Path
 
 from spine_mj.errors import SpineInputError
 
-__all__ = ["all_or_none", "atomic_output", "writable_path"]
+__all__ = ["all_or_none", "atomic_output", "remove_temporaries", "writable_path"]
 
 
 @contextlib.contextmanager
@@ -44,7 +45,12 @@ def atomic_output(path: str | os.PathLike, *, suffix: str | None = None) -> Iter
     os.close(fd)
     tmp = Path(tmp_name)
     try:
-        yield tmp
+        try:
+            yield tmp
+        except OSError as exc:  # a writer's error without its file (a full disk): name it
+            if exc.filename is not None:
+                raise
+            raise SpineInputError(f"cannot write {dest}: {exc.strerror or exc}") from None
         umask = os.umask(0)
         os.umask(umask)
         os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; give the usual permissions
@@ -52,6 +58,27 @@ def atomic_output(path: str | os.PathLike, *, suffix: str | None = None) -> Iter
     finally:
         if tmp.exists():
             tmp.unlink()
+
+
+#: The temporary files of :func:`atomic_output` (``.NAME.XXXXXXXX.SUFFIX``, mkstemp's 8
+#: random characters) and :func:`all_or_none` (``.NAME.PID.keep``).
+_TEMPORARY = re.compile(r"^\.(?P<name>.+)\.(?:[a-z0-9_]{8}(?P<suffix>\.[^.]+)?|\d+\.keep)$")
+
+
+def remove_temporaries(folder: str | os.PathLike) -> list[Path]:
+    """Delete, under ``folder`` (recursively), the temporary files that :func:`atomic_output`
+    and :func:`all_or_none` leave when their process is killed; a resumed run calls this for
+    the run it replaces. Returns the files removed."""
+    removed = []
+    for path in Path(folder).rglob(".*"):
+        m = _TEMPORARY.match(path.name)
+        if not (m and path.is_file()):
+            continue
+        if m["suffix"] is not None and Path(m["name"]).suffix != m["suffix"]:
+            continue  # not one of ours: the suffix is the destination's
+        path.unlink(missing_ok=True)
+        removed.append(path)
+    return removed
 
 
 def _missing_folders(path: Path) -> list[Path]:

@@ -35,7 +35,7 @@ import numpy as np
 
 from spine_mj.engagement import DEFAULT_TOL, ENGAGED, SELF_LOCK, SLIP, quadratic_coefficients
 from spine_mj.errors import SpineInputError
-from spine_mj.streamline import Outcome, StreamlineParams, _check_step, _starts
+from spine_mj.streamline import Outcome, StreamlineParams, _starts, check_step
 from spine_mj.surfaces import Surface
 
 __all__ = ["CompliantResult", "Fold", "MotionState", "compliant_streamlines", "hold_force"]
@@ -306,7 +306,7 @@ def compliant_streamlines(
     if not (number and math.isfinite(c) and c > 0):
         raise SpineInputError(f"stiffness (k / W, 1 / length) must be a finite number > 0, got {stiffness!r}")
     xs, ys = _starts(surface, starts)
-    _check_step(surface, params.dl)
+    check_step(surface, params.dl)
     end = np.broadcast_to(np.asarray(np.inf if carriage_end is None else carriage_end, float), xs.shape)
     if np.isnan(end).any() or (end < xs).any():
         raise SpineInputError(

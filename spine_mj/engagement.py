@@ -101,9 +101,15 @@ def kappa(fx, fy, mu, *, tol: float = DEFAULT_TOL) -> tuple[np.ndarray, np.ndarr
       > 0``); kappa is the larger such root, the force at which the hold breaks.
     * ``SLIP`` (0): neither; gravity alone slides the tip; ``kappa = NaN``.
 
-    Near ``A' = 0`` (the self-lock boundary) the roots come from the cancellation-free
-    form ``q = -(B + sign(B) sqrt(D)) / 2``, roots ``q / A`` and ``C / q``; ``q / A`` is
-    only used where ``|A'| >= tol``, so no division by a tiny ``A'`` happens.
+    The larger root is evaluated in closed form, not from the quadratic formula, whose
+    discriminant cancels (and whose ``mu^2`` overflows) at large mu: writing the drive
+    direction ``r`` at angle ``psi`` from the vertical, the tip sticks for
+    ``|psi - theta| <= gamma`` with ``tan theta = f_x`` and
+    ``tan gamma = sqrt(mu^2 - w^2) / rho``, ``w = |f_y| / sqrt(1 + f_x^2)``,
+    ``rho = sqrt(1 + f_y^2 / (1 + f_x^2))``, so ``kappa = tan(theta + gamma)`` (the 2-D
+    closed form ``tan(theta + arctan mu)`` when ``f_y = 0``) and
+    ``A' = rho^2 (1 - f_x tan gamma)(1 + f_x tan gamma)``, which decides the self-lock
+    without forming ``mu^2``. Right for any finite mu.
 
     Parameters
     ----------
@@ -141,19 +147,22 @@ def kappa(fx, fy, mu, *, tol: float = DEFAULT_TOL) -> tuple[np.ndarray, np.ndarr
     if not (tol >= 0):
         raise SpineInputError(f"tol must be >= 0, got {tol!r}")
     fx, fy = np.broadcast_arrays(np.asarray(fx, dtype=float), np.asarray(fy, dtype=float))
-    a, b, c = quadratic_coefficients(fx, fy, mu)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        disc = b * b - 4.0 * a * c
-        sq = np.sqrt(np.where(disc >= 0, disc, np.nan))
-        q = -0.5 * (b + np.where(b >= 0, 1.0, -1.0) * sq)
-        big_a = np.abs(a) >= tol
-        r1 = np.where(big_a & (q != 0), q / np.where(big_a, a, 1.0), np.nan)
-        r2 = np.where(q != 0, c / q, np.nan)
-        ok1 = (r1 > 0) & (1.0 + r1 * fx > 0)
-        ok2 = (r2 > 0) & (1.0 + r2 * fx > 0)
-        k = np.fmax(np.where(ok1, r1, np.nan), np.where(ok2, r2, np.nan))
-    lock = (a < tol) & (fx > 0)
-    region = np.where(lock, SELF_LOCK, np.where(np.isfinite(k), ENGAGED, SLIP)).astype(np.int8)
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        one_fx2 = 1.0 + fx * fx
+        rho = np.sqrt((one_fx2 + fy * fy) / one_fx2)
+        w = np.abs(fy) / np.sqrt(one_fx2)
+        # tan(gamma), the cone's half-width in the drive plane; no cone (NaN) where w > mu
+        tg = np.sqrt(mu - w) * np.sqrt(mu + w) / rho
+        a_scaled = rho * rho * (1.0 - fx * tg) * (1.0 + fx * tg)  # = A' (see kappa docs)
+        lock = (fx > 0) & (a_scaled < tol)
+        # tan(theta + gamma), divided through by tg where tg > 1 so that nothing overflows
+        big = tg > 1.0
+        inv = np.where(big, 1.0 / np.where(big, tg, 1.0), 1.0)
+        num = np.where(big, fx * inv + 1.0, fx + tg)
+        den = np.where(big, inv - fx, 1.0 - fx * tg)
+        engaged = ~lock & (num > 0) & (den > 0)
+        k = np.where(engaged, num / np.where(engaged, den, 1.0), np.nan)
+    region = np.where(lock, SELF_LOCK, np.where(engaged, ENGAGED, SLIP)).astype(np.int8)
     k = np.where(lock, np.inf, k)
     return k, region
 

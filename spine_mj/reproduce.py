@@ -28,6 +28,7 @@ from spine_mj.plotting import (
 from spine_mj.presets import load_preset, resolve_mu
 from spine_mj.streamline import Outcome, StreamlineParams, ideal_trajectories, streamlines
 from spine_mj.surfaces import GaussianSurface, fractal_fbm, random_gaussians, single_gaussian
+from spine_mj.workers import check_workers
 
 __all__ = [
     "REPRODUCTIONS",
@@ -462,6 +463,11 @@ def _fractal_chunk(args):
     return hurst, np.array(locked), np.array(sect), np.array(hess)
 
 
+#: Most fractal surfaces per H value of :func:`fractal_hurst` (the default is 300; this is
+#: about an hour's work on two workers).
+MAX_SURFACES_PER_HURST = 20_000
+
+
 def fractal_hurst(
     *,
     quick: bool = False,
@@ -496,6 +502,12 @@ def fractal_hurst(
     groups = int(rep.get("groups", 3))
     if n < groups:
         raise SpineInputError(f"surfaces must be >= groups ({groups}), got {n}")
+    if n > MAX_SURFACES_PER_HURST:
+        raise SpineInputError(
+            f"--surfaces: at most {MAX_SURFACES_PER_HURST} per H ({len(hursts)} H values; the "
+            f"default {default} takes about a minute on 2 workers), got {n}"
+        )
+    check_workers(workers)
     gen = {
         "nx": int(over.get("nx", rep.get("nx", pre.params["nx"]))),
         "size": float(over.get("size", pre.params["size"])),

@@ -1,4 +1,5 @@
-"""Where the files that ship with the package live: the MuJoCo rig and the surface presets.
+"""Where the files that ship with the package live: the MuJoCo rig, the surface presets and
+the README's examples (two measured scans, the sweep configs).
 
 The repository keeps them at its top level (``models/spine_rig.xml``, ``surfaces/*.toml``);
 ``setup.py`` maps those folders onto the packages ``spine_mj._data.models`` and
@@ -12,10 +13,13 @@ from __future__ import annotations
 from importlib import resources
 from pathlib import Path
 
-__all__ = ["MODEL_NAME", "model_path", "presets_dir"]
+__all__ = ["MODEL_NAME", "examples_dirs", "model_path", "presets_dir"]
 
 MODELS_PACKAGE = "spine_mj._data.models"
 SURFACES_PACKAGE = "spine_mj._data.surfaces"
+#: The README's examples: measured scans (``tests/data/``) and sweep configs (``analysis/sweeps/``).
+SCANS_PACKAGE = "spine_mj._data.scans"
+SWEEPS_PACKAGE = "spine_mj._data.sweeps"
 MODEL_NAME = "spine_rig.xml"
 
 
@@ -33,3 +37,9 @@ def model_path(name: str = MODEL_NAME) -> Path:
 def presets_dir() -> Path:
     """Folder holding the surface presets (``*.toml``) shipped with spine_mj."""
     return _folder(SURFACES_PACKAGE)
+
+
+def examples_dirs() -> dict[str, Path]:
+    """The folders of the shipped examples by kind: ``"scan"`` (measured topographies, see
+    their README for source and licence) and ``"sweep"`` (sweep configs)."""
+    return {"scan": _folder(SCANS_PACKAGE), "sweep": _folder(SWEEPS_PACKAGE)}

@@ -193,8 +193,9 @@ class Roughness:
         l_s (:func:`slope_correlation_length`).
     hurst : float
         ``-(s + 2) / 2`` from the log-log slope ``s`` of the PSD over its middle decade(s)
-        (``C ~ q^-(2H+2)``); NaN when fewer than 4 rings are usable. Meaningful only for
-        self-affine surfaces.
+        (``C ~ q^-(2H+2)``); NaN ("not estimated") when fewer than 4 rings are usable, or
+        when the fit is no self-affine power law: H outside :data:`HURST_RANGE` or a fit
+        explaining less than :data:`MIN_HURST_FIT_R2` of the log PSD's variance.
     psd_prefactor, fit_range : float, (float, float)
         The fit ``C = psd_prefactor q^-(2H+2)`` and the q range it was made over.
     q, psd : ndarray
@@ -219,15 +220,27 @@ class Roughness:
         return {k: getattr(self, k) for k in self.__dataclass_fields__ if k not in skip}
 
 
+#: A Hurst index is reported only inside this range (self-affine surfaces, 0 <= H <= 1) ...
+HURST_RANGE = (0.0, 1.0)
+#: ... and when the log-log fit of the PSD explains at least this share of its variance.
+MIN_HURST_FIT_R2 = 0.9
+
+
 def _hurst_fit(q: np.ndarray, psd: np.ndarray) -> tuple[float, float, tuple[float, float]]:
     """Least-squares fit ``log C = log A - (2H + 2) log q`` over the rings between 4 times
     the lowest and a third of the highest q: ``(H, A, (q_lo, q_hi))``, NaN when fewer
-    than 4 rings are usable."""
+    than 4 rings are usable or the fit is no self-affine power law (see :class:`Roughness`)."""
     ok = (q > 4 * q.min()) & (q < q.max() / 3) & (psd > 0)
+    nan = float("nan")
     if ok.sum() < 4:
-        return float("nan"), float("nan"), (float("nan"), float("nan"))
-    slope, intercept = np.polyfit(np.log(q[ok]), np.log(psd[ok]), 1)
-    return float(-(slope + 2) / 2), float(np.exp(intercept)), (float(q[ok].min()), float(q[ok].max()))
+        return nan, nan, (nan, nan)
+    x, y = np.log(q[ok]), np.log(psd[ok])
+    slope, intercept = np.polyfit(x, y, 1)
+    hurst = float(-(slope + 2) / 2)
+    r2 = 1.0 - np.sum((y - (slope * x + intercept)) ** 2) / max(np.sum((y - y.mean()) ** 2), 1e-300)
+    if not (HURST_RANGE[0] <= hurst <= HURST_RANGE[1] and r2 >= MIN_HURST_FIT_R2):
+        return nan, nan, (nan, nan)  # not a self-affine power law over those rings
+    return hurst, float(np.exp(intercept)), (float(q[ok].min()), float(q[ok].max()))
 
 
 def summarize(surface: Surface) -> Roughness:

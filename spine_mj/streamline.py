@@ -55,7 +55,15 @@ from spine_mj.surfaces import (
     check_grid_size,
 )
 
-__all__ = ["Outcome", "StreamlineParams", "StreamlineResult", "dilate", "ideal_trajectories", "streamlines"]
+__all__ = [
+    "Outcome",
+    "StreamlineParams",
+    "StreamlineResult",
+    "check_step",
+    "dilate",
+    "ideal_trajectories",
+    "streamlines",
+]
 
 
 class Outcome(enum.IntEnum):
@@ -319,7 +327,7 @@ def _starts(surface: Surface, starts) -> tuple[np.ndarray, np.ndarray]:
 MIN_STEP_OF_COORDINATES = 1e-9
 
 
-def _check_step(surface: Surface, dl: float) -> None:
+def check_step(surface: Surface, dl: float) -> None:
     """Refuse a step length ``dl`` no path can use on ``surface``: not smaller than the
     domain (every path leaves at its first step) or lost in the rounding of a position."""
     xmin, xmax, ymin, ymax = surface.bounds
@@ -345,7 +353,7 @@ def _trajectories(surface, starts, params, *, ideal, store_paths, backend):
     if backend not in ("numba", "numpy", "auto"):
         raise SpineInputError(f"backend must be 'numba', 'numpy' or 'auto', got {backend!r}")
     xs, ys = _starts(surface, starts)
-    _check_step(surface, params.dl)
+    check_step(surface, params.dl)
     data = _surface_data(surface)
     if backend == "numba" and data is None:
         raise SpineInputError(

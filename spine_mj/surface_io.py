@@ -110,6 +110,10 @@ def load_surface(path: str | os.PathLike) -> Surface:
     try:
         with np.load(path, allow_pickle=False) as npz:
             for name in npz.files:  # sizes from the headers, before a compressed array is inflated
+                if f"{name}.npy" not in npz.zip.namelist():
+                    raise SpineInputError(
+                        f"{path} is not a spine_mj .npz surface: member {name!r} is not a .npy array"
+                    )
                 shape = _npz_member_shape(npz, name)
                 if math.prod(shape) > MAX_GRID_POINTS:
                     raise SpineInputError(
@@ -131,6 +135,10 @@ def load_surface(path: str | os.PathLike) -> Surface:
                 raise SpineInputError(f"array {name!r} must be numeric, got dtype {arr.dtype}")
         kind = str(data["kind"])
         unit = str(data["unit"])
+        if unit != "1" and length_unit(unit) is None:
+            raise SpineInputError(
+                f"unit must be '1' (dimensionless) or a length unit {sorted(LENGTH_UNITS_M)}, got {unit!r}"
+            )
         if kind == "grid":
             periodic = data["periodic"]
             if periodic.shape != () or periodic.dtype.kind not in "bi" or periodic not in (0, 1):

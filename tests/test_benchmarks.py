@@ -21,3 +21,31 @@ def test_median_interval_is_the_binomial_order_statistics_and_covers_the_median(
         lo, hi = median_interval(list(rng.standard_cauchy(21)))  # heavy tails: distribution-free
         hits += lo <= 0.0 <= hi
     assert 0.95 <= hits / 2000 <= 0.99  # exact coverage 0.973
+
+
+def test_a_missed_target_is_marked_and_a_met_one_is_not():
+    from run_all import MISSED, target_cell
+
+    assert target_cell(0.833, ">=", 0.85) == f">= 0.85 {MISSED}"
+    assert target_cell(0.863, ">=", 0.85) == ">= 0.85"
+    assert target_cell(4.6e7, ">=", 2e7) == ">= 2e7"
+    assert target_cell(61.0, "<=", 60, " s") == f"<= 60 s {MISSED}"
+
+
+def test_bench_writes_an_untracked_folder_unless_asked_to_update(tmp_path):
+    """`make bench` must leave the tree clean: its default output is git-ignored."""
+    import subprocess
+
+    root = Path(__file__).resolve().parents[1]
+    probe = "benchmarks/out/results.json"
+    ignored = subprocess.run(["git", "check-ignore", "-q", probe], cwd=root, check=False)
+    if ignored.returncode == 128:  # not a git checkout (an sdist): nothing to check
+        return
+    assert ignored.returncode == 0
+    out = subprocess.run(
+        [sys.executable, str(root / "benchmarks" / "run_all.py"), "--readme"],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert out.returncode == 2 and "give --update" in out.stderr

@@ -180,3 +180,47 @@ def test_crease_engagement_of_a_floor_beside_a_wall(floor_fy):
         assert region == ENGAGED
         assert float(k) == pytest.approx(expected, rel=1e-3)
         assert (float(vx), abs(float(vy))) == pytest.approx((cx, abs(cy)), abs=1e-3)
+
+
+@pytest.mark.parametrize("mu", [2.0, 1e4, 1e8, 1e15, 1e100, 1e300, 1.7e308])
+def test_two_d_closed_form_at_any_finite_mu(mu):
+    """tan(theta + arctan mu) written as (f_x + mu) / (1 - mu f_x), exact for large mu."""
+    fx = np.array([-50.0, -3.0, -0.9, -0.5, -1e-3, 0.0])
+    k, region = kappa(fx, 0.0, mu)
+    descends_past_phi = fx < -mu  # theta + phi < 0
+    assert np.all(region[descends_past_phi] == SLIP)
+    fx, k, region = fx[~descends_past_phi], k[~descends_past_phi], region[~descends_past_phi]
+    assert np.all(region == ENGAGED)
+    expected = (fx / mu + 1.0) / (1.0 / mu - fx)  # the closed form divided through by mu
+    np.testing.assert_allclose(k, expected, rtol=1e-12)
+    # no point can slip once mu exceeds the steepest slope; uphill past 1/mu self-locks
+    up = np.array([0.9, 1.0, 10.0]) * max(1.0 / mu, 1e-300) * 2.0
+    _, region_up = kappa(up, 0.0, mu)
+    assert np.all(region_up == SELF_LOCK)
+
+
+@pytest.mark.parametrize("mu", [1e8, 1e15, 1e100, 1e308])
+def test_no_slip_on_the_single_peak_once_mu_exceeds_its_steepest_slope(mu):
+    from spine_mj.presets import make_surface
+
+    surf = make_surface("paper-single-peak")
+    x, y = np.meshgrid(np.linspace(-5, 5, 201), np.linspace(-5, 5, 201))
+    fx, fy = surf.gradient(x, y)
+    assert max(np.abs(fx).max(), np.abs(fy).max()) < 1.0 < mu
+    k, region = kappa(fx, fy, mu)
+    assert not np.any(region == SLIP)
+    assert np.all(np.isfinite(k[region == ENGAGED]))
+    assert np.all(k[region == ENGAGED] > 0)
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.floats(-3, 3), st.floats(-3, 3), st.floats(2.5, 1e6))
+def test_brute_force_friction_cone_at_large_mu(fx, fy, mu):
+    k, region = kappa(fx, fy, mu)
+    k = float(k)
+    if region == ENGAGED:
+        eps = 1e-6 * max(1.0, k)
+        assert _holds(fx, fy, mu, k - min(eps, 0.5 * k), margin=1e-9)
+        assert not _holds(fx, fy, mu, k + eps + 1e-3 * k, margin=-1e-9)
+    elif region == SELF_LOCK:
+        assert _holds(fx, fy, mu, 1e9)

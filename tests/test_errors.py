@@ -71,3 +71,42 @@ def test_an_unwritable_path_is_refused_before_any_work(tmp_path):
         writable_path(tmp_path / "file" / "out.txt")
     with pytest.raises(SpineInputError, match="it is a folder"):
         writable_path(tmp_path)
+
+
+def test_a_full_disk_names_the_file_being_written(tmp_path):
+    """pyarrow and numpy raise ENOSPC without a file name: the error names the output."""
+    import errno
+
+    dest = tmp_path / "runs.parquet"
+    with pytest.raises(SpineInputError, match=r"cannot write .*runs\.parquet: No space left on device"):
+        with atomic_output(dest):
+            raise OSError(errno.ENOSPC, "No space left on device")
+    assert list(tmp_path.iterdir()) == []
+    with pytest.raises(FileNotFoundError):  # an error that names its own file is left as it is
+        with atomic_output(dest):
+            open(tmp_path / "missing.txt")
+
+
+def test_remove_temporaries_removes_what_a_killed_writer_left_and_nothing_else(tmp_path):
+    from spine_mj.atomic import remove_temporaries
+
+    figures = tmp_path / "figures"
+    figures.mkdir()
+    left = [figures / ".boundary.png.k3x_9q2a.png", tmp_path / ".validation.json.abcdefgh.json"]
+    left.append(tmp_path / ".report.md.4242.keep")
+    kept = [figures / "boundary.png", figures / ".hidden", tmp_path / ".notes.txt.abcdefgh.png"]
+    for p in left + kept:
+        p.write_text("x")
+    assert sorted(remove_temporaries(tmp_path)) == sorted(left)
+    assert all(p.exists() for p in kept) and not any(p.exists() for p in left)
+
+
+def test_atomic_output_temporaries_are_what_remove_temporaries_removes(tmp_path):
+    """A writer killed inside the block leaves its temporary; the pattern must know its name."""
+    from spine_mj.atomic import remove_temporaries
+
+    dest = tmp_path / "fig.png"
+    writer = atomic_output(dest)  # entered and never left, as in a killed process
+    tmp = writer.__enter__()
+    assert tmp.exists()
+    assert remove_temporaries(tmp_path) == [tmp]

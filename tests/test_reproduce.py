@@ -116,3 +116,17 @@ def test_options_are_used_or_refused_never_ignored(tmp_path):
         res = CliRunner().invoke(main, ["reproduce", "kappa-map", "--out", str(tmp_path), *option])
         assert res.exit_code == 2 and f"reproduce kappa-map does not use {option[0]}" in res.output
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    ("args", "fragment"),
+    [
+        (["--surfaces", "100000000", "--workers", "1"], "--surfaces: at most 20000 per H"),
+        (["--workers", "100000"], "--workers: must be an integer from 1 to"),
+    ],
+)
+def test_fractal_hurst_counts_are_checked_before_any_work(tmp_path, args, fragment):
+    out = tmp_path / "r"
+    result = CliRunner().invoke(main, ["reproduce", "fractal-hurst", "--quick", "--out", str(out), *args])
+    assert result.exit_code == 2 and fragment in result.output, result.output
+    assert not out.exists()

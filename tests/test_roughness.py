@@ -100,3 +100,11 @@ def test_cli_surface_info(tmp_path):
     result = CliRunner().invoke(main, ["surface", "info", "paper-single-peak", "--json"])
     assert result.exit_code == 0, result.output
     assert '"slope_correlation_length": 1.97' in result.output
+
+
+def test_hurst_is_not_estimated_where_the_psd_is_no_power_law():
+    """Thousands of overlapping Gaussians: the log-log PSD fit gave H = 4.74, meaningless."""
+    from spine_mj.surfaces import random_gaussians
+
+    rough = roughness.summarize(random_gaussians(n_peaks=2000, rng=0))
+    assert np.isnan(rough.hurst)

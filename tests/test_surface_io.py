@@ -184,3 +184,25 @@ def test_grid_surface_metadata_survives(tmp_path):
         heights=np.zeros((4, 4)), x=np.arange(4.0), y=np.arange(4.0), metadata={"note": "flat", "n": 3}
     )
     assert load_surface(save_surface(surf, tmp_path / "f.npz")).metadata == {"note": "flat", "n": 3}
+
+
+@pytest.mark.parametrize("unit", ["banana", ""])
+def test_load_refuses_a_surface_whose_unit_is_no_length_unit(tmp_path, unit):
+    from spine_mj.presets import make_surface
+
+    path = save_surface(make_surface("paper-single-peak").sample(16), tmp_path / "s.npz")
+    data = dict(np.load(path))
+    data["unit"] = np.array(unit)
+    np.savez(path, **data)
+    with pytest.raises(SpineInputError, match=rf"s\.npz: unit must be '1' .* got '{unit}'"):
+        load_surface(path)
+
+
+def test_load_refuses_a_zip_that_is_not_an_npz_of_arrays(tmp_path):
+    import zipfile
+
+    path = tmp_path / "z.npz"
+    with zipfile.ZipFile(path, "w") as z:
+        z.writestr("hello.txt", "hello")
+    with pytest.raises(SpineInputError, match=r"z\.npz is not a spine_mj \.npz surface: member 'hello\.txt'"):
+        load_surface(path)

@@ -6,12 +6,11 @@ commands: :mod:`~spine_mj.cli.surface` (``surface make/show/info/export``),
 :mod:`~spine_mj.cli.theory` (``kappa``, ``streamline``, ``reproduce``),
 :mod:`~spine_mj.cli.sim` (``simulate``, ``replay``, ``view``, ``sim export``),
 :mod:`~spine_mj.cli.sweep` (``sweep run/status``, ``report``), :mod:`~spine_mj.cli.array`
-(``array``) and
-:mod:`~spine_mj.cli.validate` (``validate``). Importing this package registers every
-command on :func:`main`.
+(``array``), :mod:`~spine_mj.cli.validate` (``validate``) and :mod:`~spine_mj.cli.examples`
+(``examples``). Importing this package registers every command on :func:`main`.
 """
 
-from spine_mj.cli import array, sim, surface, sweep, theory, validate
+from spine_mj.cli import array, examples, sim, surface, sweep, theory, validate
 from spine_mj.cli.app import INPUT_ERROR_EXIT, InputError, Progress, _exit_on_sigterm, main, run
 
 __all__ = [
@@ -20,6 +19,7 @@ __all__ = [
     "Progress",
     "_exit_on_sigterm",
     "array",
+    "examples",
     "main",
     "run",
     "sim",

@@ -18,7 +18,7 @@ import click
 import numpy as np
 from tqdm import tqdm
 
-from spine_mj import presets, surface_io
+from spine_mj import examples, presets, surface_io
 from spine_mj.errors import SpineInputError
 
 INPUT_ERROR_EXIT = 2
@@ -50,6 +50,11 @@ class Progress:
             self.bar.set_postfix(postfix, refresh=False)
         self.bar.refresh()
 
+    def complete(self) -> None:
+        """Move an open bar to its total: a job that ended early (a breakaway) is done too."""
+        if self.bar is not None:
+            self.update(self.bar.total, self.bar.total)
+
     def close(self) -> None:
         if self.bar is not None:
             self.bar.close()
@@ -72,10 +77,25 @@ class InputError(click.ClickException):
 _SHOWS_HELP = tuple(e for e in [getattr(click.exceptions, "NoArgsIsHelpError", None)] if e)
 
 
+def _one_line(exc: click.UsageError) -> str:
+    """A usage error's message (a choice list spans lines) and its help hint, on one line."""
+    hint = f" (see '{exc.ctx.command_path} --help')" if exc.ctx is not None else ""
+    return " ".join(exc.format_message().split()) + hint
+
+
 class _Group(click.Group):
     """Turns the library's input errors and click's usage errors into :class:`InputError`
     (one line) for every subcommand, and so too a request too large for memory or out of
     floating-point range that no check at the boundary caught (not a traceback)."""
+
+    def parse_args(self, ctx, args):
+        """The root's own options (``spine-mj --bogus``) fail here, before :meth:`invoke`."""
+        try:
+            return super().parse_args(ctx, args)
+        except _SHOWS_HELP:
+            raise
+        except click.UsageError as exc:
+            raise InputError(_one_line(exc)) from None
 
     def invoke(self, ctx):
         try:
@@ -86,15 +106,15 @@ class _Group(click.Group):
         except _SHOWS_HELP:
             raise
         except click.UsageError as exc:  # click's own: usage, hint and error in one line
-            hint = f" (see '{exc.ctx.command_path} --help')" if exc.ctx is not None else ""
-            raise InputError(exc.format_message() + hint) from None
+            raise InputError(_one_line(exc)) from None
         except SpineInputError as exc:
             root = ctx.find_root()
             if exc.details and root.params.get("verbose"):
                 click.echo(exc.details, err=True)
             raise InputError(str(exc)) from None
         except OSError as exc:
-            raise InputError(f"{exc.strerror or exc}: {exc.filename}") from None
+            where = f": {exc.filename}" if exc.filename is not None else " (the system named no file)"
+            raise InputError(f"{exc.strerror or exc}{where}") from None
         except MemoryError as exc:  # the checks at the boundary missed a size: still one line
             raise InputError(
                 f"not enough memory for this request ({exc or 'MemoryError'}): a size, resolution or "
@@ -128,8 +148,10 @@ def _exit_on_sigterm(signum, frame):
 
 
 def load_surface_arg(spec: str):
-    """A SURFACE argument: a saved .npz, a preset name, or an instrument file."""
+    """A SURFACE argument: a saved .npz, a preset name, an instrument file, or a shipped
+    example (``example:plu-1.plu``)."""
 
+    spec = examples.resolve(spec)
     path = Path(spec)
     if path.suffix == ".npz":
         return surface_io.load_surface(path)
@@ -138,8 +160,8 @@ def load_surface_arg(spec: str):
     if path.is_file():
         return surface_io.import_topography(path)
     raise SpineInputError(
-        f"SURFACE must be a .npz file, a preset ({', '.join(presets.list_presets())}) or an "
-        f"instrument file, got {spec!r}"
+        f"SURFACE must be a .npz file, a preset ({', '.join(presets.list_presets())}), an "
+        f"instrument file or an example (spine-mj examples), got {spec!r}"
     )
 
 

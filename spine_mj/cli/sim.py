@@ -8,7 +8,7 @@ from pathlib import Path
 
 import click
 
-from spine_mj import presets, sim
+from spine_mj import extras, presets, sim
 from spine_mj.cli.app import (
     InputError,
     Progress,
@@ -224,6 +224,7 @@ def simulate(
     """
 
     if render:
+        extras.require("video", "--render")
         choose_gl_backend()
 
     x0, y0 = parse_start(start)
@@ -256,6 +257,7 @@ def simulate(
     )
     with Progress("simulating", unit="%") as bar:
         result = rig.run(drv, start=(x0, y0), progress=lambda frac: bar.update(round(100 * frac, 1), 100))
+        bar.complete()
     with Progress("rendering MP4", unit="frame", quiet=not render) as bar:
         written = write_run(out_dir, rig, result, mp4=render, progress=bar.update)
     click.echo(
@@ -306,11 +308,15 @@ def replay(run_dir, speed, duration, mp4):
         sys.platform.startswith("linux")
         and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
     )
+    if headless:  # --duration closes the viewer; an MP4 has the run's length at --speed
+        refuse_options_not_for("replay to an MP4 (no display, or --mp4)", ["duration"])
     if duration is not None:
         check_positive("--duration", duration)
     if headless:
         choose_gl_backend()
     rig, track = load_run(run_dir)
+    if headless:
+        extras.require("video", "replay without a display (an MP4)" if mp4 is None else "--mp4")
     span = float(track.time_s[-1] - track.time_s[0])
     speed = check_positive("--speed", speed) if speed is not None else default_speed(track.time_s)
     if headless:

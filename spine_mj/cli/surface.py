@@ -7,13 +7,14 @@ import math
 
 import click
 
-from spine_mj import presets, roughness, surface_io
+from spine_mj import examples, presets, roughness, surface_io
 from spine_mj.atomic import all_or_none
 from spine_mj.cli.app import (
     _Group,
     check_suffix,
     load_surface_arg,
     main,
+    refuse_options_not_for,
 )
 from spine_mj.drive_limits import drive_limits
 from spine_mj.errors import SpineInputError, check_positive
@@ -45,7 +46,7 @@ def surface_list():
     "--from-file",
     "from_file",
     type=click.Path(dir_okay=False),
-    help="Import a measured topography (x3p, opd, datx, plu, di, sur, ...).",
+    help="Import a measured topography (x3p, opd, datx, plu, di, sur, ...; or example:plu-1.plu).",
 )
 @click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="Output .npz file.")
 @click.option("--seed", type=click.IntRange(min=0), help="Override the preset's seed.")
@@ -80,9 +81,15 @@ def surface_make(preset, from_file, output, seed, hurst, sets, fill, no_level, s
 
     if (preset is None) == (from_file is None):
         raise SpineInputError("give exactly one of PRESET or --from-file")
+    if from_file is None:
+        refuse_options_not_for(
+            f"preset {preset!r} (not a file import)", ["fill", "no_level", "spacing", "channel"]
+        )
+    else:
+        refuse_options_not_for("--from-file (an import, not a generator)", ["seed", "hurst", "sets"])
     if from_file is not None:
         surf = surface_io.import_topography(
-            from_file, channel=channel, fill=fill, level=not no_level, spacing_m=spacing
+            examples.resolve(from_file), channel=channel, fill=fill, level=not no_level, spacing_m=spacing
         )
     else:
         overrides = dict(presets.parse_override(s) for s in sets)
@@ -133,7 +140,7 @@ def surface_info(surface_spec, output, as_json, mu, tip_radius):
 
     \b
     Example:
-      spine-mj surface info tests/data/plu-1.plu --mu 0.5 -o psd.png
+      spine-mj surface info example:plu-1.plu --mu 0.5 -o psd.png
     """
     if output:
         check_suffix(output, ".png", "-o/--output")
@@ -152,7 +159,8 @@ def surface_info(surface_spec, output, as_json, mu, tip_radius):
     click.echo(f"rms curvature            {rough.rms_curvature:.4g}{'' if not unit else ' 1/' + surf.unit}")
     click.echo(f"L_c (asperity length)    {rough.char_length:.4g}{unit}")
     click.echo(f"l_s (slope correlation)  {rough.slope_correlation_length:.4g}{unit}")
-    click.echo(f"Hurst estimate (PSD fit) {rough.hurst:.3g}")
+    hurst = f"{rough.hurst:.3g}" if math.isfinite(rough.hurst) else "not estimated (the PSD is no power law)"
+    click.echo(f"Hurst estimate (PSD fit) {hurst}")
     if limits is None:
         click.echo("drive limits             give --mu (no preset mu_s)")
     else:

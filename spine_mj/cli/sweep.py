@@ -6,12 +6,14 @@ from pathlib import Path
 
 import click
 
+from spine_mj import examples
 from spine_mj import sweep as sw
 from spine_mj.cli.app import (
     Progress,
     _Group,
     check_suffix,
     main,
+    refuse_options_not_for,
 )
 
 
@@ -40,7 +42,7 @@ def sweep():
 
     \b
     Examples:
-      spine-mj sweep analysis/sweeps/paper-quasistatic.toml --out runs/qs
+      spine-mj sweep example:paper-quasistatic.toml --out runs/qs
       spine-mj sweep config.toml --out runs/x --scheduler tcp://head:8786
       spine-mj sweep status runs/qs
     """
@@ -71,16 +73,26 @@ def sweep():
     "inputs (removes only the files the store wrote).",
 )
 @click.option("--retry-failed", is_flag=True, help="Run again the cases with failed runs.")
+@click.option(
+    "--worker-wait",
+    type=float,
+    default=sw.DEFAULT_WORKER_WAIT_S,
+    show_default=True,
+    metavar="SECONDS",
+    help="With --scheduler: how long to wait for its first worker before giving up.",
+)
 @click.option("--quiet", is_flag=True, help="No progress bar.")
-def sweep_run(config, out_dir, workers, scheduler, overwrite, retry_failed, quiet):
+def sweep_run(config, out_dir, workers, scheduler, overwrite, retry_failed, worker_wait, quiet):
     """Run the sweep CONFIG (TOML) into --out; re-running resumes and skips finished runs.
 
     \b
     Example:
-      spine-mj sweep analysis/sweeps/paper-quasistatic.toml --out runs/qs --workers 4
+      spine-mj sweep example:paper-quasistatic.toml --out runs/qs --workers 4
     """
 
-    cfg = sw.load_config(config)
+    if scheduler is None:
+        refuse_options_not_for("a sweep without --scheduler", ["worker_wait"])
+    cfg = sw.load_config(examples.resolve(config))
     with Progress(cfg.name, unit="case", quiet=quiet) as bar:
         try:
             summary = sw.run_sweep(
@@ -93,7 +105,11 @@ def sweep_run(config, out_dir, workers, scheduler, overwrite, retry_failed, quie
                 progress=lambda p: bar.update(
                     p.finished_cases + p.skipped_cases, p.total_cases, ok=p.ok_runs, failed=p.failed_runs
                 ),
+                worker_wait_s=worker_wait,
+                notice=lambda text: click.echo(text, err=True),
             )
+        except sw.SchedulerUnavailable as exc:  # the environment: exit code 1
+            raise click.ClickException(str(exc)) from None
         except sw.WorkersCannotStart as exc:  # the environment, not the input: exit code 1
             raise click.ClickException(f"{exc}; the finished cases are kept, a re-run resumes") from None
     if summary.rerun_corrupt:

@@ -53,6 +53,10 @@ _MIN_ENGINE_RATIO = 1e-9  # smallest length ratio (tip / L_c, spacing / L_c) the
 #: Physical range of lengths [m] and masses [kg] (outside it the model means nothing).
 PHYSICAL_LENGTH_M = (1e-12, 1e3)
 PHYSICAL_MASS_KG = (1e-24, 1e6)
+#: Largest load per unit moving mass, F_p / m_eff [m/s^2] (1e5 g): beyond it a run's time
+#: scale sqrt(m L_c / F_p) falls below any physical meaning (preload 1e30 N ended a run
+#: at 7e-16 s with the carriage at 1.2e14 m/s).
+MAX_PRELOAD_ACCELERATION_M_S2 = 1e6
 
 
 class Cone(enum.Enum):
@@ -128,6 +132,13 @@ class TipParams:
         if self.preload_n == 0 and self.gravity_m_s2 == 0:
             raise SpineInputError(
                 "preload_n and gravity_m_s2 are both 0: the tip has no normal preload; give one of them > 0"
+            )
+        accel = self.preload_total_n / self.mass_kg
+        if not accel <= MAX_PRELOAD_ACCELERATION_M_S2:
+            raise SpineInputError(
+                f"preload_n and gravity_m_s2: the load per unit mass (m g + preload) / m must be at most "
+                f"{MAX_PRELOAD_ACCELERATION_M_S2:g} m/s^2, got {accel:.3g} m/s^2 (preload "
+                f"{self.preload_n:g} N, gravity {self.gravity_m_s2:g} m/s^2, mass {self.mass_kg:g} kg)"
             )
 
     @property

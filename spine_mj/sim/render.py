@@ -59,16 +59,30 @@ def default_speed(time_s: np.ndarray, seconds: float = 10.0) -> float:
 def choose_gl_backend() -> str:
     """Set ``MUJOCO_GL`` to a headless backend that works here (EGL, else OSMesa) and return it.
 
-    A value already set is kept. Each candidate is tried in a child process, since MuJoCo
-    reads the variable once, on import. Raises :class:`SpineInputError` naming what to install.
+    A value already set is kept if it renders, else refused. Each candidate is tried in a
+    child process, since MuJoCo reads the variable once, on import. Raises
+    :class:`SpineInputError` naming what to install or set.
     """
-    if os.environ.get("MUJOCO_GL"):
-        return os.environ["MUJOCO_GL"]
     probe = "import mujoco; mujoco.Renderer(mujoco.MjModel.from_xml_string('<mujoco/>'), 8, 8).render()"
+
+    def renders(env) -> subprocess.CompletedProcess:
+        return subprocess.run(
+            [sys.executable, "-c", probe], env=env, capture_output=True, text=True, timeout=120
+        )
+
+    given = os.environ.get("MUJOCO_GL")
+    if given:
+        tried = renders(dict(os.environ))
+        if tried.returncode != 0:
+            lines = tried.stderr.strip().splitlines()
+            raise SpineInputError(
+                f"MUJOCO_GL={given!r} cannot render here ({lines[-1] if lines else 'no output'}): "
+                "set MUJOCO_GL=egl (needs libegl1) or osmesa (needs libosmesa6), or unset it to "
+                "let spine-mj choose"
+            )
+        return given
     for backend in ("egl", "osmesa"):
-        env = dict(os.environ, MUJOCO_GL=backend, PYOPENGL_PLATFORM=backend)
-        ok = subprocess.run([sys.executable, "-c", probe], env=env, capture_output=True, timeout=120)
-        if ok.returncode == 0:
+        if renders(dict(os.environ, MUJOCO_GL=backend, PYOPENGL_PLATFORM=backend)).returncode == 0:
             os.environ["MUJOCO_GL"] = backend
             return backend
     raise SpineInputError(

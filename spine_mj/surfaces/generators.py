@@ -155,6 +155,7 @@ def random_gaussians(
     n_peaks = int(n_peaks)
     if sign not in (1, -1):
         raise SpineInputError(f"sign must be +1 (convex peaks) or -1 (concave valleys), got {sign!r}")
+    anisotropic, overlap = _flag("anisotropic", anisotropic), _flag("overlap", overlap)
     xmin, xmax, ymin, ymax = _bounds(bounds)
     s_lo, s_hi = _range("sigma_range (widths)", sigma_range)
     a_lo, a_hi = _range("amplitude_range (heights)", amplitude_range)

@@ -55,6 +55,7 @@ from spine_mj.sweep.analyses import MUJOCO_PARAMS, QUASISTATIC_PARAMS
 from spine_mj.sweep.case_runs import run_case
 from spine_mj.sweep.cases import Case, expand_cases
 from spine_mj.sweep.config import StartsSpec, SurfaceSpec, SweepConfig, load_config, parse_config
+from spine_mj.sweep.executors import DEFAULT_WORKER_WAIT_S, SchedulerUnavailable
 from spine_mj.sweep.pool import WorkersCannotStart
 from spine_mj.sweep.registry import (
     ANALYSES,
@@ -71,6 +72,7 @@ from spine_mj.sweep.store import StoreStatus, consolidate, load_runs, load_traje
 
 __all__ = [
     "ANALYSES",
+    "DEFAULT_WORKER_WAIT_S",
     "MUJOCO_PARAMS",
     "QUASISTATIC_PARAMS",
     "REQUIRED",
@@ -80,6 +82,7 @@ __all__ = [
     "Case",
     "ParamSpec",
     "Progress",
+    "SchedulerUnavailable",
     "StartsSpec",
     "StoreStatus",
     "SurfaceSpec",

@@ -45,7 +45,7 @@ from pydantic import (
     model_validator,
 )
 
-from spine_mj import presets, surface_io
+from spine_mj import examples, presets, surface_io
 from spine_mj.errors import SpineInputError
 from spine_mj.jsonio import to_jsonable
 from spine_mj.sweep.registry import ANALYSES, PRESET_MU, REQUIRED, ParamSpec, param_specs
@@ -273,6 +273,10 @@ class _SurfaceEntry(_Table):
 
     @field_validator("file")
     def _existing_file(cls, file, info):
+        try:
+            file = examples.resolve(file)  # example:NAME, a shipped scan
+        except SpineInputError as exc:
+            raise ValueError(str(exc)) from None
         path = (Path((info.context or {}).get("base_dir", ".")) / file).resolve()
         if not path.is_file():
             raise ValueError(f"no such file {str(path)!r}")

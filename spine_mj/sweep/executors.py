@@ -15,8 +15,10 @@ import multiprocessing
 import os
 import threading
 import time
+from collections.abc import Callable
 
 from distributed import Client, as_completed
+from distributed.comm.core import CommClosedError
 
 from spine_mj.sweep.case_runs import failed_rows, run_case
 from spine_mj.sweep.cases import Case
@@ -107,11 +109,39 @@ def _preload_worker_modules() -> None:
         importlib.import_module(name)
 
 
-def run_dask(todo: list[Case], scheduler, handle) -> None:
-    """The workers of a Dask scheduler (an address, or a connected ``distributed.Client``)."""
+#: Seconds a sweep waits for the first worker of a Dask scheduler that has none (the CLI's
+#: ``--worker-wait``).
+DEFAULT_WORKER_WAIT_S = 300.0
+
+
+class SchedulerUnavailable(RuntimeError):
+    """The Dask scheduler had no worker within the wait, or was lost mid-sweep: the
+    environment, not a case (the finished cases are kept; a re-run resumes)."""
+
+
+def run_dask(
+    todo: list[Case],
+    scheduler,
+    handle,
+    *,
+    worker_wait_s: float = DEFAULT_WORKER_WAIT_S,
+    notice: Callable[[str], None] | None = None,
+) -> None:
+    """The workers of a Dask scheduler (an address, or a connected ``distributed.Client``).
+
+    Waits at most ``worker_wait_s`` for a first worker, saying so through ``notice``.
+
+    Raises
+    ------
+    SchedulerUnavailable
+        No worker within ``worker_wait_s``, or the scheduler lost while cases were running.
+    """
     own = not isinstance(scheduler, Client)
     client = Client(scheduler) if own else scheduler
+    address = client.scheduler.address
+    done = 0
     try:
+        _wait_for_workers(client, address, worker_wait_s, notice)
         futures = client.map(
             encoded_case,
             todo,
@@ -122,6 +152,31 @@ def run_dask(todo: list[Case], scheduler, handle) -> None:
             result = fut.result()
             fut.release()
             handle(result)
+            done += 1
+    except (cf.CancelledError, CommClosedError, OSError) as exc:
+        raise SchedulerUnavailable(
+            f"lost the Dask scheduler {address} after {done} of {len(todo)} cases "
+            f"({type(exc).__name__}); the finished cases are kept: re-run the same command to "
+            "resume, with a scheduler that is up or without --scheduler to finish here"
+        ) from None
     finally:
         if own:
             client.close()
+
+
+def _wait_for_workers(client, address: str, wait_s: float, notice) -> None:
+    n = len(client.scheduler_info().get("workers", {}))
+    say = notice or (lambda text: None)
+    if n:
+        say(f"scheduler {address}: {n} worker{'s' if n != 1 else ''}")
+        return
+    say(f"waiting for workers: scheduler {address} has 0; giving up after {wait_s:g} s (--worker-wait)")
+    try:
+        client.wait_for_workers(1, timeout=wait_s)
+    except TimeoutError:
+        raise SchedulerUnavailable(
+            f"scheduler {address} still had no workers after {wait_s:g} s: start some "
+            f"(dask worker {address}) and re-run, or wait longer with --worker-wait"
+        ) from None
+    n = len(client.scheduler_info().get("workers", {}))
+    say(f"scheduler {address}: {n} worker{'s' if n != 1 else ''}")

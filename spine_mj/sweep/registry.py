@@ -185,6 +185,9 @@ class Analysis:
     names in ``requires`` to their results for the same case. ``check_config``, if given,
     is called with every validated config that chooses this analysis and raises
     SpineInputError for a combination of values its parameters cannot check one by one.
+    ``check_case``, if given, is ``check_case(case, surface, starts)``: it raises the
+    SpineInputError that ``func`` would raise for the case's inputs, without running it
+    (:mod:`spine_mj.sweep.preflight` calls it before a sweep starts).
     """
 
     name: str
@@ -193,6 +196,7 @@ class Analysis:
     requires: tuple[str, ...] = ()
     doc: str = ""
     check_config: Callable[[Any], None] | None = None
+    check_case: Callable[..., None] | None = None
 
 
 #: Registry of analyses by name; :func:`register_analysis` adds to it.

@@ -9,6 +9,7 @@ at the end. Killed at any moment, the next session resumes where it stopped.
 from __future__ import annotations
 
 import datetime
+import math
 import os
 import re
 import time
@@ -25,7 +26,8 @@ from spine_mj.sweep.analyses import quasistatic
 from spine_mj.sweep.analyses.mujoco import case_rig
 from spine_mj.sweep.cases import expand_cases, longest_first
 from spine_mj.sweep.config import SweepConfig, _make_surface, load_config
-from spine_mj.sweep.executors import run_dask, run_here, run_processes
+from spine_mj.sweep.executors import DEFAULT_WORKER_WAIT_S, run_dask, run_here, run_processes
+from spine_mj.sweep.preflight import check_cases
 from spine_mj.sweep.store import (
     consolidate,
     corrupt_cases,
@@ -38,6 +40,7 @@ from spine_mj.sweep.store import (
     store_lock,
     versions,
 )
+from spine_mj.workers import MAX_WORKERS_PER_CORE, check_workers  # noqa: F401 (re-exported)
 
 
 @dataclass(frozen=True)
@@ -107,6 +110,8 @@ def run_sweep(
     overwrite: bool = False,
     retry_failed: bool = False,
     progress: Callable[[Progress], None] | None = None,
+    worker_wait_s: float = DEFAULT_WORKER_WAIT_S,
+    notice: Callable[[str], None] | None = None,
 ) -> SweepSummary:
     """Run (or resume) a sweep into ``out_dir``.
 
@@ -132,6 +137,10 @@ def run_sweep(
     progress : callable, optional
         Called with a :class:`Progress` once after the skipped cases are counted and after
         every finished case.
+    worker_wait_s : float
+        With ``scheduler``: seconds to wait for its first worker before giving up.
+    notice : callable, optional
+        Called with a line of text on what the sweep waits for (a scheduler's workers).
 
     Returns
     -------
@@ -144,7 +153,12 @@ def run_sweep(
     WorkersCannotStart
         Local worker processes die or hang before their first case (the finished cases
         are kept; a re-run resumes).
+    SchedulerUnavailable
+        The Dask scheduler had no worker within ``worker_wait_s`` or was lost (the
+        finished cases are kept; a re-run resumes).
     """
+    if not (math.isfinite(worker_wait_s) and worker_wait_s > 0):
+        raise SpineInputError(f"--worker-wait must be a number of seconds > 0, got {worker_wait_s!r}")
     if not isinstance(config, SweepConfig):
         config = load_config(config)
     if workers is not None:
@@ -155,8 +169,9 @@ def run_sweep(
     cases = expand_cases(config)
     n_workers = None if scheduler is not None else (workers or os.cpu_count() or 1)
     session = _session_record(n_workers, scheduler)
-    client = None if scheduler is None else connect(scheduler)  # before anything is written
     clear_caches()
+    check_cases(cases, config.swept)  # an input error refuses the config, not every run
+    client = None if scheduler is None else connect(scheduler)  # before anything is written
     try:
         out_dir.mkdir(parents=True, exist_ok=True)
         with store_lock(out_dir):
@@ -170,6 +185,8 @@ def run_sweep(
                 overwrite=overwrite,
                 retry_failed=retry_failed,
                 progress=progress,
+                worker_wait_s=worker_wait_s,
+                notice=notice,
             )
     finally:
         if client is not None and client is not scheduler:
@@ -195,22 +212,6 @@ def clear_caches() -> None:
     case_rig.cache_clear()
 
 
-#: Local worker processes allowed per core (more only cost memory: ~300 MB each).
-MAX_WORKERS_PER_CORE = 4
-
-
-def check_workers(workers) -> int:
-    """``workers`` if it is an integer from 1 to :data:`MAX_WORKERS_PER_CORE` per core."""
-    cores = os.cpu_count() or 1
-    limit = MAX_WORKERS_PER_CORE * cores
-    if isinstance(workers, bool) or not isinstance(workers, int) or not 1 <= workers <= limit:
-        raise SpineInputError(
-            f"--workers: must be an integer from 1 to {limit} ({MAX_WORKERS_PER_CORE} per core "
-            f"on {cores} cores), got {workers!r}"
-        )
-    return workers
-
-
 _ADDRESS = re.compile(r"^((tcp|tls|ucx|ws|wss)://)?[A-Za-z0-9._-]+(:[0-9]{1,5})?$|^inproc://\S+$")
 
 
@@ -234,7 +235,18 @@ CONNECT_TIMEOUT_S = 10
 
 
 def _run_locked(
-    config, cases, out_dir, session, *, n_workers, scheduler, overwrite, retry_failed, progress
+    config,
+    cases,
+    out_dir,
+    session,
+    *,
+    n_workers,
+    scheduler,
+    overwrite,
+    retry_failed,
+    progress,
+    worker_wait_s=DEFAULT_WORKER_WAIT_S,
+    notice=None,
 ) -> SweepSummary:
     prepare_store(config, cases, out_dir, overwrite=overwrite, session=session)
     remove_temporaries(out_dir)
@@ -273,7 +285,7 @@ def _run_locked(
     report(None)
     if todo:
         if scheduler is not None:
-            run_dask(longest_first(todo), scheduler, handle)
+            run_dask(longest_first(todo), scheduler, handle, worker_wait_s=worker_wait_s, notice=notice)
         elif n_workers == 1 or len(todo) == 1:
             # one case left: no processes to start; its engine batch gets the workers' threads
             run_here(todo, handle, threads=n_workers)

@@ -25,6 +25,7 @@ interval from the two Wilson intervals) and in holding per spine (paired bootstr
 
 from __future__ import annotations
 
+import contextlib
 import math
 from dataclasses import dataclass, field
 
@@ -300,16 +301,15 @@ def array_study(plan: ValidationPlan, runner=None) -> ArrayStudyResult:
     for key, preset, mu in SURFACES:
         if key not in ap.surfaces:
             continue
-        if runner is not None:
-            runner.note(f"arrays on {key}")
-        rig, speed = _rig(preset, mu, ap)
-        drive, done = _surface_runs(rig, speed, ap)
-        if not done:
-            continue
-        det = sim.Detection().resolve(rig.scales)
-        travel = TRAVEL_LS * rig.scales.slope_length_m / rig.length_scale_m
-        refs = _reference(rig, drive, [runs for _, runs in done], travel, det)
-        rows += [{"surface": key, **_row(cfg, runs, ref, ap)} for (cfg, runs), ref in zip(done, refs)]
+        with contextlib.nullcontext() if runner is None else runner.phase(f"arrays on {key}"):
+            rig, speed = _rig(preset, mu, ap)
+            drive, done = _surface_runs(rig, speed, ap)
+            if not done:
+                continue
+            det = sim.Detection().resolve(rig.scales)
+            travel = TRAVEL_LS * rig.scales.slope_length_m / rig.length_scale_m
+            refs = _reference(rig, drive, [runs for _, runs in done], travel, det)
+            rows += [{"surface": key, **_row(cfg, runs, ref, ap)} for (cfg, runs), ref in zip(done, refs)]
     conj, pooled = _conjecture(rows, ap)
     for r in rows:
         r.pop("_hold"), r.pop("_ok")

@@ -220,19 +220,20 @@ def _ramp_runs(
     surface = presets.make_surface(preset, **({} if seed is None else {"seed": int(seed)}))
     lc = sim.characteristic_length(surface)
     sx, sy = fam.first_start(surface)
-    runner.note(f"ramp pilots on {preset}")
     by_dur: dict[float, list[float]] = {}
-    for v in plan.ie_values:
-        rp = ramp_duration(
-            rig,
-            (sx, sy),
-            v,
-            target_lc=(surface.bounds[1] - sx) / lc,
-            max_steps=plan.ramp_max_steps,
-            slide_lc=plan.ramp_slide_lc,
-        )
-        ramp_plans.setdefault(preset, {})[float(v)] = rp.as_dict()
-        by_dur.setdefault(rp.duration_s, []).append(float(v))
+    with runner.phase(f"ramp pilots on {preset}", len(plan.ie_values)) as tick:
+        for v in plan.ie_values:
+            rp = ramp_duration(
+                rig,
+                (sx, sy),
+                v,
+                target_lc=(surface.bounds[1] - sx) / lc,
+                max_steps=plan.ramp_max_steps,
+                slide_lc=plan.ramp_slide_lc,
+            )
+            ramp_plans.setdefault(preset, {})[float(v)] = rp.as_dict()
+            by_dur.setdefault(rp.duration_s, []).append(float(v))
+            tick()
     out = []
     for j, (dur, ies_) in enumerate(sorted(by_dur.items())):
         doc = family_doc(

@@ -90,8 +90,8 @@ class GroundTruthResult:
 def ground_truth(plan: ValidationPlan, runner: StudyRunner) -> GroundTruthResult:
     """Run the three closed-form checks of ``plan`` (its ``ground_truth_*`` sizes)."""
     runner.study = "ground_truth"
-    runner.note("spring-block on a flat plane")
-    block = spring_block_check()
+    with runner.phase("spring-block on a flat plane"):
+        block = spring_block_check()
     rows = []
     for s in plan.ground_truth_slopes:
         for mu in plan.ground_truth_mus:

@@ -184,8 +184,8 @@ def stiffness_map(plan: ValidationPlan, runner: StudyRunner) -> StiffnessMapResu
     runs, samples, predicted = [], {}, {}
     for fam in fams:
         sub = subset_starts(plan.map_family(fam), plan.stiffness_map_starts)
-        runner.note(f"predicted drive limits of {fam.name}")
-        predicted[fam.name] = family_limits(plan, sub)
+        with runner.phase(f"predicted drive limits of {fam.name}"):
+            predicted[fam.name] = family_limits(plan, sub)
         for preset in fam.presets:
             doc = family_doc(
                 sub,
@@ -195,8 +195,8 @@ def stiffness_map(plan: ValidationPlan, runner: StudyRunner) -> StiffnessMapResu
                 grid=preset_grid(plan, sub, preset),
             )
             df, store = runner(doc, f"stiffness_map/{preset}")
-            runner.note(f"slip events and energy on {preset}")
-            runs.append(_run_rows(df, store, fam.name, preset, samples))
+            with runner.phase(f"slip events and energy on {preset}"):
+                runs.append(_run_rows(df, store, fam.name, preset, samples))
     table = pd.concat(runs, ignore_index=True)
     pooled = {k: {n: np.concatenate(v) for n, v in d.items()} for k, d in samples.items()}
     slip = slip_rows(table)

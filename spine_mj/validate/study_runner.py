@@ -7,9 +7,10 @@ where it stopped) and reports :class:`ValidationProgress` to the caller's callba
 
 from __future__ import annotations
 
+import contextlib
 import os
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -30,7 +31,8 @@ class ValidationProgress:
     step : str
         What runs now (a sweep name or a phase).
     finished_cases, total_cases : int
-        Of the current sweep (0, 0 between sweeps).
+        Of the current sweep, or the parts of a phase that runs none
+        (:meth:`StudyRunner.phase`).
     elapsed_s : float
         Since the validation started.
     """
@@ -76,10 +78,25 @@ class StudyRunner:
         self.t0 = t0
         self.study = ""
 
-    def note(self, step: str) -> None:
-        """Report a phase that runs no sweep (``step``)."""
-        if self.progress is not None:
-            self.progress(ValidationProgress(self.study, step, 0, 0, time.perf_counter() - self.t0))
+    @contextlib.contextmanager
+    def phase(self, step: str, total: int = 1) -> Iterator[Callable[[], None]]:
+        """A phase that runs no sweep (``step``), of ``total`` parts: reported at 0 as it
+        starts, at every call of the ``tick`` it yields, and at ``total`` as it ends (a
+        phase reported only as it started was left at 0 % by the CLI's bar)."""
+        done = 0
+
+        def report(n: int) -> None:
+            if self.progress is not None:
+                self.progress(ValidationProgress(self.study, step, n, total, time.perf_counter() - self.t0))
+
+        def tick() -> None:
+            nonlocal done
+            done = min(done + 1, total)
+            report(done)
+
+        report(0)
+        yield tick
+        report(total)
 
     def __call__(self, doc: dict, name: str, *, workers: int | None = None):
         """Run the sweep config ``doc`` into ``out/sweeps/<name>`` (overwriting it).

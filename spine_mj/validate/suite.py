@@ -11,6 +11,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from spine_mj import sim
+from spine_mj.atomic import remove_temporaries
 from spine_mj.errors import SpineInputError
 from spine_mj.jsonio import write_json
 from spine_mj.surfaces import single_gaussian
@@ -27,6 +28,7 @@ from spine_mj.validate.platform import platform_info
 from spine_mj.validate.report.document import write_report
 from spine_mj.validate.studies import STUDIES
 from spine_mj.validate.study_runner import StudyRunner, ValidationProgress
+from spine_mj.workers import check_workers
 
 __all__ = ["run_validation"]
 
@@ -65,12 +67,13 @@ def run_validation(
         if plan not in PLANS:
             raise SpineInputError(f"plan must be one of {sorted(PLANS)}, got {plan!r}")
         plan = PLANS[plan]
-    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
-        raise SpineInputError(f"workers must be an integer >= 1, got {workers!r}")
+    if workers is not None:
+        check_workers(workers)  # before anything is written
     out = Path(out_dir).resolve()  # stores refer to files under it: one absolute root
     if out.exists() and not out.is_dir():
         raise SpineInputError(f"--out {out} exists and is not a folder")
     out.mkdir(parents=True, exist_ok=True)
+    remove_temporaries(out)  # of a killed run this one resumes
     t0 = time.perf_counter()
     runner = StudyRunner(out, workers, progress, t0)
     timings = {}
@@ -80,9 +83,9 @@ def run_validation(
         results.append(study.run(plan, runner))
         timings[study.name] = round(time.perf_counter() - t, 2)
     runner.study = "report"
-    runner.note("figures and report")
-    result = _summary(plan, results, timings)
-    write_report(out, result, results)
+    with runner.phase("figures and report"):
+        result = _summary(plan, results, timings)
+        write_report(out, result, results)
     result["timings_s"]["total"] = round(time.perf_counter() - t0, 2)
     write_json(out / "validation.json", result)
     return result

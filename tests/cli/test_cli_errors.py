@@ -263,6 +263,7 @@ def test_a_drive_speed_no_time_step_can_resolve_names_the_speed(tmp_path):
 
 
 def test_replay_at_a_speed_that_would_need_endless_frames_is_refused(tmp_path):
+    pytest.importorskip("imageio", reason="needs the optional extra 'video': pip install 'spine-mj[video]'")
     run_dir = recorded_run(tmp_path)
     mp4 = tmp_path / "x.mp4"
     assert_one_error_line(
@@ -284,3 +285,45 @@ def test_replay_at_a_speed_that_would_need_endless_frames_is_refused(tmp_path):
 )
 def test_usage_errors_are_one_line_too(args, fragments):
     assert_one_error_line(run(*args), *fragments)
+
+
+@pytest.mark.parametrize(
+    ("args", "fragment"),
+    [
+        (("paper-single-peak", "--fill", "harmonic"), "does not use --fill"),
+        (("paper-single-peak", "--spacing", "1e-6"), "does not use --spacing"),
+        (("paper-single-peak", "--no-level"), "does not use --no-level"),
+        (("paper-single-peak", "--channel", "3"), "does not use --channel"),
+        (("--from-file", "tests/data/di-1.di", "--seed", "3"), "does not use --seed"),
+        (("--from-file", "tests/data/di-1.di", "--hurst", "0.7"), "does not use --hurst"),
+        (("--from-file", "tests/data/di-1.di", "--set", "nx=5"), "does not use --set"),
+    ],
+)
+def test_surface_make_refuses_options_its_input_would_ignore(tmp_path, args, fragment):
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[2]
+    args = tuple(str(root / a) if a.startswith("tests/data") else a for a in args)
+    out = tmp_path / "s.npz"
+    assert_one_error_line(run("surface", "make", *args, "-o", out), fragment)
+    assert not out.exists()
+
+
+def test_headless_replay_refuses_duration_which_only_closes_a_viewer(tmp_path):
+    run_dir = recorded_run(tmp_path)
+    mp4 = tmp_path / "x.mp4"
+    assert_one_error_line(
+        run("replay", run_dir, "--speed", "0.01", "--duration", "20", "--mp4", mp4), "--duration"
+    )
+    assert not mp4.exists()
+
+
+@pytest.mark.parametrize(
+    ("args", "fragment"),
+    [
+        (("--bogus",), "No such option '--bogus'"),
+        (("reproduce",), "Choose from: single-peak, random-gaussian"),
+    ],
+)
+def test_root_and_choice_usage_errors_are_one_line(args, fragment):
+    assert_one_error_line(run(*args), fragment)

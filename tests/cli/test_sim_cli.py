@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import mujoco
+import pytest
 
 
 def test_cli_simulate_export_and_view(tmp_path, monkeypatch):
@@ -51,6 +52,7 @@ def test_a_missing_gl_backend_is_one_error_line_naming_it(tmp_path, monkeypatch)
         raise mujoco.FatalError("an OpenGL platform library has not been loaded")
 
     monkeypatch.setattr(mujoco, "Renderer", no_gl)
+    pytest.importorskip("imageio", reason="needs the optional extra 'video': pip install 'spine-mj[video]'")
     res = CliRunner().invoke(
         main,
         [

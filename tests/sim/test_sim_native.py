@@ -88,7 +88,9 @@ def _headless_env(monkeypatch):
 
 
 def test_replay_without_a_display_writes_an_mp4_with_trail_streamline_and_overlay(run_dir, monkeypatch):
-    import imageio.v3 as iio
+    iio = pytest.importorskip(
+        "imageio.v3", reason="needs the optional extra 'video': pip install 'spine-mj[video]'"
+    )
 
     _, track = load_run(run_dir)
     span = float(track.time_s[-1] - track.time_s[0])

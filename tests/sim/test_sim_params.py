@@ -183,3 +183,12 @@ def test_a_time_step_whose_contact_rests_the_tip_too_deep_is_refused_with_the_la
     tiny = 0.5 * MIN_TIMESTEP_TAU * base.scales.time_s
     with pytest.raises(SpineInputError, match=r"timestep_s must be at least 1e-09 of the time scale"):
         Rig(surface, tip=tip, engine=EngineSettings(timestep_s=tiny, solref=(2 * tiny, 1.0)))
+
+
+@pytest.mark.parametrize(
+    "kwargs", [dict(preload_n=1e30), dict(gravity_m_s2=1e9), dict(mass_kg=1e-24, preload_n=1.0)]
+)
+def test_a_load_per_unit_mass_beyond_physics_is_refused(kwargs):
+    with pytest.raises(SpineInputError, match=r"preload_n and gravity_m_s2: the load per unit mass"):
+        TipParams(**kwargs)
+    TipParams(preload_n=1e3)  # 1e5 m/s^2 on the default 10 g: allowed

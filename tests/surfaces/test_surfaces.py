@@ -493,3 +493,23 @@ def test_gaussian_sum_on_a_grid_equals_its_pointwise_values():
     for a, b in zip(grid, points):
         assert a.shape == (23, 37)
         np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-12)
+
+
+@pytest.mark.parametrize(
+    "key, value", [("overlap", float("nan")), ("overlap", 2), ("anisotropic", "no"), ("anisotropic", None)]
+)
+def test_random_gaussians_refuse_a_flag_that_is_not_a_boolean(key, value):
+    with pytest.raises(SpineInputError, match=f"{key} must be true or false"):
+        random_gaussians(n_peaks=3, rng=0, **{key: value})
+
+
+def test_sweep_set_with_a_non_boolean_flag_is_refused_when_the_config_is_read():
+    from spine_mj.sweep import parse_config
+
+    doc = {
+        "surfaces": [{"preset": "paper-random-convex", "set": {"anisotropic": "no"}}],
+        "starts": {"points": [[0.1, 0.5]]},
+        "grid": {"mu": 0.5},
+    }
+    with pytest.raises(SpineInputError, match="anisotropic must be true or false"):
+        parse_config(doc)

@@ -156,3 +156,70 @@ def test_starts_spec_validates_when_made_directly():
     assert sweep.StartsSpec(frame="absolute", x=-3, y=[-1, -2]).count == 2
     with pytest.raises(ValueError, match=r"coordinates must be numbers in \[0, 1\] in the relative frame"):
         sweep.StartsSpec(points=((2.0, 0.5),))
+
+
+@pytest.mark.parametrize(
+    "protocol, key, value",
+    [
+        ("static", "K", 3.0),
+        ("spring", "start_force", 0.1),
+        ("spring", "slide_distance", 1e-3),
+        ("ramp", "stiffness", 10.0),
+        ("static", "duration", 1.0),
+        (["static", "spring"], "K", 3.0),
+    ],
+)
+def test_a_drive_key_that_the_protocol_ignores_is_refused(protocol, key, value):
+    doc = with_(sweep__analyses=["mujoco"], drive__protocol=protocol, **{f"drive__{key}": value})
+    with pytest.raises(SpineInputError, match=rf"config key {key} = \[.*\]: the .* drive ignores it"):
+        sweep.parse_config(doc)
+
+
+def test_drive_keys_that_the_protocol_reads_are_accepted():
+    for protocol, key, value in (
+        ("spring", "K", 3.0),
+        ("ramp", "duration", 1.0),
+        ("static", "start_force", 0.1),
+    ):
+        sweep.parse_config(
+            with_(sweep__analyses=["mujoco"], drive__protocol=protocol, **{f"drive__{key}": value})
+        )
+
+
+@pytest.mark.parametrize(
+    "analyses, key, value, message",
+    [
+        (["mujoco"], "hfield_resolution", 100000, "hfield_resolution must be <= 8192"),
+        (["mujoco"], "timestep", 1.0, "rests the tip .* deep in the surface"),
+        (["mujoco"], "ie", 1e-30, "more than the limit"),
+        (["mujoco"], "gravity", 0.0, "the tip has no normal preload"),
+        (["mujoco"], "mass", 1e30, "mass_kg must lie in"),
+        (["mujoco"], "length_scale", 1e9, "length_scale_m must lie in"),
+        (["quasistatic"], "dl", 1e-300, "a step would be lost in rounding"),
+    ],
+)
+def test_a_value_error_a_run_would_meet_refuses_the_sweep_before_anything_is_written(
+    tmp_path, analyses, key, value, message
+):
+    doc = with_(sweep__analyses=analyses, **{f"grid__{key}": [0.5, value] if key == "dl" else value})
+    if analyses == ["mujoco"]:
+        doc["grid"]["mu"] = 0.5
+    out = tmp_path / "out"
+    with pytest.raises(SpineInputError, match=rf"sweep case \(paper-single-peak.*\): .*{message}"):
+        sweep.run_sweep(sweep.parse_config(doc), out, workers=1)
+    assert not out.exists()
+
+
+def test_a_sweep_over_a_surface_file_with_an_unknown_unit_is_refused(tmp_path):
+    import numpy as np
+
+    from spine_mj import presets, surface_io
+
+    path = surface_io.save_surface(presets.make_surface("paper-single-peak").sample(16), tmp_path / "s.npz")
+    data = dict(np.load(path))
+    data["unit"] = np.array("banana")
+    np.savez(path, **data)
+    doc = with_(surfaces=[{"file": str(path)}], grid__mu=0.5)
+    with pytest.raises(SpineInputError, match="unit must be '1'"):
+        sweep.run_sweep(sweep.parse_config(doc), tmp_path / "out", workers=1)
+    assert not (tmp_path / "out").exists()

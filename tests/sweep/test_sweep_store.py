@@ -119,41 +119,44 @@ def test_kill_9_midway_then_resume_loses_and_duplicates_nothing(tmp_path):
 
 
 def test_failing_runs_are_recorded_and_the_sweep_goes_on(tmp_path):
-    (tmp_path / "broken.npz").write_bytes(b"not a zip file at all" * 10)
-    cfg = write_config(
-        tmp_path,
-        """
+    body = """
         [sweep]
         name = "failures"
         [[surfaces]]
         preset = "paper-single-peak"
         starts = { frame = "absolute", points = [[-4.0, 0.0], [40.0, 0.0]] }
         [[surfaces]]
-        file = "broken.npz"
-        [[surfaces]]
         preset = "paper-single-valley"
         [starts]
         points = [[0.05, 0.5], [0.05, 0.3]]
         [grid]
         mu = [0.5, 1.25]
-    """,
-    )
+    """
+    cfg = write_config(tmp_path, body)
     out = tmp_path / "out"
     summary = sweep.run_sweep(cfg, out, workers=2)
-    assert summary.status_counts == {"ok": 4, "failed": 4, "bad_surface": 4}
-    assert (summary.ok_runs, summary.failed_runs) == (4, 8)
+    assert summary.status_counts == {"ok": 4, "failed": 4}
+    assert (summary.ok_runs, summary.failed_runs) == (4, 4)
     runs = sweep.load_runs(out)
     failed = runs[runs.status == "failed"]
     assert set(failed.surface) == {"paper-single-peak"}
     assert failed.reason.str.contains("SpineInputError: starts must lie inside").all()
-    bad = runs[runs.status == "bad_surface"]
-    assert set(bad.surface) == {"broken"} and bad.reason.str.len().gt(10).all()
-    assert bad.end_x.isna().all()
     ok = runs[runs.status == "ok"]
     assert set(ok.surface) == {"paper-single-valley"} and ok.end_x.notna().all()
     # a finished store with failures is not re-run unless asked
     assert sweep.run_sweep(cfg, out, workers=1).run_cases == 0
-    assert sweep.run_sweep(cfg, out, workers=1, retry_failed=True).run_cases == 4
+    assert sweep.run_sweep(cfg, out, workers=1, retry_failed=True).run_cases == 2
+    # a surface file that cannot be read refuses the sweep before anything runs (it was a
+    # bad_surface row per run, the sweep exiting 0)
+    (tmp_path / "broken.npz").write_bytes(b"not a zip file at all" * 10)
+    cfg = write_config(
+        tmp_path, body.replace("[starts]", '[[surfaces]]\n        file = "broken.npz"\n        [starts]')
+    )
+    with pytest.raises(
+        SpineInputError, match=r"sweep case \(broken, mu = 0.5\): .*broken.npz is not a readable"
+    ):
+        sweep.run_sweep(cfg, tmp_path / "out2", workers=1)
+    assert not (tmp_path / "out2").exists()
 
 
 def test_a_store_held_by_a_running_sweep_is_refused_at_once_and_free_when_it_ends(tmp_path):

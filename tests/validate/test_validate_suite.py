@@ -95,3 +95,26 @@ def test_cli_bad_input_is_one_line_exit_2_and_writes_nothing(tmp_path, args, mat
     lines = res.output.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("Error:") and match in lines[0]
     assert sorted(p.name for p in tmp_path.iterdir()) == before
+
+
+def test_too_many_workers_are_refused_before_anything_is_written(tmp_path):
+    out = tmp_path / "v"
+    result = CliRunner().invoke(main, ["validate", "--quick", "--workers", "100000", "--out", str(out)])
+    assert result.exit_code == 2 and "--workers: must be an integer from 1 to" in result.output, result.output
+    assert not out.exists()
+
+
+def test_a_phase_without_a_sweep_ends_its_progress_at_100_percent(tmp_path):
+    from spine_mj.validate.study_runner import StudyRunner
+
+    seen = []
+    runner = StudyRunner(tmp_path, 1, seen.append, 0.0)
+    runner.study = "report"
+    with runner.phase("figures and report"):
+        pass
+    with runner.phase("ramp pilots", 3) as tick:
+        for _ in range(3):
+            tick()
+    steps = [(p.step, p.finished_cases, p.total_cases) for p in seen]
+    assert steps[:2] == [("figures and report", 0, 1), ("figures and report", 1, 1)]
+    assert steps[2:] == [("ramp pilots", n, 3) for n in (0, 1, 2, 3, 3)]

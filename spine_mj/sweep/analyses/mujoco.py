@@ -16,6 +16,7 @@ from spine_mj import sim
 from spine_mj.errors import SpineInputError
 from spine_mj.sim.params import surface_unit_m
 from spine_mj.sim.ramp import nominal_time_s
+from spine_mj.sim.rollout import drive_steps
 from spine_mj.sweep.registry import (
     CASE_THREADS,
     KAPPA_CAP_PARAM,
@@ -143,13 +144,33 @@ MUJOCO_PARAMS = (
 )
 
 
+#: The drive keys each protocol reads (the others, ie, speed and settle_time, every one).
+PROTOCOL_KEYS = {
+    "K": ("spring",),
+    "stiffness": ("spring",),
+    "duration": ("spring", "ramp"),
+    "start_force": ("static",),
+    "slide_distance": ("ramp",),
+}
+
+
 def _check_speed(config) -> None:
+    """One of ie/speed and K/stiffness; no drive key that a chosen protocol would ignore."""
     grid = dict(config.grid)
     for a, b, what in (("ie", "speed", "the inertia number or the speed"), ("K", "stiffness", "K or k")):
         if grid[a] != (None,) and grid[b] != (None,):
             raise SpineInputError(
                 f"config keys grid.{a} and grid.{b}: give one of them ({what}), got "
                 f"{a} = {list(grid[a])} and {b} = {list(grid[b])}"
+            )
+    defaults = {s.name: s.default for s in MUJOCO_PARAMS}
+    protocols = grid["protocol"]
+    for key, readers in PROTOCOL_KEYS.items():
+        ignoring = [p for p in protocols if p not in readers]
+        if grid[key] != (defaults[key],) and ignoring:
+            raise SpineInputError(
+                f"config key {key} = {list(grid[key])}: the {' and '.join(ignoring)} drive ignores it "
+                f"(read only by {' and '.join(readers)}); remove it, or sweep that protocol separately"
             )
 
 
@@ -254,6 +275,18 @@ def _runs(rig, p: dict, starts) -> list:
     if p["protocol"] == "ramp":
         return [rig.run(drive, start=s, detection=det) for s in pts]
     return rig.run_batch(drive, pts, detection=det, nthread=CASE_THREADS.get())
+
+
+def _check_case(case, surface, starts) -> None:
+    """The inputs' errors a run would meet, without running: the rig (tip, scales, engine),
+    the drive and, for the open-loop drives, the length of the run from the first start."""
+    rig = case_rig(case, surface)
+    drive = case_drive(rig, case.params)
+    rig.check_drive(drive)
+    if case.params["protocol"] != "ramp" and len(starts):
+        det = sim.Detection(kappa_cap=case.params["kappa_cap"]).resolve(rig.scales)
+        x0 = float(min(s[0] for s in starts)) * rig.length_scale_m
+        drive_steps(rig, drive, x0, det)
 
 
 def peak_drive_over_fp(run, preload_n: float) -> float:
@@ -372,5 +405,6 @@ register_analysis(
         MUJOCO_PARAMS,
         doc="MuJoCo rig run from every start with the chosen drive: spine_mj.sim",
         check_config=_check_speed,
+        check_case=_check_case,
     )
 )

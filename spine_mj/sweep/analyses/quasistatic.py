@@ -54,12 +54,24 @@ def traced_surface(case, surface):
     return _dilated(case.surface, r) if r > 0 else surface
 
 
+def _params(case, surface) -> sl.StreamlineParams:
+    """The streamline parameters of ``case`` on ``surface`` (the traced one)."""
+    p = case.params
+    xmin, xmax, ymin, ymax = surface.bounds
+    dl = p["dl"] if p["dl"] is not None else 0.0015 * min(xmax - xmin, ymax - ymin)
+    return sl.StreamlineParams(mu=p["mu"], dl=dl, max_steps=p["max_steps"], kappa_cap=p["kappa_cap"])
+
+
+def _check_case(case, surface, starts) -> None:
+    """The inputs' errors a run would meet: the parameters and the step on this surface."""
+    sl.check_step(surface, _params(case, surface).dl)
+
+
 def _quasistatic(case, surface, starts, upstream):
     p = case.params
     surface = traced_surface(case, surface)
-    xmin, xmax, ymin, ymax = surface.bounds
-    dl = p["dl"] if p["dl"] is not None else 0.0015 * min(xmax - xmin, ymax - ymin)
-    params = sl.StreamlineParams(mu=p["mu"], dl=dl, max_steps=p["max_steps"], kappa_cap=p["kappa_cap"])
+    params = _params(case, surface)
+    dl = params.dl
     func = sl.streamlines if p["trajectory"] == "streamline" else sl.ideal_trajectories
     res = func(surface, starts, params, store_paths=True)
     names = np.array(["", *[o.name.lower() for o in sl.Outcome]], dtype=object)
@@ -98,5 +110,6 @@ register_analysis(
         _quasistatic,
         QUASISTATIC_PARAMS,
         doc="quasistatic streamline (or ideal trajectory) from every start: spine_mj.streamline",
+        check_case=_check_case,
     )
 )

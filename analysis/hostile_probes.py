@@ -1,0 +1,343 @@
+"""Re-run the hostile-input probes of issue 28 from a folder outside the repository.
+
+Each probe is a command line with what must come of it: ``refuse`` (exit 2, one line
+``Error: ...``, none of its outputs written) or ``ok`` (exit 0, with a text the output
+must hold). Prints one line per probe and the tally. Run from anywhere:
+
+    python analysis/hostile_probes.py [--novideo /path/to/venv-without-imageio/bin]
+
+Probes that need a real scheduler, a full disk or a killed validation are covered by the
+test suite instead (tests/sweep/test_sweep_scheduler.py, tests/test_errors.py).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import textwrap
+from pathlib import Path
+
+SPINE = [str(Path(sys.executable).with_name("spine-mj"))]
+
+
+def sweep_config(folder: Path, name: str, body: str) -> str:
+    path = folder / f"{name}.toml"
+    path.write_text(textwrap.dedent(body))
+    return str(path)
+
+
+MUJOCO = """
+[sweep]
+analyses = ["{analysis}"]
+[[surfaces]]
+{surface}
+[starts]
+frame = "absolute"
+points = [[-3.0, -2.0]]
+[{table}]
+{key}
+"""
+
+
+def probes(work: Path, novideo: str | None) -> list[tuple[str, list[str], str, str, dict]]:
+    py = sys.executable
+    make = [
+        py,
+        "-c",
+        "import numpy as np, sys; from spine_mj import presets, surface_io; "
+        "s = presets.make_surface('paper-single-peak').sample(32); "
+        "surface_io.save_surface(s, 'u.npz'); d = dict(np.load('u.npz')); "
+        "d['unit'] = np.array(sys.argv[1]); np.savez(sys.argv[2], **d)",
+    ]
+    subprocess.run([*make, "banana", "banana.npz"], cwd=work, check=True)
+    subprocess.run([*make, "", "empty.npz"], cwd=work, check=True)
+    import zipfile
+
+    with zipfile.ZipFile(work / "hello.npz", "w") as z:
+        z.writestr("hello.txt", "hello")
+    flat = (
+        "import numpy as np; from spine_mj import surfaces, surface_io; x = np.linspace(0, 1, 16); "
+        "surface_io.save_surface(surfaces.GridSurface(heights=np.zeros((16, 16)), x=x, y=x), 'flat.npz')"
+    )
+    subprocess.run([py, "-c", flat], cwd=work, check=True)
+    subprocess.run(
+        [
+            *SPINE,
+            "simulate",
+            "paper-single-peak",
+            "--start",
+            "-3,-1",
+            "--resolution",
+            "41",
+            "--duration",
+            "0.01",
+            "--out",
+            "rec",
+        ],
+        cwd=work,
+        check=True,
+        capture_output=True,
+    )
+    out = []
+
+    def add(name, args, expect, needle="", env=None):
+        out.append((name, args, expect, needle, env or {}))
+
+    # README from any folder
+    add(
+        "README surface make --from-file example:plu-1.plu",
+        [
+            *SPINE,
+            "surface",
+            "make",
+            "--from-file",
+            "example:plu-1.plu",
+            "--fill",
+            "harmonic",
+            "--spacing",
+            "2e-6",
+            "-o",
+            "scan.npz",
+        ],
+        "ok",
+        "wrote",
+    )
+    add(
+        "README sweep example:mujoco-ie.toml (config read)",
+        [
+            py,
+            "-c",
+            "from spine_mj import sweep, examples; "
+            "print(sweep.load_config(examples.resolve('example:mujoco-ie.toml')).name)",
+        ],
+        "ok",
+        "mujoco-ie",
+    )
+    # optional extras and the rendering backend
+    sim = [
+        *SPINE,
+        "simulate",
+        "paper-single-peak",
+        "--start",
+        "-3,-2",
+        "--resolution",
+        "41",
+        "--duration",
+        "0.01",
+    ]
+    for gl in ("bogus", "osmesa"):
+        add(
+            f"MUJOCO_GL={gl} simulate --render",
+            [*sim, "--render", "--out", "gl"],
+            "refuse",
+            "MUJOCO_GL",
+            {"MUJOCO_GL": gl},
+        )
+    if novideo:
+        nv = [str(Path(novideo) / "spine-mj")]
+        add(
+            "no [video]: simulate --render",
+            [*nv, *sim[1:], "--render", "--out", "nv"],
+            "refuse",
+            "spine-mj[video]",
+        )
+        add(
+            "no [video]: headless replay",
+            [*nv, "replay", "rec", "--mp4", "nv.mp4"],
+            "refuse",
+            "spine-mj[video]",
+        )
+    # options accepted and ignored
+    for opt in (["--fill", "harmonic"], ["--spacing", "1e-6"], ["--no-level"], ["--channel", "3"]):
+        add(
+            f"surface make preset {opt[0]}",
+            [*SPINE, "surface", "make", "paper-single-peak", *opt, "-o", "m.npz"],
+            "refuse",
+            opt[0],
+        )
+    for opt in (["--seed", "3"], ["--hurst", "0.7"], ["--set", "nx=5"]):
+        add(
+            f"surface make --from-file {opt[0]}",
+            [*SPINE, "surface", "make", "--from-file", "example:di-1.di", *opt, "-o", "m.npz"],
+            "refuse",
+            opt[0],
+        )
+    for v in ("overlap=nan", "overlap=2", 'anisotropic="no"'):
+        add(
+            f"surface make --set {v}",
+            [*SPINE, "surface", "make", "paper-random-convex", "--set", v, "-o", "m.npz"],
+            "refuse",
+            v.split("=")[0],
+        )
+    add(
+        "replay headless --duration",
+        [*SPINE, "replay", "rec", "--speed", "0.01", "--duration", "20", "--mp4", "r.mp4"],
+        "refuse",
+        "--duration",
+    )
+    # sweep keys ignored, and value errors found only at run time
+    ignored = [
+        ("static", "K = 3.0"),
+        ("spring", "start_force = 0.1"),
+        ("spring", "slide_distance = 0.001"),
+        ("ramp", "stiffness = 10.0"),
+        ("static", "duration = 1.0"),
+    ]
+    for protocol, kv in ignored:
+        cfg = sweep_config(
+            work,
+            f"ign-{kv.split()[0]}",
+            MUJOCO.format(
+                analysis="mujoco",
+                surface='preset = "paper-single-peak"',
+                table="drive",
+                key=f'protocol = "{protocol}"\n{kv}',
+            ),
+        )
+        add(
+            f"sweep {kv} with {protocol}",
+            [*SPINE, "sweep", cfg, "--out", f"o-{kv.split()[0]}"],
+            "refuse",
+            "ignores it",
+        )
+    for kv, analysis in (
+        ("hfield_resolution = 100000", "mujoco"),
+        ("timestep = 1.0", "mujoco"),
+        ("ie = 1e-30", "mujoco"),
+        ("gravity = 0.0", "mujoco"),
+        ("mass = 1e30", "mujoco"),
+        ("length_scale = 1e9", "mujoco"),
+        ("dl = 1e-300", "quasistatic"),
+    ):
+        cfg = sweep_config(
+            work,
+            f"val-{kv.split()[0]}",
+            MUJOCO.format(analysis=analysis, surface='preset = "paper-single-peak"', table="grid", key=kv),
+        )
+        add(f"sweep {kv}", [*SPINE, "sweep", cfg, "--out", f"v-{kv.split()[0]}"], "refuse", "sweep case")
+    cfg = sweep_config(
+        work,
+        "aniso",
+        'starts = {points = [[0.1, 0.5]]}\n[[surfaces]]\npreset = "paper-random-convex"\n'
+        'set = { anisotropic = "no" }\n[grid]\nmu = 0.5\n'.replace("starts = {points = [[0.1, 0.5]]}\n", "")
+        + "[starts]\npoints = [[0.1, 0.5]]\n",
+    )
+    add(
+        'sweep set = { anisotropic = "no" }',
+        [*SPINE, "sweep", cfg, "--out", "o-aniso"],
+        "refuse",
+        "anisotropic",
+    )
+    cfg = sweep_config(
+        work,
+        "banana-sweep",
+        '[[surfaces]]\nfile = "banana.npz"\n[starts]\npoints = [[0.1, 0.5]]\n[grid]\nmu = 0.5\n',
+    )
+    add(
+        "sweep over a surface with unit banana", [*SPINE, "sweep", cfg, "--out", "o-banana"], "refuse", "unit"
+    )
+    # a wrong physical answer
+    for mu in ("1e8", "1e15", "1e100", "1e308"):
+        add(
+            f"kappa --mu {mu}",
+            [*SPINE, "kappa", "paper-single-peak", "--mu", mu, "-o", f"k{mu}.png"],
+            "ok",
+            "slip 0.0 %",
+        )
+    # nonsense that runs
+    add("simulate --preload 1e30", [*sim, "--preload", "1e30", "--out", "pl"], "refuse", "preload")
+    add("simulate --mu 0 (the mu rule: issue 24)", [*sim, "--mu", "0", "--out", "mu0"], "refuse", "mu")
+    for f in ("banana.npz", "empty.npz"):
+        add(f"surface info {f}", [*SPINE, "surface", "info", f], "refuse", "unit")
+    add(
+        "surface make 2000 Gaussians",
+        [*SPINE, "surface", "make", "paper-random-convex", "--set", "n_peaks=2000", "-o", "many.npz"],
+        "ok",
+        "wrote",
+    )
+    add("surface info 2000 Gaussians", [*SPINE, "surface", "info", "many.npz"], "ok", "not estimated")
+    # a traceback, a hang, a partial output
+    add("surface info zip not npz", [*SPINE, "surface", "info", "hello.npz"], "refuse", "hello.npz")
+    add(
+        "reproduce fractal-hurst --surfaces 1e8",
+        [
+            *SPINE,
+            "reproduce",
+            "fractal-hurst",
+            "--quick",
+            "--surfaces",
+            "100000000",
+            "--workers",
+            "1",
+            "--out",
+            "rp",
+        ],
+        "refuse",
+        "--surfaces",
+    )
+    add(
+        "validate --workers 100",
+        [*SPINE, "validate", "--quick", "--workers", "100", "--out", "v"],
+        "refuse",
+        "--workers",
+    )
+    # errors longer than one line
+    add("unknown global option", [*SPINE, "--bogus"], "refuse", "--bogus")
+    add("bare reproduce", [*SPINE, "reproduce"], "refuse", "Choose from")
+    add(
+        "surface info, no slope correlation length",
+        [*SPINE, "surface", "info", "flat.npz"],
+        "refuse",
+        "slope",
+    )
+    return out
+
+
+def run_probe(work, name, args, expect, needle, env):
+    before = {p for p in work.rglob("*")}
+    try:
+        proc = subprocess.run(
+            args, cwd=work, capture_output=True, text=True, timeout=120, env={**os.environ, **env}
+        )
+    except subprocess.TimeoutExpired:
+        return False, "timed out after 120 s"
+    text = (proc.stdout + proc.stderr).replace("\r", "\n")
+    lines = [ln for ln in text.splitlines() if ln.strip() and "%|" not in ln]
+    if expect == "ok":
+        good = proc.returncode == 0 and needle in text
+        return good, f"exit {proc.returncode}" + ("" if good else f": {lines[-1:]}")
+    new = sorted(str(p.relative_to(work)) for p in set(work.rglob("*")) - before)
+    good = (
+        proc.returncode == 2
+        and len(lines) == 1
+        and lines[0].startswith("Error:")
+        and needle in lines[0]
+        and not new
+    )
+    detail = lines[0] if len(lines) == 1 else f"{len(lines)} lines: {lines[:3]}"
+    return good, f"exit {proc.returncode}, {detail}" + (f", wrote {new}" if new else "")
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--novideo", help="bin/ folder of an environment without the video extra")
+    args = ap.parse_args(argv)
+    work = Path(tempfile.mkdtemp(prefix="spine-mj-probes-"))
+    try:
+        results = []
+        for name, cmd, expect, needle, env in probes(work, args.novideo):
+            good, detail = run_probe(work, name, cmd, expect, needle, env)
+            results.append(good)
+            print(f"{'PASS' if good else 'FAIL'}  {name}: {detail}", flush=True)
+        print(f"{sum(results)} of {len(results)} probes end as they must")
+        return 0 if all(results) else 1
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
