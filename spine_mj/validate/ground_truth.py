@@ -299,9 +299,25 @@ def _liftoff(plan: ValidationPlan, runner: StudyRunner, width: float) -> dict:
 def _crest_gap(x, z, width: float, tip: float) -> float:
     """Largest height of the tip centre above its path on the ridge within half a width of
     the crest, in tip radii (surface units in)."""
+    _, gaps = crest_gaps(x, z, width, tip)
+    return float(gaps.max()) if gaps.size else math.nan
+
+
+def crest_gaps(x, z, width: float, tip: float) -> tuple[np.ndarray, np.ndarray]:
+    """The recorded steps within half a width of the crest of :func:`ridge` (height
+    :data:`RIDGE_HEIGHT`): their x and the height of the tip centre above its path there,
+    in tip radii, in recording order (positions and ``tip`` in surface units)."""
+    x, z = np.asarray(x, float), np.asarray(z, float)
     near = np.abs(x) < 0.5 * width
-    if not near.any():
-        return math.nan
     f = RIDGE_HEIGHT * np.exp(-(x[near] ** 2) / (2 * width**2))
     fp = -x[near] / width**2 * f
-    return float(((z[near] - f - tip * np.sqrt(1 + fp * fp)) / tip).max())
+    return x[near], (z[near] - f - tip * np.sqrt(1 + fp * fp)) / tip
+
+
+def longest_flight(x, gaps, threshold: float = LIFTOFF_GAP_RADII) -> float:
+    """The x-length of the longest run of consecutive steps whose gap exceeds ``threshold``
+    tip radii (0 when none): a flight, which one step's contact chatter is not."""
+    above = np.concatenate([[False], np.asarray(gaps) > threshold, [False]])
+    edges = np.flatnonzero(above[1:] != above[:-1])
+    x = np.asarray(x, float)
+    return max((float(x[b - 1] - x[a]) for a, b in zip(edges[0::2], edges[1::2])), default=0.0)
