@@ -162,9 +162,13 @@ def integrate(p: PTParams, profile, x0: float, duration_s: float, dt_s: float, r
         )
         m = (grid >= t) & (grid <= sol.t[-1])
         xs[m], vs[m] = sol.sol(grid[m])
+        stalled = sol.t[-1] <= t  # a slide stopped where it began, at the cone's edge
         t, x = float(sol.t[-1]), float(sol.y[0, -1])
         lifted = sol.t_events[1].size > 0
         v = 0.0 if sol.t_events[0].size else float(sol.y[1, -1])
+        if stalled and v == 0.0:  # stay stuck one sample: the spring loads past the edge
+            m = (grid >= t) & (grid < t + dt_s)
+            xs[m], vs[m], t = x, 0.0, t + dt_s
     keep = np.isfinite(xs)
     return _sampled(p, profile, grid[keep], xs[keep], vs[keep], x0, lifted)
 
