@@ -28,7 +28,8 @@ from spine_mj.tomlinson import (
     liftoff_inertia_number,
     spring_block_period_s,
 )
-from spine_mj.validate.plans import MASS_KG, ValidationPlan
+from spine_mj.tomlinson_dynamics import PTParams, SineProfile, integrate
+from spine_mj.validate.plans import GRAVITY, MASS_KG, ValidationPlan
 from spine_mj.validate.study_runner import StudyRunner
 
 __all__ = ["GroundTruthResult", "ground_truth", "spring_block_check"]
@@ -162,6 +163,7 @@ def _tomlinson(plan: ValidationPlan, runner: StudyRunner, s: float, mu: float) -
         }
         if k < k_star:
             fold = c.fold(k)[1]
+            row.update(_reference(c, r, k, travel))
             row.update(
                 fold_kappa=fold,
                 onset_max_fp=float(r["slip_onset_fp_max"]),
@@ -171,6 +173,31 @@ def _tomlinson(plan: ValidationPlan, runner: StudyRunner, s: float, mu: float) -
             )
         rows.append(row)
     return rows
+
+
+def _reference(c: Corrugation, r, k: float, travel: float) -> dict:
+    """The reference integrator (:mod:`spine_mj.tomlinson_dynamics`, a point tip on the
+    smooth profile) with the MuJoCo run's m, k, W, V, over its travel: events per
+    wavelength, onset errors against the fold and the longest jump [wavelengths]."""
+    unit, w = sim.DEFAULT_LENGTH_SCALE_M, MASS_KG * GRAVITY
+    p = PTParams(MASS_KG, k * w / (float(r["slope_length"]) * unit), w, float(r["speed_m_s"]), c.mu)
+    stretch = w * c.kappa_range()[1] / p.stiffness_n_m
+    run = integrate(
+        p,
+        SineProfile(c.slope_amplitude, unit),
+        CORRUGATION_START * unit,
+        (max(travel, 1.0) * unit + stretch) / p.speed_m_s,
+        0.01 * 2 * math.pi / p.omega_rad_s,
+    )
+    fold = c.fold(k)[1]
+    onsets = np.array([e.onset_force_n / w for e in run.events]) / fold - 1
+    waves = (run.x_m[-1] - run.x_m[0]) / unit
+    return {
+        "ref_events_per_wave": len(run.events) / waves if waves > 0 else math.nan,
+        "ref_onset_max_rel_error": float(onsets.max()) if onsets.size else math.nan,
+        "ref_onset_mean_rel_error": float(onsets.mean()) if onsets.size else math.nan,
+        "ref_max_jump_waves": max((e.jump_length_m / unit for e in run.events), default=math.nan),
+    }
 
 
 #: Where the corrugation runs start (x over the wavelength; y = 0): a quarter wavelength
@@ -272,9 +299,25 @@ def _liftoff(plan: ValidationPlan, runner: StudyRunner, width: float) -> dict:
 def _crest_gap(x, z, width: float, tip: float) -> float:
     """Largest height of the tip centre above its path on the ridge within half a width of
     the crest, in tip radii (surface units in)."""
+    _, gaps = crest_gaps(x, z, width, tip)
+    return float(gaps.max()) if gaps.size else math.nan
+
+
+def crest_gaps(x, z, width: float, tip: float) -> tuple[np.ndarray, np.ndarray]:
+    """The recorded steps within half a width of the crest of :func:`ridge` (height
+    :data:`RIDGE_HEIGHT`): their x and the height of the tip centre above its path there,
+    in tip radii, in recording order (positions and ``tip`` in surface units)."""
+    x, z = np.asarray(x, float), np.asarray(z, float)
     near = np.abs(x) < 0.5 * width
-    if not near.any():
-        return math.nan
     f = RIDGE_HEIGHT * np.exp(-(x[near] ** 2) / (2 * width**2))
     fp = -x[near] / width**2 * f
-    return float(((z[near] - f - tip * np.sqrt(1 + fp * fp)) / tip).max())
+    return x[near], (z[near] - f - tip * np.sqrt(1 + fp * fp)) / tip
+
+
+def longest_flight(x, gaps, threshold: float = LIFTOFF_GAP_RADII) -> float:
+    """The x-length of the longest run of consecutive steps whose gap exceeds ``threshold``
+    tip radii (0 when none): a flight, which one step's contact chatter is not."""
+    above = np.concatenate([[False], np.asarray(gaps) > threshold, [False]])
+    edges = np.flatnonzero(above[1:] != above[:-1])
+    x = np.asarray(x, float)
+    return max((float(x[b - 1] - x[a]) for a, b in zip(edges[0::2], edges[1::2])), default=0.0)

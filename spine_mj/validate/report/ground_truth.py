@@ -71,7 +71,12 @@ def _tomlinson(rows: list[dict]) -> list[str]:
         f"{f(np.mean([r['events_per_wave'] for r in below]) if below else math.nan)} events per "
         f"wavelength on average; the largest onset force within {f(100 * max(err, default=math.nan))} % "
         "of W kappa at the fold. The mean onset is lower where a jump overshoots past the next "
-        "fold (inertia): the tip then reloads and jumps below the fold's force.",
+        "fold (inertia): the tip then reloads and jumps below the fold's force. The reference "
+        "integrator (spine_mj.tomlinson_dynamics: a rigid point tip on the smooth profile with "
+        "Coulomb friction, the same m, k, W, V) overshoots too: below about 0.35 K* Coulomb "
+        "friction cannot stop a jump within a wavelength at any speed, so one event per "
+        "wavelength at the fold's force is not reachable there by correct rigid-body dynamics "
+        "(docs/physics.md, section 6).",
         "",
         table(
             rows,
@@ -88,6 +93,10 @@ def _tomlinson(rows: list[dict]) -> list[str]:
                 "onset_mean_rel_error",
                 "max_speed_v",
                 "stuck_fraction",
+                "ref_events_per_wave",
+                "ref_onset_max_rel_error",
+                "ref_onset_mean_rel_error",
+                "ref_max_jump_waves",
             ],
             [
                 "s",
@@ -102,6 +111,10 @@ def _tomlinson(rows: list[dict]) -> list[str]:
                 "mean onset error",
                 "max speed (V)",
                 "stuck",
+                "reference per wavelength",
+                "reference max onset error",
+                "reference mean onset error",
+                "reference longest jump (lambda)",
             ],
         ),
         "",
