@@ -297,6 +297,8 @@ def _conjecture(rows: list[dict], plan: ArrayPlan) -> tuple[list[dict], dict]:
 def array_study(plan: ValidationPlan, runner=None) -> ArrayStudyResult:
     """Run the array study at the size of ``plan`` (:data:`ARRAY_PLANS` by its name)."""
     ap = ARRAY_PLANS.get(plan.name, ARRAY_PLANS["quick"])
+    if runner is not None:
+        runner.study = "arrays"
     rows = []
     for key, preset, mu in SURFACES:
         if key not in ap.surfaces:
