@@ -28,6 +28,8 @@ MIN_EVENTS = 200
 XMIN_CANDIDATES = 64
 #: Fewest events a candidate tail keeps.
 MIN_TAIL = 50
+#: The exponents a fit may return (the density's ``alpha``).
+ALPHA_RANGE = (1.0, 20.0)
 
 
 def xmin_by_ks(x: np.ndarray) -> float:
@@ -73,7 +75,8 @@ def fit_tail(samples) -> dict:
 
     with warnings.catch_warnings(), contextlib.redirect_stdout(io.StringIO()), np.errstate(all="ignore"):
         warnings.simplefilter("ignore")
-        fit = powerlaw.Fit(x, xmin=xmin_by_ks(x), verbose=False)
+        # the package bounds alpha to [0, 3] by default, which pins steep tails at 3
+        fit = powerlaw.Fit(x, xmin=xmin_by_ks(x), parameter_ranges={"alpha": ALPHA_RANGE}, verbose=False)
         pl = fit.power_law
         ratio, p = fit.distribution_compare("power_law", "exponential", normalized_ratio=True)
     alpha, sigma = float(pl.alpha), float(pl.standard_err)

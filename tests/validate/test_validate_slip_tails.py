@@ -42,3 +42,10 @@ def test_the_quantile_search_agrees_with_the_packages_search_over_every_value():
         ref = powerlaw.Fit(x, verbose=False)
     fit = fit_tail(x)
     assert fit["alpha"] == pytest.approx(float(ref.power_law.alpha), abs=0.15)
+
+
+def test_a_steep_tail_is_not_pinned_at_the_packages_default_bound_of_3():
+    rng = np.random.default_rng(1)
+    x = (1 - rng.random(3000)) ** (-1 / 3.0)  # p(S) ~ S^-4
+    fit = fit_tail(x)
+    assert fit["ci_low"] < 4.0 < fit["ci_high"]
