@@ -10,6 +10,7 @@ callbacks.
 
 from __future__ import annotations
 
+import os
 import signal
 import sys
 from pathlib import Path
@@ -112,6 +113,9 @@ class _Group(click.Group):
             if exc.details and root.params.get("verbose"):
                 click.echo(exc.details, err=True)
             raise InputError(str(exc)) from None
+        except BrokenPipeError:  # the reader left (`spine-mj examples | head`): no error to report
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # the exit's flush too
+            raise SystemExit(128 + signal.SIGPIPE) from None
         except OSError as exc:
             where = f": {exc.filename}" if exc.filename is not None else " (the system named no file)"
             raise InputError(f"{exc.strerror or exc}{where}") from None

@@ -327,3 +327,25 @@ def test_headless_replay_refuses_duration_which_only_closes_a_viewer(tmp_path):
 )
 def test_root_and_choice_usage_errors_are_one_line(args, fragment):
     assert_one_error_line(run(*args), fragment)
+
+
+def test_a_reader_that_leaves_the_pipe_early_gets_no_error_line():
+    # `spine-mj examples | head -1`: writing into a pipe whose reader has gone is no error
+    import os
+    import subprocess
+    import sys
+
+    read_end, write_end = os.pipe()
+    os.close(read_end)
+    try:
+        proc = subprocess.run(
+            [sys.executable, "-m", "spine_mj.cli", "examples"],
+            stdout=write_end,
+            stderr=subprocess.PIPE,
+            text=True,
+            timeout=120,
+        )
+    finally:
+        os.close(write_end)
+    assert proc.stderr == ""
+    assert proc.returncode == 141  # 128 + SIGPIPE, what a shell reports for such a writer
