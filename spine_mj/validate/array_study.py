@@ -39,6 +39,7 @@ from spine_mj.compliant import compliant_streamlines
 from spine_mj.sim.drives import stiffness_n_m
 from spine_mj.streamline import StreamlineParams, dilate
 from spine_mj.validate.fractal_lock import CONFIDENCE, lock_rate
+from spine_mj.validate.intervals import newcombe_difference
 from spine_mj.validate.plans import SANDPAPER_MU, ValidationPlan
 
 __all__ = ["ARRAY_PLANS", "ArrayPlan", "ArrayStudyResult", "array_study", "newcombe_difference"]
@@ -104,16 +105,6 @@ class ArrayStudyResult:
         return {"rows": self.rows, "conjecture": self.conjecture, "pooled": self.pooled, "plan": self.plan}
 
 
-def newcombe_difference(a: dict, b: dict) -> dict:
-    """``a["rate"] - b["rate"]`` of two :func:`lock_rate` records with Newcombe's hybrid
-    score interval (method 10) built from their Wilson intervals."""
-    pa, pb = a["rate"], b["rate"]
-    d = pa - pb
-    lo = d - math.sqrt((pa - a["ci_low"]) ** 2 + (b["ci_high"] - pb) ** 2)
-    hi = d + math.sqrt((a["ci_high"] - pa) ** 2 + (pb - b["ci_low"]) ** 2)
-    return {"diff": d, "ci_low": lo, "ci_high": hi}
-
-
 def _mean_ci(values, n_resamples: int, seed: int) -> tuple[float, float, float]:
     v = np.asarray(values, dtype=float)
     v = v[np.isfinite(v)]
@@ -134,7 +125,7 @@ def _mean_ci(values, n_resamples: int, seed: int) -> tuple[float, float, float]:
 
 def _rig(preset: str, mu: float | None, plan: ArrayPlan):
     surf = presets.make_surface(preset)
-    mu = mu if mu is not None else (presets.preset_mu(surf) or 0.5)
+    mu = presets.resolve_mu(surf, mu)
     tip = sim.TipParams(mu_s=mu)
     res = plan.hfield_resolution if surf.unit == "1" else None
     sc = sim.Scales.for_surface(surf, tip=tip, hfield_resolution=res)

@@ -23,6 +23,7 @@ __all__ = [
     "TARGET_SLACK",
     "bootstrap",
     "meets_target",
+    "newcombe_difference",
     "runs_to_meet",
     "wilson",
 ]
@@ -79,6 +80,17 @@ def bootstrap(
         rng=np.random.default_rng(seed),
     )
     return float(res.confidence_interval.low), float(res.confidence_interval.high)
+
+
+def newcombe_difference(a: dict, b: dict) -> dict:
+    """``a["rate"] - b["rate"]`` of two rate records (``rate``, ``ci_low``, ``ci_high``: e.g.
+    :func:`~spine_mj.validate.fractal_lock.lock_rate`) with Newcombe's hybrid
+    score interval (method 10) built from their Wilson intervals."""
+    pa, pb = a["rate"], b["rate"]
+    d = pa - pb
+    lo = d - math.sqrt((pa - a["ci_low"]) ** 2 + (b["ci_high"] - pb) ** 2)
+    hi = d + math.sqrt((a["ci_high"] - pa) ** 2 + (pb - b["ci_low"]) ** 2)
+    return {"diff": d, "ci_low": lo, "ci_high": hi}
 
 
 def meets_target(point: float, interval: Sequence[float], target: float, *, higher_is_better: bool) -> bool:
