@@ -16,7 +16,7 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["ball_on_facets"]
+__all__ = ["ball_at", "ball_on_facets"]
 
 
 @njit(cache=True)
@@ -37,67 +37,71 @@ def ball_on_facets(x, y, h, x0, y0, dx, dy, r):
     f = np.empty(n)
     fx = np.empty(n)
     fy = np.empty(n)
+    for p in range(n):
+        f[p], fx[p], fy[p] = ball_at(x[p], y[p], h, x0, y0, dx, dy, r)
+    return f, fx, fy
+
+
+@njit(cache=True)
+def ball_at(cx, cy, h, x0, y0, dx, dy, r):
+    """``(f, fx, fy)`` of :func:`ball_on_facets` at the one point ``(cx, cy)`` (for compiled
+    callers that step along a path, :mod:`spine_mj._compliant_kernel`)."""
     mx = int(math.ceil(2 * r / dx)) + 2
     my = int(math.ceil(2 * r / dy)) + 2
     r2 = r * r
-    for p in range(n):
-        cx, cy = x[p], y[p]
-        ib = int(math.floor((cx - r - x0) / dx))
-        jb = int(math.floor((cy - r - y0) / dy))
-        best = -np.inf
-        qx, qy, qz = 0.0, 0.0, 0.0
-        for j in range(jb, jb + my):  # vertices: the sphere around each
+    ib = int(math.floor((cx - r - x0) / dx))
+    jb = int(math.floor((cy - r - y0) / dy))
+    best = -np.inf
+    qx, qy, qz = 0.0, 0.0, 0.0
+    for j in range(jb, jb + my):  # vertices: the sphere around each
+        for i in range(ib, ib + mx):
+            ax, ay, az, aok = _node(h, i, j, x0, y0, dx, dy)
+            d2 = (cx - ax) ** 2 + (cy - ay) ** 2
+            if aok and d2 <= r2:
+                z = az + math.sqrt(r2 - d2)
+                if z > best:
+                    best, qx, qy, qz = z, ax, ay, az
+    for si, sj in ((1, 0), (0, 1), (1, 1)):  # edges: the cylinder around each
+        for j in range(jb, jb + my):
             for i in range(ib, ib + mx):
                 ax, ay, az, aok = _node(h, i, j, x0, y0, dx, dy)
-                d2 = (cx - ax) ** 2 + (cy - ay) ** 2
-                if aok and d2 <= r2:
-                    z = az + math.sqrt(r2 - d2)
+                bx, by, bz, bok = _node(h, i + si, j + sj, x0, y0, dx, dy)
+                if not (aok and bok):
+                    continue
+                ex, ey, ez = bx - ax, by - ay, bz - az
+                ll = ex * ex + ey * ey + ez * ez
+                wd = (cx - ax) * ex + (cy - ay) * ey
+                alpha = (ex * ex + ey * ey) / ll
+                beta = wd * ez / ll
+                gamma = (cx - ax) ** 2 + (cy - ay) ** 2 - wd * wd / ll - r2
+                disc = beta * beta - alpha * gamma
+                if not (disc >= 0):
+                    continue
+                e = (beta + math.sqrt(disc)) / alpha
+                t = (wd + e * ez) / ll
+                if math.isfinite(e) and t >= 0 and t <= 1:
+                    z = az + e
                     if z > best:
-                        best, qx, qy, qz = z, ax, ay, az
-        for si, sj in ((1, 0), (0, 1), (1, 1)):  # edges: the cylinder around each
-            for j in range(jb, jb + my):
-                for i in range(ib, ib + mx):
-                    ax, ay, az, aok = _node(h, i, j, x0, y0, dx, dy)
-                    bx, by, bz, bok = _node(h, i + si, j + sj, x0, y0, dx, dy)
-                    if not (aok and bok):
-                        continue
-                    ex, ey, ez = bx - ax, by - ay, bz - az
-                    ll = ex * ex + ey * ey + ez * ez
-                    wd = (cx - ax) * ex + (cy - ay) * ey
-                    alpha = (ex * ex + ey * ey) / ll
-                    beta = wd * ez / ll
-                    gamma = (cx - ax) ** 2 + (cy - ay) ** 2 - wd * wd / ll - r2
-                    disc = beta * beta - alpha * gamma
-                    if not (disc >= 0):
-                        continue
-                    e = (beta + math.sqrt(disc)) / alpha
-                    t = (wd + e * ez) / ll
-                    if math.isfinite(e) and t >= 0 and t <= 1:
-                        z = az + e
-                        if z > best:
-                            best, qx, qy, qz = z, ax + t * ex, ay + t * ey, az + t * ez
-        for lower in (True, False):  # faces: the plane lifted along its normal
-            for j in range(jb, jb + my):
-                for i in range(ib, ib + mx):
-                    ax, ay, az, aok = _node(h, i, j, x0, y0, dx, dy)
-                    _, _, h11, ok11 = _node(h, i + 1, j + 1, x0, y0, dx, dy)
-                    _, _, h10, ok10 = _node(h, i + 1, j, x0, y0, dx, dy)
-                    _, _, h01, ok01 = _node(h, i, j + 1, x0, y0, dx, dy)
-                    if not (aok and ok11 and (ok10 if lower else ok01)):
-                        continue
-                    gx = ((h10 - az) if lower else (h11 - h01)) / dx
-                    gy = ((h11 - h10) if lower else (h01 - az)) / dy
-                    norm = math.sqrt(1.0 + gx * gx + gy * gy)
-                    px, py = cx + r * gx / norm, cy + r * gy / norm
-                    s, t = (px - ax) / dx, (py - ay) / dy
-                    inside = (t >= 0 and t <= s and s <= 1) if lower else (s >= 0 and s <= t and t <= 1)
-                    if inside:
-                        pz = az + gx * (px - ax) + gy * (py - ay)
-                        z = pz + r / norm
-                        if z > best:
-                            best, qx, qy, qz = z, px, py, pz
-        nzc = best - qz
-        f[p] = best - r
-        fx[p] = -(cx - qx) / nzc
-        fy[p] = -(cy - qy) / nzc
-    return f, fx, fy
+                        best, qx, qy, qz = z, ax + t * ex, ay + t * ey, az + t * ez
+    for lower in (True, False):  # faces: the plane lifted along its normal
+        for j in range(jb, jb + my):
+            for i in range(ib, ib + mx):
+                ax, ay, az, aok = _node(h, i, j, x0, y0, dx, dy)
+                _, _, h11, ok11 = _node(h, i + 1, j + 1, x0, y0, dx, dy)
+                _, _, h10, ok10 = _node(h, i + 1, j, x0, y0, dx, dy)
+                _, _, h01, ok01 = _node(h, i, j + 1, x0, y0, dx, dy)
+                if not (aok and ok11 and (ok10 if lower else ok01)):
+                    continue
+                gx = ((h10 - az) if lower else (h11 - h01)) / dx
+                gy = ((h11 - h10) if lower else (h01 - az)) / dy
+                norm = math.sqrt(1.0 + gx * gx + gy * gy)
+                px, py = cx + r * gx / norm, cy + r * gy / norm
+                s, t = (px - ax) / dx, (py - ay) / dy
+                inside = (t >= 0 and t <= s and s <= 1) if lower else (s >= 0 and s <= t and t <= 1)
+                if inside:
+                    pz = az + gx * (px - ax) + gy * (py - ay)
+                    z = pz + r / norm
+                    if z > best:
+                        best, qx, qy, qz = z, px, py, pz
+    nzc = best - qz
+    return best - r, -(cx - qx) / nzc, -(cy - qy) / nzc

@@ -188,6 +188,48 @@ def test_ball_on_facets_like_the_rigid_reference():
         assert np.all(np.diff(np.floor(f.x[landed & (f.x > starts[i][0] + 1e-9)])) == 1)
 
 
+def test_compiled_fold_and_landing_searches_equal_the_numpy_ones():
+    from spine_mj import _compliant_kernel as kernel
+    from spine_mj.compliant import _BISECTIONS, _GOLDEN_ITERATIONS, _fold_along, _landing_along
+
+    grid = corrugation(slope_amplitude=0.4, n_waves=3, points_per_wave=16)
+    contact = BallOnFacets(TriangulatedSurface.from_grid(grid), 0.05)
+    rng = np.random.default_rng(7)
+    n = 64
+    px, py = rng.uniform(0.2, 2.6, n), rng.uniform(-0.2, 0.2, n)
+    ang = rng.uniform(-0.6, 0.6, n)
+    vx, vy, h = np.cos(ang), np.sin(ang), rng.uniform(0.01, 0.2, n)
+    c, mu, tol = 3.0, 0.6, 1e-12
+    s_ref, x_ref = _fold_along(contact, px, py, vx, vy, h, c, mu, tol)
+    s_fast, x_fast = kernel.fold_on_facets(
+        px, py, vx, vy, h, c, mu, tol, _GOLDEN_ITERATIONS, *contact.kernel_args()
+    )
+    np.testing.assert_allclose(s_fast, s_ref, rtol=0, atol=1e-12 * h.max())
+    np.testing.assert_allclose(x_fast, x_ref, rtol=1e-12)
+    carriage = px + rng.uniform(0.0, 0.5, n)
+    l_ref = _landing_along(contact, px, py, vx, vy, h, carriage, c, mu, tol)
+    l_fast = kernel.landing_on_facets(
+        px, py, vx, vy, h, carriage, c, mu, tol, _BISECTIONS, *contact.kernel_args()
+    )
+    np.testing.assert_allclose(l_fast, l_ref, rtol=0, atol=1e-12 * h.max())
+
+
+def test_soft_spring_on_facets_compiled_and_numpy_alike():
+    """The whole soft-spring path (many folds and landings) with the compiled kernels and with
+    the numpy contact and searches: the same jumps, paths within round-off."""
+    grid = corrugation(slope_amplitude=0.3, n_waves=4, points_per_wave=24)
+    facets = TriangulatedSurface.from_grid(grid)
+    p = StreamlineParams(mu=0.5, dl=0.005)
+    starts = [(0.3, 0.0), (0.5, 0.2)]
+    fast = compliant_streamlines(BallOnFacets(facets, 0.04), starts, p, stiffness=0.1 / L_S)
+    slow = compliant_streamlines(BallOnFacets(facets, 0.04, compiled=False), starts, p, stiffness=0.1 / L_S)
+    assert len(fast.folds) == len(slow.folds) >= 6
+    np.testing.assert_array_equal(fast.outcome, slow.outcome)
+    for i in range(2):
+        assert _distance(fast, slow, i) < 1e-9
+    np.testing.assert_allclose(fast.folds.onset_force, slow.folds.onset_force, rtol=1e-9)
+
+
 def test_many_starts_equal_one_at_a_time():
     surf = single_gaussian(sign=1)
     starts = [(-3.0, y) for y in (-3.0, -1.0, -0.5)]

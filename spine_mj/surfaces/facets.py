@@ -137,24 +137,25 @@ class BallOnFacets(Surface):
         if self.compiled:
             from spine_mj._contact_kernel import ball_on_facets
 
-            fac = self.facets
-            ny, nx = fac.heights.shape
-            dx = (fac.x[-1] - fac.x[0]) / (nx - 1)
-            dy = (fac.y[-1] - fac.y[0]) / (ny - 1)
             f, fx, fy = ball_on_facets(
                 np.ascontiguousarray(x, dtype=float),
                 np.ascontiguousarray(y, dtype=float),
-                np.ascontiguousarray(fac.heights, dtype=float),
-                float(fac.x[0]),
-                float(fac.y[0]),
-                float(dx),
-                float(dy),
-                float(self.radius),
+                *self.kernel_args(),
             )
         else:
             parts = [self._contact(x[s : s + 1024], y[s : s + 1024]) for s in range(0, x.size, 1024)]
             f, fx, fy = (np.concatenate([p[k] for p in parts]) for k in range(3))
         return (f,) if order == 0 else (f, fx, fy)
+
+    def kernel_args(self) -> tuple:
+        """``(heights, x0, y0, dx, dy, radius)``: the grid as the compiled kernels take it
+        (:func:`spine_mj._contact_kernel.ball_on_facets` and the callers of ``ball_at``)."""
+        fac = self.facets
+        ny, nx = fac.heights.shape
+        dx = (fac.x[-1] - fac.x[0]) / (nx - 1)
+        dy = (fac.y[-1] - fac.y[0]) / (ny - 1)
+        heights = np.ascontiguousarray(fac.heights, dtype=float)
+        return heights, float(fac.x[0]), float(fac.y[0]), float(dx), float(dy), float(self.radius)
 
     def _contact(self, x, y):
         """Centre height less the radius and the contact's slopes at points ``x``, ``y``

@@ -1,8 +1,9 @@
 """The machine a validation ran on, for ``validation.json``.
 
-MuJoCo's vectorized paths round differently on different CPUs (an AVX-512 machine flipped
-two fractal runs against the committed AVX2 numbers), so every set of headline numbers
-names the CPU, its vector instruction sets, and the versions that made them.
+Vectorized code paths round differently on different CPUs (an AVX-512 machine flipped two
+fractal runs against the committed AVX2 numbers), so every set of headline numbers names
+the CPU, its vector instruction sets, the versions that made them, and any variable that
+switched the run-time choice of code paths.
 """
 
 from __future__ import annotations
@@ -16,6 +17,16 @@ __all__ = ["platform_info"]
 
 #: CPU flags that name the vector instruction sets MuJoCo's compiled code can take.
 VECTOR_FLAGS = ("sse4_2", "avx", "avx2", "fma", "avx512f", "avx512dq", "avx512vl", "neon", "asimd")
+
+
+#: Environment variables that change which vector code paths numpy and the C library's maths
+#: take at run time (recorded when set: the numbers then stand for another CPU's paths).
+DISPATCH_VARIABLES = (
+    "NPY_DISABLE_CPU_FEATURES",
+    "NPY_ENABLE_CPU_FEATURES",
+    "GLIBC_TUNABLES",
+    "NUMBA_CPU_NAME",
+)
 
 
 def _cpuinfo() -> tuple[str, list[str]]:
@@ -41,8 +52,9 @@ def _cpuinfo() -> tuple[str, list[str]]:
 def platform_info() -> dict:
     """CPU, vector instruction sets, OS and versions of Python, numpy and MuJoCo.
 
-    ``vector_instruction_sets`` are those the CPU offers; MuJoCo's wheels pick their code
-    paths at run time from them, so they stand for the ones MuJoCo used.
+    ``vector_instruction_sets`` are those the CPU offers; numpy and the C library pick
+    their code paths at run time from them, unless ``dispatch_overrides`` (the environment
+    variables of :data:`DISPATCH_VARIABLES` that were set) switched some off.
     """
     import numpy as np
 
@@ -62,4 +74,6 @@ def platform_info() -> dict:
         "python": sys.version.split()[0],
         "numpy": np.__version__,
         "mujoco": mj_version,
+        # set to emulate another CPU's code paths (analysis/reproduction_check.py)
+        "dispatch_overrides": {k: os.environ[k] for k in DISPATCH_VARIABLES if os.environ.get(k)},
     }

@@ -75,3 +75,9 @@ def test_the_fewest_runs_that_can_meet_a_rate_target():
     assert meets_target(1.0, wilson(n, n), 0.95, higher_is_better=True)
     assert not meets_target(1.0, wilson(n - 1, n - 1), 0.95, higher_is_better=True)
     assert n == 35  # z^2 (1 - 0.9) / 0.1 rounded up: 30 all-agreeing runs are not enough
+
+
+def test_platform_records_the_variables_that_switch_code_paths(monkeypatch):
+    monkeypatch.setenv("NPY_DISABLE_CPU_FEATURES", "X86_V4")
+    monkeypatch.delenv("GLIBC_TUNABLES", raising=False)
+    assert platform_info()["dispatch_overrides"] == {"NPY_DISABLE_CPU_FEATURES": "X86_V4"}

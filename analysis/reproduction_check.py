@@ -1,0 +1,98 @@
+"""Do the committed quick-plan numbers reproduce on this machine? Put a new run's headline
+numbers beside the committed 95 % intervals (spine_mj.validate.reproducibility).
+
+    # on another CPU: run the quick plan there, then
+    python analysis/reproduction_check.py demo-out/validation.json
+
+    # on this CPU with the vector code paths of an older one (x86-64-v2: no AVX2, FMA or
+    # AVX-512 in numpy's dispatch or the C library's maths), the quick plan run and checked
+    python analysis/reproduction_check.py --emulate-x86-64-v2 --out emulated-out
+
+Writes a Markdown table (``-o``, default: printed) and exits 1 when a number lies outside
+its committed interval or a family's verdict changed.
+
+What differs between two x86-64 CPUs is the code paths picked by CPU: numpy's dispatch
+(NPY_DISABLE_CPU_FEATURES), glibc's maths (GLIBC_TUNABLES) and the machine code numba
+generates for the host (NUMBA_CPU_NAME); the emulation switches all three to x86-64-v2. On
+an AVX-512 machine numpy's and glibc's exp, log, power and trigonometric results then
+differ in the last bits, as another CPU's do. MuJoCo's wheel carries one AVX build without
+run-time dispatch (no cpuid, no AVX-512 instruction in libmujoco 4.0.0), so its own
+arithmetic is the same on every AVX machine and differs only through glibc's maths. Another
+architecture (ARM) or MuJoCo build is not covered: that needs the other machine.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+from spine_mj.validate.reproducibility import check_reproduction
+
+REPO = Path(__file__).resolve().parents[1]
+COMMITTED = REPO / "analysis" / "reports" / "validation-quick" / "validation.json"
+
+#: What an x86-64-v2 CPU gives numpy's dispatch and glibc's maths (Linux, glibc >= 2.33).
+X86_64_V2 = {
+    "NPY_DISABLE_CPU_FEATURES": "X86_V3 X86_V4 AVX512_ICL AVX512_SPR",
+    "GLIBC_TUNABLES": "glibc.cpu.hwcaps=-AVX2,-FMA,-AVX512F,-AVX512DQ,-AVX512VL,-AVX512BW",
+    "NUMBA_CPU_NAME": "x86-64-v2",
+}
+
+
+def _fmt(v) -> str:
+    return "-" if v is None else f"{v:.4g}"
+
+
+def table(rows) -> str:
+    lines = [
+        "| number | committed | 95 % interval | new | inside | verdict kept |",
+        "|---|---|---|---|---|---|",
+    ]
+    for r in rows:
+        ci = "-" if r.interval is None else f"[{_fmt(r.interval[0])}, {_fmt(r.interval[1])}]"
+        lines.append(
+            f"| {r.key} | {_fmt(r.committed)} | {ci} | {_fmt(r.new)} | "
+            f"{'yes' if r.inside else '**no**'} | {'yes' if r.verdict_kept else '**no**'} |"
+        )
+    bad = sum(not r.ok for r in rows)
+    lines.append("")
+    lines.append(f"{len(rows) - bad} of {len(rows)} inside the committed intervals, verdicts kept.")
+    return "\n".join(lines)
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("new", nargs="?", help="validation.json of the new run")
+    ap.add_argument("--committed", default=str(COMMITTED), help="the committed validation.json")
+    ap.add_argument(
+        "--emulate-x86-64-v2", action="store_true", help="run the quick plan with x86-64-v2 code paths"
+    )
+    ap.add_argument("--out", default="emulated-out", help="output folder of the emulated run")
+    ap.add_argument("-o", "--report", help="write the table here (Markdown)")
+    args = ap.parse_args()
+    if args.emulate_x86_64_v2:
+        env = {**os.environ, **X86_64_V2}
+        spine = str(Path(sys.executable).with_name("spine-mj"))
+        subprocess.run([spine, "validate", "--quick", "--out", args.out], env=env, check=True)
+        new = Path(args.out) / "validation.json"
+    elif args.new:
+        new = Path(args.new)
+    else:
+        ap.error("give the new run's validation.json or --emulate-x86-64-v2")
+    committed = json.loads(Path(args.committed).read_text())
+    fresh = json.loads(new.read_text())
+    text = f"New: {fresh.get('platform')}\n\nCommitted: {committed.get('platform')}\n\n"
+    rows = check_reproduction(fresh, committed)
+    text += table(rows) + "\n"
+    if args.report:
+        Path(args.report).write_text(text)
+    print(text)
+    return 0 if all(r.ok for r in rows) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
