@@ -204,9 +204,11 @@ def limit_doc(plan: ValidationPlan, fam: FamilySpec, preset: str, name: str, ove
         "dl": tip / 2,
         **engine_grid(plan, overrides, preset, fam.seeds, tip),
     }
-    if plan.ensemble_members > 1 and not overrides:
-        fam = ensemble_family(fam, preset, plan.ensemble_members)
-    return family_doc(
+    members = plan.ensemble_members if not overrides else 1
+    if members > 1:
+        fam = ensemble_family(fam, preset, members)
+        grid["ensemble_members"] = members
+    doc = family_doc(
         fam,
         name=name,
         preset=preset,
@@ -214,6 +216,27 @@ def limit_doc(plan: ValidationPlan, fam: FamilySpec, preset: str, name: str, ove
         grid=grid,
         miss_reasons=not overrides,
     )
+    if members > 1:
+        doc["surfaces"] = _chunked(doc["surfaces"], doc["starts"], CASE_STARTS * members)
+    return doc
+
+
+#: Starts (whole ensembles) per case of a limit sweep: a preset's starts split into cases of at
+#: most this many, so that a sweep of one preset keeps every worker busy (a case's MuJoCo
+#: runs share its threads, but its reference streamlines are serial Python: on one case the
+#: second core idled through half the study). Each start's runs and comparison are its own,
+#: so the numbers do not depend on the split.
+CASE_STARTS = 3
+
+
+def _chunked(surfaces: list[dict], starts: dict, size: int) -> list[dict]:
+    """Each ``surfaces`` entry once per run of ``size`` points of ``starts`` (a points table),
+    with those points as its own starts."""
+    pts = list(starts["points"])
+    chunks = [pts[i : i + size] for i in range(0, len(pts), size)]
+    return [
+        {**entry, "starts": {"frame": starts["frame"], "points": c}} for entry in surfaces for c in chunks
+    ]
 
 
 def _preset_comparison(

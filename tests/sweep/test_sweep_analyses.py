@@ -112,3 +112,43 @@ def test_a_scan_in_um_takes_its_tip_radius_in_um(tmp_path, topography_dir):
     rig = case_rig(case)
     assert rig.surface.unit == "um" and rig.length_scale_m == 1e-6
     assert rig.tip.tip_radius_m == pytest.approx(5e-6, rel=1e-12)
+
+
+ENSEMBLE = """
+[sweep]
+name = "ensemble"
+analyses = ["quasistatic", "mujoco", "compare"]
+[[surfaces]]
+preset = "paper-single-peak"
+[starts]
+frame = "absolute"
+points = [[-4.0, 1.0], [-4.001, 1.0], [-4.0, 1.001], [-4.0, 0.0], [-4.001, 0.0], [-4.0, 0.001]]
+[drive]
+protocol = "spring"
+ie = 0.01
+[grid]
+mu = 1.25
+dl = 0.02
+ensemble_members = {members}
+"""
+
+
+def test_an_ensembles_copies_get_their_outcome_and_its_first_member_everything(tmp_path):
+    """With ``ensemble_members`` = 3 the first start of each three gets the whole comparison,
+    the same as without ensembles; the copies get their outcome on both sides only."""
+    rows = {}
+    for members in (1, 3):
+        cfg = write_config(tmp_path, ENSEMBLE.format(members=members), name=f"e{members}.toml")
+        out = tmp_path / f"out{members}"
+        sweep.run_sweep(cfg, out, workers=1)
+        runs = sweep.load_runs(out)
+        rows[members] = runs[runs.analysis == "compare"].set_index("start").sort_index()
+    full, ens = rows[1], rows[3]
+    lead = ens.index % 3 == 0
+    for col in ("frechet", "lateral_deviation", "frechet_smooth", "geometry_frechet", "compliant_frechet"):
+        np.testing.assert_allclose(ens[col][lead], full[col][lead], rtol=1e-9, err_msg=col)
+        assert ens[col][~lead].isna().all(), col
+    for col in ("agree", "agree_lock", "reference_outcome"):
+        assert (ens[col] == full[col]).all(), col
+    assert ens.agree_smooth[lead].astype(bool).tolist() == full.agree_smooth[lead].astype(bool).tolist()
+    assert ens.agree_smooth[~lead].isna().all()

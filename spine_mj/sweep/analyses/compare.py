@@ -35,17 +35,23 @@ def _xy(res: sl.StreamlineResult, i: int) -> np.ndarray:
     return np.column_stack([q["x"], q["y"]])
 
 
-def _deviations(mpaths, qs: sl.StreamlineResult, lc: float) -> tuple[np.ndarray, np.ndarray]:
-    """Frechet and mean lateral deviation of each MuJoCo path from the streamline of its start."""
+def _deviations(mpaths, qpaths: dict, lc: float, *, lateral: bool = True):
+    """Frechet and (with ``lateral``) mean lateral deviation of MuJoCo path ``i`` from
+    ``qpaths[i]`` (``(n, 2)``, its streamline) for each ``i`` in ``qpaths``; NaN elsewhere."""
     frechet = np.full(len(mpaths), np.nan)
-    lateral = np.full(len(mpaths), np.nan)
-    for i, mpath in enumerate(mpaths):
-        if mpath.shape[0] == 0:
+    side = np.full(len(mpaths), np.nan)
+    for i, qpath in qpaths.items():
+        if mpaths[i].shape[0] == 0:
             continue
-        qpath = _xy(qs, i)
-        frechet[i] = compare.path_frechet(mpath, qpath, length_scale=lc)
-        lateral[i] = compare.mean_lateral_deviation(mpath, qpath, length_scale=lc)
-    return frechet, lateral
+        frechet[i] = compare.path_frechet(mpaths[i], qpath, length_scale=lc)
+        if lateral:
+            side[i] = compare.mean_lateral_deviation(mpaths[i], qpath, length_scale=lc)
+    return frechet, side
+
+
+def _paths(res: sl.StreamlineResult, idx) -> dict:
+    """Path ``j`` of ``res`` under the run index ``idx[j]``."""
+    return {int(i): _xy(res, j) for j, i in enumerate(idx)}
 
 
 def _outcomes(qs: sl.StreamlineResult, mj_locked, mj_end, lc: float) -> dict[str, np.ndarray]:
@@ -100,19 +106,27 @@ def _miss_reasons(contact, params, trace, mpaths, facets, mj_locked, mj_end, lc,
     return reason, offset
 
 
-def _compliant(contact, params, starts, runs, preload_n, s, mpaths, facets, mj_locked, mj_end, lc) -> dict:
+def _compliant(
+    contact, params, starts, runs, preload_n, s, mpaths, facets, mj_locked, mj_end, lc, lead
+) -> dict:
     """MuJoCo against the compliant-drive streamline of the run's own spring
     (:mod:`spine_mj.compliant`, ``k / W`` from the run), traced like the rigid reference:
     what stiffness does is predicted there, what is left over is inertia. NaN for drives
-    without a spring. ``stiffness_frechet`` is the compliant reference's distance from the
-    rigid one, ``compliant_jumps`` its folds. The reference's carriage stops where the run's
-    does (``carriage_end``)."""
+    without a spring and for the starts not in ``lead`` (an ensemble's perturbed members).
+    ``stiffness_frechet`` is the compliant reference's distance from the rigid one,
+    ``compliant_jumps`` its folds. The reference's carriage stops where the run's does
+    (``carriage_end``)."""
     n = len(runs)
-    nan = np.full(n, np.nan)
-    out = {"compliant_frechet": nan, "agree_compliant": nan, "compliant_jumps": nan, "stiffness_frechet": nan}
+    out = {
+        k: np.full(n, np.nan)
+        for k in ("compliant_frechet", "agree_compliant", "compliant_jumps", "stiffness_frechet")
+    }
     k = runs[0].stiffness_n_m if n else 0.0
-    if not (k > 0):
+    if not (k > 0) or not lead.any():
         return out
+    idx = np.flatnonzero(lead)
+    starts = np.asarray(starts, float)[idx]
+    runs = [runs[i] for i in idx]
     # where the run's drive ran out, the carriage stops where the run's did: a soft spring's
     # reference is not held at a force cap the engine's carriage never reached (a run that
     # ended on an event, a lock or the edge, has its own outcome to compare)
@@ -124,18 +138,15 @@ def _compliant(contact, params, starts, runs, preload_n, s, mpaths, facets, mj_l
             for r in runs
         ]
     )
-    end = np.asarray(starts, float)[:, 0] + np.where(np.isfinite(travel), np.maximum(travel, 0.0), np.inf)
+    end = starts[:, 0] + np.where(np.isfinite(travel), np.maximum(travel, 0.0), np.inf)
     ref = compliant_streamlines(contact, starts, params, stiffness=k * s / preload_n, carriage_end=end)
-    frechet, _ = _deviations(mpaths, ref, lc)
-    agree = _outcomes(ref, mj_locked, mj_end, lc)["agree"]
-    return {
-        "compliant_frechet": frechet,
-        "agree_compliant": agree.astype(float),
-        "compliant_jumps": np.bincount(ref.folds.start, minlength=n).astype(float),
-        "stiffness_frechet": np.array(
-            [compare.path_frechet(_xy(ref, i), _xy(facets, i), length_scale=lc) for i in range(n)]
-        ),
-    }
+    out["compliant_frechet"] = _deviations(mpaths, _paths(ref, idx), lc, lateral=False)[0]
+    out["agree_compliant"][idx] = _outcomes(ref, mj_locked[idx], mj_end[idx], lc)["agree"]
+    out["compliant_jumps"][idx] = np.bincount(ref.folds.start, minlength=idx.size)
+    out["stiffness_frechet"][idx] = [
+        compare.path_frechet(_xy(ref, j), _xy(facets, i), length_scale=lc) for j, i in enumerate(idx)
+    ]
+    return out
 
 
 def _compare(case, surface, starts, upstream):
@@ -147,7 +158,12 @@ def _compare(case, surface, starts, upstream):
     # traced to the very edge is a tip radius longer: measured on the random Gaussian, that
     # tail alone made the Frechet distance 0.12 L_c where the paths were 0.01-0.03 apart)
     margin = dataclasses.replace(quasistatic.params, edge_margin=runs[0].detection.domain_margin_m / s)
-    smooth = trace(traced_surface(case, surface), starts, margin, store_paths=True)
+    # an ensemble's perturbed members (every start but each group's first) decide only their
+    # outcome on both sides (validate.ensembles): the paths' distances, the smooth surface's
+    # streamline, the compliant one and the miss reasons are the first member's alone
+    members = int(case.params["ensemble_members"])
+    lead = np.arange(len(runs)) % members == 0
+    smooth = trace(traced_surface(case, surface), np.asarray(starts, float)[lead], margin, store_paths=True)
     contact = rig.contact_surface()
     # steps no longer than an eighth of the tip radius: a longer step can jump a crease
     # between facets where the engine's tip wedges (measured on a fractal: dl = R/2 passed
@@ -156,25 +172,27 @@ def _compare(case, surface, starts, upstream):
     facets = trace(contact, starts, params, store_paths=True)
     lc = rig.scales.char_length_m / s
     mpaths = [r.position_m[r.drive_start_index :, :2] / s for r in runs]
-    frechet, lateral = _deviations(mpaths, facets, lc)
-    frechet_smooth, _ = _deviations(mpaths, smooth, lc)
-    geometry = np.array(
-        [compare.path_frechet(_xy(facets, i), _xy(smooth, i), length_scale=lc) for i in range(len(facets))]
-    )
+    idx = np.flatnonzero(lead)
+    smooth_paths = _paths(smooth, idx)
+    frechet, lateral = _deviations(mpaths, {int(i): _xy(facets, i) for i in idx}, lc)
+    frechet_smooth, _ = _deviations(mpaths, smooth_paths, lc, lateral=False)
+    geometry = np.full(len(runs), np.nan)
+    geometry[idx] = [compare.path_frechet(_xy(facets, i), smooth_paths[i], length_scale=lc) for i in idx]
     mj_locked = np.array([r.end_reason.value == "self_lock" for r in runs])
     mj_end = np.array([r.position_m[-1, :2] / s for r in runs])
     agree = _outcomes(facets, mj_locked, mj_end, lc)
-    agree_smooth = _outcomes(smooth, mj_locked, mj_end, lc)
+    agree_smooth = np.full(len(runs), np.nan) if members > 1 else np.zeros(len(runs), bool)
+    agree_smooth[lead] = _outcomes(smooth, mj_locked[lead], mj_end[lead], lc)["agree"]
     status = np.array(
         upstream["mujoco"].status if upstream["mujoco"].status is not None else np.full(len(runs), "ok"),
         dtype=object,
     )
-    explain = ~agree["agree"] & (status == "ok") & bool(case.params["miss_reasons"])
+    explain = ~agree["agree"] & (status == "ok") & bool(case.params["miss_reasons"]) & lead
     miss_reason, miss_offset = _miss_reasons(
         contact, params, trace, mpaths, facets, mj_locked, mj_end, lc, explain
     )
     compliant = _compliant(
-        contact, params, starts, runs, rig.scales.preload_n, s, mpaths, facets, mj_locked, mj_end, lc
+        contact, params, starts, runs, rig.scales.preload_n, s, mpaths, facets, mj_locked, mj_end, lc, lead
     )
     peak = np.array([peak_drive_over_fp(r, rig.scales.preload_n) for r in runs])
     kap = compare.kappa_agreement(facets.max_kappa, peak, kappa_cap=runs[0].detection.kappa_cap)
@@ -191,7 +209,7 @@ def _compare(case, surface, starts, upstream):
         "reference_outcome": np.array(facets.outcome_names, dtype=object),
         "reference_max_kappa": facets.max_kappa,
         "frechet_smooth": frechet_smooth,
-        "agree_smooth": agree_smooth["agree"],
+        "agree_smooth": agree_smooth,
         "geometry_frechet": geometry,
         **compliant,
         "kappa_ratio": kap["ratio"],
@@ -227,6 +245,15 @@ register_analysis(
                 "tell why each disagreeing run disagrees (miss_reason): the reference restarted "
                 f"from {MISS_CHECKPOINTS} points of its MuJoCo path, a trace each",
                 True,
+            ),
+            ParamSpec(
+                "ensemble_members",
+                "int",
+                "starts come in ensembles of this many, a start and its perturbed copies "
+                "(spine_mj.validate.ensembles): the copies get their outcome only, no path "
+                "distances, smooth or compliant reference or miss reasons",
+                1,
+                1,
             ),
         ),
         requires=("quasistatic", "mujoco"),
