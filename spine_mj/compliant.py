@@ -16,7 +16,7 @@ dimensionless stiffness is ``K = c l_s``). Quasistatically (docs/physics.md §6)
   until the force has fallen to the hold force again (the landing, where it sticks).
 
 The fold is located by a golden-section search for the maximum of ``X(s)`` along the step
-that crossed it, the landing by bisection on ``c (X - x(s)) - H(s)``, both to round-off
+that crossed it, the landing by bisection on ``c (X - x(s)) - H(s)``, both to ~1e-8 of a step
 along the path, so the onset force ``H`` at the fold, the carriage position there and the
 jump length do not depend on the step (:class:`Fold`). Regions, the self-lock rule, the
 step control and the stall test are those of :mod:`spine_mj.streamline` (same
@@ -178,10 +178,13 @@ class CompliantResult:
         return Fold(**{k: getattr(self.folds, k)[sel] for k in Fold.__dataclass_fields__})
 
 
-#: Golden-section steps locating a fold: the bracket shrinks to 0.618**60 ~ 3e-13 of a step.
-_GOLDEN_ITERATIONS = 60
-#: Bisections locating a landing: 2**-52 of a step, round-off.
-_BISECTIONS = 52
+#: Golden-section steps locating a fold: the bracket shrinks to 0.618**40 ~ 5e-9 of a step
+#: (a step is at most dl; in the validation R / 8), six orders below anything compared (the
+#: ensembles' 1e-3 L_c). To round-off (60 steps) it cost the quick plan's sandpaper a third
+#: more of its 1.3 ms per jump.
+_GOLDEN_ITERATIONS = 40
+#: Bisections locating a landing: 2**-36 ~ 1.5e-11 of a step.
+_BISECTIONS = 36
 #: Where the probe sits along a slide step, from its end, as a fraction of the step.
 _PROBE = 1e-6
 
@@ -204,7 +207,7 @@ def _hold_at(surface, x, y, mu, tol):
 
 def _fold_along(surface, px, py, vx, vy, h, c, mu, tol):
     """``s`` in ``[0, h]`` maximizing ``X(s) = x(s) + H(s) / c`` along ``p + s v``, and
-    ``X`` there (golden section to round-off; NaN or inf ``H``: ``X = -inf``)."""
+    ``X`` there (golden section, :data:`_GOLDEN_ITERATIONS` steps; NaN or inf ``H``: ``X = -inf``)."""
 
     def carriage(s):
         hx = _hold_at(surface, px + s * vx, py + s * vy, mu, tol)
@@ -235,8 +238,9 @@ def _fold_along(surface, px, py, vx, vy, h, c, mu, tol):
 
 
 def _landing_along(surface, px, py, vx, vy, h, carriage, c, mu, tol):
-    """Smallest ``s`` in ``(0, h]`` (to round-off) where ``c (X - x(s)) <= H(s)``: the
-    spring force has fallen to the hold along a slip step (bisection; NaN ``H``: slips)."""
+    """Smallest ``s`` in ``(0, h]`` where ``c (X - x(s)) <= H(s)`` (:data:`_BISECTIONS`
+    halvings of ``h``): the spring force has fallen to the hold along a slip step (NaN ``H``:
+    slips)."""
 
     def slipping(s):
         hx = _hold_at(surface, px + s * vx, py + s * vy, mu, tol)
