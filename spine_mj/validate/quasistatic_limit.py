@@ -23,7 +23,7 @@ from spine_mj.validate.plans import FRECHET_TARGET, OUTCOME_TARGET, RECOMMENDED,
 from spine_mj.validate.study_runner import StudyRunner
 from spine_mj.validate.sweep_configs import engine_grid, family_doc
 
-__all__ = ["LimitPath", "QuasistaticLimitResult", "limit_doc", "quasistatic_limit"]
+__all__ = ["LimitPath", "QuasistaticLimitResult", "limit_doc", "limit_family_docs", "quasistatic_limit"]
 
 #: Columns of the per-run rows.
 RUN_COLUMNS = (
@@ -142,7 +142,10 @@ def quasistatic_limit(plan: ValidationPlan, runner: StudyRunner) -> QuasistaticL
     for fam in plan.families:
         fam = plan.corner_family(fam)
         groups: list[dict] = []
-        comps = [_preset_comparison(plan, runner, fam, preset, paths, groups) for preset in fam.presets]
+        comps = [
+            _sweep_comparison(plan, fam, *runner(doc, f"limit/{name}"), paths, groups)
+            for name, doc in limit_family_docs(plan, fam)
+        ]
         allc = pd.concat(comps, ignore_index=True)
         summ = _family_summary(allc)
         summ.update(ensemble_verdicts(groups))
@@ -221,6 +224,21 @@ def limit_doc(plan: ValidationPlan, fam: FamilySpec, preset: str, name: str, ove
     return doc
 
 
+def limit_family_docs(plan: ValidationPlan, fam: FamilySpec) -> list[tuple[str, dict]]:
+    """The sweeps of ``fam``'s corner as ``(name, config)``: one for the whole family where
+    its presets share one grid (mu, tip radius, engine: so its cases share the workers, and
+    one heavy case of one preset does not leave a core idle while the next preset waits),
+    else one per preset (:func:`limit_doc`)."""
+    docs = [(preset, limit_doc(plan, fam, preset, f"limit-{preset}")) for preset in fam.presets]
+    first = docs[0][1]
+    own_starts = all("starts" in e for _, d in docs for e in d["surfaces"])
+    if len(docs) == 1 or not (own_starts and all(d["grid"] == first["grid"] for _, d in docs)):
+        return docs if len(docs) > 1 else [(docs[0][0], first)]
+    merged = {**first, "sweep": {**first["sweep"], "name": f"limit-{fam.name}"}}
+    merged["surfaces"] = [e for _, d in docs for e in d["surfaces"]]
+    return [(fam.name, merged)]
+
+
 #: Starts (whole ensembles) per case of a limit sweep: a preset's starts split into cases of at
 #: most this many, so that a sweep of one preset keeps every worker busy (a case's MuJoCo
 #: runs share its threads, but its reference streamlines are serial Python: on one case the
@@ -239,14 +257,13 @@ def _chunked(surfaces: list[dict], starts: dict, size: int) -> list[dict]:
     ]
 
 
-def _preset_comparison(
-    plan: ValidationPlan, runner: StudyRunner, fam: FamilySpec, preset: str, paths: dict, groups: list
+def _sweep_comparison(
+    plan: ValidationPlan, fam: FamilySpec, df: pd.DataFrame, store, paths: dict, groups: list
 ) -> pd.DataFrame:
-    """The ``compare`` rows of one preset's sweep (each ensemble's own start) with the MuJoCo
-    row's end and status; the ensembles' outcomes go into ``groups``
-    (:func:`~spine_mj.validate.ensembles.ensemble_verdicts`), the single peak/valley
-    family's paths into ``paths``."""
-    df, store = runner(limit_doc(plan, fam, preset, f"limit-{preset}"), f"limit/{preset}")
+    """The ``compare`` rows of one limit sweep (its run table ``df`` and ``store``; each
+    ensemble's own start) with the MuJoCo row's end and status and the row's preset; the
+    ensembles' outcomes go into ``groups`` (:func:`~spine_mj.validate.ensembles.ensemble_verdicts`),
+    the single peak/valley family's paths into ``paths``."""
     members = max(int(plan.ensemble_members), 1)
     groups.extend(ensemble_groups(df, store, members))
     df = df[df["start"].astype(int) % members == 0].copy()  # the runs: each ensemble's own start
@@ -255,7 +272,8 @@ def _preset_comparison(
     mj = df[df["analysis"] == "mujoco"].set_index(["case_id", "start"])
     key = list(zip(comp["case_id"], comp["start"].astype(int)))
     comp["family"] = fam.name
-    comp["preset"] = preset
+    # a preset surface's label is the preset's name, with "#seed" after a seeded one
+    comp["preset"] = comp["surface"].astype(str).str.partition("#")[0]
     comp["end_reason"] = [mj.loc[k, "end_reason"] for k in key]
     comp["end_detail"] = [mj.loc[k, "end_detail"] for k in key]
     comp["mujoco_status"] = [mj.loc[k, "status"] for k in key]
@@ -266,7 +284,7 @@ def _preset_comparison(
             mpaths = stored_paths(store, case_id, "mujoco")
             for s, x0, y0 in zip(grp["start"].astype(int) * members, grp["start_x"], grp["start_y"]):
                 empty = np.zeros((0, 2))
-                paths.setdefault(preset, []).append(
+                paths.setdefault(grp["preset"].iloc[0], []).append(
                     LimitPath(smooth[s], facets.get(s, empty), mpaths.get(s, empty), (x0, y0))
                 )
     return comp
