@@ -94,3 +94,35 @@ def test_the_limit_study_runs_each_start_as_an_ensemble_on_both_sides(tmp_path):
     assert set(f["ill_conditioned_share"]) == {"mujoco", "reference"}
     assert [r["start_y"] for r in res.runs] == [-2.0, -4.0]  # each ensemble's own start
     assert all(r["ill_conditioned"] in ("", "mujoco", "reference", "both") for r in res.runs)
+
+
+def test_a_familys_presets_share_one_sweep_in_cases_of_whole_ensembles():
+    """Presets with one grid run as one sweep; each preset's ensemble starts split into
+    cases of at most CASE_STARTS whole ensembles, in order, none lost."""
+    import dataclasses
+
+    from spine_mj.sweep import expand_cases, parse_config
+    from spine_mj.validate.ensembles import ensemble_family
+    from spine_mj.validate.plans import PLANS, FamilySpec, paper_starts
+    from spine_mj.validate.quasistatic_limit import CASE_STARTS, limit_family_docs
+
+    ys = list(np.linspace(-0.5, -4.0, 2 * CASE_STARTS + 1))
+    fam = FamilySpec(
+        "single_peak_valley", ("paper-single-peak", "paper-single-valley"), None, paper_starts(ys)
+    )
+    plan = dataclasses.replace(PLANS["smoke"], families=(fam,), ensemble_members=3)
+    ((name, doc),) = limit_family_docs(plan, fam)
+    assert name == "single_peak_valley"
+    cases = expand_cases(parse_config(doc))
+    assert len(cases) == 2 * 3  # per preset: CASE_STARTS, CASE_STARTS and 1 ensemble
+    for preset in fam.presets:
+        mine = [c for c in cases if c.surface.source == preset]
+        points = [tuple(p) for c in mine for p in c.starts.as_dict()["points"]]
+        expected = ensemble_family(fam, preset, 3).starts_table()["points"]
+        assert points == [tuple(p) for p in expected]
+        assert all(len(c.starts.as_dict()["points"]) % 3 == 0 for c in mine)
+        assert max(len(c.starts.as_dict()["points"]) for c in mine) == 3 * CASE_STARTS
+    assert {c.params["ensemble_members"] for c in cases} == {3}
+    # without ensembles every preset keeps its own sweep of the family's starts
+    single = dataclasses.replace(plan, ensemble_members=1)
+    assert [n for n, _ in limit_family_docs(single, fam)] == list(fam.presets)
