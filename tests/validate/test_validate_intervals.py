@@ -81,3 +81,11 @@ def test_platform_records_the_variables_that_switch_code_paths(monkeypatch):
     monkeypatch.setenv("NPY_DISABLE_CPU_FEATURES", "X86_V4")
     monkeypatch.delenv("GLIBC_TUNABLES", raising=False)
     assert platform_info()["dispatch_overrides"] == {"NPY_DISABLE_CPU_FEATURES": "X86_V4"}
+
+
+def test_the_reports_platform_line_names_switched_code_paths():
+    from spine_mj.validate.report.verdicts import platform_line
+
+    info = {**platform_info(), "dispatch_overrides": {"NUMBA_CPU_NAME": "x86-64-v2"}}
+    assert "NUMBA_CPU_NAME=x86-64-v2" in platform_line(info)[0]
+    assert "switched" not in platform_line({**info, "dispatch_overrides": {}})[0]

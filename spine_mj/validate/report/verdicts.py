@@ -84,11 +84,18 @@ def platform_line(platform: dict | None) -> list[str]:
     if not platform:
         return []
     isa = ", ".join(platform.get("vector_instruction_sets") or []) or "unknown"
+    overrides = platform.get("dispatch_overrides") or {}
+    switched = (
+        " Code paths switched by " + ", ".join(f"{k}={v}" for k, v in overrides.items()) + "."
+        if overrides
+        else ""
+    )
     return [
         f"Made on {platform.get('cpu')} ({platform.get('machine')}; vector instruction sets: {isa}; "
         f"{platform.get('cpu_count')} cores), {platform.get('os')}, Python {platform.get('python')}, "
-        f"numpy {platform.get('numpy')}, MuJoCo {platform.get('mujoco')}. MuJoCo rounds differently "
-        "on other CPUs: runs near a watershed may flip there; the intervals say how far the "
-        "numbers may move.",
+        f"numpy {platform.get('numpy')}, MuJoCo {platform.get('mujoco')}.{switched} Other CPUs take "
+        "other vector code paths in numpy, the C library's maths and numba, which round "
+        "differently: runs near a watershed may flip there; the intervals say how far the "
+        "numbers may move (analysis/reproduction_check.py compares a run with them).",
         "",
     ]
