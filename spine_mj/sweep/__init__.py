@@ -47,7 +47,7 @@ their parameters), :mod:`~spine_mj.sweep.config` (the TOML schema),
 case), :mod:`~spine_mj.sweep.store` (the result store and its readers),
 :mod:`~spine_mj.sweep.pool` (local worker processes that die with their parent),
 :mod:`~spine_mj.sweep.executors` (in-process, local processes, Dask),
-:mod:`~spine_mj.sweep.session` (:func:`run_sweep`), :mod:`~spine_mj.sweep.report` (HTML),
+:mod:`~spine_mj.sweep.session` (:func:`run_sweep`, :func:`run_sweeps`), :mod:`~spine_mj.sweep.report` (HTML),
 and :mod:`~spine_mj.sweep.analyses` (the built-in analyses, registered on import).
 """
 
@@ -67,7 +67,7 @@ from spine_mj.sweep.registry import (
     register_analysis,
 )
 from spine_mj.sweep.report import write_report
-from spine_mj.sweep.session import Progress, SweepSummary, run_sweep
+from spine_mj.sweep.session import Progress, SweepSummary, run_sweep, run_sweeps
 from spine_mj.sweep.store import StoreStatus, consolidate, load_runs, load_trajectories, store_status
 
 __all__ = [
@@ -98,6 +98,7 @@ __all__ = [
     "register_analysis",
     "run_case",
     "run_sweep",
+    "run_sweeps",
     "store_status",
     "write_report",
 ]

@@ -8,12 +8,13 @@ at the end. Killed at any moment, the next session resumes where it stopped.
 
 from __future__ import annotations
 
+import contextlib
 import datetime
 import math
 import os
 import re
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -234,6 +235,83 @@ def connect(scheduler):
 CONNECT_TIMEOUT_S = 10
 
 
+@dataclass
+class _Store:
+    """One sweep's store while its cases run: what is left to do and what came back."""
+
+    config: SweepConfig
+    cases: list
+    out_dir: Path
+    todo: list
+    skipped: int
+    skipped_runs: int
+    corrupt: list
+    finished: int = 0
+    ok: int = 0
+    failed: int = 0
+
+    def progress(self, t0: float, case_id: str | None) -> Progress:
+        return Progress(
+            total_cases=len(self.cases),
+            finished_cases=self.finished,
+            skipped_cases=self.skipped,
+            ok_runs=self.ok,
+            failed_runs=self.failed,
+            elapsed_s=time.perf_counter() - t0,
+            case_id=case_id,
+        )
+
+    def store(self, encoded) -> None:
+        store_encoded(self.out_dir, encoded)
+        statuses = encoded[1]
+        ok = sum(1 for s in statuses if s == "ok")
+        self.finished += 1
+        self.ok += ok
+        self.failed += len(statuses) - ok
+
+    def summary(self, t0: float, n_workers) -> SweepSummary:
+        cases = self.cases
+        return SweepSummary(
+            out_dir=self.out_dir,
+            total_cases=len(cases),
+            run_cases=self.finished,
+            skipped_cases=self.skipped,
+            total_runs=sum(c.starts.count for c in cases) * len(self.config.analyses),
+            ok_runs=self.ok,
+            failed_runs=self.failed,
+            skipped_runs=self.skipped_runs,
+            elapsed_s=time.perf_counter() - t0,
+            workers=n_workers,
+            status_counts=_status_counts(consolidate(self.out_dir)),
+            rerun_corrupt=tuple(self.corrupt),
+        )
+
+
+def _open_store(config, cases, out_dir, session, *, overwrite, retry_failed) -> _Store:
+    """Prepare the store (locked by the caller) and list the cases left to run."""
+    prepare_store(config, cases, out_dir, overwrite=overwrite, session=session)
+    remove_temporaries(out_dir)
+    corrupt = corrupt_cases(out_dir)
+    reopen_cases(out_dir, corrupt)  # unreadable: run again
+    done = _done_cases(out_dir, retry_failed)
+    todo = [c for c in cases if c.case_id not in done]
+    skipped_runs = sum(c.starts.count for c in cases if c.case_id in done) * len(config.analyses)
+    return _Store(config, cases, out_dir, todo, len(cases) - len(todo), skipped_runs, list(corrupt))
+
+
+def _execute(todo, handle, *, n_workers, scheduler=None, worker_wait_s=DEFAULT_WORKER_WAIT_S, notice=None):
+    """Run ``todo`` on the chosen backend, ``handle`` taking each finished case."""
+    if not todo:
+        return
+    if scheduler is not None:
+        run_dask(longest_first(todo), scheduler, handle, worker_wait_s=worker_wait_s, notice=notice)
+    elif n_workers == 1 or len(todo) == 1:
+        # one case left: no processes to start; its engine batch gets the workers' threads
+        run_here(todo, handle, threads=n_workers)
+    else:
+        run_processes(longest_first(todo), n_workers, handle)
+
+
 def _run_locked(
     config,
     cases,
@@ -248,64 +326,91 @@ def _run_locked(
     worker_wait_s=DEFAULT_WORKER_WAIT_S,
     notice=None,
 ) -> SweepSummary:
-    prepare_store(config, cases, out_dir, overwrite=overwrite, session=session)
-    remove_temporaries(out_dir)
-    corrupt = corrupt_cases(out_dir)
-    reopen_cases(out_dir, corrupt)  # unreadable: run again
-    done = _done_cases(out_dir, retry_failed)
-    todo = [c for c in cases if c.case_id not in done]
-    skipped = len(cases) - len(todo)
-    skipped_runs = sum(c.starts.count for c in cases if c.case_id in done) * len(config.analyses)
+    st = _open_store(config, cases, out_dir, session, overwrite=overwrite, retry_failed=retry_failed)
     t0 = time.perf_counter()
-    counts = {"finished": 0, "ok": 0, "failed": 0}
-
-    def report(case_id):
-        if progress is not None:
-            progress(
-                Progress(
-                    total_cases=len(cases),
-                    finished_cases=counts["finished"],
-                    skipped_cases=skipped,
-                    ok_runs=counts["ok"],
-                    failed_runs=counts["failed"],
-                    elapsed_s=time.perf_counter() - t0,
-                    case_id=case_id,
-                )
-            )
 
     def handle(encoded):
-        store_encoded(out_dir, encoded)
-        case_id, statuses = encoded[:2]
-        ok = sum(1 for s in statuses if s == "ok")
-        counts["finished"] += 1
-        counts["ok"] += ok
-        counts["failed"] += len(statuses) - ok
-        report(case_id)
+        st.store(encoded)
+        if progress is not None:
+            progress(st.progress(t0, encoded[0]))
 
-    report(None)
-    if todo:
-        if scheduler is not None:
-            run_dask(longest_first(todo), scheduler, handle, worker_wait_s=worker_wait_s, notice=notice)
-        elif n_workers == 1 or len(todo) == 1:
-            # one case left: no processes to start; its engine batch gets the workers' threads
-            run_here(todo, handle, threads=n_workers)
-        else:
-            run_processes(longest_first(todo), n_workers, handle)
-    status_counts = _status_counts(consolidate(out_dir))
-    return SweepSummary(
-        out_dir=out_dir,
-        total_cases=len(cases),
-        run_cases=counts["finished"],
-        skipped_cases=skipped,
-        total_runs=sum(c.starts.count for c in cases) * len(config.analyses),
-        ok_runs=counts["ok"],
-        failed_runs=counts["failed"],
-        skipped_runs=skipped_runs,
-        elapsed_s=time.perf_counter() - t0,
-        workers=n_workers,
-        status_counts=status_counts,
-        rerun_corrupt=tuple(corrupt),
+    if progress is not None:
+        progress(st.progress(t0, None))
+    _execute(
+        st.todo, handle, n_workers=n_workers, scheduler=scheduler, worker_wait_s=worker_wait_s, notice=notice
     )
+    return st.summary(t0, n_workers)
+
+
+def run_sweeps(
+    jobs: Sequence[tuple[SweepConfig, str | os.PathLike]],
+    *,
+    workers: int | None = None,
+    overwrite: bool = False,
+    progress: Callable[[Progress], None] | None = None,
+) -> list[SweepSummary]:
+    """Run (or resume) several sweeps, their cases sharing one pool of local workers.
+
+    Each ``(config, out_dir)`` is stored exactly as :func:`run_sweep` would store it (and
+    resumes the same way); the cases of all of them are handed to the workers together,
+    longest first, so one sweep's slow last case does not leave the other workers idle
+    while the next sweep waits. A case found in two sweeps runs once and is stored in
+    both. ``progress`` gets one :class:`Progress` over all the sweeps' cases.
+
+    Returns
+    -------
+    list of SweepSummary
+        One per job, in order.
+    """
+    if workers is not None:
+        check_workers(workers)
+    n_workers = workers or os.cpu_count() or 1
+    configs = [c if isinstance(c, SweepConfig) else load_config(c) for c, _ in jobs]
+    dirs = [Path(d) for _, d in jobs]
+    if len({d.resolve() for d in dirs}) != len(dirs):
+        raise SpineInputError("run_sweeps: every sweep needs its own out_dir")
+    expanded = [expand_cases(c) for c in configs]
+    session = _session_record(n_workers, None)
+    clear_caches()
+    for config, cases in zip(configs, expanded):
+        check_cases(cases, config.swept)
+    with contextlib.ExitStack() as locks:
+        stores = []
+        for config, cases, d in zip(configs, expanded, dirs):
+            d.mkdir(parents=True, exist_ok=True)
+            locks.enter_context(store_lock(d))
+            stores.append(_open_store(config, cases, d, session, overwrite=overwrite, retry_failed=False))
+        owners: dict[str, list[_Store]] = {}
+        todo = []
+        for st in stores:
+            for case in st.todo:
+                if case.case_id not in owners:
+                    todo.append(case)
+                owners.setdefault(case.case_id, []).append(st)
+        t0 = time.perf_counter()
+
+        def report(case_id):
+            if progress is not None:
+                progress(
+                    Progress(
+                        total_cases=sum(len(st.cases) for st in stores),
+                        finished_cases=sum(st.finished for st in stores),
+                        skipped_cases=sum(st.skipped for st in stores),
+                        ok_runs=sum(st.ok for st in stores),
+                        failed_runs=sum(st.failed for st in stores),
+                        elapsed_s=time.perf_counter() - t0,
+                        case_id=case_id,
+                    )
+                )
+
+        def handle(encoded):
+            for st in owners[encoded[0]]:
+                st.store(encoded)
+            report(encoded[0])
+
+        report(None)
+        _execute(todo, handle, n_workers=n_workers)
+        return [st.summary(t0, n_workers) for st in stores]
 
 
 def _done_cases(out_dir: Path, retry_failed: bool) -> set[str]:

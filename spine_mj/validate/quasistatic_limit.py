@@ -139,13 +139,18 @@ def quasistatic_limit(plan: ValidationPlan, runner: StudyRunner) -> QuasistaticL
     """
     runner.study = "limit"
     families, runs_rows, paths = {}, [], {}
-    for fam in plan.families:
-        fam = plan.corner_family(fam)
+    corner = [plan.corner_family(fam) for fam in plan.families]
+    docs = [(fam, name, doc) for fam in corner for name, doc in limit_family_docs(plan, fam)]
+    variations = _variation_docs(plan)
+    # every sweep of the study at once: the workers stay busy across the sweeps' ends
+    done = runner.many(
+        [(doc, f"limit/{name}") for _, name, doc in docs] + [(doc, name) for _, name, doc in variations],
+        "corner and engine variations",
+    )
+    swept = dict(zip([name for _, name, _ in docs], done[: len(docs)]))
+    for fam in corner:
         groups: list[dict] = []
-        comps = [
-            _sweep_comparison(plan, fam, *runner(doc, f"limit/{name}"), paths, groups)
-            for name, doc in limit_family_docs(plan, fam)
-        ]
+        comps = [_sweep_comparison(plan, fam, *swept[name], paths, groups) for f, name, _ in docs if f is fam]
         allc = pd.concat(comps, ignore_index=True)
         summ = _family_summary(allc)
         summ.update(ensemble_verdicts(groups))
@@ -190,7 +195,7 @@ def quasistatic_limit(plan: ValidationPlan, runner: StudyRunner) -> QuasistaticL
     return QuasistaticLimitResult(
         families=families,
         runs=runs_rows,
-        variations=_variations(plan, runner, runs_rows),
+        variations=_variations(plan, variations, done[len(docs) :], runs_rows),
         paths=paths,
         lowest_ie=plan.lowest_ie,
     )
@@ -290,17 +295,29 @@ def _sweep_comparison(
     return comp
 
 
-def _variations(plan: ValidationPlan, runner: StudyRunner, runs_rows: list[dict]) -> dict[str, dict]:
-    """The plan's engine variations on the first family's first preset, after the
-    recommended settings (summarised from ``runs_rows``)."""
-    variations = {}
+def _variation_docs(plan: ValidationPlan) -> list[tuple[str, str, dict]]:
+    """``(label, store name, config)`` of each engine variation of ``plan`` on the first
+    family's first preset."""
     fam0 = plan.corner_family(plan.families[0])
     preset = fam0.presets[0]
+    out = []
     for label, ov in plan.limit_variations:
         tag = "-".join(f"{k}{v}" for k, v in ov)
-        df, _ = runner(limit_doc(plan, fam0, preset, f"limit-var-{label}", ov), f"limit-var/{preset}-{tag}")
+        out.append(
+            (label, f"limit-var/{preset}-{tag}", limit_doc(plan, fam0, preset, f"limit-var-{label}", ov))
+        )
+    return out
+
+
+def _variations(plan: ValidationPlan, docs, results, runs_rows: list[dict]) -> dict[str, dict]:
+    """The engine variations (``docs`` of :func:`_variation_docs` and their sweeps'
+    ``results``) after the recommended settings (summarised from ``runs_rows``)."""
+    variations = {}
+    preset = plan.corner_family(plan.families[0]).presets[0]
+    for (label, _, _), (df, _) in zip(docs, results):
         comp = df[df["analysis"] == "compare"]
-        variations[label] = {**_family_summary(comp), "settings": dict(ov), "surface": preset}
+        settings = dict(dict(plan.limit_variations)[label])
+        variations[label] = {**_family_summary(comp), "settings": settings, "surface": preset}
     base = [r for r in runs_rows if r["preset"] == preset]
     return {
         RECOMMENDED[0]: {

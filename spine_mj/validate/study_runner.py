@@ -127,3 +127,32 @@ class StudyRunner:
         w = w or os.cpu_count() or 1
         sweep.run_sweep(config, store, workers=w, overwrite=True, progress=cb)
         return sweep.load_runs(store), store
+
+    def many(self, jobs, step: str):
+        """Run the sweep configs of ``jobs`` (``(doc, name)`` pairs) together, their cases
+        sharing the workers (:func:`spine_mj.sweep.run_sweeps`), each into
+        ``out/sweeps/<name>``; progress is reported as one ``step``.
+
+        Returns
+        -------
+        list of (DataFrame, Path)
+            Per job, in order, as :meth:`__call__` returns.
+        """
+        configs = [sweep.parse_config(doc, base_dir=self.out_dir) for doc, _ in jobs]
+        stores = [self.out_dir / "sweeps" / name for _, name in jobs]
+
+        def cb(p):
+            if self.progress is not None:
+                self.progress(
+                    ValidationProgress(
+                        self.study,
+                        step,
+                        p.finished_cases + p.skipped_cases,
+                        p.total_cases,
+                        time.perf_counter() - self.t0,
+                    )
+                )
+
+        w = self.workers or os.cpu_count() or 1
+        sweep.run_sweeps(list(zip(configs, stores)), workers=w, overwrite=True, progress=cb)
+        return [(sweep.load_runs(store), store) for store in stores]

@@ -40,3 +40,39 @@ def test_same_metrics_with_one_or_two_workers_and_on_a_dask_cluster(tmp_path):
     pd.testing.assert_frame_equal(metrics_frame(tmp_path / "dask"), ref)
     manifest = json.loads((tmp_path / "dask" / "manifest.json").read_text())
     assert manifest["sessions"][0]["scheduler"].startswith(("tcp://", "inproc://"))
+
+
+def test_sweeps_run_together_store_what_each_alone_stores(tmp_path):
+    """run_sweeps: two sweeps sharing one pool give each store the rows run_sweep gives it,
+    and a sweep given twice (a case in both) runs its cases once and stores them in both."""
+    from sweep_support import peak_config
+
+    (tmp_path / "ca").mkdir()
+    (tmp_path / "cb").mkdir()
+    a = peak_config(tmp_path / "ca", nmu=3, ny=2, name="a")
+    b = peak_config(tmp_path / "cb", nmu=2, ny=3, dl=0.03, name="b")
+    sweep.run_sweep(a, tmp_path / "a_alone", workers=1)
+    sweep.run_sweep(b, tmp_path / "b_alone", workers=1)
+    summaries = sweep.run_sweeps([(a, tmp_path / "a"), (b, tmp_path / "b")], workers=2)
+    assert [s.run_cases for s in summaries] == [3, 2]
+    for name in ("a", "b"):
+        pd.testing.assert_frame_equal(
+            metrics_frame(tmp_path / name), metrics_frame(tmp_path / f"{name}_alone")
+        )
+    # resumed: nothing left to run
+    again = sweep.run_sweeps([(a, tmp_path / "a"), (b, tmp_path / "b")], workers=2)
+    assert [s.skipped_cases for s in again] == [3, 2] and [s.run_cases for s in again] == [0, 0]
+    twice = sweep.run_sweeps([(a, tmp_path / "a1"), (a, tmp_path / "a2")], workers=1)
+    assert [s.run_cases for s in twice] == [3, 3]
+    pd.testing.assert_frame_equal(metrics_frame(tmp_path / "a1"), metrics_frame(tmp_path / "a2"))
+
+
+def test_sweeps_run_together_need_their_own_folders(tmp_path):
+    import pytest
+    from sweep_support import peak_config
+
+    from spine_mj.errors import SpineInputError
+
+    a = peak_config(tmp_path, nmu=2, ny=1, name="a")
+    with pytest.raises(SpineInputError, match="own out_dir"):
+        sweep.run_sweeps([(a, tmp_path / "x"), (a, tmp_path / "x")])
