@@ -4,6 +4,7 @@ and the I_e* where it breaks, with a bracketing interval and a bootstrap over st
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -149,16 +150,26 @@ def boundary(plan: ValidationPlan, runner: StudyRunner) -> BoundaryResult:
     runner.study = "boundary"
     fams = [f for f in plan.families if f.name in plan.boundary_families]
     curves, stars, skip = {}, {}, {}
+    ramp_plans = {proto: {} for proto in plan.protocols}
+    jobs = [
+        (proto, job)
+        for proto in plan.protocols
+        for fam in fams
+        for preset in fam.presets
+        for job in _preset_jobs(plan, runner, fam, preset, proto, ramp_plans[proto])
+    ]
+    # every drive's sweeps at once: the workers stay busy across the sweeps' ends
+    done = runner.many([(doc, name) for _, (doc, name, _) in jobs], "spring and ramp sweeps")
     for proto in plan.protocols:
-        comps, mjs, ramp_plans = [], [], {}
-        for fam in fams:
-            for preset in fam.presets:
-                for c, m in _preset_runs(plan, runner, fam, preset, proto, ramp_plans):
-                    comps.append(c)
-                    mjs.append(m)
+        comps, mjs = [], []
+        for (p, (_, _, rows)), (df, store) in zip(jobs, done):
+            if p == proto:
+                c, m = rows(df, store)
+                comps.append(c)
+                mjs.append(m)
         comp = pd.concat(comps, ignore_index=True)
         mj = pd.concat(mjs, ignore_index=True)
-        curves[proto], skip[proto], amat, fmat = _curve(plan, proto, comp, mj, ramp_plans)
+        curves[proto], skip[proto], amat, fmat = _curve(plan, proto, comp, mj, ramp_plans[proto])
         stars[proto] = _protocol_ie_star(plan, curves[proto], amat, fmat)
     return BoundaryResult(curves=curves, ie_star=stars, skip_rate=skip, families=[f.name for f in fams])
 
@@ -184,14 +195,15 @@ def quasistatic_locked(agree_lock, mj_locked) -> np.ndarray:
     return np.where(agree, mj, ~mj)
 
 
-def _preset_runs(
+def _preset_jobs(
     plan: ValidationPlan, runner: StudyRunner, fam: FamilySpec, preset: str, proto: str, ramp_plans: dict
-) -> list[tuple[pd.DataFrame, pd.DataFrame]]:
-    """The (``compare``, ``mujoco``) rows of one preset's sweeps under ``proto``."""
+) -> list[tuple[dict, str, Callable]]:
+    """One preset's sweeps under ``proto`` as ``(config, store name, rows)``: ``rows(df,
+    store)`` gives the sweep's (``compare``, ``mujoco``) rows."""
     grid = preset_grid(plan, fam, preset)
     mu, tip = grid["mu"], grid["tip_radius"]
     if proto == "ramp":
-        return _ramp_runs(plan, runner, fam, preset, mu, tip, grid, ramp_plans)
+        return _ramp_jobs(plan, runner, fam, preset, mu, tip, grid, ramp_plans)
     doc = family_doc(
         fam,
         name=f"boundary-{proto}-{preset}",
@@ -199,11 +211,14 @@ def _preset_runs(
         drive={"protocol": proto, "ie": list(plan.ie_values)},
         grid=grid,
     )
-    df, _ = runner(doc, f"boundary/{proto}-{preset}")
-    return [(df[df["analysis"] == "compare"], df[df["analysis"] == "mujoco"])]
+
+    def rows(df, _store):
+        return df[df["analysis"] == "compare"], df[df["analysis"] == "mujoco"]
+
+    return [(doc, f"boundary/{proto}-{preset}", rows)]
 
 
-def _ramp_runs(
+def _ramp_jobs(
     plan: ValidationPlan,
     runner: StudyRunner,
     fam: FamilySpec,
@@ -212,9 +227,9 @@ def _ramp_runs(
     tip: float,
     grid: dict,
     ramp_plans: dict,
-) -> list[tuple[pd.DataFrame, pd.DataFrame]]:
-    """Ramp sweeps of one preset: a pilot per I_e sets the duration (into ``ramp_plans``);
-    I_e values that share a duration run in one sweep."""
+) -> list[tuple[dict, str, Callable]]:
+    """Ramp sweeps of one preset (as :func:`_preset_jobs`): a pilot per I_e sets the
+    duration (into ``ramp_plans``); I_e values that share a duration run in one sweep."""
     seed = None if fam.seeds is None else fam.seeds[0]
     rig, _ = pilot_rig(preset, seed, mu, tip, plan.hfield_resolution)
     surface = presets.make_surface(preset, **({} if seed is None else {"seed": int(seed)}))
@@ -234,6 +249,13 @@ def _ramp_runs(
             ramp_plans.setdefault(preset, {})[float(v)] = rp.as_dict()
             by_dur.setdefault(rp.duration_s, []).append(float(v))
             tick()
+
+    def rows(df, store):
+        c = df[df["analysis"] == "compare"].copy()
+        m = df[df["analysis"] == "mujoco"]
+        c["prefix_frechet"], c["coverage"], c["ie_achieved"] = _ramp_metrics(c, m, store, surface, rig)
+        return c, m
+
     out = []
     for j, (dur, ies_) in enumerate(sorted(by_dur.items())):
         doc = family_doc(
@@ -248,11 +270,7 @@ def _ramp_runs(
             },
             grid=grid,
         )
-        df, store = runner(doc, f"boundary/ramp-{preset}-d{dur:.4g}")
-        c = df[df["analysis"] == "compare"].copy()
-        m = df[df["analysis"] == "mujoco"]
-        c["prefix_frechet"], c["coverage"], c["ie_achieved"] = _ramp_metrics(c, m, store, surface, rig)
-        out.append((c, m))
+        out.append((doc, f"boundary/ramp-{preset}-d{dur:.4g}", rows))
     return out
 
 
