@@ -181,7 +181,7 @@ def stiffness_map(plan: ValidationPlan, runner: StudyRunner) -> StiffnessMapResu
     empty = StiffnessMapResult(ies, ks, [f.name for f in fams], plan.stiffness_map_starts, {}, [], [])
     if not ies or not ks or not fams:
         return empty
-    runs, samples, predicted = [], {}, {}
+    runs, samples, predicted, jobs = [], {}, {}, []
     for fam in fams:
         sub = subset_starts(plan.map_family(fam), plan.stiffness_map_starts)
         with runner.phase(f"predicted drive limits of {fam.name}"):
@@ -194,9 +194,12 @@ def stiffness_map(plan: ValidationPlan, runner: StudyRunner) -> StiffnessMapResu
                 drive={"protocol": "spring", "ie": ies, "K": ks},
                 grid=preset_grid(plan, sub, preset),
             )
-            df, store = runner(doc, f"stiffness_map/{preset}")
-            with runner.phase(f"slip events and energy on {preset}"):
-                runs.append(_run_rows(df, store, fam.name, preset, samples))
+            jobs.append((fam.name, preset, doc))
+    # every preset's sweep at once: the workers stay busy across the sweeps' ends
+    done = runner.many([(doc, f"stiffness_map/{preset}") for _, preset, doc in jobs], "the (I_e, K) map")
+    for (family, preset, _), (df, store) in zip(jobs, done):
+        with runner.phase(f"slip events and energy on {preset}"):
+            runs.append(_run_rows(df, store, family, preset, samples))
     table = pd.concat(runs, ignore_index=True)
     pooled = {k: {n: np.concatenate(v) for n, v in d.items()} for k, d in samples.items()}
     slip = slip_rows(table)
