@@ -93,10 +93,25 @@ def ground_truth(plan: ValidationPlan, runner: StudyRunner) -> GroundTruthResult
     runner.study = "ground_truth"
     with runner.phase("spring-block on a flat plane"):
         block = spring_block_check()
+    corrugations = [
+        Corrugation(s, mu, tip_radius=TOMLINSON_TIP)
+        for s in plan.ground_truth_slopes
+        for mu in plan.ground_truth_mus
+    ]
+    ks = [
+        [float(f"{f * c.critical_stiffness():.6g}") for f in plan.ground_truth_k_factors]
+        for c in corrugations
+    ]
+    names = [f"ground-truth/pt-s{c.slope_amplitude:g}-mu{c.mu:g}" for c in corrugations]
+    jobs = [
+        (corrugation_doc(name, c.slope_amplitude, c.mu, k, TOMLINSON_IE, plan.ground_truth_waves), name)
+        for c, k, name in zip(corrugations, ks, names)
+    ]
+    # the corrugations' sweeps at once: the workers stay busy across the sweeps' ends
+    done = runner.many(jobs, "Prandtl-Tomlinson corrugations")
     rows = []
-    for s in plan.ground_truth_slopes:
-        for mu in plan.ground_truth_mus:
-            rows += _tomlinson(plan, runner, s, mu)
+    for c, (df, _) in zip(corrugations, done):
+        rows += _tomlinson(c, df[df["analysis"] == "mujoco"])
     lift = [_liftoff(plan, runner, w) for w in plan.ground_truth_ridge_widths]
     return GroundTruthResult(spring_block=block, tomlinson=rows, liftoff=lift)
 
@@ -135,14 +150,10 @@ def spring_block_check(speed_m_s: float = 0.004, stiffness_n_m: float = 100.0, m
     }
 
 
-def _tomlinson(plan: ValidationPlan, runner: StudyRunner, s: float, mu: float) -> list[dict]:
-    """The rows of one corrugation (slope amplitude ``s``, ``mu``) over the plan's K / K*."""
-    c = Corrugation(s, mu, tip_radius=TOMLINSON_TIP)
+def _tomlinson(c: Corrugation, df) -> list[dict]:
+    """The rows of one corrugation's MuJoCo runs ``df`` (one per K)."""
+    s, mu = c.slope_amplitude, c.mu
     k_star = c.critical_stiffness()
-    ks = [float(f"{f * k_star:.6g}") for f in plan.ground_truth_k_factors]
-    df = corrugation_runs(
-        runner, f"ground-truth/pt-s{s:g}-mu{mu:g}", s, mu, ks, TOMLINSON_IE, plan.ground_truth_waves
-    )
     rows = []
     for _, r in df.sort_values("K").iterrows():
         k = float(r["K"])
@@ -206,10 +217,16 @@ CORRUGATION_START = 0.75
 
 
 def corrugation_runs(runner: StudyRunner, name: str, s: float, mu: float, ks, ie, waves: int):
-    """The ``mujoco`` rows of the spring drive on a corrugation (slope amplitude ``s``,
-    unit wavelength, :data:`POINTS_PER_WAVE`, ``waves`` wavelengths) at stiffness numbers
-    ``ks`` and I_e ``ie`` (one or a list), from :data:`CORRUGATION_START`."""
-    doc = {
+    """The ``mujoco`` rows of :func:`corrugation_doc`'s sweep, stored as ``name``."""
+    df, _ = runner(corrugation_doc(name, s, mu, ks, ie, waves), name)
+    return df[df["analysis"] == "mujoco"]
+
+
+def corrugation_doc(name: str, s: float, mu: float, ks, ie, waves: int) -> dict:
+    """The sweep config of the spring drive on a corrugation (slope amplitude ``s``, unit
+    wavelength, :data:`POINTS_PER_WAVE`, ``waves`` wavelengths) at stiffness numbers ``ks``
+    and I_e ``ie`` (one or a list), from :data:`CORRUGATION_START`."""
+    return {
         "sweep": {"name": name.replace("/", "-"), "seed": 1, "analyses": ["mujoco"]},
         "surfaces": [
             {
@@ -221,8 +238,6 @@ def corrugation_runs(runner: StudyRunner, name: str, s: float, mu: float, ks, ie
         "drive": {"protocol": "spring", "ie": ie, "K": list(ks)},
         "grid": {"mu": mu, "tip_radius": TOMLINSON_TIP, "record_every": 50},
     }
-    df, _ = runner(doc, name)
-    return df[df["analysis"] == "mujoco"]
 
 
 def ridge(width: float, height: float = RIDGE_HEIGHT) -> GridSurface:
