@@ -5,15 +5,16 @@ numbers beside the committed 95 % intervals (spine_mj.validate.reproducibility).
     python analysis/reproduction_check.py demo-out/validation.json
 
     # on this CPU with the vector code paths of an older one (x86-64-v2: no AVX2, FMA or
-    # AVX-512 in numpy's dispatch or the C library's maths), the quick plan run and checked
+    # AVX-512 in numpy, the C library's maths, OpenBLAS or numba), the quick plan run and checked
     python analysis/reproduction_check.py --emulate-x86-64-v2 --out emulated-out
 
 Writes a Markdown table (``-o``, default: printed) and exits 1 when a number lies outside
 its committed interval or a family's verdict changed.
 
 What differs between two x86-64 CPUs is the code paths picked by CPU: numpy's dispatch
-(NPY_DISABLE_CPU_FEATURES), glibc's maths (GLIBC_TUNABLES) and the machine code numba
-generates for the host (NUMBA_CPU_NAME); the emulation switches all three to x86-64-v2. On
+(NPY_DISABLE_CPU_FEATURES), glibc's maths (GLIBC_TUNABLES), OpenBLAS's kernels behind numpy's
+and scipy's matrix products (OPENBLAS_CORETYPE) and the machine code numba generates for the
+host (NUMBA_CPU_NAME); the emulation switches all four to x86-64-v2 (OpenBLAS to Nehalem). On
 an AVX-512 machine numpy's and glibc's exp, log, power and trigonometric results then
 differ in the last bits, as another CPU's do. MuJoCo's wheel carries one AVX build without
 run-time dispatch (no cpuid, no AVX-512 instruction in libmujoco 4.0.0), so its own
@@ -40,6 +41,7 @@ X86_64_V2 = {
     "NPY_DISABLE_CPU_FEATURES": "X86_V3 X86_V4 AVX512_ICL AVX512_SPR",
     "GLIBC_TUNABLES": "glibc.cpu.hwcaps=-AVX2,-FMA,-AVX512F,-AVX512DQ,-AVX512VL,-AVX512BW",
     "NUMBA_CPU_NAME": "x86-64-v2",
+    "OPENBLAS_CORETYPE": "Nehalem",
 }
 
 

@@ -19,13 +19,14 @@ __all__ = ["platform_info"]
 VECTOR_FLAGS = ("sse4_2", "avx", "avx2", "fma", "avx512f", "avx512dq", "avx512vl", "neon", "asimd")
 
 
-#: Environment variables that change which vector code paths numpy and the C library's maths
-#: take at run time (recorded when set: the numbers then stand for another CPU's paths).
+#: Environment variables that change which vector code paths numpy, the C library's maths,
+#: OpenBLAS and numba take at run time (recorded when set: the numbers then stand for another CPU's paths).
 DISPATCH_VARIABLES = (
     "NPY_DISABLE_CPU_FEATURES",
     "NPY_ENABLE_CPU_FEATURES",
     "GLIBC_TUNABLES",
     "NUMBA_CPU_NAME",
+    "OPENBLAS_CORETYPE",
 )
 
 

@@ -94,7 +94,7 @@ def platform_line(platform: dict | None) -> list[str]:
         f"Made on {platform.get('cpu')} ({platform.get('machine')}; vector instruction sets: {isa}; "
         f"{platform.get('cpu_count')} cores), {platform.get('os')}, Python {platform.get('python')}, "
         f"numpy {platform.get('numpy')}, MuJoCo {platform.get('mujoco')}.{switched} Other CPUs take "
-        "other vector code paths in numpy, the C library's maths and numba, which round "
+        "other vector code paths in numpy, the C library's maths, OpenBLAS and numba, which round "
         "differently: runs near a watershed may flip there; the intervals say how far the "
         "numbers may move (analysis/reproduction_check.py compares a run with them).",
         "",
