@@ -238,7 +238,7 @@ def limit_family_docs(plan: ValidationPlan, fam: FamilySpec) -> list[tuple[str, 
     first = docs[0][1]
     own_starts = all("starts" in e for _, d in docs for e in d["surfaces"])
     if len(docs) == 1 or not (own_starts and all(d["grid"] == first["grid"] for _, d in docs)):
-        return docs if len(docs) > 1 else [(docs[0][0], first)]
+        return docs
     merged = {**first, "sweep": {**first["sweep"], "name": f"limit-{fam.name}"}}
     merged["surfaces"] = [e for _, d in docs for e in d["surfaces"]]
     return [(fam.name, merged)]
