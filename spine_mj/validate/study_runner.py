@@ -98,6 +98,17 @@ class StudyRunner:
         yield tick
         report(total)
 
+    def _sweep_progress(self, step: str) -> Callable:
+        """A sweep's progress callback reporting its cases as ``step`` of this study."""
+
+        def report(p) -> None:
+            if self.progress is not None:
+                done = p.finished_cases + p.skipped_cases
+                elapsed = time.perf_counter() - self.t0
+                self.progress(ValidationProgress(self.study, step, done, p.total_cases, elapsed))
+
+        return report
+
     def __call__(self, doc: dict, name: str, *, workers: int | None = None):
         """Run the sweep config ``doc`` into ``out/sweeps/<name>`` (overwriting it).
 
@@ -109,23 +120,11 @@ class StudyRunner:
         config = sweep.parse_config(doc, base_dir=self.out_dir)
         store = self.out_dir / "sweeps" / name
 
-        def cb(p):
-            if self.progress is not None:
-                self.progress(
-                    ValidationProgress(
-                        self.study,
-                        name,
-                        p.finished_cases + p.skipped_cases,
-                        p.total_cases,
-                        time.perf_counter() - self.t0,
-                    )
-                )
-
         # not capped at the case count: a sweep of one case steps its engine batch on the
         # workers' threads instead of starting processes
         w = workers if workers is not None else self.workers
         w = w or os.cpu_count() or 1
-        sweep.run_sweep(config, store, workers=w, overwrite=True, progress=cb)
+        sweep.run_sweep(config, store, workers=w, overwrite=True, progress=self._sweep_progress(name))
         return sweep.load_runs(store), store
 
     def many(self, jobs, step: str):
@@ -141,18 +140,7 @@ class StudyRunner:
         configs = [sweep.parse_config(doc, base_dir=self.out_dir) for doc, _ in jobs]
         stores = [self.out_dir / "sweeps" / name for _, name in jobs]
 
-        def cb(p):
-            if self.progress is not None:
-                self.progress(
-                    ValidationProgress(
-                        self.study,
-                        step,
-                        p.finished_cases + p.skipped_cases,
-                        p.total_cases,
-                        time.perf_counter() - self.t0,
-                    )
-                )
-
         w = self.workers or os.cpu_count() or 1
-        sweep.run_sweeps(list(zip(configs, stores)), workers=w, overwrite=True, progress=cb)
+        progress = self._sweep_progress(step)
+        sweep.run_sweeps(list(zip(configs, stores)), workers=w, overwrite=True, progress=progress)
         return [(sweep.load_runs(store), store) for store in stores]
