@@ -61,11 +61,13 @@ def bootstrap(
 ) -> tuple[float, float]:
     """Percentile bootstrap interval of ``statistic`` over the finite ``values`` (runs).
 
-    A fixed ``seed`` makes the interval a function of the values alone. (NaN, NaN) with
-    fewer than two finite values; a sample of one repeated value gives that value twice.
+    A fixed ``seed`` and the values sorted first make the interval a function of the values
+    alone, not of the order the runs came in (how a study splits its sweeps into cases).
+    (NaN, NaN) with fewer than two finite values; a sample of one repeated value gives that
+    value twice.
     """
     v = np.asarray(values, dtype=float)
-    v = v[np.isfinite(v)]
+    v = np.sort(v[np.isfinite(v)])
     if v.size < 2:
         return math.nan, math.nan
     if np.all(v == v[0]):

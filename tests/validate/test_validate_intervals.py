@@ -89,3 +89,8 @@ def test_the_reports_platform_line_names_switched_code_paths():
     info = {**platform_info(), "dispatch_overrides": {"NUMBA_CPU_NAME": "x86-64-v2"}}
     assert "NUMBA_CPU_NAME=x86-64-v2" in platform_line(info)[0]
     assert "switched" not in platform_line({**info, "dispatch_overrides": {}})[0]
+
+
+def test_the_bootstrap_interval_does_not_depend_on_the_order_of_the_runs():
+    v = np.random.default_rng(3).lognormal(size=41)
+    assert bootstrap(v) == bootstrap(v[::-1]) == bootstrap(np.random.default_rng(4).permutation(v))
