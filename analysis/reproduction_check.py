@@ -31,7 +31,8 @@ import subprocess
 import sys
 from pathlib import Path
 
-from spine_mj.validate.reproducibility import check_reproduction
+from spine_mj.errors import SpineInputError
+from spine_mj.validate.reproducibility import check_reproduction, headline_numbers
 
 REPO = Path(__file__).resolve().parents[1]
 COMMITTED = REPO / "analysis" / "reports" / "validation-quick" / "validation.json"
@@ -85,10 +86,17 @@ def main() -> int:
         new = Path(args.new)
     else:
         ap.error("give the new run's validation.json or --emulate-x86-64-v2")
-    committed = json.loads(Path(args.committed).read_text())
-    fresh = json.loads(new.read_text())
-    text = f"New: {fresh.get('platform')}\n\nCommitted: {committed.get('platform')}\n\n"
+    docs = []
+    for path in (args.committed, new):
+        try:
+            docs.append(json.loads(Path(path).read_text()))
+            headline_numbers(docs[-1])
+        except (OSError, ValueError, SpineInputError) as exc:  # a missing or malformed file
+            print(f"Error: {path}: {exc}", file=sys.stderr)
+            return 2
+    committed, fresh = docs
     rows = check_reproduction(fresh, committed)
+    text = f"New: {fresh.get('platform')}\n\nCommitted: {committed.get('platform')}\n\n"
     text += table(rows) + "\n"
     if args.report:
         Path(args.report).write_text(text)

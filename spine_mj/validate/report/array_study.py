@@ -11,7 +11,7 @@ import numpy as np
 
 from spine_mj.plotting import new_figure, save_figure, sig, styled
 from spine_mj.validate.array_study import ArrayStudyResult
-from spine_mj.validate.report.common import ReportContext
+from spine_mj.validate.report.common import ReportContext, table
 
 __all__ = ["array_figure", "array_section", "headline", "section"]
 
@@ -87,34 +87,51 @@ def array_section(res: ArrayStudyResult | None, figure: str | None = None) -> st
         "95 %). A spine's peak force overshoots the quasistatic one by about sqrt(I_e K_c) F_p (the "
         "spring-block swing past breakaway, K_c = k L_c / F_p); the sum over spines smooths it.",
         "",
-        "| surface | N | spacing [l_s] | layout | holding (MuJoCo) | 95 % CI | holding (QS) | "
-        "P(lock) MuJoCo | 95 % CI | P(lock) QS | lock agreement | failed | QS paths short |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
+    rows = []
     for r in res.rows:
         pl, pq = r["p_lock"], r["p_lock_qs"]
-        lines.append(
-            f"| {r['surface']} | {r['n_spines']} | {sig(r['spacing_ls'])} | {r['layout']} | "
-            f"{sig(r['holding_per_spine'])} | {_ci(*r['holding_ci'])} | {sig(r['holding_per_spine_qs'])} | "
-            f"{pl['locked']}/{pl['n_ok']} | {_ci(pl['ci_low'], pl['ci_high'])} | "
-            f"{pq['locked']}/{pq['n_ok']} | "
-            f"{sig(r['lock_agreement'])} | {r['failed_runs']} | {r['reference_short_spines']} |"
+        rows.append(
+            {
+                "surface": r["surface"],
+                "N": r["n_spines"],
+                "spacing": sig(r["spacing_ls"]),
+                "layout": r["layout"],
+                "holding": sig(r["holding_per_spine"]),
+                "holding_ci": _ci(*r["holding_ci"]),
+                "holding_qs": sig(r["holding_per_spine_qs"]),
+                "lock": f"{pl['locked']}/{pl['n_ok']}",
+                "lock_ci": _ci(pl["ci_low"], pl["ci_high"]),
+                "lock_qs": f"{pq['locked']}/{pq['n_ok']}",
+                "agreement": sig(r["lock_agreement"]),
+                "failed": r["failed_runs"],
+                "short": r["reference_short_spines"],
+            }
         )
+    names = ["surface", "N", "spacing [l_s]", "layout", "holding (MuJoCo)", "95 % CI", "holding (QS)"]
+    names += ["P(lock) MuJoCo", "95 % CI", "P(lock) QS", "lock agreement", "failed", "QS paths short"]
+    cols = ["surface", "N", "spacing", "layout", "holding", "holding_ci", "holding_qs", "lock", "lock_ci"]
+    lines.append(table(rows, [*cols, "lock_qs", "agreement", "failed", "short"], names))
     if figure:
         lines += ["", f"![Holding per spine and P(lock) against N per layout]({figure})"]
     lines += ["", "### The conjecture: staggered (and random) against aligned, same placements", ""]
-    lines += [
-        "| surface | N | spacing [l_s] | layout | P(lock) - P(lock, grid) | 95 % CI | "
-        "holding - holding(grid) | 95 % CI |",
-        "|---|---|---|---|---|---|---|---|",
+    diffs = [
+        {
+            "surface": c["surface"],
+            "N": c["n_spines"],
+            "spacing": sig(c["spacing_ls"]),
+            "layout": c["layout"],
+            "p_lock": sig(c["p_lock_diff"]["diff"]),
+            "p_lock_ci": _ci(c["p_lock_diff"]["ci_low"], c["p_lock_diff"]["ci_high"]),
+            "holding": sig(c["holding_diff"]["diff"]),
+            "holding_ci": _ci(c["holding_diff"]["ci_low"], c["holding_diff"]["ci_high"]),
+        }
+        for c in res.conjecture
     ]
-    for c in res.conjecture:
-        d, h = c["p_lock_diff"], c["holding_diff"]
-        lines.append(
-            f"| {c['surface']} | {c['n_spines']} | {sig(c['spacing_ls'])} | {c['layout']} | "
-            f"{sig(d['diff'])} | "
-            f"{_ci(d['ci_low'], d['ci_high'])} | {sig(h['diff'])} | {_ci(h['ci_low'], h['ci_high'])} |"
-        )
+    names = ["surface", "N", "spacing [l_s]", "layout", "P(lock) - P(lock, grid)", "95 % CI"]
+    names += ["holding - holding(grid)", "95 % CI"]
+    cols = ["surface", "N", "spacing", "layout", "p_lock", "p_lock_ci", "holding", "holding_ci"]
+    lines.append(table(diffs, cols, names))
     lines += ["", _verdict(res)]
     return "\n".join(lines) + "\n"
 
