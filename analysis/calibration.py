@@ -1,7 +1,7 @@
 """Calibration study for the paper's reproductions (issue 3).
 
 Runs the reproductions through the package's public API (``spine_mj.reproduce``,
-``spine_mj.streamline``) with the parameters the paper leaves open varied, and writes
+``spine_mj.theory.streamline``) with the parameters the paper leaves open varied, and writes
 ``analysis/reports/calibration.md`` plus PNGs beside it. Takes a few minutes on 2 cores::
 
     .venv/bin/python analysis/calibration.py            # full study
@@ -25,8 +25,8 @@ import numpy as np
 
 from spine_mj.presets import load_preset
 from spine_mj.reproduce import calibrate_single_peak_mu, fractal_hurst, random_gaussian, single_peak
-from spine_mj.streamline import StreamlineParams, ideal_trajectories, streamlines
 from spine_mj.surfaces import single_gaussian
+from spine_mj.theory.streamline import StreamlineParams, ideal_trajectories, streamlines
 
 OUT = Path(__file__).parent / "reports"
 PAPER_RG = {

@@ -4,7 +4,7 @@ Rebuilds, for the full plan's sandpaper and fractal families at the lowest I_e, 
 sweep's ``compare`` analysis compared before its contact surface became exact
 (:class:`spine_mj.surfaces.BallOnFacets`): the MuJoCo runs (the ``mujoco`` analysis of each
 case, about a minute for both families) and the reference streamline traced on the facets
-dilated by the tip and sampled at R/8 under a spline (``spine_mj.streamline.dilate``), with
+dilated by the tip and sampled at R/8 under a spline (``spine_mj.theory.streamline.dilate``), with
 the same mu_s, step and force cap. Then, per run that disagrees or whose reference stalls or holds:
 
 * the reference with fixed steps (``max_halvings = 0``, the integrator before the step
@@ -26,19 +26,19 @@ import dataclasses
 import numpy as np
 
 from spine_mj import compare
-from spine_mj import streamline as sl
-from spine_mj.engagement import kappa
 from spine_mj.sim.model import from_hfield
 from spine_mj.surfaces import TriangulatedSurface
 from spine_mj.sweep import ANALYSES, expand_cases, parse_config
 from spine_mj.sweep.analyses.mujoco import case_rig
+from spine_mj.theory import streamline as sl
+from spine_mj.theory.engagement import kappa
 from spine_mj.validate.plans import FRACTAL, PLANS, SANDPAPER
 from spine_mj.validate.quasistatic_limit import limit_doc
 
 
 def exact_contact(facets, c, radius, n=321):
     """Height of the dilated facets at ``c`` (shifted down by the radius, as
-    :func:`spine_mj.streamline.dilate`) and the slope from the highest contact, by brute
+    :func:`spine_mj.theory.streamline.dilate`) and the slope from the highest contact, by brute
     force over ``n x n`` points of the tip's footprint."""
     u = np.linspace(-radius, radius, n)
     x, y = np.meshgrid(c[0] + u, c[1] + u)

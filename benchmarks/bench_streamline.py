@@ -5,8 +5,8 @@ import time
 import numpy as np
 
 from spine_mj.reproduce import fractal_hurst
-from spine_mj.streamline import StreamlineParams, streamlines
 from spine_mj.surfaces import fractal_fbm, single_gaussian
+from spine_mj.theory.streamline import StreamlineParams, streamlines
 
 
 def steps_per_second(surface, starts, params, repeat=5, backend="auto"):

@@ -86,8 +86,8 @@ def section(fn, *args):
 def bench_streamline(quick: bool) -> dict:
     from bench_streamline import steps_per_second
 
-    from spine_mj.streamline import StreamlineParams
     from spine_mj.surfaces import fractal_fbm, single_gaussian
+    from spine_mj.theory.streamline import StreamlineParams
 
     n = 500 if quick else 2000
     n_np = 100 if quick else 300

@@ -26,8 +26,8 @@ import math
 import numpy as np
 from numba import njit
 
-from spine_mj.engagement import SLIP
 from spine_mj.errors import SpineInputError
+from spine_mj.theory.engagement import SLIP
 
 #: What "agree" means at the quasistatic corner, for sweeps and validation alike: outcome
 #: agreement at least this share of the runs, and path deviation (Frechet over L_c) at most.
@@ -347,7 +347,7 @@ def capture_rate(locked) -> float:
 
 def slide_fraction(path, region) -> float:
     """Share of a streamline's arc length traced in the slip region (``region`` per point,
-    :data:`spine_mj.engagement.SLIP`; a segment counts by its first point), where gravity
+    :data:`spine_mj.theory.engagement.SLIP`; a segment counts by its first point), where gravity
     alone slides the tip (docs/physics.md §2).
 
     There the quasistatic model has no drive force and no rate: the engine's tip falls at

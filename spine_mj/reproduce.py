@@ -16,8 +16,6 @@ from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 
-from spine_mj.convexity import CONCAVE, CONVEX, SADDLE, hessian_class, sectional_class
-from spine_mj.engagement import ENGAGED, REGION_NAMES, SLIP, kappa, kappa_grid
 from spine_mj.errors import SpineInputError
 from spine_mj.plotting import (
     fractal_hurst_figure,
@@ -26,8 +24,10 @@ from spine_mj.plotting import (
     single_peak_figure,
 )
 from spine_mj.presets import load_preset, resolve_mu
-from spine_mj.streamline import Outcome, StreamlineParams, ideal_trajectories, streamlines
 from spine_mj.surfaces import GaussianSurface, fractal_fbm, random_gaussians, single_gaussian
+from spine_mj.theory.convexity import CONCAVE, CONVEX, SADDLE, hessian_class, sectional_class
+from spine_mj.theory.engagement import ENGAGED, REGION_NAMES, SLIP, kappa, kappa_grid
+from spine_mj.theory.streamline import Outcome, StreamlineParams, ideal_trajectories, streamlines
 from spine_mj.workers import check_workers
 
 __all__ = [

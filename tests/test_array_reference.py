@@ -7,9 +7,14 @@ import math
 import numpy as np
 import pytest
 
-from spine_mj.array_reference import force_control_release, forward_branch, profile_spine_curve, summed_curve
 from spine_mj.errors import SpineInputError
 from spine_mj.sim.layout import MAX_SPINES, Layout
+from spine_mj.theory.array_reference import (
+    force_control_release,
+    forward_branch,
+    profile_spine_curve,
+    summed_curve,
+)
 
 
 def test_forward_branch_jumps_past_a_fold():
@@ -92,10 +97,10 @@ def test_bad_layouts_are_refused():
 
 
 def test_compliant_spine_curves_follow_the_prandtl_tomlinson_curve_on_a_corrugation():
-    from spine_mj.array_reference import compliant_spine_curves
-    from spine_mj.compliant import compliant_streamlines
-    from spine_mj.streamline import StreamlineParams
     from spine_mj.surfaces import corrugation
+    from spine_mj.theory.array_reference import compliant_spine_curves
+    from spine_mj.theory.compliant import compliant_streamlines
+    from spine_mj.theory.streamline import StreamlineParams
 
     surf = corrugation(n_waves=4, width=0.5, points_per_wave=64)
     starts = np.array([[1.1, 0.0], [1.4, 0.0]])

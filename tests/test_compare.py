@@ -145,7 +145,7 @@ def test_miss_reason_reads_where_the_restarted_reference_first_ends_as_the_run()
 
 
 def test_slide_fraction_counts_the_arc_length_of_slip_segments():
-    from spine_mj.engagement import ENGAGED, SELF_LOCK, SLIP
+    from spine_mj.theory.engagement import ENGAGED, SELF_LOCK, SLIP
 
     path = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 3.0], [1.0, 4.0]])
     region = [ENGAGED, SLIP, SLIP, SELF_LOCK]  # the last point's region starts no segment

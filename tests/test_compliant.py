@@ -9,10 +9,7 @@ import pytest
 from scipy.optimize import brentq
 
 from spine_mj.compare import path_frechet
-from spine_mj.compliant import MotionState, compliant_streamlines, hold_force
-from spine_mj.engagement import kappa
 from spine_mj.errors import SpineInputError
-from spine_mj.streamline import Outcome, StreamlineParams, streamlines
 from spine_mj.surfaces import (
     BallOnFacets,
     Surface,
@@ -20,6 +17,9 @@ from spine_mj.surfaces import (
     corrugation,
     single_gaussian,
 )
+from spine_mj.theory.compliant import MotionState, compliant_streamlines, hold_force
+from spine_mj.theory.engagement import kappa
+from spine_mj.theory.streamline import Outcome, StreamlineParams, streamlines
 
 L_S = 0.190  # slope correlation length of a corrugation, in wavelengths
 
@@ -189,8 +189,8 @@ def test_ball_on_facets_like_the_rigid_reference():
 
 
 def test_compiled_fold_and_landing_searches_equal_the_numpy_ones():
-    from spine_mj import _compliant_kernel as kernel
-    from spine_mj.compliant import _BISECTIONS, _GOLDEN_ITERATIONS, _fold_along, _landing_along
+    from spine_mj.theory import _compliant_kernel as kernel
+    from spine_mj.theory.compliant import _BISECTIONS, _GOLDEN_ITERATIONS, _fold_along, _landing_along
 
     grid = corrugation(slope_amplitude=0.4, n_waves=3, points_per_wave=16)
     contact = BallOnFacets(TriangulatedSurface.from_grid(grid), 0.05)

@@ -3,7 +3,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from spine_mj.convexity import (
+from spine_mj.surfaces import single_gaussian
+from spine_mj.theory.convexity import (
     CONCAVE,
     CONVEX,
     SADDLE,
@@ -12,7 +13,6 @@ from spine_mj.convexity import (
     section_curvature,
     sectional_class,
 )
-from spine_mj.surfaces import single_gaussian
 
 finite = st.floats(-5, 5)
 

@@ -6,9 +6,9 @@ from dataclasses import dataclass, field
 import numpy as np
 import pytest
 
-from spine_mj.drive_limits import crest_curvature, drive_limits, kappa_fall, trap_depths
 from spine_mj.errors import SpineInputError
 from spine_mj.surfaces import GaussianSurface, Surface, corrugation
+from spine_mj.theory.drive_limits import crest_curvature, drive_limits, kappa_fall, trap_depths
 
 
 @dataclass(frozen=True, eq=False)

@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 from sim_rigs import MU, flat_rig
 
-from spine_mj.energy import elastic_release_j, energy_budget, quasistatic_work_j
 from spine_mj.sim import SpringDrive
 from spine_mj.sim.drives import stiffness_n_m
+from spine_mj.theory.energy import elastic_release_j, energy_budget, quasistatic_work_j
 
 
 def test_spring_on_a_flat_plane_accounts_for_the_carriage_work():

@@ -5,8 +5,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from spine_mj.engagement import ENGAGED, SELF_LOCK, SLIP, kappa, kappa_of_normal, slip_direction
 from spine_mj.errors import SpineInputError
+from spine_mj.theory.engagement import ENGAGED, SELF_LOCK, SLIP, kappa, kappa_of_normal, slip_direction
 
 
 def _holds(fx, fy, mu, k, margin=0.0):
@@ -148,7 +148,7 @@ def test_kappa_of_normal_handles_walls_and_batches():
 def test_crease_engagement_of_a_v_groove_is_the_wedge():
     """A V-groove along the drive with flanks of angle theta: the wedge's kappa = mu / cos(theta),
     sliding along +x; symmetric in the order of the sides."""
-    from spine_mj.engagement import crease_engagement
+    from spine_mj.theory.engagement import crease_engagement
 
     t = 2.0  # tan(theta)
     for a, b in (((0.0, t), (0.0, -t)), ((0.0, -t), (0.0, t))):
@@ -167,7 +167,7 @@ def test_crease_engagement_of_a_floor_beside_a_wall(floor_fy):
     n_b, horizontal part h_b) gives ``kappa = mu / (c_x - mu |c_y| (1 - n_bz) / h_b)`` along
     the foot ``c``; a floor tilted by 1e-4 either way changes it by about that much (it was
     rejected as no two-contact state when the tilt left the wall's load at zero drive < 0)."""
-    from spine_mj.engagement import crease_engagement
+    from spine_mj.theory.engagement import crease_engagement
 
     mu, wall = 0.5, (5.0, -4.0)
     s = math.sqrt(1.0 + wall[0] ** 2 + wall[1] ** 2)

@@ -8,9 +8,9 @@ import math
 import numpy as np
 import pytest
 
-from spine_mj.engagement import ENGAGED, SELF_LOCK, SLIP, kappa
 from spine_mj.errors import SpineInputError
-from spine_mj.multicontact import (
+from spine_mj.theory.engagement import ENGAGED, SELF_LOCK, SLIP, kappa
+from spine_mj.theory.multicontact import (
     CONE_SIDES,
     hold_kappa,
     normals_of_slopes,
@@ -130,7 +130,7 @@ def _asymmetric_groove(radius=None):
 def test_a_streamline_crossing_a_wedging_crease_is_held_there(radius):
     """Each flank alone moves at kappa 15.5 and 19.2, below the cap of 20; the two together
     hold to 30.6: a path on single contacts zig-zags across the crease and goes on."""
-    from spine_mj import streamline as sl
+    from spine_mj.theory import streamline as sl
 
     surface = _asymmetric_groove(radius)
     ks = kappa(np.array([0.7336, 0.7336]), np.array([-0.2964, 0.199]), 1.25)[0]

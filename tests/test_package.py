@@ -19,6 +19,48 @@ def test_analytic_side_imports_without_mujoco():
     assert out.stdout.strip() == "False"
 
 
+#: Every module that moved, by its old public path, and a name each one exports.
+OLD_PATHS = {
+    "spine_mj.engagement": ("spine_mj.theory.engagement", "kappa"),
+    "spine_mj.streamline": ("spine_mj.theory.streamline", "StreamlineParams"),
+    "spine_mj.compliant": ("spine_mj.theory.compliant", "compliant_streamlines"),
+    "spine_mj.convexity": ("spine_mj.theory.convexity", "hessian_class"),
+    "spine_mj.multicontact": ("spine_mj.theory.multicontact", "two_contact_kappa"),
+    "spine_mj.tomlinson": ("spine_mj.theory.tomlinson", "Corrugation"),
+    "spine_mj.tomlinson_dynamics": ("spine_mj.theory.tomlinson_dynamics", "integrate"),
+    "spine_mj.drive_limits": ("spine_mj.theory.drive_limits", "drive_limits"),
+    "spine_mj.energy": ("spine_mj.theory.energy", "elastic_release_j"),
+    "spine_mj.array_reference": ("spine_mj.theory.array_reference", "summed_curve"),
+    "spine_mj._kernels": ("spine_mj.theory._kernels", "run_trajectories"),
+    "spine_mj._compliant_kernel": ("spine_mj.theory._compliant_kernel", "fold_on_facets"),
+    "spine_mj._contact_kernel": ("spine_mj.surfaces._contact_kernel", "ball_on_facets"),
+    "spine_mj.array_outputs": ("spine_mj.sim.array_outputs", "write_array_outputs"),
+}
+
+
+def test_every_old_import_path_still_works():
+    # in a fresh interpreter, so that no earlier import has loaded a module by its new name
+    code = f"""
+import importlib, sys
+for old, (new, name) in {OLD_PATHS!r}.items():
+    package, _, leaf = old.rpartition(".")
+    by_path, by_name, by_package = {{}}, {{}}, {{}}
+    exec(f"import {{old}}", by_path)
+    exec(f"from {{old}} import {{name}}", by_name)
+    exec(f"from {{package}} import {{leaf}}", by_package)
+    home = sys.modules[new]
+    assert home.__name__ == new and sys.modules[old] is home and by_package[leaf] is home, old
+    assert eval(old, by_path) is home and by_name[name] is getattr(home, name), old
+"""
+    subprocess.run([sys.executable, "-c", code], check=True)
+
+
+def test_old_module_names_resolve_as_attributes_of_the_package():
+    code = "import spine_mj; print(spine_mj.streamline.streamlines is spine_mj.streamlines)"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "True"
+
+
 def test_shipped_files_are_found_through_the_package():
     # models/ and surfaces/ ship as spine_mj._data.* (setup.py), found by spine_mj.resources
     # in an editable install and in a wheel alike (`make wheel-check` covers the wheel)

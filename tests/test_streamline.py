@@ -5,17 +5,17 @@ import numpy as np
 import pytest
 from scipy.spatial import cKDTree
 
-from spine_mj.engagement import ENGAGED, SELF_LOCK
 from spine_mj.errors import SpineInputError
 from spine_mj.presets import load_preset, make_surface
-from spine_mj.streamline import (
+from spine_mj.surfaces import GridSurface, fractal_fbm, random_gaussians, single_gaussian
+from spine_mj.theory.engagement import ENGAGED, SELF_LOCK
+from spine_mj.theory.streamline import (
     Outcome,
     StreamlineParams,
     dilate,
     ideal_trajectories,
     streamlines,
 )
-from spine_mj.surfaces import GridSurface, fractal_fbm, random_gaussians, single_gaussian
 
 FIVE_STARTS = [(-3.0, y) for y in (-4.0, -3.0, -2.0, -1.0, -0.5)]
 MU = load_preset("paper-single-peak").extras["engagement"]["mu"]
@@ -385,8 +385,8 @@ def test_kernel_has_no_out_of_bounds_access_on_capped_paths(monkeypatch):
     # silently writing outside it, and run it on capped, ragged and locking starts.
     from numba import njit
 
-    import spine_mj.streamline as sl
-    from spine_mj import _kernels
+    import spine_mj.theory.streamline as sl
+    from spine_mj.theory import _kernels
 
     checked = njit(boundscheck=True, fastmath=_kernels._FM, error_model="numpy")(
         _kernels.run_trajectories.py_func
@@ -449,8 +449,8 @@ def test_a_crease_descending_along_the_drive_is_followed_at_its_two_contact_kapp
     """A V-groove whose floor descends gently along the drive: on either flank the slip
     direction points across the crease (a single-contact path would zig-zag there); the path
     follows the crease at the two-contact kappa of its flanks (crease_engagement)."""
-    from spine_mj.engagement import crease_engagement
     from spine_mj.surfaces import BallOnFacets, TriangulatedSurface
+    from spine_mj.theory.engagement import crease_engagement
 
     x = np.linspace(0.0, 1.0, 21)
     y = np.linspace(-0.5, 0.5, 21)

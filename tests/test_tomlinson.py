@@ -1,4 +1,4 @@
-"""Closed forms of the dynamics (spine_mj.tomlinson) against their textbook values."""
+"""Closed forms of the dynamics (spine_mj.theory.tomlinson) against their textbook values."""
 
 import math
 
@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from spine_mj.errors import SpineInputError
-from spine_mj.tomlinson import (
+from spine_mj.theory.tomlinson import (
     Corrugation,
     gaussian_ridge_path_curvature,
     liftoff_inertia_number,

@@ -5,8 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from spine_mj.tomlinson import Corrugation, spring_block_x
-from spine_mj.tomlinson_dynamics import PTParams, SineProfile, integrate
+from spine_mj.theory.tomlinson import Corrugation, spring_block_x
+from spine_mj.theory.tomlinson_dynamics import PTParams, SineProfile, integrate
 
 #: The issue's corrugation, unit wavelength and load, I_e = m V^2 / (W L_c) = 1e-4.
 SLOPE, MU, SPEED = 0.3, 0.5, 0.01

@@ -81,7 +81,7 @@ def array_cmd(
     Example:
       spine-mj array corrugation --layout staggered --rows 2 --cols 3 --spacing 0.3 --drive force --out arr/
     """
-    from spine_mj.array_outputs import write_array_outputs
+    from spine_mj.sim.array_outputs import write_array_outputs
 
     if drive == "force" and duration is not None:
         raise SpineInputError("--duration is for --drive speed (a force pull runs to its cap)")

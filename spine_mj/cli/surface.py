@@ -16,7 +16,6 @@ from spine_mj.cli.app import (
     main,
     refuse_options_not_for,
 )
-from spine_mj.drive_limits import drive_limits
 from spine_mj.errors import SpineInputError, check_positive
 from spine_mj.jsonio import to_jsonable
 from spine_mj.plotting import (
@@ -25,6 +24,7 @@ from spine_mj.plotting import (
     surface_preview,
 )
 from spine_mj.surfaces import LENGTH_UNITS_M, length_unit
+from spine_mj.theory.drive_limits import drive_limits
 
 
 @main.group(cls=_Group)
@@ -170,7 +170,7 @@ def surface_info(surface_spec, output, as_json, mu, tip_radius):
 
 
 def _drive_limits(surf, mu, tip_radius):
-    """:func:`spine_mj.drive_limits.drive_limits` of ``surf`` with the one mu rule
+    """:func:`spine_mj.theory.drive_limits.drive_limits` of ``surf`` with the one mu rule
     (:func:`spine_mj.presets.resolve_mu`); None without a mu_s (info still reports the
     roughness)."""
     if mu is None and presets.preset_mu(surf) is None:

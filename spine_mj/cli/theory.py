@@ -8,7 +8,7 @@ import click
 import numpy as np
 import pandas as pd
 
-from spine_mj import engagement, presets, reproduce
+from spine_mj import presets, reproduce
 from spine_mj.atomic import all_or_none, atomic_output
 from spine_mj.cli.app import (
     Progress,
@@ -24,8 +24,9 @@ from spine_mj.plotting import (
     save_figure,
     streamline_figure,
 )
-from spine_mj.streamline import StreamlineParams, dilate, ideal_trajectories, streamlines
 from spine_mj.surfaces import check_grid_size
+from spine_mj.theory import engagement
+from spine_mj.theory.streamline import StreamlineParams, dilate, ideal_trajectories, streamlines
 
 
 @main.command("kappa")

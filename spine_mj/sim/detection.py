@@ -21,10 +21,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from spine_mj.engagement import DEFAULT_KAPPA_CAP, SELF_LOCK, kappa_of_normal
 from spine_mj.errors import check_positive
 from spine_mj.sim.params import EndReason, Scales, check_optional, penetration_tolerance_m
 from spine_mj.sim.recording import Recording
+from spine_mj.theory.engagement import DEFAULT_KAPPA_CAP, SELF_LOCK, kappa_of_normal
 
 #: Kinds of engine trouble: a non-finite number, a MuJoCo warning (the engine stopped or
 #: reset the run), penetration above tolerance, or a diverging state (speed or position).
@@ -127,7 +127,7 @@ def normal_lock_marks(
 ) -> tuple[np.ndarray, np.ndarray]:
     """First step of each run at which the shared lock rule holds (or -1), and the carry.
 
-    The rule the streamline uses (:func:`spine_mj.engagement.kappa_of_normal`, paper
+    The rule the streamline uses (:func:`spine_mj.theory.engagement.kappa_of_normal`, paper
     Fig. 2C), made sustained for a dynamic run: the tip is stuck in contact, the normal of
     its deepest contact lies in the self-lock region, and while both hold without a break
     the drive force has risen by :data:`LOCK_RISE_FP` preloads (the drive pushes into the

@@ -5,7 +5,7 @@ force climbs. Once the tip has been still for :data:`QUIET_STEPS` steps on one c
 normal (tangential speed at most ``Detection.stick_speed_m_s``, the normal unchanged
 within :data:`NORMAL_TOL`) with the noslip solver on, :class:`StickFastForward` predicts
 the breakaway force ``F_b = kappa_of_normal(n, mu) F_p`` (the lock rule the streamline
-uses, :func:`spine_mj.engagement.kappa_of_normal`; infinite in the self-lock region) and
+uses, :func:`spine_mj.theory.engagement.kappa_of_normal`; infinite in the self-lock region) and
 lets the force climb to ``min((1 - margin) F_b, F_b - NOMINAL_STEPS increments,
 kappa_cap F_p)`` in :data:`RISE_STEPS` steps. A tip that moves during the climb
 (tangential speed above the stick speed, or contact lost) makes the caller go back to
@@ -33,7 +33,7 @@ import math
 
 import numpy as np
 
-from spine_mj.engagement import SELF_LOCK, kappa_of_normal
+from spine_mj.theory.engagement import SELF_LOCK, kappa_of_normal
 
 #: Steps the tip must be still on one normal before a fast-forward phase starts.
 QUIET_STEPS = 8

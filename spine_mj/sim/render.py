@@ -18,11 +18,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from spine_mj import streamline as sl
 from spine_mj.atomic import atomic_output
 from spine_mj.errors import SpineInputError
 from spine_mj.sim.drives import Drive
 from spine_mj.sim.model import RigModel
+from spine_mj.theory import streamline as sl
 
 TRAIL_RGBA = (1.0, 0.55, 0.0, 1.0)
 STREAMLINE_RGBA = (0.0, 0.8, 0.9, 0.9)

@@ -20,7 +20,6 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from spine_mj.engagement import DEFAULT_TOL
 from spine_mj.sim.detection import (
     LOCK_RISE_FP,
     MARK_KEYS,
@@ -39,6 +38,7 @@ from spine_mj.sim.model import RigModel
 from spine_mj.sim.motion import MOTION_NAMES, SlipEvent, motion_fractions, motion_states, slip_events
 from spine_mj.sim.params import EndReason, EngineSettings, Scales, TipParams
 from spine_mj.sim.recording import COLUMNS, RESULT_COLUMNS, SENSOR_NAMES, Recording, RunColumns
+from spine_mj.theory.engagement import DEFAULT_TOL
 
 
 @dataclass(frozen=True, eq=False)

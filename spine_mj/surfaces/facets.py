@@ -99,7 +99,7 @@ class BallOnFacets(Surface):
     what the engine's contact reports, with no interpolation between samples. Where two
     contacts tie (a concave crease) the slope is that of one of them.
 
-    This is the exact form of ``spine_mj.streamline.dilate(facets, radius)``, which samples
+    This is the exact form of ``spine_mj.theory.streamline.dilate(facets, radius)``, which samples
     the same height on a grid and interpolates it by a spline: at steep kinks (grit walls)
     the spline overshoots, and the sampled dilation sits up to slope x spacing low
     (docs/physics.md §4). Points whose ball reaches beyond the facets see only the facets
@@ -111,7 +111,7 @@ class BallOnFacets(Surface):
     radius : float
         Ball radius in the surface's length unit, > 0.
     compiled : bool
-        Evaluate with the compiled kernel (:mod:`spine_mj._contact_kernel`, the default) or
+        Evaluate with the compiled kernel (:mod:`spine_mj.surfaces._contact_kernel`, the default) or
         with the numpy reference it is tested against (same numbers; about 1 ms per call).
     """
 
@@ -135,7 +135,7 @@ class BallOnFacets(Surface):
         if order > 1:
             raise SpineInputError("BallOnFacets has no Hessian (order 2): its facets are flat")
         if self.compiled:
-            from spine_mj._contact_kernel import ball_on_facets
+            from spine_mj.surfaces._contact_kernel import ball_on_facets
 
             f, fx, fy = ball_on_facets(
                 np.ascontiguousarray(x, dtype=float),
@@ -149,7 +149,7 @@ class BallOnFacets(Surface):
 
     def kernel_args(self) -> tuple:
         """``(heights, x0, y0, dx, dy, radius)``: the grid as the compiled kernels take it
-        (:func:`spine_mj._contact_kernel.ball_on_facets` and the callers of ``ball_at``)."""
+        (:func:`spine_mj.surfaces._contact_kernel.ball_on_facets` and the callers of ``ball_at``)."""
         fac = self.facets
         ny, nx = fac.heights.shape
         dx = (fac.x[-1] - fac.x[0]) / (nx - 1)

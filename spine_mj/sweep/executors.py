@@ -95,7 +95,7 @@ def dead_worker_case(case: Case, reason: str) -> tuple:
 #: table; mujoco: spine_mj.sim imports it lazily).
 _WORKER_MODULES = (
     "spine_mj.sweep",
-    "spine_mj.streamline",
+    "spine_mj.theory.streamline",
     "spine_mj.sim",
     "pyarrow.parquet",
     "pandas",

@@ -18,8 +18,8 @@ import numpy as np
 from annotated_types import Interval
 from pydantic import AllowInfNan, Strict
 
-from spine_mj.engagement import DEFAULT_KAPPA_CAP
 from spine_mj.errors import SpineInputError
+from spine_mj.theory.engagement import DEFAULT_KAPPA_CAP
 
 #: Threads a case's engine batch may use: 1 where cases run side by side in worker
 #: processes or one at a time with ``workers = 1``; the sweep's workers where a single case
@@ -143,7 +143,7 @@ MU_PARAM = ParamSpec(
 
 
 #: The force cap, shared by the streamline and the engine so that both call "held" by the
-#: same test (declared once; :data:`spine_mj.engagement.DEFAULT_KAPPA_CAP`).
+#: same test (declared once; :data:`spine_mj.theory.engagement.DEFAULT_KAPPA_CAP`).
 KAPPA_CAP_PARAM = ParamSpec(
     "kappa_cap",
     "float",

@@ -15,8 +15,8 @@ the largest total spring force, mean over placements with a 95 % bootstrap inter
 the probability that at least one spine self-locks (its spring at ``kappa_cap F_p`` while
 stuck; Wilson interval, :func:`~spine_mj.validate.fractal_lock.lock_rate`), from MuJoCo
 and from the quasistatic reference: each spine on its own compliant-drive streamline
-(:func:`~spine_mj.compliant.compliant_streamlines`, same friction, spring, force cap and
-domain margin), the array's curve their sum (:mod:`spine_mj.array_reference`). Like the
+(:func:`~spine_mj.theory.compliant.compliant_streamlines`, same friction, spring, force cap and
+domain margin), the array's curve their sum (:mod:`spine_mj.theory.array_reference`). Like the
 single spine's comparison, agreement is the share of spines whose lock verdict matches
 (target :data:`~spine_mj.compare.OUTCOME_TARGET`). The conjecture is answered by the
 difference staggered - aligned (and random - aligned) in the lock probability (Newcombe's
@@ -33,11 +33,11 @@ import numpy as np
 from scipy.stats import bootstrap
 
 from spine_mj import presets, sim
-from spine_mj.array_reference import compliant_spine_curves
 from spine_mj.compare import OUTCOME_TARGET
-from spine_mj.compliant import compliant_streamlines
 from spine_mj.sim.drives import stiffness_n_m
-from spine_mj.streamline import StreamlineParams, dilate
+from spine_mj.theory.array_reference import compliant_spine_curves
+from spine_mj.theory.compliant import compliant_streamlines
+from spine_mj.theory.streamline import StreamlineParams, dilate
 from spine_mj.validate.fractal_lock import CONFIDENCE, lock_rate
 from spine_mj.validate.intervals import newcombe_difference
 from spine_mj.validate.plans import SANDPAPER_MU, ValidationPlan

@@ -1,5 +1,5 @@
 """Study: ground truth for the dynamics. MuJoCo's spring drive against the closed forms of
-:mod:`spine_mj.tomlinson`, each with its measured error:
+:mod:`spine_mj.theory.tomlinson`, each with its measured error:
 
 * the spring-block on a flat plane: the period ``2 pi / w`` and peak speed ``2 V`` of the
   speed swing after breakaway (one direct run of :class:`spine_mj.sim.Rig`: a plane has no
@@ -21,14 +21,14 @@ import numpy as np
 from spine_mj import sim, sweep
 from spine_mj.surface_io import save_surface
 from spine_mj.surfaces import GridSurface
-from spine_mj.tomlinson import (
+from spine_mj.theory.tomlinson import (
     SLOPE_LENGTH_PER_WAVELENGTH,
     Corrugation,
     gaussian_ridge_path_curvature,
     liftoff_inertia_number,
     spring_block_period_s,
 )
-from spine_mj.tomlinson_dynamics import PTParams, SineProfile, integrate
+from spine_mj.theory.tomlinson_dynamics import PTParams, SineProfile, integrate
 from spine_mj.validate.plans import GRAVITY, MASS_KG, ValidationPlan
 from spine_mj.validate.study_runner import StudyRunner
 
@@ -187,7 +187,7 @@ def _tomlinson(c: Corrugation, df) -> list[dict]:
 
 
 def _reference(c: Corrugation, r, k: float, travel: float) -> dict:
-    """The reference integrator (:mod:`spine_mj.tomlinson_dynamics`, a point tip on the
+    """The reference integrator (:mod:`spine_mj.theory.tomlinson_dynamics`, a point tip on the
     smooth profile) with the MuJoCo run's m, k, W, V, over its travel: events per
     wavelength, onset errors against the fold and the longest jump [wavelengths]."""
     unit, w = sim.DEFAULT_LENGTH_SCALE_M, MASS_KG * GRAVITY

@@ -15,9 +15,9 @@ from pathlib import Path
 import numpy as np
 
 from spine_mj import compare, presets, sim, sweep
-from spine_mj import streamline as sl
 from spine_mj.errors import SpineInputError
 from spine_mj.surfaces import GridSurface, TriangulatedSurface, from_hfield, to_hfield
+from spine_mj.theory import streamline as sl
 from spine_mj.validate.plans import MASS_KG
 
 __all__ = [
@@ -46,7 +46,7 @@ def tip_radius(preset: str, seeds, resolution: int) -> float:
 
 def streamline_paths(surface, starts, mu: float, dl: float, tip: float) -> sl.StreamlineResult:
     """Streamlines (with paths) from ``starts`` on ``surface`` dilated by ``tip``
-    (:func:`spine_mj.streamline.dilate`: MuJoCo's facets are sampled at ``tip / 8``, finer
+    (:func:`spine_mj.theory.streamline.dilate`: MuJoCo's facets are sampled at ``tip / 8``, finer
     than the hfield, before the dilation)."""
     traced = sl.dilate(surface, tip) if tip > 0 else surface
     params = sl.StreamlineParams(mu=mu, dl=dl)

@@ -1,4 +1,4 @@
-"""Predicted drive limits of the validation's families (:mod:`spine_mj.drive_limits`),
+"""Predicted drive limits of the validation's families (:mod:`spine_mj.theory.drive_limits`),
 set beside the measured boundary of the (I_e, K) map.
 
 Each family's prediction is made on the surfaces the map runs (its presets, first seed
@@ -11,7 +11,7 @@ The family's ``K*`` is the largest of its surfaces' and its ``I_e*`` the smalles
 from __future__ import annotations
 
 from spine_mj import presets
-from spine_mj.drive_limits import drive_limits
+from spine_mj.theory.drive_limits import drive_limits
 from spine_mj.validate.paths import tip_radius
 from spine_mj.validate.plans import FamilySpec, ValidationPlan
 

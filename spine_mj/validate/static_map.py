@@ -11,7 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from spine_mj import engagement, sim, surface_io
+from spine_mj import sim, surface_io
+from spine_mj.theory import engagement
 from spine_mj.validate.plans import GRAVITY, MASS_KG, ValidationPlan
 from spine_mj.validate.study_runner import StudyRunner
 from spine_mj.validate.sweep_configs import engine_default

@@ -12,7 +12,7 @@ from spine_mj import presets, sim
 from spine_mj.errors import SpineInputError
 from spine_mj.presets import calibrated_mu
 from spine_mj.sim.motion import slip_events
-from spine_mj.tomlinson import Corrugation
+from spine_mj.theory.tomlinson import Corrugation
 from spine_mj.validate.ground_truth import CORRUGATION_START, TOMLINSON_TIP, corrugation_runs
 from spine_mj.validate.paths import mujoco_traces, tip_radius
 from spine_mj.validate.plans import GRAVITY, MASS_KG, FamilySpec, ValidationPlan, relative_starts
@@ -46,7 +46,7 @@ class SlipStats:
     onset_indices, stop_indices : ndarray of int, shape (count,)
         Trace samples at which each event begins (the last loading sample before it) and
         ends, so that the spring energy released over the same
-        events (:func:`spine_mj.energy.elastic_release_j`) is read at the same points.
+        events (:func:`spine_mj.theory.energy.elastic_release_j`) is read at the same points.
     """
 
     count: int
@@ -145,7 +145,7 @@ class StickSlipResult:
         The spring drive on the corrugation :data:`K_SCAN_SURFACE` per (I_e, K): slip
         events, events per wavelength, motion fractions, the largest speed [V].
     k_star : float
-        That corrugation's K* (:meth:`spine_mj.tomlinson.Corrugation.critical_stiffness`).
+        That corrugation's K* (:meth:`spine_mj.theory.tomlinson.Corrugation.critical_stiffness`).
     transitions : list of dict
         Per I_e of the scan: where stick-slip gives way to steady sliding (the bracket of K
         between the last K with at least :data:`SLIPS_PER_WAVE` slips per wavelength and the

@@ -2,7 +2,7 @@
 
 A spring drive is quasistatic only when it is slow (I_e << 1) *and* stiff: a spring of
 stiffness ``k`` holding ``F`` stores ``F^2 / (2 k)``, released into the tip at every
-breakaway whatever the carriage speed (:mod:`spine_mj.energy`). The drive stiffness number
+breakaway whatever the carriage speed (:mod:`spine_mj.theory.energy`). The drive stiffness number
 ``K = k l_s / F_p`` (``l_s``: the slope correlation length) measures that release against
 the work over one slope length. This study runs the spring drive on a grid of I_e x K for
 the plan's families and reports, from the same runs:
@@ -32,9 +32,9 @@ import numpy as np
 import pandas as pd
 
 from spine_mj import presets, sim, sweep
-from spine_mj.energy import elastic_release_j, quasistatic_work_j
 from spine_mj.errors import SpineInputError
 from spine_mj.sim.motion import SLIPPING
+from spine_mj.theory.energy import elastic_release_j, quasistatic_work_j
 from spine_mj.validate.boundary import preset_grid, quasistatic_locked
 from spine_mj.validate.ie_star import ie_star_by_criterion, passes_criterion, quiet_nan_warnings
 from spine_mj.validate.paths import mujoco_traces

@@ -11,12 +11,12 @@ import pytest
 from sim_rigs import MU, R_TIP
 
 from spine_mj import sim, surfaces
-from spine_mj.array_reference import force_control_release, profile_spine_curve, summed_curve
 from spine_mj.errors import SpineInputError
 from spine_mj.sim.array import ArrayRig, ForcePull
 from spine_mj.sim.drives import stiffness_n_m
 from spine_mj.sim.layout import Layout
 from spine_mj.sim.planes import inclined_plane
+from spine_mj.theory.array_reference import force_control_release, profile_spine_curve, summed_curve
 
 
 def _plane_rig(slope_deg):

@@ -8,8 +8,8 @@ import math
 import pytest
 from sim_rigs import MU, PHI, START, flat_rig, plane_rig
 
-from spine_mj.engagement import SELF_LOCK, kappa
 from spine_mj.sim import EndReason, SpringDrive, StaticProbe
+from spine_mj.theory.engagement import SELF_LOCK, kappa
 
 
 @pytest.mark.parametrize("slope_deg", [-15.0, 0.0, 20.0, 45.0, 60.0])

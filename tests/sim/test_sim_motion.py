@@ -1,4 +1,4 @@
-"""Motion states relative to the drive, against the closed forms (spine_mj.tomlinson)."""
+"""Motion states relative to the drive, against the closed forms (spine_mj.theory.tomlinson)."""
 
 import numpy as np
 import pytest
@@ -7,7 +7,7 @@ from sim_rigs import MU, flat_rig
 from spine_mj.sim import Rig, SpringDrive, TipParams
 from spine_mj.sim.motion import SLIDING, SLIPPING, STUCK, motion_fractions, motion_states, slip_events
 from spine_mj.surfaces import corrugation
-from spine_mj.tomlinson import (
+from spine_mj.theory.tomlinson import (
     Corrugation,
     spring_block_period_s,
     spring_block_x,

@@ -7,7 +7,7 @@ import pytest
 
 from spine_mj import sim
 from spine_mj.sim.build import build_drive, build_rig
-from spine_mj.tomlinson import gaussian_ridge_path_curvature, liftoff_inertia_number
+from spine_mj.theory.tomlinson import gaussian_ridge_path_curvature, liftoff_inertia_number
 from spine_mj.validate.ground_truth import (
     LIFTOFF_GAP_RADII,
     RIDGE_HEIGHT,

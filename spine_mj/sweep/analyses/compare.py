@@ -10,7 +10,7 @@ the same domain) is kept beside it (``*_smooth``), and the gap between the two s
 is the geometry part (``geometry_frechet``). A run that disagrees gets a ``miss_reason``
 (:func:`spine_mj.compare.miss_reason`: the reference restarted along its path). A spring
 drive is also compared with the compliant-drive streamline of its own spring
-(``compliant_frechet``, ``agree_compliant``; :mod:`spine_mj.compliant`). Touches
+(``compliant_frechet``, ``agree_compliant``; :mod:`spine_mj.theory.compliant`). Touches
 the API of :mod:`spine_mj.compare` here only; needs the results of the ``quasistatic`` and
 ``mujoco`` analyses of the same case.
 """
@@ -22,11 +22,11 @@ import dataclasses
 import numpy as np
 
 from spine_mj import compare
-from spine_mj import streamline as sl
-from spine_mj.compliant import compliant_streamlines
 from spine_mj.sweep.analyses.mujoco import peak_drive_over_fp
 from spine_mj.sweep.analyses.quasistatic import path_table, traced_surface
 from spine_mj.sweep.registry import Analysis, AnalysisResult, ParamSpec, register_analysis
+from spine_mj.theory import streamline as sl
+from spine_mj.theory.compliant import compliant_streamlines
 
 
 def _xy(res: sl.StreamlineResult, i: int) -> np.ndarray:
@@ -110,7 +110,7 @@ def _compliant(
     contact, params, starts, runs, preload_n, s, mpaths, facets, mj_locked, mj_end, lc, lead
 ) -> dict:
     """MuJoCo against the compliant-drive streamline of the run's own spring
-    (:mod:`spine_mj.compliant`, ``k / W`` from the run), traced like the rigid reference:
+    (:mod:`spine_mj.theory.compliant`, ``k / W`` from the run), traced like the rigid reference:
     what stiffness does is predicted there, what is left over is inertia. NaN for drives
     without a spring and for the starts not in ``lead`` (an ensemble's perturbed members).
     ``stiffness_frechet`` is the compliant reference's distance from the rigid one,

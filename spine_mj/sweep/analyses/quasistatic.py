@@ -1,6 +1,6 @@
 """The ``quasistatic`` analysis: a streamline (or ideal trajectory) from every start.
 
-Touches the API of :mod:`spine_mj.streamline` here only, so that a change there is a
+Touches the API of :mod:`spine_mj.theory.streamline` here only, so that a change there is a
 change here in one place.
 """
 
@@ -10,7 +10,6 @@ import functools
 
 import numpy as np
 
-from spine_mj import streamline as sl
 from spine_mj.sweep.registry import (
     KAPPA_CAP_PARAM,
     MU_PARAM,
@@ -19,6 +18,7 @@ from spine_mj.sweep.registry import (
     ParamSpec,
     register_analysis,
 )
+from spine_mj.theory import streamline as sl
 
 QUASISTATIC_PARAMS = (
     MU_PARAM,
@@ -109,7 +109,7 @@ register_analysis(
         "quasistatic",
         _quasistatic,
         QUASISTATIC_PARAMS,
-        doc="quasistatic streamline (or ideal trajectory) from every start: spine_mj.streamline",
+        doc="quasistatic streamline (or ideal trajectory) from every start: spine_mj.theory.streamline",
         check_case=_check_case,
     )
 )

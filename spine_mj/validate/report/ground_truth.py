@@ -72,7 +72,7 @@ def _tomlinson(rows: list[dict]) -> list[str]:
         f"wavelength on average; the largest onset force within {f(100 * max(err, default=math.nan))} % "
         "of W kappa at the fold. The mean onset is lower where a jump overshoots past the next "
         "fold (inertia): the tip then reloads and jumps below the fold's force. The reference "
-        "integrator (spine_mj.tomlinson_dynamics: a rigid point tip on the smooth profile with "
+        "integrator (spine_mj.theory.tomlinson_dynamics: a rigid point tip on the smooth profile with "
         "Coulomb friction, the same m, k, W, V) overshoots too: below about 0.35 K* Coulomb "
         "friction cannot stop a jump within a wavelength at any speed, so one event per "
         "wavelength at the fold's force is not reachable there by correct rigid-body dynamics "

@@ -1,6 +1,6 @@
 """Quasistatic engagement streamlines and ideal trajectories (paper §2.2, Eq. 4).
 
-At each point the tip is classified (:func:`spine_mj.engagement.kappa`); a self-locked tip
+At each point the tip is classified (:func:`spine_mj.theory.engagement.kappa`); a self-locked tip
 stops. Otherwise the drive is raised to its limit ``F = kappa W`` (engaged) or is zero
 (slip), the tip steps a length ``dl`` along the tangential load ``v = T / |T|`` and is put
 back on the surface vertically::
@@ -35,17 +35,7 @@ import numpy as np
 import pandas as pd
 from scipy import ndimage
 
-from spine_mj._kernels import run_trajectories
-from spine_mj.engagement import (
-    REGION_NAMES,
-    SELF_LOCK,
-    SLIP,
-    crease_engagement,
-    kappa,
-    slip_direction,
-)
 from spine_mj.errors import SpineInputError
-from spine_mj.multicontact import two_contact_kappa
 from spine_mj.surfaces import (
     BallOnFacets,
     GaussianSurface,
@@ -54,6 +44,16 @@ from spine_mj.surfaces import (
     TriangulatedSurface,
     check_grid_size,
 )
+from spine_mj.theory._kernels import run_trajectories
+from spine_mj.theory.engagement import (
+    REGION_NAMES,
+    SELF_LOCK,
+    SLIP,
+    crease_engagement,
+    kappa,
+    slip_direction,
+)
+from spine_mj.theory.multicontact import two_contact_kappa
 
 __all__ = [
     "Outcome",
@@ -74,7 +74,7 @@ class Outcome(enum.IntEnum):
     STALLED = 3  #: no net progress (|T| = 0, or too little progress over stall_window steps)
     STEP_CAP = 4  #: max_steps taken without any of the above
     FORCE_CAP = 5  #: the drive force needed, kappa W, exceeds ``kappa_cap`` W (held by the cap)
-    DRIVE_END = 6  #: the carriage reached the end of its travel (compliant drive, :mod:`spine_mj.compliant`)
+    DRIVE_END = 6  #: the carriage reached the end of its travel (:mod:`~spine_mj.theory.compliant`)
 
 
 @dataclass(frozen=True)
@@ -101,7 +101,7 @@ class StreamlineParams:
         concave crease (two contacts, which a single-contact path cannot rest on) stalls
         within a window instead of creeping until the step cap. None means ``dl``.
     tol : float
-        Tolerance on the scaled self-lock coefficient A' (see :func:`~spine_mj.engagement.kappa`).
+        Tolerance on the scaled self-lock coefficient A' (see :func:`~spine_mj.theory.engagement.kappa`).
     max_halvings : int
         Step-size control: a step after which the horizontal slip direction reverses (turns
         by more than 90 degrees) has crossed something it did not resolve, such as the floor
@@ -115,7 +115,7 @@ class StreamlineParams:
         kappa exceeds it ends the path as ``FORCE_CAP`` (held: no drive up to ``kappa_cap W``
         moves it), as a MuJoCo drive that reaches ``kappa_cap F_p`` unmoved ends there
         (:class:`spine_mj.sim.Detection`, the same default
-        :data:`spine_mj.engagement.DEFAULT_KAPPA_CAP` in a comparison). ``inf``, the
+        :data:`spine_mj.theory.engagement.DEFAULT_KAPPA_CAP` in a comparison). ``inf``, the
         paper's theory: only the self-lock region stops a path.
     edge_margin : float
         A path ends ``LEFT_DOMAIN`` where its next step would come closer than this to
@@ -455,7 +455,7 @@ CREASE_KINK = 1e-6
 def _wedged(xa, ya, fx, fy, prev, params) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Points that crossed a concave crease from the last accepted point and rest there on
     both sides, held: by the two-contact rule
-    (:func:`spine_mj.multicontact.two_contact_kappa`) beyond the force cap or for every
+    (:func:`spine_mj.theory.multicontact.two_contact_kappa`) beyond the force cap or for every
     drive. A path that crosses such a crease without turning back (its two sides' slip
     directions less than 90 deg apart, each pressing into the other side) would zig-zag
     across it on single contacts and pass where the tip wedges.
@@ -484,11 +484,11 @@ def _run_numpy(surface, xs, ys, params, *, ideal, store):
 
     A reversal at the shortest step (or on a crease already followed) is a tip resting in a
     concave crease on two contacts: the path follows the crease at the two-contact kappa of
-    its sides (:func:`spine_mj.engagement.crease_engagement`) with whole steps. Only this
+    its sides (:func:`spine_mj.theory.engagement.crease_engagement`) with whole steps. Only this
     backend has the crease state; the compiled kernel traces smooth surfaces (Gaussian sums,
     splines) and takes such a reversal as it is. On facets (a ball on them or bare), a step
     that crosses a concave crease tests the two contacts' hold there
-    (:func:`spine_mj.multicontact.two_contact_kappa`, :func:`_wedged`): a tip wedged beyond
+    (:func:`spine_mj.theory.multicontact.two_contact_kappa`, :func:`_wedged`): a tip wedged beyond
     the force cap, or for every drive, is held where a path on single contacts would
     zig-zag across the crease and go on.
 

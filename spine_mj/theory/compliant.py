@@ -19,10 +19,10 @@ The fold is located by a golden-section search for the maximum of ``X(s)`` along
 that crossed it, the landing by bisection on ``c (X - x(s)) - H(s)``, both to ~1e-8 of a step
 along the path, so the onset force ``H`` at the fold, the carriage position there and the
 jump length do not depend on the step (:class:`Fold`). Regions, the self-lock rule, the
-step control and the stall test are those of :mod:`spine_mj.streamline` (same
-:class:`~spine_mj.streamline.StreamlineParams`); above ``K*`` (no fold) the path is the
+step control and the stall test are those of :mod:`spine_mj.theory.streamline` (same
+:class:`~spine_mj.theory.streamline.StreamlineParams`); above ``K*`` (no fold) the path is the
 rigid streamline's and only the carriage differs. The spring never pushes the tip off
-the surface here: lift-off is an inertial effect (:mod:`spine_mj.drive_limits`).
+the surface here: lift-off is an inertial effect (:mod:`spine_mj.theory.drive_limits`).
 """
 
 from __future__ import annotations
@@ -33,10 +33,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from spine_mj.engagement import DEFAULT_TOL, ENGAGED, SELF_LOCK, SLIP, quadratic_coefficients
 from spine_mj.errors import SpineInputError
-from spine_mj.streamline import Outcome, StreamlineParams, _starts, check_step
 from spine_mj.surfaces import BallOnFacets, Surface
+from spine_mj.theory.engagement import DEFAULT_TOL, ENGAGED, SELF_LOCK, SLIP, quadratic_coefficients
+from spine_mj.theory.streamline import Outcome, StreamlineParams, _starts, check_step
 
 __all__ = ["CompliantResult", "Fold", "MotionState", "compliant_streamlines", "hold_force"]
 
@@ -52,7 +52,7 @@ class MotionState(enum.IntEnum):
 def hold_force(fx, fy, mu, *, tol: float = DEFAULT_TOL) -> tuple[np.ndarray, np.ndarray]:
     """Largest drive per unit preload ``H`` (any sign) that holds the tip, and the region.
 
-    ``H = kappa`` where engaged (:func:`spine_mj.engagement.kappa`, the same roots of Eq. 2
+    ``H = kappa`` where engaged (:func:`spine_mj.theory.engagement.kappa`, the same roots of Eq. 2
     by the same cancellation-free formula), ``+inf`` where self-locked; in the slip region
     the largest root of Eq. 2 with ``N > 0`` when one exists (a backward pull that holds:
     negative), else NaN (nothing holds). A tip held by a spring force ``F`` sticks while
@@ -123,8 +123,8 @@ class CompliantResult:
     stiffness : float
         ``c = k / W`` (1 / surface length).
     start_x, start_y, outcome, end_x, end_y, n_steps, max_kappa : ndarray, shape (n,)
-        As in :class:`spine_mj.streamline.StreamlineResult` (``outcome``:
-        :class:`~spine_mj.streamline.Outcome` codes).
+        As in :class:`spine_mj.theory.streamline.StreamlineResult` (``outcome``:
+        :class:`~spine_mj.theory.streamline.Outcome` codes).
     offsets : ndarray of int64, shape (n + 1,)
     x, y, z, kappa : ndarray, shape (total,)
         Path points and kappa there (NaN in the slip region).
@@ -365,7 +365,7 @@ def _classify(L, a, hold, region, c):
 def _search(surface, L, lanes, kind, c, params):
     """Replace the candidate of ``lanes`` by the fold (kind 1) or landing (kind 2) located
     along the step from their last accepted point; on the tip's compiled facets by the same
-    searches compiled (:mod:`spine_mj._compliant_kernel`: the numpy ones spent ~100 us of
+    searches compiled (:mod:`spine_mj.theory._compliant_kernel`: the numpy ones spent ~100 us of
     call overhead per evaluation of a few lanes)."""
     if lanes.size == 0:
         return
@@ -373,7 +373,7 @@ def _search(surface, L, lanes, kind, c, params):
     mu, tol = float(params.mu), float(params.tol)
     compiled = isinstance(surface, BallOnFacets) and surface.compiled
     if compiled:
-        from spine_mj import _compliant_kernel as kernel
+        from spine_mj.theory import _compliant_kernel as kernel
     if kind == 1:
         if compiled:
             grid = surface.kernel_args()

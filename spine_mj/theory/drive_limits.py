@@ -6,9 +6,9 @@ Both come from the rigid streamlines (paper Eq. 4) traced from a grid of starts 
 surface, pure numpy on the analytic side:
 
 * ``K* = l_s max(-dH/dx)`` along the paths, ``H`` the hold force per unit preload
-  (:func:`spine_mj.compliant.hold_force`, kappa where engaged): below it the carriage
+  (:func:`spine_mj.theory.compliant.hold_force`, kappa where engaged): below it the carriage
   position that holds the tip, ``X = x + (W / k) H``, falls somewhere along a path, a fold
-  of the compliant-drive streamline (:mod:`spine_mj.compliant`). On a corrugation this is
+  of the compliant-drive streamline (:mod:`spine_mj.theory.compliant`). On a corrugation this is
   the Prandtl-Tomlinson ``K* = l_s max(-d kappa / dx)``.
 * ``I_e*`` the lowest of three thresholds. *Lift-off*: a tip carried at horizontal speed
   ``v`` over a profile ``z(h)`` (h: horizontal arc length along the path) needs the
@@ -35,12 +35,12 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from spine_mj import roughness
-from spine_mj import streamline as sl
 from spine_mj.compare import FRECHET_TARGET
-from spine_mj.compliant import hold_force
-from spine_mj.engagement import DEFAULT_KAPPA_CAP, SELF_LOCK
 from spine_mj.errors import SpineInputError
 from spine_mj.surfaces import Surface
+from spine_mj.theory import streamline as sl
+from spine_mj.theory.compliant import hold_force
+from spine_mj.theory.engagement import DEFAULT_KAPPA_CAP, SELF_LOCK
 
 __all__ = ["DriveLimits", "crest_curvature", "drive_limits", "kappa_fall", "trap_depths"]
 

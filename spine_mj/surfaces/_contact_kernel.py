@@ -54,7 +54,7 @@ def ball_on_facets(x, y, h, x0, y0, dx, dy, r):
 @njit(cache=True)
 def ball_at(cx, cy, h, x0, y0, dx, dy, r):
     """``(f, fx, fy)`` of :func:`ball_on_facets` at the one point ``(cx, cy)`` (for compiled
-    callers that step along a path, :mod:`spine_mj._compliant_kernel`)."""
+    callers that step along a path, :mod:`spine_mj.theory._compliant_kernel`)."""
     mx = int(math.ceil(2 * r / dx)) + 2
     my = int(math.ceil(2 * r / dy)) + 2
     r2 = r * r

@@ -1,4 +1,4 @@
-"""Compiled (numba) fold and landing searches of :mod:`spine_mj.compliant` on the tip's
+"""Compiled (numba) fold and landing searches of :mod:`spine_mj.theory.compliant` on the tip's
 facets (:class:`spine_mj.surfaces.BallOnFacets`); imported on first use.
 
 The compliant reference locates each jump's fold by a golden-section search of ``X(s)``
@@ -8,7 +8,7 @@ the quick plan's sandpaper the searches were 350 of the demo's 825 CPU seconds. 
 lane runs its whole search in compiled code, the same steps in the same order as
 ``compliant._fold_along`` and ``compliant._landing_along`` (the numpy reference, which
 ``tests/test_compliant.py`` checks this against) with the hold of
-:func:`spine_mj.compliant.hold_force` written out for one point.
+:func:`spine_mj.theory.compliant.hold_force` written out for one point.
 """
 
 import math
@@ -16,7 +16,7 @@ import math
 import numpy as np
 from numba import njit
 
-from spine_mj._contact_kernel import ball_at
+from spine_mj.surfaces._contact_kernel import ball_at
 
 __all__ = ["fold_on_facets", "landing_on_facets"]
 
@@ -26,7 +26,7 @@ _GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0
 
 @njit(cache=True)
 def _hold(fx, fy, mu, tol):
-    """:func:`spine_mj.compliant.hold_force` at one point: ``+inf`` self-locked, NaN where
+    """:func:`spine_mj.theory.compliant.hold_force` at one point: ``+inf`` self-locked, NaN where
     nothing holds (the same operations in the same order)."""
     m2 = mu * mu
     a = 1.0 + fy * fy - m2 * fx * fx
@@ -64,7 +64,7 @@ def _carriage(px, py, vx, vy, s, c, mu, tol, h, x0, y0, dx, dy, r):
 def fold_on_facets(px, py, vx, vy, step, c, mu, tol, iterations, h, x0, y0, dx, dy, r):
     """Per lane, ``s`` in ``[0, step]`` maximizing ``X(s) = x(s) + H(s) / c`` and ``X``
     there: ``compliant._fold_along`` (golden section, ``iterations`` steps) on the ball's
-    facets (``h, x0, y0, dx, dy, r`` as for :func:`spine_mj._contact_kernel.ball_on_facets`)."""
+    facets (``h, x0, y0, dx, dy, r`` as for :func:`spine_mj.surfaces._contact_kernel.ball_on_facets`)."""
     n = px.size
     s_out = np.empty(n)
     x_out = np.empty(n)

@@ -1,19 +1,19 @@
-"""Compiled (numba) kernels behind :mod:`spine_mj.streamline`; imported on first use.
+"""Compiled (numba) kernels behind :mod:`spine_mj.theory.streamline`; imported on first use.
 
 ``run_trajectories`` steps ``lanes`` starts together on one core (a finished lane takes the
 next start): per iteration every lane gets its height and slopes, then kappa, region and
 slip direction in branch-free loops over the lanes that LLVM vectorizes (AVX2: 4 lanes per
 instruction), then a scalar pass controls the step (a point where the slip direction
-reverses is rejected and the step halves; see :class:`spine_mj.streamline.StreamlineParams`
+reverses is rejected and the step halves; see :class:`spine_mj.theory.streamline.StreamlineParams`
 ``max_halvings``), records, stops and steps. The trajectories are independent
 and each is computed with the same operations as one at a time, so the result does not
 depend on ``lanes``. A single Gaussian has its own path (exp through libm, the rest
 vectorized); Gaussian sums and grids evaluate lane by lane. ``kind`` 0
 evaluates a Gaussian sum (``g`` rows: amplitude, centre x, centre y, 1/sigma_x,
 1/sigma_y), ``kind`` 1 a cubic B-spline grid (``coef`` and ``sp`` = offset, x0, dx, nx,
-y0, dy, ny, periodic). The physics mirrors :func:`spine_mj.engagement.kappa` and
-:func:`spine_mj.engagement.slip_direction`; ``tests/test_streamline.py`` checks this
-kernel against the pure-numpy reference in :mod:`spine_mj.streamline`.
+y0, dy, ny, periodic). The physics mirrors :func:`spine_mj.theory.engagement.kappa` and
+:func:`spine_mj.theory.engagement.slip_direction`; ``tests/test_streamline.py`` checks this
+kernel against the pure-numpy reference in :mod:`spine_mj.theory.streamline`.
 """
 
 import math

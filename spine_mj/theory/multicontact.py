@@ -1,7 +1,7 @@
 """The multi-contact quasistatic lock: a tip resting on several facets at once holds while
 the drive and the preload can be balanced by contact forces inside every friction cone.
 
-The single-contact rule (:func:`spine_mj.engagement.kappa`) cannot describe a tip wedged in a
+The single-contact rule (:func:`spine_mj.theory.engagement.kappa`) cannot describe a tip wedged in a
 concave crease or a pocket of MuJoCo's facets: on each facet alone the slip direction points
 into the other, and the pair holds like one contact of a larger friction (the wedge effect,
 :func:`wedge_kappa`). Per unit preload the load on the tip is ``F = kappa e_x - e_z``
@@ -28,8 +28,8 @@ import math
 
 import numpy as np
 
-from spine_mj.engagement import ENGAGED, SELF_LOCK, SLIP, crease_engagement, kappa, slip_direction
 from spine_mj.errors import SpineInputError
+from spine_mj.theory.engagement import ENGAGED, SELF_LOCK, SLIP, crease_engagement, kappa, slip_direction
 
 __all__ = [
     "CONE_SIDES",
@@ -80,7 +80,7 @@ def hold_kappa(normals, mu: float, *, sides: int = CONE_SIDES) -> float:
     float
         ``inf`` where every drive is held (self-lock), NaN where even no drive is (the
         preload alone slides the tip: the slip region), else the drive at which it moves.
-        With one contact: :func:`spine_mj.engagement.kappa` (to the pyramid's accuracy).
+        With one contact: :func:`spine_mj.theory.engagement.kappa` (to the pyramid's accuracy).
 
     Raises
     ------
@@ -152,8 +152,8 @@ def two_contact_kappa(fx_a, fy_a, fx_b, fy_b, mu) -> tuple[np.ndarray, np.ndarra
     """The drive at which a tip resting on two contacts (slopes ``a`` and ``b``) moves.
 
     Each way the tip can move is tried at its own onset drive: sliding along the crease with
-    both contacts pressed (:func:`spine_mj.engagement.crease_engagement`), or sliding on one
-    contact alone (:func:`spine_mj.engagement.kappa` and its slip direction), which only
+    both contacts pressed (:func:`spine_mj.theory.engagement.crease_engagement`), or sliding on one
+    contact alone (:func:`spine_mj.theory.engagement.kappa` and its slip direction), which only
     counts where that direction leaves the other contact (does not press into it). The tip
     moves at the smallest onset drive of the motions that count. The normal forces are those
     the load itself presses, with no squeeze between the contacts: what MuJoCo's contacts
@@ -163,7 +163,7 @@ def two_contact_kappa(fx_a, fy_a, fx_b, fy_b, mu) -> tuple[np.ndarray, np.ndarra
     closed form gives 1.907, the feasibility 3.18). Where no motion counts at its onset, the
     feasibility's kappa is the bound: the tip holds at least up to the smallest onset drive,
     and at most up to that bound. Where gravity alone slides the tip down the crease, that
-    comes first (slip), as in :func:`~spine_mj.engagement.crease_engagement`: measured on
+    comes first (slip), as in :func:`~spine_mj.theory.engagement.crease_engagement`: measured on
     sandpaper P36 and P60 grit walls, a crease taken as locked there (the drive's precedence
     of the single-contact rule) held the reference where MuJoCo's tip moves on.
 
@@ -180,7 +180,7 @@ def two_contact_kappa(fx_a, fy_a, fx_b, fy_b, mu) -> tuple[np.ndarray, np.ndarra
         The drive over the preload at which the tip moves; ``inf`` where it never does
         (self-lock); NaN where the preload alone slides it.
     region : ndarray of int8, shape S
-        ``SLIP``, ``ENGAGED`` or ``SELF_LOCK`` (:mod:`spine_mj.engagement`).
+        ``SLIP``, ``ENGAGED`` or ``SELF_LOCK`` (:mod:`spine_mj.theory.engagement`).
     """
     fx_a, fy_a, fx_b, fy_b = np.broadcast_arrays(*(np.asarray(v, float) for v in (fx_a, fy_a, fx_b, fy_b)))
     na, nb = normals_of_slopes(fx_a, fy_a), normals_of_slopes(fx_b, fy_b)

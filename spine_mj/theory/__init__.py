@@ -1,0 +1,21 @@
+"""The quasistatic and closed-form models: what the MuJoCo rig is validated against.
+
+Nothing here imports MuJoCo or :mod:`spine_mj.sim` (a test checks the import graph), so the
+theory runs wherever numpy and numba do.
+
+- :mod:`~spine_mj.theory.engagement`: the engagement ratio kappa of one contact (paper
+  Eq. 2) and of a tip wedged in a crease;
+- :mod:`~spine_mj.theory.multicontact`: the hold force of a tip touching several facets;
+- :mod:`~spine_mj.theory.streamline`: quasistatic paths of a tip under gravity and a drive;
+- :mod:`~spine_mj.theory.compliant`: the same behind a spring drive (stick-slip, folds);
+- :mod:`~spine_mj.theory.convexity`: sectional and Hessian classification (Eqs. 6-10);
+- :mod:`~spine_mj.theory.drive_limits`: the drive stiffness and inertia number a surface
+  allows before the quasistatic picture fails;
+- :mod:`~spine_mj.theory.tomlinson`, :mod:`~spine_mj.theory.tomlinson_dynamics`: closed
+  forms and a reference integrator for the Prandtl-Tomlinson corrugation;
+- :mod:`~spine_mj.theory.energy`: energy budget of a stick-slip event;
+- :mod:`~spine_mj.theory.array_reference`: the quasistatic hold curve of a spine array.
+
+The same modules import by their old names (``spine_mj.streamline``, ``spine_mj.engagement``,
+...): :mod:`spine_mj` maps those onto these.
+"""
