@@ -88,7 +88,7 @@ def array_cmd(
     layout = sim.Layout(
         kind=kind, rows=rows, cols=cols, spacing=spacing, spacing_unit=spacing_unit, seed=seed
     )
-    rig = _build_rig(surface_spec, **rig_opts, ie=ie)
+    rig = _build_rig(surface_spec, **rig_opts, ie=ie, stiffness_number=stiffness_number)
     sc = rig.scales
     speed = sc.speed_for(check_positive("--ie", ie))
     k = None if stiffness_number is None else sc.stiffness_for(check_positive("--K", stiffness_number))

@@ -84,6 +84,8 @@ def _build_rig(
     ie=None,
     speed=None,
     rate=None,
+    stiffness_number=None,
+    stiffness_n_m=None,
     driven=True,
 ):
     """The rig of the shared rig options (:func:`spine_mj.sim.build_rig`); the drive's pace
@@ -103,6 +105,8 @@ def _build_rig(
         ie=ie,
         speed_m_s=speed,
         rate_n_s=rate,
+        stiffness_number=stiffness_number,
+        stiffness_n_m=stiffness_n_m,
         driven=driven,
     )
 
@@ -137,10 +141,10 @@ def sim_export(surface_spec, output, start, stiffness, **rig_opts):
       spine-mj sim export paper-single-peak -o rig.xml && python -m mujoco.viewer --mjcf rig.xml
     """
     check_suffix(output, ".xml", "-o/--output")
-    rig = _build_rig(surface_spec, **rig_opts, driven=False)
-    xy = None if start is None else parse_start(start)
     if stiffness is not None:
         check_positive("--stiffness", stiffness)
+    rig = _build_rig(surface_spec, **rig_opts, stiffness_n_m=stiffness, driven=False)
+    xy = None if start is None else parse_start(start)
     rig.export_xml(output, start=xy, stiffness_n_m=stiffness)
     u = rig.units
     click.echo(
@@ -243,7 +247,15 @@ def simulate(
         raise SpineInputError("give one of --K or --stiffness, got both")
     if ie is not None:
         check_positive("--ie", ie)
-    rig = _build_rig(surface_spec, **rig_opts, ie=ie, speed=speed, rate=rate)
+    rig = _build_rig(
+        surface_spec,
+        **rig_opts,
+        ie=ie,
+        speed=speed,
+        rate=rate,
+        stiffness_number=stiffness_number,
+        stiffness_n_m=stiffness,
+    )
     drv = sim.build_drive(
         rig.scales,
         drive,

@@ -23,7 +23,7 @@ Two rules live here:
 from __future__ import annotations
 
 from spine_mj.errors import SpineInputError, check_positive
-from spine_mj.sim.drives import Drive, RampDrive, SpringDrive, StaticProbe
+from spine_mj.sim.drives import Drive, RampDrive, SpringDrive, StaticProbe, spring_stiffness_n_m
 from spine_mj.sim.params import Cone, Integrator, Scales, TipParams, default_engine
 from spine_mj.sim.rig import Rig
 from spine_mj.surfaces import GridSurface, Surface
@@ -74,6 +74,8 @@ def build_rig(
     ie: float | None = None,
     speed_m_s: float | None = None,
     rate_n_s: float | None = None,
+    stiffness_number: float | None = None,
+    stiffness_n_m: float | None = None,
     driven: bool = True,
 ) -> Rig:
     """The rig of ``surface`` and a tip of friction ``mu`` (resolve it with
@@ -95,6 +97,10 @@ def build_rig(
     ie, speed_m_s, rate_n_s
         The drive's pace, as for :func:`build_drive`: its speed (:func:`drive_speed_m_s`)
         bounds the engine step for impacts.
+    stiffness_number, stiffness_n_m
+        The drive spring's stiffness, as for :func:`build_drive` (none: K = 30): it bounds
+        the engine step (:func:`default_engine`), so a rig runs spring drives up to this
+        stiffness (a stiffer one is refused by :meth:`Rig.check_drive`).
     driven : bool
         False for a model no drive of ours runs (``sim export``, the viewer: the user's
         sliders drive it): then only the surface's falls bound the step.
@@ -112,6 +118,7 @@ def build_rig(
     resolution = None if isinstance(surface, GridSurface) else hfield_resolution
     scales = Scales.for_surface(surface, tip=tip, length_scale_m=length_scale_m, hfield_resolution=resolution)
     speed = drive_speed_m_s(scales, ie=ie, speed_m_s=speed_m_s, rate_n_s=rate_n_s) if driven else None
+    spring = spring_stiffness_n_m(scales, stiffness_number=stiffness_number, stiffness_n_m=stiffness_n_m)
     overrides = _given(
         timestep_s=timestep_s,
         integrator=integrator,
@@ -126,7 +133,7 @@ def build_rig(
             2 * dt if solref_timeconst_s is None else solref_timeconst_s,
             1.0 if solref_dampratio is None else solref_dampratio,
         )
-    engine = default_engine(scales, speed_m_s=speed, **overrides)
+    engine = default_engine(scales, speed_m_s=speed, stiffness_n_m=spring, **overrides)
     return Rig(surface, tip=tip, engine=engine, length_scale_m=length_scale_m)
 
 

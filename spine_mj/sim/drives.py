@@ -11,16 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from spine_mj.errors import SpineInputError, check_positive
-from spine_mj.sim.params import Scales, check_optional
-
-#: The spring drive's default stiffness number K = k l_s / F_p (docs/physics.md §4). A drive
-#: is quasistatic only when it is slow *and* stiff: the elastic energy a spring stores at
-#: breakaway, (kappa F_p)^2 / 2k = kappa^2 F_p l_s / 2K, is released into the slip. Measured
-#: on three fractal seeds x 5 starts at I_e = 1e-4: K = 3 stopped 8/15 runs on penetration
-#: (hops on landing), K = 10 3/15, K = 30 and 100 none, with the median Frechet distance
-#: from the streamline 0.35, 0.10, 0.021 and 0.030 L_c. 30 is the softest of those clean ones
-#: (the stiffer, the more steps per spring period the time step must resolve).
-DEFAULT_STIFFNESS_NUMBER = 30.0
+from spine_mj.sim.params import DEFAULT_STIFFNESS_NUMBER, Scales, check_optional
 
 
 @dataclass(frozen=True)
@@ -123,9 +114,18 @@ def _check_margin(drive: RampDrive | StaticProbe) -> None:
 def stiffness_n_m(drive: SpringDrive, scales: Scales) -> float:
     """The spring's stiffness [N/m]: the drive's own, else K = :data:`DEFAULT_STIFFNESS_NUMBER`
     on the surface's slope length (``K F_p / l_s``)."""
-    if drive.stiffness_n_m is not None:
-        return drive.stiffness_n_m
-    return scales.stiffness_for(DEFAULT_STIFFNESS_NUMBER)
+    return spring_stiffness_n_m(scales, stiffness_n_m=drive.stiffness_n_m)
+
+
+def spring_stiffness_n_m(
+    scales: Scales, *, stiffness_number: float | None = None, stiffness_n_m: float | None = None
+) -> float:
+    """A spring's stiffness [N/m] from ``stiffness_n_m``, else the stiffness number
+    ``stiffness_number`` (``k = K F_p / l_s``), else :data:`DEFAULT_STIFFNESS_NUMBER`."""
+    if stiffness_n_m is not None:
+        return check_positive("stiffness_n_m", stiffness_n_m)
+    k_number = DEFAULT_STIFFNESS_NUMBER if stiffness_number is None else stiffness_number
+    return scales.stiffness_for(check_positive("K", k_number))
 
 
 def rate_n_s(drive: RampDrive | StaticProbe, scales: Scales) -> float:

@@ -31,6 +31,7 @@ from spine_mj.sim.drives import Drive, SpringDrive, speed_m_s, stiffness_n_m
 from spine_mj.sim.drives import stiffness_n_m as spring_stiffness_n_m
 from spine_mj.sim.params import (
     MAX_DRIVE_ADVANCE_PER_STEP,
+    MAX_SPRING_OMEGA_DT,
     EngineSettings,
     Scales,
     TipParams,
@@ -39,6 +40,7 @@ from spine_mj.sim.params import (
     default_engine,
     hfield_of,
     rest_depth_m,
+    spring_omega_dt,
 )
 from spine_mj.sim.placement import Placer
 from spine_mj.sim.recording import SENSOR_NAMES
@@ -370,10 +372,23 @@ class RigModel:
 
     def check_drive(self, drive: Drive) -> None:
         """Refuse a drive whose inertia number is beyond :data:`MAX_INERTIA_NUMBER`, however it
-        was given (an I_e, a speed or a force rate), or that advances more than
-        :data:`MAX_DRIVE_ADVANCE_PER_STEP` L_c in one time step of this rig."""
+        was given (an I_e, a speed or a force rate), that advances more than
+        :data:`MAX_DRIVE_ADVANCE_PER_STEP` L_c in one time step of this rig, or whose spring
+        this rig's step cannot integrate (``omega dt`` above
+        :data:`~spine_mj.sim.params.MAX_SPRING_OMEGA_DT`)."""
         speed = check_drive_speed(self.scales, self.speed_of(drive))
         dt, lc = self.engine.timestep_s, self.scales.char_length_m
+        if isinstance(drive, SpringDrive):
+            k = stiffness_n_m(drive, self.scales)
+            wdt = spring_omega_dt(k, self.scales.mass_kg, dt)
+            if wdt > MAX_SPRING_OMEGA_DT * (1 + 1e-9):
+                most = MAX_SPRING_OMEGA_DT / wdt * dt
+                raise SpineInputError(
+                    f"the drive spring (K = {self.scales.stiffness_number(k):.3g}, k = {k:.3g} N/m) swings "
+                    f"{wdt:.3g} rad in one time step of {dt:.3g} s, more than {MAX_SPRING_OMEGA_DT:g}: the "
+                    f"engine integrates it explicitly and would get it wrong; build the rig for this "
+                    f"stiffness (build_rig(stiffness_number=...)) or use a time step of at most {most:.3g} s"
+                )
         if speed * dt > MAX_DRIVE_ADVANCE_PER_STEP * lc:
             raise SpineInputError(
                 f"the drive advances {speed * dt / lc:.3g} L_c in one time step of {dt:.3g} s (speed "

@@ -46,6 +46,24 @@ _IMPACT_DEPTH_OF_TOLERANCE = 0.5  # impact depth an arrival may reach, in penetr
 #: fall add to the carriage's speed. Measured on the single peak and valley with the default
 #: spring at I_e = 0.03-1: normal speeds at contact onset of 1.0-2.0 times the drive speed.
 _LANDING_SPEED_FACTOR = 2.0
+#: The spring drive's default stiffness number K = k l_s / F_p (docs/physics.md §4). A drive
+#: is quasistatic only when it is slow *and* stiff: the elastic energy a spring stores at
+#: breakaway, (kappa F_p)^2 / 2k = kappa^2 F_p l_s / 2K, is released into the slip. Measured
+#: on three fractal seeds x 5 starts at I_e = 1e-4: K = 3 stopped 8/15 runs on penetration
+#: (hops on landing), K = 10 3/15, K = 30 and 100 none, with the median Frechet distance
+#: from the streamline 0.35, 0.10, 0.021 and 0.030 L_c. 30 is the softest of those clean ones
+#: (the stiffer, the more steps per spring period the time step must resolve).
+DEFAULT_STIFFNESS_NUMBER = 30.0
+#: Largest ``omega dt`` the step rule gives the drive spring, ``omega = sqrt(k / m)``. MuJoCo
+#: integrates a position actuator's stiffness explicitly (``implicitfast`` takes only velocity
+#: derivatives implicitly), so the spring-tip oscillator runs under semi-implicit Euler:
+#: stable for ``omega dt < 2``, with a period error of ``(omega dt)^2 / 24`` and a peak-speed
+#: error of ``(omega dt)^2 / 16`` (0.38 % and 0.57 % at 0.3; docs/physics.md §7).
+SPRING_OMEGA_DT = 0.3
+#: Largest ``omega dt`` a spring drive may run at on a rig built for a softer spring or with a
+#: user's step: twice the rule's, where the spring-block's period is still within 1.5 % and
+#: its peak speed within 2.3 % (beyond it the run is refused, never run inaccurately).
+MAX_SPRING_OMEGA_DT = 2 * SPRING_OMEGA_DT
 _MIN_SPACING_PER_TIP_RADIUS = 0.25  # finer hfields exceed MuJoCo's 50 contacts per geom pair
 _SCAN_TIP_SPACINGS = 2.0  # default tip radius of a measured scan, in lateral spacings
 MAX_HFIELD_SIDE = 8192  # samples a side of an hfield (memory; MuJoCo's collision stays local)
@@ -550,7 +568,13 @@ def hfield_spacing(hfield: HField, length_scale_m: float = 1.0) -> float:
     return length_scale_m * 2 * max(rx / (hfield.ncol - 1), ry / (hfield.nrow - 1))
 
 
-def default_engine(scales: Scales, *, speed_m_s: float | None = None, **overrides) -> EngineSettings:
+def default_engine(
+    scales: Scales,
+    *,
+    speed_m_s: float | None = None,
+    stiffness_n_m: float | None = None,
+    **overrides,
+) -> EngineSettings:
     """Engine settings derived from the problem's scales, by one rule in engine units.
 
     ``dt = sqrt(0.005 min(r_tip, L_c) / L_c) tau`` (``dt / tau`` rounded to 2 digits, so the
@@ -571,7 +595,53 @@ def default_engine(scales: Scales, *, speed_m_s: float | None = None, **override
     up to twice the carriage's speed) and the landing speed of the surface's fall,
     ``sqrt(2 a_p scales.fall_height_m)`` (:func:`fall_height`: falls off grit flanks and
     scan-line steps land at many times a quasistatic drive's speed).
+
+    The drive spring also limits the step: ``dt <= SPRING_OMEGA_DT / omega``, ``omega =
+    sqrt(k / m)``, for the spring of ``stiffness_n_m`` (None: the default spring, ``K =``
+    :data:`DEFAULT_STIFFNESS_NUMBER`), since MuJoCo integrates the spring explicitly
+    (:data:`SPRING_OMEGA_DT`). In engine units ``omega tau = sqrt(K L_c / l_s)``, so a stiff drive costs ``sqrt(K)`` in steps: on the paper's
+    fractal (``L_c / l_s = 24``) K = 30 is still set by the contact, K = 3000 takes 10 times
+    the steps. The contact keeps its own time constant ``solref = (2 dt_contact, 1)`` from
+    the contact rule above, so refining the step for the spring changes nothing else of the
+    model.
     """
+    dt_contact = _contact_step_tau(scales, speed_m_s)
+    if stiffness_n_m is None:
+        stiffness_n_m = scales.stiffness_for(DEFAULT_STIFFNESS_NUMBER)
+    omega_tau = math.sqrt(check_positive("stiffness_n_m", stiffness_n_m) / scales.mass_kg) * scales.time_s
+    dt_tau = min(dt_contact, _two_digits_down(SPRING_OMEGA_DT / omega_tau))
+    dt = dt_tau * scales.time_s
+    if not dt > 0 and "timestep_s" not in overrides:
+        raise SpineInputError(
+            f"impacts at drive speed {speed_m_s!r} m/s (or a fall down the surface) would need a time "
+            f"step of {dt:.3g} s: lower the speed (I_e)"
+        )
+    base = {
+        "timestep_s": dt,
+        "solref": (2 * dt_contact * scales.time_s, 1.0),
+        "solimp": (0.99, 0.99, 0.01 * scales.tip_radius_m, 0.5, 2.0),
+        "hfield_resolution": scales.hfield_resolution,
+    }
+    if "timestep_s" in overrides and "solref" not in overrides:
+        base["solref"] = (2 * float(overrides["timestep_s"]), 1.0)
+    base.update(overrides)
+    return EngineSettings(**base)
+
+
+def _two_digits_down(x: float) -> float:
+    """``x`` > 0 cut to two significant digits (never rounded up: the bound stays a bound)."""
+    scale = 10.0 ** (math.floor(math.log10(x)) - 1)
+    return math.floor(x / scale * (1 + 1e-12)) * scale
+
+
+def spring_omega_dt(stiffness_n_m: float, mass_kg: float, timestep_s: float) -> float:
+    """``omega dt`` of a drive spring on a tip of ``mass_kg``, ``omega = sqrt(k / m)``."""
+    return math.sqrt(stiffness_n_m / mass_kg) * timestep_s
+
+
+def _contact_step_tau(scales: Scales, speed_m_s: float | None) -> float:
+    """The contact's step rule of :func:`default_engine` in engine units (``dt / tau``,
+    rounded to 2 digits; 0 where impacts would need a step below that precision)."""
     ratio = min(scales.tip_radius_m / scales.char_length_m, 1.0)
     dt_tau = math.sqrt(_REST_PENETRATION_FRACTION * ratio)
     v = math.sqrt(2 * scales.fall_height_m / scales.char_length_m)  # engine units: a_p = 1
@@ -581,22 +651,7 @@ def default_engine(scales: Scales, *, speed_m_s: float | None = None, **override
     if v > 0:
         depth = _IMPACT_DEPTH_OF_TOLERANCE * penetration_tolerance_m(scales) / scales.char_length_m
         dt_tau = min(dt_tau, math.e * depth / (2 * v))
-    dt = float(f"{dt_tau:.2g}") * scales.time_s
-    if not dt > 0 and "timestep_s" not in overrides:
-        raise SpineInputError(
-            f"impacts at {v:.3g} L_c/tau (drive speed {speed_m_s!r} m/s, or a fall down the surface) "
-            f"would need a time step of {dt_tau * scales.time_s:.3g} s: lower the speed (I_e)"
-        )
-    base = {
-        "timestep_s": dt,
-        "solref": (2 * dt, 1.0),
-        "solimp": (0.99, 0.99, 0.01 * scales.tip_radius_m, 0.5, 2.0),
-        "hfield_resolution": scales.hfield_resolution,
-    }
-    if "timestep_s" in overrides and "solref" not in overrides:
-        base["solref"] = (2 * float(overrides["timestep_s"]), 1.0)
-    base.update(overrides)
-    return EngineSettings(**base)
+    return float(f"{dt_tau:.2g}")
 
 
 def check_inertia_number(inertia_number: float, what: str = "inertia number I_e") -> float:

@@ -177,7 +177,7 @@ def _check_speed(config) -> None:
 @functools.lru_cache(maxsize=4)
 def _rig(spec, key):
     """The rig of a surface and tip/engine parameters (cached: cases differing only in the
-    drive's stiffness or protocol share it; the speed sets the engine step)."""
+    protocol share it; the speed and the spring's stiffness set the engine step)."""
     p = dict(key)
     return sim.build_rig(
         spec.make(),
@@ -197,6 +197,8 @@ def _rig(spec, key):
         solref_dampratio=p["solref_dampratio"],
         ie=p["ie"],
         speed_m_s=p["speed"],
+        stiffness_number=p["K"],
+        stiffness_n_m=p["stiffness"],
     )
 
 
@@ -228,6 +230,8 @@ def _mujoco(case, surface, starts, upstream):
 _RIG_KEYS = (
     "ie",  # the drive speed limits the engine step (impacts)
     "speed",
+    "K",  # the drive spring's stiffness too (its period)
+    "stiffness",
     "mass",
     "mu",
     "preload",
