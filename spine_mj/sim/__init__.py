@@ -70,6 +70,8 @@ from spine_mj.sim.params import (
     DEFAULT_LENGTH_SCALE_M,
     LENGTH_UNITS_M,
     MAX_INERTIA_NUMBER,
+    MAX_SPRING_OMEGA_DT,
+    SPRING_OMEGA_DT,
     Cone,
     EndReason,
     EngineSettings,
@@ -82,6 +84,7 @@ from spine_mj.sim.params import (
     hfield_of,
     hfield_spacing,
     penetration_tolerance_m,
+    spring_omega_dt,
 )
 from spine_mj.sim.planes import inclined_plane
 from spine_mj.sim.results import RunResult
@@ -92,12 +95,14 @@ __all__ = [
     "DEFAULT_LENGTH_SCALE_M",
     "LENGTH_UNITS_M",
     "MAX_INERTIA_NUMBER",
+    "MAX_SPRING_OMEGA_DT",
     "MODEL_PATH",
     "MOTION_NAMES",
     "PROTOCOLS",
     "REFINE_TIMESTEP",
     "SLIDING",
     "SLIPPING",
+    "SPRING_OMEGA_DT",
     "STUCK",
     "ArrayResult",
     "ArrayRig",
@@ -129,4 +134,5 @@ __all__ = [
     "hfield_spacing",
     "inclined_plane",
     "penetration_tolerance_m",
+    "spring_omega_dt",
 ]

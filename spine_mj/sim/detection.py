@@ -269,13 +269,21 @@ def end_candidates(
     return candidates
 
 
+#: Steps after touch-down within which a penetration counts as the landing's: an impact
+#: sinks deepest about one contact time constant after touch-down, 2 to 3 steps by the step
+#: rule (a step refined for the spring drive keeps the contact's time constant).
+_LANDING_STEPS = 8
+
+
 def _penetration_cause(rec: Recording, k: int, preload_n: float) -> str:
     """What sank the tip at step ``k``: a landing (the speed it arrived with, how long it
     was airborne) or a contact pressed by a large force (the normal force in F_p)."""
-    touching = np.flatnonzero(rec.contact[:k])
-    airborne = k - 1 - int(touching[-1]) if touching.size else k
-    if airborne > 0:
-        speed = float(np.linalg.norm(rec.velocity_m_s[k - 1]))
+    apart = np.flatnonzero(~rec.contact[: k + 1])
+    onset = int(apart[-1]) + 1 if apart.size else 0  # first step of the contact that sank
+    if 0 < onset and k - onset < _LANDING_STEPS:
+        before = np.flatnonzero(rec.contact[:onset])
+        airborne = onset - 1 - int(before[-1]) if before.size else onset
+        speed = float(np.linalg.norm(rec.velocity_m_s[onset - 1]))
         return f"landing at {speed:.3g} m/s after {airborne} steps airborne"
     return f"contact pressed by a normal force of {rec.normal_force_n[k] / preload_n:.3g} F_p"
 

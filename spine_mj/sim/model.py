@@ -378,6 +378,12 @@ class RigModel:
         :data:`~spine_mj.sim.params.MAX_SPRING_OMEGA_DT`)."""
         speed = check_drive_speed(self.scales, self.speed_of(drive))
         dt, lc = self.engine.timestep_s, self.scales.char_length_m
+        if speed * dt > MAX_DRIVE_ADVANCE_PER_STEP * lc:
+            raise SpineInputError(
+                f"the drive advances {speed * dt / lc:.3g} L_c in one time step of {dt:.3g} s (speed "
+                f"{speed:.3g} m/s), more than {MAX_DRIVE_ADVANCE_PER_STEP:g}: use a time step of at most "
+                f"{MAX_DRIVE_ADVANCE_PER_STEP * lc / speed:.3g} s, or none (derived)"
+            )
         if isinstance(drive, SpringDrive):
             k = stiffness_n_m(drive, self.scales)
             wdt = spring_omega_dt(k, self.scales.mass_kg, dt)
@@ -389,9 +395,3 @@ class RigModel:
                     f"engine integrates it explicitly and would get it wrong; build the rig for this "
                     f"stiffness (build_rig(stiffness_number=...)) or use a time step of at most {most:.3g} s"
                 )
-        if speed * dt > MAX_DRIVE_ADVANCE_PER_STEP * lc:
-            raise SpineInputError(
-                f"the drive advances {speed * dt / lc:.3g} L_c in one time step of {dt:.3g} s (speed "
-                f"{speed:.3g} m/s), more than {MAX_DRIVE_ADVANCE_PER_STEP:g}: use a time step of at most "
-                f"{MAX_DRIVE_ADVANCE_PER_STEP * lc / speed:.3g} s, or none (derived)"
-            )

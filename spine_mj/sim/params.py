@@ -599,11 +599,11 @@ def default_engine(
     The drive spring also limits the step: ``dt <= SPRING_OMEGA_DT / omega``, ``omega =
     sqrt(k / m)``, for the spring of ``stiffness_n_m`` (None: the default spring, ``K =``
     :data:`DEFAULT_STIFFNESS_NUMBER`), since MuJoCo integrates the spring explicitly
-    (:data:`SPRING_OMEGA_DT`). In engine units ``omega tau = sqrt(K L_c / l_s)``, so a stiff drive costs ``sqrt(K)`` in steps: on the paper's
-    fractal (``L_c / l_s = 24``) K = 30 is still set by the contact, K = 3000 takes 10 times
-    the steps. The contact keeps its own time constant ``solref = (2 dt_contact, 1)`` from
-    the contact rule above, so refining the step for the spring changes nothing else of the
-    model.
+    (:data:`SPRING_OMEGA_DT`). In engine units ``omega tau = sqrt(K L_c / l_s)``, so a
+    stiff drive costs ``sqrt(K)`` in steps: on the paper's fractal (``L_c / l_s = 24``)
+    K = 30 is still set by the contact, K = 3000 takes 10 times the steps. The contact keeps
+    its own time constant ``solref = (2 dt_contact, 1)`` from the contact rule above, so
+    refining the step for the spring changes nothing else of the model.
     """
     dt_contact = _contact_step_tau(scales, speed_m_s)
     if stiffness_n_m is None:

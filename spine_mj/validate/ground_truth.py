@@ -12,6 +12,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -32,7 +33,7 @@ from spine_mj.theory.tomlinson_dynamics import PTParams, SineProfile, integrate
 from spine_mj.validate.plans import GRAVITY, MASS_KG, ValidationPlan
 from spine_mj.validate.study_runner import StudyRunner
 
-__all__ = ["GroundTruthResult", "ground_truth", "spring_block_check"]
+__all__ = ["GroundTruthResult", "ground_truth", "spring_block_check", "spring_block_ladder"]
 
 #: I_e of the Prandtl-Tomlinson runs (the quasistatic corner).
 TOMLINSON_IE = 1e-4
@@ -74,14 +75,23 @@ class GroundTruthResult:
         measured at the crest, the crest gap of each and its largest gap on the flat
         approach (the harness's own hop) [tip radii], the bracket of the
         crest I_e (last that held, first that left) and its ratios to the prediction.
+    spring_block_ladder : list of dict
+        :func:`spring_block_check` at each of :data:`SPRING_BLOCK_K` (the engine step's
+        spring rule, from the softest drive to the stiffest).
     """
 
     spring_block: dict
     tomlinson: list[dict]
     liftoff: list[dict]
+    spring_block_ladder: list[dict] = dataclasses.field(default_factory=list)
 
     def as_dict(self) -> dict:
-        return {"spring_block": self.spring_block, "tomlinson": self.tomlinson, "liftoff": self.liftoff}
+        return {
+            "spring_block": self.spring_block,
+            "spring_block_ladder": self.spring_block_ladder,
+            "tomlinson": self.tomlinson,
+            "liftoff": self.liftoff,
+        }
 
     def validation_keys(self) -> dict:
         """This study's key of ``validation.json``."""
@@ -93,6 +103,7 @@ def ground_truth(plan: ValidationPlan, runner: StudyRunner) -> GroundTruthResult
     runner.study = "ground_truth"
     with runner.phase("spring-block on a flat plane"):
         block = spring_block_check()
+        ladder = spring_block_ladder()
     corrugations = [
         Corrugation(s, mu, tip_radius=TOMLINSON_TIP)
         for s in plan.ground_truth_slopes
@@ -113,33 +124,58 @@ def ground_truth(plan: ValidationPlan, runner: StudyRunner) -> GroundTruthResult
     for c, (df, _) in zip(corrugations, done):
         rows += _tomlinson(c, df[df["analysis"] == "mujoco"])
     lift = [_liftoff(plan, runner, w) for w in plan.ground_truth_ridge_widths]
-    return GroundTruthResult(spring_block=block, tomlinson=rows, liftoff=lift)
+    return GroundTruthResult(spring_block=block, tomlinson=rows, liftoff=lift, spring_block_ladder=ladder)
 
 
-def spring_block_check(speed_m_s: float = 0.004, stiffness_n_m: float = 100.0, mu: float = 0.5) -> dict:
+#: Stiffness numbers of the spring-block ladder (K = k l_s / F_p; on a plane l_s = L_c): the
+#: step rule must keep the period and peak speed right from the softest drive to the stiffest.
+SPRING_BLOCK_K = (3.0, 30.0, 300.0, 3000.0, 30000.0)
+
+
+def spring_block_check(
+    speed_m_s: float = 0.004,
+    stiffness_n_m: float | None = 100.0,
+    mu: float = 0.5,
+    *,
+    stiffness_number: float | None = None,
+    periods: int = 12,
+) -> dict:
     """The spring-block on a flat plane after breakaway: the period of the speed swing
-    (autocorrelation's first peak) and its peak (mean plus the fundamental's amplitude:
-    the contact adds step-to-step noise on top) against ``2 pi / w`` and ``2 V``."""
-    rig = sim.Rig(
-        sim.inclined_plane(slope_deg=0.0, half_width=0.05, n=101),
-        tip=sim.TipParams(tip_radius_m=5e-4, mu_s=mu, mass_kg=MASS_KG),
-    )
+    (autocorrelation's first peak, refined between steps by a parabola through its three
+    highest lags) and its peak (mean plus the fundamental's amplitude: the contact adds
+    step-to-step noise on top) against ``2 pi / w`` and ``2 V``. The period tests the
+    engine step (its error grows as ``(omega dt)^2 / 24``); the peak also the friction: the
+    swing's force amplitude ``V sqrt(k m)`` is small beside ``mu W`` on a soft spring, where
+    MuJoCo's velocity-dependent (soft) friction rows flatten it. The rig is built for the
+    spring (the step rule's ``omega dt``), the run lasts until ``periods`` swings after the
+    predicted breakaway. ``stiffness_number`` (K) replaces ``stiffness_n_m`` when given."""
+    surface = sim.inclined_plane(slope_deg=0.0, half_width=0.05, n=101)
+    tip = sim.TipParams(tip_radius_m=5e-4, mu_s=mu, mass_kg=MASS_KG)
+    scales = sim.Scales.for_surface(surface, tip=tip)
+    k = scales.stiffness_for(stiffness_number) if stiffness_number is not None else stiffness_n_m
+    rig = sim.Rig(surface, tip=tip, engine=sim.default_engine(scales, speed_m_s=speed_m_s, stiffness_n_m=k))
+    period = spring_block_period_s(k, tip.mass_kg)
+    breakaway = mu * scales.preload_n / (k * speed_m_s)
     res = rig.run(
-        sim.SpringDrive(speed_m_s=speed_m_s, stiffness_n_m=stiffness_n_m, duration_s=1.0), start=(-0.04, 0.0)
+        sim.SpringDrive(speed_m_s=speed_m_s, stiffness_n_m=k, duration_s=1.05 * breakaway + periods * period),
+        start=(-0.04, 0.0),
     )
     i0 = res.drive_start_index + int(np.argmax(res.moving[res.drive_start_index :]))
     vx, t = res.velocity_m_s[i0:, 0], res.time_s[i0:]
     dt = float(t[1] - t[0])
-    period = spring_block_period_s(stiffness_n_m, rig.tip.mass_kg)
     dv = vx - vx.mean()
     ac = np.correlate(dv, dv, "full")[dv.size - 1 :]
-    lags = np.arange(int(0.5 * period / dt), int(1.5 * period / dt))
-    measured = float(lags[np.argmax(ac[lags])] * dt)
+    lags = np.arange(max(2, int(0.5 * period / dt)), min(int(1.5 * period / dt), ac.size - 1))
+    j = int(lags[np.argmax(ac[lags])])
+    a, b, c = ac[j - 1], ac[j], ac[j + 1]
+    measured = float((j + 0.5 * (a - c) / (a - 2 * b + c)) * dt)
     n = int((t[-1] - t[0]) // measured * measured / dt)
     ph = 2 * np.pi * (t[:n] - t[0]) / measured
     amp = 2 * np.hypot((dv[:n] * np.cos(ph)).mean(), (dv[:n] * np.sin(ph)).mean())
     peak = float((vx[:n].mean() + amp) / speed_m_s)
     return {
+        "stiffness_number_K": scales.stiffness_number(k),
+        "stiffness_n_m": k,
         "period_s": measured,
         "period_predicted_s": period,
         "period_rel_error": measured / period - 1,
@@ -147,7 +183,15 @@ def spring_block_check(speed_m_s: float = 0.004, stiffness_n_m: float = 100.0, m
         "peak_speed_rel_error": peak / 2 - 1,
         "slip_events": len(res.slip_events),
         "timestep_s": rig.engine.timestep_s,
+        "omega_dt": sim.spring_omega_dt(k, tip.mass_kg, rig.engine.timestep_s),
+        "steps": res.simulated_steps,
+        "end_reason": res.end_reason.value,
     }
+
+
+def spring_block_ladder(stiffness_numbers=SPRING_BLOCK_K) -> list[dict]:
+    """:func:`spring_block_check` at each stiffness number: the step rule's check."""
+    return [spring_block_check(stiffness_number=float(kn)) for kn in stiffness_numbers]
 
 
 def _tomlinson(c: Corrugation, df) -> list[dict]:

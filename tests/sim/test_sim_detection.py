@@ -30,9 +30,14 @@ def test_every_end_reason_is_reachable_and_recorded():
     force = float(res.end_detail.split("pressed by a normal force of ")[1].split()[0])
     assert 0.95 < force < 1.05
     reasons[res.end_reason] = res
-    # a spring the step cannot integrate (it used to blow up into a MuJoCo reset) is refused
+    # a spring the step cannot integrate is refused; run anyway, it blows up into a MuJoCo reset
+    blow_up = SpringDrive(speed_m_s=0.01, stiffness_n_m=1e9, duration_s=0.05)
     with pytest.raises(SpineInputError, match=r"drive spring .* swings .* rad in one time step"):
-        rig.run(SpringDrive(speed_m_s=0.01, stiffness_n_m=1e9, duration_s=0.05), start=(0.0, 0.0))
+        rig.run(blow_up, start=(0.0, 0.0))
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(type(rig), "check_drive", lambda self, drive: None)
+        res = rig.run(blow_up, start=(0.0, 0.0), detection=Detection(kappa_cap=1e12))
+    assert res.end_reason is EndReason.ENGINE_TROUBLE and "reset" in res.end_detail
     for slope, probe in ((0.0, StaticProbe()), (40.0, StaticProbe())):
         res = plane_rig(slope).run(probe, start=START)
         reasons[res.end_reason] = res

@@ -21,15 +21,22 @@ def simulate(*args):
     return CliRunner().invoke(main, ["simulate", "paper-single-peak", "--start", "-3,-1", *map(str, args)])
 
 
-def test_engine_blow_ups_end_as_engine_trouble_and_leave_no_mujoco_log(in_tmp):
-    # a 1e12 N/m spring with a 10 ms step: MuJoCo's "Nan, Inf or huge value in QACC"
+def test_a_spring_the_step_cannot_integrate_is_refused_and_leaves_no_mujoco_log(in_tmp):
+    # a 1e12 N/m spring with a 10 ms step blew up into MuJoCo's "Nan, Inf or huge value in
+    # QACC"; the step rule's bound (sim.params.MAX_SPRING_OMEGA_DT) refuses it before running
     result = simulate("--stiffness", 1e12, "--timestep", 0.01, "--out", "run")
+    assert result.exit_code == 2, result.output
+    assert re.search(r"drive spring .* swings 1e\+05 rad in one time step .* at most 6e-08 s", result.output)
+    assert len(result.output.strip().splitlines()) == 1
+    assert sorted(os.listdir(in_tmp)) == []
+
+
+def test_a_stiff_spring_gets_a_step_that_integrates_it(in_tmp):
+    """K = 30000 on the single peak: the step rule refines the step for the spring."""
+    result = simulate("--K", 30000, "--duration", 0.02, "--out", "run")
     assert result.exit_code == 0, result.output
     summary = json.loads((in_tmp / "run" / "summary.json").read_text())
-    assert summary["end_reason"] == "engine_trouble"
-    assert "MuJoCo warning" in summary["end_detail"]
-    assert not (in_tmp / "MUJOCO_LOG.TXT").exists()
-    assert sorted(os.listdir(in_tmp)) == ["run"]
+    assert summary["end_reason"] == "completed", summary["end_detail"]
 
 
 @pytest.mark.parametrize(

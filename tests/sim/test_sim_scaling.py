@@ -9,7 +9,7 @@ import pytest
 
 from spine_mj.errors import SpineInputError
 from spine_mj.roughness import characteristic_length
-from spine_mj.sim import EndReason, Rig, SpringDrive, TipParams
+from spine_mj.sim import EndReason, Rig, Scales, SpringDrive, TipParams, default_engine
 from spine_mj.surface_io import import_topography, load_surface, save_surface
 from spine_mj.surfaces import GridSurface, fractal_fbm, single_gaussian
 
@@ -21,8 +21,9 @@ def _dimensionless_run(surface, length_scale_m, *, ie, k_number, tip_over_l, mas
     path in L_c, time in tau and drive force in F_p."""
     lc = characteristic_length(surface) * length_scale_m
     tip = TipParams(tip_radius_m=tip_over_l * lc, mass_kg=mass_kg, mu_s=0.5)
-    rig = Rig(surface, tip=tip, length_scale_m=length_scale_m)
-    sc = rig.scales
+    sc = Scales.for_surface(surface, tip=tip, length_scale_m=length_scale_m)
+    engine = default_engine(sc, stiffness_n_m=sc.stiffness_for(k_number))  # the spring bounds the step
+    rig = Rig(surface, tip=tip, length_scale_m=length_scale_m, engine=engine)
     drive = SpringDrive(
         speed_m_s=sc.speed_for(ie), stiffness_n_m=sc.stiffness_for(k_number), duration_s=40 * sc.time_s
     )
