@@ -56,13 +56,15 @@ Modules: :mod:`~spine_mj.sim.params` (tip, engine, scales and their rules),
 :mod:`~spine_mj.sim.fastforward` (the stick-phase fast-forward rule both use),
 :mod:`~spine_mj.sim.render`, :mod:`~spine_mj.sim.planes`, :mod:`~spine_mj.sim.rig`
 (:class:`Rig`, the object users hold) and :mod:`~spine_mj.sim.build` (:func:`build_rig` and
-:func:`build_drive`: a rig and a drive from dimensionless or SI inputs).
+:func:`build_drive`: a rig and a drive from dimensionless or SI inputs) and
+:mod:`~spine_mj.sim.holding` (an array's predicted holding excess and its default pace).
 """
 
 from spine_mj.sim.array import ArrayResult, ArrayRig, ForcePull
 from spine_mj.sim.build import DEFAULT_INERTIA_NUMBER, PROTOCOLS, build_drive, build_rig, drive_speed_m_s
 from spine_mj.sim.detection import Detection, Event
 from spine_mj.sim.drives import Drive, RampDrive, SpringDrive, StaticProbe
+from spine_mj.sim.holding import HOLDING_TOLERANCE, array_ie, holding_excess
 from spine_mj.sim.layout import Layout, LayoutKind
 from spine_mj.sim.model import MODEL_PATH
 from spine_mj.sim.motion import MOTION_NAMES, SLIDING, SLIPPING, STUCK, SlipEvent
@@ -92,6 +94,7 @@ from spine_mj.sim.rig import REFINE_TIMESTEP, Rig
 
 __all__ = [
     "DEFAULT_INERTIA_NUMBER",
+    "HOLDING_TOLERANCE",
     "DEFAULT_LENGTH_SCALE_M",
     "LENGTH_UNITS_M",
     "MAX_INERTIA_NUMBER",
@@ -125,6 +128,7 @@ __all__ = [
     "SpringDrive",
     "StaticProbe",
     "TipParams",
+    "array_ie",
     "build_drive",
     "build_rig",
     "characteristic_length",
@@ -132,6 +136,7 @@ __all__ = [
     "drive_speed_m_s",
     "hfield_of",
     "hfield_spacing",
+    "holding_excess",
     "inclined_plane",
     "penetration_tolerance_m",
     "spring_omega_dt",

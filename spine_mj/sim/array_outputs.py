@@ -24,7 +24,10 @@ ARRAY_OUTPUTS = ("curve.csv", "spines.csv", "summary.json", "layout.png")
 
 def array_summary(res, arr) -> dict:
     """``summary.json`` of an array run: ``n_spines``, ``holding_force_n``, ``holding_ratio``
-    (holding force over the total preload ``N F_p``), ``locked_spines`` and what they came from."""
+    (holding force over the total preload ``N F_p``), ``locked_spines``, the holding's
+    predicted dynamic excess per spine (``holding_excess_predicted``, in ``F_p``), the
+    largest total force of the run (``peak_force_n``, ``peak_ratio``), the pace
+    (``inertia_number``) and what they came from."""
     rig, lay = arr.rig, arr.layout
     sc = rig.scales
     return {
@@ -33,6 +36,10 @@ def array_summary(res, arr) -> dict:
         "holding_ratio": res.holding_ratio,
         "locked_spines": res.locked_spines,
         "holding_force_per_spine_n": res.holding_force_n / res.n_spines,
+        "holding_excess_predicted": res.holding_excess_predicted,
+        "peak_force_n": res.peak_force_n,
+        "peak_ratio": res.peak_ratio,
+        "inertia_number": res.inertia_number,
         "drive": "force" if arr.force_control else "speed",
         "end_reason": res.end_reason,
         "end_detail": res.end_detail,

@@ -7,6 +7,11 @@ last state and warm start. After each piece it reads every step: the springs' fo
 (``k (anchor - x)`` capped at ``kappa_cap F_p``, what the actuators apply), the tips'
 speeds, self-locks, the domain's edge and non-finite numbers; it keeps every
 ``stride``-th row. A run ends at its first decided row.
+
+The holding force is read where the array lets go (displacement control: the last step
+before every spine moves; force control: the largest pull under which the carriage held),
+not at the spring force's dynamic peak, and stated with its predicted excess over the
+quasistatic holding (:mod:`spine_mj.sim.holding`).
 """
 
 from __future__ import annotations
@@ -17,6 +22,8 @@ import numpy as np
 
 from spine_mj.sim.detection import Detection
 from spine_mj.sim.drives import SpringDrive, stiffness_n_m
+from spine_mj.sim.holding import holding_excess
+from spine_mj.sim.motion import STUCK_SPEED_FRACTION
 from spine_mj.sim.params import check_optional
 
 _CAP_SLACK = 1e-6
@@ -91,12 +98,25 @@ class ArrayResult:
     locked : (N,) bool
         Spines that reached ``kappa_cap F_p`` while stuck (self-lock).
     holding_force_n : float
-        Displacement control: the largest total force the spines carried together (every
-        step). Force control: the largest pull under which the carriage held, moving slower
-        than the pull's equivalent speed ``L_c (dF/dt) / (N F_p)`` (faster, it has let go; a
-        carriage caught again by re-engaging spines holds again).
+        Displacement control: the largest total force the spines carried while the array
+        held, up to the last step before every spine moved faster than
+        :data:`~spine_mj.sim.motion.STUCK_SPEED_FRACTION` of the carriage speed (the whole
+        run if some spine never let go). Force control: the largest pull under which the
+        carriage held, moving slower than the pull's equivalent speed ``L_c (dF/dt) / (N
+        F_p)`` (faster, it has let go; a carriage caught again by re-engaging spines holds
+        again).
     holding_ratio : float
         ``holding_force_n`` over the total preload ``N F_p``.
+    holding_excess_predicted : float
+        The predicted dynamic excess of ``holding_ratio`` over the quasistatic holding
+        (:func:`~spine_mj.sim.holding.holding_excess`, per spine in ``F_p``): the part of
+        the spring-block swing read before let-go, or the force-rate lag.
+    peak_force_n, peak_ratio : float
+        The largest total spring force over the whole run (every step) and it over ``N F_p``:
+        the force-displacement curve's maximum, dynamic swings included (under displacement
+        control up to ``sqrt(I_e K L_c / l_s)`` per spine above the quasistatic curve).
+    inertia_number : float
+        The drive's pace: ``I_e`` of the carriage's speed, or of the pull's rate per spine.
     end_reason : str
         ``completed``, ``left_domain`` (a tip reached the domain's edge), ``locked`` (every
         spine self-locked), ``held`` (force control: the full pull held) or ``engine_trouble``.
@@ -122,6 +142,10 @@ class ArrayResult:
     end_detail: str
     simulated_steps: int
     step_index: np.ndarray
+    holding_excess_predicted: float
+    peak_force_n: float
+    peak_ratio: float
+    inertia_number: float
 
     @property
     def n_spines(self) -> int:
@@ -142,7 +166,9 @@ class _Run:
         self.done = 0
         self.max_force = np.full(n_spines, -np.inf)
         self.locked = np.zeros(n_spines, dtype=bool)
-        self.hold = -np.inf  # largest total spring force so far (engine units)
+        self.hold = -np.inf  # holding force so far (engine units)
+        self.peak = -np.inf  # largest total spring force so far
+        self.let_go = False  # displacement control: every spine has moved
         self.held_x = init[0, 1 + 3 * n_spines] if init.shape[1] > 1 + 3 * n_spines else 0.0
         self.rows: list[tuple] = []  # kept rows: (time, X, forces, positions, pull, step index)
         self.stride, self.kept = 1, 0
@@ -193,6 +219,16 @@ class ArrayBatch:
         # (L_c per F_p of pull per spine, engine units: rate / N)
         self.release = self.rate / self.n
         self.f0 = self.n * drive.start_force_n / u.force_n if self.force else 0.0
+        sc = rig.scales
+        self.ie = sc.inertia_number(
+            sc.equivalent_speed(arr.pull_rate_n_s(drive) / self.n) if self.force else drive.speed_m_s
+        )
+        self.excess = holding_excess(
+            self.ie,
+            force_control=self.force,
+            stiffness_number=sc.stiffness_number(stiffness_n_m(drive, sc)),
+            lc_over_ls=sc.char_length_m / sc.slope_length_m,
+        )
 
     # ----------------------------------------------------------------- controls
 
@@ -300,12 +336,18 @@ class ArrayBatch:
             run.end = self.completion(k, speed[-1])
         keep = slice(0, last)
         run.max_force = np.maximum(run.max_force, f[keep].max(axis=0))
+        run.peak = max(run.peak, float(f[keep].sum(axis=1).max()))
         if self.force:  # the pull while the carriage holds (slower than the release speed)
             run.held_x = float(last_held[last - 1])
             if held[keep].any():
                 run.hold = max(run.hold, float(self.pull(k, rows[keep][held[keep]]).max()))
-        else:
-            run.hold = max(run.hold, float(f[keep].sum(axis=1).max()))
+        elif not run.let_go:  # the total force up to the last step before every spine moved
+            moving = (speed[keep] >= STUCK_SPEED_FRACTION * self.speed).all(axis=1)
+            moving &= rows[keep] >= self.plans[k][0]  # once the carriage moves
+            held = int(np.argmax(moving)) if moving.any() else last
+            run.let_go = bool(moving.any())
+            if held:
+                run.hold = max(run.hold, float(f[:held].sum(axis=1).max()))
         run.locked = locked_by_row[last - 1]
         pick = np.flatnonzero(((rows[keep] + 1) % run.stride == 0) | (np.arange(last) == last - 1))
         u = self.u
@@ -357,6 +399,10 @@ class ArrayBatch:
             end_detail=run.end[1] if run.end else "",
             simulated_steps=int(run.done),
             step_index=steps,
+            holding_excess_predicted=self.excess,
+            peak_force_n=run.peak * u.force_n,
+            peak_ratio=run.peak * u.force_n / (self.n * fp),
+            inertia_number=self.ie,
         )
 
 
