@@ -93,9 +93,7 @@ def quasistatic_ie(
     )
 
 
-def array_ie(
-    scales: Scales, *, mu: float, force_control: bool, stiffness_n_m: float | None = None
-) -> float:
+def array_ie(scales: Scales, *, mu: float, force_control: bool, stiffness_n_m: float | None = None) -> float:
     """The arrays' default pace (:func:`quasistatic_ie` on ``scales``): the inertia number
     of the carriage's speed (displacement control) or of the pull's rate per spine (force
     control) whose predicted holding excess is :data:`HOLDING_TOLERANCE` ``mu F_p``.

@@ -11,7 +11,11 @@ footprint at spacings in multiples of ``l_s``. Each (surface, N, spacing) draws
 the layouts are compared pairwise on the same patches of surface.
 
 Per configuration it reports the holding force per spine (holding force over ``N F_p``:
-the largest total spring force, mean over placements with a 95 % bootstrap interval) and
+the largest total spring force over the travel, ``ArrayResult.peak_ratio``, mean over
+placements with a 95 % bootstrap interval; beside it the spring-block swing it can carry
+above the quasistatic one, ``sqrt(I_e K L_c / l_s)`` per spine, and whether that is within
+:data:`~spine_mj.sim.holding.HOLDING_TOLERANCE` of the quasistatic holding: at
+:data:`ARRAY_IE` it is not, on any surface, and the number is marked unconverged) and
 the probability that at least one spine self-locks (its spring at ``kappa_cap F_p`` while
 stuck; Wilson interval, :func:`~spine_mj.validate.fractal_lock.lock_rate`), from MuJoCo
 and from the quasistatic reference: each spine on its own compliant-drive streamline
@@ -35,6 +39,7 @@ from scipy.stats import bootstrap
 from spine_mj import presets, sim
 from spine_mj.compare import OUTCOME_TARGET
 from spine_mj.sim.drives import stiffness_n_m
+from spine_mj.sim.holding import HOLDING_TOLERANCE, spring_swing
 from spine_mj.theory.array_reference import compliant_spine_curves
 from spine_mj.theory.compliant import compliant_streamlines
 from spine_mj.theory.streamline import StreamlineParams, dilate
@@ -183,6 +188,17 @@ def _reference(rig, drive, groups: list[list], travel: float, det) -> list[tuple
     return out
 
 
+def _swing(rig, drive) -> float:
+    """The spring-block swing ``sqrt(I_e K L_c / l_s)`` [F_p per spine] the study's holding
+    (the largest force over the travel) can carry above the quasistatic one."""
+    sc = rig.scales
+    return spring_swing(
+        sc.inertia_number(drive.speed_m_s),
+        sc.stiffness_number(stiffness_n_m(drive, sc)),
+        sc.char_length_m / sc.slope_length_m,
+    )
+
+
 def _surface_runs(rig, speed, plan: ArrayPlan):
     """Every MuJoCo array run on one surface: ``[(config, runs)]`` with ``config`` the
     (side, nominal spacing, spacing [l_s], layout, seed) and ``runs`` its placements."""
@@ -214,7 +230,7 @@ def _row(config, runs, reference, plan: ArrayPlan) -> dict:
     side, nominal, spacing, kind, seed = config
     qs_hold, qs_lock, qs_short = reference
     ok = np.array([r.end_reason != "engine_trouble" for r in runs])
-    mj_hold = np.array([r.holding_ratio for r in runs])
+    mj_hold = np.array([r.peak_ratio for r in runs])
     mj_lock = np.array([r.locked for r in runs])
     agree = (mj_lock == qs_lock)[ok]
     m, lo, hi = _mean_ci(mj_hold[ok], plan.bootstrap, seed)
@@ -302,7 +318,11 @@ def array_study(plan: ValidationPlan, runner=None) -> ArrayStudyResult:
             det = sim.Detection().resolve(rig.scales)
             travel = TRAVEL_LS * rig.scales.slope_length_m / rig.length_scale_m
             refs = _reference(rig, drive, [runs for _, runs in done], travel, det)
-            rows += [{"surface": key, **_row(cfg, runs, ref, ap)} for (cfg, runs), ref in zip(done, refs)]
+            swing = _swing(rig, drive)
+            for (cfg, runs), ref in zip(done, refs):
+                row = {"surface": key, **_row(cfg, runs, ref, ap), "holding_excess_predicted": swing}
+                row["holding_converged"] = bool(swing <= HOLDING_TOLERANCE * row["holding_per_spine_qs"])
+                rows.append(row)
     conj, pooled = _conjecture(rows, ap)
     for r in rows:
         r.pop("_hold"), r.pop("_ok")

@@ -38,7 +38,9 @@ def test_array_writes_curve_spines_summary_and_figure(tmp_path):
     spines = pd.read_csv(out / "spines.csv")
     assert len(spines) == 2 and spines["x0"].diff().iloc[1] == pytest.approx(0.3)
     curve = pd.read_csv(out / "curve.csv")
-    assert curve["total_force_n"].max() == pytest.approx(summary["holding_force_n"], rel=1e-9)
+    assert curve["total_force_n"].max() == pytest.approx(summary["peak_force_n"], rel=1e-9)
+    assert summary["holding_force_n"] <= summary["peak_force_n"]
+    assert summary["holding_excess_predicted"] > 0 and summary["inertia_number"] == pytest.approx(1e-2)
     assert (out / "layout.png").stat().st_size > 10_000
 
 

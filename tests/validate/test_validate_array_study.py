@@ -33,6 +33,9 @@ def test_smoke_study_has_one_row_per_layout_and_size_with_intervals(smoke):
         assert 0 <= r["p_lock"]["ci_low"] <= r["p_lock"]["ci_high"] <= 1
         assert 0 <= r["lock_agreement"] <= 1
         assert r["holding_per_spine_qs"] > 0
+        # the fractal at I_e = 1e-3, K = 30, L_c / l_s = 24: a swing of 0.85 F_p per spine
+        assert r["holding_excess_predicted"] == pytest.approx(math.sqrt(1e-3 * 30 * 24), rel=0.01)
+        assert r["holding_converged"] is False
     one = {r["layout"]: r for r in smoke.rows if r["n_spines"] == 1}
     assert one["grid"]["holding_per_spine"] == one["staggered"]["holding_per_spine"]  # one spine: one layout
 
@@ -45,5 +48,5 @@ def test_smoke_study_answers_the_conjecture_in_the_report(smoke, tmp_path):
     fig = array_figure(smoke, tmp_path / "arrays.png")
     assert fig is not None and fig.stat().st_size > 10_000
     text = array_section(smoke, "figures/arrays.png")
-    assert "## Spine arrays" in text and "**Answer" in text and "![" in text
+    assert "## Spine arrays" in text and "**Answer" in text and "![" in text and "(unconverged)" in text
     assert not any(isinstance(v, float) and math.isnan(v) for v in smoke.pooled["staggered"]["diff"].values())

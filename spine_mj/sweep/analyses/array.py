@@ -5,8 +5,10 @@ keys of ``spine-mj array`` (``layout``, ``rows``, ``cols``, ``spacing``, ``spaci
 ``layout_seed``, ``array_drive``); the tip, engine and drive speed are the ``mujoco``
 analysis's parameters (:data:`~spine_mj.sweep.analyses.mujoco.MUJOCO_PARAMS`, one rig per
 case: :func:`~spine_mj.sweep.analyses.mujoco.case_rig`). Per start it records the keys of
-the command's ``summary.json``: ``n_spines``, ``holding_force_n``, ``holding_ratio`` and
-``locked_spines``. Touches the API of :mod:`spine_mj.sim`'s arrays here only.
+the command's ``summary.json``: ``n_spines``, ``holding_force_n``, ``holding_ratio``, its
+predicted dynamic excess ``holding_excess_predicted`` (per spine, ``F_p``; the drive's pace
+is the case's ``ie``: the arrays' own default pace is :func:`spine_mj.sim.array_ie`),
+``peak_ratio`` and ``locked_spines``. Touches the API of :mod:`spine_mj.sim`'s arrays here only.
 """
 
 from __future__ import annotations
@@ -71,6 +73,8 @@ def _array(case, surface, starts, upstream):
         "n_spines": np.array([r.n_spines for r in runs]),
         "holding_force_n": np.array([r.holding_force_n for r in runs]),
         "holding_ratio": np.array([r.holding_ratio for r in runs]),
+        "holding_excess_predicted": np.array([r.holding_excess_predicted for r in runs]),
+        "peak_ratio": np.array([r.peak_ratio for r in runs]),
         "locked_spines": np.array([r.locked_spines for r in runs]),
         "end_reason": np.array([r.end_reason for r in runs], dtype=object),
         "simulated_steps": np.array([r.simulated_steps for r in runs]),

@@ -85,7 +85,9 @@ def array_section(res: ArrayStudyResult | None, figure: str | None = None) -> st
         "(Wilson 95 %). The quasistatic reference puts each spine on its own compliant-drive streamline and "
         "sums them; agreement = share of spines whose lock verdict matches (single-spine target "
         "95 %). A spine's peak force overshoots the quasistatic one by about sqrt(I_e K_c) F_p (the "
-        "spring-block swing past breakaway, K_c = k L_c / F_p); the sum over spines smooths it.",
+        "spring-block swing past breakaway, K_c = k L_c / F_p); the sum over spines smooths it. "
+        "'predicted excess' states that swing per spine; a holding whose swing exceeds 1 % of the "
+        "quasistatic holding is unconverged (spine-mj array's default pace keeps it below).",
         "",
     ]
     rows = []
@@ -100,6 +102,8 @@ def array_section(res: ArrayStudyResult | None, figure: str | None = None) -> st
                 "holding": sig(r["holding_per_spine"]),
                 "holding_ci": _ci(*r["holding_ci"]),
                 "holding_qs": sig(r["holding_per_spine_qs"]),
+                "excess": sig(r["holding_excess_predicted"])
+                + ("" if r["holding_converged"] else " (unconverged)"),
                 "lock": f"{pl['locked']}/{pl['n_ok']}",
                 "lock_ci": _ci(pl["ci_low"], pl["ci_high"]),
                 "lock_qs": f"{pq['locked']}/{pq['n_ok']}",
@@ -109,8 +113,20 @@ def array_section(res: ArrayStudyResult | None, figure: str | None = None) -> st
             }
         )
     names = ["surface", "N", "spacing [l_s]", "layout", "holding (MuJoCo)", "95 % CI", "holding (QS)"]
+    names += ["predicted excess"]
     names += ["P(lock) MuJoCo", "95 % CI", "P(lock) QS", "lock agreement", "failed", "QS paths short"]
-    cols = ["surface", "N", "spacing", "layout", "holding", "holding_ci", "holding_qs", "lock", "lock_ci"]
+    cols = [
+        "surface",
+        "N",
+        "spacing",
+        "layout",
+        "holding",
+        "holding_ci",
+        "holding_qs",
+        "excess",
+        "lock",
+        "lock_ci",
+    ]
     lines.append(table(rows, [*cols, "lock_qs", "agreement", "failed", "short"], names))
     if figure:
         lines += ["", f"![Holding per spine and P(lock) against N per layout]({figure})"]
