@@ -94,8 +94,8 @@ from spine_mj.sim.rig import REFINE_TIMESTEP, Rig
 
 __all__ = [
     "DEFAULT_INERTIA_NUMBER",
-    "HOLDING_TOLERANCE",
     "DEFAULT_LENGTH_SCALE_M",
+    "HOLDING_TOLERANCE",
     "LENGTH_UNITS_M",
     "MAX_INERTIA_NUMBER",
     "MAX_SPRING_OMEGA_DT",

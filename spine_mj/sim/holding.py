@@ -108,10 +108,10 @@ def array_ie(scales: Scales, *, mu: float, force_control: bool, stiffness_n_m: f
 
 
 __all__ = [
-    "array_ie",
     "HOLDING_TOLERANCE",
     "ONSET_SHARE",
     "PULL_LAG_FACTOR",
+    "array_ie",
     "holding_excess",
     "quasistatic_ie",
     "spring_swing",
