@@ -44,6 +44,7 @@ def analyse_window(
     units,
     prm,
     speed_limit2,
+    force_limit,
     firsts,
     held_from,
     out_rows,
@@ -74,8 +75,9 @@ def analyse_window(
     [m], slip speed [m/s], penetration tolerance [m], the cap's force times (1 - 1e-9) [N],
     mu_s, the self-lock tolerance, the lock rule's rise [N]. ``spring`` (g,)
     marks the runs whose carriage is recorded; ``speed_limit2`` (g,) the squared speed
-    limits; ``held_from`` (g,) the lock rule's carry (NaN: none). Writes the columns,
-    ``marks`` (g, 9) in :data:`~spine_mj.sim.detection.MARK_KEYS` order (-1: none) and ``held_out`` (g,).
+    limits; ``force_limit`` (g,) the drive force limits [N]; ``held_from`` (g,) the lock
+    rule's carry (NaN: none). Writes the columns,
+    ``marks`` (g, 10) in :data:`~spine_mj.sim.detection.MARK_KEYS` order (-1: none) and ``held_out`` (g,).
     """
     g = out_rows.size
     p, v, cn, cd, sp, pu = adr[0], adr[1], adr[2], adr[3], adr[4], adr[5]
@@ -86,7 +88,7 @@ def analyse_window(
     m2 = mu * mu
     nstate, nsens = state.shape[2], sens.shape[2]
     for r in range(g):
-        for k in range(9):
+        for k in range(marks.shape[1]):
             marks[r, k] = -1
         o = out_rows[r]
         streak = not math.isnan(held_from[r])
@@ -169,6 +171,8 @@ def analyse_window(
                 marks[r, 6] = i
             if marks[r, 7] < 0 and fd >= cap and not slips:
                 marks[r, 7] = i
+            if marks[r, 9] < 0 and not (abs(fd) <= force_limit[r]):
+                marks[r, 9] = i
 
             held = False
             if touching and not slips:  # the lock rule: engagement.kappa_of_normal's region

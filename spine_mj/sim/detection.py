@@ -82,6 +82,17 @@ class Detection:
         }
         return dataclasses.replace(self, **{k: v for k, v in defaults.items() if getattr(self, k) is None})
 
+    def force_limit_n(self, scales: Scales, drive_speed_m_s: float, stiffness_n_m: float) -> float:
+        """Drive force beyond which a spring run has diverged: twice the most a physical run
+        can pull, the force cap plus the preload's share (``(kappa_cap + 1) F_p``) and the
+        spring-block overshoot ``V sqrt(k m)`` (docs/physics.md §7). A spring the step
+        integrates unstably grows its stretch without bound; infinite for force drives,
+        whose force is the ramp's own."""
+        if stiffness_n_m <= 0:
+            return math.inf
+        overshoot = drive_speed_m_s * math.sqrt(stiffness_n_m * scales.mass_kg)
+        return 2 * ((self.kappa_cap + 1) * scales.preload_n + overshoot)
+
     def speed_limit_m_s(self, scales: Scales, drive_speed_m_s: float) -> float:
         """Speed above which a run diverges: 10 times the larger of the drive's speed and the
         speed the drive (at most ``kappa_cap F_p``) and the preload could give the tip over
@@ -157,7 +168,7 @@ def normal_lock_marks(
 
 
 #: The end conditions, in the order of a group's mark columns (the keys of :func:`end_marks`).
-MARK_KEYS = ("nonfinite", "reset", "fast", "sank", "flew", "deep", "out", "lock", "lock_rule")
+MARK_KEYS = ("nonfinite", "reset", "fast", "sank", "flew", "deep", "out", "lock", "lock_rule", "strained")
 
 
 def end_marks(
@@ -170,6 +181,7 @@ def end_marks(
     det: Detection,
     preload_n: float,
     speed_limit_m_s: np.ndarray,
+    force_limit_n: np.ndarray | None = None,
     mu: float | None = None,
     first_step: int = 0,
 ) -> dict[str, np.ndarray]:
@@ -181,7 +193,9 @@ def end_marks(
     above its highest by the domain's size; ``bounds_m`` is ``(xmin, xmax, ymin, ymax,
     zmin, zmax)``), ``deep`` (penetration above tolerance), ``out`` (the tip left the
     domain), ``lock_rule`` (the shared lock rule, :func:`normal_lock_marks`; needs ``mu``)
-    and ``lock`` (the safety net: the drive force reached ``kappa_cap F_p`` while stuck).
+    and ``lock`` (the safety net: the drive force reached ``kappa_cap F_p`` while stuck),
+    ``strained`` (a drive force beyond the run's ``force_limit_n`` ``(g,)``,
+    :meth:`Detection.force_limit_n`: a spring stretch no drive can produce).
     ``first_step``: the run step of the rows' first row (a window of a run; the marks are
     window rows, and the lock rule sees the window alone).
     """
@@ -209,6 +223,9 @@ def end_marks(
         "out": first_indices((px < xmin + mg) | (px > xmax - mg) | (py < ymin + mg) | (py > ymax - mg)),
         "lock": first_indices((rec.drive_force_n >= cap * (1 - 1e-9)) & ~rec.moving),
         "lock_rule": np.full(g, -1) if mu is None else normal_lock_marks(rec, mu, preload_n)[0],
+        "strained": np.full(g, -1)
+        if force_limit_n is None
+        else first_indices(~(np.abs(rec.drive_force_n) <= np.asarray(force_limit_n)[:, None])),
     }
 
 
@@ -242,6 +259,12 @@ def end_candidates(
     pos, vel = rec.position_m, rec.velocity_m_s
     if (k := mark("fast")) is not None:
         detail = f"speed {np.linalg.norm(vel[k]):.3g} m/s beyond the energy bound (diverged)"
+        candidates.append(Ending(k, 1, trouble, detail, "diverged"))
+    if (k := mark("strained")) is not None:
+        detail = (
+            f"drive force {rec.drive_force_n[k]:.3g} N: a spring stretch no drive can produce "
+            f"({rec.drive_force_n[k] / preload_n:.3g} F_p, diverged)"
+        )
         candidates.append(Ending(k, 1, trouble, detail, "diverged"))
     for key, where in (("sank", "below the surface's lowest point"), ("flew", "far above the surface")):
         if (k := mark(key)) is not None:

@@ -262,6 +262,9 @@ class GroupAnalysis:
             stiffness_n_m(d, rig.scales) if sp else 0.0 for d, sp in zip(self.drives, self.spring)
         ]
         self.limits = np.array([det.speed_limit_m_s(rig.scales, v) for v in self.speeds])
+        self.force_limits = np.array(
+            [det.force_limit_n(rig.scales, v, k) for v, k in zip(self.speeds, self.stiffness)]
+        )
         self.cols = Recording.empty((self.g, self.n))
         self._results_view = self.cols.read_only()  # a RunResult cannot write the group's columns
         self._mark_rows = np.full((self.g, len(MARK_KEYS)), -1)  # first run row of each end mark
@@ -346,6 +349,7 @@ class GroupAnalysis:
             det=det,
             preload_n=rig.scales.preload_n,
             speed_limit_m_s=self.limits[runs],
+            force_limit_n=self.force_limits[runs],
             first_step=a,
         )
         marks["lock_rule"], self.held_from_n[runs] = normal_lock_marks(
@@ -374,6 +378,7 @@ class GroupAnalysis:
             self._units,
             self._prm,
             self.limits[runs] ** 2,
+            self.force_limits[runs],
             np.ascontiguousarray(a),
             self.held_from_n[runs],
             runs,

@@ -74,3 +74,24 @@ def test_move_events_match_the_reference_on_random_flags():
             for start in sorted({0, 1, n // 3, n, n + 2}):
                 got = [(e.kind, e.index, e.time_s) for e in move_events(moving, t, start)]
                 assert got == _move_events_reference(moving, t, start), (n, p, start)
+
+
+def test_a_spring_integrated_unstably_ends_as_diverged_by_its_stretch_never_ok():
+    """omega dt = 2.2 (the refusal switched off): the spring's stretch grows 2.4x a step once
+    the tip breaks away; the run ends as engine trouble at the first drive force beyond
+    Detection.force_limit_n, 20 steps before MuJoCo would warn (a run going on to that
+    warning reports the warning first); omega dt = 0.5 runs clean."""
+    rig = flat_rig()
+    dt, m = rig.engine.timestep_s, rig.scales.mass_kg
+    ends = {}
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(type(rig), "check_drive", lambda self, drive: None)
+        for wdt in (0.5, 2.2):
+            drive = SpringDrive(speed_m_s=0.01, stiffness_n_m=m * (wdt / dt) ** 2, duration_s=15 * dt)
+            ends[wdt] = rig.run(drive, start=(0.0, 0.0))
+    assert ends[0.5].engine_trouble == "" and ends[0.5].end_reason is EndReason.COMPLETED
+    bad = ends[2.2]
+    assert bad.end_reason is EndReason.ENGINE_TROUBLE and bad.engine_trouble == "diverged", bad.end_detail
+    assert "a spring stretch no drive can produce" in bad.end_detail
+    limit = Detection().resolve(rig.scales).force_limit_n(rig.scales, 0.01, m * (2.2 / dt) ** 2)
+    assert np.abs(bad.drive_force_n[-1]) > limit > np.abs(bad.drive_force_n[:-1]).max()
