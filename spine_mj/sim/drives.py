@@ -22,17 +22,28 @@ class SpringDrive:
     ``stiffness_n_m`` None: :data:`DEFAULT_STIFFNESS_NUMBER` ``F_p / l_s``. ``duration_s``
     None: the time the carriage needs to cover 1.1 times the distance to the domain's +x
     edge plus the spring stretch at ``(1 + mu_s) F_p``.
+
+    ``fast_forward``: while the tip sticks on one contact normal (noslip on), the carriage
+    advances quickly until the spring force is ``1 - fast_forward_margin`` of the breakaway
+    force predicted from that normal, then at ``speed_m_s`` again through breakaway
+    (:mod:`spine_mj.sim.rollout`, the rule of :mod:`spine_mj.sim.fastforward`); a tip that
+    moves during the climb goes on from before it on the plain controls. ``duration_s`` and
+    the result's ``time_s`` count physical time (the carriage's), not engine steps. CPU
+    backends only.
     """
 
     speed_m_s: float
     stiffness_n_m: float | None = None
     duration_s: float | None = None
     settle_time_s: float | None = None
+    fast_forward: bool = True
+    fast_forward_margin: float = 0.03
 
     def __post_init__(self):
         object.__setattr__(self, "speed_m_s", check_positive("speed_m_s", self.speed_m_s))
         check_optional(self, ["stiffness_n_m", "duration_s"])
         check_optional(self, ["settle_time_s"], allow_zero=True)
+        _check_margin(self)
 
 
 @dataclass(frozen=True)
@@ -102,7 +113,7 @@ class StaticProbe:
 Drive = SpringDrive | RampDrive | StaticProbe
 
 
-def _check_margin(drive: RampDrive | StaticProbe) -> None:
+def _check_margin(drive: Drive) -> None:
     """``fast_forward_margin`` must lie in (0, 1): the fast climb stops that fraction below
     the predicted breakaway force."""
     m = check_positive("fast_forward_margin", drive.fast_forward_margin)

@@ -134,6 +134,18 @@ class StickFastForward:
         self.phases += 1
         return "start"
 
+    def skim(self, vt_max: float, force_max: float) -> None:
+        """Rows the caller did not :meth:`watch` one by one (a spring run's piece, of which
+        only the last rows are watched): unblock as :meth:`watch` would have, where the tip
+        slipped (``vt_max``) or the force passed where the last phase ended (``force_max``)."""
+        if vt_max > self.slip or force_max > self.blocked_to_n:
+            self.blocked = False
+
+    def finish(self, force: float) -> None:
+        """End the phase at ``force``, where the caller's climb ended (a spring's climb
+        stops a fraction of a step's increment short of the target)."""
+        self._end(force)
+
     def _end(self, force: float) -> None:
         self.active, self.blocked, self.quiet, self.blocked_to_n = False, True, 0, force
 

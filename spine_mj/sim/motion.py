@@ -135,8 +135,20 @@ def slip_events(
     return out
 
 
-def motion_fractions(states: np.ndarray, start: int = 0) -> dict[str, float]:
-    """Fraction of the rows from ``start`` on spent in each state (zeros when none)."""
+def motion_fractions(
+    states: np.ndarray, start: int = 0, time_s: np.ndarray | None = None
+) -> dict[str, float]:
+    """Fraction of the rows from ``start`` on spent in each state (zeros when none).
+
+    ``time_s`` (the rows' times, the first one step after time 0): fractions of the time
+    instead, each row counting the time since the row before (a fast-forwarded stick
+    phase's rows count more than one step each; for a plain run the two agree)."""
     s = np.asarray(states)[start:]
-    n = max(s.size, 1)
-    return {name: float(np.count_nonzero(s == code) / n) for code, name in enumerate(MOTION_NAMES)}
+    if time_s is None:
+        w = np.ones(s.size)
+    else:
+        w = np.diff(np.asarray(time_s, float), prepend=0.0)[start:]
+    total = w.sum()
+    if not total > 0:
+        return {name: 0.0 for name in MOTION_NAMES}
+    return {name: float(w[s == code].sum() / total) for code, name in enumerate(MOTION_NAMES)}

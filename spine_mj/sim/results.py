@@ -182,7 +182,7 @@ class RunResult(RunColumns):
     def slip_summary(self) -> dict:
         """The slip events and motion states of the run, JSON-ready: ``slip_events``
         (count), ``slip_onset_forces_fp``, ``slip_force_drops_fp``, ``slip_jump_lengths_m``,
-        ``slip_durations_s``, ``motion_fractions`` (over the drive phase) and
+        ``slip_durations_s``, ``motion_fractions`` (of the drive phase's time) and
         ``max_speed_over_drive`` (the tip's largest x-speed after the settle phase over
         the drive's speed)."""
         fp, ev = self.scales.preload_n, self.slip_events
@@ -193,7 +193,7 @@ class RunResult(RunColumns):
             "slip_force_drops_fp": [e.force_drop_n / fp for e in ev],
             "slip_jump_lengths_m": [e.jump_length_m for e in ev],
             "slip_durations_s": [e.duration_s for e in ev],
-            "motion_fractions": motion_fractions(self.motion, self.drive_start_index),
+            "motion_fractions": motion_fractions(self.motion, self.drive_start_index, self.time_s),
             "max_speed_over_drive": float(vx.max() / self.speed_m_s) if vx.size else 0.0,
         }
 
@@ -388,6 +388,12 @@ class GroupAnalysis:
         )
         self.held_from_n[runs] = held
         return marks
+
+    def add_time(self, r: int, a: int, b: int, extra_s) -> None:
+        """Add ``extra_s`` [s] (a number, or one per row) to the recorded time of rows
+        ``a..b-1`` of run ``r``, after :meth:`add`: the time a fast-forward skipped (the
+        engine's clock, which the reset check reads, counts one step a row)."""
+        self.cols.time_s[r, a:b] += extra_s
 
     def run(self, r: int) -> Recording:
         """The recorded rows of run ``r`` (views of the group's columns)."""

@@ -25,6 +25,25 @@ settled rows and, where it predicts a breakaway, the probe's remaining controls 
 just below it in :data:`~spine_mj.sim.fastforward.RISE_STEPS` steps, then go on at the
 nominal rate. That climb is its own piece; if the tip moved during it, the piece is
 dropped and the probe goes on from its settled state with the plain controls.
+
+A spring drive with fast-forward (:class:`~spine_mj.sim.drives.SpringDrive`) is watched
+the same way after each of its pieces: where the tip has been still on one normal for its
+last :data:`~spine_mj.sim.fastforward.QUIET_STEPS` rows and the spring force ``k (X - x)``
+lies far below the breakaway force predicted from that normal, its next piece is a
+climb. A stuck tip sees the force rise at ``k V`` whatever the carriage did before, so
+the climb covers ``s`` rows of the carriage's schedule in
+:data:`~spine_mj.sim.fastforward.RISE_STEPS` (the carriage, the spring's anchor, moving
+``s / RISE_STEPS`` times faster) to just below the breakaway force, and the rest of the
+schedule follows at the carriage's speed V: the run plans ``s - RISE_STEPS`` rows fewer
+and ends where the plain run's carriage does. The rise is the one the ramp and the probe
+use (50 contact time constants): the stuck contact follows it, and a stuck tip does not
+load the spring's own oscillation. A tip that moved, lost contact or changed its normal
+during the climb sends the run back to before it, on the plain controls (the rows, the
+warm start and the planned length as they were), and no new climb starts until the tip has
+slipped or the force has passed where it moved. The recorded ``time_s`` is physical time:
+each row of a climb counts ``s / RISE_STEPS`` steps and every later row carries the time
+skipped, so the carriage sits at ``V t`` from its start as in the plain run (the engine's
+own clock, one step a row, is what the reset check reads).
 """
 
 from __future__ import annotations
@@ -35,6 +54,7 @@ import os
 import queue
 import threading
 from collections.abc import Sequence
+from typing import NamedTuple
 
 import numpy as np
 
@@ -62,6 +82,14 @@ BATCH_MEMORY_BYTES = 256 * 2**20
 FIRST_PIECE_STEPS = 128
 #: Longest piece: the most steps a run is simulated between two looks at its end conditions.
 PIECE_STEPS = 1024
+#: Longest piece of a fast-forwarding spring run: a stick phase is seen at the end of a
+#: piece, so a piece's length is the latency of its climb (a piece costs ~15 steps' time
+#: in the calling thread: 256 rows cost ~6 %; measured on the fractal at K = 3).
+SPRING_PIECE_STEPS = 256
+#: A spring run fast-forwards only where the force cap ``kappa_cap F_p`` is more than this
+#: many of its steps' increments ``k V dt``: else no stick phase can outlast a climb
+#: (:data:`~spine_mj.sim.fastforward.RISE_STEPS`) and its nominal approach.
+SPRING_MIN_CLIMB_STEPS = 4 * RISE_STEPS
 #: Most steps an open-loop run may plan: its recording (~0.5 kB a step) stays within ~2 GiB.
 MAX_RUN_STEPS = 2**22
 #: Tips placed at a time, their first pieces then handed to the workers (the very first
@@ -280,11 +308,22 @@ class _Group:
         self.live = np.ones(g, dtype=bool)
         self.warnings: list[tuple[int | None, str] | None] = [None] * g
         self.n_settle = [settle_steps(d, rig.engine.timestep_s) for d in self.drives]
-        self.climbs: dict[int, tuple[StickFastForward, np.ndarray, np.ndarray]] = {}
+        self.climbs: dict[int, _Climb] = {}  # climb pieces under way
         # a probe that may fast-forward is decided from its settled rows: its settle phase is a piece
         self.settle_apart = [
             isinstance(d, StaticProbe) and fast_forward_on(d, rig.engine, rig.tip) for d in self.drives
         ]
+        # a spring run that may fast-forward is watched after each piece, where a stick
+        # phase (at most the force cap's worth of steps) can outlast a climb
+        cap = self.det.kappa_cap * rig.scales.preload_n
+        self.spring_ff = [
+            isinstance(d, SpringDrive)
+            and fast_forward_on(d, rig.engine, rig.tip)
+            and cap > SPRING_MIN_CLIMB_STEPS * self.nominal_step_n(k)
+            for k, d in enumerate(self.drives)
+        ]
+        self.watchers: dict[int, StickFastForward] = {}  # spring runs' watchers, kept across pieces
+        self.skipped_s = np.zeros(g)  # physical time a spring run's climbs skipped [s]
         self.analysis: GroupAnalysis | None = None  # built once the workers have pieces
         self.profiles: dict[object, np.ndarray] = {}  # control profiles shared by starts (profile_key)
 
@@ -354,6 +393,8 @@ class _Group:
                 b = a + RISE_STEPS
             else:
                 size = min(PIECE_STEPS, FIRST_PIECE_STEPS << int(self.pieces[k]))
+                if self.spring_ff[k]:
+                    size = min(size, SPRING_PIECE_STEPS)
                 b = max(a, self.n_settle[k]) + size
                 if self.end[k] - b < size // 2:  # no short last piece: it joins this one
                     b = int(self.end[k])
@@ -373,10 +414,11 @@ class _Group:
         return k, a, b, warm, warning
 
     def advance(self, done: list) -> None:
-        """Take finished pieces: check probes' climbs, analyse the new rows (all at once),
-        stop decided runs, decide probes' fast-forward after settling."""
+        """Take finished pieces: check climbs, analyse the new rows (all at once), stop
+        decided runs, decide probes' fast-forward after settling and springs' after each piece."""
         new = []
         stop = set()
+        held: dict[int, int] = {}  # spring runs whose climb held: the rows it skipped
         runs = [piece[0] for piece in done]  # a run has one piece out at a time: no repeats
         self.analysis.simulated[runs] += [b - a for _, a, b, _, _ in done]
         self.warm[runs] = [piece[3] for piece in done]
@@ -392,37 +434,52 @@ class _Group:
                 self.warnings[k] = (a + warning[0], warning[1])
                 stop.add(k)
             if k in self.climbs:
-                if not self.climb_held(k, a, b):
-                    continue  # dropped: the probe goes on from its settled state
-                self.pieces[k] = 1  # the breakaway is expected within ~2 NOMINAL_STEPS: a 256-step piece
+                climb = self.climbs.pop(k)
+                if not self.climb_held(k, climb, a, b):
+                    continue  # dropped: the run goes on from before the climb
+                # the breakaway is expected within ~2 NOMINAL_STEPS: a 256-step piece (a
+                # spring's margin may take longer, and its next stick phase is to be seen soon)
+                self.pieces[k] = 0 if climb.skip else 1
+                if climb.skip:
+                    held[k] = climb.skip
             new.append((k, a, b))
         if not new:
             return
         ks, a, b = (np.array(col, dtype=np.int64) for col in zip(*new))
         decided = self.analysis.add(ks, a, b, self.state, self.sens)
+        self.add_skipped_time(new, held)
         self.done[ks] = b
-        for k, bk, dec in zip(ks.tolist(), b.tolist(), decided):
+        for k, ak, bk, dec in zip(ks.tolist(), a.tolist(), b.tolist(), decided):
             if bk >= self.end[k] or (self.stop_early and (dec or k in stop)):
                 self.live[k] = False
             elif bk == self.n_settle[k] and not dec:
                 self.fast_forward(k)
+            elif self.spring_ff[k] and not dec and k not in stop and k not in held:
+                self.spring_climb(k, ak, bk)
+
+    def add_skipped_time(self, new: list, held: dict[int, int]) -> None:
+        """Make the recorded time of spring runs' new rows physical: a held climb's row i
+        (from 0) counts ``(i + 1) skip / RISE_STEPS`` steps, every later row the climbs'
+        skipped time (see the module docstring)."""
+        dt = self.rig.engine.timestep_s
+        for k, a, b in new:
+            extra = self.skipped_s[k]
+            skip = held.get(k)
+            if skip is not None:
+                rows = np.minimum(np.arange(1, b - a + 1), RISE_STEPS)
+                extra = extra + rows * (skip / RISE_STEPS - 1) * dt
+                self.skipped_s[k] += (skip - RISE_STEPS) * dt
+            if skip is not None or extra:
+                self.analysis.add_time(k, a, b, extra)
 
     def fast_forward(self, k: int) -> None:
         """After settling: a probe whose tip is stuck on one normal gets controls that climb
         to just below the breakaway force predicted from it (:class:`StickFastForward`)."""
-        rig, det, drive = self.rig, self.det, self.drives[k]
+        rig, drive = self.rig, self.drives[k]
         if not self.settle_apart[k]:
             return
-        fp, cap = rig.scales.preload_n, det.kappa_cap * rig.scales.preload_n
-        ff = StickFastForward(
-            mu=rig.tip.mu_s,
-            preload_n=fp,
-            cap_n=cap * (1 + 1e-9),
-            margin=drive.fast_forward_margin,
-            stick_speed_m_s=det.stick_speed_m_s,
-            move_speed_m_s=det.move_speed_m_s,
-        )
-        step = rate_n_s(drive, rig.scales) * rig.engine.timestep_s
+        cap = self.det.kappa_cap * rig.scales.preload_n
+        ff, step = self.watcher(k), self.nominal_step_n(k)
         rec, ns = self.analysis.run(k), self.n_settle[k]
         verdict = ""
         for i in range(max(0, ns - QUIET_STEPS - 1), ns):
@@ -435,15 +492,67 @@ class _Group:
         push = np.concatenate([rise, np.minimum(nominal, cap * (1 + 1e-9))]) / rig.units.force_n
         if ns + push.size > self.n:
             return
-        self.climbs[k] = (ff, self.warm[k].copy(), self.ctrl[k, ns:, 1].copy())
+        self.climbs[k] = _Climb(ff, self.warm[k].copy(), self.ctrl[k, ns:].copy(), int(self.end[k]), 0)
         self.ctrl[k, ns : ns + push.size, 1] = push
         self.end[k] = ns + push.size
 
-    def climb_held(self, k: int, a: int, b: int) -> bool:
-        """Whether probe ``k`` stayed stuck on its normal through its climb (rows a..b-1);
-        if not, its controls and warm start go back to the plain probe's after settling."""
-        ff, warm, plain = self.climbs.pop(k)
+    def spring_climb(self, k: int, a: int, b: int) -> None:
+        """After rows a..b-1 of spring run ``k``: where its tip has been still on one normal
+        for the last :data:`QUIET_STEPS` rows and the force lies far below the predicted
+        breakaway (:meth:`StickFastForward.watch`), its next piece is a climb that covers
+        ``skip`` rows of the carriage's schedule in :data:`RISE_STEPS` (see the module
+        docstring); the schedule's rows after them follow, ``skip - RISE_STEPS`` earlier."""
+        lo = max(a, self.n_settle[k])
+        if b - lo <= QUIET_STEPS:
+            return
+        ff = self.watchers.get(k)
+        if ff is None:
+            ff = self.watchers[k] = self.watcher(k)
+        rec, step = self.analysis.run(k), self.nominal_step_n(k)
+        ff.skim(float(rec.tangential_speed_m_s[lo:b].max()), float(rec.drive_force_n[lo:b].max()))
+        verdict = ""
+        for i in range(b - QUIET_STEPS - 1, b):
+            verdict = ff.watch(*_still(rec, i), float(rec.drive_force_n[i]), step)
+        if verdict != "start":
+            return
+        force, end = float(rec.drive_force_n[b - 1]), int(self.end[k])
+        skip = min(int((ff.target_n - force) / step), end - b)
+        if skip < 2 * RISE_STEPS:  # the plan ends first: the climb would save too little
+            ff.finish(force)
+            return
+        rows = self.ctrl[k, b:end].copy()
+        self.climbs[k] = _Climb(ff, self.warm[k].copy(), rows, end, skip)
+        self.end[k] = end - skip + RISE_STEPS
+        self.ctrl[k, b + RISE_STEPS : self.end[k]] = rows[skip:]
+        self.ctrl[k, b : b + RISE_STEPS] = rows[:RISE_STEPS]
+        x0, x1 = self.ctrl[k, b - 1, [0, 3]], rows[skip - 1, [0, 3]]  # the spring's anchor and the carriage
+        frac = np.arange(1, RISE_STEPS + 1)[:, None] / RISE_STEPS
+        self.ctrl[k][b : b + RISE_STEPS, [0, 3]] = x0 + frac * (x1 - x0)
+
+    def watcher(self, k: int) -> StickFastForward:
+        """A :class:`StickFastForward` for run ``k`` (SI: it reads the recorded rows)."""
         rig, det = self.rig, self.det
+        return StickFastForward(
+            mu=rig.tip.mu_s,
+            preload_n=rig.scales.preload_n,
+            cap_n=det.kappa_cap * rig.scales.preload_n * (1 + 1e-9),
+            margin=self.drives[k].fast_forward_margin,
+            stick_speed_m_s=det.stick_speed_m_s,
+            move_speed_m_s=det.move_speed_m_s,
+        )
+
+    def nominal_step_n(self, k: int) -> float:
+        """The force run ``k``'s drive adds per step at its nominal pace [N]: ``k V dt`` on
+        a stuck tip for a spring, ``rate dt`` for a probe."""
+        rig, drive = self.rig, self.drives[k]
+        if isinstance(drive, SpringDrive):
+            return stiffness_n_m(drive, rig.scales) * drive.speed_m_s * rig.engine.timestep_s
+        return rate_n_s(drive, rig.scales) * rig.engine.timestep_s
+
+    def climb_held(self, k: int, climb: _Climb, a: int, b: int) -> bool:
+        """Whether run ``k`` stayed stuck on its normal through its climb (rows a..b-1); if
+        not, its controls, planned length and warm start go back to those before the climb."""
+        rig, det, ff = self.rig, self.det, climb.ff
         rec = Recording.from_sensors(
             rig.sensor_adr,
             self.state[k : k + 1, a:b],
@@ -452,15 +561,26 @@ class _Group:
             carriage_x=np.full((1, b - a), np.nan),
             move_speed_m_s=det.move_speed_m_s,
         ).run(0)
-        step = rate_n_s(self.drives[k], rig.scales) * rig.engine.timestep_s
+        step = self.nominal_step_n(k)
         for i in range(b - a):
             verdict = ff.watch(*_still(rec, i), float(rec.drive_force_n[i]), step)
             if verdict == "rollback" or (not ff.active and i < b - a - 1):
-                ns = self.n_settle[k]
-                self.ctrl[k, ns:, 1] = plain
-                self.end[k], self.warm[k] = self.n, warm
+                self.ctrl[k, a : climb.end] = climb.rows
+                self.end[k], self.warm[k] = climb.end, climb.warm
                 return False
+        if ff.active:
+            ff.finish(float(rec.drive_force_n[-1]))
         return True
+
+
+class _Climb(NamedTuple):
+    """A climb piece under way: its watcher, and what puts the run back if the tip moves."""
+
+    ff: StickFastForward
+    warm: np.ndarray  # the warm start before the climb
+    rows: np.ndarray  # the controls from the climb's first row to ``end``, as they were
+    end: int  # the planned rows before the climb
+    skip: int  # rows of a spring's schedule the climb covers (0: a probe's climb)
 
 
 def _still(rec: Recording, i: int) -> tuple[float, np.ndarray, bool]:
