@@ -1,5 +1,5 @@
-"""Stick-phase fast-forward of the force ramp and the static probe, and the ramp's early
-termination: same physics, fewer steps.
+"""Stick-phase fast-forward of the force ramp, the static probe and the spring drive, and
+the ramp's early termination: same physics, fewer steps.
 
 The plain ramp (``fast_forward=False``) is the reference: where it finishes its cycles the
 fast-forwarded ramp must break away at the same force (0.5 %), end the same way and follow
@@ -14,10 +14,12 @@ import math
 
 import numpy as np
 import pytest
-from sim_rigs import PHI, plane_rig
+from sim_rigs import MU, PHI, flat_rig, plane_rig
 
 from spine_mj import compare, sim
-from spine_mj.sim import EndReason, RampDrive
+from spine_mj.sim import EndReason, RampDrive, Rig, SpringDrive, TipParams
+from spine_mj.surfaces import corrugation
+from spine_mj.tomlinson import Corrugation
 from spine_mj.sim.ramp import cycle_breakaways, nominal_time_s, rows_to_reset
 
 
@@ -221,3 +223,122 @@ def test_a_probe_that_moves_during_its_climb_goes_on_as_the_plain_probe(monkeypa
     np.testing.assert_array_equal(fast.position_m, plain.position_m)
     np.testing.assert_array_equal(fast.drive_force_n, plain.drive_force_n)
     assert fast.simulated_steps == plain.simulated_steps + ff.RISE_STEPS
+
+
+# -- spring drives ------------------------------------------------------------------------
+# The plain spring run (``fast_forward=False``) is the reference. Its time_s is physical in
+# both, so the two are compared at equal times and carriage positions.
+
+
+def test_a_fast_forwarded_spring_block_breaks_away_where_the_plain_one_does():
+    """Flat plane, K = 10, I_e = 1e-6: the block sticks until k V t = mu F_p (4.9 s, ~9700
+    steps), then swings. The climb skips most of the stick: the same breakaway time and
+    force, the same path at every time after it (the stuck tip does not notice how fast
+    its spring was loaded), the same end time and carriage position, in 1/8 of the steps."""
+    rig = flat_rig()
+    v, k, fp = 0.001, 10.0, rig.scales.preload_n
+    t_b = MU * fp / (k * v)
+    drive = SpringDrive(speed_m_s=v, stiffness_n_m=k, duration_s=t_b + 0.4)
+    plain, fast = (rig.run(dataclasses.replace(drive, fast_forward=f), start=(-0.04, 2.3e-4)) for f in (0, 1))
+    assert plain.end_reason is EndReason.COMPLETED and fast.end_reason is EndReason.COMPLETED
+    onset = [r.drive_start_index + int(np.argmax(r.moving[r.drive_start_index :])) for r in (plain, fast)]
+    t0 = plain.time_s[plain.drive_start_index - 1]
+    assert plain.time_s[onset[0]] - t0 == pytest.approx(t_b, rel=0.01)  # k V t = mu F_p
+    assert fast.time_s[onset[1]] == pytest.approx(plain.time_s[onset[0]], abs=0.5 * rig.engine.timestep_s)
+    assert fast.drive_force_n[onset[1]] == pytest.approx(plain.drive_force_n[onset[0]], rel=1e-6)
+    t = plain.time_s[onset[0] :]
+    x_fast = np.interp(t, fast.time_s, fast.position_m[:, 0])
+    assert np.abs(x_fast - plain.position_m[onset[0] :, 0]).max() < 1e-6 * rig.scales.char_length_m
+    assert fast.time_s[-1] == pytest.approx(plain.time_s[-1], rel=1e-9)
+    assert fast.carriage_x_m[-1] == pytest.approx(plain.carriage_x_m[-1], rel=1e-9)
+    frac = (plain.slip_summary()["motion_fractions"], fast.slip_summary()["motion_fractions"])
+    assert frac[1]["stuck"] == pytest.approx(frac[0]["stuck"], abs=1e-6)  # time-weighted
+    assert fast.simulated_steps < plain.simulated_steps / 6
+
+
+def _same_slips(plain, fast, *, force_rel, travel_lc, share):
+    """At least ``share`` of the plain run's slip events have one in the fast run whose
+    onset lies within ``travel_lc`` L_c of carriage travel and ``force_rel`` of its force."""
+    lc, v = plain.scales.char_length_m, plain.speed_m_s
+    hits = 0
+    for e in plain.slip_events:
+        hits += any(
+            abs(f.onset_time_s - e.onset_time_s) * v <= travel_lc * lc
+            and abs(f.onset_force_n / e.onset_force_n - 1) <= force_rel
+            for f in fast.slip_events
+        )
+    return hits >= share * len(plain.slip_events)
+
+
+def test_fast_forward_keeps_the_prandtl_tomlinson_stick_slip_on_a_corrugation():
+    """s = 0.3, mu = 0.5, K = 0.8 K*, I_e = 1e-5, three wavelengths: the tip sticks at the
+    start and after each landing, slides up to the fold and jumps (three slips). Plain runs
+    from starts 1e-9 m apart differ by 0.04 s in the onsets (0.004 L_c of travel), 0.1 % in
+    their forces and up to 0.07 L_c in the jumps; the fast-forwarded run lies within that."""
+    rig = Rig(corrugation(n_waves=4, points_per_wave=128), tip=TipParams(mu_s=0.5, tip_radius_m=1e-4))
+    sc = rig.scales
+    c = Corrugation(0.3, 0.5, wavelength=1.0, tip_radius=rig.tip.tip_radius_m / 0.01)
+    K = 0.8 * c.critical_stiffness(sc.slope_length_m / 0.01)
+    v = sc.speed_for(1e-5)
+    drive = SpringDrive(speed_m_s=v, stiffness_n_m=sc.stiffness_for(K), duration_s=0.03 / v)
+    plain, fast = rig.run_batch([dataclasses.replace(drive, fast_forward=False), drive], [(0.75, 0.0)] * 2)
+    assert plain.end_reason is EndReason.COMPLETED and fast.end_reason is EndReason.COMPLETED
+    assert len(plain.slip_events) == len(fast.slip_events) == 3
+    assert _same_slips(plain, fast, force_rel=0.01, travel_lc=0.01, share=1.0)
+    jumps = [[e.jump_length_m / sc.char_length_m for e in r.slip_events] for r in (plain, fast)]
+    np.testing.assert_allclose(jumps[1], jumps[0], atol=0.1)
+    assert np.abs(fast.position_m[-1] - plain.position_m[-1]).max() < 0.01 * sc.char_length_m
+    assert fast.time_s[-1] == pytest.approx(plain.time_s[-1], rel=1e-9)
+    assert fast.simulated_steps < 0.95 * plain.simulated_steps
+
+
+def test_fast_forward_keeps_spring_runs_on_a_fractal():
+    """paper-fractal, K = 3, I_e = 1e-5, four starts, 0.5 L_c of travel (~25 slips each, the
+    tip stuck 40 % of the time in phases of at most ~900 steps). The fast-forwarded runs end
+    within 0.01 L_c of the plain ones, on paths within 0.01 L_c (Frechet), and match 90 % of
+    their slip events (onset within 0.01 L_c of travel and 5 % of force). Plain runs from
+    starts 1e-9 m apart already differ by up to 3 slips of 28 after 7 s: the landings of
+    the larger jumps are ill-conditioned."""
+    from spine_mj import presets
+    from spine_mj.sim import build_rig
+
+    rig = build_rig(presets.make_surface("paper-fractal", seed=1), mu=0.5, ie=1e-5)
+    sc = rig.scales
+    v = sc.speed_for(1e-5)
+    drive = SpringDrive(
+        speed_m_s=v, stiffness_n_m=sc.stiffness_for(3.0), duration_s=0.5 * sc.char_length_m / v
+    )
+    x0, x1, y0, y1 = (b / rig.length_scale_m for b in rig.bounds_m)
+    starts = [(x0 + 0.05 * (x1 - x0), y0 + f * (y1 - y0)) for f in (0.2, 0.4, 0.6, 0.8)]
+    plain = rig.run_batch(dataclasses.replace(drive, fast_forward=False), starts)
+    fast = rig.run_batch(drive, starts)
+    lc = sc.char_length_m
+    for p, f in zip(plain, fast):
+        assert p.end_reason is f.end_reason
+        assert np.abs(f.position_m[-1] - p.position_m[-1]).max() < 0.01 * lc
+        assert compare.path_frechet(f.position_m[:, :2], p.position_m[:, :2], length_scale=lc) <= 0.01
+        assert _same_slips(p, f, force_rel=0.05, travel_lc=0.01, share=0.85)
+    assert sum(len(f.slip_events) for f in fast) == pytest.approx(
+        sum(len(p.slip_events) for p in plain), rel=0.05
+    )
+    assert sum(f.simulated_steps for f in fast) < 0.97 * sum(p.simulated_steps for p in plain)
+
+
+def test_a_spring_whose_tip_moves_during_its_climb_goes_on_as_the_plain_run(monkeypatch):
+    """A breakaway predicted 50 % too high: the tip slips during each climb, the climb is
+    dropped and the run goes on from before it on the plain controls, so the run is the
+    plain run to the last bit (plus RISE_STEPS dropped steps a climb)."""
+    import spine_mj.sim.fastforward as ff
+
+    rig = flat_rig()
+    drive = SpringDrive(speed_m_s=0.001, stiffness_n_m=10.0, duration_s=5.3)
+    plain = rig.run(dataclasses.replace(drive, fast_forward=False), start=(-0.04, 2.3e-4))
+    kappa_of_normal = ff.kappa_of_normal
+    monkeypatch.setattr(
+        ff, "kappa_of_normal", lambda n, mu: (1.5 * kappa_of_normal(n, mu)[0], kappa_of_normal(n, mu)[1])
+    )
+    fast = rig.run(drive, start=(-0.04, 2.3e-4))
+    for name in ("time_s", "position_m", "drive_force_n", "carriage_x_m"):
+        np.testing.assert_array_equal(getattr(fast, name), getattr(plain, name))
+    dropped = fast.simulated_steps - plain.simulated_steps
+    assert dropped > 0 and dropped % ff.RISE_STEPS == 0
