@@ -20,7 +20,7 @@ from spine_mj import compare, sim
 from spine_mj.sim import EndReason, RampDrive, Rig, SpringDrive, TipParams
 from spine_mj.sim.ramp import cycle_breakaways, nominal_time_s, rows_to_reset
 from spine_mj.surfaces import corrugation
-from spine_mj.tomlinson import Corrugation
+from spine_mj.theory.tomlinson import Corrugation
 
 
 def _assert_same_physics(plain, fast, cycles):
