@@ -12,7 +12,14 @@ reasons, the engine steps of each and their ratio, and the load average.
 Static probe (:func:`probe_rows`): the static map's probe (validate.static_map) on inclined
 planes at several slopes and azimuths and on the single peak, plain and fast-forwarded, at
 ``--ie``: kappa_mj of each (target: within 0.5 %), the recorded rows and the simulated
-steps. Writes nothing.
+steps.
+
+Spring drive (:func:`spring_rows`, ``--spring``): the cost of a spring run against I_e
+(1e-4, 1e-5, 1e-6) and K (3, 30, 300, 3000) with and without fast-forward, on the paper
+fractal (seed 1, mu 0.5, two starts, 0.25 L_c of carriage travel) and on a flat plane where
+the spring-block sticks most of the time (K = 10, the carriage covering 1.1 times the
+stretch to breakaway): simulated steps and CPU seconds per run, the end reasons,
+and the largest end-point difference between the two in L_c. Writes nothing.
 """
 
 from __future__ import annotations
@@ -127,12 +134,77 @@ def ramp_rows(res: int, ie: float, cycles: int) -> list[dict]:
     return rows
 
 
+#: The spring drive's cost grid: inertia numbers and stiffness numbers K = k l_s / F_p.
+SPRING_IES = (1e-4, 1e-5, 1e-6)
+SPRING_KS = (3.0, 30.0, 300.0, 3000.0)
+
+
+def _spring_cases(ies, ks):
+    """(surface, I_e, K, rig, drive, starts) of the spring cost grid."""
+    from spine_mj import presets
+
+    surface = presets.make_surface("paper-fractal", seed=1)
+    for ie in ies:
+        rig = sim.build_rig(surface, mu=0.5, ie=ie)
+        sc = rig.scales
+        x0, x1, y0, y1 = (b / rig.length_scale_m for b in rig.bounds_m)
+        starts = [(x0 + 0.05 * (x1 - x0), y0 + f * (y1 - y0)) for f in (0.3, 0.7)]
+        v = sc.speed_for(ie)
+        for kf in ks:
+            drive = sim.SpringDrive(
+                speed_m_s=v, stiffness_n_m=sc.stiffness_for(kf), duration_s=0.25 * sc.char_length_m / v
+            )
+            yield "paper fractal", ie, kf, rig, drive, starts
+    rig = sim.Rig(
+        sim.inclined_plane(slope_deg=0.0, half_width=0.05, n=101),
+        tip=sim.TipParams(tip_radius_m=5e-4, mu_s=0.5),
+    )
+    sc = rig.scales
+    for ie in ies:
+        v, k = sc.speed_for(ie), sc.stiffness_for(10.0)
+        drive = sim.SpringDrive(speed_m_s=v, stiffness_n_m=k, duration_s=1.1 * 0.5 * sc.preload_n / (k * v))
+        yield "flat plane", ie, 10.0, rig, drive, [(-0.04, 2.3e-4)]
+
+
+def spring_rows(ies=SPRING_IES, ks=SPRING_KS) -> list[dict]:
+    """Plain and fast-forwarded spring runs on the cost grid: steps and CPU seconds per run."""
+    rows = []
+    for surface, ie, kf, rig, drive, starts in _spring_cases(ies, ks):
+        row = {"surface": surface, "ie": ie, "K": kf, "runs": len(starts)}
+        ends = {}
+        for label, ff in (("plain", False), ("fast", True)):
+            c0 = time.process_time()
+            res = rig.run_batch(dataclasses.replace(drive, fast_forward=ff), starts, nthread=1)
+            row[f"cpu_s_{label}"] = (time.process_time() - c0) / len(starts)
+            row[f"steps_{label}"] = float(np.mean([r.simulated_steps for r in res]))
+            row[f"end_{label}"] = sorted({r.end_reason.value for r in res})
+            ends[label] = res
+        row["end_dx_lc"] = max(
+            float(np.abs(f.position_m[-1] - p.position_m[-1]).max()) / rig.scales.char_length_m
+            for p, f in zip(ends["plain"], ends["fast"])
+        )
+        rows.append(row)
+    return rows
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--ie", type=float, default=1e-2)
     ap.add_argument("--cycles", type=int, default=2)
     ap.add_argument("--res", type=int, default=61)
+    ap.add_argument("--spring", action="store_true", help="only the spring drive's cost grid")
     args = ap.parse_args()
+    if args.spring:
+        for r in spring_rows():
+            print(
+                f"spring {r['surface']:13s} I_e {r['ie']:.0e} K {r['K']:6g}  "
+                f"steps/run {r['steps_plain']:9.0f} / {r['steps_fast']:9.0f} = "
+                f"{r['steps_plain'] / r['steps_fast']:4.1f}x  CPU s/run {r['cpu_s_plain']:6.2f} / "
+                f"{r['cpu_s_fast']:6.2f}  end {','.join(r['end_plain'])}/{','.join(r['end_fast'])}  "
+                f"end dx {r['end_dx_lc']:.1e} L_c  load {os.getloadavg()[0]:.1f}",
+                flush=True,
+            )
+        return
     for r in ramp_rows(args.res, args.ie, args.cycles):
         print(
             f"{r['case']:32s} breakaways {r['breakaways']} max rel diff {r['max_rel_diff']:.2e}  "

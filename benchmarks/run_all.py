@@ -15,7 +15,8 @@ Sections (each records the machine's load average before and after it):
   ratio). And the steps and time ``Rig.run_batch`` saves by stopping decided runs
   (``stop_early``) on a fractal where most runs self-lock.
 * ``fastforward``: the static probe and the force ramp with and without stick-phase
-  fast-forward (``benchmarks/bench_fastforward.py``): breakaway forces, steps.
+  fast-forward (``benchmarks/bench_fastforward.py``): breakaway forces, steps; and the
+  cost of a spring run (steps and CPU seconds) against I_e and K with and without it.
 * ``sweep``: the one-worker sweep against bare rollout, and its two-worker efficiency.
 * ``cost``: steps per spring-drive run against I_e and the spring stiffness K on the single
   peak and on a fractal, with a fitted cost model (see :func:`fit_cost`).
@@ -202,13 +203,15 @@ def early_stop(quick: bool, nthread: int) -> dict:
 
 
 def bench_fastforward_section(quick: bool) -> dict:
-    """The static probe at I_e 1e-3 and 1e-2 and the ramp at I_e 1e-2 (2 cycles), plain and
-    fast-forwarded (see bench_fastforward.py)."""
-    from bench_fastforward import probe_rows, ramp_rows
+    """The static probe at I_e 1e-3 and 1e-2, the ramp at I_e 1e-2 (2 cycles) and the spring
+    drive's cost grid (I_e 1e-4...1e-6, K 3...3000; quick: I_e 1e-4, 1e-5 and K 3, 30),
+    plain and fast-forwarded (see bench_fastforward.py)."""
+    from bench_fastforward import SPRING_IES, SPRING_KS, probe_rows, ramp_rows, spring_rows
 
     out = {"probe": {str(ie): probe_rows(61, ie) for ie in (1e-3, 1e-2)}}
     if not quick:
         out["ramp"] = ramp_rows(61, 1e-2, 2)
+    out["spring"] = spring_rows(SPRING_IES[:2], SPRING_KS[:2]) if quick else spring_rows()
     return out
 
 
@@ -598,7 +601,31 @@ def _fastforward_markdown(ff) -> list[str]:
             f"{max(r['frechet_lc'] for r in rows):.1e} L_c, steps to the second reset "
             f"{sum(r['steps_plain'] for r in rows)} plain against {sum(r['steps_fast'] for r in rows)}."
         )
+    out += _spring_markdown(ff.get("spring"))
     out.append(f"\nLoad: {ff['load_before']}-{ff['load_after']}.")
+    return out
+
+
+def _spring_markdown(rows) -> list[str]:
+    if not rows:
+        return []
+    out = [
+        "",
+        "Spring drive, cost per run against I_e and K = k l_s / F_p, plain / fast-forwarded: the "
+        "paper fractal (seed 1, mu 0.5, 2 starts, 0.25 L_c of travel) and the spring-block on a "
+        "flat plane (stuck until k V t = mu F_p, 91 % of the run). A spring run "
+        "fast-forwards only where a preload is over 400 of its steps' increments k V dt "
+        "(`rollout.SPRING_MIN_CLIMB_STEPS`); the end-point difference is in L_c:",
+        "",
+        "| surface | I_e | K | steps / run | ratio | CPU s / run | end | end-point diff. |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- |",
+    ]
+    for r in rows:
+        out.append(
+            f"| {r['surface']} | {r['ie']:g} | {r['K']:g} | {r['steps_plain']:.0f} / {r['steps_fast']:.0f} | "
+            f"{r['steps_plain'] / r['steps_fast']:.2f} | {r['cpu_s_plain']:.3f} / {r['cpu_s_fast']:.3f} | "
+            f"{', '.join(r['end_plain'])} / {', '.join(r['end_fast'])} | {r['end_dx_lc']:.1e} |"
+        )
     return out
 
 

@@ -28,8 +28,10 @@ class SpringDrive:
     force predicted from that normal, then at ``speed_m_s`` again through breakaway
     (:mod:`spine_mj.sim.rollout`, the rule of :mod:`spine_mj.sim.fastforward`); a tip that
     moves during the climb goes on from before it on the plain controls. ``duration_s`` and
-    the result's ``time_s`` count physical time (the carriage's), not engine steps. CPU
-    backends only.
+    the result's ``time_s`` count physical time (the carriage's), not engine steps. Only
+    where a stick phase can outlast a climb (a preload is many steps of the spring's force
+    increment ``k V dt``: soft springs, slow drives; ``rollout.SPRING_MIN_CLIMB_STEPS``), on
+    the CPU backends.
     """
 
     speed_m_s: float

@@ -86,9 +86,12 @@ PIECE_STEPS = 1024
 #: piece, so a piece's length is the latency of its climb (a piece costs ~15 steps' time
 #: in the calling thread: 256 rows cost ~6 %; measured on the fractal at K = 3).
 SPRING_PIECE_STEPS = 256
-#: A spring run fast-forwards only where the force cap ``kappa_cap F_p`` is more than this
-#: many of its steps' increments ``k V dt``: else no stick phase can outlast a climb
-#: (:data:`~spine_mj.sim.fastforward.RISE_STEPS`) and its nominal approach.
+#: A spring run fast-forwards only where one preload ``F_p`` is more than this many of its
+#: steps' increments ``k V dt``: a stick phase gains about a preload's worth of force (kappa
+#: varies by O(1) along a path), and a shorter one hardly outlasts the climb
+#: (:data:`~spine_mj.sim.fastforward.RISE_STEPS`), its nominal approach and the latency of
+#: :data:`SPRING_PIECE_STEPS`, so its pieces' overhead would be spent for nothing. On the
+#: paper fractal at K = 30 (step 0.004 F_p at I_e = 1e-6) no still phase lasted 300 steps.
 SPRING_MIN_CLIMB_STEPS = 4 * RISE_STEPS
 #: Most steps an open-loop run may plan: its recording (~0.5 kB a step) stays within ~2 GiB.
 MAX_RUN_STEPS = 2**22
@@ -313,13 +316,12 @@ class _Group:
         self.settle_apart = [
             isinstance(d, StaticProbe) and fast_forward_on(d, rig.engine, rig.tip) for d in self.drives
         ]
-        # a spring run that may fast-forward is watched after each piece, where a stick
-        # phase (at most the force cap's worth of steps) can outlast a climb
-        cap = self.det.kappa_cap * rig.scales.preload_n
+        # a spring run that may fast-forward is watched after each piece, where its stick
+        # phases (about a preload's worth of force each) can outlast a climb
         self.spring_ff = [
             isinstance(d, SpringDrive)
             and fast_forward_on(d, rig.engine, rig.tip)
-            and cap > SPRING_MIN_CLIMB_STEPS * self.nominal_step_n(k)
+            and rig.scales.preload_n > SPRING_MIN_CLIMB_STEPS * self.nominal_step_n(k)
             for k, d in enumerate(self.drives)
         ]
         self.watchers: dict[int, StickFastForward] = {}  # spring runs' watchers, kept across pieces
