@@ -23,8 +23,11 @@ the margin at the nominal rate cost ~1000 steps per ramp cycle at kappa ~ 5 and 
 1e-4; the approach and its rollback cost ~250.
 
 Users: :mod:`spine_mj.sim.ramp` (every stick phase of the ramp with reset) and
-:mod:`spine_mj.sim.rollout` (the static probe's one stick phase, after settling). What the
-equivalence neglects is written in the ramp's module docstring and the README.
+:mod:`spine_mj.sim.rollout` (the static probe's one stick phase, after settling, and every
+stick phase of a spring drive that a piece of its rollout ends in: the spring's force
+``k (X - x)`` on a stuck tip is the ramp's force, its rate ``k V``, and the carriage's
+advance is what climbs). What the equivalence neglects is written in the ramp's module
+docstring and the README.
 """
 
 from __future__ import annotations
