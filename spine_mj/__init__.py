@@ -13,6 +13,10 @@ Modules that moved keep their old import paths (``import spine_mj.streamline``,
 ``from spine_mj.engagement import kappa``): :data:`MOVED` maps each old name to its home,
 and an import finder hands out the module from there (the same module object, imported on
 first use).
+
+``import spine_mj`` itself is light (no numba, pandas, SciPy or MuJoCo): every public name
+is imported from its home module on first use (:func:`__getattr__`, :data:`HOMES`), so the
+command line starts at once and a user pays only for what they touch.
 """
 
 import importlib
@@ -20,42 +24,7 @@ import importlib.abc
 import importlib.util
 import sys
 
-from spine_mj._version import __version__
-from spine_mj.compare import (
-    capture_rate,
-    frechet_distance,
-    kappa_agreement,
-    mean_lateral_deviation,
-    outcome_agreement,
-)
-from spine_mj.errors import SpineInputError
-from spine_mj.presets import list_presets, load_preset, make_surface
-from spine_mj.surface_io import import_topography, load_surface, save_surface, write_stl
-from spine_mj.surfaces import (
-    GaussianSurface,
-    GridSurface,
-    HField,
-    Surface,
-    TriangulatedSurface,
-    fractal_fbm,
-    from_hfield,
-    random_gaussians,
-    sandpaper,
-    single_gaussian,
-    to_hfield,
-)
-from spine_mj.theory.compliant import CompliantResult, compliant_streamlines
-from spine_mj.theory.convexity import classify_points, hessian_class, sectional_class
-from spine_mj.theory.drive_limits import DriveLimits
-from spine_mj.theory.engagement import ENGAGED, SELF_LOCK, SLIP, kappa
-from spine_mj.theory.streamline import (
-    Outcome,
-    StreamlineParams,
-    StreamlineResult,
-    dilate,
-    ideal_trajectories,
-    streamlines,
-)
+from spine_mj._version import __version__ as __version__
 
 #: Old module name -> the module's home (imports by the old name get the same module).
 MOVED = {
@@ -99,75 +68,84 @@ class _MovedModules(importlib.abc.MetaPathFinder, importlib.abc.Loader):
 if not any(isinstance(f, _MovedModules) for f in sys.meta_path):
     sys.meta_path.append(_MovedModules())
 
-_LAZY = {
-    name: "spine_mj.sim"
-    for name in (
-        "Rig",
-        "TipParams",
-        "EngineSettings",
-        "SpringDrive",
-        "RampDrive",
-        "StaticProbe",
-        "Detection",
-        "RunResult",
-        "EndReason",
-        "Cone",
-        "Integrator",
-        "default_engine",
-        "inclined_plane",
-    )
+#: Public name -> the module that defines it (imported on first use of the name).
+HOMES = {
+    **dict.fromkeys(
+        (
+            "capture_rate",
+            "frechet_distance",
+            "kappa_agreement",
+            "mean_lateral_deviation",
+            "outcome_agreement",
+        ),
+        "spine_mj.compare",
+    ),
+    **dict.fromkeys(("CompliantResult", "compliant_streamlines"), "spine_mj.theory.compliant"),
+    **dict.fromkeys(("classify_points", "hessian_class", "sectional_class"), "spine_mj.theory.convexity"),
+    "DriveLimits": "spine_mj.theory.drive_limits",
+    **dict.fromkeys(("ENGAGED", "SELF_LOCK", "SLIP", "kappa"), "spine_mj.theory.engagement"),
+    "SpineInputError": "spine_mj.errors",
+    **dict.fromkeys(("list_presets", "load_preset", "make_surface", "open_surface"), "spine_mj.presets"),
+    **dict.fromkeys(
+        ("Outcome", "StreamlineParams", "StreamlineResult", "dilate", "ideal_trajectories", "streamlines"),
+        "spine_mj.theory.streamline",
+    ),
+    **dict.fromkeys(
+        ("import_topography", "load_surface", "save_surface", "write_stl"), "spine_mj.surface_io"
+    ),
+    **dict.fromkeys(
+        (
+            "GaussianSurface",
+            "GridSurface",
+            "HField",
+            "Surface",
+            "TriangulatedSurface",
+            "fractal_fbm",
+            "from_hfield",
+            "random_gaussians",
+            "sandpaper",
+            "single_gaussian",
+            "to_hfield",
+        ),
+        "spine_mj.surfaces",
+    ),
+    **dict.fromkeys(
+        (
+            "Rig",
+            "TipParams",
+            "EngineSettings",
+            "SpringDrive",
+            "RampDrive",
+            "StaticProbe",
+            "Detection",
+            "RunResult",
+            "EndReason",
+            "Cone",
+            "Integrator",
+            "default_engine",
+            "inclined_plane",
+        ),
+        "spine_mj.sim",
+    ),
 }
 
 
 def __getattr__(name):
-    if name in _LAZY:
-        return getattr(importlib.import_module(_LAZY[name]), name)
-    if f"spine_mj.{name}" in MOVED:
+    """A public name from its home (:data:`HOMES`), or a submodule (``spine_mj.sim``, or a
+    moved one such as ``spine_mj.streamline``) on first use."""
+    if name in HOMES:
+        value = getattr(importlib.import_module(HOMES[name]), name)
+        globals()[name] = value
+        return value
+    if f"spine_mj.{name}" in MOVED or (
+        not name.startswith("_") and importlib.util.find_spec(f"spine_mj.{name}") is not None
+    ):
         return importlib.import_module(f"spine_mj.{name}")
     raise AttributeError(f"module 'spine_mj' has no attribute {name!r}")
 
 
-__all__ = [
-    "ENGAGED",
-    "SELF_LOCK",
-    "SLIP",
-    "CompliantResult",
-    "DriveLimits",
-    "GaussianSurface",
-    "GridSurface",
-    "HField",
-    "Outcome",
-    "SpineInputError",
-    "StreamlineParams",
-    "StreamlineResult",
-    "Surface",
-    "TriangulatedSurface",
-    "__version__",
-    "capture_rate",
-    "classify_points",
-    "compliant_streamlines",
-    "dilate",
-    "fractal_fbm",
-    "frechet_distance",
-    "from_hfield",
-    "hessian_class",
-    "ideal_trajectories",
-    "import_topography",
-    "kappa",
-    "kappa_agreement",
-    "list_presets",
-    "load_preset",
-    "load_surface",
-    "make_surface",
-    "mean_lateral_deviation",
-    "outcome_agreement",
-    "random_gaussians",
-    "sandpaper",
-    "save_surface",
-    "sectional_class",
-    "single_gaussian",
-    "streamlines",
-    "to_hfield",
-    "write_stl",
-    *sorted(_LAZY),
-]
+def __dir__():
+    return sorted({*globals(), *__all__})
+
+
+__all__ = sorted(["__version__", *HOMES])

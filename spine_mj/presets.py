@@ -27,9 +27,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from spine_mj import resources, surfaces
+from spine_mj import examples, resources, surface_io, surfaces
 from spine_mj.errors import SpineInputError
-from spine_mj.surface_io import import_topography
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -44,6 +43,7 @@ __all__ = [
     "list_presets",
     "load_preset",
     "make_surface",
+    "open_surface",
     "parse_override",
     "preset_mu",
     "presets_dir",
@@ -56,7 +56,7 @@ def _measured(*, file: str, **options):
     path = Path(file)
     if not path.is_absolute():
         path = presets_dir() / path
-    return import_topography(path, **options)
+    return surface_io.import_topography(path, **options)
 
 
 #: Generator names usable in a preset, and the functions they call.
@@ -253,3 +253,33 @@ def make_surface(preset: Preset | str, **overrides) -> surfaces.Surface:
         raise SpineInputError(f"preset {preset.name}: bad parameter: {exc}") from None
     surface.metadata["preset"] = preset.name
     return surface
+
+
+def open_surface(spec: str, **overrides) -> surfaces.Surface:
+    """The surface a SURFACE argument or a sweep's ``[[surfaces]]`` entry names: a shipped
+    example (``example:plu-1.plu``), a saved ``.npz``, a preset (a name of
+    :func:`list_presets` or a ``.toml`` recipe, made with ``overrides`` as in
+    :func:`make_surface`) or an instrument file (:func:`~spine_mj.surface_io.import_topography`).
+
+    Raises
+    ------
+    SpineInputError
+        ``spec`` names none of these, or ``overrides`` are given for a file (only a preset
+        has generator parameters).
+    """
+    spec = examples.resolve(spec)
+    path = Path(spec)
+    if spec in list_presets() or path.suffix == ".toml":
+        return make_surface(spec, **overrides)
+    if overrides:
+        raise SpineInputError(
+            f"{spec!r} is a surface file: overrides ({', '.join(sorted(overrides))}) are for presets"
+        )
+    if path.suffix == ".npz":
+        return surface_io.load_surface(path)
+    if path.is_file():
+        return surface_io.import_topography(path)
+    raise SpineInputError(
+        f"SURFACE must be a .npz file, a preset ({', '.join(list_presets())}), an "
+        f"instrument file or an example (spine-mj examples), got {spec!r}"
+    )

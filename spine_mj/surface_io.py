@@ -19,8 +19,6 @@ import zipfile
 from pathlib import Path
 
 import numpy as np
-import trimesh
-from scipy import ndimage
 
 from spine_mj.atomic import atomic_output
 from spine_mj.errors import SpineInputError, check_positive
@@ -327,6 +325,8 @@ def _fill_missing(heights, missing, method, topo):
         out[missing] = heights[~missing].mean()
         return out
 
+    from scipy import ndimage
+
     _, (ii, jj) = ndimage.distance_transform_edt(missing, return_indices=True)
     return heights[ii, jj]
 
@@ -380,6 +380,8 @@ def surface_mesh(
     walls = np.concatenate(
         [np.column_stack([ring, ring + off, nxt + off]), np.column_stack([ring, nxt + off, nxt])]
     )
+    import trimesh  # on demand, like SurfaceTopography: the meshes are an export
+
     mesh = trimesh.Trimesh(
         vertices=vertices, faces=np.concatenate([top_faces, bottom_faces, walls]), process=False
     )

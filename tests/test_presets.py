@@ -95,3 +95,28 @@ def test_corrugation_preset_is_the_prandtl_tomlinson_profile():
 def test_corrugation_refuses_nonsense(bad):
     with pytest.raises(SpineInputError, match=next(iter(bad))):
         make_surface("corrugation", **bad)
+
+
+def test_open_surface_reads_every_kind_of_spec(tmp_path):
+    from spine_mj.presets import open_surface
+    from spine_mj.surface_io import save_surface
+
+    peak = open_surface("paper-single-peak")
+    assert peak.metadata["preset"] == "paper-single-peak"
+    assert (
+        open_surface("paper-fractal", seed=4).heights.tolist()
+        == make_surface("paper-fractal", seed=4).heights.tolist()
+    )
+    save_surface(peak.sample(16), tmp_path / "p.npz")
+    np.testing.assert_array_equal(open_surface(str(tmp_path / "p.npz")).heights, peak.sample(16).heights)
+    scan = open_surface("example:plu-1.plu")  # a shipped instrument file
+    assert scan.unit != "1" and scan.heights.ndim == 2
+
+
+def test_open_surface_names_what_it_cannot_open(tmp_path):
+    from spine_mj.presets import open_surface
+
+    with pytest.raises(SpineInputError, match=r"SURFACE must be a \.npz file, a preset .* got 'no-such'"):
+        open_surface("no-such")
+    with pytest.raises(SpineInputError, match=r"is a surface file: overrides \(seed\) are for presets"):
+        open_surface("example:plu-1.plu", seed=3)

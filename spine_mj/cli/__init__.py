@@ -7,10 +7,13 @@ commands: :mod:`~spine_mj.cli.surface` (``surface make/show/info/export``),
 :mod:`~spine_mj.cli.sim` (``simulate``, ``replay``, ``view``, ``sim export``),
 :mod:`~spine_mj.cli.sweep` (``sweep run/status``, ``report``), :mod:`~spine_mj.cli.array`
 (``array``), :mod:`~spine_mj.cli.validate` (``validate``) and :mod:`~spine_mj.cli.examples`
-(``examples``). Importing this package registers every command on :func:`main`.
+(``examples``).
+
+The CLI starts at once: a command's module is imported when the command is named (or its
+help listed), and each module imports the library inside its commands, so ``spine-mj
+--help`` loads neither numpy nor MuJoCo (``tests/cli/test_cli_startup.py``).
 """
 
-from spine_mj.cli import array, examples, sim, surface, sweep, theory, validate
 from spine_mj.cli.app import INPUT_ERROR_EXIT, InputError, Progress, _exit_on_sigterm, main, run
 
 __all__ = [
@@ -18,13 +21,6 @@ __all__ = [
     "InputError",
     "Progress",
     "_exit_on_sigterm",
-    "array",
-    "examples",
     "main",
     "run",
-    "sim",
-    "surface",
-    "sweep",
-    "theory",
-    "validate",
 ]

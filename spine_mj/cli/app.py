@@ -10,16 +10,16 @@ callbacks.
 
 from __future__ import annotations
 
+import importlib
 import os
 import signal
 import sys
+import warnings
 from pathlib import Path
+from typing import ClassVar
 
 import click
-import numpy as np
-from tqdm import tqdm
 
-from spine_mj import examples, presets, surface_io
 from spine_mj.errors import SpineInputError
 
 INPUT_ERROR_EXIT = 2
@@ -41,6 +41,8 @@ class Progress:
         if self.bar is not None and desc is not None and desc != self.bar.desc:
             self.close()
         if self.bar is None:
+            from tqdm import tqdm
+
             tqdm.monitor_interval = 0  # no monitor thread: a single-threaded CLI forks its workers
             self.bar = tqdm(
                 total=total, desc=desc or self.desc, unit=self.unit, dynamic_ncols=True, file=sys.stderr
@@ -84,10 +86,30 @@ def _one_line(exc: click.UsageError) -> str:
     return " ".join(exc.format_message().split()) + hint
 
 
+class _Command(click.Command):
+    """A command run with numpy's overflow and invalid-value warnings off (results are
+    checked for finiteness where it matters), and other libraries' warnings held back: a
+    command that fails shows only its one error line, one that succeeds shows each warning
+    as one line after its work (never a warning's source line). numpy is imported here,
+    when a command runs, not for ``--help``."""
+
+    def invoke(self, ctx):
+        import numpy as np
+
+        with warnings.catch_warnings(record=True) as caught, np.errstate(all="ignore"):
+            result = super().invoke(ctx)
+        for text in dict.fromkeys(f"{w.category.__name__}: {w.message}" for w in caught):
+            click.echo(f"Warning: {' '.join(text.split())}", err=True)
+        return result
+
+
 class _Group(click.Group):
     """Turns the library's input errors and click's usage errors into :class:`InputError`
     (one line) for every subcommand, and so too a request too large for memory or out of
     floating-point range that no check at the boundary caught (not a traceback)."""
+
+    command_class = _Command
+    group_class = type
 
     def parse_args(self, ctx, args):
         """The root's own options (``spine-mj --bogus``) fail here, before :meth:`invoke`."""
@@ -100,10 +122,7 @@ class _Group(click.Group):
 
     def invoke(self, ctx):
         try:
-            # numpy's overflow and invalid-value warnings would print lines before the one
-            # error line; results are checked for finiteness where it matters
-            with np.errstate(all="ignore"):
-                return super().invoke(ctx)
+            return super().invoke(ctx)
         except _SHOWS_HELP:
             raise
         except click.UsageError as exc:  # click's own: usage, hint and error in one line
@@ -130,7 +149,38 @@ class _Group(click.Group):
             ) from None
 
 
-@click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})
+class _Root(_Group):
+    """The root group: each command's module (and so its dependencies) is imported only when
+    that command is named, or listed by ``--help``; the command modules import the library
+    inside their functions, so listing them stays light too."""
+
+    #: command name -> the module of :mod:`spine_mj.cli` that registers it on :func:`main`
+    lazy_commands: ClassVar[dict[str, str]] = {
+        "array": "array",
+        "examples": "examples",
+        "kappa": "theory",
+        "replay": "sim",
+        "report": "sweep",
+        "reproduce": "theory",
+        "sim": "sim",
+        "simulate": "sim",
+        "streamline": "theory",
+        "surface": "surface",
+        "sweep": "sweep",
+        "validate": "validate",
+        "view": "sim",
+    }
+
+    def list_commands(self, ctx):
+        return sorted({*self.commands, *self.lazy_commands})
+
+    def get_command(self, ctx, name):
+        if name not in self.commands and name in self.lazy_commands:
+            importlib.import_module(f"spine_mj.cli.{self.lazy_commands[name]}")
+        return self.commands.get(name)
+
+
+@click.group(cls=_Root, context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(package_name="spine_mj")
 @click.option("-v", "--verbose", is_flag=True, help="Show the full text behind an error (e.g. a reader's).")
 def main(verbose):
@@ -141,32 +191,28 @@ def main(verbose):
 def run() -> None:
     """The ``spine-mj`` program: :func:`main`, with a SIGTERM (kill, timeout, a scheduler)
     unwinding like Ctrl-C so that temporary outputs are removed. Callers of :func:`main`
-    in their own process (tests, notebooks) keep their signal handling."""
+    in their own process (tests, notebooks) keep their signal handling.
+
+    A SIGTERM that arrives while a command imports its dependencies can surface as another
+    exception (an extension module's ``ImportError: initialization failed`` wraps the
+    handler's exit): once the signal came, any exception ends the program as the kill."""
     signal.signal(signal.SIGTERM, _exit_on_sigterm)
-    main()
+    try:
+        main()
+    except Exception:
+        if _TERMINATED:
+            raise SystemExit(128 + signal.SIGTERM) from None
+        raise
+
+
+#: Set by :func:`_exit_on_sigterm`: the process was told to stop.
+_TERMINATED = []
 
 
 def _exit_on_sigterm(signum, frame):
     """SIGTERM's handler: exit as a kill would (128 + signal), through every ``finally``."""
+    _TERMINATED.append(signum)
     raise SystemExit(128 + signum)
-
-
-def load_surface_arg(spec: str):
-    """A SURFACE argument: a saved .npz, a preset name, an instrument file, or a shipped
-    example (``example:plu-1.plu``)."""
-
-    spec = examples.resolve(spec)
-    path = Path(spec)
-    if path.suffix == ".npz":
-        return surface_io.load_surface(path)
-    if spec in presets.list_presets() or path.suffix == ".toml":
-        return presets.make_surface(spec)
-    if path.is_file():
-        return surface_io.import_topography(path)
-    raise SpineInputError(
-        f"SURFACE must be a .npz file, a preset ({', '.join(presets.list_presets())}), an "
-        f"instrument file or an example (spine-mj examples), got {spec!r}"
-    )
 
 
 def check_suffix(path: str, suffix: str, option: str) -> None:

@@ -4,10 +4,9 @@ from __future__ import annotations
 
 import click
 
-from spine_mj import sim
-from spine_mj.cli.app import main, parse_start
-from spine_mj.cli.sim import _build_rig, _rig_options
-from spine_mj.errors import SpineInputError, check_positive
+from spine_mj.cli.app import main, parse_start, refuse_options_not_for
+from spine_mj.cli.sim import _rig_inputs, _rig_options
+from spine_mj.errors import check_positive
 
 
 @main.command("array")
@@ -25,7 +24,9 @@ from spine_mj.errors import SpineInputError, check_positive
     show_default=True,
     help="Unit of --spacing: surface units, or the surface's l_s or L_c.",
 )
-@click.option("--seed", type=int, default=0, show_default=True, help="Seed of the random layout.")
+@click.option(
+    "--seed", type=click.IntRange(min=0), default=0, show_default=True, help="Seed of the random layout."
+)
 @click.option(
     "--drive",
     type=click.Choice(["speed", "force"]),
@@ -84,29 +85,27 @@ def array_cmd(
     Example:
       spine-mj array corrugation --layout staggered --rows 2 --cols 3 --spacing 0.3 --drive force --out arr/
     """
+    from spine_mj import sim
     from spine_mj.sim.array_outputs import write_array_outputs
 
-    if drive == "force" and duration is not None:
-        raise SpineInputError("--duration is for --drive speed (a force pull runs to its cap)")
+    if kind != "random":
+        refuse_options_not_for(f"--layout {kind}", ["seed"])
+    if drive == "force":
+        refuse_options_not_for("--drive force (a pull runs to its cap)", ["duration"])
+    for name, value in (("--ie", ie), ("--K", stiffness_number)):
+        if value is not None:
+            check_positive(name, value)
     layout = sim.Layout(
         kind=kind, rows=rows, cols=cols, spacing=spacing, spacing_unit=spacing_unit, seed=seed
     )
-    rig = _build_rig(surface_spec, **rig_opts, ie=ie, stiffness_number=stiffness_number)
-    sc = rig.scales
-    k = None if stiffness_number is None else sc.stiffness_for(check_positive("--K", stiffness_number))
-    if ie is None:  # the default pace, and the engine step it allows
-        ie = sim.array_ie(sc, mu=rig.tip.mu_s, force_control=drive == "force", stiffness_n_m=k)
-        rig = _build_rig(surface_spec, **rig_opts, ie=ie)
-    speed = sc.speed_for(check_positive("--ie", ie))
-    arr = sim.ArrayRig(rig, layout, force_control=drive == "force")
+    surf, rig_kw = _rig_inputs(surface_spec, **rig_opts)
+    arr, carriage, ie = sim.build_array_on(
+        surf, layout, drive, ie=ie, stiffness_number=stiffness_number, duration_s=duration, **rig_kw
+    )
     where = arr.default_centre() if centre is None else parse_start(centre)
     arr.starts(where)  # spines off the surface: refused before anything runs or is written
-    if drive == "speed":
-        drv = sim.build_drive(sc, "spring", ie=ie, stiffness_n_m=k, duration_s=duration)
-    else:
-        drv = sim.ForcePull(rate_n_s=sc.force_rate_for(speed), stiffness_n_m=k)
     click.echo(f"{layout.n_spines} spines, {drive} drive, I_e = {ie:g}: simulating ...")
-    res = arr.run(drv, centre=where)
+    res = arr.run(carriage, centre=where)
     written = write_array_outputs(res, arr, out_dir)
     click.echo(
         f"holding force {res.holding_force_n:.4g} N ({res.holding_ratio:.4g} of the total preload, predicted "

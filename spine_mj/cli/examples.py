@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import click
 
-from spine_mj import examples
 from spine_mj.cli.app import main
 
 
@@ -19,6 +18,8 @@ def examples_cmd():
       spine-mj surface info example:plu-1.plu
       spine-mj sweep example:paper-quasistatic.toml --out runs/qs
     """
+
+    from spine_mj import examples
 
     for name, (kind, path) in examples.list_examples().items():
         click.echo(f"{examples.PREFIX + name:40s} {kind:6s} {path}")

@@ -8,22 +8,16 @@ from pathlib import Path
 
 import click
 
-from spine_mj import extras, presets, sim
 from spine_mj.cli.app import (
     InputError,
     Progress,
     _Group,
     check_suffix,
-    load_surface_arg,
     main,
     parse_start,
     refuse_options_not_for,
 )
 from spine_mj.errors import SpineInputError, check_positive
-from spine_mj.sim.model import compile_spec
-from spine_mj.sim.render import choose_gl_backend, default_speed, write_mp4
-from spine_mj.sim.replay import play_in_viewer, run_in_viewer
-from spine_mj.sim.run_folder import load_run, write_run
 
 
 def _rig_options(f):
@@ -69,39 +63,46 @@ def _rig_options(f):
     return f
 
 
+def _rig_inputs(
+    surface_spec, tip_radius, mass, mu, preload, length_scale, resolution, timestep, noslip, impratio
+):
+    """The surface of SURFACE and the shared rig options as :func:`spine_mj.sim.build_rig`'s
+    keywords (``mu`` resolved by the one mu rule)."""
+    from spine_mj import presets
+
+    surf = presets.open_surface(surface_spec)
+    return surf, {
+        "mu": presets.resolve_mu(surf, mu, name="--mu"),
+        "tip_radius_m": tip_radius,
+        "mass_kg": mass,
+        "preload_n": preload,
+        "length_scale_m": length_scale,
+        "hfield_resolution": resolution,
+        "timestep_s": timestep,
+        "noslip_iterations": noslip,
+        "impratio": impratio,
+    }
+
+
 def _build_rig(
     surface_spec,
-    tip_radius,
-    mass,
-    mu,
-    preload,
-    length_scale,
-    resolution,
-    timestep,
-    noslip,
-    impratio,
-    *,
+    *rig_opts,
     ie=None,
     speed=None,
     rate=None,
     stiffness_number=None,
     stiffness_n_m=None,
     driven=True,
+    **rig_kw,
 ):
     """The rig of the shared rig options (:func:`spine_mj.sim.build_rig`); the drive's pace
-    (``ie``, ``speed`` or ``rate``) bounds the engine step for impacts (``driven``)."""
-    surf = load_surface_arg(surface_spec)
+    (``ie``, ``speed`` or ``rate``) and spring bound the engine step (``driven``)."""
+    from spine_mj import sim
+
+    surf, kw = _rig_inputs(surface_spec, *rig_opts, **rig_kw)
     return sim.build_rig(
         surf,
-        mu=presets.resolve_mu(surf, mu, name="--mu"),
-        tip_radius_m=tip_radius,
-        mass_kg=mass,
-        preload_n=preload,
-        length_scale_m=length_scale,
-        hfield_resolution=resolution,
-        timestep_s=timestep,
-        noslip_iterations=noslip,
-        impratio=impratio,
+        **kw,
         ie=ie,
         speed_m_s=speed,
         rate_n_s=rate,
@@ -227,6 +228,10 @@ def simulate(
       spine-mj simulate paper-single-peak --start -3,-1 --drive spring --ie 1e-3 --K 10 --out out/
     """
 
+    from spine_mj import extras, sim
+    from spine_mj.sim.render import choose_gl_backend
+    from spine_mj.sim.run_folder import write_run
+
     if render:
         extras.require("video", "--render")
         choose_gl_backend()
@@ -292,6 +297,8 @@ def _motion_line(result) -> str:
 
 def _render_mp4(rig, run, path: Path, *, speed: float | None = None) -> None:
     """Write the MP4 of a run (a RunResult or a replay Track), with a progress bar."""
+    from spine_mj.sim.render import write_mp4
+
     with Progress("rendering MP4", unit="frame") as bar:
         write_mp4(rig, run, path, speed=speed, progress=bar.update)
 
@@ -306,7 +313,7 @@ def _render_mp4(rig, run, path: Path, *, speed: float | None = None) -> None:
     "--mp4", type=click.Path(dir_okay=False), default=None, help="Write this MP4 instead (headless)."
 )
 def replay(run_dir, speed, duration, mp4):
-    """Play a run recorded by `spine-mj simulate` in MuJoCo's viewer (RUN_DIR: its --out-dir).
+    """Play a run recorded by `spine-mj simulate` in MuJoCo's viewer (RUN_DIR: its --out).
 
     The tip moves through its recorded positions at the recorded times (times --speed),
     with its path so far (orange) and the streamline from the same start (cyan). Without a
@@ -316,6 +323,11 @@ def replay(run_dir, speed, duration, mp4):
     Example:
       spine-mj simulate paper-single-peak --start -3,-1 --out run/ && spine-mj replay run/
     """
+    from spine_mj import extras
+    from spine_mj.sim.render import choose_gl_backend, default_speed
+    from spine_mj.sim.replay import play_in_viewer
+    from spine_mj.sim.run_folder import load_run
+
     headless = mp4 is not None or (
         sys.platform.startswith("linux")
         and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
@@ -360,6 +372,9 @@ def view(surface_spec, start, duration, **rig_opts):
     runs in physical real time, seen from the camera 'follow' (Esc: the free camera).
     To watch a recorded run instead, use `spine-mj replay RUN_DIR`.
     """
+
+    from spine_mj.sim.model import compile_spec
+    from spine_mj.sim.replay import run_in_viewer
 
     if duration is not None:
         check_positive("--duration", duration)

@@ -7,24 +7,8 @@ import math
 
 import click
 
-from spine_mj import examples, presets, roughness, surface_io
-from spine_mj.atomic import all_or_none
-from spine_mj.cli.app import (
-    _Group,
-    check_suffix,
-    load_surface_arg,
-    main,
-    refuse_options_not_for,
-)
+from spine_mj.cli.app import _Group, check_suffix, main, refuse_options_not_for
 from spine_mj.errors import SpineInputError, check_positive
-from spine_mj.jsonio import to_jsonable
-from spine_mj.plotting import (
-    roughness_figure,
-    save_figure,
-    surface_preview,
-)
-from spine_mj.surfaces import LENGTH_UNITS_M, length_unit
-from spine_mj.theory.drive_limits import drive_limits
 
 
 @main.group(cls=_Group)
@@ -35,6 +19,7 @@ def surface():
 @surface.command("list")
 def surface_list():
     """List the surface presets in surfaces/."""
+    from spine_mj import presets
 
     for name in presets.list_presets():
         click.echo(f"{name:24s} {presets.load_preset(name).description}")
@@ -79,6 +64,10 @@ def surface_make(preset, from_file, output, seed, hurst, sets, fill, no_level, s
       spine-mj surface make --from-file scan.plu --fill harmonic -o scan.npz
     """
 
+    from spine_mj import examples, presets, surface_io
+    from spine_mj.atomic import all_or_none
+    from spine_mj.plotting import save_figure, surface_preview
+
     if (preset is None) == (from_file is None):
         raise SpineInputError("give exactly one of PRESET or --from-file")
     if from_file is None:
@@ -118,8 +107,11 @@ def surface_show(surface_file, output):
       spine-mj surface show fractal.npz -o fractal.png
     """
 
+    from spine_mj import presets
+    from spine_mj.plotting import save_figure, surface_preview
+
     check_suffix(output, ".png", "-o/--output")
-    surf = load_surface_arg(surface_file)
+    surf = presets.open_surface(surface_file)
     save_figure(surface_preview(surf), output)
     click.echo(f"wrote {output}")
 
@@ -142,12 +134,19 @@ def surface_info(surface_spec, output, as_json, mu, tip_radius):
     Example:
       spine-mj surface info example:plu-1.plu --mu 0.5 -o psd.png
     """
+    from spine_mj import presets, roughness
+    from spine_mj.jsonio import to_jsonable
+
     if output:
         check_suffix(output, ".png", "-o/--output")
-    surf = load_surface_arg(surface_spec)
+    surf = presets.open_surface(surface_spec)
+    if mu is None and presets.preset_mu(surf) is None:  # no drive limits: nothing uses the tip
+        refuse_options_not_for("surface info without a mu_s (no --mu, no preset's)", ["tip_radius"])
     rough = roughness.summarize(surf)
     limits = _drive_limits(surf, mu, tip_radius)
     if output:
+        from spine_mj.plotting import roughness_figure, save_figure
+
         save_figure(roughness_figure(rough), output)
     if as_json:
         doc = dict(rough.as_dict(), drive_limits=None if limits is None else limits.as_dict())
@@ -173,6 +172,9 @@ def _drive_limits(surf, mu, tip_radius):
     """:func:`spine_mj.theory.drive_limits.drive_limits` of ``surf`` with the one mu rule
     (:func:`spine_mj.presets.resolve_mu`); None without a mu_s (info still reports the
     roughness)."""
+    from spine_mj import presets
+    from spine_mj.theory.drive_limits import drive_limits
+
     if mu is None and presets.preset_mu(surf) is None:
         return None
     mu = presets.resolve_mu(surf, mu, name="--mu")
@@ -214,13 +216,17 @@ def surface_export(surface_file, stl, stl_scale, base_thickness, hfield, resolut
       spine-mj surface export fractal.npz --stl fractal.stl --hfield fractal-hfield.npz
     """
 
+    from spine_mj import presets, surface_io
+    from spine_mj.atomic import all_or_none
+    from spine_mj.surfaces import LENGTH_UNITS_M, length_unit
+
     if not stl and not hfield:
         raise SpineInputError("nothing to export: give --stl and/or --hfield")
     if stl:
         check_suffix(stl, ".stl", "--stl")
     if hfield:
         check_suffix(hfield, ".npz", "--hfield")
-    surf = load_surface_arg(surface_file)
+    surf = presets.open_surface(surface_file)
     unit = length_unit(surf.unit)
     mm_scale = 1.0 if unit is None else LENGTH_UNITS_M[unit] / LENGTH_UNITS_M["mm"]
     scale = stl_scale if stl_scale is not None else mm_scale

@@ -6,8 +6,6 @@ from pathlib import Path
 
 import click
 
-from spine_mj import examples
-from spine_mj import sweep as sw
 from spine_mj.cli.app import (
     Progress,
     _Group,
@@ -76,10 +74,9 @@ def sweep():
 @click.option(
     "--worker-wait",
     type=float,
-    default=sw.DEFAULT_WORKER_WAIT_S,
-    show_default=True,
+    default=None,
     metavar="SECONDS",
-    help="With --scheduler: how long to wait for its first worker before giving up.",
+    help="With --scheduler: how long to wait for its first worker before giving up [default: 300].",
 )
 @click.option("--quiet", is_flag=True, help="No progress bar.")
 def sweep_run(config, out_dir, workers, scheduler, overwrite, retry_failed, worker_wait, quiet):
@@ -90,8 +87,15 @@ def sweep_run(config, out_dir, workers, scheduler, overwrite, retry_failed, work
       spine-mj sweep example:paper-quasistatic.toml --out runs/qs --workers 4
     """
 
+    from spine_mj import examples
+    from spine_mj import sweep as sw
+
     if scheduler is None:
         refuse_options_not_for("a sweep without --scheduler", ["worker_wait"])
+    else:  # the cluster's workers are the scheduler's
+        refuse_options_not_for(f"a sweep on --scheduler {scheduler}", ["workers"])
+    if worker_wait is None:
+        worker_wait = sw.DEFAULT_WORKER_WAIT_S
     cfg = sw.load_config(examples.resolve(config))
     with Progress(cfg.name, unit="case", quiet=quiet) as bar:
         try:
@@ -148,6 +152,8 @@ def sweep_status(out_dir):
       spine-mj sweep status runs/qs
     """
 
+    from spine_mj import sweep as sw
+
     st = sw.store_status(out_dir)
     runs = sum(st.status_counts.values())
     click.echo(
@@ -178,6 +184,8 @@ def report(out_dir, output):
     Example:
       spine-mj report runs/qs -o qs-report.html
     """
+
+    from spine_mj import sweep as sw
 
     check_suffix(output, ".html", "-o/--output")
     sw.write_report(out_dir, output)

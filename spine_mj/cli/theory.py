@@ -5,28 +5,8 @@ from __future__ import annotations
 from pathlib import Path
 
 import click
-import numpy as np
-import pandas as pd
 
-from spine_mj import presets, reproduce
-from spine_mj.atomic import all_or_none, atomic_output
-from spine_mj.cli.app import (
-    Progress,
-    check_suffix,
-    load_surface_arg,
-    main,
-    parse_start,
-    refuse_options_not_for,
-)
-from spine_mj.jsonio import write_json
-from spine_mj.plotting import (
-    kappa_map_figure,
-    save_figure,
-    streamline_figure,
-)
-from spine_mj.surfaces import check_grid_size
-from spine_mj.theory import engagement
-from spine_mj.theory.streamline import StreamlineParams, dilate, ideal_trajectories, streamlines
+from spine_mj.cli.app import Progress, check_suffix, main, parse_start, refuse_options_not_for
 
 
 @main.command("kappa")
@@ -45,9 +25,16 @@ def kappa_cmd(surface_spec, mu, output, resolution):
       spine-mj kappa paper-single-peak --mu 1.2 -o map.png
     """
 
+    import numpy as np
+
+    from spine_mj import presets
+    from spine_mj.plotting import kappa_map_figure, save_figure
+    from spine_mj.surfaces import check_grid_size
+    from spine_mj.theory import engagement
+
     check_suffix(output, ".png", "-o/--output")
     check_grid_size(resolution, resolution, where="kappa --resolution")
-    surf = load_surface_arg(surface_spec)
+    surf = presets.open_surface(surface_spec)
     mu = presets.resolve_mu(surf, mu, name="--mu")
     xs, _, heights, k, region = engagement.kappa_grid(surf, mu, resolution)
     fig = kappa_map_figure({surf.metadata.get("preset", "surface"): (xs, heights, k, region)}, mu)
@@ -91,38 +78,20 @@ def streamline_cmd(surface_spec, mu, starts, dl, tip_radius, fmt, out_dir):
 
     \b
     Example:
-      spine-mj streamline paper-single-valley --mu 1.2 --start -3,-1 --start -3,-2 -o out/
+      spine-mj streamline paper-single-valley --mu 1.2 --start -3,-1 --start -3,-2 --out out/
     """
 
+    from spine_mj import presets
+    from spine_mj.theory.streamline_outputs import trace_starts, write_streamline_outputs
+
     pts = [parse_start(s) for s in starts]
-    surf = load_surface_arg(surface_spec)
+    surf = presets.open_surface(surface_spec)
     mu = presets.resolve_mu(surf, mu, name="--mu")
-    xmin, xmax, ymin, ymax = surf.bounds
-    params = StreamlineParams(mu=mu, dl=dl if dl is not None else max(xmax - xmin, ymax - ymin) / 1000)
-    if tip_radius:
-        surf = dilate(surf, tip_radius)
-    stream = streamlines(surf, pts, params)
-    ideal = ideal_trajectories(surf, pts, params)
-    table = pd.concat([stream.to_frame(), ideal.to_frame()], ignore_index=True)
-    table["mu"] = mu
-    table["tip_radius"] = tip_radius
-    out = Path(out_dir)
-    path = out / f"streamlines.{fmt}"
-    with all_or_none(path, out / "streamlines.png"):
-        with atomic_output(path) as tmp:
-            if fmt == "parquet":
-                table.to_parquet(tmp, index=False)
-            else:
-                table.to_csv(tmp, index=False)
-        save_figure(streamline_figure(surf, stream, ideal, title=f"mu_s = {mu:g}"), out / "streamlines.png")
-    for i, (x, y) in enumerate(pts):
-        click.echo(
-            f"start ({x:g}, {y:g}): streamline {stream.outcome_names[i]} at "
-            f"({stream.end_x[i]:.3f}, {stream.end_y[i]:.3f}), max kappa "
-            f"{stream.max_kappa[i]:.3g}; ideal {ideal.outcome_names[i]}, max kappa "
-            f"{ideal.max_kappa[i]:.3g}"
-        )
-    click.echo(f"wrote {path} and {out / 'streamlines.png'}")
+    run = trace_starts(surf, pts, mu=mu, dl=dl, tip_radius=tip_radius)
+    written = write_streamline_outputs(run, out_dir, fmt=fmt)
+    for line in run.summary_lines():
+        click.echo(line)
+    click.echo(f"wrote {written[0]} and {written[1]}")
 
 
 @main.command("reproduce")
@@ -161,6 +130,11 @@ def reproduce_cmd(name, out_dir, quick, surfaces, workers):
     Example:
       spine-mj reproduce single-peak --out repro/
     """
+
+    from spine_mj import reproduce
+    from spine_mj.atomic import all_or_none
+    from spine_mj.jsonio import write_json
+    from spine_mj.plotting import save_figure
 
     options = {}
     if name == "fractal-hurst":

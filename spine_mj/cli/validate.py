@@ -6,11 +6,7 @@ from pathlib import Path
 
 import click
 
-from spine_mj import validate
-from spine_mj.cli.app import (
-    Progress,
-    main,
-)
+from spine_mj.cli.app import Progress, main
 from spine_mj.errors import SpineInputError
 
 
@@ -51,6 +47,9 @@ def validate_cmd(out_dir, quick, plan_name, workers, quiet):
       spine-mj validate --quick --out demo-out
     """
 
+    from spine_mj import validate
+    from spine_mj.validate.summary import summary_lines
+
     if plan_name is not None and quick and plan_name != "quick":
         raise SpineInputError(f"--quick and --plan {plan_name}: give one of them")
     plan = plan_name or ("quick" if quick else "full")
@@ -66,44 +65,8 @@ def validate_cmd(out_dir, quick, plan_name, workers, quiet):
                 p.finished_cases, max(p.total_cases, 1), desc=f"{p.study}: {p.step}"
             ),
         )
-    click.echo(
-        f"static kappa max rel. error (engaged, default settings): {result['static_kappa_max_rel_error']:.3g}"
-    )
-    for fam, summ in result["limit_families"].items():
-        stops = ", ".join(f"{k} {n}" for k, n in summ["failed_runs"].items()) or "none"
-        click.echo(
-            f"I_e = {result['lowest_ie']:g}, {fam}: outcome agreement {summ['outcome_agreement']:.0%} "
-            f"of {summ['runs']}, median Frechet {summ['median_frechet']:.3g} L_c, engine stops: {stops}"
-        )
-    for row in result.get("fractal_lock_rate", {}).get("rows", []):
-        rates = ", ".join(
-            f"{k} {row[f'rate_{k}']:.2f} ({row[f'locked_{k}']}/{row[f'n_ok_{k}']})"
-            for k in ("streamline", "mujoco_corner", "mujoco_dynamic")
-            if f"rate_{k}" in row
-        )
-        click.echo(f"fractal self-lock rate, H = {row['hurst']:g}: {rates}")
-    for kind, pool in result.get("arrays", {}).get("pooled", {}).items():
-        if pool.get("diff"):
-            d = pool["diff"]
-            click.echo(
-                f"arrays: P(at least one spine locks), {kind} - aligned = {d['diff']:+.3f} "
-                f"[{d['ci_low']:+.3f}, {d['ci_high']:+.3f}] ({pool['locked']}/{pool['n_ok']} against "
-                f"{pool['locked_grid']}/{pool['n_ok_grid']})"
-            )
-    for proto, s in result["ie_star"].items():
-        if s.get("valid") is False:
-            click.echo(f"I_e* ({proto}) {s['note']}")
-            continue
-        for star in (s, s["by_criterion"].get("departure")):
-            if star is None:
-                continue
-            click.echo(f"I_e* ({proto}) criterion: {star['criterion']}")
-            if star["kind"] == "bracketed":
-                click.echo(f"  I_e* = {star['value']:.3g} in [{star['low']:.3g}, {star['high']:.3g}]")
-            elif star["kind"] == "above":
-                click.echo(f"  I_e* > {star['low']:.3g} (agreement holds on the whole grid)")
-            else:
-                click.echo(f"  I_e* < {star['high']:.3g} (no agreement at the lowest I_e)")
+    for line in summary_lines(result):
+        click.echo(line)
     click.echo(
         f"wrote {out / 'report.md'} and {out / 'validation.json'} ({result['timings_s']['total']:.0f} s)"
     )

@@ -61,7 +61,16 @@ Modules: :mod:`~spine_mj.sim.params` (tip, engine, scales and their rules),
 """
 
 from spine_mj.sim.array import ArrayResult, ArrayRig, ForcePull
-from spine_mj.sim.build import DEFAULT_INERTIA_NUMBER, PROTOCOLS, build_drive, build_rig, drive_speed_m_s
+from spine_mj.sim.build import (
+    ARRAY_DRIVES,
+    DEFAULT_INERTIA_NUMBER,
+    PROTOCOLS,
+    build_array,
+    build_array_on,
+    build_drive,
+    build_rig,
+    drive_speed_m_s,
+)
 from spine_mj.sim.detection import Detection, Event
 from spine_mj.sim.drives import Drive, RampDrive, SpringDrive, StaticProbe
 from spine_mj.sim.holding import HOLDING_TOLERANCE, array_ie, holding_excess
@@ -93,6 +102,7 @@ from spine_mj.sim.results import RunResult
 from spine_mj.sim.rig import REFINE_TIMESTEP, Rig
 
 __all__ = [
+    "ARRAY_DRIVES",
     "DEFAULT_INERTIA_NUMBER",
     "DEFAULT_LENGTH_SCALE_M",
     "HOLDING_TOLERANCE",
@@ -129,6 +139,8 @@ __all__ = [
     "StaticProbe",
     "TipParams",
     "array_ie",
+    "build_array",
+    "build_array_on",
     "build_drive",
     "build_rig",
     "characteristic_length",

@@ -23,18 +23,34 @@ Two rules live here:
 from __future__ import annotations
 
 from spine_mj.errors import SpineInputError, check_positive
+from spine_mj.sim.array import ArrayRig
+from spine_mj.sim.array_run import ArrayDrive, ForcePull
 from spine_mj.sim.drives import Drive, RampDrive, SpringDrive, StaticProbe, spring_stiffness_n_m
+from spine_mj.sim.holding import array_ie
+from spine_mj.sim.layout import Layout
 from spine_mj.sim.params import Cone, Integrator, Scales, TipParams, default_engine
 from spine_mj.sim.rig import Rig
 from spine_mj.surfaces import GridSurface, Surface
 
-__all__ = ["DEFAULT_INERTIA_NUMBER", "PROTOCOLS", "build_drive", "build_rig", "drive_speed_m_s"]
+__all__ = [
+    "ARRAY_DRIVES",
+    "DEFAULT_INERTIA_NUMBER",
+    "PROTOCOLS",
+    "build_array",
+    "build_array_on",
+    "build_drive",
+    "build_rig",
+    "drive_speed_m_s",
+]
 
 #: The inertia number of a drive given no speed, rate or I_e.
 DEFAULT_INERTIA_NUMBER = 1e-3
 
 #: The drive protocols, by the names the CLI and sweep configs use.
 PROTOCOLS = ("spring", "ramp", "static")
+
+#: An array's carriage drives (``spine-mj array --drive``, a sweep's ``array_drive``).
+ARRAY_DRIVES = ("speed", "force")
 
 
 def drive_speed_m_s(
@@ -186,6 +202,101 @@ def build_drive(
             slide_distance_m=slide_distance_m,
         )
     raise SpineInputError(f"protocol must be one of {', '.join(PROTOCOLS)}, got {protocol!r}")
+
+
+def build_array(
+    rig: Rig,
+    layout: Layout,
+    drive: str = "speed",
+    *,
+    ie: float | None = None,
+    speed_m_s: float | None = None,
+    stiffness_number: float | None = None,
+    stiffness_n_m: float | None = None,
+    duration_s: float | None = None,
+    settle_time_s: float | None = None,
+) -> tuple[ArrayRig, ArrayDrive]:
+    """An array of ``layout`` on ``rig``'s surface and tip, and its carriage's drive: the
+    one way ``spine-mj array`` and a sweep's ``array`` analysis make them.
+
+    Parameters
+    ----------
+    drive : {"speed", "force"}
+        ``speed``: the carriage moves at the drive's speed, each spine on its spring (the
+        spring drive of :func:`build_drive`); ``force``: a free carriage pulled by a
+        force whose rate per spine has the drive speed's equivalent
+        (:meth:`Scales.force_rate_for`, :class:`~spine_mj.sim.ForcePull`).
+    ie, speed_m_s
+        The pace, as for :func:`drive_speed_m_s` (none: ``I_e =`` :data:`DEFAULT_INERTIA_NUMBER`).
+    stiffness_number, stiffness_n_m
+        Each spring's stiffness as ``K = k l_s / F_p`` or in N/m (none: the drives' default).
+    duration_s
+        Run time of a speed drive (None: to the far edge); a force pull runs to its cap.
+    settle_time_s
+        Settle phase before the drive starts (None: the drives' default).
+
+    Raises
+    ------
+    SpineInputError
+        An unknown ``drive``, a ``duration_s`` for a force pull, or any value out of range.
+    """
+    if drive not in ARRAY_DRIVES:
+        raise SpineInputError(f"array drive must be one of {', '.join(ARRAY_DRIVES)}, got {drive!r}")
+    if stiffness_number is not None:
+        stiffness_n_m = rig.scales.stiffness_for(check_positive("K", stiffness_number))
+    if drive == "speed":
+        carriage = build_drive(
+            rig.scales,
+            "spring",
+            ie=ie,
+            speed_m_s=speed_m_s,
+            stiffness_n_m=stiffness_n_m,
+            duration_s=duration_s,
+            settle_time_s=settle_time_s,
+        )
+    else:
+        if duration_s is not None:
+            raise SpineInputError("duration is for the speed drive (a force pull runs to its cap)")
+        speed = drive_speed_m_s(rig.scales, ie=ie, speed_m_s=speed_m_s)
+        carriage = ForcePull(
+            rate_n_s=rig.scales.force_rate_for(speed),
+            stiffness_n_m=stiffness_n_m,
+            settle_time_s=settle_time_s,
+        )
+    return ArrayRig(rig, layout, force_control=drive == "force"), carriage
+
+
+def build_array_on(
+    surface: Surface,
+    layout: Layout,
+    drive: str = "speed",
+    *,
+    mu: float,
+    ie: float | None = None,
+    stiffness_number: float | None = None,
+    stiffness_n_m: float | None = None,
+    duration_s: float | None = None,
+    settle_time_s: float | None = None,
+    **rig_options,
+) -> tuple[ArrayRig, ArrayDrive, float]:
+    """An array of ``layout`` on ``surface`` at the arrays' own pace (``spine-mj array``):
+    the rig of ``mu`` and ``rig_options`` (:func:`build_rig`'s keywords), its array and
+    drive (:func:`build_array`), and the inertia number they run at.
+
+    ``ie`` None: :func:`~spine_mj.sim.holding.array_ie`, the fastest pace whose predicted
+    holding excess stays within :data:`~spine_mj.sim.holding.HOLDING_TOLERANCE` ``mu F_p``
+    per spine; the rig is built for that pace and spring (they bound the engine step).
+    """
+    springs = {"stiffness_number": stiffness_number, "stiffness_n_m": stiffness_n_m}
+    if ie is None:
+        scales = build_rig(surface, mu=mu, **springs, **rig_options).scales
+        k = spring_stiffness_n_m(scales, **springs)
+        ie = array_ie(scales, mu=mu, force_control=drive == "force", stiffness_n_m=k)
+    rig = build_rig(surface, mu=mu, ie=check_positive("I_e", ie), **springs, **rig_options)
+    arr, carriage = build_array(
+        rig, layout, drive, ie=ie, **springs, duration_s=duration_s, settle_time_s=settle_time_s
+    )
+    return arr, carriage, ie
 
 
 def _given(**values) -> dict:

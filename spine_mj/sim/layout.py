@@ -59,7 +59,7 @@ class Layout:
     spacing_unit : SpacingUnit or str
         ``surface`` (surface units), ``l_s`` or ``L_c``.
     seed : int
-        Seed of the random pattern (ignored by the grids).
+        Seed of the random pattern, >= 0 (ignored by the grids).
     """
 
     kind: LayoutKind | str = LayoutKind.GRID
@@ -91,6 +91,8 @@ class Layout:
                 f"= {self.n_spines}"
             )
         object.__setattr__(self, "spacing", check_positive("spacing", self.spacing))
+        if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)) or self.seed < 0:
+            raise SpineInputError(f"layout seed must be an integer >= 0, got {self.seed!r}")
 
     @property
     def n_spines(self) -> int:

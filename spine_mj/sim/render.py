@@ -96,8 +96,7 @@ def streamline_path_m(rig: RigModel, start: tuple[float, float]) -> np.ndarray:
     rig's mu_s, on the surface dilated by the tip radius (what the rig's sphere rides on)."""
     s = rig.length_scale_m
     radius = rig.tip.tip_radius_m / s
-    xmin, xmax, ymin, ymax = rig.surface.bounds
-    params = sl.StreamlineParams(mu=rig.tip.mu_s, dl=max(xmax - xmin, ymax - ymin) / 1000)
+    params = sl.StreamlineParams(mu=rig.tip.mu_s, dl=sl.default_step(rig.surface))
     path = sl.streamlines(sl.dilate(rig.surface, radius), [start], params).path(0)
     return s * np.column_stack([path["x"], path["y"], path["z"] + radius])
 

@@ -7,7 +7,6 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy import ndimage
 
 from spine_mj.errors import SpineInputError, check_positive
 from spine_mj.surfaces.base import (
@@ -287,6 +286,8 @@ class GridSurface(Surface):
         x, y = coords["x"], coords["y"]
         dx, dy = (x[-1] - x[0]) / (nx - 1), (y[-1] - y[0]) / (ny - 1)
         periodic = _flag("periodic", self.periodic)
+        from scipy import ndimage  # on demand: a grid's spline; scipy.ndimage takes ~0.3 s to import
+
         if periodic:
             coef = np.pad(ndimage.spline_filter(heights, order=3, mode="grid-wrap"), 2, mode="wrap")
             offset = 2

@@ -45,7 +45,7 @@ from pydantic import (
     model_validator,
 )
 
-from spine_mj import examples, presets, surface_io
+from spine_mj import examples, presets
 from spine_mj.errors import SpineInputError
 from spine_mj.jsonio import to_jsonable
 from spine_mj.sweep.registry import ANALYSES, PRESET_MU, REQUIRED, ParamSpec, param_specs
@@ -672,15 +672,10 @@ def digest(obj) -> str:
 
 @functools.lru_cache(maxsize=8)
 def _make_surface(spec: SurfaceSpec, stamp=None):
-    if spec.kind == "file":
-        path = Path(spec.source)
-        if path.suffix == ".npz":
-            return surface_io.load_surface(path)
-        return surface_io.import_topography(path)
     overrides = {k: _thaw(v) for k, v in spec.overrides}
     if spec.seed is not None:
         overrides["seed"] = spec.seed
-    return presets.make_surface(spec.source, **overrides)
+    return presets.open_surface(spec.source, **overrides)
 
 
 def _thaw(value):

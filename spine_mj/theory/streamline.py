@@ -56,10 +56,12 @@ from spine_mj.theory.engagement import (
 from spine_mj.theory.multicontact import two_contact_kappa
 
 __all__ = [
+    "DEFAULT_STEP_FRACTION",
     "Outcome",
     "StreamlineParams",
     "StreamlineResult",
     "check_step",
+    "default_step",
     "dilate",
     "ideal_trajectories",
     "streamlines",
@@ -404,6 +406,18 @@ def _trajectories(surface, starts, params, *, ideal, store_paths, backend):
         kappa=pk,
         region=pr,
     )
+
+
+#: The step of a streamline given no ``dl``, as a fraction of the domain's longer side.
+DEFAULT_STEP_FRACTION = 1e-3
+
+
+def default_step(surface: Surface) -> float:
+    """The streamline step ``dl`` when none is given: :data:`DEFAULT_STEP_FRACTION` of the
+    longer side of ``surface.bounds`` (surface units), what ``spine-mj streamline`` and the
+    streamline drawn beside a MuJoCo run use."""
+    xmin, xmax, ymin, ymax = surface.bounds
+    return DEFAULT_STEP_FRACTION * max(xmax - xmin, ymax - ymin)
 
 
 def streamlines(

@@ -51,7 +51,13 @@ def test_array_writes_curve_spines_summary_and_figure(tmp_path):
         (("--rows", "20", "--cols", "20"), "at most 256 spines"),
         (("--rows", "0"), "rows must be an integer >= 1"),
         (("--spacing", "nan"), "spacing"),
-        (("--drive", "force", "--duration", "1"), "--duration is for --drive speed"),
+        (
+            ("--drive", "force", "--duration", "1"),
+            "--drive force (a pull runs to its cap) does not use --duration",
+        ),
+        (("--layout", "random", "--seed", "-1"), "--seed"),
+        (("--layout", "grid", "--seed", "5"), "--layout grid does not use --seed"),
+        (("--layout", "staggered", "--seed", "0"), "--layout staggered does not use --seed"),
         (("--centre", "100,0"), "puts spine"),
     ],
 )

@@ -129,6 +129,34 @@ def test_sweep_refuses_worker_wait_without_a_scheduler(tmp_path):
     )
 
 
+def test_sweep_on_a_scheduler_refuses_local_workers(tmp_path):
+    config = tmp_path / "c.toml"
+    config.write_text('[[surfaces]]\npreset = "paper-single-peak"\n[starts]\npoints = [[0.1, 0.5]]\n')
+    (tmp_path / "keep").mkdir()
+    refused(
+        [
+            "sweep",
+            "run",
+            config,
+            "--out",
+            tmp_path / "keep" / "out",
+            "--scheduler",
+            "tcp://nowhere:1",
+            "--workers",
+            "2",
+        ],
+        tmp_path / "keep",
+        ["--workers"],
+    )
+
+
+def test_surface_info_without_a_mu_refuses_a_tip_radius(tmp_path):
+    scan = "example:plu-1.plu"  # a measured scan: no preset mu_s
+    refused(["surface", "info", scan, "--tip-radius", "1e-6"], tmp_path, ["--tip-radius"])
+    result = CliRunner().invoke(main, ["surface", "info", scan, "--tip-radius", "1e-6", "--mu", "0.5"])
+    assert result.exit_code == 0 and "drive limits (mu_s 0.5)" in result.output, result.output
+
+
 @pytest.fixture(scope="module")
 def recorded_run(tmp_path_factory):
     run_dir = tmp_path_factory.mktemp("replay") / "run"

@@ -17,7 +17,7 @@ import numpy as np
 
 from spine_mj import sim
 from spine_mj.sim.layout import MAX_SPINES
-from spine_mj.sweep.analyses.mujoco import MUJOCO_PARAMS, case_drive, case_rig
+from spine_mj.sweep.analyses.mujoco import MUJOCO_PARAMS, case_rig
 from spine_mj.sweep.registry import CASE_THREADS, Analysis, AnalysisResult, ParamSpec, register_analysis
 
 ARRAY_PARAMS = (
@@ -35,7 +35,7 @@ ARRAY_PARAMS = (
         "str",
         "speed: the carriage moves at the drive speed; force: a free carriage pulled by a rising force",
         "speed",
-        choices=("speed", "force"),
+        choices=sim.ARRAY_DRIVES,
         array=True,
     ),
 )
@@ -43,8 +43,6 @@ ARRAY_PARAMS = (
 
 def _array(case, surface, starts, upstream):
     p = case.params
-    rig = case_rig(case, surface)
-    sc = rig.scales
     layout = sim.Layout(
         kind=p["layout"],
         rows=p["rows"],
@@ -53,16 +51,17 @@ def _array(case, surface, starts, upstream):
         spacing_unit=p["spacing_unit"],
         seed=p["layout_seed"],
     )
-    force = p["array_drive"] == "force"
-    arr = sim.ArrayRig(rig, layout, force_control=force)
-    if force:
-        speed = sim.drive_speed_m_s(sc, ie=p["ie"], speed_m_s=p["speed"])
-        stiffness = p["stiffness"] if p["K"] is None else sc.stiffness_for(p["K"])
-        drive = sim.ForcePull(
-            rate_n_s=sc.force_rate_for(speed), stiffness_n_m=stiffness, settle_time_s=p["settle_time"]
-        )
-    else:
-        drive = case_drive(rig, {**p, "protocol": "spring"})
+    arr, drive = sim.build_array(
+        case_rig(case, surface),
+        layout,
+        p["array_drive"],
+        ie=p["ie"],
+        speed_m_s=p["speed"],
+        stiffness_number=p["K"],
+        stiffness_n_m=p["stiffness"],
+        duration_s=None if p["array_drive"] == "force" else p["duration"],
+        settle_time_s=p["settle_time"],
+    )
     det = sim.Detection(kappa_cap=p["kappa_cap"])
     runs = arr.run_batch(drive, [tuple(s) for s in starts], detection=det, nthread=CASE_THREADS.get())
     trouble = np.array([r.end_reason == "engine_trouble" for r in runs])

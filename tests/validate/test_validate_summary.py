@@ -1,0 +1,36 @@
+"""The validation's headline lines, read from the committed full and quick results."""
+
+import json
+from pathlib import Path
+
+import pytest
+
+from spine_mj.validate.summary import summary_lines
+
+REPORTS = Path(__file__).parents[2] / "analysis" / "reports"
+
+
+@pytest.mark.parametrize("plan", ["validation-full", "validation-quick"])
+def test_summary_lines_state_the_headline_numbers(plan):
+    result = json.loads((REPORTS / plan / "validation.json").read_text())
+    lines = summary_lines(result)
+    assert lines[0].endswith(f"{result['static_kappa_max_rel_error']:.3g}")
+    families = [line for line in lines if line.startswith(f"I_e = {result['lowest_ie']:g}, ")]
+    assert len(families) == len(result["limit_families"])
+    for (fam, summ), line in zip(result["limit_families"].items(), families, strict=True):
+        assert f", {fam}: outcome agreement {summ['outcome_agreement']:.0%} of {summ['runs']}," in line
+    for proto, star in result["ie_star"].items():
+        assert any(line.startswith(f"I_e* ({proto})") for line in lines), proto
+        if star.get("kind") == "bracketed":
+            assert f"  I_e* = {star['value']:.3g} in [{star['low']:.3g}, {star['high']:.3g}]" in lines
+    assert all("\n" not in line for line in lines)
+
+
+def test_a_plan_without_the_optional_studies_gives_no_line_for_them():
+    result = json.loads((REPORTS / "validation-full" / "validation.json").read_text())
+    bare = {k: v for k, v in result.items() if k not in ("fractal_lock_rate", "arrays")}
+    lines = summary_lines(bare)
+    assert not any(line.startswith(("fractal self-lock", "arrays:")) for line in lines)
+    assert len(lines) < len(summary_lines(result)) or not (
+        result.get("fractal_lock_rate") or result.get("arrays")
+    )
