@@ -175,6 +175,12 @@ class ValidationPlan:
         Runs per start of the quasistatic-limit study, on each side: the start and
         ``ensemble_members - 1`` starts around it (:mod:`spine_mj.validate.ensembles`);
         1: no ensembles (no start is found ill-conditioned).
+    convergence_starts : int
+        Y starts per surface of each corner family rerun under refinement (solution
+        verification, :mod:`spine_mj.validate.convergence`; 0: none).
+    convergence_refinements : tuple of str
+        The refinements (keys of :data:`spine_mj.validate.convergence.REFINEMENTS`); with
+        ``dt_quartered`` beside ``dt_halved`` three step levels give an observed order.
     corner : tuple of (family name, seeds, starts)
         The quasistatic-limit study's own seeds and starts table per family (the corner's
         sample size), where they differ from the family's (which the boundary study and the
@@ -220,6 +226,8 @@ class ValidationPlan:
     stiffness_map_runs: int = 0
     ensemble_members: int = 1
     corner: tuple[tuple[str, Any, tuple], ...] = ()
+    convergence_starts: int = 0
+    convergence_refinements: tuple[str, ...] = ("dt_halved", "hfield_doubled")
     extra: dict = field(default_factory=dict, compare=False)
 
     def map_family(self, fam: FamilySpec) -> FamilySpec:
@@ -311,6 +319,7 @@ PLANS: dict[str, ValidationPlan] = {
         ground_truth_waves=3,
         ground_truth_ridge_widths=(0.5,),
         ground_truth_liftoff_factors=(0.5, 1.5),
+        convergence_starts=1,
     ),
     "quick": ValidationPlan(
         name="quick",
@@ -350,6 +359,8 @@ PLANS: dict[str, ValidationPlan] = {
             ("fractal", (1, 2, 3), relative_starts(6)),
             ("sandpaper", None, relative_starts(12, 0.25)),
         ),
+        # solution verification: 2 starts a surface (26 runs a refinement over the families)
+        convergence_starts=2,
         stiffness_map_ie=(1e-2, 1.0),
         stiffness_map_k=(1.0, 10.0, 100.0),
         stiffness_map_families=("single_peak_valley", "random_gaussian", "fractal"),
@@ -412,5 +423,9 @@ PLANS: dict[str, ValidationPlan] = {
             ("fractal", (1, 2, 3, 4, 5), relative_starts(12)),
             ("sandpaper", None, relative_starts(12, 0.25)),
         ),
+        # solution verification on 3 starts a surface (81 runs a refinement), three step
+        # levels for an observed order
+        convergence_starts=3,
+        convergence_refinements=("dt_halved", "dt_quartered", "hfield_doubled"),
     ),
 }

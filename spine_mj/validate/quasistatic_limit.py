@@ -9,13 +9,14 @@ smooth surface (the total), and the two streamlines against each other (the geom
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
 
 from spine_mj.compare import MISS_REASONS
 from spine_mj.presets import calibrated_mu
+from spine_mj.validate.convergence import REFINEMENTS, family_convergence, refinable, thin_starts
 from spine_mj.validate.ensembles import ensemble_family, ensemble_groups, ensemble_verdicts
 from spine_mj.validate.intervals import bootstrap, meets_target, wilson
 from spine_mj.validate.paths import stored_paths, tip_radius
@@ -91,6 +92,11 @@ class QuasistaticLimitResult:
     paths : dict
         Preset of the single peak/valley family -> list of :class:`LimitPath`.
     lowest_ie : float
+    convergence : dict
+        Family -> its solution verification
+        (:func:`~spine_mj.validate.convergence.family_convergence`): per refinement
+        (``dt_halved``, ``hfield_doubled``, ...) the change of each headline and whether it
+        is converged; empty where the plan refines nothing.
     """
 
     families: dict[str, dict]
@@ -98,6 +104,7 @@ class QuasistaticLimitResult:
     variations: dict[str, dict]
     paths: dict[str, list[LimitPath]]
     lowest_ie: float
+    convergence: dict = field(default_factory=dict)
 
     def validation_keys(self) -> dict:
         """This study's keys of ``validation.json``."""
@@ -110,6 +117,7 @@ class QuasistaticLimitResult:
             "failed_runs": {k: v["failed_runs"] for k, v in fams.items()},
             "limit_families": fams,
             "limit_variations": self.variations,
+            "convergence": self.convergence,
         }
 
     def as_dict(self) -> dict:
@@ -119,6 +127,7 @@ class QuasistaticLimitResult:
             "variations": self.variations,
             "paths": {k: [p.as_dict() for p in v] for k, v in self.paths.items()},
             "lowest_ie": self.lowest_ie,
+            "convergence": self.convergence,
         }
 
 
@@ -142,12 +151,17 @@ def quasistatic_limit(plan: ValidationPlan, runner: StudyRunner) -> QuasistaticL
     corner = [plan.corner_family(fam) for fam in plan.families]
     docs = [(fam, name, doc) for fam in corner for name, doc in limit_family_docs(plan, fam)]
     variations = _variation_docs(plan)
+    refinements = _refinement_docs(plan, corner)
     # every sweep of the study at once: the workers stay busy across the sweeps' ends
     done = runner.many(
-        [(doc, f"limit/{name}") for _, name, doc in docs] + [(doc, name) for _, name, doc in variations],
-        "corner and engine variations",
+        [(doc, f"limit/{name}") for _, name, doc in docs]
+        + [(doc, name) for _, name, doc in variations]
+        + [(doc, name) for _, _, name, doc in refinements],
+        "corner, engine variations and refinements",
     )
     swept = dict(zip([name for _, name, _ in docs], done[: len(docs)]))
+    refined_done = done[len(docs) + len(variations) :]
+    convergence = {}
     for fam in corner:
         groups: list[dict] = []
         comps = [_sweep_comparison(plan, fam, *swept[name], paths, groups) for f, name, _ in docs if f is fam]
@@ -188,6 +202,9 @@ def quasistatic_limit(plan: ValidationPlan, runner: StudyRunner) -> QuasistaticL
         )
         ill = summ.pop("ill_conditioned")
         families[fam.name] = summ
+        if plan.convergence_starts > 0:
+            refined = _refined_rows(fam.name, plan.convergence_refinements, refinements, refined_done)
+            convergence[fam.name] = family_convergence(summ, allc, refined)
         for _, r in allc.iterrows():
             row = {k: _plain(r[k]) for k in RUN_COLUMNS if k != "ill_conditioned"}
             row["ill_conditioned"] = ill.get(f"{r['case_id']}/{int(r['start'])}", "")
@@ -195,10 +212,40 @@ def quasistatic_limit(plan: ValidationPlan, runner: StudyRunner) -> QuasistaticL
     return QuasistaticLimitResult(
         families=families,
         runs=runs_rows,
-        variations=_variations(plan, variations, done[len(docs) :], runs_rows),
+        variations=_variations(plan, variations, done[len(docs) : len(docs) + len(variations)], runs_rows),
         paths=paths,
         lowest_ie=plan.lowest_ie,
+        convergence=convergence,
     )
+
+
+def _refinement_docs(plan: ValidationPlan, corner: list[FamilySpec]) -> list[tuple[str, str, str, dict]]:
+    """``(family, refinement key, store name, config)`` of every refinement of every corner
+    family's thinned starts (:func:`~spine_mj.validate.convergence.thin_starts`), one per
+    preset the refinement changes (:func:`~spine_mj.validate.convergence.refinable`)."""
+    if plan.convergence_starts <= 0:
+        return []
+    out = []
+    for fam in corner:
+        thin = thin_starts(fam, plan.convergence_starts)
+        for key in plan.convergence_refinements:
+            for preset in fam.presets:
+                if refinable(preset, fam.seeds, key):
+                    doc = limit_doc(plan, thin, preset, f"limit-refined-{key}-{preset}", REFINEMENTS[key])
+                    out.append((fam.name, key, f"limit-refined/{key}/{preset}", doc))
+    return out
+
+
+def _refined_rows(family: str, keys, refinements, results) -> dict[str, pd.DataFrame | None]:
+    """Refinement key -> the comparison rows of ``family``'s refined sweeps (one run per
+    start; ``refinements`` of :func:`_refinement_docs` and their sweeps' ``results``), None
+    where no preset of the family could be refined."""
+    out: dict[str, pd.DataFrame | None] = {key: None for key in keys}
+    for (fam, key, _, _), (df, _) in zip(refinements, results):
+        if fam == family:
+            rows = df[df["analysis"] == "compare"]
+            out[key] = rows if out[key] is None else pd.concat([out[key], rows], ignore_index=True)
+    return out
 
 
 def limit_doc(plan: ValidationPlan, fam: FamilySpec, preset: str, name: str, overrides=()) -> dict:
@@ -206,11 +253,12 @@ def limit_doc(plan: ValidationPlan, fam: FamilySpec, preset: str, name: str, ove
     both sides (``overrides``: an engine variation)."""
     res = dict(overrides).get("hfield_resolution", plan.hfield_resolution)
     tip = tip_radius(preset, fam.seeds, res)
+    mu = fam.mu if fam.mu is not None else calibrated_mu(preset)
     grid = {
-        "mu": fam.mu if fam.mu is not None else calibrated_mu(preset),
+        "mu": mu,
         "tip_radius": tip,
         "dl": tip / 2,
-        **engine_grid(plan, overrides, preset, fam.seeds, tip),
+        **engine_grid(plan, overrides, preset, fam.seeds, tip, mu=mu, ie=plan.lowest_ie),
     }
     members = plan.ensemble_members if not overrides else 1
     if members > 1:

@@ -5,6 +5,8 @@ self-lock rates, the arrays' pooled differences and I_e* per protocol, read from
 
 from __future__ import annotations
 
+from spine_mj.validate.convergence import unconverged_mark
+
 __all__ = ["summary_lines"]
 
 
@@ -16,9 +18,12 @@ def summary_lines(result: dict) -> list[str]:
     ]
     for fam, summ in result["limit_families"].items():
         stops = ", ".join(f"{k} {n}" for k, n in summ["failed_runs"].items()) or "none"
+        conv = result.get("convergence", {}).get(fam)
         lines.append(
-            f"I_e = {result['lowest_ie']:g}, {fam}: outcome agreement {summ['outcome_agreement']:.0%} "
-            f"of {summ['runs']}, median Frechet {summ['median_frechet']:.3g} L_c, engine stops: {stops}"
+            f"I_e = {result['lowest_ie']:g}, {fam}: outcome agreement {summ['outcome_agreement']:.0%}"
+            f"{unconverged_mark(conv, 'outcome_agreement')} of {summ['runs']}, median Frechet "
+            f"{summ['median_frechet']:.3g} L_c{unconverged_mark(conv, 'median_frechet')}, "
+            f"engine stops: {stops}"
         )
     for row in result.get("fractal_lock_rate", {}).get("rows", []):
         rates = ", ".join(

@@ -11,9 +11,19 @@ from collections.abc import Sequence
 from typing import Any
 
 from spine_mj import presets, sim, sweep
+from spine_mj.sim.drives import spring_stiffness_n_m
+from spine_mj.sim.params import surface_unit_m
+from spine_mj.surfaces import GridSurface
 from spine_mj.validate.plans import MASS_KG, FamilySpec, ValidationPlan
 
-__all__ = ["engine_default", "engine_grid", "family_doc", "surfaces_table"]
+__all__ = [
+    "engine_default",
+    "engine_grid",
+    "family_doc",
+    "refined_resolution",
+    "rig_engine",
+    "surfaces_table",
+]
 
 
 def surfaces_table(presets_: Sequence[str], seeds, variants=((),)) -> list[dict]:
@@ -61,21 +71,69 @@ def engine_default(key: str):
     return {p.name: p.default for p in sweep.ANALYSES["mujoco"].parameters}[key]
 
 
+def rig_engine(
+    preset: str,
+    seeds,
+    *,
+    tip: float,
+    mu: float,
+    ie: float,
+    hfield_resolution: int,
+    stiffness_number: float | None = None,
+) -> sim.EngineSettings:
+    """The engine settings the sweep's rig gets for ``preset`` (its first seed), a tip of
+    radius ``tip`` (surface units), mu, the spring drive at ``ie`` and stiffness number
+    ``stiffness_number`` (None: the default spring): the same rule
+    (:func:`spine_mj.sim.default_engine`), from the same speed and stiffness, without
+    compiling a model."""
+    surface = presets.make_surface(preset, **({} if seeds is None else {"seed": seeds[0]}))
+    unit_m = surface_unit_m(surface, None)
+    scales = sim.Scales.for_surface(
+        surface,
+        tip=sim.TipParams(tip_radius_m=tip * unit_m, mass_kg=MASS_KG, mu_s=mu),
+        hfield_resolution=None if isinstance(surface, GridSurface) else hfield_resolution,
+    )
+    speed = sim.drive_speed_m_s(scales, ie=ie)
+    spring = spring_stiffness_n_m(scales, stiffness_number=stiffness_number)
+    return sim.default_engine(scales, speed_m_s=speed, stiffness_n_m=spring)
+
+
+def refined_resolution(resolution: int, factor: int) -> int:
+    """Samples a side ``factor`` times as dense, every old sample kept: ``(n - 1) f + 1``."""
+    return (int(resolution) - 1) * int(factor) + 1
+
+
 def engine_grid(
-    plan: ValidationPlan, overrides: Sequence[tuple[str, Any]], preset: str, seeds, tip: float
+    plan: ValidationPlan,
+    overrides: Sequence[tuple[str, Any]],
+    preset: str,
+    seeds,
+    tip: float,
+    *,
+    mu: float,
+    ie: float,
+    stiffness_number: float | None = None,
 ) -> dict:
-    """Grid keys of an engine variation; ``*_factor`` keys scale the rig's default dt."""
+    """Grid keys of an engine variation. Three keys are relative to the rig's own settings
+    (:func:`rig_engine`): ``timestep_factor`` scales its step with the contact's time
+    constant kept (passed explicitly, so that only the step changes), and
+    ``solref_timeconst_factor`` scales that time constant; ``hfield_factor`` multiplies the
+    samples between the plan's (:func:`refined_resolution`) with the tip kept."""
     out = {"hfield_resolution": plan.hfield_resolution}
     ov = dict(overrides)
+    if "hfield_factor" in ov:
+        out["hfield_resolution"] = refined_resolution(plan.hfield_resolution, ov.pop("hfield_factor"))
     if "timestep_factor" in ov or "solref_timeconst_factor" in ov:
-        surface = presets.make_surface(preset, **({} if seeds is None else {"seed": seeds[0]}))
-        unit_m = sim.DEFAULT_LENGTH_SCALE_M if surface.unit == "1" else 1.0
-        scales = sim.Scales.for_surface(
-            surface, tip=sim.TipParams(tip_radius_m=tip * unit_m, mass_kg=MASS_KG)
+        engine = rig_engine(
+            preset,
+            seeds,
+            tip=tip,
+            mu=mu,
+            ie=ie,
+            hfield_resolution=plan.hfield_resolution,
+            stiffness_number=stiffness_number,
         )
-        dt = sim.default_engine(scales).timestep_s
-        dt_new = dt * float(ov.pop("timestep_factor", 1.0))
-        out["timestep"] = dt_new
-        out["solref_timeconst"] = 2 * dt_new * float(ov.pop("solref_timeconst_factor", 1.0))
+        out["timestep"] = engine.timestep_s * float(ov.pop("timestep_factor", 1.0))
+        out["solref_timeconst"] = engine.solref[0] * float(ov.pop("solref_timeconst_factor", 1.0))
     out.update(ov)
     return out

@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 
 from spine_mj.compare import OUTCOME_TARGET
+from spine_mj.validate.convergence import unconverged_mark
 from spine_mj.validate.ensembles import ENSEMBLE_RADIUS_LC
 from spine_mj.validate.intervals import TARGET_RULE, runs_to_meet
 
@@ -25,12 +26,15 @@ def _ci(pair, digits: int = 3) -> str:
     return f"[{_num(pair[0], digits)}, {_num(pair[1], digits)}]"
 
 
-def verdicts_section(families: dict) -> list[str]:
+def verdicts_section(families: dict, convergence: dict | None = None) -> list[str]:
     """Markdown lines: per family the agreement on well-conditioned starts with its Wilson
     interval, the ill-conditioned share on each side (:mod:`spine_mj.validate.ensembles`),
     the agreement over all starts and the median Frechet distance with their intervals, and
     the verdict under the target rule; ``families`` is ``validation.json``'s
-    ``limit_families``."""
+    ``limit_families``. A headline that a refinement moved outside its interval
+    (``convergence``, family -> :func:`~spine_mj.validate.convergence.family_convergence`)
+    is marked unconverged."""
+    convergence = convergence or {}
     head = [
         "family",
         "agreement, well-conditioned [95 % CI]",
@@ -51,8 +55,10 @@ def verdicts_section(families: dict) -> list[str]:
             f"{f.get('well_conditioned_runs', '-')} / {f.get('starts', f['runs'])} "
             f"({f.get('stopped_starts', 0)})",
             f"{_num(ill.get('mujoco'))} / {_num(ill.get('reference'))}",
-            f"{_num(f['outcome_agreement'])} {_ci(f.get('outcome_agreement_ci'))}",
-            f"{_num(f['median_frechet'])} {_ci(f.get('median_frechet_ci'))}",
+            f"{_num(f['outcome_agreement'])} {_ci(f.get('outcome_agreement_ci'))}"
+            + unconverged_mark(convergence.get(name), "outcome_agreement"),
+            f"{_num(f['median_frechet'])} {_ci(f.get('median_frechet_ci'))}"
+            + unconverged_mark(convergence.get(name), "median_frechet"),
             "yes" if f.get("meets_target") else "no",
         ]
         table.append("| " + " | ".join(row) + " |")

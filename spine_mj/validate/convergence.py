@@ -1,0 +1,241 @@
+"""Solution verification of the quasistatic corner: is a headline the engine's answer, or
+its step's and its hfield's? (docs/physics.md §7; ASME V&V 20, Roache.)
+
+Each family's corner headlines (outcome agreement and median Frechet distance at the
+lowest I_e, :mod:`spine_mj.validate.quasistatic_limit`) are recomputed under refinement
+(:data:`REFINEMENTS`, engine variations of
+:func:`~spine_mj.validate.sweep_configs.engine_grid`):
+
+- ``dt_halved``: the rig's own step halved, the contact's time constant passed explicitly
+  so that only the step changes (and ``dt_quartered``, a third level, where the plan asks
+  for an observed order);
+- ``hfield_doubled``: an analytic surface's hfield at twice the samples a side, every old
+  sample kept and the tip's radius kept; a gridded surface (a generated fractal, a scan)
+  keeps its samples, so there is nothing to refine and the entry says so.
+
+A refinement reruns a subset of the corner's starts (``plan.convergence_starts`` y starts
+per surface, the same points, one run each), and the change of a headline is the paired
+change on those starts: the refined runs' number minus the same number of the corner's own
+runs from those starts. A headline is *converged* under a refinement when the headline
+plus that change lies inside the headline's own 95 % interval (Wilson for the agreement,
+bootstrap for the median): the refinement moves it less than the sample already leaves
+open. With three step levels the observed order and the Richardson estimate follow
+(:func:`observed_order`, :func:`richardson`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from spine_mj import presets
+from spine_mj.errors import SpineInputError
+from spine_mj.surfaces import GridSurface
+from spine_mj.validate.plans import FamilySpec
+
+__all__ = [
+    "HEADLINES",
+    "REFINEMENTS",
+    "REFINEMENT_LABELS",
+    "family_convergence",
+    "is_converged",
+    "observed_order",
+    "paired_change",
+    "refinable",
+    "richardson",
+    "thin_starts",
+    "unconverged_mark",
+]
+
+#: Refinements by their key in ``validation.json``: engine-variation overrides
+#: (:func:`~spine_mj.validate.sweep_configs.engine_grid`).
+REFINEMENTS: dict[str, tuple[tuple[str, Any], ...]] = {
+    "dt_halved": (("timestep_factor", 0.5),),
+    "dt_quartered": (("timestep_factor", 0.25),),
+    "hfield_doubled": (("hfield_factor", 2),),
+}
+
+#: How the report names each refinement.
+REFINEMENT_LABELS = {"dt_halved": "dt / 2", "dt_quartered": "dt / 4", "hfield_doubled": "hfield x 2"}
+
+#: The corner's headlines: key in the family summary -> the key of its 95 % interval.
+HEADLINES = {"outcome_agreement": "outcome_agreement_ci", "median_frechet": "median_frechet_ci"}
+
+#: The names of the changes in ``validation.json`` (the issue's keys).
+CHANGE_KEYS = {"outcome_agreement": "agreement_change", "median_frechet": "median_frechet_change"}
+
+
+def observed_order(fine: float, medium: float, coarse: float, *, ratio: float = 2.0) -> float:
+    """Observed order of convergence from three levels refined by ``ratio`` each:
+    ``p = ln((coarse - medium) / (medium - fine)) / ln(ratio)``.
+
+    NaN where it is undefined: a level not finite, no change between the two finer levels
+    (converged there already, or a rate that flipped no run), or changes of opposite sign
+    (oscillatory convergence, no asymptotic order).
+    """
+    if ratio <= 1:
+        raise ValueError(f"ratio must be > 1, got {ratio!r}")
+    d_coarse, d_fine = coarse - medium, medium - fine
+    if not all(math.isfinite(v) for v in (d_coarse, d_fine)) or d_fine == 0 or d_coarse * d_fine <= 0:
+        return math.nan
+    return math.log(d_coarse / d_fine) / math.log(ratio)
+
+
+def richardson(fine: float, medium: float, order: float, *, ratio: float = 2.0) -> float:
+    """Richardson estimate of the converged value, ``fine + (fine - medium) / (ratio^p - 1)``
+    (NaN without a positive finite ``order``)."""
+    if not (math.isfinite(order) and order > 0):
+        return math.nan
+    return fine + (fine - medium) / (ratio**order - 1.0)
+
+
+def is_converged(value: float, change: float, interval: Sequence[float]) -> bool | None:
+    """Whether ``value + change`` lies inside ``interval`` (the value's own 95 % interval);
+    None where any of them is not finite (nothing was refined, or no interval)."""
+    low, high = (float(b) for b in interval)
+    if not all(math.isfinite(v) for v in (value, change, low, high)):
+        return None
+    return bool(low <= value + change <= high)
+
+
+def refinable(preset: str, seeds, key: str) -> bool:
+    """Whether refinement ``key`` changes anything on ``preset``: a gridded surface keeps its
+    samples, so its hfield cannot be refined."""
+    if key != "hfield_doubled":
+        return True
+    surface = presets.make_surface(preset, **({} if seeds is None else {"seed": seeds[0]}))
+    return not isinstance(surface, GridSurface)
+
+
+def thin_starts(fam: FamilySpec, n: int) -> FamilySpec:
+    """``fam`` with at most ``n`` of its y starts (spread over its list, both ends kept; the
+    same values, so the same points), on all its seeds and generator variants."""
+    if n < 1:
+        raise SpineInputError(f"starts must be >= 1, got {n}")
+    t = dict(fam.starts)
+    ys = tuple(t["y"])
+    if len(ys) > n:
+        idx = np.unique(np.linspace(0, len(ys) - 1, n).round().astype(int))
+        t["y"] = tuple(ys[i] for i in idx)
+    return dataclasses.replace(fam, starts=tuple(t.items()))
+
+
+def _statistic(rows: pd.DataFrame, headline: str) -> float:
+    """A headline over ``rows``: the share agreeing (a run without an outcome disagrees) or
+    the median Frechet distance (NaN without finite ones)."""
+    if not len(rows):
+        return math.nan
+    if headline == "outcome_agreement":
+        return float(rows["agree"].fillna(False).astype(bool).mean())
+    f = rows["frechet"].to_numpy(dtype=float)
+    return float(np.median(f[np.isfinite(f)])) if np.isfinite(f).any() else math.nan
+
+
+def _keys(rows: pd.DataFrame) -> pd.Series:
+    """A start's identity across sweeps: its surface and its point (rounded far below any
+    ensemble offset)."""
+    return (
+        rows["surface"].astype(str)
+        + "@"
+        + rows["start_x"].astype(float).round(9).astype(str)
+        + ","
+        + rows["start_y"].astype(float).round(9).astype(str)
+    )
+
+
+def paired_change(base: pd.DataFrame, refined: pd.DataFrame) -> dict:
+    """Each headline of the corner's own runs ``base`` and of the ``refined`` runs on the
+    starts both have (``surface``, ``start_x``, ``start_y``, ``agree``, ``frechet``), and its
+    change (refined - base), with the number of paired runs ``runs``."""
+    b = base.assign(_key=_keys(base)).drop_duplicates("_key").set_index("_key")
+    r = refined.assign(_key=_keys(refined)).drop_duplicates("_key").set_index("_key")
+    common = b.index.intersection(r.index)
+    b, r = b.loc[common], r.loc[common]
+    out: dict[str, Any] = {"runs": int(len(common))}
+    for headline in HEADLINES:
+        before, after = _statistic(b, headline), _statistic(r, headline)
+        out[headline] = {"base": before, "refined": after, "change": after - before}
+    return out
+
+
+def family_convergence(summary: dict, base: pd.DataFrame, refined: dict[str, pd.DataFrame | None]) -> dict:
+    """A family's ``convergence`` entry of ``validation.json``.
+
+    Parameters
+    ----------
+    summary : dict
+        The family's corner summary (its headlines and their ``*_ci`` intervals).
+    base : DataFrame
+        The corner's own comparison rows of the family.
+    refined : dict
+        Refinement key -> the refined comparison rows (None: not refinable, a gridded
+        surface's hfield).
+
+    Returns
+    -------
+    dict
+        Per refinement: ``refined`` (bool), ``runs`` (paired), ``agreement_change``,
+        ``median_frechet_change`` (NaN where not refined), per headline its base / refined
+        values on the paired starts and ``*_converged`` (:func:`is_converged`), and
+        ``converged``: both headlines (None where not refined). With ``dt_halved`` and
+        ``dt_quartered``, ``dt_order``: per headline the observed order of the three step
+        levels on the paired starts and the Richardson estimate. ``converged`` at the top:
+        every refined verdict true (None where nothing was refined).
+    """
+    out: dict[str, Any] = {}
+    for key, rows in refined.items():
+        entry: dict[str, Any] = {"refined": rows is not None}
+        if rows is None:
+            entry.update(
+                runs=0,
+                note="gridded surfaces keep their samples: no hfield to refine",
+                converged=None,
+                **{name: math.nan for name in CHANGE_KEYS.values()},
+            )
+            out[key] = entry
+            continue
+        pc = paired_change(base, rows)
+        entry["runs"] = pc["runs"]
+        verdicts = []
+        for headline, ci_key in HEADLINES.items():
+            change = pc[headline]["change"]
+            ok = is_converged(summary[headline], change, summary[ci_key])
+            entry[CHANGE_KEYS[headline]] = change
+            entry[headline] = {"base": pc[headline]["base"], "refined": pc[headline]["refined"]}
+            entry[f"{headline}_converged"] = ok
+            verdicts.append(ok)
+        entry["converged"] = None if any(v is None for v in verdicts) else all(verdicts)
+        out[key] = entry
+    if out.get("dt_halved", {}).get("refined") and out.get("dt_quartered", {}).get("refined"):
+        order = {}
+        for headline in HEADLINES:
+            coarse = out["dt_halved"][headline]["base"]
+            medium = out["dt_halved"][headline]["refined"]
+            fine = out["dt_quartered"][headline]["refined"]
+            p = observed_order(fine, medium, coarse)
+            order[headline] = {"order": p, "richardson": richardson(fine, medium, p)}
+        out["dt_order"] = order
+    verdicts = [e["converged"] for e in out.values() if isinstance(e, dict) and "converged" in e]
+    known = [v for v in verdicts if v is not None]
+    out["converged"] = all(known) if known else None
+    return out
+
+
+def unconverged_mark(convergence: dict | None, headline: str) -> str:
+    """What to write after a headline quoted anywhere: `` (unconverged: dt / 2, ...)``
+    naming the refinements that moved it outside its interval (a family's ``convergence``
+    entry, ``headline`` a key of :data:`HEADLINES`); empty where none did or nothing was
+    refined."""
+    if not convergence:
+        return ""
+    moved = [
+        REFINEMENT_LABELS.get(key, key)
+        for key, entry in convergence.items()
+        if isinstance(entry, dict) and entry.get(f"{headline}_converged") is False
+    ]
+    return f" (unconverged: {', '.join(moved)})" if moved else ""

@@ -1,0 +1,181 @@
+"""Solution verification of the corner: observed order, Richardson, the converged verdict,
+the paired change, and the refined sweeps' engine keys."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from spine_mj import presets, sim
+from spine_mj.validate.convergence import (
+    family_convergence,
+    is_converged,
+    observed_order,
+    paired_change,
+    refinable,
+    richardson,
+    thin_starts,
+)
+from spine_mj.validate.paths import tip_radius
+from spine_mj.validate.plans import MASS_KG, PLANS, FamilySpec, paper_starts, relative_starts
+from spine_mj.validate.quasistatic_limit import limit_doc
+from spine_mj.validate.sweep_configs import engine_grid, refined_resolution, rig_engine
+
+
+@pytest.mark.parametrize("order", [1.0, 2.0, 0.5])
+@pytest.mark.parametrize("ratio", [2.0, 3.0])
+def test_observed_order_and_richardson_recover_a_power_law_sequence(order, ratio):
+    # f(h) = f0 + C h^p at h, h / r, h / r^2: the order is p and Richardson gives f0 exactly
+    f0, c, h = 0.87, -0.3, 0.1
+    coarse, medium, fine = (f0 + c * (h / ratio**i) ** order for i in range(3))
+    p = observed_order(fine, medium, coarse, ratio=ratio)
+    assert p == pytest.approx(order, rel=1e-9)
+    assert richardson(fine, medium, p, ratio=ratio) == pytest.approx(f0, abs=1e-12)
+
+
+def test_observed_order_is_undefined_without_a_monotone_change():
+    assert math.isnan(observed_order(1.0, 1.0, 0.9))  # no change between the finer two
+    assert math.isnan(observed_order(1.0, 0.9, 1.0))  # oscillatory
+    assert math.isnan(observed_order(float("nan"), 0.9, 1.0))
+    assert math.isnan(richardson(1.0, 0.9, float("nan")))
+    assert math.isnan(richardson(1.0, 0.9, -1.0))
+    with pytest.raises(ValueError, match="ratio must be > 1"):
+        observed_order(1.0, 0.9, 0.8, ratio=1.0)
+
+
+def test_converged_means_the_refined_value_stays_inside_the_interval():
+    assert is_converged(0.9, 0.05, (0.8, 0.96)) is True
+    assert is_converged(0.9, 0.07, (0.8, 0.96)) is False
+    assert is_converged(0.9, -0.1, (0.8, 0.96)) is True  # the low end is inside
+    assert is_converged(0.9, -0.11, (0.8, 0.96)) is False
+    assert is_converged(0.9, float("nan"), (0.8, 0.96)) is None
+    assert is_converged(0.9, 0.0, (float("nan"), float("nan"))) is None
+
+
+def _rows(surface, ys, agree, frechet):
+    return pd.DataFrame(
+        {
+            "surface": surface,
+            "start_x": -3.0,
+            "start_y": np.asarray(ys, float),
+            "agree": agree,
+            "frechet": np.asarray(frechet, float),
+        }
+    )
+
+
+def test_the_change_is_paired_on_the_starts_both_sides_ran():
+    base = _rows("peak", [-1.0, -2.0, -3.0, -4.0], [True, True, False, np.nan], [0.01, 0.02, 0.5, np.nan])
+    # the refined runs: two of the base's starts (one flips to agreeing) and one it never ran
+    refined = _rows("peak", [-2.0, -3.0, -9.0], [True, True, False], [0.03, 0.04, 9.0])
+    pc = paired_change(base, refined)
+    assert pc["runs"] == 2
+    assert pc["outcome_agreement"] == {"base": 0.5, "refined": 1.0, "change": 0.5}
+    assert pc["median_frechet"]["base"] == pytest.approx(0.26)
+    assert pc["median_frechet"]["refined"] == pytest.approx(0.035)
+    # another surface's start at the same point is another start
+    assert paired_change(base, _rows("valley", [-2.0], [True], [0.1]))["runs"] == 0
+
+
+def test_a_family_is_converged_only_where_every_refinement_keeps_its_numbers_inside():
+    ys = np.linspace(-1, -4, 10)
+    agree = [True] * 9 + [False]
+    base = _rows("peak", ys, agree, np.full(10, 0.010))
+    summary = {
+        "outcome_agreement": 0.9,
+        "outcome_agreement_ci": [0.6, 1.0],
+        "median_frechet": 0.010,
+        "median_frechet_ci": [0.009, 0.012],
+    }
+    halved = _rows("peak", ys, agree, np.full(10, 0.011))  # a change inside both intervals
+    quartered = _rows("peak", ys, agree, np.full(10, 0.0115))
+    finer_hfield = _rows("peak", ys, [True] * 10, np.full(10, 0.02))  # the Frechet leaves its interval
+    out = family_convergence(
+        summary, base, {"dt_halved": halved, "dt_quartered": quartered, "hfield_doubled": finer_hfield}
+    )
+    assert out["dt_halved"]["converged"] is True
+    assert out["dt_halved"]["runs"] == 10
+    assert out["dt_halved"]["agreement_change"] == 0.0
+    assert out["dt_halved"]["median_frechet_change"] == pytest.approx(0.001)
+    assert out["hfield_doubled"]["agreement_change"] == pytest.approx(0.1)
+    assert out["hfield_doubled"]["outcome_agreement_converged"] is True
+    assert out["hfield_doubled"]["median_frechet_converged"] is False
+    assert out["hfield_doubled"]["converged"] is False
+    assert out["converged"] is False
+    # three step levels, changes 0.001 then 0.0005: first order, converged value 0.012
+    order = out["dt_order"]["median_frechet"]
+    assert order["order"] == pytest.approx(1.0)
+    assert order["richardson"] == pytest.approx(0.012)
+    assert math.isnan(out["dt_order"]["outcome_agreement"]["order"])  # no run flipped
+
+
+def test_a_gridded_family_says_its_hfield_was_not_refined():
+    base = _rows("fractal", [0.2, 0.8], [True, True], [0.01, 0.01])
+    summary = {
+        "outcome_agreement": 1.0,
+        "outcome_agreement_ci": [0.3, 1.0],
+        "median_frechet": 0.01,
+        "median_frechet_ci": [0.01, 0.01],
+    }
+    out = family_convergence(summary, base, {"dt_halved": base, "hfield_doubled": None})
+    hf = out["hfield_doubled"]
+    assert hf["refined"] is False and hf["converged"] is None and "gridded" in hf["note"]
+    assert math.isnan(hf["agreement_change"]) and math.isnan(hf["median_frechet_change"])
+    assert out["converged"] is True  # decided by what was refined
+    assert not refinable("paper-fractal", (1,), "hfield_doubled")
+    assert refinable("paper-fractal", (1,), "dt_halved")
+    assert refinable("paper-single-peak", None, "hfield_doubled")
+
+
+def test_thin_starts_keeps_the_same_points_on_every_surface():
+    fam = FamilySpec(
+        "f", ("a",), (1, 2, 3), relative_starts(6), variants=((("hurst", 0.7),), (("hurst", 0.9),))
+    )
+    thin = thin_starts(fam, 2)
+    ys = dict(fam.starts)["y"]
+    assert dict(thin.starts)["y"] == (ys[0], ys[-1])
+    assert thin.seeds == fam.seeds and thin.variants == fam.variants
+    assert thin_starts(fam, 10) == fam
+
+
+def test_the_rigs_engine_is_the_sweeps_and_a_halved_step_keeps_the_contacts_time_constant():
+    preset, res, ie, mu = "paper-single-peak", 101, 1e-3, presets.calibrated_mu("paper-single-peak")
+    tip = tip_radius(preset, None, res)
+    engine = rig_engine(preset, None, tip=tip, mu=mu, ie=ie, hfield_resolution=res, stiffness_number=300.0)
+    rig = sim.build_rig(
+        presets.make_surface(preset),
+        mu=mu,
+        tip_radius_m=tip * sim.DEFAULT_LENGTH_SCALE_M,
+        mass_kg=MASS_KG,
+        hfield_resolution=res,
+        ie=ie,
+        stiffness_number=300.0,
+    )
+    assert engine == rig.engine
+    plan = PLANS["smoke"]
+    grid = engine_grid(
+        plan, (("timestep_factor", 0.5),), preset, None, tip, mu=mu, ie=ie, stiffness_number=300.0
+    )
+    assert grid["timestep"] == pytest.approx(engine.timestep_s / 2)
+    assert grid["solref_timeconst"] == engine.solref[0]  # explicit: only the step changes
+    soft = engine_grid(plan, (("solref_timeconst_factor", 10.0),), preset, None, tip, mu=mu, ie=ie)
+    # the contact's time constant is the contact rule's, whatever the spring
+    assert soft["solref_timeconst"] == pytest.approx(10 * engine.solref[0])
+
+
+def test_a_doubled_hfield_nests_the_old_samples_and_keeps_the_tip():
+    assert refined_resolution(151, 2) == 301 and refined_resolution(101, 4) == 401
+    plan = PLANS["smoke"]
+    fam = plan.families[0]
+    base = limit_doc(plan, fam, "paper-single-peak", "base")
+    finer = limit_doc(plan, fam, "paper-single-peak", "finer", (("hfield_factor", 2),))
+    assert finer["grid"]["hfield_resolution"] == 2 * plan.hfield_resolution - 1
+    assert finer["grid"]["tip_radius"] == base["grid"]["tip_radius"]
+    assert (
+        finer["starts"]
+        == base["starts"]
+        == FamilySpec("x", (), None, paper_starts([-2.0, -4.0])).starts_table()
+    )
