@@ -150,6 +150,17 @@ class ValidationPlan:
         MuJoCo runs' cost there).
     stiffness_map_ie, stiffness_map_k : tuple of float
         Grid of the (I_e, K) map of the spring drive, K = k l_s / F_p (empty: no map).
+    stiffness_map_k_factors : tuple of float
+        The map's K axis relative to each family's predicted K*
+        (:mod:`spine_mj.validate.predicted_limits`): K = factor x K*, two digits (empty: the
+        absolute ``stiffness_map_k`` on every family).
+    stiffness_map_deep_ie : tuple of float
+        I_e values below the map's grid, run at each family's stiffest K only: the gap to
+        the streamline against I_e where the spring's offset is smallest (the convergence
+        to the theory, :mod:`spine_mj.validate.theory_orders`).
+    stiffness_map_deep_starts : int
+        Starts per preset of those deep runs (0: the map's): a run at I_e = 1e-6 is slow
+        (a carriage 100 times slower than at 1e-2).
     stiffness_map_families : tuple of str
         Families (by name) of the map.
     stiffness_map_starts : int
@@ -214,6 +225,9 @@ class ValidationPlan:
     stiffness_map_ie: tuple[float, ...] = ()
     stiffness_map_k: tuple[float, ...] = ()
     stiffness_map_families: tuple[str, ...] = ()
+    stiffness_map_k_factors: tuple[float, ...] = ()
+    stiffness_map_deep_ie: tuple[float, ...] = ()
+    stiffness_map_deep_starts: int = 0
     stiffness_map_starts: int = 2
     stick_slip_k_ie: tuple[float, ...] = (1e-4, 1e-2)
     stick_slip_k_factors: tuple[float, ...] = (0.125, 0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 4.0, 8.0)
@@ -362,7 +376,9 @@ PLANS: dict[str, ValidationPlan] = {
         # solution verification: 2 starts a surface (26 runs a refinement over the families)
         convergence_starts=2,
         stiffness_map_ie=(1e-2, 1.0),
-        stiffness_map_k=(1.0, 10.0, 100.0),
+        # a reduced ladder past each family's K*, and one deeper I_e at the stiffest
+        stiffness_map_k_factors=(0.3, 1.0, 3.0, 10.0),
+        stiffness_map_deep_ie=(1e-3,),
         stiffness_map_families=("single_peak_valley", "random_gaussian", "fractal"),
         stiffness_map_starts=2,
         stick_slip_k_ie=(1e-4,),
@@ -410,7 +426,12 @@ PLANS: dict[str, ValidationPlan] = {
         bootstrap=500,
         ramp_max_steps=200_000,
         stiffness_map_ie=(1e-4, 1e-3, 1e-2, 1e-1, 1.0),
-        stiffness_map_k=(1.0, 3.0, 10.0, 30.0, 100.0),
+        # K / K* to 10 on every family, by factors of at most 2 around K* (the predicted K*
+        # is judged within a factor of 2); I_e down to 1e-6 at the stiffest K (a run there
+        # measured 9 s of CPU on the fractal at K = 1000 before the stick fast-forward)
+        stiffness_map_k_factors=(0.1, 0.3, 0.5, 1.0, 2.0, 3.0, 10.0),
+        stiffness_map_deep_ie=(1e-5, 1e-6),
+        stiffness_map_deep_starts=10,
         stiffness_map_families=("single_peak_valley", "random_gaussian", "fractal"),
         # at least 30 runs per (I_e, K) point and family (map_family)
         stiffness_map_starts=30,

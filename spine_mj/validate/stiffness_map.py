@@ -44,12 +44,14 @@ from spine_mj.validate.slip_tails import fit_tail
 from spine_mj.validate.stick_slip import slip_statistics
 from spine_mj.validate.study_runner import StudyRunner
 from spine_mj.validate.sweep_configs import family_doc
+from spine_mj.validate.theory_orders import order_rows, prediction_check
 
 __all__ = [
     "SLIP_FAMILIES",
     "StiffnessMapResult",
     "agreement_map",
     "energy_rows",
+    "k_ladder",
     "slip_rows",
     "stiffness_map",
     "subset_starts",
@@ -70,7 +72,8 @@ class StiffnessMapResult:
     Attributes
     ----------
     ie, stiffness_numbers : list of float
-        The grid: I_e values and K = k l_s / F_p values.
+        The grid: I_e values (the deep ones of the stiffest K included) and every K = k l_s /
+        F_p value of any family.
     families : list of str
     starts_per_preset : int
     agreement : dict
@@ -89,6 +92,16 @@ class StiffnessMapResult:
         Per (I_e, K) and quantity (``jump_lc``, ``force_drop_fp``): the maximum-likelihood
         tail fit (:func:`spine_mj.validate.slip_tails.fit_tail`; series of fewer than 200
         events are counted, not fitted).
+    k_by_family : dict
+        Family -> its K axis (``k_factors`` x its predicted K*, or the plan's K values).
+    k_factors : list of float
+        The ladder K / K* (empty: absolute K values).
+    orders : list of dict
+        The gap to the streamline against I_e and 1/K per family with its fitted and
+        predicted order (:func:`spine_mj.validate.theory_orders.order_rows`).
+    prediction_check : list of dict
+        The predicted K* and I_e* against the measured ones per family
+        (:func:`spine_mj.validate.theory_orders.prediction_check`).
     transitions : list of dict
         Per I_e: the K bracket where stick-slip (at least :data:`SLIPS_PER_LC` slip events
         per L_c) gives way to steady sliding on the :data:`SLIP_FAMILIES` runs.
@@ -106,6 +119,14 @@ class StiffnessMapResult:
     transitions: list = dataclasses.field(default_factory=list)
     agreement_compliant: dict = dataclasses.field(default_factory=dict)
     predicted: dict = dataclasses.field(default_factory=dict)
+    k_by_family: dict = dataclasses.field(default_factory=dict)
+    k_factors: list = dataclasses.field(default_factory=list)
+    orders: list = dataclasses.field(default_factory=list)
+    prediction_check: list = dataclasses.field(default_factory=list)
+
+    def family_k(self, family: str) -> list[float]:
+        """The K axis of ``family`` (its ladder from K*, else the map's K values)."""
+        return list(self.k_by_family.get(family) or self.stiffness_numbers)
 
     def ie_star(self) -> dict:
         """family -> K (str) -> I_e* (value, low, high, ci_low, ci_high, kind, criterion)."""
@@ -125,6 +146,8 @@ class StiffnessMapResult:
                 f: {k: d[k] for k in ("k_star", "ie_star", "limit")} for f, d in self.predicted.items()
             },
             "stiffness_map": self.as_dict(),
+            "convergence_to_theory": self.orders,
+            "predicted_vs_measured": self.prediction_check,
         }
 
     def as_dict(self) -> dict:
@@ -141,6 +164,10 @@ class StiffnessMapResult:
             "transitions": self.transitions,
             "agreement_compliant": self.agreement_compliant,
             "predicted": self.predicted,
+            "k_by_family": self.k_by_family,
+            "k_factors": self.k_factors,
+            "orders": self.orders,
+            "prediction_check": self.prediction_check,
         }
 
     def ie_star_compliant(self) -> dict:
@@ -179,36 +206,49 @@ def stiffness_map(plan: ValidationPlan, runner: StudyRunner) -> StiffnessMapResu
     ks = [float(v) for v in plan.stiffness_map_k]
     fams = [f for f in plan.families if f.name in plan.stiffness_map_families]
     empty = StiffnessMapResult(ies, ks, [f.name for f in fams], plan.stiffness_map_starts, {}, [], [])
-    if not ies or not ks or not fams:
+    if not ies or not (ks or plan.stiffness_map_k_factors) or not fams:
         return empty
-    runs, samples, predicted, jobs = [], {}, {}, []
+    runs, samples, predicted, jobs, k_by_family = [], {}, {}, [], {}
     for fam in fams:
         sub = subset_starts(plan.map_family(fam), plan.stiffness_map_starts)
+        deep = (
+            subset_starts(sub, plan.stiffness_map_deep_starts) if plan.stiffness_map_deep_starts > 0 else sub
+        )
         with runner.phase(f"predicted drive limits of {fam.name}"):
             predicted[fam.name] = family_limits(plan, sub)
+        fks = k_ladder(predicted[fam.name]["k_star"], plan.stiffness_map_k_factors) or ks
+        k_by_family[fam.name] = fks
         for preset in fam.presets:
-            doc = family_doc(
-                sub,
-                name=f"stiffness-map-{preset}",
-                preset=preset,
-                drive={"protocol": "spring", "ie": ies, "K": ks},
-                grid=preset_grid(plan, sub, preset),
-            )
-            jobs.append((fam.name, preset, doc))
+            drives = [("", {"protocol": "spring", "ie": ies, "K": fks})]
+            if plan.stiffness_map_deep_ie:
+                drives.append(
+                    ("-deep", {"protocol": "spring", "ie": list(plan.stiffness_map_deep_ie), "K": max(fks)})
+                )
+            for tag, drive in drives:
+                starts = sub if not tag or plan.stiffness_map_deep_starts <= 0 else deep
+                doc = family_doc(
+                    starts,
+                    name=f"stiffness-map-{preset}{tag}",
+                    preset=preset,
+                    drive=drive,
+                    grid=preset_grid(plan, starts, preset),
+                )
+                jobs.append((fam.name, preset, f"{preset}{tag}", doc))
     # every preset's sweep at once: the workers stay busy across the sweeps' ends
-    done = runner.many([(doc, f"stiffness_map/{preset}") for _, preset, doc in jobs], "the (I_e, K) map")
-    for (family, preset, _), (df, store) in zip(jobs, done):
+    done = runner.many([(doc, f"stiffness_map/{name}") for _, _, name, doc in jobs], "the (I_e, K) map")
+    for (family, preset, _, _), (df, store) in zip(jobs, done):
         with runner.phase(f"slip events and energy on {preset}"):
             runs.append(_run_rows(df, store, family, preset, samples))
     table = pd.concat(runs, ignore_index=True)
+    agreement = agreement_map(table, n_boot=plan.bootstrap)
     pooled = {k: {n: np.concatenate(v) for n, v in d.items()} for k, d in samples.items()}
     slip = slip_rows(table)
     return StiffnessMapResult(
-        ie=ies,
-        stiffness_numbers=ks,
+        ie=sorted(set(ies) | {float(v) for v in plan.stiffness_map_deep_ie}),
+        stiffness_numbers=sorted({k for v in k_by_family.values() for k in v}),
         families=[f.name for f in fams],
         starts_per_preset=plan.stiffness_map_starts,
-        agreement=agreement_map(table, n_boot=plan.bootstrap),
+        agreement=agreement,
         energy=energy_rows(table),
         slip=slip,
         slip_samples=pooled,
@@ -219,7 +259,19 @@ def stiffness_map(plan: ValidationPlan, runner: StudyRunner) -> StiffnessMapResu
             n_boot=plan.bootstrap,
         ),
         predicted=predicted,
+        k_by_family=k_by_family,
+        k_factors=[float(f) for f in plan.stiffness_map_k_factors],
+        orders=order_rows(agreement, predicted),
+        prediction_check=prediction_check(agreement, predicted),
     )
+
+
+def k_ladder(k_star: float, factors) -> list[float]:
+    """The K axis ``factors`` x ``k_star``, each to two significant digits (empty without
+    factors or without a finite positive K*)."""
+    if not factors or not (np.isfinite(k_star) and k_star > 0):
+        return []
+    return sorted({float(f"{f * k_star:.2g}") for f in factors})
 
 
 #: A cell of the map is stick-slip when its runs slip at least this often per L_c advanced.
@@ -393,12 +445,13 @@ def agreement_map(runs: pd.DataFrame, *, n_boot: int, rng=12345) -> dict:
             n.append(len(cell))
             amat.append(a)
             fmat.append(f)
-        if len(ies) >= 2:
-            m = min(len(a) for a in amat)  # a resample needs one start set across I_e
+        # a resample needs one start set across I_e: the grid's, not a deeper I_e's subset
+        full = [i for i, a in enumerate(amat) if len(a) == max(len(b) for b in amat)]
+        if len(full) >= 2:
             by = ie_star_by_criterion(
-                np.array(ies),
-                np.array([a[:m] for a in amat]),
-                np.array([f[:m] for f in fmat]),
+                np.array([ies[i] for i in full]),
+                np.array([amat[i] for i in full]),
+                np.array([fmat[i] for i in full]),
                 n_boot=n_boot,
                 rng=rng,
             )
@@ -418,6 +471,12 @@ def agreement_map(runs: pd.DataFrame, *, n_boot: int, rng=12345) -> dict:
     return out
 
 
+def grid_lowest_ie(runs: pd.DataFrame) -> float:
+    """The lowest I_e every K of ``runs`` ran at (the grid's, not a deeper one of the
+    stiffest K)."""
+    return float(runs.groupby("K")["ie"].min().max())
+
+
 def energy_rows(runs: pd.DataFrame) -> list[dict]:
     """Per K at the lowest I_e of ``runs`` (where inertia plays no part), pooled over the
     families: spring energy released at breakaways per L_c the MuJoCo tip advanced, the
@@ -429,7 +488,7 @@ def energy_rows(runs: pd.DataFrame) -> list[dict]:
     """
     if runs.empty:
         return []
-    low = runs[np.isclose(runs["ie"], runs["ie"].min())]
+    low = runs[np.isclose(runs["ie"], grid_lowest_ie(runs))]
     rows = []
     for (k,), g in _cells(low, "K"):
         ok = g[~g["engine_trouble"].astype(bool)]

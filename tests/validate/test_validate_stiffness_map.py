@@ -164,7 +164,7 @@ def test_measured_k_star_brackets_the_first_passing_stiffness():
     from spine_mj.validate.report.stiffness_map import measured_k_star
 
     def cells(passes):
-        return {k: {"passes": [p, False]} for k, p in passes.items()}
+        return {k: {"ie": [1e-4, 1e-2], "passes": [p, False]} for k, p in passes.items()}
 
     assert measured_k_star(cells({"1": False, "3": False, "10": True, "30": True})) == "3-10"
     assert measured_k_star(cells({"1": True, "3": True})) == "< 1"

@@ -70,6 +70,15 @@ def test_smoke_validation_writes_report_and_json(tmp_path, monkeypatch):
     assert "over (I_e, K)" in report and "figures/ie_k_map.png" in report
     assert (out / "figures" / "ie_k_map.png").stat().st_size > 1000
     assert "slip_ccdf.png" not in report and not (out / "figures" / "slip_ccdf.png").exists()
+    # solution verification of the corner, per family and refinement, shown in the report
+    conv = doc["convergence"]["single_peak_valley"]
+    for key in ("dt_halved", "hfield_doubled"):
+        assert {"agreement_change", "median_frechet_change", "converged"} <= set(conv[key])
+        assert conv[key]["refined"] and conv[key]["runs"] == plan.convergence_starts
+    assert "Solution verification" in report
+    # the map's convergence to the theory and the predicted limits against the measured
+    assert {r["axis"] for r in doc["convergence_to_theory"]} == {"ie", "inverse_k"}
+    assert doc["predicted_vs_measured"][0]["family"] == "single_peak_valley"
 
 
 def test_unknown_plan_is_rejected():

@@ -18,9 +18,11 @@ from spine_mj.plotting import (
     styled,
 )
 from spine_mj.validate.report.common import ReportContext, assemble, cell, image, table
+from spine_mj.validate.report.theory_orders import causes_lines, orders_figure, orders_lines, prediction_lines
 from spine_mj.validate.slip_tails import MIN_EVENTS
 from spine_mj.validate.stick_slip import complementary_cdf
 from spine_mj.validate.stiffness_map import CRITERION, SLIP_FAMILIES, SLIPS_PER_LC, StiffnessMapResult
+from spine_mj.validate.theory_orders import common_lowest_ie, k_boundary
 
 #: At most this many (I_e, K) series in the CCDF figure.
 MAX_CCDF_SERIES = 5
@@ -60,13 +62,18 @@ def map_figure(km: StiffnessMapResult, path: Path) -> Path | None:
     fams = [f for f in km.families if f in km.agreement]
     fig = new_figure(figsize=(4.2 * len(fams) + 1.2, 3.8), constrained_layout=True)
     axes = np.atleast_1d(fig.subplots(1, len(fams), sharey=True))
-    ie_e, k_e = _log_edges(km.ie), _log_edges(km.stiffness_numbers)
+    ie_e = _log_edges(km.ie)
     mesh = None
     for ax, fam in zip(axes, fams):
-        grid = np.full((len(km.stiffness_numbers), len(km.ie)), np.nan)
+        ks = km.family_k(fam)
+        # relative to the family's predicted K* where the plan set the axis so
+        scale = km.predicted.get(fam, {}).get("k_star", np.nan) if km.k_factors else 1.0
+        k_e = _log_edges(np.asarray(ks) / scale)
+        grid = np.full((len(ks), len(km.ie)), np.nan)
         xs, ys, lo, hi, open_x, open_y, fail_x, fail_y = [], [], [], [], [], [], [], []
-        for i, k in enumerate(km.stiffness_numbers):
-            cell = km.agreement[fam].get(f"{k:g}")
+        for i, k_abs in enumerate(ks):
+            k = k_abs / scale
+            cell = km.agreement[fam].get(f"{k_abs:g}")
             if cell is None:
                 continue
             for ie, a, ok in zip(cell["ie"], cell["agreement"], cell["passes"]):
@@ -109,10 +116,11 @@ def map_figure(km: StiffnessMapResult, path: Path) -> Path | None:
                 mec=THRESHOLD_COLOR,
                 label="I_e* outside the grid (edge shown)",
             )
-        _draw_prediction(ax, km.predicted.get(fam))
+        pred = km.predicted.get(fam)
+        _draw_prediction(ax, pred if not km.k_factors or not pred else {**pred, "k_star": 1.0})
         ax.set(xscale="log", yscale="log", xlabel="I_e", title=fam.replace("_", " "))
         ax.grid(False)
-    axes[0].set_ylabel("K = k l_s / F_p")
+    axes[0].set_ylabel("K / K* (predicted)" if km.k_factors else "K = k l_s / F_p")
     fig.colorbar(mesh, ax=list(axes), label="outcome agreement [1]")
     handles = {}
     for ax in axes:  # one legend for the panels, below them: the cells stay visible
@@ -152,18 +160,15 @@ def _draw_prediction(ax, pred: dict | None) -> None:
 
 def measured_k_star(cells: dict) -> str:
     """The measured K boundary at the lowest I_e of a family's map (``K`` -> agreement
-    cell): ``low-high`` between the largest K that fails and the next that passes, ``< K``
-    when the smallest passes, ``> K`` when none does."""
-    ks = sorted(cells, key=float)
-    passes = [bool(cells[k]["passes"][0]) for k in ks]
-    if all(passes):
-        return f"< {sig(float(ks[0]))}"
-    if not any(passes):
-        return f"> {sig(float(ks[-1]))}"
-    last_fail = max(i for i, p in enumerate(passes) if not p)
-    if last_fail + 1 >= len(ks):
-        return f"> {sig(float(ks[-1]))}"
-    return f"{sig(float(ks[last_fail]))}-{sig(float(ks[last_fail + 1]))}"
+    cell; :func:`~spine_mj.validate.theory_orders.k_boundary`): ``low-high`` between the
+    largest K that fails and the next, which passes, ``< K`` when the smallest passes, ``> K``
+    when the stiffest fails."""
+    low, high = k_boundary(cells)
+    if not np.isfinite(low):
+        return f"< {sig(high)}"
+    if np.isinf(high):
+        return f"> {sig(low)}"
+    return f"{sig(low)}-{sig(high)}"
 
 
 def _prediction_rows(km: StiffnessMapResult) -> list[dict]:
@@ -301,16 +306,30 @@ def map_sections(km: StiffnessMapResult) -> dict[str, str]:
     }
 
 
+def _k_axis(km: StiffnessMapResult) -> str:
+    """The map's K axis in words: a ladder relative to each family's predicted K*, or the
+    absolute values."""
+    if km.k_factors:
+        per = "; ".join(f"{f}: {', '.join(sig(v) for v in km.family_k(f))}" for f in km.families)
+        return (
+            f"K = k l_s / F_p at K / K* = {', '.join(sig(v) for v in km.k_factors)} of each family's "
+            f"predicted K* ({per})"
+        )
+    return f"K = k l_s / F_p = {', '.join(sig(v) for v in km.stiffness_numbers)}"
+
+
 def _map_lines(km: StiffnessMapResult) -> list[str]:
     """The I_e*(K) table per family and K, with what its columns mean."""
     star_rows = []
     for fam, by_k in km.agreement.items():
         for k, grid_cell in by_k.items():
             s = grid_cell["ie_star"]
+            k_star = km.predicted.get(fam, {}).get("k_star", np.nan)
             star_rows.append(
                 {
                     "family": fam,
                     "K": float(k),
+                    "k_rel": float(k) / k_star if np.isfinite(k_star) and k_star > 0 else np.nan,
                     "ie_star": s.get("value"),
                     "bracket": _bracket(s),
                     "ci": f"{cell(s.get('ci_low'))}-{cell(s.get('ci_high'))}",
@@ -321,8 +340,8 @@ def _map_lines(km: StiffnessMapResult) -> list[str]:
     head = [
         "## The quasistatic boundary over (I_e, K)",
         "",
-        f"Spring drive over I_e = {', '.join(sig(v) for v in km.ie)} and K = k l_s / F_p = "
-        f"{', '.join(sig(v) for v in km.stiffness_numbers)}, {km.starts_per_preset} starts per preset "
+        f"Spring drive over I_e = {', '.join(sig(v) for v in km.ie)} and {_k_axis(km)}, "
+        f"{km.starts_per_preset} starts per preset "
         "(few: the lowest I_e and the many K are the expensive corner, so every cell's agreement "
         "moves in steps of one run). A cell agrees when the boundary study's criterion holds "
         f"({CRITERION.replace('_', ' ')}: outcome agreement >= 95 % and median Frechet <= 0.1 L_c); "
@@ -332,8 +351,17 @@ def _map_lines(km: StiffnessMapResult) -> list[str]:
         "",
         table(
             star_rows,
-            ["family", "K", "ie_star", "bracket", "ci", "kind", "runs"],
-            ["family", "K", "I_e*", "bracket", "bootstrap 16-84 %", "kind", "runs (ok / all, per I_e)"],
+            ["family", "K", "k_rel", "ie_star", "bracket", "ci", "kind", "runs"],
+            [
+                "family",
+                "K",
+                "K / K*",
+                "I_e*",
+                "bracket",
+                "bootstrap 16-84 %",
+                "kind",
+                "runs (ok / all, per I_e)",
+            ],
         ),
         "",
         "The heat map shows the fraction of runs whose outcome agrees in each cell (crosses: the "
@@ -446,17 +474,19 @@ def _prediction_text(km: StiffnessMapResult) -> list[str]:
         return []
     comp_rows = []
     for fam, by_k in km.agreement_compliant.items():
+        low = common_lowest_ie(by_k)
         for k, c in by_k.items():
             rigid = km.agreement.get(fam, {}).get(k)
+            i = c["ie"].index(low)
             comp_rows.append(
                 {
                     "family": fam,
                     "K": float(k),
-                    "ie": float(c["ie"][0]),
-                    "rigid": f"{cell(rigid['agreement'][0])} / {cell(rigid['median_frechet'][0])}"
+                    "ie": low,
+                    "rigid": f"{cell(rigid['agreement'][i])} / {cell(rigid['median_frechet'][i])}"
                     if rigid
                     else "-",
-                    "compliant": f"{cell(c['agreement'][0])} / {cell(c['median_frechet'][0])}",
+                    "compliant": f"{cell(c['agreement'][i])} / {cell(c['median_frechet'][i])}",
                     "star": _bracket(c["ie_star"]),
                 }
             )
@@ -522,9 +552,13 @@ def section(km: StiffnessMapResult, ctx: ReportContext) -> str | None:
     text = map_sections(km)
     heat = ctx.draw(map_figure, km, "ie_k_map.png")
     ccdf = ctx.draw(ccdf_figure, km, "slip_ccdf.png")
+    orders = ctx.draw(orders_figure, km, "gap_orders.png")
     return assemble(
         text["map"],
+        "\n".join(prediction_lines(km) + causes_lines(km, ctx.results.get("limit"))),
         image("Outcome agreement over (I_e, K) per family with I_e*(K)", heat),
+        "\n".join(orders_lines(km)),
+        image("The gap to the streamline against I_e and 1/K, log-log, with the orders", orders),
         text["energy"],
         text["slip"],
         image("Complementary CDFs of slip size and force drop", ccdf),

@@ -1,0 +1,129 @@
+"""Convergence to the theory: fitted orders on known power laws, the K ladder from K*, the
+measured K boundary and the factor-2 verdicts on the predicted limits."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from spine_mj.validate.stiffness_map import agreement_map, k_ladder
+from spine_mj.validate.theory_orders import (
+    FRECHET_FLOOR_LC,
+    fit_order,
+    gap_series,
+    k_boundary,
+    order_rows,
+    prediction_check,
+    within_factor,
+)
+
+
+def test_fit_order_recovers_an_exact_power_law_with_a_tight_interval():
+    x = np.array([1e-6, 1e-5, 1e-4, 1e-3])
+    fit = fit_order(x, 3.0 * x**1.0)
+    assert fit["order"] == pytest.approx(1.0)
+    assert fit["ci_low"] == pytest.approx(1.0, abs=1e-6) and fit["ci_high"] == pytest.approx(1.0, abs=1e-6)
+    assert fit["n"] == 4
+
+
+def test_fit_order_interval_holds_the_true_order_of_a_noisy_law():
+    rng = np.random.default_rng(3)
+    x = np.geomspace(1e-4, 1.0, 9)
+    fit = fit_order(x, 0.5 * x**0.5 * np.exp(rng.normal(0, 0.05, x.size)))
+    assert fit["ci_low"] < 0.5 < fit["ci_high"]
+    assert fit["ci_high"] - fit["ci_low"] < 0.2
+
+
+def test_fit_order_leaves_out_what_the_metric_does_not_resolve():
+    x = np.array([1e-4, 1e-3, 1e-2, 1e-1])
+    gap = np.array([0.01, 0.01, 0.05, 0.5])  # the first two at the Frechet's floor
+    fit = fit_order(x, gap, floor=2 * FRECHET_FLOOR_LC)
+    assert fit["n"] == 2 and fit["order"] == pytest.approx(1.0)
+    assert math.isnan(fit["ci_low"])  # two points: a slope, no interval
+    assert fit_order(x, np.zeros(4))["n"] == 0 and math.isnan(fit_order(x, np.zeros(4))["order"])
+
+
+def test_the_k_ladder_is_set_from_k_star_in_two_digits():
+    assert k_ladder(104.78, (0.1, 0.3, 1.0, 3.0, 10.0)) == [10.0, 31.0, 100.0, 310.0, 1000.0]
+    assert k_ladder(104.78, ()) == [] and k_ladder(float("nan"), (1.0,)) == []
+
+
+def _cells(ks, ies, passes, agreement=None, frechet=None):
+    out = {}
+    for i, k in enumerate(ks):
+        out[f"{k:g}"] = {
+            "ie": list(ies),
+            "passes": list(passes[i]),
+            "agreement": list(agreement[i]) if agreement else [1.0] * len(ies),
+            "median_frechet": list(frechet[i]) if frechet else [0.01] * len(ies),
+            "ie_star": {"kind": "bracketed", "value": 0.05, "low": 0.01, "high": 0.1},
+        }
+    return out
+
+
+def test_the_k_boundary_brackets_the_last_failure_at_the_lowest_ie():
+    ies = [1e-4, 1e-2]
+    assert k_boundary(_cells([10, 30, 100], ies, [[False, False], [True, False], [True, True]])) == (
+        10.0,
+        30.0,
+    )
+    assert k_boundary(_cells([10, 30], ies, [[True, False], [True, False]]))[1] == 10.0
+    assert k_boundary(_cells([10, 30], ies, [[False, False], [False, True]])) == (30.0, math.inf)
+
+
+def test_within_a_factor_of_two_needs_the_whole_bracket():
+    assert within_factor(100.0, 60.0, 150.0) == "within"
+    assert within_factor(100.0, 30.0, 100.0) == "consistent"  # wider than the factor: undecided
+    assert within_factor(100.0, 250.0, 300.0) == "outside"
+    assert within_factor(100.0, float("nan"), 40.0) == "outside"  # passes already below K* / 2
+    assert within_factor(100.0, 150.0, math.inf) == "consistent"
+    assert within_factor(float("nan"), 1.0, 2.0) == "-"
+
+
+def test_gap_series_takes_ie_at_the_stiffest_k_and_1_over_k_above_k_star():
+    cells = _cells(
+        [10, 100, 1000],
+        [1e-4, 1e-2],
+        [[False, False], [True, True], [True, True]],
+        agreement=[[0.5, 0.4], [0.9, 0.8], [1.0, 0.9]],
+        frechet=[[0.5, 0.6], [0.05, 0.2], [0.02, 0.1]],
+    )
+    cells["1000"]["ie"] = [1e-6, 1e-4, 1e-2]  # a deeper I_e at the stiffest K only
+    cells["1000"]["agreement"] = [1.0, 1.0, 0.9]
+    cells["1000"]["median_frechet"] = [0.011, 0.02, 0.1]
+    s = gap_series(cells, k_star=50.0)
+    assert s["ie"]["x"] == [1e-6, 1e-4, 1e-2] and s["ie"]["at"] == 1000.0
+    assert s["inverse_k"]["x"] == [0.01, 0.001] and s["inverse_k"]["at"] == 1e-4
+    assert s["inverse_k"]["median_frechet"] == [0.05, 0.02]
+    rows = order_rows({"fam": cells}, {"fam": {"k_star": 50.0}})
+    assert {(r["axis"], r["gap"]) for r in rows} == {
+        (a, g) for a in ("ie", "inverse_k") for g in ("agreement_gap", "median_frechet")
+    }
+    check = prediction_check({"fam": cells}, {"fam": {"k_star": 50.0, "ie_star": 0.05, "limit": "lag"}})[0]
+    assert (check["k_low"], check["k_high"], check["k_verdict"]) == (10.0, 100.0, "consistent")
+    assert check["ie_verdict"] == "consistent" and check["ie_at_k"] == 1000.0
+
+
+def test_the_ie_star_bootstrap_leaves_out_a_deeper_ie_run_from_fewer_starts():
+    rows = []
+    for ie, starts in ((1e-6, 2), (1e-4, 4), (1e-2, 4), (1.0, 4)):
+        for s in range(starts):
+            rows.append(
+                {
+                    "family": "f",
+                    "K": 100.0,
+                    "ie": ie,
+                    "surface": "a",
+                    "start": s,
+                    "agree": ie < 0.5,
+                    "frechet": 0.01 if ie < 0.5 else 1.0,
+                    "engine_trouble": False,
+                }
+            )
+    cell = agreement_map(pd.DataFrame(rows), n_boot=20)["f"]["100"]
+    assert cell["ie"] == [1e-6, 1e-4, 1e-2, 1.0] and cell["n"] == [2, 4, 4, 4]
+    assert cell["ie_star"]["kind"] == "bracketed"
+    assert (cell["ie_star"]["low"], cell["ie_star"]["high"]) == (1e-2, 1.0)
