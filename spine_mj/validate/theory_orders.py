@@ -4,7 +4,7 @@ predicts, and the predicted drive limits against the measured ones.
 
 The gap is ``1 - agreement`` (outcome agreement) and the median Frechet distance (in L_c),
 each cell's over its runs (:func:`spine_mj.validate.stiffness_map.agreement_map`). Two
-series per family (docs/physics.md §9):
+series per family (docs/physics.md §10):
 
 - against I_e at the family's stiffest K (the spring's offset smallest there): the tip's
   lag behind a turn is ``I_e L_c / (2 mu)``, first order in I_e;
@@ -40,7 +40,7 @@ __all__ = [
     "within_factor",
 ]
 
-#: Orders the theory predicts (docs/physics.md §9): axis -> order of the gap.
+#: Orders the theory predicts (docs/physics.md §10): axis -> order of the gap.
 PREDICTED_ORDERS = {"ie": 1.0, "inverse_k": 1.0}
 
 #: The median Frechet distance's resolution in L_c: :func:`spine_mj.compare.path_frechet`

@@ -108,7 +108,7 @@ def orders_lines(km: StiffnessMapResult) -> list[str]:
         "The order is the least-squares slope on log-log axes with its 95 % t interval, over the "
         "points the metric resolves (a median Frechet above twice its resolution of "
         f"{FRECHET_FLOOR_LC:g} L_c, the paths resampled at L_c / 50; an agreement gap above zero). "
-        "Predicted (docs/physics.md §9): first order in I_e (the lag behind a turn, "
+        "Predicted (docs/physics.md §10): first order in I_e (the lag behind a turn, "
         "I_e L_c / (2 mu)) and first order in 1/K (the compliant offset, kappa l_s / K).",
         "",
         table(
