@@ -20,6 +20,7 @@ import numpy as np
 from spine_mj.compare import FRECHET_TARGET, OUTCOME_TARGET
 
 __all__ = [
+    "DT_HALVED",
     "FRECHET_TARGET",
     "GRAVITY",
     "IMPRATIO",
@@ -269,6 +270,8 @@ class ValidationPlan:
 RECOMMENDED = ("recommended (elliptic, noslip 3)", ())
 NO_NOSLIP = ("no noslip (elliptic, impratio 1)", (("noslip_iterations", 0),))
 IMPRATIO = ("no noslip, impratio 10", (("noslip_iterations", 0), ("impratio", 10.0)))
+#: The rig's step halved, the contact's time constant kept (solution verification).
+DT_HALVED = ("time step / 2 (contact solref kept)", (("timestep_factor", 0.5),))
 
 #: The paper's single peak and valley with the five starts of Figs. 3-4 (every plan).
 #: The fractal family: 3 seeds x 2 Hurst exponents x 5 starts.
@@ -302,7 +305,7 @@ PLANS: dict[str, ValidationPlan] = {
         name="smoke",
         slopes_deg=(20.0, 70.0),
         azimuths_deg=(0.0,),
-        static_engines=(RECOMMENDED,),
+        static_engines=(RECOMMENDED, DT_HALVED),
         families=(
             FamilySpec("single_peak_valley", ("paper-single-peak",), None, paper_starts([-2.0, -4.0])),
         ),
@@ -339,7 +342,7 @@ PLANS: dict[str, ValidationPlan] = {
         name="quick",
         slopes_deg=(0.0, 15.0, 30.0, 45.0, 60.0, 75.0),
         azimuths_deg=(0.0, 60.0, 120.0, 180.0),
-        static_engines=(RECOMMENDED, NO_NOSLIP),
+        static_engines=(RECOMMENDED, NO_NOSLIP, DT_HALVED),
         families=(
             PEAK_VALLEY,
             FamilySpec(
@@ -392,7 +395,7 @@ PLANS: dict[str, ValidationPlan] = {
         name="full",
         slopes_deg=tuple(np.arange(0.0, 76.0, 7.5)),
         azimuths_deg=(0.0, 30.0, 60.0, 90.0, 120.0, 150.0, 180.0),
-        static_engines=(RECOMMENDED, NO_NOSLIP, IMPRATIO),
+        static_engines=(RECOMMENDED, NO_NOSLIP, IMPRATIO, DT_HALVED),
         families=(
             PEAK_VALLEY,
             FamilySpec(

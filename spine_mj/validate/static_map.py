@@ -7,20 +7,29 @@ and slip regions, Eqs. 1-3), per engine setting of the plan.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from spine_mj import sim, surface_io
 from spine_mj.theory import engagement
-from spine_mj.validate.plans import GRAVITY, MASS_KG, ValidationPlan
+from spine_mj.validate.convergence import REFINEMENTS
+from spine_mj.validate.intervals import TARGET_SLACK
+from spine_mj.validate.plans import GRAVITY, MASS_KG, STATIC_TARGET, ValidationPlan
 from spine_mj.validate.study_runner import StudyRunner
-from spine_mj.validate.sweep_configs import engine_default
+from spine_mj.validate.sweep_configs import (
+    RELATIVE_ENGINE_KEYS,
+    engine_default,
+    relative_engine_keys,
+    rig_engine,
+)
 
 __all__ = ["PLANE_START", "StaticMapResult", "hold_force", "static_map"]
 
 #: Where the probe starts on every plane (metres).
 PLANE_START = (3.1e-4, 2.7e-4)
+#: The inertia number of the probe's force ramp.
+PROBE_IE = 1e-2
 
 
 @dataclass(frozen=True)
@@ -41,18 +50,24 @@ class StaticMapResult:
     static_kappa_max_rel_error : float
         ``max_rel_error`` of the default (first) setting; inf when an engaged plane did not
         break away.
+    convergence : dict
+        Refinement key (``dt_halved``) -> the change of the default setting's
+        ``max_rel_error`` and ``region_agreement`` under it, and ``converged``
+        (:func:`static_convergence`); empty where the plan refines nothing.
     """
 
     rows: list[dict]
     per_engine: dict[str, dict]
     mu: float
     static_kappa_max_rel_error: float
+    convergence: dict = field(default_factory=dict)
 
     def validation_keys(self) -> dict:
         """This study's keys of ``validation.json``."""
         return {
             "static_kappa_max_rel_error": self.static_kappa_max_rel_error,
             "static_by_engine": self.per_engine,
+            "static_convergence": self.convergence,
         }
 
     def as_dict(self) -> dict:
@@ -83,7 +98,7 @@ def static_map(plan: ValidationPlan, runner: StudyRunner, *, mu: float = 0.5) ->
 
     Every plane is a surface file under ``out/surfaces``; the probe starts at rest with the
     smallest holding force plus half the gap to the breakaway force (where gravity alone
-    would slide the tip) and ramps the force at ``I_e = 0.01`` until breakaway.
+    would slide the tip) and ramps the force at ``I_e = PROBE_IE`` until breakaway.
 
     Returns
     -------
@@ -103,7 +118,40 @@ def static_map(plan: ValidationPlan, runner: StudyRunner, *, mu: float = 0.5) ->
     max_err = first["max_rel_error"]
     if first["engaged_breakaways"] < first["engaged_planes"]:
         max_err = float("inf")  # an engaged plane that did not break away is no agreement
-    return StaticMapResult(rows=rows, per_engine=per_engine, mu=mu, static_kappa_max_rel_error=max_err)
+    return StaticMapResult(
+        rows=rows,
+        per_engine=per_engine,
+        mu=mu,
+        static_kappa_max_rel_error=max_err,
+        convergence=static_convergence(plan, per_engine),
+    )
+
+
+def static_convergence(plan: ValidationPlan, per_engine: dict) -> dict:
+    """The default setting's numbers under each refinement the plan's static settings hold
+    (an engine setting whose overrides are a :data:`~spine_mj.validate.convergence.REFINEMENTS`
+    entry): the change of ``max_rel_error`` and ``region_agreement``, and ``converged``
+    when the error moves by at most the target rule's slack on a length,
+    ``TARGET_SLACK x STATIC_TARGET`` (one probe per plane: no interval of its own), and no
+    plane changes region."""
+    base = per_engine[plan.static_engines[0][0]]
+    out = {}
+    for label, ov in plan.static_engines[1:]:
+        key = next((k for k, v in REFINEMENTS.items() if tuple(v) == tuple(ov)), None)
+        if key is None:
+            continue
+        ref = per_engine[label]
+        change = ref["max_rel_error"] - base["max_rel_error"]
+        regions = ref["region_agreement"] - base["region_agreement"]
+        out[key] = {
+            "setting": label,
+            "max_rel_error_change": change,
+            "region_agreement_change": regions,
+            "converged": bool(
+                np.isfinite(change) and abs(change) <= TARGET_SLACK * STATIC_TARGET and regions == 0
+            ),
+        }
+    return out
 
 
 def _plane_rows(plan: ValidationPlan, runner: StudyRunner, slope: float, az: float, mu: float) -> list[dict]:
@@ -117,7 +165,7 @@ def _plane_rows(plan: ValidationPlan, runner: StudyRunner, slope: float, az: flo
     path = runner.out_dir / "surfaces" / f"plane_s{slope:g}_a{az:g}.npz"
     if not path.is_file():
         surface_io.save_surface(sim.inclined_plane(slope_deg=slope, azimuth_deg=az), path)
-    keys = sorted({k_ for _, ov in engines for k_, _ in ov})
+    keys = sorted({k_ for _, ov in engines for k_, _ in ov} - set(RELATIVE_ENGINE_KEYS))
     rows = []
     for label, ov in engines:
         # the cap must lie above the breakaway force, or a steep engaged plane
@@ -125,7 +173,16 @@ def _plane_rows(plan: ValidationPlan, runner: StudyRunner, slope: float, az: flo
         cap = max(10.0, 1.5 * k) if np.isfinite(k) else 10.0
         grid = {"mu": mu, "kappa_cap": float(f"{cap:.4g}")}
         grid.update({k_: engine_default(k_) for k_ in keys})
-        grid.update(dict(ov))
+        rest = dict(ov)
+        grid.update(
+            relative_engine_keys(
+                rest,
+                lambda: rig_engine(
+                    surface_io.load_surface(path), tip=None, mu=mu, ie=PROBE_IE, hfield_resolution=None
+                ),
+            )
+        )
+        grid.update(rest)
         doc = {
             "sweep": {
                 "name": f"static-s{slope:g}-a{az:g}",
@@ -135,7 +192,7 @@ def _plane_rows(plan: ValidationPlan, runner: StudyRunner, slope: float, az: flo
             },
             "surfaces": [{"file": str(path)}],
             "starts": {"frame": "absolute", "points": [list(PLANE_START)]},
-            "drive": {"protocol": "static", "ie": 1e-2, "start_force": hold * MASS_KG * GRAVITY},
+            "drive": {"protocol": "static", "ie": PROBE_IE, "start_force": hold * MASS_KG * GRAVITY},
             "grid": grid,
         }
         tag = "-".join(f"{k_}{v}" for k_, v in ov) or "default"

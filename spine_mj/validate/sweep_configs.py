@@ -7,7 +7,7 @@ config that several studies share are built here, once.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any
 
 from spine_mj import presets, sim, sweep
@@ -17,10 +17,12 @@ from spine_mj.surfaces import GridSurface
 from spine_mj.validate.plans import MASS_KG, FamilySpec, ValidationPlan
 
 __all__ = [
+    "RELATIVE_ENGINE_KEYS",
     "engine_default",
     "engine_grid",
     "family_doc",
     "refined_resolution",
+    "relative_engine_keys",
     "rig_engine",
     "surfaces_table",
 ]
@@ -72,30 +74,46 @@ def engine_default(key: str):
 
 
 def rig_engine(
-    preset: str,
-    seeds,
+    surface,
     *,
-    tip: float,
+    tip: float | None,
     mu: float,
     ie: float,
-    hfield_resolution: int,
+    hfield_resolution: int | None,
     stiffness_number: float | None = None,
 ) -> sim.EngineSettings:
-    """The engine settings the sweep's rig gets for ``preset`` (its first seed), a tip of
-    radius ``tip`` (surface units), mu, the spring drive at ``ie`` and stiffness number
-    ``stiffness_number`` (None: the default spring): the same rule
+    """The engine settings the sweep's rig gets for ``surface``, a tip of radius ``tip``
+    (surface units; None: the rig's default), mu, the drive at ``ie`` and the spring of
+    stiffness number ``stiffness_number`` (None: the default spring): the same rule
     (:func:`spine_mj.sim.default_engine`), from the same speed and stiffness, without
     compiling a model."""
-    surface = presets.make_surface(preset, **({} if seeds is None else {"seed": seeds[0]}))
     unit_m = surface_unit_m(surface, None)
     scales = sim.Scales.for_surface(
         surface,
-        tip=sim.TipParams(tip_radius_m=tip * unit_m, mass_kg=MASS_KG, mu_s=mu),
+        tip=sim.TipParams(tip_radius_m=None if tip is None else tip * unit_m, mass_kg=MASS_KG, mu_s=mu),
         hfield_resolution=None if isinstance(surface, GridSurface) else hfield_resolution,
     )
     speed = sim.drive_speed_m_s(scales, ie=ie)
     spring = spring_stiffness_n_m(scales, stiffness_number=stiffness_number)
     return sim.default_engine(scales, speed_m_s=speed, stiffness_n_m=spring)
+
+
+#: Engine overrides relative to the rig's own settings (:func:`relative_engine_keys`).
+RELATIVE_ENGINE_KEYS = ("timestep_factor", "solref_timeconst_factor")
+
+
+def relative_engine_keys(overrides: dict, engine: Callable[[], sim.EngineSettings]) -> dict:
+    """The grid keys of the relative engine overrides in ``overrides`` (removed from it):
+    ``timestep_factor`` scales the rig's step (``engine()``) with the contact's time
+    constant passed explicitly, so that only the step changes; ``solref_timeconst_factor``
+    scales that time constant."""
+    if not any(k in overrides for k in RELATIVE_ENGINE_KEYS):
+        return {}
+    e = engine()
+    return {
+        "timestep": e.timestep_s * float(overrides.pop("timestep_factor", 1.0)),
+        "solref_timeconst": e.solref[0] * float(overrides.pop("solref_timeconst_factor", 1.0)),
+    }
 
 
 def refined_resolution(resolution: int, factor: int) -> int:
@@ -115,25 +133,25 @@ def engine_grid(
     stiffness_number: float | None = None,
 ) -> dict:
     """Grid keys of an engine variation. Three keys are relative to the rig's own settings
-    (:func:`rig_engine`): ``timestep_factor`` scales its step with the contact's time
-    constant kept (passed explicitly, so that only the step changes), and
-    ``solref_timeconst_factor`` scales that time constant; ``hfield_factor`` multiplies the
-    samples between the plan's (:func:`refined_resolution`) with the tip kept."""
+    (:func:`rig_engine`): ``timestep_factor`` and ``solref_timeconst_factor``
+    (:func:`relative_engine_keys`), and ``hfield_factor``, which multiplies the samples
+    between the plan's (:func:`refined_resolution`) with the tip kept."""
     out = {"hfield_resolution": plan.hfield_resolution}
     ov = dict(overrides)
     if "hfield_factor" in ov:
         out["hfield_resolution"] = refined_resolution(plan.hfield_resolution, ov.pop("hfield_factor"))
-    if "timestep_factor" in ov or "solref_timeconst_factor" in ov:
-        engine = rig_engine(
-            preset,
-            seeds,
-            tip=tip,
-            mu=mu,
-            ie=ie,
-            hfield_resolution=plan.hfield_resolution,
-            stiffness_number=stiffness_number,
+    out.update(
+        relative_engine_keys(
+            ov,
+            lambda: rig_engine(
+                presets.make_surface(preset, **({} if seeds is None else {"seed": seeds[0]})),
+                tip=tip,
+                mu=mu,
+                ie=ie,
+                hfield_resolution=plan.hfield_resolution,
+                stiffness_number=stiffness_number,
+            ),
         )
-        out["timestep"] = engine.timestep_s * float(ov.pop("timestep_factor", 1.0))
-        out["solref_timeconst"] = engine.solref[0] * float(ov.pop("solref_timeconst_factor", 1.0))
+    )
     out.update(ov)
     return out

@@ -144,9 +144,10 @@ def test_thin_starts_keeps_the_same_points_on_every_surface():
 def test_the_rigs_engine_is_the_sweeps_and_a_halved_step_keeps_the_contacts_time_constant():
     preset, res, ie, mu = "paper-single-peak", 101, 1e-3, presets.calibrated_mu("paper-single-peak")
     tip = tip_radius(preset, None, res)
-    engine = rig_engine(preset, None, tip=tip, mu=mu, ie=ie, hfield_resolution=res, stiffness_number=300.0)
+    surface = presets.make_surface(preset)
+    engine = rig_engine(surface, tip=tip, mu=mu, ie=ie, hfield_resolution=res, stiffness_number=300.0)
     rig = sim.build_rig(
-        presets.make_surface(preset),
+        surface,
         mu=mu,
         tip_radius_m=tip * sim.DEFAULT_LENGTH_SCALE_M,
         mass_kg=MASS_KG,
@@ -179,3 +180,23 @@ def test_a_doubled_hfield_nests_the_old_samples_and_keeps_the_tip():
         == base["starts"]
         == FamilySpec("x", (), None, paper_starts([-2.0, -4.0])).starts_table()
     )
+
+
+def test_the_static_error_is_converged_when_a_halved_step_moves_it_less_than_the_slack():
+    from spine_mj.validate.plans import DT_HALVED, RECOMMENDED
+    from spine_mj.validate.static_map import static_convergence
+
+    plan = PLANS["smoke"]
+    assert plan.static_engines == (RECOMMENDED, DT_HALVED)
+
+    def per_engine(err_halved, regions_halved=1.0):
+        return {
+            RECOMMENDED[0]: {"max_rel_error": 0.006, "region_agreement": 1.0},
+            DT_HALVED[0]: {"max_rel_error": err_halved, "region_agreement": regions_halved},
+        }
+
+    out = static_convergence(plan, per_engine(0.0045))
+    assert out["dt_halved"]["max_rel_error_change"] == pytest.approx(-0.0015)
+    assert out["dt_halved"]["converged"] is True
+    assert static_convergence(plan, per_engine(0.0100))["dt_halved"]["converged"] is False  # > 0.0025
+    assert static_convergence(plan, per_engine(0.006, 0.5))["dt_halved"]["converged"] is False

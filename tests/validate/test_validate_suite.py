@@ -42,6 +42,9 @@ def test_smoke_validation_writes_report_and_json(tmp_path, monkeypatch):
     assert {"value", "low", "high", "kind"} <= set(doc["ie_star"]["spring"])
     # the static probe on a 20 deg plane (engaged) matches tan(theta + arctan mu) closely
     assert doc["static_kappa_max_rel_error"] < 0.05
+    # and again with the step halved (the contact's time constant kept)
+    halved = doc["static_convergence"]["dt_halved"]
+    assert abs(halved["max_rel_error_change"]) < 0.05 and halved["region_agreement_change"] == 0
     report = (out / "report.md").read_text()
     assert "Quasistatic limit" in report and "figures/boundary.png" in report
     assert "Verdicts with their intervals" in report and doc["platform"]["cpu"] in report

@@ -12,8 +12,9 @@ from spine_mj.plotting import (
     sig,
     styled,
 )
+from spine_mj.validate.convergence import REFINEMENT_LABELS
 from spine_mj.validate.report.common import ReportContext, assemble, cell, image, table
-from spine_mj.validate.static_map import StaticMapResult
+from spine_mj.validate.static_map import PROBE_IE, StaticMapResult
 
 
 @styled
@@ -49,7 +50,7 @@ def _lines(static: StaticMapResult) -> list[str]:
     return [
         "## Static breakaway ratio on inclined planes",
         "",
-        f"mu = {static.mu:g}; probe ramp at I_e = 0.01; kappa from Eqs. 1-3.",
+        f"mu = {static.mu:g}; probe ramp at I_e = {sig(PROBE_IE)}; kappa from Eqs. 1-3.",
         "",
         table(
             [{"engine": k, **v} for k, v in static.per_engine.items()],
@@ -64,7 +65,7 @@ def _lines(static: StaticMapResult) -> list[str]:
         ),
         "",
         f"`static_kappa_max_rel_error` (engaged, default settings) = "
-        f"{cell(static.static_kappa_max_rel_error)} (target <= 0.05).",
+        f"{cell(static.static_kappa_max_rel_error)}{_convergence_note(static)} (target <= 0.05).",
         "",
         "<details><summary>per plane</summary>",
         "",
@@ -86,6 +87,16 @@ def _lines(static: StaticMapResult) -> list[str]:
         "</details>",
         "",
     ]
+
+
+def _convergence_note(static: StaticMapResult) -> str:
+    """The error's change under each refinement and its verdict (solution verification)."""
+    parts = [
+        f"{REFINEMENT_LABELS.get(k, k)}: change {cell(e['max_rel_error_change'])}, "
+        f"{'converged' if e['converged'] else 'unconverged'}"
+        for k, e in static.convergence.items()
+    ]
+    return f" ({'; '.join(parts)})" if parts else ""
 
 
 def headline(static: StaticMapResult) -> list[str]:
