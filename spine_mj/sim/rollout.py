@@ -494,7 +494,7 @@ class _Group:
         push = np.concatenate([rise, np.minimum(nominal, cap * (1 + 1e-9))]) / rig.units.force_n
         if ns + push.size > self.n:
             return
-        self.climbs[k] = _Climb(ff, self.warm[k].copy(), self.ctrl[k, ns:].copy(), int(self.end[k]), 0)
+        self.climbs[k] = _Climb(ff, self.warm[k].copy(), [1], self.ctrl[k][ns:, [1]], int(self.end[k]), 0)
         self.ctrl[k, ns : ns + push.size, 1] = push
         self.end[k] = ns + push.size
 
@@ -522,14 +522,14 @@ class _Group:
         if skip < 2 * RISE_STEPS:  # the plan ends first: the climb would save too little
             ff.finish(force)
             return
-        rows = self.ctrl[k, b:end].copy()
-        self.climbs[k] = _Climb(ff, self.warm[k].copy(), rows, end, skip)
+        cols = [0, 3]  # the spring's anchor and the carriage: the others are constant while driving
+        ctrl = self.ctrl[k]
+        rows = ctrl[b:end, cols]  # a copy
+        self.climbs[k] = _Climb(ff, self.warm[k].copy(), cols, rows, end, skip)
         self.end[k] = end - skip + RISE_STEPS
-        self.ctrl[k, b + RISE_STEPS : self.end[k]] = rows[skip:]
-        self.ctrl[k, b : b + RISE_STEPS] = rows[:RISE_STEPS]
-        x0, x1 = self.ctrl[k, b - 1, [0, 3]], rows[skip - 1, [0, 3]]  # the spring's anchor and the carriage
+        ctrl[b + RISE_STEPS : self.end[k], cols] = rows[skip:]
         frac = np.arange(1, RISE_STEPS + 1)[:, None] / RISE_STEPS
-        self.ctrl[k][b : b + RISE_STEPS, [0, 3]] = x0 + frac * (x1 - x0)
+        ctrl[b : b + RISE_STEPS, cols] = ctrl[b - 1, cols] + frac * (rows[skip - 1] - ctrl[b - 1, cols])
 
     def watcher(self, k: int) -> StickFastForward:
         """A :class:`StickFastForward` for run ``k`` (SI: it reads the recorded rows)."""
@@ -567,7 +567,7 @@ class _Group:
         for i in range(b - a):
             verdict = ff.watch(*_still(rec, i), float(rec.drive_force_n[i]), step)
             if verdict == "rollback" or (not ff.active and i < b - a - 1):
-                self.ctrl[k, a : climb.end] = climb.rows
+                self.ctrl[k][a : climb.end, climb.cols] = climb.rows
                 self.end[k], self.warm[k] = climb.end, climb.warm
                 return False
         if ff.active:
@@ -580,7 +580,8 @@ class _Climb(NamedTuple):
 
     ff: StickFastForward
     warm: np.ndarray  # the warm start before the climb
-    rows: np.ndarray  # the controls from the climb's first row to ``end``, as they were
+    cols: list[int]  # the control columns the climb changes
+    rows: np.ndarray  # those columns from the climb's first row to ``end``, as they were
     end: int  # the planned rows before the climb
     skip: int  # rows of a spring's schedule the climb covers (0: a probe's climb)
 
