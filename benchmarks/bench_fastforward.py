@@ -145,12 +145,12 @@ def _spring_cases(ies, ks):
 
     surface = presets.make_surface("paper-fractal", seed=1)
     for ie in ies:
-        rig = sim.build_rig(surface, mu=0.5, ie=ie)
-        sc = rig.scales
-        x0, x1, y0, y1 = (b / rig.length_scale_m for b in rig.bounds_m)
-        starts = [(x0 + 0.05 * (x1 - x0), y0 + f * (y1 - y0)) for f in (0.3, 0.7)]
-        v = sc.speed_for(ie)
-        for kf in ks:
+        for kf in ks:  # the engine's step resolves the spring's swing
+            rig = sim.build_rig(surface, mu=0.5, ie=ie, stiffness_number=kf)
+            sc = rig.scales
+            x0, x1, y0, y1 = (b / rig.length_scale_m for b in rig.bounds_m)
+            starts = [(x0 + 0.05 * (x1 - x0), y0 + f * (y1 - y0)) for f in (0.3, 0.7)]
+            v = sc.speed_for(ie)
             drive = sim.SpringDrive(
                 speed_m_s=v, stiffness_n_m=sc.stiffness_for(kf), duration_s=0.25 * sc.char_length_m / v
             )
