@@ -617,7 +617,8 @@ def _spring_markdown(rows) -> list[str]:
     out = [
         "",
         "Spring drive, cost per run against I_e and K = k l_s / F_p, plain / fast-forwarded: the "
-        "paper fractal (seed 1, mu 0.5, 2 starts, 0.25 L_c of travel) and the spring-block on a "
+        "paper fractal (seed 1, mu 0.5 and, at K 3, the preset's 1.25; 2 starts, 0.25 L_c of travel) "
+        "and the spring-block on a "
         "flat plane (stuck until k V t = mu F_p, 91 % of the run). A spring run "
         "fast-forwards only where a preload is over 400 of its steps' increments k V dt "
         "(`rollout.SPRING_MIN_CLIMB_STEPS`); the end-point difference is in L_c:",

@@ -82,16 +82,15 @@ BATCH_MEMORY_BYTES = 256 * 2**20
 FIRST_PIECE_STEPS = 128
 #: Longest piece: the most steps a run is simulated between two looks at its end conditions.
 PIECE_STEPS = 1024
-#: Longest piece of a fast-forwarding spring run: a stick phase is seen at the end of a
-#: piece, so a piece's length is the latency of its climb (a piece costs ~15 steps' time
-#: in the calling thread: 256 rows cost ~6 %; measured on the fractal at K = 3).
-SPRING_PIECE_STEPS = 256
 #: A spring run fast-forwards only where one preload ``F_p`` is more than this many of its
 #: steps' increments ``k V dt``: a stick phase gains about a preload's worth of force (kappa
 #: varies by O(1) along a path), and a shorter one hardly outlasts the climb
-#: (:data:`~spine_mj.sim.fastforward.RISE_STEPS`), its nominal approach and the latency of
-#: :data:`SPRING_PIECE_STEPS`, so its pieces' overhead would be spent for nothing. On the
+#: (:data:`~spine_mj.sim.fastforward.RISE_STEPS`), its nominal approach and the wait for
+#: the end of a piece, so the checks after each piece would be spent for nothing. On the
 #: paper fractal at K = 30 (step 0.004 F_p at I_e = 1e-6) no still phase lasted 300 steps.
+#: (A stick phase is seen at the end of a piece; capping a fast-forwarding run's pieces at
+#: 256 steps saved 5 % of its steps on the fractal at K = 3, mu 1.25, I_e 1e-6, but cost
+#: 15 % more CPU time than the usual pieces: a piece costs ~15 steps' time.)
 SPRING_MIN_CLIMB_STEPS = 4 * RISE_STEPS
 #: Most steps an open-loop run may plan: its recording (~0.5 kB a step) stays within ~2 GiB.
 MAX_RUN_STEPS = 2**22
@@ -395,8 +394,6 @@ class _Group:
                 b = a + RISE_STEPS
             else:
                 size = min(PIECE_STEPS, FIRST_PIECE_STEPS << int(self.pieces[k]))
-                if self.spring_ff[k]:
-                    size = min(size, SPRING_PIECE_STEPS)
                 b = max(a, self.n_settle[k]) + size
                 if self.end[k] - b < size // 2:  # no short last piece: it joins this one
                     b = int(self.end[k])
