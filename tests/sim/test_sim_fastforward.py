@@ -343,3 +343,28 @@ def test_a_spring_whose_tip_moves_during_its_climb_goes_on_as_the_plain_run(monk
         np.testing.assert_array_equal(getattr(fast, name), getattr(plain, name))
     dropped = fast.simulated_steps - plain.simulated_steps
     assert dropped > 0 and dropped % ff.RISE_STEPS == 0
+
+
+def test_a_spring_run_that_ends_stuck_completes_where_the_plain_one_does():
+    """The planned end falls inside the stick phase: the climb stops at the plain run's last
+    carriage position, and the run completes there, at the same physical time."""
+    rig = flat_rig()
+    v, k = 0.001, 10.0
+    drive = SpringDrive(speed_m_s=v, stiffness_n_m=k, duration_s=0.5 * MU * rig.scales.preload_n / (k * v))
+    plain, fast = (rig.run(dataclasses.replace(drive, fast_forward=f), start=(-0.04, 2.3e-4)) for f in (0, 1))
+    assert plain.end_reason is EndReason.COMPLETED and fast.end_reason is EndReason.COMPLETED
+    assert not plain.moving.any() and not fast.moving.any()
+    assert fast.time_s[-1] == pytest.approx(plain.time_s[-1], rel=1e-9)
+    assert fast.carriage_x_m[-1] == plain.carriage_x_m[-1]
+    assert fast.drive_force_n[-1] == pytest.approx(plain.drive_force_n[-1], rel=1e-6)
+    assert fast.simulated_steps < plain.simulated_steps / 4
+
+
+def test_the_fast_forwarded_rollout_equals_its_python_reference():
+    """The native pieces and the plain mj_step loop take the same climbs: the same run."""
+    rig = flat_rig()
+    drive = SpringDrive(speed_m_s=0.001, stiffness_n_m=10.0, duration_s=5.1)
+    native, python = (rig.run(drive, start=(-0.04, 2.3e-4), backend=b) for b in ("rollout", "python"))
+    assert native.simulated_steps == python.simulated_steps < 2000
+    for name in ("time_s", "position_m", "drive_force_n", "carriage_x_m"):
+        np.testing.assert_array_equal(getattr(native, name), getattr(python, name))
