@@ -294,6 +294,38 @@ def probes(work: Path, novideo: str | None) -> list[tuple[str, list[str], str, s
         "refuse",
         "slope",
     )
+    # issue 36: options the chosen layout or executor would ignore, and help examples
+    arr = [*SPINE, "array", "corrugation", "--rows", "1", "--cols", "2", "--out", "arr"]
+    add("array --layout random --seed -1", [*arr, "--layout", "random", "--seed", "-1"], "refuse", "--seed")
+    add("array --layout grid --seed 5", [*arr, "--layout", "grid", "--seed", "5"], "refuse", "--seed")
+    add(
+        "sweep --scheduler with --workers",
+        [
+            *SPINE,
+            "sweep",
+            "example:paper-quasistatic.toml",
+            "--out",
+            "s",
+            "--scheduler",
+            "tcp://x:1",
+            "--workers",
+            "2",
+        ],
+        "refuse",
+        "--workers",
+    )
+    add(
+        "surface info SCAN --tip-radius without --mu",
+        [*SPINE, "surface", "info", "example:plu-1.plu", "--tip-radius", "1e-6"],
+        "refuse",
+        "--tip-radius",
+    )
+    add(
+        "streamline's help example (--out)",
+        [*SPINE, "streamline", "paper-single-valley", "--mu", "1.2", "--start", "-3,-1", "--out", "sl"],
+        "ok",
+        "wrote",
+    )
     return out
 
 
