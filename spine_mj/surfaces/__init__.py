@@ -21,7 +21,8 @@ its instrument's length unit (:data:`LENGTH_UNITS_M`, spelled by :func:`length_u
 Modules: :mod:`~spine_mj.surfaces.base` (units, size limits, argument checks),
 :mod:`~spine_mj.surfaces.types` (the surface types), :mod:`~spine_mj.surfaces.generators`,
 :mod:`~spine_mj.surfaces.hfield` (MuJoCo's height field) and
-:mod:`~spine_mj.surfaces.facets` (the facets MuJoCo collides with and the ball tip on them).
+:mod:`~spine_mj.surfaces.facets` (the facets MuJoCo collides with and the ball tip on them),
+:mod:`~spine_mj.surfaces.dilation` (the surface a spherical tip's centre rides on).
 Every public name is importable from ``spine_mj.surfaces``.
 """
 
@@ -33,6 +34,7 @@ from spine_mj.surfaces.base import (
     check_grid_size,
     length_unit,
 )
+from spine_mj.surfaces.dilation import ball_dilation, ball_dilation_reference, dilate
 from spine_mj.surfaces.facets import BallOnFacets, TriangulatedSurface
 from spine_mj.surfaces.generators import (
     corrugation,
@@ -56,8 +58,11 @@ __all__ = [
     "HField",
     "Surface",
     "TriangulatedSurface",
+    "ball_dilation",
+    "ball_dilation_reference",
     "check_grid_size",
     "corrugation",
+    "dilate",
     "fractal_fbm",
     "from_hfield",
     "length_unit",

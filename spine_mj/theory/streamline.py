@@ -21,8 +21,8 @@ one core) and ``"numpy"`` (a plain loop over steps, vectorized over starts, for 
 :class:`~spine_mj.surfaces.Surface`; the reference the tests check the kernels against).
 
 A finite tip of radius R rides with its centre on the surface dilated by a ball of radius
-R: :func:`dilate` builds that surface (shifted down by R so that R -> 0 gives the
-original), on which the same streamline rules apply.
+R: :func:`~spine_mj.surfaces.dilation.dilate` (re-exported here) builds that surface, on
+which the same streamline rules apply.
 """
 
 from __future__ import annotations
@@ -33,7 +33,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
-from scipy import ndimage
 
 from spine_mj.errors import SpineInputError
 from spine_mj.surfaces import (
@@ -42,8 +41,8 @@ from spine_mj.surfaces import (
     GridSurface,
     Surface,
     TriangulatedSurface,
-    check_grid_size,
 )
+from spine_mj.surfaces.dilation import dilate
 from spine_mj.theory._kernels import run_trajectories
 from spine_mj.theory.engagement import (
     REGION_NAMES,
@@ -675,99 +674,3 @@ def _packed(paths: list, store: bool) -> tuple:
     flat = np.array([pt for p in paths for pt in p], dtype=float).reshape(-1, 5)
     ppx, ppy, ppz, ppk = (np.ascontiguousarray(flat[:, c]) for c in range(4))
     return offsets, ppx, ppy, ppz, ppk, flat[:, 4].astype(np.int8)
-
-
-# --------------------------------------------------------------------------- finite tip
-
-
-def dilate(surface: Surface, radius: float, *, spacing: float | None = None) -> GridSurface:
-    """Surface traced by a spherical tip of radius R, shifted down by R (R -> 0: the surface).
-
-    ``g(x, y) = max_{u^2 + v^2 <= R^2} [f(x + u, y + v) + sqrt(R^2 - u^2 - v^2)] - R`` is the
-    tip centre's height minus R: grey dilation of the sampled heights with a spherical
-    structuring element (``scipy.ndimage.grey_dilation``). The tip touches the surface
-    at the point of the cap that attains the maximum; its slope is that of ``g``.
-
-    Parameters
-    ----------
-    surface : Surface
-        Analytic surfaces are sampled on ``bounds`` widened by R (so the edge sees the
-        outside); gridded ones at their own spacing unless ``spacing`` is given; surfaces
-        defined only inside their bounds (non-periodic grids, MuJoCo's facets as a
-        :class:`~spine_mj.surfaces.TriangulatedSurface`) are padded with their edge values.
-    radius : float
-        Tip radius R >= 0 in the surface's length unit; 0 returns the sampled surface.
-    spacing : float, optional
-        Sample spacing; defaults to ``min(R / 8, extent / 400)`` for analytic surfaces.
-
-    Returns
-    -------
-    GridSurface
-        Same bounds as ``surface`` (same periodicity for gridded ones).
-    """
-
-    radius = float(radius)
-    if not (math.isfinite(radius) and radius >= 0):
-        raise SpineInputError(f"radius (tip radius) must be finite and >= 0, got {radius!r}")
-    if spacing is not None and not (math.isfinite(spacing) and spacing > 0):
-        raise SpineInputError(f"spacing must be finite and > 0, got {spacing!r}")
-    grid = _dilation_grid(surface, radius, spacing)
-    if radius == 0:
-        return grid
-    dx, dy = grid.spacing
-    check_grid_size(
-        2 * radius / dx + 1,
-        2 * radius / dy + 1,
-        where=f"the tip's footprint (radius {radius:g} on a grid of spacing {dx:g} x {dy:g} surface units)",
-    )
-    rx, ry = int(math.floor(radius / dx)), int(math.floor(radius / dy))
-    u = dx * np.arange(-rx, rx + 1)
-    v = dy * np.arange(-ry, ry + 1)
-    rho2 = u[None, :] ** 2 + v[:, None] ** 2
-    footprint = rho2 <= radius * radius
-    cap = np.sqrt(np.clip(radius * radius - rho2, 0, None)) - radius
-    if grid.periodic:
-        heights = ndimage.grey_dilation(grid.heights, footprint=footprint, structure=cap, mode="wrap")
-    elif not isinstance(surface, (GridSurface, TriangulatedSurface)):
-        # an analytic surface: sample a margin of R outside so the edge sees the true neighbourhood
-        xw = grid.x[0] + dx * np.arange(-rx, grid.x.size + rx)
-        yw = grid.y[0] + dy * np.arange(-ry, grid.y.size + ry)
-        wide = surface.height(xw[None, :], yw[:, None])
-        heights = ndimage.grey_dilation(wide, footprint=footprint, structure=cap)[
-            ry : -ry or None, rx : -rx or None
-        ]
-    else:
-        heights = ndimage.grey_dilation(grid.heights, footprint=footprint, structure=cap, mode="nearest")
-    meta = dict(surface.metadata, tip_radius=radius)
-    return GridSurface(
-        heights=heights, x=grid.x, y=grid.y, periodic=grid.periodic, unit=surface.unit, metadata=meta
-    )
-
-
-def _dilation_grid(surface: Surface, radius: float, spacing: float | None) -> GridSurface:
-    """The samples :func:`dilate` dilates: a grid's own (or resampled to ``spacing``), an
-    analytic surface's on its bounds at ``spacing`` (default ``min(R / 8, extent / 400)``)."""
-    if isinstance(surface, GridSurface) and spacing is None:
-        return surface
-    xmin, xmax, ymin, ymax = surface.bounds
-    h = spacing
-    if h is None:
-        extent = max(xmax - xmin, ymax - ymin)
-        h = min(radius / 8, extent / 400) if radius > 0 else extent / 400
-    if isinstance(surface, GridSurface) and surface.periodic:
-        return surface.resample(h)
-    check_grid_size(
-        (xmax - xmin) / h + 1,
-        (ymax - ymin) / h + 1,
-        where=f"dilating by the tip radius {radius:g} at spacing {h:g} (surface units)",
-    )
-    nx = int(math.ceil((xmax - xmin) / h)) + 1
-    ny = int(math.ceil((ymax - ymin) / h)) + 1
-    x, y = np.linspace(xmin, xmax, nx), np.linspace(ymin, ymax, ny)
-    return GridSurface(
-        heights=surface.height(x[None, :], y[:, None]),
-        x=x,
-        y=y,
-        unit=surface.unit,
-        metadata=dict(surface.metadata),
-    )
