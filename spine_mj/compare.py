@@ -27,12 +27,20 @@ import numpy as np
 from numba import njit
 
 from spine_mj.errors import SpineInputError
+from spine_mj.memory import BLOCK_BYTES
 from spine_mj.theory.engagement import SLIP
 
 #: What "agree" means at the quasistatic corner, for sweeps and validation alike: outcome
 #: agreement at least this share of the runs, and path deviation (Frechet over L_c) at most.
 OUTCOME_TARGET = 0.95
 FRECHET_TARGET = 0.1
+
+#: The most points :func:`resample_by_arclength` returns (2^16, 1 MiB of x-y): at the
+#: default spacing L_c / 50 a path over 1300 L_c long, hundreds of times any run across a
+#: surface; a longer one (a diverged run) is sampled more coarsely rather than without bound.
+MAX_RESAMPLED_POINTS = 2**16
+# bytes of float64 temporaries per (point, segment) pair in _point_segment_distance
+_PAIR_BYTES = 8 * 8
 
 #: The kinds :func:`miss_reason` tells apart, in the order reports list them, and what each
 #: means (the report prints these).
@@ -52,6 +60,7 @@ MISS_REASONS = {
 
 __all__ = [
     "FRECHET_TARGET",
+    "MAX_RESAMPLED_POINTS",
     "MISS_REASONS",
     "OUTCOME_TARGET",
     "capture_rate",
@@ -157,14 +166,20 @@ def frechet_distance_reference(path_a, path_b) -> float:
 
 
 def resample_by_arclength(path, spacing: float) -> np.ndarray:
-    """Points equally spaced by ``spacing`` in arc length along a polyline (ends kept)."""
+    """Points equally spaced by ``spacing`` in arc length along a polyline (ends kept).
+
+    At most :data:`MAX_RESAMPLED_POINTS`: a path longer than that many spacings is
+    resampled at its arc length / (``MAX_RESAMPLED_POINTS`` - 1) instead, so memory and the
+    comparisons' time stay bounded whatever the path's length (a diverged run's path that
+    flies off to 1e6 L_c and back would otherwise need 5e7 samples at L_c / 50).
+    """
     p = _path("path", path)
     spacing = _length_scale(spacing)
     seg = np.linalg.norm(np.diff(p, axis=0), axis=1)
     s = np.concatenate([[0.0], np.cumsum(seg)])
     if s[-1] == 0:
         return p[:1].copy()
-    n = max(2, int(math.ceil(s[-1] / spacing)) + 1)
+    n = int(min(MAX_RESAMPLED_POINTS, max(2, math.ceil(s[-1] / spacing) + 1)))
     target = np.linspace(0.0, s[-1], n)
     keep = np.concatenate([[True], seg > 0])
     return np.column_stack([np.interp(target, s[keep], p[keep, k]) for k in range(p.shape[1])])
@@ -185,18 +200,26 @@ def path_frechet(path, reference, *, length_scale: float, spacing: float | None 
 
 
 def _point_segment_distance(points, seg_start, seg_end):
-    """Distance from each point (P, 2) to the nearest of the segments (S, 2) -> (P,)."""
+    """Distance from each point (P, 2) to the nearest of the segments (S, 2) -> (P,).
+
+    Blocks of points x segments whose temporaries take at most
+    :data:`spine_mj.memory.BLOCK_BYTES`, so memory is O(P + S) whatever their product."""
     d = seg_end - seg_start
     len2 = np.einsum("sk,sk->s", d, d)
+    inv = np.divide(1.0, len2, out=np.zeros_like(len2), where=len2 > 0)
     best = np.full(points.shape[0], np.inf)
-    for lo in range(0, seg_start.shape[0], 2048):
-        a, dd, l2 = seg_start[lo : lo + 2048], d[lo : lo + 2048], len2[lo : lo + 2048]
-        rel = points[:, None, :] - a[None, :, :]
-        t = np.where(l2 > 0, np.einsum("psk,sk->ps", rel, dd) / np.where(l2 > 0, l2, 1), 0.0)
-        t = np.clip(t, 0.0, 1.0)
-        closest = a[None] + t[..., None] * dd[None]
-        dist = np.linalg.norm(points[:, None, :] - closest, axis=2)
-        best = np.minimum(best, dist.min(axis=1))
+    pairs = max(1, BLOCK_BYTES // _PAIR_BYTES)
+    pstep = max(1, min(points.shape[0], pairs))
+    sstep = max(1, pairs // pstep)
+    for plo in range(0, points.shape[0], pstep):
+        pts = points[plo : plo + pstep]
+        for lo in range(0, seg_start.shape[0], sstep):
+            a, dd, il2 = seg_start[lo : lo + sstep], d[lo : lo + sstep], inv[lo : lo + sstep]
+            rel = pts[:, None, :] - a[None, :, :]
+            t = np.clip(np.einsum("psk,sk->ps", rel, dd) * il2, 0.0, 1.0)
+            rel -= t[..., None] * dd[None]
+            dist = np.sqrt(np.einsum("psk,psk->ps", rel, rel))
+            np.minimum(best[plo : plo + pstep], dist.min(axis=1), out=best[plo : plo + pstep])
     return best
 
 

@@ -1,5 +1,6 @@
 """Comparison metrics on constructed cases whose answers are known by hand."""
 
+import itertools
 import math
 
 import numpy as np
@@ -7,8 +8,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from spine_mj import SpineInputError
+from spine_mj import SpineInputError, compare
 from spine_mj.compare import (
+    MAX_RESAMPLED_POINTS,
     capture_rate,
     frechet_distance,
     frechet_distance_reference,
@@ -82,6 +84,48 @@ def test_resample_by_arclength():
     assert len(r) == 8
     np.testing.assert_allclose(np.linalg.norm(np.diff(r, axis=0), axis=1), 1.0)
     np.testing.assert_allclose(r[-1], [3.0, 4.0])
+
+
+def _segment_distance_by_point(points, ref):
+    """Plain reference: each point against every segment of ``ref``, one point at a time."""
+    out = []
+    for p in points:
+        best = math.inf
+        for a, b in itertools.pairwise(ref):
+            d = b - a
+            t = 0.0 if d @ d == 0 else min(1.0, max(0.0, (p - a) @ d / (d @ d)))
+            best = min(best, float(np.linalg.norm(p - (a + t * d))))
+        out.append(best)
+    return np.array(out)
+
+
+@pytest.mark.parametrize("block_bytes", [64, 64 * 7, 2**25])
+def test_point_segment_distance_in_blocks_equals_the_plain_loop(monkeypatch, block_bytes):
+    """Whatever the byte budget cuts the points x segments into (one pair a block, a few,
+    all), the distances are those of the plain loop; repeated vertices (zero-length
+    segments) included."""
+    monkeypatch.setattr(compare, "BLOCK_BYTES", block_bytes)
+    rng = np.random.default_rng(5)
+    ref = np.cumsum(rng.normal(size=(23, 2)), axis=0)
+    ref[7] = ref[6]
+    points = rng.normal(scale=3.0, size=(31, 2))
+    got = compare._point_segment_distance(points, ref[:-1], ref[1:])
+    np.testing.assert_allclose(got, _segment_distance_by_point(points, ref), rtol=1e-12)
+
+
+def test_a_path_flown_to_a_million_lc_and_back_is_compared_in_bounded_samples():
+    """A diverged run's path: 1e6 L_c out along x and back. Resampled at L_c / 50 it would
+    take 1e8 points; it gets MAX_RESAMPLED_POINTS, ends kept, and its deviation from a
+    reference along [0, 10] is the closed form mean(max(x - 10, 0)) over the out-and-back."""
+    far = 1e6
+    wild = np.array([[0.0, 0.0], [far, 0.0], [0.0, 0.0]])
+    samples = resample_by_arclength(wild, 1 / 50)
+    assert samples.shape == (MAX_RESAMPLED_POINTS, 2)
+    np.testing.assert_array_equal(samples[[0, -1]], wild[[0, -1]])
+    ref = line(0.0, n=11, x0=0.0, x1=10.0)
+    expected = (far - 10) ** 2 / (2 * far)
+    assert mean_lateral_deviation(wild, ref) == pytest.approx(expected, rel=1e-3)
+    assert compare.path_frechet(wild, ref, length_scale=1.0) == pytest.approx(far - 10, rel=1e-3)
 
 
 def test_outcome_agreement_cases():
