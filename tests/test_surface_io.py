@@ -2,8 +2,10 @@
 
 import numpy as np
 import pytest
+from click.testing import CliRunner
 
 from spine_mj import SpineInputError
+from spine_mj.cli import main
 from spine_mj.surface_io import (
     import_topography,
     load_surface,
@@ -11,7 +13,7 @@ from spine_mj.surface_io import (
     surface_mesh,
     write_stl,
 )
-from spine_mj.surfaces import GridSurface, fractal_fbm, random_gaussians, single_gaussian
+from spine_mj.surfaces import MAX_PEAKS, GridSurface, fractal_fbm, random_gaussians, single_gaussian
 
 
 def test_npz_round_trip_grid_and_gaussian(tmp_path):
@@ -51,6 +53,35 @@ def test_load_rejects_corrupt_and_foreign_files(tmp_path):
     np.savez(nan, **data)
     with pytest.raises(SpineInputError, match="NaN"):
         load_surface(nan)
+
+
+def test_a_file_over_the_gaussian_limit_is_refused_when_read(tmp_path):
+    """At most MAX_PEAKS Gaussians, whether generated or read: a file holding 200 000
+    (written by hand) is refused on reading, before any evaluation (``surface info`` used to
+    work 352 s on one, ``surface show`` drew it), with one line and nothing written."""
+    small = tmp_path / "small.npz"
+    save_surface(random_gaussians(n_peaks=5, rng=2), small)
+    with np.load(small) as npz:
+        data = dict(npz)
+    n = 2 * MAX_PEAKS
+    for key in ("amplitude", "center_x", "center_y"):
+        data[key] = np.zeros(n)
+    data["sigma_x"] = data["sigma_y"] = np.ones(n)
+    big = tmp_path / "big.npz"
+    np.savez(big, **data)
+    with pytest.raises(
+        SpineInputError, match=rf"big.npz: a Gaussian surface holds at most {MAX_PEAKS} Gaussians, got {n}"
+    ):
+        load_surface(big)
+    for args in (
+        ["surface", "info", str(big)],
+        ["surface", "show", str(big), "-o", str(tmp_path / "big.png")],
+    ):
+        result = CliRunner().invoke(main, args)
+        lines = result.output.strip().splitlines()
+        assert result.exit_code == 2 and len(lines) == 1 and lines[0].startswith("Error: "), result.output
+        assert f"at most {MAX_PEAKS} Gaussians" in lines[0]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["big.npz", "small.npz"]
 
 
 def test_failed_save_leaves_nothing(tmp_path):

@@ -47,6 +47,15 @@ def _check_ball(heights, radius, spacing) -> tuple[np.ndarray, float, float, flo
     return h, radius, *_spacing_pair(spacing)
 
 
+def _check_footprint(radius: float, dx: float, dy: float) -> None:
+    """A tip wider than a grid of MAX_GRID_POINTS samples is refused, as any such grid."""
+    check_grid_size(
+        2 * radius / dx + 1,
+        2 * radius / dy + 1,
+        where=f"the tip's footprint (radius {radius:g} on a grid of spacing {dx:g} x {dy:g} surface units)",
+    )
+
+
 def ball_dilation(heights, radius: float, *, spacing, periodic: bool = False) -> np.ndarray:
     """Grey-scale dilation of sampled heights by a ball of radius R, shifted down by R.
 
@@ -74,12 +83,14 @@ def ball_dilation(heights, radius: float, *, spacing, periodic: bool = False) ->
     Raises
     ------
     SpineInputError
-        For a non-finite or negative radius or spacing, non-finite heights, or a grid whose
-        arrays would exceed the memory budget (:mod:`spine_mj.memory`).
+        For a non-finite or negative radius or spacing, non-finite heights, a tip whose
+        footprint spans more than :data:`~spine_mj.surfaces.MAX_GRID_POINTS` samples, or a
+        grid whose arrays would exceed the memory budget (:mod:`spine_mj.memory`).
     """
     h, radius, dx, dy = _check_ball(heights, radius, spacing)
     if radius == 0:
         return h.copy()
+    _check_footprint(radius, dx, dy)
     check_memory(_GRID_ARRAYS * h.nbytes, where=f"dilating a {h.shape[0]} x {h.shape[1]} grid by a tip")
     from spine_mj.surfaces._dilation_kernel import ball_dilation as kernel
 
@@ -149,6 +160,7 @@ def dilate(surface: Surface, radius: float, *, spacing: float | None = None) -> 
     if radius == 0:
         return grid
     dx, dy = grid.spacing
+    _check_footprint(radius, dx, dy)
     if grid.periodic or isinstance(surface, (GridSurface, TriangulatedSurface)):
         heights = ball_dilation(grid.heights, radius, spacing=(dx, dy), periodic=grid.periodic)
     else:

@@ -513,3 +513,22 @@ def test_sweep_set_with_a_non_boolean_flag_is_refused_when_the_config_is_read():
     }
     with pytest.raises(SpineInputError, match="anisotropic must be true or false"):
         parse_config(doc)
+
+
+def test_gaussian_sums_in_byte_budget_blocks_equal_one_pass(monkeypatch):
+    """A Gaussian surface evaluates points x Gaussians in blocks within BLOCK_BYTES (at
+    MAX_PEAKS Gaussians one 32768-point chunk held 26 GB per temporary); whatever the
+    blocks, on a tensor grid and pointwise, the sums are the one-pass ones."""
+    from spine_mj.surfaces import types
+
+    surf = random_gaussians(n_peaks=300, rng=1)
+    x = np.linspace(*surf.bounds[:2], 57)
+    y = np.linspace(*surf.bounds[2:], 43)
+    xx, yy = np.meshgrid(x, y)
+    whole = surf.evaluate(x[None, :], y[:, None], order=2)
+    # blocks of 5 points, and of 15 Gaussians on the grid
+    monkeypatch.setattr(types, "BLOCK_BYTES", 8 * 8 * 300 * 5)
+    assert surf._points_per_chunk() == 5
+    for got in (surf.evaluate(x[None, :], y[:, None], order=2), surf.evaluate(xx, yy, order=2)):
+        for a, b in zip(got, whole, strict=True):
+            np.testing.assert_allclose(a, b, rtol=0, atol=1e-12)
