@@ -1,0 +1,90 @@
+"""Memory bounded by design: the two paths that used to grow without bound, measured.
+
+Each runs in a fresh interpreter; the growth of its peak resident set
+(``resource.getrusage``'s ``ru_maxrss``) over the peak after imports and a warm-up is its
+memory. Before: a diverged path of 1e6 L_c took the compare analysis past 18 GB, and the
+801 x 801 dilation by a tip 110 samples wide peaked at 15 GB.
+"""
+
+import json
+import subprocess
+import sys
+import textwrap
+
+import pytest
+
+from spine_mj.errors import SpineInputError
+from spine_mj.memory import ENV_VAR, check_memory, format_bytes, memory_budget
+
+MIB = 2**20
+
+_HARNESS = """
+import json, resource
+import numpy as np
+{setup}
+before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+{work}
+after = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+print(json.dumps({{"growth_mib": (after - before) / 1024, "peak_mib": after / 1024}}))
+"""
+
+
+def _measure(setup: str, work: str) -> dict:
+    code = _HARNESS.format(setup=textwrap.dedent(setup), work=textwrap.dedent(work))
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True, timeout=600
+    )
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def test_a_path_flown_to_a_million_lc_and_back_is_compared_in_bounded_memory():
+    """The diverged run of issue 32 as the compare analysis sees it: 5000 recorded points
+    out to 1e6 L_c and back, against a 400-point streamline."""
+    m = _measure(
+        """
+        from spine_mj import compare
+        t = np.linspace(0.0, 1.0, 5000)
+        wild = np.column_stack([1e6 * np.sin(np.pi * t), 0.3 * np.sin(40 * t)])
+        ref = np.column_stack([np.linspace(0.0, 10.0, 400), np.zeros(400)])
+        compare.path_frechet(wild[:50], ref[:50], length_scale=1.0)  # compile
+        """,
+        """
+        fr = compare.path_frechet(wild, ref, length_scale=1.0)
+        lat = compare.mean_lateral_deviation(wild, ref, length_scale=1.0)
+        assert fr > 9e5 and lat > 4e5
+        """,
+    )
+    assert m["growth_mib"] < 150, m
+
+
+def test_an_801_grid_dilated_by_a_tip_110_samples_wide_stays_small():
+    m = _measure(
+        """
+        from spine_mj.surfaces import GridSurface, dilate
+        x = np.arange(801.0)
+        grid = GridSurface(heights=np.random.default_rng(0).normal(size=(801, 801)), x=x, y=x.copy())
+        dilate(GridSurface(heights=np.zeros((8, 8)), x=x[:8], y=x[:8]), 2.0)  # compile
+        """,
+        """
+        g = dilate(grid, 55.0)
+        assert g.heights.shape == (801, 801)
+        """,
+    )
+    assert m["growth_mib"] < 150 and m["peak_mib"] < 1024, m
+
+
+def test_the_budget_is_read_from_the_environment(monkeypatch):
+    monkeypatch.setenv(ENV_VAR, "1.5G")
+    assert memory_budget() == int(1.5 * 2**30)
+    check_memory(2**30, where="one GiB")
+    with pytest.raises(
+        SpineInputError, match=r"^two GiB would need 2 GiB of memory, more than the budget of 1.5 GiB"
+    ):
+        check_memory(2 * 2**30, where="two GiB")
+    for bad in ("lots", "-3G", "0", "1e999"):
+        monkeypatch.setenv(ENV_VAR, bad)
+        with pytest.raises(SpineInputError, match=f"{ENV_VAR} must be a size in bytes"):
+            memory_budget()
+    monkeypatch.delenv(ENV_VAR)
+    assert 0 < memory_budget() < 2**50
+    assert format_bytes(512) == "512 B" and format_bytes(3 * MIB) == "3 MiB"
