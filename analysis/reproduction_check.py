@@ -31,6 +31,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+from spine_mj.atomic import atomic_output
 from spine_mj.errors import SpineInputError
 from spine_mj.validate.reproducibility import check_reproduction, headline_numbers
 
@@ -67,8 +68,27 @@ def table(rows) -> str:
     return "\n".join(lines)
 
 
-def main() -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+class _Parser(argparse.ArgumentParser):
+    """Usage errors as one ``Error:`` line, exit 2, like the CLI's."""
+
+    def error(self, message):
+        self.exit(2, f"Error: {message} (see --help)\n")
+
+
+def _writable(path: Path) -> None:
+    """Refuse, before any work, a report path that cannot be written."""
+    if path.is_dir():
+        raise SpineInputError(f"-o {path}: is a folder; give a file name")
+    folder = path.parent
+    while not folder.exists() and folder != folder.parent:
+        folder = folder.parent  # atomic_output makes the missing folders
+    blocked = not folder.is_dir() or not os.access(folder, os.W_OK)
+    if blocked or (path.exists() and not os.access(path, os.W_OK)):
+        raise SpineInputError(f"-o {path}: cannot write there ({folder} is not a writable folder)")
+
+
+def main(argv=None) -> int:
+    ap = _Parser(description=__doc__.split("\n\n")[0])
     ap.add_argument("new", nargs="?", help="validation.json of the new run")
     ap.add_argument("--committed", default=str(COMMITTED), help="the committed validation.json")
     ap.add_argument(
@@ -76,7 +96,17 @@ def main() -> int:
     )
     ap.add_argument("--out", default="emulated-out", help="output folder of the emulated run")
     ap.add_argument("-o", "--report", help="write the table here (Markdown)")
-    args = ap.parse_args()
+    args = ap.parse_args(argv)
+    try:
+        return _run(args)
+    except SpineInputError as exc:
+        print(f"Error: {exc}", file=sys.stderr)
+        return 2
+
+
+def _run(args) -> int:
+    if args.report:
+        _writable(Path(args.report))
     if args.emulate_x86_64_v2:
         env = {**os.environ, **X86_64_V2}
         spine = str(Path(sys.executable).with_name("spine-mj"))
@@ -85,21 +115,24 @@ def main() -> int:
     elif args.new:
         new = Path(args.new)
     else:
-        ap.error("give the new run's validation.json or --emulate-x86-64-v2")
+        raise SpineInputError("give the new run's validation.json, or --emulate-x86-64-v2 (see --help)")
     docs = []
     for path in (args.committed, new):
         try:
             docs.append(json.loads(Path(path).read_text()))
             headline_numbers(docs[-1])
         except (OSError, ValueError, SpineInputError) as exc:  # a missing or malformed file
-            print(f"Error: {path}: {exc}", file=sys.stderr)
-            return 2
+            raise SpineInputError(f"{path}: {exc}") from None
     committed, fresh = docs
     rows = check_reproduction(fresh, committed)
     text = f"New: {fresh.get('platform')}\n\nCommitted: {committed.get('platform')}\n\n"
     text += table(rows) + "\n"
     if args.report:
-        Path(args.report).write_text(text)
+        try:
+            with atomic_output(Path(args.report)) as tmp:
+                tmp.write_text(text)
+        except OSError as exc:
+            raise SpineInputError(f"-o {args.report}: cannot write it ({exc.strerror})") from None
     print(text)
     return 0 if all(r.ok for r in rows) else 1
 

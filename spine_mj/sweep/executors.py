@@ -10,7 +10,9 @@ encode_case`); the caller writes the store, so workers never touch it. Workers r
 from __future__ import annotations
 
 import concurrent.futures as cf
+import contextlib
 import importlib
+import logging
 import multiprocessing
 import os
 import threading
@@ -136,6 +138,31 @@ def run_dask(
     SchedulerUnavailable
         No worker within ``worker_wait_s``, or the scheduler lost while cases were running.
     """
+    with _quiet_distributed():
+        _run_dask(todo, scheduler, handle, worker_wait_s=worker_wait_s, notice=notice)
+
+
+@contextlib.contextmanager
+def _quiet_distributed():
+    """Hold back Dask's own log lines while a sweep runs on its scheduler: a lost scheduler
+    is one line of ours (:class:`SchedulerUnavailable`), not ``distributed.client - ERROR -
+    Failed to reconnect`` before it; what a case raises reaches us through its future."""
+    names = [
+        "distributed",
+        *(n for n in list(logging.root.manager.loggerDict) if n.startswith("distributed.")),
+    ]
+    loggers = [logging.getLogger(n) for n in names]
+    levels = [lg.level for lg in loggers]
+    for lg in loggers:
+        lg.setLevel(logging.CRITICAL + 1)
+    try:
+        yield
+    finally:
+        for lg, level in zip(loggers, levels, strict=True):
+            lg.setLevel(level)
+
+
+def _run_dask(todo, scheduler, handle, *, worker_wait_s, notice) -> None:
     own = not isinstance(scheduler, Client)
     client = Client(scheduler) if own else scheduler
     address = client.scheduler.address

@@ -52,8 +52,25 @@ def _num(v) -> float | None:
     return None if v is None or (isinstance(v, float) and math.isnan(v)) else float(v)
 
 
-def _pair(lo, hi) -> tuple[float, float] | None:
-    lo, hi = _num(lo), _num(hi)
+def _number(where: str, v, *, missing: bool = False) -> float | None:
+    """``v`` as a finite number; None (or NaN) only where ``missing`` values are allowed."""
+    if missing and _num(v) is None:
+        return None
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+        raise SpineInputError(f"{where} must be a finite number, got {v!r}")
+    return float(v)
+
+
+def _table(where: str, v) -> dict:
+    if not isinstance(v, dict):
+        raise SpineInputError(f"{where} must be a JSON object, got {type(v).__name__} {v!r:.60}")
+    return v
+
+
+def _interval(where: str, v, *, missing: bool = False) -> tuple[float, float] | None:
+    if not (isinstance(v, (list, tuple)) and len(v) == 2):
+        raise SpineInputError(f"{where} must be a pair [low, high], got {v!r:.60}")
+    lo, hi = (_number(f"{where}[{i}]", x, missing=missing) for i, x in enumerate(v))
     return None if lo is None or hi is None else (lo, hi)
 
 
@@ -64,14 +81,28 @@ def headline_numbers(validation: dict) -> dict[str, Headline]:
     agreement (``agreement_ci``, Wilson), the agreement over all runs
     (``outcome_agreement_ci``) and the median Frechet distance (``median_frechet_ci``,
     bootstrap); the family's ``meets_target`` is the verdict. I_e* of each drive
-    (``ie_star``, bootstrap over starts). The fractal self-lock rates per H and series
-    (Wilson). Keys read ``limit.fractal.agreement_well_conditioned`` and so on.
+    (``ie_star``, bootstrap over starts; None or NaN where it lies outside the grid). The
+    fractal self-lock rates per H and series (Wilson). Keys read
+    ``limit.fractal.agreement_well_conditioned`` and so on.
+
+    Raises
+    ------
+    SpineInputError
+        Naming the field, for what is not a validation: no or empty ``limit_families``, a
+        field of the wrong type (a number where a table or a pair belongs), a family's
+        number or interval NaN or infinite.
     """
     if not isinstance(validation, dict) or "limit_families" not in validation:
         raise SpineInputError("validation must be a loaded validation.json (with limit_families)")
+    families = _table("limit_families", validation["limit_families"])
+    if not families:
+        raise SpineInputError("limit_families must hold at least one family, got none")
     out: dict[str, Headline] = {}
-    for fam, s in validation["limit_families"].items():
-        verdict = bool(s["meets_target"]) if "meets_target" in s else None
+    for fam, s in families.items():
+        s = _table(f"limit_families.{fam}", s)
+        verdict = s.get("meets_target")
+        if verdict is not None and not isinstance(verdict, bool):
+            raise SpineInputError(f"limit_families.{fam}.meets_target must be true or false, got {verdict!r}")
         for name, ci in (
             ("agreement_well_conditioned", "agreement_ci"),
             ("outcome_agreement", "outcome_agreement_ci"),
@@ -79,17 +110,30 @@ def headline_numbers(validation: dict) -> dict[str, Headline]:
         ):
             if name in s and ci in s:
                 key = f"limit.{fam}.{name}"
-                out[key] = Headline(key, _num(s[name]), _pair(*s[ci]), verdict)
-    for drive, est in (validation.get("ie_star") or {}).items():
-        if isinstance(est, dict) and "ci_low" in est:
-            key = f"ie_star.{drive}"
-            out[key] = Headline(key, _num(est.get("value")), _pair(est["ci_low"], est["ci_high"]))
-    for row in (validation.get("fractal_lock_rate") or {}).get("rows", []):
+                where = f"limit_families.{fam}."
+                out[key] = Headline(
+                    key, _number(where + name, s[name]), _interval(where + ci, s[ci]), verdict
+                )
+    for drive, est in _table("ie_star", validation.get("ie_star") or {}).items():
+        est = _table(f"ie_star.{drive}", est)
+        if "ci_low" in est:
+            key, where = f"ie_star.{drive}", f"ie_star.{drive}."
+            value = _number(where + "value", est.get("value"), missing=True)
+            interval = _interval(where + "ci_low/ci_high", [est["ci_low"], est.get("ci_high")], missing=True)
+            out[key] = Headline(key, value, interval)
+    lock = _table("fractal_lock_rate", validation.get("fractal_lock_rate") or {})
+    rows = lock.get("rows", [])
+    if not isinstance(rows, list):
+        raise SpineInputError(f"fractal_lock_rate.rows must be a list, got {rows!r:.60}")
+    for i, row in enumerate(rows):
+        row = _table(f"fractal_lock_rate.rows[{i}]", row)
         for series in ("streamline", "mujoco_corner", "mujoco_dynamic"):
             if f"rate_{series}" in row:
-                key = f"fractal_lock.H{row['hurst']}.{series}"
-                interval = _pair(row[f"ci_low_{series}"], row[f"ci_high_{series}"])
-                out[key] = Headline(key, _num(row[f"rate_{series}"]), interval)
+                key = f"fractal_lock.H{row.get('hurst')}.{series}"
+                where = f"fractal_lock_rate.rows[{i}]."
+                value = _number(where + f"rate_{series}", row[f"rate_{series}"])
+                pair = [row.get(f"ci_low_{series}"), row.get(f"ci_high_{series}")]
+                out[key] = Headline(key, value, _interval(where + f"ci_low/high_{series}", pair))
     return out
 
 

@@ -55,3 +55,29 @@ def test_array_key_given_twice_is_refused(tmp_path):
     doc = ARRAY + "[grid]\nrows = 3\n"
     with pytest.raises(SpineInputError, match=r"array\.rows: also given as grid\.rows"):
         sweep.load_config(write_config(tmp_path, doc))
+
+
+@pytest.mark.parametrize(
+    ("table", "match"),
+    [
+        # over the spine limit: refused by the config, not recorded `failed` run by run
+        (
+            "rows = 17\ncols = 16",
+            r"config \[array\]: an array has at most 256 spines, got rows x cols = 17 x 16",
+        ),
+        # a seed no layout reads
+        (
+            'layout = ["grid", "staggered"]\nlayout_seed = 5',
+            r"layout_seed = \[5\]: the grid and staggered layout ignores",
+        ),
+        # a random layout whose tips cannot stand apart at this spacing on the corrugation
+        (
+            'layout = "random"\nrows = 8\ncols = 8\nspacing = 0.001\nspacing_unit = "surface"',
+            r"config \[array\] on surface corrugation: spacing 0.001 is too small for 64 random spines",
+        ),
+    ],
+)
+def test_array_layouts_the_command_refuses_are_refused_at_config_time(tmp_path, table, match):
+    doc = ARRAY.split("[array]")[0] + "[array]\n" + table + "\n"
+    with pytest.raises(SpineInputError, match=match):
+        sweep.load_config(write_config(tmp_path, doc))

@@ -76,3 +76,35 @@ def test_sweeps_run_together_need_their_own_folders(tmp_path):
     a = peak_config(tmp_path, nmu=2, ny=1, name="a")
     with pytest.raises(SpineInputError, match="own out_dir"):
         sweep.run_sweeps([(a, tmp_path / "x"), (a, tmp_path / "x")])
+
+
+def test_dask_log_lines_are_held_back_while_a_sweep_runs_on_a_scheduler():
+    """The line distributed prints when its scheduler is gone ("distributed.client - ERROR -
+    Failed to reconnect ...") would come before the sweep's own one-line error: inside
+    run_dask the library's loggers pass nothing to their handlers, and their levels are
+    restored after."""
+    import logging
+
+    from spine_mj.sweep.executors import _quiet_distributed
+
+    seen = []
+
+    class Keep(logging.Handler):
+        def emit(self, record):
+            seen.append(record.getMessage())
+
+    keep = Keep()
+    client_log, comm_log = logging.getLogger("distributed.client"), logging.getLogger("distributed.comm.tcp")
+    client_log.addHandler(keep)
+    logging.getLogger("distributed").addHandler(keep)
+    level = client_log.level
+    try:
+        with _quiet_distributed():
+            client_log.error("Failed to reconnect to scheduler after 30.00 seconds, closing client")
+            comm_log.warning("closed")
+        assert seen == [] and client_log.level == level
+        client_log.error("after the sweep")
+        assert seen and set(seen) == {"after the sweep"}
+    finally:
+        client_log.removeHandler(keep)
+        logging.getLogger("distributed").removeHandler(keep)

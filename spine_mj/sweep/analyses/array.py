@@ -13,11 +13,14 @@ is the case's ``ie``: the arrays' own default pace is :func:`spine_mj.sim.array_
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 
 from spine_mj import sim
+from spine_mj.errors import SpineInputError
 from spine_mj.sim.layout import MAX_SPINES
-from spine_mj.sweep.analyses.mujoco import MUJOCO_PARAMS, case_rig
+from spine_mj.sweep.analyses.mujoco import MUJOCO_PARAMS, case_rig, case_scales
 from spine_mj.sweep.registry import CASE_THREADS, Analysis, AnalysisResult, ParamSpec, register_analysis
 
 ARRAY_PARAMS = (
@@ -41,9 +44,12 @@ ARRAY_PARAMS = (
 )
 
 
-def _array(case, surface, starts, upstream):
-    p = case.params
-    layout = sim.Layout(
+_LAYOUT_KEYS = ("layout", "rows", "cols", "spacing", "spacing_unit", "layout_seed")
+
+
+def _layout(p: dict) -> sim.Layout:
+    """The layout of parameters ``p`` (one value each), as ``spine-mj array`` builds it."""
+    return sim.Layout(
         kind=p["layout"],
         rows=p["rows"],
         cols=p["cols"],
@@ -51,6 +57,50 @@ def _array(case, surface, starts, upstream):
         spacing_unit=p["spacing_unit"],
         seed=p["layout_seed"],
     )
+
+
+def _check_layouts(config) -> None:
+    """Refuse at config time what ``spine-mj array`` refuses up front, rather than record
+    every run ``failed``: a layout of more than MAX_SPINES spines, ``layout_seed`` where no
+    random layout reads it, and a random layout whose spines cannot stand apart at its
+    spacing on a case's surface (placed as the run would, from the case's tip and scales)."""
+    grid = dict(config.grid)
+    if grid["layout_seed"] != (0,) and "random" not in grid["layout"]:
+        raise SpineInputError(
+            f"config key layout_seed = {list(grid['layout_seed'])}: the {' and '.join(grid['layout'])} "
+            "layout ignores it (read only by the random layout); remove it"
+        )
+    for values in itertools.product(*(grid[k] for k in _LAYOUT_KEYS)):
+        try:
+            _layout(dict(zip(_LAYOUT_KEYS, values, strict=True)))
+        except SpineInputError as exc:
+            raise SpineInputError(f"config [array]: {exc}") from None
+    if "random" not in grid["layout"]:
+        return
+    from spine_mj.sweep.cases import expand_cases
+
+    surfaces, checked = {}, set()
+    for case in expand_cases(config):
+        p = case.params
+        key = (
+            case.surface,
+            *(p[k] for k in (*_LAYOUT_KEYS, "tip_radius", "length_scale", "hfield_resolution")),
+        )
+        if p["layout"] != "random" or key in checked:
+            continue
+        checked.add(key)
+        sc = case_scales(case, surfaces.setdefault(case.surface, case.surface.make()))
+        layout, s = _layout(p), sc.length_scale_m
+        spacing = layout.spacing_in_surface_units(l_s=sc.slope_length_m / s, l_c=sc.char_length_m / s)
+        try:
+            layout.offsets(spacing, tip_radius=sc.tip_radius_m / s)
+        except SpineInputError as exc:
+            raise SpineInputError(f"config [array] on surface {case.surface.label}: {exc}") from None
+
+
+def _array(case, surface, starts, upstream):
+    p = case.params
+    layout = _layout(p)
     arr, drive = sim.build_array(
         case_rig(case, surface),
         layout,
@@ -87,6 +137,7 @@ register_analysis(
         "array",
         _array,
         ARRAY_PARAMS,
+        check_config=_check_layouts,
         doc="an array of spines on one carriage centred at every start ([array] table): sim.ArrayRig",
     )
 )

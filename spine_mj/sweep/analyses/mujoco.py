@@ -17,6 +17,7 @@ from spine_mj.errors import SpineInputError
 from spine_mj.sim.params import surface_unit_m
 from spine_mj.sim.ramp import nominal_time_s
 from spine_mj.sim.rollout import drive_steps
+from spine_mj.surfaces import GridSurface
 from spine_mj.sweep.registry import (
     CASE_THREADS,
     KAPPA_CAP_PARAM,
@@ -212,6 +213,18 @@ def case_rig(case, surface=None):
 
 
 case_rig.cache_clear = _rig.cache_clear
+
+
+def case_scales(case, surface=None) -> sim.Scales:
+    """The scales of the rig :func:`case_rig` would build for ``case`` (its tip radius,
+    L_c, l_s), without building it: for checks of a config before any case runs."""
+    surface = case.surface.make() if surface is None else surface
+    p = dict(_rig_key(case.params, surface))
+    tip = sim.TipParams(tip_radius_m=p["tip_radius_m"], mu_s=p["mu"])
+    resolution = None if isinstance(surface, GridSurface) else p["hfield_resolution"]
+    return sim.Scales.for_surface(
+        surface, tip=tip, length_scale_m=p["length_scale"], hfield_resolution=resolution
+    )
 
 
 def _mujoco(case, surface, starts, upstream):
