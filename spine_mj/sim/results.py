@@ -41,6 +41,27 @@ from spine_mj.sim.recording import COLUMNS, RESULT_COLUMNS, SENSOR_NAMES, Record
 from spine_mj.theory.engagement import DEFAULT_TOL
 
 
+def breakaway_rows(speed_m_s: np.ndarray, onsets, stick_speed_m_s: float) -> np.ndarray:
+    """Where each breakaway's force is read: for every move onset with a stuck row (tangential
+    speed at most ``stick_speed_m_s``) after the onset before it, the last such row. An
+    onset without one (the tip slowed below the move speed but never stuck, or hopped) is
+    the same slip going on, not a new breakaway.
+
+    At the onset itself (speed above ``Detection.move_speed_m_s``) the force has risen past
+    breakaway while the tip accelerated, by ``sqrt(2 m v_move rate)``: ``sqrt(2e-3
+    sqrt(I_e)) F_p`` at the default move speed, 1.4 % of ``F_p`` at the ramp's default
+    ``I_e = 0.01``; at a stuck row the lag is one step's rise and ``sqrt(2e-5 sqrt(I_e)) F_p``
+    (the static probe's ``kappa_mj`` is read the same way)."""
+    onsets = np.asarray(onsets, dtype=int)
+    stuck = np.flatnonzero(np.asarray(speed_m_s) <= stick_speed_m_s)
+    if not stuck.size:
+        return onsets[:0]
+    at = np.searchsorted(stuck, onsets) - 1  # the last stuck row before each onset
+    row = stuck[np.maximum(at, 0)]
+    after = np.concatenate([[-1], onsets[:-1]])
+    return row[(at >= 0) & (row > after)]
+
+
 @dataclass(frozen=True, eq=False)
 class RunResult(RunColumns):
     """One run. Arrays have ``n`` rows, one per recorded step (the settle phase included).
@@ -85,8 +106,9 @@ class RunResult(RunColumns):
     kappa_mj : float
         Static probe: F_breakaway / F_p (NaN unless ``end_reason`` is BREAKAWAY).
     breakaway_kappas : (k,)
-        Drive force / F_p at each ``move_onset`` after the settle phase (the tip starting
-        to move: a force ramp's breakaway per cycle).
+        Drive force / F_p at each breakaway after the settle phase (a ``move_onset`` after
+        the tip had stuck: a force ramp's breakaway per cycle), read at the last stuck row
+        before it (:func:`breakaway_rows`), as the static probe's ``kappa_mj``.
     inertia_number, speed_m_s : float
         I_e and the speed (or equivalent speed) it uses.
     stiffness_number, stiffness_n_m : float
@@ -448,7 +470,10 @@ class GroupAnalysis:
             engine_trouble=ending.trouble,
             drive_start_index=n_settle,
             kappa_mj=kappa_mj,
-            breakaway_kappas=rec.drive_force_n[onsets] / rig.scales.preload_n,
+            breakaway_kappas=rec.drive_force_n[
+                breakaway_rows(rec.tangential_speed_m_s, onsets, self.det.stick_speed_m_s)
+            ]
+            / rig.scales.preload_n,
             inertia_number=rig.scales.inertia_number(speed),
             speed_m_s=speed,
             stiffness_number=rig.scales.stiffness_number(k),
