@@ -81,3 +81,15 @@ def test_array_layouts_the_command_refuses_are_refused_at_config_time(tmp_path, 
     doc = ARRAY.split("[array]")[0] + "[array]\n" + table + "\n"
     with pytest.raises(SpineInputError, match=match):
         sweep.load_config(write_config(tmp_path, doc))
+
+
+def test_array_sweep_without_a_pace_runs_at_the_arrays_default_pace(tmp_path):
+    # the predicted holding excess of the default pace is 1 % of mu F_p
+    doc = ARRAY.replace("ie = 1e-2\n", "").replace('layout = ["grid", "staggered"]', 'layout = "grid"')
+    out = tmp_path / "out"
+    sweep.run_sweep(write_config(tmp_path, doc), out, workers=1)
+    runs = sweep.load_runs(out)
+    from spine_mj import presets
+
+    mu = presets.preset_mu("corrugation")
+    np.testing.assert_allclose(runs.holding_excess_predicted, 0.01 * mu, rtol=1e-9)

@@ -6,9 +6,11 @@ keys of ``spine-mj array`` (``layout``, ``rows``, ``cols``, ``spacing``, ``spaci
 analysis's parameters (:data:`~spine_mj.sweep.analyses.mujoco.MUJOCO_PARAMS`, one rig per
 case: :func:`~spine_mj.sweep.analyses.mujoco.case_rig`). Per start it records the keys of
 the command's ``summary.json``: ``n_spines``, ``holding_force_n``, ``holding_ratio``, its
-predicted dynamic excess ``holding_excess_predicted`` (per spine, ``F_p``; the drive's pace
-is the case's ``ie``: the arrays' own default pace is :func:`spine_mj.sim.array_ie`),
-``peak_ratio`` and ``locked_spines``. Touches the API of :mod:`spine_mj.sim`'s arrays here only.
+predicted dynamic excess ``holding_excess_predicted`` (per spine, ``F_p``), ``peak_ratio``
+and ``locked_spines``. Without ``ie`` or ``speed`` the drive runs at the arrays' default
+pace (:func:`spine_mj.sim.array_ie`: its predicted excess is 1 % of ``mu F_p``) on the
+case's rig (whose step the default single-spine pace bounds: never coarser than the
+slower pace would allow). Touches the API of :mod:`spine_mj.sim`'s arrays here only.
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ import numpy as np
 
 from spine_mj import sim
 from spine_mj.errors import SpineInputError
+from spine_mj.sim.drives import spring_stiffness_n_m
 from spine_mj.sim.layout import MAX_SPINES
 from spine_mj.sweep.analyses.mujoco import MUJOCO_PARAMS, case_rig, case_scales
 from spine_mj.sweep.registry import CASE_THREADS, Analysis, AnalysisResult, ParamSpec, register_analysis
@@ -101,11 +104,18 @@ def _check_layouts(config) -> None:
 def _array(case, surface, starts, upstream):
     p = case.params
     layout = _layout(p)
+    rig = case_rig(case, surface)
+    ie = p["ie"]
+    if ie is None and p["speed"] is None:  # the arrays' default pace
+        k = spring_stiffness_n_m(rig.scales, stiffness_number=p["K"], stiffness_n_m=p["stiffness"])
+        ie = sim.array_ie(
+            rig.scales, mu=rig.tip.mu_s, force_control=p["array_drive"] == "force", stiffness_n_m=k
+        )
     arr, drive = sim.build_array(
-        case_rig(case, surface),
+        rig,
         layout,
         p["array_drive"],
-        ie=p["ie"],
+        ie=ie,
         speed_m_s=p["speed"],
         stiffness_number=p["K"],
         stiffness_n_m=p["stiffness"],
