@@ -1,11 +1,12 @@
-# Two entry points: `make demo` and `make test`. Both create .venv when missing.
+# Two entry points: `make demo` and `make test`. Both create .venv when missing; so does
+# `make docs` (the Sphinx site in docs/_build/html, with the [docs] extra).
 PYTHON ?= python3
 VENV ?= .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed-stamp
 DEMO_OUT ?= demo-out
 
-.PHONY: demo test lint bench wheel-check clean
+.PHONY: demo test lint bench wheel-check docs clean
 
 $(STAMP): pyproject.toml setup.py
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -13,12 +14,17 @@ $(STAMP): pyproject.toml setup.py
 	$(BIN)/python -m pip install --quiet -e ".[dev,video,slurm]"
 	touch $(STAMP)
 
+DOCS_STAMP := $(VENV)/.docs-stamp
+$(DOCS_STAMP): $(STAMP)
+	$(BIN)/python -m pip install --quiet -e ".[dev,video,slurm,docs]"
+	touch $(DOCS_STAMP)
+
 demo: $(STAMP)
 	$(BIN)/spine-mj validate --quick --out $(DEMO_OUT)
 
 # a test that crashes its worker fails once; a replacement worker would run it again
 test: lint
-	$(BIN)/python -m pytest -q -n 2 --dist loadfile --max-worker-restart=0
+	$(BIN)/python -m pytest -q -n 2 --dist loadfile --max-worker-restart=0 -m "not docs"
 
 lint: $(STAMP)
 	$(BIN)/ruff check .
@@ -55,5 +61,13 @@ wheel-check: $(STAMP)
 	"$$tmp/venv/bin/spine-mj" sweep example:paper-quasistatic.toml --out runs/qs --quiet; \
 	echo "wheel-check: OK"
 
+# The site: README's headline table regenerated from the committed validation.json, then
+# Sphinx with warnings as errors (the gallery's scripts run, the results pages are written
+# from analysis/reports/). Output: docs/_build/html/index.html
+docs: $(DOCS_STAMP)
+	$(BIN)/python docs/tools/readme_table.py
+	$(BIN)/sphinx-build -W --keep-going -q -b html docs docs/_build/html
+	$(BIN)/python -m pytest -q -n 2 --dist loadfile -m docs tests/docs
+
 clean:
-	rm -rf $(VENV) $(DEMO_OUT) .pytest_cache .ruff_cache build
+	rm -rf $(VENV) $(DEMO_OUT) .pytest_cache .ruff_cache build docs/_build
