@@ -1,0 +1,69 @@
+"""The pages written from the data at build time (docs/tools/generate.py)."""
+
+import copy
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "docs" / "tools"))
+
+import generate  # noqa: E402
+
+FULL = generate.load_validation("validation-full")
+
+
+def test_committed_plans_render():
+    for plan, folder, command in generate.PLANS:
+        validation = generate.load_validation(folder)
+        page = generate.results_page(plan, folder, command, validation)
+        for family in validation["limit_families"]:
+            assert generate.FAMILY_NAMES.get(family, family) in page
+        assert f"reports/{folder}/report.md" in page
+
+
+def test_headline_table_numbers_are_the_json_numbers():
+    rows = generate.headline_table(FULL)
+    assert len(rows) == 2 + len(FULL["limit_families"])
+    fam = FULL["limit_families"]["fractal"]
+    row = next(r for r in rows if r.startswith("| fractal |"))
+    assert f"{fam['agreement_well_conditioned']:.3g}" in row
+    assert f"{fam['median_frechet_ci'][1]:.3g}" in row
+
+
+def test_convergence_absent_renders_nothing():
+    stripped = {k: v for k, v in FULL.items() if k != "convergence"}
+    for s in stripped["limit_families"].values():
+        s.pop("convergence", None)
+    assert generate.convergence_section(stripped) == []
+    assert "Convergence" not in generate.results_page("full", "validation-full", "x", stripped)
+
+
+@pytest.mark.parametrize("where", ["top", "family"])
+def test_convergence_present_is_rendered(where):
+    check = {
+        "dt_halved": {"agreement_change": -0.02, "median_frechet_change": 0.0011, "converged": True},
+        "hfield_doubled": {"agreement_change": 0.05, "median_frechet_change": -0.004, "converged": False},
+    }
+    v = copy.deepcopy(FULL)
+    if where == "top":
+        v["convergence"] = {"fractal": check, "sandpaper": check}
+    else:
+        v["limit_families"]["fractal"]["convergence"] = check
+    lines = generate.convergence_section(v)
+    text = "\n".join(lines)
+    assert "dt_halved" in text and "hfield_doubled" in text
+    assert "-0.02" in text and "0.0011" in text and "True" in text and "False" in text
+    assert "| fractal | dt_halved |" in text
+
+
+def test_every_public_name_is_on_one_api_page(tmp_path):
+    generate.api_pages(tmp_path)
+    text = {p.stem: p.read_text() for p in tmp_path.glob("*.rst")}
+    import importlib
+
+    for package in generate.PACKAGES:
+        for name in importlib.import_module(package).__all__:
+            if not name.startswith("_"):
+                assert f"   {name}\n" in text[package] or f"{name}`" in text[package], f"{package}.{name}"
