@@ -36,9 +36,10 @@ def blocks(text: str) -> list[tuple[str, str]]:
     return [(m.group(1).lower(), m.group(2)) for m in _FENCE.finditer(text)]
 
 
-def shell_lines(body: str) -> list[str]:
-    """The command lines of a shell block: continuations joined, comments dropped."""
-    lines, cur = [], ""
+def shell_commands(body: str) -> list[tuple[str, str]]:
+    """The commands of a shell block as ``(command, comment)``: continuations joined,
+    the comment after ``#`` (stripped, "" without one) kept apart."""
+    out, cur = [], ""
     for raw in body.splitlines():
         line = raw.rstrip()
         if line.endswith("\\"):
@@ -47,9 +48,15 @@ def shell_lines(body: str) -> list[str]:
         cur += line
         code = _strip_comment(cur).strip()
         if code:
-            lines.append(code)
+            comment = cur.split(" #", 1)[1].strip() if " #" in cur else ""
+            out.append((code, comment))
         cur = ""
-    return lines
+    return out
+
+
+def shell_lines(body: str) -> list[str]:
+    """The command lines of a shell block: continuations joined, comments dropped."""
+    return [code for code, _ in shell_commands(body)]
 
 
 def _strip_comment(line: str) -> str:

@@ -21,12 +21,9 @@ TUTORIALS = sorted((ROOT / "docs" / "tutorials").glob("*.md"))
 TUTORIALS = [p for p in TUTORIALS if p.name != "index.md"]
 
 
-def _expected_exit(raw_body: str, line: str) -> int:
+def _expected_exit(comment: str) -> int:
     """0, or the code a line's comment announces (``# exits 2: ...``)."""
-    for raw in raw_body.splitlines():
-        if raw.strip().startswith(line.split()[0]) and line.split()[-1] in raw and "# exits " in raw:
-            return int(raw.split("# exits ", 1)[1].split(":")[0])
-    return 0
+    return int(comment[len("exits ") :].split(":")[0]) if comment.startswith("exits ") else 0
 
 
 def _steps(text: str):
@@ -38,8 +35,8 @@ def _steps(text: str):
             assert first.startswith("# ") and first.endswith(".toml"), "a TOML block names its file"
             yield "file", (first[2:].strip(), body)
         elif lang in ("sh", "bash"):
-            for line in doccommands.shell_lines(body):
-                yield "sh", (line, _expected_exit(body, line))
+            for line, comment in doccommands.shell_commands(body):
+                yield "sh", (line, _expected_exit(comment))
         elif lang == "python" and "# not run by the tests:" not in body.splitlines()[0]:
             yield "python", body
 
