@@ -5,7 +5,7 @@ Stick-slip on a corrugation against Prandtl-Tomlinson
 A tip pulled through a spring of stiffness number ``K = k l_s / F_p`` over the corrugation
 ``z = h sin(2 pi x / lambda)`` is the Prandtl-Tomlinson model with Coulomb friction: the
 motion is smooth for ``K > K*`` and sticks and slips below, jumping once per wavelength at
-the fold of the quasistatic branch (:class:`spine_mj.tomlinson.Corrugation`; the
+the fold of the quasistatic branch (:class:`spine_mj.theory.tomlinson.Corrugation`; the
 physics notes, §6-§7). The MuJoCo spring drive at a small inertia number, against the
 compliant-drive streamline (:func:`spine_mj.compliant_streamlines`), which is that model
 traced on the surface the tip's centre rides on. Drawn against the tip's position, the
@@ -17,7 +17,7 @@ import numpy as np
 
 import spine_mj as sm
 from spine_mj import sim
-from spine_mj.tomlinson import Corrugation
+from spine_mj.theory.tomlinson import Corrugation
 
 mu = 0.5
 surface = sm.make_surface("corrugation", n_waves=4, points_per_wave=128)
