@@ -200,3 +200,30 @@ def test_the_static_error_is_converged_when_a_halved_step_moves_it_less_than_the
     assert out["dt_halved"]["converged"] is True
     assert static_convergence(plan, per_engine(0.0100))["dt_halved"]["converged"] is False  # > 0.0025
     assert static_convergence(plan, per_engine(0.006, 0.5))["dt_halved"]["converged"] is False
+
+
+@pytest.mark.parametrize("plan_name", ["quick", "full"])
+def test_every_refined_sweep_of_the_plans_is_a_valid_config_that_changes_only_its_refinement(plan_name):
+    from spine_mj import sweep
+    from spine_mj.validate.quasistatic_limit import _refinement_docs
+
+    plan = PLANS[plan_name]
+    # the analytic families (the quick plan: all; each fractal seed costs a surface)
+    corner = [plan.corner_family(f) for f in plan.families if plan_name == "quick" or f.name != "fractal"]
+    docs = _refinement_docs(plan, corner)
+    keys = {(fam, key) for fam, key, _, _ in docs}
+    for fam in corner:
+        assert (fam.name, "dt_halved") in keys
+        # an analytic family's hfield is refined, a gridded one's is not
+        assert ((fam.name, "hfield_doubled") in keys) == refinable(
+            fam.presets[0], fam.seeds, "hfield_doubled"
+        )
+    for _, key, _, doc in docs:
+        sweep.parse_config(doc)
+        grid = doc["grid"]
+        if key.startswith("dt_"):
+            assert grid["hfield_resolution"] == plan.hfield_resolution
+            assert grid["timestep"] < grid["solref_timeconst"] / 2  # the contact's own time constant
+        else:
+            assert grid["hfield_resolution"] == refined_resolution(plan.hfield_resolution, 2)
+            assert "timestep" not in grid
