@@ -211,7 +211,9 @@ def convergence_lines(limit: QuasistaticLimitResult) -> list[str]:
         "",
         "Each family's corner rerun from a subset of its starts (the same points, one run "
         "each) with the engine's step halved (the contact's time constant passed explicitly, "
-        "so only the step changes) and with an analytic surface's hfield at twice the samples "
+        "so only the step changes; one step per sweep, half the rule's step on the family's "
+        "first surface, which lies within 2 % of every other surface's on the paper's "
+        "families) and with an analytic surface's hfield at twice the samples "
         "a side (the tip kept; a gridded surface, the fractal and the sandpapers, keeps its "
         "samples and has no finer hfield). The change is paired: the refined runs' number "
         "minus the corner's own runs' from the same starts. A headline is converged when it "
