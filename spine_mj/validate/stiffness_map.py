@@ -36,6 +36,7 @@ from spine_mj.errors import SpineInputError
 from spine_mj.sim.motion import SLIPPING
 from spine_mj.theory.energy import elastic_release_j, quasistatic_work_j
 from spine_mj.validate.boundary import preset_grid, quasistatic_locked
+from spine_mj.validate.convergence import thin_starts
 from spine_mj.validate.ie_star import ie_star_by_criterion, passes_criterion, quiet_nan_warnings
 from spine_mj.validate.paths import mujoco_traces
 from spine_mj.validate.plans import GRAVITY, MASS_KG, FamilySpec, ValidationPlan
@@ -181,16 +182,9 @@ class StiffnessMapResult:
 def subset_starts(fam: FamilySpec, n: int) -> FamilySpec:
     """``fam`` with at most ``n`` of its y starts, spread over its list (first and last kept),
     on one surface per preset: its first seed and generator variant (the map's many cells
-    multiply every surface's cost)."""
-    if n < 1:
-        raise SpineInputError(f"starts must be >= 1, got {n}")
-    t = dict(fam.starts)
-    ys = tuple(t["y"])
-    if len(ys) > n:
-        idx = np.unique(np.linspace(0, len(ys) - 1, n).round().astype(int))
-        t["y"] = tuple(ys[i] for i in idx)
+    multiply every surface's cost; :func:`~spine_mj.validate.convergence.thin_starts`)."""
     seeds = fam.seeds[:1] if fam.seeds else fam.seeds
-    return dataclasses.replace(fam, starts=tuple(t.items()), seeds=seeds, variants=fam.variants[:1])
+    return dataclasses.replace(thin_starts(fam, n), seeds=seeds, variants=fam.variants[:1])
 
 
 def stiffness_map(plan: ValidationPlan, runner: StudyRunner) -> StiffnessMapResult:
