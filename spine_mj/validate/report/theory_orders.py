@@ -153,7 +153,15 @@ def prediction_lines(km: StiffnessMapResult) -> list[str]:
         "*within* where the whole measured bracket lies within the factor of the prediction, "
         "*consistent* where they overlap but the bracket is wider than the factor (a finer "
         "ladder would decide), *outside* where they do not overlap (the named term of the "
-        "prediction fails).",
+        "prediction fails). The two K are not the same event: the predicted K* is the first "
+        "fold anywhere on the paths (the largest local fall of the hold force, "
+        "`l_s max(-dH/dx)`), the measured boundary the stiffness where the median path stays "
+        "within 0.1 L_c and 95 % of outcomes agree. A fold whose jump, `dH l_s / K` past a "
+        "drop `dH` of the hold force (docs/physics.md §10), is shorter than that tolerance "
+        "passes the criterion, so where the steepest falls are short (a path brushing the "
+        "lock boundary, where kappa climbs and falls within a slope length) the predicted K* "
+        "lies above the measured boundary: the local term is the one to replace by the jump "
+        "length when it fails.",
         "",
         table(
             rows,
