@@ -229,17 +229,29 @@ def test_a_probe_that_moves_during_its_climb_goes_on_as_the_plain_probe(monkeypa
 # The plain spring run (``fast_forward=False``) is the reference. Its time_s is physical in
 # both, so the two are compared at equal times and carriage positions.
 
+BLOCK_START = (-0.04, 2.3e-4)
+
+
+def _spring_block(stick_fraction):
+    """The flat rig and a spring-block drive (K = 10, I_e = 1e-6) whose run lasts
+    ``stick_fraction`` times the stick phase ``t_b = mu F_p / (k V)`` (4.9 s)."""
+    rig = flat_rig()
+    v, k = 0.001, 10.0
+    t_b = MU * rig.scales.preload_n / (k * v)
+    return rig, SpringDrive(speed_m_s=v, stiffness_n_m=k, duration_s=stick_fraction * t_b), t_b
+
+
+def _plain_and_fast(rig, drive, start=BLOCK_START):
+    return tuple(rig.run(dataclasses.replace(drive, fast_forward=f), start=start) for f in (False, True))
+
 
 def test_a_fast_forwarded_spring_block_breaks_away_where_the_plain_one_does():
     """Flat plane, K = 10, I_e = 1e-6: the block sticks until k V t = mu F_p (4.9 s, ~9700
     steps), then swings. The climb skips most of the stick: the same breakaway time and
     force, the same path at every time after it (the stuck tip does not notice how fast
     its spring was loaded), the same end time and carriage position, in 1/8 of the steps."""
-    rig = flat_rig()
-    v, k, fp = 0.001, 10.0, rig.scales.preload_n
-    t_b = MU * fp / (k * v)
-    drive = SpringDrive(speed_m_s=v, stiffness_n_m=k, duration_s=t_b + 0.4)
-    plain, fast = (rig.run(dataclasses.replace(drive, fast_forward=f), start=(-0.04, 2.3e-4)) for f in (0, 1))
+    rig, drive, t_b = _spring_block(1.08)
+    plain, fast = _plain_and_fast(rig, drive)
     assert plain.end_reason is EndReason.COMPLETED and fast.end_reason is EndReason.COMPLETED
     onset = [r.drive_start_index + int(np.argmax(r.moving[r.drive_start_index :])) for r in (plain, fast)]
     t0 = plain.time_s[plain.drive_start_index - 1]
@@ -331,14 +343,13 @@ def test_a_spring_whose_tip_moves_during_its_climb_goes_on_as_the_plain_run(monk
     plain run to the last bit (plus RISE_STEPS dropped steps a climb)."""
     import spine_mj.sim.fastforward as ff
 
-    rig = flat_rig()
-    drive = SpringDrive(speed_m_s=0.001, stiffness_n_m=10.0, duration_s=5.3)
-    plain = rig.run(dataclasses.replace(drive, fast_forward=False), start=(-0.04, 2.3e-4))
+    rig, drive, _ = _spring_block(1.08)
+    plain = rig.run(dataclasses.replace(drive, fast_forward=False), start=BLOCK_START)
     kappa_of_normal = ff.kappa_of_normal
     monkeypatch.setattr(
         ff, "kappa_of_normal", lambda n, mu: (1.5 * kappa_of_normal(n, mu)[0], kappa_of_normal(n, mu)[1])
     )
-    fast = rig.run(drive, start=(-0.04, 2.3e-4))
+    fast = rig.run(drive, start=BLOCK_START)
     for name in ("time_s", "position_m", "drive_force_n", "carriage_x_m"):
         np.testing.assert_array_equal(getattr(fast, name), getattr(plain, name))
     dropped = fast.simulated_steps - plain.simulated_steps
@@ -348,10 +359,8 @@ def test_a_spring_whose_tip_moves_during_its_climb_goes_on_as_the_plain_run(monk
 def test_a_spring_run_that_ends_stuck_completes_where_the_plain_one_does():
     """The planned end falls inside the stick phase: the climb stops at the plain run's last
     carriage position, and the run completes there, at the same physical time."""
-    rig = flat_rig()
-    v, k = 0.001, 10.0
-    drive = SpringDrive(speed_m_s=v, stiffness_n_m=k, duration_s=0.5 * MU * rig.scales.preload_n / (k * v))
-    plain, fast = (rig.run(dataclasses.replace(drive, fast_forward=f), start=(-0.04, 2.3e-4)) for f in (0, 1))
+    rig, drive, _ = _spring_block(0.5)
+    plain, fast = _plain_and_fast(rig, drive)
     assert plain.end_reason is EndReason.COMPLETED and fast.end_reason is EndReason.COMPLETED
     assert not plain.moving.any() and not fast.moving.any()
     assert fast.time_s[-1] == pytest.approx(plain.time_s[-1], rel=1e-9)
@@ -362,9 +371,8 @@ def test_a_spring_run_that_ends_stuck_completes_where_the_plain_one_does():
 
 def test_the_fast_forwarded_rollout_equals_its_python_reference():
     """The native pieces and the plain mj_step loop take the same climbs: the same run."""
-    rig = flat_rig()
-    drive = SpringDrive(speed_m_s=0.001, stiffness_n_m=10.0, duration_s=5.1)
-    native, python = (rig.run(drive, start=(-0.04, 2.3e-4), backend=b) for b in ("rollout", "python"))
+    rig, drive, _ = _spring_block(1.04)
+    native, python = (rig.run(drive, start=BLOCK_START, backend=b) for b in ("rollout", "python"))
     assert native.simulated_steps == python.simulated_steps < 2000
     for name in ("time_s", "position_m", "drive_force_n", "carriage_x_m"):
         np.testing.assert_array_equal(getattr(native, name), getattr(python, name))
