@@ -109,7 +109,8 @@ def build_rig(
     timestep_s, integrator, cone, impratio, noslip_iterations
         Engine overrides of :func:`default_engine`.
     solref_timeconst_s, solref_dampratio
-        The contact's time constant (None: twice the step) and damping ratio (None: 1).
+        The contact's time constant (None: the rule's, twice the step) and damping ratio
+        (None: 1).
     ie, speed_m_s, rate_n_s
         The drive's pace, as for :func:`build_drive`: its speed (:func:`drive_speed_m_s`)
         bounds the engine step for impacts.
@@ -144,10 +145,10 @@ def build_rig(
     )
     overrides["hfield_resolution"] = resolution  # None: the rig's own rule (a grid's samples)
     if solref_timeconst_s is not None or solref_dampratio is not None:
-        dt = timestep_s if timestep_s is not None else default_engine(scales, speed_m_s=speed).timestep_s
+        rule = default_engine(scales, speed_m_s=speed, stiffness_n_m=spring, **overrides)
         overrides["solref"] = (
-            2 * dt if solref_timeconst_s is None else solref_timeconst_s,
-            1.0 if solref_dampratio is None else solref_dampratio,
+            rule.solref[0] if solref_timeconst_s is None else solref_timeconst_s,
+            rule.solref[1] if solref_dampratio is None else solref_dampratio,
         )
     engine = default_engine(scales, speed_m_s=speed, stiffness_n_m=spring, **overrides)
     return Rig(surface, tip=tip, engine=engine, length_scale_m=length_scale_m)

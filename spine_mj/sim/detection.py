@@ -83,15 +83,16 @@ class Detection:
         return dataclasses.replace(self, **{k: v for k, v in defaults.items() if getattr(self, k) is None})
 
     def force_limit_n(self, scales: Scales, drive_speed_m_s: float, stiffness_n_m: float) -> float:
-        """Drive force beyond which a spring run has diverged: twice the most a physical run
-        can pull, the force cap plus the preload's share (``(kappa_cap + 1) F_p``) and the
-        spring-block overshoot ``V sqrt(k m)`` (docs/physics.md §7). A spring the step
-        integrates unstably grows its stretch without bound; infinite for force drives,
-        whose force is the ramp's own."""
+        """Drive force beyond which a spring run has diverged: the force cap and the
+        preload, ``2 (kappa_cap + 1) F_p``, plus the force of a spring that holds the
+        energy bound's kinetic energy, ``v_max sqrt(k m)`` with ``v_max`` =
+        :meth:`speed_limit_m_s` (the same energy stored in the spring instead of the motion).
+        A spring the step integrates unstably grows its stretch geometrically and crosses
+        it within steps; infinite for force drives, whose force is the ramp's own."""
         if stiffness_n_m <= 0:
             return math.inf
-        overshoot = drive_speed_m_s * math.sqrt(stiffness_n_m * scales.mass_kg)
-        return 2 * ((self.kappa_cap + 1) * scales.preload_n + overshoot)
+        swing = self.speed_limit_m_s(scales, drive_speed_m_s) * math.sqrt(stiffness_n_m * scales.mass_kg)
+        return 2 * (self.kappa_cap + 1) * scales.preload_n + swing
 
     def speed_limit_m_s(self, scales: Scales, drive_speed_m_s: float) -> float:
         """Speed above which a run diverges: 10 times the larger of the drive's speed and the

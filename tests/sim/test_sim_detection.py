@@ -76,13 +76,14 @@ def test_move_events_match_the_reference_on_random_flags():
                 assert got == _move_events_reference(moving, t, start), (n, p, start)
 
 
-def test_a_spring_integrated_unstably_ends_as_diverged_by_its_stretch_never_ok():
+def test_a_spring_integrated_unstably_ends_as_diverged_never_ok():
     """omega dt = 2.2 (the refusal switched off): the spring's stretch grows 2.4x a step once
-    the tip breaks away; the run ends as engine trouble at the first drive force beyond
-    Detection.force_limit_n, 20 steps before MuJoCo would warn (a run going on to that
-    warning reports the warning first); omega dt = 0.5 runs clean."""
+    the tip breaks away; the run ends as engine trouble "diverged" (its speed or its spring
+    force beyond the energy bound, Detection.speed_limit_m_s / force_limit_n) before MuJoCo
+    would warn; omega dt = 0.5 runs clean."""
     rig = flat_rig()
     dt, m = rig.engine.timestep_s, rig.scales.mass_kg
+    det = Detection().resolve(rig.scales)
     ends = {}
     with pytest.MonkeyPatch.context() as mp:
         mp.setattr(type(rig), "check_drive", lambda self, drive: None)
@@ -92,6 +93,21 @@ def test_a_spring_integrated_unstably_ends_as_diverged_by_its_stretch_never_ok()
     assert ends[0.5].engine_trouble == "" and ends[0.5].end_reason is EndReason.COMPLETED
     bad = ends[2.2]
     assert bad.end_reason is EndReason.ENGINE_TROUBLE and bad.engine_trouble == "diverged", bad.end_detail
-    assert "a spring stretch no drive can produce" in bad.end_detail
-    limit = Detection().resolve(rig.scales).force_limit_n(rig.scales, 0.01, m * (2.2 / dt) ** 2)
-    assert np.abs(bad.drive_force_n[-1]) > limit > np.abs(bad.drive_force_n[:-1]).max()
+    speed = np.linalg.norm(bad.velocity_m_s[-1])
+    force = abs(bad.drive_force_n[-1])
+    assert speed > det.speed_limit_m_s(rig.scales, 0.01) or force > det.force_limit_n(
+        rig.scales, 0.01, m * (2.2 / dt) ** 2
+    )
+
+
+def test_a_spring_stretch_beyond_the_energy_bound_is_a_divergence():
+    """The force limit is the energy bound's kinetic energy stored in the spring instead,
+    plus the force cap and preload: above every force a run within the bound can reach."""
+    rig = flat_rig()
+    det = Detection().resolve(rig.scales)
+    k, v = 1e4, 0.01
+    fp = rig.scales.preload_n
+    limit = det.force_limit_n(rig.scales, v, k)
+    swing = det.speed_limit_m_s(rig.scales, v) * np.sqrt(k * rig.scales.mass_kg)
+    assert limit == pytest.approx(2 * (det.kappa_cap + 1) * fp + swing)
+    assert det.force_limit_n(rig.scales, v, 0.0) == np.inf  # a force drive pulls with its own force

@@ -192,3 +192,29 @@ def test_a_load_per_unit_mass_beyond_physics_is_refused(kwargs):
     with pytest.raises(SpineInputError, match=r"preload_n and gravity_m_s2: the load per unit mass"):
         TipParams(**kwargs)
     TipParams(preload_n=1e3)  # 1e5 m/s^2 on the default 10 g: allowed
+
+
+@pytest.mark.parametrize("k_number", [3.0, 30.0, 300.0, 3000.0, 30000.0])
+def test_the_step_rule_resolves_the_drive_spring_and_the_contact_follows_the_step(k_number):
+    """omega dt <= SPRING_OMEGA_DT for any K (MuJoCo integrates the spring explicitly), the
+    contact's time constant twice the step (stiffer than the spring: omega_c ~ 1 / (2 dt)
+    against omega <= 0.3 / dt), and build_rig gives the rule with or without a contact
+    damping ratio given (a sweep always passes one)."""
+    from spine_mj import presets, sim
+
+    surface = presets.make_surface("paper-fractal", seed=1)
+    mu = presets.resolve_mu(surface, None)
+    tip = sim.TipParams(mu_s=mu)
+    scales = sim.Scales.for_surface(surface, tip=tip)
+    k = scales.stiffness_for(k_number)
+    eng = sim.default_engine(scales, speed_m_s=scales.speed_for(1e-4), stiffness_n_m=k)
+    wdt = sim.spring_omega_dt(k, scales.mass_kg, eng.timestep_s)
+    contact = sim.default_engine(scales, speed_m_s=scales.speed_for(1e-4), stiffness_n_m=1e-30).timestep_s
+    assert wdt <= sim.SPRING_OMEGA_DT * (1 + 1e-9)
+    # the spring sets the step where the contact's would not resolve it (cut to 2 digits)
+    assert eng.timestep_s == pytest.approx(contact) if k_number <= 30 else wdt > 0.9 * sim.SPRING_OMEGA_DT
+    assert eng.solref == pytest.approx((2 * eng.timestep_s, 1.0))
+    for damp in (None, 1.0):
+        rig = sim.build_rig(surface, mu=mu, ie=1e-4, stiffness_number=k_number, solref_dampratio=damp)
+        assert rig.engine.timestep_s == pytest.approx(eng.timestep_s)
+        assert rig.engine.solref == pytest.approx(eng.solref)
