@@ -29,6 +29,7 @@ HEAVY = (
     "matplotlib",
     "pyarrow",
     "SurfaceTopography",
+    "pybullet",
 )
 
 
