@@ -18,6 +18,7 @@ EXTRAS = {
     "video": ("imageio", "imageio_ffmpeg"),
     "slurm": ("dask_jobqueue",),
     "gpu": ("mujoco_warp",),
+    "bullet": ("pybullet",),
 }
 
 

@@ -93,15 +93,19 @@ def _build_rig(
     stiffness_number=None,
     stiffness_n_m=None,
     driven=True,
+    engine="mujoco",
     **rig_kw,
 ):
-    """The rig of the shared rig options (:func:`spine_mj.sim.build_rig`); the drive's pace
-    (``ie``, ``speed`` or ``rate``) and spring bound the engine step (``driven``)."""
+    """The rig of the shared rig options in ``engine`` (:func:`spine_mj.sim.build_engine_rig`);
+    the drive's pace (``ie``, ``speed`` or ``rate``) and spring bound the engine step
+    (``driven``)."""
     from spine_mj import sim
 
+    sim.check_engine_name(engine, "--engine")
     surf, kw = _rig_inputs(surface_spec, *rig_opts, **rig_kw)
-    return sim.build_rig(
+    return sim.build_engine_rig(
         surf,
+        engine=engine,
         **kw,
         ie=ie,
         speed_m_s=speed,
@@ -191,6 +195,13 @@ def sim_export(surface_spec, output, start, stiffness, **rig_opts):
 )
 @click.option("--duration", type=float, default=None, help="Run time [s] (spring, ramp).")
 @click.option(
+    "--engine",
+    type=click.Choice(["mujoco", "bullet"]),
+    default="mujoco",
+    show_default=True,
+    help="Physics engine: MuJoCo (soft contact) or Bullet (hard contact; the [bullet] extra).",
+)
+@click.option(
     "--render",
     is_flag=True,
     help="Also write run.mp4 (headless: MUJOCO_GL=egl, else osmesa) with the tip's path, the "
@@ -215,6 +226,7 @@ def simulate(
     rate,
     start_force,
     duration,
+    engine,
     render,
     out_dir,
     **rig_opts,
@@ -260,6 +272,7 @@ def simulate(
         rate=rate,
         stiffness_number=stiffness_number,
         stiffness_n_m=stiffness,
+        engine=engine,
     )
     drv = sim.build_drive(
         rig.scales,

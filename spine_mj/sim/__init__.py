@@ -54,6 +54,8 @@ Modules: :mod:`~spine_mj.sim.params` (tip, engine, scales and their rules),
 :mod:`~spine_mj.sim.detection` (events, end reasons), :mod:`~spine_mj.sim.results`,
 :mod:`~spine_mj.sim.rollout` (open-loop batches), :mod:`~spine_mj.sim.ramp` (closed loop),
 :mod:`~spine_mj.sim.fastforward` (the stick-phase fast-forward rule both use),
+:mod:`~spine_mj.sim.engines` (one rig, two engines: :func:`build_engine_rig`),
+:mod:`~spine_mj.sim.bullet` (the same rig in Bullet, hard contact; the ``[bullet]`` extra),
 :mod:`~spine_mj.sim.render`, :mod:`~spine_mj.sim.planes`, :mod:`~spine_mj.sim.rig`
 (:class:`Rig`, the object users hold) and :mod:`~spine_mj.sim.build` (:func:`build_rig` and
 :func:`build_drive`: a rig and a drive from dimensionless or SI inputs) and
@@ -73,6 +75,7 @@ from spine_mj.sim.build import (
 )
 from spine_mj.sim.detection import Detection, Event
 from spine_mj.sim.drives import Drive, RampDrive, SpringDrive, StaticProbe
+from spine_mj.sim.engines import DEFAULT_ENGINE, ENGINES, EngineRig, build_engine_rig, check_engine_name
 from spine_mj.sim.holding import HOLDING_TOLERANCE, array_ie, holding_excess
 from spine_mj.sim.layout import Layout, LayoutKind
 from spine_mj.sim.model import MODEL_PATH
@@ -103,8 +106,10 @@ from spine_mj.sim.rig import REFINE_TIMESTEP, Rig
 
 __all__ = [
     "ARRAY_DRIVES",
+    "DEFAULT_ENGINE",
     "DEFAULT_INERTIA_NUMBER",
     "DEFAULT_LENGTH_SCALE_M",
+    "ENGINES",
     "HOLDING_TOLERANCE",
     "LENGTH_UNITS_M",
     "MAX_INERTIA_NUMBER",
@@ -124,6 +129,7 @@ __all__ = [
     "Drive",
     "EndReason",
     "EngineSettings",
+    "EngineRig",
     "EngineUnits",
     "Event",
     "ForcePull",
@@ -142,8 +148,10 @@ __all__ = [
     "build_array",
     "build_array_on",
     "build_drive",
+    "build_engine_rig",
     "build_rig",
     "characteristic_length",
+    "check_engine_name",
     "default_engine",
     "drive_speed_m_s",
     "hfield_of",
