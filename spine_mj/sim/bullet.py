@@ -67,7 +67,15 @@ from spine_mj import extras
 from spine_mj.engagement import DEFAULT_KAPPA_CAP
 from spine_mj.errors import SpineInputError, check_positive
 from spine_mj.sim.detection import Detection, Event
-from spine_mj.sim.drives import Drive, RampDrive, SpringDrive, StaticProbe, rate_n_s, settle_steps, stiffness_n_m
+from spine_mj.sim.drives import (
+    Drive,
+    RampDrive,
+    SpringDrive,
+    StaticProbe,
+    rate_n_s,
+    settle_steps,
+    stiffness_n_m,
+)
 from spine_mj.sim.model import RigModel, start_pair
 from spine_mj.sim.params import (
     MIN_TIMESTEP_TAU,
@@ -157,15 +165,22 @@ class BulletSettings:
 
 
 def default_bullet_engine(
-    scales: Scales, *, speed_m_s: float | None = None, kappa_cap: float = DEFAULT_KAPPA_CAP, **overrides
+    scales: Scales,
+    *,
+    speed_m_s: float | None = None,
+    stiffness_n_m: float | None = None,
+    kappa_cap: float = DEFAULT_KAPPA_CAP,
+    **overrides,
 ) -> BulletSettings:
     """Bullet's settings from the problem's scales (rules in the module docstring).
 
-    ``speed_m_s``: the drive's speed, which bounds the recorded step as it does MuJoCo's
-    (:func:`~spine_mj.sim.params.default_engine`). ``overrides`` replace fields (a
-    ``timestep_s`` alone re-derives the substeps).
+    ``speed_m_s`` and ``stiffness_n_m``: the drive's speed and spring, which bound the
+    recorded step as they do MuJoCo's (:func:`~spine_mj.sim.params.default_engine`).
+    ``overrides`` replace fields (a ``timestep_s`` alone re-derives the substeps).
     """
-    dt = overrides.get("timestep_s") or default_engine(scales, speed_m_s=speed_m_s).timestep_s
+    dt = overrides.get("timestep_s") or (
+        default_engine(scales, speed_m_s=speed_m_s, stiffness_n_m=stiffness_n_m).timestep_s
+    )
     tol = penetration_tolerance_m(scales)
     slop = overrides.get("contact_slop_m") or SLOP_OF_TOLERANCE * tol
     approach = _SLOP_MARGIN * (1 + kappa_cap) * scales.preload_n / scales.mass_kg * dt**2
@@ -325,7 +340,9 @@ class BulletRig:
             drives = [drives] * len(starts)
         drives = list(drives)
         if len(drives) != len(starts):
-            raise SpineInputError(f"drives must be one drive or one per start ({len(starts)}), got {len(drives)}")
+            raise SpineInputError(
+                f"drives must be one drive or one per start ({len(starts)}), got {len(drives)}"
+            )
         return [self._run(d, s, detection, None, stop_early=stop_early) for d, s in zip(drives, starts)]
 
     def _run(self, drive, start, detection, progress, *, stop_early: bool) -> RunResult:
@@ -371,7 +388,9 @@ class BulletRig:
         result = analysis.results([None])[0]
         if ctl is not None:
             resets = tuple(Event("reset", i, float(result.time_s[i])) for i in ctl.resets if i < result.n)
-            events = sorted(result.events + resets, key=lambda e: (e.index, e.kind == result.end_reason.value))
+            events = sorted(
+                result.events + resets, key=lambda e: (e.index, e.kind == result.end_reason.value)
+            )
             result = dataclasses.replace(result, events=tuple(events))
         return result
 
@@ -452,10 +471,18 @@ class _World:
         )
         centre = [hf.pos[0] * s, hf.pos[1] * s, 0.5 * (heights.min() + heights.max())]
         quarter = pb.getQuaternionFromEuler([0.0, 0.0, math.pi / 2])
-        body = pb.createMultiBody(0, shape, basePosition=centre, baseOrientation=quarter, physicsClientId=self.cid)
+        body = pb.createMultiBody(
+            0, shape, basePosition=centre, baseOrientation=quarter, physicsClientId=self.cid
+        )
         pb.changeDynamics(
-            body, -1, lateralFriction=1.0, restitution=0.0, rollingFriction=0.0, spinningFriction=0.0,
-            frictionAnchor=int(rig.engine.friction_anchor), physicsClientId=self.cid,
+            body,
+            -1,
+            lateralFriction=1.0,
+            restitution=0.0,
+            rollingFriction=0.0,
+            spinningFriction=0.0,
+            frictionAnchor=int(rig.engine.friction_anchor),
+            physicsClientId=self.cid,
         )
         return body
 
@@ -465,14 +492,26 @@ class _World:
         if self.tip is not None:
             pb.removeBody(self.tip, physicsClientId=self.cid)
         self.tip = pb.createMultiBody(
-            1.0, self.tip_shape, basePosition=list(map(float, qpos0)), useMaximalCoordinates=True,
+            1.0,
+            self.tip_shape,
+            basePosition=list(map(float, qpos0)),
+            useMaximalCoordinates=True,
             physicsClientId=self.cid,
         )
         pb.changeDynamics(
-            self.tip, -1, mass=1.0, localInertiaDiagonal=[1e8] * 3, lateralFriction=rig.tip.mu_s,
-            restitution=0.0, rollingFriction=0.0, spinningFriction=0.0, linearDamping=0.0,
-            angularDamping=0.0, frictionAnchor=int(rig.engine.friction_anchor),
-            activationState=pb.ACTIVATION_STATE_DISABLE_SLEEPING, physicsClientId=self.cid,
+            self.tip,
+            -1,
+            mass=1.0,
+            localInertiaDiagonal=[1e8] * 3,
+            lateralFriction=rig.tip.mu_s,
+            restitution=0.0,
+            rollingFriction=0.0,
+            spinningFriction=0.0,
+            linearDamping=0.0,
+            angularDamping=0.0,
+            frictionAnchor=int(rig.engine.friction_anchor),
+            activationState=pb.ACTIVATION_STATE_DISABLE_SLEEPING,
+            physicsClientId=self.cid,
         )
         h = rig.engine.timestep_s / rig.units.time_s / substeps
         pb.setPhysicsEngineParameter(fixedTimeStep=h, numSubSteps=0, physicsClientId=self.cid)

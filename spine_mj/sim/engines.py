@@ -19,7 +19,7 @@ from spine_mj import extras
 from spine_mj.errors import SpineInputError
 from spine_mj.sim.build import build_rig, drive_speed_m_s
 from spine_mj.sim.detection import Detection
-from spine_mj.sim.drives import Drive
+from spine_mj.sim.drives import Drive, spring_stiffness_n_m
 from spine_mj.sim.params import EngineUnits, Scales, TipParams
 from spine_mj.sim.results import RunResult
 from spine_mj.surfaces import GridSurface, Surface
@@ -30,7 +30,14 @@ __all__ = ["DEFAULT_ENGINE", "ENGINES", "EngineRig", "build_engine_rig", "check_
 ENGINES = ("mujoco", "bullet")
 DEFAULT_ENGINE = "mujoco"
 #: Options of :func:`spine_mj.sim.build_rig` that only MuJoCo reads.
-MUJOCO_ONLY = ("integrator", "cone", "impratio", "noslip_iterations", "solref_timeconst_s", "solref_dampratio")
+MUJOCO_ONLY = (
+    "integrator",
+    "cone",
+    "impratio",
+    "noslip_iterations",
+    "solref_timeconst_s",
+    "solref_dampratio",
+)
 
 
 class EngineRig(Protocol):
@@ -112,5 +119,8 @@ def build_engine_rig(surface: Surface, *, engine: str = DEFAULT_ENGINE, **option
     overrides = {"hfield_resolution": resolution}
     if options.get("timestep_s") is not None:
         overrides["timestep_s"] = options["timestep_s"]
-    engine_settings = default_bullet_engine(scales, speed_m_s=speed, **overrides)
+    spring = spring_stiffness_n_m(
+        scales, stiffness_number=options.get("stiffness_number"), stiffness_n_m=options.get("stiffness_n_m")
+    )
+    engine_settings = default_bullet_engine(scales, speed_m_s=speed, stiffness_n_m=spring, **overrides)
     return BulletRig(surface, tip=tip, engine=engine_settings, length_scale_m=length_scale_m)

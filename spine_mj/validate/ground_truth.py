@@ -139,6 +139,7 @@ def spring_block_check(
     *,
     stiffness_number: float | None = None,
     periods: int = 12,
+    engine: str = "mujoco",
 ) -> dict:
     """The spring-block on a flat plane after breakaway: the period of the speed swing
     (autocorrelation's first peak, refined between steps by a parabola through its three
@@ -148,12 +149,21 @@ def spring_block_check(
     swing's force amplitude ``V sqrt(k m)`` is small beside ``mu W`` on a soft spring, where
     MuJoCo's velocity-dependent (soft) friction rows flatten it. The rig is built for the
     spring (the step rule's ``omega dt``), the run lasts until ``periods`` swings after the
-    predicted breakaway. ``stiffness_number`` (K) replaces ``stiffness_n_m`` when given."""
+    predicted breakaway. ``stiffness_number`` (K) replaces ``stiffness_n_m`` when given;
+    ``engine`` is one of :data:`spine_mj.sim.ENGINES`."""
     surface = sim.inclined_plane(slope_deg=0.0, half_width=0.05, n=101)
     tip = sim.TipParams(tip_radius_m=5e-4, mu_s=mu, mass_kg=MASS_KG)
     scales = sim.Scales.for_surface(surface, tip=tip)
     k = scales.stiffness_for(stiffness_number) if stiffness_number is not None else stiffness_n_m
-    rig = sim.Rig(surface, tip=tip, engine=sim.default_engine(scales, speed_m_s=speed_m_s, stiffness_n_m=k))
+    rig = sim.build_engine_rig(
+        surface,
+        engine=engine,
+        tip_radius_m=5e-4,
+        mu=mu,
+        mass_kg=MASS_KG,
+        speed_m_s=speed_m_s,
+        stiffness_n_m=k,
+    )
     period = spring_block_period_s(k, tip.mass_kg)
     breakaway = mu * scales.preload_n / (k * speed_m_s)
     res = rig.run(

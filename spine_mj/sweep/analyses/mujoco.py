@@ -31,6 +31,14 @@ from spine_mj.sweep.registry import (
 MUJOCO_PARAMS = (
     MU_PARAM,
     ParamSpec(
+        "engine",
+        "str",
+        "physics engine: mujoco (soft contact) or bullet (hard contact; the [bullet] extra); "
+        "bullet reads none of MuJoCo's solver keys",
+        sim.DEFAULT_ENGINE,
+        choices=sim.ENGINES,
+    ),
+    ParamSpec(
         "tip_radius",
         "float",
         "tip radius in the surface's length unit (mujoco: 0 lets "
@@ -164,6 +172,8 @@ def _check_speed(config) -> None:
                 f"config keys grid.{a} and grid.{b}: give one of them ({what}), got "
                 f"{a} = {list(grid[a])} and {b} = {list(grid[b])}"
             )
+    if "bullet" in grid["engine"]:
+        sim.check_engine_name("bullet", "config key engine =")
     defaults = {s.name: s.default for s in MUJOCO_PARAMS}
     protocols = grid["protocol"]
     for key, readers in PROTOCOL_KEYS.items():
@@ -180,8 +190,18 @@ def _rig(spec, key):
     """The rig of a surface and tip/engine parameters (cached: cases differing only in the
     protocol share it; the speed and the spring's stiffness set the engine step)."""
     p = dict(key)
-    return sim.build_rig(
+    mujoco_only = {
+        "integrator": p["integrator"],
+        "cone": p["cone"],
+        "impratio": p["impratio"],
+        "noslip_iterations": p["noslip_iterations"],
+        "solref_timeconst_s": p["solref_timeconst"],
+        "solref_dampratio": p["solref_dampratio"],
+    }
+    return sim.build_engine_rig(
         spec.make(),
+        engine=p["engine"],
+        **(mujoco_only if p["engine"] == "mujoco" else {}),
         mu=p["mu"],
         tip_radius_m=p["tip_radius_m"],
         mass_kg=p["mass"],
@@ -190,12 +210,6 @@ def _rig(spec, key):
         length_scale_m=p["length_scale"],
         hfield_resolution=p["hfield_resolution"],
         timestep_s=p["timestep"],
-        integrator=p["integrator"],
-        cone=p["cone"],
-        impratio=p["impratio"],
-        noslip_iterations=p["noslip_iterations"],
-        solref_timeconst_s=p["solref_timeconst"],
-        solref_dampratio=p["solref_dampratio"],
         ie=p["ie"],
         speed_m_s=p["speed"],
         stiffness_number=p["K"],
@@ -241,6 +255,7 @@ def _mujoco(case, surface, starts, upstream):
 
 
 _RIG_KEYS = (
+    "engine",
     "ie",  # the drive speed limits the engine step (impacts)
     "speed",
     "K",  # the drive spring's stiffness too (its period)

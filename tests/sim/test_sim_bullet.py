@@ -1,0 +1,278 @@
+"""The rig in Bullet (spine_mj.sim.bullet, spine_mj.sim.engines): the same surface, rules and
+results as MuJoCo's, the closed forms, and each Bullet pitfall measured with its fix."""
+
+import dataclasses
+import json
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+from click.testing import CliRunner
+from sweep_support import write_config
+
+from spine_mj import engagement, extras, sim, sweep
+from spine_mj.cli import main
+from spine_mj.errors import SpineInputError
+from spine_mj.surfaces import GridSurface, TriangulatedSurface, from_hfield
+
+pytest.importorskip("pybullet", reason="the Bullet engine needs the [bullet] extra (pybullet)")
+
+from spine_mj.sim.bullet import BulletRig, default_bullet_engine
+
+MU = 0.5
+
+
+def plane_rig(slope_deg=0.0, azimuth_deg=0.0, **engine):
+    surf = sim.inclined_plane(slope_deg=slope_deg, azimuth_deg=azimuth_deg)
+    tip = sim.TipParams(mu_s=MU)
+    if not engine:
+        return BulletRig(surf, tip=tip)
+    sc = sim.Scales.for_surface(surf, tip=tip)
+    return BulletRig(surf, tip=tip, engine=default_bullet_engine(sc, **engine))
+
+
+def test_the_heightfield_is_mujocos_triangles():
+    """Bullet splits its cells along the other diagonal; the quarter turn makes them MuJoCo's."""
+    import pybullet as pb
+
+    rng = np.random.default_rng(3)
+    x, y = np.linspace(-0.02, 0.02, 9), np.linspace(-0.015, 0.015, 7)
+    surf = GridSurface(heights=rng.normal(0, 2e-3, (7, 9)), x=x, y=y, unit="m")
+    rig = BulletRig(surf, tip=sim.TipParams(tip_radius_m=3e-3, mu_s=MU))
+    w = rig.world()
+    facets = TriangulatedSurface.from_grid(from_hfield(rig.hfield, unit="m"))
+    px, py = rng.uniform(-0.0199, 0.0199, 200), rng.uniform(-0.0149, 0.0149, 200)
+    lu = rig.units.length_m
+    hits = pb.rayTestBatch(
+        [[a / lu, b / lu, 10.0] for a, b in zip(px, py)],
+        [[a / lu, b / lu, -10.0] for a, b in zip(px, py)],
+        physicsClientId=w.cid,
+    )
+    z = np.array([h[3][2] for h in hits]) * lu
+    np.testing.assert_allclose(z, facets.height(px, py), atol=1e-8)
+
+
+@pytest.mark.parametrize(("slope", "az"), [(0.0, 0.0), (10.0, 0.0), (-10.0, 0.0), (20.0, 45.0)])
+def test_static_probe_on_inclined_planes_matches_the_closed_form(slope, az):
+    rig = plane_rig(slope, az)
+    t = math.tan(math.radians(slope))
+    k, _ = engagement.kappa(t * math.cos(math.radians(az)), t * math.sin(math.radians(az)), MU)
+    run = rig.run(sim.build_drive(rig.scales, "static", ie=1e-2), start=(0.0, 0.0))
+    assert run.end_reason is sim.EndReason.BREAKAWAY
+    assert run.kappa_mj == pytest.approx(float(k), rel=5e-3)
+    assert run.engine.to_dict()["engine"] == "bullet"
+    # same result record as MuJoCo's: every column, one row per recorded step
+    assert run.position_m.shape == (run.n, 3) and run.motion.shape == (run.n,)
+    assert run.time_s[1] - run.time_s[0] == pytest.approx(rig.engine.timestep_s)
+
+
+def test_cone_friction_pitfall():
+    """Bullet's two friction rows alone form a pyramid: on a plane whose fall line is at 45
+    deg to the drive, the tip holds more than mu allows; the cone holds the closed form."""
+    t = math.tan(math.radians(20.0))
+    k, _ = engagement.kappa(t / math.sqrt(2), t / math.sqrt(2), MU)
+    kappas = {}
+    for cone in (True, False):
+        rig = plane_rig(20.0, 45.0, cone_friction=cone)
+        run = rig.run(sim.build_drive(rig.scales, "static", ie=1e-2), start=(0.0, 0.0))
+        kappas[cone] = run.kappa_mj
+    assert kappas[True] == pytest.approx(float(k), rel=5e-3)
+    assert kappas[False] > 1.02 * float(k)
+
+
+def test_a_held_tip_does_not_creep():
+    """On a slope below the friction angle the tip holds: drift below 1e-9 tip radii per
+    time scale (placed touching; a tip started sunk by the slop crept at ~5e-4 v_c)."""
+    rig = plane_rig(20.0, 0.0)
+    drive = sim.SpringDrive(speed_m_s=1e-9, duration_s=0.2)  # a carriage that barely moves
+    run = rig.run(dataclasses.replace(drive, stiffness_n_m=1e-9), start=(0.0, 0.0))
+    drift = np.abs(run.position_m[-1, :2] - run.position_m[10, :2]).max()
+    per_tau = drift / rig.tip.tip_radius_m / ((run.time_s[-1] - run.time_s[10]) / rig.scales.time_s)
+    assert per_tau < 1e-9
+    assert not run.moving[10:].any()
+
+
+def test_internal_edge_pitfall():
+    """A frictionless tip slid fast over a flat triangulated plane: with the heightfield's
+    internal-edge info it stays on the plane; without it, the triangles' shared edges
+    kick it up (measured: 4 % of its speed at 3 L_c / tau)."""
+    import pybullet as pb
+
+    surf = sim.inclined_plane(slope_deg=0.0)
+    tip = sim.TipParams(mu_s=0.0)
+    sc = sim.Scales.for_surface(surf, tip=tip)
+    hops = {}
+    for edges in (True, False):
+        rig = BulletRig(surf, tip=tip, engine=default_bullet_engine(sc, internal_edges=edges))
+        w = rig.world()
+        run = w.start(rig.place(-0.012, -0.01), 1)
+        v = 3.0  # L_c / tau
+        pb.resetBaseVelocity(w.tip, [0.8 * v, 0.6 * v, 0.0], physicsClientId=w.cid)
+        state, sens = np.zeros(7), np.zeros(20)
+        up, i = 0.0, 0
+        while state[1] * rig.units.length_m < 0.012:  # on the plane, 1.5 L_c of sliding
+            run.step(i, np.zeros(6), 0.0, 0.0, state, sens)
+            up, i = max(up, abs(state[6]) if i > 2 else 0.0), i + 1
+        hops[edges] = up / v
+    assert hops[True] < 1e-4
+    assert hops[False] > 1e-2
+
+
+def test_landings_do_not_bounce():
+    """Restitution 0: a tip landing at the fastest speed the step rule plans for (half the
+    contact breaking distance a step) leaves with under 1 % of its speed; with restitution
+    0.5 (Bullet's combined value of two bodies at 0.7) it bounces."""
+    import pybullet as pb
+
+    rig = plane_rig()
+    u, e = rig.units, rig.engine
+    v = 0.5 * e.contact_breaking_m / e.timestep_s / u.speed_m_s
+    w = rig.world()
+    bounce = {}
+    for restitution in (0.0, 0.7):
+        run = w.start(rig.place(0.0, 0.0) + np.array([0.0, 0.0, 0.02]), 1)
+        for body in (w.tip, w.ground):
+            pb.changeDynamics(body, -1, restitution=restitution, physicsClientId=w.cid)
+        pb.resetBaseVelocity(w.tip, [0.0, 0.0, -v], physicsClientId=w.cid)
+        state, sens = np.zeros(7), np.zeros(20)
+        up = 0.0
+        for i in range(400):
+            run.step(i, np.zeros(6), 0.0, 0.0, state, sens)
+            up = max(up, state[6])
+        bounce[restitution] = up / v
+    assert bounce[0.0] < 0.01
+    assert bounce[0.7] > 0.3
+
+
+def test_spring_block_period_and_peak_speed():
+    """On a flat plane, after breakaway, the tip's speed swings between 0 and 2 V with period
+    2 pi / w (docs/physics.md §6). A spring 100 times stiffer runs 2 substeps a row (omega dt = 0.3):
+    its period still holds to the row it is read in, and its swing is MuJoCo's."""
+    from spine_mj.validate.ground_truth import spring_block_check
+
+    got = spring_block_check(stiffness_n_m=100.0, engine="bullet")
+    assert abs(got["period_rel_error"]) < 0.01
+    assert abs(got["peak_speed_rel_error"]) < 0.01
+    stiff = {e: spring_block_check(stiffness_n_m=1e4, engine=e) for e in sim.ENGINES}
+    resolution = stiff["bullet"]["timestep_s"] / stiff["bullet"]["period_predicted_s"]
+    assert abs(stiff["bullet"]["period_rel_error"]) < 0.01 + resolution
+    assert stiff["bullet"]["peak_speed_v"] == pytest.approx(stiff["mujoco"]["peak_speed_v"], rel=0.05)
+
+
+def test_the_force_ramp_with_reset_runs_and_resets():
+    rig = plane_rig()
+    drive = sim.build_drive(rig.scales, "ramp", ie=1e-1, duration_s=0.6)
+    run = rig.run(drive, start=(-0.012, 0.0))
+    assert [e.kind for e in run.events].count("reset") >= 1
+    # breaks away at mu plus the ramp's lag over the slip detection (MuJoCo: 0.521)
+    assert run.breakaway_kappas[:2] == pytest.approx(MU, rel=0.06)
+
+
+def test_build_engine_rig_gives_the_same_scales_and_step_in_both_engines():
+    surf = sim.inclined_plane(slope_deg=5.0)
+    rigs = {e: sim.build_engine_rig(surf, engine=e, mu=MU, ie=1e-3) for e in sim.ENGINES}
+    assert rigs["mujoco"].scales == rigs["bullet"].scales
+    assert rigs["mujoco"].engine.timestep_s == rigs["bullet"].engine.timestep_s
+    with pytest.raises(SpineInputError, match="impratio: MuJoCo's solver options, not read by engine bullet"):
+        sim.build_engine_rig(surf, engine="bullet", mu=MU, impratio=10.0)
+    with pytest.raises(SpineInputError, match="engine must be one of mujoco, bullet, got 'ode'"):
+        sim.build_engine_rig(surf, engine="ode", mu=MU)
+
+
+def test_simulate_engine_bullet_writes_the_same_run_folder(tmp_path):
+    folders = {}
+    for engine in sim.ENGINES:
+        out = tmp_path / engine
+        res = CliRunner().invoke(
+            main,
+            [
+                "simulate",
+                "paper-single-peak",
+                "--engine",
+                engine,
+                "--start",
+                "-3,-1",
+                "--resolution",
+                "61",
+                "--duration",
+                "0.2",
+                "--out",
+                str(out),
+            ],
+        )
+        assert res.exit_code == 0, res.output
+        folders[engine] = out
+    names = {e: sorted(p.name for p in f.iterdir()) for e, f in folders.items()}
+    assert names["bullet"] == names["mujoco"]
+    tables = {e: pd.read_parquet(f / "trajectory.parquet") for e, f in folders.items()}
+    assert list(tables["bullet"].columns) == list(tables["mujoco"].columns)
+    summary = json.loads((folders["bullet"] / "summary.json").read_text())
+    assert summary["engine"]["engine"] == "bullet"
+    assert set(summary) == set(json.loads((folders["mujoco"] / "summary.json").read_text()))
+
+
+def test_without_the_extra_bullet_is_one_error_line(monkeypatch, tmp_path):
+    monkeypatch.setitem(extras.EXTRAS, "bullet", ("no_such_module_spine_mj",))
+    res = CliRunner().invoke(
+        main,
+        [
+            "simulate",
+            "paper-single-peak",
+            "--engine",
+            "bullet",
+            "--start",
+            "-3,-1",
+            "--out",
+            str(tmp_path / "r"),
+        ],
+    )
+    assert res.exit_code == 2
+    assert res.output.strip().splitlines() == [
+        "Error: --engine bullet needs the optional extra 'bullet' (no_such_module_spine_mj not installed): "
+        "pip install 'spine-mj[bullet]'"
+    ]
+    assert not (tmp_path / "r").exists()
+
+
+ENGINE_SWEEP = """
+[sweep]
+name = "engines"
+analyses = ["mujoco"]
+
+[[surfaces]]
+preset = "paper-single-peak"
+
+[starts]
+frame = "absolute"
+points = [[-3.0, -1.0], [-3.0, 1.0]]
+
+[drive]
+protocol = "spring"
+ie = 1e-3
+duration = 0.1
+
+[grid]
+engine = ["mujoco", "bullet"]
+hfield_resolution = 61
+"""
+
+
+def test_a_sweep_over_both_engines_resumes(tmp_path):
+    cfg = write_config(tmp_path, ENGINE_SWEEP)
+    out = tmp_path / "out"
+    sweep.run_sweep(cfg, out, workers=1)
+    before = (
+        sweep.load_runs(out).drop(columns=["time_s", "cpu_s"]).sort_values("run_id").reset_index(drop=True)
+    )
+    assert sorted(before["engine"].unique()) == ["bullet", "mujoco"]
+    assert (before["status"] == "ok").all()
+    files = sorted((out / "runs").glob("*.parquet"))
+    files[0].unlink()  # a case lost to a kill
+    (out / "runs.parquet").unlink(missing_ok=True)
+    summary = sweep.run_sweep(cfg, out, workers=1)
+    assert (summary.run_cases, summary.skipped_cases) == (1, 1)
+    after = (
+        sweep.load_runs(out).drop(columns=["time_s", "cpu_s"]).sort_values("run_id").reset_index(drop=True)
+    )
+    pd.testing.assert_frame_equal(after, before)
