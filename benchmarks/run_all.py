@@ -31,6 +31,8 @@ Sections (each records the machine's load average before and after it):
   against ``tan(theta + arctan mu)``) of the CPU engine with noslip, of the CPU engine
   without noslip at a high impratio (what a noslip-less engine sees), and of MuJoCo Warp
   with both settings where a CUDA device exists; and GPU against CPU throughput.
+* ``engines`` (with the ``[bullet]`` extra): Bullet against MuJoCo on the same runs
+  (``benchmarks/bench_engines.py``): steps per second and cost per compared run.
 
 Timings are the best (streamline) or the median (ratios) of repeats: the machine is shared.
 """
@@ -39,6 +41,7 @@ from __future__ import annotations
 
 import argparse
 import datetime
+import importlib.util
 import json
 import math
 import os
@@ -59,6 +62,8 @@ from bench_cli import bench_cli  # noqa: E402
 from bench_cli import markdown as cli_markdown  # noqa: E402
 from bench_memory import bench_memory  # noqa: E402
 from bench_memory import markdown as memory_markdown  # noqa: E402
+from bench_engines import bench_engines  # noqa: E402
+from bench_engines import markdown as engines_markdown  # noqa: E402
 
 # the Performance page of the site (it was the README's Performance section)
 README = HERE.parent / "docs" / "user_guide" / "performance.md"
@@ -517,6 +522,7 @@ def markdown(res: dict) -> str:
         ]
     lines += _cost_markdown(res.get("cost"))
     lines += array_markdown(res.get("array"))
+    lines += engines_markdown(res.get("engines"))
     lines += _fastforward_markdown(res.get("fastforward"))
     lines += cli_markdown(res.get("cli"))
     lines += _gpu_markdown(res.get("gpu"))
@@ -732,6 +738,8 @@ def main(argv=None) -> None:
         sections["fastforward"] = bench_fastforward_section
         sections["array"] = bench_array
         sections["cli"] = bench_cli
+        if importlib.util.find_spec("pybullet") is not None:  # the [bullet] extra
+            sections["engines"] = bench_engines
         if args.gpu:
             sections["gpu"] = bench_gpu
         sections["memory"] = bench_memory
