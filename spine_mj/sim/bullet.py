@@ -38,7 +38,9 @@ Bullet's absolute thresholds meet O(1) numbers at every physical scale):
 * **Friction**: ``enableConeFriction`` (measured: without it Bullet's two friction rows
   form a pyramid that holds ``sqrt(2) mu N`` at 45 deg to its axes, 0.716 for mu = 0.5);
   Bullet multiplies the two bodies' frictions, so the surface gets 1 and the tip ``mu_s``;
-  friction anchors off (measured: no change in the creep above).
+  friction anchors on (measured: a tip resting in a V-groove on two contacts crept down it
+  at 0.1 tip radii per second without them and did not move, to 1e-7 radii, with them;
+  they change nothing on one contact).
 * **Restitution** 0 on both bodies: landings are perfectly inelastic as MuJoCo's critically
   damped contacts are (measured: a tip landing at 1 L_c/tau rebounds at 2e-3 with 0, at
   0.29 with 0.5).
@@ -143,7 +145,7 @@ class BulletSettings:
     erp: float = 0.2
     cfm: float = 0.0
     cone_friction: bool = True
-    friction_anchor: bool = False
+    friction_anchor: bool = True
     internal_edges: bool = True
     hfield_resolution: int | None = None
 

@@ -1,0 +1,521 @@
+"""Study: the closed forms in both engines, MuJoCo (soft contact) beside Bullet (hard contact).
+
+Each check is a closed form the rig must reproduce, run the same way in both engines
+(:func:`spine_mj.sim.build_engine_rig`, the same surface, drive and detection), with the
+tolerance the MuJoCo report states for it:
+
+* **static kappa** on inclined planes (Eqs. 1-3): breakaway force / W against
+  ``kappa(f_x, f_y, mu)``, within 5 % (the static map's target);
+* **spring-block** (docs/physics.md §6): period against ``2 pi / w`` within 2 % (the
+  ladder's), peak speed against ``2 V`` (shown; MuJoCo's soft friction rows flatten it);
+* **Prandtl-Tomlinson** on a corrugation (s = 0.3, mu = 0.5, K* = 0.47): one slip per
+  wavelength below K*, none above;
+* **V-groove wedge lock**: a tip in a groove rising at theta with flanks tilted by alpha
+  holds ``tan(theta + arctan(mu / cos alpha))`` (the single-contact rule says
+  ``tan(theta + arctan mu)``), within 5 %, and self-locks once
+  ``theta + arctan(mu / cos alpha) >= 90 deg``;
+* **Dai's interlock** on a half-embedded sphere of radius R against a tip of radius r,
+  pushed horizontally into it: self-lock possible iff ``R / r >= 1 / sin(arctan mu) - 1``,
+  run at 0.9, 0.97, 1.03 and 1.1 times that threshold. Both engines collide with the
+  sphere's heightfield facets (at most 4 samples per tip radius, the rig's rule), whose
+  contact normal at the tip's rest differs from the smooth sphere's: the table gives the
+  rule applied to the facets' normal too (the fair reference, as the streamline on the
+  contact surface is for paths);
+* **creep**: the drift speed of a held tip (tip radii per second) on a 20 deg plane and
+  wedged against the sphere under a rising force.
+
+* **fractal self-lock rate against H** (``--fractal N``): the validation's fractal study
+  (:mod:`spine_mj.validate.fractal_lock`) at its corner I_e in both engines, N surfaces per H,
+  one sweep with ``engine = ["mujoco", "bullet"]``, rates with Wilson intervals.
+
+``python -m spine_mj.validate.engines --out DIR [--quick] [--fractal N]`` runs it (Bullet
+needs the ``[bullet]`` extra) and writes ``engines.json`` and ``engines.md``; the committed
+``analysis/reports/engines.md`` is ``--fractal 30``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from spine_mj import presets, sim
+from spine_mj.surfaces import GridSurface
+from spine_mj.theory import engagement
+from spine_mj.theory.tomlinson import Corrugation
+
+__all__ = ["EnginesResult", "dai_threshold", "engines_ground_truth", "section"]
+
+MU = 0.5
+STATIC_TOL = 0.05
+PERIOD_TOL = 0.02
+#: Planes of the static check: (slope, azimuth) [deg].
+PLANES = ((0.0, 0.0), (10.0, 0.0), (-10.0, 0.0), (20.0, 45.0), (30.0, 0.0))
+#: Dai's ratios, in thresholds.
+DAI_FACTORS = (0.9, 0.97, 1.03, 1.1)
+DAI_SPHERE_M = 4e-3
+#: V-grooves: (theta, alpha) [deg]. The closed form takes the flanks' tilt in the groove's
+#: own inclined plane; on ``groove`` it holds for moderate angles only, so no self-locking
+#: groove (theta + arctan(mu / cos alpha) >= 90 deg needs steep ones) is run.
+GROOVES = ((20.0, 30.0),)
+
+
+def dai_threshold(mu: float) -> float:
+    """The smallest R / r at which a tip pushed into a half-embedded sphere can self-lock."""
+    return 1.0 / math.sin(math.atan(mu)) - 1.0
+
+
+@dataclass(frozen=True)
+class EnginesResult:
+    """Rows of every check: ``check``, ``case``, the closed form, the fair reference where
+    it differs, each engine's measurement and verdict, the tolerance; and the engines run."""
+
+    rows: list[dict]
+    engines: tuple[str, ...]
+    wall_s: dict
+    fractal: list[dict] = ()
+
+    def as_dict(self) -> dict:
+        return {
+            "rows": self.rows,
+            "engines": list(self.engines),
+            "wall_s": self.wall_s,
+            "fractal": list(self.fractal),
+        }
+
+
+def _rig(engine, surface, mu=MU, **kw):
+    return sim.build_engine_rig(surface, engine=engine, mu=mu, **kw)
+
+
+def _static_rows(engine: str) -> list[dict]:
+    rows = []
+    from spine_mj.validate.static_map import hold_force
+
+    for slope, az in PLANES:
+        t = math.tan(math.radians(slope))
+        k, low, _ = hold_force(t * math.cos(math.radians(az)), t * math.sin(math.radians(az)), MU)
+        hold = 0.5 * (low + k) if low > 0 else 0.0  # as the static map: where gravity alone slides
+        rig = _rig(engine, sim.inclined_plane(slope_deg=slope, azimuth_deg=az), ie=1e-2)
+        drive = sim.build_drive(rig.scales, "static", ie=1e-2, start_force_n=hold * rig.scales.preload_n)
+        run = rig.run(drive, start=(0.0, 0.0))
+        rows.append(
+            {
+                "check": "static kappa",
+                "case": f"plane {slope:g} deg, azimuth {az:g} deg",
+                "closed_form": float(k),
+                "measured": run.kappa_mj,
+                "error": run.kappa_mj / float(k) - 1,
+                "ok": abs(run.kappa_mj / float(k) - 1) <= STATIC_TOL,
+                "tolerance": f"{STATIC_TOL:.0%}",
+                "detail": run.end_detail,
+            }
+        )
+    return rows
+
+
+def _spring_block_rows(engine: str) -> list[dict]:
+    from spine_mj.validate.ground_truth import spring_block_check
+
+    b = spring_block_check(engine=engine)
+    return [
+        {
+            "check": "spring-block period",
+            "case": "k = 100 N/m, m = 10 g, V = 4 mm/s",
+            "closed_form": b["period_predicted_s"],
+            "measured": b["period_s"],
+            "error": b["period_rel_error"],
+            "ok": abs(b["period_rel_error"]) <= PERIOD_TOL,
+            "tolerance": f"{PERIOD_TOL:.0%}",
+            "detail": "",
+        },
+        {
+            "check": "spring-block peak speed",
+            "case": "k = 100 N/m, m = 10 g, V = 4 mm/s",
+            "closed_form": 2.0,
+            "measured": b["peak_speed_v"],
+            "error": b["peak_speed_rel_error"],
+            "ok": None,
+            "tolerance": "shown",
+            "detail": "in V",
+        },
+    ]
+
+
+def _tomlinson_rows(engine: str, quick: bool) -> list[dict]:
+    c = Corrugation(0.3, MU, tip_radius=0.01)
+    k_star = c.critical_stiffness()
+    waves = 2 if quick else 3
+    surf = presets.make_surface("corrugation", slope_amplitude=0.3, points_per_wave=128, n_waves=waves + 1)
+    rows = []
+    for factor in (0.5, 2.0):
+        k = factor * k_star
+        rig = _rig(engine, surf, tip_radius_m=0.01 * sim.DEFAULT_LENGTH_SCALE_M, ie=1e-3, stiffness_number=k)
+        sc = rig.scales
+        speed = sc.speed_for(1e-3)
+        duration = waves * sim.DEFAULT_LENGTH_SCALE_M / speed
+        run = rig.run(
+            sim.SpringDrive(speed_m_s=speed, stiffness_n_m=sc.stiffness_for(k), duration_s=duration),
+            start=(0.75, 0.0),
+        )
+        travel = (run.position_m[-1, 0] - run.position_m[0, 0]) / sim.DEFAULT_LENGTH_SCALE_M
+        per_wave = len(run.slip_events) / travel if travel > 0 else math.nan
+        expected = 1.0 if factor < 1 else 0.0
+        # one slip per wavelength: the count within one of the wavelengths travelled
+        ok = abs(len(run.slip_events) - expected * travel) < 1 if factor < 1 else not run.slip_events
+        rows.append(
+            {
+                "check": "Prandtl-Tomlinson slips per wavelength",
+                "case": f"s = 0.3, mu = {MU:g}, K = {factor:g} K* (I_e = 1e-3)",
+                "closed_form": expected,
+                "measured": per_wave,
+                "error": per_wave - expected,
+                "ok": bool(ok),
+                "tolerance": "slips within 1 of the wavelengths travelled below K*, none above",
+                "detail": f"{len(run.slip_events)} slips in {travel:.2f} wavelengths; {run.end_reason.value}",
+            }
+        )
+    return rows
+
+
+def groove(theta_deg: float, alpha_deg: float, half_width_m: float = 0.02, n: int = 81) -> GridSurface:
+    """``z = tan(theta) x + tan(alpha) |y|``: a V-groove along x rising at theta, flanks tilted by alpha."""
+    x = np.linspace(-half_width_m, half_width_m, n)
+    h = (
+        math.tan(math.radians(theta_deg)) * x[None, :]
+        + math.tan(math.radians(alpha_deg)) * np.abs(x)[:, None]
+    )
+    return GridSurface(heights=h, x=x, y=x.copy(), unit="m", metadata={"generator": "groove"})
+
+
+def _groove_rows(engine: str) -> list[dict]:
+    rows = []
+    for theta, alpha in GROOVES:
+        wedge = math.radians(theta) + math.atan(MU / math.cos(math.radians(alpha)))
+        lock = wedge >= math.pi / 2
+        kappa = math.inf if lock else math.tan(wedge)
+        single = math.tan(math.radians(theta) + math.atan(MU))
+        cap = 20.0 if lock else 2 * kappa
+        rig = _rig(engine, groove(theta, alpha), ie=1e-2, tip_radius_m=2e-3)
+        det = sim.Detection(kappa_cap=cap)
+        # where gravity alone would slide the tip down the groove it is held at twice the
+        # force that holds it
+        hold = 2 * max(0.0, math.tan(math.radians(theta) - math.atan(MU / math.cos(math.radians(alpha)))))
+        drive = sim.build_drive(rig.scales, "static", ie=1e-2, start_force_n=hold * rig.scales.preload_n)
+        run = rig.run(drive, start=(0.0, 0.0), detection=det)
+        locked = run.end_reason is sim.EndReason.SELF_LOCK
+        row = {
+            "check": "V-groove wedge",
+            "case": f"theta {theta:g} deg, alpha {alpha:g} deg (single-contact rule: {single:.3g})",
+            "closed_form": "self-lock" if lock else kappa,
+            "measured": "self-lock" if locked else run.kappa_mj,
+            "tolerance": "lock" if lock else f"{STATIC_TOL:.0%}",
+            "detail": run.end_detail,
+        }
+        if lock:
+            row.update(error=math.nan, ok=locked)
+        else:
+            err = run.kappa_mj / kappa - 1
+            row.update(error=err, ok=bool(abs(err) <= STATIC_TOL))
+        rows.append(row)
+    return rows
+
+
+def dai_surface(sphere_m: float, tip_m: float) -> GridSurface:
+    """A half-embedded sphere of radius ``sphere_m`` on a floor, on a grid at a quarter of
+    the tip radius ``tip_m`` (the rig's finest)."""
+    step = tip_m / 4
+    half = 3 * (sphere_m + tip_m)
+    x = np.arange(-half, half + step / 2, step)
+    xx, yy = np.meshgrid(x, x)
+    h = np.sqrt(np.clip(sphere_m**2 - xx**2 - yy**2, 0.0, None))
+    return GridSurface(heights=h, x=x, y=x.copy(), unit="m", metadata={"generator": "dai"})
+
+
+def dai_start(ball, sphere_m: float, tip_m: float) -> tuple[float, float]:
+    """Where a tip sliding in +x along the floor first touches the faceted sphere (``ball``:
+    the rig's contact surface, metres): the first point, on a 1e-4 tip-radius grid, where
+    the ball rises off the floor."""
+    x_smooth = -math.sqrt((sphere_m + tip_m) ** 2 - tip_m**2)
+    xs = np.linspace(x_smooth - 0.5 * tip_m, x_smooth + 0.5 * tip_m, 10001)
+    lifted = np.flatnonzero(ball.height(xs, np.zeros_like(xs)) > 1e-6 * tip_m)
+    return float(xs[lifted[0]]), 0.0
+
+
+def _dai_rows(engine: str) -> list[dict]:
+    thr = dai_threshold(MU)
+    rows = []
+    for f in DAI_FACTORS:
+        tip_m = DAI_SPHERE_M / (f * thr)
+        rig = _rig(engine, dai_surface(DAI_SPHERE_M, tip_m), ie=1.0, tip_radius_m=tip_m)
+        ball = rig.contact_surface()
+        start = dai_start(ball, DAI_SPHERE_M, tip_m)
+        gx, gy = ball.gradient(np.array([start[0]]), np.array([start[1]]))
+        k_facets, region = engagement.kappa(float(gx[0]), float(gy[0]), MU)
+        lock_facets = region == engagement.SELF_LOCK
+        phi = math.asin(1.0 / (1.0 + f * thr))  # the smooth sphere's normal above the horizontal
+        wedge = math.pi / 2 - phi + math.atan(MU)
+        lock = wedge >= math.pi / 2
+        kappa = math.inf if lock else math.tan(wedge)
+        cap = 20.0 if lock_facets else float(min(1.5 * k_facets, 400.0))
+        run = rig.run(
+            sim.build_drive(rig.scales, "static", ie=1.0), start=start, detection=sim.Detection(kappa_cap=cap)
+        )
+        locked = run.end_reason is sim.EndReason.SELF_LOCK
+        held = run.moving.size and ~run.moving[run.drive_start_index :]
+        rows.append(
+            {
+                "check": "Dai interlock",
+                "case": f"R / r = {f:g} x {thr:.3f}",
+                "closed_form": "self-lock" if lock else kappa,
+                "facets": "self-lock" if lock_facets else float(k_facets),
+                "measured": "self-lock" if locked else run.kappa_mj,
+                "error": math.nan,
+                "ok": bool(locked == lock),
+                "ok_facets": bool(locked == lock_facets),
+                "tolerance": "lock iff R/r >= threshold",
+                "detail": run.end_detail,
+                "creep_radii_per_s": _creep(run, held) if locked else math.nan,
+            }
+        )
+    return rows
+
+
+def _creep(run, held) -> float:
+    """Drift speed [tip radii / s] of the tip over the rows it is held (not moving)."""
+    rows = np.flatnonzero(held) + run.drive_start_index
+    if rows.size < 2:
+        return math.nan
+    a, b = rows[0], rows[-1]
+    drift = np.linalg.norm(run.position_m[b, :2] - run.position_m[a, :2])
+    return float(drift / run.tip.tip_radius_m / (run.time_s[b] - run.time_s[a]))
+
+
+def _creep_rows(engine: str) -> list[dict]:
+    rig = _rig(engine, sim.inclined_plane(slope_deg=20.0), ie=1e-2)
+    drive = sim.SpringDrive(speed_m_s=1e-9, stiffness_n_m=1e-9, duration_s=0.5)
+    run = rig.run(drive, start=(0.0, 0.0))
+    speed = _creep(run, ~run.moving[run.drive_start_index :])
+    return [
+        {
+            "check": "creep of a held tip",
+            "case": "20 deg plane, mu 0.5, no drive, 0.5 s",
+            "closed_form": 0.0,
+            "measured": speed,
+            "error": speed,
+            "ok": None,
+            "tolerance": "shown (tip radii / s)",
+            "detail": "",
+        }
+    ]
+
+
+def engines_ground_truth(
+    *, quick: bool = False, engines=sim.ENGINES, progress: Callable[[str], None] | None = None
+) -> EnginesResult:
+    """Every check in every engine of ``engines``; rows merged by (check, case)."""
+    by_key: dict[tuple, dict] = {}
+    wall = {}
+    checks = {
+        "static kappa": _static_rows,
+        "spring-block": _spring_block_rows,
+        "V-groove": _groove_rows,
+        "Dai interlock": _dai_rows,
+        "creep": _creep_rows,
+        "Prandtl-Tomlinson": lambda e: _tomlinson_rows(e, quick),
+    }
+    for engine in engines:
+        t0 = time.perf_counter()
+        for name, check in checks.items():
+            if progress is not None:
+                progress(f"{engine}: {name}")
+            for row in check(engine):
+                key = (row["check"], row["case"])
+                merged = by_key.setdefault(
+                    key,
+                    {k: row[k] for k in ("check", "case", "closed_form", "tolerance") if k in row}
+                    | ({"facets": row["facets"]} if "facets" in row else {}),
+                )
+                for k in ("measured", "error", "ok", "detail", "ok_facets", "creep_radii_per_s"):
+                    if k in row:
+                        merged[f"{engine}_{k}"] = row[k]
+        wall[engine] = round(time.perf_counter() - t0, 1)
+    return EnginesResult(rows=list(by_key.values()), engines=tuple(engines), wall_s=wall)
+
+
+def _fmt(v) -> str:
+    if v is None:
+        return "-"
+    if isinstance(v, str):
+        return v
+    if isinstance(v, bool):
+        return "yes" if v else "**no**"
+    if isinstance(v, float) and not math.isfinite(v):
+        return "n/a"
+    return f"{v:.4g}"
+
+
+def section(res: EnginesResult | None) -> str:
+    """The report section "Engines side by side: the closed forms" ("" without a result)."""
+    if res is None:
+        return ""
+    engines = res.engines
+    head = ["check", "case", "closed form", "facets' rule"]
+    for e in engines:
+        head += [f"{e}", f"{e} error", f"{e} within"]
+    head += ["tolerance"]
+    lines = [
+        "## Engines side by side: the closed forms",
+        "",
+        "Each closed form run the same way in MuJoCo (soft contact) and Bullet (hard contact; "
+        "docs/physics.md §10), with the tolerance the MuJoCo report states. The facets' rule is "
+        "the closed form applied to the contact normal of the heightfield's facets at the start "
+        "(what both engines collide with).",
+        "",
+        "| " + " | ".join(head) + " |",
+        "|" + "---|" * len(head),
+    ]
+    for r in res.rows:
+        cells = [r["check"], r["case"], _fmt(r["closed_form"]), _fmt(r.get("facets"))]
+        for e in engines:
+            err = r.get(f"{e}_error")
+            err_s = (
+                "-" if err is None or (isinstance(err, float) and not math.isfinite(err)) else f"{err:+.2%}"
+            )
+            ok = r.get(f"{e}_ok")
+            if "facets" in r:
+                ok_f = r.get(f"{e}_ok_facets")
+                ok_s = f"{_fmt(ok)} (facets: {_fmt(ok_f)})"
+            else:
+                ok_s = _fmt(ok)
+            cells += [_fmt(r.get(f"{e}_measured")), err_s, ok_s]
+        cells.append(r["tolerance"])
+        lines.append("| " + " | ".join(cells) + " |")
+    creep = [r for r in res.rows if r["check"] == "Dai interlock"]
+    if creep:
+        lines += [
+            "",
+            "Creep while locked against the sphere (tip radii / s): "
+            + "; ".join(
+                f"{r['case']}: " + ", ".join(f"{e} {_fmt(r.get(f'{e}_creep_radii_per_s'))}" for e in engines)
+                for r in creep
+            )
+            + ".",
+        ]
+    lines += ["", "Wall time: " + ", ".join(f"{e} {s:g} s" for e, s in res.wall_s.items()) + "."]
+    lines += _fractal_lines(res.fractal)
+    return "\n".join(lines) + "\n"
+
+
+def _fractal_lines(rows) -> list[str]:
+    """The fractal self-lock rate against H, the engines side by side."""
+    if not rows:
+        return []
+    engines = list(dict.fromkeys(r["engine"] for r in rows))
+    head = ["H", *[f"{e} self-lock rate (95 % interval; locked / ok runs; failed)" for e in engines]]
+    out = [
+        "",
+        "### Fractal self-lock rate against H, both engines",
+        "",
+        f"The validation's fractal study (paper-fractal, Fig. 9 height scale and seeds, one start "
+        f"per surface, default spring K = 30) at I_e = {rows[0]['ie']:g} in each engine.",
+        "",
+        "| " + " | ".join(head) + " |",
+        "|" + "---|" * len(head),
+    ]
+    for h in dict.fromkeys(r["hurst"] for r in rows):
+        cells = [f"{h:g}"]
+        for e in engines:
+            (r,) = [r for r in rows if r["hurst"] == h and r["engine"] == e]
+            cells.append(
+                f"{_fmt(r['rate'])} ({_fmt(r['ci_low'])}-{_fmt(r['ci_high'])}; {r['locked']} / {r['n_ok']}; "
+                f"{r['failed_runs']})"
+            )
+        out.append("| " + " | ".join(cells) + " |")
+    return out
+
+
+def main(argv=None) -> None:
+    ap = argparse.ArgumentParser(description="The closed forms in both engines (MuJoCo and Bullet).")
+    ap.add_argument("--out", type=Path, required=True, help="folder for engines.json and engines.md")
+    ap.add_argument("--quick", action="store_true", help="fewer corrugation wavelengths")
+    ap.add_argument(
+        "--fractal",
+        type=int,
+        default=0,
+        metavar="N",
+        help="also the fractal self-lock rate, N surfaces per H",
+    )
+    ap.add_argument("--workers", type=int, default=None, help="worker processes of the fractal sweep")
+    args = ap.parse_args(argv)
+    import dataclasses
+
+    from spine_mj.jsonio import write_json
+
+    res = engines_ground_truth(quick=args.quick, progress=lambda s: print(s, flush=True))
+    if args.fractal:
+        t0 = time.perf_counter()
+        fractal = fractal_engines(args.out, surfaces_per_hurst=args.fractal, workers=args.workers)
+        wall = dict(res.wall_s, fractal=round(time.perf_counter() - t0, 1))
+        res = dataclasses.replace(res, fractal=fractal, wall_s=wall)
+    args.out.mkdir(parents=True, exist_ok=True)
+    write_json(args.out / "engines.json", res.as_dict())
+    (args.out / "engines.md").write_text(section(res))
+    print(section(res))
+
+
+if __name__ == "__main__":
+    main()
+
+
+#: The fractal self-lock comparison's Hurst exponents and I_e: the full validation plan's
+#: fractal study (its corner); surfaces per H are the caller's (``--fractal N``).
+FRACTAL_HURSTS = (0.65, 0.75, 0.8, 0.85, 0.95)
+FRACTAL_SURFACES = 30
+FRACTAL_IE = 1e-4
+
+
+def fractal_engines(
+    out_dir: Path,
+    *,
+    hursts=FRACTAL_HURSTS,
+    surfaces_per_hurst: int = FRACTAL_SURFACES,
+    ie: float = FRACTAL_IE,
+    workers: int | None = None,
+) -> list[dict]:
+    """The fractal self-lock rate against H in both engines (the validation's fractal study,
+    :mod:`spine_mj.validate.fractal_lock`: its surfaces, start, spring drive and lock rule),
+    one sweep with ``engine = ["mujoco", "bullet"]``; per H and engine the rate among the
+    runs without engine trouble with its Wilson interval. Stored under ``out_dir/sweeps``."""
+    from spine_mj.presets import calibrated_mu
+    from spine_mj.validate.fractal_lock import PRESET, lock_rate, surfaces_table
+    from spine_mj.validate.paths import tip_radius
+    from spine_mj.validate.study_runner import StudyRunner
+
+    surfaces = surfaces_table(hursts, surfaces_per_hurst)
+    seed_hurst = {seed: s["set"]["hurst"] for s in surfaces for seed in s["seeds"]}
+    tip = tip_radius(PRESET, None, None)
+    doc = {
+        "sweep": {"name": "fractal-engines", "seed": 11, "analyses": ["mujoco"], "store_trajectories": False},
+        "surfaces": surfaces,
+        "starts": {"frame": "relative", "x": [0.05], "y": [0.5]},
+        "drive": {"protocol": "spring", "ie": ie},
+        "grid": {"mu": calibrated_mu(PRESET), "tip_radius": tip, "engine": list(sim.ENGINES)},
+    }
+    runner = StudyRunner(Path(out_dir).resolve(), workers, None, time.perf_counter())
+    runner.study = "engines"
+    df, _ = runner(doc, "fractal-engines")
+    rows = []
+    for h in hursts:
+        for engine in sim.ENGINES:
+            sel = df[(df["engine"] == engine) & (df["surface_seed"].map(seed_hurst) == h)]
+            rate = lock_rate(
+                sel["self_locked"].fillna(False).astype(bool).tolist(), (sel["status"] == "ok").tolist()
+            )
+            rows.append({"hurst": float(h), "engine": engine, "ie": ie, **rate})
+    return rows

@@ -1,0 +1,75 @@
+"""The closed forms in both engines (spine_mj.validate.engines): the references, and the
+cheap checks run in MuJoCo and Bullet."""
+
+import math
+
+import numpy as np
+import pytest
+
+from spine_mj import sim
+from spine_mj.validate import engines as study
+
+
+def test_dai_threshold_is_the_friction_angle_rule():
+    # self-lock iff the contact normal's elevation phi, sin(phi) = r / (R + r), is at most
+    # the friction angle: R / r >= 1 / sin(arctan mu) - 1 (sqrt(5) - 1 for mu = 0.5)
+    assert study.dai_threshold(0.5) == pytest.approx(math.sqrt(5) - 1)
+    for mu in (0.3, 0.5, 1.0):
+        ratio = study.dai_threshold(mu)
+        assert math.asin(1 / (1 + ratio)) == pytest.approx(math.atan(mu))
+
+
+def test_groove_is_a_v_rising_along_x():
+    g = study.groove(20.0, 30.0, n=41)
+    x, y = g.x, g.y
+    assert g.heights[20, 20] == pytest.approx(0.0)
+    np.testing.assert_allclose(g.heights[20], math.tan(math.radians(20)) * x, atol=1e-15)
+    np.testing.assert_allclose(g.heights[:, 20], math.tan(math.radians(30)) * np.abs(y), atol=1e-15)
+
+
+def test_dai_start_is_the_first_touch_of_the_faceted_sphere():
+    tip = 1e-3
+    surf = study.dai_surface(2e-3, tip)
+    ball = sim.build_engine_rig(surf, mu=0.5, tip_radius_m=tip, ie=1.0).contact_surface()
+    x0, _ = study.dai_start(ball, 2e-3, tip)
+    before = ball.height(np.array([x0 - 1e-3 * tip]), np.zeros(1))[0]
+    at = ball.height(np.array([x0]), np.zeros(1))[0]
+    assert before <= 1e-6 * tip < at
+
+
+@pytest.mark.parametrize("engine", sim.ENGINES)
+def test_the_wedge_holds_more_than_one_contact_in_both_engines(engine):
+    if engine == "bullet":
+        pytest.importorskip("pybullet", reason="the Bullet engine needs the [bullet] extra (pybullet)")
+    (row,) = study._groove_rows(engine)
+    single = math.tan(math.radians(20) + math.atan(study.MU))
+    assert row["ok"], row
+    assert row["measured"] > 1.05 * single  # the wedge, not the single-contact rule
+
+
+def test_section_sets_the_engines_side_by_side():
+    res = study.EnginesResult(
+        rows=[
+            {
+                "check": "static kappa",
+                "case": "plane 0 deg",
+                "closed_form": 0.5,
+                "tolerance": "5%",
+                "mujoco_measured": 0.5016,
+                "mujoco_error": 0.0032,
+                "mujoco_ok": True,
+                "bullet_measured": 0.4992,
+                "bullet_error": -0.0016,
+                "bullet_ok": True,
+            },
+        ],
+        engines=("mujoco", "bullet"),
+        wall_s={"mujoco": 1.0, "bullet": 2.0},
+    )
+    text = study.section(res)
+    assert "## Engines side by side: the closed forms" in text
+    assert (
+        "| static kappa | plane 0 deg | 0.5 | - | 0.5016 | +0.32% | yes | 0.4992 | -0.16% | yes | 5% |"
+        in text
+    )
+    assert study.section(None) == ""
