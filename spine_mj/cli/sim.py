@@ -245,6 +245,11 @@ def simulate(
     from spine_mj.sim.run_folder import write_run
 
     if render:
+        if engine == "bullet":
+            raise SpineInputError(
+                "--render draws with MuJoCo's renderer, not with --engine bullet: run without it, "
+                "then `spine-mj replay RUN_DIR --mp4 run.mp4` shows the run on MuJoCo's model"
+            )
         extras.require("video", "--render")
         choose_gl_backend()
 

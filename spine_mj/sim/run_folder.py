@@ -4,7 +4,8 @@ A run folder holds ``trajectory.parquet`` (:meth:`RunResult.table`), ``summary.j
 (:meth:`RunResult.summary`: tip, engine, scales, drive), ``surface.npz`` (the surface),
 ``run.png`` (:func:`spine_mj.plotting.sim_run_figure`) and, when asked, ``run.mp4``.
 :func:`write_run` writes all of them or none; :func:`load_run` rebuilds the rig from the
-first three, so that ``spine-mj replay`` shows the same model.
+first three, so that ``spine-mj replay`` shows the same model (a Bullet run's on MuJoCo's
+model of the same surface and tip).
 """
 
 from __future__ import annotations
@@ -51,7 +52,10 @@ def load_run(run_dir: str | Path) -> tuple[RigModel, Track]:
         rig = RigModel(
             surface_io.load_surface(run_dir / "surface.npz"),
             tip=TipParams(**summary["tip"]),
-            engine=EngineSettings(**summary["engine"]),
+            # a Bullet run is shown on MuJoCo's model of the same surface (its derived settings)
+            engine=None
+            if summary["engine"].get("engine") == "bullet"
+            else EngineSettings(**summary["engine"]),
             length_scale_m=sc["length_scale_m"],
             char_length_m=sc["char_length_m"],
         )

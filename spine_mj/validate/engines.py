@@ -193,7 +193,11 @@ def groove(theta_deg: float, alpha_deg: float, half_width_m: float = 0.02, n: in
     return GridSurface(heights=h, x=x, y=x.copy(), unit="m", metadata={"generator": "groove"})
 
 
-def _groove_rows(engine: str) -> list[dict]:
+def _groove_rows(engine: str, **settings) -> list[dict]:
+    """The groove checks in ``engine``; ``settings`` replace fields of its engine settings
+    (Bullet's ``friction_anchor``: the wedge's creep, docs/physics.md §10)."""
+    import dataclasses
+
     rows = []
     for theta, alpha in GROOVES:
         wedge = math.radians(theta) + math.atan(MU / math.cos(math.radians(alpha)))
@@ -202,6 +206,8 @@ def _groove_rows(engine: str) -> list[dict]:
         single = math.tan(math.radians(theta) + math.atan(MU))
         cap = 20.0 if lock else 2 * kappa
         rig = _rig(engine, groove(theta, alpha), ie=1e-2, tip_radius_m=2e-3)
+        if settings:
+            rig = type(rig)(rig.surface, tip=rig.tip, engine=dataclasses.replace(rig.engine, **settings))
         det = sim.Detection(kappa_cap=cap)
         # where gravity alone would slide the tip down the groove it is held at twice the
         # force that holds it
@@ -211,7 +217,8 @@ def _groove_rows(engine: str) -> list[dict]:
         locked = run.end_reason is sim.EndReason.SELF_LOCK
         row = {
             "check": "V-groove wedge",
-            "case": f"theta {theta:g} deg, alpha {alpha:g} deg (single-contact rule: {single:.3g})",
+            "case": f"theta {theta:g} deg, alpha {alpha:g} deg (single-contact rule: {single:.3g})"
+            + "".join(f", {k} = {v}" for k, v in settings.items()),
             "closed_form": "self-lock" if lock else kappa,
             "measured": "self-lock" if locked else run.kappa_mj,
             "tolerance": "lock" if lock else f"{STATIC_TOL:.0%}",
@@ -325,6 +332,9 @@ def engines_ground_truth(
         "static kappa": _static_rows,
         "spring-block": _spring_block_rows,
         "V-groove": _groove_rows,
+        "V-groove, Bullet's friction anchors on": lambda e: (
+            _groove_rows(e, friction_anchor=True) if e == "bullet" else []
+        ),
         "Dai interlock": _dai_rows,
         "creep": _creep_rows,
         "Prandtl-Tomlinson": lambda e: _tomlinson_rows(e, quick),

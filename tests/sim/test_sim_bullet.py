@@ -14,6 +14,7 @@ from sweep_support import write_config
 from spine_mj import engagement, extras, sim, sweep
 from spine_mj.cli import main
 from spine_mj.errors import SpineInputError
+from spine_mj.sim.run_folder import load_run
 from spine_mj.surfaces import GridSurface, TriangulatedSurface, from_hfield
 
 pytest.importorskip("pybullet", reason="the Bullet engine needs the [bullet] extra (pybullet)")
@@ -93,10 +94,30 @@ def test_a_held_tip_does_not_creep():
     assert not run.moving[10:].any()
 
 
+def test_friction_anchor_pitfall():
+    """A tip resting in a V-groove on two contacts creeps down it without friction anchors,
+    and a static probe reads the creep as a slide; with anchors it holds and breaks away at
+    the wedge's kappa. The default is off (anchors disturb sliding: docs/physics.md §10)."""
+    from spine_mj.validate.engines import groove
+
+    rig = sim.build_engine_rig(groove(20.0, 30.0), engine="bullet", mu=MU, tip_radius_m=2e-3, ie=1e-2)
+    assert not rig.engine.friction_anchor
+    wedge = math.tan(math.radians(20) + math.atan(MU / math.cos(math.radians(30))))
+    runs = {}
+    for anchor in (True, False):
+        r = BulletRig(
+            rig.surface, tip=rig.tip, engine=dataclasses.replace(rig.engine, friction_anchor=anchor)
+        )
+        runs[anchor] = r.run(sim.build_drive(r.scales, "static", ie=1e-2), start=(0.0, 0.0))
+    assert runs[True].end_reason is sim.EndReason.BREAKAWAY
+    assert runs[True].kappa_mj == pytest.approx(wedge, rel=0.05)
+    assert runs[False].end_reason is sim.EndReason.SLID
+
+
 def test_internal_edge_pitfall():
     """A frictionless tip slid fast over a flat triangulated plane: with the heightfield's
     internal-edge info it stays on the plane; without it, the triangles' shared edges
-    kick it up (measured: 4 % of its speed at 3 L_c / tau)."""
+    kick it up (measured: 5 % of its speed at 3 L_c / tau)."""
     import pybullet as pb
 
     surf = sim.inclined_plane(slope_deg=0.0)
@@ -210,6 +231,26 @@ def test_simulate_engine_bullet_writes_the_same_run_folder(tmp_path):
     summary = json.loads((folders["bullet"] / "summary.json").read_text())
     assert summary["engine"]["engine"] == "bullet"
     assert set(summary) == set(json.loads((folders["mujoco"] / "summary.json").read_text()))
+    rig, track = load_run(folders["bullet"])  # replayed on MuJoCo's model of the same surface
+    assert isinstance(rig, sim.model.RigModel) and rig.tip.tip_radius_m == summary["tip"]["tip_radius_m"]
+    np.testing.assert_array_equal(
+        track.position_m, tables["bullet"][["position_x_m", "position_y_m", "position_z_m"]]
+    )
+    res = CliRunner().invoke(
+        main,
+        [
+            "simulate",
+            "paper-single-peak",
+            "--engine",
+            "bullet",
+            "--render",
+            "--start",
+            "-3,-1",
+            "--out",
+            str(tmp_path / "r"),
+        ],
+    )
+    assert res.exit_code == 2 and "--render draws with MuJoCo's renderer" in res.output
 
 
 def test_without_the_extra_bullet_is_one_error_line(monkeypatch, tmp_path):
