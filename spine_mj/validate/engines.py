@@ -195,7 +195,7 @@ def groove(theta_deg: float, alpha_deg: float, half_width_m: float = 0.02, n: in
 
 def _groove_rows(engine: str, **settings) -> list[dict]:
     """The groove checks in ``engine``; ``settings`` replace fields of its engine settings
-    (Bullet's ``friction_anchor``: the wedge's creep, docs/physics.md §10)."""
+    (Bullet's ``friction_anchor``: the wedge's creep, docs/physics.md §11)."""
     import dataclasses
 
     rows = []
@@ -383,7 +383,7 @@ def section(res: EnginesResult | None) -> str:
         "## Engines side by side: the closed forms",
         "",
         "Each closed form run the same way in MuJoCo (soft contact) and Bullet (hard contact; "
-        "docs/physics.md §10), with the tolerance the MuJoCo report states. The facets' rule is "
+        "docs/physics.md §11), with the tolerance the MuJoCo report states. The facets' rule is "
         "the closed form applied to the contact normal of the heightfield's facets at the start "
         "(what both engines collide with).",
         "",

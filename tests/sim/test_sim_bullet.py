@@ -97,7 +97,7 @@ def test_a_held_tip_does_not_creep():
 def test_friction_anchor_pitfall():
     """A tip resting in a V-groove on two contacts creeps down it without friction anchors,
     and a static probe reads the creep as a slide; with anchors it holds and breaks away at
-    the wedge's kappa. The default is off (anchors disturb sliding: docs/physics.md §10)."""
+    the wedge's kappa. The default is off (anchors disturb sliding: docs/physics.md §11)."""
     from spine_mj.validate.engines import groove
 
     rig = sim.build_engine_rig(groove(20.0, 30.0), engine="bullet", mu=MU, tip_radius_m=2e-3, ie=1e-2)

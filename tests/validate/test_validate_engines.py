@@ -41,7 +41,7 @@ def test_dai_start_is_the_first_touch_of_the_faceted_sphere():
 def test_the_wedge_holds_more_than_one_contact_in_both_engines(engine):
     if engine == "bullet":
         pytest.importorskip("pybullet", reason="the Bullet engine needs the [bullet] extra (pybullet)")
-    # Bullet holds the wedge with friction anchors (without them it creeps: docs/physics.md §10)
+    # Bullet holds the wedge with friction anchors (without them it creeps: docs/physics.md §11)
     (row,) = study._groove_rows(engine, **({"friction_anchor": True} if engine == "bullet" else {}))
     single = math.tan(math.radians(20) + math.atan(study.MU))
     assert row["ok"], row
