@@ -30,7 +30,8 @@ tolerance the MuJoCo report states for it:
 
 ``python -m spine_mj.validate.engines --out DIR [--quick] [--fractal N]`` runs it (Bullet
 needs the ``[bullet]`` extra) and writes ``engines.json`` and ``engines.md``; the committed
-``analysis/reports/engines.md`` is ``--fractal 30``.
+``analysis/reports/engines.md`` is ``--fractal 30``. With ``--out OUT/engines``, OUT a
+validation's output folder, the validation report written there next has the section.
 """
 
 from __future__ import annotations
@@ -87,6 +88,13 @@ class EnginesResult:
             "wall_s": self.wall_s,
             "fractal": list(self.fractal),
         }
+
+    @classmethod
+    def from_dict(cls, d: dict) -> EnginesResult:
+        """The result :meth:`as_dict` wrote (``engines.json``)."""
+        return cls(
+            rows=d["rows"], engines=tuple(d["engines"]), wall_s=d["wall_s"], fractal=d.get("fractal", [])
+        )
 
 
 def _rig(engine, surface, mu=MU, **kw):

@@ -74,3 +74,51 @@ def test_section_sets_the_engines_side_by_side():
         in text
     )
     assert study.section(None) == ""
+
+
+def test_the_result_round_trips_through_its_json():
+    import json
+
+    res = study.EnginesResult(
+        rows=[
+            {
+                "check": "creep of a held tip",
+                "case": "20 deg plane",
+                "closed_form": 0.0,
+                "tolerance": "shown",
+                "mujoco_measured": 1e-17,
+                "bullet_measured": 2e-8,
+            }
+        ],
+        engines=("mujoco", "bullet"),
+        wall_s={"mujoco": 1.0},
+        fractal=[
+            {
+                "hurst": 0.8,
+                "engine": e,
+                "ie": 1e-4,
+                "n": 3,
+                "n_ok": 3,
+                "locked": 1,
+                "failed_runs": 0,
+                "rate": 1 / 3,
+                "ci_low": 0.06,
+                "ci_high": 0.79,
+            }
+            for e in ("mujoco", "bullet")
+        ],
+    )
+    back = study.EnginesResult.from_dict(json.loads(json.dumps(res.as_dict())))
+    assert study.section(back) == study.section(res)
+    assert "| 0.8 | 0.3333 (0.06-0.79; 1 / 3; 0) | 0.3333 (0.06-0.79; 1 / 3; 0) |" in study.section(res)
+
+
+def test_the_validation_report_has_the_section_when_the_study_ran_into_its_folder(tmp_path):
+    from spine_mj.jsonio import write_json
+    from spine_mj.validate.report.document import write_report
+
+    summary = {"plan": "smoke", "engine_settings": {}, "timings_s": {}}
+    assert "Engines side by side" not in write_report(tmp_path, summary, []).read_text()
+    res = study.EnginesResult(rows=[], engines=("mujoco", "bullet"), wall_s={"mujoco": 1.0})
+    write_json(tmp_path / "engines" / "engines.json", res.as_dict())
+    assert study.section(res) in write_report(tmp_path, summary, []).read_text()
