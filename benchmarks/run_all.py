@@ -60,10 +60,10 @@ from bench_array import bench_array  # noqa: E402
 from bench_array import markdown as array_markdown  # noqa: E402
 from bench_cli import bench_cli  # noqa: E402
 from bench_cli import markdown as cli_markdown  # noqa: E402
-from bench_memory import bench_memory  # noqa: E402
-from bench_memory import markdown as memory_markdown  # noqa: E402
 from bench_engines import bench_engines  # noqa: E402
 from bench_engines import markdown as engines_markdown  # noqa: E402
+from bench_memory import bench_memory  # noqa: E402
+from bench_memory import markdown as memory_markdown  # noqa: E402
 
 # the Performance page of the site (it was the README's Performance section)
 README = HERE.parent / "docs" / "user_guide" / "performance.md"
