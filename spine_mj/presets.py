@@ -236,6 +236,12 @@ def make_surface(preset: Preset | str, **overrides) -> surfaces.Surface:
 
     ``seed`` in ``overrides`` replaces the preset's seed; every other key must be a
     parameter of the preset's generator. The preset's name is recorded in the metadata.
+
+    Examples
+    --------
+    >>> surface = make_surface("paper-fractal", seed=3, hurst=0.7)
+    >>> surface.metadata["preset"], surface.metadata["seed"], surface.metadata["params"]["hurst"]
+    ('paper-fractal', 3, 0.7)
     """
     if isinstance(preset, str):
         preset = load_preset(preset)

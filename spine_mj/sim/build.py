@@ -126,6 +126,21 @@ def build_rig(
     ------
     SpineInputError
         Any parameter out of range (named), or a drive the engine cannot resolve.
+
+    Examples
+    --------
+    A rig on the paper's single peak, one spring-drive run at ``I_e = 1e-3`` from a start
+    in front of the peak; results are in SI units.
+
+    >>> import spine_mj as sm
+    >>> from spine_mj import sim
+    >>> rig = sim.build_rig(sm.make_surface("paper-single-peak"), mu=1.23)
+    >>> drive = sim.build_drive(rig.scales, "spring", ie=1e-3)
+    >>> run = rig.run(drive, start=(-3.0, -1.0))
+    >>> run.end_reason.name
+    'LEFT_DOMAIN'
+    >>> round(run.inertia_number, 6)
+    0.001
     """
     tip = TipParams(
         tip_radius_m=tip_radius_m,

@@ -157,6 +157,29 @@ def run_sweep(
     SchedulerUnavailable
         The Dask scheduler had no worker within ``worker_wait_s`` or was lost (the
         finished cases are kept; a re-run resumes).
+
+    Examples
+    --------
+    A quasistatic sweep of two friction coefficients on the single valley, run twice: the
+    second call finds every case finished and skips it (a killed sweep resumes this way).
+
+    >>> import tempfile
+    >>> from spine_mj import sweep
+    >>> config = sweep.parse_config({
+    ...     "sweep": {"name": "valley", "seed": 1, "analyses": ["quasistatic"]},
+    ...     "surfaces": [{"preset": "paper-single-valley"}],
+    ...     "starts": {"frame": "absolute", "x": [-3.0], "y": [-1.0, -4.0]},
+    ...     "grid": {"mu": [0.6, 1.23]},
+    ... })
+    >>> out = tempfile.mkdtemp()
+    >>> summary = sweep.run_sweep(config, out, workers=1)
+    >>> summary.run_cases, summary.ok_runs
+    (2, 4)
+    >>> sweep.run_sweep(config, out, workers=1).skipped_cases
+    2
+    >>> runs = sweep.load_runs(out)
+    >>> sorted(runs.groupby("mu")["self_locked"].sum().astype(int).tolist())
+    [0, 1]
     """
     if not (math.isfinite(worker_wait_s) and worker_wait_s > 0):
         raise SpineInputError(f"--worker-wait must be a number of seconds > 0, got {worker_wait_s!r}")

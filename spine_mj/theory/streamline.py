@@ -445,6 +445,20 @@ def streamlines(
     ------
     SpineInputError
         Starts outside the bounds, wrong shapes or parameter types.
+
+    Examples
+    --------
+    The paper's single valley (Fig. 4): a start near its axis is trapped and self-locks,
+    one far from it passes by.
+
+    >>> import spine_mj as sm
+    >>> valley = sm.make_surface("paper-single-valley")
+    >>> res = sm.streamlines(valley, [(-3.0, -1.0), (-3.0, -4.0)], sm.StreamlineParams(mu=1.23))
+    >>> [sm.Outcome(o).name for o in res.outcome]
+    ['SELF_LOCKED', 'LEFT_DOMAIN']
+    >>> path = slice(res.offsets[0], res.offsets[1])  # the first start's points
+    >>> bool(res.x[path][-1] == res.end_x[0])
+    True
     """
     return _trajectories(surface, starts, params, ideal=False, store_paths=store_paths, backend=backend)
 

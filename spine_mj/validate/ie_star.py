@@ -102,6 +102,18 @@ def estimate_ie_star(
     ------
     SpineInputError
         Shapes differ, fewer than 2 values, or ``ie`` not strictly increasing and positive.
+
+    Examples
+    --------
+    Agreement holds up to ``I_e = 0.01`` and fails at 0.1, where the Frechet distance
+    (0.12 L_c) passes its target of 0.1: I_e* lies in that bracket, where the path metric
+    crosses its threshold (interpolated in ``log10 I_e``).
+
+    >>> star = estimate_ie_star([1e-3, 1e-2, 1e-1, 1.0], [1.0, 1.0, 0.97, 0.6], [0.01, 0.03, 0.12, 0.5])
+    >>> star.kind, star.low, star.high
+    ('bracketed', 0.01, 0.1)
+    >>> 0.01 < star.value < 0.1
+    True
     """
     ie = np.asarray(ie, dtype=float)
     ag = np.asarray(agreement, dtype=float)
