@@ -232,6 +232,20 @@ def mean_lateral_deviation(
     that the mean weighs the path by length, not by how densely it was recorded; each
     sample's distance to the nearest point of the reference polyline (segments, not only
     vertices) is averaged.
+
+    Parameters
+    ----------
+    path, reference : array_like, shapes (n, d), (m, d), d = 2 or 3
+        Vertices in walking order (only x and y are used), in one length unit.
+    length_scale : float
+        ``L_c`` in that unit; the result is in units of it.
+    spacing : float, optional
+        Resampling step of ``path`` in that unit (default ``length_scale / 50``).
+
+    Returns
+    -------
+    float
+        The mean distance over ``length_scale``.
     """
     lc = _length_scale(length_scale)
     p = _path("path", path)[:, :2]
@@ -255,7 +269,9 @@ def outcome_agreement(
         Whether each run of A (e.g. quasistatic) and B (e.g. MuJoCo) ended self-locked.
     end_a, end_b : array_like, shape (n, 2) or (n, 3)
         End points (x, y[, z]); only x and y are compared.
-    end_tolerance
+    length_scale : float
+        ``L_c`` in the end points' unit.
+    end_tolerance : float
         End points closer than ``end_tolerance * L_c`` in x-y count as the same place.
 
     Returns
@@ -348,6 +364,15 @@ def kappa_agreement(
     ``kappa_cap`` (force reaching ``kappa_cap * W`` without motion), so both are clipped to
     the cap before comparing.
 
+    Parameters
+    ----------
+    max_kappa_quasistatic : array_like, shape (n,)
+        Largest kappa along each streamline (paper Eqs. 1-3; inf where it self-locked).
+    peak_force_over_weight : array_like, shape (n,)
+        Largest drive force of each dynamic run over the preload W (dimensionless).
+    kappa_cap : float
+        The force cap over W that both sides are clipped to.
+
     Returns
     -------
     dict of arrays, shape (n,)
@@ -363,7 +388,18 @@ def kappa_agreement(
 
 
 def capture_rate(locked) -> float:
-    """Fraction of runs that ended self-locked; NaN for no runs."""
+    """Fraction of runs that ended self-locked; NaN for no runs.
+
+    Parameters
+    ----------
+    locked : array_like of bool, shape (n,)
+        Whether each run ended self-locked.
+
+    Returns
+    -------
+    float
+        ``locked.mean()``, in [0, 1]; NaN when ``n = 0``.
+    """
     arr = np.asarray(locked, dtype=bool)
     return float(arr.mean()) if arr.size else float("nan")
 

@@ -99,7 +99,23 @@ def list_presets() -> list[str]:
 
 
 def load_preset(name: str) -> Preset:
-    """Load preset ``name`` (a file stem in :func:`presets_dir`) or a path to a .toml."""
+    """Load a surface preset (a TOML recipe: generator, parameters, seed, calibrated mu).
+
+    Parameters
+    ----------
+    name : str
+        A preset's name (a file stem in :func:`presets_dir`, e.g. ``"paper-fractal"``) or
+        the path of a ``.toml`` file.
+
+    Returns
+    -------
+    Preset
+
+    Raises
+    ------
+    SpineInputError
+        An unknown name, an unreadable file, or a preset whose keys do not check.
+    """
     path = Path(name)
     if path.suffix != ".toml":
         path = presets_dir() / f"{name}.toml"
@@ -234,8 +250,19 @@ def parse_override(text: str) -> tuple[str, Any]:
 def make_surface(preset: Preset | str, **overrides) -> surfaces.Surface:
     """Make the surface a preset describes, with parameters replaced by ``overrides``.
 
-    ``seed`` in ``overrides`` replaces the preset's seed; every other key must be a
-    parameter of the preset's generator. The preset's name is recorded in the metadata.
+    Parameters
+    ----------
+    preset : Preset or str
+        A preset, or its name for :func:`load_preset`.
+    **overrides
+        ``seed`` replaces the preset's seed; every other key must be a parameter of the
+        preset's generator (e.g. ``hurst`` for ``paper-fractal``).
+
+    Returns
+    -------
+    Surface
+        The surface, its metadata recording the preset's name, generator, parameters and
+        seed.
 
     Examples
     --------

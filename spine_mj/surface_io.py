@@ -52,7 +52,23 @@ FILL_METHODS = ("refuse", "harmonic", "nearest", "mean")
 
 
 def save_surface(surface: Surface, path: str | os.PathLike) -> Path:
-    """Write ``surface`` to ``path`` (.npz), atomically. Returns the path."""
+    """Write ``surface`` to ``path`` (.npz), atomically.
+
+    Every array and the metadata (generator, parameters, seed, version, unit) as JSON; the
+    file loads with ``numpy.load(..., allow_pickle=False)`` and :func:`load_surface`.
+
+    Parameters
+    ----------
+    surface : Surface
+        A Gaussian or grid surface.
+    path : str or os.PathLike
+        The output file.
+
+    Returns
+    -------
+    Path
+        The path written.
+    """
     path = Path(path)
     if path.suffix != ".npz":
         raise SpineInputError(f"surface files must end in .npz, got {path.name!r}")
@@ -95,6 +111,15 @@ def _npz_member_shape(npz, name: str) -> tuple[int, ...]:
 
 def load_surface(path: str | os.PathLike) -> Surface:
     """Read a surface written by :func:`save_surface`.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        An ``.npz`` file (or ``example:NAME`` resolved by the caller).
+
+    Returns
+    -------
+    Surface
 
     Raises
     ------
@@ -390,7 +415,22 @@ def surface_mesh(
 
 
 def write_stl(surface: Surface, path: str | os.PathLike, **mesh_options) -> Path:
-    """Write :func:`surface_mesh` as binary STL, atomically; refuse a non-watertight mesh."""
+    """Write :func:`surface_mesh` as binary STL, atomically; refuse a non-watertight mesh.
+
+    Parameters
+    ----------
+    surface : Surface
+        The surface to print: a solid under its heights (mm for physical surfaces).
+    path : str or os.PathLike
+        The output ``.stl`` file.
+    **mesh_options
+        Passed on to :func:`surface_mesh`: ``resolution``, ``base_thickness``, ``scale``.
+
+    Returns
+    -------
+    Path
+        The path written.
+    """
     path = Path(path)
     if path.suffix.lower() != ".stl":
         raise SpineInputError(f"STL output must end in .stl, got {path.name!r}")

@@ -67,15 +67,42 @@ def section_curvature(fx, fy, fxx, fxy, fyy) -> np.ndarray:
 
 
 def sectional_class(fx, fy, fxx, fxy, fyy) -> np.ndarray:
-    """Sectional criterion (Eq. 6): CONCAVE where ``d2x/dy2 < 0``, CONVEX where ``> 0``,
-    FLAT where zero or undefined. Returns int8 codes of the broadcast shape."""
+    """Sectional criterion (Eq. 6): the curvature of the section along the drive.
+
+    CONCAVE where ``d2x/dy2 < 0``, CONVEX where ``> 0``, FLAT where zero or undefined.
+
+    Parameters
+    ----------
+    fx, fy : array_like
+        Slopes of the height (dimensionless).
+    fxx, fxy, fyy : array_like
+        Second derivatives of the height (1 / length); all five broadcast together.
+
+    Returns
+    -------
+    ndarray of int8
+        The class codes, of the broadcast shape.
+    """
     c = section_curvature(fx, fy, fxx, fxy, fyy)
     return np.where(c < 0, CONCAVE, np.where(c > 0, CONVEX, FLAT)).astype(np.int8)
 
 
 def hessian_class(fxx, fxy, fyy) -> np.ndarray:
-    """Hessian criterion (Eqs. 8-10): SADDLE (det < 0), CONCAVE (det > 0, f_xx > 0),
-    CONVEX (det > 0, f_xx < 0), FLAT otherwise. Returns int8 codes."""
+    """Hessian criterion (Eqs. 8-10) of the surface's curvature at points.
+
+    SADDLE where ``det < 0``, CONCAVE where ``det > 0`` and ``f_xx > 0``, CONVEX where
+    ``det > 0`` and ``f_xx < 0``, FLAT otherwise (``det = f_xx f_yy - f_xy^2``).
+
+    Parameters
+    ----------
+    fxx, fxy, fyy : array_like
+        Second derivatives of the height (1 / length), broadcast together.
+
+    Returns
+    -------
+    ndarray of int8
+        The class codes, of the broadcast shape.
+    """
     fxx, fxy, fyy = _arrays(fxx, fxy, fyy)
     det = fxx * fyy - fxy * fxy
     return np.where(
@@ -86,7 +113,20 @@ def hessian_class(fxx, fxy, fyy) -> np.ndarray:
 
 
 def classify_points(surface, x, y) -> tuple[np.ndarray, np.ndarray]:
-    """Sectional and Hessian classes of points ``(x, y)`` on ``surface`` (shape of x, y)."""
+    """Sectional and Hessian classes of points ``(x, y)`` on ``surface``.
+
+    Parameters
+    ----------
+    surface : Surface
+        Any surface (its exact or interpolated second derivatives are used).
+    x, y : array_like
+        Points inside ``surface.bounds``, broadcast together to shape ``S``.
+
+    Returns
+    -------
+    sectional, hessian : ndarray of int8, shape S
+        :func:`sectional_class` (Eq. 6) and :func:`hessian_class` (Eqs. 8-10) codes.
+    """
     _, fx, fy, fxx, fxy, fyy = surface.evaluate(x, y, order=2)
     return sectional_class(fx, fy, fxx, fxy, fyy), hessian_class(fxx, fxy, fyy)
 

@@ -468,7 +468,26 @@ def ideal_trajectories(
 ) -> StreamlineResult:
     """Ideal trajectories (paper §3.1.2): ``y = y0``, +x in arc-length steps ``dl``.
 
-    Same parameters and result as :func:`streamlines`; stops on self-lock or at the edge.
+    The path a spine would take if it were never deflected: the reference against which the
+    streamlines' bypass and trap effects are measured. Stops on self-lock or at the edge.
+
+    Parameters
+    ----------
+    surface : Surface
+        Any surface; Gaussian and gridded surfaces run on the compiled kernel.
+    starts : array_like, shape (n, 2)
+        Start points ``(x0, y0)`` inside ``surface.bounds``.
+    params : StreamlineParams
+        Friction coefficient, step length, caps.
+    store_paths : bool
+        Keep every path point (False keeps only outcomes, end points and max kappa).
+    backend : {"auto", "numba", "numpy"}
+        ``"auto"`` uses the kernel where the surface type allows.
+
+    Returns
+    -------
+    StreamlineResult
+        As :func:`streamlines` returns, with ``ideal`` True.
     """
     return _trajectories(surface, starts, params, ideal=True, store_paths=store_paths, backend=backend)
 
