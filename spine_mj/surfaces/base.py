@@ -29,8 +29,19 @@ _NONPERIODIC_PAD = 8  # cells of odd reflection before the spline filter, see Gr
 
 
 def length_unit(unit: str) -> str | None:
-    """The spelling of :data:`LENGTH_UNITS_M` for the length unit ``unit`` ("µm" -> "um"),
-    or None when ``unit`` is not one of them (dimensionless "1", "A", "km", ...)."""
+    """The spelling of :data:`LENGTH_UNITS_M` for a length unit ("µm" -> "um").
+
+    Parameters
+    ----------
+    unit : str
+        A unit as a file or a user writes it.
+
+    Returns
+    -------
+    str or None
+        The table's spelling, or None when ``unit`` is not one of them (dimensionless "1",
+        "A", "km", ...).
+    """
     unit = _UNIT_SPELLINGS.get(unit, unit) if isinstance(unit, str) else None
     return unit if unit in LENGTH_UNITS_M else None
 
@@ -108,6 +119,13 @@ def _count_at_least(name: str, n, least: int) -> int:
 
 def check_grid_size(nx: int, ny: int, *, where: str) -> None:
     """Refuse a grid of more than :data:`MAX_GRID_POINTS` points before allocating it.
+
+    Parameters
+    ----------
+    nx, ny : int
+        The grid's points along x and y.
+    where : str
+        What makes the grid, for the message (a generator, a resampling, a file).
 
     Raises
     ------

@@ -45,6 +45,23 @@ def single_gaussian(
     ``f = sign * k / (2 pi sx sy) * exp(-(x-mx)^2/(2 sx^2) - (y-my)^2/(2 sy^2))``; with the
     paper's ``k = 10 pi`` and ``sx = sy = 1.5`` the amplitude is 2.22 and the steepest
     slope 0.90 (docs/physics.md §3). Dimensionless.
+
+    Parameters
+    ----------
+    sign : {1, -1}
+        Peak or valley.
+    k : float
+        Volume under the Gaussian, > 0.
+    sigma_x, sigma_y : float
+        Widths ``sx``, ``sy`` > 0.
+    center : tuple of float
+        ``(mx, my)``.
+    bounds : tuple of float
+        ``(xmin, xmax, ymin, ymax)`` of the domain.
+
+    Returns
+    -------
+    GaussianSurface
     """
     if sign not in (1, -1):
         raise SpineInputError(f"sign must be +1 (peak) or -1 (valley), got {sign!r}")
@@ -82,13 +99,31 @@ def corrugation(
     points_per_wave: int = 32,
 ) -> GridSurface:
     """A sinusoidal corrugation ``z = h sin(2 pi x / lambda)``, uniform in y: the
-    Prandtl-Tomlinson profile, a surface whose dynamics have closed forms (docs/physics.md).
+    Prandtl-Tomlinson profile, a surface whose dynamics have closed forms (docs/physics.md §6).
 
     ``h = slope_amplitude * wavelength / (2 pi)``, so the steepest slope is
     ``slope_amplitude``; ``L_c = wavelength`` (rms height over rms slope times 2 pi) and the
     slope correlation length is ``0.190 wavelength``. The grid is periodic in x over
     ``n_waves`` whole wavelengths starting at x = 0 (a crest's rising flank begins there)
     and spans ``width`` in y, centred on y = 0. Dimensionless.
+
+    Parameters
+    ----------
+    wavelength : float
+        ``lambda`` > 0.
+    slope_amplitude : float
+        The steepest slope ``2 pi h / lambda``, in [0, 10].
+    n_waves : int
+        Whole wavelengths along x, >= 1.
+    width : float
+        Extent in y, > 0.
+    points_per_wave : int
+        Grid points per wavelength, >= 8 (128 for MuJoCo runs: a coarse hfield's facet kinks
+        add slip bursts).
+
+    Returns
+    -------
+    GridSurface
     """
     lam = check_positive("wavelength", wavelength)
     s = float(slope_amplitude)
@@ -149,6 +184,29 @@ def random_gaussians(
 
     The draws happen in a fixed order (centres, widths, amplitudes), so one seed gives the
     same surface on every machine.
+
+    Parameters
+    ----------
+    n_peaks : int
+        Number of Gaussians, 1 to :data:`MAX_PEAKS`.
+    sign : {1, -1}
+        Convex peaks or concave valleys.
+    bounds : tuple of float
+        ``(xmin, xmax, ymin, ymax)`` of the domain.
+    sigma_range, amplitude_range : tuple of float
+        Ranges of the widths and of the amplitudes' magnitude.
+    anisotropic : bool
+        Draw ``sigma_x`` and ``sigma_y`` independently.
+    overlap : bool
+        Allow centres closer than ``min_separation * (sigma_i + sigma_j)``.
+    min_separation : float
+        See ``overlap``.
+    rng : int or numpy.random.Generator, optional
+        The only source of randomness: a seed or a generator.
+
+    Returns
+    -------
+    GaussianSurface
     """
     if isinstance(n_peaks, bool) or int(n_peaks) != n_peaks or not 0 < n_peaks <= MAX_PEAKS:
         raise SpineInputError(f"n_peaks must be an integer in 1..{MAX_PEAKS}, got {n_peaks!r}")
@@ -262,6 +320,18 @@ def fractal_fbm(
     periodic
         If False, a surface twice as large is synthesized and one quadrant kept, so the
         result does not wrap around.
+    long_cutoff, short_cutoff : float, optional
+        Wavelengths (length unit) above which the PSD is flat and below which it is zero
+        (default: neither; the grid's own size and spacing bound it).
+    unit : str
+        Length unit of the coordinates and heights (``"1"``: dimensionless).
+    rng : int or numpy.random.Generator, optional
+        The only source of randomness: a seed or a generator.
+
+    Returns
+    -------
+    GridSurface
+        Periodic (unless ``periodic=False``), zero mean, metadata recording every argument.
     """
     periodic = _flag("periodic", periodic)
     nx, ny, lx, ly = _fbm_grid(nx, ny, size, periodic)
@@ -411,8 +481,27 @@ def sandpaper(
     grit
         One of ``P36``, ``P60``, ``P600`` (mean particle size from the paper), or None
         when ``particle_diameter_m`` is given.
+    particle_diameter_m : float, optional
+        Mean particle diameter [m], instead of ``grit``.
     size_m
         Side of the square patch, metres.
+    tip_radius_m : float
+        Radius of the tip the grid must resolve [m] (sets the default spacing).
+    spacing_m : float, optional
+        Grid spacing [m]; default ``min(tip_radius_m / 5, particle_diameter_m / 10)``.
+    coverage : float
+        Share of the base area covered by particle cross-sections (overlaps counted).
+    size_cv : float
+        Coefficient of variation of the log-normal diameters.
+    embed_range : tuple of float
+        Range of the sunk fraction of each diameter, drawn uniformly.
+    rng : int or numpy.random.Generator, optional
+        The only source of randomness: a seed or a generator.
+
+    Returns
+    -------
+    GridSurface
+        Periodic, in metres.
     """
     d_mean = _grit_diameter(grit, particle_diameter_m)
     size_m = check_positive("size_m", size_m)

@@ -48,6 +48,20 @@ def to_hfield(
     resampling; an analytic surface is sampled on ``nrow x ncol`` points over its bounds
     (default 201 x 201). ``base_z`` (the solid's thickness below the lowest point)
     defaults to a tenth of the larger horizontal radius.
+
+    Parameters
+    ----------
+    surface : Surface
+        Any surface.
+    nrow, ncol : int, optional
+        Samples along y (rows) and x (columns).
+    base_z : float, optional
+        Thickness of the solid under the lowest point (surface length unit).
+
+    Returns
+    -------
+    HField
+        ``data`` (nrow x ncol in [0, 1], row 0 at the smallest y), ``size`` and ``pos``.
     """
     if isinstance(surface, GridSurface) and nrow is None and ncol is None:
         grid = surface
@@ -69,7 +83,19 @@ def to_hfield(
 
 
 def from_hfield(hfield: HField, *, unit: str = "1") -> GridSurface:
-    """Inverse of :func:`to_hfield`: the gridded surface MuJoCo's samples describe."""
+    """Inverse of :func:`to_hfield`: the gridded surface MuJoCo's samples describe.
+
+    Parameters
+    ----------
+    hfield : HField
+        MuJoCo's height field data.
+    unit : str
+        Length unit of the result's coordinates and heights.
+
+    Returns
+    -------
+    GridSurface
+    """
     nrow, ncol = hfield.data.shape
     rx, ry, elevation, _ = hfield.size
     cx, cy, cz = hfield.pos

@@ -218,6 +218,18 @@ class BSplineGrid:
     i - 1 + a + offset]`` with ``u = (x - x0) / dx``, ``i = floor(u)``, ``t_x = u - i``
     (likewise in y) and the standard cubic B-spline basis. For periodic grids ``u`` is
     taken modulo ``nx`` first; otherwise ``i`` is clipped to ``[0, nx - 2]``.
+
+    Attributes
+    ----------
+    coef : ndarray, 2-D
+        The spline's coefficients, indexed as above.
+    offset : int
+        Index shift of the coefficients (padding of the non-periodic grid).
+    x0, dx, y0, dy : float
+        The grid's first coordinate and spacing along x and y.
+    nx, ny : int
+        Grid points along x and y.
+    periodic : bool
     """
 
     coef: np.ndarray
