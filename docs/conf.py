@@ -8,6 +8,8 @@ commands' help). The gallery's scripts in ``examples/`` run at every build.
 
 from __future__ import annotations
 
+import enum
+import importlib
 import sys
 from pathlib import Path
 
@@ -72,6 +74,16 @@ numpydoc_validation_exclude = {
     r"\.model_fields$",
     r"\.model_computed_fields$",
     r"\.model_post_init$",
+}
+# a dataclass documents its fields (its constructor's parameters) as Attributes
+numpydoc_validation_overrides = {"PR01": [r"(?m)^\s*Attributes\s*$"]}
+# an enum's constructor is the Enum machinery's: its members are documented, not its call
+numpydoc_validation_exclude |= {
+    rf"\.{name}$"
+    for package in generate.PACKAGES
+    for name in importlib.import_module(package).__all__
+    if isinstance(getattr(importlib.import_module(package), name), type)
+    and issubclass(getattr(importlib.import_module(package), name), enum.Enum)
 }
 # the docstrings not brought to the standard yet, one name a line (the list only shrinks)
 numpydoc_validation_exclude |= {
