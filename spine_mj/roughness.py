@@ -51,6 +51,16 @@ def characteristic_length(surface: Surface) -> float:
     grid, ``2 pi`` times the rms height over the rms slope (the wavelength of a sine with
     the same rms height and slope), clipped to ``[4 dx, domain size]``; a plane (no
     height variation) gives the domain size.
+
+    Parameters
+    ----------
+    surface : Surface
+        Any surface.
+
+    Returns
+    -------
+    float
+        ``L_c``, the length of the inertia number ``I_e = m v^2 / (F_p L_c)``.
     """
     xmin, xmax, ymin, ymax = surface.bounds
     span = float(min(xmax - xmin, ymax - ymin))

@@ -49,6 +49,7 @@ class ArrayRig:
     rig : RigModel
         The single-spine rig whose surface, tip, scales and engine settings the array uses.
     layout : Layout
+        How many spines, in which pattern, at which spacing.
     force_control : bool
         Build the free carriage of :class:`ForcePull` (else the moving anchors of a spring drive).
 

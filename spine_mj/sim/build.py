@@ -60,9 +60,27 @@ def drive_speed_m_s(
     speed_m_s: float | None = None,
     rate_n_s: float | None = None,
 ) -> float:
-    """The drive's speed [m/s]: ``speed_m_s`` when given, else a force rate's equivalent
-    speed (:meth:`Scales.equivalent_speed`), else the speed of ``ie`` (default
-    :data:`DEFAULT_INERTIA_NUMBER`)."""
+    """The drive's speed [m/s] from whichever pace is given.
+
+    ``speed_m_s`` when given, else a force rate's equivalent speed
+    (:meth:`Scales.equivalent_speed`), else the speed of ``ie`` (default
+    :data:`DEFAULT_INERTIA_NUMBER`): ``v = sqrt(I_e F_p L_c / m)``.
+
+    Parameters
+    ----------
+    scales : Scales
+        The rig's scales.
+    ie : float, optional
+        Inertia number ``m v^2 / (F_p L_c)``.
+    speed_m_s : float, optional
+        Carriage speed [m/s].
+    rate_n_s : float, optional
+        Force rate [N/s] of a ramp or probe.
+
+    Returns
+    -------
+    float
+    """
     if speed_m_s is not None:
         return speed_m_s
     if rate_n_s is not None:
@@ -99,6 +117,11 @@ def build_rig(
 
     Parameters
     ----------
+    surface : Surface
+        The surface the tip runs on (any length unit; dimensionless ones are scaled by
+        ``length_scale_m``).
+    mu : float
+        The tip's static friction coefficient mu_s.
     tip_radius_m, mass_kg, preload_n, gravity_m_s2
         The tip (:class:`TipParams`; None: its default, the radius from the surface).
     length_scale_m : float or None
@@ -187,6 +210,10 @@ def build_drive(
 
     Parameters
     ----------
+    scales : Scales
+        The rig's scales (``rig.scales``): L_c, F_p, l_s and the length unit.
+    protocol : {"spring", "ramp", "static"}
+        The spring drive, the force ramp with reset, or the static probe.
     ie, speed_m_s, rate_n_s
         Its pace: an inertia number, a carriage speed [m/s] (spring) or a force rate
         [N/s] (ramp, static), at most one of them; none: ``I_e =``

@@ -105,7 +105,17 @@ class Detection:
 
 @dataclass(frozen=True)
 class Event:
-    """One event in a run: ``kind`` in {"move_onset", "move_stop", "reset"} or an end reason."""
+    """One event in a run.
+
+    Attributes
+    ----------
+    kind : str
+        ``"move_onset"``, ``"move_stop"``, ``"reset"`` (a force ramp's) or an end reason.
+    index : int
+        The recorded row it happened at.
+    time_s : float
+        Its time [s].
+    """
 
     kind: str
     index: int

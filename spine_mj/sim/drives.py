@@ -32,6 +32,18 @@ class SpringDrive:
     where a stick phase can outlast a climb (a preload is many steps of the spring's force
     increment ``k V dt``: soft springs, slow drives; ``rollout.SPRING_MIN_CLIMB_STEPS``), on
     the CPU backends.
+
+    Attributes
+    ----------
+    speed_m_s : float
+        Carriage speed V [m/s] (``I_e = m V^2 / (F_p L_c)``).
+    stiffness_n_m : float or None
+        Spring stiffness k [N/m] (``K = k l_s / F_p``).
+    duration_s, settle_time_s : float or None
+        Run time after settling [s], and the settle phase before the carriage moves [s].
+    fast_forward : bool
+    fast_forward_margin : float
+        Fraction below the predicted breakaway where the fast climb stops.
     """
 
     speed_m_s: float
@@ -65,6 +77,19 @@ class RampDrive:
     then at ``rate_n_s`` through breakaway (:mod:`spine_mj.sim.ramp`; ``duration_s`` counts
     engine time). ``stop_early``: the run stops stepping at its first end event (left the
     domain, self-lock, engine trouble) instead of running out its duration.
+
+    Attributes
+    ----------
+    rate_n_s : float or None
+        Force rate [N/s].
+    duration_s, settle_time_s : float or None
+        Run time [s], and how long the tip must stay stuck before a new ramp [s].
+    slide_distance_m : float or None
+        Slip [m] after which the force drops.
+    fast_forward : bool
+    fast_forward_margin : float
+        Fraction below the predicted breakaway where the fast climb stops.
+    stop_early : bool
     """
 
     rate_n_s: float | None = None
@@ -95,6 +120,18 @@ class StaticProbe:
     breakaway force predicted from that normal, then at ``rate_n_s`` through breakaway
     (:mod:`spine_mj.sim.fastforward`, the rule the ramp uses); a tip that moves during the
     climb is run again from the settled state at the nominal rate.
+
+    Attributes
+    ----------
+    rate_n_s : float or None
+        Force rate [N/s].
+    start_force_n : float
+        Force [N] applied from the start, >= 0.
+    settle_time_s : float or None
+        Settle phase before the force rises [s].
+    fast_forward : bool
+    fast_forward_margin : float
+        Fraction below the predicted breakaway where the fast climb stops.
     """
 
     rate_n_s: float | None = None

@@ -558,12 +558,36 @@ def _slope_length(surface: Surface, length_scale_m: float, char_length_m: float)
 
 
 def hfield_of(surface: Surface, resolution: int | None = None) -> HField:
-    """The surface as MuJoCo hfield data, resampled to ``resolution`` a side when given."""
+    """The surface as MuJoCo hfield data, resampled to ``resolution`` a side when given.
+
+    Parameters
+    ----------
+    surface : Surface
+        Any surface.
+    resolution : int, optional
+        Samples a side (None: a grid surface's own, 201 for an analytic one).
+
+    Returns
+    -------
+    HField
+    """
     return to_hfield(surface, nrow=resolution, ncol=resolution) if resolution else to_hfield(surface)
 
 
 def hfield_spacing(hfield: HField, length_scale_m: float = 1.0) -> float:
-    """The larger of an hfield's two sample spacings, in metres."""
+    """The larger of an hfield's two sample spacings, in metres.
+
+    Parameters
+    ----------
+    hfield : HField
+        MuJoCo height field data.
+    length_scale_m : float
+        Metres per surface unit.
+
+    Returns
+    -------
+    float
+    """
     rx, ry = hfield.size[0], hfield.size[1]
     return length_scale_m * 2 * max(rx / (hfield.ncol - 1), ry / (hfield.nrow - 1))
 
@@ -607,6 +631,21 @@ def default_engine(
     spring's swings (measured on the fractal at K = 3000 with the contact kept at the
     contact rule's 2 dt: half the runs oscillated at +-50 F_p and agreed with the
     streamline 12 of 24; with the contact following the step, see docs/physics.md §7).
+
+    Parameters
+    ----------
+    scales : Scales
+        The problem's scales (tip radius, L_c, F_p, mass, the surface's fall).
+    speed_m_s : float, optional
+        The drive's speed [m/s], for the impact bound.
+    stiffness_n_m : float, optional
+        The drive spring's stiffness [N/m], for the spring bound.
+    **overrides
+        Fields of :class:`EngineSettings` to replace.
+
+    Returns
+    -------
+    EngineSettings
     """
     dt_contact = _contact_step_tau(scales, speed_m_s)  # engine units
     if stiffness_n_m is None:
@@ -720,5 +759,14 @@ def penetration_tolerance_m(scales: Scales) -> float:
     Beyond ~10 % of the tip radius the contacts of neighbouring facets tilt the normal by
     tens of degrees (docs/physics.md §5); beyond 1 % of L_c the tip no longer follows the
     surface it is meant to probe.
+
+    Parameters
+    ----------
+    scales : Scales
+        The problem's scales (tip radius, L_c).
+
+    Returns
+    -------
+    float
     """
     return min(0.1 * scales.tip_radius_m, 0.01 * scales.char_length_m)

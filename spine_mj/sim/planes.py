@@ -15,7 +15,25 @@ def inclined_plane(
 ) -> GridSurface:
     """A plane ``z = tan(slope) (x cos(az) + y sin(az))`` on a square grid.
 
-    ``azimuth_deg = 0`` makes the plane rise in +x (the closed form's theta > 0).
+    ``azimuth_deg = 0`` makes the plane rise in +x (the closed form's theta > 0), where
+    ``kappa = tan(theta + arctan mu)`` (docs/physics.md §1) is the static probe's target.
+
+    Parameters
+    ----------
+    slope_deg : float
+        Inclination theta [deg].
+    azimuth_deg : float
+        Direction of steepest rise from +x [deg].
+    half_width : float
+        Half the side of the square domain, centred on 0.
+    n : int
+        Grid points a side.
+    unit : str
+        Length unit of the coordinates and heights.
+
+    Returns
+    -------
+    GridSurface
     """
     slope = float(slope_deg)
     if not (math.isfinite(slope) and -89.0 <= slope <= 89.0):

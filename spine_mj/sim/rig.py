@@ -39,6 +39,7 @@ class Rig(RigModel):
     surface : Surface
         Any surface; dimensionless ones are scaled by ``length_scale_m``.
     tip : TipParams
+        The tip: radius, mass, friction, preload.
     engine : EngineSettings or None
         None: :func:`default_engine` of the scales.
     length_scale_m : float or None
