@@ -22,6 +22,11 @@ from spine_mj.sweep.registry import ANALYSES, RESERVED, AnalysisResult
 def run_case(case: Case) -> tuple[Any, Any]:
     """Run every analysis of ``case``; never raises for a failing analysis.
 
+    Parameters
+    ----------
+    case : Case
+        One surface instance at one grid point, with its starts.
+
     Returns
     -------
     rows : pyarrow.Table

@@ -53,6 +53,17 @@ class Case:
 def expand_cases(config: SweepConfig) -> list[Case]:
     """The cases of ``config``: surfaces x grid (product of all parameter lists), in order.
 
+    Parameters
+    ----------
+    config : SweepConfig
+        A validated config.
+
+    Returns
+    -------
+    list of Case
+        Each with its id (a hash of its parameters) and its seed (from the master seed and
+        that id).
+
     Raises
     ------
     SpineInputError

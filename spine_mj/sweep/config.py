@@ -454,6 +454,16 @@ class SweepConfig:
 def load_config(path: str | os.PathLike) -> SweepConfig:
     """Read and validate a sweep config TOML file.
 
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The TOML file (``example:NAME`` for a shipped one); relative file paths in it are
+        taken from its folder.
+
+    Returns
+    -------
+    SweepConfig
+
     Raises
     ------
     SpineInputError
@@ -475,8 +485,25 @@ def load_config(path: str | os.PathLike) -> SweepConfig:
 
 
 def parse_config(doc: Mapping, *, base_dir: str | os.PathLike = ".") -> SweepConfig:
-    """Validate a config given as a dict (the parsed TOML); relative file paths are taken
-    from ``base_dir``. See :func:`load_config`."""
+    """Validate a config given as a dict (the parsed TOML). See :func:`load_config`.
+
+    Parameters
+    ----------
+    doc : Mapping
+        The config's tables (``sweep``, ``surfaces``, ``starts``, ``drive``, ``grid``,
+        ``array``) as a dict.
+    base_dir : str or os.PathLike
+        Folder relative file paths are taken from.
+
+    Returns
+    -------
+    SweepConfig
+
+    Raises
+    ------
+    SpineInputError
+        Unknown keys or analyses, bad values: the message names the key's path.
+    """
     document = _validate(_Document, doc, context={"base_dir": Path(base_dir)})
     sweep = document.sweep
     specs = tuple(param_specs(sweep.analyses).values())

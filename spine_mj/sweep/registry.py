@@ -188,6 +188,21 @@ class Analysis:
     ``check_case``, if given, is ``check_case(case, surface, starts)``: it raises the
     SpineInputError that ``func`` would raise for the case's inputs, without running it
     (:mod:`spine_mj.sweep.preflight` calls it before a sweep starts).
+
+    Attributes
+    ----------
+    name : str
+        The name a config's ``analyses`` list uses.
+    func : callable
+        ``func(case, surface, starts, upstream) -> AnalysisResult``.
+    parameters : tuple of ParamSpec
+        The grid keys it reads, with their checks and defaults.
+    requires : tuple of str
+        Analyses whose results it needs (run first, passed as ``upstream``).
+    doc : str
+        One line for ``spine-mj sweep --help`` and the report.
+    check_config, check_case : callable or None
+        See above.
     """
 
     name: str
@@ -204,7 +219,18 @@ ANALYSES: dict[str, Analysis] = {}
 
 
 def register_analysis(analysis: Analysis) -> Analysis:
-    """Add ``analysis`` to :data:`ANALYSES` (replacing one of the same name)."""
+    """Add ``analysis`` to :data:`ANALYSES` (replacing one of the same name).
+
+    Parameters
+    ----------
+    analysis : Analysis
+        The analysis to register.
+
+    Returns
+    -------
+    Analysis
+        ``analysis``, so that the call can decorate its definition.
+    """
     for spec in analysis.parameters:
         if spec.name in RESERVED:
             raise SpineInputError(f"parameter name {spec.name!r} is reserved for the run table")

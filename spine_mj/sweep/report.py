@@ -94,6 +94,14 @@ _OVERLAY_STARTS = 3
 def write_report(out_dir: str | os.PathLike, output: str | os.PathLike) -> Path:
     """Write the HTML report of the sweep store in ``out_dir`` to ``output``.
 
+    Parameters
+    ----------
+    out_dir : str or os.PathLike
+        The result store.
+    output : str or os.PathLike
+        The ``.html`` file to write: runs by status, metric tables, plots of the metrics
+        against the swept parameters.
+
     Returns
     -------
     Path

@@ -380,6 +380,17 @@ def run_sweeps(
     while the next sweep waits. A case found in two sweeps runs once and is stored in
     both. ``progress`` gets one :class:`Progress` over all the sweeps' cases.
 
+    Parameters
+    ----------
+    jobs : sequence of (SweepConfig, path)
+        Each sweep's config and result store.
+    workers : int, optional
+        Local worker processes (default: all cores).
+    overwrite : bool
+        Replace stores that hold another config.
+    progress : callable, optional
+        Called with a :class:`Progress` over all the sweeps' cases.
+
     Returns
     -------
     list of SweepSummary

@@ -260,7 +260,18 @@ def reopen_cases(out_dir: Path, case_ids) -> None:
 
 
 def consolidate(out_dir: str | os.PathLike):
-    """Rebuild ``runs.parquet`` from the per-case files; returns the table (pyarrow)."""
+    """Rebuild ``runs.parquet`` from the per-case files.
+
+    Parameters
+    ----------
+    out_dir : str or os.PathLike
+        The result store.
+
+    Returns
+    -------
+    pyarrow.Table
+        The run table, one row per run.
+    """
     out_dir = Path(out_dir)
     tables = [t for t in (_read(f) for f in _case_files(out_dir)) if t is not None]
     if not tables:
@@ -350,7 +361,18 @@ class StoreStatus:
 
 
 def store_status(out_dir: str | os.PathLike) -> StoreStatus:
-    """Read the state of the store in ``out_dir`` (works while a sweep is running)."""
+    """Read the state of the store in ``out_dir`` (works while a sweep is running).
+
+    Parameters
+    ----------
+    out_dir : str or os.PathLike
+        The result store.
+
+    Returns
+    -------
+    StoreStatus
+        Cases and runs done, by status, and any truncated case files.
+    """
     out_dir = Path(out_dir)
     manifest = read_manifest(out_dir)
     if manifest is None:
@@ -383,7 +405,21 @@ def store_status(out_dir: str | os.PathLike) -> StoreStatus:
 
 
 def load_runs(out_dir: str | os.PathLike, *, columns: list[str] | None = None):
-    """The run table of a store as a pandas DataFrame (rebuilt if the sweep is unfinished)."""
+    """The run table of a store as a pandas DataFrame (rebuilt if the sweep is unfinished).
+
+    Parameters
+    ----------
+    out_dir : str or os.PathLike
+        The result store.
+    columns : list of str, optional
+        Only these columns.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per run: the case's parameters, the analysis's metrics, ``status`` and
+        ``reason``, timing.
+    """
     out_dir = Path(out_dir)
     if read_manifest(out_dir) is None:
         raise SpineInputError(f"{out_dir} holds no sweep ({MANIFEST} not found)")
@@ -413,7 +449,9 @@ def load_trajectories(
     Parameters
     ----------
     out_dir : path
+        The result store.
     case_id : str
+        The case's id (``case_id`` in the run table).
     analysis : str, optional
         Only this analysis's paths.
     start : int, optional
