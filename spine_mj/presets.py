@@ -166,6 +166,11 @@ def preset_mu(preset: Preset | str | surfaces.Surface | None) -> float | None:
 def calibrated_mu(preset: Preset | str) -> float:
     """:func:`preset_mu` for code that needs one (validation, the paper's reproductions).
 
+    Parameters
+    ----------
+    preset : Preset or str
+        A preset or its name.
+
     Raises
     ------
     SpineInputError

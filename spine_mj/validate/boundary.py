@@ -143,6 +143,13 @@ def boundary(plan: ValidationPlan, runner: StudyRunner) -> BoundaryResult:
     the median Frechet over starts (the headline: robust to one marginal start), and with
     the mean, each with a bootstrap interval over starts.
 
+    Parameters
+    ----------
+    plan : ValidationPlan
+        The validation's sizes (:data:`PLANS`).
+    runner : StudyRunner
+        Runs the study's sweeps into resumable stores under the output folder.
+
     Returns
     -------
     BoundaryResult

@@ -180,6 +180,13 @@ def fractal_lock(plan: ValidationPlan, runner: StudyRunner) -> FractalLockResult
     ``plan.fractal_dynamic_ie`` with the mujoco analysis alone. Default spring drive
     (K = 30), the rig's default tip and engine.
 
+    Parameters
+    ----------
+    plan : ValidationPlan
+        The validation's sizes (:data:`PLANS`).
+    runner : StudyRunner
+        Runs the study's sweeps into resumable stores under the output folder.
+
     Returns
     -------
     FractalLockResult

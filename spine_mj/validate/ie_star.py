@@ -93,6 +93,10 @@ def estimate_ie_star(
         Outcome agreement (fraction in [0, 1]) at each I_e.
     frechet : array_like, shape (n,), optional
         Mean Frechet deviation / L_c at each I_e.
+    agree_min : float
+        The agreement target (default :data:`~spine_mj.compare.OUTCOME_TARGET`, 0.95).
+    frechet_max : float
+        The Frechet target / L_c (default :data:`~spine_mj.compare.FRECHET_TARGET`, 0.1).
 
     Returns
     -------
@@ -164,6 +168,21 @@ def bootstrap_ie_star(
     (``"mean"``, ``"median"`` or None: agreement only) reduces the Frechet deviations of a
     resample. A resample whose I_e* is not bracketed contributes the edge of the grid it
     points at.
+
+    Parameters
+    ----------
+    ie : array_like, shape (n_ie,)
+        Strictly increasing inertia numbers.
+    agree_matrix, frechet_matrix : array_like, shape (n_ie, n_starts)
+        Per-run agreement (0 / 1) and Frechet deviation / L_c.
+    n_boot : int
+        Resamples.
+    rng : int or numpy.random.Generator
+        The resampling's randomness.
+    agree_min, frechet_max : float
+        The targets (:func:`estimate_ie_star`).
+    stat : {"mean", "median", None}
+        How a resample's Frechet deviations are reduced (None: agreement only).
     """
     if stat not in ("mean", "median", None):
         raise SpineInputError(f"stat must be 'mean', 'median' or None, got {stat!r}")
@@ -237,8 +256,13 @@ def ie_star_by_criterion(ie, agree_matrix, frechet_matrix, *, n_boot: int, rng=1
     Parameters
     ----------
     ie : array_like, shape (n_ie,)
+        Strictly increasing inertia numbers.
     agree_matrix, frechet_matrix : array_like, shape (n_ie, n_starts)
         Per-run agreement (0 / 1) and Frechet deviation / L_c.
+    n_boot : int
+        Resamples of the starts for each interval.
+    rng : int or numpy.random.Generator
+        The resampling's randomness.
 
     Returns
     -------
@@ -275,6 +299,17 @@ def departure_ie_star(ie, agree_matrix, *, n_boot: int, rng=12345) -> IeStar:
     The absolute criteria fail at every I_e when a few starts disagree for reasons that do
     not depend on I_e (a marginal start, hfield facets); this one still locates where
     inertia makes agreement break down.
+
+    Parameters
+    ----------
+    ie : array_like, shape (n_ie,)
+        Strictly increasing inertia numbers.
+    agree_matrix : array_like, shape (n_ie, n_starts)
+        Per-run agreement (0 / 1).
+    n_boot : int
+        Resamples of the starts.
+    rng : int or numpy.random.Generator
+        The resampling's randomness.
     """
     a = np.asarray(agree_matrix, dtype=float)
 

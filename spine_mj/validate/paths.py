@@ -34,7 +34,17 @@ __all__ = [
 def tip_radius(preset: str, seeds, resolution: int) -> float:
     """The rig's default tip radius (:meth:`spine_mj.sim.Scales.for_surface`) in surface
     units, so that the quasistatic streamline runs on the surface traced by the same sphere.
-    A grid keeps its own samples here; ``resolution`` applies to analytic surfaces."""
+    A grid keeps its own samples here; ``resolution`` applies to analytic surfaces.
+
+    Parameters
+    ----------
+    preset : str
+        The surface's preset.
+    seeds : sequence of int or None
+        Its seeds: the first one's surface is measured (None: the preset's seed).
+    resolution : int
+        Samples a side of an analytic surface's hfield.
+    """
     surface = presets.make_surface(preset, **({} if seeds is None else {"seed": seeds[0]}))
     scales = sim.Scales.for_surface(
         surface,
@@ -47,7 +57,21 @@ def tip_radius(preset: str, seeds, resolution: int) -> float:
 def streamline_paths(surface, starts, mu: float, dl: float, tip: float) -> sl.StreamlineResult:
     """Streamlines (with paths) from ``starts`` on ``surface`` dilated by ``tip``
     (:func:`spine_mj.theory.streamline.dilate`: MuJoCo's facets are sampled at ``tip / 8``, finer
-    than the hfield, before the dilation)."""
+    than the hfield, before the dilation).
+
+    Parameters
+    ----------
+    surface : Surface
+        Any surface.
+    starts : array_like, shape (n, 2)
+        Start points in surface units.
+    mu : float
+        Static friction coefficient mu_s.
+    dl : float
+        Streamline step (surface units).
+    tip : float
+        Tip radius (surface units); 0 traces the surface itself.
+    """
     traced = sl.dilate(surface, tip) if tip > 0 else surface
     params = sl.StreamlineParams(mu=mu, dl=dl)
     return sl.streamlines(traced, np.asarray(starts, float), params, store_paths=True)
@@ -55,7 +79,15 @@ def streamline_paths(surface, starts, mu: float, dl: float, tip: float) -> sl.St
 
 def triangulated_surface(surface, resolution: int | None) -> TriangulatedSurface:
     """MuJoCo's hfield of ``surface`` as facets (a grid keeps its samples; else
-    ``resolution`` per side, or the default when None)."""
+    ``resolution`` per side, or the default when None).
+
+    Parameters
+    ----------
+    surface : Surface
+        Any surface.
+    resolution : int or None
+        Samples a side of an analytic surface's hfield.
+    """
     hf = (
         to_hfield(surface)
         if (isinstance(surface, GridSurface) or not resolution)
@@ -66,7 +98,15 @@ def triangulated_surface(surface, resolution: int | None) -> TriangulatedSurface
 
 def path_metrics(mpath: np.ndarray, qpath: np.ndarray, lc: float) -> tuple[float, float]:
     """Frechet and mean lateral deviation of ``mpath`` from ``qpath`` over ``lc`` (NaN, NaN
-    when either has fewer than two points)."""
+    when either has fewer than two points).
+
+    Parameters
+    ----------
+    mpath, qpath : ndarray, shape (n, 2), (m, 2)
+        The MuJoCo path and the streamline (x, y in surface units).
+    lc : float
+        ``L_c`` in surface units; the results are in units of it.
+    """
     if mpath.shape[0] < 2 or qpath.shape[0] < 2:
         return float("nan"), float("nan")
     fr = compare.path_frechet(mpath, qpath, length_scale=lc)
@@ -74,7 +114,15 @@ def path_metrics(mpath: np.ndarray, qpath: np.ndarray, lc: float) -> tuple[float
 
 
 def prefix_frechet(mpath: np.ndarray, qpath: np.ndarray, lc: float) -> float:
-    """Frechet deviation of a MuJoCo path from the streamline cut at the same arc length."""
+    """Frechet deviation of a MuJoCo path from the streamline cut at the same arc length.
+
+    Parameters
+    ----------
+    mpath, qpath : ndarray, shape (n, 2), (m, 2)
+        The MuJoCo path and the streamline (x, y in surface units).
+    lc : float
+        ``L_c`` in surface units; the result is in units of it.
+    """
     if mpath.shape[0] < 2 or qpath.shape[0] < 2:
         return float("nan")
     arc_m = float(np.linalg.norm(np.diff(mpath, axis=0), axis=1).sum())

@@ -55,7 +55,16 @@ RUN_COLUMNS = (
 
 @dataclass(frozen=True)
 class LimitPath:
-    """The three paths of one start (``(n, 2)`` x, y in surface units) for the figure."""
+    """The three paths of one start, for the figure.
+
+    Attributes
+    ----------
+    smooth, tri, mujoco : ndarray, shape (n, 2)
+        x, y in surface units of the streamline on the smooth surface, the streamline on
+        MuJoCo's facets, and the MuJoCo run.
+    start : tuple of float
+        The start.
+    """
 
     smooth: np.ndarray
     tri: np.ndarray
@@ -141,6 +150,13 @@ def quasistatic_limit(plan: ValidationPlan, runner: StudyRunner) -> QuasistaticL
     against each other (the geometry part). Runs the engine stopped count as
     disagreements and are listed per family by status (``failed_runs``). Then on the single
     peak the settings of ``plan.limit_variations`` one at a time.
+
+    Parameters
+    ----------
+    plan : ValidationPlan
+        The validation's sizes (:data:`PLANS`).
+    runner : StudyRunner
+        Runs the study's sweeps into resumable stores under the output folder.
 
     Returns
     -------

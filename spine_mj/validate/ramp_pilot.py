@@ -68,6 +68,19 @@ class RampPlan:
 def pilot_rig(preset: str, seed, mu: float, tip: float, resolution: int):
     """The rig a sweep case builds for these keys (default engine from the scales).
 
+    Parameters
+    ----------
+    preset : str
+        The surface's preset.
+    seed : int or None
+        Its seed (None: the preset's).
+    mu : float
+        Static friction coefficient mu_s.
+    tip : float
+        Tip radius in surface units.
+    resolution : int
+        Samples a side of an analytic surface's hfield.
+
     Returns
     -------
     (Rig, float)
@@ -93,6 +106,23 @@ def ramp_duration(
     one ramp to the self-lock cap ``kappa_cap F_p`` (a trapped tip must get there to count as
     locked), capped at ``max_steps`` engine steps. A run that leaves the domain or locks
     ends early. The cap is the honest limit of a run here: see the report.
+
+    Parameters
+    ----------
+    rig : Rig
+        The rig the run uses.
+    start : tuple of float
+        The start (surface units).
+    ie : float
+        The ramp's equivalent inertia number.
+    target_lc : float
+        Distance along x to cover, in L_c.
+    max_steps : int
+        Cap on the run's engine steps.
+    slide_lc : float
+        The ramp's slide distance before the force drops, in L_c.
+    pilot_cycles : int
+        Ramp cycles of the pilot run.
     """
     sc = rig.scales
     dt = rig.engine.timestep_s

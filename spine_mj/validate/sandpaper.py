@@ -48,6 +48,13 @@ class SandpaperResult:
 def sandpaper(plan: ValidationPlan, runner: StudyRunner) -> SandpaperResult:
     """Study 5: spring drive over sandpaper analogs with a 25 um tip (paper Fig. 6).
 
+    Parameters
+    ----------
+    plan : ValidationPlan
+        The validation's sizes (:data:`PLANS`).
+    runner : StudyRunner
+        Runs the study's sweeps into resumable stores under the output folder.
+
     Returns
     -------
     SandpaperResult

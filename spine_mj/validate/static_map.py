@@ -100,6 +100,15 @@ def static_map(plan: ValidationPlan, runner: StudyRunner, *, mu: float = 0.5) ->
     smallest holding force plus half the gap to the breakaway force (where gravity alone
     would slide the tip) and ramps the force at ``I_e = PROBE_IE`` until breakaway.
 
+    Parameters
+    ----------
+    plan : ValidationPlan
+        The validation's sizes (:data:`PLANS`).
+    runner : StudyRunner
+        Runs the study's sweeps into resumable stores under the output folder.
+    mu : float
+        The planes' friction coefficient mu_s.
+
     Returns
     -------
     StaticMapResult

@@ -76,6 +76,8 @@ def slip_statistics(time_s, x, y, force, motion) -> SlipStats:
     Parameters
     ----------
     time_s, x, y, force : array_like, shape (n,)
+        The recorded rows: time, tip position and drive force, in one consistent set of
+        units (the study passes seconds, L_c and F_p).
     motion : array_like of int, shape (n,)
         Motion state codes (:data:`spine_mj.sim.motion.MOTION_NAMES`), as recorded.
 
@@ -176,6 +178,13 @@ class StickSlipResult:
 
 def stick_slip(plan: ValidationPlan, runner: StudyRunner) -> StickSlipResult:
     """Study 4: spring drive on a random concave surface (traps) over I_e x stiffness.
+
+    Parameters
+    ----------
+    plan : ValidationPlan
+        The validation's sizes (:data:`PLANS`).
+    runner : StudyRunner
+        Runs the study's sweeps into resumable stores under the output folder.
 
     Returns
     -------

@@ -191,6 +191,13 @@ def stiffness_map(plan: ValidationPlan, runner: StudyRunner) -> StiffnessMapResu
     """Study 7: the spring drive over ``plan.stiffness_map_ie`` x ``plan.stiffness_map_k``
     on ``plan.stiffness_map_families`` (an empty grid runs nothing).
 
+    Parameters
+    ----------
+    plan : ValidationPlan
+        The validation's sizes (:data:`PLANS`).
+    runner : StudyRunner
+        Runs the study's sweeps into resumable stores under the output folder.
+
     Returns
     -------
     StiffnessMapResult
