@@ -361,6 +361,9 @@ def _write(path: Path, text: str) -> None:
 
 def write_all(docs: Path) -> None:
     """Every generated page under ``docs`` (the site's source folder)."""
-    api_pages(docs / "api" / "generated")
+    api = docs / "api" / "generated"
+    if api.exists():
+        shutil.rmtree(api)  # stubs of names no longer public go with them
+    api_pages(api)
     results_pages(docs / "results" / "generated")
     _write(docs / "user_guide" / "cli_reference.md", cli_reference())
