@@ -12,9 +12,7 @@ OUTSTANDING = docstrings.outstanding()
 
 
 def test_public_docstrings_pass_numpydoc_validation():
-    failing = {
-        name: docstrings.errors(obj) for name, obj in OBJECTS.items() if name not in OUTSTANDING
-    }
+    failing = {name: docstrings.errors(obj) for name, obj in OBJECTS.items() if name not in OUTSTANDING}
     failing = {name: errs for name, errs in failing.items() if errs}
     assert failing == {}, "document these (numpydoc: Parameters, Returns) " + repr(failing)
 
