@@ -164,3 +164,12 @@ def test_sigterm_while_simulate_starts_unwinds_quietly(tmp_path, delay_s):
     assert proc.returncode in (128 + signal.SIGTERM, -signal.SIGTERM), (proc.returncode, stderr)
     assert "Traceback" not in stderr and "Error" not in stderr, stderr
     assert not out.exists() or not any(out.iterdir())
+
+
+def test_a_sigterm_a_library_swallowed_stops_the_command_at_its_next_progress_report(monkeypatch):
+    from spine_mj.cli import app
+
+    monkeypatch.setattr(app, "_TERMINATED", [signal.SIGTERM])
+    with pytest.raises(SystemExit) as stop:
+        app.Progress("simulating", quiet=True).update(1, 10)
+    assert stop.value.code == 128 + signal.SIGTERM
