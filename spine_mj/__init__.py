@@ -47,6 +47,7 @@ MOVED = {
     },
     "spine_mj._contact_kernel": "spine_mj.surfaces._contact_kernel",
     "spine_mj.array_outputs": "spine_mj.sim.array_outputs",
+    "spine_mj.sim.motion": "spine_mj.theory.motion",
 }
 
 

@@ -29,11 +29,10 @@ from numba import njit
 from spine_mj.errors import SpineInputError
 from spine_mj.memory import BLOCK_BYTES
 from spine_mj.theory.engagement import SLIP
-
-#: What "agree" means at the quasistatic corner, for sweeps and validation alike: outcome
-#: agreement at least this share of the runs, and path deviation (Frechet over L_c) at most.
-OUTCOME_TARGET = 0.95
-FRECHET_TARGET = 0.1
+from spine_mj.theory.targets import (  # their old home: still importable from here
+    FRECHET_TARGET,
+    OUTCOME_TARGET,
+)
 
 #: The most points :func:`resample_by_arclength` returns (2^16, 1 MiB of x-y): at the
 #: default spacing L_c / 50 a path over 1300 L_c long, hundreds of times any run across a

@@ -35,6 +35,7 @@ OLD_PATHS = {
     "spine_mj._compliant_kernel": ("spine_mj.theory._compliant_kernel", "fold_on_facets"),
     "spine_mj._contact_kernel": ("spine_mj.surfaces._contact_kernel", "ball_on_facets"),
     "spine_mj.array_outputs": ("spine_mj.sim.array_outputs", "write_array_outputs"),
+    "spine_mj.sim.motion": ("spine_mj.theory.motion", "slip_events"),
 }
 
 
@@ -122,6 +123,25 @@ def test_no_module_imports_one_that_imports_it_back():
         if node not in state:
             visit(node, [])
     assert not cycles, "import cycles: " + "; ".join(" -> ".join(c) for c in cycles)
+
+
+def test_the_theory_imports_neither_mujoco_nor_the_sim():
+    graph = _package_imports()
+    theory = sorted(m for m in graph if m == "spine_mj.theory" or m.startswith("spine_mj.theory."))
+    assert "spine_mj.theory.streamline" in theory
+    upward = {
+        m: sorted(e for e in graph[m] if e.split(".")[1] in {"sim", "sweep", "validate", "cli"})
+        for m in theory
+    }
+    assert not any(upward.values()), upward
+    code = (
+        "import sys, spine_mj.theory, pkgutil, importlib\n"
+        "for m in pkgutil.iter_modules(spine_mj.theory.__path__):\n"
+        "    importlib.import_module('spine_mj.theory.' + m.name)\n"
+        "print(sorted(n for n in sys.modules if n == 'mujoco' or n.startswith(('mujoco.', 'spine_mj.sim'))))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[]"
 
 
 def test_the_packages_import_together():

@@ -35,7 +35,7 @@ from spine_mj.sim.detection import (
 )
 from spine_mj.sim.drives import Drive, SpringDrive, StaticProbe, settle_steps, stiffness_n_m
 from spine_mj.sim.model import RigModel
-from spine_mj.sim.motion import MOTION_NAMES, SlipEvent, motion_fractions, motion_states, slip_events
+from spine_mj.theory.motion import MOTION_NAMES, SlipEvent, motion_fractions, motion_states, slip_events
 from spine_mj.sim.params import EndReason, EngineSettings, Scales, TipParams
 from spine_mj.sim.recording import COLUMNS, RESULT_COLUMNS, SENSOR_NAMES, Recording, RunColumns
 from spine_mj.theory.engagement import DEFAULT_TOL
@@ -89,10 +89,10 @@ class RunResult(RunColumns):
         Tangential speed above ``detection.move_speed_m_s`` (the engine side's "not stuck",
         read by the lock rule and the fast-forward; not a slip).
     motion : (n,) int8
-        Motion state relative to the drive, :data:`~spine_mj.sim.motion.STUCK`,
-        ``SLIDING`` or ``SLIPPING`` (:func:`~spine_mj.sim.motion.motion_states`).
+        Motion state relative to the drive, :data:`~spine_mj.theory.motion.STUCK`,
+        ``SLIDING`` or ``SLIPPING`` (:func:`~spine_mj.theory.motion.motion_states`).
     slip_events : tuple of SlipEvent
-        The slips (:func:`~spine_mj.sim.motion.slip_events`): onset force, force drop,
+        The slips (:func:`~spine_mj.theory.motion.slip_events`): onset force, force drop,
         jump length and duration of each.
     events : tuple of Event
     end_reason : EndReason

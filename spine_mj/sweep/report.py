@@ -20,7 +20,6 @@ import pandas as pd
 from pandas.api.types import is_bool_dtype, is_numeric_dtype
 
 from spine_mj.atomic import atomic_output
-from spine_mj.compare import FRECHET_TARGET, OUTCOME_TARGET
 from spine_mj.plotting import (
     THRESHOLD_COLOR,
     house_style,
@@ -32,6 +31,7 @@ from spine_mj.plotting import (
 from spine_mj.sweep.registry import ANALYSES, RESERVED
 from spine_mj.sweep.store import load_runs, load_trajectories, read_manifest, store_status
 from spine_mj.templates import render
+from spine_mj.theory.targets import FRECHET_TARGET, OUTCOME_TARGET
 
 __all__ = ["METRIC_UNITS", "write_report"]
 

@@ -13,8 +13,11 @@ theory runs wherever numpy and numba do.
   allows before the quasistatic picture fails;
 - :mod:`~spine_mj.theory.tomlinson`, :mod:`~spine_mj.theory.tomlinson_dynamics`: closed
   forms and a reference integrator for the Prandtl-Tomlinson corrugation;
+- :mod:`~spine_mj.theory.motion`: stuck, sliding and slipping relative to the drive, and the
+  slip events they make (of a MuJoCo run and of the reference integrator alike);
 - :mod:`~spine_mj.theory.energy`: energy budget of a stick-slip event;
-- :mod:`~spine_mj.theory.array_reference`: the quasistatic hold curve of a spine array.
+- :mod:`~spine_mj.theory.array_reference`: the quasistatic hold curve of a spine array;
+- :mod:`~spine_mj.theory.targets`: how close a dynamic run must come to count as agreeing.
 
 The same modules import by their old names (``spine_mj.streamline``, ``spine_mj.engagement``,
 ...): :mod:`spine_mj` maps those onto these.

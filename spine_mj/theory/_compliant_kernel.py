@@ -7,7 +7,7 @@ With numpy that is a few microseconds of arithmetic under a hundred of call over
 the quick plan's sandpaper the searches were 350 of the demo's 825 CPU seconds. Here each
 lane runs its whole search in compiled code, the same steps in the same order as
 ``compliant._fold_along`` and ``compliant._landing_along`` (the numpy reference, which
-``tests/test_compliant.py`` checks this against) with the hold of
+``tests/theory/test_theory_compliant.py`` checks this against) with the hold of
 :func:`spine_mj.theory.compliant.hold_force` written out for one point.
 """
 

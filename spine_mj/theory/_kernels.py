@@ -12,7 +12,7 @@ vectorized); Gaussian sums and grids evaluate lane by lane. ``kind`` 0
 evaluates a Gaussian sum (``g`` rows: amplitude, centre x, centre y, 1/sigma_x,
 1/sigma_y), ``kind`` 1 a cubic B-spline grid (``coef`` and ``sp`` = offset, x0, dx, nx,
 y0, dy, ny, periodic). The physics mirrors :func:`spine_mj.theory.engagement.kappa` and
-:func:`spine_mj.theory.engagement.slip_direction`; ``tests/test_streamline.py`` checks this
+:func:`spine_mj.theory.engagement.slip_direction`; ``tests/theory/test_theory_streamline.py`` checks this
 kernel against the pure-numpy reference in :mod:`spine_mj.theory.streamline`.
 """
 

@@ -35,12 +35,12 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from spine_mj import roughness
-from spine_mj.compare import FRECHET_TARGET
 from spine_mj.errors import SpineInputError
 from spine_mj.surfaces import Surface
 from spine_mj.theory import streamline as sl
 from spine_mj.theory.compliant import hold_force
 from spine_mj.theory.engagement import DEFAULT_KAPPA_CAP, SELF_LOCK
+from spine_mj.theory.targets import FRECHET_TARGET
 
 __all__ = ["DriveLimits", "crest_curvature", "drive_limits", "kappa_fall", "trap_depths"]
 
@@ -205,7 +205,7 @@ def drive_limits(
         Hold forces above it count as held (the comparison's force cap).
     path_tolerance : float
         How far (in ``L_c``) a path may lag the streamline, for ``ie_lag``; default the
-        comparison's Frechet target (:data:`spine_mj.compare.FRECHET_TARGET`, 0.1).
+        comparison's Frechet target (:data:`spine_mj.theory.targets.FRECHET_TARGET`, 0.1).
 
     Returns
     -------

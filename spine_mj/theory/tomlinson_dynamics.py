@@ -17,7 +17,7 @@ A stuck tip stays while ``W kappa_b(x) <= F <= W kappa(x)``,
 (backward); since ``F`` grows at ``k V`` while stuck, the release time is exact. Slides are
 integrated by :func:`scipy.integrate.solve_ivp` (DOP853) up to ``x' = 0`` or ``N = 0``
 (lift-off, which ends the run). The trajectory is sampled on a uniform grid so that
-:mod:`spine_mj.sim.motion` classifies it exactly as it does a MuJoCo run.
+:mod:`spine_mj.theory.motion` classifies it exactly as it does a MuJoCo run.
 
 Analytic side: numpy and scipy only, no MuJoCo.
 """
@@ -31,7 +31,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from spine_mj.errors import SpineInputError, check_positive
-from spine_mj.sim.motion import SlipEvent, motion_states, slip_events
+from spine_mj.theory.motion import SlipEvent, motion_states, slip_events
 
 
 @dataclass(frozen=True)
@@ -75,7 +75,7 @@ class PTParams:
 @dataclass(frozen=True)
 class PTRun:
     """Result of :func:`integrate`: samples every ``dt`` (time, tip x, x-speed, carriage X,
-    spring force ``k (X - x)``, normal force), the slip events of :mod:`spine_mj.sim.motion`
+    spring force ``k (X - x)``, normal force), the slip events of :mod:`spine_mj.theory.motion`
     and whether the tip lifted off (the run then ends there)."""
 
     time_s: np.ndarray

@@ -22,7 +22,7 @@ and from the quasistatic reference: each spine on its own compliant-drive stream
 (:func:`~spine_mj.theory.compliant.compliant_streamlines`, same friction, spring, force cap and
 domain margin), the array's curve their sum (:mod:`spine_mj.theory.array_reference`). Like the
 single spine's comparison, agreement is the share of spines whose lock verdict matches
-(target :data:`~spine_mj.compare.OUTCOME_TARGET`). The conjecture is answered by the
+(target :data:`~spine_mj.theory.targets.OUTCOME_TARGET`). The conjecture is answered by the
 difference staggered - aligned (and random - aligned) in the lock probability (Newcombe's
 interval from the two Wilson intervals) and in holding per spine (paired bootstrap).
 """
@@ -37,12 +37,12 @@ import numpy as np
 from scipy.stats import bootstrap
 
 from spine_mj import presets, sim
-from spine_mj.compare import OUTCOME_TARGET
 from spine_mj.sim.drives import stiffness_n_m
 from spine_mj.sim.holding import HOLDING_TOLERANCE, spring_swing
 from spine_mj.theory.array_reference import compliant_spine_curves
 from spine_mj.theory.compliant import compliant_streamlines
 from spine_mj.theory.streamline import StreamlineParams, dilate
+from spine_mj.theory.targets import OUTCOME_TARGET
 from spine_mj.validate.fractal_lock import CONFIDENCE, lock_rate
 from spine_mj.validate.intervals import newcombe_difference
 from spine_mj.validate.plans import SANDPAPER_MU, ValidationPlan

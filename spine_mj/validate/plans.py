@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from spine_mj.compare import FRECHET_TARGET, OUTCOME_TARGET
+from spine_mj.theory.targets import FRECHET_TARGET, OUTCOME_TARGET
 
 __all__ = [
     "DT_HALVED",

@@ -11,7 +11,7 @@ import numpy as np
 from spine_mj import presets, sim
 from spine_mj.errors import SpineInputError
 from spine_mj.presets import calibrated_mu
-from spine_mj.sim.motion import slip_events
+from spine_mj.theory.motion import slip_events
 from spine_mj.theory.tomlinson import Corrugation
 from spine_mj.validate.ground_truth import CORRUGATION_START, TOMLINSON_TIP, corrugation_runs
 from spine_mj.validate.paths import mujoco_traces, tip_radius
@@ -71,7 +71,7 @@ class SlipStats:
 
 def slip_statistics(time_s, x, y, force, motion) -> SlipStats:
     """Slip events of a trace (its runs of ``slipping`` motion states,
-    :func:`spine_mj.sim.motion.slip_events`), with jump length and force drop.
+    :func:`spine_mj.theory.motion.slip_events`), with jump length and force drop.
 
     Parameters
     ----------
@@ -79,7 +79,7 @@ def slip_statistics(time_s, x, y, force, motion) -> SlipStats:
         The recorded rows: time, tip position and drive force, in one consistent set of
         units (the study passes seconds, L_c and F_p).
     motion : array_like of int, shape (n,)
-        Motion state codes (:data:`spine_mj.sim.motion.MOTION_NAMES`), as recorded.
+        Motion state codes (:data:`spine_mj.theory.motion.MOTION_NAMES`), as recorded.
 
     Returns
     -------

@@ -5,7 +5,7 @@ import pytest
 
 from spine_mj import validate
 from spine_mj.errors import SpineInputError
-from spine_mj.sim.motion import SLIPPING, STUCK
+from spine_mj.theory.motion import SLIPPING, STUCK
 
 
 def test_slip_statistics_on_a_constructed_stick_slip_trace():

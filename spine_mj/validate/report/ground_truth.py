@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 
-from spine_mj.sim.motion import SLIP_SPEED_FACTOR, STUCK_SPEED_FRACTION
+from spine_mj.theory.motion import SLIP_SPEED_FACTOR, STUCK_SPEED_FRACTION
 from spine_mj.validate.ground_truth import LIFTOFF_GAP_RADII, POINTS_PER_WAVE, TOMLINSON_IE, GroundTruthResult
 from spine_mj.validate.report.common import ReportContext, cell, table
 

@@ -14,7 +14,7 @@ from spine_mj.plotting import (
     sig,
     styled,
 )
-from spine_mj.sim.motion import SLIP_SPEED_FACTOR
+from spine_mj.theory.motion import SLIP_SPEED_FACTOR
 from spine_mj.validate.report.common import ReportContext, assemble, cell, image, table
 from spine_mj.validate.stick_slip import K_SCAN_SURFACE, SLIPS_PER_WAVE, StickSlipResult
 

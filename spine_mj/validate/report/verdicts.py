@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import math
 
-from spine_mj.compare import OUTCOME_TARGET
+from spine_mj.theory.targets import OUTCOME_TARGET
 from spine_mj.validate.convergence import unconverged_mark
 from spine_mj.validate.ensembles import ENSEMBLE_RADIUS_LC
 from spine_mj.validate.intervals import TARGET_RULE, runs_to_meet

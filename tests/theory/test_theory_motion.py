@@ -5,7 +5,7 @@ import pytest
 from sim_rigs import MU, flat_rig
 
 from spine_mj.sim import Rig, SpringDrive, TipParams
-from spine_mj.sim.motion import SLIDING, SLIPPING, STUCK, motion_fractions, motion_states, slip_events
+from spine_mj.theory.motion import SLIDING, SLIPPING, STUCK, motion_fractions, motion_states, slip_events
 from spine_mj.surfaces import corrugation
 from spine_mj.theory.tomlinson import (
     Corrugation,
