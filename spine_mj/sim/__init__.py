@@ -79,7 +79,6 @@ from spine_mj.sim.engines import DEFAULT_ENGINE, ENGINES, EngineRig, build_engin
 from spine_mj.sim.holding import HOLDING_TOLERANCE, array_ie, holding_excess
 from spine_mj.sim.layout import Layout, LayoutKind
 from spine_mj.sim.model import MODEL_PATH
-from spine_mj.theory.motion import MOTION_NAMES, SLIDING, SLIPPING, STUCK, SlipEvent
 from spine_mj.sim.params import (
     DEFAULT_LENGTH_SCALE_M,
     LENGTH_UNITS_M,
@@ -103,6 +102,7 @@ from spine_mj.sim.params import (
 from spine_mj.sim.planes import inclined_plane
 from spine_mj.sim.results import RunResult
 from spine_mj.sim.rig import REFINE_TIMESTEP, Rig
+from spine_mj.theory.motion import MOTION_NAMES, SLIDING, SLIPPING, STUCK, SlipEvent
 
 __all__ = [
     "ARRAY_DRIVES",

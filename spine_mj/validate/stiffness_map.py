@@ -33,8 +33,8 @@ import pandas as pd
 
 from spine_mj import presets, sim, sweep
 from spine_mj.errors import SpineInputError
-from spine_mj.theory.motion import SLIPPING
 from spine_mj.theory.energy import elastic_release_j, quasistatic_work_j
+from spine_mj.theory.motion import SLIPPING
 from spine_mj.validate.boundary import preset_grid, quasistatic_locked
 from spine_mj.validate.convergence import thin_starts
 from spine_mj.validate.ie_star import ie_star_by_criterion, passes_criterion, quiet_nan_warnings

@@ -5,8 +5,8 @@ import pytest
 from sim_rigs import MU, flat_rig
 
 from spine_mj.sim import Rig, SpringDrive, TipParams
-from spine_mj.theory.motion import SLIDING, SLIPPING, STUCK, motion_fractions, motion_states, slip_events
 from spine_mj.surfaces import corrugation
+from spine_mj.theory.motion import SLIDING, SLIPPING, STUCK, motion_fractions, motion_states, slip_events
 from spine_mj.theory.tomlinson import (
     Corrugation,
     spring_block_period_s,
