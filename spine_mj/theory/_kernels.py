@@ -197,30 +197,33 @@ def run_trajectories(
     for j in range(L):
         lx[j] = xs[0]  # idle lanes compute on a valid point, results unused
         ly[j] = ys[0]
-        if nxt < n:
-            _load_lane(
-                j,
-                nxt,
-                xs,
-                ys,
-                stall_window,
-                dl,
-                lidx,
-                lx,
-                ly,
-                lcx,
-                lcy,
-                lmk,
-                lstep,
-                luntil,
-                lstall,
-                lh,
-                lhp,
-                larc,
-            )
-            nxt += 1
-            nact += 1
-    while nact > 0:
+    while True:
+        for j in range(L):  # idle lanes take the next starts, in lane order
+            if lidx[j] < 0 and nxt < n:
+                _load_lane(
+                    j,
+                    nxt,
+                    xs,
+                    ys,
+                    stall_window,
+                    dl,
+                    lidx,
+                    lx,
+                    ly,
+                    lcx,
+                    lcy,
+                    lmk,
+                    lstep,
+                    luntil,
+                    lstall,
+                    lh,
+                    lhp,
+                    larc,
+                )
+                nxt += 1
+                nact += 1
+        if nact == 0:
+            break
         # 1. height and slopes of every lane
         if single:
             for j in range(L):
@@ -352,7 +355,7 @@ def run_trajectories(
             luntil[j] = u
             lmoved[j] = go
             levent[j] = (not go) | (u == 0)
-        # 5. the rare events: a trajectory ends (the lane takes the next start), stall checks.
+        # 5. the rare events: a trajectory ends (its lane takes the next start), stall checks.
         # A lane that moved is on a point not evaluated yet: it only gets its progress check
         # here (a stall or the step cap ends it after the next pass has recorded that point).
         # A lane that did not move ends now, on the point just recorded. Deciding an end for
@@ -397,31 +400,8 @@ def run_trajectories(
                 ex[i] = x
                 ey[i] = y
                 ez[i] = lf[j]
-                if nxt < n:
-                    _load_lane(
-                        j,
-                        nxt,
-                        xs,
-                        ys,
-                        stall_window,
-                        dl,
-                        lidx,
-                        lx,
-                        ly,
-                        lcx,
-                        lcy,
-                        lmk,
-                        lstep,
-                        luntil,
-                        lstall,
-                        lh,
-                        lhp,
-                        larc,
-                    )
-                    nxt += 1
-                else:
-                    lidx[j] = -1
-                    nact -= 1
+                lidx[j] = -1
+                nact -= 1
     # paths back to back in start order (points of one start were produced in step order)
     offsets = np.zeros(n + 1, np.int64)
     if not store:
