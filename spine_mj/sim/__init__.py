@@ -102,6 +102,7 @@ from spine_mj.sim.params import (
 from spine_mj.sim.planes import inclined_plane
 from spine_mj.sim.results import RunResult
 from spine_mj.sim.rig import REFINE_TIMESTEP, Rig
+from spine_mj.sim.rollout import BatchOptions
 from spine_mj.theory.motion import MOTION_NAMES, SLIDING, SLIPPING, STUCK, SlipEvent
 
 __all__ = [
@@ -124,6 +125,7 @@ __all__ = [
     "STUCK",
     "ArrayResult",
     "ArrayRig",
+    "BatchOptions",
     "Cone",
     "Detection",
     "Drive",

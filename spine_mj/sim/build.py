@@ -171,7 +171,9 @@ def build_rig(
         **_given(mass_kg=mass_kg, preload_n=preload_n, gravity_m_s2=gravity_m_s2),
     )
     resolution = None if isinstance(surface, GridSurface) else hfield_resolution
-    scales = Scales.for_surface(surface, tip=tip, length_scale_m=length_scale_m, hfield_resolution=resolution)
+    scales, hfield = Scales.with_hfield(
+        surface, tip=tip, length_scale_m=length_scale_m, hfield_resolution=resolution
+    )
     speed = drive_speed_m_s(scales, ie=ie, speed_m_s=speed_m_s, rate_n_s=rate_n_s) if driven else None
     spring = spring_stiffness_n_m(scales, stiffness_number=stiffness_number, stiffness_n_m=stiffness_n_m)
     overrides = _given(
@@ -181,7 +183,6 @@ def build_rig(
         impratio=impratio,
         noslip_iterations=noslip_iterations,
     )
-    overrides["hfield_resolution"] = resolution  # None: the rig's own rule (a grid's samples)
     if solref_timeconst_s is not None or solref_dampratio is not None:
         rule = default_engine(scales, speed_m_s=speed, stiffness_n_m=spring, **overrides)
         overrides["solref"] = (
@@ -189,7 +190,7 @@ def build_rig(
             rule.solref[1] if solref_dampratio is None else solref_dampratio,
         )
     engine = default_engine(scales, speed_m_s=speed, stiffness_n_m=spring, **overrides)
-    return Rig(surface, tip=tip, engine=engine, length_scale_m=length_scale_m)
+    return Rig(surface, tip=tip, engine=engine, sized=(scales, hfield))
 
 
 def build_drive(

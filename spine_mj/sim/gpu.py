@@ -1,7 +1,8 @@
 """Open-loop batches on a GPU through MuJoCo Warp: the optional backend of ``run_batch``.
 
 Install with ``pip install 'spine_mj[gpu]'`` (``mujoco-warp``, which brings ``warp-lang``).
-:func:`run_batch_gpu` takes a rig and the arguments of :meth:`Rig.run_batch` and returns the
+:func:`run_batch_gpu` takes a rig, drives, starts and the :class:`~spine_mj.sim.rollout.BatchOptions`
+of :meth:`Rig.run_batch` and returns the
 same :class:`~spine_mj.sim.results.RunResult` objects: tips are placed, controls built and
 runs analysed by the same public functions as the CPU rollout
 (:func:`~spine_mj.sim.rollout.controls`, :func:`~spine_mj.sim.results.analyse_group`);
@@ -21,12 +22,13 @@ mujoco-warp 4.0 on, has the noslip pass the rig relies on to hold a stuck tip
 (docs/physics.md §5); older MuJoCo Warp and MJX have none, so a rig for them needs
 ``noslip_iterations=0`` and a high ``impratio``. ``benchmarks/run_all.py --gpu`` measures the
 static kappa error of both settings against the CPU engine on inclined planes.
-``device="cpu"`` runs MuJoCo Warp on Warp's CPU device (slow; for checking the path where
+``BatchOptions(device="cpu")`` runs MuJoCo Warp on Warp's CPU device (slow; for checking the path where
 no GPU exists).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import importlib
 import importlib.util
 from collections.abc import Sequence
@@ -38,7 +40,7 @@ from spine_mj.sim.detection import Detection
 from spine_mj.sim.drives import Drive, SpringDrive, settle_steps, stiffness_n_m
 from spine_mj.sim.model import RigModel
 from spine_mj.sim.results import RunResult, analyse_group
-from spine_mj.sim.rollout import batch_drives, controls, drive_steps, run_batch
+from spine_mj.sim.rollout import BatchOptions, batch_drives, controls, drive_steps, run_batch
 
 # import name -> the PyPI package that provides it
 GPU_PACKAGES = {"warp": "warp-lang", "mujoco_warp": "mujoco-warp"}
@@ -116,23 +118,20 @@ def run_batch_gpu(
     rig: RigModel,
     drives: Drive | Sequence[Drive],
     starts: Sequence[tuple[float, float]],
-    *,
-    detection: Detection | None = None,
-    backend: str = "gpu",
-    nthread: int | None = None,
-    device: str | None = None,
+    options: BatchOptions | None = None,
 ) -> list[RunResult]:
     """:meth:`Rig.run_batch` with the stepping on a GPU (MuJoCo Warp).
 
     Parameters
     ----------
     rig : RigModel
-    drives, starts, detection, nthread
-        As for :meth:`Rig.run_batch`; ``nthread`` is used only by the CPU fallback.
-    backend : {"gpu", "auto", "rollout", "python"}
-        See the module docstring; the CPU names run :func:`spine_mj.sim.rollout.run_batch`.
-    device : str or None
-        Warp device; None: the CUDA device. ``"cpu"`` runs MuJoCo Warp on the CPU (tests).
+    drives, starts
+        As for :meth:`Rig.run_batch`.
+    options : BatchOptions or None
+        As for :meth:`Rig.run_batch` (None: ``BatchOptions(backend="gpu")``). ``backend``:
+        see the module docstring; the CPU names run :func:`spine_mj.sim.rollout.run_batch`,
+        which alone uses ``nthread``. ``device``: the Warp device (None: the CUDA device;
+        ``"cpu"`` runs MuJoCo Warp on the CPU, for tests).
 
     Returns
     -------
@@ -144,13 +143,15 @@ def run_batch_gpu(
     SpineInputError
         As :func:`resolve_backend`; bad drives or starts as :meth:`Rig.run_batch`.
     """
+    opt = BatchOptions(backend="gpu") if options is None else options
+    backend, device = opt.backend, opt.device
     if device is None or backend != "gpu":
         backend = resolve_backend(backend)
     if backend != "gpu":
-        return run_batch(rig, drives, starts, detection=detection, backend=backend, nthread=nthread)
+        return run_batch(rig, drives, starts, dataclasses.replace(opt, backend=backend))
     wp, mjw = require_packages()
     drives, starts = batch_drives(drives, starts)
-    det = (Detection() if detection is None else detection).resolve(rig.scales)
+    det = (Detection() if opt.detection is None else opt.detection).resolve(rig.scales)
     rig.check_starts(starts)
     dev = device or "cuda:0"
     dt, s = rig.engine.timestep_s, rig.length_scale_m

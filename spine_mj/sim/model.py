@@ -44,7 +44,7 @@ from spine_mj.sim.params import (
 )
 from spine_mj.sim.placement import Placer
 from spine_mj.sim.recording import SENSOR_NAMES
-from spine_mj.surfaces import BallOnFacets, Surface, TriangulatedSurface, from_hfield
+from spine_mj.surfaces import BallOnFacets, HField, Surface, TriangulatedSurface, from_hfield
 
 MODEL_PATH = model_path()
 #: MuJoCo's latest warning messages (the engine's own text), newest last.
@@ -90,7 +90,12 @@ def start_pair(start) -> tuple[float, float]:
 
 
 class RigModel:
-    """The MuJoCo model of one surface and one tip (parameters as for :class:`~spine_mj.sim.Rig`)."""
+    """The MuJoCo model of one surface and one tip (parameters as for :class:`~spine_mj.sim.Rig`).
+
+    ``sized``, when given, is ``Scales.with_hfield`` of this surface and tip, computed by
+    the caller (:func:`~spine_mj.sim.build.build_rig` needs the scales for the engine
+    first): the rig then uses those scales and that hfield instead of measuring again
+    (``length_scale_m``, ``char_length_m`` and ``hfield_resolution`` are theirs)."""
 
     def __init__(
         self,
@@ -100,6 +105,8 @@ class RigModel:
         engine: EngineSettings | None = None,
         length_scale_m: float | None = None,
         char_length_m: float | None = None,
+        hfield_resolution: int | None = None,
+        sized: tuple[Scales, HField] | None = None,
     ):
         import mujoco
 
@@ -107,23 +114,21 @@ class RigModel:
             raise SpineInputError(f"surface must be a spine_mj Surface, got {type(surface).__name__}")
         quiet_engine()
         tip = TipParams() if tip is None else tip
-        self.scales = Scales.for_surface(
-            surface,
-            tip=tip,
-            length_scale_m=length_scale_m,
-            char_length_m=char_length_m,
-            hfield_resolution=engine.hfield_resolution if engine is not None else None,
-        )
-        resolution = self.scales.hfield_resolution
-        if engine is not None and engine.hfield_resolution != resolution:
-            engine = dataclasses.replace(engine, hfield_resolution=resolution)
+        if sized is None:
+            sized = Scales.with_hfield(
+                surface,
+                tip=tip,
+                length_scale_m=length_scale_m,
+                char_length_m=char_length_m,
+                hfield_resolution=hfield_resolution,
+            )
+        self.scales, self.hfield = sized
         self.surface = surface
         self.tip = dataclasses.replace(tip, tip_radius_m=self.scales.tip_radius_m)
         self.length_scale_m = length_scale_m = self.scales.length_scale_m
         self.units = self.scales.units
         self.engine = default_engine(self.scales) if engine is None else engine
         check_engine_for(self.engine, self.scales)
-        self.hfield = hfield_of(surface, resolution)
         xmin, xmax, ymin, ymax = surface.bounds
         self.bounds_m = tuple(length_scale_m * b for b in (xmin, xmax, ymin, ymax))
         self.z_range_m = self._z_range_m()
@@ -206,7 +211,7 @@ class RigModel:
         """Replace the surface (same grid size) and recompile in place (``spec.recompile``)."""
         import mujoco
 
-        hf = hfield_of(surface, self.engine.hfield_resolution)
+        hf = hfield_of(surface, self.scales.hfield_resolution)
         if (hf.nrow, hf.ncol) != (self.hfield.nrow, self.hfield.ncol):
             raise SpineInputError(
                 f"set_surface needs a {self.hfield.nrow} x {self.hfield.ncol} hfield, "

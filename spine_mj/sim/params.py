@@ -182,9 +182,9 @@ class EngineSettings:
         Contact reference; ``timeconst_s >= 2 timestep_s`` for stability.
     solimp : (dmin, dmax, width_m, midpoint, power)
         Contact impedance.
-    hfield_resolution : int or None
-        Samples per side when an analytic surface is turned into an hfield (None: 201;
-        a grid surface keeps its own samples).
+
+    The hfield's resolution is the rig's geometry, not an engine setting: it lives in
+    :class:`Scales` (``hfield_resolution``).
     """
 
     timestep_s: float
@@ -194,7 +194,6 @@ class EngineSettings:
     noslip_iterations: int = 3
     solref: tuple[float, float] = (1e-3, 1.0)
     solimp: tuple[float, float, float, float, float] = (0.99, 0.99, 1e-3, 0.5, 2.0)
-    hfield_resolution: int | None = None
 
     def __post_init__(self):
         object.__setattr__(self, "timestep_s", check_positive("timestep_s", self.timestep_s))
@@ -239,9 +238,6 @@ class EngineSettings:
                 f"0 < dmin, dmax < 1 and width_m > 0, got {self.solimp!r}"
             )
         object.__setattr__(self, "solimp", si)
-        res = self.hfield_resolution
-        if res is not None and (isinstance(res, bool) or int(res) != res or res < 4):
-            raise SpineInputError(f"hfield_resolution must be an integer >= 4 or None, got {res!r}")
 
     def to_dict(self) -> dict:
         d = dataclasses.asdict(self)
@@ -333,7 +329,28 @@ class Scales:
         char_length_m: float | None = None,
         hfield_resolution: int | None = None,
     ) -> Scales:
-        """The scales of ``tip`` on ``surface``: the one place the rig's sizing rules live.
+        """The scales of ``tip`` on ``surface`` (:meth:`with_hfield` without the hfield)."""
+        return cls.with_hfield(
+            surface,
+            tip=tip,
+            length_scale_m=length_scale_m,
+            char_length_m=char_length_m,
+            hfield_resolution=hfield_resolution,
+        )[0]
+
+    @classmethod
+    def with_hfield(
+        cls,
+        surface: Surface,
+        *,
+        tip: TipParams | None = None,
+        length_scale_m: float | None = None,
+        char_length_m: float | None = None,
+        hfield_resolution: int | None = None,
+    ) -> tuple[Scales, HField]:
+        """The scales of ``tip`` on ``surface`` and the hfield they were measured on (the
+        rig's model is built from that same hfield): the one place the rig's sizing rules
+        live.
 
         * ``length_scale_m``: None gives :data:`DEFAULT_LENGTH_SCALE_M` for a dimensionless
           surface (``unit == "1"``) and the unit's size (:data:`LENGTH_UNITS_M`) otherwise.
@@ -362,10 +379,11 @@ class Scales:
         if char_length_m is None:
             char_length_m = characteristic_length(surface) * length_scale_m
         char_length_m = check_physical_length("char_length_m", char_length_m)
-        if hfield_resolution is not None and hfield_resolution > MAX_HFIELD_SIDE:
-            raise SpineInputError(
-                f"hfield_resolution must be <= {MAX_HFIELD_SIDE} samples a side, got {hfield_resolution}"
-            )
+        res = hfield_resolution
+        if res is not None and (isinstance(res, bool) or int(res) != res or res < 4):
+            raise SpineInputError(f"hfield_resolution must be an integer >= 4 or None, got {res!r}")
+        if res is not None and res > MAX_HFIELD_SIDE:
+            raise SpineInputError(f"hfield_resolution must be <= {MAX_HFIELD_SIDE} samples a side, got {res}")
         hf = hfield_of(surface, hfield_resolution)
         spacing = hfield_spacing(hf, length_scale_m)
         radius = tip.tip_radius_m
@@ -386,7 +404,7 @@ class Scales:
             mu=tip.mu_s,
             radius=radius,
         )
-        return cls(
+        scales = cls(
             length_scale_m=length_scale_m,
             char_length_m=char_length_m,
             mass_kg=tip.mass_kg,
@@ -398,6 +416,7 @@ class Scales:
             extent_m=math.hypot(xmax - xmin, ymax - ymin),
             fall_height_m=fall,
         )
+        return scales, hf
 
     @property
     def units(self) -> EngineUnits:
@@ -662,7 +681,6 @@ def default_engine(
         "timestep_s": dt,
         "solref": (2 * dt, 1.0),
         "solimp": (0.99, 0.99, 0.01 * scales.tip_radius_m, 0.5, 2.0),
-        "hfield_resolution": scales.hfield_resolution,
     }
     if "timestep_s" in overrides and "solref" not in overrides:
         base["solref"] = (2 * float(overrides["timestep_s"]), 1.0)

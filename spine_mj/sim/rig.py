@@ -20,7 +20,7 @@ from spine_mj.sim.model import RigModel
 from spine_mj.sim.ramp import run_ramp
 from spine_mj.sim.render import render_frames
 from spine_mj.sim.results import RunResult
-from spine_mj.sim.rollout import batch_drives, controls, run_batch
+from spine_mj.sim.rollout import BatchOptions, batch_drives, controls, run_batch
 
 #: A run stopped on penetration is run once more at this fraction of the time step and
 #: contact time constant (``Rig.run_batch``, ``refine``). The engine rule bounds the
@@ -47,6 +47,13 @@ class Rig(RigModel):
         length unit otherwise (1e-6 for ``"um"``; :func:`~spine_mj.sim.params.surface_unit_m`).
     char_length_m : float or None
         L_c [m]; None: :func:`characteristic_length` times ``length_scale_m``.
+    hfield_resolution : int or None
+        Samples a side the hfield is resampled to (None: a grid keeps its own samples, an
+        analytic surface gets 201; either coarsened to a quarter tip radius,
+        :meth:`~spine_mj.sim.params.Scales.with_hfield`).
+    sized : (Scales, HField) or None
+        ``Scales.with_hfield`` of this surface and tip when the caller already has them
+        (:func:`~spine_mj.sim.build.build_rig`); None measures them here.
 
     Raises
     ------
@@ -115,23 +122,29 @@ class Rig(RigModel):
         rig at :data:`REFINE_TIMESTEP` of its step (a landing the engine rule did not
         foresee); its result replaces the stopped one (CPU backends).
         """
-        if backend in ("gpu", "auto"):
-            return run_batch_gpu(self, drives, starts, detection=detection, backend=backend, nthread=nthread)
-        runs = run_batch(
-            self, drives, starts, detection=detection, backend=backend, nthread=nthread, stop_early=stop_early
+        return self.run_batch_with(
+            drives,
+            starts,
+            BatchOptions(
+                detection=detection, backend=backend, nthread=nthread, stop_early=stop_early, refine=refine
+            ),
         )
+
+    def run_batch_with(
+        self, drives: Drive | Sequence[Drive], starts: Sequence[tuple[float, float]], options: BatchOptions
+    ) -> list[RunResult]:
+        """:meth:`run_batch` with its options as one record (and a GPU ``device``)."""
+        if options.backend in ("gpu", "auto"):
+            return run_batch_gpu(self, drives, starts, options)
+        runs = run_batch(self, drives, starts, options)
         redo = [i for i, r in enumerate(runs) if r.engine_trouble == "penetration"]
-        if not refine or not redo:
+        if not options.refine or not redo:
             return runs
         drive_list, start_list = batch_drives(drives, starts)
-        again = self.refined().run_batch(
+        again = self.refined().run_batch_with(
             [drive_list[i] for i in redo],
             [start_list[i] for i in redo],
-            detection=detection,
-            backend=backend,
-            nthread=nthread,
-            stop_early=stop_early,
-            refine=False,
+            dataclasses.replace(options, refine=False),
         )
         runs = list(runs)
         for i, run in zip(redo, again):
@@ -145,13 +158,7 @@ class Rig(RigModel):
         engine = dataclasses.replace(
             e, timestep_s=factor * e.timestep_s, solref=(factor * e.solref[0], e.solref[1])
         )
-        return Rig(
-            self.surface,
-            tip=self.tip,
-            engine=engine,
-            length_scale_m=self.length_scale_m,
-            char_length_m=self.scales.char_length_m,
-        )
+        return Rig(self.surface, tip=self.tip, engine=engine, sized=(self.scales, self.hfield))
 
     def controls(self, drive: Drive, qpos0: np.ndarray, detection: Detection) -> np.ndarray:
         """Open-loop controls ``(nstep, 6)`` of a run from the placed start ``qpos0``.

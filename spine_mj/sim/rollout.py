@@ -54,6 +54,7 @@ import os
 import queue
 import threading
 from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
@@ -234,28 +235,58 @@ def batch_drives(drives, starts) -> tuple[list[Drive], list[tuple[float, float]]
     return drives, starts
 
 
+@dataclass(frozen=True)
+class BatchOptions:
+    """How a batch runs: the options of :meth:`~spine_mj.sim.Rig.run_batch`, one record
+    for the CPU path (:func:`run_batch`) and the GPU path
+    (:func:`~spine_mj.sim.gpu.run_batch_gpu`).
+
+    Attributes
+    ----------
+    detection : Detection or None
+        The end events (None: :class:`~spine_mj.sim.detection.Detection`'s defaults).
+    backend : {"rollout", "python", "gpu", "auto"}
+        Native CPU threads, the plain reference loop, MuJoCo Warp, or the GPU where one is
+        present (:func:`~spine_mj.sim.gpu.resolve_backend`).
+    nthread : int or None
+        Worker threads of the CPU rollout (None: the CPU count).
+    stop_early : bool
+        Stop a run after the piece that decided its outcome (CPU backends).
+    refine : bool
+        Run a run stopped on penetration once more at a finer step (CPU backends;
+        :meth:`~spine_mj.sim.Rig.run_batch`).
+    device : str or None
+        Warp device of the GPU backend (None: the CUDA device; ``"cpu"``: Warp's CPU).
+    """
+
+    detection: Detection | None = None
+    backend: str = "rollout"
+    nthread: int | None = None
+    stop_early: bool = True
+    refine: bool = True
+    device: str | None = None
+
+
 def run_batch(
     rig: RigModel,
     drives: Drive | Sequence[Drive],
     starts: Sequence[tuple[float, float]],
-    *,
-    detection: Detection | None = None,
-    backend: str = "rollout",
-    nthread: int | None = None,
-    stop_early: bool = True,
+    options: BatchOptions | None = None,
 ) -> list[RunResult]:
-    """Run many starts and/or drive parameter sets of ``rig``'s model (see :meth:`Rig.run_batch`)."""
+    """Run many starts and/or drive parameter sets of ``rig``'s model on the CPU (see
+    :meth:`Rig.run_batch`; ``options.refine`` and ``options.device`` are not used here)."""
+    opt = BatchOptions() if options is None else options
     drives, starts = batch_drives(drives, starts)
-    if backend not in ("rollout", "python"):
-        raise SpineInputError(f"backend must be 'rollout' or 'python', got {backend!r}")
-    det = (Detection() if detection is None else detection).resolve(rig.scales)
+    if opt.backend not in ("rollout", "python"):
+        raise SpineInputError(f"backend must be 'rollout' or 'python', got {opt.backend!r}")
+    det = (Detection() if opt.detection is None else opt.detection).resolve(rig.scales)
     rig.check_starts(starts)
     runner = _BatchRunner(rig, drives, starts, det)
-    nthread = (os.cpu_count() or 1) if nthread is None else max(1, int(nthread))
-    lanes = _NativeLanes(nthread) if backend == "rollout" else _PythonLane()
+    nthread = (os.cpu_count() or 1) if opt.nthread is None else max(1, int(opt.nthread))
+    lanes = _NativeLanes(nthread) if opt.backend == "rollout" else _PythonLane()
     try:
         for idx in plan_groups(runner.lengths, 8 * (runner.nstate + rig.model.nsensordata)):
-            group = _Group(runner, idx, stop_early)
+            group = _Group(runner, idx, opt.stop_early)
             for j, res in zip(idx, group.run(lanes)):
                 runner.results[j] = res
     finally:

@@ -49,15 +49,16 @@ def load_run(run_dir: str | Path) -> tuple[RigModel, Track]:
         raise SpineInputError(f"{run_dir / 'summary.json'} is not readable JSON ({exc})") from None
     try:
         sc = summary["scales"]
+        engine = dict(summary["engine"])
+        engine.pop("hfield_resolution", None)  # older runs recorded it with the engine; the scales hold it
         rig = RigModel(
             surface_io.load_surface(run_dir / "surface.npz"),
             tip=TipParams(**summary["tip"]),
             # a Bullet run is shown on MuJoCo's model of the same surface (its derived settings)
-            engine=None
-            if summary["engine"].get("engine") == "bullet"
-            else EngineSettings(**summary["engine"]),
+            engine=None if engine.get("engine") == "bullet" else EngineSettings(**engine),
             length_scale_m=sc["length_scale_m"],
             char_length_m=sc["char_length_m"],
+            hfield_resolution=sc.get("hfield_resolution"),
         )
         drive = _DRIVES[summary["drive"]](**summary["drive_params"])
         start = tuple(summary["start"])

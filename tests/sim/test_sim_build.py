@@ -86,7 +86,7 @@ def test_cli_and_sweep_build_the_same_model_on_an_analytic_surface(tmp_path):
         {"mu": 1.2, "tip_radius": 0.2, "hfield_resolution": 41},
     )
     _assert_same_model(summary, rig, drive)
-    assert rig.hfield.ncol == 41 and summary["engine"]["hfield_resolution"] == 41
+    assert rig.hfield.ncol == 41 and summary["scales"]["hfield_resolution"] == 41
 
 
 def test_cli_and_sweep_keep_a_grids_own_samples(tmp_path):

@@ -11,7 +11,7 @@ import pytest
 from sim_rigs import MU, START, flat_rig
 
 from spine_mj.errors import SpineInputError
-from spine_mj.sim import SpringDrive, gpu
+from spine_mj.sim import BatchOptions, SpringDrive, gpu
 
 DRIVE = SpringDrive(speed_m_s=0.01, stiffness_n_m=50.0, duration_s=0.25)  # slides after ~0.1 s
 STARTS = [START, (1e-3, -2e-3)]
@@ -26,7 +26,7 @@ def test_missing_package_is_one_clear_error(rig, monkeypatch):
     monkeypatch.setitem(sys.modules, "mujoco_warp", None)  # what find_spec reports when absent
     assert "mujoco-warp" in gpu.missing_packages()
     with pytest.raises(SpineInputError, match=r"mujoco-warp.*pip install 'spine_mj\[gpu\]'"):
-        gpu.run_batch_gpu(rig, DRIVE, STARTS, backend="gpu")
+        gpu.run_batch_gpu(rig, DRIVE, STARTS, BatchOptions(backend="gpu"))
     assert gpu.cuda_device_count() == 0
 
 
@@ -41,7 +41,7 @@ def test_auto_falls_back_to_the_cpu_rollout(rig):
     if gpu.gpu_available():
         pytest.skip("a CUDA device is present: auto runs on it")
     assert gpu.resolve_backend("auto") == "rollout"
-    got = gpu.run_batch_gpu(rig, DRIVE, STARTS, backend="auto")
+    got = gpu.run_batch_gpu(rig, DRIVE, STARTS, BatchOptions(backend="auto"))
     ref = rig.run_batch(DRIVE, STARTS)
     for a, b in zip(got, ref):
         np.testing.assert_array_equal(a.position_m, b.position_m)
@@ -79,7 +79,7 @@ def test_warp_on_cpu_matches_the_cpu_engine(rig):
     friction cone creeps below mu N).
     """
     pytest.importorskip("mujoco_warp")
-    got = gpu.run_batch_gpu(rig, DRIVE, STARTS, device="cpu")
+    got = gpu.run_batch_gpu(rig, DRIVE, STARTS, BatchOptions(backend="gpu", device="cpu"))
     ref = rig.run_batch(DRIVE, STARTS)
     for a, b in zip(got, ref):
         assert a.n == b.n and a.end_reason is b.end_reason

@@ -147,7 +147,7 @@ def test_fine_grid_is_coarsened_to_respect_the_contact_cap():
     surf = sandpaper(grit="P600", size_m=0.3e-3, rng=1)
     rig = Rig(surf, tip=TipParams(tip_radius_m=25e-6))
     assert rig.scales.hfield_spacing_m >= 0.25 * 25e-6 * (1 - 1e-9)
-    assert rig.engine.hfield_resolution == rig.hfield.ncol
+    assert rig.scales.hfield_resolution == rig.hfield.ncol
     for start in [(0.0, 0.0), (-1e-4, 5e-5), (1e-4, -1e-4)]:
         z = rig.place(*start)[2] * rig.units.length_m
         assert surf.height(*start) < z < surf.heights.max() + 2 * 25e-6

@@ -58,9 +58,8 @@ def test_engine_settings_are_recorded_with_every_run():
     summary = res.summary()
     eng = summary["engine"]
     assert eng["timestep_s"] == rig.engine.timestep_s and eng["cone"] == "elliptic"
-    assert {"integrator", "impratio", "noslip_iterations", "solref", "solimp", "hfield_resolution"} <= set(
-        eng
-    )
+    assert {"integrator", "impratio", "noslip_iterations", "solref", "solimp"} <= set(eng)
+    assert summary["scales"]["hfield_resolution"] == rig.scales.hfield_resolution
     # the default rule: resting penetration a_p dt^2 <= 0.5 % of the tip radius
     assert rig.scales.preload_n / rig.tip.mass_kg * rig.engine.timestep_s**2 <= 0.005 * R_TIP
     assert res.penetration_m.max() < 0.01 * rig.scales.char_length_m
@@ -75,9 +74,11 @@ def test_scales_for_surface_are_the_rigs_scales_without_building_a_model():
     tip = TipParams(mass_kg=0.02)
     scales = Scales.for_surface(surf, tip=tip, hfield_resolution=101)
     rig = Rig(
-        surf, tip=tip, engine=EngineSettings(timestep_s=1e-3, solref=(2e-3, 1.0), hfield_resolution=101)
+        surf, tip=tip, engine=EngineSettings(timestep_s=1e-3, solref=(2e-3, 1.0)), hfield_resolution=101
     )
     assert scales == rig.scales
+    hfield = Scales.with_hfield(surf, tip=tip, hfield_resolution=101)[1]
+    assert hfield.size == rig.hfield.size and (hfield.data == rig.hfield.data).all()
     lc_m = characteristic_length(surf) * DEFAULT_LENGTH_SCALE_M
     spacing_m = 10 / 100 * DEFAULT_LENGTH_SCALE_M
     assert scales.char_length_m == pytest.approx(lc_m, rel=1e-12)

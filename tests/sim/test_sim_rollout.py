@@ -124,8 +124,8 @@ def _stiff_spring_rig():
     surface = presets.make_surface("paper-single-peak")
     tip = sim.TipParams(mu_s=1.23)
     scales = sim.Scales.for_surface(surface, tip=tip, hfield_resolution=61)
-    engine = sim.default_engine(scales, hfield_resolution=61, timestep_s=0.01)
-    rig = sim.Rig(surface, tip=tip, engine=engine)
+    engine = sim.default_engine(scales, timestep_s=0.01)
+    rig = sim.Rig(surface, tip=tip, engine=engine, hfield_resolution=61)
     rig.check_drive = lambda drive: None  # run the spring the rig would refuse (model.check_drive)
     return rig
 
