@@ -19,9 +19,9 @@ def bench_array(quick: bool) -> dict:
 
     surf = presets.make_surface("paper-random-concave")
     tip = sim.TipParams(mu_s=presets.preset_mu(surf) or 0.5)
-    sc = sim.Scales.for_surface(surf, tip=tip, hfield_resolution=151)
+    sc, hfield = sim.Scales.with_hfield(surf, tip=tip, hfield_resolution=151)
     speed = sc.speed_for(1e-3)
-    rig = sim.Rig(surf, tip=tip, engine=sim.default_engine(sc, speed_m_s=speed))
+    rig = sim.Rig(surf, tip=tip, engine=sim.default_engine(sc, speed_m_s=speed), sized=(sc, hfield))
     drive = sim.SpringDrive(speed_m_s=speed, duration_s=2 * sc.char_length_m / speed)
     repeats = 2 if quick else 5
     rows = []

@@ -133,9 +133,9 @@ def _rig(preset: str, mu: float | None, plan: ArrayPlan):
     mu = presets.resolve_mu(surf, mu)
     tip = sim.TipParams(mu_s=mu)
     res = plan.hfield_resolution if surf.unit == "1" else None
-    sc = sim.Scales.for_surface(surf, tip=tip, hfield_resolution=res)
-    speed = sc.speed_for(ARRAY_IE)
-    return sim.Rig(surf, tip=tip, engine=sim.default_engine(sc, speed_m_s=speed)), speed
+    sized = sim.Scales.with_hfield(surf, tip=tip, hfield_resolution=res)
+    speed = sized[0].speed_for(ARRAY_IE)
+    return sim.Rig(surf, tip=tip, engine=sim.default_engine(sized[0], speed_m_s=speed), sized=sized), speed
 
 
 def _centres(
