@@ -22,6 +22,8 @@ Two rules live here:
 
 from __future__ import annotations
 
+import dataclasses
+
 from spine_mj.errors import SpineInputError, check_positive
 from spine_mj.sim.array import ArrayRig
 from spine_mj.sim.array_run import ArrayDrive, ForcePull
@@ -174,6 +176,7 @@ def build_rig(
     scales, hfield = Scales.with_hfield(
         surface, tip=tip, length_scale_m=length_scale_m, hfield_resolution=resolution
     )
+    tip = dataclasses.replace(tip, tip_radius_m=scales.tip_radius_m)  # the radius the rig was sized for
     speed = drive_speed_m_s(scales, ie=ie, speed_m_s=speed_m_s, rate_n_s=rate_n_s) if driven else None
     spring = spring_stiffness_n_m(scales, stiffness_number=stiffness_number, stiffness_n_m=stiffness_n_m)
     overrides = _given(

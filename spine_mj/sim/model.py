@@ -124,7 +124,8 @@ class RigModel:
             )
         self.scales, self.hfield = sized
         self.surface = surface
-        self.tip = dataclasses.replace(tip, tip_radius_m=self.scales.tip_radius_m)
+        radius = self.scales.tip_radius_m
+        self.tip = tip if tip.tip_radius_m == radius else dataclasses.replace(tip, tip_radius_m=radius)
         self.length_scale_m = length_scale_m = self.scales.length_scale_m
         self.units = self.scales.units
         self.engine = default_engine(self.scales) if engine is None else engine
