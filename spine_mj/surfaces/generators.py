@@ -342,7 +342,6 @@ def fractal_fbm(
     long_cutoff = None if long_cutoff is None else check_positive("long_cutoff", long_cutoff)
     short_cutoff = None if short_cutoff is None else check_positive("short_cutoff", short_cutoff)
     gen, seed = _rng_and_seed(rng)
-
     dx, dy = lx / nx, ly / ny
     heights = _fbm_heights(gen, (nx, ny), (dx, dy), hurst, periodic, long_cutoff, short_cutoff)
     if rms_slope is not None:
@@ -354,12 +353,10 @@ def fractal_fbm(
             f"fractal_fbm: size {lx:g} x {ly:g} with rms_height {rms_height} and rms_slope {rms_slope} "
             "gives heights beyond floating-point range; use sizes and RMS values nearer 1"
         )
-    x = -lx / 2 + dx * np.arange(nx)
-    y = -ly / 2 + dy * np.arange(ny)
     return GridSurface(
         heights=heights,
-        x=x,
-        y=y,
+        x=-lx / 2 + dx * np.arange(nx),
+        y=-ly / 2 + dy * np.arange(ny),
         periodic=bool(periodic),
         unit=unit,
         metadata=_meta(

@@ -128,9 +128,8 @@ def run_sweep(
         process. Ignored when ``scheduler`` is given.
     scheduler : str or distributed.Client, optional
         Address of a Dask distributed scheduler (``tcp://host:8786``) or a connected client:
-        cases run on its workers, which need spine_mj installed. Results come back to this
-        process, which writes the store, so workers need no shared file system (surface
-        files named in the config must be readable by them, though).
+        cases run on its workers (spine_mj installed, the config's surface files readable);
+        results come back to this process, which writes the store (no shared file system).
     overwrite : bool
         Replace a store holding another config.
     retry_failed : bool
@@ -181,17 +180,8 @@ def run_sweep(
     >>> sorted(runs.groupby("mu")["self_locked"].sum().astype(int).tolist())
     [0, 1]
     """
-    if not (math.isfinite(worker_wait_s) and worker_wait_s > 0):
-        raise SpineInputError(f"--worker-wait must be a number of seconds > 0, got {worker_wait_s!r}")
-    if not isinstance(config, SweepConfig):
-        config = load_config(config)
-    if workers is not None:
-        check_workers(workers)
-    out_dir = Path(out_dir)
-    if out_dir.exists() and not out_dir.is_dir():
-        raise SpineInputError(f"--out {out_dir} exists and is not a folder")
+    config, out_dir, n_workers = _checked_inputs(config, out_dir, workers, scheduler, worker_wait_s)
     cases = expand_cases(config)
-    n_workers = None if scheduler is not None else (workers or os.cpu_count() or 1)
     session = _session_record(n_workers, scheduler)
     clear_caches()
     check_cases(cases, config.swept)  # an input error refuses the config, not every run
@@ -215,6 +205,23 @@ def run_sweep(
     finally:
         if client is not None and client is not scheduler:
             client.close()
+
+
+def _checked_inputs(
+    config, out_dir, workers, scheduler, worker_wait_s
+) -> tuple[SweepConfig, Path, int | None]:
+    """:func:`run_sweep`'s config (read if a path), store folder and local worker count
+    (None with a scheduler), or SpineInputError naming the bad one."""
+    if not (math.isfinite(worker_wait_s) and worker_wait_s > 0):
+        raise SpineInputError(f"--worker-wait must be a number of seconds > 0, got {worker_wait_s!r}")
+    if not isinstance(config, SweepConfig):
+        config = load_config(config)
+    if workers is not None:
+        check_workers(workers)
+    out_dir = Path(out_dir)
+    if out_dir.exists() and not out_dir.is_dir():
+        raise SpineInputError(f"--out {out_dir} exists and is not a folder")
+    return config, out_dir, None if scheduler is not None else (workers or os.cpu_count() or 1)
 
 
 def _session_record(n_workers: int | None, scheduler) -> dict:

@@ -463,6 +463,24 @@ def _stalled(L, a, params):
     return check[stuck]
 
 
+def _end_decided(L, rec, a, stopped, locked, hold, finite, params) -> np.ndarray:
+    """End the lanes ``a`` whose path is decided at their accepted point, each by the first
+    reason that applies (carriage at its end, self-lock, force cap, step cap, no direction);
+    returns the mask of the ended ones."""
+    ended = np.zeros(a.size, bool)
+    for mask, code in (
+        (stopped, Outcome.DRIVE_END),
+        (locked, Outcome.SELF_LOCKED),
+        (~locked & (hold > params.kappa_cap), Outcome.FORCE_CAP),
+        (L.n_steps[a] >= params.max_steps, Outcome.STEP_CAP),
+        (~finite, Outcome.STALLED),
+    ):
+        m = mask & ~ended
+        _end(L, rec, a[m], code)
+        ended |= m
+    return ended
+
+
 def _run(surface, xs, ys, params, c, carriage_end):
     """The vectorized loop: one surface evaluation for all active lanes per iteration."""
     n = xs.size
@@ -508,17 +526,7 @@ def _run(surface, xs, ys, params, c, carriage_end):
         a, z, kap, hold, slip = a[ok], z[ok], kap[ok], hold[ok], slip[ok]
         vx, vy, locked, finite, reversed_ = vx[ok], vy[ok], locked[ok], finite[ok], reversed_[ok]
         stopped = _accept(L, rec, a, z, kap, hold, slip, c, carriage_end)
-        ended = np.zeros(a.size, bool)
-        for mask, code in (
-            (stopped, Outcome.DRIVE_END),
-            (locked, Outcome.SELF_LOCKED),
-            (~locked & (hold > params.kappa_cap), Outcome.FORCE_CAP),
-            (L.n_steps[a] >= params.max_steps, Outcome.STEP_CAP),
-            (~finite, Outcome.STALLED),
-        ):
-            m = mask & ~ended
-            _end(L, rec, a[m], code)
-            ended |= m
+        ended = _end_decided(L, rec, a, stopped, locked, hold, finite, params)
         left = _step(L, a[~ended], vx[~ended], vy[~ended], slip[~ended], reversed_[~ended], params, domain)
         _end(L, rec, left, Outcome.LEFT_DOMAIN)
         stalled = _stalled(L, a[~ended], params)

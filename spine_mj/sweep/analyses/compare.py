@@ -149,6 +149,20 @@ def _compliant(
     return out
 
 
+def _pace(facets, runs, scales) -> dict:
+    """Whether the paths are quasistatic at all: the share of the reference's path that
+    gravity slides alone, and the engine tip's own peak speed as an inertia number (falls
+    go at gravity's pace, whatever the drive's)."""
+    return {
+        "reference_slide_fraction": np.array(
+            [compare.slide_fraction(_xy(facets, i), facets.path(i)["region"]) for i in range(len(facets))]
+        ),
+        "tip_peak_ie": np.array(
+            [scales.inertia_number(compare.peak_speed(r.velocity_m_s[r.drive_start_index :])) for r in runs]
+        ),
+    }
+
+
 def _compare(case, surface, starts, upstream):
     quasistatic = upstream["quasistatic"].data
     rig, runs = upstream["mujoco"].data
@@ -214,17 +228,7 @@ def _compare(case, surface, starts, upstream):
         **compliant,
         "kappa_ratio": kap["ratio"],
         "inertia_number": np.array([r.inertia_number for r in runs]),
-        # whether the paths are quasistatic at all: gravity slides on the reference, and the
-        # engine tip's own peak speed as an inertia number (falls go at gravity's pace)
-        "reference_slide_fraction": np.array(
-            [compare.slide_fraction(_xy(facets, i), facets.path(i)["region"]) for i in range(len(facets))]
-        ),
-        "tip_peak_ie": np.array(
-            [
-                rig.scales.inertia_number(compare.peak_speed(r.velocity_m_s[r.drive_start_index :]))
-                for r in runs
-            ]
-        ),
+        **_pace(facets, runs, rig.scales),
     }
     reason = np.where(
         status == "ok", "", "mujoco run: " + np.asarray(upstream["mujoco"].reason, dtype=object)
