@@ -36,7 +36,7 @@ import numpy as np
 from spine_mj.errors import SpineInputError
 from spine_mj.surfaces import BallOnFacets, Surface
 from spine_mj.theory.engagement import DEFAULT_TOL, ENGAGED, SELF_LOCK, SLIP, quadratic_coefficients
-from spine_mj.theory.streamline import Outcome, StreamlineParams, _starts, check_step
+from spine_mj.theory.streamline import Outcome, StreamlineParams, check_step, start_points
 
 __all__ = ["CompliantResult", "Fold", "MotionState", "compliant_streamlines", "hold_force"]
 
@@ -309,7 +309,7 @@ def compliant_streamlines(
     number = isinstance(c, (int, float, np.floating)) and not isinstance(c, bool)
     if not (number and math.isfinite(c) and c > 0):
         raise SpineInputError(f"stiffness (k / W, 1 / length) must be a finite number > 0, got {stiffness!r}")
-    xs, ys = _starts(surface, starts)
+    xs, ys = start_points(surface, starts)
     check_step(surface, params.dl)
     end = np.broadcast_to(np.asarray(np.inf if carriage_end is None else carriage_end, float), xs.shape)
     if np.isnan(end).any() or (end < xs).any():
