@@ -320,23 +320,11 @@ class Scales:
     fall_height_m: float = 0.0
 
     @classmethod
-    def for_surface(
-        cls,
-        surface: Surface,
-        *,
-        tip: TipParams | None = None,
-        length_scale_m: float | None = None,
-        char_length_m: float | None = None,
-        hfield_resolution: int | None = None,
-    ) -> Scales:
-        """The scales of ``tip`` on ``surface`` (:meth:`with_hfield` without the hfield)."""
-        return cls.with_hfield(
-            surface,
-            tip=tip,
-            length_scale_m=length_scale_m,
-            char_length_m=char_length_m,
-            hfield_resolution=hfield_resolution,
-        )[0]
+    def for_surface(cls, surface: Surface, **sizing) -> Scales:
+        """The scales of a tip on ``surface``: :meth:`with_hfield` (the same keyword
+        arguments: ``tip``, ``length_scale_m``, ``char_length_m``, ``hfield_resolution``)
+        without the hfield."""
+        return cls.with_hfield(surface, **sizing)[0]
 
     @classmethod
     def with_hfield(
