@@ -19,7 +19,8 @@ change on those starts: the refined runs' number minus the same number of the co
 runs from those starts. A headline is *converged* under a refinement when the headline
 plus that change lies inside the headline's own 95 % interval (Wilson for the agreement,
 bootstrap for the median): the refinement moves it less than the sample already leaves
-open. With three step levels the observed order and the Richardson estimate follow
+open; or when the change is below what the metric resolves (:data:`RESOLUTIONS`). With
+three step levels the observed order and the Richardson estimate follow
 (:func:`observed_order`, :func:`richardson`).
 """
 
@@ -37,6 +38,7 @@ from spine_mj import presets
 from spine_mj.errors import SpineInputError
 from spine_mj.surfaces import GridSurface
 from spine_mj.validate.plans import FamilySpec
+from spine_mj.validate.theory_orders import FRECHET_FLOOR_LC
 
 __all__ = [
     "HEADLINES",
@@ -66,6 +68,12 @@ REFINEMENT_LABELS = {"dt_halved": "dt / 2", "dt_quartered": "dt / 4", "hfield_do
 #: The corner's headlines: key in the family summary -> the key of its 95 % interval.
 HEADLINES = {"outcome_agreement": "outcome_agreement_ci", "median_frechet": "median_frechet_ci"}
 
+#: The resolution of each headline: the Frechet distance resolves half a sample of the
+#: paths' L_c / 50 resampling (:data:`spine_mj.validate.theory_orders.FRECHET_FLOOR_LC`; the
+#: corner's medians sit at it where paths coincide, so their bootstrap interval can be
+#: narrower than what the metric tells apart); a rate, one run.
+RESOLUTIONS = {"outcome_agreement": 0.0, "median_frechet": FRECHET_FLOOR_LC}
+
 #: The names of the changes in ``validation.json`` (the issue's keys).
 CHANGE_KEYS = {"outcome_agreement": "agreement_change", "median_frechet": "median_frechet_change"}
 
@@ -94,13 +102,17 @@ def richardson(fine: float, medium: float, order: float, *, ratio: float = 2.0) 
     return fine + (fine - medium) / (ratio**order - 1.0)
 
 
-def is_converged(value: float, change: float, interval: Sequence[float]) -> bool | None:
-    """Whether ``value + change`` lies inside ``interval`` (the value's own 95 % interval);
-    None where any of them is not finite (nothing was refined, or no interval)."""
+def is_converged(
+    value: float, change: float, interval: Sequence[float], *, resolution: float = 0.0
+) -> bool | None:
+    """Whether ``value + change`` lies inside ``interval`` (the value's own 95 % interval),
+    or the change is within the metric's ``resolution`` (a change the metric cannot tell
+    from none); None where any of them is not finite (nothing was refined, or no
+    interval)."""
     low, high = (float(b) for b in interval)
     if not all(math.isfinite(v) for v in (value, change, low, high)):
         return None
-    return bool(low <= value + change <= high)
+    return bool(low <= value + change <= high or abs(change) <= resolution)
 
 
 def refinable(preset: str, seeds, key: str) -> bool:
@@ -137,10 +149,12 @@ def _statistic(rows: pd.DataFrame, headline: str) -> float:
 
 
 def _keys(rows: pd.DataFrame) -> pd.Series:
-    """A start's identity across sweeps: its surface and its point (rounded far below any
-    ensemble offset)."""
+    """A start's identity across sweeps: its surface (label and L_c: a generator variant
+    keeps the label) and its point (rounded far below any ensemble offset)."""
     return (
         rows["surface"].astype(str)
+        + "/"
+        + rows["surface_lc"].astype(float).round(9).astype(str)
         + "@"
         + rows["start_x"].astype(float).round(9).astype(str)
         + ","
@@ -150,8 +164,9 @@ def _keys(rows: pd.DataFrame) -> pd.Series:
 
 def paired_change(base: pd.DataFrame, refined: pd.DataFrame) -> dict:
     """Each headline of the corner's own runs ``base`` and of the ``refined`` runs on the
-    starts both have (``surface``, ``start_x``, ``start_y``, ``agree``, ``frechet``), and its
-    change (refined - base), with the number of paired runs ``runs``."""
+    starts both have (``surface``, ``surface_lc``: the surface's L_c, ``start_x``,
+    ``start_y``, ``agree``, ``frechet``), and its change (refined - base), with the number
+    of paired runs ``runs``."""
     b = base.assign(_key=_keys(base)).drop_duplicates("_key").set_index("_key")
     r = refined.assign(_key=_keys(refined)).drop_duplicates("_key").set_index("_key")
     common = b.index.intersection(r.index)
@@ -204,7 +219,7 @@ def family_convergence(summary: dict, base: pd.DataFrame, refined: dict[str, pd.
         verdicts = []
         for headline, ci_key in HEADLINES.items():
             change = pc[headline]["change"]
-            ok = is_converged(summary[headline], change, summary[ci_key])
+            ok = is_converged(summary[headline], change, summary[ci_key], resolution=RESOLUTIONS[headline])
             entry[CHANGE_KEYS[headline]] = change
             entry[headline] = {"base": pc[headline]["base"], "refined": pc[headline]["refined"]}
             entry[f"{headline}_converged"] = ok

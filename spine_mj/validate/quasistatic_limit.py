@@ -259,7 +259,9 @@ def _refined_rows(family: str, keys, refinements, results) -> dict[str, pd.DataF
     out: dict[str, pd.DataFrame | None] = {key: None for key in keys}
     for (fam, key, _, _), (df, _) in zip(refinements, results):
         if fam == family:
-            rows = df[df["analysis"] == "compare"]
+            rows = df[df["analysis"] == "compare"].copy()
+            mj = df[df["analysis"] == "mujoco"].set_index(["case_id", "start"])
+            rows["surface_lc"] = [mj.loc[k, "char_length"] for k in zip(rows["case_id"], rows["start"])]
             out[key] = rows if out[key] is None else pd.concat([out[key], rows], ignore_index=True)
     return out
 
@@ -344,6 +346,7 @@ def _sweep_comparison(
     comp["family"] = fam.name
     # a preset surface's label is the preset's name, with "#seed" after a seeded one
     comp["preset"] = comp["surface"].astype(str).str.partition("#")[0]
+    comp["surface_lc"] = [mj.loc[k, "char_length"] for k in key]  # tells a generator variant apart
     comp["end_reason"] = [mj.loc[k, "end_reason"] for k in key]
     comp["end_detail"] = [mj.loc[k, "end_detail"] for k in key]
     comp["mujoco_status"] = [mj.loc[k, "status"] for k in key]

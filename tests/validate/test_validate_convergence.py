@@ -53,12 +53,17 @@ def test_converged_means_the_refined_value_stays_inside_the_interval():
     assert is_converged(0.9, -0.11, (0.8, 0.96)) is False
     assert is_converged(0.9, float("nan"), (0.8, 0.96)) is None
     assert is_converged(0.9, 0.0, (float("nan"), float("nan"))) is None
+    # a median at the metric's resolution: a narrower interval than the metric resolves
+    assert is_converged(0.0100, -0.002, (0.0100, 0.0101)) is False
+    assert is_converged(0.0100, -0.002, (0.0100, 0.0101), resolution=0.01) is True
+    assert is_converged(0.0100, 0.02, (0.0100, 0.0101), resolution=0.01) is False
 
 
-def _rows(surface, ys, agree, frechet):
+def _rows(surface, ys, agree, frechet, lc=1.0):
     return pd.DataFrame(
         {
             "surface": surface,
+            "surface_lc": lc,
             "start_x": -3.0,
             "start_y": np.asarray(ys, float),
             "agree": agree,
@@ -76,8 +81,10 @@ def test_the_change_is_paired_on_the_starts_both_sides_ran():
     assert pc["outcome_agreement"] == {"base": 0.5, "refined": 1.0, "change": 0.5}
     assert pc["median_frechet"]["base"] == pytest.approx(0.26)
     assert pc["median_frechet"]["refined"] == pytest.approx(0.035)
-    # another surface's start at the same point is another start
+    # another surface's start at the same point is another start, a generator variant
+    # (same label, another L_c) too
     assert paired_change(base, _rows("valley", [-2.0], [True], [0.1]))["runs"] == 0
+    assert paired_change(base, _rows("peak", [-2.0], [True], [0.1], lc=2.0))["runs"] == 0
 
 
 def test_a_family_is_converged_only_where_every_refinement_keeps_its_numbers_inside():
@@ -92,7 +99,7 @@ def test_a_family_is_converged_only_where_every_refinement_keeps_its_numbers_ins
     }
     halved = _rows("peak", ys, agree, np.full(10, 0.011))  # a change inside both intervals
     quartered = _rows("peak", ys, agree, np.full(10, 0.0115))
-    finer_hfield = _rows("peak", ys, [True] * 10, np.full(10, 0.02))  # the Frechet leaves its interval
+    finer_hfield = _rows("peak", ys, [True] * 10, np.full(10, 0.03))  # the Frechet leaves its interval
     out = family_convergence(
         summary, base, {"dt_halved": halved, "dt_quartered": quartered, "hfield_doubled": finer_hfield}
     )
@@ -102,7 +109,7 @@ def test_a_family_is_converged_only_where_every_refinement_keeps_its_numbers_ins
     assert out["dt_halved"]["median_frechet_change"] == pytest.approx(0.001)
     assert out["hfield_doubled"]["agreement_change"] == pytest.approx(0.1)
     assert out["hfield_doubled"]["outcome_agreement_converged"] is True
-    assert out["hfield_doubled"]["median_frechet_converged"] is False
+    assert out["hfield_doubled"]["median_frechet_converged"] is False  # by 0.02, twice what it resolves
     assert out["hfield_doubled"]["converged"] is False
     assert out["converged"] is False
     # three step levels, changes 0.001 then 0.0005: first order, converged value 0.012
