@@ -11,7 +11,7 @@ DEMO_OUT ?= demo-out
 $(STAMP): pyproject.toml setup.py
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e ".[dev,video,slurm]"
+	$(BIN)/python -m pip install --quiet -e ".[dev,video,slurm,bullet]"
 	touch $(STAMP)
 
 DOCS_STAMP := $(VENV)/.docs-stamp

@@ -487,10 +487,6 @@ def main(argv=None) -> None:
     print(section(res))
 
 
-if __name__ == "__main__":
-    main()
-
-
 #: The fractal self-lock comparison's Hurst exponents and I_e: the full validation plan's
 #: fractal study (its corner); surfaces per H are the caller's (``--fractal N``).
 FRACTAL_HURSTS = (0.65, 0.75, 0.8, 0.85, 0.95)
@@ -537,3 +533,7 @@ def fractal_engines(
             )
             rows.append({"hurst": float(h), "engine": engine, "ie": ie, **rate})
     return rows
+
+
+if __name__ == "__main__":
+    main()
