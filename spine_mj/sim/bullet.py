@@ -91,7 +91,7 @@ from spine_mj.sim.params import (
     hfield_of,
     penetration_tolerance_m,
 )
-from spine_mj.sim.ramp import ResetController
+from spine_mj.sim.ramp import ResetController, ramp_duration_s
 from spine_mj.sim.results import GroupAnalysis, RunResult
 from spine_mj.sim.rollout import controls
 from spine_mj.surfaces import Surface
@@ -405,9 +405,6 @@ class BulletRig:
         :class:`~spine_mj.sim.ramp.ResetController`, which reads rows in the sensor layout
         written here), in engine units; no fast-forward."""
         u, dt, sc = self.units, self.engine.timestep_s, self.scales
-        duration = drive.duration_s
-        if duration is None:
-            duration = min(40 * det.kappa_cap * sc.preload_n / rate_n_s(drive, sc), 200 * sc.time_s)
         n_settle = settle_steps(drive, dt)
         slide = drive.slide_distance_m
         ctl = ResetController(
@@ -418,7 +415,7 @@ class BulletRig:
             move_speed_m_s=det.move_speed_m_s / u.speed_m_s,
             sensor_adr=SENSOR_ADR,
         )
-        return n_settle + int(math.ceil(duration / dt)), ctl
+        return n_settle + int(math.ceil(ramp_duration_s(drive, det, sc) / dt)), ctl
 
 
 class _World:

@@ -307,6 +307,14 @@ def _step_loop(rig, st: _Stepper, nstep: int, n_settle: int, stop_early: bool, p
     return nstep, None
 
 
+def ramp_duration_s(drive: RampDrive, det: Detection, scales) -> float:
+    """The ramp's drive phase [s]: its ``duration_s``, else 40 ramps to ``kappa_cap F_p``,
+    capped at 200 tau (:class:`~spine_mj.sim.RampDrive`); ``det`` resolved."""
+    if drive.duration_s is not None:
+        return drive.duration_s
+    return min(40 * det.kappa_cap * scales.preload_n / rate_n_s(drive, scales), 200 * scales.time_s)
+
+
 def run_ramp(
     rig: RigModel,
     drive: RampDrive,
@@ -329,12 +337,7 @@ def run_ramp(
     d.mocap_pos[0] = qpos0 + np.array([0.0, 0.0, 2 * rig.tip.tip_radius_m / u.length_m])
     dt = rig.engine.timestep_s
     n_settle = settle_steps(drive, dt)
-    duration = drive.duration_s
-    if duration is None:
-        duration = min(
-            40 * det.kappa_cap * rig.scales.preload_n / rate_n_s(drive, rig.scales), 200 * rig.scales.time_s
-        )
-    nstep = n_settle + int(math.ceil(duration / dt))
+    nstep = n_settle + int(math.ceil(ramp_duration_s(drive, det, rig.scales) / dt))
     ctl = _controller(rig, drive, det, n_settle)
     st = _Stepper(m, d, nstep, ctl, GroupAnalysis(rig, [drive], [start], det, np.full((1, nstep), np.nan)))
     stop, warning = _step_loop(rig, st, nstep, n_settle, drive.stop_early, progress)
