@@ -4,27 +4,45 @@ The paper ends on arrays: "multi-spine arrays with staggered spatial layouts may
 the probability that at least one spine samples a favorable concave region". On a random
 Gaussian (paper-random-concave), a fractal (paper-fractal) and a sandpaper (P60) surface,
 arrays of ``N = side^2`` spines (side 1 to 8) are dragged under displacement control
-(the spring drive at :data:`ARRAY_IE`, ``K = 30`` per spine) over :data:`TRAVEL_LS` slope
-lengths, laid out as an aligned grid, a staggered grid and a random pattern of one
-footprint at spacings in multiples of ``l_s``. Each (surface, N, spacing) draws
-``placements`` array centres once (seeded) and runs every layout at the same centres, so
-the layouts are compared pairwise on the same patches of surface.
+(the spring drive, ``K = 30`` per spine) over :data:`TRAVEL_LS` slope lengths, laid out as
+an aligned grid, a staggered grid and a random pattern of one footprint at spacings in
+multiples of ``l_s``. Each (surface, N, spacing) draws ``placements`` array centres once
+(seeded) and runs every layout at the same centres, so the layouts are compared pairwise
+on the same patches of surface.
 
-Per configuration it reports the holding force per spine (holding force over ``N F_p``:
-the largest total spring force over the travel, ``ArrayResult.peak_ratio``, mean over
-placements with a 95 % bootstrap interval; beside it the spring-block swing it can carry
-above the quasistatic one, ``sqrt(I_e K L_c / l_s)`` per spine, and whether that is within
-:data:`~spine_mj.sim.holding.HOLDING_TOLERANCE` of the quasistatic holding: at
-:data:`ARRAY_IE` it is not, on any surface, and the number is marked unconverged) and
-the probability that at least one spine self-locks (its spring at ``kappa_cap F_p`` while
-stuck; Wilson interval, :func:`~spine_mj.validate.fractal_lock.lock_rate`), from MuJoCo
+**Holding, extrapolated to the quasistatic drive.** The holding force per spine is the
+largest total spring force over the travel over ``N F_p`` (``ArrayResult.peak_ratio``),
+the quantity the quasistatic reference computes (the maximum of its summed curve; the
+let-go reading ``holding_ratio`` stops at the first slip of a single spine, where the
+reference's curve goes on). Its dynamic excess over the quasistatic curve is the
+spring-block swing, ``sqrt(I_e K L_c / l_s)`` per spine (:func:`~spine_mj.sim.holding.spring_swing`):
+first order in ``sqrt(I_e)``, and 0.85 ``F_p`` on the fractal at ``I_e = 1e-3``
+(``L_c / l_s = 24``). A pace whose swing is 1 % of the holding costs ~100 times the steps,
+so the study runs each configuration at the plan's :attr:`ArrayPlan.paces`, each a
+quarter of the one before (the carriage's speed halved, the swing halved), at the same
+placements, and extrapolates each placement's holding to ``I_e -> 0`` by Richardson's
+step of order 1 in ``sqrt(I_e)`` from the two slowest paces (:func:`extrapolate_to_rest`;
+the order the swing predicts, never fitted). With three paces the observed order of the
+means is reported beside it. A row's holding is *converged* when its extrapolation step
+(the extrapolated mean minus the slowest pace's) lies inside the slowest pace's own 95 %
+bootstrap interval (:func:`~spine_mj.validate.convergence.is_converged`): the pace moves
+it less than the placements already leave open; otherwise it is marked unconverged. The
+predicted swing at the slowest pace is stated beside it. Where the plan asks
+(``dt_check``), the grid layout is run again at the fastest pace with the engine's step
+halved (the contact's time constant kept), and each holding's change and verdict are
+reported (``dt_halved``).
+
+The probability that at least one spine self-locks (its spring at ``kappa_cap F_p`` while
+stuck; Wilson interval, :func:`~spine_mj.validate.fractal_lock.lock_rate`) is read at the
+slowest pace, with its change from the pace before and the same verdict, from MuJoCo
 and from the quasistatic reference: each spine on its own compliant-drive streamline
 (:func:`~spine_mj.theory.compliant.compliant_streamlines`, same friction, spring, force cap and
 domain margin), the array's curve their sum (:mod:`spine_mj.theory.array_reference`). Like the
 single spine's comparison, agreement is the share of spines whose lock verdict matches
 (target :data:`~spine_mj.theory.targets.OUTCOME_TARGET`). The conjecture is answered by the
 difference staggered - aligned (and random - aligned) in the lock probability (Newcombe's
-interval from the two Wilson intervals) and in holding per spine (paired bootstrap).
+interval from the two Wilson intervals) and in the extrapolated holding per spine
+(paired bootstrap).
 """
 
 from __future__ import annotations
@@ -38,19 +56,33 @@ from scipy.stats import bootstrap
 
 from spine_mj import presets, sim
 from spine_mj.sim.drives import stiffness_n_m
-from spine_mj.sim.holding import HOLDING_TOLERANCE, spring_swing
+from spine_mj.sim.holding import spring_swing
 from spine_mj.theory.array_reference import compliant_spine_curves
 from spine_mj.theory.compliant import compliant_streamlines
 from spine_mj.theory.streamline import StreamlineParams, dilate
 from spine_mj.theory.targets import OUTCOME_TARGET
+from spine_mj.validate.convergence import is_converged, observed_order, richardson
 from spine_mj.validate.fractal_lock import CONFIDENCE, lock_rate
 from spine_mj.validate.intervals import newcombe_difference
 from spine_mj.validate.plans import SANDPAPER_MU, ValidationPlan
 
-__all__ = ["ARRAY_PLANS", "ArrayPlan", "ArrayStudyResult", "array_study", "newcombe_difference"]
+__all__ = [
+    "ARRAY_PLANS",
+    "PACE_RATIO",
+    "ArrayPlan",
+    "ArrayStudyResult",
+    "array_study",
+    "extrapolate_to_rest",
+    "newcombe_difference",
+]
 
-#: Inertia number of the arrays' carriage (per spine, as the single rig's I_e).
+#: Inertia number of the arrays' fastest pace (per spine, as the single rig's I_e).
 ARRAY_IE = 1e-3
+#: Each pace's I_e over the next slower one's: the carriage's speed halves, and with it the
+#: spring-block swing (first order in sqrt(I_e)).
+PACE_RATIO = 4.0
+#: The holding's dynamic excess's order in ``sqrt(I_e)`` (the spring-block swing).
+EXCESS_ORDER = 1.0
 #: Carriage travel of each run, in slope lengths l_s.
 TRAVEL_LS = 3.0
 #: The study's surfaces: (key, preset, mu or None for the preset's own).
@@ -75,8 +107,10 @@ DL_LS = 0.01
 @dataclass(frozen=True)
 class ArrayPlan:
     """The study's size: array sides (``N = side^2``), spacings (in units of
-    ``max(l_s, MIN_SPACING_TIP_RADII r_tip)``), placements per configuration, surfaces and
-    bootstrap resamples."""
+    ``max(l_s, MIN_SPACING_TIP_RADII r_tip)``), placements per configuration, surfaces,
+    bootstrap resamples, the number of paces (from :data:`ARRAY_IE` down by
+    :data:`PACE_RATIO`; two at least, for the extrapolation) and whether the grid layout is
+    rerun with the engine's step halved (``dt_check``)."""
 
     sides: tuple[int, ...]
     spacings_ls: tuple[float, ...]
@@ -84,12 +118,31 @@ class ArrayPlan:
     surfaces: tuple[str, ...] = tuple(s[0] for s in SURFACES)
     bootstrap: int = 500
     hfield_resolution: int | None = 151
+    n_paces: int = 2
+    dt_check: bool = False
+
+    @property
+    def paces(self) -> tuple[float, ...]:
+        """The paces' I_e, fastest first."""
+        return tuple(ARRAY_IE / PACE_RATIO**i for i in range(self.n_paces))
+
+
+def extrapolate_to_rest(slow, fast):
+    """Richardson's extrapolation of a holding to ``I_e -> 0`` from two paces, ``fast`` at
+    :data:`PACE_RATIO` times ``slow``'s I_e (arrays of equal shape, or floats): the excess
+    is first order in ``sqrt(I_e)`` (:data:`EXCESS_ORDER`, the spring-block swing), so
+    ``slow + (slow - fast) / (sqrt(PACE_RATIO) - 1)``."""
+    return richardson(
+        np.asarray(slow, float), np.asarray(fast, float), EXCESS_ORDER, ratio=math.sqrt(PACE_RATIO)
+    )
 
 
 ARRAY_PLANS = {
     "smoke": ArrayPlan(sides=(1, 2), spacings_ls=(1.0,), placements=3, surfaces=("fractal",), bootstrap=50),
     "quick": ArrayPlan(sides=(1, 2, 4), spacings_ls=(1.0,), placements=6, bootstrap=300),
-    "full": ArrayPlan(sides=(1, 2, 4, 8), spacings_ls=(1.0, 1.5), placements=6, bootstrap=1000),
+    "full": ArrayPlan(
+        sides=(1, 2, 4, 8), spacings_ls=(1.0, 1.5), placements=6, bootstrap=1000, n_paces=3, dt_check=True
+    ),
 }
 
 
@@ -128,14 +181,22 @@ def _mean_ci(values, n_resamples: int, seed: int) -> tuple[float, float, float]:
     return float(v.mean()), float(ci.low), float(ci.high)
 
 
-def _rig(preset: str, mu: float | None, plan: ArrayPlan):
+def _rig(preset: str, mu: float | None, plan: ArrayPlan, ie: float, *, timestep_factor: float = 1.0):
+    """The surface's rig at pace ``ie`` (the engine's default step at that speed, times
+    ``timestep_factor`` with the contact's time constant kept) and the carriage's speed."""
     surf = presets.make_surface(preset)
     mu = presets.resolve_mu(surf, mu)
     tip = sim.TipParams(mu_s=mu)
     res = plan.hfield_resolution if surf.unit == "1" else None
     sized = sim.Scales.with_hfield(surf, tip=tip, hfield_resolution=res)
-    speed = sized[0].speed_for(ARRAY_IE)
-    return sim.Rig(surf, tip=tip, engine=sim.default_engine(sized[0], speed_m_s=speed), sized=sized), speed
+    sc = sized[0]
+    speed = sc.speed_for(ie)
+    engine = sim.default_engine(sc, speed_m_s=speed)
+    if timestep_factor != 1.0:
+        engine = sim.default_engine(
+            sc, speed_m_s=speed, timestep_s=engine.timestep_s * timestep_factor, solref=engine.solref
+        )
+    return sim.Rig(surf, tip=tip, engine=engine, sized=sized), speed
 
 
 def _centres(
@@ -189,8 +250,8 @@ def _reference(rig, drive, groups: list[list], travel: float, det) -> list[tuple
 
 
 def _swing(rig, drive) -> float:
-    """The spring-block swing ``sqrt(I_e K L_c / l_s)`` [F_p per spine] the study's holding
-    (the largest force over the travel) can carry above the quasistatic one."""
+    """The spring-block swing ``sqrt(I_e K L_c / l_s)`` [F_p per spine] the holding (the
+    largest force over the travel) can carry above the quasistatic one at ``drive``'s pace."""
     sc = rig.scales
     return spring_swing(
         sc.inertia_number(drive.speed_m_s),
@@ -199,9 +260,10 @@ def _swing(rig, drive) -> float:
     )
 
 
-def _surface_runs(rig, speed, plan: ArrayPlan):
-    """Every MuJoCo array run on one surface: ``[(config, runs)]`` with ``config`` the
-    (side, nominal spacing, spacing [l_s], layout, seed) and ``runs`` its placements."""
+def _surface_runs(rig, speed, plan: ArrayPlan, layouts=LAYOUTS):
+    """Every MuJoCo array run on one surface at one pace: ``[(config, runs)]`` with
+    ``config`` the (side, nominal spacing, spacing [l_s], layout, seed) and ``runs`` its
+    placements (the same centres at every pace)."""
     ls = rig.scales.slope_length_m / rig.length_scale_m
     r_tip = rig.tip.tip_radius_m / rig.length_scale_m
     drive = sim.SpringDrive(speed_m_s=speed, duration_s=TRAVEL_LS * rig.scales.slope_length_m / speed)
@@ -213,7 +275,7 @@ def _surface_runs(rig, speed, plan: ArrayPlan):
             centres = _centres(rig, side, spacing * ls, TRAVEL_LS * ls, plan.placements, seed)
             if not centres:
                 continue
-            for kind in LAYOUTS:
+            for kind in layouts:
                 if side == 1 and kind == "staggered":  # one spine: the staggered grid is the grid
                     done.append(((side, nominal, spacing, kind, seed), done[-1][1]))
                     continue
@@ -225,15 +287,35 @@ def _surface_runs(rig, speed, plan: ArrayPlan):
     return drive, done
 
 
-def _row(config, runs, reference, plan: ArrayPlan) -> dict:
-    """One configuration's row, with the per-placement numbers kept for the paired comparisons."""
+def _holding(runs) -> tuple[np.ndarray, np.ndarray]:
+    """Each placement's holding per spine (the curve's peak) and whether it ran cleanly."""
+    ok = np.array([r.end_reason != "engine_trouble" for r in runs])
+    return np.array([r.peak_ratio for r in runs]), ok
+
+
+def _row(config, paced, reference, plan: ArrayPlan) -> dict:
+    """One configuration's row from its runs at every pace (``paced``: ``[(ie, swing,
+    runs)]``, fastest first), with the per-placement extrapolated holdings kept for the
+    paired comparisons."""
     side, nominal, spacing, kind, seed = config
     qs_hold, qs_lock, qs_short = reference
-    ok = np.array([r.end_reason != "engine_trouble" for r in runs])
-    mj_hold = np.array([r.peak_ratio for r in runs])
+    held = [_holding(runs) for _, _, runs in paced]
+    ok = np.logical_and.reduce([k for _, k in held])
+    by_pace = []
+    for (ie, swing, _), (h, _) in zip(paced, held):
+        m, lo, hi = _mean_ci(h[ok], plan.bootstrap, seed)
+        by_pace.append({"ie": ie, "holding": m, "holding_ci": [lo, hi], "excess_predicted": swing})
+    rest = extrapolate_to_rest(held[-1][0], held[-2][0])
+    m, lo, hi = _mean_ci(rest[ok], plan.bootstrap, seed)
+    slow = by_pace[-1]
+    step = m - slow["holding"]
+    means = [b["holding"] for b in by_pace]
+    order = observed_order(*means[::-1][:3], ratio=math.sqrt(PACE_RATIO)) if len(means) >= 3 else math.nan
+    runs = paced[-1][2]
     mj_lock = np.array([r.locked for r in runs])
     agree = (mj_lock == qs_lock)[ok]
-    m, lo, hi = _mean_ci(mj_hold[ok], plan.bootstrap, seed)
+    p_lock = lock_rate(mj_lock.any(axis=1), ok)
+    p_lock_fast = lock_rate(np.array([r.locked for r in paced[-2][2]]).any(axis=1), ok)
     qm, qlo, qhi = _mean_ci(qs_hold, plan.bootstrap, seed)
     return {
         "layout": kind,
@@ -243,19 +325,47 @@ def _row(config, runs, reference, plan: ArrayPlan) -> dict:
         "placements": len(runs),
         "holding_per_spine": m,
         "holding_ci": [lo, hi],
+        "holding_by_pace": by_pace,
+        "holding_extrapolation_step": step,
+        "holding_observed_order": order,
+        "holding_excess_predicted": slow["excess_predicted"],
+        "holding_converged": is_converged(slow["holding"], step, slow["holding_ci"]),
         "holding_per_spine_qs": qm,
         "holding_qs_ci": [qlo, qhi],
-        "holding_rel_error_median": float(np.nanmedian(np.abs(mj_hold[ok] / qs_hold[ok] - 1)))
+        "holding_rel_error_median": float(np.nanmedian(np.abs(rest[ok] / qs_hold[ok] - 1)))
         if ok.any()
         else math.nan,
-        "p_lock": lock_rate(mj_lock.any(axis=1), ok),
+        "p_lock": p_lock,
+        "p_lock_change": p_lock["rate"] - p_lock_fast["rate"] if ok.any() else math.nan,
+        "p_lock_converged": is_converged(
+            p_lock["rate"], p_lock["rate"] - p_lock_fast["rate"], (p_lock["ci_low"], p_lock["ci_high"])
+        )
+        if ok.any()
+        else None,
         "p_lock_qs": lock_rate(qs_lock.any(axis=1)),
         "lock_agreement": float(agree.mean()) if agree.size else math.nan,
         "meets_outcome_target": bool(agree.size and agree.mean() >= OUTCOME_TARGET),
         "failed_runs": int((~ok).sum()),
         "reference_short_spines": int(qs_short.sum()),
-        "_hold": mj_hold.tolist(),
+        "_hold": rest.tolist(),
         "_ok": ok.tolist(),
+    }
+
+
+def _dt_halved(row: dict, fast_runs, halved_runs) -> dict:
+    """The fastest pace's holding with the engine's step halved: its paired change (over
+    the placements both ran cleanly) and whether the halved mean lies inside the default
+    step's own 95 % interval."""
+    h, ok = _holding(fast_runs)
+    h2, ok2 = _holding(halved_runs)
+    both = ok & ok2
+    change = float((h2 - h)[both].mean()) if both.any() else math.nan
+    fast = row["holding_by_pace"][0]
+    return {
+        "ie": fast["ie"],
+        "runs": int(both.sum()),
+        "holding_change": change,
+        "converged": is_converged(fast["holding"], change, fast["holding_ci"]),
     }
 
 
@@ -301,6 +411,32 @@ def _conjecture(rows: list[dict], plan: ArrayPlan) -> tuple[list[dict], dict]:
     return out, pooled
 
 
+def _surface_rows(key: str, preset: str, mu, ap: ArrayPlan) -> list[dict]:
+    """One surface's rows: every configuration at every pace, the reference, the step check."""
+    paced = []
+    for ie in ap.paces:
+        rig, speed = _rig(preset, mu, ap, ie)
+        drive, done = _surface_runs(rig, speed, ap)
+        if not done:
+            return []
+        paced.append((ie, _swing(rig, drive), drive, done))
+    det = sim.Detection().resolve(rig.scales)
+    travel = TRAVEL_LS * rig.scales.slope_length_m / rig.length_scale_m
+    refs = _reference(rig, drive, [runs for _, runs in done], travel, det)
+    halved = {}
+    if ap.dt_check:
+        rig2, speed2 = _rig(preset, mu, ap, ap.paces[0], timestep_factor=0.5)
+        halved = dict(_surface_runs(rig2, speed2, ap, layouts=("grid",))[1])
+    rows = []
+    for i, ((cfg, _), ref) in enumerate(zip(done, refs)):
+        per_pace = [(ie, swing, d[i][1]) for ie, swing, _, d in paced]
+        row = {"surface": key, **_row(cfg, per_pace, ref, ap)}
+        if cfg in halved:
+            row["dt_halved"] = _dt_halved(row, paced[0][3][i][1], halved[cfg])
+        rows.append(row)
+    return rows
+
+
 def array_study(plan: ValidationPlan, runner=None) -> ArrayStudyResult:
     """Run the array study at the size of ``plan`` (:data:`ARRAY_PLANS` by its name)."""
     ap = ARRAY_PLANS.get(plan.name, ARRAY_PLANS["quick"])
@@ -311,29 +447,26 @@ def array_study(plan: ValidationPlan, runner=None) -> ArrayStudyResult:
         if key not in ap.surfaces:
             continue
         with contextlib.nullcontext() if runner is None else runner.phase(f"arrays on {key}"):
-            rig, speed = _rig(preset, mu, ap)
-            drive, done = _surface_runs(rig, speed, ap)
-            if not done:
-                continue
-            det = sim.Detection().resolve(rig.scales)
-            travel = TRAVEL_LS * rig.scales.slope_length_m / rig.length_scale_m
-            refs = _reference(rig, drive, [runs for _, runs in done], travel, det)
-            swing = _swing(rig, drive)
-            for (cfg, runs), ref in zip(done, refs):
-                row = {"surface": key, **_row(cfg, runs, ref, ap), "holding_excess_predicted": swing}
-                row["holding_converged"] = bool(swing <= HOLDING_TOLERANCE * row["holding_per_spine_qs"])
-                rows.append(row)
+            rows += _surface_rows(key, preset, mu, ap)
     conj, pooled = _conjecture(rows, ap)
     for r in rows:
         r.pop("_hold"), r.pop("_ok")
+    checked = [r["dt_halved"] for r in rows if "dt_halved" in r]
+    verdicts = [c["converged"] for c in checked if c["converged"] is not None]
     plan_info = {
         "name": plan.name,
         "sides": list(ap.sides),
         "spacings_ls": list(ap.spacings_ls),
         "placements": ap.placements,
         "surfaces": list(ap.surfaces),
-        "ie": ARRAY_IE,
+        "ie": list(ap.paces),
+        "pace_ratio": PACE_RATIO,
         "travel_ls": TRAVEL_LS,
-        "array_runs": sum(r["placements"] for r in rows),
+        "array_runs": len(ap.paces) * sum(r["placements"] for r in rows) + sum(c["runs"] for c in checked),
+        "dt_halved": {
+            "rows": len(checked),
+            "converged": all(verdicts) if verdicts else None,
+            "max_abs_change": max((abs(c["holding_change"]) for c in checked), default=math.nan),
+        },
     }
     return ArrayStudyResult(rows=rows, conjecture=conj, pooled=pooled, plan=plan_info)
