@@ -138,7 +138,9 @@ def extrapolate_to_rest(slow, fast):
 
 
 ARRAY_PLANS = {
-    "smoke": ArrayPlan(sides=(1, 2), spacings_ls=(1.0,), placements=3, surfaces=("fractal",), bootstrap=50),
+    "smoke": ArrayPlan(
+        sides=(1, 2), spacings_ls=(1.0,), placements=3, surfaces=("fractal",), bootstrap=50, dt_check=True
+    ),
     "quick": ArrayPlan(sides=(1, 2, 4), spacings_ls=(1.0,), placements=6, bootstrap=300),
     "full": ArrayPlan(
         sides=(1, 2, 4, 8), spacings_ls=(1.0, 1.5), placements=6, bootstrap=1000, n_paces=3, dt_check=True
@@ -148,19 +150,28 @@ ARRAY_PLANS = {
 
 @dataclass
 class ArrayStudyResult:
-    """Rows per (surface, N, spacing, layout), the conjecture's differences and the plan."""
+    """Rows per (surface, N, spacing, layout), the conjecture's differences, the plan and
+    the holding's solution verification (``convergence``: ``pace``, the extrapolation's
+    verdicts; ``dt_halved``, the step's, where the plan ran it)."""
 
     rows: list[dict] = field(default_factory=list)
     conjecture: list[dict] = field(default_factory=list)
     pooled: dict = field(default_factory=dict)
     plan: dict = field(default_factory=dict)
+    convergence: dict = field(default_factory=dict)
 
     def validation_keys(self) -> dict:
         """This study's keys of ``validation.json``."""
         return {"arrays": self.as_dict()}
 
     def as_dict(self) -> dict:
-        return {"rows": self.rows, "conjecture": self.conjecture, "pooled": self.pooled, "plan": self.plan}
+        return {
+            "rows": self.rows,
+            "conjecture": self.conjecture,
+            "pooled": self.pooled,
+            "plan": self.plan,
+            "convergence": self.convergence,
+        }
 
 
 def _mean_ci(values, n_resamples: int, seed: int) -> tuple[float, float, float]:
@@ -452,7 +463,6 @@ def array_study(plan: ValidationPlan, runner=None) -> ArrayStudyResult:
     for r in rows:
         r.pop("_hold"), r.pop("_ok")
     checked = [r["dt_halved"] for r in rows if "dt_halved" in r]
-    verdicts = [c["converged"] for c in checked if c["converged"] is not None]
     plan_info = {
         "name": plan.name,
         "sides": list(ap.sides),
@@ -463,10 +473,29 @@ def array_study(plan: ValidationPlan, runner=None) -> ArrayStudyResult:
         "pace_ratio": PACE_RATIO,
         "travel_ls": TRAVEL_LS,
         "array_runs": len(ap.paces) * sum(r["placements"] for r in rows) + sum(c["runs"] for c in checked),
-        "dt_halved": {
-            "rows": len(checked),
-            "converged": all(verdicts) if verdicts else None,
-            "max_abs_change": max((abs(c["holding_change"]) for c in checked), default=math.nan),
-        },
     }
-    return ArrayStudyResult(rows=rows, conjecture=conj, pooled=pooled, plan=plan_info)
+    convergence = {
+        "pace": _verdicts(
+            [r["holding_converged"] for r in rows], [r["holding_extrapolation_step"] for r in rows]
+        )
+    }
+    if checked:
+        convergence["dt_halved"] = _verdicts(
+            [c["converged"] for c in checked], [c["holding_change"] for c in checked]
+        )
+    return ArrayStudyResult(
+        rows=rows, conjecture=conj, pooled=pooled, plan=plan_info, convergence=convergence
+    )
+
+
+def _verdicts(verdicts: list, changes: list) -> dict:
+    """Rows checked, rows converged, the largest change and ``converged``: every decided
+    verdict true (None where none was decided)."""
+    known = [v for v in verdicts if v is not None]
+    finite = [abs(c) for c in changes if math.isfinite(c)]
+    return {
+        "rows": len(verdicts),
+        "rows_converged": sum(known),
+        "max_abs_change": max(finite, default=math.nan),
+        "converged": all(known) if known else None,
+    }

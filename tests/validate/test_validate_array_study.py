@@ -59,6 +59,11 @@ def test_smoke_study_has_one_row_per_layout_and_size_with_intervals(smoke):
         assert r["holding_extrapolation_step"] == pytest.approx(r["holding_per_spine"] - slow)
         lo, hi = paces[1]["holding_ci"]
         assert r["holding_converged"] is (lo <= r["holding_per_spine"] <= hi)
+    assert smoke.convergence["pace"]["rows"] == len(smoke.rows)
+    # the step check: the grid layout at the fastest pace, paired per placement
+    grid = [r for r in smoke.rows if r["layout"] == "grid"]
+    assert all(r["dt_halved"]["ie"] == ARRAY_IE and r["dt_halved"]["runs"] == 3 for r in grid)
+    assert smoke.convergence["dt_halved"]["rows"] == len(grid)
     one = {r["layout"]: r for r in smoke.rows if r["n_spines"] == 1}
     assert one["grid"]["holding_per_spine"] == one["staggered"]["holding_per_spine"]  # one spine: one layout
 

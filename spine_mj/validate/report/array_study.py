@@ -125,14 +125,22 @@ def array_section(res: ArrayStudyResult | None, figure: str | None = None) -> st
     cols = ["surface", "N", "spacing", "layout", "holding", "holding_ci", "by_pace", "step", "holding_qs"]
     cols += ["excess", "dt", "lock", "lock_ci"]
     lines.append(table(rows, [*cols, "lock_qs", "agreement", "failed", "short"], names))
-    dt = p.get("dt_halved") or {}
-    if dt.get("rows"):
-        verdict = {True: "converged", False: "unconverged", None: "not decided"}[dt["converged"]]
+    conv = res.convergence
+    if conv.get("pace"):
+        c = conv["pace"]
+        lines += [
+            "",
+            f"Extrapolation to I_e -> 0: {c['rows_converged']} of {c['rows']} holdings converged (the "
+            "step inside the slowest pace's 95 % interval); largest step "
+            f"{sig(c['max_abs_change'])} F_p per spine.",
+        ]
+    if conv.get("dt_halved"):
+        c = conv["dt_halved"]
         lines += [
             "",
             f"Solution verification: the grid layout rerun at I_e = {sig(paces[0])} with the engine's step "
-            f"halved ({dt['rows']} configurations): largest holding change {sig(dt['max_abs_change'])} F_p "
-            f"per spine, {verdict} (every change inside its holding's own 95 % interval).",
+            f"halved: {c['rows_converged']} of {c['rows']} holdings converged (the change inside the "
+            f"holding's own 95 % interval); largest change {sig(c['max_abs_change'])} F_p per spine.",
         ]
     if figure:
         lines += ["", f"![Holding per spine and P(lock) against N per layout]({figure})"]
