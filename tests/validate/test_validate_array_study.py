@@ -1,5 +1,6 @@
 """The array study at smoke size: rows with intervals, the conjecture's differences, the report."""
 
+import copy
 import math
 
 import numpy as np
@@ -109,3 +110,12 @@ def test_extrapolation_removes_the_spring_block_swing_from_an_arrays_peak_on_a_p
     for peak, swing in zip(peaks, swings):
         assert peak - MU == pytest.approx(swing, rel=0.1)
     assert abs(float(extrapolate_to_rest(peaks[1], peaks[0])) - MU) < 0.1 * swings[1]
+
+
+def test_report_shows_the_observed_order_only_with_three_paces(smoke):
+    assert "observed order" not in array_section(smoke)
+    three = copy.deepcopy(smoke)
+    three.plan["ie"] = [ARRAY_IE / PACE_RATIO**i for i in range(3)]
+    for r in three.rows:
+        r["holding_observed_order"] = 1.0
+    assert "observed order" in array_section(three)

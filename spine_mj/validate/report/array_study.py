@@ -72,7 +72,7 @@ def array_section(res: ArrayStudyResult | None, figure: str | None = None) -> st
     if res is None or not res.rows:
         return ""
     p = res.plan
-    paces = p["ie"] if isinstance(p["ie"], list) else [p["ie"]]
+    paces = p["ie"]
     lines = [
         "## Spine arrays and the staggered-layout conjecture",
         "",
@@ -92,7 +92,13 @@ def array_section(res: ArrayStudyResult | None, figure: str | None = None) -> st
         "P(lock) (share of placements where at least one spine self-locked, Wilson 95 %, read at the "
         "slowest pace) likewise with its change from the pace before. The quasistatic reference puts each "
         "spine on its own compliant-drive streamline and sums them; agreement = share of spines whose lock "
-        "verdict matches (single-spine target 95 %).",
+        "verdict matches (single-spine target 95 %)."
+        + (
+            " With three paces, 'observed order' is that of the means in sqrt(I_e) (predicted: 1; '-' where "
+            "the changes flip sign or vanish)."
+            if len(paces) >= 3
+            else ""
+        ),
         "",
     ]
     rows = []
@@ -108,6 +114,9 @@ def array_section(res: ArrayStudyResult | None, figure: str | None = None) -> st
                 "holding_ci": _ci(*r["holding_ci"]),
                 "by_pace": ", ".join(sig(b["holding"]) for b in r["holding_by_pace"]),
                 "step": sig(r["holding_extrapolation_step"]),
+                "order": sig(r["holding_observed_order"])
+                if math.isfinite(r["holding_observed_order"])
+                else "-",
                 "holding_qs": sig(r["holding_per_spine_qs"]),
                 "excess": sig(r["holding_excess_predicted"]),
                 "dt": _dt(r.get("dt_halved")),
@@ -120,9 +129,12 @@ def array_section(res: ArrayStudyResult | None, figure: str | None = None) -> st
             }
         )
     names = ["surface", "N", "spacing [l_s]", "layout", "holding (MuJoCo, I_e -> 0)", "95 % CI"]
-    names += ["holding per pace", "extrapolation step", "holding (QS)", "predicted excess", "dt / 2 change"]
+    three = len(paces) >= 3
+    names += ["holding per pace", "extrapolation step", *(["observed order"] if three else [])]
+    names += ["holding (QS)", "predicted excess", "dt / 2 change"]
     names += ["P(lock) MuJoCo", "95 % CI", "P(lock) QS", "lock agreement", "failed", "QS paths short"]
-    cols = ["surface", "N", "spacing", "layout", "holding", "holding_ci", "by_pace", "step", "holding_qs"]
+    cols = ["surface", "N", "spacing", "layout", "holding", "holding_ci", "by_pace", "step"]
+    cols += [*(["order"] if three else []), "holding_qs"]
     cols += ["excess", "dt", "lock", "lock_ci"]
     lines.append(table(rows, [*cols, "lock_qs", "agreement", "failed", "short"], names))
     conv = res.convergence
