@@ -13,12 +13,13 @@ on the same patches of surface.
 **Holding, extrapolated to the quasistatic drive.** The holding force per spine is the
 largest total spring force over the travel over ``N F_p`` (``ArrayResult.peak_ratio``),
 the quantity the quasistatic reference computes (the maximum of its summed curve; the
-let-go reading ``holding_ratio`` stops at the first slip of a single spine, where the
-reference's curve goes on). Its dynamic excess over the quasistatic curve is the
+let-go reading ``holding_ratio`` stops where the array first lets go, a single spine's
+first slip, where the reference's curve goes on). Its dynamic excess over the quasistatic curve is the
 spring-block swing, ``sqrt(I_e K L_c / l_s)`` per spine (:func:`~spine_mj.sim.holding.spring_swing`):
 first order in ``sqrt(I_e)``, and 0.85 ``F_p`` on the fractal at ``I_e = 1e-3``
-(``L_c / l_s = 24``). A pace whose swing is 1 % of the holding costs ~100 times the steps,
-so the study runs each configuration at the plan's :attr:`ArrayPlan.paces`, each a
+(``L_c / l_s = 24``). A pace whose swing is 1 % of the holding (~3 ``F_p`` there) or of
+``mu F_p`` (mu 1.25) costs 30 to 70 times the steps of ``I_e = 1e-3``, so the study runs each
+configuration at the plan's :attr:`ArrayPlan.paces`, each a
 quarter of the one before (the carriage's speed halved, the swing halved), at the same
 placements, and extrapolates each placement's holding to ``I_e -> 0`` by Richardson's
 step of order 1 in ``sqrt(I_e)`` from the two slowest paces (:func:`extrapolate_to_rest`;
