@@ -299,6 +299,14 @@ def open_surface(spec: str, **overrides) -> surfaces.Surface:
     :func:`list_presets` or a ``.toml`` recipe, made with ``overrides`` as in
     :func:`make_surface`) or an instrument file (:func:`~spine_mj.surface_io.import_topography`).
 
+    Parameters
+    ----------
+    spec : str
+        ``example:NAME``, a ``.npz`` path, a preset's name or ``.toml`` path, or an instrument
+        file's path.
+    **overrides
+        Generator parameters (and ``seed``) replaced in a preset; none for a file.
+
     Raises
     ------
     SpineInputError

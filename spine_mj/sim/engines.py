@@ -70,7 +70,20 @@ class EngineRig(Protocol):
 
 
 def check_engine_name(engine: str, what: str = "engine") -> str:
-    """``engine`` if it is one of :data:`ENGINES`; for ``"bullet"`` the extra must be installed."""
+    """``engine`` if it is one of :data:`ENGINES`; for ``"bullet"`` the extra must be installed.
+
+    Parameters
+    ----------
+    engine : str
+        The engine's name.
+    what : str
+        How the message names the argument (an option, a config key).
+
+    Returns
+    -------
+    str
+        ``engine``.
+    """
     if engine not in ENGINES:
         raise SpineInputError(f"{what} must be one of {', '.join(ENGINES)}, got {engine!r}")
     if engine == "bullet":

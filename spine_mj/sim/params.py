@@ -683,7 +683,22 @@ def _two_digits_down(x: float) -> float:
 
 
 def spring_omega_dt(stiffness_n_m: float, mass_kg: float, timestep_s: float) -> float:
-    """``omega dt`` of a drive spring on a tip of ``mass_kg``, ``omega = sqrt(k / m)``."""
+    """``omega dt`` of a drive spring on a tip of ``mass_kg``, ``omega = sqrt(k / m)``.
+
+    Parameters
+    ----------
+    stiffness_n_m : float
+        The spring's stiffness k [N/m].
+    mass_kg : float
+        The tip's mass m [kg].
+    timestep_s : float
+        The engine step dt [s].
+
+    Returns
+    -------
+    float
+        Dimensionless; the step rule keeps it at most :data:`SPRING_OMEGA_DT`.
+    """
     return math.sqrt(stiffness_n_m / mass_kg) * timestep_s
 
 

@@ -103,6 +103,17 @@ def ball_dilation_reference(heights, radius: float, *, spacing, periodic: bool =
     ``scipy.ndimage.grey_dilation`` with the ball's cap as a non-flat structuring element:
     its memory grows with the grid's points times the footprint's (15 GB for an 801 x 801
     grid and a tip 110 samples wide).
+
+    Parameters
+    ----------
+    heights : array_like, shape (ny, nx)
+        Heights on a uniform grid.
+    radius : float
+        The ball's radius, in the heights' length unit.
+    spacing : tuple of float
+        Grid spacing ``(dx, dy)``, in the same unit.
+    periodic : bool
+        Wrap the grid around at its edges.
     """
     from scipy import ndimage
 
