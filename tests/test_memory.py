@@ -88,3 +88,20 @@ def test_the_budget_is_read_from_the_environment(monkeypatch):
     monkeypatch.delenv(ENV_VAR)
     assert 0 < memory_budget() < 2**50
     assert format_bytes(512) == "512 B" and format_bytes(3 * MIB) == "3 MiB"
+
+
+def test_a_command_over_the_budget_is_refused_before_it_allocates(monkeypatch, tmp_path):
+    """With a budget below what a run's recording (or its surface's grid) takes, `simulate`
+    ends with one line naming the size and the budget, exit 2, nothing written."""
+    from click.testing import CliRunner
+
+    from spine_mj.cli import main
+
+    monkeypatch.setenv(ENV_VAR, "64K")
+    out = tmp_path / "sim"
+    args = ["simulate", "paper-single-peak", "--start", "-3,-1", "--duration", "0.05", "--resolution", "41"]
+    result = CliRunner().invoke(main, [*args, "--out", str(out)])
+    lines = result.output.strip().splitlines()
+    assert result.exit_code == 2 and len(lines) == 1 and lines[0].startswith("Error: "), result.output
+    assert "of memory, more than the budget of 64 KiB" in lines[0]
+    assert not out.exists()

@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 
 from spine_mj.errors import SpineInputError
+from spine_mj.memory import check_memory
 
 #: Mean particle sizes of the sandpapers in the paper's experiment (§3.3), metres.
 GRIT_PARTICLE_DIAMETER_M = {"P36": 538e-6, "P60": 269e-6, "P600": 25.8e-6}
@@ -25,6 +26,8 @@ MAX_GRID_POINTS = 2**26
 #: Most Gaussians of a random surface: every height costs one exponential per Gaussian.
 MAX_PEAKS = 100_000
 _CHUNK = 1 << 15
+# float64 arrays of a grid's size that making and holding one takes at once (check_grid_size)
+_GRID_ARRAYS = 4
 _NONPERIODIC_PAD = 8  # cells of odd reflection before the spline filter, see GridSurface
 
 
@@ -118,7 +121,9 @@ def _count_at_least(name: str, n, least: int) -> int:
 
 
 def check_grid_size(nx: int, ny: int, *, where: str) -> None:
-    """Refuse a grid of more than :data:`MAX_GRID_POINTS` points before allocating it.
+    """Refuse a grid of more than :data:`MAX_GRID_POINTS` points, or one whose arrays
+    (:data:`_GRID_ARRAYS` float64 arrays of its size: heights, spline coefficients and the
+    temporaries of making them) would exceed the memory budget, before allocating it.
 
     Parameters
     ----------
@@ -131,7 +136,8 @@ def check_grid_size(nx: int, ny: int, *, where: str) -> None:
     ------
     SpineInputError
         Naming ``where``, the grid's shape, the limit and the memory one height array
-        of that shape would take.
+        of that shape would take; or the memory needed and the budget
+        (:func:`spine_mj.memory.check_memory`).
     """
     points = float(nx) * float(ny)  # counts may come as floats, before rounding: inf is refused too
     if not points <= MAX_GRID_POINTS:
@@ -140,6 +146,7 @@ def check_grid_size(nx: int, ny: int, *, where: str) -> None:
             f"{where}: a {_count(ny)} x {_count(nx)} grid has {points:.3g} points, more than the limit "
             f"{MAX_GRID_POINTS:.3g} ({gib:.3g} GiB per height array); use fewer points or a coarser spacing"
         )
+    check_memory(8.0 * _GRID_ARRAYS * points, where=f"{where}: a {_count(ny)} x {_count(nx)} grid")
 
 
 def _count(n) -> str:
