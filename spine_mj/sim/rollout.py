@@ -60,7 +60,6 @@ from typing import NamedTuple
 import numpy as np
 
 from spine_mj.errors import SpineInputError
-from spine_mj.memory import check_memory
 from spine_mj.sim.detection import Detection
 from spine_mj.sim.drives import (
     Drive,
@@ -331,8 +330,6 @@ class _Group:
         self.models = [runner.models[j] for j in idx]
         g, n = len(idx), runner.lengths[idx[0]]
         self.n = n
-        row = 6 + runner.nstate + rig.model.nsensordata
-        check_memory(8.0 * g * n * row, where=f"recording {g} runs of {n} planned steps")
         self.ctrl = np.empty((g, n, 6))
         self.state = np.empty((g, n, runner.nstate))
         self.sens = np.empty((g, n, rig.model.nsensordata))
