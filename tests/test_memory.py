@@ -91,8 +91,8 @@ def test_the_budget_is_read_from_the_environment(monkeypatch):
 
 
 def test_a_command_over_the_budget_is_refused_before_it_allocates(monkeypatch, tmp_path):
-    """With a budget below what its surface's grid takes, `simulate`
-    ends with one line naming the size and the budget, exit 2, nothing written."""
+    """With a budget below what its surface's grid takes, `simulate` ends with one line
+    naming the size and the budget, exit 2, nothing written."""
     from click.testing import CliRunner
 
     from spine_mj.cli import main
