@@ -11,6 +11,7 @@ committed ``benchmarks/results.json`` is marked, like a missed target.
 
 from __future__ import annotations
 
+import json
 import os
 import subprocess
 import sys
@@ -65,16 +66,30 @@ def _jobs(quick: bool) -> dict[str, list[str]]:
 
 
 def measure(argv: list[str], cwd: Path) -> dict:
-    """Wall time and peak resident set (MiB) of one command run to its end."""
+    """Wall time and peak resident set (MiB) of one command run to its end.
+
+    Through a fresh launcher (this file's ``__main__``): Linux keeps a forking parent's
+    peak in its child's ``ru_maxrss`` across ``exec``, so a job forked straight from a bench
+    process that already holds a gigabyte would report that gigabyte."""
+    out = subprocess.run(
+        [sys.executable, __file__, "--launch", *argv], cwd=cwd, capture_output=True, text=True, check=False
+    )
+    if out.returncode != 0:
+        raise RuntimeError(f"{' '.join(argv)} failed: {out.stderr[-2000:]}")
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def _launch(argv: list[str]) -> None:
+    """Run ``argv``, print its wall time and peak as JSON (the launcher's job)."""
     t0 = time.perf_counter()
-    proc = subprocess.Popen(argv, cwd=cwd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    proc = subprocess.Popen(argv, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     stderr = proc.stderr.read()
     _, status, usage = os.wait4(proc.pid, 0)
-    proc.returncode = os.waitstatus_to_exitcode(status)
     wall = time.perf_counter() - t0
-    if proc.returncode != 0:
-        raise RuntimeError(f"{' '.join(argv)} exited {proc.returncode}: {stderr.decode()[-2000:]}")
-    return {"wall_s": round(wall, 2), "peak_rss_mib": round(usage.ru_maxrss / 1024, 1)}
+    if os.waitstatus_to_exitcode(status) != 0:
+        sys.stderr.write(f"exited {os.waitstatus_to_exitcode(status)}: {stderr.decode()[-2000:]}")
+        sys.exit(1)
+    print(json.dumps({"wall_s": round(wall, 2), "peak_rss_mib": round(usage.ru_maxrss / 1024, 1)}))
 
 
 def bench_memory(quick: bool, committed: dict | None = None) -> dict:
@@ -115,6 +130,7 @@ def markdown(res: dict | None, missed: str) -> list[str]:
 
 
 if __name__ == "__main__":
-    import json
-
-    print(json.dumps(bench_memory(quick="--quick" in sys.argv), indent=2))
+    if sys.argv[1:2] == ["--launch"]:
+        _launch(sys.argv[2:])
+    else:
+        print(json.dumps(bench_memory(quick="--quick" in sys.argv), indent=2))

@@ -49,3 +49,20 @@ def test_bench_writes_an_untracked_folder_unless_asked_to_update(tmp_path):
         check=False,
     )
     assert out.returncode == 2 and "give --update" in out.stderr
+
+
+def test_a_peak_grown_by_more_than_a_fifth_is_marked():
+    from bench_memory import GROWTH_LIMIT
+    from bench_memory import markdown as memory_markdown
+    from run_all import MISSED
+
+    jobs = {
+        "kept": {"wall_s": 1.0, "peak_rss_mib": 119.0, "committed_peak_rss_mib": 100.0, "grew": False},
+        "grown": {"wall_s": 1.0, "peak_rss_mib": 121.0, "committed_peak_rss_mib": 100.0, "grew": True},
+    }
+    rows = {
+        line.split(" | ")[0].strip("| "): line
+        for line in memory_markdown({"jobs": jobs, "growth_limit": GROWTH_LIMIT}, MISSED)
+    }
+    assert MISSED in rows["grown"] and MISSED not in rows["kept"]
+    assert 121.0 > GROWTH_LIMIT * 100.0 > 119.0
