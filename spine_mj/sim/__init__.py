@@ -48,7 +48,9 @@ needs feedback and steps in Python. The ramp and the static probe fast-forward t
 stick phases (:mod:`~spine_mj.sim.fastforward`). Every run ends with a recorded
 :class:`EndReason`, never with an exception from the engine.
 
-Modules: :mod:`~spine_mj.sim.params` (tip, engine, scales and their rules),
+Modules: :mod:`~spine_mj.sim.params` (tip, engine, scales and their rules, in one import:
+:mod:`~spine_mj.sim.records` the parameter records, :mod:`~spine_mj.sim.scales` the
+scales and hfield, :mod:`~spine_mj.sim.step_rule` the engine's step rule),
 :mod:`~spine_mj.sim.drives`, :mod:`~spine_mj.sim.model` (building the MuJoCo model),
 :mod:`~spine_mj.sim.placement`, :mod:`~spine_mj.sim.recording` (per-step columns),
 :mod:`~spine_mj.sim.detection` (events, end reasons), :mod:`~spine_mj.sim.results`,

@@ -119,10 +119,10 @@ def test_a_penetration_stop_is_run_again_at_a_quarter_of_the_step(monkeypatch):
     deep): landings on the peak's fast runs then sink too far; run_batch runs each such run
     once more at a quarter of the step, and the result carries the step it ran at."""
     from spine_mj import presets, sim
-    from spine_mj.sim import params
+    from spine_mj.sim import step_rule
 
-    monkeypatch.setattr(params, "_IMPACT_DEPTH_OF_TOLERANCE", 2.0)
-    monkeypatch.setattr(params, "_LANDING_SPEED_FACTOR", 1.0)
+    monkeypatch.setattr(step_rule, "_IMPACT_DEPTH_OF_TOLERANCE", 2.0)
+    monkeypatch.setattr(step_rule, "_LANDING_SPEED_FACTOR", 1.0)
     surface, tip = presets.make_surface("paper-single-peak"), sim.TipParams(mu_s=1.23)
     scales = sim.Scales.for_surface(surface, tip=tip)
     speed = scales.speed_for(0.1)

@@ -1,0 +1,405 @@
+"""The problem's scales and the one home of the rig's scaling rule.
+
+:class:`Scales` derives the problem's scales from a surface and a tip
+(:meth:`Scales.for_surface`: length scale, ``L_c``, ``l_s``, default tip radius, hfield
+spacing and coarsening, the surface's fall height), :class:`EngineUnits` the units MuJoCo
+works in; the hfield helpers (:func:`hfield_of`, :func:`hfield_spacing`),
+:func:`surface_unit_m` and :func:`fall_height` are the rules they use. Nothing here needs
+MuJoCo; :mod:`spine_mj.sim.params` re-exports every name.
+
+The scaling rule. MuJoCo sees the problem in its own units: length ``L_c``, force
+``F_p = m g + preload``, mass ``m``, hence time ``tau = sqrt(m L_c / F_p)`` and speed
+``sqrt(F_p L_c / m)`` (a drive of inertia number ``I_e`` moves at ``sqrt(I_e)``). The same
+dimensionless problem at any physical scale is then the same model, bit for bit, and every
+number the engine meets (mass 1, tip radius ``r / L_c``, time step ``dt / tau``) is O(1)
+or a ratio of the problem's own lengths, far from MuJoCo's absolute floors (``mjMINVAL =
+1e-15``) that a micrometre tip in SI units falls below.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from spine_mj.errors import SpineInputError, check_positive
+from spine_mj.roughness import characteristic_length, slope_correlation_length
+from spine_mj.sim.records import TipParams
+from spine_mj.surfaces import LENGTH_UNITS_M, GridSurface, HField, Surface, length_unit, to_hfield
+
+DEFAULT_LENGTH_SCALE_M = 0.01
+#: Largest inertia number a drive may have: beyond it the quasistatic question is moot and
+#: the engine step (bounded by impacts at the drive speed) shrinks without end.
+MAX_INERTIA_NUMBER = 1e4
+_MIN_SPACING_PER_TIP_RADIUS = 0.25  # finer hfields exceed MuJoCo's 50 contacts per geom pair
+_SCAN_TIP_SPACINGS = 2.0  # default tip radius of a measured scan, in lateral spacings
+MAX_HFIELD_SIDE = 8192  # samples a side of an hfield (memory; MuJoCo's collision stays local)
+_MIN_ENGINE_RATIO = 1e-9  # smallest length ratio (tip / L_c, spacing / L_c) the engine resolves
+#: Physical range of lengths [m] (outside it the model means nothing).
+PHYSICAL_LENGTH_M = (1e-12, 1e3)
+
+
+@dataclass(frozen=True)
+class EngineUnits:
+    """The units MuJoCo works in: length ``L_c``, force ``F_p``, mass ``m`` (module docstring).
+
+    A number in engine units times the matching unit here is the SI value; the rig
+    converts with these and nowhere else.
+
+    Attributes
+    ----------
+    length_m, force_n, mass_kg : float
+    """
+
+    length_m: float
+    force_n: float
+    mass_kg: float
+
+    @property
+    def time_s(self) -> float:
+        """sqrt(m L_c / F_p)."""
+        return math.sqrt(self.mass_kg * self.length_m / self.force_n)
+
+    @property
+    def speed_m_s(self) -> float:
+        return self.length_m / self.time_s
+
+    @property
+    def acceleration_m_s2(self) -> float:
+        return self.force_n / self.mass_kg
+
+    @property
+    def stiffness_n_m(self) -> float:
+        return self.force_n / self.length_m
+
+
+@dataclass(frozen=True)
+class Scales:
+    """The problem's scales, all in SI units; :meth:`for_surface` derives them.
+
+    Attributes
+    ----------
+    length_scale_m : float
+        Metres per surface length unit (1 for surfaces in metres).
+    char_length_m : float
+        L_c, the characteristic asperity length [m].
+    mass_kg, preload_n, tip_radius_m : float
+        m_eff [kg], F_p [N], tip radius [m].
+    hfield_spacing_m : float
+        Larger of the hfield's two sample spacings [m].
+    hfield_resolution : int or None
+        Samples a side the hfield is resampled to (None: a grid keeps its own samples,
+        an analytic surface gets :func:`spine_mj.surfaces.to_hfield`'s default).
+    slope_length_m : float or None
+        l_s, the slope correlation length [m] (:func:`slope_correlation_length`; L_c where
+        the surface has none, a plane); the length of the drive stiffness number K.
+    extent_m : float or None
+        Diagonal of the surface's domain [m] (bounds the energy a run can gain).
+    fall_height_m : float
+        The height a slip can turn into an impact [m] (:func:`fall_height`: a fall down a
+        grit flank or a scan-line step onto the floor below); 0 on planes and on surfaces
+        no steeper than the friction angle. It bounds the engine step
+        (:func:`~spine_mj.sim.step_rule.default_engine`).
+    """
+
+    length_scale_m: float
+    char_length_m: float
+    mass_kg: float
+    preload_n: float
+    tip_radius_m: float
+    hfield_spacing_m: float
+    hfield_resolution: int | None = None
+    slope_length_m: float | None = None
+    extent_m: float | None = None
+    fall_height_m: float = 0.0
+
+    @classmethod
+    def for_surface(cls, surface: Surface, **sizing) -> Scales:
+        """The scales of a tip on ``surface``: :meth:`with_hfield` (the same keyword
+        arguments: ``tip``, ``length_scale_m``, ``char_length_m``, ``hfield_resolution``)
+        without the hfield."""
+        return cls.with_hfield(surface, **sizing)[0]
+
+    @classmethod
+    def with_hfield(
+        cls,
+        surface: Surface,
+        *,
+        tip: TipParams | None = None,
+        length_scale_m: float | None = None,
+        char_length_m: float | None = None,
+        hfield_resolution: int | None = None,
+    ) -> tuple[Scales, HField]:
+        """The scales of ``tip`` on ``surface`` and the hfield they were measured on (the
+        rig's model is built from that same hfield): the one place the rig's sizing rules
+        live.
+
+        * ``length_scale_m``: None gives :data:`DEFAULT_LENGTH_SCALE_M` for a dimensionless
+          surface (``unit == "1"``) and the unit's size (:data:`LENGTH_UNITS_M`) otherwise.
+        * ``char_length_m``: None gives :func:`characteristic_length` in metres.
+        * tip radius (when ``tip.tip_radius_m`` is None): the surface's own
+          ``metadata["params"]["tip_radius_m"]`` (sandpaper); for a measured scan (a grid
+          in a physical unit) the larger of two lateral spacings and ``L_c / 100`` (the
+          sphere rests on several facets, never in one pixel); else the larger of one
+          hfield spacing and ``L_c / 100``; to 3 significant digits.
+        * hfield resolution: an hfield finer than a quarter tip radius is coarsened to that
+          (MuJoCo keeps at most 50 contacts per geom pair: a tip over too many cells loses
+          its deepest contacts).
+        * fall height: :func:`fall_height` of that hfield with the tip's ``mu_s`` and radius.
+
+        Raises
+        ------
+        SpineInputError
+            A surface in an unknown unit, scales outside the physical range, a tip larger
+            than the surface, or an hfield coarser than two tip radii (the sphere would see
+            single facets and their kinks).
+        """
+        if not isinstance(surface, Surface):
+            raise SpineInputError(f"surface must be a spine_mj Surface, got {type(surface).__name__}")
+        tip = TipParams() if tip is None else tip
+        length_scale_m = surface_unit_m(surface, length_scale_m)
+        if char_length_m is None:
+            char_length_m = characteristic_length(surface) * length_scale_m
+        char_length_m = check_physical_length("char_length_m", char_length_m)
+        res = hfield_resolution
+        if res is not None and (isinstance(res, bool) or int(res) != res or res < 4):
+            raise SpineInputError(f"hfield_resolution must be an integer >= 4 or None, got {res!r}")
+        if res is not None and res > MAX_HFIELD_SIDE:
+            raise SpineInputError(f"hfield_resolution must be <= {MAX_HFIELD_SIDE} samples a side, got {res}")
+        hf = hfield_of(surface, hfield_resolution)
+        spacing = hfield_spacing(hf, length_scale_m)
+        radius = tip.tip_radius_m
+        if radius is None:
+            radius = default_tip_radius(surface, spacing, char_length_m)
+        xmin, xmax, ymin, ymax = (length_scale_m * b for b in surface.bounds)
+        _check_sizes(radius, spacing, char_length_m, min(xmax - xmin, ymax - ymin))
+        resolution = hfield_resolution
+        if resolution is None and spacing < _MIN_SPACING_PER_TIP_RADIUS * radius:
+            extent = 2 * max(hf.size[0], hf.size[1]) * length_scale_m
+            resolution = math.ceil(extent / (_MIN_SPACING_PER_TIP_RADIUS * radius)) + 1
+            hf = hfield_of(surface, resolution)
+            spacing = hfield_spacing(hf, length_scale_m)
+        rx, ry, elevation = hf.size[0], hf.size[1], hf.size[2]
+        fall = fall_height(
+            hf.data.astype(float) * (elevation * length_scale_m),  # float64: the same at every scale
+            (2 * rx / (hf.ncol - 1) * length_scale_m, 2 * ry / (hf.nrow - 1) * length_scale_m),
+            mu=tip.mu_s,
+            radius=radius,
+        )
+        scales = cls(
+            length_scale_m=length_scale_m,
+            char_length_m=char_length_m,
+            mass_kg=tip.mass_kg,
+            preload_n=tip.preload_total_n,
+            tip_radius_m=radius,
+            hfield_spacing_m=spacing,
+            hfield_resolution=resolution,
+            slope_length_m=_slope_length(surface, length_scale_m, char_length_m),
+            extent_m=math.hypot(xmax - xmin, ymax - ymin),
+            fall_height_m=fall,
+        )
+        return scales, hf
+
+    @property
+    def units(self) -> EngineUnits:
+        """The engine's units: length L_c, force F_p, mass m."""
+        return EngineUnits(length_m=self.char_length_m, force_n=self.preload_n, mass_kg=self.mass_kg)
+
+    @property
+    def time_s(self) -> float:
+        """tau = sqrt(m L_c / F_p), the time over which the preload moves the tip by L_c."""
+        return math.sqrt(self.mass_kg * self.char_length_m / self.preload_n)
+
+    @property
+    def speed_m_s(self) -> float:
+        """sqrt(F_p L_c / m): the speed at which I_e = 1."""
+        return math.sqrt(self.preload_n * self.char_length_m / self.mass_kg)
+
+    def inertia_number(self, speed_m_s: float) -> float:
+        """I_e = m v^2 / (F_p L_c) (paper §2.2)."""
+        return self.mass_kg * speed_m_s**2 / (self.preload_n * self.char_length_m)
+
+    def speed_for(self, inertia_number: float) -> float:
+        """The drive speed [m/s] of inertia number ``inertia_number`` (inverse of I_e).
+
+        Raises
+        ------
+        SpineInputError
+            Unless ``0 < I_e <= MAX_INERTIA_NUMBER``.
+        """
+        return math.sqrt(check_inertia_number(inertia_number)) * self.speed_m_s
+
+    def force_rate_for(self, speed_m_s: float) -> float:
+        """The force rate [N/s] of a force drive (ramp, static probe) at equivalent speed
+        ``speed_m_s``: ``v F_p / L_c``, the rate at which the force rises by one preload in
+        the time the tip would cross one feature at that speed (inverse of
+        :meth:`equivalent_speed`)."""
+        return speed_m_s * self.preload_n / self.char_length_m
+
+    def equivalent_speed(self, rate_n_s: float) -> float:
+        """A force drive's equivalent speed [m/s], ``v_eq = L_c rate / F_p``."""
+        return self.char_length_m * rate_n_s / self.preload_n
+
+    def stiffness_number(self, stiffness_n_m: float) -> float:
+        """K = k l_s / F_p (docs/physics.md §4), l_s the slope correlation length."""
+        return stiffness_n_m * self.slope_length_m / self.preload_n
+
+    def stiffness_for(self, stiffness_number: float) -> float:
+        """The spring stiffness [N/m] of drive stiffness number ``K`` (inverse of K)."""
+        return stiffness_number * self.preload_n / self.slope_length_m
+
+
+def surface_unit_m(surface: Surface, length_scale_m: float | None) -> float:
+    """Metres per surface length unit: ``length_scale_m``, else by the surface's unit
+    (:data:`~spine_mj.surfaces.LENGTH_UNITS_M`; "1", dimensionless, gives
+    :data:`DEFAULT_LENGTH_SCALE_M`)."""
+    unit = length_unit(surface.unit)
+    if surface.unit != "1" and unit is None:
+        raise SpineInputError(
+            f"surface unit must be '1' (dimensionless) or a length unit {sorted(LENGTH_UNITS_M)}, "
+            f"got {surface.unit!r}"
+        )
+    if length_scale_m is None:
+        length_scale_m = DEFAULT_LENGTH_SCALE_M if unit is None else LENGTH_UNITS_M[unit]
+    return check_physical_length("length_scale_m", length_scale_m)
+
+
+def check_physical_length(name: str, value: float) -> float:
+    """``value`` [m] if it lies in :data:`PHYSICAL_LENGTH_M`, else :class:`SpineInputError`."""
+    value = check_positive(name, value)
+    lo, hi = PHYSICAL_LENGTH_M
+    if not lo <= value <= hi:
+        raise SpineInputError(
+            f"{name} must lie in [{lo:g}, {hi:g}] m (a rigid-sphere contact means nothing outside), "
+            f"got {value:g}"
+        )
+    return value
+
+
+def default_tip_radius(surface: Surface, spacing_m: float, char_length_m: float) -> float:
+    """The default tip radius [m] (rule in :meth:`Scales.for_surface`)."""
+    params = surface.metadata.get("params", {}) if isinstance(surface.metadata, dict) else {}
+    radius = params.get("tip_radius_m") if surface.unit != "1" else None
+    if radius:
+        return float(radius)
+    scan = isinstance(surface, GridSurface) and surface.unit != "1"
+    spacings = _SCAN_TIP_SPACINGS if scan else 1.0
+    return float(f"{max(spacings * spacing_m, 0.01 * char_length_m):.3g}")
+
+
+def fall_height(
+    heights: np.ndarray, spacing: tuple[float, float], *, mu: float, radius: float, rows: int = 512
+) -> float:
+    """The height a slip can turn into an impact: the largest landing of a tip on ``heights``.
+
+    A tip that slips down a slope steeper than its friction angle gains speed; down a
+    cliff (a grit's overhang, an AFM scan-line step) it falls. Its speed is that of a fall
+    from ``H = drop - mu run``: the sliding friction takes ``mu`` times the weight per unit
+    of horizontal run (the work ``mu N ds`` with ``N = W cos(theta)``), nothing where the
+    tip is airborne or on a wall. Where the surface then turns up by ``theta`` (measured over
+    one tip radius, the scale the sphere feels), the part ``sin(theta)`` of that speed hits
+    the next facet: a landing like a fall from ``H sin^2(theta)``. The result is the largest
+    such height along every row and column of the grid, walked both ways: exact for the
+    straight falls of a quasistatic slip, 0 on a plane (no turn) and where no slope beats
+    friction (no drop). Pure numpy, ``rows`` lines at a time.
+
+    Parameters
+    ----------
+    heights : ndarray, shape (ny, nx)
+        ``heights[iy, ix]`` in some length unit (the result is in that unit).
+    spacing : (dx, dy)
+        Grid spacings in the same unit.
+    mu, radius : float
+        The tip's friction coefficient and radius (same unit).
+    """
+    heights = np.asarray(heights, dtype=float)
+    best = 0.0
+    for grid, step in ((heights, spacing[0]), (heights.T, spacing[1])):
+        m = max(1, round(radius / step))  # cells per tip radius
+        n = grid.shape[1]
+        if n <= 2 * m:
+            continue
+        run = mu * step * np.arange(n)
+        for lo in range(0, grid.shape[0], rows):
+            for a in (grid[lo : lo + rows], grid[lo : lo + rows, ::-1]):
+                g = a + run  # height plus the friction's toll: falling from i to j gains g_i - g_j
+                drop = np.maximum.accumulate(g, axis=1) - g
+                into = np.arctan((a[:, m : n - m] - a[:, : n - 2 * m]) / (m * step))
+                out = np.arctan((a[:, 2 * m :] - a[:, m : n - m]) / (m * step))
+                turn = np.clip(out - into, 0.0, math.pi / 2)
+                best = max(best, float((drop[:, m : n - m] * np.sin(turn) ** 2).max()))
+    return best
+
+
+def _check_sizes(radius: float, spacing: float, char_length: float, span: float) -> None:
+    """Tip, hfield spacing and L_c against each other and the domain (all in metres)."""
+    if 2 * radius >= span:
+        raise SpineInputError(
+            f"tip_radius_m {radius:.3g} m is larger than the surface: its diameter must be "
+            f"smaller than the domain's width {span:.3g} m"
+        )
+    if min(radius, spacing) < _MIN_ENGINE_RATIO * char_length:
+        raise SpineInputError(
+            f"tip_radius_m {radius:.3g} m or hfield spacing {spacing:.3g} m is finer than the engine "
+            f"resolves: both must exceed {_MIN_ENGINE_RATIO:g} L_c = {_MIN_ENGINE_RATIO * char_length:.3g} m"
+        )
+    if spacing > 2 * radius * (1 + 1e-9):
+        raise SpineInputError(
+            f"surface too coarse for the tip: hfield spacing {spacing:.3g} m > 2 x tip_radius_m "
+            f"= {2 * radius:.3g} m; raise hfield_resolution or the tip radius"
+        )
+
+
+def _slope_length(surface: Surface, length_scale_m: float, char_length_m: float) -> float:
+    """l_s [m], or L_c for a surface without one (a plane)."""
+    try:
+        return slope_correlation_length(surface) * length_scale_m
+    except SpineInputError:
+        return char_length_m
+
+
+def hfield_of(surface: Surface, resolution: int | None = None) -> HField:
+    """The surface as MuJoCo hfield data, resampled to ``resolution`` a side when given.
+
+    Parameters
+    ----------
+    surface : Surface
+        Any surface.
+    resolution : int, optional
+        Samples a side (None: a grid surface's own, 201 for an analytic one).
+
+    Returns
+    -------
+    HField
+    """
+    return to_hfield(surface, nrow=resolution, ncol=resolution) if resolution else to_hfield(surface)
+
+
+def hfield_spacing(hfield: HField, length_scale_m: float = 1.0) -> float:
+    """The larger of an hfield's two sample spacings, in metres.
+
+    Parameters
+    ----------
+    hfield : HField
+        MuJoCo height field data.
+    length_scale_m : float
+        Metres per surface unit.
+
+    Returns
+    -------
+    float
+    """
+    rx, ry = hfield.size[0], hfield.size[1]
+    return length_scale_m * 2 * max(rx / (hfield.ncol - 1), ry / (hfield.nrow - 1))
+
+
+def check_inertia_number(inertia_number: float, what: str = "inertia number I_e") -> float:
+    """``inertia_number`` if ``0 < I_e <= MAX_INERTIA_NUMBER``, else SpineInputError naming ``what``."""
+    if isinstance(inertia_number, (int, float)) and inertia_number > MAX_INERTIA_NUMBER * (1 + 1e-12):
+        raise SpineInputError(  # (1 + 1e-12): the limit itself, through a speed and back
+            f"{what} must be <= {MAX_INERTIA_NUMBER:g} (the tip crosses an asperity "
+            f"{math.sqrt(MAX_INERTIA_NUMBER):g} times faster than the preload can move it), "
+            f"got {inertia_number:g}"
+        )
+    return check_positive(what, inertia_number)
