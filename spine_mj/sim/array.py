@@ -36,9 +36,10 @@ from spine_mj.errors import SpineInputError
 from spine_mj.sim.array_run import HOLD_FRACTION, ArrayBatch, ArrayDrive, ArrayResult, ForcePull
 from spine_mj.sim.detection import Detection
 from spine_mj.sim.drives import SpringDrive, StaticProbe, rate_n_s, settle_steps, stiffness_n_m
+from spine_mj.sim.lanes import NativeLanes, PythonLane
 from spine_mj.sim.layout import Layout
 from spine_mj.sim.model import RigModel, compile_spec, start_pair
-from spine_mj.sim.rollout import _NativeLanes, _PythonLane, drive_steps
+from spine_mj.sim.rollout import drive_steps
 
 
 class ArrayRig:
@@ -215,7 +216,7 @@ class ArrayRig:
         import os
 
         nthread = (os.cpu_count() or 1) if nthread is None else max(1, int(nthread))
-        lanes = _NativeLanes(nthread) if backend == "rollout" else _PythonLane()
+        lanes = NativeLanes(nthread) if backend == "rollout" else PythonLane()
         try:
             return ArrayBatch(self, drive, starts, det).run(lanes)
         finally:

@@ -1,4 +1,4 @@
-"""Open-loop runs in batches: controls, grouping, and the pieced native rollout.
+"""Open-loop runs in batches: grouping, and the pieced native rollout.
 
 Spring drives and static probes need no feedback: their controls are known in advance
 (:func:`controls`), so they go through :func:`mujoco.rollout.rollout` on worker threads
@@ -16,8 +16,10 @@ warm start (``qacc_warmstart``) its worker's ``MjData`` holds after the piece, w
 recorded state lacks (without it the constraint solver starts elsewhere and the trajectory
 drifts by ~1e-5 L_c within a step). Each piece is one run on one ``MjData``, so that warm
 start is there to read; the pieces then give bit for bit the trajectory of one
-uninterrupted rollout (tested). :func:`python_steps` is the plain ``mj_step`` reference of
-a piece.
+uninterrupted rollout (tested). The controls are :mod:`spine_mj.sim.open_loop`'s, the
+worker threads and the plain ``mj_step`` reference of a piece
+(:func:`~spine_mj.sim.lanes.python_steps`) are :mod:`spine_mj.sim.lanes`'; this module
+re-exports their public names.
 
 A static probe with fast-forward (:class:`~spine_mj.sim.drives.StaticProbe`) is decided
 after its settle piece: :class:`~spine_mj.sim.fastforward.StickFastForward` reads the
@@ -51,8 +53,6 @@ from __future__ import annotations
 import itertools
 import math
 import os
-import queue
-import threading
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import NamedTuple
@@ -71,7 +71,20 @@ from spine_mj.sim.drives import (
     stiffness_n_m,
 )
 from spine_mj.sim.fastforward import QUIET_STEPS, RISE_STEPS, StickFastForward, fast_forward_on
+from spine_mj.sim.lanes import NativeLanes, PythonLane
+from spine_mj.sim.lanes import python_steps as python_steps  # re-exported (its old home)
+from spine_mj.sim.lanes import warning_text as warning_text
+from spine_mj.sim.lanes import warning_total as warning_total
 from spine_mj.sim.model import RigModel, start_pair
+from spine_mj.sim.open_loop import MAX_RUN_STEPS as MAX_RUN_STEPS  # re-exported (its old home)
+from spine_mj.sim.open_loop import (
+    control_profile,
+    drive_steps,
+    length_from_start,
+    profile_key,
+    start_offsets,
+)
+from spine_mj.sim.open_loop import controls as controls
 from spine_mj.sim.recording import Recording
 from spine_mj.sim.results import GroupAnalysis, RunResult
 
@@ -93,114 +106,11 @@ PIECE_STEPS = 1024
 #: 256 steps saved 5 % of its steps on the fractal at K = 3, mu 1.25, I_e 1e-6, but cost
 #: 15 % more CPU time than the usual pieces: a piece costs ~15 steps' time.)
 SPRING_MIN_CLIMB_STEPS = 4 * RISE_STEPS
-#: Most steps an open-loop run may plan: its recording (~0.5 kB a step) stays within ~2 GiB.
-MAX_RUN_STEPS = 2**22
 #: Tips placed at a time, their first pieces then handed to the workers (the very first
 #: chunk is one tip per worker, so that each starts as soon as it can). Placing 16 tips
 #: (~1 ms) takes less than a first piece (~2.5 ms on the single peak), and a 64-run batch
 #: spends 1.3 ms less of its calling thread's CPU than with chunks of 4 (fewer cold calls).
 PLACE_CHUNK = 16
-
-
-def length_from_start(drive: Drive) -> bool:
-    """Whether :func:`drive_steps` depends on the start: a spring drive without a duration
-    runs until its carriage has passed the far edge."""
-    return isinstance(drive, SpringDrive) and drive.duration_s is None
-
-
-def drive_steps(rig: RigModel, drive: Drive, x0_m: float, detection: Detection) -> int:
-    """Steps of the drive phase of an open-loop run starting at ``x0_m`` [m]."""
-    rig.check_drive(drive)
-    dt = rig.engine.timestep_s
-    if isinstance(drive, SpringDrive):
-        duration = drive.duration_s
-        if length_from_start(drive):
-            stretch = (1 + rig.tip.mu_s) * rig.scales.preload_n / stiffness_n_m(drive, rig.scales)
-            duration = (1.1 * max(rig.bounds_m[1] - x0_m, 0.0) + stretch) / drive.speed_m_s
-        steps = duration / dt
-        _check_run_steps(
-            steps,
-            dt,
-            f"a spring run of {duration:.3g} s",
-            "shorten duration_s, or raise the speed (I_e) or the timestep",
-        )
-        return max(1, int(math.ceil(steps)))
-    if isinstance(drive, StaticProbe):
-        cap = detection.kappa_cap * rig.scales.preload_n
-        rate = rate_n_s(drive, rig.scales)
-        steps = (cap - drive.start_force_n) / rate / dt
-        what = (
-            f"a static probe from {drive.start_force_n:.3g} N to the force cap {cap:.3g} N at {rate:.3g} N/s"
-        )
-        _check_run_steps(steps, dt, what, "raise the rate or lower kappa_cap")
-        return max(1, int(math.ceil(steps)) + 2)
-    raise SpineInputError(
-        f"open-loop controls exist for SpringDrive and StaticProbe, got {type(drive).__name__}"
-    )
-
-
-def _check_run_steps(steps: float, dt: float, what: str, remedy: str) -> None:
-    """Refuse a run of ``steps`` (a float, before rounding) beyond :data:`MAX_RUN_STEPS`."""
-    if not (math.isfinite(steps) and steps <= MAX_RUN_STEPS):
-        raise SpineInputError(
-            f"{what} would take {steps:.3g} steps of {dt:.3g} s, more than the limit "
-            f"{MAX_RUN_STEPS}: {remedy}"
-        )
-
-
-def controls(
-    rig: RigModel, drive: Drive, qpos0: np.ndarray, detection: Detection, out: np.ndarray | None = None
-) -> np.ndarray:
-    """Open-loop controls ``(nstep, 6)`` in engine units: ctrl (spring, push, preload) then mocap xyz.
-
-    ``qpos0`` is the placed start (:meth:`RigModel.place`, engine units), ``detection``
-    resolved (:meth:`Detection.resolve`): its ``kappa_cap`` bounds a probe's force.
-    ``out``: an array of that shape to fill and return (a batch's row) instead of a new one.
-    The controls are the drive's :func:`control_profile` shifted by the start
-    (:func:`start_offsets`).
-    """
-    profile = control_profile(rig, drive, qpos0[0] * rig.units.length_m, detection)
-    if out is not None and out.shape != profile.shape:
-        raise ValueError(f"out must have shape {profile.shape}, got {out.shape}")
-    return np.add(profile, start_offsets(drive, qpos0), out=out)
-
-
-def control_profile(rig: RigModel, drive: Drive, x0_m: float, detection: Detection) -> np.ndarray:
-    """The controls of :func:`controls` for a start at the origin ``(nstep, 6)``, engine
-    units (``x0_m`` [m] sets only the length of a spring run without a duration): what
-    every start of one drive shares, so that a batch computes it once per drive."""
-    u = rig.units
-    dt = rig.engine.timestep_s
-    n_settle = settle_steps(drive, dt)
-    n_drive = drive_steps(rig, drive, x0_m, detection)
-    ctrl = np.zeros((n_settle + n_drive, 6))
-    ctrl[:, 2] = -rig.tip.preload_n / u.force_n
-    ctrl[:, 5] = 2 * rig.tip.tip_radius_m / u.length_m
-    ramp_t = (dt / u.time_s) * np.arange(1, n_drive + 1)
-    if isinstance(drive, SpringDrive):
-        ctrl[n_settle:, 0] = (drive.speed_m_s / u.speed_m_s) * ramp_t
-        ctrl[:, 3] = ctrl[:, 0]
-    else:
-        cap = detection.kappa_cap * rig.scales.preload_n / u.force_n
-        f0 = drive.start_force_n / u.force_n
-        ctrl[:, 1] = f0
-        rate = rate_n_s(drive, rig.scales) * u.time_s / u.force_n
-        ctrl[n_settle:, 1] = np.minimum(f0 + rate * ramp_t, cap * (1 + 1e-9))
-    return ctrl
-
-
-def start_offsets(drive: Drive, qpos0: np.ndarray) -> np.ndarray:
-    """What a placed start ``qpos0`` (engine units) adds to each row of its drive's
-    :func:`control_profile` ``(6,)``: the spring's anchor and the mocap carriage follow the
-    start (the anchor only for a spring drive)."""
-    x0, y0, z0 = (float(c) for c in qpos0)
-    return np.array([x0 if isinstance(drive, SpringDrive) else 0.0, 0.0, 0.0, x0, y0, z0])
-
-
-def profile_key(drive: Drive, x0: float):
-    """What a run's :func:`control_profile` (and length) depends on: the drive, and the
-    start ``x0`` where the length does (:func:`length_from_start`)."""
-    return (id(drive), x0) if length_from_start(drive) else id(drive)
 
 
 def plan_groups(lengths: Sequence[int], bytes_per_step: int) -> list[list[int]]:
@@ -283,7 +193,7 @@ def run_batch(
     rig.check_starts(starts)
     runner = _BatchRunner(rig, drives, starts, det)
     nthread = (os.cpu_count() or 1) if opt.nthread is None else max(1, int(opt.nthread))
-    lanes = _NativeLanes(nthread) if opt.backend == "rollout" else _PythonLane()
+    lanes = NativeLanes(nthread) if opt.backend == "rollout" else PythonLane()
     try:
         for idx in plan_groups(runner.lengths, 8 * (runner.nstate + rig.model.nsensordata)):
             group = _Group(runner, idx, opt.stop_early)
@@ -618,156 +528,3 @@ def _still(rec: Recording, i: int) -> tuple[float, np.ndarray, bool]:
     """Tangential speed, outward normal and contact of row ``i``: what
     :meth:`StickFastForward.watch` reads."""
     return float(rec.tangential_speed_m_s[i]), rec.normal[i], bool(rec.contact[i])
-
-
-class _NativeLanes:
-    """Worker threads, each taking pieces from one queue and stepping them through
-    :func:`mujoco.rollout.rollout` on its own ``MjData`` (whose warm start the run goes on
-    from); :meth:`take` hands finished pieces back in the order they finished."""
-
-    def __init__(self, nthread: int):
-        import mujoco
-
-        self.spec = int(mujoco.mjtState.mjSTATE_CTRL) | int(mujoco.mjtState.mjSTATE_MOCAP_POS)
-        self.nthread = nthread
-        self.local = threading.local()
-        self.jobs: queue.SimpleQueue = queue.SimpleQueue()
-        self.finished: list = []  # (ok, result or exception), under ``ready``
-        self.ready = threading.Condition()
-        self.wanted = 0  # take() waits for this many: the workers wake it once, not per piece
-        self.cancelled = False
-        self.threads = [threading.Thread(target=self._work, daemon=True) for _ in range(nthread)]
-        for t in self.threads:
-            t.start()
-
-    def _work(self) -> None:
-        while (job := self.jobs.get()) is not None:
-            if not self.cancelled:
-                fn, args = job
-                try:
-                    item = (True, fn(*args))
-                except BaseException as exc:  # raised again by take(), on the calling thread
-                    item = (False, exc)
-                with self.ready:
-                    self.finished.append(item)
-                    if len(self.finished) == self.wanted or not item[0]:
-                        self.ready.notify()
-
-    def put(self, fn, args: tuple) -> None:
-        """Queue ``fn(*args)``."""
-        self.jobs.put((fn, args))
-
-    def take(self, n: int) -> list:
-        """At least ``n`` finished pieces (waiting for them) and any others finished by then."""
-        with self.ready:
-            self.wanted = n
-            self.ready.wait_for(lambda: len(self.finished) >= n or not all(ok for ok, _ in self.finished))
-            got, self.finished, self.wanted = self.finished, [], 0
-        for ok, value in got:
-            if not ok:
-                raise value
-        return [value for _, value in got]
-
-    def step(self, model, init, warm, ctrl, state, sens):
-        """Rows ``ctrl.shape[1]`` of one run from full physics state ``init`` and warm start
-        ``warm`` into ``state`` and ``sens`` (each a C-contiguous view with a leading axis of
-        one: the run as a batch of one, as rollout takes it); returns the warm start
-        after the last row (a list) and ``"frozen"`` if MuJoCo warned (the rollout clears the
-        warnings at its start, stops stepping at one and repeats the row), else None."""
-        import mujoco
-        from mujoco import rollout
-
-        lane = getattr(self.local, "lane", None)
-        if lane is None:  # the rig's models differ in the spring's stiffness only: one MjData fits all
-            data = mujoco.MjData(model)
-            # live views of the warnings and the warm start, read through memoryviews: after a
-            # piece, the bindings' and numpy's code has left the cache, and reading
-            # ``data.warning`` then costs ~100 us a piece against ~10 (measured)
-            warned, warm_out = memoryview(data.warning.number), memoryview(data.qacc_warmstart)
-            lane = self.local.lane = (data, rollout.Rollout(nthread=0), warned, warm_out)
-        data, pool, warned, warm_out = lane
-        pool.rollout(
-            [model],
-            [data],
-            init,
-            ctrl,
-            control_spec=self.spec,
-            skip_checks=True,
-            nstep=ctrl.shape[1],
-            initial_warmstart=warm,
-            state=state,
-            sensordata=sens,
-        )
-        return warm_out.tolist(), ("frozen" if any(warned) else None)
-
-    def close(self) -> None:
-        """Stop the workers (pieces still queued are dropped) and wait for them."""
-        self.cancelled = True
-        for _ in self.threads:
-            self.jobs.put(None)
-        for t in self.threads:
-            t.join()
-
-
-class _PythonLane:
-    """The reference backend: every piece stepped by :func:`python_steps` on the calling
-    thread, when it is queued."""
-
-    nthread = 1
-
-    def __init__(self):
-        self.finished: list = []
-
-    def put(self, fn, args: tuple) -> None:
-        self.finished.append(fn(*args))
-
-    def take(self, n: int) -> list:
-        got, self.finished = self.finished, []
-        return got
-
-    def step(self, model, init, warm, ctrl, state, sens):
-        return python_steps(model, init[0], warm[0], ctrl[0], state[0], sens[0])
-
-    def close(self) -> None:
-        pass
-
-
-def warning_total(d) -> int:
-    """The number of MuJoCo warnings ``d`` (an ``MjData``) has seen (read as one array: a
-    loop over the warning structs costs 100 us)."""
-    return int(d.warning.number.sum())
-
-
-def warning_text(d) -> str:
-    """The names of the warnings ``d`` has seen, comma separated."""
-    import mujoco
-
-    names = [n for n in dir(mujoco.mjtWarning) if n.startswith("mjWARN_") and n != "mjWARN_NWARNING"]
-    hit = [n for n in names if d.warning[int(getattr(mujoco.mjtWarning, n))].number > 0]
-    return ", ".join(h.removeprefix("mjWARN_") for h in hit) or "unknown"
-
-
-def python_steps(model, init, warm, ctrl, state, sens):
-    """Reference for one run's piece of :func:`mujoco.rollout.rollout`: a plain ``mj_step``
-    loop from full physics state ``init`` and warm start ``warm``, filling ``state``
-    ``(nstep, nstate)`` and ``sens`` ``(nstep, nsensordata)``.
-
-    Returns the warm start after the last step and ``(first step with a new MuJoCo warning,
-    warning names)`` or None (the loop steps on after a warning).
-    """
-    import mujoco
-
-    full = mujoco.mjtState.mjSTATE_FULLPHYSICS
-    d = mujoco.MjData(model)
-    mujoco.mj_setState(model, d, init, full)
-    d.qacc_warmstart[:] = warm
-    first_warn = None
-    for i in range(ctrl.shape[0]):
-        d.ctrl[:] = ctrl[i, : model.nu]
-        d.mocap_pos[:] = ctrl[i, model.nu :].reshape(-1, 3)
-        mujoco.mj_step(model, d)
-        mujoco.mj_getState(model, d, state[i], full)
-        sens[i] = d.sensordata
-        if first_warn is None and warning_total(d):
-            first_warn = (i, warning_text(d))
-    return d.qacc_warmstart.copy(), first_warn

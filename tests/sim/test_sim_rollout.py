@@ -180,9 +180,9 @@ def test_stopping_decided_runs_early_changes_no_result():
 def test_worker_lanes_hand_back_a_pieces_exception_and_close_with_pieces_queued():
     import threading
 
-    from spine_mj.sim.rollout import _NativeLanes
+    from spine_mj.sim.lanes import NativeLanes
 
-    lanes = _NativeLanes(2)
+    lanes = NativeLanes(2)
     release = threading.Event()
     ran = []
 
