@@ -42,7 +42,9 @@ resumes without losing or repeating a run; ``runs.parquet`` is rebuilt from thos
 the end of every sweep.
 
 Modules, each importing only those above it: :mod:`~spine_mj.sweep.registry` (analyses and
-their parameters), :mod:`~spine_mj.sweep.config` (the TOML schema),
+their parameters), :mod:`~spine_mj.sweep.tables` (the schema's table base, value types
+and one-line errors), :mod:`~spine_mj.sweep.digests` (config hashes, input digests),
+:mod:`~spine_mj.sweep.config` (the TOML schema),
 :mod:`~spine_mj.sweep.cases` (expansion, ids, seeds), :mod:`~spine_mj.sweep.case_runs` (one
 case), :mod:`~spine_mj.sweep.store` (the result store and its readers),
 :mod:`~spine_mj.sweep.pool` (local worker processes that die with their parent),

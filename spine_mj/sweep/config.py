@@ -8,8 +8,9 @@ and [grid], [drive] and [array] (the array analysis's layout), built by
 :mod:`spine_mj.sweep.registry` (types, bounds, defaults). The checks that span tables
 (defaults, the size, the analyses' own config checks) follow in :func:`parse_config`.
 Every error is one SpineInputError line naming the key, what is allowed and what arrived
-(:func:`_validate`). The normalized config (:meth:`SweepConfig.as_dict`) is what the
-config hash, and so the resume of a store, covers.
+(:func:`~spine_mj.sweep.tables.validate_table`; the tables' base and value types are
+:mod:`spine_mj.sweep.tables`'). The normalized config (:meth:`SweepConfig.as_dict`) is what
+the config hash (:mod:`spine_mj.sweep.digests`), and so the resume of a store, covers.
 """
 
 from __future__ import annotations
@@ -17,29 +18,21 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import functools
-import hashlib
 import inspect
-import json
 import math
 import os
 import sys
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Annotated, Any, ClassVar, Literal
+from typing import Any, Literal
 
 import numpy as np
 from pydantic import (
-    AllowInfNan,
     BaseModel,
-    ConfigDict,
     Field,
-    PlainValidator,
-    Strict,
     StrictBool,
     StrictStr,
-    TypeAdapter,
-    ValidationError,
     create_model,
     field_validator,
     model_validator,
@@ -48,87 +41,27 @@ from pydantic import (
 from spine_mj import examples, presets
 from spine_mj.errors import SpineInputError
 from spine_mj.jsonio import to_jsonable
+from spine_mj.sweep.digests import digest
+from spine_mj.sweep.digests import input_digests as input_digests  # re-exported (its old home)
 from spine_mj.sweep.registry import ANALYSES, PRESET_MU, REQUIRED, ParamSpec, param_specs
+from spine_mj.sweep.tables import (
+    MAX_CASES,
+    MAX_RUNS,
+    Finite,
+    Seed,
+    Table,
+    count_type,
+    validate_table,
+    value_list,
+)
 
 if sys.version_info >= (3, 11):
     import tomllib
 else:  # pragma: no cover
     import tomli as tomllib
 
-#: Most cases and runs one config may expand to (checked before anything is allocated).
-MAX_CASES = 1_000_000
-MAX_RUNS = 10_000_000
 #: Rough bytes of the run table per run, for the size in the message.
 _BYTES_PER_RUN = 300
-
-#: A finite number (an integer becomes a float; booleans and strings are refused).
-Finite = Annotated[float, Strict(), AllowInfNan(False)]
-#: A generator or master seed: an integer >= 0.
-Seed = Annotated[int, Strict(), Field(ge=0)]
-
-
-def _count(maximum: int) -> Any:
-    """The type of a count: an integer from 1 to ``maximum``."""
-    return Annotated[int, Strict(), Field(ge=1, le=maximum)]
-
-
-class _Table(BaseModel):
-    """A TOML table: frozen, and a key it does not declare is an error."""
-
-    model_config = ConfigDict(frozen=True, extra="forbid")
-    #: What its keys are, in the message for an unknown one.
-    noun: ClassVar[str] = "key"
-
-
-class _Span(_Table):
-    """``{linspace = [a, b], num = n}`` or ``{logspace = [a, b], num = n}``: ``n`` values from
-    ``a`` to ``b``, evenly or geometrically spaced."""
-
-    linspace: tuple[Finite, Finite] | None = None
-    logspace: tuple[Finite, Finite] | None = None
-    num: _count(MAX_CASES)
-
-    @field_validator("logspace")
-    def _positive_ends(cls, ends):
-        if min(ends) <= 0:
-            raise ValueError(f"end values must be > 0 (they are values, not exponents), got {list(ends)}")
-        return ends
-
-    @model_validator(mode="after")
-    def _one_spacing(self):
-        if (self.linspace is None) == (self.logspace is None):
-            both = "neither" if self.linspace is None else "both"
-            raise ValueError(f"give exactly one of linspace = [a, b] or logspace = [a, b], got {both}")
-        return self
-
-    def values(self) -> list[float]:
-        space = np.linspace if self.logspace is None else np.geomspace
-        return [float(v) for v in space(*(self.linspace or self.logspace), self.num)]
-
-
-def _values(item: Any, expected: str, *, distinct: bool = False) -> Any:
-    """The type of a key that takes a value, a non-empty list of them or a :class:`_Span`:
-    a tuple of values of the pydantic type ``item`` (``expected`` names it in the message);
-    with ``distinct``, none repeated."""
-    adapter = TypeAdapter(item)
-
-    def validate(value) -> tuple:
-        if isinstance(value, dict):
-            value = _Span.model_validate(value).values()
-        value = value if isinstance(value, list) else [value]
-        if not value:
-            raise ValueError("must be a value or a non-empty list, got []")
-        out = []
-        for v in value:
-            try:
-                out.append(adapter.validate_python(v))
-            except ValidationError:
-                raise ValueError(f"must be {expected} (or a list of them), got {v!r}") from None
-        if distinct and len(set(out)) != len(out):
-            raise ValueError(f"repeated value in {out!r}")
-        return tuple(out)
-
-    return Annotated[tuple, PlainValidator(validate)]
 
 
 @dataclass(frozen=True)
@@ -173,7 +106,7 @@ class SurfaceSpec:
         return _make_surface(self, stamp)
 
 
-class StartsSpec(_Table):
+class StartsSpec(Table):
     """Start points of every case: the [starts] table, or a [[surfaces]] entry's ``starts``.
 
     Attributes
@@ -189,9 +122,9 @@ class StartsSpec(_Table):
 
     frame: Literal["relative", "absolute"] = "relative"
     points: tuple[tuple[Finite, Finite], ...] | None = None
-    x: _values(Finite, "a finite number") | None = None
-    y: _values(Finite, "a finite number") | None = None
-    random: _count(MAX_RUNS) | None = None
+    x: value_list(Finite, "a finite number") | None = None
+    y: value_list(Finite, "a finite number") | None = None
+    random: count_type(MAX_RUNS) | None = None
 
     @model_validator(mode="before")
     def _one_kind(cls, data):
@@ -242,7 +175,7 @@ class StartsSpec(_Table):
         return pts
 
 
-class _SurfaceEntry(_Table):
+class _SurfaceEntry(Table):
     """A [[surfaces]] entry: a preset, with one of ``seed``, ``seeds`` or ``n_seeds`` (that
     many, derived from the master seed) if its generator takes one and generator overrides
     ``set``; or a ``file`` (.npz or instrument), relative to the config. ``starts`` replaces
@@ -252,7 +185,7 @@ class _SurfaceEntry(_Table):
     file: StrictStr | None = None
     seed: Seed | None = None
     seeds: list[Seed] | None = Field(None, min_length=1)
-    n_seeds: _count(MAX_CASES) | None = None
+    n_seeds: count_type(MAX_CASES) | None = None
     overrides: dict[str, Any] = Field({}, alias="set")
     starts: StartsSpec | None = None
 
@@ -325,7 +258,7 @@ class _SurfaceEntry(_Table):
         return [SurfaceSpec(kind, source, s, overrides, stem if s is None else f"{stem}#{s}") for s in seeds]
 
 
-class _Sweep(_Table):
+class _Sweep(Table):
     """The [sweep] table: ``seed`` is the master seed (each case derives its own);
     ``analyses``, a name or a list, run in the registry's order."""
 
@@ -354,16 +287,16 @@ class _Sweep(_Table):
         return tuple(a for a in ANALYSES if a in analyses)
 
 
-class _Document(_Table):
+class _Document(Table):
     """A whole config; [grid] and [drive] are checked by :func:`_parameters_model` once the
     analyses are known."""
 
     sweep: _Sweep = _Sweep()
     surfaces: list[_SurfaceEntry] = Field(min_length=1)
     starts: StartsSpec | None = Field(None, validate_default=True)
-    grid: dict[str, Any] = {}
-    drive: dict[str, Any] = {}
-    array: dict[str, Any] = {}
+    grid: dict[str, Any] = Field(default_factory=dict)
+    drive: dict[str, Any] = Field(default_factory=dict)
+    array: dict[str, Any] = Field(default_factory=dict)
 
     @field_validator("starts")
     def _for_every_surface(cls, starts, info):
@@ -381,8 +314,8 @@ def _parameters_model(analyses: tuple[str, ...], specs: tuple[ParamSpec, ...]) -
     (:func:`_grid` fills in the defaults)."""
 
     def table(name: str, noun: str, keys) -> type[BaseModel]:
-        fields = {s.name: (_values(s.annotation, s.expected(), distinct=True), None) for s in keys}
-        model = create_model(name, __base__=_Table, **fields)
+        fields = {s.name: (value_list(s.annotation, s.expected(), distinct=True), None) for s in keys}
+        model = create_model(name, __base__=Table, **fields)
         model.noun = f"{noun} for analyses {list(analyses)}"
         return model
 
@@ -391,7 +324,7 @@ def _parameters_model(analyses: tuple[str, ...], specs: tuple[ParamSpec, ...]) -
     drive = table("drive", "drive parameter", [s for s in specs if s.drive])
     array = table("array", "array parameter", [s for s in specs if s.array])
     return create_model(
-        "parameters", __base__=_Table, grid=(grid, grid()), drive=(drive, drive()), array=(array, array())
+        "parameters", __base__=Table, grid=(grid, grid()), drive=(drive, drive()), array=(array, array())
     )
 
 
@@ -504,10 +437,10 @@ def parse_config(doc: Mapping, *, base_dir: str | os.PathLike = ".") -> SweepCon
     SpineInputError
         Unknown keys or analyses, bad values: the message names the key's path.
     """
-    document = _validate(_Document, doc, context={"base_dir": Path(base_dir)})
+    document = validate_table(_Document, doc, context={"base_dir": Path(base_dir)})
     sweep = document.sweep
     specs = tuple(param_specs(sweep.analyses).values())
-    params = _validate(
+    params = validate_table(
         _parameters_model(sweep.analyses, specs),
         {"grid": document.grid, "drive": document.drive, "array": document.array},
     )
@@ -582,119 +515,12 @@ def _human_bytes(n: float) -> str:
     return f"{n:.3g} PB"
 
 
-#: pydantic's words for the errors whose usual "Input should be ..." would not read well.
-_MESSAGES = {
-    "model_type": "must be a table",
-    "dict_type": "must be a table",
-    "list_type": "must be a list",
-    "tuple_type": "must be a list",
-    "bool_type": "must be true or false",
-    "too_short": "must have at least {min_length} item(s)",
-    "too_long": "must have at most {max_length} item(s)",
-    "string_too_short": "must be a non-empty string",
-}
-
-
-def _validate(model: type[BaseModel], data, context: dict | None = None):
-    """``model`` validated from ``data``, or a SpineInputError of one line: the first problem
-    (key path, what is expected, what arrived) and how many others there are."""
-    try:
-        return model.model_validate(data, context=context)
-    except ValidationError as exc:
-        errors = exc.errors()
-        n = len(errors) - 1
-        more = f" (and {n} other problem{'s' if n > 1 else ''})" if n else ""
-        raise SpineInputError(_describe(model, errors[0]) + more) from None
-
-
-def _describe(model: type[BaseModel], error: dict) -> str:
-    """A pydantic error as ``config key grid.ie[2]: must be ..., got ...``."""
-    loc, kind, ctx = error["loc"], error["type"], error.get("ctx", {})
-    if kind == "value_error":  # raised by the validators here, whose messages say what arrived
-        what = str(ctx["error"])
-    elif kind == "missing":
-        what = "required"
-    elif kind == "extra_forbidden":
-        table = _table_at(model, loc)
-        what = f"unknown {table.noun}; allowed: "
-        what += ", ".join(f.alias or n for n, f in table.model_fields.items()) or "none"
-    else:
-        what = (
-            _MESSAGES[kind].format(**ctx)
-            if kind in _MESSAGES
-            else error["msg"].replace("Input should", "must")
-        )
-        what += f", got {error['input']!r}"
-    path = "".join(f"[{k}]" if isinstance(k, int) else f".{k}" for k in loc).lstrip(".")
-    return f"config key {path}: {what}" if path else f"config: {what}"
-
-
-def _table_at(model: type[BaseModel], loc: tuple) -> type[BaseModel]:
-    """The model of the table holding the key at ``loc`` (a table inside a value: a _Span)."""
-    for key in loc[:-1]:
-        if isinstance(key, str):
-            field = next((f for n, f in model.model_fields.items() if (f.alias or n) == key), None)
-            model = next(_models_in(getattr(field, "annotation", None)), _Span)
-    return model
-
-
-def _models_in(annotation):
-    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
-        yield annotation
-    for arg in getattr(annotation, "__args__", ()):
-        yield from _models_in(arg)
-
-
 def _freeze(value):
     if isinstance(value, list):
         return tuple(_freeze(v) for v in value)
     if isinstance(value, dict):
         return tuple(sorted((k, _freeze(v)) for k, v in value.items()))
     return value
-
-
-def input_digests(config: SweepConfig) -> dict[str, str]:
-    """sha256 of every input of ``config`` beyond its text: the contents of each surface
-    file, and the resolved preset (generator, parameters, seed, [engagement] and other
-    tables; the contents of a measured preset's file). Keyed ``file:<path>`` /
-    ``preset:<name>``; a store resumes only while these are unchanged."""
-    out = {}
-    for spec in config.surfaces:
-        key = f"{spec.kind}:{spec.source}"
-        if key in out:
-            continue
-        if spec.kind == "file":
-            out[key] = _file_digest(Path(spec.source))
-            continue
-        preset = presets.load_preset(spec.source)
-        resolved = {
-            "generator": preset.generator,
-            "params": to_jsonable(preset.params),
-            "seed": preset.seed,
-            "extras": to_jsonable(preset.extras),
-        }
-        measured = preset.params.get("file") if preset.generator == "measured" else None
-        if isinstance(measured, str) and Path(measured).is_file():
-            resolved["file_sha256"] = _file_digest(Path(measured))
-        out[key] = digest(resolved)
-    return out
-
-
-def _file_digest(path: Path) -> str:
-    h = hashlib.sha256()
-    try:
-        with open(path, "rb") as fh:
-            for block in iter(lambda: fh.read(1 << 20), b""):
-                h.update(block)
-    except OSError as exc:
-        raise SpineInputError(f"surface file {str(path)!r} cannot be read: {exc.strerror or exc}") from None
-    return h.hexdigest()
-
-
-def digest(obj) -> str:
-    """sha256 (hex) of ``obj`` as canonical JSON (sorted keys): config hashes and case ids."""
-    text = json.dumps(obj, sort_keys=True, separators=(",", ":"), allow_nan=True)
-    return hashlib.sha256(text.encode()).hexdigest()
 
 
 @functools.lru_cache(maxsize=8)
