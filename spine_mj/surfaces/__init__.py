@@ -20,6 +20,7 @@ its instrument's length unit (:data:`LENGTH_UNITS_M`, spelled by :func:`length_u
 
 Modules: :mod:`~spine_mj.surfaces.base` (units, size limits, argument checks),
 :mod:`~spine_mj.surfaces.types` (the surface types), :mod:`~spine_mj.surfaces.generators`,
+:mod:`~spine_mj.surfaces.sandpaper`,
 :mod:`~spine_mj.surfaces.hfield` (MuJoCo's height field) and
 :mod:`~spine_mj.surfaces.facets` (the facets MuJoCo collides with and the ball tip on them),
 :mod:`~spine_mj.surfaces.dilation` (the surface a spherical tip's centre rides on).
@@ -36,14 +37,9 @@ from spine_mj.surfaces.base import (
 )
 from spine_mj.surfaces.dilation import ball_dilation, ball_dilation_reference, dilate
 from spine_mj.surfaces.facets import BallOnFacets, TriangulatedSurface
-from spine_mj.surfaces.generators import (
-    corrugation,
-    fractal_fbm,
-    random_gaussians,
-    sandpaper,
-    single_gaussian,
-)
+from spine_mj.surfaces.generators import corrugation, fractal_fbm, random_gaussians, single_gaussian
 from spine_mj.surfaces.hfield import HField, from_hfield, to_hfield
+from spine_mj.surfaces.sandpaper import sandpaper
 from spine_mj.surfaces.types import BSplineGrid, GaussianSurface, GridSurface, Surface
 
 __all__ = [

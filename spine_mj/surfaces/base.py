@@ -8,6 +8,7 @@ from typing import Any
 
 import numpy as np
 
+from spine_mj._version import __version__
 from spine_mj.errors import SpineInputError
 from spine_mj.memory import check_memory
 
@@ -153,3 +154,9 @@ def _count(n) -> str:
     """A point count for a message: whole numbers as integers, others as floats."""
     n = float(n)
     return str(int(n)) if math.isfinite(n) and n == int(n) and abs(n) < 1e15 else f"{n:.4g}"
+
+
+def _meta(generator: str, seed, **params) -> dict:
+    """A generated surface's metadata: the generator, its seed and every parameter."""
+    clean = {k: (list(v) if isinstance(v, tuple) else v) for k, v in params.items()}
+    return {"generator": generator, "seed": seed, "params": clean, "spine_mj_version": __version__}

@@ -1,6 +1,7 @@
 """Surface generators: the paper's single Gaussian and random Gaussian surfaces (§3.1-3.2),
-fractal fBm surfaces and sandpaper analogs (§3.3). Pure functions with keyword-only
-options; randomness enters only through ``rng``, so a seed reproduces a surface bit for bit."""
+fractal fBm surfaces and, from :mod:`spine_mj.surfaces.sandpaper`, sandpaper analogs
+(§3.3). Pure functions with keyword-only options; randomness enters only through ``rng``,
+so a seed reproduces a surface bit for bit."""
 
 from __future__ import annotations
 
@@ -8,27 +9,22 @@ import math
 
 import numpy as np
 
-from spine_mj._version import __version__
 from spine_mj.errors import SpineInputError, check_positive
 from spine_mj.surfaces.base import (
     _MIN_POINTS_PER_SIDE,
-    GRIT_PARTICLE_DIAMETER_M,
     MAX_PEAKS,
     _bounds,
     _count_at_least,
     _flag,
     _grid_count,
+    _meta,
     _pair,
     _range,
     _rng_and_seed,
     check_grid_size,
 )
+from spine_mj.surfaces.sandpaper import sandpaper as sandpaper  # re-exported (its old home)
 from spine_mj.surfaces.types import GaussianSurface, GridSurface
-
-
-def _meta(generator: str, seed, **params) -> dict:
-    clean = {k: (list(v) if isinstance(v, tuple) else v) for k, v in params.items()}
-    return {"generator": generator, "seed": seed, "params": clean, "spine_mj_version": __version__}
 
 
 def single_gaussian(
@@ -182,7 +178,7 @@ def random_gaussians(
     * ``overlap=False`` rejects centres closer than ``min_separation * (sigma_i + sigma_j)``
       (drawn in sequence), and fails clearly when they cannot all be placed.
 
-    The draws happen in a fixed order (centres, widths, amplitudes), so one seed gives the
+    The draws happen in a fixed order (widths, amplitudes, centres), so one seed gives the
     same surface on every machine.
 
     Parameters
@@ -197,10 +193,8 @@ def random_gaussians(
         Ranges of the widths and of the amplitudes' magnitude.
     anisotropic : bool
         Draw ``sigma_x`` and ``sigma_y`` independently.
-    overlap : bool
+    overlap, min_separation : bool, float
         Allow centres closer than ``min_separation * (sigma_i + sigma_j)``.
-    min_separation : float
-        See ``overlap``.
     rng : int or numpy.random.Generator, optional
         The only source of randomness: a seed or a generator.
 
@@ -208,49 +202,67 @@ def random_gaussians(
     -------
     GaussianSurface
     """
-    if isinstance(n_peaks, bool) or int(n_peaks) != n_peaks or not 0 < n_peaks <= MAX_PEAKS:
-        raise SpineInputError(f"n_peaks must be an integer in 1..{MAX_PEAKS}, got {n_peaks!r}")
-    n_peaks = int(n_peaks)
-    if sign not in (1, -1):
-        raise SpineInputError(f"sign must be +1 (convex peaks) or -1 (concave valleys), got {sign!r}")
+    params = _random_gaussian_params(
+        n_peaks, sign, bounds, sigma_range, amplitude_range, anisotropic, overlap, min_separation
+    )
+    gen, seed = _rng_and_seed(rng)
+    return GaussianSurface(
+        **_draw_peaks(gen, **params),
+        bounds=params["bounds"],
+        unit="1",
+        metadata=_meta("random_gaussians", seed, **params),
+    )
+
+
+def _random_gaussian_params(
+    n_peaks, sign, bounds, sigma_range, amplitude_range, anisotropic, overlap, min_separation
+) -> dict:
+    """The arguments of :func:`random_gaussians` checked, in the order its metadata records them."""
+    n_peaks = _peak_count(n_peaks, sign)
     anisotropic, overlap = _flag("anisotropic", anisotropic), _flag("overlap", overlap)
-    xmin, xmax, ymin, ymax = _bounds(bounds)
-    s_lo, s_hi = _range("sigma_range (widths)", sigma_range)
-    a_lo, a_hi = _range("amplitude_range (heights)", amplitude_range)
+    box = _bounds(bounds)
+    sigmas = _range("sigma_range (widths)", sigma_range)
+    amplitudes = _range("amplitude_range (heights)", amplitude_range)
     min_separation = float(min_separation)
     if not overlap and not (min_separation > 0):
         raise SpineInputError(f"min_separation must be > 0, got {min_separation!r}")
-    gen, seed = _rng_and_seed(rng)
+    return {
+        "n_peaks": n_peaks,
+        "sign": sign,
+        "bounds": box,
+        "sigma_range": sigmas,
+        "amplitude_range": amplitudes,
+        "anisotropic": bool(anisotropic),
+        "overlap": bool(overlap),
+        "min_separation": min_separation,
+    }
 
-    sigma_x = gen.uniform(s_lo, s_hi, n_peaks)
-    sigma_y = gen.uniform(s_lo, s_hi, n_peaks) if anisotropic else sigma_x.copy()
-    amplitude = sign * gen.uniform(a_lo, a_hi, n_peaks)
+
+def _peak_count(n_peaks, sign) -> int:
+    """``n_peaks`` as an int, checked (1 to :data:`MAX_PEAKS`), and ``sign`` checked (+-1)."""
+    if isinstance(n_peaks, bool) or int(n_peaks) != n_peaks or not 0 < n_peaks <= MAX_PEAKS:
+        raise SpineInputError(f"n_peaks must be an integer in 1..{MAX_PEAKS}, got {n_peaks!r}")
+    if sign not in (1, -1):
+        raise SpineInputError(f"sign must be +1 (convex peaks) or -1 (concave valleys), got {sign!r}")
+    return int(n_peaks)
+
+
+def _draw_peaks(
+    gen, *, n_peaks, sign, bounds, sigma_range, amplitude_range, anisotropic, overlap, min_separation
+) -> dict:
+    """The peaks of :func:`random_gaussians` as its keyword arguments of
+    :class:`GaussianSurface`, drawn from ``gen`` in a fixed order: widths, amplitudes,
+    centres."""
+    xmin, xmax, ymin, ymax = bounds
+    sigma_x = gen.uniform(*sigma_range, n_peaks)
+    sigma_y = gen.uniform(*sigma_range, n_peaks) if anisotropic else sigma_x.copy()
+    amplitude = sign * gen.uniform(*amplitude_range, n_peaks)
     if overlap:
         cx = gen.uniform(xmin, xmax, n_peaks)
         cy = gen.uniform(ymin, ymax, n_peaks)
     else:
-        cx, cy = _separated_centres(gen, (xmin, xmax, ymin, ymax), 0.5 * (sigma_x + sigma_y), min_separation)
-    return GaussianSurface(
-        amplitude=amplitude,
-        center_x=cx,
-        center_y=cy,
-        sigma_x=sigma_x,
-        sigma_y=sigma_y,
-        bounds=(xmin, xmax, ymin, ymax),
-        unit="1",
-        metadata=_meta(
-            "random_gaussians",
-            seed,
-            n_peaks=n_peaks,
-            sign=sign,
-            bounds=(xmin, xmax, ymin, ymax),
-            sigma_range=(s_lo, s_hi),
-            amplitude_range=(a_lo, a_hi),
-            anisotropic=bool(anisotropic),
-            overlap=bool(overlap),
-            min_separation=min_separation,
-        ),
-    )
+        cx, cy = _separated_centres(gen, bounds, 0.5 * (sigma_x + sigma_y), min_separation)
+    return {"amplitude": amplitude, "center_x": cx, "center_y": cy, "sigma_x": sigma_x, "sigma_y": sigma_y}
 
 
 def _separated_centres(gen, bounds, radius: np.ndarray, min_separation: float):
@@ -335,26 +347,15 @@ def fractal_fbm(
     """
     periodic = _flag("periodic", periodic)
     nx, ny, lx, ly = _fbm_grid(nx, ny, size, periodic)
-    hurst = float(hurst)
-    if not (0.0 < hurst < 1.0):
-        raise SpineInputError(f"hurst must lie in the open interval (0, 1), got {hurst!r}")
+    hurst = _hurst(hurst)
     rms_height, rms_slope = _fbm_normalization(rms_height, rms_slope)
     long_cutoff = None if long_cutoff is None else check_positive("long_cutoff", long_cutoff)
     short_cutoff = None if short_cutoff is None else check_positive("short_cutoff", short_cutoff)
     gen, seed = _rng_and_seed(rng)
     dx, dy = lx / nx, ly / ny
     heights = _fbm_heights(gen, (nx, ny), (dx, dy), hurst, periodic, long_cutoff, short_cutoff)
-    if rms_slope is not None:
-        heights *= rms_slope / _rms_slope(heights, dx, dy, periodic)
-    else:
-        heights *= rms_height / heights.std()
-    if not np.isfinite(heights).all():
-        raise SpineInputError(
-            f"fractal_fbm: size {lx:g} x {ly:g} with rms_height {rms_height} and rms_slope {rms_slope} "
-            "gives heights beyond floating-point range; use sizes and RMS values nearer 1"
-        )
     return GridSurface(
-        heights=heights,
+        heights=_fbm_normalized(heights, (lx, ly), (dx, dy), periodic, rms_height, rms_slope),
         x=-lx / 2 + dx * np.arange(nx),
         y=-ly / 2 + dy * np.arange(ny),
         periodic=bool(periodic),
@@ -374,6 +375,30 @@ def fractal_fbm(
             unit=unit,
         ),
     )
+
+
+def _hurst(hurst) -> float:
+    """The Hurst index H as a float, checked: 0 < H < 1."""
+    hurst = float(hurst)
+    if not (0.0 < hurst < 1.0):
+        raise SpineInputError(f"hurst must lie in the open interval (0, 1), got {hurst!r}")
+    return hurst
+
+
+def _fbm_normalized(heights, size, spacing, periodic: bool, rms_height, rms_slope) -> np.ndarray:
+    """``heights`` scaled in place to ``rms_slope`` (when given) or ``rms_height``; refused
+    where that leaves floating-point range."""
+    (lx, ly), (dx, dy) = size, spacing
+    if rms_slope is not None:
+        heights *= rms_slope / _rms_slope(heights, dx, dy, periodic)
+    else:
+        heights *= rms_height / heights.std()
+    if not np.isfinite(heights).all():
+        raise SpineInputError(
+            f"fractal_fbm: size {lx:g} x {ly:g} with rms_height {rms_height} and rms_slope {rms_slope} "
+            "gives heights beyond floating-point range; use sizes and RMS values nearer 1"
+        )
+    return heights
 
 
 def _fbm_grid(nx, ny, size, periodic: bool) -> tuple[int, int, float, float]:
@@ -424,161 +449,3 @@ def _fbm_heights(gen, shape, spacing, hurst, periodic, long_cutoff, short_cutoff
     heights = np.fft.ifft2(np.fft.fft2(noise) * amp).real[:ny, :nx]
     heights -= heights.mean()
     return heights
-
-
-def _particle_envelope(n, spacing, diam, px, py, embed) -> np.ndarray:
-    """Upper envelope ``(n, n)`` of the base z = 0 and spheres of diameters ``diam`` at
-    ``(px, py)``, each sunk by ``embed`` times its diameter, on a periodic grid."""
-    heights = np.zeros((n, n))
-    grid = np.arange(n)
-    for d, cx, cy, e in zip(diam, px, py, embed):
-        r = d / 2
-        zc = r - e * d
-        half = int(math.ceil(r / spacing)) + 1
-        ix0, iy0 = int(round(cx / spacing)), int(round(cy / spacing))
-        ix = np.arange(ix0 - half, ix0 + half + 1)
-        iy = np.arange(iy0 - half, iy0 + half + 1)
-        ddx = ix * spacing - cx
-        ddy = iy * spacing - cy
-        rho2 = ddy[:, None] ** 2 + ddx[None, :] ** 2
-        cap = zc + np.sqrt(np.clip(r * r - rho2, 0, None))
-        cap[rho2 >= r * r] = 0.0
-        rows, cols = grid[np.mod(iy, n)], grid[np.mod(ix, n)]
-        block = heights[np.ix_(rows, cols)]
-        heights[np.ix_(rows, cols)] = np.maximum(block, cap)
-    return heights
-
-
-def sandpaper(
-    *,
-    grit: str | None = None,
-    particle_diameter_m: float | None = None,
-    size_m: float = 4e-3,
-    tip_radius_m: float = 25e-6,
-    spacing_m: float | None = None,
-    coverage: float = 0.6,
-    size_cv: float = 0.25,
-    embed_range: tuple[float, float] = (0.3, 0.6),
-    rng: int | np.random.Generator | None = None,
-) -> GridSurface:
-    """Sandpaper analog: partly embedded spherical grit particles on a flat base (§3.3).
-
-    Particles are placed uniformly at random (overlaps allowed) on a square periodic
-    patch; diameters are log-normal with mean ``particle_diameter_m`` and coefficient of
-    variation ``size_cv``; each sphere is sunk into the base by a fraction of its diameter
-    drawn uniformly from ``embed_range``. The height is the upper envelope of the exposed
-    caps and the base (z = 0). Their number fills ``coverage`` of the base area with
-    particle cross-sections (counting overlaps).
-
-    The default spacing, ``min(tip_radius_m / 5, particle_diameter_m / 10)``, resolves both
-    a tip of radius ``tip_radius_m`` and the particles (P600's 25.8 um grains included).
-
-    Parameters
-    ----------
-    grit
-        One of ``P36``, ``P60``, ``P600`` (mean particle size from the paper), or None
-        when ``particle_diameter_m`` is given.
-    particle_diameter_m : float, optional
-        Mean particle diameter [m], instead of ``grit``.
-    size_m
-        Side of the square patch, metres.
-    tip_radius_m : float
-        Radius of the tip the grid must resolve [m] (sets the default spacing).
-    spacing_m : float, optional
-        Grid spacing [m]; default ``min(tip_radius_m / 5, particle_diameter_m / 10)``.
-    coverage : float
-        Share of the base area covered by particle cross-sections (overlaps counted).
-    size_cv : float
-        Coefficient of variation of the log-normal diameters.
-    embed_range : tuple of float
-        Range of the sunk fraction of each diameter, drawn uniformly.
-    rng : int or numpy.random.Generator, optional
-        The only source of randomness: a seed or a generator.
-
-    Returns
-    -------
-    GridSurface
-        Periodic, in metres.
-    """
-    d_mean = _grit_diameter(grit, particle_diameter_m)
-    size_m = check_positive("size_m", size_m)
-    tip_radius_m = check_positive("tip_radius_m", tip_radius_m)
-    spacing_m = (
-        min(tip_radius_m / 5, d_mean / 10) if spacing_m is None else check_positive("spacing_m", spacing_m)
-    )
-    coverage = check_positive("coverage", coverage)
-    size_cv = float(size_cv)
-    if not (0 <= size_cv < 2):
-        raise SpineInputError(f"size_cv must be in [0, 2), got {size_cv!r}")
-    e_lo, e_hi = _range("embed_range", embed_range, positive=False)
-    if not (0 <= e_lo and e_hi < 1):
-        raise SpineInputError(f"embed_range must lie within [0, 1), got {embed_range!r}")
-    n = _patch_points(size_m, spacing_m, d_mean)
-    gen, seed = _rng_and_seed(rng)
-    spacing = size_m / n
-    mean_area = math.pi * (d_mean / 2) ** 2 * (1 + size_cv**2)
-    n_particles = max(1, round(coverage * size_m**2 / mean_area))
-
-    heights = _particle_envelope(
-        n, spacing, *_particles(gen, n_particles, d_mean, size_cv, size_m, (e_lo, e_hi))
-    )
-    coords = spacing * np.arange(n) - size_m / 2
-    return GridSurface(
-        heights=heights,
-        x=coords,
-        y=coords.copy(),
-        periodic=True,
-        unit="m",
-        metadata=_meta(
-            "sandpaper",
-            seed,
-            grit=grit,
-            particle_diameter_m=d_mean,
-            size_m=size_m,
-            tip_radius_m=tip_radius_m,
-            spacing_m=spacing,
-            coverage=coverage,
-            size_cv=size_cv,
-            embed_range=(e_lo, e_hi),
-            n_particles=n_particles,
-        ),
-    )
-
-
-def _grit_diameter(grit: str | None, particle_diameter_m: float | None) -> float:
-    """The mean particle diameter [m]: ``particle_diameter_m``, else the grit's."""
-    if grit is not None:
-        if grit not in GRIT_PARTICLE_DIAMETER_M:
-            raise SpineInputError(f"grit must be one of {sorted(GRIT_PARTICLE_DIAMETER_M)}, got {grit!r}")
-        if particle_diameter_m is None:
-            particle_diameter_m = GRIT_PARTICLE_DIAMETER_M[grit]
-    if particle_diameter_m is None:
-        raise SpineInputError("give grit (P36, P60, P600) or particle_diameter_m")
-    return check_positive("particle_diameter_m", particle_diameter_m)
-
-
-def _patch_points(size_m: float, spacing_m: float, d_mean: float) -> int:
-    """Grid points a side of a sandpaper patch, refused when too many or too few, or when the
-    patch is smaller than two particles."""
-    check_grid_size(
-        size_m / spacing_m, size_m / spacing_m, where="sandpaper (size_m / spacing_m points a side)"
-    )
-    n = math.ceil(size_m / spacing_m - 1e-9)
-    if n < _MIN_POINTS_PER_SIDE:
-        raise SpineInputError(f"size_m / spacing_m gives {n} points; need at least 4")
-    if size_m < 2 * d_mean:
-        raise SpineInputError(
-            f"size_m ({size_m:g}) must be at least twice the particle diameter ({d_mean:g})"
-        )
-    return n
-
-
-def _particles(gen, n_particles: int, d_mean: float, size_cv: float, size_m: float, embed_range):
-    """Diameters (log-normal, mean ``d_mean``, variation ``size_cv``), centres (uniform on the
-    patch) and embedding fractions (uniform on ``embed_range``), drawn in that order."""
-    sig_ln = math.sqrt(math.log1p(size_cv**2))
-    diam = d_mean * np.exp(gen.normal(-0.5 * sig_ln**2, sig_ln, n_particles))
-    px = gen.uniform(0, size_m, n_particles)
-    py = gen.uniform(0, size_m, n_particles)
-    embed = gen.uniform(*embed_range, n_particles)
-    return diam, px, py, embed
