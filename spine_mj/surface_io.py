@@ -130,23 +130,7 @@ def load_surface(path: str | os.PathLike) -> Surface:
     path = Path(path)
     if not path.is_file():
         raise SpineInputError(f"surface file not found: {path}")
-    try:
-        with np.load(path, allow_pickle=False) as npz:
-            for name in npz.files:  # sizes from the headers, before a compressed array is inflated
-                if f"{name}.npy" not in npz.zip.namelist():
-                    raise SpineInputError(
-                        f"{path} is not a spine_mj .npz surface: member {name!r} is not a .npy array"
-                    )
-                shape = _npz_member_shape(npz, name)
-                if math.prod(shape) > MAX_GRID_POINTS:
-                    raise SpineInputError(
-                        f"{path}: array {name!r} has shape {shape}, more than {MAX_GRID_POINTS} values"
-                    )
-            data = {k: npz[k] for k in npz.files}
-    except SpineInputError:
-        raise
-    except (zipfile.BadZipFile, ValueError, OSError, EOFError) as exc:
-        raise SpineInputError(f"{path} is not a readable spine_mj .npz surface ({exc})") from None
+    data = _read_npz(path)
     if str(data.get("format", "")) != FORMAT:
         raise SpineInputError(f"{path} is not a spine_mj surface file (no format tag {FORMAT!r})")
     try:
@@ -195,6 +179,29 @@ def load_surface(path: str | os.PathLike) -> Surface:
 
 
 # --------------------------------------------------------------------------- measured data
+
+
+def _read_npz(path: Path) -> dict[str, np.ndarray]:
+    """The arrays of the .npz file at ``path``, each checked for size from its header before
+    a compressed array is inflated; SpineInputError for a file that is no readable .npz of
+    .npy arrays."""
+    try:
+        with np.load(path, allow_pickle=False) as npz:
+            for name in npz.files:  # sizes from the headers, before a compressed array is inflated
+                if f"{name}.npy" not in npz.zip.namelist():
+                    raise SpineInputError(
+                        f"{path} is not a spine_mj .npz surface: member {name!r} is not a .npy array"
+                    )
+                shape = _npz_member_shape(npz, name)
+                if math.prod(shape) > MAX_GRID_POINTS:
+                    raise SpineInputError(
+                        f"{path}: array {name!r} has shape {shape}, more than {MAX_GRID_POINTS} values"
+                    )
+            return {k: npz[k] for k in npz.files}
+    except SpineInputError:
+        raise
+    except (zipfile.BadZipFile, ValueError, OSError, EOFError) as exc:
+        raise SpineInputError(f"{path} is not a readable spine_mj .npz surface ({exc})") from None
 
 
 def _unreadable(path: Path, exc: Exception) -> SpineInputError:

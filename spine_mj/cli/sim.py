@@ -240,35 +240,15 @@ def simulate(
       spine-mj simulate paper-single-peak --start -3,-1 --drive spring --ie 1e-3 --K 10 --out out/
     """
 
-    from spine_mj import extras, sim
-    from spine_mj.sim.render import choose_gl_backend
+    from spine_mj import sim
     from spine_mj.sim.run_folder import write_run
 
     if render:
-        if engine == "bullet":
-            raise SpineInputError(
-                "--render draws with MuJoCo's renderer, not with --engine bullet: run without it, "
-                "then `spine-mj replay RUN_DIR --mp4 run.mp4` shows the run on MuJoCo's model"
-            )
-        extras.require("video", "--render")
-        choose_gl_backend()
-
+        _check_render(engine)
     x0, y0 = parse_start(start)
-    refuse_options_not_for(
-        f"--drive {drive}",
-        {
-            "spring": ["rate", "start_force"],
-            "ramp": ["speed", "stiffness_number", "stiffness", "start_force"],
-            "static": ["speed", "stiffness_number", "stiffness", "duration"],
-        }[drive],
+    _check_drive_options(
+        drive, ie=ie, speed=speed, rate=rate, stiffness_number=stiffness_number, stiffness=stiffness
     )
-    for a, b, names in ((ie, speed, "--ie or --speed"), (ie, rate, "--ie or --rate")):
-        if a is not None and b is not None:
-            raise SpineInputError(f"give one of {names}, got both")
-    if stiffness_number is not None and stiffness is not None:
-        raise SpineInputError("give one of --K or --stiffness, got both")
-    if ie is not None:
-        check_positive("--ie", ie)
     rig = _build_rig(
         surface_spec,
         **rig_opts,
@@ -301,6 +281,39 @@ def simulate(
     )
     click.echo(_motion_line(result))
     click.echo(f"wrote {', '.join(str(w) for w in written)}")
+
+
+def _check_render(engine: str) -> None:
+    """Refuse --render where it cannot run (Bullet, no video extra); choose the GL backend."""
+    from spine_mj import extras
+    from spine_mj.sim.render import choose_gl_backend
+
+    if engine == "bullet":
+        raise SpineInputError(
+            "--render draws with MuJoCo's renderer, not with --engine bullet: run without it, "
+            "then `spine-mj replay RUN_DIR --mp4 run.mp4` shows the run on MuJoCo's model"
+        )
+    extras.require("video", "--render")
+    choose_gl_backend()
+
+
+def _check_drive_options(drive: str, *, ie, speed, rate, stiffness_number, stiffness) -> None:
+    """Refuse the options --drive does not read, and pace or stiffness given twice."""
+    refuse_options_not_for(
+        f"--drive {drive}",
+        {
+            "spring": ["rate", "start_force"],
+            "ramp": ["speed", "stiffness_number", "stiffness", "start_force"],
+            "static": ["speed", "stiffness_number", "stiffness", "duration"],
+        }[drive],
+    )
+    for a, b, names in ((ie, speed, "--ie or --speed"), (ie, rate, "--ie or --rate")):
+        if a is not None and b is not None:
+            raise SpineInputError(f"give one of {names}, got both")
+    if stiffness_number is not None and stiffness is not None:
+        raise SpineInputError("give one of --K or --stiffness, got both")
+    if ie is not None:
+        check_positive("--ie", ie)
 
 
 def _motion_line(result) -> str:
