@@ -157,7 +157,6 @@ LONG_FUNCTIONS_LEFT = {
     "spine_mj/sim/build.py:build_rig",
     "spine_mj/sweep/session.py:run_sweep",
     "spine_mj/validate/quasistatic_limit.py:quasistatic_limit",
-    "spine_mj/validate/report/array_study.py:array_section",
 }
 
 

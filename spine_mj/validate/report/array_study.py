@@ -73,7 +73,29 @@ def array_section(res: ArrayStudyResult | None, figure: str | None = None) -> st
         return ""
     p = res.plan
     paces = p["ie"]
-    lines = [
+    lines = _method(p, paces)
+    rows = [_row(r) for r in res.rows]
+    names = ["surface", "N", "spacing [l_s]", "layout", "holding (MuJoCo, I_e -> 0)", "95 % CI"]
+    three = len(paces) >= 3
+    names += ["holding per pace", "extrapolation step", *(["observed order"] if three else [])]
+    names += ["holding (QS)", "predicted excess", "dt / 2 change"]
+    names += ["P(lock) MuJoCo", "95 % CI", "P(lock) QS", "lock agreement", "failed", "QS paths short"]
+    cols = ["surface", "N", "spacing", "layout", "holding", "holding_ci", "by_pace", "step"]
+    cols += [*(["order"] if three else []), "holding_qs"]
+    cols += ["excess", "dt", "lock", "lock_ci"]
+    lines.append(table(rows, [*cols, "lock_qs", "agreement", "failed", "short"], names))
+    lines += _convergence_notes(res.convergence, paces)
+    if figure:
+        lines += ["", f"![Holding per spine and P(lock) against N per layout]({figure})"]
+    lines += ["", "### The conjecture: staggered (and random) against aligned, same placements", ""]
+    lines.append(_conjecture_table(res.conjecture))
+    lines += ["", _verdict(res)]
+    return "\n".join(lines) + "\n"
+
+
+def _method(p: dict, paces) -> list[str]:
+    """The section's heading and its paragraph on the method (plan ``p``, paces ``paces``)."""
+    return [
         "## Spine arrays and the staggered-layout conjecture",
         "",
         f"Arrays of N = {', '.join(str(s * s) for s in p['sides'])} spines (aligned grid, staggered grid, "
@@ -101,43 +123,36 @@ def array_section(res: ArrayStudyResult | None, figure: str | None = None) -> st
         ),
         "",
     ]
-    rows = []
-    for r in res.rows:
-        pl, pq = r["p_lock"], r["p_lock_qs"]
-        rows.append(
-            {
-                "surface": r["surface"],
-                "N": r["n_spines"],
-                "spacing": sig(r["spacing_ls"]),
-                "layout": r["layout"],
-                "holding": sig(r["holding_per_spine"]) + _mark(r["holding_converged"]),
-                "holding_ci": _ci(*r["holding_ci"]),
-                "by_pace": ", ".join(sig(b["holding"]) for b in r["holding_by_pace"]),
-                "step": sig(r["holding_extrapolation_step"]),
-                "order": sig(r["holding_observed_order"])
-                if math.isfinite(r["holding_observed_order"])
-                else "-",
-                "holding_qs": sig(r["holding_per_spine_qs"]),
-                "excess": sig(r["holding_excess_predicted"]),
-                "dt": _dt(r.get("dt_halved")),
-                "lock": f"{pl['locked']}/{pl['n_ok']}" + _mark(r["p_lock_converged"]),
-                "lock_ci": _ci(pl["ci_low"], pl["ci_high"]),
-                "lock_qs": f"{pq['locked']}/{pq['n_ok']}",
-                "agreement": sig(r["lock_agreement"]),
-                "failed": r["failed_runs"],
-                "short": r["reference_short_spines"],
-            }
-        )
-    names = ["surface", "N", "spacing [l_s]", "layout", "holding (MuJoCo, I_e -> 0)", "95 % CI"]
-    three = len(paces) >= 3
-    names += ["holding per pace", "extrapolation step", *(["observed order"] if three else [])]
-    names += ["holding (QS)", "predicted excess", "dt / 2 change"]
-    names += ["P(lock) MuJoCo", "95 % CI", "P(lock) QS", "lock agreement", "failed", "QS paths short"]
-    cols = ["surface", "N", "spacing", "layout", "holding", "holding_ci", "by_pace", "step"]
-    cols += [*(["order"] if three else []), "holding_qs"]
-    cols += ["excess", "dt", "lock", "lock_ci"]
-    lines.append(table(rows, [*cols, "lock_qs", "agreement", "failed", "short"], names))
-    conv = res.convergence
+
+
+def _row(r: dict) -> dict:
+    """One row of the holding and P(lock) table, from a study row ``r``."""
+    pl, pq = r["p_lock"], r["p_lock_qs"]
+    return {
+        "surface": r["surface"],
+        "N": r["n_spines"],
+        "spacing": sig(r["spacing_ls"]),
+        "layout": r["layout"],
+        "holding": sig(r["holding_per_spine"]) + _mark(r["holding_converged"]),
+        "holding_ci": _ci(*r["holding_ci"]),
+        "by_pace": ", ".join(sig(b["holding"]) for b in r["holding_by_pace"]),
+        "step": sig(r["holding_extrapolation_step"]),
+        "order": sig(r["holding_observed_order"]) if math.isfinite(r["holding_observed_order"]) else "-",
+        "holding_qs": sig(r["holding_per_spine_qs"]),
+        "excess": sig(r["holding_excess_predicted"]),
+        "dt": _dt(r.get("dt_halved")),
+        "lock": f"{pl['locked']}/{pl['n_ok']}" + _mark(r["p_lock_converged"]),
+        "lock_ci": _ci(pl["ci_low"], pl["ci_high"]),
+        "lock_qs": f"{pq['locked']}/{pq['n_ok']}",
+        "agreement": sig(r["lock_agreement"]),
+        "failed": r["failed_runs"],
+        "short": r["reference_short_spines"],
+    }
+
+
+def _convergence_notes(conv: dict, paces) -> list[str]:
+    """The lines on the extrapolation's and the halved step's convergence (none where not run)."""
+    lines = []
     if conv.get("pace"):
         c = conv["pace"]
         lines += [
@@ -154,9 +169,11 @@ def array_section(res: ArrayStudyResult | None, figure: str | None = None) -> st
             f"halved: {c['rows_converged']} of {c['rows']} holdings converged (the change inside the "
             f"holding's own 95 % interval); largest change {sig(c['max_abs_change'])} F_p per spine.",
         ]
-    if figure:
-        lines += ["", f"![Holding per spine and P(lock) against N per layout]({figure})"]
-    lines += ["", "### The conjecture: staggered (and random) against aligned, same placements", ""]
+    return lines
+
+
+def _conjecture_table(conjecture: list[dict]) -> str:
+    """The table of staggered (and random) against aligned, same placements."""
     diffs = [
         {
             "surface": c["surface"],
@@ -168,14 +185,12 @@ def array_section(res: ArrayStudyResult | None, figure: str | None = None) -> st
             "holding": sig(c["holding_diff"]["diff"]),
             "holding_ci": _ci(c["holding_diff"]["ci_low"], c["holding_diff"]["ci_high"]),
         }
-        for c in res.conjecture
+        for c in conjecture
     ]
     names = ["surface", "N", "spacing [l_s]", "layout", "P(lock) - P(lock, grid)", "95 % CI"]
     names += ["holding - holding(grid)", "95 % CI"]
     cols = ["surface", "N", "spacing", "layout", "p_lock", "p_lock_ci", "holding", "holding_ci"]
-    lines.append(table(diffs, cols, names))
-    lines += ["", _verdict(res)]
-    return "\n".join(lines) + "\n"
+    return table(diffs, cols, names)
 
 
 def _mark(converged) -> str:
