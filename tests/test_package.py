@@ -156,7 +156,6 @@ MAX_MODULE_LINES, MAX_FUNCTION_LINES = 600, 80
 LONG_FUNCTIONS_LEFT = {
     "spine_mj/sim/build.py:build_rig",
     "spine_mj/sweep/session.py:run_sweep",
-    "spine_mj/validate/quasistatic_limit.py:quasistatic_limit",
 }
 
 

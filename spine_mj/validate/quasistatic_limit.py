@@ -182,40 +182,7 @@ def quasistatic_limit(plan: ValidationPlan, runner: StudyRunner) -> QuasistaticL
         groups: list[dict] = []
         comps = [_sweep_comparison(plan, fam, *swept[name], paths, groups) for f, name, _ in docs if f is fam]
         allc = pd.concat(comps, ignore_index=True)
-        summ = _family_summary(allc)
-        summ.update(ensemble_verdicts(groups))
-        failed = allc.loc[allc["mujoco_status"] != "ok", "mujoco_status"].value_counts()
-        summ.update(
-            {
-                "median_frechet_smooth": float(np.nanmedian(allc["frechet_smooth"])),
-                "outcome_agreement_smooth": float(allc["agree_smooth"].fillna(False).astype(bool).mean()),
-                "mean_geometry_frechet": float(np.nanmean(allc["geometry_frechet"])),
-                # against the compliant-drive streamline of the run's own spring (NaN in a
-                # store written before compare had it)
-                **_compliant_summary(allc),
-                "failed_runs": {str(k): int(v) for k, v in failed.items()},
-                # no progress even with the step cut to dl / 2**max_halvings (a fixed step
-                # once zig-zagged across grit valleys narrower than itself and stalled
-                # there: docs/physics.md §2)
-                "reference_stalled": int((allc["reference_outcome"] == "stalled").sum()),
-                "misses": _misses(allc),
-                "slide_runs": int((allc["reference_slide_fraction"] > 0).sum()),
-                "median_tip_peak_ie": float(np.nanmedian(allc["tip_peak_ie"])),
-            }
-        )
-        summ.update(_intervals(allc, summ))
-        summ["meets_target"] = bool(
-            meets_target(
-                summ["agreement_well_conditioned"],
-                summ["agreement_ci"],
-                OUTCOME_TARGET,
-                higher_is_better=True,
-            )
-            and meets_target(
-                summ["median_frechet"], summ["median_frechet_ci"], FRECHET_TARGET, higher_is_better=False
-            )
-            and "penetration" not in failed
-        )
+        summ = _limit_summary(allc, groups)
         ill = summ.pop("ill_conditioned")
         families[fam.name] = summ
         if plan.convergence_starts > 0:
@@ -233,6 +200,46 @@ def quasistatic_limit(plan: ValidationPlan, runner: StudyRunner) -> QuasistaticL
         lowest_ie=plan.lowest_ie,
         convergence=convergence,
     )
+
+
+def _limit_summary(allc: pd.DataFrame, groups: list[dict]) -> dict:
+    """One family's summary of the quasistatic-limit study from its comparison rows
+    ``allc`` and ensemble groups: agreements, distances, failures and the target verdict."""
+    summ = _family_summary(allc)
+    summ.update(ensemble_verdicts(groups))
+    failed = allc.loc[allc["mujoco_status"] != "ok", "mujoco_status"].value_counts()
+    summ.update(
+        {
+            "median_frechet_smooth": float(np.nanmedian(allc["frechet_smooth"])),
+            "outcome_agreement_smooth": float(allc["agree_smooth"].fillna(False).astype(bool).mean()),
+            "mean_geometry_frechet": float(np.nanmean(allc["geometry_frechet"])),
+            # against the compliant-drive streamline of the run's own spring (NaN in a
+            # store written before compare had it)
+            **_compliant_summary(allc),
+            "failed_runs": {str(k): int(v) for k, v in failed.items()},
+            # no progress even with the step cut to dl / 2**max_halvings (a fixed step
+            # once zig-zagged across grit valleys narrower than itself and stalled
+            # there: docs/physics.md §2)
+            "reference_stalled": int((allc["reference_outcome"] == "stalled").sum()),
+            "misses": _misses(allc),
+            "slide_runs": int((allc["reference_slide_fraction"] > 0).sum()),
+            "median_tip_peak_ie": float(np.nanmedian(allc["tip_peak_ie"])),
+        }
+    )
+    summ.update(_intervals(allc, summ))
+    summ["meets_target"] = bool(
+        meets_target(
+            summ["agreement_well_conditioned"],
+            summ["agreement_ci"],
+            OUTCOME_TARGET,
+            higher_is_better=True,
+        )
+        and meets_target(
+            summ["median_frechet"], summ["median_frechet_ci"], FRECHET_TARGET, higher_is_better=False
+        )
+        and "penetration" not in failed
+    )
+    return summ
 
 
 def _refinement_docs(plan: ValidationPlan, corner: list[FamilySpec]) -> list[tuple[str, str, str, dict]]:
