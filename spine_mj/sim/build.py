@@ -30,7 +30,7 @@ from spine_mj.sim.array_run import ArrayDrive, ForcePull
 from spine_mj.sim.drives import Drive, RampDrive, SpringDrive, StaticProbe, spring_stiffness_n_m
 from spine_mj.sim.holding import array_ie
 from spine_mj.sim.layout import Layout
-from spine_mj.sim.params import Cone, Integrator, Scales, TipParams, default_engine
+from spine_mj.sim.params import Cone, EngineSettings, Integrator, Scales, TipParams, default_engine
 from spine_mj.sim.rig import Rig
 from spine_mj.surfaces import GridSurface, Surface
 
@@ -172,11 +172,7 @@ def build_rig(
         mu_s=mu,
         **_given(mass_kg=mass_kg, preload_n=preload_n, gravity_m_s2=gravity_m_s2),
     )
-    resolution = None if isinstance(surface, GridSurface) else hfield_resolution
-    scales, hfield = Scales.with_hfield(
-        surface, tip=tip, length_scale_m=length_scale_m, hfield_resolution=resolution
-    )
-    tip = dataclasses.replace(tip, tip_radius_m=scales.tip_radius_m)  # the radius the rig was sized for
+    tip, scales, hfield = _sized(surface, tip, length_scale_m, hfield_resolution)
     speed = drive_speed_m_s(scales, ie=ie, speed_m_s=speed_m_s, rate_n_s=rate_n_s) if driven else None
     spring = spring_stiffness_n_m(scales, stiffness_number=stiffness_number, stiffness_n_m=stiffness_n_m)
     overrides = _given(
@@ -186,14 +182,32 @@ def build_rig(
         impratio=impratio,
         noslip_iterations=noslip_iterations,
     )
-    if solref_timeconst_s is not None or solref_dampratio is not None:
+    engine = _engine(scales, speed, spring, (solref_timeconst_s, solref_dampratio), overrides)
+    return Rig(surface, tip=tip, engine=engine, sized=(scales, hfield))
+
+
+def _sized(surface: Surface, tip: TipParams, length_scale_m, hfield_resolution) -> tuple:
+    """``(tip, scales, hfield)`` of ``tip`` on ``surface``: the tip with the radius the rig
+    was sized for (a gridded surface keeps its own samples: ``hfield_resolution`` ignored)."""
+    resolution = None if isinstance(surface, GridSurface) else hfield_resolution
+    scales, hfield = Scales.with_hfield(
+        surface, tip=tip, length_scale_m=length_scale_m, hfield_resolution=resolution
+    )
+    return dataclasses.replace(tip, tip_radius_m=scales.tip_radius_m), scales, hfield
+
+
+def _engine(scales: Scales, speed, spring, solref: tuple, overrides: dict) -> EngineSettings:
+    """:func:`default_engine` for a drive of ``speed`` [m/s] and spring ``spring`` [N/m] with
+    the user's ``overrides``, and ``solref = (timeconst_s, dampratio)``, each None for the
+    rule's own."""
+    timeconst_s, dampratio = solref
+    if timeconst_s is not None or dampratio is not None:
         rule = default_engine(scales, speed_m_s=speed, stiffness_n_m=spring, **overrides)
         overrides["solref"] = (
-            rule.solref[0] if solref_timeconst_s is None else solref_timeconst_s,
-            rule.solref[1] if solref_dampratio is None else solref_dampratio,
+            rule.solref[0] if timeconst_s is None else timeconst_s,
+            rule.solref[1] if dampratio is None else dampratio,
         )
-    engine = default_engine(scales, speed_m_s=speed, stiffness_n_m=spring, **overrides)
-    return Rig(surface, tip=tip, engine=engine, sized=(scales, hfield))
+    return default_engine(scales, speed_m_s=speed, stiffness_n_m=spring, **overrides)
 
 
 def build_drive(
