@@ -1,15 +1,16 @@
 """Open-loop runs in batches: grouping, and the pieced native rollout.
 
 Spring drives and static probes need no feedback: their controls are known in advance
-(:func:`controls`), so they go through :func:`mujoco.rollout.rollout` on worker threads
-(``rollout`` releases the GIL). Runs of equal planned length form a group (within 256 MiB
-of output); each run is simulated in pieces (its settle phase, then :data:`PIECE_STEPS`
-steps at a time), and after each piece its new rows are analysed
-(:class:`~spine_mj.sim.results.GroupAnalysis`): a run whose outcome is decided (self-lock,
-left the domain, engine trouble, a probe's breakaway or slide) is not simulated further.
-The pieces stream: worker threads take them from one queue, and the calling thread takes
-finished ones in small batches, analyses them and queues each live run's next piece while
-the workers still have queued pieces to simulate (no round waits for its slowest piece).
+(:func:`~spine_mj.sim.open_loop.controls`), so they go through
+:func:`mujoco.rollout.rollout` on worker threads (``rollout`` releases the GIL). Runs of
+equal planned length form a group (within 256 MiB of output); each run is simulated in
+pieces (its settle phase, then :data:`PIECE_STEPS` steps at a time), and after each piece
+its new rows are analysed (:class:`~spine_mj.sim.results.GroupAnalysis`): a run whose
+outcome is decided (self-lock, left the domain, engine trouble, a probe's breakaway or
+slide) is not simulated further. The pieces stream: worker threads take them from one
+queue, and the calling thread takes finished ones in small batches, analyses them and
+queues each live run's next piece while the workers still have queued pieces to simulate
+(no round waits for its slowest piece).
 
 A run is continued from its exact state: the full physics state of its last row and the
 warm start (``qacc_warmstart``) its worker's ``MjData`` holds after the piece, which the
