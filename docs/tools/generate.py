@@ -136,8 +136,9 @@ def headline_table(validation: dict) -> list[str]:
         "well-conditioned / starts",
         "median Frechet / L_c [95 % CI]",
         "target",
+        "under refinement",
     ]
-    rows = ["| " + " | ".join(cols) + " |", "|---|---|---|---|---|"]
+    rows = ["| " + " | ".join(cols) + " |", "|---|---|---|---|---|---|"]
     for key, fam in validation.get("limit_families", {}).items():
         rows.append(
             "| "
@@ -148,11 +149,26 @@ def headline_table(validation: dict) -> list[str]:
                     f"{fam.get('well_conditioned_runs', '-')} / {fam.get('starts', fam.get('runs', '-'))}",
                     _num(fam.get("median_frechet")) + _ci(fam.get("median_frechet_ci")),
                     "met" if fam.get("meets_target") else "not met",
+                    refinement_verdict(validation, key),
                 ]
             )
             + " |"
         )
     return rows
+
+
+def refinement_verdict(validation: dict, family: str) -> str:
+    """A family's solution-verification verdict (``convergence``): "converged", the
+    refinements under which it moved, or "not checked" for a report without the check."""
+    conv = (validation.get("convergence") or {}).get(family)
+    if not isinstance(conv, dict):
+        return "not checked"
+    moved = [
+        name.replace("_", " ")
+        for name, r in conv.items()
+        if isinstance(r, dict) and r.get("refined") and r.get("converged") is False
+    ]
+    return "unconverged (" + ", ".join(moved) + ")" if moved else "converged"
 
 
 def _flat(d: dict, prefix: str = "") -> dict:

@@ -34,7 +34,14 @@ def table() -> str:
             f"Full plan of `spine-mj validate` at the quasistatic corner (I_e = "
             f"{generate._num(validation.get('lowest_ie'))}), MuJoCo {plat.get('mujoco', '?')}; "
             "agreement over the well-conditioned starts with its 95 % Wilson interval, the "
-            "median Frechet distance with its bootstrap interval.",
+            "median Frechet distance with its bootstrap interval; under refinement: the "
+            "solution verification (step halved, hfield doubled)"
+            + (
+                "."
+                if validation.get("convergence")
+                else ", not in this full report (made before the check existed; the quick "
+                "plan's report has it)."
+            ),
         ]
     )
 
