@@ -282,6 +282,10 @@ def build_array(
 
     Parameters
     ----------
+    rig : Rig
+        The single-spine rig whose surface, tip, scales and engine the array takes.
+    layout : Layout
+        Where the spines sit on the carriage.
     drive : {"speed", "force"}
         ``speed``: the carriage moves at the drive's speed, each spine on its spring (the
         spring drive of :func:`build_drive`); ``force``: a free carriage pulled by a
@@ -344,9 +348,30 @@ def build_array_on(
     the rig of ``mu`` and ``rig_options`` (:func:`build_rig`'s keywords), its array and
     drive (:func:`build_array`), and the inertia number they run at.
 
-    ``ie`` None: :func:`~spine_mj.sim.holding.array_ie`, the fastest pace whose predicted
-    holding excess stays within :data:`~spine_mj.sim.holding.HOLDING_TOLERANCE` ``mu F_p``
-    per spine; the rig is built for that pace and spring (they bound the engine step).
+    Parameters
+    ----------
+    surface : Surface
+        The surface the array is dragged over.
+    layout : Layout
+        Where the spines sit on the carriage.
+    drive : {"speed", "force"}
+        As for :func:`build_array`.
+    mu : float
+        The tips' friction coefficient.
+    ie : float or None
+        The pace; None: :func:`~spine_mj.sim.holding.array_ie`, the fastest pace whose
+        predicted holding excess stays within
+        :data:`~spine_mj.sim.holding.HOLDING_TOLERANCE` ``mu F_p`` per spine. The rig is
+        built for that pace and spring (they bound the engine step).
+    stiffness_number, stiffness_n_m, duration_s, settle_time_s
+        As for :func:`build_array`.
+    **rig_options
+        :func:`build_rig`'s other keywords (tip, length scale, hfield, engine overrides).
+
+    Returns
+    -------
+    (ArrayRig, ArrayDrive, float)
+        The array, its carriage's drive and the inertia number they run at.
     """
     springs = {"stiffness_number": stiffness_number, "stiffness_n_m": stiffness_n_m}
     if ie is None:

@@ -41,7 +41,21 @@ MUJOCO_ONLY = (
 
 
 class EngineRig(Protocol):
-    """What a rig of either engine offers (SI in, SI out; starts in surface units)."""
+    """What a rig of either engine offers (SI in, SI out; starts in surface units).
+
+    Attributes
+    ----------
+    surface : Surface
+        The surface the rig was built on.
+    scales : Scales
+        Its scales (``L_c``, ``l_s``, ``F_p``, the tip radius, the hfield spacing).
+    tip : TipParams
+        The tip, its radius sized by the scales.
+    units : EngineUnits
+        The units the engine works in.
+    length_scale_m : float
+        Metres per surface unit.
+    """
 
     surface: Surface
     scales: Scales
@@ -94,9 +108,21 @@ def check_engine_name(engine: str, what: str = "engine") -> str:
 def build_engine_rig(surface: Surface, *, engine: str = DEFAULT_ENGINE, **options) -> EngineRig:
     """The rig of ``surface`` in ``engine`` (``"mujoco"`` or ``"bullet"``).
 
-    ``options`` are those of :func:`spine_mj.sim.build_rig` (same meaning, same rules);
-    MuJoCo's own solver options (:data:`MUJOCO_ONLY`) are refused for Bullet when given,
-    a ``timestep_s`` sets Bullet's recorded step.
+    Parameters
+    ----------
+    surface : Surface
+        The surface, as for :func:`spine_mj.sim.build_rig`.
+    engine : {"mujoco", "bullet"}
+        The engine that runs the rig.
+    **options
+        :func:`spine_mj.sim.build_rig`'s keywords (same meaning, same rules); MuJoCo's own
+        solver options (:data:`MUJOCO_ONLY`) are refused for Bullet when given, a
+        ``timestep_s`` sets Bullet's recorded step.
+
+    Returns
+    -------
+    EngineRig
+        A :class:`~spine_mj.sim.Rig` for MuJoCo, a ``BulletRig`` for Bullet.
 
     Raises
     ------

@@ -63,8 +63,24 @@ def holding_excess(
 ) -> float:
     """The predicted excess of an array's holding reading over the quasistatic holding,
     per spine [F_p] (module docstring): ``ONSET_SHARE`` of the spring-block swing under
-    displacement control (``stiffness_number`` and ``lc_over_ls`` needed), the force-rate
-    lag ``2 sqrt(I_e)`` under force control."""
+    displacement control, the force-rate lag ``2 sqrt(I_e)`` under force control.
+
+    Parameters
+    ----------
+    ie : float
+        The drive's inertia number (the carriage's speed, or the pull's rate per spine).
+    force_control : bool
+        A free carriage pulled by a force (True) or a carriage moving at constant speed.
+    stiffness_number : float or None
+        Each spring's ``K = k l_s / F_p`` (needed under displacement control).
+    lc_over_ls : float or None
+        The surface's ``L_c / l_s`` (needed under displacement control).
+
+    Returns
+    -------
+    float
+        The excess per spine in units of F_p.
+    """
     if force_control:
         return PULL_LAG_FACTOR * math.sqrt(check_positive("I_e", ie))
     return ONSET_SHARE * spring_swing(ie, stiffness_number, lc_over_ls)
@@ -97,7 +113,23 @@ def array_ie(scales: Scales, *, mu: float, force_control: bool, stiffness_n_m: f
     """The arrays' default pace (:func:`quasistatic_ie` on ``scales``): the inertia number
     of the carriage's speed (displacement control) or of the pull's rate per spine (force
     control) whose predicted holding excess is :data:`HOLDING_TOLERANCE` ``mu F_p``.
-    ``stiffness_n_m`` None: the spring drive's default ``K``."""
+
+    Parameters
+    ----------
+    scales : Scales
+        The rig's scales (``L_c``, ``l_s``, ``F_p``).
+    mu : float
+        The tip's friction coefficient.
+    force_control : bool
+        A free carriage pulled by a force (True) or a carriage moving at constant speed.
+    stiffness_n_m : float or None
+        Each spring's stiffness [N/m] (None: the spring drive's default ``K``).
+
+    Returns
+    -------
+    float
+        The inertia number of the pace.
+    """
     k = DEFAULT_STIFFNESS_NUMBER if stiffness_n_m is None else scales.stiffness_number(stiffness_n_m)
     return quasistatic_ie(
         mu=mu,
