@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+import tomllib
 from sweep_support import write_config
 
 from spine_mj import sweep
@@ -152,3 +153,43 @@ def test_an_ensembles_copies_get_their_outcome_and_its_first_member_everything(t
         assert (ens[col] == full[col]).all(), col
     assert ens.agree_smooth[lead].astype(bool).tolist() == full.agree_smooth[lead].astype(bool).tolist()
     assert ens.agree_smooth[~lead].isna().all()
+
+
+def test_compare_leaves_out_a_run_the_engine_failed(tmp_path):
+    """A run the engine failed (here marked diverged, its path replaced by a pathological
+    one 1e6 L_c out and back) is not compared as physics: no distances, status
+    ``dependency_failed``; the healthy run beside it gets the same numbers as before, and
+    the memory stays bounded by the recorded size (no resampling of the long path)."""
+    import dataclasses
+    import tracemalloc
+
+    from spine_mj.sweep.registry import ANALYSES, AnalysisResult
+
+    (case,) = sweep.expand_cases(
+        sweep.parse_config(tomllib.loads(MJ.replace("ie = [0.01, 0.1]", "ie = 0.01")), base_dir=tmp_path)
+    )
+    surface = case.surface.make()
+    starts = case.starts.resolve(surface.bounds, case.seed)
+    up = {"quasistatic": ANALYSES["quasistatic"].func(case, surface, starts, {})}
+    up["mujoco"] = ANALYSES["mujoco"].func(case, surface, starts, up)
+    before = ANALYSES["compare"].func(case, surface, starts, up)
+    rig, runs = up["mujoco"].data
+    lc = rig.scales.char_length_m
+    n = runs[1].position_m.shape[0]
+    wild = runs[1].position_m.copy()
+    wild[runs[1].drive_start_index :, 0] += (
+        1e6 * lc * np.sin(np.linspace(0, np.pi, n - runs[1].drive_start_index))
+    )
+    runs = [runs[0], dataclasses.replace(runs[1], position_m=wild)]
+    status = np.array(["ok", "diverged"], dtype=object)
+    up["mujoco"] = AnalysisResult(
+        up["mujoco"].metrics, status=status, reason=np.array(["", "diverged"]), data=(rig, runs)
+    )
+    tracemalloc.start()
+    after = ANALYSES["compare"].func(case, surface, starts, up)
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    assert list(after.status) == ["ok", "dependency_failed"]
+    assert np.isnan(after.metrics["frechet"][1]) and np.isnan(after.metrics["lateral_deviation"][1])
+    assert after.metrics["frechet"][0] == pytest.approx(before.metrics["frechet"][0], rel=1e-12)
+    assert peak < 200 * 2**20

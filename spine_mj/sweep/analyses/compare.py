@@ -185,7 +185,15 @@ def _compare(case, surface, starts, upstream):
     params = dataclasses.replace(margin, dl=min(margin.dl, contact.radius / 8))
     facets = trace(contact, starts, params, store_paths=True)
     lc = rig.scales.char_length_m / s
-    mpaths = [r.position_m[r.drive_start_index :, :2] / s for r in runs]
+    status = np.array(
+        upstream["mujoco"].status if upstream["mujoco"].status is not None else np.full(len(runs), "ok"),
+        dtype=object,
+    )
+    # a run the engine failed (diverged, stopped) has no path to compare: an empty one
+    mpaths = [
+        r.position_m[r.drive_start_index :, :2] / s if ok else np.empty((0, 2))
+        for r, ok in zip(runs, status == "ok", strict=True)
+    ]
     idx = np.flatnonzero(lead)
     smooth_paths = _paths(smooth, idx)
     frechet, lateral = _deviations(mpaths, {int(i): _xy(facets, i) for i in idx}, lc)
@@ -197,10 +205,6 @@ def _compare(case, surface, starts, upstream):
     agree = _outcomes(facets, mj_locked, mj_end, lc)
     agree_smooth = np.full(len(runs), np.nan) if members > 1 else np.zeros(len(runs), bool)
     agree_smooth[lead] = _outcomes(smooth, mj_locked[lead], mj_end[lead], lc)["agree"]
-    status = np.array(
-        upstream["mujoco"].status if upstream["mujoco"].status is not None else np.full(len(runs), "ok"),
-        dtype=object,
-    )
     explain = ~agree["agree"] & (status == "ok") & bool(case.params["miss_reasons"]) & lead
     miss_reason, miss_offset = _miss_reasons(
         contact, params, trace, mpaths, facets, mj_locked, mj_end, lc, explain
