@@ -30,7 +30,7 @@ from spine_mj.sim.array_run import ArrayDrive, ForcePull
 from spine_mj.sim.drives import Drive, RampDrive, SpringDrive, StaticProbe, spring_stiffness_n_m
 from spine_mj.sim.holding import array_ie
 from spine_mj.sim.layout import Layout
-from spine_mj.sim.params import Cone, EngineSettings, Integrator, Scales, TipParams, default_engine
+from spine_mj.sim.params import EngineOverrides, Scales, TipParams
 from spine_mj.sim.rig import Rig
 from spine_mj.surfaces import GridSurface, Surface
 
@@ -100,19 +100,13 @@ def build_rig(
     gravity_m_s2: float | None = None,
     length_scale_m: float | None = None,
     hfield_resolution: int | None = None,
-    timestep_s: float | None = None,
-    integrator: str | Integrator | None = None,
-    cone: str | Cone | None = None,
-    impratio: float | None = None,
-    noslip_iterations: int | None = None,
-    solref_timeconst_s: float | None = None,
-    solref_dampratio: float | None = None,
     ie: float | None = None,
     speed_m_s: float | None = None,
     rate_n_s: float | None = None,
     stiffness_number: float | None = None,
     stiffness_n_m: float | None = None,
     driven: bool = True,
+    **engine_overrides,
 ) -> Rig:
     """The rig of ``surface`` and a tip of friction ``mu`` (resolve it with
     :func:`spine_mj.presets.friction_coefficient`); None leaves a parameter to its rule.
@@ -131,21 +125,19 @@ def build_rig(
     hfield_resolution : int or None
         Samples a side of the hfield of an analytic surface; ignored for a gridded one,
         which keeps its own samples (module docstring).
-    timestep_s, integrator, cone, impratio, noslip_iterations
-        Engine overrides of :func:`default_engine`.
-    solref_timeconst_s, solref_dampratio
-        The contact's time constant (None: the rule's, twice the step) and damping ratio
-        (None: 1).
     ie, speed_m_s, rate_n_s
         The drive's pace, as for :func:`build_drive`: its speed (:func:`drive_speed_m_s`)
         bounds the engine step for impacts.
     stiffness_number, stiffness_n_m
         The drive spring's stiffness, as for :func:`build_drive` (none: K = 30): it bounds
-        the engine step (:func:`default_engine`), so a rig runs spring drives up to this
+        the engine step (:func:`~spine_mj.sim.default_engine`), so a rig runs spring drives up to this
         stiffness (a stiffer one is refused by :meth:`Rig.check_drive`).
     driven : bool
         False for a model no drive of ours runs (``sim export``, the viewer: the user's
         sliders drive it): then only the surface's falls bound the step.
+    **engine_overrides
+        The fields of :class:`EngineOverrides` (``timestep_s``, ``integrator``, ``cone``,
+        ``impratio``, ``noslip_iterations``, ``solref_timeconst_s``, ``solref_dampratio``).
 
     Raises
     ------
@@ -167,6 +159,7 @@ def build_rig(
     >>> round(run.inertia_number, 6)
     0.001
     """
+    overrides = EngineOverrides(**engine_overrides)
     tip = TipParams(
         tip_radius_m=tip_radius_m,
         mu_s=mu,
@@ -175,14 +168,7 @@ def build_rig(
     tip, scales, hfield = _sized(surface, tip, length_scale_m, hfield_resolution)
     speed = drive_speed_m_s(scales, ie=ie, speed_m_s=speed_m_s, rate_n_s=rate_n_s) if driven else None
     spring = spring_stiffness_n_m(scales, stiffness_number=stiffness_number, stiffness_n_m=stiffness_n_m)
-    overrides = _given(
-        timestep_s=timestep_s,
-        integrator=integrator,
-        cone=cone,
-        impratio=impratio,
-        noslip_iterations=noslip_iterations,
-    )
-    engine = _engine(scales, speed, spring, (solref_timeconst_s, solref_dampratio), overrides)
+    engine = overrides.engine(scales, speed_m_s=speed, stiffness_n_m=spring)
     return Rig(surface, tip=tip, engine=engine, sized=(scales, hfield))
 
 
@@ -194,20 +180,6 @@ def _sized(surface: Surface, tip: TipParams, length_scale_m, hfield_resolution) 
         surface, tip=tip, length_scale_m=length_scale_m, hfield_resolution=resolution
     )
     return dataclasses.replace(tip, tip_radius_m=scales.tip_radius_m), scales, hfield
-
-
-def _engine(scales: Scales, speed, spring, solref: tuple, overrides: dict) -> EngineSettings:
-    """:func:`default_engine` for a drive of ``speed`` [m/s] and spring ``spring`` [N/m] with
-    the user's ``overrides``, and ``solref = (timeconst_s, dampratio)``, each None for the
-    rule's own."""
-    timeconst_s, dampratio = solref
-    if timeconst_s is not None or dampratio is not None:
-        rule = default_engine(scales, speed_m_s=speed, stiffness_n_m=spring, **overrides)
-        overrides["solref"] = (
-            rule.solref[0] if timeconst_s is None else timeconst_s,
-            rule.solref[1] if dampratio is None else dampratio,
-        )
-    return default_engine(scales, speed_m_s=speed, stiffness_n_m=spring, **overrides)
 
 
 def build_drive(

@@ -10,10 +10,12 @@ needs MuJoCo; :mod:`spine_mj.sim.params` re-exports every name.
 
 from __future__ import annotations
 
+import dataclasses
 import math
+from dataclasses import dataclass
 
 from spine_mj.errors import SpineInputError, check_positive
-from spine_mj.sim.records import EngineSettings
+from spine_mj.sim.records import Cone, EngineSettings, Integrator
 from spine_mj.sim.scales import Scales, check_inertia_number
 
 _REST_PENETRATION_FRACTION = 0.005
@@ -122,6 +124,66 @@ def default_engine(
         base["solref"] = (2 * float(overrides["timestep_s"]), 1.0)
     base.update(overrides)
     return EngineSettings(**base)
+
+
+@dataclass(frozen=True)
+class EngineOverrides:
+    """A user's replacements for the step rule's engine settings (:func:`default_engine`):
+    what :func:`~spine_mj.sim.build_rig` takes besides the problem (``--timestep``,
+    ``--noslip``, ``--impratio``, a sweep's engine keys). None keeps the rule's value.
+
+    Attributes
+    ----------
+    timestep_s : float or None
+        Time step [s] (the contact's time constant then follows it, ``2 timestep_s``).
+    integrator, cone : str, Integrator, Cone or None
+        MuJoCo's integrator and friction cone.
+    impratio : float or None
+        Frictional to normal constraint impedance.
+    noslip_iterations : int or None
+        Noslip solver passes.
+    solref_timeconst_s, solref_dampratio : float or None
+        The contact's time constant [s] and damping ratio, each replacing its half of the
+        rule's ``solref`` (the other half stays the rule's).
+    """
+
+    timestep_s: float | None = None
+    integrator: str | Integrator | None = None
+    cone: str | Cone | None = None
+    impratio: float | None = None
+    noslip_iterations: int | None = None
+    solref_timeconst_s: float | None = None
+    solref_dampratio: float | None = None
+
+    def engine(
+        self, scales: Scales, *, speed_m_s: float | None = None, stiffness_n_m: float | None = None
+    ) -> EngineSettings:
+        """:func:`default_engine` for a drive of ``speed_m_s`` and spring ``stiffness_n_m``
+        with these overrides.
+
+        Parameters
+        ----------
+        scales : Scales
+            The rig's scales.
+        speed_m_s : float, optional
+            The drive's speed [m/s] (None: an undriven rig, only the surface's falls bound
+            the step).
+        stiffness_n_m : float, optional
+            The drive spring's stiffness [N/m] (None: the default spring).
+
+        Returns
+        -------
+        EngineSettings
+        """
+        given = {k: v for k, v in dataclasses.asdict(self).items() if v is not None}
+        timeconst_s, dampratio = given.pop("solref_timeconst_s", None), given.pop("solref_dampratio", None)
+        if timeconst_s is not None or dampratio is not None:
+            rule = default_engine(scales, speed_m_s=speed_m_s, stiffness_n_m=stiffness_n_m, **given)
+            given["solref"] = (
+                rule.solref[0] if timeconst_s is None else timeconst_s,
+                rule.solref[1] if dampratio is None else dampratio,
+            )
+        return default_engine(scales, speed_m_s=speed_m_s, stiffness_n_m=stiffness_n_m, **given)
 
 
 def _two_digits_down(x: float) -> float:

@@ -11,22 +11,28 @@ from __future__ import annotations
 
 import concurrent.futures as cf
 import contextlib
+import dataclasses
 import importlib
 import logging
+import math
 import multiprocessing
 import os
+import re
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
 
 from distributed import Client, as_completed
 from distributed.comm.core import CommClosedError
 
+from spine_mj.errors import SpineInputError
 from spine_mj.sweep.case_runs import failed_rows, run_case
-from spine_mj.sweep.cases import Case
+from spine_mj.sweep.cases import Case, longest_first
 from spine_mj.sweep.pool import run_pool
 from spine_mj.sweep.registry import CASE_THREADS
 from spine_mj.sweep.store import encode_case
+from spine_mj.workers import check_workers
 
 
 def encoded_case(case: Case) -> tuple:
@@ -207,3 +213,102 @@ def _wait_for_workers(client, address: str, wait_s: float, notice) -> None:
         ) from None
     n = len(client.scheduler_info().get("workers", {}))
     say(f"scheduler {address}: {n} worker{'s' if n != 1 else ''}")
+
+
+@dataclass(frozen=True)
+class Backend:
+    """Where a sweep session's cases run: local worker processes, or the workers of a Dask
+    scheduler (checked on creation; :func:`~spine_mj.sweep.run_sweep`'s keywords).
+
+    Attributes
+    ----------
+    workers : int or None
+        Local worker processes; None: all cores (``os.cpu_count()``). 1 runs in this
+        process. Ignored when ``scheduler`` is given.
+    scheduler : str or distributed.Client or None
+        Address of a Dask distributed scheduler (``tcp://host:8786``) or a connected client:
+        cases run on its workers (spine_mj installed, the config's surface files readable);
+        results come back to this process, which writes the store (no shared file system).
+    worker_wait_s : float
+        With ``scheduler``: seconds to wait for its first worker before giving up.
+    notice : callable or None
+        Called with a line of text on what the sweep waits for (a scheduler's workers).
+    """
+
+    workers: int | None = None
+    scheduler: str | Client | None = None
+    worker_wait_s: float = DEFAULT_WORKER_WAIT_S
+    notice: Callable[[str], None] | None = None
+
+    def __post_init__(self):
+        wait = self.worker_wait_s
+        if not (math.isfinite(wait) and wait > 0):
+            raise SpineInputError(f"--worker-wait must be a number of seconds > 0, got {wait!r}")
+        if self.workers is not None:
+            check_workers(self.workers)
+
+    @property
+    def n_workers(self) -> int | None:
+        """Local worker processes (None with a scheduler)."""
+        return None if self.scheduler is not None else (self.workers or os.cpu_count() or 1)
+
+    def record(self) -> dict:
+        """What a store's manifest records of the backend: workers and scheduler."""
+        scheduler = self.scheduler
+        return {
+            "workers": self.n_workers,
+            "scheduler": None if scheduler is None else str(getattr(scheduler, "scheduler", scheduler)),
+        }
+
+    @contextlib.contextmanager
+    def connected(self) -> Iterator[Backend]:
+        """This backend with its scheduler connected (a client made here is closed on exit);
+        SpineInputError for a malformed or unreachable address, before anything is written."""
+        if self.scheduler is None:
+            yield self
+            return
+        client = connect(self.scheduler)
+        try:
+            yield dataclasses.replace(self, scheduler=client)
+        finally:
+            if client is not self.scheduler:
+                client.close()
+
+    def run(self, todo: list[Case], handle) -> None:
+        """Run ``todo``, ``handle`` taking each finished case (longest first on processes and
+        Dask; one case left runs here, its engine batch on the workers' threads)."""
+        if not todo:
+            return
+        if self.scheduler is not None:
+            run_dask(
+                longest_first(todo),
+                self.scheduler,
+                handle,
+                worker_wait_s=self.worker_wait_s,
+                notice=self.notice,
+            )
+        elif self.n_workers == 1 or len(todo) == 1:
+            run_here(todo, handle, threads=self.n_workers)
+        else:
+            run_processes(longest_first(todo), self.n_workers, handle)
+
+
+_ADDRESS = re.compile(r"^((tcp|tls|ucx|ws|wss)://)?[A-Za-z0-9._-]+(:[0-9]{1,5})?$|^inproc://\S+$")
+
+#: Seconds to wait for a Dask scheduler to answer.
+CONNECT_TIMEOUT_S = 10
+
+
+def connect(scheduler) -> Client:
+    """A client of the Dask scheduler ``scheduler`` (an address, or a connected client,
+    returned as is); SpineInputError for a malformed or unreachable address."""
+    if isinstance(scheduler, Client):
+        return scheduler
+    if not isinstance(scheduler, str) or not _ADDRESS.match(scheduler):
+        raise SpineInputError(
+            f"--scheduler: must be a Dask scheduler address like tcp://host:8786, got {scheduler!r}"
+        )
+    try:
+        return Client(scheduler, timeout=CONNECT_TIMEOUT_S)
+    except (OSError, TimeoutError, ValueError) as exc:
+        raise SpineInputError(f"--scheduler {scheduler}: cannot connect ({exc})") from None

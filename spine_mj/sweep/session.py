@@ -10,9 +10,7 @@ from __future__ import annotations
 
 import contextlib
 import datetime
-import math
 import os
-import re
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -20,14 +18,13 @@ from pathlib import Path
 
 import numpy as np
 import pyarrow.compute as pc
-from distributed import Client
 
 from spine_mj.errors import SpineInputError
 from spine_mj.sweep.analyses import quasistatic
 from spine_mj.sweep.analyses.mujoco import case_rig
-from spine_mj.sweep.cases import expand_cases, longest_first
+from spine_mj.sweep.cases import expand_cases
 from spine_mj.sweep.config import SweepConfig, _make_surface, load_config
-from spine_mj.sweep.executors import DEFAULT_WORKER_WAIT_S, run_dask, run_here, run_processes
+from spine_mj.sweep.executors import DEFAULT_WORKER_WAIT_S, Backend
 from spine_mj.sweep.preflight import check_cases
 from spine_mj.sweep.store import (
     consolidate,
@@ -123,13 +120,11 @@ def run_sweep(
     out_dir : path
         The result store (created if missing). If it holds a sweep of the same config, the
         finished cases are skipped; of another config, SpineInputError unless ``overwrite``.
-    workers : int, optional
-        Local worker processes; default all cores (``os.cpu_count()``). 1 runs in this
-        process. Ignored when ``scheduler`` is given.
-    scheduler : str or distributed.Client, optional
-        Address of a Dask distributed scheduler (``tcp://host:8786``) or a connected client:
-        cases run on its workers (spine_mj installed, the config's surface files readable);
-        results come back to this process, which writes the store (no shared file system).
+    workers, scheduler, worker_wait_s, notice
+        Where the cases run (:class:`~spine_mj.sweep.executors.Backend`): ``workers`` local
+        processes (default all cores; 1: this process), or the workers of the Dask
+        ``scheduler`` (an address or a client), waiting ``worker_wait_s`` for the first and
+        saying so through ``notice``.
     overwrite : bool
         Replace a store holding another config.
     retry_failed : bool
@@ -137,10 +132,6 @@ def run_sweep(
     progress : callable, optional
         Called with a :class:`Progress` once after the skipped cases are counted and after
         every finished case.
-    worker_wait_s : float
-        With ``scheduler``: seconds to wait for its first worker before giving up.
-    notice : callable, optional
-        Called with a line of text on what the sweep waits for (a scheduler's workers).
 
     Returns
     -------
@@ -150,12 +141,10 @@ def run_sweep(
     ------
     SpineInputError
         A bad config, store, worker count or scheduler address.
-    WorkersCannotStart
-        Local worker processes die or hang before their first case (the finished cases
-        are kept; a re-run resumes).
-    SchedulerUnavailable
-        The Dask scheduler had no worker within ``worker_wait_s`` or was lost (the
-        finished cases are kept; a re-run resumes).
+    WorkersCannotStart, SchedulerUnavailable
+        Local worker processes died or hung before their first case; the Dask scheduler
+        had no worker within ``worker_wait_s`` or was lost. The finished cases are kept: a
+        re-run resumes.
 
     Examples
     --------
@@ -180,56 +169,48 @@ def run_sweep(
     >>> sorted(runs.groupby("mu")["self_locked"].sum().astype(int).tolist())
     [0, 1]
     """
-    config, out_dir, n_workers = _checked_inputs(config, out_dir, workers, scheduler, worker_wait_s)
-    cases = expand_cases(config)
-    session = _session_record(n_workers, scheduler)
-    clear_caches()
-    check_cases(cases, config.swept)  # an input error refuses the config, not every run
-    client = None if scheduler is None else connect(scheduler)  # before anything is written
-    try:
-        out_dir.mkdir(parents=True, exist_ok=True)
-        with store_lock(out_dir):
-            return _run_locked(
-                config,
-                cases,
-                out_dir,
-                session,
-                n_workers=n_workers,
-                scheduler=client,
-                overwrite=overwrite,
-                retry_failed=retry_failed,
-                progress=progress,
-                worker_wait_s=worker_wait_s,
-                notice=notice,
-            )
-    finally:
-        if client is not None and client is not scheduler:
-            client.close()
+    backend = Backend(workers, scheduler, worker_wait_s, notice)
+    config, out_dir = _checked_inputs(config, out_dir)
+    cases = _checked_cases(config)
+    session = _session_record(backend)
+    with backend.connected() as backend, _locked(out_dir):  # connected before anything is written
+        st = _open_store(config, cases, out_dir, session, overwrite=overwrite, retry_failed=retry_failed)
+        return _run_stores([st], backend, progress)[0]
 
 
-def _checked_inputs(
-    config, out_dir, workers, scheduler, worker_wait_s
-) -> tuple[SweepConfig, Path, int | None]:
-    """:func:`run_sweep`'s config (read if a path), store folder and local worker count
-    (None with a scheduler), or SpineInputError naming the bad one."""
-    if not (math.isfinite(worker_wait_s) and worker_wait_s > 0):
-        raise SpineInputError(f"--worker-wait must be a number of seconds > 0, got {worker_wait_s!r}")
+def _checked_inputs(config, out_dir) -> tuple[SweepConfig, Path]:
+    """:func:`run_sweep`'s config (read if a path) and store folder, or SpineInputError
+    naming the bad one."""
     if not isinstance(config, SweepConfig):
         config = load_config(config)
-    if workers is not None:
-        check_workers(workers)
     out_dir = Path(out_dir)
     if out_dir.exists() and not out_dir.is_dir():
         raise SpineInputError(f"--out {out_dir} exists and is not a folder")
-    return config, out_dir, None if scheduler is not None else (workers or os.cpu_count() or 1)
+    return config, out_dir
 
 
-def _session_record(n_workers: int | None, scheduler) -> dict:
+def _checked_cases(config: SweepConfig) -> list:
+    """The cases of ``config``, read afresh (:func:`clear_caches`) and checked: an input
+    error refuses the config, not every run."""
+    cases = expand_cases(config)
+    clear_caches()
+    check_cases(cases, config.swept)
+    return cases
+
+
+@contextlib.contextmanager
+def _locked(out_dir: Path):
+    """The store folder, created if missing, locked for this session (:func:`store_lock`)."""
+    out_dir.mkdir(parents=True, exist_ok=True)
+    with store_lock(out_dir):
+        yield
+
+
+def _session_record(backend: Backend) -> dict:
     """What the manifest records of this session: start time, workers, scheduler, versions."""
     return {
         "started": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
-        "workers": n_workers,
-        "scheduler": None if scheduler is None else str(getattr(scheduler, "scheduler", scheduler)),
+        **backend.record(),
         "versions": versions(),
         "git": git_commit(),
     }
@@ -241,28 +222,6 @@ def clear_caches() -> None:
     _make_surface.cache_clear()
     quasistatic.clear_cache()
     case_rig.cache_clear()
-
-
-_ADDRESS = re.compile(r"^((tcp|tls|ucx|ws|wss)://)?[A-Za-z0-9._-]+(:[0-9]{1,5})?$|^inproc://\S+$")
-
-
-def connect(scheduler):
-    """A client of the Dask scheduler ``scheduler`` (an address, or a connected client,
-    returned as is); SpineInputError for a malformed or unreachable address."""
-    if isinstance(scheduler, Client):
-        return scheduler
-    if not isinstance(scheduler, str) or not _ADDRESS.match(scheduler):
-        raise SpineInputError(
-            f"--scheduler: must be a Dask scheduler address like tcp://host:8786, got {scheduler!r}"
-        )
-    try:
-        return Client(scheduler, timeout=CONNECT_TIMEOUT_S)
-    except (OSError, TimeoutError, ValueError) as exc:
-        raise SpineInputError(f"--scheduler {scheduler}: cannot connect ({exc})") from None
-
-
-#: Seconds to wait for a Dask scheduler to answer.
-CONNECT_TIMEOUT_S = 10
 
 
 @dataclass
@@ -279,17 +238,6 @@ class _Store:
     finished: int = 0
     ok: int = 0
     failed: int = 0
-
-    def progress(self, t0: float, case_id: str | None) -> Progress:
-        return Progress(
-            total_cases=len(self.cases),
-            finished_cases=self.finished,
-            skipped_cases=self.skipped,
-            ok_runs=self.ok,
-            failed_runs=self.failed,
-            elapsed_s=time.perf_counter() - t0,
-            case_id=case_id,
-        )
 
     def store(self, encoded) -> None:
         store_encoded(self.out_dir, encoded)
@@ -329,47 +277,41 @@ def _open_store(config, cases, out_dir, session, *, overwrite, retry_failed) -> 
     return _Store(config, cases, out_dir, todo, len(cases) - len(todo), skipped_runs, list(corrupt))
 
 
-def _execute(todo, handle, *, n_workers, scheduler=None, worker_wait_s=DEFAULT_WORKER_WAIT_S, notice=None):
-    """Run ``todo`` on the chosen backend, ``handle`` taking each finished case."""
-    if not todo:
-        return
-    if scheduler is not None:
-        run_dask(longest_first(todo), scheduler, handle, worker_wait_s=worker_wait_s, notice=notice)
-    elif n_workers == 1 or len(todo) == 1:
-        # one case left: no processes to start; its engine batch gets the workers' threads
-        run_here(todo, handle, threads=n_workers)
-    else:
-        run_processes(longest_first(todo), n_workers, handle)
-
-
-def _run_locked(
-    config,
-    cases,
-    out_dir,
-    session,
-    *,
-    n_workers,
-    scheduler,
-    overwrite,
-    retry_failed,
-    progress,
-    worker_wait_s=DEFAULT_WORKER_WAIT_S,
-    notice=None,
-) -> SweepSummary:
-    st = _open_store(config, cases, out_dir, session, overwrite=overwrite, retry_failed=retry_failed)
+def _run_stores(stores: list[_Store], backend: Backend, progress) -> list[SweepSummary]:
+    """Run the cases left in ``stores`` (locked by the caller) on ``backend``: a case found
+    in two stores runs once and is stored in both; ``progress`` gets one :class:`Progress`
+    over all of them, once before the first case and after each."""
+    owners: dict[str, list[_Store]] = {}
+    todo = []
+    for st in stores:
+        for case in st.todo:
+            if case.case_id not in owners:
+                todo.append(case)
+            owners.setdefault(case.case_id, []).append(st)
     t0 = time.perf_counter()
 
-    def handle(encoded):
-        st.store(encoded)
+    def report(case_id):
         if progress is not None:
-            progress(st.progress(t0, encoded[0]))
+            progress(
+                Progress(
+                    total_cases=sum(len(st.cases) for st in stores),
+                    finished_cases=sum(st.finished for st in stores),
+                    skipped_cases=sum(st.skipped for st in stores),
+                    ok_runs=sum(st.ok for st in stores),
+                    failed_runs=sum(st.failed for st in stores),
+                    elapsed_s=time.perf_counter() - t0,
+                    case_id=case_id,
+                )
+            )
 
-    if progress is not None:
-        progress(st.progress(t0, None))
-    _execute(
-        st.todo, handle, n_workers=n_workers, scheduler=scheduler, worker_wait_s=worker_wait_s, notice=notice
-    )
-    return st.summary(t0, n_workers)
+    def handle(encoded):
+        for st in owners[encoded[0]]:
+            st.store(encoded)
+        report(encoded[0])
+
+    report(None)
+    backend.run(todo, handle)
+    return [st.summary(t0, backend.n_workers) for st in stores]
 
 
 def run_sweeps(
@@ -403,55 +345,19 @@ def run_sweeps(
     list of SweepSummary
         One per job, in order.
     """
-    if workers is not None:
-        check_workers(workers)
-    n_workers = workers or os.cpu_count() or 1
+    backend = Backend(workers)
     configs = [c if isinstance(c, SweepConfig) else load_config(c) for c, _ in jobs]
     dirs = [Path(d) for _, d in jobs]
     if len({d.resolve() for d in dirs}) != len(dirs):
         raise SpineInputError("run_sweeps: every sweep needs its own out_dir")
-    expanded = [expand_cases(c) for c in configs]
-    session = _session_record(n_workers, None)
-    clear_caches()
-    for config, cases in zip(configs, expanded):
-        check_cases(cases, config.swept)
+    expanded = [_checked_cases(c) for c in configs]
+    session = _session_record(backend)
     with contextlib.ExitStack() as locks:
         stores = []
         for config, cases, d in zip(configs, expanded, dirs):
-            d.mkdir(parents=True, exist_ok=True)
-            locks.enter_context(store_lock(d))
+            locks.enter_context(_locked(d))
             stores.append(_open_store(config, cases, d, session, overwrite=overwrite, retry_failed=False))
-        owners: dict[str, list[_Store]] = {}
-        todo = []
-        for st in stores:
-            for case in st.todo:
-                if case.case_id not in owners:
-                    todo.append(case)
-                owners.setdefault(case.case_id, []).append(st)
-        t0 = time.perf_counter()
-
-        def report(case_id):
-            if progress is not None:
-                progress(
-                    Progress(
-                        total_cases=sum(len(st.cases) for st in stores),
-                        finished_cases=sum(st.finished for st in stores),
-                        skipped_cases=sum(st.skipped for st in stores),
-                        ok_runs=sum(st.ok for st in stores),
-                        failed_runs=sum(st.failed for st in stores),
-                        elapsed_s=time.perf_counter() - t0,
-                        case_id=case_id,
-                    )
-                )
-
-        def handle(encoded):
-            for st in owners[encoded[0]]:
-                st.store(encoded)
-            report(encoded[0])
-
-        report(None)
-        _execute(todo, handle, n_workers=n_workers)
-        return [st.summary(t0, n_workers) for st in stores]
+        return _run_stores(stores, backend, progress)
 
 
 def _done_cases(out_dir: Path, retry_failed: bool) -> set[str]:

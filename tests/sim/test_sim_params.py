@@ -219,3 +219,23 @@ def test_the_step_rule_resolves_the_drive_spring_and_the_contact_follows_the_ste
         rig = sim.build_rig(surface, mu=mu, ie=1e-4, stiffness_number=k_number, solref_dampratio=damp)
         assert rig.engine.timestep_s == pytest.approx(eng.timestep_s)
         assert rig.engine.solref == pytest.approx(eng.solref)
+
+
+def test_engine_overrides_replace_only_what_they_name():
+    """No override gives the rule; a timestep carries the contact along (2 dt); each half of
+    solref replaces its own half of the rule's, the other half stays the rule's."""
+    from spine_mj import sim
+
+    scales = sim.Scales.for_surface(single_gaussian(), tip=TipParams(mu_s=0.5))
+    rule = sim.default_engine(scales, speed_m_s=scales.speed_for(1e-3))
+    engine = sim.EngineOverrides().engine
+    assert engine(scales, speed_m_s=scales.speed_for(1e-3)) == rule
+    dt = rule.timestep_s / 4
+    assert sim.EngineOverrides(timestep_s=dt).engine(scales).solref == pytest.approx((2 * dt, 1.0))
+    damped = sim.EngineOverrides(solref_dampratio=0.5).engine(scales, speed_m_s=scales.speed_for(1e-3))
+    assert damped.solref == pytest.approx((rule.solref[0], 0.5))
+    slow = sim.EngineOverrides(solref_timeconst_s=3 * rule.solref[0]).engine(
+        scales, speed_m_s=scales.speed_for(1e-3)
+    )
+    assert slow.solref == pytest.approx((3 * rule.solref[0], 1.0))
+    assert slow.timestep_s == rule.timestep_s
