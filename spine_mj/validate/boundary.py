@@ -1,5 +1,15 @@
 """Study 3: the quasistatic boundary. Agreement against I_e for the spring and ramp drives,
 and the I_e* where it breaks, with a bracketing interval and a bootstrap over starts.
+
+Solution verification of I_e* (``plan.boundary_refinements``, keys of
+:data:`~spine_mj.validate.convergence.REFINEMENTS`): every start rerun under the refinement
+at the grid values of the headline's bracket and :data:`IE_WINDOW` either side of it (where
+I_e* is decided; a run there is fast, the carriage at I_e ~ 0.1), the refined I_e* read from
+the curve with those values replaced, and *converged* when it lies inside the headline's own
+95 % bootstrap interval (:func:`~spine_mj.validate.convergence.headline_convergence`, on
+``log10 I_e*``). The grid values outside the window keep their runs: there agreement holds
+(below) or fails (above) by a margin, and the corner's own refinement
+(:mod:`spine_mj.validate.quasistatic_limit`) checks the lowest I_e.
 """
 
 from __future__ import annotations
@@ -12,14 +22,36 @@ import pandas as pd
 
 from spine_mj import presets, sim
 from spine_mj.presets import calibrated_mu
-from spine_mj.validate.ie_star import ie_star_by_criterion, quiet_nan_warnings
+from spine_mj.validate.convergence import REFINEMENTS, headline_convergence, refinable
+from spine_mj.validate.ie_star import (
+    IE_STAR_CRITERIA,
+    bootstrap_ie_star,
+    criterion_ie_star,
+    grid_point,
+    ie_star_by_criterion,
+    quiet_nan_warnings,
+)
 from spine_mj.validate.paths import prefix_frechet, stored_paths, tip_radius
 from spine_mj.validate.plans import FRECHET_TARGET, RAMP_MIN_COVERAGE, FamilySpec, ValidationPlan
 from spine_mj.validate.ramp_pilot import pilot_rig, ramp_duration
 from spine_mj.validate.study_runner import StudyRunner
-from spine_mj.validate.sweep_configs import family_doc
+from spine_mj.validate.sweep_configs import engine_grid, family_doc
 
-__all__ = ["BoundaryCurve", "BoundaryResult", "boundary", "preset_grid", "quasistatic_locked"]
+__all__ = [
+    "HEADLINE_CRITERION",
+    "IE_WINDOW",
+    "BoundaryCurve",
+    "BoundaryResult",
+    "boundary",
+    "preset_grid",
+    "quasistatic_locked",
+    "refinement_window",
+]
+
+#: The criterion of the I_e* headline (:data:`~spine_mj.validate.ie_star.IE_STAR_CRITERIA`).
+HEADLINE_CRITERION = "median_frechet"
+#: Grid values either side of the headline I_e*'s bracket rerun under refinement.
+IE_WINDOW = 1
 
 
 @dataclass(frozen=True)
@@ -97,9 +129,11 @@ class BoundaryResult:
         Protocol -> :class:`BoundaryCurve`.
     ie_star : dict
         Protocol -> the headline (median-Frechet) :meth:`IeStar.as_dict` with ``criterion``,
-        ``by_criterion`` (:func:`ie_star_by_criterion`) and ``ie_used``; or, for a ramp that
-        covers too little of the path, ``kind`` ``"not measured"``, ``valid`` False and a
-        ``note``.
+        ``by_criterion`` (:func:`ie_star_by_criterion`) and ``ie_used``, and where the plan
+        refines it ``convergence`` (:func:`~spine_mj.validate.convergence.headline_convergence`
+        on ``log10 I_e*`` with ``ie_refined``, the window rerun, and ``ci95``, the
+        headline's 95 % interval); or, for a ramp that covers too little of the path,
+        ``kind`` ``"not measured"``, ``valid`` False and a ``note``.
     skip_rate : dict
         Protocol -> per-I_e fraction of quasistatic traps MuJoCo skips.
     families : list of str
@@ -167,18 +201,125 @@ def boundary(plan: ValidationPlan, runner: StudyRunner) -> BoundaryResult:
     ]
     # every drive's sweeps at once: the workers stay busy across the sweeps' ends
     done = runner.many([(doc, name) for _, (doc, name, _) in jobs], "spring and ramp sweeps")
+    matrices = {}
     for proto in plan.protocols:
-        comps, mjs = [], []
-        for (p, (_, _, rows)), (df, store) in zip(jobs, done):
-            if p == proto:
-                c, m = rows(df, store)
-                comps.append(c)
-                mjs.append(m)
-        comp = pd.concat(comps, ignore_index=True)
-        mj = pd.concat(mjs, ignore_index=True)
+        comp, mj = _rows_of(proto, jobs, done)
         curves[proto], skip[proto], amat, fmat = _curve(plan, proto, comp, mj, ramp_plans[proto])
         stars[proto] = _protocol_ie_star(plan, curves[proto], amat, fmat)
+        matrices[proto] = (amat, fmat)
+    refined = _refined_jobs(plan, fams, jobs, curves, stars)
+    if refined:
+        rdone = runner.many([(doc, name) for _, _, (doc, name, _) in refined], "I_e* under refinement")
+        for proto in plan.protocols:
+            if stars[proto].get("valid") is not False:
+                stars[proto]["convergence"] = _ie_star_convergence(
+                    plan, proto, curves[proto], matrices[proto], refined, rdone, ramp_plans[proto]
+                )
     return BoundaryResult(curves=curves, ie_star=stars, skip_rate=skip, families=[f.name for f in fams])
+
+
+def _rows_of(proto: str, jobs, done, key: str | None = None) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """The (``compare``, ``mujoco``) rows of ``proto``'s sweeps among ``jobs`` (``(proto,
+    job)``, or ``(proto, key, job)`` with the refinement ``key``) and their results
+    ``done``."""
+    comps, mjs = [], []
+    for job, (df, store) in zip(jobs, done):
+        p, k, (_, _, rows) = job if len(job) == 3 else (job[0], None, job[1])
+        if p == proto and k == key:
+            c, m = rows(df, store)
+            comps.append(c)
+            mjs.append(m)
+    if not comps:
+        return pd.DataFrame(), pd.DataFrame()
+    return pd.concat(comps, ignore_index=True), pd.concat(mjs, ignore_index=True)
+
+
+def refinement_window(ie, star: dict) -> list[float]:
+    """The I_e values rerun under refinement: the headline I_e*'s bracket (its two grid
+    values; the grid's top two where agreement holds everywhere, its bottom two where it
+    holds nowhere) and :data:`IE_WINDOW` grid values either side, from ``ie`` (the values
+    the estimate used, increasing); empty where I_e* was not measured."""
+    ies = [float(v) for v in ie]
+    kind = star.get("kind")
+    if kind == "bracketed":
+        lo = int(np.argmin(np.abs(np.log(ies) - np.log(star["low"]))))
+        hi = lo + 1
+    elif kind == "above":
+        lo, hi = len(ies) - 2, len(ies) - 1
+    elif kind == "below":
+        lo, hi = 0, 1
+    else:
+        return []
+    return ies[max(0, lo - IE_WINDOW) : hi + IE_WINDOW + 1]
+
+
+def _refined_jobs(plan: ValidationPlan, fams, jobs, curves, stars) -> list[tuple[str, str, tuple]]:
+    """``(protocol, refinement key, (config, store name, rows))`` of every refinement of
+    ``plan.boundary_refinements``: each sweep of ``jobs`` once per I_e of its protocol's
+    :func:`refinement_window`, with the refinement's engine keys at that I_e (the step is
+    the rig's own at that pace, :func:`~spine_mj.validate.sweep_configs.engine_grid`); a
+    refinement a family's surface does not take (a gridded surface's hfield) is skipped for
+    the study."""
+    seeds = {p: f.seeds for f in fams for p in f.presets}
+    out = []
+    for key in plan.boundary_refinements:
+        if not all(refinable(p, s, key) for p, s in seeds.items()):
+            continue
+        for proto, (doc, name, rows) in jobs:
+            star = stars[proto]
+            window = refinement_window(star.get("ie_used", curves[proto].ie), star)
+            preset = doc["surfaces"][0]["preset"]
+            grid = doc["grid"]
+            for v in (float(x) for x in doc["drive"]["ie"]):
+                if not np.isclose(window, v, rtol=1e-9).any():
+                    continue
+                keys = engine_grid(
+                    plan, REFINEMENTS[key], preset, seeds[preset], grid["tip_radius"], mu=grid["mu"], ie=v
+                )
+                refined = {
+                    **doc,
+                    "sweep": {**doc["sweep"], "name": f"{doc['sweep']['name']}-{key}-ie{v:.3g}"},
+                    "drive": {**doc["drive"], "ie": [v]},
+                    "grid": {**grid, **keys},
+                }
+                store = f"boundary-refined/{key}/{name.split('/')[-1]}-ie{v:.3g}"
+                out.append((proto, key, (refined, store, rows)))
+    return out
+
+
+def _ie_star_convergence(
+    plan: ValidationPlan, proto: str, curve: BoundaryCurve, matrices, refined, rdone, ramp_plans: dict
+) -> dict:
+    """The headline I_e*'s ``convergence`` entry of one protocol: per refinement the I_e*
+    of the curve whose window values (:func:`refinement_window`) are the refined runs',
+    judged against the headline's 95 % bootstrap interval."""
+    ies, a_base, f_base = _used(curve, *matrices)
+    stat = IE_STAR_CRITERIA[HEADLINE_CRITERION][0]
+    ci95 = bootstrap_ie_star(
+        ies, a_base, f_base, n_boot=plan.bootstrap, rng=12345, stat=stat, confidence=0.95
+    )
+    base = grid_point(criterion_ie_star(ies, a_base, f_base, HEADLINE_CRITERION))
+    by_key: dict[str, dict | None] = {}
+    window: list[float] = []
+    for key in plan.boundary_refinements:
+        comp, mj = _rows_of(proto, refined, rdone, key)
+        if comp.empty:
+            by_key[key] = None
+            continue
+        rc, _, ra, rf = _curve(plan, proto, comp, mj, ramp_plans)
+        a, f = a_base.copy(), f_base.copy()
+        n = a.shape[1]
+        for v, ar, fr in zip(rc.ie, ra, rf):
+            i = np.flatnonzero(np.isclose(ies, v, rtol=1e-9))
+            if i.size and len(ar) >= n:
+                a[i[0]], f[i[0]] = ar[:n], fr[:n]
+        window = [float(v) for v in rc.ie]
+        star = criterion_ie_star(ies, a, f, HEADLINE_CRITERION)
+        by_key[key] = {"base": base, "refined": grid_point(star), "runs": int(len(comp))}
+    conv = headline_convergence(
+        base, ci95, by_key, log=True, note="gridded surfaces keep their samples: no hfield to refine"
+    )
+    return {**conv, "ie_refined": window, "ci95": list(ci95)}
 
 
 def preset_grid(plan: ValidationPlan, fam: FamilySpec, preset: str) -> dict:
@@ -364,23 +505,28 @@ def _curve(
     return curve, skips, amat, fmat
 
 
+def _used(
+    curve: BoundaryCurve, amat: list[np.ndarray], fmat: list[np.ndarray]
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The I_e values an I_e* of ``curve`` uses and their per-run agreement and deviation
+    ``(n_ie, runs_per_ie)``: a capped ramp that covers a sliver of the path agrees
+    trivially, so such I_e values take no part."""
+    ies = np.asarray(curve.ie, dtype=float)
+    n_min = curve.runs_per_ie
+    use = (np.asarray(curve.coverage) >= RAMP_MIN_COVERAGE) if curve.is_ramp else np.ones(len(ies), bool)
+    a = np.array([x[:n_min] for x, u in zip(amat, use) if u], dtype=float).reshape(-1, n_min)
+    f = np.array([x[:n_min] for x, u in zip(fmat, use) if u], dtype=float).reshape(-1, n_min)
+    return ies[use], a, f
+
+
 def _protocol_ie_star(
     plan: ValidationPlan, curve: BoundaryCurve, amat: list[np.ndarray], fmat: list[np.ndarray]
 ) -> dict:
     """I_e* of one protocol: the headline criterion with all of them under ``by_criterion``."""
-    ies = np.asarray(curve.ie, dtype=float)
-    n_min = curve.runs_per_ie
-    # a capped ramp that covers a sliver of the path agrees trivially: such I_e values
-    # take no part in its I_e*
-    use = (np.asarray(curve.coverage) >= RAMP_MIN_COVERAGE) if curve.is_ramp else np.ones(len(ies), bool)
-    if use.sum() >= 2:
-        by = ie_star_by_criterion(
-            ies[use],
-            np.array([x[:n_min] for x, u in zip(amat, use) if u]),
-            np.array([x[:n_min] for x, u in zip(fmat, use) if u]),
-            n_boot=plan.bootstrap,
-        )
-        return {**by["median_frechet"], "by_criterion": by, "ie_used": ies[use].tolist()}
+    ies, a, f = _used(curve, amat, fmat)
+    if len(ies) >= 2:
+        by = ie_star_by_criterion(ies, a, f, n_boot=plan.bootstrap)
+        return {**by[HEADLINE_CRITERION], "by_criterion": by, "ie_used": ies.tolist()}
     return {
         "kind": "not measured",
         "valid": False,

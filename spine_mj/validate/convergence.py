@@ -45,10 +45,12 @@ __all__ = [
     "REFINEMENTS",
     "REFINEMENT_LABELS",
     "family_convergence",
+    "headline_convergence",
     "is_converged",
     "observed_order",
     "paired_change",
     "refinable",
+    "refinement_note",
     "richardson",
     "thin_starts",
     "unconverged_mark",
@@ -227,30 +229,129 @@ def family_convergence(summary: dict, base: pd.DataFrame, refined: dict[str, pd.
         entry["converged"] = None if any(v is None for v in verdicts) else all(verdicts)
         out[key] = entry
     if out.get("dt_halved", {}).get("refined") and out.get("dt_quartered", {}).get("refined"):
-        order = {}
-        for headline in HEADLINES:
-            coarse = out["dt_halved"][headline]["base"]
-            medium = out["dt_halved"][headline]["refined"]
-            fine = out["dt_quartered"][headline]["refined"]
-            p = observed_order(fine, medium, coarse)
-            order[headline] = {"order": p, "richardson": richardson(fine, medium, p)}
-        out["dt_order"] = order
-    verdicts = [e["converged"] for e in out.values() if isinstance(e, dict) and "converged" in e]
-    known = [v for v in verdicts if v is not None]
-    out["converged"] = all(known) if known else None
+        out["dt_order"] = {
+            headline: _step_order(
+                out["dt_halved"][headline]["base"],
+                out["dt_halved"][headline]["refined"],
+                out["dt_quartered"][headline]["refined"],
+            )
+            for headline in HEADLINES
+        }
+    out["converged"] = _overall(out)
     return out
 
 
-def unconverged_mark(convergence: dict | None, headline: str) -> str:
+def headline_convergence(
+    value: float,
+    interval: Sequence[float],
+    refined: dict[str, dict | None],
+    *,
+    log: bool = False,
+    resolution: float = 0.0,
+    note: str = "nothing to refine",
+) -> dict:
+    """The ``convergence`` entry of one headline number (an I_e*, a lock rate).
+
+    Parameters
+    ----------
+    value : float
+        The headline.
+    interval : (low, high)
+        Its own 95 % interval.
+    refined : dict
+        Refinement key -> ``{"base", "refined", "runs"}``: the headline recomputed on the
+        refined runs and on the headline's own runs from the same starts (``runs`` of them;
+        the change is paired); None where the refinement changes nothing (``note`` says
+        why).
+    log : bool
+        Judge ``log10`` of the numbers (a quantity located on a logarithmic grid, I_e*).
+    resolution : float
+        A change the headline cannot tell from none (:func:`is_converged`), on the scale
+        judged.
+
+    Returns
+    -------
+    dict
+        Per refinement: ``refined`` (bool), ``runs``, ``base``, ``refined_value``,
+        ``change`` (refined - base, of ``log10`` where ``log``) and ``converged``
+        (:func:`is_converged`; None where not refined); with ``dt_halved`` and
+        ``dt_quartered`` ``dt_order`` (:func:`observed_order` and :func:`richardson`, of
+        the judged scale); ``converged`` at the top: every refined verdict true (None where
+        nothing was refined).
+    """
+
+    def judged(v):
+        return math.log10(v) if log and v > 0 else (math.nan if log else v)
+
+    out: dict[str, Any] = {}
+    for key, r in refined.items():
+        if r is None:
+            out[key] = {"refined": False, "runs": 0, "note": note, "change": math.nan, "converged": None}
+            continue
+        change = judged(float(r["refined"])) - judged(float(r["base"]))
+        ok = is_converged(judged(value), change, [judged(float(b)) for b in interval], resolution=resolution)
+        out[key] = {
+            "refined": True,
+            "runs": int(r["runs"]),
+            "base": float(r["base"]),
+            "refined_value": float(r["refined"]),
+            "change": change,
+            "converged": ok,
+        }
+    if out.get("dt_halved", {}).get("refined") and out.get("dt_quartered", {}).get("refined"):
+        order = _step_order(
+            judged(out["dt_halved"]["base"]),
+            judged(out["dt_halved"]["refined_value"]),
+            judged(out["dt_quartered"]["refined_value"]),
+        )
+        if log and math.isfinite(order["richardson"]):
+            order["richardson"] = 10 ** order["richardson"]
+        out["dt_order"] = order
+    out["converged"] = _overall(out)
+    return out
+
+
+def _step_order(coarse: float, medium: float, fine: float) -> dict:
+    """The observed order of three step levels and the Richardson estimate."""
+    p = observed_order(fine, medium, coarse)
+    return {"order": p, "richardson": richardson(fine, medium, p)}
+
+
+def _overall(entries: dict) -> bool | None:
+    """Every decided refinement verdict of ``entries`` true (None where none was decided)."""
+    verdicts = [e["converged"] for e in entries.values() if isinstance(e, dict) and "converged" in e]
+    known = [v for v in verdicts if v is not None]
+    return all(known) if known else None
+
+
+def unconverged_mark(convergence: dict | None, headline: str | None = None) -> str:
     """What to write after a headline quoted anywhere: `` (unconverged: dt / 2, ...)``
-    naming the refinements that moved it outside its interval (a family's ``convergence``
-    entry, ``headline`` a key of :data:`HEADLINES`); empty where none did or nothing was
-    refined."""
+    naming the refinements that moved it outside its interval; empty where none did or
+    nothing was refined. ``convergence`` is a family's entry (:func:`family_convergence`,
+    ``headline`` a key of :data:`HEADLINES`) or one headline's
+    (:func:`headline_convergence`, ``headline`` None)."""
     if not convergence:
         return ""
+    verdict = "converged" if headline is None else f"{headline}_converged"
     moved = [
         REFINEMENT_LABELS.get(key, key)
         for key, entry in convergence.items()
-        if isinstance(entry, dict) and entry.get(f"{headline}_converged") is False
+        if isinstance(entry, dict) and entry.get(verdict) is False
     ]
     return f" (unconverged: {', '.join(moved)})" if moved else ""
+
+
+def refinement_note(convergence: dict | None, headline: str | None = None) -> str:
+    """What to write beside a headline: :func:`unconverged_mark` where a refinement moved
+    it, `` (converged: dt / 2, hfield x 2)`` naming the refinements that did not, empty
+    where nothing was refined (arguments as for :func:`unconverged_mark`)."""
+    mark = unconverged_mark(convergence, headline)
+    if mark or not convergence:
+        return mark
+    verdict = "converged" if headline is None else f"{headline}_converged"
+    kept = [
+        REFINEMENT_LABELS.get(key, key)
+        for key, entry in convergence.items()
+        if isinstance(entry, dict) and entry.get(verdict) is True
+    ]
+    return f" (converged: {', '.join(kept)})" if kept else ""

@@ -25,8 +25,10 @@ __all__ = [
     "IE_STAR_CRITERIA",
     "IeStar",
     "bootstrap_ie_star",
+    "criterion_ie_star",
     "departure_ie_star",
     "estimate_ie_star",
+    "grid_point",
     "ie_star_by_criterion",
     "passes_criterion",
     "quiet_nan_warnings",
@@ -161,8 +163,10 @@ def bootstrap_ie_star(
     agree_min: float = OUTCOME_TARGET,
     frechet_max: float = FRECHET_TARGET,
     stat: str | None = "mean",
+    confidence: float = 0.68,
 ) -> tuple[float, float]:
-    """16th / 84th percentiles of I_e* when the starts are resampled with replacement.
+    """16th / 84th percentiles of I_e* when the starts are resampled with replacement (the
+    ``confidence`` interval's ends: 0.68 by default).
 
     ``agree_matrix`` and ``frechet_matrix`` have shape ``(n_ie, n_starts)``; ``stat``
     (``"mean"``, ``"median"`` or None: agreement only) reduces the Frechet deviations of a
@@ -183,6 +187,9 @@ def bootstrap_ie_star(
         The targets (:func:`estimate_ie_star`).
     stat : {"mean", "median", None}
         How a resample's Frechet deviations are reduced (None: agreement only).
+    confidence : float
+        Of the percentile interval, in (0, 1) (0.95 for a solution-verification verdict,
+        :mod:`spine_mj.validate.convergence`).
     """
     if stat not in ("mean", "median", None):
         raise SpineInputError(f"stat must be 'mean', 'median' or None, got {stat!r}")
@@ -200,25 +207,29 @@ def bootstrap_ie_star(
                 ie, a[:, idx].mean(axis=1), fr, agree_min=agree_min, frechet_max=frechet_max
             )
 
-    return _log_interval(estimate, n, n_boot, rng)
+    return _log_interval(estimate, n, n_boot, rng, confidence=confidence)
 
 
-def _grid_point(est: IeStar) -> float:
-    """I_e* of an estimate, or the edge of the grid it points at when not bracketed."""
+def grid_point(est: IeStar) -> float:
+    """I_e* of an estimate, or the edge of the grid it points at when not bracketed (a
+    number for every kind: what an interval and a change of I_e* are taken of)."""
     return est.value if est.kind == "bracketed" else (est.low if est.kind == "above" else est.high)
 
 
-def _log_interval(estimate, n_starts: int, n_boot: int, rng) -> tuple[float, float]:
-    """16th / 84th percentiles of ``log10 I_e*`` over resamples of the starts
-    (``scipy.stats.bootstrap``, percentile method); ``estimate(indices) -> IeStar``."""
+def _log_interval(
+    estimate, n_starts: int, n_boot: int, rng, *, confidence: float = 0.68
+) -> tuple[float, float]:
+    """The ``confidence`` percentile interval (16th / 84th percentiles by default) of
+    ``log10 I_e*`` over resamples of the starts (``scipy.stats.bootstrap``, percentile
+    method); ``estimate(indices) -> IeStar``."""
     if n_starts < 2:
-        value = _grid_point(estimate(np.arange(n_starts)))
+        value = grid_point(estimate(np.arange(n_starts)))
         return value, value
     res = stats.bootstrap(
         (np.arange(n_starts),),
-        lambda idx: math.log10(_grid_point(estimate(idx))),
+        lambda idx: math.log10(grid_point(estimate(idx))),
         n_resamples=n_boot,
-        confidence_level=0.68,
+        confidence_level=confidence,
         method="percentile",
         vectorized=False,
         rng=np.random.default_rng(rng),
@@ -273,13 +284,7 @@ def ie_star_by_criterion(ie, agree_matrix, frechet_matrix, *, n_boot: int, rng=1
     f = np.asarray(frechet_matrix, dtype=float)
     out = {}
     for label, (stat, text) in IE_STAR_CRITERIA.items():
-        with quiet_nan_warnings():
-            fr = (
-                None
-                if stat is None
-                else (np.nanmean(f, axis=1) if stat == "mean" else np.nanmedian(f, axis=1))
-            )
-        star = estimate_ie_star(ie, a.mean(axis=1), fr)
+        star = criterion_ie_star(ie, a, f, label)
         lo, hi = bootstrap_ie_star(ie, a, f, n_boot=n_boot, rng=rng, stat=stat)
         out[label] = {**dataclasses.replace(star, ci_low=lo, ci_high=hi).as_dict(), "criterion": text}
     out["departure"] = {
@@ -289,6 +294,28 @@ def ie_star_by_criterion(ie, agree_matrix, frechet_matrix, *, n_boot: int, rng=1
         "relative to the engine's own low-speed agreement)",
     }
     return out
+
+
+def criterion_ie_star(ie, agree_matrix, frechet_matrix, criterion: str) -> IeStar:
+    """I_e* under one criterion of :data:`IE_STAR_CRITERIA` (no interval).
+
+    Parameters
+    ----------
+    ie : array_like, shape (n_ie,)
+        Strictly increasing inertia numbers.
+    agree_matrix, frechet_matrix : array_like, shape (n_ie, n_starts)
+        Per-run agreement (0 / 1) and Frechet deviation / L_c.
+    criterion : str
+        A key of :data:`IE_STAR_CRITERIA`.
+    """
+    if criterion not in IE_STAR_CRITERIA:
+        raise SpineInputError(f"criterion must be one of {sorted(IE_STAR_CRITERIA)}, got {criterion!r}")
+    stat = IE_STAR_CRITERIA[criterion][0]
+    a = np.asarray(agree_matrix, dtype=float)
+    f = np.asarray(frechet_matrix, dtype=float)
+    with quiet_nan_warnings():
+        fr = None if stat is None else (np.nanmean(f, axis=1) if stat == "mean" else np.nanmedian(f, axis=1))
+    return estimate_ie_star(ie, a.mean(axis=1), fr)
 
 
 def departure_ie_star(ie, agree_matrix, *, n_boot: int, rng=12345) -> IeStar:

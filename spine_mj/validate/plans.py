@@ -23,6 +23,7 @@ __all__ = [
     "DT_HALVED",
     "FRECHET_TARGET",
     "GRAVITY",
+    "HFIELD_DOUBLED",
     "IMPRATIO",
     "MASS_KG",
     "NO_NOSLIP",
@@ -193,6 +194,10 @@ class ValidationPlan:
     convergence_refinements : tuple of str
         The refinements (keys of :data:`spine_mj.validate.convergence.REFINEMENTS`); with
         ``dt_quartered`` beside ``dt_halved`` three step levels give an observed order.
+    boundary_refinements : tuple of str
+        The refinements of the boundary study's I_e* (keys of
+        :data:`spine_mj.validate.convergence.REFINEMENTS`; empty: none): every start rerun
+        at the I_e values around the headline's bracket (:mod:`spine_mj.validate.boundary`).
     corner : tuple of (family name, seeds, starts)
         The quasistatic-limit study's own seeds and starts table per family (the corner's
         sample size), where they differ from the family's (which the boundary study and the
@@ -243,6 +248,7 @@ class ValidationPlan:
     corner: tuple[tuple[str, Any, tuple], ...] = ()
     convergence_starts: int = 0
     convergence_refinements: tuple[str, ...] = ("dt_halved", "hfield_doubled")
+    boundary_refinements: tuple[str, ...] = ()
     extra: dict = field(default_factory=dict, compare=False)
 
     def map_family(self, fam: FamilySpec) -> FamilySpec:
@@ -272,6 +278,8 @@ NO_NOSLIP = ("no noslip (elliptic, impratio 1)", (("noslip_iterations", 0),))
 IMPRATIO = ("no noslip, impratio 10", (("noslip_iterations", 0), ("impratio", 10.0)))
 #: The rig's step halved, the contact's time constant kept (solution verification).
 DT_HALVED = ("time step / 2 (contact solref kept)", (("timestep_factor", 0.5),))
+#: The surface's grid at twice the samples a side (solution verification of the static map).
+HFIELD_DOUBLED = ("hfield x 2", (("hfield_factor", 2),))
 
 #: The paper's single peak and valley with the five starts of Figs. 3-4 (every plan).
 #: The fractal family: 3 seeds x 2 Hurst exponents x 5 starts.
@@ -305,7 +313,7 @@ PLANS: dict[str, ValidationPlan] = {
         name="smoke",
         slopes_deg=(20.0, 70.0),
         azimuths_deg=(0.0,),
-        static_engines=(RECOMMENDED, DT_HALVED),
+        static_engines=(RECOMMENDED, DT_HALVED, HFIELD_DOUBLED),
         families=(
             FamilySpec("single_peak_valley", ("paper-single-peak",), None, paper_starts([-2.0, -4.0])),
         ),
@@ -337,6 +345,7 @@ PLANS: dict[str, ValidationPlan] = {
         ground_truth_ridge_widths=(0.5,),
         ground_truth_liftoff_factors=(0.5, 1.5),
         convergence_starts=1,
+        boundary_refinements=("dt_halved",),
     ),
     "quick": ValidationPlan(
         name="quick",
@@ -395,7 +404,7 @@ PLANS: dict[str, ValidationPlan] = {
         name="full",
         slopes_deg=tuple(np.arange(0.0, 76.0, 7.5)),
         azimuths_deg=(0.0, 30.0, 60.0, 90.0, 120.0, 150.0, 180.0),
-        static_engines=(RECOMMENDED, NO_NOSLIP, IMPRATIO, DT_HALVED),
+        static_engines=(RECOMMENDED, NO_NOSLIP, IMPRATIO, DT_HALVED, HFIELD_DOUBLED),
         families=(
             PEAK_VALLEY,
             FamilySpec(
@@ -453,5 +462,9 @@ PLANS: dict[str, ValidationPlan] = {
         # levels for an observed order
         convergence_starts=3,
         convergence_refinements=("dt_halved", "dt_quartered", "hfield_doubled"),
+        # I_e* rerun around its bracket (4 I_e x 10 starts x 2 drives a refinement): ~155 s
+        # of CPU for both, estimated from a reduced run (spring 0.45-0.5 s a run, ramp 1.1-1.8
+        # s); dt / 4 for an observed order would add ~170 s
+        boundary_refinements=("dt_halved", "hfield_doubled"),
     ),
 }

@@ -20,6 +20,7 @@ from spine_mj.validate.study_runner import StudyRunner
 from spine_mj.validate.sweep_configs import (
     RELATIVE_ENGINE_KEYS,
     engine_default,
+    refined_resolution,
     relative_engine_keys,
     rig_engine,
 )
@@ -30,6 +31,9 @@ __all__ = ["PLANE_START", "StaticMapResult", "hold_force", "static_map"]
 PLANE_START = (3.1e-4, 2.7e-4)
 #: The inertia number of the probe's force ramp.
 PROBE_IE = 1e-2
+#: Samples a side of each plane's grid (an engine setting's ``hfield_factor`` refines it:
+#: a plane's facets are the plane at any resolution, so the breakaway must not move).
+PLANE_SAMPLES = 41
 
 
 @dataclass(frozen=True)
@@ -51,7 +55,7 @@ class StaticMapResult:
         ``max_rel_error`` of the default (first) setting; inf when an engaged plane did not
         break away.
     convergence : dict
-        Refinement key (``dt_halved``) -> the change of the default setting's
+        Refinement key (``dt_halved``, ``hfield_doubled``) -> the change of the default setting's
         ``max_rel_error`` and ``region_agreement`` under it, and ``converged``
         (:func:`static_convergence`); empty where the plan refines nothing.
     """
@@ -171,10 +175,7 @@ def _plane_rows(plan: ValidationPlan, runner: StudyRunner, slope: float, az: flo
     fx, fy = t * math.cos(math.radians(az)), t * math.sin(math.radians(az))
     k, low, region = hold_force(fx, fy, mu)
     hold = 0.5 * (low + k) if (low > 0 and np.isfinite(k)) else (1.5 * low if low > 0 else 0.0)
-    path = runner.out_dir / "surfaces" / f"plane_s{slope:g}_a{az:g}.npz"
-    if not path.is_file():
-        surface_io.save_surface(sim.inclined_plane(slope_deg=slope, azimuth_deg=az), path)
-    keys = sorted({k_ for _, ov in engines for k_, _ in ov} - set(RELATIVE_ENGINE_KEYS))
+    keys = sorted({k_ for _, ov in engines for k_, _ in ov} - {*RELATIVE_ENGINE_KEYS, "hfield_factor"})
     rows = []
     for label, ov in engines:
         # the cap must lie above the breakaway force, or a steep engaged plane
@@ -183,10 +184,11 @@ def _plane_rows(plan: ValidationPlan, runner: StudyRunner, slope: float, az: flo
         grid = {"mu": mu, "kappa_cap": float(f"{cap:.4g}")}
         grid.update({k_: engine_default(k_) for k_ in keys})
         rest = dict(ov)
+        path = _plane_file(runner.out_dir, slope, az, int(rest.pop("hfield_factor", 1)))
         grid.update(
             relative_engine_keys(
                 rest,
-                lambda: rig_engine(
+                lambda path=path: rig_engine(
                     surface_io.load_surface(path), tip=None, mu=mu, ie=PROBE_IE, hfield_resolution=None
                 ),
             )
@@ -225,6 +227,17 @@ def _plane_rows(plan: ValidationPlan, runner: StudyRunner, slope: float, az: flo
             }
         )
     return rows
+
+
+def _plane_file(out_dir, slope: float, az: float, factor: int):
+    """The plane's surface file under ``out_dir/surfaces`` (written once), its grid
+    :data:`PLANE_SAMPLES` a side refined ``factor`` times (:func:`refined_resolution`)."""
+    n = refined_resolution(PLANE_SAMPLES, factor)
+    name = f"plane_s{slope:g}_a{az:g}" + (f"_n{n}" if factor != 1 else "")
+    path = out_dir / "surfaces" / f"{name}.npz"
+    if not path.is_file():
+        surface_io.save_surface(sim.inclined_plane(slope_deg=slope, azimuth_deg=az, n=n), path)
+    return path
 
 
 def _engine_summary(sel: list[dict]) -> dict:

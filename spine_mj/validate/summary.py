@@ -5,7 +5,7 @@ self-lock rates, the arrays' pooled differences and I_e* per protocol, read from
 
 from __future__ import annotations
 
-from spine_mj.validate.convergence import unconverged_mark
+from spine_mj.validate.convergence import refinement_note, unconverged_mark
 
 __all__ = ["summary_lines"]
 
@@ -54,10 +54,11 @@ def _ie_star_lines(proto: str, s: dict) -> list[str]:
         if star is None:
             continue
         lines.append(f"I_e* ({proto}) criterion: {star['criterion']}")
+        note = refinement_note(s.get("convergence")) if star is s else ""
         if star["kind"] == "bracketed":
-            lines.append(f"  I_e* = {star['value']:.3g} in [{star['low']:.3g}, {star['high']:.3g}]")
+            lines.append(f"  I_e* = {star['value']:.3g} in [{star['low']:.3g}, {star['high']:.3g}]{note}")
         elif star["kind"] == "above":
-            lines.append(f"  I_e* > {star['low']:.3g} (agreement holds on the whole grid)")
+            lines.append(f"  I_e* > {star['low']:.3g} (agreement holds on the whole grid){note}")
         else:
-            lines.append(f"  I_e* < {star['high']:.3g} (no agreement at the lowest I_e)")
+            lines.append(f"  I_e* < {star['high']:.3g} (no agreement at the lowest I_e){note}")
     return lines

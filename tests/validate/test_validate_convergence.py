@@ -12,12 +12,15 @@ import pytest
 from spine_mj import presets, sim
 from spine_mj.validate.convergence import (
     family_convergence,
+    headline_convergence,
     is_converged,
     observed_order,
     paired_change,
     refinable,
+    refinement_note,
     richardson,
     thin_starts,
+    unconverged_mark,
 )
 from spine_mj.validate.paths import tip_radius
 from spine_mj.validate.plans import MASS_KG, PLANS, FamilySpec, paper_starts, relative_starts
@@ -190,21 +193,23 @@ def test_a_doubled_hfield_nests_the_old_samples_and_keeps_the_tip():
 
 
 def test_the_static_error_is_converged_when_a_halved_step_moves_it_less_than_the_slack():
-    from spine_mj.validate.plans import DT_HALVED, RECOMMENDED
+    from spine_mj.validate.plans import DT_HALVED, HFIELD_DOUBLED, RECOMMENDED
     from spine_mj.validate.static_map import static_convergence
 
     plan = PLANS["smoke"]
-    assert plan.static_engines == (RECOMMENDED, DT_HALVED)
+    assert plan.static_engines == (RECOMMENDED, DT_HALVED, HFIELD_DOUBLED)
 
     def per_engine(err_halved, regions_halved=1.0):
         return {
             RECOMMENDED[0]: {"max_rel_error": 0.006, "region_agreement": 1.0},
             DT_HALVED[0]: {"max_rel_error": err_halved, "region_agreement": regions_halved},
+            HFIELD_DOUBLED[0]: {"max_rel_error": 0.006, "region_agreement": 1.0},
         }
 
     out = static_convergence(plan, per_engine(0.0045))
     assert out["dt_halved"]["max_rel_error_change"] == pytest.approx(-0.0015)
     assert out["dt_halved"]["converged"] is True
+    assert out["hfield_doubled"]["max_rel_error_change"] == 0.0 and out["hfield_doubled"]["converged"]
     assert static_convergence(plan, per_engine(0.0100))["dt_halved"]["converged"] is False  # > 0.0025
     assert static_convergence(plan, per_engine(0.006, 0.5))["dt_halved"]["converged"] is False
 
@@ -234,3 +239,45 @@ def test_every_refined_sweep_of_the_plans_is_a_valid_config_that_changes_only_it
         else:
             assert grid["hfield_resolution"] == refined_resolution(plan.hfield_resolution, 2)
             assert "timestep" not in grid
+
+
+def test_a_single_headline_is_judged_on_log10_where_it_lives_on_a_log_grid():
+    # I_e* 0.1 with its 95 % interval [0.05, 0.3]: x 1.5 stays inside, x 4 leaves it
+    refined = {
+        "dt_halved": {"base": 0.1, "refined": 0.15, "runs": 20},
+        "hfield_doubled": {"base": 0.1, "refined": 0.4, "runs": 20},
+        "dt_quartered": {"base": 0.1, "refined": 0.15 * 1.5**0.5, "runs": 20},
+    }
+    out = headline_convergence(0.1, (0.05, 0.3), refined, log=True)
+    assert out["dt_halved"]["change"] == pytest.approx(math.log10(1.5))
+    assert out["dt_halved"]["converged"] is True
+    assert out["hfield_doubled"]["converged"] is False and out["converged"] is False
+    # log10 I_e* moves by log10 1.5, then by half that: order 1, Richardson 0.1 * 1.5**2
+    assert out["dt_order"]["order"] == pytest.approx(1.0)
+    assert out["dt_order"]["richardson"] == pytest.approx(0.1 * 1.5**2)
+    assert unconverged_mark(out) == " (unconverged: hfield x 2)"
+    assert refinement_note(out) == " (unconverged: hfield x 2)"
+    del out["hfield_doubled"]
+    assert refinement_note(out) == " (converged: dt / 2, dt / 4)"
+
+
+def test_a_rate_is_judged_on_its_paired_change_and_a_refinement_that_changes_nothing_says_why():
+    # a rate of 0.5 [0.3, 0.7] over 30 surfaces; on 10 of them 4 -> 5 locked
+    out = headline_convergence(
+        0.5,
+        (0.3, 0.7),
+        {"dt_halved": {"base": 0.4, "refined": 0.5, "runs": 10}, "hfield_doubled": None},
+        note="gridded",
+    )
+    assert out["dt_halved"]["change"] == pytest.approx(0.1) and out["dt_halved"]["converged"] is True
+    assert out["hfield_doubled"] == {
+        "refined": False,
+        "runs": 0,
+        "note": "gridded",
+        "change": out["hfield_doubled"]["change"],
+        "converged": None,
+    }
+    assert math.isnan(out["hfield_doubled"]["change"])
+    assert out["converged"] is True and "dt_order" not in out
+    assert headline_convergence(0.5, (0.3, 0.7), {"hfield_doubled": None})["converged"] is None
+    assert refinement_note(None) == "" and refinement_note({"hfield_doubled": out["hfield_doubled"]}) == ""

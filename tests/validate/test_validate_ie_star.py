@@ -96,3 +96,33 @@ def test_departure_ie_star_finds_the_break_below_an_imperfect_plateau():
     assert 1e-2 <= dep.value <= 1e-1
     flat = validate.departure_ie_star(ie, np.ones((5, 10)), n_boot=0)
     assert flat.kind == "above"
+
+
+def test_a_single_criterion_is_the_one_ie_star_by_criterion_reports():
+    from spine_mj.validate.ie_star import criterion_ie_star, grid_point
+
+    rng = np.random.default_rng(3)
+    ag = (rng.random((5, 8)) < np.array([1.0, 1.0, 0.97, 0.6, 0.1])[:, None]).astype(float)
+    fr = rng.uniform(0.0, 0.2, (5, 8)) * np.array([0.1, 0.2, 0.5, 1.0, 3.0])[:, None]
+    by = validate.ie_star_by_criterion(IE, ag, fr, n_boot=20, rng=0)
+    for key in validate.IE_STAR_CRITERIA:
+        star = criterion_ie_star(IE, ag, fr, key)
+        assert star.kind == by[key]["kind"] and star.low == by[key]["low"]
+        assert grid_point(star) == pytest.approx(
+            by[key]["value"]
+            if star.kind == "bracketed"
+            else (star.low if star.kind == "above" else star.high)
+        )
+    with pytest.raises(SpineInputError, match="criterion must be one of"):
+        criterion_ie_star(IE, ag, fr, "nope")
+
+
+def test_a_95_percent_interval_holds_the_68_percent_one():
+    ag = np.ones((5, 12))
+    ag[3, :5] = 0.0  # five of twelve starts fail at 1e-1
+    ag[4, :] = 0.0
+    fr = np.full_like(ag, 0.01)
+    lo68, hi68 = validate.bootstrap_ie_star(IE, ag, fr, n_boot=300, rng=0)
+    lo95, hi95 = validate.bootstrap_ie_star(IE, ag, fr, n_boot=300, rng=0, confidence=0.95)
+    assert lo95 <= lo68 < hi68 <= hi95
+    assert lo95 < lo68 or hi68 < hi95

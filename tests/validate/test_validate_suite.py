@@ -45,6 +45,9 @@ def test_smoke_validation_writes_report_and_json(tmp_path, monkeypatch):
     # and again with the step halved (the contact's time constant kept)
     halved = doc["static_convergence"]["dt_halved"]
     assert abs(halved["max_rel_error_change"]) < 0.05 and halved["region_agreement_change"] == 0
+    # and on the plane's grid at twice the samples (its facets are the same plane)
+    finer = doc["static_convergence"]["hfield_doubled"]
+    assert abs(finer["max_rel_error_change"]) < 0.05 and finer["region_agreement_change"] == 0
     report = (out / "report.md").read_text()
     assert "Quasistatic limit" in report and "figures/boundary.png" in report
     assert "Verdicts with their intervals" in report and doc["platform"]["cpu"] in report
@@ -79,6 +82,11 @@ def test_smoke_validation_writes_report_and_json(tmp_path, monkeypatch):
         assert {"agreement_change", "median_frechet_change", "converged"} <= set(conv[key])
         assert conv[key]["refined"] and conv[key]["runs"] == plan.convergence_starts
     assert "Solution verification" in report
+    # and of I_e*: the smoke grid's two I_e values rerun with the step halved
+    star_conv = doc["ie_star"]["spring"]["convergence"]
+    assert star_conv["dt_halved"]["runs"] == len(plan.ie_values) * 2
+    assert star_conv["ie_refined"] == list(plan.ie_values)
+    assert "Solution verification of I_e*" in report
     # the map's convergence to the theory and the predicted limits against the measured
     assert {r["axis"] for r in doc["convergence_to_theory"]} == {"ie", "inverse_k"}
     assert doc["predicted_vs_measured"][0]["family"] == "single_peak_valley"

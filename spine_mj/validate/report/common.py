@@ -18,8 +18,9 @@ from pathlib import Path
 from typing import Any
 
 from spine_mj.plotting import sig
+from spine_mj.validate.convergence import REFINEMENT_LABELS
 
-__all__ = ["ReportContext", "assemble", "cell", "image", "table"]
+__all__ = ["ReportContext", "assemble", "cell", "image", "refinement_rows", "refinement_verdict", "table"]
 
 
 @dataclass(frozen=True)
@@ -77,3 +78,29 @@ def image(alt: str, link: str | None, before: str = "") -> str | None:
 def assemble(text: str, *figures: str | None) -> str:
     """A section: its text, then each figure that was drawn, a blank line between them."""
     return "\n".join([text, *(f for f in figures if f is not None)])
+
+
+def refinement_verdict(entry: dict) -> str:
+    """A refinement's verdict in words (an entry of a ``convergence`` dict)."""
+    if not entry.get("refined"):
+        return entry.get("note", "not refined")
+    return {True: "converged", False: "not converged", None: "-"}[entry.get("converged")]
+
+
+def refinement_rows(convergence: dict, **fields) -> list[dict]:
+    """One table row per refinement of a headline's ``convergence`` entry
+    (:func:`~spine_mj.validate.convergence.headline_convergence`): ``fields``, then
+    ``refinement``, ``runs``, ``base``, ``refined``, ``change`` and ``verdict``."""
+    return [
+        {
+            **fields,
+            "refinement": REFINEMENT_LABELS[key],
+            "runs": e.get("runs", 0),
+            "base": e.get("base"),
+            "refined": e.get("refined_value"),
+            "change": e.get("change"),
+            "verdict": refinement_verdict(e),
+        }
+        for key, e in convergence.items()
+        if key in REFINEMENT_LABELS
+    ]

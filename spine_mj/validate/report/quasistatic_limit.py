@@ -26,7 +26,7 @@ from spine_mj.validate.convergence import HEADLINES, REFINEMENT_LABELS, unconver
 from spine_mj.validate.platform import platform_info
 from spine_mj.validate.quasistatic_limit import QuasistaticLimitResult
 from spine_mj.validate.report.boundary import star_to_draw
-from spine_mj.validate.report.common import ReportContext, assemble, cell, image, table
+from spine_mj.validate.report.common import ReportContext, assemble, cell, image, refinement_verdict, table
 from spine_mj.validate.report.verdicts import platform_line, verdicts_section
 
 
@@ -177,13 +177,6 @@ def _marked(v: dict, conv: dict | None) -> dict:
     return {h: f"{cell(v[h])}{unconverged_mark(conv, h)}" for h in HEADLINES}
 
 
-def _verdict(entry: dict) -> str:
-    """A refinement's verdict in words."""
-    if not entry.get("refined"):
-        return entry.get("note", "not refined")
-    return {True: "converged", False: "not converged", None: "-"}[entry.get("converged")]
-
-
 def convergence_lines(limit: QuasistaticLimitResult) -> list[str]:
     """The solution verification of the corner's headlines (empty where the plan refined
     nothing): per family and refinement the paired change of each headline and the verdict,
@@ -199,7 +192,7 @@ def convergence_lines(limit: QuasistaticLimitResult) -> list[str]:
                         "runs": e.get("runs", 0),
                         "agreement_change": e.get("agreement_change"),
                         "median_frechet_change": e.get("median_frechet_change"),
-                        "verdict": _verdict(e),
+                        "verdict": refinement_verdict(e),
                     }
                 )
         for h, o in conv.get("dt_order", {}).items():
