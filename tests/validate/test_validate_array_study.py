@@ -78,7 +78,7 @@ def test_smoke_study_answers_the_conjecture_in_the_report(smoke, tmp_path):
     assert fig is not None and fig.stat().st_size > 10_000
     text = array_section(smoke, "figures/arrays.png")
     assert "## Spine arrays" in text and "**Answer" in text and "![" in text
-    assert text.count("(unconverged)") >= sum(not r["holding_converged"] for r in smoke.rows)
+    assert text.count("(unconverged: ") >= sum(not r["holding_converged"] for r in smoke.rows)
     assert not any(isinstance(v, float) and math.isnan(v) for v in smoke.pooled["staggered"]["diff"].values())
 
 

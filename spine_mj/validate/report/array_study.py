@@ -110,7 +110,8 @@ def _method(p: dict, paces) -> list[str]:
         "is extrapolated to I_e -> 0 by Richardson's step of that order from the two slowest paces "
         "(mean, 95 % bootstrap interval over placements); 'predicted excess' is the swing at the slowest "
         "pace, 'extrapolation step' the extrapolated mean minus the slowest pace's. A holding is converged "
-        "when that step lies inside the slowest pace's own 95 % interval, else marked (unconverged); "
+        "when that step lies inside the slowest pace's own 95 % interval, else marked (unconverged: "
+        "pace; and dt / 2 where the halved step moved the fastest pace's holding out of its interval); "
         "P(lock) (share of placements where at least one spine self-locked, Wilson 95 %, read at the "
         "slowest pace) likewise with its change from the pace before. The quasistatic reference puts each "
         "spine on its own compliant-drive streamline and sums them; agreement = share of spines whose lock "
@@ -133,7 +134,8 @@ def _row(r: dict) -> dict:
         "N": r["n_spines"],
         "spacing": sig(r["spacing_ls"]),
         "layout": r["layout"],
-        "holding": sig(r["holding_per_spine"]) + _mark(r["holding_converged"]),
+        "holding": sig(r["holding_per_spine"])
+        + _mark(r["holding_converged"], (r.get("dt_halved") or {}).get("converged")),
         "holding_ci": _ci(*r["holding_ci"]),
         "by_pace": ", ".join(sig(b["holding"]) for b in r["holding_by_pace"]),
         "step": sig(r["holding_extrapolation_step"]),
@@ -193,9 +195,11 @@ def _conjecture_table(conjecture: list[dict]) -> str:
     return table(diffs, cols, names)
 
 
-def _mark(converged) -> str:
-    """`` (unconverged)`` after a number whose verdict is False."""
-    return " (unconverged)" if converged is False else ""
+def _mark(converged, dt_converged=None) -> str:
+    """`` (unconverged: pace, dt / 2)`` after a number, naming the checks whose verdict is
+    False (``converged``: the extrapolation's, ``dt_converged``: the halved step's)."""
+    moved = [name for name, v in (("pace", converged), ("dt / 2", dt_converged)) if v is False]
+    return f" (unconverged: {', '.join(moved)})" if moved else ""
 
 
 def _dt(check: dict | None) -> str:
