@@ -86,7 +86,7 @@ def array_cmd(
       spine-mj array corrugation --layout staggered --rows 2 --cols 3 --spacing 0.3 --drive force --out arr/
     """
     from spine_mj import sim
-    from spine_mj.sim.array_outputs import write_array_outputs
+    from spine_mj.sim.array_outputs import array_to
 
     if kind != "random":
         refuse_options_not_for(f"--layout {kind}", ["seed"])
@@ -99,14 +99,20 @@ def array_cmd(
         kind=kind, rows=rows, cols=cols, spacing=spacing, spacing_unit=spacing_unit, seed=seed
     )
     surf, rig_kw = _rig_inputs(surface_spec, **rig_opts)
-    arr, carriage, ie = sim.build_array_on(
-        surf, layout, drive, ie=ie, stiffness_number=stiffness_number, duration_s=duration, **rig_kw
+    res, ie, written = array_to(
+        out_dir,
+        surf,
+        layout,
+        drive,
+        centre=None if centre is None else parse_start(centre),
+        started=lambda pace: click.echo(
+            f"{layout.n_spines} spines, {drive} drive, I_e = {pace:g}: simulating ..."
+        ),
+        ie=ie,
+        stiffness_number=stiffness_number,
+        duration_s=duration,
+        **rig_kw,
     )
-    where = arr.default_centre() if centre is None else parse_start(centre)
-    arr.starts(where)  # spines off the surface: refused before anything runs or is written
-    click.echo(f"{layout.n_spines} spines, {drive} drive, I_e = {ie:g}: simulating ...")
-    res = arr.run(carriage, centre=where)
-    written = write_array_outputs(res, arr, out_dir)
     click.echo(
         f"holding force {res.holding_force_n:.4g} N ({res.holding_ratio:.4g} of the total preload, predicted "
         f"dynamic excess {res.holding_excess_predicted:.2g} per spine), "

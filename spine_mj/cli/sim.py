@@ -66,8 +66,9 @@ def _rig_options(f):
 def _rig_inputs(
     surface_spec, tip_radius, mass, mu, preload, length_scale, resolution, timestep, noslip, impratio
 ):
-    """The surface of SURFACE and the shared rig options as :func:`spine_mj.sim.build_rig`'s
-    keywords (``mu`` resolved by the one mu rule)."""
+    """The SURFACE argument and the shared rig options parsed: the surface
+    (:func:`spine_mj.presets.open_surface`) and :func:`spine_mj.sim.build_rig`'s keywords
+    (``mu`` resolved by the one mu rule)."""
     from spine_mj import presets
 
     surf = presets.open_surface(surface_spec)
@@ -82,38 +83,6 @@ def _rig_inputs(
         "noslip_iterations": noslip,
         "impratio": impratio,
     }
-
-
-def _build_rig(
-    surface_spec,
-    *rig_opts,
-    ie=None,
-    speed=None,
-    rate=None,
-    stiffness_number=None,
-    stiffness_n_m=None,
-    driven=True,
-    engine="mujoco",
-    **rig_kw,
-):
-    """The rig of the shared rig options in ``engine`` (:func:`spine_mj.sim.build_engine_rig`);
-    the drive's pace (``ie``, ``speed`` or ``rate``) and spring bound the engine step
-    (``driven``)."""
-    from spine_mj import sim
-
-    sim.check_engine_name(engine, "--engine")
-    surf, kw = _rig_inputs(surface_spec, *rig_opts, **rig_kw)
-    return sim.build_engine_rig(
-        surf,
-        engine=engine,
-        **kw,
-        ie=ie,
-        speed_m_s=speed,
-        rate_n_s=rate,
-        stiffness_number=stiffness_number,
-        stiffness_n_m=stiffness_n_m,
-        driven=driven,
-    )
 
 
 @main.group("sim", cls=_Group)
@@ -145,12 +114,14 @@ def sim_export(surface_spec, output, start, stiffness, **rig_opts):
     Example:
       spine-mj sim export paper-single-peak -o rig.xml && python -m mujoco.viewer --mjcf rig.xml
     """
+    from spine_mj.sim.replay import export_rig
+
     check_suffix(output, ".xml", "-o/--output")
     if stiffness is not None:
         check_positive("--stiffness", stiffness)
-    rig = _build_rig(surface_spec, **rig_opts, stiffness_n_m=stiffness, driven=False)
+    surf, rig_kw = _rig_inputs(surface_spec, **rig_opts)
     xy = None if start is None else parse_start(start)
-    rig.export_xml(output, start=xy, stiffness_n_m=stiffness)
+    rig = export_rig(output, surf, start=xy, stiffness_n_m=stiffness, **rig_kw)
     u = rig.units
     click.echo(
         f"wrote {output} (hfield {rig.hfield.nrow} x {rig.hfield.ncol}, "
@@ -241,40 +212,45 @@ def simulate(
     """
 
     from spine_mj import sim
-    from spine_mj.sim.run_folder import write_run
+    from spine_mj.sim.run_folder import simulate_to
 
     if render:
         _check_render(engine)
-    x0, y0 = parse_start(start)
+    xy = parse_start(start)
     _check_drive_options(
         drive, ie=ie, speed=speed, rate=rate, stiffness_number=stiffness_number, stiffness=stiffness
     )
-    rig = _build_rig(
-        surface_spec,
-        **rig_opts,
-        ie=ie,
-        speed=speed,
-        rate=rate,
-        stiffness_number=stiffness_number,
-        stiffness_n_m=stiffness,
-        engine=engine,
-    )
-    drv = sim.build_drive(
-        rig.scales,
-        drive,
-        ie=ie,
-        speed_m_s=speed,
-        rate_n_s=rate,
-        stiffness_number=stiffness_number,
-        stiffness_n_m=stiffness,
-        duration_s=duration,
-        start_force_n=start_force,
-    )
-    with Progress("simulating", unit="%") as bar:
-        result = rig.run(drv, start=(x0, y0), progress=lambda frac: bar.update(round(100 * frac, 1), 100))
+    sim.check_engine_name(engine, "--engine")
+    surf, rig_kw = _rig_inputs(surface_spec, **rig_opts)
+    with (
+        Progress("simulating", unit="%") as bar,
+        Progress("rendering MP4", unit="frame", quiet=not render) as frames,
+    ):
+
+        def rendering(done, total):
+            bar.complete()  # the run is over (a run that broke away early too)
+            bar.close()
+            frames.update(done, total)
+
+        result, written = simulate_to(
+            out_dir,
+            surf,
+            start=xy,
+            protocol=drive,
+            engine=engine,
+            ie=ie,
+            speed_m_s=speed,
+            rate_n_s=rate,
+            stiffness_number=stiffness_number,
+            stiffness_n_m=stiffness,
+            duration_s=duration,
+            start_force_n=start_force,
+            mp4=render,
+            progress=lambda frac: bar.update(round(100 * frac, 1), 100),
+            render_progress=rendering,
+            **rig_kw,
+        )
         bar.complete()
-    with Progress("rendering MP4", unit="frame", quiet=not render) as bar:
-        written = write_run(out_dir, rig, result, mp4=render, progress=bar.update)
     click.echo(
         f"end: {result.end_reason.value} ({result.end_detail}); I_e = {result.inertia_number:.3g}"
         + (f", K = {result.stiffness_number:.3g}" if drive == "spring" else "")
@@ -404,8 +380,7 @@ def view(surface_spec, start, duration, **rig_opts):
     To watch a recorded run instead, use `spine-mj replay RUN_DIR`.
     """
 
-    from spine_mj.sim.model import compile_spec
-    from spine_mj.sim.replay import run_in_viewer
+    from spine_mj.sim.replay import view_rig
 
     if duration is not None:
         check_positive("--duration", duration)
@@ -416,6 +391,5 @@ def view(surface_spec, start, duration, **rig_opts):
             "no display (DISPLAY and WAYLAND_DISPLAY are unset): the viewer "
             "needs one; use `spine-mj sim export`, `simulate --render` or `replay --mp4`"
         )
-    rig = _build_rig(surface_spec, **rig_opts, driven=False)
-    model = compile_spec(rig.export_spec(None if start is None else parse_start(start)))
-    run_in_viewer(model, time_scale=1.0 / rig.units.time_s, duration_s=duration)
+    surf, rig_kw = _rig_inputs(surface_spec, **rig_opts)
+    view_rig(surf, start=None if start is None else parse_start(start), duration_s=duration, **rig_kw)

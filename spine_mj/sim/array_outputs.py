@@ -4,12 +4,14 @@ summary and a figure of the layout on the surface with each spine's path.
 :func:`array_summary`, :func:`curve_table` and :func:`spine_table` turn an
 :class:`~spine_mj.sim.ArrayResult` into plain records (SI units);
 :func:`spine_mj.plotting.array_figure` draws it; :func:`write_array_outputs` writes them
-all or none into one folder.
+all or none into one folder; :func:`array_to` builds, places and runs an array and writes
+its folder (the whole of ``spine-mj array``).
 """
 
 from __future__ import annotations
 
 import os
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -17,6 +19,7 @@ import pandas as pd
 
 from spine_mj.atomic import all_or_none, atomic_output
 from spine_mj.jsonio import write_json
+from spine_mj.sim.build import build_array_on
 
 #: The files :func:`write_array_outputs` writes.
 ARRAY_OUTPUTS = ("curve.csv", "spines.csv", "summary.json", "layout.png")
@@ -108,3 +111,55 @@ def write_array_outputs(res, arr, out_dir: str | os.PathLike) -> list[Path]:
         write_json(paths[2], array_summary(res, arr))
         save_figure(array_figure(res, arr), paths[3])
     return paths
+
+
+def array_to(
+    out_dir: str | os.PathLike,
+    surface,
+    layout,
+    drive: str = "speed",
+    *,
+    mu: float,
+    centre: tuple[float, float] | None = None,
+    started: Callable[[float], None] | None = None,
+    **array_options,
+) -> tuple:
+    """An array of ``layout`` dragged over ``surface`` and its outputs written: what
+    ``spine-mj array`` does.
+
+    The array and its carriage's drive (:func:`~spine_mj.sim.build_array_on`, at its own
+    pace unless ``ie`` is given), its placement at ``centre`` (refused before anything runs
+    when a spine would sit off the surface), the run and :func:`write_array_outputs`.
+
+    Parameters
+    ----------
+    out_dir : path
+        The output folder (:data:`ARRAY_OUTPUTS`).
+    surface : Surface
+        The surface the array is dragged over.
+    layout : Layout
+        Where the spines sit on the carriage.
+    drive : {"speed", "force"}
+        As for :func:`~spine_mj.sim.build_array`.
+    mu : float
+        The tips' friction coefficient.
+    centre : (float, float), optional
+        The array's centre in surface units (None: its default, the rear a tenth in).
+    started : callable, optional
+        Called with the inertia number once the array is placed, before it runs.
+    **array_options
+        :func:`~spine_mj.sim.build_array_on`'s other keywords (pace, springs, duration, the
+        rig's options).
+
+    Returns
+    -------
+    (ArrayResult, float, list of Path)
+        The run, the inertia number it ran at and the files written.
+    """
+    arr, carriage, ie = build_array_on(surface, layout, drive, mu=mu, **array_options)
+    where = arr.default_centre() if centre is None else centre
+    arr.starts(where)  # spines off the surface: refused before anything runs or is written
+    if started is not None:
+        started(ie)
+    res = arr.run(carriage, centre=where)
+    return res, ie, write_array_outputs(res, arr, out_dir)

@@ -1,6 +1,7 @@
-"""MuJoCo's interactive viewer: a rig simulated live (:func:`run_in_viewer`) and a recorded
-run played back (:func:`play_in_viewer`, the rig and track of
-:func:`spine_mj.sim.run_folder.load_run`).
+"""MuJoCo's interactive viewer: a rig simulated live (:func:`run_in_viewer`, or
+:func:`view_rig` from a surface: ``spine-mj view``), the same model written for it
+(:func:`export_rig`: ``spine-mj sim export``) and a recorded run played back
+(:func:`play_in_viewer`, the rig and track of :func:`spine_mj.sim.run_folder.load_run`).
 """
 
 from __future__ import annotations
@@ -11,7 +12,8 @@ from collections.abc import Callable
 
 import numpy as np
 
-from spine_mj.sim.model import RigModel
+from spine_mj.sim.build import build_rig
+from spine_mj.sim.model import RigModel, compile_spec
 from spine_mj.sim.render import (
     STREAMLINE_RGBA,
     TRAIL_RGBA,
@@ -20,6 +22,60 @@ from spine_mj.sim.render import (
     decimate,
     streamline_path_m,
 )
+
+
+def export_rig(
+    path, surface, *, mu: float, start=None, stiffness_n_m: float | None = None, **rig_options
+) -> RigModel:
+    """Write the self-contained MJCF of the rig on ``surface`` for MuJoCo's viewer, the tip
+    resting at ``start`` with the spring on (:meth:`~spine_mj.sim.Rig.export_xml`).
+
+    Parameters
+    ----------
+    path : path
+        The ``.xml`` to write.
+    surface : Surface
+        The surface.
+    mu : float
+        The tip's friction coefficient.
+    start : (float, float), optional
+        Where the tip rests, in surface units (None: a tenth in from the -x edge, mid y).
+    stiffness_n_m : float, optional
+        The spring's stiffness [N/m] (None: K = 30); it bounds the step.
+    **rig_options
+        :func:`~spine_mj.sim.build_rig`'s other keywords; the rig is built undriven
+        (the user's sliders drive it).
+
+    Returns
+    -------
+    Rig
+        The rig written (its hfield, step, tip and units, for the caller to report).
+    """
+    rig = build_rig(surface, mu=mu, stiffness_n_m=stiffness_n_m, driven=False, **rig_options)
+    rig.export_xml(path, start=start, stiffness_n_m=stiffness_n_m)
+    return rig
+
+
+def view_rig(surface, *, mu: float, start=None, duration_s: float | None = None, **rig_options) -> None:
+    """Open the model :func:`export_rig` writes in MuJoCo's viewer, running in physical
+    real time (:func:`run_in_viewer`; needs a display).
+
+    Parameters
+    ----------
+    surface : Surface
+        The surface.
+    mu : float
+        The tip's friction coefficient.
+    start : (float, float), optional
+        Where the tip rests, in surface units (None: a tenth in from the -x edge, mid y).
+    duration_s : float, optional
+        Close the viewer after this many wall seconds.
+    **rig_options
+        :func:`~spine_mj.sim.build_rig`'s other keywords (the rig is built undriven).
+    """
+    rig = build_rig(surface, mu=mu, driven=False, **rig_options)
+    model = compile_spec(rig.export_spec(start))
+    run_in_viewer(model, time_scale=1.0 / rig.units.time_s, duration_s=duration_s)
 
 
 def run_in_viewer(model, *, time_scale: float = 1.0, duration_s: float | None = None) -> None:

@@ -3,9 +3,10 @@
 A run folder holds ``trajectory.parquet`` (:meth:`RunResult.table`), ``summary.json``
 (:meth:`RunResult.summary`: tip, engine, scales, drive), ``surface.npz`` (the surface),
 ``run.png`` (:func:`spine_mj.plotting.sim_run_figure`) and, when asked, ``run.mp4``.
-:func:`write_run` writes all of them or none; :func:`load_run` rebuilds the rig from the
-first three, so that ``spine-mj replay`` shows the same model (a Bullet run's on MuJoCo's
-model of the same surface and tip).
+:func:`simulate_to` builds the rig and drive, runs it and writes the folder (the whole of
+``spine-mj simulate``); :func:`write_run` writes all of them or none; :func:`load_run`
+rebuilds the rig from the first three, so that ``spine-mj replay`` shows the same model (a
+Bullet run's on MuJoCo's model of the same surface and tip).
 """
 
 from __future__ import annotations
@@ -22,13 +23,16 @@ from spine_mj.atomic import all_or_none, atomic_output
 from spine_mj.errors import SpineInputError
 from spine_mj.jsonio import write_json
 from spine_mj.plotting import save_figure, sim_run_figure
+from spine_mj.sim.build import build_drive
 from spine_mj.sim.drives import RampDrive, SpringDrive, StaticProbe
+from spine_mj.sim.engines import DEFAULT_ENGINE, build_engine_rig
 from spine_mj.sim.model import RigModel
 from spine_mj.sim.params import EngineSettings, TipParams
 from spine_mj.sim.render import Track, write_mp4
 from spine_mj.sim.results import RunResult
+from spine_mj.surfaces import Surface
 
-__all__ = ["RUN_FILES", "load_run", "write_run"]
+__all__ = ["RUN_FILES", "load_run", "simulate_to", "write_run"]
 
 RUN_FILES = ("summary.json", "surface.npz", "trajectory.parquet")
 _DRIVES = {cls.__name__: cls for cls in (SpringDrive, RampDrive, StaticProbe)}
@@ -105,3 +109,71 @@ def write_run(
         if mp4:
             write_mp4(rig, result, out / "run.mp4", progress=progress)
     return paths
+
+
+def simulate_to(
+    out_dir: str | Path,
+    surface: Surface,
+    *,
+    mu: float,
+    start: tuple[float, float],
+    protocol: str = "spring",
+    engine: str = DEFAULT_ENGINE,
+    ie: float | None = None,
+    speed_m_s: float | None = None,
+    rate_n_s: float | None = None,
+    stiffness_number: float | None = None,
+    stiffness_n_m: float | None = None,
+    duration_s: float | None = None,
+    start_force_n: float = 0.0,
+    mp4: bool = False,
+    progress: Callable[[float], None] | None = None,
+    render_progress: Callable[[int, int], None] | None = None,
+    **rig_options,
+) -> tuple[RunResult, list[Path]]:
+    """One drive on ``surface`` written as a run folder: what ``spine-mj simulate`` does.
+
+    The rig (:func:`~spine_mj.sim.build_engine_rig`, its step bounded by the drive's pace
+    and spring), the drive (:func:`~spine_mj.sim.build_drive`), the run from ``start``, and
+    its folder (:func:`write_run`: every file or none).
+
+    Parameters
+    ----------
+    out_dir : path
+        The run folder.
+    surface : Surface
+        The surface the tip runs on.
+    mu : float
+        The tip's friction coefficient.
+    start : (float, float)
+        The start ``(x0, y0)`` in surface units.
+    protocol : {"spring", "ramp", "static"}
+        The drive.
+    engine : {"mujoco", "bullet"}
+        The engine that runs it.
+    ie, speed_m_s, rate_n_s, stiffness_number, stiffness_n_m, duration_s, start_force_n
+        The drive, as for :func:`~spine_mj.sim.build_drive` (pace and spring also size the
+        rig's step, as for :func:`~spine_mj.sim.build_rig`).
+    mp4 : bool
+        Also write ``run.mp4``.
+    progress : callable, optional
+        Called with the run's fraction done while it runs.
+    render_progress : callable, optional
+        Called with ``(frames done, frames)`` while the MP4 is written.
+    **rig_options
+        :func:`~spine_mj.sim.build_rig`'s other keywords (tip, length scale, hfield,
+        engine overrides).
+
+    Returns
+    -------
+    (RunResult, list of Path)
+        The run and the files written.
+    """
+    pace = {"ie": ie, "speed_m_s": speed_m_s, "rate_n_s": rate_n_s}
+    spring = {"stiffness_number": stiffness_number, "stiffness_n_m": stiffness_n_m}
+    rig = build_engine_rig(surface, engine=engine, mu=mu, **pace, **spring, **rig_options)
+    drive = build_drive(
+        rig.scales, protocol, **pace, **spring, duration_s=duration_s, start_force_n=start_force_n
+    )
+    result = rig.run(drive, start=start, progress=progress)
+    return result, write_run(out_dir, rig, result, mp4=mp4, progress=render_progress)
