@@ -49,7 +49,9 @@ def kappa_cmd(surface_spec, mu, output, resolution):
 @click.option(
     "--start", "starts", multiple=True, required=True, metavar="X,Y", help="Start point, repeatable."
 )
-@click.option("--dl", type=float, default=None, help="Step length (default: 1/1000 of the domain).")
+@click.option(
+    "--dl", type=float, default=None, help="Step length (default: 1/1000 of the domain's shorter side)."
+)
 @click.option(
     "--tip-radius",
     type=float,

@@ -195,16 +195,29 @@ def _trajectories(surface, starts, params, *, ideal, store_paths, backend):
     )
 
 
-#: The step of a streamline given no ``dl``, as a fraction of the domain's longer side.
+#: The step of a streamline given no ``dl``, as a fraction of the domain's shorter side.
 DEFAULT_STEP_FRACTION = 1e-3
 
 
 def default_step(surface: Surface) -> float:
     """The streamline step ``dl`` when none is given: :data:`DEFAULT_STEP_FRACTION` of the
-    longer side of ``surface.bounds`` (surface units), what ``spine-mj streamline`` and the
-    streamline drawn beside a MuJoCo run use."""
+    shorter side of ``surface.bounds`` (surface units). The one default of ``spine-mj
+    streamline``, the sweep's ``quasistatic`` analysis and the streamline drawn beside a
+    MuJoCo run. The shorter side, because a path turns on the scale of the domain's width
+    as well as its length: on a long strip a thousandth of its length could be as coarse as
+    its features (and a strip 1000 times longer than wide would leave at the first step).
+
+    Parameters
+    ----------
+    surface : Surface
+        The surface traced.
+
+    Returns
+    -------
+    float
+    """
     xmin, xmax, ymin, ymax = surface.bounds
-    return DEFAULT_STEP_FRACTION * max(xmax - xmin, ymax - ymin)
+    return DEFAULT_STEP_FRACTION * min(xmax - xmin, ymax - ymin)
 
 
 def streamlines(

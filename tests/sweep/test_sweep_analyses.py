@@ -193,3 +193,30 @@ def test_compare_leaves_out_a_run_the_engine_failed(tmp_path):
     assert np.isnan(after.metrics["frechet"][1]) and np.isnan(after.metrics["lateral_deviation"][1])
     assert after.metrics["frechet"][0] == pytest.approx(before.metrics["frechet"][0], rel=1e-12)
     assert peak < 200 * 2**20
+
+
+def test_quasistatic_without_dl_steps_as_the_streamline_command(tmp_path):
+    """One default step (theory.streamline.default_step): a thousandth of the shorter side
+    of the domain, here the corrugation's width (8 x 1), as ``spine-mj streamline`` takes."""
+    from spine_mj import presets
+    from spine_mj.theory import streamline as sl
+
+    doc = """
+[sweep]
+name = "step"
+analyses = ["quasistatic"]
+[[surfaces]]
+preset = "corrugation"
+[starts]
+frame = "absolute"
+points = [[0.5, 0.0], [0.5, 0.2]]
+[grid]
+mu = 0.6
+"""
+    out = tmp_path / "out"
+    sweep.run_sweep(write_config(tmp_path, doc), out, workers=1)
+    runs = sweep.load_runs(out)
+    assert (runs.n_steps > 0).all()
+    step = sl.default_step(presets.make_surface("corrugation"))
+    assert step == pytest.approx(1e-3)
+    np.testing.assert_allclose(runs.path_length / runs.n_steps, step, rtol=1e-12)

@@ -7,16 +7,17 @@ import pytest
 
 from spine_mj import streamline as sl
 from spine_mj.errors import SpineInputError
-from spine_mj.surfaces import single_gaussian
+from spine_mj.surfaces import corrugation, single_gaussian
 from spine_mj.theory.streamline_outputs import FIGURE_NAME, trace_starts, write_streamline_outputs
 
 STARTS = [(-3.0, -1.0), (-3.0, -2.0)]
 
 
-def test_the_default_step_is_a_thousandth_of_the_longer_side():
-    surf = single_gaussian()
+def test_the_default_step_is_a_thousandth_of_the_shorter_side():
+    surf = corrugation()  # 8 x 1
     xmin, xmax, ymin, ymax = surf.bounds
-    assert sl.default_step(surf) == pytest.approx(max(xmax - xmin, ymax - ymin) / 1000)
+    assert (xmax - xmin) / (ymax - ymin) == pytest.approx(8.0)
+    assert sl.default_step(surf) == pytest.approx((ymax - ymin) / 1000)
 
 
 def test_the_run_equals_the_two_analyses_run_apart():

@@ -26,7 +26,8 @@ QUASISTATIC_PARAMS = (
     ParamSpec(
         "dl",
         "float",
-        "streamline step in the surface's length unit (default: 0.0015 times the smaller side of the domain)",
+        "streamline step in the surface's length unit (default: "
+        f"{sl.DEFAULT_STEP_FRACTION:g} times the shorter side of the domain, as for spine-mj streamline)",
         None,
         0.0,
         exclusive=True,
@@ -57,8 +58,7 @@ def traced_surface(case, surface):
 def _params(case, surface) -> sl.StreamlineParams:
     """The streamline parameters of ``case`` on ``surface`` (the traced one)."""
     p = case.params
-    xmin, xmax, ymin, ymax = surface.bounds
-    dl = p["dl"] if p["dl"] is not None else 0.0015 * min(xmax - xmin, ymax - ymin)
+    dl = p["dl"] if p["dl"] is not None else sl.default_step(surface)
     return sl.StreamlineParams(mu=p["mu"], dl=dl, max_steps=p["max_steps"], kappa_cap=p["kappa_cap"])
 
 
