@@ -175,3 +175,25 @@ def test_no_module_or_function_is_too_long():
                     long_functions[f"{name}:{node.name}"] = lines
     assert not long_modules, f"modules over {MAX_MODULE_LINES} lines: {long_modules}"
     assert not long_functions, f"functions over {MAX_FUNCTION_LINES} lines: {long_functions}"
+
+
+#: The most modules directly in spine_mj/ (the rest live in its packages).
+MAX_FLAT_MODULES = 15
+
+
+def test_the_top_of_the_package_holds_at_most_15_flat_modules():
+    root = Path(spine_mj.__file__).parent
+    flat = sorted(p.stem for p in root.glob("*.py") if p.name != "__init__.py")
+    assert "jsonio" in flat and "streamline" not in flat
+    assert len(flat) <= MAX_FLAT_MODULES, flat
+
+
+def test_the_tests_mirror_the_surfaces_package_and_the_modules_once_untested():
+    root, tests = Path(spine_mj.__file__).parent, Path(__file__).parent
+    surfaces = [p.stem.lstrip("_") for p in (root / "surfaces").glob("*.py") if p.name != "__init__.py"]
+    assert len(surfaces) >= 9
+    missing = [s for s in surfaces if not (tests / "surfaces" / f"test_surfaces_{s}.py").is_file()]
+    assert not missing, f"surfaces modules without a test module: {missing}"
+    direct = ["sim/test_sim_array_outputs.py", "test_jsonio.py", "test_workers.py"]
+    direct += ["surfaces/test_surfaces_contact_kernel.py", "validate/report/test_validate_report_document.py"]
+    assert all((tests / d).is_file() for d in direct), [d for d in direct if not (tests / d).is_file()]
