@@ -22,11 +22,12 @@ from spine_mj.sim.render import (
     decimate,
     streamline_path_m,
 )
+from spine_mj.sim.rig import Rig
 
 
 def export_rig(
     path, surface, *, mu: float, start=None, stiffness_n_m: float | None = None, **rig_options
-) -> RigModel:
+) -> Rig:
     """Write the self-contained MJCF of the rig on ``surface`` for MuJoCo's viewer, the tip
     resting at ``start`` with the spring on (:meth:`~spine_mj.sim.Rig.export_xml`).
 
