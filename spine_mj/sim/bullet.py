@@ -88,13 +88,12 @@ from spine_mj.sim.params import (
     Scales,
     TipParams,
     default_engine,
-    hfield_of,
     penetration_tolerance_m,
 )
 from spine_mj.sim.ramp import ResetController, ramp_duration_s
 from spine_mj.sim.results import GroupAnalysis, RunResult
 from spine_mj.sim.rollout import controls
-from spine_mj.surfaces import Surface
+from spine_mj.surfaces import HField, Surface
 
 __all__ = ["BulletRig", "BulletSettings", "default_bullet_engine"]
 
@@ -137,8 +136,9 @@ class BulletSettings:
         Error reduction (position correction per step, by split impulse) and constraint
         force mixing (0: hard).
     cone_friction, friction_anchor, internal_edges : bool
-    hfield_resolution : int or None
-        As :class:`~spine_mj.sim.EngineSettings`.
+
+    The hfield's resolution is the rig's scales' (:attr:`Scales.hfield_resolution`),
+    measured once with the hfield (:meth:`Scales.with_hfield`), not a setting.
     """
 
     timestep_s: float
@@ -151,7 +151,6 @@ class BulletSettings:
     cone_friction: bool = True
     friction_anchor: bool = False
     internal_edges: bool = True
-    hfield_resolution: int | None = None
 
     def __post_init__(self):
         object.__setattr__(self, "timestep_s", check_positive("timestep_s", self.timestep_s))
@@ -195,7 +194,6 @@ def default_bullet_engine(
         "substeps": max(1, math.ceil(math.sqrt(approach / slop) - 1e-9)),
         "contact_slop_m": slop,
         "contact_breaking_m": tol,
-        "hfield_resolution": scales.hfield_resolution,
     }
     base.update(overrides)
     return BulletSettings(**base)
@@ -214,6 +212,10 @@ def spring_substeps(engine: BulletSettings, drive: Drive, scales: Scales) -> int
 class BulletRig:
     """The rig of one surface and one tip in Bullet (parameters as :class:`~spine_mj.sim.Rig`,
     ``engine`` a :class:`BulletSettings`; None: :func:`default_bullet_engine`).
+
+    ``sized``, when given, is ``Scales.with_hfield`` of this surface and tip computed by the
+    caller (:func:`~spine_mj.sim.build_engine_rig` needs the scales for the settings
+    first), as for MuJoCo's rig: the scales and the hfield are measured once.
 
     The attributes and checks that do not depend on the engine (``scales``, ``tip``,
     ``units``, ``hfield``, ``bounds_m``, :meth:`check_drive`, :meth:`contact_surface`, ...)
@@ -237,31 +239,32 @@ class BulletRig:
         engine: BulletSettings | None = None,
         length_scale_m: float | None = None,
         char_length_m: float | None = None,
+        hfield_resolution: int | None = None,
+        sized: tuple[Scales, HField] | None = None,
     ):
         extras.require("bullet", "the Bullet engine")
         if not isinstance(surface, Surface):
             raise SpineInputError(f"surface must be a spine_mj Surface, got {type(surface).__name__}")
         tip = TipParams() if tip is None else tip
-        self.scales = Scales.for_surface(
-            surface,
-            tip=tip,
-            length_scale_m=length_scale_m,
-            char_length_m=char_length_m,
-            hfield_resolution=engine.hfield_resolution if engine is not None else None,
-        )
+        if sized is None:
+            sized = Scales.with_hfield(
+                surface,
+                tip=tip,
+                length_scale_m=length_scale_m,
+                char_length_m=char_length_m,
+                hfield_resolution=hfield_resolution,
+            )
+        self.scales, self.hfield = sized
         self.surface = surface
         self.tip = dataclasses.replace(tip, tip_radius_m=self.scales.tip_radius_m)
         self.length_scale_m = self.scales.length_scale_m
         self.units = self.scales.units
-        if engine is None:
-            engine = default_bullet_engine(self.scales)
-        self.engine = dataclasses.replace(engine, hfield_resolution=self.scales.hfield_resolution)
+        self.engine = default_bullet_engine(self.scales) if engine is None else engine
         if self.engine.timestep_s < MIN_TIMESTEP_TAU * self.scales.time_s:
             raise SpineInputError(
                 f"timestep_s must be at least {MIN_TIMESTEP_TAU:g} of the time scale tau = "
                 f"{self.scales.time_s:.3g} s, or none (derived), got {self.engine.timestep_s:.3g}"
             )
-        self.hfield = hfield_of(surface, self.scales.hfield_resolution)
         xmin, xmax, ymin, ymax = surface.bounds
         self.bounds_m = tuple(self.length_scale_m * b for b in (xmin, xmax, ymin, ymax))
         self.z_range_m = RigModel._z_range_m(self)

@@ -17,12 +17,12 @@ from typing import Protocol
 
 from spine_mj import extras
 from spine_mj.errors import SpineInputError
-from spine_mj.sim.build import build_rig, drive_speed_m_s
+from spine_mj.sim.build import _sized, build_rig, drive_speed_m_s
 from spine_mj.sim.detection import Detection
 from spine_mj.sim.drives import Drive, spring_stiffness_n_m
 from spine_mj.sim.params import EngineUnits, Scales, TipParams
 from spine_mj.sim.results import RunResult
-from spine_mj.surfaces import GridSurface, Surface
+from spine_mj.surfaces import Surface
 
 __all__ = ["DEFAULT_ENGINE", "ENGINES", "EngineRig", "build_engine_rig", "check_engine_name"]
 
@@ -141,25 +141,19 @@ def build_engine_rig(surface: Surface, *, engine: str = DEFAULT_ENGINE, **option
     tip = TipParams(
         tip_radius_m=options.get("tip_radius_m"),
         mu_s=options["mu"],
-        **{
-            k: options[o]
-            for k, o in (("mass_kg", "mass_kg"), ("preload_n", "preload_n"), ("gravity_m_s2", "gravity_m_s2"))
-            if options.get(o) is not None
-        },
+        **{k: options[k] for k in ("mass_kg", "preload_n", "gravity_m_s2") if options.get(k) is not None},
     )
-    resolution = None if isinstance(surface, GridSurface) else options.get("hfield_resolution")
-    length_scale_m = options.get("length_scale_m")
-    scales = Scales.for_surface(surface, tip=tip, length_scale_m=length_scale_m, hfield_resolution=resolution)
+    tip, scales, hfield = _sized(
+        surface, tip, options.get("length_scale_m"), options.get("hfield_resolution")
+    )
     speed = None
     if options.get("driven", True):
         speed = drive_speed_m_s(
             scales, ie=options.get("ie"), speed_m_s=options.get("speed_m_s"), rate_n_s=options.get("rate_n_s")
         )
-    overrides = {"hfield_resolution": resolution}
-    if options.get("timestep_s") is not None:
-        overrides["timestep_s"] = options["timestep_s"]
+    overrides = {"timestep_s": options["timestep_s"]} if options.get("timestep_s") is not None else {}
     spring = spring_stiffness_n_m(
         scales, stiffness_number=options.get("stiffness_number"), stiffness_n_m=options.get("stiffness_n_m")
     )
-    engine_settings = default_bullet_engine(scales, speed_m_s=speed, stiffness_n_m=spring, **overrides)
-    return BulletRig(surface, tip=tip, engine=engine_settings, length_scale_m=length_scale_m)
+    settings = default_bullet_engine(scales, speed_m_s=speed, stiffness_n_m=spring, **overrides)
+    return BulletRig(surface, tip=tip, engine=settings, sized=(scales, hfield))

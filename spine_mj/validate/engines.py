@@ -215,7 +215,12 @@ def _groove_rows(engine: str, **settings) -> list[dict]:
         cap = 20.0 if lock else 2 * kappa
         rig = _rig(engine, groove(theta, alpha), ie=1e-2, tip_radius_m=2e-3)
         if settings:
-            rig = type(rig)(rig.surface, tip=rig.tip, engine=dataclasses.replace(rig.engine, **settings))
+            rig = type(rig)(
+                rig.surface,
+                tip=rig.tip,
+                engine=dataclasses.replace(rig.engine, **settings),
+                sized=(rig.scales, rig.hfield),
+            )
         det = sim.Detection(kappa_cap=cap)
         # where gravity alone would slide the tip down the groove it is held at twice the
         # force that holds it

@@ -201,6 +201,28 @@ def test_build_engine_rig_gives_the_same_scales_and_step_in_both_engines():
         sim.build_engine_rig(surf, engine="ode", mu=MU)
 
 
+def test_the_scales_and_hfield_are_measured_once_and_shared(monkeypatch):
+    """Bullet's rig takes the scales and hfield build_engine_rig measured (``sized=``), as
+    MuJoCo's does: one measurement, the same hfield samples as MuJoCo's."""
+    from spine_mj import presets
+
+    surf = presets.make_surface("paper-single-peak")
+    real = sim.Scales.with_hfield.__func__
+    calls = []
+
+    def counted(cls, *args, **kwargs):
+        calls.append(kwargs.get("hfield_resolution"))
+        return real(cls, *args, **kwargs)
+
+    monkeypatch.setattr(sim.Scales, "with_hfield", classmethod(counted))
+    rig = sim.build_engine_rig(surf, engine="bullet", mu=MU, ie=1e-3, hfield_resolution=61)
+    assert rig.hfield.nrow == 61
+    assert calls == [61]
+    assert rig.scales.hfield_resolution == 61 and not hasattr(rig.engine, "hfield_resolution")
+    mj = sim.build_engine_rig(surf, engine="mujoco", mu=MU, ie=1e-3, hfield_resolution=61)
+    np.testing.assert_array_equal(rig.hfield.data, mj.hfield.data)
+
+
 def test_simulate_engine_bullet_writes_the_same_run_folder(tmp_path):
     folders = {}
     for engine in sim.ENGINES:
