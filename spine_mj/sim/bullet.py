@@ -37,21 +37,30 @@ Bullet's absolute thresholds meet O(1) numbers at every physical scale):
   ``CFM = 0`` (hard contact).
 * **Friction**: ``enableConeFriction`` (measured: without it Bullet's two friction rows
   form a pyramid that holds ``sqrt(2) mu N`` at 45 deg to its axes, 0.716 for mu = 0.5);
-  Bullet multiplies the two bodies' frictions, so the surface gets 1 and the tip ``mu_s``;
-  friction anchors off. Measured both ways: a tip resting in a V-groove on two contacts
-  creeps down it at 0.1 tip radii per second without them (below the slip threshold, but a
-  static probe reads it as a slide once it has crept 0.1 tip radii) and holds with them at
-  the drive's step; but with them a frictionless tip slid over a flat plane hops by up to
-  15 % of its speed (0.1 % without) and the spring-block's peak speed is 1.1 % low (0.1 %
-  without). Sliding is most of every run, so anchors stay off; the wedge's creep is a
-  measured limit (``friction_anchor=True`` where a wedge's hold is the question).
+  Bullet multiplies the two bodies' frictions, so the surface gets 1 and the tip ``mu_s``.
+* **Friction anchors while wedged and held** (``friction_anchor="held"``). Measured: a tip
+  resting in a V-groove on two flanks without anchors has its load on one flank's contact
+  at a time (normal forces 0.90 and 0 F_p at a row, the flanks alternating), sees one
+  flank's slope (34 deg, above the 27 deg friction angle) and creeps down the groove at
+  0.1 tip radii per second, which a static probe reads as a slide; with anchors the load
+  splits (0.77 and 0.43 F_p) and it holds. On a single contact anchors are not needed and
+  disturb: with them always on a frictionless tip slid over a flat plane hops by up to
+  15 % of its speed and a stiff spring-block's swing (k = 1e4 N/m) peaks at 1.79 V
+  instead of 2.00 V. So anchors are set while the tip touches along normals more than
+  :data:`WEDGE_ANGLE_DEG` apart and moves slower than the detection's move speed, and
+  lifted once it has moved the breakaway distance or runs :data:`ANCHOR_RELEASE` move
+  speeds (``"never"`` and ``"always"`` measure the pitfall).
 * **Restitution** 0 on both bodies: landings are perfectly inelastic as MuJoCo's critically
   damped contacts are (measured: a tip landing at 1 L_c/tau rebounds at 2e-3 with 0, at
   0.29 with 0.5).
 * **Internal edges**: the heightfield is built with ``GEOM_CONCAVE_INTERNAL_EDGE``
   (measured: a sphere sliding at 3 L_c/tau over a flat triangulated plane saw contact
   normals tilted by 1.6 deg at the triangles' shared edges and hopped at 4 % of its speed;
-  with internal-edge info, 0 deg and 0.01 %).
+  with internal-edge info, 0 deg and 0.01 %). Its cost, measured and left as a stated
+  limit: at a concave kink the adjustment snaps the contact normal to a facet's, so a tip
+  pushed into the kink between a floor and a half-embedded sphere (Dai's interlock at
+  0.97 times the threshold) self-locks where the facets' rule and MuJoCo release at 10.4;
+  without internal edges the same run breaks away at 10.61 (+2.3 %).
 * No sleeping (a resting tip must still feel the rising drive force).
 
 Runs step in Python (feedback is free here, so the force ramp with reset runs like the
@@ -103,6 +112,16 @@ SLOP_OF_TOLERANCE = 0.1
 _SLOP_MARGIN = 1.25
 #: Largest omega h of the spring's explicit force.
 MAX_SPRING_OMEGA_H = 0.2
+#: When friction anchors are on: while the tip is held (the rule), never, always.
+FRICTION_ANCHORS = ("held", "never", "always")
+#: Contacts whose normals are this far apart wedge the tip (anchors while held).
+WEDGE_ANGLE_DEG = 1.0
+WEDGE_COS = math.cos(math.radians(WEDGE_ANGLE_DEG))
+#: Anchors set while held are lifted above this many move speeds, before the breakaway
+#: distance (a wedged tip's swing through zero speed; measured on a plane with anchors
+#: always on: a stiff spring-block's swing at k = 1e4 N/m peaked at 1.79 V, 2.00 V without;
+#: a wedge's creep runs at 0.4-1.4 move speeds).
+ANCHOR_RELEASE = 10.0
 #: Rows simulated between two looks at a run's end conditions.
 WINDOW_ROWS = 512
 #: Recorded sensor layout: MuJoCo's sensors (``models/spine_rig.xml``), in the same order.
@@ -135,7 +154,10 @@ class BulletSettings:
     erp, cfm : float
         Error reduction (position correction per step, by split impulse) and constraint
         force mixing (0: hard).
-    cone_friction, friction_anchor, internal_edges : bool
+    cone_friction, internal_edges : bool
+    friction_anchor : {"held", "never", "always"}
+        When Bullet's friction anchors are on (module docstring): ``"held"`` while the tip
+        moves slower than the detection's move speed, so a wedge holds and a slide is free.
 
     The hfield's resolution is the rig's scales' (:attr:`Scales.hfield_resolution`),
     measured once with the hfield (:meth:`Scales.with_hfield`), not a setting.
@@ -149,7 +171,7 @@ class BulletSettings:
     erp: float = 0.2
     cfm: float = 0.0
     cone_friction: bool = True
-    friction_anchor: bool = False
+    friction_anchor: str = "held"
     internal_edges: bool = True
 
     def __post_init__(self):
@@ -161,6 +183,10 @@ class BulletSettings:
             object.__setattr__(self, name, int(v))
         for name in ("contact_slop_m", "contact_breaking_m", "cfm"):
             object.__setattr__(self, name, check_positive(name, getattr(self, name), allow_zero=True))
+        if self.friction_anchor not in FRICTION_ANCHORS:
+            raise SpineInputError(
+                f"friction_anchor must be one of {', '.join(FRICTION_ANCHORS)}, got {self.friction_anchor!r}"
+            )
         if not 0 <= self.erp <= 1:
             raise SpineInputError(f"erp must lie in [0, 1], got {self.erp!r}")
 
@@ -375,7 +401,9 @@ class BulletRig:
         k = stiffness_n_m(drive, self.scales) / u.stiffness_n_m if isinstance(drive, SpringDrive) else 0.0
         n_sub = spring_substeps(self.engine, drive, self.scales)
         n_settle = settle_steps(drive, self.engine.timestep_s)
-        sim = self.world().start(qpos0, n_sub)
+        sim = self.world().start(
+            qpos0, n_sub, held=(det.move_speed_m_s / u.speed_m_s, det.breakaway_distance_m / u.length_m)
+        )
         done, steps = 0, 0
         while done < nstep:
             end = min(nstep, done + WINDOW_ROWS)
@@ -487,13 +515,15 @@ class _World:
             restitution=0.0,
             rollingFriction=0.0,
             spinningFriction=0.0,
-            frictionAnchor=int(rig.engine.friction_anchor),
+            frictionAnchor=int(rig.engine.friction_anchor == "always"),
             physicsClientId=self.cid,
         )
         return body
 
-    def start(self, qpos0: np.ndarray, substeps: int) -> _Run:
-        """A fresh tip resting at ``qpos0`` (engine units), stepping ``substeps`` per row."""
+    def start(self, qpos0: np.ndarray, substeps: int, held: tuple[float, float] = (0.0, 0.0)) -> _Run:
+        """A fresh tip resting at ``qpos0`` (engine units), stepping ``substeps`` per row;
+        ``held``: the detection's move speed and breakaway distance (engine units), which
+        say when the tip is held (friction anchors ``"held"``)."""
         pb, rig = self.pb, self.rig
         if self.tip is not None:
             pb.removeBody(self.tip, physicsClientId=self.cid)
@@ -515,13 +545,12 @@ class _World:
             spinningFriction=0.0,
             linearDamping=0.0,
             angularDamping=0.0,
-            frictionAnchor=int(rig.engine.friction_anchor),
             activationState=pb.ACTIVATION_STATE_DISABLE_SLEEPING,
             physicsClientId=self.cid,
         )
         h = rig.engine.timestep_s / rig.units.time_s / substeps
         pb.setPhysicsEngineParameter(fixedTimeStep=h, numSubSteps=0, physicsClientId=self.cid)
-        return _Run(self, substeps, h)
+        return _Run(self, substeps, h, held)
 
     def close(self) -> None:
         try:
@@ -534,8 +563,11 @@ class _Run:
     """The stepping of one run: a row is ``substeps`` Bullet steps, written in MuJoCo's
     state and sensor layout (engine units)."""
 
-    def __init__(self, world: _World, substeps: int, h: float):
+    def __init__(self, world: _World, substeps: int, h: float, held: tuple[float, float]):
         self.w, self.n, self.h = world, substeps, h
+        self.held_speed, self.held_distance = held
+        self.anchored_at = None  # where the anchors were set (rule "held")
+        self.wedged = False  # touching the surface along normals apart (the last row)
         self.t = 0.0
 
     def step(self, i: int, ctrl: np.ndarray, x_prev: float, k: float, state: np.ndarray, sens: np.ndarray):
@@ -544,6 +576,8 @@ class _Run:
         and ``sens`` (:data:`SENSOR_ADR`)."""
         pb, cid, tip, n = self.w.pb, self.w.cid, self.w.tip, self.n
         push, fz = float(ctrl[1]), float(ctrl[2])
+        if self.w.rig.engine.friction_anchor == "held":
+            self._anchor()
         spring_sum = 0.0
         for j in range(n):
             pos = pb.getBasePositionAndOrientation(tip, physicsClientId=cid)[0]
@@ -563,23 +597,53 @@ class _Run:
         sens[18] = spring_sum / n
         sens[19] = push
         pts = pb.getContactPoints(tip, self.w.ground, physicsClientId=cid)
+        self.wedged = False
         if not pts:
             return
         touch = 0.5 * self.w.rig.engine.contact_slop_m / self.w.lu
         net = np.zeros(3)
         deepest = None
+        normals = []
         for p in pts:
             dist = p[8]
             if dist > touch:
                 continue
+            normals.append(p[7])
             net += p[9] * np.asarray(p[7]) + p[10] * np.asarray(p[11]) + p[12] * np.asarray(p[13])
             if deepest is None or dist < deepest[8]:
                 deepest = p
         if deepest is None:
             return
+        normals = np.asarray(normals)
+        self.wedged = bool((normals @ normals.T).min() < WEDGE_COS)
         sens[6] = 1.0
         sens[7:10] = -net  # MuJoCo's sensor: the tip's force on the surface
         sens[10] = 1.0
         sens[11] = deepest[8]
         sens[12:15] = deepest[6]
         sens[15:18] = deepest[7]
+
+    def _anchor(self) -> None:
+        """Friction anchors (rule ``"held"``): set once the tip is wedged (touching along
+        normals more than :data:`WEDGE_ANGLE_DEG` apart) and moves slower than the move
+        speed; lifted once it has moved the breakaway distance from where they were set (the
+        detection's own meaning of held) or runs :data:`ANCHOR_RELEASE` move speeds. On
+        and off at the move speed alone they flicker at a creep's speed and the creep goes
+        on; on a single contact they are not needed (no creep) and a swing through zero
+        speed would be caught by them. The ground's flag: pybullet sets none on a body of
+        maximal coordinates."""
+        pb, cid, tip = self.w.pb, self.w.cid, self.w.tip
+        pos = np.asarray(pb.getBasePositionAndOrientation(tip, physicsClientId=cid)[0])
+        speed = np.linalg.norm(pb.getBaseVelocity(tip, physicsClientId=cid)[0])
+        if self.anchored_at is not None:
+            moved = np.linalg.norm(pos - self.anchored_at) > self.held_distance
+            if not moved and speed <= ANCHOR_RELEASE * self.held_speed:
+                return
+            self.anchored_at = None
+        elif speed < self.held_speed and self.wedged:
+            self.anchored_at = pos
+        else:
+            return
+        pb.changeDynamics(
+            self.w.ground, -1, frictionAnchor=int(self.anchored_at is not None), physicsClientId=cid
+        )

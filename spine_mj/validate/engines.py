@@ -9,11 +9,16 @@ tolerance the MuJoCo report states for it:
 * **spring-block** (docs/physics.md §6): period against ``2 pi / w`` within 2 % (the
   ladder's), peak speed against ``2 V`` (shown; MuJoCo's soft friction rows flatten it);
 * **Prandtl-Tomlinson** on a corrugation (s = 0.3, mu = 0.5, K* = 0.47): one slip per
-  wavelength below K*, none above;
-* **V-groove wedge lock**: a tip in a groove rising at theta with flanks tilted by alpha
-  holds ``tan(theta + arctan(mu / cos alpha))`` (the single-contact rule says
-  ``tan(theta + arctan mu)``), within 5 %, and self-locks once
-  ``theta + arctan(mu / cos alpha) >= 90 deg``;
+  wavelength below K*, none above; and the largest onset force at K*/4 (I_e = 1e-4, the
+  ground truth's) against ``W kappa`` at the fold, within 2 % (the MuJoCo report's);
+* **crest lift-off** over the ground truth's Gaussian ridges (widths 0.35 and 0.5 L_c):
+  contact kept at 0.6 I_e*, a flight by 1.6 I_e* (:func:`~spine_mj.validate.ground_truth.crest_check`,
+  the MuJoCo test's tolerance);
+* **V-groove wedge lock**: a tip in a groove rising at theta with flanks tilted by alpha'
+  in the groove's plane holds ``tan(theta + arctan(mu / cos alpha'))`` (the single-contact
+  rule says ``tan(theta + arctan mu)``), within 5 %, and self-locks once
+  ``theta + arctan(mu / cos alpha') >= 90 deg``; :func:`groove`'s flanks, tilted by alpha
+  across the x axis, have ``tan alpha' = tan alpha cos theta`` (:func:`flank_tilt`);
 * **Dai's interlock** on a half-embedded sphere of radius R against a tip of radius r,
   pushed horizontally into it: self-lock possible iff ``R / r >= 1 / sin(arctan mu) - 1``,
   run at 0.9, 0.97, 1.03 and 1.1 times that threshold. Both engines collide with the
@@ -23,6 +28,11 @@ tolerance the MuJoCo report states for it:
   contact surface is for paths);
 * **creep**: the drift speed of a held tip (tip radii per second) on a 20 deg plane and
   wedged against the sphere under a rising force.
+
+Bullet's pitfalls run beside the rule's choice, each with its measured cause: the groove
+without friction anchors (``friction_anchor="never"``: it creeps and reads as a slide) and
+Dai's 0.97 without internal-edge normals (``internal_edges=False``: it releases as the
+facets' rule says; with them Bullet self-locks).
 
 * **fractal self-lock rate against H** (``--fractal N``): the validation's fractal study
   (:mod:`spine_mj.validate.fractal_lock`) at its corner I_e in both engines, N surfaces per H,
@@ -60,10 +70,16 @@ PLANES = ((0.0, 0.0), (10.0, 0.0), (-10.0, 0.0), (20.0, 45.0), (30.0, 0.0))
 #: Dai's ratios, in thresholds.
 DAI_FACTORS = (0.9, 0.97, 1.03, 1.1)
 DAI_SPHERE_M = 4e-3
+#: Ridge widths of the lift-off check (L_c), as the MuJoCo test's.
+LIFTOFF_WIDTHS = (0.35, 0.5)
 #: V-grooves: (theta, alpha) [deg]. The closed form takes the flanks' tilt in the groove's
 #: own inclined plane; on ``groove`` it holds for moderate angles only, so no self-locking
 #: groove (theta + arctan(mu / cos alpha) >= 90 deg needs steep ones) is run.
 GROOVES = ((20.0, 30.0),)
+#: The onset force's K / K* and tolerance: where the MuJoCo report states the largest onset
+#: within 2 % of the fold (docs/physics.md §6), at the ground truth's I_e.
+ONSET_FACTOR = 0.25
+ONSET_TOL = 0.02
 
 
 def dai_threshold(mu: float) -> float:
@@ -163,14 +179,7 @@ def _tomlinson_rows(engine: str, quick: bool) -> list[dict]:
     rows = []
     for factor in (0.5, 2.0):
         k = factor * k_star
-        rig = _rig(engine, surf, tip_radius_m=0.01 * sim.DEFAULT_LENGTH_SCALE_M, ie=1e-3, stiffness_number=k)
-        sc = rig.scales
-        speed = sc.speed_for(1e-3)
-        duration = waves * sim.DEFAULT_LENGTH_SCALE_M / speed
-        run = rig.run(
-            sim.SpringDrive(speed_m_s=speed, stiffness_n_m=sc.stiffness_for(k), duration_s=duration),
-            start=(0.75, 0.0),
-        )
+        run = _corrugation_run(engine, surf, k, 1e-3, waves)
         travel = (run.position_m[-1, 0] - run.position_m[0, 0]) / sim.DEFAULT_LENGTH_SCALE_M
         per_wave = len(run.slip_events) / travel if travel > 0 else math.nan
         expected = 1.0 if factor < 1 else 0.0
@@ -188,7 +197,39 @@ def _tomlinson_rows(engine: str, quick: bool) -> list[dict]:
                 "detail": f"{len(run.slip_events)} slips in {travel:.2f} wavelengths; {run.end_reason.value}",
             }
         )
-    return rows
+    return [*rows, _onset_row(engine, c, surf, waves)]
+
+
+def _corrugation_run(engine: str, surf, k: float, ie: float, waves: int):
+    """The spring drive at stiffness number ``k`` and ``ie`` over ``waves`` wavelengths."""
+    rig = _rig(engine, surf, tip_radius_m=0.01 * sim.DEFAULT_LENGTH_SCALE_M, ie=ie, stiffness_number=k)
+    sc = rig.scales
+    speed = sc.speed_for(ie)
+    duration = waves * sim.DEFAULT_LENGTH_SCALE_M / speed
+    drive = sim.SpringDrive(speed_m_s=speed, stiffness_n_m=sc.stiffness_for(k), duration_s=duration)
+    return rig.run(drive, start=(0.75, 0.0))
+
+
+def _onset_row(engine: str, c: Corrugation, surf, waves: int) -> dict:
+    """The largest slip onset force at :data:`ONSET_FACTOR` K* and the ground truth's
+    I_e against ``W kappa`` at the fold."""
+    from spine_mj.validate.ground_truth import TOMLINSON_IE
+
+    k = ONSET_FACTOR * c.critical_stiffness()
+    run = _corrugation_run(engine, surf, k, TOMLINSON_IE, waves)
+    fold = c.fold(k)[1]
+    onset = max((e.onset_force_n for e in run.slip_events), default=math.nan) / run.scales.preload_n
+    err = onset / fold - 1
+    return {
+        "check": "Prandtl-Tomlinson onset force at the fold",
+        "case": f"s = 0.3, mu = {MU:g}, K = {ONSET_FACTOR:g} K* (I_e = {TOMLINSON_IE:g}), largest onset",
+        "closed_form": fold,
+        "measured": onset,
+        "error": err,
+        "ok": bool(abs(err) <= ONSET_TOL),
+        "tolerance": f"{ONSET_TOL:.0%}",
+        "detail": f"in F_p, {len(run.slip_events)} slips",
+    }
 
 
 def groove(theta_deg: float, alpha_deg: float, half_width_m: float = 0.02, n: int = 81) -> GridSurface:
@@ -201,37 +242,45 @@ def groove(theta_deg: float, alpha_deg: float, half_width_m: float = 0.02, n: in
     return GridSurface(heights=h, x=x, y=x.copy(), unit="m", metadata={"generator": "groove"})
 
 
-def _groove_rows(engine: str, **settings) -> list[dict]:
-    """The groove checks in ``engine``; ``settings`` replace fields of its engine settings
-    (Bullet's ``friction_anchor``: the wedge's creep, docs/physics.md §11)."""
+def _with_settings(rig, settings: dict):
+    """``rig`` with ``settings`` replacing fields of its engine settings (its scales and
+    hfield kept): the measured cause of a Bullet pitfall, run beside the rule's choice."""
     import dataclasses
 
+    if not settings:
+        return rig
+    engine = dataclasses.replace(rig.engine, **settings)
+    return type(rig)(rig.surface, tip=rig.tip, engine=engine, sized=(rig.scales, rig.hfield))
+
+
+def _settings_label(settings: dict) -> str:
+    return "".join(f", {k} = {v}" for k, v in settings.items())
+
+
+def _groove_rows(engine: str, **settings) -> list[dict]:
+    """The groove checks in ``engine``; ``settings`` replace fields of its engine settings
+    (Bullet's ``friction_anchor="never"``: the wedge's creep, docs/physics.md §11)."""
     rows = []
     for theta, alpha in GROOVES:
-        wedge = math.radians(theta) + math.atan(MU / math.cos(math.radians(alpha)))
+        wedge = math.radians(theta) + math.atan(MU / math.cos(flank_tilt(theta, alpha)))
         lock = wedge >= math.pi / 2
         kappa = math.inf if lock else math.tan(wedge)
         single = math.tan(math.radians(theta) + math.atan(MU))
         cap = 20.0 if lock else 2 * kappa
-        rig = _rig(engine, groove(theta, alpha), ie=1e-2, tip_radius_m=2e-3)
-        if settings:
-            rig = type(rig)(
-                rig.surface,
-                tip=rig.tip,
-                engine=dataclasses.replace(rig.engine, **settings),
-                sized=(rig.scales, rig.hfield),
-            )
+        rig = _with_settings(_rig(engine, groove(theta, alpha), ie=1e-2, tip_radius_m=2e-3), settings)
         det = sim.Detection(kappa_cap=cap)
         # where gravity alone would slide the tip down the groove it is held at twice the
         # force that holds it
-        hold = 2 * max(0.0, math.tan(math.radians(theta) - math.atan(MU / math.cos(math.radians(alpha)))))
+        hold = 2 * max(
+            0.0, math.tan(math.radians(theta) - math.atan(MU / math.cos(flank_tilt(theta, alpha))))
+        )
         drive = sim.build_drive(rig.scales, "static", ie=1e-2, start_force_n=hold * rig.scales.preload_n)
         run = rig.run(drive, start=(0.0, 0.0), detection=det)
         locked = run.end_reason is sim.EndReason.SELF_LOCK
         row = {
             "check": "V-groove wedge",
             "case": f"theta {theta:g} deg, alpha {alpha:g} deg (single-contact rule: {single:.3g})"
-            + "".join(f", {k} = {v}" for k, v in settings.items()),
+            + _settings_label(settings),
             "closed_form": "self-lock" if lock else kappa,
             "measured": "self-lock" if locked else run.kappa_mj,
             "tolerance": "lock" if lock else f"{STATIC_TOL:.0%}",
@@ -244,6 +293,13 @@ def _groove_rows(engine: str, **settings) -> list[dict]:
             row.update(error=err, ok=bool(abs(err) <= STATIC_TOL))
         rows.append(row)
     return rows
+
+
+def flank_tilt(theta_deg: float, alpha_deg: float) -> float:
+    """The flanks' tilt [rad] of :func:`groove` in the groove's own inclined plane (the
+    closed form's alpha): ``tan(alpha') = tan(alpha) cos(theta)`` (the flank's normal
+    ``(-tan theta, -+tan alpha, 1)`` seen across the groove's line ``(1, 0, tan theta)``)."""
+    return math.atan(math.tan(math.radians(alpha_deg)) * math.cos(math.radians(theta_deg)))
 
 
 def dai_surface(sphere_m: float, tip_m: float) -> GridSurface:
@@ -267,12 +323,15 @@ def dai_start(ball, sphere_m: float, tip_m: float) -> tuple[float, float]:
     return float(xs[lifted[0]]), 0.0
 
 
-def _dai_rows(engine: str) -> list[dict]:
+def _dai_rows(engine: str, factors=DAI_FACTORS, **settings) -> list[dict]:
+    """Dai's interlock at ``factors`` times the threshold; ``settings`` as for the groove
+    (Bullet's ``internal_edges=False``: the contact normal at the floor-sphere kink)."""
     thr = dai_threshold(MU)
     rows = []
-    for f in DAI_FACTORS:
+    for f in factors:
         tip_m = DAI_SPHERE_M / (f * thr)
         rig = _rig(engine, dai_surface(DAI_SPHERE_M, tip_m), ie=1.0, tip_radius_m=tip_m)
+        rig = _with_settings(rig, settings)
         ball = rig.contact_surface()
         start = dai_start(ball, DAI_SPHERE_M, tip_m)
         gx, gy = ball.gradient(np.array([start[0]]), np.array([start[1]]))
@@ -291,7 +350,7 @@ def _dai_rows(engine: str) -> list[dict]:
         rows.append(
             {
                 "check": "Dai interlock",
-                "case": f"R / r = {f:g} x {thr:.3f}",
+                "case": f"R / r = {f:g} x {thr:.3f}" + _settings_label(settings),
                 "closed_form": "self-lock" if lock else kappa,
                 "facets": "self-lock" if lock_facets else float(k_facets),
                 "measured": "self-lock" if locked else run.kappa_mj,
@@ -303,6 +362,40 @@ def _dai_rows(engine: str) -> list[dict]:
                 "creep_radii_per_s": _creep(run, held) if locked else math.nan,
             }
         )
+    return rows
+
+
+def _liftoff_rows(engine: str) -> list[dict]:
+    """Lift-off over the ground truth's Gaussian ridges: contact kept at
+    :data:`~spine_mj.validate.ground_truth.LIFTOFF_BELOW` I_e*, a flight by
+    :data:`~spine_mj.validate.ground_truth.LIFTOFF_ABOVE` I_e* (the MuJoCo test's tolerance)."""
+    from spine_mj.validate.ground_truth import (
+        LIFTOFF_ABOVE,
+        LIFTOFF_BELOW,
+        LIFTOFF_GAP_RADII,
+        crest_check,
+    )
+
+    rows = []
+    for width in LIFTOFF_WIDTHS:
+        for factor, expect in ((LIFTOFF_BELOW, "contact"), (LIFTOFF_ABOVE, "flight")):
+            ie, gap, flight = crest_check(width, factor, engine)
+            if expect == "contact":
+                ok = ie < 0.8 and gap < LIFTOFF_GAP_RADII and flight == 0.0
+            else:
+                ok = ie > 1.0 and gap > 2 * LIFTOFF_GAP_RADII and flight > 0.25
+            rows.append(
+                {
+                    "check": "crest lift-off",
+                    "case": f"Gaussian ridge, width {width:g} L_c, carriage at {factor:g} I_e*",
+                    "closed_form": expect,
+                    "measured": "flight" if flight > 0 else "contact",
+                    "error": math.nan,
+                    "ok": bool(ok),
+                    "tolerance": "contact at 0.6 I_e*, a flight over 1/4 width at 1.6 I_e*",
+                    "detail": f"crest I_e {ie:.3g} I_e*, gap {gap:.3g} tip radii, flight {flight:.3g} widths",
+                }
+            )
     return rows
 
 
@@ -345,10 +438,14 @@ def engines_ground_truth(
         "static kappa": _static_rows,
         "spring-block": _spring_block_rows,
         "V-groove": _groove_rows,
-        "V-groove, Bullet's friction anchors on": lambda e: (
-            _groove_rows(e, friction_anchor=True) if e == "bullet" else []
+        "V-groove, Bullet's friction anchors never": lambda e: (
+            _groove_rows(e, friction_anchor="never") if e == "bullet" else []
         ),
         "Dai interlock": _dai_rows,
+        "Dai interlock, Bullet's internal edges off": lambda e: (
+            _dai_rows(e, (0.97,), internal_edges=False) if e == "bullet" else []
+        ),
+        "crest lift-off": _liftoff_rows,
         "creep": _creep_rows,
         "Prandtl-Tomlinson": lambda e: _tomlinson_rows(e, quick),
     }

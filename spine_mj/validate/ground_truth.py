@@ -33,7 +33,7 @@ from spine_mj.theory.tomlinson_dynamics import PTParams, SineProfile, integrate
 from spine_mj.validate.plans import GRAVITY, MASS_KG, ValidationPlan
 from spine_mj.validate.study_runner import StudyRunner
 
-__all__ = ["GroundTruthResult", "ground_truth", "spring_block_check", "spring_block_ladder"]
+__all__ = ["GroundTruthResult", "crest_check", "ground_truth", "spring_block_check", "spring_block_ladder"]
 
 #: I_e of the Prandtl-Tomlinson runs (the quasistatic corner).
 TOMLINSON_IE = 1e-4
@@ -56,6 +56,10 @@ RIDGE_SOLREF_S = 1e-3
 RIDGE_K = 300.0
 #: The tip has left the crest when its centre rises this many tip radii above its path.
 LIFTOFF_GAP_RADII = 0.5
+#: The lift-off check's tolerance, in carriage I_e over I_e*: contact holds at the first and
+#: is lost by the second (the scan measured the crest I_e that first left within
+#: 0.85-1.11 I_e* at width 0.5 and 1.23-1.66 I_e* at width 0.35).
+LIFTOFF_BELOW, LIFTOFF_ABOVE = 0.6, 1.6
 
 
 @dataclass(frozen=True)
@@ -363,6 +367,29 @@ def _liftoff(plan: ValidationPlan, runner: StudyRunner, width: float) -> dict:
         "ratio_low": last_held / ie_star,
         "ratio_high": first / ie_star,
     }
+
+
+def crest_check(width: float, factor: float, engine: str = "mujoco") -> tuple[float, float, float]:
+    """One carriage over :func:`ridge` of ``width`` at ``factor`` times the predicted I_e* in
+    ``engine`` (the scan's tip, spring, mu and step; MuJoCo also its contact time constant):
+    ``(crest I_e / I_e*, largest crest gap [tip radii], longest flight [widths])``, the
+    crest I_e that of the speed measured at the crest."""
+    surf = ridge(width)
+    unit = sim.DEFAULT_LENGTH_SCALE_M
+    ie_star = liftoff_inertia_number(
+        gaussian_ridge_path_curvature(RIDGE_HEIGHT * unit, width * unit, RIDGE_TIP_M),
+        sim.characteristic_length(surf) * unit,
+    )
+    ie = factor * ie_star
+    soft = {"solref_timeconst_s": RIDGE_SOLREF_S} if engine == "mujoco" else {}
+    rig = sim.build_engine_rig(
+        surf, engine=engine, mu=0.3, tip_radius_m=RIDGE_TIP_M, timestep_s=RIDGE_TIMESTEP_S, ie=ie, **soft
+    )
+    res = rig.run(sim.build_drive(rig.scales, ie=ie, stiffness_number=RIDGE_K), start=(-2.0, 0.0))
+    x, z = res.position_m[:, 0] / unit, res.position_m[:, 2] / unit
+    crest_speed = res.velocity_m_s[np.abs(x) < 0.1 * width, 0].mean()
+    xs, gaps = crest_gaps(x, z, width, RIDGE_TIP_M / unit)
+    return factor * (crest_speed / res.speed_m_s) ** 2, float(gaps.max()), longest_flight(xs, gaps) / width
 
 
 def _crest_gap(x, z, width: float, tip: float) -> float:

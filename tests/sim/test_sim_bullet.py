@@ -95,23 +95,28 @@ def test_a_held_tip_does_not_creep():
 
 
 def test_friction_anchor_pitfall():
-    """A tip resting in a V-groove on two contacts creeps down it without friction anchors,
-    and a static probe reads the creep as a slide; with anchors it holds and breaks away at
-    the wedge's kappa. The default is off (anchors disturb sliding: docs/physics.md §11)."""
-    from spine_mj.validate.engines import groove
+    """A tip resting in a V-groove on two contacts: without friction anchors the load sits on
+    one flank at a time and the tip creeps down the groove (a static probe reads it as a
+    slide); with anchors while held (the rule) it holds and breaks away at the wedge's kappa."""
+    from spine_mj.validate.engines import flank_tilt, groove
 
     rig = sim.build_engine_rig(groove(20.0, 30.0), engine="bullet", mu=MU, tip_radius_m=2e-3, ie=1e-2)
-    assert not rig.engine.friction_anchor
-    wedge = math.tan(math.radians(20) + math.atan(MU / math.cos(math.radians(30))))
+    assert rig.engine.friction_anchor == "held"
+    wedge = math.tan(math.radians(20) + math.atan(MU / math.cos(flank_tilt(20.0, 30.0))))
     runs = {}
-    for anchor in (True, False):
+    for anchor in ("held", "never"):
         r = BulletRig(
-            rig.surface, tip=rig.tip, engine=dataclasses.replace(rig.engine, friction_anchor=anchor)
+            rig.surface,
+            tip=rig.tip,
+            engine=dataclasses.replace(rig.engine, friction_anchor=anchor),
+            sized=(rig.scales, rig.hfield),
         )
         runs[anchor] = r.run(sim.build_drive(r.scales, "static", ie=1e-2), start=(0.0, 0.0))
-    assert runs[True].end_reason is sim.EndReason.BREAKAWAY
-    assert runs[True].kappa_mj == pytest.approx(wedge, rel=0.05)
-    assert runs[False].end_reason is sim.EndReason.SLID
+    assert runs["held"].end_reason is sim.EndReason.BREAKAWAY
+    assert runs["held"].kappa_mj == pytest.approx(wedge, rel=0.05)
+    assert runs["never"].end_reason is sim.EndReason.SLID
+    with pytest.raises(SpineInputError, match="friction_anchor must be one of held, never, always"):
+        dataclasses.replace(rig.engine, friction_anchor=True)
 
 
 def test_internal_edge_pitfall():
