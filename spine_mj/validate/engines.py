@@ -59,6 +59,7 @@ from spine_mj import presets, sim
 from spine_mj.surfaces import GridSurface
 from spine_mj.theory import engagement
 from spine_mj.theory.tomlinson import Corrugation
+from spine_mj.validate.report.engines import section
 
 __all__ = ["EnginesResult", "dai_threshold", "engines_ground_truth", "section"]
 
@@ -466,98 +467,6 @@ def engines_ground_truth(
                         merged[f"{engine}_{k}"] = row[k]
         wall[engine] = round(time.perf_counter() - t0, 1)
     return EnginesResult(rows=list(by_key.values()), engines=tuple(engines), wall_s=wall)
-
-
-def _fmt(v) -> str:
-    if v is None:
-        return "-"
-    if isinstance(v, str):
-        return v
-    if isinstance(v, bool):
-        return "yes" if v else "**no**"
-    if isinstance(v, float) and not math.isfinite(v):
-        return "n/a"
-    return f"{v:.4g}"
-
-
-def section(res: EnginesResult | None) -> str:
-    """The report section "Engines side by side: the closed forms" ("" without a result)."""
-    if res is None:
-        return ""
-    engines = res.engines
-    head = ["check", "case", "closed form", "facets' rule"]
-    for e in engines:
-        head += [f"{e}", f"{e} error", f"{e} within"]
-    head += ["tolerance"]
-    lines = [
-        "## Engines side by side: the closed forms",
-        "",
-        "Each closed form run the same way in MuJoCo (soft contact) and Bullet (hard contact; "
-        "docs/physics.md §11), with the tolerance the MuJoCo report states. The facets' rule is "
-        "the closed form applied to the contact normal of the heightfield's facets at the start "
-        "(what both engines collide with).",
-        "",
-        "| " + " | ".join(head) + " |",
-        "|" + "---|" * len(head),
-    ]
-    for r in res.rows:
-        cells = [r["check"], r["case"], _fmt(r["closed_form"]), _fmt(r.get("facets"))]
-        for e in engines:
-            err = r.get(f"{e}_error")
-            err_s = (
-                "-" if err is None or (isinstance(err, float) and not math.isfinite(err)) else f"{err:+.2%}"
-            )
-            ok = r.get(f"{e}_ok")
-            if "facets" in r:
-                ok_f = r.get(f"{e}_ok_facets")
-                ok_s = f"{_fmt(ok)} (facets: {_fmt(ok_f)})"
-            else:
-                ok_s = _fmt(ok)
-            cells += [_fmt(r.get(f"{e}_measured")), err_s, ok_s]
-        cells.append(r["tolerance"])
-        lines.append("| " + " | ".join(cells) + " |")
-    creep = [r for r in res.rows if r["check"] == "Dai interlock"]
-    if creep:
-        lines += [
-            "",
-            "Creep while locked against the sphere (tip radii / s): "
-            + "; ".join(
-                f"{r['case']}: " + ", ".join(f"{e} {_fmt(r.get(f'{e}_creep_radii_per_s'))}" for e in engines)
-                for r in creep
-            )
-            + ".",
-        ]
-    lines += ["", "Wall time: " + ", ".join(f"{e} {s:g} s" for e, s in res.wall_s.items()) + "."]
-    lines += _fractal_lines(res.fractal)
-    return "\n".join(lines) + "\n"
-
-
-def _fractal_lines(rows) -> list[str]:
-    """The fractal self-lock rate against H, the engines side by side."""
-    if not rows:
-        return []
-    engines = list(dict.fromkeys(r["engine"] for r in rows))
-    head = ["H", *[f"{e} self-lock rate (95 % interval; locked / ok runs; failed)" for e in engines]]
-    out = [
-        "",
-        "### Fractal self-lock rate against H, both engines",
-        "",
-        f"The validation's fractal study (paper-fractal, Fig. 9 height scale and seeds, one start "
-        f"per surface, default spring K = 30) at I_e = {rows[0]['ie']:g} in each engine.",
-        "",
-        "| " + " | ".join(head) + " |",
-        "|" + "---|" * len(head),
-    ]
-    for h in dict.fromkeys(r["hurst"] for r in rows):
-        cells = [f"{h:g}"]
-        for e in engines:
-            (r,) = [r for r in rows if r["hurst"] == h and r["engine"] == e]
-            cells.append(
-                f"{_fmt(r['rate'])} ({_fmt(r['ci_low'])}-{_fmt(r['ci_high'])}; {r['locked']} / {r['n_ok']}; "
-                f"{r['failed_runs']})"
-            )
-        out.append("| " + " | ".join(cells) + " |")
-    return out
 
 
 def main(argv=None) -> None:
