@@ -41,6 +41,15 @@ from spine_mj.sim.layout import Layout
 from spine_mj.sim.model import RigModel, compile_spec, start_pair
 from spine_mj.sim.rollout import drive_steps
 
+#: Why arrays run in MuJoCo only: an array is one MuJoCo model (N tips on slide joints, their
+#: springs, a free carriage body tied to them by tendons under force control) stepped in
+#: batches by MuJoCo's rollout; Bullet's rig is one tip stepped in Python, and an array there
+#: would need its own N-body world and carriage coupling.
+ARRAY_ENGINE_REFUSAL = (
+    "engine bullet: spine arrays run in MuJoCo only (one MuJoCo model of N tips and their "
+    "carriage; Bullet's rig is one tip): use engine mujoco for arrays"
+)
+
 
 class ArrayRig:
     """One MuJoCo model of an array of spines on ``rig``'s surface (see the module docstring).
@@ -61,6 +70,8 @@ class ArrayRig:
     """
 
     def __init__(self, rig: RigModel, layout: Layout, *, force_control: bool = False):
+        if not isinstance(rig, RigModel):
+            raise SpineInputError(ARRAY_ENGINE_REFUSAL)
         if not isinstance(layout, Layout):
             raise SpineInputError(f"layout must be a Layout, got {type(layout).__name__}")
         self.rig, self.layout, self.force_control = rig, layout, bool(force_control)

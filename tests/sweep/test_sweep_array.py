@@ -93,3 +93,18 @@ def test_array_sweep_without_a_pace_runs_at_the_arrays_default_pace(tmp_path):
 
     mu = presets.preset_mu("corrugation")
     np.testing.assert_allclose(runs.holding_excess_predicted, 0.01 * mu, rtol=1e-9)
+
+
+def test_arrays_on_bullet_are_refused_in_one_line(tmp_path):
+    """Arrays run in MuJoCo only (one MuJoCo model of N tips and their carriage): engine
+    bullet is refused at config time, and an ArrayRig on a Bullet rig the same way."""
+    pytest.importorskip("pybullet", reason="the Bullet engine needs the [bullet] extra (pybullet)")
+    from spine_mj import sim
+
+    doc = ARRAY + '[grid]\nengine = ["mujoco", "bullet"]\n'
+    with pytest.raises(SpineInputError, match=r"^engine bullet: spine arrays run in MuJoCo only") as err:
+        sweep.load_config(write_config(tmp_path, doc))
+    assert "\n" not in str(err.value)
+    rig = sim.build_engine_rig(sim.inclined_plane(slope_deg=0.0), engine="bullet", mu=0.5)
+    with pytest.raises(SpineInputError, match="spine arrays run in MuJoCo only"):
+        sim.ArrayRig(rig, sim.Layout(rows=2, cols=2))

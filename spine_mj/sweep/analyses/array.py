@@ -21,6 +21,7 @@ import numpy as np
 
 from spine_mj import sim
 from spine_mj.errors import SpineInputError
+from spine_mj.sim.array import ARRAY_ENGINE_REFUSAL
 from spine_mj.sim.drives import spring_stiffness_n_m
 from spine_mj.sim.layout import MAX_SPINES
 from spine_mj.sweep.analyses.mujoco import MUJOCO_PARAMS, case_rig, case_scales
@@ -68,6 +69,8 @@ def _check_layouts(config) -> None:
     random layout reads it, and a random layout whose spines cannot stand apart at its
     spacing on a case's surface (placed as the run would, from the case's tip and scales)."""
     grid = dict(config.grid)
+    if "bullet" in grid["engine"]:
+        raise SpineInputError(ARRAY_ENGINE_REFUSAL)
     if grid["layout_seed"] != (0,) and "random" not in grid["layout"]:
         raise SpineInputError(
             f"config key layout_seed = {list(grid['layout_seed'])}: the {' and '.join(grid['layout'])} "
