@@ -4,6 +4,11 @@ results as MuJoCo's, the closed forms, and each Bullet pitfall measured with its
 import dataclasses
 import json
 import math
+import os
+import signal
+import subprocess
+import sys
+import time
 
 import numpy as np
 import pandas as pd
@@ -326,21 +331,75 @@ hfield_resolution = 61
 """
 
 
-def test_a_sweep_over_both_engines_resumes(tmp_path):
-    cfg = write_config(tmp_path, ENGINE_SWEEP)
+def _run_cases_alone(cfg):
+    """Each case of ``cfg`` run on its own (no sweep, no store): run_id -> end_x."""
+    got = {}
+    for case in sweep.expand_cases(sweep.load_config(cfg)):
+        rows, _ = sweep.run_case(case)
+        got.update(rows.to_pandas().set_index("run_id")["end_x"].to_dict())
+    return got
+
+
+KILL_SWEEP = ENGINE_SWEEP.replace("points = [[-3.0, -1.0], [-3.0, 1.0]]", "points = [[-3.0, -1.0]]").replace(
+    "hfield_resolution = 61", "hfield_resolution = 61\nmu = [0.6, 0.7, 0.8, 0.9, 1.0, 1.1, 1.2, 1.3]"
+)
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="kills a process group")
+def test_a_sweep_over_both_engines_killed_midway_resumes_to_the_same_results(tmp_path):
+    """The CLI sweep over ``engine = ["mujoco", "bullet"]`` killed (SIGKILL) once some cases
+    are stored, then resumed: every run stored once, the stored numbers those of each case
+    run on its own, in both engines."""
+    cfg = write_config(tmp_path, KILL_SWEEP)
     out = tmp_path / "out"
-    sweep.run_sweep(cfg, out, workers=1)
-    before = (
-        sweep.load_runs(out).drop(columns=["time_s", "cpu_s"]).sort_values("run_id").reset_index(drop=True)
-    )
-    assert sorted(before["engine"].unique()) == ["bullet", "mujoco"]
-    assert (before["status"] == "ok").all()
-    files = sorted((out / "runs").glob("*.parquet"))
-    files[0].unlink()  # a case lost to a kill
-    (out / "runs.parquet").unlink(missing_ok=True)
+    cmd = [
+        sys.executable,
+        "-m",
+        "spine_mj.cli",
+        "sweep",
+        str(cfg),
+        "--out",
+        str(out),
+        "--workers",
+        "1",
+        "--quiet",
+    ]
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, start_new_session=True)
+
+    def n_done():
+        return len([p for p in (out / "runs").glob("*.parquet") if not p.name.startswith(".")])
+
+    deadline = time.monotonic() + 120
+    try:
+        while time.monotonic() < deadline and proc.poll() is None and n_done() < 2:
+            time.sleep(0.005)
+    finally:
+        os.killpg(proc.pid, signal.SIGKILL)
+        proc.wait()
+    assert proc.returncode == -signal.SIGKILL, proc.stderr.read()
+    killed_at = n_done()
+    assert 2 <= killed_at < 16, "the sweep must be killed midway"
+
     summary = sweep.run_sweep(cfg, out, workers=1)
-    assert (summary.run_cases, summary.skipped_cases) == (1, 1)
-    after = (
-        sweep.load_runs(out).drop(columns=["time_s", "cpu_s"]).sort_values("run_id").reset_index(drop=True)
-    )
-    pd.testing.assert_frame_equal(after, before)
+    assert summary.skipped_cases == killed_at and summary.run_cases == 16 - killed_at
+    runs = sweep.load_runs(out)
+    assert len(runs) == 16 and runs.run_id.is_unique and (runs["status"] == "ok").all()
+    assert sorted(runs["engine"].unique()) == ["bullet", "mujoco"]
+    alone = _run_cases_alone(cfg)
+    np.testing.assert_array_equal(runs.set_index("run_id").loc[list(alone), "end_x"], list(alone.values()))
+
+
+def test_a_sweep_over_both_engines_on_a_dask_cluster_stores_what_one_process_stores(tmp_path):
+    """The Dask path runs Bullet cases too (threads of a local cluster, one pybullet client
+    per rig): the same rows as one worker process."""
+    from distributed import LocalCluster
+    from sweep_support import metrics_frame
+
+    cfg = write_config(tmp_path, ENGINE_SWEEP)
+    sweep.run_sweep(cfg, tmp_path / "w1", workers=1)
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None) as cluster:
+        summary = sweep.run_sweep(cfg, tmp_path / "dask", scheduler=cluster.scheduler_address)
+    assert summary.run_cases == 2
+    ref = metrics_frame(tmp_path / "w1")
+    assert sorted(ref["engine"]) == ["bullet", "bullet", "mujoco", "mujoco"] and (ref["status"] == "ok").all()
+    pd.testing.assert_frame_equal(metrics_frame(tmp_path / "dask"), ref)
