@@ -9,7 +9,13 @@ surface, pure numpy on the analytic side:
   (:func:`spine_mj.theory.compliant.hold_force`, kappa where engaged): below it the carriage
   position that holds the tip, ``X = x + (W / k) H``, falls somewhere along a path, a fold
   of the compliant-drive streamline (:mod:`spine_mj.theory.compliant`). On a corrugation this is
-  the Prandtl-Tomlinson ``K* = l_s max(-d kappa / dx)``.
+  the Prandtl-Tomlinson ``K* = l_s max(-d kappa / dx)``. It is the first fold anywhere, a
+  sufficient condition; the comparison's criterion sees a fold only through what its jump
+  does to the path's trace and outcome (a jump along the path leaves the trace where it
+  was). ``K_path`` (:func:`path_stiffness`), given the starts of a measurement, is the
+  stiffness where the compliant-drive paths (the spring drive's ``I_e -> 0`` limit) meet
+  that criterion against the rigid ones: the boundary a measurement with that criterion
+  sees, ``<= K*`` on the same paths (no fold: the two paths coincide).
 * ``I_e*`` the lowest of three thresholds. *Lift-off*: a tip carried at horizontal speed
   ``v`` over a profile ``z(h)`` (h: horizontal arc length along the path) needs the
   vertical acceleration ``z'' v^2``; preload and gravity give at most ``F_p / m``, so it
@@ -25,6 +31,11 @@ surface, pure numpy on the analytic side:
   friction (``mu F_p`` at most) has taken its kinetic energy: over ``m v^2 / (2 mu F_p) =
   I_e L_c / (2 mu)``. The path lags the streamline by that much; it stays within a path
   tolerance ``t L_c`` while ``I_e < 2 mu t``.
+* For a spring drive of stiffness ``K`` two more (:func:`spring_ie_limits`): the tip set
+  sliding from rest swings about its quasistatic place by ``L_c sqrt(I_e / K_c)`` and its
+  drive force by ``sqrt(I_e K_c) F_p`` (the spring-block, ``K_c = K L_c / l_s``): within
+  the path tolerance while ``I_e < t^2 K_c``, within :data:`SWING_BOUND_FP` while
+  ``I_e < 1 / K_c``.
 """
 
 from __future__ import annotations
@@ -35,14 +46,36 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from spine_mj import roughness
+from spine_mj.compare import outcome_agreement, path_frechet
 from spine_mj.errors import SpineInputError
 from spine_mj.surfaces import Surface
 from spine_mj.theory import streamline as sl
-from spine_mj.theory.compliant import hold_force
+from spine_mj.theory.compliant import compliant_streamlines, hold_force
 from spine_mj.theory.engagement import DEFAULT_KAPPA_CAP, SELF_LOCK
-from spine_mj.theory.targets import FRECHET_TARGET
+from spine_mj.theory.targets import FRECHET_TARGET, OUTCOME_TARGET
 
-__all__ = ["DriveLimits", "crest_curvature", "drive_limits", "kappa_fall", "trap_depths"]
+__all__ = [
+    "SWING_BOUND_FP",
+    "DriveLimits",
+    "crest_curvature",
+    "drive_limits",
+    "kappa_fall",
+    "path_criterion",
+    "path_stiffness",
+    "spring_ie_limits",
+    "trap_depths",
+]
+
+#: The largest spring-block force swing ``V sqrt(k m)`` (in F_p) with which a spring drive
+#: is still quasistatic: a dynamic excess as large as the preload itself, the scale of every
+#: quasistatic force of the problem (it unloads the tip on a 45 degree downslope, where the
+#: normal load is ``(W + F dz/dx) / sqrt(1 + |grad z|^2)``; docs/physics.md §8).
+SWING_BOUND_FP = 1.0
+
+#: ``K_path`` is bracketed to this factor (the map's ladder steps are 3 and more).
+PATH_STIFFNESS_RESOLUTION = 2 ** (1 / 4)
+#: The softest K ``path_stiffness`` tries, as a fraction of the paths' own fold ``K*``.
+PATH_STIFFNESS_RANGE = 1e-3
 
 
 @dataclass(frozen=True)
@@ -72,6 +105,12 @@ class DriveLimits:
     min_trap_depth : float
         The shallowest trap's ``D`` (length; inf without traps).
     n_paths, n_traps : int
+    k_path : float
+        ``K_path``: the smallest stiffness at which the compliant-drive paths from
+        ``path_starts`` meet the comparison's criterion against the rigid ones
+        (:func:`path_stiffness`; NaN: not computed, no ``path_starts``).
+    k_star_path_starts : float
+        The fold ``K*`` on the paths from ``path_starts`` (NaN: not computed).
     """
 
     k_star: float
@@ -88,6 +127,8 @@ class DriveLimits:
     min_trap_depth: float
     n_paths: int
     n_traps: int
+    k_path: float = math.nan
+    k_star_path_starts: float = math.nan
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -95,7 +136,9 @@ class DriveLimits:
     def sentence(self) -> str:
         """``"quasistatic needs K > ... and I_e < ..."``."""
         return (
-            f"quasistatic needs K > {self.k_star:.3g} and I_e < {self.ie_star:.3g} "
+            f"quasistatic needs K > {self.k_star:.3g}"
+            + (f" (the paths from the starts given: {self.k_path:.3g})" if math.isfinite(self.k_path) else "")
+            + f" and I_e < {self.ie_star:.3g} "
             f"(set by {self.limit}; lift-off {self.ie_lift:.3g}, trap {self.ie_trap:.3g}, "
             f"lag {self.ie_lag:.3g})"
         )
@@ -151,6 +194,123 @@ def trap_depths(surface: Surface, x, y, f_arrival, mu: float, *, step: float, ka
     return np.where(np.isfinite(x), dz + mu * dx + f * (mu * dz - dx), np.inf)
 
 
+def spring_ie_limits(
+    stiffness_number: float,
+    lc_over_ls: float,
+    *,
+    path_tolerance: float = FRECHET_TARGET,
+    force_bound: float = SWING_BOUND_FP,
+) -> dict[str, float]:
+    """The inertia numbers at which a spring drive of stiffness ``K`` stops being
+    quasistatic through its own swing (docs/physics.md §8). A tip set sliding from rest
+    behind a carriage at ``V`` swings about its quasistatic place with the spring-block's
+    amplitudes: ``V / w = L_c sqrt(I_e / K_c)`` in position and ``V sqrt(k m) =
+    sqrt(I_e K_c) F_p`` in force (``K_c = K L_c / l_s``, :func:`spine_mj.sim.holding.spring_swing`).
+
+    Returns
+    -------
+    dict
+        ``"swing-path"``: where the position swing reaches the path tolerance ``t L_c``,
+        ``t^2 K_c``; ``"swing-force"``: where the force swing reaches ``force_bound`` F_p,
+        ``force_bound^2 / K_c`` (inf for both without a finite positive ``K_c``).
+    """
+    kc = float(stiffness_number) * float(lc_over_ls)
+    if not (math.isfinite(kc) and kc > 0):
+        return {"swing-path": math.inf, "swing-force": math.inf}
+    return {"swing-path": path_tolerance**2 * kc, "swing-force": force_bound**2 / kc}
+
+
+def path_criterion(rigid, compliant, char_length: float) -> tuple[float, float]:
+    """Outcome agreement (share of starts) and median Frechet distance (in ``L_c``, x-y
+    traces) of ``compliant`` paths against the ``rigid`` ones from the same starts: the
+    comparison a spring-drive run meets against its streamline
+    (:func:`spine_mj.compare.outcome_agreement`, :func:`spine_mj.compare.path_frechet`; a
+    rigid path that stalled decided nothing and disagrees, as in the sweep's comparison)."""
+    agree = outcome_agreement(
+        rigid.self_locked,
+        np.column_stack([rigid.end_x, rigid.end_y]),
+        compliant.self_locked,
+        np.column_stack([compliant.end_x, compliant.end_y]),
+        length_scale=char_length,
+    )["agree"] & (rigid.outcome != sl.Outcome.STALLED)
+    frechet = [
+        path_frechet(
+            np.column_stack([compliant.path(i)["x"], compliant.path(i)["y"]]),
+            np.column_stack([rigid.path(i)["x"], rigid.path(i)["y"]]),
+            length_scale=char_length,
+        )
+        for i in range(len(rigid))
+    ]
+    return float(np.mean(agree)), float(np.median(frechet))
+
+
+def path_stiffness(
+    surface: Surface,
+    starts,
+    params: sl.StreamlineParams,
+    *,
+    slope_length: float,
+    char_length: float,
+    frechet_target: float = FRECHET_TARGET,
+    outcome_target: float = OUTCOME_TARGET,
+) -> tuple[float, float]:
+    """``K_path``: the smallest ``K = k l_s / W`` at which the compliant-drive paths from
+    ``starts`` meet the comparison's criterion against the rigid streamlines (outcome
+    agreement >= ``outcome_target``, median Frechet <= ``frechet_target``; docs/physics.md §8).
+
+    Above the fold ``K*`` of these paths (:func:`kappa_fall` along them) no path folds and the compliant path
+    is the rigid one, so the criterion holds there; below it a fold's jump counts only
+    through what it does to the trace (a lateral offset, a branch of the flow left) and the
+    outcome. The search halves ``K`` from the fold down to the stiffest K that fails (as a
+    measured boundary is the largest K that fails: softer springs can pass again, their
+    jumps running along the path), then bisects that halving to
+    :data:`PATH_STIFFNESS_RESOLUTION`.
+
+    Parameters
+    ----------
+    surface : Surface
+        The surface the tip's centre rides on (dilated by the tip radius where it has one).
+    starts : array_like, shape (n, 2)
+    params : StreamlineParams
+        Friction, step and force cap of both tracings.
+    slope_length, char_length : float
+        ``l_s`` (turns ``K`` into ``k / W``) and ``L_c`` (the Frechet distance's unit).
+    frechet_target, outcome_target : float
+        The criterion (default the comparison's, :mod:`spine_mj.theory.targets`).
+
+    Returns
+    -------
+    k_path : float
+        The passing end of the bracket (the first halving below
+        ``PATH_STIFFNESS_RANGE k_fold`` where none fails; 0 without a fold on any path).
+    k_fold : float
+        The fold ``K*`` on these paths.
+    """
+    pts = np.asarray(starts, float)
+    rigid = sl.streamlines(surface, pts, params, store_paths=True)
+    k_fold = slope_length * max(0.0, _path_statistics(surface, rigid, params.mu, params.kappa_cap)[0])
+    if not (k_fold > 0 and math.isfinite(k_fold)):
+        return 0.0, k_fold
+
+    def passes(k: float) -> bool:
+        comp = compliant_streamlines(surface, pts, params, stiffness=k / slope_length)
+        agreement, frechet = path_criterion(rigid, comp, char_length)
+        return agreement >= outcome_target and frechet <= frechet_target
+
+    # down from the fold in halvings to the stiffest K that fails (a measured boundary is
+    # the largest K that fails, too: softer springs can agree again, their jumps along
+    # the path), then that halving bisected
+    hi, lo = k_fold, k_fold / 2
+    while passes(lo):
+        if lo <= PATH_STIFFNESS_RANGE * k_fold:
+            return lo, k_fold
+        hi, lo = lo, lo / 2
+    while hi / lo > PATH_STIFFNESS_RESOLUTION:
+        mid = math.sqrt(lo * hi)
+        lo, hi = (lo, mid) if passes(mid) else (mid, hi)
+    return hi, k_fold
+
+
 def _path_statistics(surface: Surface, res, mu: float, kappa_cap: float) -> tuple[float, float, np.ndarray]:
     """Over the paths of ``res``: the steepest fall of the hold force ``max(-dH/dx)``, the
     sharpest crest ``max(-z'')``, and per path the last finite hold force (a trap's
@@ -187,6 +347,7 @@ def drive_limits(
     tip_radius: float = 0.0,
     kappa_cap: float = DEFAULT_KAPPA_CAP,
     path_tolerance: float = FRECHET_TARGET,
+    path_starts=None,
 ) -> DriveLimits:
     """Predict ``K*`` and ``I_e*`` of ``surface`` from its quasistatic paths (module doc).
 
@@ -206,6 +367,9 @@ def drive_limits(
     path_tolerance : float
         How far (in ``L_c``) a path may lag the streamline, for ``ie_lag``; default the
         comparison's Frechet target (:data:`spine_mj.theory.targets.FRECHET_TARGET`, 0.1).
+    path_starts : array_like, shape (m, 2), optional
+        The starts of a measurement: ``K_path`` (:func:`path_stiffness`) and the fold
+        ``K*`` on their paths are computed from them (NaN without).
 
     Returns
     -------
@@ -238,6 +402,9 @@ def drive_limits(
     ie_lag = 2.0 * float(mu) * float(path_tolerance)
     limits = {"lift-off": ie_lift, "trap": ie_trap, "lag": ie_lag}
     limit = min(limits, key=limits.get)
+    k_path = k_fold_starts = math.nan
+    if path_starts is not None:
+        k_path, k_fold_starts = path_stiffness(traced, path_starts, params, slope_length=l_s, char_length=l_c)
     return DriveLimits(
         k_star=l_s * max(0.0, max_fall),
         ie_star=limits[limit],
@@ -253,4 +420,6 @@ def drive_limits(
         min_trap_depth=min_depth,
         n_paths=len(res),
         n_traps=int(trapped.sum()),
+        k_path=k_path,
+        k_star_path_starts=k_fold_starts,
     )

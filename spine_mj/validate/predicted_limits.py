@@ -6,22 +6,42 @@ and generator variant: :func:`spine_mj.validate.stiffness_map.subset_starts`), w
 family's mu_s and traced on the surface dilated by the rig's tip radius
 (:func:`spine_mj.validate.paths.tip_radius`), i.e. what the MuJoCo tip's centre rides on.
 The family's ``K*`` is the largest of its surfaces' and its ``I_e*`` the smallest.
+
+``k_path`` is the boundary the map's criterion sees (:func:`~spine_mj.theory.drive_limits.path_stiffness`):
+the compliant-drive paths from the family's own starts (its x, its y range respread over
+``n_starts`` rows) against the rigid ones, the largest over its surfaces. ``lc_over_ls`` is
+the largest ``L_c / l_s`` of its surfaces (the spring-block swing's scale,
+:func:`spine_mj.sim.holding.spring_swing`).
 """
 
 from __future__ import annotations
+
+import numpy as np
 
 from spine_mj import presets
 from spine_mj.theory.drive_limits import drive_limits
 from spine_mj.validate.paths import tip_radius
 from spine_mj.validate.plans import FamilySpec, ValidationPlan
 
-__all__ = ["family_limits"]
+__all__ = ["family_limits", "path_starts"]
+
+
+def path_starts(fam: FamilySpec, surface, n: int) -> np.ndarray:
+    """``n`` starts of ``fam`` on ``surface``: its first x, its y range respread over ``n``
+    values (a relative frame scaled to the surface's bounds); shape ``(n, 2)``."""
+    t = fam.starts_table()
+    ys = np.linspace(min(t["y"]), max(t["y"]), n)
+    x = np.full(n, float(t["x"][0]))
+    if t.get("frame") == "relative":
+        xmin, xmax, ymin, ymax = surface.bounds
+        x, ys = xmin + x * (xmax - xmin), ymin + ys * (ymax - ymin)
+    return np.column_stack([x, ys])
 
 
 def family_limits(plan: ValidationPlan, fam: FamilySpec, *, n_starts: int = 8) -> dict:
-    """``{"k_star", "ie_star", "limit", "presets": {preset: DriveLimits.as_dict()}}`` of
-    ``fam`` on its first seed and variant (see module), from ``n_starts x n_starts`` paths
-    per surface."""
+    """``{"k_star", "k_path", "ie_star", "limit", "lc_over_ls", "presets": {preset:
+    DriveLimits.as_dict()}}`` of ``fam`` on its first seed and variant (see module), from
+    ``n_starts x n_starts`` paths per surface and ``n_starts`` from the family's starts."""
     seed = fam.seeds[0] if fam.seeds else None
     variant = dict(fam.variants[0]) if fam.variants else {}
     per = {}
@@ -30,11 +50,15 @@ def family_limits(plan: ValidationPlan, fam: FamilySpec, *, n_starts: int = 8) -
         surface = presets.make_surface(preset, **overrides)
         mu = fam.mu if fam.mu is not None else presets.calibrated_mu(preset)
         tip = tip_radius(preset, None if seed is None else (seed,), plan.hfield_resolution)
-        limits = drive_limits(surface, mu, tip_radius=tip, n_starts=n_starts)
+        limits = drive_limits(
+            surface, mu, tip_radius=tip, n_starts=n_starts, path_starts=path_starts(fam, surface, n_starts)
+        )
         per[preset] = dict(limits.as_dict(), tip_radius=tip)
     worst = min(per.values(), key=lambda d: d["ie_star"])
     return {
         "k_star": max(d["k_star"] for d in per.values()),
+        "k_path": max(d["k_path"] for d in per.values()),
+        "lc_over_ls": max(d["char_length"] / d["slope_length"] for d in per.values()),
         "ie_star": worst["ie_star"],
         "limit": worst["limit"],
         "presets": per,

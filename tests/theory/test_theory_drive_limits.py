@@ -6,9 +6,22 @@ from dataclasses import dataclass, field
 import numpy as np
 import pytest
 
+from spine_mj import roughness
 from spine_mj.errors import SpineInputError
+from spine_mj.sim.holding import spring_swing
 from spine_mj.surfaces import GaussianSurface, Surface, corrugation
-from spine_mj.theory.drive_limits import crest_curvature, drive_limits, kappa_fall, trap_depths
+from spine_mj.theory import streamline as sl
+from spine_mj.theory.compliant import compliant_streamlines
+from spine_mj.theory.drive_limits import (
+    PATH_STIFFNESS_RESOLUTION,
+    crest_curvature,
+    drive_limits,
+    kappa_fall,
+    path_criterion,
+    path_stiffness,
+    spring_ie_limits,
+    trap_depths,
+)
 
 
 @dataclass(frozen=True, eq=False)
@@ -25,6 +38,29 @@ class Wall(Surface):
         on = (x > 0) & (x < self.w)
         out = (self.t * np.clip(x, 0, self.w), np.where(on, self.t, 0.0), np.zeros_like(x))
         return out[:1] if order == 0 else out
+
+
+@dataclass(frozen=True, eq=False)
+class Tilted(Surface):
+    """A corrugation of steepest slope ``s`` and unit wavelength whose crests run at ``phi``
+    to the y axis: a fold's jump (along ``F u_x + W g``) leaves the slide's direction."""
+
+    s: float = 0.4
+    phi: float = 0.5
+    bounds: tuple = (0.0, 4.0, -1.5, 1.5)
+    unit: str = "1"
+    metadata: dict = field(default_factory=dict)
+
+    def _evaluate(self, x, y, order):
+        c, sn = np.cos(self.phi), np.sin(self.phi)
+        u = 2 * np.pi * (x * c + y * sn)
+        out = (self.s / (2 * np.pi) * np.sin(u), self.s * np.cos(u) * c, self.s * np.cos(u) * sn)
+        return out[:1] if order == 0 else out
+
+
+def _left_starts(surf, n):
+    xmin, xmax, ymin, ymax = surf.bounds
+    return np.column_stack([np.full(n, xmin + 0.05 * (xmax - xmin)), np.linspace(ymin + 0.3, ymax - 0.3, n)])
 
 
 @pytest.mark.parametrize("s, mu", [(0.3, 0.5), (0.5, 0.8)])
@@ -75,6 +111,54 @@ def test_trap_depth_of_a_wall_is_the_work_to_its_top():
     assert d.n_traps == 2 and d.ie_star == d.ie_trap and d.limit == "trap"
     assert d.min_trap_depth == pytest.approx(t * w + mu * w + mu * (mu * t * w - w), rel=0.05)
     assert d.ie_trap == pytest.approx(2 * d.min_trap_depth / d.char_length)
+
+
+def test_a_jump_along_a_corrugation_leaves_the_trace_and_the_outcome_as_they_were():
+    # Prandtl-Tomlinson: below K* every wave folds, but on a profile uniform in y the jump
+    # runs along the path: the criterion cannot see it (K_path is no boundary at all there)
+    surf = corrugation(slope_amplitude=0.5, n_waves=3, points_per_wave=64)
+    mu, starts = 0.8, _left_starts(surf, 2)
+    params = sl.StreamlineParams(mu=mu, dl=0.005)
+    rigid = sl.streamlines(surf, starts, params, store_paths=True)
+    k_star = drive_limits(surf, mu, n_starts=2, dl=0.005).k_star
+    ls = roughness.slope_correlation_length(surf)
+    soft = compliant_streamlines(surf, starts, params, stiffness=0.1 * k_star / ls)
+    assert soft.folds.start.size >= 2 * 2  # every wave of both paths jumps
+    agreement, frechet = path_criterion(rigid, soft, roughness.characteristic_length(surf))
+    assert agreement == 1.0 and frechet < 0.01
+
+
+def test_k_path_is_where_the_compliant_paths_stop_meeting_the_criterion_below_the_fold():
+    surf, mu = Tilted(), 0.8
+    starts = _left_starts(surf, 3)
+    ls, lc = roughness.slope_correlation_length(surf), roughness.characteristic_length(surf)
+    params = sl.StreamlineParams(mu=mu, dl=ls / 40)
+    k_path, k_fold = path_stiffness(surf, starts, params, slope_length=ls, char_length=lc)
+    rigid = sl.streamlines(surf, starts, params, store_paths=True)
+
+    def criterion(k):
+        return path_criterion(rigid, compliant_streamlines(surf, starts, params, stiffness=k / ls), lc)
+
+    assert 0 < k_path < k_fold  # no fold above k_fold: the two paths are one
+    assert criterion(k_fold) == (1.0, pytest.approx(0.0, abs=1e-9))
+    agree, frechet = criterion(k_path)
+    assert agree >= 0.95 and frechet <= 0.1
+    agree, frechet = criterion(k_path / PATH_STIFFNESS_RESOLUTION)
+    assert agree < 0.95 or frechet > 0.1
+    # folds below the fold K* that the criterion does not see: the sub-threshold jumps
+    between = compliant_streamlines(surf, starts, params, stiffness=np.sqrt(k_path * k_fold) / ls)
+    assert between.folds.start.size > 0
+
+
+def test_the_spring_swing_limits_invert_the_spring_block_amplitudes():
+    k, ratio, t = 30.0, 0.8, 0.1
+    lim = spring_ie_limits(k, ratio, path_tolerance=t, force_bound=1.0)
+    # force: V sqrt(k m) = sqrt(I_e K L_c / l_s) F_p reaches F_p
+    assert spring_swing(lim["swing-force"], k, ratio) == pytest.approx(1.0)
+    # position: V / w = L_c sqrt(I_e / (K L_c / l_s)) reaches t L_c
+    assert math.sqrt(lim["swing-path"] / (k * ratio)) == pytest.approx(t)
+    assert lim["swing-path"] * lim["swing-force"] == pytest.approx(t**2)  # widest at K_c = 1 / t
+    assert spring_ie_limits(float("nan"), ratio) == {"swing-path": math.inf, "swing-force": math.inf}
 
 
 def test_finite_differences_on_closed_forms():

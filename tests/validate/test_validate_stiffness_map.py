@@ -181,6 +181,9 @@ def test_family_limits_predict_on_the_maps_surfaces():
     assert set(got["presets"]) == {"paper-single-peak"}
     one = got["presets"]["paper-single-peak"]
     assert got["k_star"] == one["k_star"] > 0 and got["ie_star"] == one["ie_star"] > 0
+    # the criterion's boundary on the family's own starts lies at or below their fold
+    assert 0 <= got["k_path"] == one["k_path"] <= one["k_star_path_starts"]
+    assert got["lc_over_ls"] == pytest.approx(one["char_length"] / one["slope_length"])
     assert one["tip_radius"] > 0 and one["mu"] == pytest.approx(1.23, abs=0.05)
 
 
