@@ -15,6 +15,14 @@ series per family (docs/physics.md §10):
 The order is the least-squares slope of log gap against log x with its t interval
 (:func:`fit_order`), over the points the metric resolves: a median Frechet above twice its
 resolution (:data:`FRECHET_FLOOR_LC`), an agreement gap above zero.
+
+The predicted drive limits against the measured ones (:func:`prediction_check`) compare
+like with like (docs/physics.md §8): the K boundary is read only in cells below both
+spring-swing limits of their K (:func:`spine_mj.theory.drive_limits.spring_ie_limits`: the
+swing within the path tolerance, its force within F_p), each K at its lowest such I_e, and
+set beside ``K_path``, the boundary the same criterion draws between the compliant-drive
+and the rigid paths; the I_e* at the stiffest K is set beside the lowest of the geometry's
+thresholds and that K's swing limits.
 """
 
 from __future__ import annotations
@@ -25,6 +33,7 @@ from collections.abc import Sequence
 import numpy as np
 from scipy import stats
 
+from spine_mj.theory.drive_limits import spring_ie_limits
 from spine_mj.validate.intervals import CONFIDENCE
 
 __all__ = [
@@ -35,6 +44,7 @@ __all__ = [
     "fit_order",
     "gap_series",
     "k_boundary",
+    "k_readings",
     "order_rows",
     "prediction_check",
     "within_factor",
@@ -148,13 +158,32 @@ def order_rows(agreement: dict, predicted: dict) -> list[dict]:
     return rows
 
 
-def k_boundary(cells: dict) -> tuple[float, float]:
-    """The measured K boundary of a family's map at its lowest common I_e: ``(low, high)``,
-    the largest K that fails the criterion and the next K, which passes (``(nan, K_min)``
-    when the smallest passes, ``(K_max, inf)`` when the stiffest fails)."""
-    ks = sorted(cells, key=float)
-    low = common_lowest_ie(cells)
-    passes = [bool(cells[k]["passes"][cells[k]["ie"].index(low)]) for k in ks]
+def k_readings(cells: dict, lc_over_ls: float = math.nan) -> dict:
+    """Where each K of a family's map is read for the K boundary: K (str) -> the index of
+    its lowest I_e below both its spring-swing limits
+    (:func:`spine_mj.theory.drive_limits.spring_ie_limits`), None where every I_e it ran at
+    swings more; without a finite ``lc_over_ls``, every K at the lowest I_e all of them ran at."""
+    if not (math.isfinite(lc_over_ls) and lc_over_ls > 0):
+        low = common_lowest_ie(cells)
+        return {k: cells[k]["ie"].index(low) for k in cells}
+    out = {}
+    for k, c in cells.items():
+        top = min(spring_ie_limits(float(k), lc_over_ls).values())
+        quiet = [i for i, ie in enumerate(c["ie"]) if ie <= top]
+        out[k] = min(quiet, key=lambda i: c["ie"][i]) if quiet else None
+    return out
+
+
+def k_boundary(cells: dict, lc_over_ls: float = math.nan) -> tuple[float, float]:
+    """The measured K boundary of a family's map over the K read (:func:`k_readings`):
+    ``(low, high)``, the largest K that fails the criterion and the next K read, which
+    passes (``(nan, K_min)`` when the smallest passes, ``(K_max, inf)`` when the stiffest
+    fails, ``(nan, nan)`` when no K is read)."""
+    read = k_readings(cells, lc_over_ls)
+    ks = sorted((k for k, i in read.items() if i is not None), key=float)
+    if not ks:
+        return math.nan, math.nan
+    passes = [bool(cells[k]["passes"][read[k]]) for k in ks]
     fails = [i for i, p in enumerate(passes) if not p]
     if not fails:
         return math.nan, float(ks[0])
@@ -181,16 +210,29 @@ def within_factor(predicted: float, low: float, high: float, factor: float = PRE
 
 
 def prediction_check(agreement: dict, predicted: dict) -> list[dict]:
-    """Per family: the predicted K* and I_e* (and the mechanism that sets I_e*) against the
-    measured K boundary (:func:`k_boundary`) and the measured I_e* at the stiffest K, each
-    with :func:`within_factor`."""
+    """Per family: the predicted K boundary against the measured one, and the predicted I_e*
+    at the stiffest K against the measured one there, each with :func:`within_factor`.
+
+    The K boundary is read where the spring's swing is small (:func:`k_boundary` with the
+    family's ``lc_over_ls``; ``k_read_ie``: K -> the I_e read, None: not read) and set
+    beside ``K_path`` (``k_verdict``) and beside the fold ``K*`` (``k_verdict_fold``). The
+    I_e* predicted at the stiffest K is the lowest of the geometry's (lift-off, trap, lag)
+    and that K's swing limits (:func:`~spine_mj.theory.drive_limits.spring_ie_limits`);
+    ``ie_limit`` names it."""
     rows = []
     for fam, cells in agreement.items():
         pred = predicted.get(fam, {})
-        k_pred = float(pred.get("k_star", math.nan))
-        ie_pred = float(pred.get("ie_star", math.nan))
-        k_lo, k_hi = k_boundary(cells)
-        top = cells[max(cells, key=float)]["ie_star"]
+        k_fold = float(pred.get("k_star", math.nan))
+        k_path = float(pred.get("k_path", math.nan))
+        ratio = float(pred.get("lc_over_ls", math.nan))
+        k_lo, k_hi = k_boundary(cells, ratio)
+        read = k_readings(cells, ratio)
+        k_top = max(cells, key=float)
+        ie_geometry = float(pred.get("ie_star", math.nan))
+        limits = {pred.get("limit", ""): ie_geometry, **spring_ie_limits(float(k_top), ratio)}
+        limit = min(limits, key=lambda n: limits[n] if math.isfinite(limits[n]) else math.inf)
+        ie_pred = limits[limit]
+        top = cells[k_top]["ie_star"]
         kind = top.get("kind")
         if kind == "bracketed":
             ie_lo, ie_hi = float(top["low"]), float(top["high"])
@@ -200,18 +242,26 @@ def prediction_check(agreement: dict, predicted: dict) -> list[dict]:
             ie_lo, ie_hi = math.nan, float(top.get("high", math.nan))
         else:
             ie_lo, ie_hi = math.nan, math.nan
+        measured = math.isfinite(k_lo) or math.isfinite(k_hi)
         rows.append(
             {
                 "family": fam,
-                "k_star_predicted": k_pred,
+                "k_star_predicted": k_fold,
+                "k_path_predicted": k_path,
+                "lc_over_ls": ratio,
+                "k_read_ie": {k: (cells[k]["ie"][i] if i is not None else None) for k, i in read.items()},
                 "k_low": k_lo,
                 "k_high": k_hi,
-                "k_verdict": within_factor(k_pred, k_lo, k_hi),
+                "k_verdict": within_factor(k_path, k_lo, k_hi) if measured else "not measured",
+                "k_verdict_fold": within_factor(k_fold, k_lo, k_hi) if measured else "not measured",
                 "ie_star_predicted": ie_pred,
-                "ie_limit": pred.get("limit", ""),
+                "ie_star_geometry": ie_geometry,
+                "ie_swing_path": limits["swing-path"],
+                "ie_swing_force": limits["swing-force"],
+                "ie_limit": limit,
                 "ie_low": ie_lo,
                 "ie_high": ie_hi,
-                "ie_at_k": float(max(cells, key=float)),
+                "ie_at_k": float(k_top),
                 "ie_verdict": within_factor(ie_pred, ie_lo, ie_hi)
                 if math.isfinite(ie_lo) or math.isfinite(ie_hi)
                 else "not measured",

@@ -15,6 +15,7 @@ from spine_mj.validate.theory_orders import (
     fit_order,
     gap_series,
     k_boundary,
+    k_readings,
     order_rows,
     prediction_check,
     within_factor,
@@ -102,9 +103,33 @@ def test_gap_series_takes_ie_at_the_stiffest_k_and_1_over_k_above_k_star():
     assert {(r["axis"], r["gap"]) for r in rows} == {
         (a, g) for a in ("ie", "inverse_k") for g in ("agreement_gap", "median_frechet")
     }
-    check = prediction_check({"fam": cells}, {"fam": {"k_star": 50.0, "ie_star": 0.05, "limit": "lag"}})[0]
-    assert (check["k_low"], check["k_high"], check["k_verdict"]) == (10.0, 100.0, "consistent")
+    pred = {"k_star": 50.0, "k_path": 300.0, "ie_star": 0.05, "limit": "lag"}
+    check = prediction_check({"fam": cells}, {"fam": pred})[0]
+    assert (check["k_low"], check["k_high"]) == (10.0, 100.0)
+    assert check["k_verdict_fold"] == "consistent" and check["k_verdict"] == "outside"
     assert check["ie_verdict"] == "consistent" and check["ie_at_k"] == 1000.0
+    assert check["ie_limit"] == "lag"  # no L_c / l_s: no swing limit
+
+
+def test_the_k_boundary_is_read_where_the_spring_swing_is_small():
+    # K_c = K L_c / l_s = 100 K: the swing's force reaches F_p at I_e = 1 / K_c, its
+    # amplitude the path tolerance (0.1 L_c) at I_e = 0.01 K_c
+    cells = _cells(
+        [1, 10, 100], [1e-5, 1e-3, 1e-2], [[False, False, False], [True, True, False], [True, True, False]]
+    )
+    cells["100"]["ie"] = [1e-3, 1e-2]  # the stiffest K ran only where its swing is F_p and more
+    cells["100"]["passes"] = [False, False]
+    assert k_readings(cells, 100.0) == {"1": 0, "10": 0, "100": None}
+    assert k_boundary(cells, 100.0) == (1.0, 10.0)  # the stiffest K failed for its swing: not read
+    assert k_boundary(cells) == (100.0, math.inf)  # read at the lowest common I_e, as before
+    assert all(math.isnan(v) for v in k_boundary({"100": cells["100"]}, 100.0))
+    pred = {"k_star": 50.0, "k_path": 2.0, "ie_star": 0.25, "limit": "lag", "lc_over_ls": 100.0}
+    check = prediction_check({"fam": cells}, {"fam": pred})[0]
+    assert check["k_verdict"] == "consistent" and check["k_verdict_fold"] == "outside"
+    assert check["k_read_ie"] == {"1": 1e-5, "10": 1e-5, "100": None}
+    # at K = 100 the force swing (I_e 1e-4) is below the lag's 0.25 and the path swing's 100
+    assert check["ie_limit"] == "swing-force" and check["ie_star_predicted"] == pytest.approx(1e-4)
+    assert check["ie_swing_path"] == pytest.approx(100.0)
 
 
 def test_the_ie_star_bootstrap_leaves_out_a_deeper_ie_run_from_fewer_starts():

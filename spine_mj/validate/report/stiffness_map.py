@@ -158,12 +158,15 @@ def _draw_prediction(ax, pred: dict | None) -> None:
     ax.set(xlim=(lo, hi), ylim=(klo, khi))
 
 
-def measured_k_star(cells: dict) -> str:
-    """The measured K boundary at the lowest I_e of a family's map (``K`` -> agreement
-    cell; :func:`~spine_mj.validate.theory_orders.k_boundary`): ``low-high`` between the
+def measured_k_star(cells: dict, lc_over_ls: float = np.nan) -> str:
+    """The measured K boundary of a family's map (``K`` -> agreement cell), each K read at
+    its lowest I_e where the spring's swing is small
+    (:func:`~spine_mj.validate.theory_orders.k_boundary`): ``low-high`` between the
     largest K that fails and the next, which passes, ``< K`` when the smallest passes, ``> K``
-    when the stiffest fails."""
-    low, high = k_boundary(cells)
+    when the stiffest fails, ``not read`` when every cell swings too much."""
+    low, high = k_boundary(cells, lc_over_ls)
+    if not (np.isfinite(low) or np.isfinite(high)):
+        return "not read"
     if not np.isfinite(low):
         return f"< {sig(high)}"
     if np.isinf(high):
@@ -175,18 +178,22 @@ def _prediction_rows(km: StiffnessMapResult) -> list[dict]:
     """Per family: predicted K* and I_e* (and which mechanism), the measured K boundary at
     the lowest I_e and I_e* at the largest K (rigid and compliant references)."""
     rows = []
+    check = {r["family"]: r for r in km.prediction_check}
     for fam, pred in km.predicted.items():
         rigid = km.agreement.get(fam, {})
         comp = km.agreement_compliant.get(fam, {})
         k_top = max(rigid, key=float) if rigid else None
+        ratio = pred.get("lc_over_ls", np.nan)
+        at_k = check.get(fam, {})
         rows.append(
             {
                 "family": fam,
                 "k_star": pred["k_star"],
-                "k_measured": measured_k_star(rigid) if rigid else "-",
-                "k_measured_compliant": measured_k_star(comp) if comp else "-",
-                "ie_star": pred["ie_star"],
-                "limit": pred["limit"],
+                "k_path": pred.get("k_path", np.nan),
+                "k_measured": measured_k_star(rigid, ratio) if rigid else "-",
+                "k_measured_compliant": measured_k_star(comp, ratio) if comp else "-",
+                "ie_star": at_k.get("ie_star_predicted", pred["ie_star"]),
+                "limit": at_k.get("ie_limit", pred["limit"]),
                 "ie_measured": _bracket(rigid[k_top]["ie_star"]) if k_top else "-",
                 "ie_measured_compliant": _bracket(comp[k_top]["ie_star"]) if k_top and k_top in comp else "-",
                 "at_k": float(k_top) if k_top else np.nan,
@@ -496,9 +503,13 @@ def _prediction_text(km: StiffnessMapResult) -> list[str]:
         "Predicted from each family's geometry alone (docs/physics.md §8, `spine-mj surface info`), on "
         "the surfaces the map runs traced under the rig's tip: K* = l_s max(-dH/dx) along the "
         "streamlines (below it the compliant-drive streamline folds: stick-slip at vanishing speed), "
-        "and I_e* the lowest of lift-off over crests, skipping the shallowest trap and the lag "
-        "behind turns (I_e < 2 mu 0.1). Measured: the K "
-        "boundary is where the criterion first holds at the lowest I_e as K grows; I_e* is the map's "
+        "K_path the stiffness where the compliant-drive paths from the family's starts meet the "
+        "map's criterion against the rigid ones (what the criterion sees of the folds), "
+        "and I_e* the lowest of lift-off over crests, skipping the shallowest trap, the lag "
+        "behind turns (I_e < 2 mu 0.1) and, at the stiffest K, the spring-block swing "
+        "sqrt(I_e K L_c / l_s) reaching F_p. Measured: the K "
+        "boundary is where the criterion first holds as K grows, each K read at its lowest I_e "
+        "whose swing is at most F_p; I_e* is the map's "
         "at its stiffest K; both against the rigid streamline and against the compliant-drive "
         "streamline of each run's spring. Dashed and dotted lines on the map.",
         "",
@@ -507,6 +518,7 @@ def _prediction_text(km: StiffnessMapResult) -> list[str]:
             [
                 "family",
                 "k_star",
+                "k_path",
                 "k_measured",
                 "k_measured_compliant",
                 "ie_star",
@@ -518,6 +530,7 @@ def _prediction_text(km: StiffnessMapResult) -> list[str]:
             [
                 "family",
                 "K* predicted",
+                "K_path predicted",
                 "K boundary (rigid ref.)",
                 "(compliant ref.)",
                 "I_e* predicted",
