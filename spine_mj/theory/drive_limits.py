@@ -368,8 +368,7 @@ def drive_limits(
         How far (in ``L_c``) a path may lag the streamline, for ``ie_lag``; default the
         comparison's Frechet target (:data:`spine_mj.theory.targets.FRECHET_TARGET`, 0.1).
     path_starts : array_like, shape (m, 2), optional
-        The starts of a measurement: ``K_path`` (:func:`path_stiffness`) and the fold
-        ``K*`` on their paths are computed from them (NaN without).
+        A measurement's starts: ``K_path`` and their paths' fold (:func:`path_stiffness`).
 
     Returns
     -------
@@ -387,24 +386,19 @@ def drive_limits(
     res = sl.streamlines(traced, pts, params, store_paths=True)
     max_fall, max_curv, arrival = _path_statistics(traced, res, mu, kappa_cap)
     trapped = res.self_locked
-    depth = trap_depths(
-        traced,
-        res.end_x[trapped],
-        res.end_y[trapped],
-        arrival[trapped],
-        mu,
-        step=params.dl / 4,
-        kappa_cap=kappa_cap,
-    )
+    xy = (res.end_x[trapped], res.end_y[trapped])
+    depth = trap_depths(traced, *xy, arrival[trapped], mu, step=params.dl / 4, kappa_cap=kappa_cap)
     min_depth = float(depth.min()) if depth.size else math.inf
     ie_lift = 1.0 / (l_c * max_curv) if max_curv > 0 else math.inf
     ie_trap = 2.0 * max(min_depth, 0.0) / l_c
     ie_lag = 2.0 * float(mu) * float(path_tolerance)
     limits = {"lift-off": ie_lift, "trap": ie_trap, "lag": ie_lag}
     limit = min(limits, key=limits.get)
-    k_path = k_fold_starts = math.nan
-    if path_starts is not None:
-        k_path, k_fold_starts = path_stiffness(traced, path_starts, params, slope_length=l_s, char_length=l_c)
+    k_path, k_fold_starts = (
+        (math.nan, math.nan)
+        if path_starts is None
+        else path_stiffness(traced, path_starts, params, slope_length=l_s, char_length=l_c)
+    )
     return DriveLimits(
         k_star=l_s * max(0.0, max_fall),
         ie_star=limits[limit],
