@@ -38,8 +38,10 @@ facets' rule says; with them Bullet self-locks).
   (:mod:`spine_mj.validate.fractal_lock`) at its corner I_e in both engines, N surfaces per H,
   one sweep with ``engine = ["mujoco", "bullet"]``, rates with Wilson intervals.
 
-``python -m spine_mj.validate.engines --out DIR [--quick] [--fractal N]`` runs it (Bullet
-needs the ``[bullet]`` extra) and writes ``engines.json`` and ``engines.md``; the committed
+``python -m spine_mj.validate.engines --out DIR [--quick] [--fractal N] [--headlines N]`` runs
+it (Bullet needs the ``[bullet]`` extra; ``--headlines``: the quasistatic-limit corner per
+family in both engines, :mod:`spine_mj.validate.engine_headlines`) and writes ``engines.json``
+and ``engines.md``; the committed
 ``analysis/reports/engines.md`` is ``--fractal 30``. With ``--out OUT/engines``, OUT a
 validation's output folder, the validation report written there next has the section.
 """
@@ -481,6 +483,9 @@ def main(argv=None) -> None:
         help="also the fractal self-lock rate, N surfaces per H",
     )
     ap.add_argument("--workers", type=int, default=None, help="worker processes of the fractal sweep")
+    from spine_mj.validate import engine_headlines
+
+    engine_headlines.add_arguments(ap)
     args = ap.parse_args(argv)
     import dataclasses
 
@@ -492,10 +497,12 @@ def main(argv=None) -> None:
         fractal = fractal_engines(args.out, surfaces_per_hurst=args.fractal, workers=args.workers)
         wall = dict(res.wall_s, fractal=round(time.perf_counter() - t0, 1))
         res = dataclasses.replace(res, fractal=fractal, wall_s=wall)
+    headlines = engine_headlines.from_arguments(args, progress=lambda s: print(s, flush=True))
     args.out.mkdir(parents=True, exist_ok=True)
     write_json(args.out / "engines.json", res.as_dict())
-    (args.out / "engines.md").write_text(section(res))
-    print(section(res))
+    text = section(res) + engine_headlines.section(headlines)
+    (args.out / "engines.md").write_text(text)
+    print(text)
 
 
 #: The fractal self-lock comparison's Hurst exponents and I_e: the full validation plan's

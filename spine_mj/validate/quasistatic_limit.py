@@ -24,7 +24,14 @@ from spine_mj.validate.plans import FRECHET_TARGET, OUTCOME_TARGET, RECOMMENDED,
 from spine_mj.validate.study_runner import StudyRunner
 from spine_mj.validate.sweep_configs import engine_grid, family_doc
 
-__all__ = ["LimitPath", "QuasistaticLimitResult", "limit_doc", "limit_family_docs", "quasistatic_limit"]
+__all__ = [
+    "LimitPath",
+    "QuasistaticLimitResult",
+    "corner_summary",
+    "limit_doc",
+    "limit_family_docs",
+    "quasistatic_limit",
+]
 
 #: Columns of the per-run rows.
 RUN_COLUMNS = (
@@ -179,10 +186,7 @@ def quasistatic_limit(plan: ValidationPlan, runner: StudyRunner) -> QuasistaticL
     refined_done = done[len(docs) + len(variations) :]
     convergence = {}
     for fam in corner:
-        groups: list[dict] = []
-        comps = [_sweep_comparison(plan, fam, *swept[name], paths, groups) for f, name, _ in docs if f is fam]
-        allc = pd.concat(comps, ignore_index=True)
-        summ = _limit_summary(allc, groups)
+        summ, allc = corner_summary(plan, fam, [swept[name] for f, name, _ in docs if f is fam], paths)
         ill = summ.pop("ill_conditioned")
         families[fam.name] = summ
         if plan.convergence_starts > 0:
@@ -200,6 +204,38 @@ def quasistatic_limit(plan: ValidationPlan, runner: StudyRunner) -> QuasistaticL
         lowest_ie=plan.lowest_ie,
         convergence=convergence,
     )
+
+
+def corner_summary(
+    plan: ValidationPlan, fam: FamilySpec, results, paths: dict | None = None
+) -> tuple[dict, pd.DataFrame]:
+    """One corner family's summary and comparison rows from its limit sweeps.
+
+    Parameters
+    ----------
+    plan : ValidationPlan
+        The plan the sweeps were written for (its ``ensemble_members``).
+    fam : FamilySpec
+        The family (its corner: :meth:`ValidationPlan.corner_family`).
+    results : sequence of (DataFrame, Path)
+        Run table and store of each of the family's limit sweeps (of one engine).
+    paths : dict, optional
+        Filled with the single peak/valley family's :class:`LimitPath` per preset.
+
+    Returns
+    -------
+    summary : dict
+        The family's entry of :attr:`QuasistaticLimitResult.families`, with
+        ``ill_conditioned`` (start key ``case_id/start`` -> the sides it splits on).
+    rows : DataFrame
+        The ``compare`` rows of every run (each ensemble's own start), with its family,
+        preset, end reason and engine status (``mujoco_status``, whichever the engine).
+    """
+    groups: list[dict] = []
+    paths = {} if paths is None else paths
+    comps = [_sweep_comparison(plan, fam, df, store, paths, groups) for df, store in results]
+    allc = pd.concat(comps, ignore_index=True)
+    return _limit_summary(allc, groups), allc
 
 
 def _limit_summary(allc: pd.DataFrame, groups: list[dict]) -> dict:

@@ -69,6 +69,10 @@ def write_report(out: Path, summary: dict, results: Iterable) -> Path:
         from spine_mj.validate.engines import section as engines_section
 
         sections.append(engines_section(EnginesResult.from_dict(json.loads(engines.read_text()))))
+        from spine_mj.validate import engine_headlines  # written beside it by --headlines
+
+        if (headlines := engine_headlines.load(engines.parent)) is not None:
+            sections.append(engine_headlines.section(headlines))
     plan = summary["plan"]
     text = render(
         "validation_report.md.j2",

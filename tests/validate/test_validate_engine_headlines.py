@@ -1,0 +1,163 @@
+"""The quasistatic-limit headlines in both engines (spine_mj.validate.engine_headlines): the
+soft-contact misses' starts, the engines' pairing, and a small corner run in MuJoCo and Bullet."""
+
+import dataclasses
+import time
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from spine_mj import presets
+from spine_mj.validate import engine_headlines as study
+from spine_mj.validate.ensembles import ensemble_family
+from spine_mj.validate.plans import PLANS, FamilySpec, paper_starts
+
+
+def _surface_units(fam, miss, point):
+    if fam.starts_table()["frame"] != "relative":
+        return point
+    kw = {} if miss.seed is None else {"seed": miss.seed}
+    xmin, xmax, ymin, ymax = presets.make_surface(miss.preset, **kw, **dict(miss.variant)).bounds
+    return xmin + point[0] * (xmax - xmin), ymin + point[1] * (ymax - ymin)
+
+
+@pytest.mark.parametrize("miss", study.SOFT_CONTACT_MISSES, ids=lambda m: m.label)
+def test_each_soft_contact_miss_is_the_full_reports_start_with_its_ensemble(miss):
+    full = PLANS["full"]
+    fam = study.miss_family(full, miss)
+    pts = fam.starts_table()["points"]
+    assert len(pts) == full.ensemble_members and fam.presets == (miss.preset,)
+    # the start the report's run table shows, to its rounding
+    x, y = _surface_units(fam, miss, pts[0])
+    assert (round(x, 2), round(y, 2)) == pytest.approx(miss.shown)
+    # and the very ensemble the plan ran: the whole family's stencil
+    (whole,) = [f for f in full.families if f.name == miss.family]
+    members = full.ensemble_members
+    ens = ensemble_family(full.corner_family(whole), miss.preset, members).starts_table()["points"]
+    assert [tuple(p) for p in pts] == [
+        tuple(p) for p in ens[miss.start * members : (miss.start + 1) * members]
+    ]
+
+
+def _starts(agree, well, held, end_x):
+    n = len(agree)
+    idx = pd.MultiIndex.from_arrays([["s"] * n, [1.0] * n, [0.0] * n, np.arange(n, dtype=float)])
+    return pd.DataFrame(
+        {"agree": agree, "well": well, "held": held, "end_x": end_x, "end_y": 0.0, "lc": 1.0}, index=idx
+    )
+
+
+def test_pairs_count_which_engine_the_streamline_supports():
+    a = _starts([True, True, False, False, True], [True] * 4 + [False], [1, 0, 1, 0, 1], [0, 5, 0, 9, 0])
+    b = _starts([True, False, True, False, False], [True] * 5, [1, 1, 0, 0, 1], [0.1, 5, 3, 2, 0])
+    p = study._pairs(a, b)
+    # the fifth start is ill-conditioned in the first engine: left out
+    assert p == {
+        "starts": 4,
+        "both_agree": 1,
+        "only_first": 1,
+        "only_second": 1,
+        "neither": 1,
+        # held alike at 0.1 L_c apart; free both (where they end does not matter)
+        "engines_alike": 2,
+    }
+
+
+def test_each_corner_sweep_runs_in_both_engines():
+    from spine_mj.sweep import expand_cases, parse_config
+
+    plan = dataclasses.replace(PLANS["quick"], families=PLANS["quick"].families[:1])
+    docs = study._corner_docs(plan, 2, ("mujoco", "bullet"))
+    assert [f.name for f, _, _ in docs] == ["single_peak_valley"]
+    for fam, name, doc in docs:
+        assert name.startswith("engines-limit/")
+        assert len(fam.starts_table()["y"]) == 2
+        cases = expand_cases(parse_config(doc))
+        engines = [c.params["engine"] for c in cases]
+        assert engines.count("mujoco") == engines.count("bullet") == len(cases) // 2
+
+
+def test_no_result_no_section():
+    assert study.section(None) == ""
+
+
+def test_the_corner_and_a_miss_run_in_both_engines(tmp_path):
+    pytest.importorskip("pybullet", reason="the Bullet engine needs the [bullet] extra (pybullet)")
+    from spine_mj.jsonio import write_json
+    from spine_mj.validate.study_runner import StudyRunner
+
+    fam = FamilySpec("single_peak_valley", ("paper-single-peak",), None, paper_starts([-2.0]))
+    plan = dataclasses.replace(PLANS["smoke"], families=(fam,), ensemble_members=2)
+    miss = study.MissStart("single_peak_valley", "paper-single-peak", None, (), 0, (-3.0, -2.0))
+    res = study.engine_headlines(
+        plan, StudyRunner(tmp_path, 1, None, time.perf_counter()), rechecks=(miss,), recheck_plan=plan
+    )
+    f = res.families["single_peak_valley"]
+    for e in ("mujoco", "bullet"):
+        assert f[e]["starts"] == 1 and f[e]["members"] == 2
+        lo, hi = f[e]["agreement_ci"]
+        assert lo <= f[e]["agreement_well_conditioned"] <= hi
+        assert res.cpu_s["single_peak_valley"][e]["runs"] == 2
+        assert res.cpu_s["single_peak_valley"][e]["engine"] > 0
+    p = f["pairs"]
+    assert p["starts"] == p["both_agree"] + p["only_first"] + p["only_second"] + p["neither"] <= 1
+    d = f["difference"]
+    assert d["ci_low"] <= d["diff"] <= d["ci_high"]
+    assert [(r["engine"], r["start"]) for r in res.rechecks] == [
+        ("mujoco", miss.label),
+        ("bullet", miss.label),
+    ]
+    write_json(tmp_path / study.RESULT_FILE, res.as_dict())
+    text = study.section(study.load(tmp_path))
+    assert text == study.section(res)  # the report from the file is the one from the run
+    assert "## Engines side by side: the headlines" in text
+    assert text.count("| single_peak_valley | streamline") == 2
+
+
+def _summary(agreeing, well, starts):
+    from spine_mj.validate.intervals import wilson
+
+    return {
+        "starts": starts,
+        "members": 3,
+        "well_conditioned_runs": well,
+        "agreement_well_conditioned": agreeing / well,
+        "agreement_ci": list(wilson(agreeing, well)),
+        "ill_conditioned_share": {"mujoco": 0.0, "reference": (starts - well) / starts},
+        "stopped_starts": 0,
+        "median_frechet": 0.01,
+        "median_frechet_ci": [0.009, 0.012],
+        "failed_runs": {},
+        "misses": {"engine_held": {"runs": well - agreeing, "offsets": []}},
+        "meets_target": False,
+    }
+
+
+def test_the_validation_report_has_the_section_when_the_study_ran_into_its_folder(tmp_path):
+    from spine_mj.jsonio import write_json
+    from spine_mj.validate.engines import EnginesResult
+    from spine_mj.validate.report.document import write_report
+
+    res = study.EngineHeadlinesResult(
+        plan="quick",
+        lowest_ie=1e-4,
+        starts_per_surface=2,
+        engines=("mujoco", "bullet"),
+        families={"fractal": {"mujoco": _summary(9, 10, 12), "bullet": _summary(10, 10, 12)}},
+        rechecks=[],
+        recheck_plan="full",
+        cpu_s={"fractal": {e: {"engine": 2.0, "reference": 3.0, "runs": 36} for e in ("mujoco", "bullet")}},
+        wall_s=10.0,
+    )
+    text = study.section(res)
+    assert "| fractal | streamline, >= 0.95 | mujoco | 0.900 [0.596, 0.982] | 9 / 10 (12) |" in text
+    assert "| fractal | streamline, >= 0.95 | bullet | 1.000 [0.722, 1.000] | 10 / 10 (12) |" in text
+    summary = {"plan": "smoke", "engine_settings": {}, "timings_s": {}}
+    write_json(
+        tmp_path / "engines" / "engines.json",
+        EnginesResult(rows=[], engines=res.engines, wall_s={}).as_dict(),
+    )
+    assert "the headlines" not in write_report(tmp_path, summary, []).read_text()
+    write_json(tmp_path / "engines" / study.RESULT_FILE, res.as_dict())
+    assert text in write_report(tmp_path, summary, []).read_text()
