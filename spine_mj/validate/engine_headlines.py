@@ -27,7 +27,6 @@ writes :data:`RESULT_FILE` beside ``engines.json``; a validation report whose fo
 from __future__ import annotations
 
 import dataclasses
-import math
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -40,8 +39,9 @@ from spine_mj import compare, sim
 from spine_mj.validate.convergence import thin_starts
 from spine_mj.validate.ensembles import ensemble_family
 from spine_mj.validate.intervals import newcombe_difference
-from spine_mj.validate.plans import FRECHET_TARGET, OUTCOME_TARGET, PLANS, FamilySpec, ValidationPlan
+from spine_mj.validate.plans import PLANS, FamilySpec, ValidationPlan
 from spine_mj.validate.quasistatic_limit import corner_summary, limit_doc, limit_family_docs
+from spine_mj.validate.report.engine_headlines import section
 from spine_mj.validate.study_runner import StudyRunner
 
 __all__ = [
@@ -428,120 +428,6 @@ def load(folder: Path) -> EngineHeadlinesResult | None:
 
     path = Path(folder) / RESULT_FILE
     return EngineHeadlinesResult.from_dict(json.loads(path.read_text())) if path.is_file() else None
-
-
-def _num(v, spec: str = ".3f") -> str:
-    return "n/a" if v is None or (isinstance(v, float) and not math.isfinite(v)) else format(v, spec)
-
-
-def _ci(lo, hi, spec: str = ".3f") -> str:
-    return f"[{_num(lo, spec)}, {_num(hi, spec)}]"
-
-
-def section(res: EngineHeadlinesResult | None) -> str:
-    """The report section "Engines side by side: the headlines" ("" without a result)."""
-    if res is None:
-        return ""
-    e0, e1 = res.engines[0], res.engines[-1]
-    size = "all" if res.starts_per_surface is None else f"{res.starts_per_surface}"
-    lines = [
-        "## Engines side by side: the headlines",
-        "",
-        f"The corner of the quasistatic-limit study (plan `{res.plan}`, I_e = {res.lowest_ie:g}, "
-        f"{size} y starts per surface, every start an ensemble of its own and its neighbours "
-        "1e-3 L_c away) run in both engines on the same surfaces and starts, one sweep per family "
-        "with `engine = [mujoco, bullet]`. The theory is the streamline on the rig's facets "
-        f"(the closed form of the quasistatic limit): target agreement >= {OUTCOME_TARGET:g} on the "
-        f"starts well-conditioned on both sides, median Frechet <= {FRECHET_TARGET:g} L_c. Agreement "
-        "with its 95 % Wilson interval (agreeing / well-conditioned starts), median Frechet with "
-        "its bootstrap interval; the difference Bullet - MuJoCo with Newcombe's interval.",
-        "",
-        "| family | theory | engine | agreement [95 %] | agreeing / well-conditioned (of starts) "
-        "| ill-conditioned (engine / reference) | median Frechet [95 %] L_c | engine stops | misses "
-        "| target |",
-        "|---|---|---|---|---|---|---|---|---|---|",
-    ]
-    for fam, f in res.families.items():
-        for e in res.engines:
-            s = f[e]
-            n = s["well_conditioned_runs"]
-            k = round(s["agreement_well_conditioned"] * n) if n else 0
-            ill = s["ill_conditioned_share"]
-            miss = "; ".join(f"{r} {v['runs']}" for r, v in s["misses"].items()) or "-"
-            stops = ", ".join(f"{r} {v}" for r, v in s["failed_runs"].items()) or "-"
-            lines.append(
-                f"| {fam} | streamline, >= {OUTCOME_TARGET:g} | {e} "
-                f"| {_num(s['agreement_well_conditioned'])} "
-                f"{_ci(*s['agreement_ci'])} | {k} / {n} ({s['starts']}) "
-                f"| {_num(ill['mujoco'], '.0%')} / {_num(ill['reference'], '.0%')} "
-                f"| {_num(s['median_frechet'], '.4f')} {_ci(*s['median_frechet_ci'], '.4f')} | {stops} "
-                f"| {miss} | {'met' if s['meets_target'] else 'not met'} |"
-            )
-    lines += ["", *_pair_lines(res, e0, e1), "", *_recheck_lines(res), "", *_cost_lines(res)]
-    return "\n".join(lines) + "\n"
-
-
-def _pair_lines(res: EngineHeadlinesResult, e0: str, e1: str) -> list[str]:
-    """Where the engines disagree, which one the streamline supports."""
-    out = [
-        f"Where the engines disagree, per start well-conditioned in both: the difference {e1} - "
-        f"{e0} in agreement, and the starts only one engine ends as the streamline does (the "
-        "closed form supports that engine).",
-        "",
-        f"| family | {e1} - {e0} [95 %] | starts | both agree | only {e0} | only {e1} | neither "
-        "| engines end alike |",
-        "|---|---|---|---|---|---|---|---|",
-    ]
-    for fam, f in res.families.items():
-        if "pairs" not in f:
-            continue
-        p, d = f["pairs"], f["difference"]
-        out.append(
-            f"| {fam} | {d['diff']:+.3f} {_ci(d['ci_low'], d['ci_high'])} | {p['starts']} "
-            f"| {p['both_agree']} "
-            f"| {p['only_first']} | {p['only_second']} | {p['neither']} | {p['engines_alike']} |"
-        )
-    return out
-
-
-def _recheck_lines(res: EngineHeadlinesResult) -> list[str]:
-    """The soft-contact misses, both engines."""
-    if not res.rechecks:
-        return []
-    out = [
-        f"The starts the `{res.recheck_plan}` plan's report attributes to MuJoCo's soft contact "
-        "(`engine_held`: MuJoCo held where the rigid-facet reference, restarted at its end, moves "
-        f"on), rerun with the `{res.recheck_plan}` plan's settings and ensembles in both engines.",
-        "",
-        "| start | engine | agrees | outcome (engine end / reference) | miss reason | ill-conditioned |",
-        "|---|---|---|---|---|---|",
-    ]
-    for r in res.rechecks:
-        out.append(
-            f"| {r['start']} | {r['engine']} | {'yes' if r['agree'] else 'no'} "
-            f"| {r['end_reason']} / {r['reference_outcome']} | {r['miss_reason'] or '-'} "
-            f"| {r['ill_conditioned'] or '-'} |"
-        )
-    return out
-
-
-def _cost_lines(res: EngineHeadlinesResult) -> list[str]:
-    """CPU seconds per family and engine: the engine's runs, the streamlines compared."""
-    out = [
-        f"Cost on this machine (CPU seconds; wall {res.wall_s:g} s in all): each engine's runs, and "
-        "the streamlines compared with them (traced once per engine's case).",
-        "",
-        "| family | engine | runs | engine CPU s | per run | reference CPU s |",
-        "|---|---|---|---|---|---|",
-    ]
-    for fam, per in res.cpu_s.items():
-        for e, c in per.items():
-            per_run = c["engine"] / c["runs"] if c["runs"] else math.nan
-            out.append(
-                f"| {fam} | {e} | {c['runs']} | {c['engine']:.1f} | {_num(per_run, '.2f')} "
-                f"| {c['reference']:.1f} |"
-            )
-    return out
 
 
 def add_arguments(ap) -> None:

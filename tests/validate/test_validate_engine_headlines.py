@@ -78,10 +78,6 @@ def test_each_corner_sweep_runs_in_both_engines():
         assert engines.count("mujoco") == engines.count("bullet") == len(cases) // 2
 
 
-def test_no_result_no_section():
-    assert study.section(None) == ""
-
-
 def test_the_corner_and_a_miss_run_in_both_engines(tmp_path):
     pytest.importorskip("pybullet", reason="the Bullet engine needs the [bullet] extra (pybullet)")
     from spine_mj.jsonio import write_json
@@ -113,51 +109,3 @@ def test_the_corner_and_a_miss_run_in_both_engines(tmp_path):
     assert text == study.section(res)  # the report from the file is the one from the run
     assert "## Engines side by side: the headlines" in text
     assert text.count("| single_peak_valley | streamline") == 2
-
-
-def _summary(agreeing, well, starts):
-    from spine_mj.validate.intervals import wilson
-
-    return {
-        "starts": starts,
-        "members": 3,
-        "well_conditioned_runs": well,
-        "agreement_well_conditioned": agreeing / well,
-        "agreement_ci": list(wilson(agreeing, well)),
-        "ill_conditioned_share": {"mujoco": 0.0, "reference": (starts - well) / starts},
-        "stopped_starts": 0,
-        "median_frechet": 0.01,
-        "median_frechet_ci": [0.009, 0.012],
-        "failed_runs": {},
-        "misses": {"engine_held": {"runs": well - agreeing, "offsets": []}},
-        "meets_target": False,
-    }
-
-
-def test_the_validation_report_has_the_section_when_the_study_ran_into_its_folder(tmp_path):
-    from spine_mj.jsonio import write_json
-    from spine_mj.validate.engines import EnginesResult
-    from spine_mj.validate.report.document import write_report
-
-    res = study.EngineHeadlinesResult(
-        plan="quick",
-        lowest_ie=1e-4,
-        starts_per_surface=2,
-        engines=("mujoco", "bullet"),
-        families={"fractal": {"mujoco": _summary(9, 10, 12), "bullet": _summary(10, 10, 12)}},
-        rechecks=[],
-        recheck_plan="full",
-        cpu_s={"fractal": {e: {"engine": 2.0, "reference": 3.0, "runs": 36} for e in ("mujoco", "bullet")}},
-        wall_s=10.0,
-    )
-    text = study.section(res)
-    assert "| fractal | streamline, >= 0.95 | mujoco | 0.900 [0.596, 0.982] | 9 / 10 (12) |" in text
-    assert "| fractal | streamline, >= 0.95 | bullet | 1.000 [0.722, 1.000] | 10 / 10 (12) |" in text
-    summary = {"plan": "smoke", "engine_settings": {}, "timings_s": {}}
-    write_json(
-        tmp_path / "engines" / "engines.json",
-        EnginesResult(rows=[], engines=res.engines, wall_s={}).as_dict(),
-    )
-    assert "the headlines" not in write_report(tmp_path, summary, []).read_text()
-    write_json(tmp_path / "engines" / study.RESULT_FILE, res.as_dict())
-    assert text in write_report(tmp_path, summary, []).read_text()
