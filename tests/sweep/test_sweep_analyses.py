@@ -220,3 +220,34 @@ mu = 0.6
     step = sl.default_step(presets.make_surface("corrugation"))
     assert step == pytest.approx(1e-3)
     np.testing.assert_allclose(runs.path_length / runs.n_steps, step, rtol=1e-12)
+
+
+def test_cases_differing_only_in_their_drive_share_their_streamlines(tmp_path):
+    """The boundary's I_e ladder and the (I_e, K) map trace the same references for every
+    drive: the second case's quasistatic and facet streamlines come from the process's
+    memo, equal to a fresh trace, and a changed start is traced anew."""
+    from spine_mj.sweep.analyses import quasistatic as qs_analysis
+    from spine_mj.sweep.registry import ANALYSES
+    from spine_mj.theory import streamline as sl
+
+    doc = tomllib.loads(MJ)
+    qs_analysis.clear_cache()
+    first, second = sweep.expand_cases(sweep.parse_config(doc, base_dir=tmp_path))
+    assert first.params["ie"] != second.params["ie"]
+    surface = first.surface.make()
+    starts = first.starts.resolve(surface.bounds, first.seed)
+    res = [ANALYSES["quasistatic"].func(c, surface, starts, {}).data for c in (first, second)]
+    assert res[1] is res[0]
+    fresh = sl.streamlines(
+        qs_analysis.traced_surface(first, surface),
+        starts,
+        qs_analysis._params(first, surface),
+        store_paths=True,
+    )
+    np.testing.assert_array_equal(res[0].x, fresh.x)
+    moved = ANALYSES["quasistatic"].func(first, surface, starts + np.array([0.0, 0.25]), {}).data
+    assert moved is not res[0] and not np.array_equal(moved.end_y, res[0].end_y)
+    key = qs_analysis.hfield_key
+    rigs = [ANALYSES["mujoco"].func(c, surface, starts, {}).data[0] for c in (first, second)]
+    assert rigs[0] is not rigs[1]
+    assert key(rigs[0].hfield, 0.1) == key(rigs[1].hfield, 0.1) != key(rigs[0].hfield, 0.2)

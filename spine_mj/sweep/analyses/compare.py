@@ -23,7 +23,7 @@ import numpy as np
 
 from spine_mj import compare
 from spine_mj.sweep.analyses.mujoco import peak_drive_over_fp
-from spine_mj.sweep.analyses.quasistatic import path_table, traced_surface
+from spine_mj.sweep.analyses.quasistatic import cached_trace, hfield_key, path_table, traced_surface
 from spine_mj.sweep.registry import Analysis, AnalysisResult, ParamSpec, register_analysis
 from spine_mj.theory import streamline as sl
 from spine_mj.theory.compliant import compliant_streamlines
@@ -177,13 +177,19 @@ def _compare(case, surface, starts, upstream):
     # streamline, the compliant one and the miss reasons are the first member's alone
     members = int(case.params["ensemble_members"])
     lead = np.arange(len(runs)) % members == 0
-    smooth = trace(traced_surface(case, surface), np.asarray(starts, float)[lead], margin, store_paths=True)
+    smooth = cached_trace(
+        trace,
+        (case.surface, case.params["tip_radius"]),
+        traced_surface(case, surface),
+        np.asarray(starts, float)[lead],
+        margin,
+    )
     contact = rig.contact_surface()
     # steps no longer than an eighth of the tip radius: a longer step can jump a crease
     # between facets where the engine's tip wedges (measured on a fractal: dl = R/2 passed
     # a crease of kappa > 20 where MuJoCo held; R/8 held within 0.003 L_c)
     params = dataclasses.replace(margin, dl=min(margin.dl, contact.radius / 8))
-    facets = trace(contact, starts, params, store_paths=True)
+    facets = cached_trace(trace, hfield_key(rig.hfield, contact.radius), contact, starts, params)
     lc = rig.scales.char_length_m / s
     status = np.array(
         upstream["mujoco"].status if upstream["mujoco"].status is not None else np.full(len(runs), "ok"),

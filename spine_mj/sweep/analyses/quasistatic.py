@@ -6,7 +6,9 @@ change here in one place.
 
 from __future__ import annotations
 
+import collections
 import functools
+import hashlib
 
 import numpy as np
 
@@ -43,9 +45,44 @@ def _dilated(spec, radius: float):
     return sl.dilate(spec.make(), radius)
 
 
+#: Streamline results a worker process keeps (:func:`cached_trace`); each holds its paths,
+#: a few MB at most for a sweep case's starts.
+TRACE_CACHE_SIZE = 8
+_traces: collections.OrderedDict = collections.OrderedDict()
+
+
 def clear_cache() -> None:
-    """Forget the dilated surfaces built in this process."""
+    """Forget the dilated surfaces and the streamlines traced in this process."""
     _dilated.cache_clear()
+    _traces.clear()
+
+
+def cached_trace(trace, surface_key, surface, starts, params: sl.StreamlineParams) -> sl.StreamlineResult:
+    """``trace(surface, starts, params, store_paths=True)``, remembered in this process.
+
+    Cases of a sweep that differ only in their drive (the boundary study's I_e ladder, the
+    (I_e, K) map) trace the same streamlines from the same starts: the drive enters neither
+    the quasistatic reference nor the facets' one. ``surface_key`` is hashable and names
+    ``surface`` (a surface spec and tip radius, or :func:`hfield_key` of a rig's facets);
+    the starts enter the key by value. The result is shared: callers must not change it.
+    """
+    starts = np.ascontiguousarray(starts, dtype=float)
+    key = (trace.__name__, surface_key, starts.shape, starts.tobytes(), params)
+    if key in _traces:
+        _traces.move_to_end(key)
+        return _traces[key]
+    res = trace(surface, starts, params, store_paths=True)
+    _traces[key] = res
+    while len(_traces) > TRACE_CACHE_SIZE:
+        _traces.popitem(last=False)
+    return res
+
+
+def hfield_key(hfield, tip_radius: float) -> tuple:
+    """A key of :func:`cached_trace` for a rig's facets under a ball of ``tip_radius``: the
+    digest of the hfield's samples, size and position (rigs of different drives share it)."""
+    h = hashlib.blake2b(np.ascontiguousarray(hfield.data).tobytes(), digest_size=16)
+    return (h.hexdigest(), tuple(hfield.size), tuple(hfield.pos), float(tip_radius))
 
 
 def traced_surface(case, surface):
@@ -73,7 +110,7 @@ def _quasistatic(case, surface, starts, upstream):
     params = _params(case, surface)
     dl = params.dl
     func = sl.streamlines if p["trajectory"] == "streamline" else sl.ideal_trajectories
-    res = func(surface, starts, params, store_paths=True)
+    res = cached_trace(func, (case.surface, p["tip_radius"]), surface, starts, params)
     names = np.array(["", *[o.name.lower() for o in sl.Outcome]], dtype=object)
     metrics = {
         "outcome": names[res.outcome],
