@@ -40,14 +40,15 @@ QUASISTATIC_PARAMS = (
 )
 
 
-@functools.lru_cache(maxsize=4)
+@functools.lru_cache(maxsize=8)  # the presets of sweeps run together (the map: five)
 def _dilated(spec, radius: float):
     return sl.dilate(spec.make(), radius)
 
 
-#: Streamline results a worker process keeps (:func:`cached_trace`); each holds its paths,
+#: Streamline results a worker process keeps (:func:`cached_trace`), enough for three traces
+#: of every surface of the map's five presets run together; each holds its paths,
 #: a few MB at most for a sweep case's starts.
-TRACE_CACHE_SIZE = 8
+TRACE_CACHE_SIZE = 32
 _traces: collections.OrderedDict = collections.OrderedDict()
 
 
