@@ -363,7 +363,9 @@ PLANS: dict[str, ValidationPlan] = {
         lowest_ie=1e-4,
         hfield_resolution=151,
         limit_variations=(NO_NOSLIP, IMPRATIO),
-        ie_values=(1e-4, 1e-3, 1e-2, 1e-1, 1.0, 10.0),
+        # the boundary lies at 1e-2 to 1 on the single peak and valley: 1e-4 (the corner
+        # study's I_e) brackets nothing there and its ramp pilot was the boundary's slowest
+        ie_values=(1e-3, 1e-2, 1e-1, 1.0, 10.0),
         boundary_families=("single_peak_valley",),
         stick_slip_ie=(1e-2, 1.0),
         stick_slip_stiffness=(2.0, 50.0),
@@ -376,17 +378,19 @@ PLANS: dict[str, ValidationPlan] = {
         # the facet streamline (~1.4 s per surface, measured) would double the study's time
         fractal_facets=False,
         ensemble_members=3,
-        # 36 starts per family: 35 agreeing ones are the fewest whose Wilson interval can
-        # meet the 95 % target (intervals.runs_to_meet), one more leaves room for a start
-        # found ill-conditioned
+        # 36 starts per paper family: 35 agreeing ones are the fewest whose Wilson interval
+        # can meet the 95 % target (intervals.runs_to_meet), one more leaves room for a start
+        # found ill-conditioned. The sandpaper's runs cost four times a paper family's
+        # (measured: 127 of the corner's 256 s of CPU at 36 starts); the demo runs 12, whose
+        # interval is reported but cannot meet the target (the full plan's 36 can)
         corner=(
             ("single_peak_valley", None, paper_starts(np.linspace(-0.5, -4.0, 18).round(4))),
             ("random_gaussian", (1,), relative_starts(18)),
             ("fractal", (1, 2, 3), relative_starts(6)),
-            ("sandpaper", None, relative_starts(12, 0.25)),
+            ("sandpaper", None, relative_starts(4, 0.25)),
         ),
-        # solution verification: 2 starts a surface (26 runs a refinement over the families)
-        convergence_starts=2,
+        # solution verification: 1 start a surface (13 runs a refinement over the families)
+        convergence_starts=1,
         stiffness_map_ie=(1e-2, 1.0),
         # a reduced ladder past each family's K*, and one deeper I_e at the stiffest
         stiffness_map_k_factors=(0.3, 1.0, 3.0, 10.0),

@@ -24,6 +24,9 @@ def test_every_family_has_enough_starts_at_the_corner_each_an_ensemble(plan, lea
     assert p.ensemble_members >= 3
     for fam in p.families:
         # and at least as many as can meet the target at all (35 all agreeing)
+        if plan == "quick" and fam.name == "sandpaper":
+            assert _corner_starts(p, fam) >= 12  # the demo's sandpaper: reported, not judged
+            continue
         need = max(
             30 if (plan == "full" and fam.name == "sandpaper") else least, runs_to_meet(OUTCOME_TARGET)
         )
