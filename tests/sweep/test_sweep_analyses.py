@@ -55,6 +55,9 @@ def test_mujoco_and_compare_runs_match_the_rig_run_directly(tmp_path):
     assert (cmp_.tip_peak_ie[ran] >= 0.5 * mjs.ie.loc[cmp_.index][ran]).all()
     assert mjs.end_detail[mjs.self_locked.astype(bool)].str.match("lock rule|force cap").all()
     assert (cmp_.status == np.where(mjs.status.loc[cmp_.index] == "ok", "ok", "dependency_failed")).all()
+    # the spring-block swing sqrt(I_e K L_c / l_s) of each run's drive, in F_p
+    swing = np.sqrt(mj.ie * mj.stiffness_number * mj.char_length / mj.slope_length)
+    np.testing.assert_allclose(mj.spring_swing_fp, swing, rtol=1e-9)
     assert cmp_.frechet[ran].notna().all() and (cmp_.frechet[ran] >= 0).all()
     # the spring drive is also set against the compliant streamline of its own spring
     assert (cmp_.compliant_frechet[ran] >= 0).all() and (cmp_.stiffness_frechet >= 0).all()

@@ -14,6 +14,7 @@ import numpy as np
 
 from spine_mj import sim
 from spine_mj.errors import SpineInputError
+from spine_mj.sim.holding import spring_swing
 from spine_mj.sim.params import surface_unit_m
 from spine_mj.sim.ramp import nominal_time_s
 from spine_mj.sim.rollout import drive_steps
@@ -365,6 +366,9 @@ def _metrics(rig, runs) -> dict[str, np.ndarray]:
         "speed_m_s": np.array([r.speed_m_s for r in runs]),
         "stiffness_number": np.array([r.stiffness_number for r in runs]),
         "stiffness_n_m": np.array([r.stiffness_n_m for r in runs]),
+        # the spring-block swing sqrt(I_e K L_c / l_s) [F_p]: a spring drive is slow for its
+        # stiffness, and a quasistatic comparison like with like, only where it is small
+        "spring_swing_fp": np.array([_swing(r, sc) for r in runs]),
         "slope_length": np.full(n, sc.slope_length_m / s),
         "max_drive_over_fp": np.array([peak_drive_over_fp(r, sc.preload_n) for r in runs]),
         "n_move_onsets": np.array(
@@ -377,6 +381,15 @@ def _metrics(rig, runs) -> dict[str, np.ndarray]:
         "char_length": np.full(n, sc.char_length_m / s),
         "tip_radius_m": np.full(n, rig.tip.tip_radius_m),
     }
+
+
+def _swing(run, scales: sim.Scales) -> float:
+    """The spring-block swing of ``run``'s drive [F_p] (:func:`spine_mj.sim.holding.spring_swing`);
+    NaN for a drive without a spring."""
+    k = run.stiffness_number
+    if not (np.isfinite(k) and k > 0 and run.inertia_number > 0):
+        return float("nan")
+    return spring_swing(run.inertia_number, k, scales.char_length_m / scales.slope_length_m)
 
 
 def _slip_metrics(runs) -> dict[str, np.ndarray]:
