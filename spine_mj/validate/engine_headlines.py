@@ -383,17 +383,17 @@ def _pairs(a: pd.DataFrame, b: pd.DataFrame) -> dict:
     free, and where held the same trap: :func:`spine_mj.compare.outcome_agreement`)."""
     both = a.merge(b, left_index=True, right_index=True, suffixes=("_a", "_b"))
     both = both[both["well_a"] & both["well_b"]]
-    same = (
-        compare.outcome_agreement(
-            both["held_a"].to_numpy(),
-            both[["end_x_a", "end_y_a"]].to_numpy(),
-            both["held_b"].to_numpy(),
-            both[["end_x_b", "end_y_b"]].to_numpy(),
-            length_scale=float(both["lc_a"].iloc[0]),
+    lc = both["lc_a"].to_numpy(float)
+    same = np.zeros(len(both), bool)
+    for scale in np.unique(lc):  # each surface's own L_c (a family's grits differ 10-fold)
+        m = lc == scale
+        same[m] = compare.outcome_agreement(
+            both["held_a"].to_numpy()[m],
+            both[["end_x_a", "end_y_a"]].to_numpy()[m],
+            both["held_b"].to_numpy()[m],
+            both[["end_x_b", "end_y_b"]].to_numpy()[m],
+            length_scale=float(scale),
         )["agree"]
-        if len(both)
-        else np.zeros(0, bool)
-    )
     ga, gb = both["agree_a"].to_numpy(bool), both["agree_b"].to_numpy(bool)
     return {
         "starts": int(len(both)),

@@ -40,11 +40,11 @@ def test_each_soft_contact_miss_is_the_full_reports_start_with_its_ensemble(miss
     ]
 
 
-def _starts(agree, well, held, end_x):
+def _starts(agree, well, held, end_x, lc=1.0):
     n = len(agree)
     idx = pd.MultiIndex.from_arrays([["s"] * n, [1.0] * n, [0.0] * n, np.arange(n, dtype=float)])
     return pd.DataFrame(
-        {"agree": agree, "well": well, "held": held, "end_x": end_x, "end_y": 0.0, "lc": 1.0}, index=idx
+        {"agree": agree, "well": well, "held": held, "end_x": end_x, "end_y": 0.0, "lc": lc}, index=idx
     )
 
 
@@ -62,6 +62,14 @@ def test_pairs_count_which_engine_the_streamline_supports():
         # held alike at 0.1 L_c apart; free both (where they end does not matter)
         "engines_alike": 2,
     }
+
+
+def test_pairs_judge_each_surface_at_its_own_length_scale():
+    # both held 0.5 apart: the same trap on a surface of L_c = 10, not on one of L_c = 1
+    lc = [10.0, 1.0]
+    a = _starts([True, True], [True, True], [1, 1], [0.0, 0.0], lc)
+    b = _starts([True, True], [True, True], [1, 1], [0.5, 0.5], lc)
+    assert study._pairs(a, b)["engines_alike"] == 1
 
 
 def test_each_corner_sweep_runs_in_both_engines():
