@@ -41,9 +41,9 @@ facets' rule says; with them Bullet self-locks).
 ``python -m spine_mj.validate.engines --out DIR [--quick] [--fractal N] [--headlines N]`` runs
 it (Bullet needs the ``[bullet]`` extra; ``--headlines``: the quasistatic-limit corner per
 family in both engines, :mod:`spine_mj.validate.engine_headlines`) and writes ``engines.json``
-and ``engines.md``; the committed
-``analysis/reports/engines.md`` is ``--fractal 30``. With ``--out OUT/engines``, OUT a
-validation's output folder, the validation report written there next has the section.
+and ``engines.md``; the committed ``analysis/reports/engines.md`` is ``--fractal 6`` (the
+full plan's 30 took 855 s). With ``--out OUT/engines``, OUT a validation's output folder,
+the validation report written there next has the section.
 """
 
 from __future__ import annotations
