@@ -163,33 +163,40 @@ def _pace(facets, runs, scales) -> dict:
     }
 
 
-def _compare(case, surface, starts, upstream):
-    quasistatic = upstream["quasistatic"].data
-    rig, runs = upstream["mujoco"].data
+def _references(case, surface, starts, quasistatic, rig, runs, lead):
+    """The two references of a comparison (:func:`cached_trace`: the same for every drive):
+    the smooth surface's streamline from the ensembles' first members and the facets' from
+    every start, both ending where the engine's runs end, with the facets' parameters."""
     trace = sl.ideal_trajectories if quasistatic.ideal else sl.streamlines
-    s = rig.length_scale_m
     # both sides end where the engine's run ends, its domain margin from the edges (a path
     # traced to the very edge is a tip radius longer: measured on the random Gaussian, that
     # tail alone made the Frechet distance 0.12 L_c where the paths were 0.01-0.03 apart)
-    margin = dataclasses.replace(quasistatic.params, edge_margin=runs[0].detection.domain_margin_m / s)
-    # an ensemble's perturbed members (every start but each group's first) decide only their
-    # outcome on both sides (validate.ensembles): the paths' distances, the smooth surface's
-    # streamline, the compliant one and the miss reasons are the first member's alone
-    members = int(case.params["ensemble_members"])
-    lead = np.arange(len(runs)) % members == 0
-    smooth = cached_trace(
-        trace,
-        (case.surface, case.params["tip_radius"]),
-        traced_surface(case, surface),
-        np.asarray(starts, float)[lead],
-        margin,
+    margin = dataclasses.replace(
+        quasistatic.params, edge_margin=runs[0].detection.domain_margin_m / rig.length_scale_m
     )
+    smooth_surface = traced_surface(case, surface)
+    smooth_key = (case.surface, case.params["tip_radius"])
+    smooth = cached_trace(trace, smooth_key, smooth_surface, np.asarray(starts, float)[lead], margin)
     contact = rig.contact_surface()
     # steps no longer than an eighth of the tip radius: a longer step can jump a crease
     # between facets where the engine's tip wedges (measured on a fractal: dl = R/2 passed
     # a crease of kappa > 20 where MuJoCo held; R/8 held within 0.003 L_c)
     params = dataclasses.replace(margin, dl=min(margin.dl, contact.radius / 8))
     facets = cached_trace(trace, hfield_key(rig.hfield, contact.radius), contact, starts, params)
+    return trace, smooth, contact, params, facets
+
+
+def _compare(case, surface, starts, upstream):
+    rig, runs = upstream["mujoco"].data
+    s = rig.length_scale_m
+    # an ensemble's perturbed members (every start but each group's first) decide only their
+    # outcome on both sides (validate.ensembles): the paths' distances, the smooth surface's
+    # streamline, the compliant one and the miss reasons are the first member's alone
+    members = int(case.params["ensemble_members"])
+    lead = np.arange(len(runs)) % members == 0
+    trace, smooth, contact, params, facets = _references(
+        case, surface, starts, upstream["quasistatic"].data, rig, runs, lead
+    )
     lc = rig.scales.char_length_m / s
     status = np.array(
         upstream["mujoco"].status if upstream["mujoco"].status is not None else np.full(len(runs), "ok"),
