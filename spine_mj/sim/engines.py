@@ -35,8 +35,11 @@ MUJOCO_ONLY = (
     "cone",
     "impratio",
     "noslip_iterations",
+    "tolerance",
+    "noslip_tolerance",
     "solref_timeconst_s",
     "solref_dampratio",
+    "timestep_factor",
 )
 
 

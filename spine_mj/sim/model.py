@@ -153,6 +153,8 @@ class RigModel:
         spec.option.cone = getattr(mujoco.mjtCone, f"mjCONE_{eng.cone.name}")
         spec.option.impratio = eng.impratio
         spec.option.noslip_iterations = eng.noslip_iterations
+        spec.option.tolerance = eng.tolerance
+        spec.option.noslip_tolerance = eng.noslip_tolerance
         spec.option.gravity = [0.0, 0.0, -tip.gravity_m_s2 / u.acceleration_m_s2]
         spec.modelname = "spine_rig"
         r = tip.tip_radius_m / u.length_m

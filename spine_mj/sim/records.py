@@ -125,6 +125,10 @@ class EngineSettings:
         Ratio of frictional to normal constraint impedance (>= 1 sensible).
     noslip_iterations : int
         Noslip solver passes (0 switches it off; then friction creeps).
+    tolerance, noslip_tolerance : float
+        MuJoCo's early-termination thresholds of the constraint solver and of the noslip
+        solver (MuJoCo's defaults, 1e-8 and 1e-6; tightened to check that a result does not
+        depend on them, :mod:`spine_mj.validate.convergence`).
     solref : (timeconst_s, dampratio)
         Contact reference; ``timeconst_s >= 2 timestep_s`` for stability.
     solimp : (dmin, dmax, width_m, midpoint, power)
@@ -139,6 +143,8 @@ class EngineSettings:
     cone: Cone = Cone.ELLIPTIC
     impratio: float = 1.0
     noslip_iterations: int = 3
+    tolerance: float = 1e-8
+    noslip_tolerance: float = 1e-6
     solref: tuple[float, float] = (1e-3, 1.0)
     solimp: tuple[float, float, float, float, float] = (0.99, 0.99, 1e-3, 0.5, 2.0)
 
@@ -159,6 +165,8 @@ class EngineSettings:
         if isinstance(ns, bool) or int(ns) != ns or ns < 0:
             raise SpineInputError(f"noslip_iterations must be an integer >= 0, got {ns!r}")
         object.__setattr__(self, "noslip_iterations", int(ns))
+        for name in ("tolerance", "noslip_tolerance"):
+            object.__setattr__(self, name, check_positive(name, getattr(self, name)))
         if self.cone is Cone.PYRAMIDAL and self.noslip_iterations > 0:
             raise SpineInputError(
                 "cone='pyramidal' with noslip_iterations > 0 holds only about half "

@@ -142,9 +142,15 @@ class EngineOverrides:
         Frictional to normal constraint impedance.
     noslip_iterations : int or None
         Noslip solver passes.
+    tolerance, noslip_tolerance : float or None
+        MuJoCo's solver and noslip tolerances.
     solref_timeconst_s, solref_dampratio : float or None
         The contact's time constant [s] and damping ratio, each replacing its half of the
         rule's ``solref`` (the other half stays the rule's).
+    timestep_factor : float or None
+        The rule's step times this, the contact's time constant kept at the rule's: only
+        the step changes (solution verification, :mod:`spine_mj.validate.convergence`);
+        not with ``timestep_s``.
     """
 
     timestep_s: float | None = None
@@ -152,8 +158,11 @@ class EngineOverrides:
     cone: str | Cone | None = None
     impratio: float | None = None
     noslip_iterations: int | None = None
+    tolerance: float | None = None
+    noslip_tolerance: float | None = None
     solref_timeconst_s: float | None = None
     solref_dampratio: float | None = None
+    timestep_factor: float | None = None
 
     def engine(
         self, scales: Scales, *, speed_m_s: float | None = None, stiffness_n_m: float | None = None
@@ -177,6 +186,16 @@ class EngineOverrides:
         """
         given = {k: v for k, v in dataclasses.asdict(self).items() if v is not None}
         timeconst_s, dampratio = given.pop("solref_timeconst_s", None), given.pop("solref_dampratio", None)
+        factor = given.pop("timestep_factor", None)
+        if factor is not None:
+            if "timestep_s" in given:
+                raise SpineInputError(
+                    f"timestep_s and timestep_factor: give one of them, got {given['timestep_s']!r} "
+                    f"and {factor!r}"
+                )
+            rule = default_engine(scales, speed_m_s=speed_m_s, stiffness_n_m=stiffness_n_m, **given)
+            given["timestep_s"] = rule.timestep_s * check_positive("timestep_factor", factor)
+            given["solref"] = rule.solref
         if timeconst_s is not None or dampratio is not None:
             rule = default_engine(scales, speed_m_s=speed_m_s, stiffness_n_m=stiffness_n_m, **given)
             given["solref"] = (

@@ -14,6 +14,16 @@ tip (the ``compare`` analysis's reference, when the plan asks for it), and MuJoC
 drive at the plan's lowest I_e and at one dynamic I_e (held: ended by the lock rule or the
 force cap). Every rate comes with its count, its Wilson interval and the runs the engine
 stopped (``failed_runs``), which are reported, not dropped silently.
+
+Solution verification (``plan.fractal_refinements``, keys of
+:data:`~spine_mj.validate.convergence.REFINEMENTS`): both MuJoCo series rerun on the first
+``plan.fractal_refined_surfaces`` surfaces of every H under each refinement, each case at
+its own rig's step refined (the sweep's ``timestep_factor``: the surfaces' steps differ by
+up to a quarter); a rate's change is paired (the refined runs' rate minus the same
+surfaces' own, over the surfaces both ran cleanly) and *converged* when the rate plus it
+stays inside the rate's Wilson interval
+(:func:`~spine_mj.validate.convergence.headline_convergence`). A fractal keeps its samples:
+there is no hfield to refine.
 """
 
 from __future__ import annotations
@@ -26,6 +36,7 @@ import pandas as pd
 
 from spine_mj.presets import calibrated_mu, load_preset
 from spine_mj.reproduce import fig9_rms_height, fig9_seeds
+from spine_mj.validate.convergence import REFINEMENTS, headline_convergence, refinable
 from spine_mj.validate.intervals import CONFIDENCE, wilson
 from spine_mj.validate.paths import tip_radius
 from spine_mj.validate.plans import ValidationPlan
@@ -39,6 +50,8 @@ PRESET = "paper-fractal"
 SERIES = ("streamline", "facets", "mujoco_corner", "mujoco_dynamic")
 #: Outcomes of the streamline that hold the tip (the self-lock region or the force cap).
 HELD_OUTCOMES = ("self_locked", "force_cap")
+#: The series the engine's refinements rerun.
+MUJOCO_SERIES = ("mujoco_corner", "mujoco_dynamic")
 
 
 def lock_rate(locked: Sequence[bool], ok: Sequence[bool] | None = None) -> dict:
@@ -108,7 +121,9 @@ class FractalLockResult:
     ----------
     rows : list of dict
         Per H (:func:`hurst_rows`): rate, Wilson interval, counts and failed runs of every
-        series of :data:`SERIES` that ran.
+        series of :data:`SERIES` that ran; where the plan refines the engine,
+        ``convergence_<series>`` of each MuJoCo series
+        (:func:`~spine_mj.validate.convergence.headline_convergence`).
     corner_ie, dynamic_ie : float
         The inertia numbers of the two MuJoCo series.
     surfaces_per_hurst : int
@@ -202,10 +217,8 @@ def fractal_lock(plan: ValidationPlan, runner: StudyRunner) -> FractalLockResult
     starts = {"frame": "relative", "x": [0.05], "y": [0.5]}
     corner = ["quasistatic", "mujoco", *(["compare"] if plan.fractal_facets else [])]
     records = []
-    for label, ie, analyses in (
-        ("corner", plan.lowest_ie, corner),
-        ("dynamic", plan.fractal_dynamic_ie, ["mujoco"]),
-    ):
+    series = (("corner", plan.lowest_ie, corner), ("dynamic", plan.fractal_dynamic_ie, ["mujoco"]))
+    for label, ie, analyses in series:
         doc = {
             "sweep": {"name": f"fractal-lock-{label}", "seed": 11, "analyses": analyses},
             "surfaces": surfaces,
@@ -220,8 +233,25 @@ def fractal_lock(plan: ValidationPlan, runner: StudyRunner) -> FractalLockResult
         df, _ = runner(doc, f"fractal-lock/{label}")
         records += _records(df, label, seed_hurst)
     runs = pd.DataFrame.from_records(records)
+    rows = hurst_rows(runs)
+    keys = [k for k in plan.fractal_refinements if refinable(PRESET, (1,), k)]
+    if keys and plan.fractal_refined_surfaces > 0:
+        thin = [{**s, "seeds": s["seeds"][: plan.fractal_refined_surfaces]} for s in surfaces]
+        jobs = [
+            (key, label, _refined_doc(key, label, ie, thin, starts, grid))
+            for key in keys
+            for label, ie, _ in series
+        ]
+        done = runner.many(
+            [(doc, f"fractal-lock-refined/{key}/{label}") for key, label, doc in jobs], "refined engine"
+        )
+        refined = {
+            (key, label): pd.DataFrame.from_records(_records(df, label, seed_hurst))
+            for (key, label, _), (df, _) in zip(jobs, done)
+        }
+        _add_convergence(rows, runs, refined, plan.fractal_refinements)
     return FractalLockResult(
-        rows=hurst_rows(runs),
+        rows=rows,
         corner_ie=float(plan.lowest_ie),
         dynamic_ie=float(plan.fractal_dynamic_ie),
         surfaces_per_hurst=n,
@@ -230,6 +260,51 @@ def fractal_lock(plan: ValidationPlan, runner: StudyRunner) -> FractalLockResult
         tip_radius=tip,
         runs=records,
     )
+
+
+def _refined_doc(key: str, label: str, ie: float, surfaces: list[dict], starts: dict, grid: dict) -> dict:
+    """The MuJoCo series ``label`` at ``ie`` on ``surfaces`` under refinement ``key``: its
+    engine keys go to the sweep as they are, so that each case refines its own rig's."""
+    return {
+        "sweep": {"name": f"fractal-lock-{label}-{key}", "seed": 11, "analyses": ["mujoco"]},
+        "surfaces": surfaces,
+        "starts": starts,
+        "drive": {"protocol": "spring", "ie": ie},
+        "grid": {**grid, **dict(REFINEMENTS[key])},
+    }
+
+
+def _add_convergence(rows: list[dict], runs: pd.DataFrame, refined: dict, keys) -> None:
+    """Each row's ``convergence_<series>`` of the MuJoCo series: per refinement of ``keys``
+    the rate of the refined runs (``refined``: (key, label) -> records) against the same
+    surfaces' own (``runs``), over the surfaces both ran cleanly."""
+    for row in rows:
+        h = row["hurst"]
+        for series in MUJOCO_SERIES:
+            if f"rate_{series}" not in row:
+                continue
+            label = series.removeprefix("mujoco_")
+            by_key: dict[str, dict | None] = {}
+            for key in keys:
+                r = refined.get((key, label))
+                if r is None:
+                    by_key[key] = None
+                    continue
+                base = runs[(runs["hurst"] == h) & (runs["series"] == series)].set_index("surface")
+                ref = r[r["hurst"] == h].set_index("surface")
+                both = base.index.intersection(ref.index)
+                both = both[base.loc[both, "ok"].to_numpy(bool) & ref.loc[both, "ok"].to_numpy(bool)]
+                by_key[key] = {
+                    "base": lock_rate(base.loc[both, "locked"])["rate"],
+                    "refined": lock_rate(ref.loc[both, "locked"])["rate"],
+                    "runs": len(both),
+                }
+            row[f"convergence_{series}"] = headline_convergence(
+                row[f"rate_{series}"],
+                (row[f"ci_low_{series}"], row[f"ci_high_{series}"]),
+                by_key,
+                note="a fractal keeps its samples: no hfield to refine",
+            )
 
 
 def _records(df: pd.DataFrame, label: str, seed_hurst: dict) -> list[dict]:

@@ -33,6 +33,7 @@ __all__ = [
     "RECOMMENDED",
     "SANDPAPER_MU",
     "STATIC_TARGET",
+    "TOLERANCE_TIGHTENED",
     "FamilySpec",
     "ValidationPlan",
     "paper_starts",
@@ -146,6 +147,12 @@ class ValidationPlan:
         interval in the full plan (>= 30), fewer in the quick one.
     fractal_dynamic_ie : float
         The I_e of the study's dynamic MuJoCo series (its other one runs at ``lowest_ie``).
+    fractal_refinements : tuple of str
+        Refinements of the fractal self-lock rates (keys of
+        :data:`spine_mj.validate.convergence.REFINEMENTS`; empty: none): both MuJoCo series
+        rerun on the first ``fractal_refined_surfaces`` surfaces of each H
+        (:mod:`spine_mj.validate.fractal_lock`).
+    fractal_refined_surfaces : int
     fractal_facets : bool
         Also count the streamline traced on MuJoCo's facets (the ``compare`` analysis's
         reference, ~1.4 s of CPU per surface measured on the fractal preset, twice the
@@ -228,6 +235,8 @@ class ValidationPlan:
     fractal_surfaces: int = 30
     fractal_dynamic_ie: float = 0.1
     fractal_facets: bool = True
+    fractal_refinements: tuple[str, ...] = ()
+    fractal_refined_surfaces: int = 0
     stiffness_map_ie: tuple[float, ...] = ()
     stiffness_map_k: tuple[float, ...] = ()
     stiffness_map_families: tuple[str, ...] = ()
@@ -280,6 +289,8 @@ IMPRATIO = ("no noslip, impratio 10", (("noslip_iterations", 0), ("impratio", 10
 DT_HALVED = ("time step / 2 (contact solref kept)", (("timestep_factor", 0.5),))
 #: The surface's grid at twice the samples a side (solution verification of the static map).
 HFIELD_DOUBLED = ("hfield x 2", (("hfield_factor", 2),))
+#: MuJoCo's solver tolerances a hundredth of their defaults (solution verification).
+TOLERANCE_TIGHTENED = ("tolerance / 100", (("tolerance", 1e-10), ("noslip_tolerance", 1e-8)))
 
 #: The paper's single peak and valley with the five starts of Figs. 3-4 (every plan).
 #: The fractal family: 3 seeds x 2 Hurst exponents x 5 starts.
@@ -346,6 +357,8 @@ PLANS: dict[str, ValidationPlan] = {
         ground_truth_liftoff_factors=(0.5, 1.5),
         convergence_starts=1,
         boundary_refinements=("dt_halved",),
+        fractal_refinements=("dt_halved",),
+        fractal_refined_surfaces=1,
     ),
     "quick": ValidationPlan(
         name="quick",
@@ -408,7 +421,7 @@ PLANS: dict[str, ValidationPlan] = {
         name="full",
         slopes_deg=tuple(np.arange(0.0, 76.0, 7.5)),
         azimuths_deg=(0.0, 30.0, 60.0, 90.0, 120.0, 150.0, 180.0),
-        static_engines=(RECOMMENDED, NO_NOSLIP, IMPRATIO, DT_HALVED, HFIELD_DOUBLED),
+        static_engines=(RECOMMENDED, NO_NOSLIP, IMPRATIO, DT_HALVED, HFIELD_DOUBLED, TOLERANCE_TIGHTENED),
         families=(
             PEAK_VALLEY,
             FamilySpec(
@@ -465,10 +478,15 @@ PLANS: dict[str, ValidationPlan] = {
         # solution verification on 3 starts a surface (81 runs a refinement), three step
         # levels for an observed order
         convergence_starts=3,
-        convergence_refinements=("dt_halved", "dt_quartered", "hfield_doubled"),
+        convergence_refinements=("dt_halved", "dt_quartered", "hfield_doubled", "tolerance_tightened"),
         # I_e* rerun around its bracket (4 I_e x 10 starts x 2 drives a refinement): ~155 s
         # of CPU for both, estimated from a reduced run (spring 0.45-0.5 s a run, ramp 1.1-1.8
         # s); dt / 4 for an observed order would add ~170 s
         boundary_refinements=("dt_halved", "hfield_doubled"),
+        # both MuJoCo series on 15 of the 30 surfaces per H: ~0.53 s a surface with dt / 2,
+        # ~0.35 s with the tolerances / 100 (measured, busy machine): ~67 s of CPU; dt / 4
+        # (an observed order) would add ~80 s
+        fractal_refinements=("dt_halved", "tolerance_tightened"),
+        fractal_refined_surfaces=15,
     ),
 }

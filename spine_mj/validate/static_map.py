@@ -182,7 +182,8 @@ def _plane_rows(plan: ValidationPlan, runner: StudyRunner, slope: float, az: flo
         # reads as self-locked
         cap = max(10.0, 1.5 * k) if np.isfinite(k) else 10.0
         grid = {"mu": mu, "kappa_cap": float(f"{cap:.4g}")}
-        grid.update({k_: engine_default(k_) for k_ in keys})
+        # every setting's sweep states the keys the others vary (a default of None: the rule's)
+        grid.update({k_: engine_default(k_) for k_ in keys if engine_default(k_) is not None})
         rest = dict(ov)
         path = _plane_file(runner.out_dir, slope, az, int(rest.pop("hfield_factor", 1)))
         grid.update(

@@ -28,6 +28,7 @@ def summary_lines(result: dict) -> list[str]:
     for row in result.get("fractal_lock_rate", {}).get("rows", []):
         rates = ", ".join(
             f"{k} {row[f'rate_{k}']:.2f} ({row[f'locked_{k}']}/{row[f'n_ok_{k}']})"
+            + unconverged_mark(row.get(f"convergence_{k}"))
             for k in ("streamline", "mujoco_corner", "mujoco_dynamic")
             if f"rate_{k}" in row
         )

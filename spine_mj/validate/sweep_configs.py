@@ -98,22 +98,18 @@ def rig_engine(
     return sim.default_engine(scales, speed_m_s=speed, stiffness_n_m=spring)
 
 
-#: Engine overrides relative to the rig's own settings (:func:`relative_engine_keys`).
-RELATIVE_ENGINE_KEYS = ("timestep_factor", "solref_timeconst_factor")
+#: Engine overrides relative to the rig's own settings that the sweep does not take as
+#: they are (:func:`relative_engine_keys`; its ``timestep_factor`` it does, case by case).
+RELATIVE_ENGINE_KEYS = ("solref_timeconst_factor",)
 
 
 def relative_engine_keys(overrides: dict, engine: Callable[[], sim.EngineSettings]) -> dict:
     """The grid keys of the relative engine overrides in ``overrides`` (removed from it):
-    ``timestep_factor`` scales the rig's step (``engine()``) with the contact's time
-    constant passed explicitly, so that only the step changes; ``solref_timeconst_factor``
-    scales that time constant."""
+    ``solref_timeconst_factor`` scales the contact's time constant of the rig
+    (``engine()``), passed explicitly."""
     if not any(k in overrides for k in RELATIVE_ENGINE_KEYS):
         return {}
-    e = engine()
-    return {
-        "timestep": e.timestep_s * float(overrides.pop("timestep_factor", 1.0)),
-        "solref_timeconst": e.solref[0] * float(overrides.pop("solref_timeconst_factor", 1.0)),
-    }
+    return {"solref_timeconst": engine().solref[0] * float(overrides.pop("solref_timeconst_factor"))}
 
 
 def refined_resolution(resolution: int, factor: int) -> int:
@@ -133,7 +129,9 @@ def engine_grid(
     stiffness_number: float | None = None,
 ) -> dict:
     """Grid keys of an engine variation. Three keys are relative to the rig's own settings
-    (:func:`rig_engine`): ``timestep_factor`` and ``solref_timeconst_factor``
+    (:func:`rig_engine`): ``timestep_factor``, which the sweep applies to each case's own
+    step with the contact's time constant kept (only the step changes,
+    :class:`~spine_mj.sim.EngineOverrides`), ``solref_timeconst_factor``
     (:func:`relative_engine_keys`), and ``hfield_factor``, which multiplies the samples
     between the plan's (:func:`refined_resolution`) with the tip kept."""
     out = {"hfield_resolution": plan.hfield_resolution}

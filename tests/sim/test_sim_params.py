@@ -239,3 +239,28 @@ def test_engine_overrides_replace_only_what_they_name():
     )
     assert slow.solref == pytest.approx((3 * rule.solref[0], 1.0))
     assert slow.timestep_s == rule.timestep_s
+
+
+def test_a_step_factor_refines_only_the_step_and_tolerances_reach_the_model():
+    """``timestep_factor`` scales the rule's step at this pace and spring, the contact's time
+    constant kept; the solver tolerances are MuJoCo's unless given, and the model reads them."""
+    from spine_mj import sim
+
+    surface = single_gaussian()
+    scales = sim.Scales.for_surface(surface, tip=TipParams(mu_s=0.5))
+    for ie, k_number in ((1e-3, 30.0), (1e-1, 300.0)):
+        speed, spring = scales.speed_for(ie), scales.stiffness_for(k_number)
+        rule = sim.default_engine(scales, speed_m_s=speed, stiffness_n_m=spring)
+        half = sim.EngineOverrides(timestep_factor=0.5).engine(scales, speed_m_s=speed, stiffness_n_m=spring)
+        assert half.timestep_s == pytest.approx(rule.timestep_s / 2)
+        assert half.solref == rule.solref and half.solimp == rule.solimp
+    with pytest.raises(SpineInputError, match="timestep_s and timestep_factor: give one of them"):
+        sim.EngineOverrides(timestep_s=1e-4, timestep_factor=0.5).engine(scales)
+    assert (rule.tolerance, rule.noslip_tolerance) == (1e-8, 1e-6)
+    rig = sim.build_rig(surface, mu=0.5, ie=1e-3, tolerance=1e-10, noslip_tolerance=1e-8, timestep_factor=0.5)
+    assert (rig.model.opt.tolerance, rig.model.opt.noslip_tolerance) == (1e-10, 1e-8)
+    plain = sim.build_rig(surface, mu=0.5, ie=1e-3)
+    assert (plain.model.opt.tolerance, plain.model.opt.noslip_tolerance) == (1e-8, 1e-6)
+    assert rig.engine.timestep_s == pytest.approx(plain.engine.timestep_s / 2)
+    with pytest.raises(SpineInputError, match="tolerance must be"):
+        sim.EngineSettings(timestep_s=1e-4, solref=(2e-4, 1.0), tolerance=0.0)

@@ -85,6 +85,9 @@ def test_mujoco_config_checks():
     doc = with_(sweep__analyses=["mujoco"], grid__ie=0.1, grid__speed=0.01)
     with pytest.raises(SpineInputError, match=r"grid.ie and grid.speed: give one of them"):
         sweep.parse_config(doc)
+    doc = with_(sweep__analyses=["mujoco"], grid__timestep=1e-4, grid__timestep_factor=0.5)
+    with pytest.raises(SpineInputError, match=r"grid.timestep and grid.timestep_factor: give one of them"):
+        sweep.parse_config(doc)
     doc = with_(sweep__analyses=["mujoco"], drive__protocol="pull")
     with pytest.raises(SpineInputError, match=r"drive.protocol: must be one of 'spring', 'ramp'"):
         sweep.parse_config(doc)

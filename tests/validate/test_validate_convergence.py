@@ -11,6 +11,7 @@ import pytest
 
 from spine_mj import presets, sim
 from spine_mj.validate.convergence import (
+    REFINEMENTS,
     family_convergence,
     headline_convergence,
     is_converged,
@@ -170,8 +171,20 @@ def test_the_rigs_engine_is_the_sweeps_and_a_halved_step_keeps_the_contacts_time
     grid = engine_grid(
         plan, (("timestep_factor", 0.5),), preset, None, tip, mu=mu, ie=ie, stiffness_number=300.0
     )
-    assert grid["timestep"] == pytest.approx(engine.timestep_s / 2)
-    assert grid["solref_timeconst"] == engine.solref[0]  # explicit: only the step changes
+    # the sweep halves each case's own step, the contact's time constant kept
+    assert grid["timestep_factor"] == 0.5 and "timestep" not in grid and "solref_timeconst" not in grid
+    halved = sim.build_rig(
+        surface,
+        mu=mu,
+        tip_radius_m=tip * sim.DEFAULT_LENGTH_SCALE_M,
+        mass_kg=MASS_KG,
+        hfield_resolution=res,
+        ie=ie,
+        stiffness_number=300.0,
+        timestep_factor=grid["timestep_factor"],
+    )
+    assert halved.engine.timestep_s == pytest.approx(engine.timestep_s / 2)
+    assert halved.engine.solref == engine.solref  # only the step changes
     soft = engine_grid(plan, (("solref_timeconst_factor", 10.0),), preset, None, tip, mu=mu, ie=ie)
     # the contact's time constant is the contact rule's, whatever the spring
     assert soft["solref_timeconst"] == pytest.approx(10 * engine.solref[0])
@@ -235,10 +248,13 @@ def test_every_refined_sweep_of_the_plans_is_a_valid_config_that_changes_only_it
         grid = doc["grid"]
         if key.startswith("dt_"):
             assert grid["hfield_resolution"] == plan.hfield_resolution
-            assert grid["timestep"] < grid["solref_timeconst"] / 2  # the contact's own time constant
-        else:
+            assert grid["timestep_factor"] == dict(REFINEMENTS[key])["timestep_factor"] < 1
+        elif key == "hfield_doubled":
             assert grid["hfield_resolution"] == refined_resolution(plan.hfield_resolution, 2)
             assert "timestep" not in grid
+        else:  # the solver's tolerances, a hundredth of MuJoCo's
+            assert (grid["tolerance"], grid["noslip_tolerance"]) == (1e-10, 1e-8)
+            assert grid["hfield_resolution"] == plan.hfield_resolution
 
 
 def test_a_single_headline_is_judged_on_log10_where_it_lives_on_a_log_grid():

@@ -85,3 +85,39 @@ def test_surfaces_are_fig9s_with_h_set_and_distinct_seeds():
     assert entry["set"]["rms_height"] == pytest.approx(rms, rel=1e-5)
     heights = [e["set"]["rms_height"] for e in table]
     assert np.all(np.diff(heights) > 0)  # the Fig. 9 synthesis: roughness grows with H
+
+
+def test_a_refined_rate_is_paired_on_the_surfaces_both_ran_cleanly():
+    from spine_mj.validate.fractal_lock import _add_convergence
+
+    # six surfaces at one H: 3 of 6 lock at the default step
+    base = pd.DataFrame(
+        {
+            "hurst": 0.8,
+            "surface": [f"s{i}" for i in range(6)],
+            "series": "mujoco_corner",
+            "locked": [True, True, True, False, False, False],
+            "ok": True,
+        }
+    )
+    rows = hurst_rows(base)
+    # the halved step reruns the first four: s0 fails, s3 locks now; s4, s5 not rerun
+    refined = pd.DataFrame(
+        {
+            "hurst": 0.8,
+            "surface": ["s0", "s1", "s2", "s3"],
+            "series": "mujoco_corner",
+            "locked": [False, True, True, True],
+            "ok": [False, True, True, True],
+        }
+    )
+    _add_convergence(rows, base, {("dt_halved", "corner"): refined}, ("dt_halved",))
+    conv = rows[0]["convergence_mujoco_corner"]
+    entry = conv["dt_halved"]
+    # paired on s1, s2, s3: 2 of 3 locked before, 3 of 3 after
+    assert entry["runs"] == 3
+    assert entry["base"] == pytest.approx(2 / 3) and entry["refined_value"] == 1.0
+    assert entry["change"] == pytest.approx(1 / 3)
+    lo, hi = rows[0]["ci_low_mujoco_corner"], rows[0]["ci_high_mujoco_corner"]
+    assert entry["converged"] is (lo <= 0.5 + 1 / 3 <= hi)
+    assert "convergence_mujoco_dynamic" not in rows[0]  # the series did not run

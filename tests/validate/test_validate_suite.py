@@ -87,6 +87,12 @@ def test_smoke_validation_writes_report_and_json(tmp_path, monkeypatch):
     assert star_conv["dt_halved"]["runs"] == len(plan.ie_values) * 2
     assert star_conv["ie_refined"] == list(plan.ie_values)
     assert "Solution verification of I_e*" in report
+    # and of the fractal lock rates: both MuJoCo series, each surface's own step halved
+    for row in fractal["rows"]:
+        for series in ("mujoco_corner", "mujoco_dynamic"):
+            entry = row[f"convergence_{series}"]["dt_halved"]
+            assert entry["runs"] == plan.fractal_refined_surfaces and entry["converged"] is not None
+    assert "Solution verification of the MuJoCo rates" in report
     # the map's convergence to the theory and the predicted limits against the measured
     assert {r["axis"] for r in doc["convergence_to_theory"]} == {"ie", "inverse_k"}
     assert doc["predicted_vs_measured"][0]["family"] == "single_peak_valley"

@@ -134,6 +134,25 @@ MUJOCO_PARAMS = (
     ParamSpec("impratio", "float", "frictional / normal impedance ratio", 1.0, 0.0, exclusive=True),
     ParamSpec("noslip_iterations", "int", "noslip solver passes", 3, 0),
     ParamSpec(
+        "tolerance", "float", "MuJoCo solver tolerance (default MuJoCo's, 1e-8)", None, 0.0, exclusive=True
+    ),
+    ParamSpec(
+        "noslip_tolerance",
+        "float",
+        "MuJoCo noslip solver tolerance (default MuJoCo's, 1e-6)",
+        None,
+        0.0,
+        exclusive=True,
+    ),
+    ParamSpec(
+        "timestep_factor",
+        "float",
+        "the rule's time step times this, the contact's time constant kept (not with timestep)",
+        None,
+        0.0,
+        exclusive=True,
+    ),
+    ParamSpec(
         "solref_timeconst",
         "float",
         "contact time constant [s] (default 2 timestep)",
@@ -165,9 +184,14 @@ PROTOCOL_KEYS = {
 
 
 def _check_speed(config) -> None:
-    """One of ie/speed and K/stiffness; no drive key that a chosen protocol would ignore."""
+    """One of ie/speed, K/stiffness and timestep/timestep_factor; no drive key that a
+    chosen protocol would ignore."""
     grid = dict(config.grid)
-    for a, b, what in (("ie", "speed", "the inertia number or the speed"), ("K", "stiffness", "K or k")):
+    for a, b, what in (
+        ("ie", "speed", "the inertia number or the speed"),
+        ("K", "stiffness", "K or k"),
+        ("timestep", "timestep_factor", "the step or the rule's step's factor"),
+    ):
         if grid[a] != (None,) and grid[b] != (None,):
             raise SpineInputError(
                 f"config keys grid.{a} and grid.{b}: give one of them ({what}), got "
@@ -196,8 +220,11 @@ def _rig(spec, key):
         "cone": p["cone"],
         "impratio": p["impratio"],
         "noslip_iterations": p["noslip_iterations"],
+        "tolerance": p["tolerance"],
+        "noslip_tolerance": p["noslip_tolerance"],
         "solref_timeconst_s": p["solref_timeconst"],
         "solref_dampratio": p["solref_dampratio"],
+        "timestep_factor": p["timestep_factor"],
     }
     return sim.build_engine_rig(
         spec.make(),
@@ -271,6 +298,9 @@ _RIG_KEYS = (
     "cone",
     "impratio",
     "noslip_iterations",
+    "tolerance",
+    "noslip_tolerance",
+    "timestep_factor",
     "solref_timeconst",
     "solref_dampratio",
     "hfield_resolution",

@@ -214,7 +214,7 @@ def _convergence_lines(boundary: BoundaryResult) -> list[str]:
         "### Solution verification of I_e*",
         "",
         "Every start rerun under each refinement at the I_e values around the headline's "
-        "bracket (the step halved or quartered, the contact's time constant passed explicitly "
+        "bracket (the step halved or quartered, the contact's time constant kept "
         "so that only the step changes; an analytic surface's hfield at twice the samples a "
         "side, the tip kept); the refined I_e* is read from the curve with those values "
         "replaced (the others keep their runs). Converged: the refined I_e* inside the "

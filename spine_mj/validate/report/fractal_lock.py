@@ -14,8 +14,9 @@ from spine_mj.plotting import (
     sig,
     styled,
 )
-from spine_mj.validate.fractal_lock import SERIES, FractalLockResult
-from spine_mj.validate.report.common import ReportContext, assemble, cell, image, table
+from spine_mj.validate.convergence import refinement_note
+from spine_mj.validate.fractal_lock import MUJOCO_SERIES, SERIES, FractalLockResult
+from spine_mj.validate.report.common import ReportContext, assemble, cell, image, refinement_rows, table
 
 
 #: Legend labels of the fractal study's series (:data:`spine_mj.validate.fractal_lock.SERIES`).
@@ -71,6 +72,7 @@ def _lines(fr: FractalLockResult) -> list[str]:
             row[s] = (
                 f"{cell(r[f'rate_{s}'], 2)} [{cell(r[f'ci_low_{s}'], 2)}, {cell(r[f'ci_high_{s}'], 2)}] "
                 f"({r[f'locked_{s}']}/{r[f'n_ok_{s}']}, failed {r[f'failed_runs_{s}']})"
+                + refinement_note(r.get(f"convergence_{s}"))
             )
         rows.append(row)
     return [
@@ -87,6 +89,46 @@ def _lines(fr: FractalLockResult) -> list[str]:
         table(rows, ["H", *present], ["H", *(labels[s] for s in present)]),
         "",
         _fractal_sentence(fr),
+        "",
+        *_convergence_lines(fr),
+    ]
+
+
+def _convergence_lines(fr: FractalLockResult) -> list[str]:
+    """The MuJoCo rates' solution verification (empty where the plan refined nothing)."""
+    labels = _fractal_labels(fr)
+    rows = [
+        r
+        for row in fr.rows
+        for s in MUJOCO_SERIES
+        if row.get(f"convergence_{s}")
+        for r in refinement_rows(row[f"convergence_{s}"], H=row["hurst"], series=labels[s])
+    ]
+    if not rows:
+        return []
+    return [
+        "### Solution verification of the MuJoCo rates",
+        "",
+        "Both MuJoCo series rerun on the first surfaces of every H under each refinement (each "
+        "surface's own rig step halved, the contact's time constant kept); the change is "
+        "paired (the refined runs' rate minus the same surfaces' own, over the surfaces both "
+        "ran cleanly), converged when the rate plus the change stays inside its Wilson interval. "
+        "A fractal keeps its samples: no hfield to refine.",
+        "",
+        table(
+            rows,
+            ["H", "series", "refinement", "runs", "base", "refined", "change", "verdict"],
+            [
+                "H",
+                "series",
+                "refinement",
+                "paired surfaces",
+                "rate (same surfaces)",
+                "refined",
+                "change",
+                "verdict",
+            ],
+        ),
         "",
     ]
 
