@@ -404,10 +404,12 @@ PLANS: dict[str, ValidationPlan] = {
         ),
         # solution verification: 1 start a surface (13 runs a refinement over the families)
         convergence_starts=1,
-        stiffness_map_ie=(1e-2, 1.0),
-        # a reduced ladder past each family's K*, and one deeper I_e at the stiffest
-        stiffness_map_k_factors=(0.3, 1.0, 3.0, 10.0),
-        stiffness_map_deep_ie=(1e-3,),
+        # I_e low enough that the stiffer K are read where their spring-block swing is
+        # small (theory_orders.k_readings), one deeper at the stiffest (10 K*)
+        stiffness_map_ie=(1e-3, 1e-1),
+        # a reduced ladder around each family's K_path, with its fold K* and 10 K*
+        stiffness_map_k_factors=(0.3, 1.0, 3.0),
+        stiffness_map_deep_ie=(1e-4,),
         stiffness_map_families=("single_peak_valley", "random_gaussian", "fractal"),
         stiffness_map_starts=2,
         stick_slip_k_ie=(1e-4,),
@@ -460,7 +462,9 @@ PLANS: dict[str, ValidationPlan] = {
         # fractal at K = 1000, one start, busy machine: 3.0 s at I_e 1e-4, 47 s at 1e-5 (its
         # stick phases too short for the fast-forward), 1.6 s at 1e-6 (fast-forwarded; 36 s
         # without): the ladder skips 1e-5
-        stiffness_map_k_factors=(0.1, 0.3, 0.5, 1.0, 2.0, 3.0, 10.0),
+        # K / K_path by factors of at most 2 around K_path (judged within a factor of 2),
+        # with each family's fold K* and 10 K* (family_k_axis)
+        stiffness_map_k_factors=(0.1, 0.3, 0.5, 1.0, 2.0, 3.0),
         stiffness_map_deep_ie=(1e-6,),
         stiffness_map_deep_starts=10,
         stiffness_map_families=("single_peak_valley", "random_gaussian", "fractal"),

@@ -52,6 +52,7 @@ __all__ = [
     "StiffnessMapResult",
     "agreement_map",
     "energy_rows",
+    "family_k_axis",
     "k_ladder",
     "slip_rows",
     "stiffness_map",
@@ -94,7 +95,8 @@ class StiffnessMapResult:
         tail fit (:func:`spine_mj.validate.slip_tails.fit_tail`; series of fewer than 200
         events are counted, not fitted).
     k_by_family : dict
-        Family -> its K axis (``k_factors`` x its predicted K*, or the plan's K values).
+        Family -> its K axis (:func:`family_k_axis`: ``k_factors`` x its predicted K_path
+        with its fold K* and 10 K*, or the plan's K values).
     k_factors : list of float
         The ladder K / K* (empty: absolute K values).
     orders : list of dict
@@ -217,7 +219,7 @@ def stiffness_map(plan: ValidationPlan, runner: StudyRunner) -> StiffnessMapResu
         )
         with runner.phase(f"predicted drive limits of {fam.name}"):
             predicted[fam.name] = family_limits(plan, sub)
-        fks = k_ladder(predicted[fam.name]["k_star"], plan.stiffness_map_k_factors) or ks
+        fks = family_k_axis(predicted[fam.name], plan.stiffness_map_k_factors) or ks
         k_by_family[fam.name] = fks
         for preset in fam.presets:
             drives = [("", {"protocol": "spring", "ie": ies, "K": fks})]
@@ -265,6 +267,18 @@ def stiffness_map(plan: ValidationPlan, runner: StudyRunner) -> StiffnessMapResu
         orders=order_rows(agreement, predicted),
         prediction_check=prediction_check(agreement, predicted),
     )
+
+
+def family_k_axis(predicted: dict, factors) -> list[float]:
+    """A family's K axis: ``factors`` x its ``k_path`` (the boundary the map's criterion
+    sees, :func:`~spine_mj.theory.drive_limits.path_stiffness`: the measured boundary is
+    judged against it within a factor of 2), with its fold ``k_star`` and ten times it (the
+    map reaches a decade past the first fold anywhere); the fold's ladder alone where
+    ``k_path`` is not finite, empty without factors."""
+    ladder = k_ladder(predicted.get("k_path", float("nan")), factors) or k_ladder(
+        predicted["k_star"], factors
+    )
+    return sorted(set(ladder) | set(k_ladder(predicted["k_star"], (1.0, 10.0) if ladder else ())))
 
 
 def k_ladder(k_star: float, factors) -> list[float]:

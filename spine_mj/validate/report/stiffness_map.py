@@ -319,8 +319,8 @@ def _k_axis(km: StiffnessMapResult) -> str:
     if km.k_factors:
         per = "; ".join(f"{f}: {', '.join(sig(v) for v in km.family_k(f))}" for f in km.families)
         return (
-            f"K = k l_s / F_p at K / K* = {', '.join(sig(v) for v in km.k_factors)} of each family's "
-            f"predicted K* ({per})"
+            f"K = k l_s / F_p at {', '.join(sig(v) for v in km.k_factors)} x each family's predicted "
+            f"K_path (the boundary its criterion sees), with its fold K* and 10 K* ({per})"
         )
     return f"K = k l_s / F_p = {', '.join(sig(v) for v in km.stiffness_numbers)}"
 
