@@ -340,14 +340,7 @@ def unconverged_mark(convergence: dict | None, headline: str | None = None) -> s
     nothing was refined. ``convergence`` is a family's entry (:func:`family_convergence`,
     ``headline`` a key of :data:`HEADLINES`) or one headline's
     (:func:`headline_convergence`, ``headline`` None)."""
-    if not convergence:
-        return ""
-    verdict = "converged" if headline is None else f"{headline}_converged"
-    moved = [
-        REFINEMENT_LABELS.get(key, key)
-        for key, entry in convergence.items()
-        if isinstance(entry, dict) and entry.get(verdict) is False
-    ]
+    moved = _judged(convergence, headline, False)
     return f" (unconverged: {', '.join(moved)})" if moved else ""
 
 
@@ -356,12 +349,15 @@ def refinement_note(convergence: dict | None, headline: str | None = None) -> st
     it, `` (converged: dt / 2, hfield x 2)`` naming the refinements that did not, empty
     where nothing was refined (arguments as for :func:`unconverged_mark`)."""
     mark = unconverged_mark(convergence, headline)
-    if mark or not convergence:
-        return mark
-    verdict = "converged" if headline is None else f"{headline}_converged"
-    kept = [
-        REFINEMENT_LABELS.get(key, key)
-        for key, entry in convergence.items()
-        if isinstance(entry, dict) and entry.get(verdict) is True
+    kept = _judged(convergence, headline, True)
+    return mark or (f" (converged: {', '.join(kept)})" if kept else "")
+
+
+def _judged(convergence: dict | None, headline: str | None, verdict: bool) -> list[str]:
+    """The labels of the refinements whose verdict on ``headline`` is ``verdict``."""
+    key = "converged" if headline is None else f"{headline}_converged"
+    return [
+        REFINEMENT_LABELS.get(name, name)
+        for name, entry in (convergence or {}).items()
+        if isinstance(entry, dict) and entry.get(key) is verdict
     ]
-    return f" (converged: {', '.join(kept)})" if kept else ""
