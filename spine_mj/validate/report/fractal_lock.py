@@ -113,7 +113,9 @@ def _convergence_lines(fr: FractalLockResult) -> list[str]:
         "surface's own rig step halved, the contact's time constant kept); the change is "
         "paired (the refined runs' rate minus the same surfaces' own, over the surfaces both "
         "ran cleanly), converged when the rate plus the change stays inside its Wilson interval. "
-        "A fractal keeps its samples: no hfield to refine.",
+        "A run the engine stopped on penetration is rerun at a quarter of its step and contact "
+        "time constant (`spine_mj.sim.rig.REFINE_TIMESTEP`) on either side, and is paired as the "
+        "rate counted it. A fractal keeps its samples: no hfield to refine.",
         "",
         table(
             rows,
