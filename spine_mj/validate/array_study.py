@@ -128,6 +128,16 @@ class ArrayPlan:
         return tuple(ARRAY_IE / PACE_RATIO**i for i in range(self.n_paces))
 
 
+def _median_rel_error(measured, reference) -> float:
+    """Median of ``|measured / reference - 1|`` over the placements whose reference holds
+    at all (a reference holding of 0 has no relative error: left out, not infinite)."""
+    measured, reference = np.asarray(measured, float), np.asarray(reference, float)
+    held = reference > 0
+    if not held.any():
+        return math.nan
+    return float(np.nanmedian(np.abs(measured[held] / reference[held] - 1)))
+
+
 def extrapolate_to_rest(slow, fast):
     """Richardson's extrapolation of a holding to ``I_e -> 0`` from two paces, ``fast`` at
     :data:`PACE_RATIO` times ``slow``'s I_e (arrays of equal shape, or floats): the excess
@@ -348,9 +358,7 @@ def _row(config, paced, reference, plan: ArrayPlan) -> dict:
         "holding_converged": is_converged(slow["holding"], step, slow["holding_ci"]),
         "holding_per_spine_qs": qm,
         "holding_qs_ci": [qlo, qhi],
-        "holding_rel_error_median": float(np.nanmedian(np.abs(rest[ok] / qs_hold[ok] - 1)))
-        if ok.any()
-        else math.nan,
+        "holding_rel_error_median": _median_rel_error(rest[ok], qs_hold[ok]),
         "p_lock": p_lock,
         "p_lock_change": p_lock["rate"] - p_lock_fast["rate"] if ok.any() else math.nan,
         "p_lock_converged": is_converged(

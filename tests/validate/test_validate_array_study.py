@@ -119,3 +119,10 @@ def test_report_shows_the_observed_order_only_with_three_paces(smoke):
     for r in three.rows:
         r["holding_observed_order"] = 1.0
     assert "observed order" in array_section(three)
+
+
+def test_the_median_relative_error_leaves_out_placements_whose_reference_holds_nothing():
+    from spine_mj.validate.array_study import _median_rel_error
+
+    assert _median_rel_error([1.1, 0.3, 0.9], [1.0, 0.0, 1.0]) == pytest.approx(0.1)
+    assert np.isnan(_median_rel_error([0.2], [0.0])) and np.isnan(_median_rel_error([], []))
