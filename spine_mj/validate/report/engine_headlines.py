@@ -165,6 +165,7 @@ def _cost(res) -> list[str]:
     names = ["family", "engine", "runs", "engine CPU s", "per run", "reference CPU s"]
     return [
         f"Cost on this machine (CPU seconds; wall {res.wall_s:g} s in all): each engine's runs, and "
-        "the streamlines compared with them (traced once per engine's case).",
+        "the streamlines compared with them, as each engine's cases recorded them (a worker "
+        "that runs both engines' cases of a surface traces them once: the sweep's memo).",
         table(rows, list(rows[0]) if rows else [], names),
     ]
