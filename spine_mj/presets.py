@@ -38,16 +38,20 @@ else:  # pragma: no cover
 __all__ = [
     "GENERATORS",
     "Preset",
+    "SurfaceInfo",
     "calibrated_mu",
     "check_generator_params",
     "list_presets",
     "load_preset",
     "make_surface",
+    "make_surface_file",
     "open_surface",
     "parse_override",
+    "preset_descriptions",
     "preset_mu",
     "presets_dir",
     "resolve_mu",
+    "surface_info",
 ]
 
 
@@ -96,6 +100,11 @@ class Preset:
 def list_presets() -> list[str]:
     """Names of all presets, sorted."""
     return sorted(p.stem for p in presets_dir().glob("*.toml"))
+
+
+def preset_descriptions() -> dict[str, str]:
+    """Each preset of :func:`list_presets` and its one-line description (``spine-mj surface list``)."""
+    return {name: load_preset(name).description for name in list_presets()}
 
 
 def load_preset(name: str) -> Preset:
@@ -329,3 +338,88 @@ def open_surface(spec: str, **overrides) -> surfaces.Surface:
         f"SURFACE must be a .npz file, a preset ({', '.join(list_presets())}), an "
         f"instrument file or an example (spine-mj examples), got {spec!r}"
     )
+
+
+def make_surface_file(
+    output: str | os.PathLike,
+    *,
+    preset: Preset | str | None = None,
+    from_file: str | None = None,
+    overrides: dict | None = None,
+    import_options: dict | None = None,
+    png: str | os.PathLike | None = None,
+) -> surfaces.Surface:
+    """Make the surface ``preset`` describes (:func:`make_surface` with ``overrides``) or
+    import the instrument file ``from_file`` (an ``example:NAME`` too;
+    :func:`~spine_mj.surface_io.import_topography` with ``import_options``), and save it as
+    the ``.npz`` ``output``, with its PNG preview at ``png`` if given: all written or none
+    (``spine-mj surface make``). Returns the surface.
+
+    Raises
+    ------
+    SpineInputError
+        Not exactly one of ``preset`` and ``from_file``; the errors of the maker or reader.
+    """
+    from spine_mj.atomic import all_or_none
+
+    if (preset is None) == (from_file is None):
+        raise SpineInputError("give exactly one of PRESET or --from-file")
+    if from_file is not None:
+        surface = surface_io.import_topography(examples.resolve(from_file), **(import_options or {}))
+    else:
+        surface = make_surface(preset, **(overrides or {}))
+    with all_or_none(output, png):
+        surface_io.save_surface(surface, output)
+        if png:
+            surface_io.write_preview(surface, png)
+    return surface
+
+
+@dataclass(frozen=True)
+class SurfaceInfo:
+    """What ``spine-mj surface info`` reports of a surface: its roughness and, where a
+    mu_s is known, its predicted drive limits (None otherwise)."""
+
+    unit: str
+    roughness: Any
+    drive_limits: Any
+
+    def as_dict(self) -> dict:
+        """The roughness numbers with ``drive_limits`` (None without a mu_s), JSON-ready."""
+        limits = None if self.drive_limits is None else self.drive_limits.as_dict()
+        return dict(self.roughness.as_dict(), drive_limits=limits)
+
+
+def surface_info(
+    surface: surfaces.Surface,
+    *,
+    mu: float | None = None,
+    tip_radius: float = 0.0,
+    psd_png: str | os.PathLike | None = None,
+) -> SurfaceInfo:
+    """:func:`~spine_mj.roughness.summarize` of ``surface`` and its
+    :func:`~spine_mj.theory.drive_limits.drive_limits` with the one mu rule
+    (:func:`resolve_mu`: ``mu``, else the preset's; no limits without either), and the PSD
+    plot written to ``psd_png`` if given (``spine-mj surface info``).
+
+    Raises
+    ------
+    SpineInputError
+        ``mu`` not finite and > 0, or ``tip_radius`` not finite and >= 0 (named as the
+        command's ``--mu`` and ``--tip-radius``).
+    """
+    from spine_mj import roughness
+    from spine_mj.theory.drive_limits import drive_limits
+
+    rough = roughness.summarize(surface)
+    limits = None
+    if mu is not None or preset_mu(surface) is not None:
+        mu = resolve_mu(surface, mu, name="--mu")
+        if not (math.isfinite(tip_radius) and tip_radius >= 0):
+            raise SpineInputError(f"--tip-radius must be a finite number >= 0, got {tip_radius!r}")
+        limits = drive_limits(surface, mu, tip_radius=tip_radius)
+    if psd_png:
+        from spine_mj.plotting import roughness_figure, save_figure
+
+        save_figure(roughness_figure(rough), psd_png)
+    return SurfaceInfo(unit=surface.unit, roughness=rough, drive_limits=limits)

@@ -36,11 +36,13 @@ from spine_mj.surfaces import (
 
 __all__ = [
     "FILL_METHODS",
+    "export_surface",
     "import_topography",
     "load_surface",
     "save_surface",
     "surface_mesh",
     "write_hfield",
+    "write_preview",
     "write_stl",
 ]
 
@@ -463,3 +465,47 @@ def write_hfield(surface: Surface, path: str | os.PathLike, *, resolution: int |
             fh, data=hf.data, size=np.asarray(hf.size), pos=np.asarray(hf.pos), unit=np.array(surface.unit)
         )
     return hf
+
+
+def write_preview(surface: Surface, path: str | os.PathLike) -> Path:
+    """Write the PNG preview of ``surface`` (height map and 3-D view,
+    :func:`~spine_mj.plotting.surface_preview`) to ``path`` atomically; returns it."""
+    from spine_mj.plotting import save_figure, surface_preview
+
+    return save_figure(surface_preview(surface), path)
+
+
+def export_surface(
+    surface: Surface,
+    *,
+    stl: str | os.PathLike | None = None,
+    hfield: str | os.PathLike | None = None,
+    stl_scale: float | None = None,
+    base_thickness: float | None = None,
+    resolution: int | None = None,
+) -> tuple[float | None, HField | None]:
+    """Write ``surface`` as the STL solid ``stl`` (:func:`write_stl`) and/or as MuJoCo hfield
+    data ``hfield`` (:func:`write_hfield`), all or none (``spine-mj surface export``).
+
+    ``stl_scale`` multiplies the STL's coordinates (None: the surface's length unit to mm,
+    1 for a dimensionless surface); ``base_thickness`` and ``resolution`` as in
+    :func:`surface_mesh`. Returns the STL's scale and the hfield written (None for an
+    output not asked for).
+    """
+    from spine_mj.atomic import all_or_none
+
+    unit = length_unit(surface.unit)
+    mm_scale = 1.0 if unit is None else LENGTH_UNITS_M[unit] / LENGTH_UNITS_M["mm"]
+    scale = check_positive("--stl-scale", stl_scale if stl_scale is not None else mm_scale)
+    if base_thickness is not None:
+        base_thickness = check_positive("--base", base_thickness)
+    hf = None
+    with all_or_none(stl, hfield):
+        if stl:
+            mesh_opts = {"scale": scale, "base_thickness": base_thickness}
+            if resolution:
+                mesh_opts["resolution"] = resolution
+            write_stl(surface, stl, **mesh_opts)
+        if hfield:
+            hf = write_hfield(surface, hfield, resolution=resolution)
+    return (scale if stl else None), hf

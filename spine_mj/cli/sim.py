@@ -2,10 +2,6 @@
 
 from __future__ import annotations
 
-import os
-import sys
-from pathlib import Path
-
 import click
 
 from spine_mj.cli.app import (
@@ -302,14 +298,6 @@ def _motion_line(result) -> str:
     return f"motion: {frac}; {slips}; largest speed {s['max_speed_over_drive']:.3g} V"
 
 
-def _render_mp4(rig, run, path: Path, *, speed: float | None = None) -> None:
-    """Write the MP4 of a run (a RunResult or a replay Track), with a progress bar."""
-    from spine_mj.sim.render import write_mp4
-
-    with Progress("rendering MP4", unit="frame") as bar:
-        write_mp4(rig, run, path, speed=speed, progress=bar.update)
-
-
 @main.command("replay")
 @click.argument("run_dir", type=click.Path(file_okay=False, exists=True))
 @click.option(
@@ -330,36 +318,19 @@ def replay(run_dir, speed, duration, mp4):
     Example:
       spine-mj simulate paper-single-peak --start -3,-1 --out run/ && spine-mj replay run/
     """
-    from spine_mj import extras
-    from spine_mj.sim.render import choose_gl_backend, default_speed
-    from spine_mj.sim.replay import play_in_viewer
-    from spine_mj.sim.run_folder import load_run
+    from spine_mj.sim.replay import replay_run
 
-    headless = mp4 is not None or (
-        sys.platform.startswith("linux")
-        and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
-    )
-    if headless:  # --duration closes the viewer; an MP4 has the run's length at --speed
-        refuse_options_not_for("replay to an MP4 (no display, or --mp4)", ["duration"])
-    if duration is not None:
-        check_positive("--duration", duration)
-    if headless:
-        choose_gl_backend()
-    rig, track = load_run(run_dir)
-    if headless:
-        extras.require("video", "replay without a display (an MP4)" if mp4 is None else "--mp4")
-    span = float(track.time_s[-1] - track.time_s[0])
-    speed = check_positive("--speed", speed) if speed is not None else default_speed(track.time_s)
-    if headless:
-        path = Path(mp4) if mp4 is not None else Path(run_dir) / "replay.mp4"
-        check_suffix(str(path), ".mp4", "--mp4")
-        if mp4 is None:
-            click.echo("no display: writing an MP4 instead of opening the viewer", err=True)
-        _render_mp4(rig, track, path, speed=speed)
-        click.echo(f"wrote {path}")
-        return
-    click.echo(f"replaying {span:g} s of run at {speed:g}x; close the window to stop", err=True)
-    play_in_viewer(rig, track, speed=speed, duration_s=duration)
+    with Progress("rendering MP4", unit="frame") as bar:
+        done = replay_run(
+            run_dir,
+            speed=speed,
+            duration_s=duration,
+            mp4=mp4,
+            notice=lambda text: click.echo(text, err=True),
+            progress=bar.update,
+        )
+    if done.mp4 is not None:
+        click.echo(f"wrote {done.mp4}")
 
 
 @main.command("view")
@@ -380,13 +351,11 @@ def view(surface_spec, start, duration, **rig_opts):
     To watch a recorded run instead, use `spine-mj replay RUN_DIR`.
     """
 
-    from spine_mj.sim.replay import view_rig
+    from spine_mj.sim.replay import has_display, view_rig
 
     if duration is not None:
         check_positive("--duration", duration)
-    if sys.platform.startswith("linux") and not (
-        os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
-    ):
+    if not has_display():
         raise InputError(
             "no display (DISPLAY and WAYLAND_DISPLAY are unset): the viewer "
             "needs one; use `spine-mj sim export`, `simulate --render` or `replay --mp4`"

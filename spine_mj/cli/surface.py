@@ -8,7 +8,7 @@ import math
 import click
 
 from spine_mj.cli.app import _Group, check_suffix, main, refuse_options_not_for
-from spine_mj.errors import SpineInputError, check_positive
+from spine_mj.errors import SpineInputError
 
 
 @main.group(cls=_Group)
@@ -21,8 +21,8 @@ def surface_list():
     """List the surface presets in surfaces/."""
     from spine_mj import presets
 
-    for name in presets.list_presets():
-        click.echo(f"{name:24s} {presets.load_preset(name).description}")
+    for name, description in presets.preset_descriptions().items():
+        click.echo(f"{name:24s} {description}")
 
 
 @surface.command("make")
@@ -64,9 +64,7 @@ def surface_make(preset, from_file, output, seed, hurst, sets, fill, no_level, s
       spine-mj surface make --from-file scan.plu --fill harmonic -o scan.npz
     """
 
-    from spine_mj import examples, presets, surface_io
-    from spine_mj.atomic import all_or_none
-    from spine_mj.plotting import save_figure, surface_preview
+    from spine_mj import presets
 
     if (preset is None) == (from_file is None):
         raise SpineInputError("give exactly one of PRESET or --from-file")
@@ -76,23 +74,21 @@ def surface_make(preset, from_file, output, seed, hurst, sets, fill, no_level, s
         )
     else:
         refuse_options_not_for("--from-file (an import, not a generator)", ["seed", "hurst", "sets"])
-    if from_file is not None:
-        surf = surface_io.import_topography(
-            examples.resolve(from_file), channel=channel, fill=fill, level=not no_level, spacing_m=spacing
-        )
-    else:
-        overrides = dict(presets.parse_override(s) for s in sets)
-        if seed is not None:
-            overrides["seed"] = seed
-        if hurst is not None:
-            overrides["hurst"] = hurst
-        surf = presets.make_surface(preset, **overrides)
+    overrides = dict(presets.parse_override(s) for s in sets)
+    if seed is not None:
+        overrides["seed"] = seed
+    if hurst is not None:
+        overrides["hurst"] = hurst
     if png:
         check_suffix(png, ".png", "--png")
-    with all_or_none(output, png):
-        surface_io.save_surface(surf, output)
-        if png:
-            save_figure(surface_preview(surf), png)
+    presets.make_surface_file(
+        output,
+        preset=preset,
+        from_file=from_file,
+        overrides=overrides,
+        import_options={"channel": channel, "fill": fill, "level": not no_level, "spacing_m": spacing},
+        png=png,
+    )
     click.echo(f"wrote {output}" + (f" and {png}" if png else ""))
 
 
@@ -107,12 +103,11 @@ def surface_show(surface_file, output):
       spine-mj surface show fractal.npz -o fractal.png
     """
 
-    from spine_mj import presets
-    from spine_mj.plotting import save_figure, surface_preview
+    from spine_mj import presets, surface_io
 
     check_suffix(output, ".png", "-o/--output")
     surf = presets.open_surface(surface_file)
-    save_figure(surface_preview(surf), output)
+    surface_io.write_preview(surf, output)
     click.echo(f"wrote {output}")
 
 
@@ -134,7 +129,7 @@ def surface_info(surface_spec, output, as_json, mu, tip_radius):
     Example:
       spine-mj surface info example:plu-1.plu --mu 0.5 -o psd.png
     """
-    from spine_mj import presets, roughness
+    from spine_mj import presets
     from spine_mj.jsonio import to_jsonable
 
     if output:
@@ -142,20 +137,15 @@ def surface_info(surface_spec, output, as_json, mu, tip_radius):
     surf = presets.open_surface(surface_spec)
     if mu is None and presets.preset_mu(surf) is None:  # no drive limits: nothing uses the tip
         refuse_options_not_for("surface info without a mu_s (no --mu, no preset's)", ["tip_radius"])
-    rough = roughness.summarize(surf)
-    limits = _drive_limits(surf, mu, tip_radius)
-    if output:
-        from spine_mj.plotting import roughness_figure, save_figure
-
-        save_figure(roughness_figure(rough), output)
+    info = presets.surface_info(surf, mu=mu, tip_radius=tip_radius, psd_png=output)
     if as_json:
-        doc = dict(rough.as_dict(), drive_limits=None if limits is None else limits.as_dict())
-        click.echo(json.dumps(to_jsonable(doc), indent=2))
+        click.echo(json.dumps(to_jsonable(info.as_dict()), indent=2))
         return
-    unit = "" if surf.unit == "1" else f" {surf.unit}"
+    rough, limits = info.roughness, info.drive_limits
+    unit = "" if info.unit == "1" else f" {info.unit}"
     click.echo(f"rms height               {rough.rms_height:.4g}{unit}")
     click.echo(f"rms slope                {rough.rms_slope:.4g}")
-    click.echo(f"rms curvature            {rough.rms_curvature:.4g}{'' if not unit else ' 1/' + surf.unit}")
+    click.echo(f"rms curvature            {rough.rms_curvature:.4g}{'' if not unit else ' 1/' + info.unit}")
     click.echo(f"L_c (asperity length)    {rough.char_length:.4g}{unit}")
     click.echo(f"l_s (slope correlation)  {rough.slope_correlation_length:.4g}{unit}")
     hurst = f"{rough.hurst:.3g}" if math.isfinite(rough.hurst) else "not estimated (the PSD is no power law)"
@@ -166,21 +156,6 @@ def surface_info(surface_spec, output, as_json, mu, tip_radius):
         click.echo(f"drive limits (mu_s {limits.mu:g})  {limits.sentence()}")
     if output:
         click.echo(f"wrote {output}")
-
-
-def _drive_limits(surf, mu, tip_radius):
-    """:func:`spine_mj.theory.drive_limits.drive_limits` of ``surf`` with the one mu rule
-    (:func:`spine_mj.presets.resolve_mu`); None without a mu_s (info still reports the
-    roughness)."""
-    from spine_mj import presets
-    from spine_mj.theory.drive_limits import drive_limits
-
-    if mu is None and presets.preset_mu(surf) is None:
-        return None
-    mu = presets.resolve_mu(surf, mu, name="--mu")
-    if not (math.isfinite(tip_radius) and tip_radius >= 0):
-        raise SpineInputError(f"--tip-radius must be a finite number >= 0, got {tip_radius!r}")
-    return drive_limits(surf, mu, tip_radius=tip_radius)
 
 
 @surface.command("export")
@@ -217,8 +192,6 @@ def surface_export(surface_file, stl, stl_scale, base_thickness, hfield, resolut
     """
 
     from spine_mj import presets, surface_io
-    from spine_mj.atomic import all_or_none
-    from spine_mj.surfaces import LENGTH_UNITS_M, length_unit
 
     if not stl and not hfield:
         raise SpineInputError("nothing to export: give --stl and/or --hfield")
@@ -227,21 +200,15 @@ def surface_export(surface_file, stl, stl_scale, base_thickness, hfield, resolut
     if hfield:
         check_suffix(hfield, ".npz", "--hfield")
     surf = presets.open_surface(surface_file)
-    unit = length_unit(surf.unit)
-    mm_scale = 1.0 if unit is None else LENGTH_UNITS_M[unit] / LENGTH_UNITS_M["mm"]
-    scale = stl_scale if stl_scale is not None else mm_scale
-    scale = check_positive("--stl-scale", scale)
-    if base_thickness is not None:
-        base_thickness = check_positive("--base", base_thickness)
-    written = []
-    with all_or_none(stl, hfield):
-        if stl:
-            mesh_opts = {"scale": scale, "base_thickness": base_thickness}
-            if resolution:
-                mesh_opts["resolution"] = resolution
-            surface_io.write_stl(surf, stl, **mesh_opts)
-            written.append(f"wrote {stl} (scale {scale:g})")
-        if hfield:
-            hf = surface_io.write_hfield(surf, hfield, resolution=resolution)
-            written.append(f"wrote {hfield} ({hf.nrow} x {hf.ncol}, size {json.dumps(hf.size)})")
+    scale, hf = surface_io.export_surface(
+        surf,
+        stl=stl,
+        hfield=hfield,
+        stl_scale=stl_scale,
+        base_thickness=base_thickness,
+        resolution=resolution,
+    )
+    written = [f"wrote {stl} (scale {scale:g})"] if stl else []
+    if hfield:
+        written.append(f"wrote {hfield} ({hf.nrow} x {hf.ncol}, size {json.dumps(hf.size)})")
     click.echo("\n".join(written))

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import click
 
 from spine_mj.cli.app import Progress, check_suffix, main, parse_start, refuse_options_not_for
@@ -25,22 +23,16 @@ def kappa_cmd(surface_spec, mu, output, resolution):
       spine-mj kappa paper-single-peak --mu 1.2 -o map.png
     """
 
-    import numpy as np
-
     from spine_mj import presets
-    from spine_mj.plotting import kappa_map_figure, save_figure
+    from spine_mj.reproduce import kappa_map_to
     from spine_mj.surfaces import check_grid_size
-    from spine_mj.theory import engagement
 
     check_suffix(output, ".png", "-o/--output")
     check_grid_size(resolution, resolution, where="kappa --resolution")
     surf = presets.open_surface(surface_spec)
     mu = presets.resolve_mu(surf, mu, name="--mu")
-    xs, _, heights, k, region = engagement.kappa_grid(surf, mu, resolution)
-    fig = kappa_map_figure({surf.metadata.get("preset", "surface"): (xs, heights, k, region)}, mu)
-    save_figure(fig, output)
-    shares = ", ".join(f"{n} {100 * np.mean(region == c):.1f} %" for c, n in engagement.REGION_NAMES.items())
-    click.echo(f"wrote {output} ({shares})")
+    shares = kappa_map_to(output, surf, mu=mu, resolution=resolution)
+    click.echo(f"wrote {output} ({', '.join(f'{n} {100 * f:.1f} %' for n, f in shares.items())})")
 
 
 @main.command("streamline")
@@ -84,13 +76,12 @@ def streamline_cmd(surface_spec, mu, starts, dl, tip_radius, fmt, out_dir):
     """
 
     from spine_mj import presets
-    from spine_mj.theory.streamline_outputs import trace_starts, write_streamline_outputs
+    from spine_mj.theory.streamline_outputs import streamline_to
 
     pts = [parse_start(s) for s in starts]
     surf = presets.open_surface(surface_spec)
     mu = presets.resolve_mu(surf, mu, name="--mu")
-    run = trace_starts(surf, pts, mu=mu, dl=dl, tip_radius=tip_radius)
-    written = write_streamline_outputs(run, out_dir, fmt=fmt)
+    run, written = streamline_to(out_dir, surf, pts, mu=mu, fmt=fmt, dl=dl, tip_radius=tip_radius)
     for line in run.summary_lines():
         click.echo(line)
     click.echo(f"wrote {written[0]} and {written[1]}")
@@ -134,9 +125,6 @@ def reproduce_cmd(name, out_dir, quick, surfaces, workers):
     """
 
     from spine_mj import reproduce
-    from spine_mj.atomic import all_or_none
-    from spine_mj.jsonio import write_json
-    from spine_mj.plotting import save_figure
 
     options = {}
     if name == "fractal-hurst":
@@ -146,9 +134,5 @@ def reproduce_cmd(name, out_dir, quick, surfaces, workers):
     else:
         refuse_options_not_for(f"reproduce {name}", ["surfaces", "workers"])
     with Progress(name) as bar:
-        numbers, fig = reproduce.run(name, quick=quick, progress=bar.update, **options)
-    out = Path(out_dir)
-    with all_or_none(out / f"{name}.json", out / f"{name}.png"):
-        write_json(out / f"{name}.json", numbers)
-        save_figure(fig, out / f"{name}.png")
-    click.echo(f"wrote {out / name}.json and {out / name}.png")
+        written = reproduce.run_to(out_dir, name, quick=quick, progress=bar.update, **options)
+    click.echo(f"wrote {written[0]} and {written[1]}")

@@ -14,11 +14,13 @@ One module per figure family: :mod:`~spine_mj.reproduce.single_peak` (Figs. 2B, 
 
 from __future__ import annotations
 
+from pathlib import Path
+
 from spine_mj.errors import SpineInputError
 from spine_mj.reproduce._common import Progress
 from spine_mj.reproduce.fractal import fig9_rms_height, fig9_seeds, fractal_hurst, raw_rms_height
 from spine_mj.reproduce.random_gaussian import random_gaussian
-from spine_mj.reproduce.single_peak import calibrate_single_peak_mu, kappa_map, single_peak
+from spine_mj.reproduce.single_peak import calibrate_single_peak_mu, kappa_map, kappa_map_to, single_peak
 
 __all__ = [
     "REPRODUCTIONS",
@@ -27,9 +29,11 @@ __all__ = [
     "fig9_seeds",
     "fractal_hurst",
     "kappa_map",
+    "kappa_map_to",
     "random_gaussian",
     "raw_rms_height",
     "run",
+    "run_to",
     "single_peak",
 ]
 
@@ -46,3 +50,27 @@ def run(name: str, *, quick: bool = False, progress: Progress = None, **options)
     if name not in REPRODUCTIONS:
         raise SpineInputError(f"NAME must be one of {', '.join(REPRODUCTIONS)}, got {name!r}")
     return REPRODUCTIONS[name](quick=quick, progress=progress, **options)
+
+
+def run_to(
+    out_dir, name: str, *, quick: bool = False, progress: Progress = None, **options
+) -> tuple[Path, Path]:
+    """:func:`run` reproduction ``name`` and write ``out_dir/NAME.json`` (its numbers) and
+    ``out_dir/NAME.png`` (its figure), both or neither (``spine-mj reproduce``).
+
+    Returns
+    -------
+    (Path, Path)
+        The JSON and the PNG written.
+    """
+    from spine_mj.atomic import all_or_none
+    from spine_mj.jsonio import write_json
+    from spine_mj.plotting import save_figure
+
+    numbers, fig = run(name, quick=quick, progress=progress, **options)
+    out = Path(out_dir)
+    json_path, png_path = out / f"{name}.json", out / f"{name}.png"
+    with all_or_none(json_path, png_path):
+        write_json(json_path, numbers)
+        save_figure(fig, png_path)
+    return json_path, png_path

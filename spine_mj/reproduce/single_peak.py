@@ -10,6 +10,7 @@ import numpy as np
 from spine_mj.errors import SpineInputError
 from spine_mj.plotting import (
     kappa_map_figure,
+    save_figure,
     single_peak_figure,
 )
 from spine_mj.reproduce._common import FIVE_Y0, Progress, _finite_or_str, _outcome_name, _settings
@@ -168,13 +169,38 @@ def kappa_map(
     mu, _, _ = _settings("paper-single-peak", mu)
     n = int(n if n is not None else (101 if quick else 301))
     numbers = {"mu": mu, "n": n}
-    maps = {}
-    for name, sign in (("convex", 1), ("concave", -1)):
-        xs, _, heights, k, region = kappa_grid(single_gaussian(sign=sign), mu, n)
-        maps[name] = (xs, heights, k, region)
-        for code, label in REGION_NAMES.items():
-            numbers[f"{name}_{label}_fraction"] = float(np.mean(region == code))
+    surfs = {"convex": single_gaussian(sign=1), "concave": single_gaussian(sign=-1)}
+    maps, fractions = _kappa_maps(surfs, mu, n)
+    for name, shares in fractions.items():
+        numbers.update({f"{name}_{label}_fraction": share for label, share in shares.items()})
     if progress:
         progress(1, 1)
 
     return numbers, kappa_map_figure(maps, mu)
+
+
+def kappa_map_to(path, surface, *, mu: float, resolution: int) -> dict[str, float]:
+    """Draw the kappa map of ``surface`` (Fig. 2B's panel: slip blank, self-lock dark red)
+    on a ``resolution`` x ``resolution`` grid and save it as the PNG ``path``
+    (``spine-mj kappa``).
+
+    Returns
+    -------
+    dict
+        The share of the grid in each region, by name (:data:`REGION_NAMES` order).
+    """
+    name = surface.metadata.get("preset", "surface")
+    maps, fractions = _kappa_maps({name: surface}, mu, resolution)
+    save_figure(kappa_map_figure(maps, mu), path)
+    return fractions[name]
+
+
+def _kappa_maps(surfs: dict, mu: float, n: int) -> tuple[dict, dict]:
+    """:func:`kappa_grid` of each named surface: the figure's maps ``(xs, heights, kappa,
+    region)`` and each map's region shares ``{label: fraction}``."""
+    maps, fractions = {}, {}
+    for name, surf in surfs.items():
+        xs, _, heights, k, region = kappa_grid(surf, mu, n)
+        maps[name] = (xs, heights, k, region)
+        fractions[name] = {label: float(np.mean(region == code)) for code, label in REGION_NAMES.items()}
+    return maps, fractions

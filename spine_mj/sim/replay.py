@@ -1,17 +1,23 @@
 """MuJoCo's interactive viewer: a rig simulated live (:func:`run_in_viewer`, or
 :func:`view_rig` from a surface: ``spine-mj view``), the same model written for it
 (:func:`export_rig`: ``spine-mj sim export``) and a recorded run played back
-(:func:`play_in_viewer`, the rig and track of :func:`spine_mj.sim.run_folder.load_run`).
+(:func:`play_in_viewer`, the rig and track of :func:`spine_mj.sim.run_folder.load_run`),
+or written as an MP4 where there is no display (:func:`replay_run`: ``spine-mj replay``).
 """
 
 from __future__ import annotations
 
+import os
+import sys
 import threading
 import time
 from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
+from spine_mj.errors import SpineInputError, check_positive
 from spine_mj.sim.build import build_rig
 from spine_mj.sim.model import RigModel, compile_spec
 from spine_mj.sim.render import (
@@ -19,8 +25,11 @@ from spine_mj.sim.render import (
     TRAIL_RGBA,
     Track,
     add_polyline,
+    choose_gl_backend,
     decimate,
+    default_speed,
     streamline_path_m,
+    write_mp4,
 )
 from spine_mj.sim.rig import Rig
 
@@ -77,6 +86,88 @@ def view_rig(surface, *, mu: float, start=None, duration_s: float | None = None,
     rig = build_rig(surface, mu=mu, driven=False, **rig_options)
     model = compile_spec(rig.export_spec(start))
     run_in_viewer(model, time_scale=1.0 / rig.units.time_s, duration_s=duration_s)
+
+
+def has_display() -> bool:
+    """Whether a window can open here: not on Linux without ``DISPLAY`` or ``WAYLAND_DISPLAY``."""
+    return not sys.platform.startswith("linux") or bool(
+        os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
+    )
+
+
+@dataclass(frozen=True)
+class Replay:
+    """What :func:`replay_run` did: the run's span and the playback speed, and the MP4
+    written (None: the run was played in the viewer)."""
+
+    span_s: float
+    speed: float
+    mp4: Path | None
+
+
+def replay_run(
+    run_dir,
+    *,
+    speed: float | None = None,
+    duration_s: float | None = None,
+    mp4=None,
+    notice: Callable[[str], None] | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> Replay:
+    """Play the run recorded in ``run_dir`` (``spine-mj simulate``'s output folder) in
+    MuJoCo's viewer or, with ``mp4`` or without a display (:func:`has_display`), write it as
+    an MP4 (``mp4``, else ``run_dir/replay.mp4``) instead.
+
+    Parameters
+    ----------
+    run_dir : path
+        The run folder (:func:`~spine_mj.sim.run_folder.load_run`).
+    speed : float, optional
+        Run seconds per wall second (None: the whole run in about 10 s).
+    duration_s : float, optional
+        Close the viewer after this many wall seconds; refused for an MP4 (it has the
+        run's length at ``speed``).
+    mp4 : path, optional
+        The MP4 to write instead of opening the viewer.
+    notice : callable, optional
+        ``notice(text)``: what is about to happen (the viewer opening, or an MP4 written
+        for want of a display).
+    progress : callable, optional
+        ``progress(done, total)`` per MP4 frame.
+
+    Raises
+    ------
+    SpineInputError
+        ``duration_s`` for an MP4, ``duration_s`` or ``speed`` not > 0, ``mp4`` not a
+        ``.mp4``, no renderer or no ``[video]`` extra for an MP4, an unreadable run folder.
+    """
+    from spine_mj import extras
+    from spine_mj.sim.run_folder import load_run  # pandas: only for a recorded run
+
+    say = notice or (lambda text: None)
+    headless = mp4 is not None or not has_display()
+    if headless and duration_s is not None:
+        raise SpineInputError("replay to an MP4 (no display, or --mp4) does not use --duration; leave it out")
+    if duration_s is not None:
+        check_positive("--duration", duration_s)
+    if headless:
+        choose_gl_backend()
+    rig, track = load_run(run_dir)
+    if headless:
+        extras.require("video", "replay without a display (an MP4)" if mp4 is None else "--mp4")
+    span = float(track.time_s[-1] - track.time_s[0])
+    speed = check_positive("--speed", speed) if speed is not None else default_speed(track.time_s)
+    if not headless:
+        say(f"replaying {span:g} s of run at {speed:g}x; close the window to stop")
+        play_in_viewer(rig, track, speed=speed, duration_s=duration_s)
+        return Replay(span, speed, None)
+    path = Path(mp4) if mp4 is not None else Path(run_dir) / "replay.mp4"
+    if path.suffix.lower() != ".mp4":
+        raise SpineInputError(f"--mp4 must name a .mp4 file, got {str(path)!r}")
+    if mp4 is None:
+        say("no display: writing an MP4 instead of opening the viewer")
+    write_mp4(rig, track, path, speed=speed, progress=progress)
+    return Replay(span, speed, path)
 
 
 def run_in_viewer(model, *, time_scale: float = 1.0, duration_s: float | None = None) -> None:

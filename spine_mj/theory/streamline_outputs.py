@@ -135,3 +135,13 @@ def write_streamline_outputs(
         figure = streamline_figure(run.surface, run.stream, run.ideal, title=f"mu_s = {run.mu:g}")
         save_figure(figure, figure_path)
     return [table_path, figure_path]
+
+
+def streamline_to(
+    out_dir: str | os.PathLike, surface: Surface, starts, *, mu: float, fmt: str = "parquet", **trace_options
+) -> tuple[StreamlineRun, list[Path]]:
+    """:func:`trace_starts` from ``starts`` and :func:`write_streamline_outputs` into
+    ``out_dir`` (``spine-mj streamline``); ``trace_options`` are :func:`trace_starts`'s
+    ``dl`` and ``tip_radius``. Returns the run and the paths written."""
+    run = trace_starts(surface, starts, mu=mu, **trace_options)
+    return run, write_streamline_outputs(run, out_dir, fmt=fmt)
