@@ -385,9 +385,12 @@ class SurfaceInfo:
     drive_limits: Any
 
     def as_dict(self) -> dict:
-        """The roughness numbers with ``drive_limits`` (None without a mu_s), JSON-ready."""
+        """The roughness numbers with ``drive_limits`` (None without a mu_s), JSON-ready
+        (:func:`~spine_mj.jsonio.to_jsonable`)."""
+        from spine_mj.jsonio import to_jsonable
+
         limits = None if self.drive_limits is None else self.drive_limits.as_dict()
-        return dict(self.roughness.as_dict(), drive_limits=limits)
+        return to_jsonable(dict(self.roughness.as_dict(), drive_limits=limits))
 
 
 def surface_info(

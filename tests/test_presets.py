@@ -120,3 +120,38 @@ def test_open_surface_names_what_it_cannot_open(tmp_path):
         open_surface("no-such")
     with pytest.raises(SpineInputError, match=r"is a surface file: overrides \(seed\) are for presets"):
         open_surface("example:plu-1.plu", seed=3)
+
+
+def test_preset_descriptions_are_each_presets_own():
+    from spine_mj.presets import preset_descriptions
+
+    described = preset_descriptions()
+    assert list(described) == list_presets()
+    assert all(described[n] == load_preset(n).description for n in described)
+
+
+def test_surface_info_has_drive_limits_only_with_a_mu(tmp_path):
+    from spine_mj import roughness
+    from spine_mj.presets import SurfaceInfo, surface_info
+    from spine_mj.surfaces import single_gaussian
+
+    surf = single_gaussian(sign=1).sample(64)  # no preset, so no calibrated mu_s
+    plain = surface_info(surf)
+    assert isinstance(plain, SurfaceInfo) and plain.unit == surf.unit and plain.drive_limits is None
+    assert plain.roughness.rms_slope == roughness.summarize(surf).rms_slope
+    assert plain.as_dict()["drive_limits"] is None
+    with pytest.raises(SpineInputError, match="--tip-radius must be a finite number >= 0"):
+        surface_info(surf, mu=0.5, tip_radius=-1.0)
+    given = surface_info(surf, mu=0.5, psd_png=tmp_path / "psd.png")
+    assert given.drive_limits.mu == 0.5 and given.as_dict()["drive_limits"]["mu"] == 0.5
+    assert (tmp_path / "psd.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_make_surface_file_needs_exactly_one_source(tmp_path):
+    from spine_mj.presets import make_surface_file
+
+    with pytest.raises(SpineInputError, match="exactly one of PRESET or --from-file"):
+        make_surface_file(tmp_path / "s.npz")
+    surf = make_surface_file(tmp_path / "s.npz", preset="paper-single-peak", png=tmp_path / "s.png")
+    assert surf.metadata["preset"] == "paper-single-peak"
+    assert (tmp_path / "s.npz").is_file() and (tmp_path / "s.png").is_file()

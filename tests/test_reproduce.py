@@ -130,3 +130,27 @@ def test_fractal_hurst_counts_are_checked_before_any_work(tmp_path, args, fragme
     result = CliRunner().invoke(main, ["reproduce", "fractal-hurst", "--quick", "--out", str(out), *args])
     assert result.exit_code == 2 and fragment in result.output, result.output
     assert not out.exists()
+
+
+def test_kappa_map_to_draws_one_surface_with_the_region_shares_of_the_paper_map(tmp_path):
+    from spine_mj.reproduce import kappa_map_to
+    from spine_mj.surfaces import single_gaussian
+    from spine_mj.theory.engagement import REGION_NAMES
+
+    numbers, _ = kappa_map(n=41)
+    shares = kappa_map_to(tmp_path / "k.png", single_gaussian(sign=1), mu=numbers["mu"], resolution=41)
+    assert list(shares) == list(REGION_NAMES.values())
+    assert shares == {label: numbers[f"convex_{label}_fraction"] for label in shares}
+    assert sum(shares.values()) == pytest.approx(1.0)
+    assert (tmp_path / "k.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_run_to_writes_the_numbers_and_figure_of_run(tmp_path):
+    import json
+
+    from spine_mj.reproduce import run_to
+
+    json_path, png_path = run_to(tmp_path / "r", "kappa-map", quick=True, n=21)
+    assert (json_path, png_path) == (tmp_path / "r" / "kappa-map.json", tmp_path / "r" / "kappa-map.png")
+    assert json.loads(json_path.read_text()) == pytest.approx(kappa_map(n=21)[0])
+    assert png_path.stat().st_size > 1000

@@ -130,7 +130,6 @@ def surface_info(surface_spec, output, as_json, mu, tip_radius):
       spine-mj surface info example:plu-1.plu --mu 0.5 -o psd.png
     """
     from spine_mj import presets
-    from spine_mj.jsonio import to_jsonable
 
     if output:
         check_suffix(output, ".png", "-o/--output")
@@ -139,7 +138,7 @@ def surface_info(surface_spec, output, as_json, mu, tip_radius):
         refuse_options_not_for("surface info without a mu_s (no --mu, no preset's)", ["tip_radius"])
     info = presets.surface_info(surf, mu=mu, tip_radius=tip_radius, psd_png=output)
     if as_json:
-        click.echo(json.dumps(to_jsonable(info.as_dict()), indent=2))
+        click.echo(json.dumps(info.as_dict(), indent=2))
         return
     rough, limits = info.roughness, info.drive_limits
     unit = "" if info.unit == "1" else f" {info.unit}"

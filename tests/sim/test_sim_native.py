@@ -165,3 +165,15 @@ def test_view_runs_the_ready_model_under_xvfb_and_exits_by_itself():
     proc = subprocess.run([*cmd, "--duration", "3"], env=env, capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stderr
     assert "Traceback" not in proc.stderr
+
+
+def test_display_rule_and_replay_refusals_before_any_run_is_read(tmp_path, monkeypatch):
+    from spine_mj.sim.replay import has_display, replay_run
+
+    monkeypatch.setenv("DISPLAY", ":0")
+    assert has_display()
+    monkeypatch.delenv("DISPLAY")
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    assert has_display() is not sys.platform.startswith("linux")
+    with pytest.raises(SpineInputError, match=r"replay to an MP4 .* does not use --duration"):
+        replay_run(tmp_path, duration_s=5.0, mp4=tmp_path / "r.mp4")  # an empty folder: not read
