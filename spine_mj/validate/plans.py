@@ -381,6 +381,9 @@ PLANS: dict[str, ValidationPlan] = {
         # study's I_e) brackets nothing there and its ramp pilot was the boundary's slowest
         ie_values=(1e-3, 1e-2, 1e-1, 1.0, 10.0),
         boundary_families=("single_peak_valley",),
+        # the spring drive's boundary only: the ramp's pilots run one by one (78 of the
+        # boundary's 113 s measured), and the full plan has both drives
+        protocols=("spring",),
         stick_slip_ie=(1e-2, 1.0),
         stick_slip_stiffness=(2.0, 50.0),
         stick_slip_starts=2,
