@@ -49,7 +49,8 @@ def test_convergence_present_is_rendered(where):
     v = copy.deepcopy(FULL)
     if where == "top":
         v["convergence"] = {"fractal": check, "sandpaper": check}
-    else:
+    else:  # the per-family record, read where validation.json has no top-level one
+        v.pop("convergence", None)
         v["limit_families"]["fractal"]["convergence"] = check
     lines = generate.convergence_section(v)
     text = "\n".join(lines)

@@ -25,7 +25,9 @@ def test_summary_lines_state_the_headline_numbers(plan):
     for proto, star in result["ie_star"].items():
         assert any(line.startswith(f"I_e* ({proto})") for line in lines), proto
         if star.get("kind") == "bracketed":
-            assert f"  I_e* = {star['value']:.3g} in [{star['low']:.3g}, {star['high']:.3g}]" in lines
+            head = re.escape(f"  I_e* = {star['value']:.3g} in [{star['low']:.3g}, {star['high']:.3g}]")
+            # a refined I_e* says whether it held (the full plan's boundary_refinements)
+            assert any(re.fullmatch(head + r"( \((un)?converged: [^)]*\))?", x) for x in lines), head
     assert all("\n" not in line for line in lines)
 
 
