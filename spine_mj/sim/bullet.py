@@ -112,20 +112,15 @@ class BulletRig:
         sized: tuple[Scales, HField] | None = None,
     ):
         extras.require("bullet", "the Bullet engine")
-        if not isinstance(surface, Surface):
-            raise SpineInputError(f"surface must be a spine_mj Surface, got {type(surface).__name__}")
-        tip = TipParams() if tip is None else tip
-        if sized is None:
-            sized = Scales.with_hfield(
-                surface,
-                tip=tip,
-                length_scale_m=length_scale_m,
-                char_length_m=char_length_m,
-                hfield_resolution=hfield_resolution,
-            )
-        self.scales, self.hfield = sized
+        self.scales, self.hfield, self.tip = Scales.for_rig(
+            surface,
+            tip=tip,
+            sized=sized,
+            length_scale_m=length_scale_m,
+            char_length_m=char_length_m,
+            hfield_resolution=hfield_resolution,
+        )
         self.surface = surface
-        self.tip = dataclasses.replace(tip, tip_radius_m=self.scales.tip_radius_m)
         self.length_scale_m = self.scales.length_scale_m
         self.units = self.scales.units
         self.engine = default_bullet_engine(self.scales) if engine is None else engine

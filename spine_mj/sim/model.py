@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import collections
 import copy
-import dataclasses
 import os
 from pathlib import Path
 
@@ -110,22 +109,16 @@ class RigModel:
     ):
         import mujoco
 
-        if not isinstance(surface, Surface):
-            raise SpineInputError(f"surface must be a spine_mj Surface, got {type(surface).__name__}")
+        self.scales, self.hfield, self.tip = Scales.for_rig(
+            surface,
+            tip=tip,
+            sized=sized,
+            length_scale_m=length_scale_m,
+            char_length_m=char_length_m,
+            hfield_resolution=hfield_resolution,
+        )
         quiet_engine()
-        tip = TipParams() if tip is None else tip
-        if sized is None:
-            sized = Scales.with_hfield(
-                surface,
-                tip=tip,
-                length_scale_m=length_scale_m,
-                char_length_m=char_length_m,
-                hfield_resolution=hfield_resolution,
-            )
-        self.scales, self.hfield = sized
         self.surface = surface
-        radius = self.scales.tip_radius_m
-        self.tip = tip if tip.tip_radius_m == radius else dataclasses.replace(tip, tip_radius_m=radius)
         self.length_scale_m = length_scale_m = self.scales.length_scale_m
         self.units = self.scales.units
         self.engine = default_engine(self.scales) if engine is None else engine

@@ -18,6 +18,7 @@ or a ratio of the problem's own lengths, far from MuJoCo's absolute floors (``mj
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -120,6 +121,30 @@ class Scales:
         arguments: ``tip``, ``length_scale_m``, ``char_length_m``, ``hfield_resolution``)
         without the hfield."""
         return cls.with_hfield(surface, **sizing)[0]
+
+    @classmethod
+    def for_rig(
+        cls,
+        surface: Surface,
+        *,
+        tip: TipParams | None = None,
+        sized: tuple[Scales, HField] | None = None,
+        **sizing,
+    ) -> tuple[Scales, HField, TipParams]:
+        """A rig's scales, hfield and tip, where both engines' rigs start: ``sized`` (the
+        ``(scales, hfield)`` its builder measured once) or :meth:`with_hfield` of
+        ``sizing`` measured here, and ``tip`` (default :class:`TipParams`) carrying the
+        scales' tip radius."""
+        if not isinstance(surface, Surface):
+            raise SpineInputError(f"surface must be a spine_mj Surface, got {type(surface).__name__}")
+        tip = TipParams() if tip is None else tip
+        scales, hfield = cls.with_hfield(surface, tip=tip, **sizing) if sized is None else sized
+        radius = scales.tip_radius_m
+        return (
+            scales,
+            hfield,
+            tip if tip.tip_radius_m == radius else dataclasses.replace(tip, tip_radius_m=radius),
+        )
 
     @classmethod
     def with_hfield(
