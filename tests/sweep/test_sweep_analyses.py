@@ -254,3 +254,37 @@ def test_cases_differing_only_in_their_drive_share_their_streamlines(tmp_path):
     rigs = [ANALYSES["mujoco"].func(c, surface, starts, {}).data[0] for c in (first, second)]
     assert rigs[0] is not rigs[1]
     assert key(rigs[0].hfield, 0.1) == key(rigs[1].hfield, 0.1) != key(rigs[0].hfield, 0.2)
+
+
+def test_miss_reasons_restart_a_run_that_left_the_domain_from_its_edge(tmp_path):
+    """A dynamic run ends past the domain's edge (the fractal at I_e = 0.1-1 did, and the
+    whole comparison failed: "starts must lie inside the surface bounds"); its checkpoints
+    out there restart the reference on the edge."""
+    from spine_mj.sweep.analyses.compare import MISS_CHECKPOINTS, _miss_reasons
+    from spine_mj.sweep.registry import ANALYSES
+    from spine_mj.theory import streamline as sl
+
+    doc = tomllib.loads(MJ.replace("ie = [0.01, 0.1]", "ie = 0.01"))
+    (case,) = sweep.expand_cases(sweep.parse_config(doc, base_dir=tmp_path))
+    surface = case.surface.make()
+    starts = case.starts.resolve(surface.bounds, case.seed)
+    up = {"quasistatic": ANALYSES["quasistatic"].func(case, surface, starts, {})}
+    rig, _ = ANALYSES["mujoco"].func(case, surface, starts, up).data
+    contact = rig.contact_surface()
+    params = up["quasistatic"].data.params
+    facets = sl.streamlines(contact, starts, params, store_paths=True)
+    xmax = contact.bounds[1]
+    past = np.column_stack([np.linspace(starts[0, 0], xmax + 0.5, 50), np.full(50, starts[0, 1])])
+    mpaths = [past, np.empty((0, 2))]
+    reason, _ = _miss_reasons(
+        contact,
+        params,
+        sl.streamlines,
+        mpaths,
+        facets,
+        np.array([False, False]),
+        np.array([past[-1], starts[1]]),
+        1.0,
+        np.array([True, False]),
+    )
+    assert reason[0] != "" and reason[1] == "" and MISS_CHECKPOINTS > 1

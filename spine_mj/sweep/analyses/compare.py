@@ -82,12 +82,14 @@ def _miss_reasons(contact, params, trace, mpaths, facets, mj_locked, mj_end, lc,
     if not runs:
         return reason, offset
     k = MISS_CHECKPOINTS
+    xmin, xmax, ymin, ymax = contact.bounds
     points = []
     for i in runs:
         path = mpaths[i]
         arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(path, axis=0), axis=1))])
         at = np.minimum(np.searchsorted(arc, np.linspace(0.0, arc[-1], k)), len(path) - 1)
-        points.append(path[at])
+        # a tip that left the domain ends past its edge: its checkpoints there restart on it
+        points.append(np.column_stack([np.clip(path[at, 0], xmin, xmax), np.clip(path[at, 1], ymin, ymax)]))
     restarts = trace(contact, np.vstack(points), params, store_paths=False)
     # a restart reaches the run's outcome as the reference agrees with it: a stall reaches none
     reaches = _outcomes(restarts, np.repeat(mj_locked[runs], k), np.repeat(mj_end[runs], k, axis=0), lc)[
