@@ -37,7 +37,13 @@ from spine_mj.surfaces.base import (
 )
 from spine_mj.surfaces.dilation import ball_dilation, ball_dilation_reference, dilate
 from spine_mj.surfaces.facets import BallOnFacets, TriangulatedSurface
-from spine_mj.surfaces.generators import corrugation, fractal_fbm, random_gaussians, single_gaussian
+from spine_mj.surfaces.generators import (
+    corrugation,
+    fractal_fbm,
+    inclined_plane,
+    random_gaussians,
+    single_gaussian,
+)
 from spine_mj.surfaces.hfield import HField, from_hfield, to_hfield
 from spine_mj.surfaces.sandpaper import sandpaper
 from spine_mj.surfaces.types import BSplineGrid, GaussianSurface, GridSurface, Surface
@@ -61,6 +67,7 @@ __all__ = [
     "dilate",
     "fractal_fbm",
     "from_hfield",
+    "inclined_plane",
     "length_unit",
     "random_gaussians",
     "sandpaper",

@@ -1,6 +1,7 @@
 """`spine-mj array`: the designer's outputs, and bad input refused with nothing written."""
 
 import json
+import math
 
 import pandas as pd
 import pytest
@@ -68,3 +69,20 @@ def test_bad_array_input_is_one_error_line_and_writes_nothing(tmp_path, args, fr
     lines = [line for line in result.output.splitlines() if line.strip()]
     assert len(lines) == 1 and lines[0].startswith("Error: ") and fragment in lines[0], result.output
     assert not out.exists()
+
+
+@pytest.mark.parametrize(("slope_deg", "drive"), [(0.0, "speed"), (15.0, "force")])
+def test_array_on_the_plane_preset_holds_n_tan_theta_plus_phi_w_at_its_default_pace(tmp_path, slope_deg, drive):
+    # the user's path: the plane preset (its mu 0.5), tilted with --set, then the array at its
+    # default pace; the plane's L_c is its side, so the spacing is given in surface units
+    surface = tmp_path / "plane.npz"
+    made = run("surface", "make", "plane", "--set", f"slope_deg={slope_deg}", "-o", surface)
+    assert made.exit_code == 0, made.output
+    out = tmp_path / "arr"
+    args = ("--spacing", "0.01", "--spacing-unit", "surface", "--mu", "0.5", "--drive", drive)
+    result = run("array", surface, *args, "--out", out)
+    assert result.exit_code == 0, result.output
+    summary = json.loads((out / "summary.json").read_text())
+    kappa = math.tan(math.radians(slope_deg) + math.atan(0.5))
+    assert summary["n_spines"] == 4 and summary["locked_spines"] == 0
+    assert summary["holding_ratio"] == pytest.approx(kappa, rel=0.01)
