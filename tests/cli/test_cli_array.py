@@ -72,7 +72,9 @@ def test_bad_array_input_is_one_error_line_and_writes_nothing(tmp_path, args, fr
 
 
 @pytest.mark.parametrize(("slope_deg", "drive"), [(0.0, "speed"), (15.0, "force")])
-def test_array_on_the_plane_preset_holds_n_tan_theta_plus_phi_w_at_its_default_pace(tmp_path, slope_deg, drive):
+def test_array_on_the_plane_preset_holds_n_tan_theta_plus_phi_w_at_its_default_pace(
+    tmp_path, slope_deg, drive
+):
     # the user's path: the plane preset (its mu 0.5), tilted with --set, then the array at its
     # default pace; the plane's L_c is its side, so the spacing is given in surface units
     surface = tmp_path / "plane.npz"
