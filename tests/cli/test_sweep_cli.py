@@ -75,3 +75,39 @@ def test_cli_refuses_another_config_in_dir(tmp_path):
     assert result.exit_code == 2 and "holds a sweep of another config" in result.output
     assert run_cli("sweep", other, "--out", out, "--workers", 1, "--overwrite", "--quiet").exit_code == 0
     assert run_cli("sweep", "status", tmp_path / "nowhere").exit_code == 2
+
+
+STIFF_SPRING = """
+[sweep]
+name = "stiff"
+analyses = ["quasistatic", "mujoco", "compare"]
+[[surfaces]]
+preset = "paper-fractal"
+seeds = [1]
+set = { hurst = 0.7 }
+[starts]
+frame = "relative"
+x = [0.05]
+y = [0.2, 0.5, 0.8]
+[drive]
+protocol = "spring"
+ie = 1e-4
+K = 30000.0
+"""
+
+
+def test_cli_refuses_a_stiff_spring_too_fast_to_compare_with_the_streamline(tmp_path):
+    """K = 30000 at I_e = 1e-4 on the fractal swings 9.3 F_p (docs/physics.md §8): one
+    line naming the drive, the bound, the swing and the I_e that would do; nothing written."""
+    cfg = write_config(tmp_path, STIFF_SPRING)
+    proc = subprocess.run(
+        [sys.executable, "-m", "spine_mj.cli", "sweep", str(cfg), "--out", str(tmp_path / "out")],
+        capture_output=True,
+        text=True,
+    )
+    assert proc.returncode == 2, proc.stderr
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("Error: sweep case (paper-fractal")
+    assert "spring drive at I_e = 0.0001, K = 30000: compared with the quasistatic streamline" in lines[0]
+    assert "swing at most 1 F_p" in lines[0] and "got 9.3 F_p" in lines[0] and "dynamic_drive = true" in lines[0]
+    assert not (tmp_path / "out").exists()

@@ -22,6 +22,7 @@ ie = [0.01, 0.1]
 [grid]
 mu = 1.25
 dl = 0.02
+dynamic_drive = true
 """
 
 
@@ -288,3 +289,51 @@ def test_miss_reasons_restart_a_run_that_left_the_domain_from_its_edge(tmp_path)
         np.array([True, False]),
     )
     assert reason[0] != "" and reason[1] == "" and MISS_CHECKPOINTS > 1
+
+
+FRACTAL_SPRING = """
+[sweep]
+name = "stiff"
+analyses = {analyses}
+[[surfaces]]
+preset = "paper-fractal"
+seeds = [1]
+set = {{ hurst = 0.7 }}
+[starts]
+frame = "relative"
+x = [0.05]
+y = [0.5]
+[drive]
+protocol = "spring"
+ie = {ie!r}
+K = {K!r}
+{extra}
+"""
+
+
+def _fractal_cases(tmp_path, *, ie, K, analyses=("quasistatic", "mujoco", "compare"), extra=""):
+    text = FRACTAL_SPRING.format(analyses=list(analyses), ie=ie, K=K, extra=extra)
+    return sweep.expand_cases(sweep.parse_config(tomllib.loads(text), base_dir=tmp_path))
+
+
+def test_a_spring_drive_too_fast_for_its_stiffness_is_refused_before_the_comparison(tmp_path):
+    """The compare analysis refuses a spring whose spring-block swing sqrt(I_e K L_c / l_s)
+    exceeds SWING_BOUND_FP preloads, and accepts it where the swing is within the bound, as
+    a dynamic study on purpose, and without the comparison."""
+    from spine_mj.errors import SpineInputError
+    from spine_mj.sweep.analyses.mujoco import case_scales
+    from spine_mj.sweep.preflight import check_cases
+    from spine_mj.theory.drive_limits import SWING_BOUND_FP
+
+    cases = _fractal_cases(tmp_path, ie=1e-4, K=3000.0)
+    sc = case_scales(cases[0])
+    kc = 3000.0 * sc.char_length_m / sc.slope_length_m
+    swing, ie_max = (1e-4 * kc) ** 0.5, SWING_BOUND_FP**2 / kc
+    assert swing > SWING_BOUND_FP
+    with pytest.raises(SpineInputError, match="K = 3000: compared") as info:
+        check_cases(cases)
+    message = str(info.value)
+    assert f"got {swing:.3g} F_p" in message and f"use I_e <= {ie_max:.3g}" in message
+    check_cases(_fractal_cases(tmp_path, ie=0.99 * ie_max, K=3000.0))
+    check_cases(_fractal_cases(tmp_path, ie=1e-4, K=3000.0, extra="[grid]\ndynamic_drive = true"))
+    check_cases(_fractal_cases(tmp_path, ie=1e-4, K=3000.0, analyses=("mujoco",)))

@@ -22,11 +22,15 @@ import dataclasses
 import numpy as np
 
 from spine_mj import compare
-from spine_mj.sweep.analyses.mujoco import peak_drive_over_fp
+from spine_mj.errors import SpineInputError
+from spine_mj.sim.drives import SpringDrive, stiffness_n_m
+from spine_mj.sim.holding import spring_swing
+from spine_mj.sweep.analyses.mujoco import case_drive, case_rig, peak_drive_over_fp
 from spine_mj.sweep.analyses.quasistatic import cached_trace, hfield_key, path_table, traced_surface
 from spine_mj.sweep.registry import Analysis, AnalysisResult, ParamSpec, register_analysis
 from spine_mj.theory import streamline as sl
 from spine_mj.theory.compliant import compliant_streamlines
+from spine_mj.theory.drive_limits import SWING_BOUND_FP, spring_ie_limits
 
 
 def _xy(res: sl.StreamlineResult, i: int) -> np.ndarray:
@@ -257,6 +261,41 @@ def _compare(case, surface, starts, upstream):
     return AnalysisResult(metrics=metrics, trajectories=path_table(facets), status=status, reason=reason)
 
 
+def _check_case(case, surface, starts) -> None:
+    """Refuse a spring drive too fast for its stiffness to be compared with the quasistatic
+    streamline (unless ``dynamic_drive``): its spring-block swing ``sqrt(I_e K L_c / l_s)``
+    (:func:`spine_mj.sim.holding.spring_swing`) above
+    :data:`~spine_mj.theory.drive_limits.SWING_BOUND_FP` preloads.
+
+    Why (docs/physics.md §8): the swing is the force the spring rings with about what the tip
+    holds, and ``2 pi`` swings are what the drive adds within one period of the spring. On the
+    paper fractal (L_c / l_s = 29, I_e = 1e-4) a swing of 2.9 F_p (K = 3000) left the tip in
+    contact 21 % of its run and 9.3 F_p (K = 30000) 7 %, against 65 % at 0.29 F_p (K = 30):
+    the tip hops, and the force cap fires at the ringing's turning points (K = 30000: the
+    force averaged over a spring period was below 1 F_p at 8 of 12 such locks), so outcome
+    and path are no longer the streamline's."""
+    if case.params["protocol"] != "spring" or case.params["dynamic_drive"]:
+        return
+    rig = case_rig(case, surface)
+    drive = case_drive(rig, case.params)
+    if not isinstance(drive, SpringDrive):
+        return
+    sc = rig.scales
+    k_number = sc.stiffness_number(stiffness_n_m(drive, sc))
+    ie = sc.inertia_number(drive.speed_m_s)
+    ratio = sc.char_length_m / sc.slope_length_m
+    swing = spring_swing(ie, k_number, ratio)
+    if swing > SWING_BOUND_FP:
+        ie_max = spring_ie_limits(k_number, ratio)["swing-force"]
+        raise SpineInputError(
+            f"spring drive at I_e = {ie:.3g}, K = {k_number:.5g}: compared with the quasistatic "
+            f"streamline it must swing at most {SWING_BOUND_FP:g} F_p (spring-block swing "
+            f"sqrt(I_e K L_c / l_s), L_c / l_s = {ratio:.3g} here), got {swing:.3g} F_p, a drive "
+            f"too fast for its stiffness (the tip rings and hops); use I_e <= {ie_max:.3g} at this "
+            "K, or set compare's dynamic_drive = true to study the dynamic drive on purpose"
+        )
+
+
 register_analysis(
     Analysis(
         "compare",
@@ -278,11 +317,20 @@ register_analysis(
                 1,
                 1,
             ),
+            ParamSpec(
+                "dynamic_drive",
+                "bool",
+                "compare a spring drive too fast for its stiffness on purpose (spring-block swing "
+                f"sqrt(I_e K L_c / l_s) above {SWING_BOUND_FP:g} F_p); off: such a case is refused "
+                "before any run",
+                False,
+            ),
         ),
         requires=("quasistatic", "mujoco"),
         doc="MuJoCo against the streamline traced on the rig's facets dilated by its tip "
         "(like for like), and against the quasistatic analysis's own path (*_smooth); "
         "why a run disagrees (miss_reason, miss_offset); "
         "lengths over L_c: spine_mj.compare",
+        check_case=_check_case,
     )
 )
