@@ -7,6 +7,7 @@ import pytest
 from click.testing import CliRunner
 from sweep_support import PEAK_QS, peak_config, write_config
 
+from spine_mj import sweep
 from spine_mj.cli import main
 
 
@@ -109,5 +110,23 @@ def test_cli_refuses_a_stiff_spring_too_fast_to_compare_with_the_streamline(tmp_
     lines = proc.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("Error: sweep case (paper-fractal")
     assert "spring drive at I_e = 0.0001, K = 30000: compared with the quasistatic streamline" in lines[0]
-    assert "swing at most 1 F_p" in lines[0] and "got 9.3 F_p" in lines[0] and "dynamic_drive = true" in lines[0]
+    assert (
+        "swing at most 1 F_p" in lines[0] and "got 9.3 F_p" in lines[0] and "dynamic_drive = true" in lines[0]
+    )
     assert not (tmp_path / "out").exists()
+
+
+def test_cli_sweep_a_stiff_spring_on_the_fractal_runs_without_an_engine_stop(tmp_path):
+    """K = 3000 on the paper fractal at the I_e its swing allows (1e-5: 0.93 F_p): the step
+    rule resolves the spring (omega dt <= 0.3), so no run ends in engine trouble. At the
+    contact's own step MuJoCo stopped 8 of 12 such runs near step 213 (issue 32)."""
+    text = STIFF_SPRING.replace("K = 30000.0", "K = 3000.0\nduration = 0.1").replace("ie = 1e-4", "ie = 1e-5")
+    cfg = write_config(tmp_path, text.replace('"quasistatic", "mujoco", "compare"', '"mujoco"'))
+    out = tmp_path / "out"
+    result = run_cli("sweep", cfg, "--out", out, "--workers", 1, "--quiet")
+    assert result.exit_code == 0, result.output
+    runs = sweep.load_runs(out)
+    assert len(runs) == 3 and (runs.status == "ok").all(), runs.end_detail.tolist()
+    assert (runs.n_steps > 1500).all() and (
+        runs.timestep_s * (runs.stiffness_n_m / runs.mass) ** 0.5 <= 0.3
+    ).all()

@@ -10,7 +10,9 @@ the same domain) is kept beside it (``*_smooth``), and the gap between the two s
 is the geometry part (``geometry_frechet``). A run that disagrees gets a ``miss_reason``
 (:func:`spine_mj.compare.miss_reason`: the reference restarted along its path). A spring
 drive is also compared with the compliant-drive streamline of its own spring
-(``compliant_frechet``, ``agree_compliant``; :mod:`spine_mj.theory.compliant`). Touches
+(``compliant_frechet``, ``agree_compliant``; :mod:`spine_mj.theory.compliant`). A spring
+drive too fast for its stiffness to be quasistatic is refused before any run unless the
+grid's ``dynamic_drive`` asks for it (:func:`_check_case`). Touches
 the API of :mod:`spine_mj.compare` here only; needs the results of the ``quasistatic`` and
 ``mujoco`` analyses of the same case.
 """
