@@ -17,6 +17,7 @@ from spine_mj.errors import SpineInputError
 from spine_mj.sim.detection import Detection
 from spine_mj.sim.drives import Drive, SpringDrive, StaticProbe, rate_n_s, settle_steps, stiffness_n_m
 from spine_mj.sim.model import RigModel
+from spine_mj.theory.drive_limits import spring_run_travel
 
 #: Most steps an open-loop run may plan: its recording (~0.5 kB a step) stays within ~2 GiB.
 MAX_RUN_STEPS = 2**22
@@ -35,8 +36,10 @@ def drive_steps(rig: RigModel, drive: Drive, x0_m: float, detection: Detection) 
     if isinstance(drive, SpringDrive):
         duration = drive.duration_s
         if length_from_start(drive):
-            stretch = (1 + rig.tip.mu_s) * rig.scales.preload_n / stiffness_n_m(drive, rig.scales)
-            duration = (1.1 * max(rig.bounds_m[1] - x0_m, 0.0) + stretch) / drive.speed_m_s
+            per_fp = rig.scales.preload_n / stiffness_n_m(drive, rig.scales)
+            duration = (
+                float(spring_run_travel(rig.bounds_m[1] - x0_m, per_fp, rig.tip.mu_s)) / drive.speed_m_s
+            )
         steps = duration / dt
         _check_run_steps(
             steps,

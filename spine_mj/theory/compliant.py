@@ -392,8 +392,10 @@ def _search(surface, L, lanes, kind, c, params):
     L.pending[lanes] = kind
 
 
-def _accept(L, rec, a, z, kap, hold, slip, c, carriage_end):
-    """Record the accepted points of lanes ``a``; open and close jumps; move the carriage."""
+def _accept(L, rec, a, z, kap, hold, slip, c, carriage_end, kappa_cap):
+    """Record the accepted points of lanes ``a``; open and close jumps; move the carriage
+    (to the hold, or to the force cap where the hold exceeds it: a run decides its lock
+    there, and a carriage that reaches it has not stopped short)."""
     x, y = L.x[a], L.y[a]
     arrived_slipping = L.slipping[a] & L.has_prev[a]
     L.jump[a] += np.where(arrived_slipping, np.hypot(x - L.px[a], y - L.py[a]), 0.0)
@@ -411,7 +413,7 @@ def _accept(L, rec, a, z, kap, hold, slip, c, carriage_end):
     stick = ~slip & (~L.has_prev[a] | landed)
     with np.errstate(invalid="ignore"):
         follow = ~slip & np.isfinite(hold)
-        L.X[a] = np.where(follow, np.maximum(L.X[a], x + hold / c), L.X[a])
+        L.X[a] = np.where(follow, np.maximum(L.X[a], x + np.minimum(hold, kappa_cap) / c), L.X[a])
     stopped = L.X[a] > carriage_end[a]  # the carriage stops short of the hold: the tip stays
     L.X[a] = np.where(stopped, carriage_end[a], L.X[a])
     state = np.where(slip, MotionState.SLIP, np.where(stick, MotionState.STICK, MotionState.SLIDE))
@@ -525,7 +527,7 @@ def _run(surface, xs, ys, params, c, carriage_end):
         ok = ~(reject | fold | land)
         a, z, kap, hold, slip = a[ok], z[ok], kap[ok], hold[ok], slip[ok]
         vx, vy, locked, finite, reversed_ = vx[ok], vy[ok], locked[ok], finite[ok], reversed_[ok]
-        stopped = _accept(L, rec, a, z, kap, hold, slip, c, carriage_end)
+        stopped = _accept(L, rec, a, z, kap, hold, slip, c, carriage_end, params.kappa_cap)
         ended = _end_decided(L, rec, a, stopped, locked, hold, finite, params)
         left = _step(L, a[~ended], vx[~ended], vy[~ended], slip[~ended], reversed_[~ended], params, domain)
         _end(L, rec, left, Outcome.LEFT_DOMAIN)

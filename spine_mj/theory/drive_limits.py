@@ -15,7 +15,13 @@ surface, pure numpy on the analytic side:
   was). ``K_path`` (:func:`path_stiffness`), given the starts of a measurement, is the
   stiffness where the compliant-drive paths (the spring drive's ``I_e -> 0`` limit) meet
   that criterion against the rigid ones: the boundary a measurement with that criterion
-  sees, ``<= K*`` on the same paths (no fold: the two paths coincide).
+  sees, ``<= K*`` on the same paths (no fold: the two paths coincide) where the carriage
+  is endless. A run's carriage is not: without a duration it stops
+  :func:`spring_run_travel` past its start (``1.1`` times the distance to the domain's
+  +x edge plus the spring's stretch at ``(1 + mu) F_p``), and a tip that must stop where
+  the spring has to be stretched further (a lock that is decided at ``kappa_cap F_p``, a
+  tip lagging the carriage by ``H l_s / K`` on its way to the edge) ends short of the
+  rigid path's end: given the domain's edge, ``K_path`` is measured with the runs' travel.
 * ``I_e*`` the lowest of three thresholds. *Lift-off*: a tip carried at horizontal speed
   ``v`` over a profile ``z(h)`` (h: horizontal arc length along the path) needs the
   vertical acceleration ``z'' v^2``; preload and gravity give at most ``F_p / m``, so it
@@ -55,6 +61,7 @@ from spine_mj.theory.engagement import DEFAULT_KAPPA_CAP, SELF_LOCK
 from spine_mj.theory.targets import FRECHET_TARGET, OUTCOME_TARGET
 
 __all__ = [
+    "SPRING_TRAVEL_PAST_EDGE",
     "SWING_BOUND_FP",
     "DriveLimits",
     "crest_curvature",
@@ -63,6 +70,7 @@ __all__ = [
     "path_criterion",
     "path_stiffness",
     "spring_ie_limits",
+    "spring_run_travel",
     "trap_depths",
 ]
 
@@ -72,10 +80,16 @@ __all__ = [
 #: normal load is ``(W + F dz/dx) / sqrt(1 + |grad z|^2)``; docs/physics.md §8).
 SWING_BOUND_FP = 1.0
 
+#: A spring run without a duration moves its carriage this many times the distance from
+#: its start to the domain's +x edge, plus the spring's stretch (:func:`spring_run_travel`).
+SPRING_TRAVEL_PAST_EDGE = 1.1
+
 #: ``K_path`` is bracketed to this factor (the map's ladder steps are 3 and more).
 PATH_STIFFNESS_RESOLUTION = 2 ** (1 / 4)
-#: The softest K ``path_stiffness`` tries, as a fraction of the paths' own fold ``K*``.
+#: The softest K ``path_stiffness`` tries, as a fraction of the first K that passes.
 PATH_STIFFNESS_RANGE = 1e-3
+#: The stiffest K ``path_stiffness`` tries, as a multiple of the paths' fold ``K*`` (or 1).
+PATH_STIFFNESS_CEILING = 2.0**20
 
 
 @dataclass(frozen=True)
@@ -111,6 +125,9 @@ class DriveLimits:
         (:func:`path_stiffness`; NaN: not computed, no ``path_starts``).
     k_star_path_starts : float
         The fold ``K*`` on the paths from ``path_starts`` (NaN: not computed).
+    k_path_endless : float
+        ``K_path`` with an endless carriage (equal to ``k_path`` without ``carriage_edge``):
+        what the folds alone make the criterion see.
     """
 
     k_star: float
@@ -129,6 +146,7 @@ class DriveLimits:
     n_traps: int
     k_path: float = math.nan
     k_star_path_starts: float = math.nan
+    k_path_endless: float = math.nan
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -137,7 +155,11 @@ class DriveLimits:
         """``"quasistatic needs K > ... and I_e < ..."``."""
         return (
             f"quasistatic needs K > {self.k_star:.3g}"
-            + (f" (the paths from the starts given: {self.k_path:.3g})" if math.isfinite(self.k_path) else "")
+            + (
+                f" (the paths from the starts given: {self.k_path:.3g})"
+                if not math.isnan(self.k_path)
+                else ""
+            )
             + f" and I_e < {self.ie_star:.3g} "
             f"(set by {self.limit}; lift-off {self.ie_lift:.3g}, trap {self.ie_trap:.3g}, "
             f"lag {self.ie_lag:.3g})"
@@ -220,6 +242,25 @@ def spring_ie_limits(
     return {"swing-path": path_tolerance**2 * kc, "swing-force": force_bound**2 / kc}
 
 
+def spring_run_travel(distance_to_edge, stretch_per_fp, mu: float):
+    """How far a spring run without a duration moves its carriage: ``1.1`` times the distance
+    from its start to the domain's +x edge (none past it), plus the spring's stretch at
+    ``(1 + mu) F_p`` (the drive of a slide up a 45 degree slope), in any one length unit.
+
+    Parameters
+    ----------
+    distance_to_edge : float or array_like
+        From the start to the domain's +x edge.
+    stretch_per_fp : float or array_like
+        ``F_p / k``, the spring's stretch per preload: ``l_s / K`` in surface units.
+    mu : float
+        mu_s.
+    """
+    return SPRING_TRAVEL_PAST_EDGE * np.maximum(distance_to_edge, 0.0) + (1.0 + mu) * np.asarray(
+        stretch_per_fp, float
+    )
+
+
 def path_criterion(rigid, compliant, char_length: float) -> tuple[float, float]:
     """Outcome agreement (share of starts) and median Frechet distance (in ``L_c``, x-y
     traces) of ``compliant`` paths against the ``rigid`` ones from the same starts: the
@@ -253,15 +294,22 @@ def path_stiffness(
     char_length: float,
     frechet_target: float = FRECHET_TARGET,
     outcome_target: float = OUTCOME_TARGET,
+    carriage_edge: float | None = None,
 ) -> tuple[float, float]:
     """``K_path``: the smallest ``K = k l_s / W`` at which the compliant-drive paths from
     ``starts`` meet the comparison's criterion against the rigid streamlines (outcome
     agreement >= ``outcome_target``, median Frechet <= ``frechet_target``; docs/physics.md §8).
 
-    Above the fold ``K*`` of these paths (:func:`kappa_fall` along them) no path folds and the compliant path
-    is the rigid one, so the criterion holds there; below it a fold's jump counts only
-    through what it does to the trace (a lateral offset, a branch of the flow left) and the
-    outcome. The search halves ``K`` from the fold down to the stiffest K that fails (as a
+    With an endless carriage, above the fold ``K*`` of these paths (:func:`kappa_fall`
+    along them) no path folds and the compliant path is the rigid one, so the criterion
+    holds there; below it a fold's jump counts only through what it does to the trace (a
+    lateral offset, a branch of the flow left) and the outcome. With ``carriage_edge`` each
+    carriage stops where a run's does (:func:`spring_run_travel` from its start): a tip
+    that needs the spring stretched further (a hold of ``H`` at ``x`` needs the carriage at
+    ``x + H l_s / K``) ends there, short of the rigid path, at any K below
+    ``(H - 1 - mu) l_s / (1.1 d - (x - x0))`` (``d`` the start's distance to the edge),
+    fold or none. The search doubles ``K`` from the fold (or 1) to the first K that passes
+    where the carriage stops, halves it from there down to the stiffest K that fails (as a
     measured boundary is the largest K that fails: softer springs can pass again, their
     jumps running along the path), then bisects that halving to
     :data:`PATH_STIFFNESS_RESOLUTION`.
@@ -277,38 +325,60 @@ def path_stiffness(
         ``l_s`` (turns ``K`` into ``k / W``) and ``L_c`` (the Frechet distance's unit).
     frechet_target, outcome_target : float
         The criterion (default the comparison's, :mod:`spine_mj.theory.targets`).
+    carriage_edge : float, optional
+        The domain's +x edge of the runs whose carriage travel the compliant paths share
+        (:func:`spring_run_travel`); None: an endless carriage.
 
     Returns
     -------
     k_path : float
-        The passing end of the bracket (the first halving below
-        ``PATH_STIFFNESS_RANGE k_fold`` where none fails; 0 without a fold on any path).
+        The passing end of the bracket (the first halving below ``PATH_STIFFNESS_RANGE``
+        times the first K that passes where none fails; 0 with an endless carriage and no
+        fold on any path; inf where no K up to :data:`PATH_STIFFNESS_CEILING` times the
+        fold passes).
     k_fold : float
         The fold ``K*`` on these paths.
     """
     pts = np.asarray(starts, float)
     rigid = sl.streamlines(surface, pts, params, store_paths=True)
     k_fold = slope_length * max(0.0, _path_statistics(surface, rigid, params.mu, params.kappa_cap)[0])
-    if not (k_fold > 0 and math.isfinite(k_fold)):
+    if carriage_edge is None and not (k_fold > 0 and math.isfinite(k_fold)):
         return 0.0, k_fold
 
     def passes(k: float) -> bool:
-        comp = compliant_streamlines(surface, pts, params, stiffness=k / slope_length)
+        end = (
+            None
+            if carriage_edge is None
+            else pts[:, 0] + spring_run_travel(carriage_edge - pts[:, 0], slope_length / k, params.mu)
+        )
+        comp = compliant_streamlines(surface, pts, params, stiffness=k / slope_length, carriage_end=end)
         agreement, frechet = path_criterion(rigid, comp, char_length)
         return agreement >= outcome_target and frechet <= frechet_target
 
-    # down from the fold in halvings to the stiffest K that fails (a measured boundary is
-    # the largest K that fails, too: softer springs can agree again, their jumps along
-    # the path), then that halving bisected
-    hi, lo = k_fold, k_fold / 2
+    top = k_fold if k_fold > 0 and math.isfinite(k_fold) else 1.0
+    return _last_failure(passes, top, check_top=carriage_edge is not None), k_fold
+
+
+def _last_failure(passes, top: float, *, check_top: bool) -> float:
+    """The passing end of the bracket of the stiffest K that fails ``passes``: up from
+    ``top`` in doublings to a K that passes (``check_top`` False: ``top`` passes), down in
+    halvings to the stiffest K that fails (a measured boundary is the largest K that fails,
+    too: softer springs can agree again, their jumps along the path), then that halving
+    bisected (see :func:`path_stiffness`)."""
+    hi = top
+    while check_top and not passes(hi):
+        if hi >= PATH_STIFFNESS_CEILING * top:
+            return math.inf
+        hi *= 2
+    first, lo = hi, hi / 2
     while passes(lo):
-        if lo <= PATH_STIFFNESS_RANGE * k_fold:
-            return lo, k_fold
+        if lo <= PATH_STIFFNESS_RANGE * first:
+            return lo
         hi, lo = lo, lo / 2
     while hi / lo > PATH_STIFFNESS_RESOLUTION:
         mid = math.sqrt(lo * hi)
         lo, hi = (lo, mid) if passes(mid) else (mid, hi)
-    return hi, k_fold
+    return hi
 
 
 def _path_statistics(surface: Surface, res, mu: float, kappa_cap: float) -> tuple[float, float, np.ndarray]:
@@ -327,6 +397,19 @@ def _path_statistics(surface: Surface, res, mu: float, kappa_cap: float) -> tupl
         arrival[i] = finite[-1] if finite.size else 0.0
     max_fall = float(np.nanmax(np.concatenate(fall), initial=0.0))
     return max_fall, float(np.nanmax(np.concatenate(curv), initial=0.0)), arrival
+
+
+def _path_stiffnesses(traced, path_starts, params, l_s: float, l_c: float, carriage_edge):
+    """``(k_path, k_fold, k_path_endless)`` of :func:`drive_limits` (NaN without starts)."""
+    if path_starts is None:
+        return math.nan, math.nan, math.nan
+    endless, k_fold = path_stiffness(traced, path_starts, params, slope_length=l_s, char_length=l_c)
+    if carriage_edge is None:
+        return endless, k_fold, endless
+    k_path, _ = path_stiffness(
+        traced, path_starts, params, slope_length=l_s, char_length=l_c, carriage_edge=carriage_edge
+    )
+    return k_path, k_fold, endless
 
 
 def _grid_starts(surface: Surface, n: int, margin: float) -> np.ndarray:
@@ -348,6 +431,7 @@ def drive_limits(
     kappa_cap: float = DEFAULT_KAPPA_CAP,
     path_tolerance: float = FRECHET_TARGET,
     path_starts=None,
+    carriage_edge: float | None = None,
 ) -> DriveLimits:
     """Predict ``K*`` and ``I_e*`` of ``surface`` from its quasistatic paths (module doc).
 
@@ -369,6 +453,8 @@ def drive_limits(
         comparison's Frechet target (:data:`spine_mj.theory.targets.FRECHET_TARGET`, 0.1).
     path_starts : array_like, shape (m, 2), optional
         A measurement's starts: ``K_path`` and their paths' fold (:func:`path_stiffness`).
+    carriage_edge : float, optional
+        The runs' +x edge: ``K_path`` with their carriage travel (:func:`path_stiffness`).
 
     Returns
     -------
@@ -394,11 +480,7 @@ def drive_limits(
     ie_lag = 2.0 * float(mu) * float(path_tolerance)
     limits = {"lift-off": ie_lift, "trap": ie_trap, "lag": ie_lag}
     limit = min(limits, key=limits.get)
-    k_path, k_fold_starts = (
-        (math.nan, math.nan)
-        if path_starts is None
-        else path_stiffness(traced, path_starts, params, slope_length=l_s, char_length=l_c)
-    )
+    k_path, k_fold_starts, k_endless = _path_stiffnesses(traced, path_starts, params, l_s, l_c, carriage_edge)
     return DriveLimits(
         k_star=l_s * max(0.0, max_fall),
         ie_star=limits[limit],
@@ -416,4 +498,5 @@ def drive_limits(
         n_traps=int(trapped.sum()),
         k_path=k_path,
         k_star_path_starts=k_fold_starts,
+        k_path_endless=k_endless,
     )

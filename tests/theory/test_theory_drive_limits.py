@@ -1,5 +1,6 @@
 """Predicted drive limits against closed forms (docs/physics.md §8)."""
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 
@@ -20,6 +21,7 @@ from spine_mj.theory.drive_limits import (
     path_criterion,
     path_stiffness,
     spring_ie_limits,
+    spring_run_travel,
     trap_depths,
 )
 
@@ -148,6 +150,41 @@ def test_k_path_is_where_the_compliant_paths_stop_meeting_the_criterion_below_th
     # folds below the fold K* that the criterion does not see: the sub-threshold jumps
     between = compliant_streamlines(surf, starts, params, stiffness=np.sqrt(k_path * k_fold) / ls)
     assert between.folds.start.size > 0
+
+
+def test_k_path_with_the_runs_travel_is_where_their_carriage_stops_short_of_a_hold():
+    # a wall of hold H = (t + mu) / (1 - mu t) = 8 > 1 + mu between flat ground: the tip
+    # climbs it with the carriage at x + H l_s / K, and a run's carriage, stopped
+    # 1.1 d + (1 + mu) l_s / K past the start (d: to the +x edge), leaves it at the wall's
+    # top (x = w) below K = (H - 1 - mu) l_s / (1.1 d - (w - x0)), where the rigid path
+    # goes on to the edge; the fold at the top (H falls to mu) jumps along the path
+    mu, t, w = 0.5, 1.5, 0.4
+    wall, x0 = Wall(t, w), -0.5
+    starts = np.array([(x0, 0.0), (x0, 0.2)])
+    params = sl.StreamlineParams(mu=mu, dl=0.01)
+    edge, ls = wall.bounds[1], 0.7
+    hold = (t + mu) / (1 - mu * t)
+    k_travel = (hold - 1 - mu) * ls / (1.1 * (edge - x0) - (w - x0))
+    k_path, k_fold = path_stiffness(
+        wall, starts, params, slope_length=ls, char_length=1.0, carriage_edge=edge
+    )
+    assert k_travel <= k_path <= k_travel * PATH_STIFFNESS_RESOLUTION
+    endless, _ = path_stiffness(wall, starts, params, slope_length=ls, char_length=1.0)
+    assert endless < k_travel < k_fold
+    # a softer spring stops the tip on the wall, where the stopped carriage holds it
+    k = k_travel / 1.1
+    end = x0 + spring_run_travel(edge - x0, ls / k, mu)
+    stopped = compliant_streamlines(wall, starts, params, stiffness=k / ls, carriage_end=end)
+    assert stopped.end_x == pytest.approx([end - hold * ls / k] * 2, abs=0.01)
+    assert 0 < end - hold * ls / k < w
+    # a hold beyond the force cap is a lock at its foot (x = 0), which the run decides at
+    # kappa_cap F_p: the carriage need only reach kappa_cap l_s / K past it
+    capped = dataclasses.replace(params, kappa_cap=5.0)
+    k_cap = (5.0 - 1 - mu) * ls / (1.1 * (edge - x0) - (0.0 - x0))
+    k_path, _ = path_stiffness(wall, starts, capped, slope_length=ls, char_length=1.0, carriage_edge=edge)
+    assert k_cap <= k_path <= k_cap * PATH_STIFFNESS_RESOLUTION
+    assert spring_run_travel(2.0, 0.5, 0.3) == pytest.approx(1.1 * 2.0 + 1.3 * 0.5)
+    assert spring_run_travel(-1.0, 0.5, 0.3) == pytest.approx(1.3 * 0.5)  # none past the edge
 
 
 def test_the_spring_swing_limits_invert_the_spring_block_amplitudes():
