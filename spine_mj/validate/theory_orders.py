@@ -40,12 +40,14 @@ __all__ = [
     "FRECHET_FLOOR_LC",
     "PREDICTED_ORDERS",
     "PREDICTION_FACTOR",
+    "bracket_ratio",
     "common_lowest_ie",
     "fit_order",
     "gap_series",
     "k_boundary",
     "k_readings",
     "order_rows",
+    "outside_factor",
     "prediction_check",
     "within_factor",
 ]
@@ -161,24 +163,41 @@ def order_rows(agreement: dict, predicted: dict) -> list[dict]:
 def k_readings(cells: dict, lc_over_ls: float = math.nan) -> dict:
     """Where each K of a family's map is read for the K boundary: K (str) -> the index of
     its lowest I_e below both its spring-swing limits
-    (:func:`spine_mj.theory.drive_limits.spring_ie_limits`), None where every I_e it ran at
-    swings more; without a finite ``lc_over_ls``, every K at the lowest I_e all of them ran at."""
+    (:func:`spine_mj.theory.drive_limits.spring_ie_limits`) and at or below the highest of
+    those I_e at which the stiffest K so read passes, None where it has none; without a
+    finite ``lc_over_ls``, every K at the lowest I_e all of them ran at, as long as the
+    stiffest passes there.
+
+    A K fails for its spring only where a stiffer one passes at the same pace: at an I_e
+    where the stiffest spring fails too, the tip's inertia fails them all (measured on the
+    fractal: every K from 2.9 to 1000 failed at I_e 1e-4, K 14 to 100 passed at 1e-6), and
+    no K is read there."""
     if not (math.isfinite(lc_over_ls) and lc_over_ls > 0):
         low = common_lowest_ie(cells)
-        return {k: cells[k]["ie"].index(low) for k in cells}
+        quiet = {k: [cells[k]["ie"].index(low)] for k in cells}
+    else:
+        quiet = {}
+        for k, c in cells.items():
+            top = min(spring_ie_limits(float(k), lc_over_ls).values())
+            quiet[k] = [i for i, ie in enumerate(c["ie"]) if ie <= top]
+    read = [k for k in cells if quiet[k]]
+    if not read:
+        return dict.fromkeys(cells)
+    stiffest = cells[max(read, key=float)]
+    passing = [stiffest["ie"][i] for i in quiet[max(read, key=float)] if stiffest["passes"][i]]
+    ceiling = max(passing, default=-math.inf)
     out = {}
     for k, c in cells.items():
-        top = min(spring_ie_limits(float(k), lc_over_ls).values())
-        quiet = [i for i, ie in enumerate(c["ie"]) if ie <= top]
-        out[k] = min(quiet, key=lambda i: c["ie"][i]) if quiet else None
+        ok = [i for i in quiet[k] if c["ie"][i] <= ceiling]
+        out[k] = min(ok, key=lambda i: c["ie"][i]) if ok else None
     return out
 
 
 def k_boundary(cells: dict, lc_over_ls: float = math.nan) -> tuple[float, float]:
     """The measured K boundary of a family's map over the K read (:func:`k_readings`):
     ``(low, high)``, the largest K that fails the criterion and the next K read, which
-    passes (``(nan, K_min)`` when the smallest passes, ``(K_max, inf)`` when the stiffest
-    fails, ``(nan, nan)`` when no K is read)."""
+    passes (``(nan, K_min)`` when the smallest passes, ``(nan, nan)`` when no K is read: the
+    stiffest fails wherever its swing is small)."""
     read = k_readings(cells, lc_over_ls)
     ks = sorted((k for k, i in read.items() if i is not None), key=float)
     if not ks:
@@ -209,13 +228,37 @@ def within_factor(predicted: float, low: float, high: float, factor: float = PRE
     return "outside"
 
 
+def outside_factor(predicted: float, low: float, high: float) -> float:
+    """How far a predicted limit lies outside a measured bracket ``[low, high]`` (NaN low: 0,
+    infinite high: unbounded), as a factor: 1 inside it, else the nearer end over the
+    prediction or the prediction over it; NaN without a positive prediction."""
+    if not (math.isfinite(predicted) and predicted > 0):
+        return math.nan
+    lo = low if math.isfinite(low) else 0.0
+    if predicted < lo:
+        return lo / predicted
+    if predicted > high:
+        return predicted / high
+    return 1.0
+
+
+def bracket_ratio(low: float, high: float) -> float:
+    """``high / low`` of a measured bracket (inf where either end is open): where it exceeds
+    :data:`PREDICTION_FACTOR` squared no prediction can be *within* the factor of all of it."""
+    return high / low if math.isfinite(low) and low > 0 and math.isfinite(high) else math.inf
+
+
 def prediction_check(agreement: dict, predicted: dict) -> list[dict]:
     """Per family: the predicted K boundary against the measured one, and the predicted I_e*
     at the stiffest K against the measured one there, each with :func:`within_factor`.
 
-    The K boundary is read where the spring's swing is small (:func:`k_boundary` with the
-    family's ``lc_over_ls``; ``k_read_ie``: K -> the I_e read, None: not read) and set
-    beside ``K_path`` (``k_verdict``) and beside the fold ``K*`` (``k_verdict_fold``). The
+    The K boundary is read where the spring's swing is small and the stiffest K passes
+    (:func:`k_boundary` with the family's ``lc_over_ls``; ``k_read_ie``: K -> the I_e read,
+    None: not read) and set beside ``K_path`` (``k_verdict``: the prediction, with the
+    carriage travel of the map's runs), beside the fold ``K*`` (``k_verdict_fold``) and
+    beside ``K_path`` with an endless carriage (``k_verdict_endless``), each with
+    :func:`outside_factor` (``k_factor``...) and the bracket's own width
+    (:func:`bracket_ratio`: above 4 a factor of 2 cannot be decided). The
     I_e* predicted at the stiffest K is the lowest of the geometry's (lift-off, trap, lag)
     and that K's swing limits (:func:`~spine_mj.theory.drive_limits.spring_ie_limits`);
     ``ie_limit`` names it."""
@@ -224,6 +267,7 @@ def prediction_check(agreement: dict, predicted: dict) -> list[dict]:
         pred = predicted.get(fam, {})
         k_fold = float(pred.get("k_star", math.nan))
         k_path = float(pred.get("k_path", math.nan))
+        k_endless = float(pred.get("k_path_endless", math.nan))
         ratio = float(pred.get("lc_over_ls", math.nan))
         k_lo, k_hi = k_boundary(cells, ratio)
         read = k_readings(cells, ratio)
@@ -252,8 +296,13 @@ def prediction_check(agreement: dict, predicted: dict) -> list[dict]:
                 "k_read_ie": {k: (cells[k]["ie"][i] if i is not None else None) for k, i in read.items()},
                 "k_low": k_lo,
                 "k_high": k_hi,
+                "k_path_endless": k_endless,
+                "k_bracket_ratio": bracket_ratio(k_lo, k_hi),
                 "k_verdict": within_factor(k_path, k_lo, k_hi) if measured else "not measured",
+                "k_factor": outside_factor(k_path, k_lo, k_hi) if measured else math.nan,
                 "k_verdict_fold": within_factor(k_fold, k_lo, k_hi) if measured else "not measured",
+                "k_factor_fold": outside_factor(k_fold, k_lo, k_hi) if measured else math.nan,
+                "k_verdict_endless": within_factor(k_endless, k_lo, k_hi) if measured else "not measured",
                 "ie_star_predicted": ie_pred,
                 "ie_star_geometry": ie_geometry,
                 "ie_swing_path": limits["swing-path"],
@@ -262,9 +311,11 @@ def prediction_check(agreement: dict, predicted: dict) -> list[dict]:
                 "ie_low": ie_lo,
                 "ie_high": ie_hi,
                 "ie_at_k": float(k_top),
+                "ie_bracket_ratio": bracket_ratio(ie_lo, ie_hi),
                 "ie_verdict": within_factor(ie_pred, ie_lo, ie_hi)
                 if math.isfinite(ie_lo) or math.isfinite(ie_hi)
                 else "not measured",
+                "ie_factor": outside_factor(ie_pred, ie_lo, ie_hi),
             }
         )
     return rows

@@ -12,11 +12,13 @@ import pytest
 from spine_mj.validate.stiffness_map import agreement_map, family_k_axis, k_ladder
 from spine_mj.validate.theory_orders import (
     FRECHET_FLOOR_LC,
+    bracket_ratio,
     fit_order,
     gap_series,
     k_boundary,
     k_readings,
     order_rows,
+    outside_factor,
     prediction_check,
     within_factor,
 )
@@ -81,7 +83,24 @@ def test_the_k_boundary_brackets_the_last_failure_at_the_lowest_ie():
         30.0,
     )
     assert k_boundary(_cells([10, 30], ies, [[True, False], [True, False]]))[1] == 10.0
-    assert k_boundary(_cells([10, 30], ies, [[False, False], [False, True]])) == (30.0, math.inf)
+    # the stiffest fails at the lowest I_e too: inertia or spring, the map cannot tell
+    assert all(math.isnan(v) for v in k_boundary(_cells([10, 30], ies, [[False, False], [False, True]])))
+
+
+def test_no_k_is_read_where_the_stiffest_spring_fails_too():
+    # the fractal of the full report: every K failed at I_e 1e-4, the stiffest (10 K*)
+    # passed at 1e-6, the only K that ran there: a failure at 1e-4 is the tip's inertia
+    cells = _cells([29, 100], [1e-4, 1e-2], [[False, False], [False, False]])
+    cells["1000"] = dict(_cells([1000], [1e-6, 1e-4], [[True, False]])["1000"])
+    assert k_readings(cells) == {"29": None, "100": None, "1000": None}  # no common lowest I_e passes
+    assert k_readings(cells, 30.0) == {"29": None, "100": None, "1000": 0}
+    low, high = k_boundary(cells, 30.0)
+    assert math.isnan(low) and high == 1000.0  # at or below the stiffest: no K boundary above it
+    # with the deep I_e at every K, the K boundary is read there
+    for k in ("29", "100"):
+        cells[k] = {**cells[k], "ie": [1e-6, *cells[k]["ie"]], "passes": [k == "100", False, False]}
+    assert k_readings(cells, 30.0) == {"29": 0, "100": 0, "1000": 0}
+    assert k_boundary(cells, 30.0) == (29.0, 100.0)
 
 
 def test_within_a_factor_of_two_needs_the_whole_bracket():
@@ -130,7 +149,8 @@ def test_the_k_boundary_is_read_where_the_spring_swing_is_small():
     cells["100"]["passes"] = [False, False]
     assert k_readings(cells, 100.0) == {"1": 0, "10": 0, "100": None}
     assert k_boundary(cells, 100.0) == (1.0, 10.0)  # the stiffest K failed for its swing: not read
-    assert k_boundary(cells) == (100.0, math.inf)  # read at the lowest common I_e, as before
+    # read at the lowest common I_e, where the stiffest fails too: nothing read
+    assert all(math.isnan(v) for v in k_boundary(cells))
     assert all(math.isnan(v) for v in k_boundary({"100": cells["100"]}, 100.0))
     pred = {"k_star": 50.0, "k_path": 2.0, "ie_star": 0.25, "limit": "lag", "lc_over_ls": 100.0}
     check = prediction_check({"fam": cells}, {"fam": pred})[0]
@@ -161,3 +181,14 @@ def test_the_ie_star_bootstrap_leaves_out_a_deeper_ie_run_from_fewer_starts():
     assert cell["ie"] == [1e-6, 1e-4, 1e-2, 1.0] and cell["n"] == [2, 4, 4, 4]
     assert cell["ie_star"]["kind"] == "bracketed"
     assert (cell["ie_star"]["low"], cell["ie_star"]["high"]) == (1e-2, 1.0)
+
+
+def test_the_factor_outside_is_the_nearer_end_over_the_prediction():
+    assert outside_factor(100.0, 60.0, 150.0) == 1.0
+    assert outside_factor(0.3, 0.9, 70.0) == pytest.approx(3.0)
+    assert outside_factor(29.0, 100.0, 1000.0) == pytest.approx(100 / 29)
+    assert outside_factor(0.2, 0.01, 0.1) == pytest.approx(2.0)
+    assert outside_factor(5.0, float("nan"), 10.0) == 1.0 and outside_factor(5.0, 1.0, math.inf) == 1.0
+    assert math.isnan(outside_factor(float("nan"), 1.0, 2.0))
+    assert bracket_ratio(0.9, 70.0) == pytest.approx(70 / 0.9)
+    assert bracket_ratio(float("nan"), 10.0) == math.inf and bracket_ratio(1.0, math.inf) == math.inf

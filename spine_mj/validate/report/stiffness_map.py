@@ -162,15 +162,14 @@ def measured_k_star(cells: dict, lc_over_ls: float = np.nan) -> str:
     """The measured K boundary of a family's map (``K`` -> agreement cell), each K read at
     its lowest I_e where the spring's swing is small
     (:func:`~spine_mj.validate.theory_orders.k_boundary`): ``low-high`` between the
-    largest K that fails and the next, which passes, ``< K`` when the smallest passes, ``> K``
-    when the stiffest fails, ``not read`` when every cell swings too much."""
+    largest K that fails and the next, which passes, ``< K`` when the smallest passes,
+    ``not read`` when every cell swings too much or the stiffest K fails too (the tip's
+    inertia, not the spring)."""
     low, high = k_boundary(cells, lc_over_ls)
     if not (np.isfinite(low) or np.isfinite(high)):
         return "not read"
     if not np.isfinite(low):
         return f"< {sig(high)}"
-    if np.isinf(high):
-        return f"> {sig(low)}"
     return f"{sig(low)}-{sig(high)}"
 
 

@@ -136,8 +136,14 @@ def _bracket(lo: float, hi: float) -> str:
     return f"{sig(lo)}-{sig(hi)}"
 
 
+def _factor(verdict: str, factor: float) -> str:
+    """A verdict with how far outside its bracket the prediction lies."""
+    return f"{verdict} (x {sig(factor)})" if verdict == "outside" and math.isfinite(factor) else verdict
+
+
 def prediction_lines(km: StiffnessMapResult) -> list[str]:
-    """The predicted K* and I_e* against the measured brackets, with the factor-2 verdicts."""
+    """The predicted K boundary and I_e* against the measured brackets, with the factor-2
+    verdicts, how far outside a prediction lies and how wide each bracket is."""
     if not km.prediction_check:
         return []
     rows = [
@@ -145,42 +151,55 @@ def prediction_lines(km: StiffnessMapResult) -> list[str]:
             **r,
             "k_measured": _bracket(r["k_low"], r["k_high"]),
             "ie_measured": _bracket(r["ie_low"], r["ie_high"]),
+            "k_verdict_x": _factor(r["k_verdict"], r.get("k_factor", math.nan)),
+            "k_verdict_fold_x": _factor(r["k_verdict_fold"], r.get("k_factor_fold", math.nan)),
+            "ie_verdict_x": _factor(r["ie_verdict"], r.get("ie_factor", math.nan)),
         }
         for r in km.prediction_check
     ]
     return [
         f"The predicted limits against the measured ones, judged within a factor of {PREDICTION_FACTOR:g}: "
         "*within* where the whole measured bracket lies within the factor of the prediction, "
-        "*consistent* where they overlap but the bracket is wider than the factor (a finer "
-        "ladder would decide), *outside* where they do not overlap (the named term of the "
-        "prediction fails). The two K are not the same event: the predicted K* is the first "
-        "fold anywhere on the paths (the largest local fall of the hold force, "
-        "`l_s max(-dH/dx)`), the measured boundary the stiffness where the median path stays "
-        "within 0.1 L_c and 95 % of outcomes agree. A fold whose jump, `dH l_s / K` past a "
-        "drop `dH` of the hold force (docs/physics.md §10), is shorter than that tolerance "
-        "passes the criterion, so where the steepest falls are short (a path brushing the "
-        "lock boundary, where kappa climbs and falls within a slope length) the predicted K* "
-        "lies above the measured boundary: the local term is the one to replace by the jump "
-        "length when it fails.",
+        "*consistent* where they overlap but the bracket is wider than the factor allows to "
+        f"decide (a bracket wider than {PREDICTION_FACTOR**2:g} times cannot be decided: a finer "
+        "ladder would), *outside* where they do not overlap, with the factor by which the "
+        "prediction misses the nearer end. The K boundary predicted is `K_path`: the stiffness "
+        "where the compliant-drive paths from the family's own starts, each carriage stopping "
+        "where the map's runs stop theirs (1.1 times the distance to the +x edge plus the "
+        "spring's stretch at (1 + mu) F_p), meet the criterion against the rigid ones "
+        "(docs/physics.md §8). A soft spring's run ends with the tip short of a hold it must "
+        "stretch the spring further for (a lock decided at kappa_cap F_p, a tip lagging by "
+        "`H l_s / K`): that, not the folds, sets the boundary where `K_path` exceeds the "
+        "endless carriage's. The fold K* (the first fold anywhere on the paths, "
+        "`l_s max(-dH/dx)`) is set beside it: a fold whose jump is shorter than the tolerance "
+        "or runs along the path passes the criterion. The measured boundary is read where the "
+        "spring's swing is small and the stiffest K passes (at an I_e where the stiffest "
+        "spring fails too, the tip's inertia fails every K).",
         "",
         table(
             rows,
             [
                 "family",
+                "k_path_predicted",
+                "k_path_endless",
                 "k_star_predicted",
                 "k_measured",
-                "k_verdict",
+                "k_verdict_x",
+                "k_verdict_fold_x",
                 "ie_star_predicted",
                 "ie_limit",
                 "ie_at_k",
                 "ie_measured",
-                "ie_verdict",
+                "ie_verdict_x",
             ],
             [
                 "family",
-                "K* predicted (fold: l_s max -dkappa/dx)",
+                "K_path predicted (runs' travel)",
+                "K_path (endless carriage)",
+                "fold K*",
                 "K boundary measured",
-                "K*",
+                "K_path",
+                "fold K*",
                 "I_e* predicted",
                 "set by",
                 "at K",
