@@ -33,7 +33,7 @@ from collections.abc import Sequence
 import numpy as np
 from scipy import stats
 
-from spine_mj.theory.drive_limits import spring_ie_limits
+from spine_mj.theory.drive_limits import PATH_STIFFNESS_RESOLUTION, spring_ie_limits
 from spine_mj.validate.intervals import CONFIDENCE
 
 __all__ = [
@@ -45,6 +45,7 @@ __all__ = [
     "fit_order",
     "gap_series",
     "k_boundary",
+    "k_path_term",
     "k_readings",
     "order_rows",
     "outside_factor",
@@ -242,6 +243,15 @@ def outside_factor(predicted: float, low: float, high: float) -> float:
     return 1.0
 
 
+def k_path_term(k_path: float, k_endless: float) -> str:
+    """What sets a family's ``K_path``: ``"carriage travel"`` where it lies above the
+    endless carriage's by more than the search's resolution (the runs stop short of a hold),
+    ``"folds"`` otherwise, ``"-"`` without both."""
+    if not (math.isfinite(k_path) and math.isfinite(k_endless)):
+        return "-"
+    return "carriage travel" if k_path > k_endless * PATH_STIFFNESS_RESOLUTION else "folds"
+
+
 def bracket_ratio(low: float, high: float) -> float:
     """``high / low`` of a measured bracket (inf where either end is open): where it exceeds
     :data:`PREDICTION_FACTOR` squared no prediction can be *within* the factor of all of it."""
@@ -256,7 +266,8 @@ def prediction_check(agreement: dict, predicted: dict) -> list[dict]:
     (:func:`k_boundary` with the family's ``lc_over_ls``; ``k_read_ie``: K -> the I_e read,
     None: not read) and set beside ``K_path`` (``k_verdict``: the prediction, with the
     carriage travel of the map's runs), beside the fold ``K*`` (``k_verdict_fold``) and
-    beside ``K_path`` with an endless carriage (``k_verdict_endless``), each with
+    beside ``K_path`` with an endless carriage (``k_verdict_endless``; ``k_path_set_by``:
+    :func:`k_path_term`), each with
     :func:`outside_factor` (``k_factor``...) and the bracket's own width
     (:func:`bracket_ratio`: above 4 a factor of 2 cannot be decided). The
     I_e* predicted at the stiffest K is the lowest of the geometry's (lift-off, trap, lag)
@@ -297,6 +308,7 @@ def prediction_check(agreement: dict, predicted: dict) -> list[dict]:
                 "k_low": k_lo,
                 "k_high": k_hi,
                 "k_path_endless": k_endless,
+                "k_path_set_by": k_path_term(k_path, k_endless),
                 "k_bracket_ratio": bracket_ratio(k_lo, k_hi),
                 "k_verdict": within_factor(k_path, k_lo, k_hi) if measured else "not measured",
                 "k_factor": outside_factor(k_path, k_lo, k_hi) if measured else math.nan,

@@ -16,6 +16,7 @@ from spine_mj.validate.theory_orders import (
     fit_order,
     gap_series,
     k_boundary,
+    k_path_term,
     k_readings,
     order_rows,
     outside_factor,
@@ -192,3 +193,15 @@ def test_the_factor_outside_is_the_nearer_end_over_the_prediction():
     assert math.isnan(outside_factor(float("nan"), 1.0, 2.0))
     assert bracket_ratio(0.9, 70.0) == pytest.approx(70 / 0.9)
     assert bracket_ratio(float("nan"), 10.0) == math.inf and bracket_ratio(1.0, math.inf) == math.inf
+
+
+def test_k_path_is_set_by_the_travel_only_where_it_exceeds_the_endless_carriages():
+    assert k_path_term(8.7, 0.32) == "carriage travel"  # the single peak/valley's map
+    assert k_path_term(20.2, 20.2) == "folds" and k_path_term(1.1, 1.0) == "folds"
+    assert k_path_term(float("nan"), 1.0) == "-"
+    check = prediction_check(
+        {"fam": _cells([5, 10], [1e-4], [[False], [True]])},
+        {"fam": {"k_star": 70.0, "k_path": 8.7, "k_path_endless": 0.32, "ie_star": 0.2, "limit": "lag"}},
+    )[0]
+    assert check["k_path_set_by"] == "carriage travel" and check["k_verdict"] == "within"
+    assert check["k_verdict_endless"] == "outside" and check["k_bracket_ratio"] == 2.0
