@@ -478,8 +478,9 @@ def _end_decided(L, rec, a, stopped, locked, hold, finite, params) -> np.ndarray
         (~finite, Outcome.STALLED),
     ):
         m = mask & ~ended
-        _end(L, rec, a[m], code)
-        ended |= m
+        if m.any():
+            _end(L, rec, a[m], code)
+            ended |= m
     return ended
 
 
@@ -498,10 +499,10 @@ def _run(surface, xs, ys, params, c, carriage_end):
         probe = a[L.has_prev[a] & ~L.slipping[a] & (L.pending[a] == 0)]
         t = L.h[probe] * (1.0 - _PROBE)
         qx, qy = L.px[probe] + t * L.pvx[probe], L.py[probe] + t * L.pvy[probe]
-        z, fx, fy = surface.evaluate(np.r_[L.x[a], qx], np.r_[L.y[a], qy], order=1)
-        hold_q = hold_force(fx[a.size :], fy[a.size :], params.mu, tol=params.tol)[0]
-        z, fx, fy = z[: a.size], fx[: a.size], fy[: a.size]
-        hold, region = hold_force(fx, fy, params.mu, tol=params.tol)
+        z, fx, fy = surface.evaluate(np.concatenate([L.x[a], qx]), np.concatenate([L.y[a], qy]), order=1)
+        hold, region = hold_force(fx, fy, params.mu, tol=params.tol)  # elementwise: one call
+        hold_q = hold[a.size :]
+        z, fx, fy, hold, region = z[: a.size], fx[: a.size], fy[: a.size], hold[: a.size], region[: a.size]
         kap = np.where(region == SLIP, np.nan, hold)
         slip, drive = _classify(L, a, hold, region, c)
         at = np.searchsorted(a, probe)
@@ -529,15 +530,20 @@ def _run(surface, xs, ys, params, c, carriage_end):
         vx, vy, locked, finite, reversed_ = vx[ok], vy[ok], locked[ok], finite[ok], reversed_[ok]
         stopped = _accept(L, rec, a, z, kap, hold, slip, c, carriage_end, params.kappa_cap)
         ended = _end_decided(L, rec, a, stopped, locked, hold, finite, params)
-        left = _step(L, a[~ended], vx[~ended], vy[~ended], slip[~ended], reversed_[~ended], params, domain)
+        go = a[~ended]
+        left = _step(L, go, vx[~ended], vy[~ended], slip[~ended], reversed_[~ended], params, domain)
         _end(L, rec, left, Outcome.LEFT_DOMAIN)
-        stalled = _stalled(L, a[~ended], params)
-        stalled = np.setdiff1d(stalled, left)
+        # lane sets as masks over the starts: sorted and unique, as the loop takes them
+        keep = np.zeros(n, bool)
+        keep[go] = True
+        keep[left] = False
+        stalled = _stalled(L, go, params)
+        stalled = stalled[keep[stalled]]
         _end(L, rec, stalled, Outcome.STALLED)
-        gone = np.union1d(left, stalled)
-        a = np.setdiff1d(a[~ended], gone)
-        active = np.sort(np.concatenate([back, a, np.flatnonzero(L.pending > 0)]))
-        active = np.unique(active)
+        keep[stalled] = False
+        keep[back] = True
+        keep |= L.pending > 0
+        active = np.flatnonzero(keep)
     offsets, cols = rec.paths(n)
     last = offsets[1:] - 1
     return CompliantResult(
