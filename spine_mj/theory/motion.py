@@ -89,17 +89,30 @@ def motion_states(velocity_m_s: np.ndarray, drive_speed_m_s: float, start: int =
     states = np.where(speed < STUCK_SPEED_FRACTION * drive_speed_m_s, STUCK, SLIDING).astype(np.int8)
     ahead = v[:, 0] > drive_speed_m_s
     ahead[: max(start, 0)] = False
-    for a, b in _runs(ahead):
-        if v[a : b + 1, 0].max() >= SLIP_SPEED_FACTOR * drive_speed_m_s:
-            states[a : b + 1] = SLIPPING
+    first, last = _run_bounds(ahead)
+    if first.size:
+        # each interval's peak x-speed at once (thousands of intervals a run at low I_e)
+        vx = np.append(v[:, 0], -np.inf)  # room for the end of an interval at the last row
+        peak = np.maximum.reduceat(vx, np.ravel(np.column_stack([first, last + 1])))[::2]
+        slip = peak >= SLIP_SPEED_FACTOR * drive_speed_m_s
+        mark = np.zeros(len(v) + 1, np.int64)
+        np.add.at(mark, first[slip], 1)
+        np.add.at(mark, last[slip] + 1, -1)
+        states[np.cumsum(mark[:-1]) > 0] = SLIPPING
     return states
+
+
+def _run_bounds(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """First and last rows of the maximal runs of True in a 1-D mask."""
+    m = np.concatenate([[False], np.asarray(mask, bool), [False]])
+    edges = np.flatnonzero(m[1:] != m[:-1])
+    return edges[0::2], edges[1::2] - 1
 
 
 def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
     """Maximal runs of True in a 1-D mask as (first, last) rows."""
-    m = np.concatenate([[False], np.asarray(mask, bool), [False]])
-    edges = np.flatnonzero(m[1:] != m[:-1])
-    return list(zip(edges[0::2].tolist(), (edges[1::2] - 1).tolist()))
+    first, last = _run_bounds(mask)
+    return list(zip(first.tolist(), last.tolist()))
 
 
 def slip_events(

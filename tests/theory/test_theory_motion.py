@@ -33,6 +33,34 @@ def test_the_spring_block_swing_is_sliding_and_a_fast_jump_is_one_slip():
     assert sum(motion_fractions(states).values()) == pytest.approx(1.0)
 
 
+def _states_by_loop(vel, v, start):
+    """motion_states written out row by row: the reference of its vectorised intervals."""
+    speed = np.linalg.norm(vel, axis=1)
+    states = np.where(speed < 0.1 * v, STUCK, SLIDING)
+    i, n = max(start, 0), len(vel)
+    while i < n:
+        if vel[i, 0] > v:
+            j = i
+            while j + 1 < n and vel[j + 1, 0] > v:
+                j += 1
+            if vel[i : j + 1, 0].max() >= 5.0 * v:
+                states[i : j + 1] = SLIPPING
+            i = j + 1
+        else:
+            i += 1
+    return states
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_motion_states_equal_the_row_by_row_rule(seed):
+    rng = np.random.default_rng(seed)
+    vel = rng.normal(0.0, 1.0, (400, 3)) * [3.0, 0.3, 0.1]
+    vel[:5, 0] = 9.0  # intervals at the first rows (inside the settle phase when start > 0)
+    vel[-3:, 0] = 9.0  # and one cut by the last row
+    for start in (0, 3, 10):
+        assert np.array_equal(motion_states(vel, 1.0, start), _states_by_loop(vel, 1.0, start))
+
+
 def test_spring_block_on_a_flat_plane_period_and_peak_speed():
     """After breakaway x(t) = V t - (V / w) sin(w t): speed 0..2 V, period 2 pi / w."""
     rig = flat_rig()
