@@ -21,7 +21,8 @@ def _corner_starts(plan, fam) -> int:
 @pytest.mark.parametrize(("plan", "least"), [("quick", 30), ("full", 100)])
 def test_every_family_has_enough_starts_at_the_corner_each_an_ensemble(plan, least):
     p = PLANS[plan]
-    assert p.ensemble_members >= 3
+    # the full plan's ensembles look on either side of a start along x; the demo's on one
+    assert p.ensemble_members >= (3 if plan == "full" else 2)
     for fam in p.families:
         # and at least as many as can meet the target at all (35 all agreeing)
         if plan == "quick" and fam.name == "sandpaper":
