@@ -24,6 +24,9 @@ Sections (each records the machine's load average before and after it):
   (``benchmarks/bench_array.py``): the median wall-time ratio, target at most about 1.
 * ``cli``: wall time of ``spine-mj --help``, of every command's help and of the commands
   that touch no engine (``benchmarks/bench_cli.py``): targets 0.5 s and 1.5 s.
+* ``plan_cost``: ``spine-mj validate --quick`` (``--quick``: the smoke plan) as a user runs
+  it, its wall time and CPU seconds, and each study's CPU seconds from its sweeps' runs
+  (``benchmarks/bench_plan_cost.py``): target ``make demo`` within 5 min.
 * ``memory``: wall time and peak resident memory of the main jobs, each in a process of
   its own (``benchmarks/bench_memory.py``), marked where a peak grew by more than 20 %
   against the committed ``benchmarks/results.json``.
@@ -64,6 +67,8 @@ from bench_engines import bench_engines  # noqa: E402
 from bench_engines import markdown as engines_markdown  # noqa: E402
 from bench_memory import bench_memory  # noqa: E402
 from bench_memory import markdown as memory_markdown  # noqa: E402
+from bench_plan_cost import bench_plan_cost  # noqa: E402
+from bench_plan_cost import markdown as plan_cost_markdown  # noqa: E402
 
 # the Performance page of the site (it was the README's Performance section)
 README = HERE.parent / "docs" / "user_guide" / "performance.md"
@@ -525,6 +530,7 @@ def markdown(res: dict) -> str:
     lines += engines_markdown(res.get("engines"))
     lines += _fastforward_markdown(res.get("fastforward"))
     lines += cli_markdown(res.get("cli"))
+    lines += plan_cost_markdown(res.get("plan_cost"))
     lines += _gpu_markdown(res.get("gpu"))
     lines += memory_markdown(res.get("memory"), MISSED)
     return "\n".join(lines) + "\n"
@@ -738,6 +744,7 @@ def main(argv=None) -> None:
         sections["fastforward"] = bench_fastforward_section
         sections["array"] = bench_array
         sections["cli"] = bench_cli
+        sections["plan_cost"] = bench_plan_cost
         if importlib.util.find_spec("pybullet") is not None:  # the [bullet] extra
             sections["engines"] = bench_engines
         if args.gpu:
