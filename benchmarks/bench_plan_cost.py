@@ -32,7 +32,7 @@ SPINE = str(Path(sys.executable).with_name("spine-mj"))
 QUICK_WALL_TARGET_S = 140.0
 
 
-def _study(store_name: str) -> str:
+def study_of(store_name: str) -> str:
     """The study a sweep store belongs to: its first folder under ``sweeps/``, as
     ``timings_s`` names it (``limit-refined`` is the limit study's refinements)."""
     head = store_name.split("/")[0].replace("-", "_")
@@ -51,7 +51,7 @@ def plan_cost(out_dir: Path) -> dict:
         store = manifest.parent
         df = sweep.load_runs(store, columns=["analysis", "cpu_s"])
         row = studies.setdefault(
-            _study(str(store.relative_to(out_dir / "sweeps"))),
+            study_of(str(store.relative_to(out_dir / "sweeps"))),
             {"wall_s": None, "sweep_cpu_s": 0.0, "runs": 0},
         )
         row["sweep_cpu_s"] += float(df["cpu_s"].sum())

@@ -66,3 +66,20 @@ def test_a_peak_grown_by_more_than_a_fifth_is_marked():
     }
     assert MISSED in rows["grown"] and MISSED not in rows["kept"]
     assert 121.0 > GROWTH_LIMIT * 100.0 > 119.0
+
+
+def test_the_plan_cost_puts_each_sweep_store_under_its_study():
+    from bench_plan_cost import study_of
+
+    from spine_mj.validate.studies import STUDIES
+
+    names = {s.name for s in STUDIES}
+    for store, study in [
+        ("limit/paper-fractal", "limit"),
+        ("limit-refined/dt_halved/sandpaper-P600", "limit"),
+        ("fractal-lock/corner", "fractal_lock"),
+        ("ground-truth/pt-s0.1-mu0.5", "ground_truth"),
+        ("stick-slip", "stick_slip"),
+        ("stiffness_map/paper-fractal-deep", "stiffness_map"),
+    ]:
+        assert study_of(store) == study and study in names
