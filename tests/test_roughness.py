@@ -108,3 +108,21 @@ def test_hurst_is_not_estimated_where_the_psd_is_no_power_law():
 
     rough = roughness.summarize(random_gaussians(n_peaks=2000, rng=0))
     assert np.isnan(rough.hurst)
+
+
+def test_a_surface_is_measured_once_its_answer_kept_while_it_lives():
+    import gc
+    import weakref
+
+    surf = single_gaussian()
+    first = roughness.slope_correlation_length(surf)
+    assert roughness._SLOPE_LENGTHS[surf] == first == roughness.slope_correlation_length(surf)
+    x = np.linspace(0, 1, 16)
+    plane = GridSurface(heights=0.2 * x[None, :] * np.ones((16, 1)), x=x, y=x.copy(), unit="1")
+    for _ in range(2):  # the kept answer of a plane is its error, raised again
+        with pytest.raises(SpineInputError, match="plane"):
+            roughness.slope_correlation_length(plane)
+    refs = [weakref.ref(surf), weakref.ref(plane)]
+    del surf, plane
+    gc.collect()
+    assert all(r() is None for r in refs)  # the answers do not keep their surfaces alive
