@@ -20,7 +20,15 @@ lowest I_e, :mod:`spine_mj.validate.quasistatic_limit`) are recomputed under ref
 A refinement reruns a subset of the corner's starts (``plan.convergence_starts`` y starts
 per surface, the same points, one run each), and the change of a headline is the paired
 change on those starts: the refined runs' number minus the same number of the corner's own
-runs from those starts. A headline is *converged* under a refinement when the headline
+runs from those starts, like for like. The corner's agreement headline, the one its target
+judges, is over the starts well-conditioned on both sides
+(:mod:`spine_mj.validate.ensembles`): its change is paired on the subset's well-conditioned
+starts only. An ill-conditioned start lies within 1e-3 L_c of a watershed, so any change of
+the engine's rounding (a finer step, a tighter tolerance) flips it as a coin would, and the
+headline leaves it out for that reason (measured on the full plan's fractal, 30 paired
+starts: dt / 2 flipped 2 runs, 1 of them ill-conditioned; tolerance / 100 flipped 3, 2 of
+them ill-conditioned). The agreement over all starts is judged on all paired starts, beside
+it. A headline is *converged* under a refinement when the headline
 plus that change lies inside the headline's own 95 % interval (Wilson for the agreement,
 bootstrap for the median): the refinement moves it less than the sample already leaves
 open; or when the change is below what the metric resolves (:data:`RESOLUTIONS`). With
@@ -46,6 +54,7 @@ from spine_mj.validate.theory_orders import FRECHET_FLOOR_LC
 
 __all__ = [
     "HEADLINES",
+    "JUDGED",
     "REFINEMENTS",
     "REFINEMENT_LABELS",
     "family_convergence",
@@ -77,17 +86,35 @@ REFINEMENT_LABELS = {
     "tolerance_tightened": "tolerance / 100",
 }
 
-#: The corner's headlines: key in the family summary -> the key of its 95 % interval.
-HEADLINES = {"outcome_agreement": "outcome_agreement_ci", "median_frechet": "median_frechet_ci"}
+#: The corner's numbers under refinement: key in the family summary -> the key of its 95 %
+#: interval. ``agreement_well_conditioned`` is the agreement the target judges (over the
+#: starts well-conditioned on both sides), ``outcome_agreement`` the one over all starts.
+HEADLINES = {
+    "agreement_well_conditioned": "agreement_ci",
+    "outcome_agreement": "outcome_agreement_ci",
+    "median_frechet": "median_frechet_ci",
+}
+
+#: The headlines a family's verdict ``converged`` rests on: those the targets judge.
+JUDGED = ("agreement_well_conditioned", "median_frechet")
 
 #: The resolution of each headline: the Frechet distance resolves half a sample of the
 #: paths' L_c / 50 resampling (:data:`spine_mj.validate.theory_orders.FRECHET_FLOOR_LC`; the
 #: corner's medians sit at it where paths coincide, so their bootstrap interval can be
 #: narrower than what the metric tells apart); a rate, one run.
-RESOLUTIONS = {"outcome_agreement": 0.0, "median_frechet": FRECHET_FLOOR_LC}
+RESOLUTIONS = {
+    "agreement_well_conditioned": 0.0,
+    "outcome_agreement": 0.0,
+    "median_frechet": FRECHET_FLOOR_LC,
+}
 
-#: The names of the changes in ``validation.json`` (the issue's keys).
-CHANGE_KEYS = {"outcome_agreement": "agreement_change", "median_frechet": "median_frechet_change"}
+#: The names of the changes in ``validation.json`` (the issue's keys: ``agreement_change`` is
+#: the change of the agreement the target judges).
+CHANGE_KEYS = {
+    "agreement_well_conditioned": "agreement_change",
+    "outcome_agreement": "agreement_change_all_starts",
+    "median_frechet": "median_frechet_change",
+}
 
 
 def observed_order(fine: float, medium: float, coarse: float, *, ratio: float = 2.0) -> float:
@@ -152,9 +179,11 @@ def thin_starts(fam: FamilySpec, n: int) -> FamilySpec:
 def _statistic(rows: pd.DataFrame, headline: str) -> float:
     """A headline over ``rows``: the share agreeing (a run without an outcome disagrees) or
     the median Frechet distance (NaN without finite ones)."""
+    if headline == "agreement_well_conditioned":
+        rows = rows[rows["well_conditioned"]] if "well_conditioned" in rows else rows
     if not len(rows):
         return math.nan
-    if headline == "outcome_agreement":
+    if headline in ("outcome_agreement", "agreement_well_conditioned"):
         return float(rows["agree"].fillna(False).astype(bool).mean())
     f = rows["frechet"].to_numpy(dtype=float)
     return float(np.median(f[np.isfinite(f)])) if np.isfinite(f).any() else math.nan
@@ -178,12 +207,21 @@ def paired_change(base: pd.DataFrame, refined: pd.DataFrame) -> dict:
     """Each headline of the corner's own runs ``base`` and of the ``refined`` runs on the
     starts both have (``surface``, ``surface_lc``: the surface's L_c, ``start_x``,
     ``start_y``, ``agree``, ``frechet``), and its change (refined - base), with the number
-    of paired runs ``runs``."""
+    of paired runs ``runs``.
+
+    ``base`` may carry ``well_conditioned`` (bool: the start's ensemble ended in one outcome
+    on both sides, none stopped): the well-conditioned agreement is then paired on those
+    starts only (``well_conditioned_runs`` of them; without the column, on all)."""
     b = base.assign(_key=_keys(base)).drop_duplicates("_key").set_index("_key")
     r = refined.assign(_key=_keys(refined)).drop_duplicates("_key").set_index("_key")
     common = b.index.intersection(r.index)
     b, r = b.loc[common], r.loc[common]
-    out: dict[str, Any] = {"runs": int(len(common))}
+    if "well_conditioned" in b:
+        r = r.assign(well_conditioned=b["well_conditioned"].astype(bool))
+    out: dict[str, Any] = {
+        "runs": int(len(common)),
+        "well_conditioned_runs": int(b["well_conditioned"].sum()) if "well_conditioned" in b else len(common),
+    }
     for headline in HEADLINES:
         before, after = _statistic(b, headline), _statistic(r, headline)
         out[headline] = {"base": before, "refined": after, "change": after - before}
@@ -198,7 +236,8 @@ def family_convergence(summary: dict, base: pd.DataFrame, refined: dict[str, pd.
     summary : dict
         The family's corner summary (its headlines and their ``*_ci`` intervals).
     base : DataFrame
-        The corner's own comparison rows of the family.
+        The corner's own comparison rows of the family, with ``well_conditioned``
+        (:func:`paired_change`).
     refined : dict
         Refinement key -> the refined comparison rows (None: not refinable, a gridded
         surface's hfield).
@@ -206,10 +245,12 @@ def family_convergence(summary: dict, base: pd.DataFrame, refined: dict[str, pd.
     Returns
     -------
     dict
-        Per refinement: ``refined`` (bool), ``runs`` (paired), ``agreement_change``,
-        ``median_frechet_change`` (NaN where not refined), per headline its base / refined
-        values on the paired starts and ``*_converged`` (:func:`is_converged`), and
-        ``converged``: both headlines (None where not refined). With ``dt_halved`` and
+        Per refinement: ``refined`` (bool), ``runs`` (paired) and
+        ``well_conditioned_runs``, ``agreement_change`` (the well-conditioned agreement's),
+        ``agreement_change_all_starts``, ``median_frechet_change`` (NaN where not refined),
+        per headline (:data:`HEADLINES`) its base / refined values on the paired starts and
+        ``*_converged`` (:func:`is_converged`), and ``converged``: the headlines the targets
+        judge (:data:`JUDGED`; None where not refined). With ``dt_halved`` and
         ``dt_quartered``, ``dt_order``: per headline the observed order of the three step
         levels on the paired starts and the Richardson estimate. ``converged`` at the top:
         every refined verdict true (None where nothing was refined).
@@ -228,14 +269,14 @@ def family_convergence(summary: dict, base: pd.DataFrame, refined: dict[str, pd.
             continue
         pc = paired_change(base, rows)
         entry["runs"] = pc["runs"]
-        verdicts = []
+        entry["well_conditioned_runs"] = pc["well_conditioned_runs"]
         for headline, ci_key in HEADLINES.items():
             change = pc[headline]["change"]
             ok = is_converged(summary[headline], change, summary[ci_key], resolution=RESOLUTIONS[headline])
             entry[CHANGE_KEYS[headline]] = change
             entry[headline] = {"base": pc[headline]["base"], "refined": pc[headline]["refined"]}
             entry[f"{headline}_converged"] = ok
-            verdicts.append(ok)
+        verdicts = [entry[f"{headline}_converged"] for headline in JUDGED]
         entry["converged"] = None if any(v is None for v in verdicts) else all(verdicts)
         out[key] = entry
     if out.get("dt_halved", {}).get("refined") and out.get("dt_quartered", {}).get("refined"):

@@ -115,7 +115,9 @@ def ensemble_verdicts(groups: Sequence[dict]) -> dict:
         ``agreement_well_conditioned`` (the share of those where the outcomes agree) with
         its Wilson ``agreement_ci``, and ``distribution_agreement`` (over all starts, the
         mean share of MuJoCo-reference member pairs that agree); ``ill_conditioned``: the
-        groups' optional ``key`` -> the sides where that start splits (:func:`_sides`).
+        groups' optional ``key`` -> the sides where that start splits (:func:`_sides`);
+        ``well_conditioned``: key -> whether that start counts in
+        ``agreement_well_conditioned``.
     """
     n = len(groups)
     mj_split = np.zeros(n, bool)
@@ -150,6 +152,7 @@ def ensemble_verdicts(groups: Sequence[dict]) -> dict:
         "ill_conditioned": {
             g["key"]: _sides(mj_split[k], ref_split[k]) for k, g in enumerate(groups) if "key" in g
         },
+        "well_conditioned": {g["key"]: bool(well[k]) for k, g in enumerate(groups) if "key" in g},
     }
 
 

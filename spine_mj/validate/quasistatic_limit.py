@@ -188,6 +188,10 @@ def quasistatic_limit(plan: ValidationPlan, runner: StudyRunner) -> QuasistaticL
     for fam in corner:
         summ, allc = corner_summary(plan, fam, [swept[name] for f, name, _ in docs if f is fam], paths)
         ill = summ.pop("ill_conditioned")
+        well = summ.pop("well_conditioned")
+        allc["well_conditioned"] = [
+            well.get(f"{c}/{int(s)}", False) for c, s in zip(allc["case_id"], allc["start"])
+        ]
         families[fam.name] = summ
         if plan.convergence_starts > 0:
             refined = _refined_rows(fam.name, plan.convergence_refinements, refinements, refined_done)

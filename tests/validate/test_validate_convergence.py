@@ -98,6 +98,8 @@ def test_a_family_is_converged_only_where_every_refinement_keeps_its_numbers_ins
     summary = {
         "outcome_agreement": 0.9,
         "outcome_agreement_ci": [0.6, 1.0],
+        "agreement_well_conditioned": 0.9,
+        "agreement_ci": [0.6, 1.0],
         "median_frechet": 0.010,
         "median_frechet_ci": [0.009, 0.012],
     }
@@ -123,11 +125,43 @@ def test_a_family_is_converged_only_where_every_refinement_keeps_its_numbers_ins
     assert math.isnan(out["dt_order"]["outcome_agreement"]["order"])  # no run flipped
 
 
+def test_the_judged_agreement_changes_on_the_well_conditioned_starts_only():
+    # 10 paired starts, 2 ill-conditioned (coin tosses: both flip under the refinement), 1
+    # well-conditioned one flips; the headline is over the well-conditioned ones, 7 / 8
+    ys = np.linspace(-1, -4, 10)
+    well = np.array([True] * 8 + [False] * 2)
+    agree = np.array([True] * 7 + [False] * 3)
+    base = _rows("peak", ys, agree, np.full(10, 0.01)).assign(well_conditioned=well)
+    refined = _rows("peak", ys, [True] * 10, np.full(10, 0.01))
+    pc = paired_change(base, refined)
+    assert pc["runs"] == 10 and pc["well_conditioned_runs"] == 8
+    assert pc["agreement_well_conditioned"] == {"base": 7 / 8, "refined": 1.0, "change": pytest.approx(1 / 8)}
+    assert pc["outcome_agreement"]["change"] == pytest.approx(0.3)
+    summary = {
+        "agreement_well_conditioned": 0.875,
+        "agreement_ci": [0.7, 1.0],
+        "outcome_agreement": 0.7,
+        "outcome_agreement_ci": [0.6, 0.8],
+        "median_frechet": 0.01,
+        "median_frechet_ci": [0.009, 0.012],
+    }
+    out = family_convergence(summary, base, {"dt_halved": refined})["dt_halved"]
+    assert out["agreement_change"] == pytest.approx(1 / 8)  # the judged headline's change
+    assert out["agreement_change_all_starts"] == pytest.approx(0.3)
+    assert out["agreement_well_conditioned_converged"] is True  # 1.0 inside [0.7, 1.0]
+    assert out["outcome_agreement_converged"] is False  # the coin tosses move it out
+    assert out["converged"] is True  # judged on what the targets judge
+    # without the column every start counts
+    assert paired_change(base.drop(columns="well_conditioned"), refined)["well_conditioned_runs"] == 10
+
+
 def test_a_gridded_family_says_its_hfield_was_not_refined():
     base = _rows("fractal", [0.2, 0.8], [True, True], [0.01, 0.01])
     summary = {
         "outcome_agreement": 1.0,
         "outcome_agreement_ci": [0.3, 1.0],
+        "agreement_well_conditioned": 1.0,
+        "agreement_ci": [0.3, 1.0],
         "median_frechet": 0.01,
         "median_frechet_ci": [0.01, 0.01],
     }

@@ -174,7 +174,7 @@ def falls_note(limit: QuasistaticLimitResult, boundary: BoundaryResult) -> list[
 
 def _marked(v: dict, conv: dict | None) -> dict:
     """The corner's headlines of a family as table cells, each marked where unconverged."""
-    return {h: f"{cell(v[h])}{unconverged_mark(conv, h)}" for h in HEADLINES}
+    return {h: f"{cell(v[h])}{unconverged_mark(conv, h)}" for h in HEADLINES if h in v}
 
 
 def convergence_lines(limit: QuasistaticLimitResult) -> list[str]:
@@ -208,7 +208,9 @@ def convergence_lines(limit: QuasistaticLimitResult) -> list[str]:
         "twice the samples "
         "a side (the tip kept; a gridded surface, the fractal and the sandpapers, keeps its "
         "samples and has no finer hfield). The change is paired: the refined runs' number "
-        "minus the corner's own runs' from the same starts. A headline is converged when it "
+        "minus the corner's own runs' from the same starts, like for like: the agreement "
+        "change is the well-conditioned agreement's (what the target judges), on the paired "
+        "starts well-conditioned on both sides. A headline is converged when it "
         "plus the change stays inside its own 95 % interval; where it does not, it is marked "
         "unconverged wherever it is quoted. Where the plan asks, the solver's tolerances are "
         "tightened a hundredfold (tolerance / 100: MuJoCo's 1e-8 and noslip 1e-6 to 1e-10 and "

@@ -51,7 +51,8 @@ def verdicts_section(families: dict, convergence: dict | None = None) -> list[st
         members.add(f.get("members", 1))
         row = [
             name,
-            f"{_num(f.get('agreement_well_conditioned'))} {_ci(f.get('agreement_ci'))}",
+            f"{_num(f.get('agreement_well_conditioned'))} {_ci(f.get('agreement_ci'))}"
+            + unconverged_mark(convergence.get(name), "agreement_well_conditioned"),
             f"{f.get('well_conditioned_runs', '-')} / {f.get('starts', f['runs'])} "
             f"({f.get('stopped_starts', 0)})",
             f"{_num(ill.get('mujoco'))} / {_num(ill.get('reference'))}",
