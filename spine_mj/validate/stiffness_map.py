@@ -350,6 +350,8 @@ def _run_rows(df: pd.DataFrame, store, family: str, preset: str, samples: dict) 
                 "ie": ie,
                 "K": k,
                 "start": s,
+                "start_x": float(r["start_x"]),
+                "start_y": float(r["start_y"]),
                 "agree": c["agree"],
                 "agree_lock": c["agree_lock"],
                 "frechet": float(c["frechet"]),
@@ -444,7 +446,10 @@ def agreement_map(runs: pd.DataFrame, *, n_boot: int, rng=12345) -> dict:
         ``median_frechet``, ``passes`` (the :data:`CRITERION` at that I_e), ``n_ok`` (runs
         without engine trouble), ``n`` (runs) per I_e, and ``ie_star``: the criterion's
         :class:`~spine_mj.validate.ie_star.IeStar` dict with ``criterion`` (NaN, kind
-        ``"not measured"``, with fewer than two I_e values).
+        ``"not measured"``, with fewer than two I_e values). It is read on the I_e values
+        every start ran; where it fails already at the lowest of those and deeper I_e values
+        ran on a subset of the starts (``start_x``, ``start_y`` tell which), it is read again
+        over every I_e on that subset, with ``starts``: how many.
     """
     out: dict = {}
     for (fam, k), grp in _cells(runs, "family", "K"):
@@ -463,14 +468,9 @@ def agreement_map(runs: pd.DataFrame, *, n_boot: int, rng=12345) -> dict:
         # a resample needs one start set across I_e: the grid's, not a deeper I_e's subset
         full = [i for i, a in enumerate(amat) if len(a) == max(len(b) for b in amat)]
         if len(full) >= 2:
-            by = ie_star_by_criterion(
-                np.array([ies[i] for i in full]),
-                np.array([amat[i] for i in full]),
-                np.array([fmat[i] for i in full]),
-                n_boot=n_boot,
-                rng=rng,
-            )
-            star = by[CRITERION]
+            star = _criterion_star(ies, amat, fmat, full, n_boot=n_boot, rng=rng)
+            if star["kind"] == "below" and len(full) < len(ies):
+                star = _deep_star(grp, ies, star, n_boot=n_boot, rng=rng)
         else:
             star = {"value": float("nan"), "kind": "not measured", "criterion": "fewer than two I_e values"}
         passes = [passes_criterion(a_, f_) for a_, f_ in zip(ag, med)]
@@ -484,6 +484,46 @@ def agreement_map(runs: pd.DataFrame, *, n_boot: int, rng=12345) -> dict:
             "ie_star": star,
         }
     return out
+
+
+def _criterion_star(ies, amat, fmat, rows, *, n_boot: int, rng) -> dict:
+    """I_e* of :data:`CRITERION` over the I_e values ``rows`` of one cell's matrices."""
+    return ie_star_by_criterion(
+        np.array([ies[i] for i in rows]),
+        np.array([amat[i] for i in rows]),
+        np.array([fmat[i] for i in rows]),
+        n_boot=n_boot,
+        rng=rng,
+    )[CRITERION]
+
+
+def _deep_star(grp: pd.DataFrame, ies: list[float], star: dict, *, n_boot: int, rng) -> dict:
+    """I_e* of one K whose grid fails already at its lowest I_e (``star``, kind ``below``),
+    read again with the deeper I_e values that ran on a subset of its starts: over every I_e,
+    on the starts that ran at all of them (matched by surface and point: a deeper sweep
+    numbers its starts anew), so that a deep cell that passes brackets I_e* from below.
+    ``star`` as it is where the rows carry no start points or fewer than two starts are
+    common."""
+    if not {"start_x", "start_y"} <= set(grp):
+        return star
+    key = (
+        grp["surface"].astype(str)
+        + "@"
+        + grp["start_x"].round(9).astype(str)
+        + ","
+        + grp["start_y"].round(9).astype(str)
+    )
+    common = set.intersection(*(set(key[grp["ie"] == ie]) for ie in ies))
+    if len(common) < 2:
+        return star
+    sub = grp[key.isin(common)].assign(_key=key)
+    amat, fmat = [], []
+    for ie in ies:
+        cell = sub[sub["ie"] == ie].drop_duplicates("_key").sort_values("_key")
+        amat.append(cell["agree"].fillna(False).astype(bool).to_numpy(dtype=float))
+        fmat.append(cell["frechet"].to_numpy(dtype=float))
+    deep = _criterion_star(ies, amat, fmat, range(len(ies)), n_boot=n_boot, rng=rng)
+    return {**deep, "starts": len(common)}
 
 
 def grid_lowest_ie(runs: pd.DataFrame) -> float:

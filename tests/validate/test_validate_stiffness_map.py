@@ -63,6 +63,27 @@ def test_agreement_map_fails_a_cell_on_median_frechet_alone():
     assert m["ie_star"]["kind"] == "below"
 
 
+def test_a_deep_cell_that_passes_brackets_an_ie_star_the_grid_reads_below():
+    # the grid fails at every I_e; a deeper sweep of 2 of the 4 starts (numbered anew) at
+    # I_e 1e-6 agrees: I_e* lies between 1e-6 and the grid's lowest, 1e-3
+    runs = _runs({1000.0: 0})
+    runs["start_x"], runs["start_y"] = 0.05, 0.2 + 0.1 * runs["start"]
+    deep = runs[(runs["ie"] == IE[0]) & runs["start"].isin([1, 3])].copy()
+    deep["start"], deep["ie"], deep["agree"], deep["engine_trouble"] = [0, 1], 1e-6, True, False
+    both = pd.concat([runs, deep], ignore_index=True)
+    star = agreement_map(runs, n_boot=10)["fractal"]["1000"]["ie_star"]
+    assert star["kind"] == "below" and star["high"] == IE[0]
+    m = agreement_map(both, n_boot=10)["fractal"]["1000"]
+    assert m["ie"][0] == 1e-6 and m["passes"][0] and m["n"][0] == 2
+    star = m["ie_star"]
+    assert star["kind"] == "bracketed" and (star["low"], star["high"]) == (1e-6, IE[0])
+    assert 1e-6 < star["value"] < IE[0] and star["starts"] == 2
+    # a deep cell that fails too leaves it below the deepest I_e
+    both.loc[both["ie"] == 1e-6, "agree"] = False
+    star = agreement_map(both, n_boot=10)["fractal"]["1000"]["ie_star"]
+    assert star["kind"] == "below" and star["high"] == 1e-6
+
+
 def test_agreement_map_counts_missing_agreement_as_disagreeing():
     runs = _runs({1.0: None})
     runs["agree"] = runs["agree"].astype(object)
