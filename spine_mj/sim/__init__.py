@@ -75,6 +75,7 @@ from spine_mj.sim.build import (
     build_drive,
     build_rig,
     drive_speed_m_s,
+    rig_scales,
 )
 from spine_mj.sim.detection import Detection, Event
 from spine_mj.sim.drives import Drive, RampDrive, SpringDrive, StaticProbe
@@ -166,5 +167,6 @@ __all__ = [
     "holding_excess",
     "inclined_plane",
     "penetration_tolerance_m",
+    "rig_scales",
     "spring_omega_dt",
 ]

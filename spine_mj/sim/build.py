@@ -43,6 +43,7 @@ __all__ = [
     "build_drive",
     "build_rig",
     "drive_speed_m_s",
+    "rig_scales",
 ]
 
 #: The inertia number of a drive given no speed, rate or I_e.
@@ -100,6 +101,7 @@ def build_rig(
     gravity_m_s2: float | None = None,
     length_scale_m: float | None = None,
     hfield_resolution: int | None = None,
+    hfield_refinement: int = 1,
     ie: float | None = None,
     speed_m_s: float | None = None,
     rate_n_s: float | None = None,
@@ -125,6 +127,10 @@ def build_rig(
     hfield_resolution : int or None
         Samples a side of the hfield of an analytic surface; ignored for a gridded one,
         which keeps its own samples (module docstring).
+    hfield_refinement : int
+        That hfield at this many times the samples a side, every sample kept, the tip's
+        default radius the one of the unrefined hfield (solution verification:
+        :meth:`Scales.with_hfield`).
     ie, speed_m_s, rate_n_s
         The drive's pace, as for :func:`build_drive`: its speed (:func:`drive_speed_m_s`)
         bounds the engine step for impacts.
@@ -165,21 +171,44 @@ def build_rig(
         mu_s=mu,
         **_given(mass_kg=mass_kg, preload_n=preload_n, gravity_m_s2=gravity_m_s2),
     )
-    tip, scales, hfield = _sized(surface, tip, length_scale_m, hfield_resolution)
+    tip, scales, hfield = _sized(surface, tip, length_scale_m, hfield_resolution, hfield_refinement)
     speed = drive_speed_m_s(scales, ie=ie, speed_m_s=speed_m_s, rate_n_s=rate_n_s) if driven else None
     spring = spring_stiffness_n_m(scales, stiffness_number=stiffness_number, stiffness_n_m=stiffness_n_m)
     engine = overrides.engine(scales, speed_m_s=speed, stiffness_n_m=spring)
     return Rig(surface, tip=tip, engine=engine, sized=(scales, hfield))
 
 
-def _sized(surface: Surface, tip: TipParams, length_scale_m, hfield_resolution) -> tuple:
+def rig_scales(
+    surface: Surface,
+    *,
+    tip: TipParams,
+    length_scale_m: float | None = None,
+    hfield_resolution: int | None = None,
+    hfield_refinement: int = 1,
+) -> Scales:
+    """The scales :func:`build_rig` sizes its rig by (the same arguments), without building
+    it: for checks of a configuration before any run."""
+    return _sized(surface, tip, length_scale_m, hfield_resolution, hfield_refinement)[1]
+
+
+def _sized(surface: Surface, tip: TipParams, length_scale_m, hfield_resolution, hfield_refinement=1) -> tuple:
     """``(tip, scales, hfield)`` of ``tip`` on ``surface``: the tip with the radius the rig
-    was sized for (a gridded surface keeps its own samples: ``hfield_resolution`` ignored)."""
+    was sized for (a gridded surface keeps its own samples: ``hfield_resolution`` ignored),
+    on the hfield refined ``hfield_refinement`` times with that radius kept."""
     resolution = None if isinstance(surface, GridSurface) else hfield_resolution
     scales, hfield = Scales.with_hfield(
         surface, tip=tip, length_scale_m=length_scale_m, hfield_resolution=resolution
     )
-    return dataclasses.replace(tip, tip_radius_m=scales.tip_radius_m), scales, hfield
+    tip = dataclasses.replace(tip, tip_radius_m=scales.tip_radius_m)
+    if hfield_refinement != 1:
+        scales, hfield = Scales.with_hfield(
+            surface,
+            tip=tip,
+            length_scale_m=length_scale_m,
+            hfield_resolution=scales.hfield_resolution,
+            hfield_refinement=hfield_refinement,
+        )
+    return tip, scales, hfield
 
 
 def build_drive(

@@ -147,7 +147,11 @@ def build_engine_rig(surface: Surface, *, engine: str = DEFAULT_ENGINE, **option
         **{k: options[k] for k in ("mass_kg", "preload_n", "gravity_m_s2") if options.get(k) is not None},
     )
     tip, scales, hfield = _sized(
-        surface, tip, options.get("length_scale_m"), options.get("hfield_resolution")
+        surface,
+        tip,
+        options.get("length_scale_m"),
+        options.get("hfield_resolution"),
+        options.get("hfield_refinement", 1),
     )
     speed = None
     if options.get("driven", True):

@@ -207,7 +207,7 @@ class RigModel:
         """Replace the surface (same grid size) and recompile in place (``spec.recompile``)."""
         import mujoco
 
-        hf = hfield_of(surface, self.scales.hfield_resolution)
+        hf = hfield_of(surface, self.scales.hfield_resolution, self.scales.hfield_refinement)
         if (hf.nrow, hf.ncol) != (self.hfield.nrow, self.hfield.ncol):
             raise SpineInputError(
                 f"set_surface needs a {self.hfield.nrow} x {self.hfield.ncol} hfield, "

@@ -92,6 +92,9 @@ class Scales:
     hfield_resolution : int or None
         Samples a side the hfield is resampled to (None: a grid keeps its own samples,
         an analytic surface gets :func:`spine_mj.surfaces.to_hfield`'s default).
+    hfield_refinement : int
+        That hfield at this many times the samples a side, every sample kept
+        (:func:`hfield_of`): solution verification's refined hfield, the tip kept.
     slope_length_m : float or None
         l_s, the slope correlation length [m] (:func:`slope_correlation_length`; L_c where
         the surface has none, a plane); the length of the drive stiffness number K.
@@ -111,6 +114,7 @@ class Scales:
     tip_radius_m: float
     hfield_spacing_m: float
     hfield_resolution: int | None = None
+    hfield_refinement: int = 1
     slope_length_m: float | None = None
     extent_m: float | None = None
     fall_height_m: float = 0.0
@@ -155,6 +159,7 @@ class Scales:
         length_scale_m: float | None = None,
         char_length_m: float | None = None,
         hfield_resolution: int | None = None,
+        hfield_refinement: int = 1,
     ) -> tuple[Scales, HField]:
         """The scales of ``tip`` on ``surface`` and the hfield they were measured on (the
         rig's model is built from that same hfield): the one place the rig's sizing rules
@@ -171,6 +176,8 @@ class Scales:
         * hfield resolution: an hfield finer than a quarter tip radius is coarsened to that
           (MuJoCo keeps at most 50 contacts per geom pair: a tip over too many cells loses
           its deepest contacts).
+        * ``hfield_refinement``: that hfield at this many times the samples a side, every
+          sample kept (:func:`hfield_of`), the tip's radius the one sized on it.
         * fall height: :func:`fall_height` of that hfield with the tip's ``mu_s`` and radius.
 
         Raises
@@ -205,6 +212,17 @@ class Scales:
             resolution = math.ceil(extent / (_MIN_SPACING_PER_TIP_RADIUS * radius)) + 1
             hf = hfield_of(surface, resolution)
             spacing = hfield_spacing(hf, length_scale_m)
+        refinement = hfield_refinement
+        if isinstance(refinement, bool) or int(refinement) != refinement or refinement < 1:
+            raise SpineInputError(f"hfield_refinement must be an integer >= 1, got {refinement!r}")
+        if refinement > 1:
+            side = (max(hf.nrow, hf.ncol) - 1) * int(refinement) + 1
+            if side > MAX_HFIELD_SIDE:
+                raise SpineInputError(
+                    f"hfield_refinement {refinement} gives {side} samples a side, more than {MAX_HFIELD_SIDE}"
+                )
+            hf = hfield_of(surface, resolution, int(refinement))
+            spacing = hfield_spacing(hf, length_scale_m)
         rx, ry, elevation = hf.size[0], hf.size[1], hf.size[2]
         fall = fall_height(
             hf.data.astype(float) * (elevation * length_scale_m),  # float64: the same at every scale
@@ -220,6 +238,7 @@ class Scales:
             tip_radius_m=radius,
             hfield_spacing_m=spacing,
             hfield_resolution=resolution,
+            hfield_refinement=int(refinement),
             slope_length_m=_slope_length(surface, length_scale_m, char_length_m),
             extent_m=math.hypot(xmax - xmin, ymax - ymin),
             fall_height_m=fall,
@@ -384,8 +403,9 @@ def _slope_length(surface: Surface, length_scale_m: float, char_length_m: float)
         return char_length_m
 
 
-def hfield_of(surface: Surface, resolution: int | None = None) -> HField:
-    """The surface as MuJoCo hfield data, resampled to ``resolution`` a side when given.
+def hfield_of(surface: Surface, resolution: int | None = None, refinement: int = 1) -> HField:
+    """The surface as MuJoCo hfield data, resampled to ``resolution`` a side when given,
+    then refined ``refinement`` times.
 
     Parameters
     ----------
@@ -393,12 +413,21 @@ def hfield_of(surface: Surface, resolution: int | None = None) -> HField:
         Any surface.
     resolution : int, optional
         Samples a side (None: a grid surface's own, 201 for an analytic one).
+    refinement : int
+        That hfield's ``n`` samples a side become ``(n - 1) refinement + 1``, every one
+        kept: an analytic surface (or a resampled grid) sampled that densely over the same
+        bounds, a grid at its own samples refined through its interpolant
+        (:func:`spine_mj.surfaces.refine_grid`).
 
     Returns
     -------
     HField
     """
-    return to_hfield(surface, nrow=resolution, ncol=resolution) if resolution else to_hfield(surface)
+    hf = to_hfield(surface, nrow=resolution, ncol=resolution) if resolution else to_hfield(surface)
+    if refinement == 1:
+        return hf
+    f = int(refinement)
+    return to_hfield(surface, nrow=(hf.nrow - 1) * f + 1, ncol=(hf.ncol - 1) * f + 1)
 
 
 def hfield_spacing(hfield: HField, length_scale_m: float = 1.0) -> float:

@@ -44,7 +44,7 @@ from spine_mj.surfaces.generators import (
     random_gaussians,
     single_gaussian,
 )
-from spine_mj.surfaces.hfield import HField, from_hfield, to_hfield
+from spine_mj.surfaces.hfield import HField, from_hfield, refine_grid, to_hfield
 from spine_mj.surfaces.sandpaper import sandpaper
 from spine_mj.surfaces.types import BSplineGrid, GaussianSurface, GridSurface, Surface
 
@@ -70,6 +70,7 @@ __all__ = [
     "inclined_plane",
     "length_unit",
     "random_gaussians",
+    "refine_grid",
     "sandpaper",
     "single_gaussian",
     "to_hfield",

@@ -45,9 +45,11 @@ def to_hfield(
     """The one conversion from a surface to MuJoCo hfield data (see :class:`HField`).
 
     A :class:`GridSurface` is used at its own samples unless ``nrow``/``ncol`` ask for a
-    resampling; an analytic surface is sampled on ``nrow x ncol`` points over its bounds
-    (default 201 x 201). ``base_z`` (the solid's thickness below the lowest point)
-    defaults to a tenth of the larger horizontal radius.
+    resampling: where they refine its own samples (``(n - 1) f + 1`` a side, the same whole
+    ``f`` on both) its interpolant is evaluated between them (:func:`refine_grid`: every
+    sample kept), else it is resampled over its bounds; an analytic surface is sampled on
+    ``nrow x ncol`` points over its bounds (default 201 x 201). ``base_z`` (the solid's
+    thickness below the lowest point) defaults to a tenth of the larger horizontal radius.
 
     Parameters
     ----------
@@ -63,8 +65,11 @@ def to_hfield(
     HField
         ``data`` (nrow x ncol in [0, 1], row 0 at the smallest y), ``size`` and ``pos``.
     """
+    factor = _nesting_factor(surface, nrow, ncol)
     if isinstance(surface, GridSurface) and nrow is None and ncol is None:
         grid = surface
+    elif factor:
+        grid = refine_grid(surface, factor)
     else:
         ncol = 201 if ncol is None else ncol
         nrow = ncol if nrow is None else nrow
@@ -80,6 +85,49 @@ def to_hfield(
     base = 0.1 * max(rx, ry) if base_z is None else check_positive("base_z", base_z)
     pos = (0.5 * float(grid.x[0] + grid.x[-1]), 0.5 * float(grid.y[0] + grid.y[-1]), zmin)
     return HField(data=data, size=(rx, ry, elevation, base), pos=pos)
+
+
+def refine_grid(surface: GridSurface, factor: int) -> GridSurface:
+    """``surface`` at ``factor`` times the samples a side, every old sample kept: its C2
+    spline (which passes through every sample) evaluated on ``(n - 1) factor + 1`` points
+    spanning its first to its last sample. How a gridded surface's hfield is refined: only
+    the facets change, not the surface.
+
+    Parameters
+    ----------
+    surface : GridSurface
+        The grid.
+    factor : int
+        >= 1.
+
+    Returns
+    -------
+    GridSurface
+        Not periodic (a periodic grid's last sample is one spacing short of its period).
+    """
+    if not isinstance(surface, GridSurface):
+        raise TypeError(f"surface must be a GridSurface, got {type(surface).__name__}")
+    if isinstance(factor, bool) or int(factor) != factor or factor < 1:
+        raise ValueError(f"factor must be an integer >= 1, got {factor!r}")
+    f = int(factor)
+    x = np.linspace(surface.x[0], surface.x[-1], (surface.x.size - 1) * f + 1)
+    y = np.linspace(surface.y[0], surface.y[-1], (surface.y.size - 1) * f + 1)
+    heights = surface.height(x[None, :], y[:, None])
+    # the old samples exactly as they were (the spline reproduces them to rounding)
+    heights[::f, ::f] = surface.heights
+    meta = dict(surface.metadata, refined_from=surface.metadata.get("generator", "grid"), refinement=f)
+    return GridSurface(heights=heights, x=x, y=y, periodic=False, unit=surface.unit, metadata=meta)
+
+
+def _nesting_factor(surface: Surface, nrow: int | None, ncol: int | None) -> int:
+    """The whole factor ``f`` > 1 by which ``nrow x ncol`` refines a grid's own samples
+    (``(n - 1) f + 1`` a side); 0 where it does not (or ``surface`` is no grid)."""
+    if not isinstance(surface, GridSurface) or nrow is None or ncol is None:
+        return 0
+    ny, nx = surface.heights.shape
+    fx, rx = divmod(int(ncol) - 1, nx - 1)
+    fy, ry = divmod(int(nrow) - 1, ny - 1)
+    return fx if rx == ry == 0 and fx == fy and fx > 1 else 0
 
 
 def from_hfield(hfield: HField, *, unit: str = "1") -> GridSurface:

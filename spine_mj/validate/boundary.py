@@ -22,7 +22,7 @@ import pandas as pd
 
 from spine_mj import presets, sim
 from spine_mj.presets import calibrated_mu
-from spine_mj.validate.convergence import REFINEMENTS, headline_convergence, refinable
+from spine_mj.validate.convergence import REFINEMENTS, headline_convergence
 from spine_mj.validate.ie_star import (
     IE_STAR_CRITERIA,
     bootstrap_ie_star,
@@ -257,14 +257,10 @@ def _refined_jobs(plan: ValidationPlan, fams, jobs, curves, stars) -> list[tuple
     """``(protocol, refinement key, (config, store name, rows))`` of every refinement of
     ``plan.boundary_refinements``: each sweep of ``jobs`` once per I_e of its protocol's
     :func:`refinement_window`, with the refinement's engine keys at that I_e (the step is
-    the rig's own at that pace, :func:`~spine_mj.validate.sweep_configs.engine_grid`); a
-    refinement a family's surface does not take (a gridded surface's hfield) is skipped for
-    the study."""
+    the rig's own at that pace, :func:`~spine_mj.validate.sweep_configs.engine_grid`)."""
     seeds = {p: f.seeds for f in fams for p in f.presets}
     out = []
     for key in plan.boundary_refinements:
-        if not all(refinable(p, s, key) for p, s in seeds.items()):
-            continue
         for proto, (doc, name, rows) in jobs:
             star = stars[proto]
             window = refinement_window(star.get("ie_used", curves[proto].ie), star)
@@ -316,9 +312,7 @@ def _ie_star_convergence(
         window = [float(v) for v in rc.ie]
         star = criterion_ie_star(ies, a, f, HEADLINE_CRITERION)
         by_key[key] = {"base": base, "refined": grid_point(star), "runs": int(len(comp))}
-    conv = headline_convergence(
-        base, ci95, by_key, log=True, note="gridded surfaces keep their samples: no hfield to refine"
-    )
+    conv = headline_convergence(base, ci95, by_key, log=True, note="not in the plan's boundary_refinements")
     return {**conv, "ie_refined": window, "ci95": list(ci95)}
 
 

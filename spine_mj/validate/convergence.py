@@ -13,9 +13,10 @@ lowest I_e, :mod:`spine_mj.validate.quasistatic_limit`) are recomputed under ref
   defaults (the main solver converges in 4 to 13 iterations at 1e-8, yet 1e-10 moved paths
   on the fractal by up to 0.04 L_c and one of four self-lock points: measured, K = 30,
   I_e = 1e-4);
-- ``hfield_doubled``: an analytic surface's hfield at twice the samples a side, every old
-  sample kept and the tip's radius kept; a gridded surface (a generated fractal, a scan)
-  keeps its samples, so there is nothing to refine and the entry says so.
+- ``hfield_doubled``: the rig's hfield at twice the samples a side, every old sample kept
+  and the tip's radius kept: an analytic surface sampled twice as densely, a gridded one (a
+  generated fractal, a scan) refined through the interpolant it is defined by
+  (:func:`spine_mj.surfaces.refine_grid`: only the facets change, not the surface).
 
 A refinement reruns a subset of the corner's starts (``plan.convergence_starts`` y starts
 per surface, the same points, one run each), and the change of a headline is the paired
@@ -46,9 +47,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from spine_mj import presets
 from spine_mj.errors import SpineInputError
-from spine_mj.surfaces import GridSurface
 from spine_mj.validate.plans import FamilySpec
 from spine_mj.validate.theory_orders import FRECHET_FLOOR_LC
 
@@ -62,7 +61,6 @@ __all__ = [
     "is_converged",
     "observed_order",
     "paired_change",
-    "refinable",
     "refinement_note",
     "richardson",
     "thin_starts",
@@ -154,15 +152,6 @@ def is_converged(
     return bool(low <= value + change <= high or abs(change) <= resolution)
 
 
-def refinable(preset: str, seeds, key: str) -> bool:
-    """Whether refinement ``key`` changes anything on ``preset``: a gridded surface keeps its
-    samples, so its hfield cannot be refined."""
-    if key != "hfield_doubled":
-        return True
-    surface = presets.make_surface(preset, **({} if seeds is None else {"seed": seeds[0]}))
-    return not isinstance(surface, GridSurface)
-
-
 def thin_starts(fam: FamilySpec, n: int) -> FamilySpec:
     """``fam`` with at most ``n`` of its y starts (spread over its list, both ends kept; the
     same values, so the same points), on all its seeds and generator variants."""
@@ -239,8 +228,7 @@ def family_convergence(summary: dict, base: pd.DataFrame, refined: dict[str, pd.
         The corner's own comparison rows of the family, with ``well_conditioned``
         (:func:`paired_change`).
     refined : dict
-        Refinement key -> the refined comparison rows (None: not refinable, a gridded
-        surface's hfield).
+        Refinement key -> the refined comparison rows (None: not run).
 
     Returns
     -------
@@ -261,7 +249,7 @@ def family_convergence(summary: dict, base: pd.DataFrame, refined: dict[str, pd.
         if rows is None:
             entry.update(
                 runs=0,
-                note="gridded surfaces keep their samples: no hfield to refine",
+                note="not run",
                 converged=None,
                 **{name: math.nan for name in CHANGE_KEYS.values()},
             )

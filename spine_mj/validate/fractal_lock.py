@@ -22,8 +22,7 @@ its own rig's step refined (the sweep's ``timestep_factor``: the surfaces' steps
 up to a quarter); a rate's change is paired (the refined runs' rate minus the same
 surfaces' own, over the surfaces both ran cleanly) and *converged* when the rate plus it
 stays inside the rate's Wilson interval
-(:func:`~spine_mj.validate.convergence.headline_convergence`). A fractal keeps its samples:
-there is no hfield to refine.
+(:func:`~spine_mj.validate.convergence.headline_convergence`).
 """
 
 from __future__ import annotations
@@ -36,7 +35,7 @@ import pandas as pd
 
 from spine_mj.presets import calibrated_mu, load_preset
 from spine_mj.reproduce import fig9_rms_height, fig9_seeds
-from spine_mj.validate.convergence import REFINEMENTS, headline_convergence, refinable
+from spine_mj.validate.convergence import REFINEMENTS, headline_convergence
 from spine_mj.validate.intervals import CONFIDENCE, wilson
 from spine_mj.validate.paths import tip_radius
 from spine_mj.validate.plans import ValidationPlan
@@ -234,7 +233,7 @@ def fractal_lock(plan: ValidationPlan, runner: StudyRunner) -> FractalLockResult
         records += _records(df, label, seed_hurst)
     runs = pd.DataFrame.from_records(records)
     rows = hurst_rows(runs)
-    keys = [k for k in plan.fractal_refinements if refinable(PRESET, (1,), k)]
+    keys = list(plan.fractal_refinements)
     if keys and plan.fractal_refined_surfaces > 0:
         thin = [{**s, "seeds": s["seeds"][: plan.fractal_refined_surfaces]} for s in surfaces]
         jobs = [
@@ -303,7 +302,7 @@ def _add_convergence(rows: list[dict], runs: pd.DataFrame, refined: dict, keys) 
                 row[f"rate_{series}"],
                 (row[f"ci_low_{series}"], row[f"ci_high_{series}"]),
                 by_key,
-                note="a fractal keeps its samples: no hfield to refine",
+                note="not in the plan's fractal_refinements",
             )
 
 

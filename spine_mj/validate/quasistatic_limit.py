@@ -16,7 +16,7 @@ import pandas as pd
 
 from spine_mj.compare import MISS_REASONS
 from spine_mj.presets import calibrated_mu
-from spine_mj.validate.convergence import REFINEMENTS, family_convergence, refinable, thin_starts
+from spine_mj.validate.convergence import REFINEMENTS, family_convergence, thin_starts
 from spine_mj.validate.ensembles import ensemble_family, ensemble_groups, ensemble_verdicts
 from spine_mj.validate.intervals import bootstrap, meets_target, wilson
 from spine_mj.validate.paths import stored_paths, tip_radius
@@ -285,7 +285,8 @@ def _limit_summary(allc: pd.DataFrame, groups: list[dict]) -> dict:
 def _refinement_docs(plan: ValidationPlan, corner: list[FamilySpec]) -> list[tuple[str, str, str, dict]]:
     """``(family, refinement key, store name, config)`` of every refinement of every corner
     family's thinned starts (:func:`~spine_mj.validate.convergence.thin_starts`), one per
-    preset the refinement changes (:func:`~spine_mj.validate.convergence.refinable`)."""
+    preset (a gridded surface's hfield is refined through its interpolant,
+    :func:`spine_mj.surfaces.refine_grid`)."""
     if plan.convergence_starts <= 0:
         return []
     out = []
@@ -293,9 +294,8 @@ def _refinement_docs(plan: ValidationPlan, corner: list[FamilySpec]) -> list[tup
         thin = thin_starts(fam, plan.convergence_starts)
         for key in plan.convergence_refinements:
             for preset in fam.presets:
-                if refinable(preset, fam.seeds, key):
-                    doc = limit_doc(plan, thin, preset, f"limit-refined-{key}-{preset}", REFINEMENTS[key])
-                    out.append((fam.name, key, f"limit-refined/{key}/{preset}", doc))
+                doc = limit_doc(plan, thin, preset, f"limit-refined-{key}-{preset}", REFINEMENTS[key])
+                out.append((fam.name, key, f"limit-refined/{key}/{preset}", doc))
     return out
 
 

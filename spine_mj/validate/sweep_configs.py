@@ -132,12 +132,14 @@ def engine_grid(
     (:func:`rig_engine`): ``timestep_factor``, which the sweep applies to each case's own
     step with the contact's time constant kept (only the step changes,
     :class:`~spine_mj.sim.EngineOverrides`), ``solref_timeconst_factor``
-    (:func:`relative_engine_keys`), and ``hfield_factor``, which multiplies the samples
-    between the plan's (:func:`refined_resolution`) with the tip kept."""
+    (:func:`relative_engine_keys`), and ``hfield_factor``, the rig's hfield at that many
+    times its samples a side, every one kept, with the tip kept (the sweep's
+    ``hfield_refinement``: an analytic surface's plan resolution refined,
+    :func:`refined_resolution`, a grid's own samples through its interpolant)."""
     out = {"hfield_resolution": plan.hfield_resolution}
     ov = dict(overrides)
     if "hfield_factor" in ov:
-        out["hfield_resolution"] = refined_resolution(plan.hfield_resolution, ov.pop("hfield_factor"))
+        out["hfield_refinement"] = int(ov.pop("hfield_factor"))
     out.update(
         relative_engine_keys(
             ov,

@@ -111,3 +111,33 @@ def test_force_rate_is_the_inverse_of_the_equivalent_speed():
     assert sc.equivalent_speed(sc.force_rate_for(v)) == pytest.approx(v, rel=1e-12)
     ramp = sim.build_drive(sc, "ramp", ie=1e-3)
     assert sc.inertia_number(sc.equivalent_speed(ramp.rate_n_s)) == pytest.approx(1e-3, rel=1e-12)
+
+
+def test_a_refined_hfield_keeps_every_sample_and_the_tip_on_a_grid_and_an_analytic_surface(tmp_path):
+    """Solution verification's hfield x 2: a grid through its own spline, an analytic surface
+    sampled twice as densely; the old samples and the default tip's radius kept, in the
+    sweep's rig (``hfield_refinement``) as in build_rig."""
+    grid = fractal_fbm(nx=48, size=10.0, hurst=0.8, rms_height=0.3, rng=3)
+    save_surface(grid, tmp_path / "f.npz")
+    for surface, entry, res in (
+        (grid, {"file": "f.npz"}, None),
+        (single_gaussian(), {"preset": "paper-single-peak"}, 41),
+    ):
+        base = sim.build_rig(surface, mu=0.8, hfield_resolution=res)
+        fine = sim.build_rig(surface, mu=0.8, hfield_resolution=res, hfield_refinement=2)
+        n0, n1 = base.hfield.ncol, fine.hfield.ncol
+        assert n1 == 2 * n0 - 1 and fine.hfield.nrow == 2 * base.hfield.nrow - 1
+        assert fine.scales.tip_radius_m == base.scales.tip_radius_m
+        assert fine.scales.hfield_spacing_m == pytest.approx(base.scales.hfield_spacing_m / 2)
+        assert fine.scales.hfield_refinement == 2 and base.scales.hfield_refinement == 1
+        old = base.hfield.data * base.hfield.size[2] + base.hfield.pos[2]
+        new = fine.hfield.data[::2, ::2] * fine.hfield.size[2] + fine.hfield.pos[2]
+        assert new == pytest.approx(old, abs=1e-6 * base.hfield.size[2])
+        rig, _ = _sweep_case(
+            tmp_path,
+            entry,
+            (0.0, 0.0),
+            {"duration": 0.002},
+            {"mu": 0.8, "hfield_resolution": res or 41, "hfield_refinement": 2},
+        )
+        assert rig.hfield.ncol == n1 and rig.scales.tip_radius_m == base.scales.tip_radius_m

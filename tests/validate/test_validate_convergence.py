@@ -17,7 +17,6 @@ from spine_mj.validate.convergence import (
     is_converged,
     observed_order,
     paired_change,
-    refinable,
     refinement_note,
     richardson,
     thin_starts,
@@ -155,7 +154,7 @@ def test_the_judged_agreement_changes_on_the_well_conditioned_starts_only():
     assert paired_change(base.drop(columns="well_conditioned"), refined)["well_conditioned_runs"] == 10
 
 
-def test_a_gridded_family_says_its_hfield_was_not_refined():
+def test_a_refinement_not_run_says_so():
     base = _rows("fractal", [0.2, 0.8], [True, True], [0.01, 0.01])
     summary = {
         "outcome_agreement": 1.0,
@@ -167,12 +166,9 @@ def test_a_gridded_family_says_its_hfield_was_not_refined():
     }
     out = family_convergence(summary, base, {"dt_halved": base, "hfield_doubled": None})
     hf = out["hfield_doubled"]
-    assert hf["refined"] is False and hf["converged"] is None and "gridded" in hf["note"]
+    assert hf["refined"] is False and hf["converged"] is None and hf["note"] == "not run"
     assert math.isnan(hf["agreement_change"]) and math.isnan(hf["median_frechet_change"])
     assert out["converged"] is True  # decided by what was refined
-    assert not refinable("paper-fractal", (1,), "hfield_doubled")
-    assert refinable("paper-fractal", (1,), "dt_halved")
-    assert refinable("paper-single-peak", None, "hfield_doubled")
 
 
 def test_thin_starts_keeps_the_same_points_on_every_surface():
@@ -230,7 +226,8 @@ def test_a_doubled_hfield_nests_the_old_samples_and_keeps_the_tip():
     fam = plan.families[0]
     base = limit_doc(plan, fam, "paper-single-peak", "base")
     finer = limit_doc(plan, fam, "paper-single-peak", "finer", (("hfield_factor", 2),))
-    assert finer["grid"]["hfield_resolution"] == 2 * plan.hfield_resolution - 1
+    assert finer["grid"]["hfield_refinement"] == 2
+    assert finer["grid"]["hfield_resolution"] == base["grid"]["hfield_resolution"]
     assert finer["grid"]["tip_radius"] == base["grid"]["tip_radius"]
     assert (
         finer["starts"]
@@ -272,19 +269,16 @@ def test_every_refined_sweep_of_the_plans_is_a_valid_config_that_changes_only_it
     docs = _refinement_docs(plan, corner)
     keys = {(fam, key) for fam, key, _, _ in docs}
     for fam in corner:
-        assert (fam.name, "dt_halved") in keys
-        # an analytic family's hfield is refined, a gridded one's is not
-        assert ((fam.name, "hfield_doubled") in keys) == refinable(
-            fam.presets[0], fam.seeds, "hfield_doubled"
-        )
+        # every family's hfield is refined, a gridded one's through its spline
+        assert {(fam.name, k) for k in plan.convergence_refinements} <= keys
     for _, key, _, doc in docs:
         sweep.parse_config(doc)
         grid = doc["grid"]
+        assert grid["hfield_resolution"] == plan.hfield_resolution
         if key.startswith("dt_"):
-            assert grid["hfield_resolution"] == plan.hfield_resolution
             assert grid["timestep_factor"] == dict(REFINEMENTS[key])["timestep_factor"] < 1
         elif key == "hfield_doubled":
-            assert grid["hfield_resolution"] == refined_resolution(plan.hfield_resolution, 2)
+            assert grid["hfield_refinement"] == 2
             assert "timestep" not in grid
         else:  # the solver's tolerances, a hundredth of MuJoCo's
             assert (grid["tolerance"], grid["noslip_tolerance"]) == (1e-10, 1e-8)

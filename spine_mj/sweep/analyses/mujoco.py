@@ -18,7 +18,6 @@ from spine_mj.sim.holding import spring_swing
 from spine_mj.sim.params import surface_unit_m
 from spine_mj.sim.ramp import nominal_time_s
 from spine_mj.sim.rollout import drive_steps
-from spine_mj.surfaces import GridSurface
 from spine_mj.sweep.registry import (
     CASE_THREADS,
     KAPPA_CAP_PARAM,
@@ -168,6 +167,14 @@ MUJOCO_PARAMS = (
         None,
         4,
     ),
+    ParamSpec(
+        "hfield_refinement",
+        "int",
+        "the hfield at this many times its samples a side, every one kept, the tip's default "
+        "radius kept (a grid refined through its interpolant; solution verification)",
+        1,
+        1,
+    ),
     KAPPA_CAP_PARAM,
     ParamSpec("record_every", "int", "store every k-th recorded step of the trajectories", 1, 1),
 )
@@ -237,6 +244,7 @@ def _rig(spec, key):
         gravity_m_s2=p["gravity"],
         length_scale_m=p["length_scale"],
         hfield_resolution=p["hfield_resolution"],
+        hfield_refinement=p["hfield_refinement"],
         timestep_s=p["timestep"],
         ie=p["ie"],
         speed_m_s=p["speed"],
@@ -262,10 +270,12 @@ def case_scales(case, surface=None) -> sim.Scales:
     L_c, l_s), without building it: for checks of a config before any case runs."""
     surface = case.surface.make() if surface is None else surface
     p = dict(_rig_key(case.params, surface))
-    tip = sim.TipParams(tip_radius_m=p["tip_radius_m"], mu_s=p["mu"])
-    resolution = None if isinstance(surface, GridSurface) else p["hfield_resolution"]
-    return sim.Scales.for_surface(
-        surface, tip=tip, length_scale_m=p["length_scale"], hfield_resolution=resolution
+    return sim.rig_scales(
+        surface,
+        tip=sim.TipParams(tip_radius_m=p["tip_radius_m"], mu_s=p["mu"]),
+        length_scale_m=p["length_scale"],
+        hfield_resolution=p["hfield_resolution"],
+        hfield_refinement=p["hfield_refinement"],
     )
 
 
@@ -304,6 +314,7 @@ _RIG_KEYS = (
     "solref_timeconst",
     "solref_dampratio",
     "hfield_resolution",
+    "hfield_refinement",
 )
 
 

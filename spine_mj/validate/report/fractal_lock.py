@@ -115,7 +115,7 @@ def _convergence_lines(fr: FractalLockResult) -> list[str]:
         "ran cleanly), converged when the rate plus the change stays inside its Wilson interval. "
         "A run the engine stopped on penetration is rerun at a quarter of its step and contact "
         "time constant (`spine_mj.sim.rig.REFINE_TIMESTEP`) on either side, and is paired as the "
-        "rate counted it. A fractal keeps its samples: no hfield to refine.",
+        "rate counted it.",
         "",
         table(
             rows,
