@@ -20,7 +20,6 @@ from spine_mj.validate.study_runner import StudyRunner
 from spine_mj.validate.sweep_configs import (
     RELATIVE_ENGINE_KEYS,
     engine_default,
-    refined_resolution,
     relative_engine_keys,
     rig_engine,
 )
@@ -31,8 +30,9 @@ __all__ = ["PLANE_START", "StaticMapResult", "hold_force", "static_map"]
 PLANE_START = (3.1e-4, 2.7e-4)
 #: The inertia number of the probe's force ramp.
 PROBE_IE = 1e-2
-#: Samples a side of each plane's grid (an engine setting's ``hfield_factor`` refines it:
-#: a plane's facets are the plane at any resolution, so the breakaway must not move).
+#: Samples a side of each plane's grid (an engine setting's ``hfield_factor`` refines its
+#: hfield, the tip kept: a plane's facets are the plane at any resolution, so the breakaway
+#: must not move).
 PLANE_SAMPLES = 41
 
 
@@ -185,7 +185,9 @@ def _plane_rows(plan: ValidationPlan, runner: StudyRunner, slope: float, az: flo
         # every setting's sweep states the keys the others vary (a default of None: the rule's)
         grid.update({k_: engine_default(k_) for k_ in keys if engine_default(k_) is not None})
         rest = dict(ov)
-        path = _plane_file(runner.out_dir, slope, az, int(rest.pop("hfield_factor", 1)))
+        path = _plane_file(runner.out_dir, slope, az)
+        if "hfield_factor" in rest:  # the plane's hfield refined, the tip kept
+            grid["hfield_refinement"] = int(rest.pop("hfield_factor"))
         grid.update(
             relative_engine_keys(
                 rest,
@@ -230,11 +232,11 @@ def _plane_rows(plan: ValidationPlan, runner: StudyRunner, slope: float, az: flo
     return rows
 
 
-def _plane_file(out_dir, slope: float, az: float, factor: int):
+def _plane_file(out_dir, slope: float, az: float):
     """The plane's surface file under ``out_dir/surfaces`` (written once), its grid
-    :data:`PLANE_SAMPLES` a side refined ``factor`` times (:func:`refined_resolution`)."""
-    n = refined_resolution(PLANE_SAMPLES, factor)
-    name = f"plane_s{slope:g}_a{az:g}" + (f"_n{n}" if factor != 1 else "")
+    :data:`PLANE_SAMPLES` a side."""
+    n = PLANE_SAMPLES
+    name = f"plane_s{slope:g}_a{az:g}" + (f"_n{n}" if n != 41 else "")
     path = out_dir / "surfaces" / f"{name}.npz"
     if not path.is_file():
         surface_io.save_surface(sim.inclined_plane(slope_deg=slope, azimuth_deg=az, n=n), path)
