@@ -124,13 +124,8 @@ def build_rig(
         The tip (:class:`TipParams`; None: its default, the radius from the surface).
     length_scale_m : float or None
         Metres per surface unit (None: 0.01 for dimensionless surfaces, else the unit's).
-    hfield_resolution : int or None
-        Samples a side of the hfield of an analytic surface; ignored for a gridded one,
-        which keeps its own samples (module docstring).
-    hfield_refinement : int
-        That hfield at this many times the samples a side, every sample kept, the tip's
-        default radius the one of the unrefined hfield (solution verification:
-        :meth:`Scales.with_hfield`).
+    hfield_resolution, hfield_refinement : int or None, int
+        An analytic surface's hfield samples a side (a grid keeps its own), refined so many times.
     ie, speed_m_s, rate_n_s
         The drive's pace, as for :func:`build_drive`: its speed (:func:`drive_speed_m_s`)
         bounds the engine step for impacts.
@@ -139,8 +134,8 @@ def build_rig(
         the engine step (:func:`~spine_mj.sim.default_engine`), so a rig runs spring drives up to this
         stiffness (a stiffer one is refused by :meth:`Rig.check_drive`).
     driven : bool
-        False for a model no drive of ours runs (``sim export``, the viewer: the user's
-        sliders drive it): then only the surface's falls bound the step.
+        False for a model no drive of ours runs (``sim export``, the viewer: the user's sliders
+        drive it): then only the surface's falls bound the step.
     **engine_overrides
         The fields of :class:`EngineOverrides` (``timestep_s``, ``integrator``, ``cone``,
         ``impratio``, ``noslip_iterations``, ``solref_timeconst_s``, ``solref_dampratio``).
@@ -186,8 +181,22 @@ def rig_scales(
     hfield_resolution: int | None = None,
     hfield_refinement: int = 1,
 ) -> Scales:
-    """The scales :func:`build_rig` sizes its rig by (the same arguments), without building
-    it: for checks of a configuration before any run."""
+    """The scales :func:`build_rig` sizes its rig by, without building it: for checks of a
+    configuration before any run.
+
+    Parameters
+    ----------
+    surface : Surface
+        The surface.
+    tip : TipParams
+        The tip (its radius None: the rule's).
+    length_scale_m, hfield_resolution, hfield_refinement
+        As for :func:`build_rig`.
+
+    Returns
+    -------
+    Scales
+    """
     return _sized(surface, tip, length_scale_m, hfield_resolution, hfield_refinement)[1]
 
 

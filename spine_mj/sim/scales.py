@@ -168,16 +168,13 @@ class Scales:
         * ``length_scale_m``: None gives :data:`DEFAULT_LENGTH_SCALE_M` for a dimensionless
           surface (``unit == "1"``) and the unit's size (:data:`LENGTH_UNITS_M`) otherwise.
         * ``char_length_m``: None gives :func:`characteristic_length` in metres.
-        * tip radius (when ``tip.tip_radius_m`` is None): the surface's own
-          ``metadata["params"]["tip_radius_m"]`` (sandpaper); for a measured scan (a grid
-          in a physical unit) the larger of two lateral spacings and ``L_c / 100`` (the
-          sphere rests on several facets, never in one pixel); else the larger of one
-          hfield spacing and ``L_c / 100``; to 3 significant digits.
-        * hfield resolution: an hfield finer than a quarter tip radius is coarsened to that
-          (MuJoCo keeps at most 50 contacts per geom pair: a tip over too many cells loses
-          its deepest contacts).
-        * ``hfield_refinement``: that hfield at this many times the samples a side, every
-          sample kept (:func:`hfield_of`), the tip's radius the one sized on it.
+        * tip radius (when ``tip.tip_radius_m`` is None): the surface's own ``metadata["params"]
+          ["tip_radius_m"]`` (sandpaper); for a measured scan (a grid in a physical unit) the larger
+          of two lateral spacings and ``L_c / 100`` (the sphere rests on several facets, never in
+          one pixel); else the larger of one hfield spacing and ``L_c / 100``; 3 significant digits.
+        * hfield resolution: an hfield finer than a quarter tip radius is coarsened to that (MuJoCo
+          keeps at most 50 contacts per geom pair: a tip over too many cells loses its deepest
+          contacts); then refined ``hfield_refinement`` times (:func:`hfield_of`)
         * fall height: :func:`fall_height` of that hfield with the tip's ``mu_s`` and radius.
 
         Raises
@@ -211,18 +208,8 @@ class Scales:
             extent = 2 * max(hf.size[0], hf.size[1]) * length_scale_m
             resolution = math.ceil(extent / (_MIN_SPACING_PER_TIP_RADIUS * radius)) + 1
             hf = hfield_of(surface, resolution)
-            spacing = hfield_spacing(hf, length_scale_m)
-        refinement = hfield_refinement
-        if isinstance(refinement, bool) or int(refinement) != refinement or refinement < 1:
-            raise SpineInputError(f"hfield_refinement must be an integer >= 1, got {refinement!r}")
-        if refinement > 1:
-            side = (max(hf.nrow, hf.ncol) - 1) * int(refinement) + 1
-            if side > MAX_HFIELD_SIDE:
-                raise SpineInputError(
-                    f"hfield_refinement {refinement} gives {side} samples a side, more than {MAX_HFIELD_SIDE}"
-                )
-            hf = hfield_of(surface, resolution, int(refinement))
-            spacing = hfield_spacing(hf, length_scale_m)
+        hf = _refined_hfield(surface, hf, resolution, hfield_refinement)
+        spacing = hfield_spacing(hf, length_scale_m)
         rx, ry, elevation = hf.size[0], hf.size[1], hf.size[2]
         fall = fall_height(
             hf.data.astype(float) * (elevation * length_scale_m),  # float64: the same at every scale
@@ -238,7 +225,7 @@ class Scales:
             tip_radius_m=radius,
             hfield_spacing_m=spacing,
             hfield_resolution=resolution,
-            hfield_refinement=int(refinement),
+            hfield_refinement=int(hfield_refinement),
             slope_length_m=_slope_length(surface, length_scale_m, char_length_m),
             extent_m=math.hypot(xmax - xmin, ymax - ymin),
             fall_height_m=fall,
@@ -401,6 +388,20 @@ def _slope_length(surface: Surface, length_scale_m: float, char_length_m: float)
         return slope_correlation_length(surface) * length_scale_m
     except SpineInputError:
         return char_length_m
+
+
+def _refined_hfield(surface: Surface, hf: HField, resolution: int | None, refinement) -> HField:
+    """``hf`` (``surface``'s at ``resolution``) refined ``refinement`` times (:func:`hfield_of`)."""
+    if refinement == 1:
+        return hf
+    if isinstance(refinement, bool) or int(refinement) != refinement or refinement < 1:
+        raise SpineInputError(f"hfield_refinement must be an integer >= 1, got {refinement!r}")
+    side = (max(hf.nrow, hf.ncol) - 1) * int(refinement) + 1
+    if side > MAX_HFIELD_SIDE:
+        raise SpineInputError(
+            f"hfield_refinement {refinement} gives {side} samples a side, more than {MAX_HFIELD_SIDE}"
+        )
+    return hfield_of(surface, resolution, int(refinement))
 
 
 def hfield_of(surface: Surface, resolution: int | None = None, refinement: int = 1) -> HField:

@@ -499,19 +499,15 @@ def _criterion_star(ies, amat, fmat, rows, *, n_boot: int, rng) -> dict:
 
 def _deep_star(grp: pd.DataFrame, ies: list[float], star: dict, *, n_boot: int, rng) -> dict:
     """I_e* of one K whose grid fails already at its lowest I_e (``star``, kind ``below``),
-    read again with the deeper I_e values that ran on a subset of its starts: over every I_e,
-    on the starts that ran at all of them (matched by surface and point: a deeper sweep
-    numbers its starts anew), so that a deep cell that passes brackets I_e* from below.
-    ``star`` as it is where the rows carry no start points or fewer than two starts are
-    common."""
+    read over every I_e on the starts that ran at all of them (matched by surface and point:
+    a deeper sweep numbers its starts anew): a deep cell that passes brackets I_e* from
+    below. ``star`` where the rows have no start points or fewer than two in common."""
     if not {"start_x", "start_y"} <= set(grp):
         return star
     key = (
         grp["surface"].astype(str)
         + "@"
-        + grp["start_x"].round(9).astype(str)
-        + ","
-        + grp["start_y"].round(9).astype(str)
+        + grp[["start_x", "start_y"]].round(9).astype(str).agg(",".join, axis=1)
     )
     common = set.intersection(*(set(key[grp["ie"] == ie]) for ie in ies))
     if len(common) < 2:
