@@ -34,9 +34,9 @@ QUICK_WALL_TARGET_S = 140.0
 
 def study_of(store_name: str) -> str:
     """The study a sweep store belongs to: its first folder under ``sweeps/``, as
-    ``timings_s`` names it (``limit-refined`` is the limit study's refinements)."""
+    ``timings_s`` names it (``limit-refined``, ``boundary-refined``: a study's refinements)."""
     head = store_name.split("/")[0].replace("-", "_")
-    return "limit" if head == "limit_refined" else head
+    return head.removesuffix("_refined")
 
 
 def plan_cost(out_dir: Path) -> dict:

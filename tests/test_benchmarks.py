@@ -77,6 +77,8 @@ def test_the_plan_cost_puts_each_sweep_store_under_its_study():
     for store, study in [
         ("limit/paper-fractal", "limit"),
         ("limit-refined/dt_halved/sandpaper-P600", "limit"),
+        ("boundary-refined/dt_halved-spring-paper-single-peak", "boundary"),
+        ("fractal-lock-refined/dt_halved", "fractal_lock"),
         ("fractal-lock/corner", "fractal_lock"),
         ("ground-truth/pt-s0.1-mu0.5", "ground_truth"),
         ("stick-slip", "stick_slip"),
