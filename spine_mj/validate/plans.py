@@ -170,6 +170,12 @@ class ValidationPlan:
     stiffness_map_deep_starts : int
         Starts per preset of those deep runs (0: the map's): a run at I_e = 1e-6 is slow
         (a carriage 100 times slower than at 1e-2).
+    stiffness_map_deep_every_k : tuple of str
+        Families (by name) whose deep I_e runs at every K of their axis, not the stiffest
+        only: where every K fails at the grid's lowest I_e the K boundary can be read on
+        the deep cells alone (the fractal: every K fails at 1e-4, 10 K* included; a deep
+        fractal run costs 0.5 to 1.4 s of CPU, a single peak/valley or random Gaussian one
+        3 to 7 s).
     stiffness_map_families : tuple of str
         Families (by name) of the map.
     stiffness_map_starts : int
@@ -243,6 +249,7 @@ class ValidationPlan:
     stiffness_map_k_factors: tuple[float, ...] = ()
     stiffness_map_deep_ie: tuple[float, ...] = ()
     stiffness_map_deep_starts: int = 0
+    stiffness_map_deep_every_k: tuple[str, ...] = ()
     stiffness_map_starts: int = 2
     stick_slip_k_ie: tuple[float, ...] = (1e-4, 1e-2)
     stick_slip_k_factors: tuple[float, ...] = (0.125, 0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 4.0, 8.0)
@@ -259,6 +266,11 @@ class ValidationPlan:
     convergence_refinements: tuple[str, ...] = ("dt_halved", "hfield_doubled")
     boundary_refinements: tuple[str, ...] = ()
     extra: dict = field(default_factory=dict, compare=False)
+
+    def deep_k_axis(self, family: str, ks: Sequence[float]) -> list[float]:
+        """The K values of ``family``'s deep I_e runs (``stiffness_map_deep_ie``): its whole
+        axis ``ks`` where ``stiffness_map_deep_every_k`` names it, else its stiffest K."""
+        return sorted(ks) if family in self.stiffness_map_deep_every_k else [max(ks)]
 
     def map_family(self, fam: FamilySpec) -> FamilySpec:
         """``fam`` for the (I_e, K) map: with ``stiffness_map_runs`` > 0, its y starts
@@ -466,15 +478,17 @@ PLANS: dict[str, ValidationPlan] = {
         ramp_max_steps=200_000,
         stiffness_map_ie=(1e-4, 1e-3, 1e-2, 1e-1, 1.0),
         # K / K* to 10 on every family, by factors of at most 2 around K* (the predicted K*
-        # is judged within a factor of 2); I_e down to 1e-6 at the stiffest K. Measured on the
-        # fractal at K = 1000, one start, busy machine: 3.0 s at I_e 1e-4, 47 s at 1e-5 (its
-        # stick phases too short for the fast-forward), 1.6 s at 1e-6 (fast-forwarded; 36 s
-        # without): the ladder skips 1e-5
+        # is judged within a factor of 2); I_e down to 1e-6 at the stiffest K, on the fractal
+        # at every K (stiffness_map_deep_every_k). Measured on the fractal at K = 1000, one
+        # start, busy machine: 3.0 s at I_e 1e-4, 47 s at 1e-5 (its stick phases too short
+        # for the fast-forward), 1.6 s at 1e-6 (fast-forwarded; 36 s without): the ladder
+        # skips 1e-5
         # K / K_path by factors of at most 2 around K_path (judged within a factor of 2),
         # with each family's fold K* and 10 K* (family_k_axis)
         stiffness_map_k_factors=(0.1, 0.3, 0.5, 1.0, 2.0, 3.0),
         stiffness_map_deep_ie=(1e-6,),
         stiffness_map_deep_starts=10,
+        stiffness_map_deep_every_k=("fractal",),
         stiffness_map_families=("single_peak_valley", "random_gaussian", "fractal"),
         # at least 30 runs per (I_e, K) point and family (map_family)
         stiffness_map_starts=30,

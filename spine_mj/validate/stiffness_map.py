@@ -223,10 +223,9 @@ def stiffness_map(plan: ValidationPlan, runner: StudyRunner) -> StiffnessMapResu
         k_by_family[fam.name] = fks
         for preset in fam.presets:
             drives = [("", {"protocol": "spring", "ie": ies, "K": fks})]
-            if plan.stiffness_map_deep_ie:
-                drives.append(
-                    ("-deep", {"protocol": "spring", "ie": list(plan.stiffness_map_deep_ie), "K": max(fks)})
-                )
+            if deep_ie := list(plan.stiffness_map_deep_ie):
+                deep_k = plan.deep_k_axis(fam.name, fks)
+                drives.append(("-deep", {"protocol": "spring", "ie": deep_ie, "K": deep_k}))
             for tag, drive in drives:
                 starts = sub if not tag or plan.stiffness_map_deep_starts <= 0 else deep
                 doc = family_doc(

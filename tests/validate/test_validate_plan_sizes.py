@@ -62,3 +62,11 @@ def test_the_full_map_reaches_ten_k_star_and_ie_1e_6_with_factor_2_steps_around_
     assert "dt_quartered" in p.convergence_refinements  # three step levels: an observed order
     q = PLANS["quick"]
     assert max(q.stiffness_map_k_factors) >= 3 and q.convergence_starts > 0
+
+
+def test_the_deep_ie_runs_on_every_k_of_the_families_the_plan_names_else_on_the_stiffest():
+    full = PLANS["full"]
+    assert full.stiffness_map_deep_every_k == ("fractal",)
+    assert full.deep_k_axis("fractal", [100.0, 2.9, 1000.0]) == [2.9, 100.0, 1000.0]
+    assert full.deep_k_axis("random_gaussian", [1.6, 190.0, 19.0]) == [190.0]
+    assert PLANS["quick"].deep_k_axis("fractal", [3.0, 30.0]) == [30.0]
