@@ -20,6 +20,8 @@ its surfaces (the spring-block swing's scale, :func:`spine_mj.sim.holding.spring
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from spine_mj import presets
@@ -27,7 +29,7 @@ from spine_mj.theory.drive_limits import drive_limits
 from spine_mj.validate.paths import tip_radius
 from spine_mj.validate.plans import FamilySpec, ValidationPlan
 
-__all__ = ["family_limits", "path_starts"]
+__all__ = ["family_k_axis", "family_limits", "k_ladder", "path_starts"]
 
 
 def path_starts(fam: FamilySpec, surface, n: int) -> np.ndarray:
@@ -74,3 +76,32 @@ def family_limits(plan: ValidationPlan, fam: FamilySpec, *, n_starts: int = 8) -
         "limit": worst["limit"],
         "presets": per,
     }
+
+
+def family_k_axis(predicted: dict, factors) -> list[float]:
+    """A family's K axis for the (I_e, K) map: ``factors`` x its ``k_path`` (the boundary the
+    map's criterion sees, :func:`~spine_mj.theory.drive_limits.path_stiffness`: the measured
+    boundary is judged against it within a factor of 2), with its fold ``k_star`` and ten
+    times it rounded up (the map reaches at least a decade past the first fold anywhere);
+    the fold's ladder alone where ``k_path`` is not finite, empty without factors."""
+    ladder = k_ladder(predicted.get("k_path", float("nan")), factors) or k_ladder(
+        predicted["k_star"], factors
+    )
+    if not ladder:
+        return []
+    fold = k_ladder(predicted["k_star"], (1.0,)) + k_ladder(predicted["k_star"], (10.0,), round_up=True)
+    return sorted(set(ladder) | set(fold))
+
+
+def k_ladder(k_star: float, factors, *, round_up: bool = False) -> list[float]:
+    """The K axis ``factors`` x ``k_star``, each to two significant digits, the nearest or
+    (``round_up``) the next up (empty without factors or without a finite positive K*)."""
+    if not factors or not (np.isfinite(k_star) and k_star > 0):
+        return []
+    if not round_up:
+        return sorted({float(f"{f * k_star:.2g}") for f in factors})
+    out = set()
+    for f in factors:
+        scale = 10.0 ** (math.floor(math.log10(f * k_star)) - 1)
+        out.add(float(f"{math.ceil(f * k_star / scale - 1e-9) * scale:.2g}"))
+    return sorted(out)

@@ -40,7 +40,7 @@ from spine_mj.validate.convergence import thin_starts
 from spine_mj.validate.ie_star import ie_star_by_criterion, passes_criterion, quiet_nan_warnings
 from spine_mj.validate.paths import mujoco_traces
 from spine_mj.validate.plans import GRAVITY, MASS_KG, FamilySpec, ValidationPlan
-from spine_mj.validate.predicted_limits import family_limits
+from spine_mj.validate.predicted_limits import family_k_axis, family_limits
 from spine_mj.validate.slip_tails import fit_tail
 from spine_mj.validate.stick_slip import slip_statistics
 from spine_mj.validate.study_runner import StudyRunner
@@ -52,8 +52,6 @@ __all__ = [
     "StiffnessMapResult",
     "agreement_map",
     "energy_rows",
-    "family_k_axis",
-    "k_ladder",
     "slip_rows",
     "stiffness_map",
     "subset_starts",
@@ -266,26 +264,6 @@ def stiffness_map(plan: ValidationPlan, runner: StudyRunner) -> StiffnessMapResu
         orders=order_rows(agreement, predicted),
         prediction_check=prediction_check(agreement, predicted),
     )
-
-
-def family_k_axis(predicted: dict, factors) -> list[float]:
-    """A family's K axis: ``factors`` x its ``k_path`` (the boundary the map's criterion
-    sees, :func:`~spine_mj.theory.drive_limits.path_stiffness`: the measured boundary is
-    judged against it within a factor of 2), with its fold ``k_star`` and ten times it (the
-    map reaches a decade past the first fold anywhere); the fold's ladder alone where
-    ``k_path`` is not finite, empty without factors."""
-    ladder = k_ladder(predicted.get("k_path", float("nan")), factors) or k_ladder(
-        predicted["k_star"], factors
-    )
-    return sorted(set(ladder) | set(k_ladder(predicted["k_star"], (1.0, 10.0) if ladder else ())))
-
-
-def k_ladder(k_star: float, factors) -> list[float]:
-    """The K axis ``factors`` x ``k_star``, each to two significant digits (empty without
-    factors or without a finite positive K*)."""
-    if not factors or not (np.isfinite(k_star) and k_star > 0):
-        return []
-    return sorted({float(f"{f * k_star:.2g}") for f in factors})
 
 
 #: A cell of the map is stick-slip when its runs slip at least this often per L_c advanced.

@@ -9,7 +9,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from spine_mj.validate.stiffness_map import agreement_map, family_k_axis, k_ladder
+from spine_mj.validate.predicted_limits import family_k_axis, k_ladder
+from spine_mj.validate.stiffness_map import agreement_map
 from spine_mj.validate.theory_orders import (
     FRECHET_FLOOR_LC,
     bracket_ratio,
@@ -53,14 +54,20 @@ def test_fit_order_leaves_out_what_the_metric_does_not_resolve():
 def test_the_k_ladder_is_set_from_k_star_in_two_digits():
     assert k_ladder(104.78, (0.1, 0.3, 1.0, 3.0, 10.0)) == [10.0, 31.0, 100.0, 310.0, 1000.0]
     assert k_ladder(104.78, ()) == [] and k_ladder(float("nan"), (1.0,)) == []
+    assert k_ladder(104.78, (1.0, 10.0), round_up=True) == [110.0, 1100.0]
+    assert k_ladder(70.4, (10.0,), round_up=True) == [710.0] and k_ladder(2.0, (10.0,), round_up=True) == [
+        20.0
+    ]
 
 
 def test_a_familys_k_axis_brackets_k_path_and_reaches_ten_fold_k_stars():
     """The ladder is set on K_path (the boundary the criterion sees, judged within a factor
     of 2) and carries the fold K* and 10 K*; without a finite K_path, the fold's ladder."""
     axis = family_k_axis({"k_path": 0.29, "k_star": 67.4}, (0.3, 0.5, 1.0, 2.0, 3.0))
-    assert axis == [0.087, 0.14, 0.29, 0.58, 0.87, 67.0, 670.0]
-    assert family_k_axis({"k_star": 104.78}, (1.0, 10.0)) == [100.0, 1000.0]
+    assert axis == [0.087, 0.14, 0.29, 0.58, 0.87, 67.0, 680.0]
+    assert family_k_axis({"k_star": 104.78}, (1.0, 10.0)) == [100.0, 1000.0, 1100.0]
+    for k_star in (19.4, 70.4, 104.78, 2.0):  # the stiffest K is at least 10 K*
+        assert max(family_k_axis({"k_path": 1.0, "k_star": k_star}, (1.0,))) / k_star >= 10
     assert family_k_axis({"k_path": 29.0, "k_star": 105.0}, ()) == []
 
 
