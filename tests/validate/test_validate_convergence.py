@@ -187,8 +187,7 @@ def test_the_rigs_engine_is_the_sweeps_and_a_halved_step_keeps_the_contacts_time
     tip = tip_radius(preset, None, res)
     surface = presets.make_surface(preset)
     engine = rig_engine(surface, tip=tip, mu=mu, ie=ie, hfield_resolution=res, stiffness_number=300.0)
-    rig = sim.build_rig(
-        surface,
+    rig_args = dict(
         mu=mu,
         tip_radius_m=tip * sim.DEFAULT_LENGTH_SCALE_M,
         mass_kg=MASS_KG,
@@ -196,23 +195,14 @@ def test_the_rigs_engine_is_the_sweeps_and_a_halved_step_keeps_the_contacts_time
         ie=ie,
         stiffness_number=300.0,
     )
-    assert engine == rig.engine
+    assert engine == sim.build_rig(surface, **rig_args).engine
     plan = PLANS["smoke"]
     grid = engine_grid(
         plan, (("timestep_factor", 0.5),), preset, None, tip, mu=mu, ie=ie, stiffness_number=300.0
     )
     # the sweep halves each case's own step, the contact's time constant kept
     assert grid["timestep_factor"] == 0.5 and "timestep" not in grid and "solref_timeconst" not in grid
-    halved = sim.build_rig(
-        surface,
-        mu=mu,
-        tip_radius_m=tip * sim.DEFAULT_LENGTH_SCALE_M,
-        mass_kg=MASS_KG,
-        hfield_resolution=res,
-        ie=ie,
-        stiffness_number=300.0,
-        timestep_factor=grid["timestep_factor"],
-    )
+    halved = sim.build_rig(surface, **rig_args, timestep_factor=grid["timestep_factor"])
     assert halved.engine.timestep_s == pytest.approx(engine.timestep_s / 2)
     assert halved.engine.solref == engine.solref  # only the step changes
     soft = engine_grid(plan, (("solref_timeconst_factor", 10.0),), preset, None, tip, mu=mu, ie=ie)
