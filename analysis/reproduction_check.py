@@ -123,6 +123,8 @@ def _run(args) -> int:
             headline_numbers(docs[-1])
         except (OSError, ValueError, SpineInputError) as exc:  # a missing or malformed file
             raise SpineInputError(f"{path}: {exc}") from None
+        except RecursionError:
+            raise SpineInputError(f"{path}: JSON nested too deep to read (not a validation.json)") from None
     committed, fresh = docs
     rows = check_reproduction(fresh, committed)
     text = f"New: {fresh.get('platform')}\n\nCommitted: {committed.get('platform')}\n\n"

@@ -30,6 +30,7 @@ from spine_mj.surfaces import (
     GridSurface,
     HField,
     Surface,
+    check_unit,
     length_unit,
     to_hfield,
 )
@@ -144,10 +145,7 @@ def load_surface(path: str | os.PathLike) -> Surface:
                 raise SpineInputError(f"array {name!r} must be numeric, got dtype {arr.dtype}")
         kind = str(data["kind"])
         unit = str(data["unit"])
-        if unit != "1" and length_unit(unit) is None:
-            raise SpineInputError(
-                f"unit must be '1' (dimensionless) or a length unit {sorted(LENGTH_UNITS_M)}, got {unit!r}"
-            )
+        check_unit(unit)
         if kind == "grid":
             periodic = data["periodic"]
             if periodic.shape != () or periodic.dtype.kind not in "bi" or periodic not in (0, 1):

@@ -100,3 +100,9 @@ def test_the_committed_run_reproduces_itself(script, committed, tmp_path, capsys
     assert script.main([str(COMMITTED), "-o", str(report)]) == 0
     assert f"{n} of {n} inside the committed intervals" in report.read_text()
     assert f"{n} of {n}" in capsys.readouterr().out
+
+
+def test_deeply_nested_json_is_one_error_line(script, tmp_path, capsys):
+    deep = tmp_path / "validation.json"
+    deep.write_text("[" * 100_000 + "]" * 100_000)
+    _one_error(capsys, script.main([str(deep)]), "nested too deep")

@@ -157,6 +157,10 @@ def default_bullet_engine(
     recorded step as they do MuJoCo's (:func:`~spine_mj.sim.params.default_engine`).
     ``overrides`` replace fields (a ``timestep_s`` alone re-derives the substeps).
     """
+    # a given step or slop is checked before the substeps are derived from it (NaN, 0)
+    for name in ("timestep_s", "contact_slop_m"):
+        if overrides.get(name) is not None:
+            overrides[name] = check_positive(name, overrides[name])
     dt = overrides.get("timestep_s") or (
         default_engine(scales, speed_m_s=speed_m_s, stiffness_n_m=stiffness_n_m).timestep_s
     )

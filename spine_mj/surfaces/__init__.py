@@ -33,6 +33,7 @@ from spine_mj.surfaces.base import (
     MAX_GRID_POINTS,
     MAX_PEAKS,
     check_grid_size,
+    check_unit,
     length_unit,
 )
 from spine_mj.surfaces.dilation import ball_dilation, ball_dilation_reference, dilate
@@ -63,6 +64,7 @@ __all__ = [
     "ball_dilation",
     "ball_dilation_reference",
     "check_grid_size",
+    "check_unit",
     "corrugation",
     "dilate",
     "fractal_fbm",

@@ -50,6 +50,18 @@ def length_unit(unit: str) -> str | None:
     return unit if unit in LENGTH_UNITS_M else None
 
 
+def check_unit(unit, name: str = "unit") -> str:
+    """``unit`` if a surface may carry it: ``"1"`` (dimensionless) or a length unit of
+    :data:`LENGTH_UNITS_M` (in any spelling :func:`length_unit` knows), else a
+    :class:`SpineInputError` naming ``name``: refused when a surface is made, not when a
+    command later reads its file."""
+    if unit != "1" and length_unit(unit) is None:
+        raise SpineInputError(
+            f"{name} must be '1' (dimensionless) or a length unit {sorted(LENGTH_UNITS_M)}, got {unit!r}"
+        )
+    return unit
+
+
 def _rng_and_seed(rng: int | np.random.Generator | None) -> tuple[np.random.Generator, Any]:
     if isinstance(rng, np.random.Generator):
         return rng, None

@@ -22,6 +22,7 @@ from spine_mj.surfaces.base import (
     _range,
     _rng_and_seed,
     check_grid_size,
+    check_unit,
 )
 from spine_mj.surfaces.sandpaper import sandpaper as sandpaper  # re-exported (its old home)
 from spine_mj.surfaces.types import GaussianSurface, GridSurface
@@ -111,21 +112,34 @@ def inclined_plane(
     -------
     GridSurface
     """
-    slope = float(slope_deg)
-    if not (math.isfinite(slope) and -89.0 <= slope <= 89.0):
+    slope = _finite("slope_deg", slope_deg)
+    if not -89.0 <= slope <= 89.0:
         raise SpineInputError(f"slope_deg must lie in [-89, 89], got {slope_deg!r}")
+    azimuth = _finite("azimuth_deg", azimuth_deg)
     half_width = check_positive("half_width", half_width)
+    unit = check_unit(unit)
+    n = _grid_count("n", n)
+    check_grid_size(n, n, where="inclined_plane")
     t = math.tan(math.radians(slope))
-    az = math.radians(float(azimuth_deg))
-    x = np.linspace(-half_width, half_width, int(n))
+    az = math.radians(azimuth)
+    x = np.linspace(-half_width, half_width, n)
     h = t * (math.cos(az) * x[None, :] + math.sin(az) * x[:, None])
     return GridSurface(
         heights=h,
         x=x,
         y=x.copy(),
         unit=unit,
-        metadata={"generator": "inclined_plane", "slope_deg": slope, "azimuth_deg": float(azimuth_deg)},
+        metadata={"generator": "inclined_plane", "slope_deg": slope, "azimuth_deg": azimuth},
     )
+
+
+def _finite(name: str, value) -> float:
+    """``float(value)`` if it is a finite number (not a bool or a string), else a
+    :class:`SpineInputError` naming ``name``."""
+    ok = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, (bool, np.bool_))
+    if not (ok and math.isfinite(value)):
+        raise SpineInputError(f"{name} must be a finite number, got {value!r}")
+    return float(value)
 
 
 def corrugation(
@@ -388,6 +402,7 @@ def fractal_fbm(
         Periodic (unless ``periodic=False``), zero mean, metadata recording every argument.
     """
     periodic = _flag("periodic", periodic)
+    unit = check_unit(unit)
     nx, ny, lx, ly = _fbm_grid(nx, ny, size, periodic)
     hurst = _hurst(hurst)
     rms_height, rms_slope = _fbm_normalization(rms_height, rms_slope)

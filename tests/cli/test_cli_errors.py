@@ -349,3 +349,34 @@ def test_a_reader_that_leaves_the_pipe_early_gets_no_error_line():
         os.close(write_end)
     assert proc.stderr == ""
     assert proc.returncode == 141  # 128 + SIGPIPE, what a shell reports for such a writer
+
+
+@pytest.mark.parametrize(
+    ("setting", "fragment"),
+    [
+        ('slope_deg="steep"', "slope_deg must be a finite number, got 'steep'"),
+        ("azimuth_deg=inf", "azimuth_deg must be a finite number, got inf"),
+        ("unit=banana", "unit must be '1' (dimensionless) or a length unit"),
+        ("n=100000", "100000 x 100000"),
+    ],
+)
+def test_plane_arguments_are_refused_before_a_file_is_written(tmp_path, setting, fragment):
+    out = tmp_path / "p.npz"
+    assert_one_error_line(run("surface", "make", "plane", "--set", setting, "-o", out), fragment)
+    assert not out.exists()
+
+
+def test_a_generated_surface_in_an_unknown_unit_is_refused_when_made(tmp_path):
+    out = tmp_path / "f.npz"
+    result = run("surface", "make", "paper-fractal", "--set", "unit=banana", "--set", "nx=16", "-o", out)
+    assert_one_error_line(result, "got 'banana'")
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("step", ["nan", "0", "-1"])
+def test_bullet_refuses_a_nonsense_time_step_as_mujoco_does(tmp_path, step):
+    pytest.importorskip("pybullet")
+    for engine in ("mujoco", "bullet"):
+        result = run(*SIMULATE, "--engine", engine, "--timestep", step, "--out", tmp_path / engine)
+        assert_one_error_line(result, "timestep_s must be a finite number > 0")
+        assert not (tmp_path / engine).exists()
