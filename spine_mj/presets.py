@@ -67,6 +67,7 @@ def _measured(*, file: str, **options):
 GENERATORS = {
     "single_gaussian": surfaces.single_gaussian,
     "corrugation": surfaces.corrugation,
+    "abbm_track": surfaces.abbm_track,
     "inclined_plane": surfaces.inclined_plane,
     "random_gaussians": surfaces.random_gaussians,
     "fractal_fbm": surfaces.fractal_fbm,

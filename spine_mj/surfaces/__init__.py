@@ -20,7 +20,7 @@ its instrument's length unit (:data:`LENGTH_UNITS_M`, spelled by :func:`length_u
 
 Modules: :mod:`~spine_mj.surfaces.base` (units, size limits, argument checks),
 :mod:`~spine_mj.surfaces.types` (the surface types), :mod:`~spine_mj.surfaces.generators`,
-:mod:`~spine_mj.surfaces.sandpaper`,
+:mod:`~spine_mj.surfaces.sandpaper`, :mod:`~spine_mj.surfaces.tracks` (the ABBM track),
 :mod:`~spine_mj.surfaces.hfield` (MuJoCo's height field) and
 :mod:`~spine_mj.surfaces.facets` (the facets MuJoCo collides with and the ball tip on them),
 :mod:`~spine_mj.surfaces.dilation` (the surface a spherical tip's centre rides on).
@@ -47,6 +47,7 @@ from spine_mj.surfaces.generators import (
 )
 from spine_mj.surfaces.hfield import HField, from_hfield, refine_grid, to_hfield
 from spine_mj.surfaces.sandpaper import sandpaper
+from spine_mj.surfaces.tracks import abbm_force_intensity, abbm_size_range, abbm_slope_walk, abbm_track
 from spine_mj.surfaces.types import BSplineGrid, GaussianSurface, GridSurface, Surface
 
 __all__ = [
@@ -61,6 +62,10 @@ __all__ = [
     "HField",
     "Surface",
     "TriangulatedSurface",
+    "abbm_force_intensity",
+    "abbm_size_range",
+    "abbm_slope_walk",
+    "abbm_track",
     "ball_dilation",
     "ball_dilation_reference",
     "check_grid_size",
