@@ -14,6 +14,10 @@ from spine_mj.errors import SpineInputError
 from spine_mj.surfaces import HField, Surface
 
 PLACE_CACHE_SIZE = 4096  # placements kept per rig (by start)
+#: MuJoCo keeps at most this many contacts of one geom pair (``mjMAXCONPAIR``): a probe that
+#: finds as many may have lost its deepest one.
+MAX_PAIR_CONTACTS = 50
+_MARGIN_RADII = 0.2  # the probe's contact margin, in tip radii: a gap above the surface reads
 
 
 class Placer:
@@ -48,8 +52,7 @@ class Placer:
 
         self.model = model
         pm = copy.copy(model)
-        pm.geom_margin[geom_tip] = 0.2 * tip_radius  # few contacts, but a gap above the surface
-        self._m, self._d = pm, mujoco.MjData(pm)
+        self._m, self._d, self._tip = pm, mujoco.MjData(pm), geom_tip
         self._surface, self._hfield = surface, hfield
         self._s, self._r = length_scale, tip_radius
         self._rest_depth = rest_depth
@@ -76,14 +79,27 @@ class Placer:
         return np.array([got[p] for p in points])
 
     def _probe(self, x0: float, y0: float, z: float) -> tuple[float | None, float]:
-        """Signed distance of the deepest contact at height ``z`` (None: none) and |n_z|."""
+        """Signed distance of the deepest contact at height ``z`` (None: none) and |n_z|.
+
+        The tip gets a contact margin of :data:`_MARGIN_RADII` tip radii (a gap above the
+        surface reads as a positive distance), cut by 4 each time the probe fills MuJoCo's
+        :data:`MAX_PAIR_CONTACTS` (on an hfield much finer than the tip, more facets lie
+        within the margin than MuJoCo keeps, and the one it drops may be the deepest: the
+        tip would then be placed sunk into the surface), down to none.
+        """
         import mujoco
 
         m, d, s = self._m, self._d, self._s
         d.qpos[:] = (x0 * s, y0 * s, z)
-        mujoco.mj_kinematics(m, d)  # positions and contacts only: no dynamics needed
-        mujoco.mj_collision(m, d)
-        n = d.ncon
+        margin = _MARGIN_RADII * self._r
+        while True:
+            m.geom_margin[self._tip] = margin
+            mujoco.mj_kinematics(m, d)  # positions and contacts only: no dynamics needed
+            mujoco.mj_collision(m, d)
+            n = d.ncon
+            if n < MAX_PAIR_CONTACTS or margin == 0:
+                break
+            margin = margin / 4 if margin > 1e-6 * self._r else 0.0
         if not n:
             return None, 1.0
         contacts = d.contact

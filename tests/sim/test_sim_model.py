@@ -11,7 +11,7 @@ import pytest
 from sim_rigs import R_TIP, START, asymmetric_surface, deepest_contacts, plane_rig
 
 from spine_mj.sim import Rig, StaticProbe, TipParams
-from spine_mj.surfaces import GridSurface, TriangulatedSurface, from_hfield, single_gaussian
+from spine_mj.surfaces import GridSurface, TriangulatedSurface, from_hfield, inclined_plane, single_gaussian
 
 
 def test_hfield_orientation_extent_and_scale_match_the_surface():
@@ -151,3 +151,26 @@ def test_fine_grid_is_coarsened_to_respect_the_contact_cap():
     for start in [(0.0, 0.0), (-1e-4, 5e-5), (1e-4, -1e-4)]:
         z = rig.place(*start)[2] * rig.units.length_m
         assert surf.height(*start) < z < surf.heights.max() + 2 * 25e-6
+
+
+def test_placement_on_a_grid_finer_than_the_contact_cap_rests_the_tip_at_its_rest_depth():
+    """A tip over many more cells than MuJoCo's 50 contacts per geom pair (a 10 deg plane
+    refined 4 times, about 16 cells a tip radius): the placement's probe must not lose
+    the deepest facet among those inside its contact margin, or the tip starts sunk into
+    the surface (sandpaper at hfield x 2 started 0.11 tip radii deep and ended as
+    "penetration" on its first step)."""
+    from spine_mj.sim import build_rig
+    from spine_mj.sim.step_rule import rest_depth_m
+
+    plane = inclined_plane(slope_deg=10.0, half_width=0.01, n=81)
+    rig = build_rig(plane, mu=0.5, tip_radius_m=1e-3, hfield_resolution=81, hfield_refinement=4)
+    r = rig.scales.tip_radius_m
+    assert rig.scales.hfield_spacing_m < 0.07 * r  # the tip spans hundreds of facets
+    rest = rest_depth_m(rig.engine, rig.scales)
+    d = mujoco.MjData(rig.model)
+    for x0, y0 in [(0.0, 0.0), (1.3e-3, -2.1e-3), (-2.7e-3, 1.9e-3)]:
+        d.qpos[:] = rig.place(x0, y0)
+        mujoco.mj_forward(rig.model, d)
+        assert 0 < d.ncon < 50
+        depth = -d.contact.dist[: d.ncon].min() * rig.units.length_m  # along the normal
+        assert depth == pytest.approx(rest * math.cos(math.radians(10.0)), rel=1e-3)
