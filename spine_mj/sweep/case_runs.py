@@ -16,7 +16,7 @@ import numpy as np
 import pyarrow as pa
 
 from spine_mj.sweep.cases import Case
-from spine_mj.sweep.registry import ANALYSES, RESERVED, AnalysisResult
+from spine_mj.sweep.registry import ANALYSES, RESERVED, AnalysisResult, param_specs
 
 
 def run_case(case: Case) -> tuple[Any, Any]:
@@ -103,8 +103,9 @@ def _rows(case: Case, analysis: str, starts, status, reason, metrics, elapsed: f
         "surface_seed": pa.array([case.surface.seed] * n, pa.int64()),
         "seed": np.full(n, case.seed, np.int64),
     }
+    specs = param_specs(case.analyses)
     for k, v in case.params.items():
-        cols[k] = pa.array([v] * n, _arrow_type(v))
+        cols[k] = pa.array([v] * n, _arrow_type(v, specs[k].kind if k in specs else None))
     cols["status"] = list(status)
     cols["reason"] = list(reason)
     cols["time_s"] = np.full(n, elapsed / max(n, 1))
@@ -114,7 +115,13 @@ def _rows(case: Case, analysis: str, starts, status, reason, metrics, elapsed: f
     return pa.table(cols)
 
 
-def _arrow_type(value):
+#: The column type of a parameter's kind (what a None of that parameter is stored as).
+_KIND_TYPES = {"float": pa.float64(), "int": pa.int64(), "str": pa.string(), "bool": pa.bool_()}
+
+
+def _arrow_type(value, kind: str | None = None):
+    if value is None and kind in _KIND_TYPES:
+        return _KIND_TYPES[kind]
     if isinstance(value, bool):
         return pa.bool_()
     if isinstance(value, int):

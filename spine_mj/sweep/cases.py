@@ -17,7 +17,7 @@ from spine_mj import presets
 from spine_mj.errors import SpineInputError
 from spine_mj.jsonio import to_jsonable
 from spine_mj.sweep.config import StartsSpec, SurfaceSpec, SweepConfig, digest
-from spine_mj.sweep.registry import PRESET_MU, param_specs
+from spine_mj.sweep.registry import PRESET_MU, applied_params, param_specs
 
 
 @dataclass(frozen=True)
@@ -33,7 +33,8 @@ class Case:
     surface : SurfaceSpec
     starts : StartsSpec
     params : dict
-        Every parameter of the sweep's analyses (one value each).
+        Every parameter of the sweep's analyses (one value each; None for one the case's
+        engine does not read).
     seed : int
         Derived from the master seed and ``case_id``: the only randomness of the case.
     analyses : tuple of str
@@ -81,7 +82,7 @@ def expand_cases(config: SweepConfig) -> list[Case]:
             else config.starts
         )
         for combo in combos:
-            params = dict(zip(names, combo))
+            params = applied_params(dict(zip(names, combo)), specs)
             for k in from_preset:
                 if params[k] is None:
                     params[k] = presets.preset_mu(surf.source)

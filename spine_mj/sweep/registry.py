@@ -86,6 +86,10 @@ class ParamSpec:
         May also be given in the ``[drive]`` table.
     array : bool
         May also be given in the ``[array]`` table (the layout of the ``array`` analysis).
+    engines : tuple of str, optional
+        The engines that read it (None: every engine, or no engine). A case whose
+        ``engine`` is not one of them records it as None (:func:`applied_params`): a row
+        records only settings that were applied.
     """
 
     name: str
@@ -98,6 +102,7 @@ class ParamSpec:
     drive: bool = False
     maximum: float | None = None
     array: bool = False
+    engines: tuple[str, ...] | None = None
 
     def expected(self) -> str:
         if self.choices:
@@ -236,6 +241,16 @@ def register_analysis(analysis: Analysis) -> Analysis:
             raise SpineInputError(f"parameter name {spec.name!r} is reserved for the run table")
     ANALYSES[analysis.name] = analysis
     return analysis
+
+
+def applied_params(params: dict, specs: dict[str, ParamSpec]) -> dict:
+    """``params`` with None for every parameter that the case's ``engine`` does not read
+    (a :class:`ParamSpec` whose ``engines`` leaves it out)."""
+    engine = params.get("engine")
+    return {
+        k: None if specs[k].engines is not None and engine not in specs[k].engines else v
+        for k, v in params.items()
+    }
 
 
 def param_specs(analyses: tuple[str, ...]) -> dict[str, ParamSpec]:

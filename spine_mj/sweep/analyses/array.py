@@ -24,7 +24,7 @@ from spine_mj.errors import SpineInputError
 from spine_mj.sim.array import ARRAY_ENGINE_REFUSAL
 from spine_mj.sim.drives import spring_stiffness_n_m
 from spine_mj.sim.layout import MAX_SPINES
-from spine_mj.sweep.analyses.mujoco import MUJOCO_PARAMS, case_rig, case_scales
+from spine_mj.sweep.analyses.mujoco import MUJOCO_PARAMS, case_rig, case_scales, check_speed
 from spine_mj.sweep.registry import CASE_THREADS, Analysis, AnalysisResult, ParamSpec, register_analysis
 
 ARRAY_PARAMS = (
@@ -63,6 +63,25 @@ def _layout(p: dict) -> sim.Layout:
     )
 
 
+def _check_drive_keys(grid: dict) -> None:
+    """Refuse the single-spine drive keys an array does not read, as ``spine-mj array``
+    does (a row records only settings that were applied): the array runs its own drive
+    (``array_drive``), not the ramp or the static probe, and a force pull runs to its cap,
+    not for a ``duration``."""
+    others = [p for p in grid["protocol"] if p != "spring"]
+    if others:
+        raise SpineInputError(
+            f"config key protocol = {list(grid['protocol'])}: the array analysis runs its own drive "
+            f"(array_drive: its carriage at the drive speed, or a force pull), not the {' and '.join(others)} "
+            "protocol; remove it, or sweep that protocol without the array"
+        )
+    if grid["duration"] != (None,) and "force" in grid["array_drive"]:
+        raise SpineInputError(
+            f"config key duration = {list(grid['duration'])}: the force array drive ignores it (a pull runs to "
+            "its cap); remove it, or sweep array_drive = 'speed' separately"
+        )
+
+
 def _check_layouts(config) -> None:
     """Refuse at config time what ``spine-mj array`` refuses up front, rather than record
     every run ``failed``: a layout of more than MAX_SPINES spines, ``layout_seed`` where no
@@ -71,6 +90,8 @@ def _check_layouts(config) -> None:
     grid = dict(config.grid)
     if "bullet" in grid["engine"]:
         raise SpineInputError(ARRAY_ENGINE_REFUSAL)
+    _check_drive_keys(grid)
+    check_speed(config)
     if grid["layout_seed"] != (0,) and "random" not in grid["layout"]:
         raise SpineInputError(
             f"config key layout_seed = {list(grid['layout_seed'])}: the {' and '.join(grid['layout'])} "

@@ -28,6 +28,9 @@ from spine_mj.sweep.registry import (
     register_analysis,
 )
 
+#: The engines that read MuJoCo's solver options (:data:`spine_mj.sim.engines.MUJOCO_ONLY`).
+_MUJOCO = ("mujoco",)
+
 MUJOCO_PARAMS = (
     MU_PARAM,
     ParamSpec(
@@ -128,12 +131,21 @@ MUJOCO_PARAMS = (
         "MuJoCo integrator",
         "implicitfast",
         choices=("euler", "implicitfast", "implicit", "rk4"),
+        engines=_MUJOCO,
     ),
-    ParamSpec("cone", "str", "friction cone", "elliptic", choices=("elliptic", "pyramidal")),
-    ParamSpec("impratio", "float", "frictional / normal impedance ratio", 1.0, 0.0, exclusive=True),
-    ParamSpec("noslip_iterations", "int", "noslip solver passes", 3, 0),
+    ParamSpec("cone", "str", "friction cone", "elliptic", choices=("elliptic", "pyramidal"), engines=_MUJOCO),
     ParamSpec(
-        "tolerance", "float", "MuJoCo solver tolerance (default MuJoCo's, 1e-8)", None, 0.0, exclusive=True
+        "impratio", "float", "frictional / normal impedance ratio", 1.0, 0.0, exclusive=True, engines=_MUJOCO
+    ),
+    ParamSpec("noslip_iterations", "int", "noslip solver passes", 3, 0, engines=_MUJOCO),
+    ParamSpec(
+        "tolerance",
+        "float",
+        "MuJoCo solver tolerance (default MuJoCo's, 1e-8)",
+        None,
+        0.0,
+        exclusive=True,
+        engines=_MUJOCO,
     ),
     ParamSpec(
         "noslip_tolerance",
@@ -142,6 +154,7 @@ MUJOCO_PARAMS = (
         None,
         0.0,
         exclusive=True,
+        engines=_MUJOCO,
     ),
     ParamSpec(
         "timestep_factor",
@@ -150,6 +163,7 @@ MUJOCO_PARAMS = (
         None,
         0.0,
         exclusive=True,
+        engines=_MUJOCO,
     ),
     ParamSpec(
         "solref_timeconst",
@@ -158,8 +172,11 @@ MUJOCO_PARAMS = (
         None,
         0.0,
         exclusive=True,
+        engines=_MUJOCO,
     ),
-    ParamSpec("solref_dampratio", "float", "contact damping ratio", 1.0, 0.0, exclusive=True),
+    ParamSpec(
+        "solref_dampratio", "float", "contact damping ratio", 1.0, 0.0, exclusive=True, engines=_MUJOCO
+    ),
     ParamSpec(
         "hfield_resolution",
         "int",
@@ -190,7 +207,7 @@ PROTOCOL_KEYS = {
 }
 
 
-def _check_speed(config) -> None:
+def check_speed(config) -> None:
     """One of ie/speed, K/stiffness and timestep/timestep_factor; no drive key that a
     chosen protocol would ignore."""
     grid = dict(config.grid)
@@ -206,6 +223,13 @@ def _check_speed(config) -> None:
             )
     if "bullet" in grid["engine"]:
         sim.check_engine_name("bullet", "config key engine =")
+        defaults = {s.name: s.default for s in MUJOCO_PARAMS if s.engines == _MUJOCO}
+        given = [f"{k} = {list(grid[k])}" for k, d in defaults.items() if grid[k] != (d,)]
+        if given:
+            raise SpineInputError(
+                f"config keys {', '.join(given)}: MuJoCo's solver options, not read by engine bullet; "
+                "remove them, or sweep engine = 'mujoco' separately"
+            )
     defaults = {s.name: s.default for s in MUJOCO_PARAMS}
     protocols = grid["protocol"]
     for key, readers in PROTOCOL_KEYS.items():
@@ -490,7 +514,7 @@ register_analysis(
         _mujoco,
         MUJOCO_PARAMS,
         doc="MuJoCo rig run from every start with the chosen drive: spine_mj.sim",
-        check_config=_check_speed,
+        check_config=check_speed,
         check_case=_check_case,
     )
 )
