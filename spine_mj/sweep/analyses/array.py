@@ -72,13 +72,13 @@ def _check_drive_keys(grid: dict) -> None:
     if others:
         raise SpineInputError(
             f"config key protocol = {list(grid['protocol'])}: the array analysis runs its own drive "
-            f"(array_drive: its carriage at the drive speed, or a force pull), not the {' and '.join(others)} "
-            "protocol; remove it, or sweep that protocol without the array"
+            f"(array_drive: its carriage at the drive speed, or a force pull), not the "
+            f"{' and '.join(others)} protocol; remove it, or sweep that protocol without the array"
         )
     if grid["duration"] != (None,) and "force" in grid["array_drive"]:
         raise SpineInputError(
-            f"config key duration = {list(grid['duration'])}: the force array drive ignores it (a pull runs to "
-            "its cap); remove it, or sweep array_drive = 'speed' separately"
+            f"config key duration = {list(grid['duration'])}: the force array drive ignores it (a pull runs "
+            "to its cap); remove it, or sweep array_drive = 'speed' separately"
         )
 
 
