@@ -24,7 +24,6 @@ architecture (ARM) or MuJoCo build is not covered: that needs the other machine.
 
 from __future__ import annotations
 
-import argparse
 import json
 import os
 import subprocess
@@ -32,7 +31,7 @@ import sys
 from pathlib import Path
 
 from spine_mj.atomic import atomic_output
-from spine_mj.errors import SpineInputError
+from spine_mj.errors import OneLineParser, SpineInputError
 from spine_mj.validate.reproducibility import check_reproduction, headline_numbers
 
 REPO = Path(__file__).resolve().parents[1]
@@ -68,13 +67,6 @@ def table(rows) -> str:
     return "\n".join(lines)
 
 
-class _Parser(argparse.ArgumentParser):
-    """Usage errors as one ``Error:`` line, exit 2, like the CLI's."""
-
-    def error(self, message):
-        self.exit(2, f"Error: {message} (see --help)\n")
-
-
 def _writable(path: Path) -> None:
     """Refuse, before any work, a report path that cannot be written."""
     if path.is_dir():
@@ -88,7 +80,7 @@ def _writable(path: Path) -> None:
 
 
 def main(argv=None) -> int:
-    ap = _Parser(description=__doc__.split("\n\n")[0])
+    ap = OneLineParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("new", nargs="?", help="validation.json of the new run")
     ap.add_argument("--committed", default=str(COMMITTED), help="the committed validation.json")
     ap.add_argument(

@@ -1,4 +1,5 @@
-"""The one exception type spine_mj raises for bad input, and the check of a positive number.
+"""The one exception type spine_mj raises for bad input, the check of a positive number, and
+the argument parser of the ``python -m`` studies and scripts that reports as the CLI does.
 
 Every check of user input raises :class:`SpineInputError` with a message that names the
 argument, what was expected and what arrived. The CLI turns it into one line on stderr and
@@ -7,9 +8,10 @@ exit code 2; library users can catch it as a ``ValueError``.
 
 from __future__ import annotations
 
+import argparse
 import math
 
-__all__ = ["SpineInputError", "check_positive"]
+__all__ = ["OneLineParser", "SpineInputError", "check_positive", "non_negative_int"]
 
 
 class SpineInputError(ValueError):
@@ -34,3 +36,23 @@ def check_positive(name: str, value, *, allow_zero: bool = False) -> float:
             f"{name} must be a finite number {'>= 0' if allow_zero else '> 0'}, got {value!r}"
         )
     return v
+
+
+class OneLineParser(argparse.ArgumentParser):
+    """An :class:`argparse.ArgumentParser` whose usage errors (a missing, unknown or
+    malformed argument) are one ``Error:`` line and exit code 2, as the CLI's, instead of
+    argparse's usage text."""
+
+    def error(self, message):
+        self.exit(2, f"Error: {message} (see --help)\n")
+
+
+def non_negative_int(text: str) -> int:
+    """An argparse ``type``: ``text`` as an integer >= 0 (argparse names the option)."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be an integer >= 0, got {text!r}") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"must be an integer >= 0, got {text!r}")
+    return value

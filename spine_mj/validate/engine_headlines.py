@@ -36,6 +36,7 @@ import numpy as np
 import pandas as pd
 
 from spine_mj import compare, sim
+from spine_mj.errors import non_negative_int
 from spine_mj.validate.convergence import thin_starts
 from spine_mj.validate.ensembles import ensemble_family
 from spine_mj.validate.intervals import newcombe_difference
@@ -434,7 +435,7 @@ def add_arguments(ap) -> None:
     """The study's options of ``python -m spine_mj.validate.engines``."""
     ap.add_argument(
         "--headlines",
-        type=int,
+        type=non_negative_int,
         default=0,
         metavar="N",
         help="also the quasistatic-limit corner per family in both engines, N y starts per surface "

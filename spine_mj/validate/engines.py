@@ -48,8 +48,8 @@ the validation report written there next has the section.
 
 from __future__ import annotations
 
-import argparse
 import math
+import sys
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -58,6 +58,8 @@ from pathlib import Path
 import numpy as np
 
 from spine_mj import presets, sim
+from spine_mj.atomic import atomic_output
+from spine_mj.errors import OneLineParser, SpineInputError, non_negative_int
 from spine_mj.surfaces import GridSurface
 from spine_mj.theory import engagement
 from spine_mj.theory.tomlinson import Corrugation
@@ -471,13 +473,15 @@ def engines_ground_truth(
     return EnginesResult(rows=list(by_key.values()), engines=tuple(engines), wall_s=wall)
 
 
-def main(argv=None) -> None:
-    ap = argparse.ArgumentParser(description="The closed forms in both engines (MuJoCo and Bullet).")
+def main(argv=None) -> int:
+    """``python -m spine_mj.validate.engines``: every argument, the output folder and the
+    ``[bullet]`` extra checked before any work; a bad one is one ``Error:`` line, exit 2."""
+    ap = OneLineParser(description="The closed forms in both engines (MuJoCo and Bullet).")
     ap.add_argument("--out", type=Path, required=True, help="folder for engines.json and engines.md")
     ap.add_argument("--quick", action="store_true", help="fewer corrugation wavelengths")
     ap.add_argument(
         "--fractal",
-        type=int,
+        type=non_negative_int,
         default=0,
         metavar="N",
         help="also the fractal self-lock rate, N surfaces per H",
@@ -487,9 +491,35 @@ def main(argv=None) -> None:
 
     engine_headlines.add_arguments(ap)
     args = ap.parse_args(argv)
+    try:
+        _check_arguments(args)
+        _run(args)
+    except SpineInputError as exc:
+        print(f"Error: {exc}", file=sys.stderr)
+        return 2
+    return 0
+
+
+def _check_arguments(args) -> None:
+    """What the study would refuse midway, refused before its first run."""
+    from spine_mj import extras
+    from spine_mj.atomic import writable_path
+    from spine_mj.workers import check_workers
+
+    if args.workers is not None:
+        check_workers(args.workers)
+    if args.out.exists() and not args.out.is_dir():
+        raise SpineInputError(f"--out {args.out}: is a file, expected a folder")
+    extras.require("bullet", "python -m spine_mj.validate.engines (it runs both engines)")
+    for name in ("engines.json", "engines.md"):
+        writable_path(args.out / name)
+
+
+def _run(args) -> None:
     import dataclasses
 
     from spine_mj.jsonio import write_json
+    from spine_mj.validate import engine_headlines
 
     res = engines_ground_truth(quick=args.quick, progress=lambda s: print(s, flush=True))
     if args.fractal:
@@ -498,10 +528,10 @@ def main(argv=None) -> None:
         wall = dict(res.wall_s, fractal=round(time.perf_counter() - t0, 1))
         res = dataclasses.replace(res, fractal=fractal, wall_s=wall)
     headlines = engine_headlines.from_arguments(args, progress=lambda s: print(s, flush=True))
-    args.out.mkdir(parents=True, exist_ok=True)
     write_json(args.out / "engines.json", res.as_dict())
     text = section(res) + engine_headlines.section(headlines)
-    (args.out / "engines.md").write_text(text)
+    with atomic_output(args.out / "engines.md") as tmp:
+        tmp.write_text(text)
     print(text)
 
 
@@ -554,4 +584,4 @@ def fractal_engines(
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

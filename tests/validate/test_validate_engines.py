@@ -143,3 +143,48 @@ def test_the_validation_report_has_the_section_when_the_study_ran_into_its_folde
     res = study.EnginesResult(rows=[], engines=("mujoco", "bullet"), wall_s={"mujoco": 1.0})
     write_json(tmp_path / "engines" / "engines.json", res.as_dict())
     assert study.section(res) in write_report(tmp_path, summary, []).read_text()
+
+
+@pytest.mark.parametrize(
+    ("args", "fragment"),
+    [
+        (["--fractal", "-1"], "argument --fractal: must be an integer >= 0, got '-1'"),
+        (["--headlines", "-1"], "argument --headlines: must be an integer >= 0, got '-1'"),
+        (["--fractal", "abc"], "argument --fractal: must be an integer >= 0, got 'abc'"),
+        (["--workers", "0"], "--workers: must be an integer from 1"),
+        (["--bogus"], "unrecognized arguments: --bogus"),
+        ("no --out", "the following arguments are required: --out"),
+        ("a file", "is a file, expected a folder"),
+        ("under a file", "is a file, not a folder"),
+    ],
+)
+def test_every_bad_argument_is_one_error_line_before_any_work(tmp_path, capsys, args, fragment):
+    (tmp_path / "afile").write_text("")
+    if args == "no --out":
+        argv = []
+    elif args == "a file":
+        argv = ["--out", str(tmp_path / "afile")]
+    elif args == "under a file":
+        argv = ["--out", str(tmp_path / "afile" / "sub")]
+    else:
+        argv = ["--out", str(tmp_path / "out"), *args]
+    try:
+        code = study.main(argv)
+    except SystemExit as stop:  # argparse's own usage errors exit through SystemExit
+        code = stop.code
+    captured = capsys.readouterr()
+    assert code == 2
+    assert captured.out == ""  # no check ran
+    assert captured.err.splitlines() == [captured.err.strip()] and captured.err.startswith("Error: ")
+    assert fragment in captured.err
+    assert not (tmp_path / "out").exists()
+
+
+def test_without_the_bullet_extra_the_study_is_refused_before_any_work(monkeypatch, tmp_path, capsys):
+    from spine_mj import extras
+
+    monkeypatch.setitem(extras.EXTRAS, "bullet", ("no_such_module_spine_mj",))
+    assert study.main(["--out", str(tmp_path / "out")]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == "" and "needs the optional extra 'bullet'" in captured.err
+    assert not (tmp_path / "out").exists()
