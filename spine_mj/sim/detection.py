@@ -293,12 +293,16 @@ def end_candidates(
     if (k := mark("lock_rule")) is not None:
         detail = (
             f"lock rule: stuck on a contact normal in the self-lock region while the drive force "
-            f"rose by {LOCK_RISE_FP:g} F_p (to {rec.drive_force_n[k] / preload_n:.3g} F_p)"
+            f"rose by {LOCK_RISE_FP:g} F_p (to {rec.drive_force_n[k] / preload_n:.3g} F_p; "
+            f"{_held_by(rec, k, preload_n)})"
         )
         candidates.append(Ending(k, 3, EndReason.SELF_LOCK, detail))
     if (k := mark("lock")) is not None:
         cap = det.kappa_cap * preload_n
-        detail = f"force cap: drive force reached kappa_cap * F_p = {cap:.4g} N without slip"
+        detail = (
+            f"force cap: drive force reached kappa_cap * F_p = {cap:.4g} N without slip "
+            f"({_held_by(rec, k, preload_n)})"
+        )
         candidates.append(Ending(k, 3, EndReason.SELF_LOCK, detail))
     return candidates
 
@@ -320,6 +324,18 @@ def _penetration_cause(rec: Recording, k: int, preload_n: float) -> str:
         speed = float(np.linalg.norm(rec.velocity_m_s[onset - 1]))
         return f"landing at {speed:.3g} m/s after {airborne} steps airborne"
     return f"contact pressed by a normal force of {rec.normal_force_n[k] / preload_n:.3g} F_p"
+
+
+def _held_by(rec: Recording, k: int, preload_n: float) -> str:
+    """The contact that holds a lock at step ``k``: its normal force (the net contact force
+    along the deepest contact's normal) in F_p and its depth. A tip wedged between facets
+    carries more normal force than a single contact would (``(W cos theta + F sin theta)
+    cos alpha`` along each flank of a V-groove, docs/physics.md §6), held at the soft
+    contact's depth, which is not engine trouble while it stays within the tolerance."""
+    return (
+        f"held with a normal force of {rec.normal_force_n[k] / preload_n:.3g} F_p "
+        f"at a depth of {rec.penetration_m[k]:.3g} m"
+    )
 
 
 def probe_candidates(

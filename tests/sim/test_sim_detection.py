@@ -111,3 +111,43 @@ def test_a_spring_stretch_beyond_the_energy_bound_is_a_divergence():
     swing = det.speed_limit_m_s(rig.scales, v) * np.sqrt(k * rig.scales.mass_kg)
     assert limit == pytest.approx(2 * (det.kappa_cap + 1) * fp + swing)
     assert det.force_limit_n(rig.scales, v, 0.0) == np.inf  # a force drive pulls with its own force
+
+
+@pytest.mark.parametrize("refinement", [1, 4])
+def test_a_tip_wedged_in_a_v_groove_ends_held_never_as_engine_trouble(refinement):
+    """A spring drive up a V-groove (docs/physics.md §6): rising at theta = 50 deg with flanks
+    at alpha = 70 deg, the pair of contacts self-locks (theta + arctan(mu / cos alpha') =
+    95.5 deg > 90 deg) where either flank's slope alone would not; a gentler groove (20, 30
+    deg) slides at the wedge's kappa = tan(theta + arctan(mu / cos alpha')). On the hfield
+    refined 1 and 4 times (16 cells a tip radius at 4) the wedged tip ends held at the
+    force cap with the contact's normal force the closed form gives, (W cos theta + F sin
+    theta) cos alpha' along a flank's normal, at a healthy depth."""
+    import math
+
+    from spine_mj import sim
+    from spine_mj.validate.engines import flank_tilt, groove
+
+    mu = 0.5
+    for theta, alpha in ((50.0, 70.0), (20.0, 30.0)):
+        tilt = flank_tilt(theta, alpha)
+        th = math.radians(theta)
+        rig = sim.build_rig(
+            groove(theta, alpha), mu=mu, tip_radius_m=2e-3, hfield_refinement=refinement, ie=1e-4
+        )
+        fp, r_tip = rig.scales.preload_n, rig.scales.tip_radius_m
+        res = rig.run(sim.build_drive(rig.scales, "spring", ie=1e-4), start=(-0.01, 0.0))
+        assert not res.engine_trouble
+        assert res.penetration_m.max() < 0.02 * r_tip
+        force = res.drive_force_n[res.drive_start_index :] / fp
+        if theta + math.degrees(math.atan(mu / math.cos(tilt))) > 90:
+            assert res.end_reason is sim.EndReason.SELF_LOCK
+            assert res.end_detail.startswith("force cap") and "held with a normal force of" in res.end_detail
+            assert force[-1] == pytest.approx(Detection().kappa_cap, rel=1e-3)
+            expected = (math.cos(th) + force[-1] * math.sin(th)) * math.cos(tilt)
+            assert res.normal_force_n[-1] / fp == pytest.approx(expected, rel=0.02)
+            assert abs(res.position_m[-1, 1]) < 0.01 * r_tip  # held in the crease
+        else:
+            assert res.end_reason is sim.EndReason.LEFT_DOMAIN  # slid up the groove
+            wedge = math.tan(th + math.atan(mu / math.cos(tilt)))
+            assert np.mean(force[len(force) // 3 :]) == pytest.approx(wedge, rel=0.05)
+            assert np.mean(force[len(force) // 3 :]) > 1.05 * math.tan(th + math.atan(mu))
