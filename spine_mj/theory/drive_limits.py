@@ -61,14 +61,17 @@ from spine_mj.theory.engagement import DEFAULT_KAPPA_CAP, SELF_LOCK
 from spine_mj.theory.targets import FRECHET_TARGET, OUTCOME_TARGET
 
 __all__ = [
+    "CORNER_MARGIN",
     "SPRING_TRAVEL_PAST_EDGE",
     "SWING_BOUND_FP",
+    "Corner",
     "DriveLimits",
     "crest_curvature",
     "drive_limits",
     "kappa_fall",
     "path_criterion",
     "path_stiffness",
+    "quasistatic_corner",
     "spring_ie_limits",
     "spring_run_travel",
     "trap_depths",
@@ -83,6 +86,18 @@ SWING_BOUND_FP = 1.0
 #: A spring run without a duration moves its carriage this many times the distance from
 #: its start to the domain's +x edge, plus the spring's stretch (:func:`spring_run_travel`).
 SPRING_TRAVEL_PAST_EDGE = 1.1
+
+#: How far inside its predicted limits a corner lies, in each of ``I_e`` and ``K``
+#: (:func:`quasistatic_corner`). Every error between the limit's path and the streamline is
+#: of first order in the distance from the limit (docs/physics.md §7): the lag of a turn
+#: grows like ``I_e L_c / (2 mu)``, the compliant offset like ``1 / K``, and at the limits
+#: they reach the path tolerance, the Frechet target of 0.1 L_c. A tenth of the way there
+#: they are 0.01 L_c, the Frechet distance's own resolution (half a sample of its L_c / 50
+#: resampling, :data:`spine_mj.validate.theory_orders.FRECHET_FLOOR_LC`): a corner whose
+#: dynamic and compliant errors the metric cannot tell from zero. For the thresholds that
+#: are not gradual (lift-off, a trap skipped) the tip then has a tenth of the kinetic energy
+#: that skips the shallowest trap, and a tenth of the crest speed squared that lifts it.
+CORNER_MARGIN = 10.0
 
 #: ``K_path`` is bracketed to this factor (the map's ladder steps are 3 and more).
 PATH_STIFFNESS_RESOLUTION = 2 ** (1 / 4)
@@ -164,6 +179,146 @@ class DriveLimits:
             f"(set by {self.limit}; lift-off {self.ie_lift:.3g}, trap {self.ie_trap:.3g}, "
             f"lag {self.ie_lag:.3g})"
         )
+
+
+@dataclass(frozen=True)
+class Corner:
+    """The quasistatic corner of a surface (:func:`quasistatic_corner`; dimensionless).
+
+    Attributes
+    ----------
+    ie : float
+        The drive's inertia number ``I_e``.
+    k : float
+        The spring's stiffness number ``K = k l_s / F_p``.
+    swing_fp : float
+        The spring-block force swing ``sqrt(I_e K L_c / l_s)`` at the corner [F_p].
+    ie_bound : str
+        What sets ``I_e``: ``"I_e*"`` (the surface's own limit over the margin),
+        ``"swing-path"`` (the position swing) or ``"swing-force"`` (:data:`SWING_BOUND_FP`).
+    k_bound : str
+        What ``K`` is the margin times: ``"K_path"`` or ``"K*"`` (no ``K_path`` given).
+    reason : str
+        One sentence: the corner and why.
+    """
+
+    ie: float
+    k: float
+    swing_fp: float
+    ie_bound: str
+    k_bound: str
+    reason: str
+
+    def as_dict(self) -> dict:
+        """``{"ie", "K", "swing_fp", "ie_bound", "k_bound", "reason"}`` (``validation.json``'s
+        ``corner``)."""
+        return {
+            "ie": self.ie,
+            "K": self.k,
+            "swing_fp": self.swing_fp,
+            "ie_bound": self.ie_bound,
+            "k_bound": self.k_bound,
+            "reason": self.reason,
+        }
+
+
+def _one_digit_down(v: float) -> float:
+    """``v`` rounded down to one significant digit (``2.46e-3 -> 2e-3``)."""
+    scale = 10.0 ** math.floor(math.log10(v))
+    return math.floor(v / scale * (1 + 1e-12)) * scale
+
+
+def _two_digits_up(v: float) -> float:
+    """``v`` rounded up to two significant digits (``291.3 -> 300``, ``70.4 -> 71``)."""
+    scale = 10.0 ** (math.floor(math.log10(v)) - 1)
+    return float(f"{math.ceil(v / scale * (1 - 1e-12)) * scale:.2g}")
+
+
+def quasistatic_corner(
+    *,
+    ie_star: float,
+    k_path: float,
+    lc_over_ls: float,
+    k_star: float = math.nan,
+    path_tolerance: float = FRECHET_TARGET,
+    margin: float = CORNER_MARGIN,
+    ie_limit: str = "",
+) -> Corner:
+    """The corner ``(I_e, K)`` at which a spring drive on a surface is quasistatic, from the
+    surface's own predicted limits (:func:`drive_limits`, :func:`spring_ie_limits`).
+
+    * ``K = margin K_path`` (``margin K*`` where ``K_path`` is not given), rounded up to two
+      digits: the compliant path's offset from the rigid one, first order in ``1 / K``,
+      is then a ``margin``-th of the path tolerance it reaches at ``K_path``.
+    * ``I_e`` the smallest of ``I_e* / margin`` (lift-off, trap skipping and lag: the lag
+      is first order in ``I_e``), ``t^2 K_c / margin^2`` (the spring-block's position swing
+      ``L_c sqrt(I_e / K_c)``, a ``margin``-th of the path tolerance ``t L_c``) and
+      ``SWING_BOUND_FP^2 / K_c`` (the force swing ``sqrt(I_e K_c)`` at most
+      :data:`SWING_BOUND_FP`), ``K_c = K L_c / l_s``; rounded down to one digit.
+
+    Parameters
+    ----------
+    ie_star : float
+        The surface's ``I_e*`` (:attr:`DriveLimits.ie_star`; the lowest of its surfaces'
+        for a family).
+    k_path : float
+        ``K_path`` of the measurement's starts (:attr:`DriveLimits.k_path`; the highest of
+        a family's); NaN: use ``k_star``.
+    lc_over_ls : float
+        ``L_c / l_s`` (the largest of a family's).
+    k_star : float
+        The fold ``K*``, used where ``k_path`` is NaN.
+    path_tolerance : float
+        ``t``, in ``L_c`` (default the Frechet target).
+    margin : float
+        How far inside the limits, > 1 (default :data:`CORNER_MARGIN`).
+    ie_limit : str
+        What set ``ie_star`` (``"trap"``, ...), for the reason.
+
+    Returns
+    -------
+    Corner
+
+    Raises
+    ------
+    SpineInputError
+        A limit that is not a positive finite number (``ie_star`` may be inf: no limit
+        from the geometry), no usable ``K_path`` nor ``K*``, or ``margin <= 1``.
+    """
+    for name, v in (("ie_star", ie_star), ("lc_over_ls", lc_over_ls), ("path_tolerance", path_tolerance)):
+        if not (isinstance(v, (int, float)) and v > 0 and not math.isnan(v)):
+            raise SpineInputError(f"{name} must be a positive number, got {v!r}")
+    if not (math.isfinite(lc_over_ls) and math.isfinite(path_tolerance)):
+        raise SpineInputError(
+            f"lc_over_ls and path_tolerance must be finite, got {lc_over_ls!r}, {path_tolerance!r}"
+        )
+    if not (isinstance(margin, (int, float)) and math.isfinite(margin) and margin > 1):
+        raise SpineInputError(f"margin must be a finite number > 1, got {margin!r}")
+    if isinstance(k_path, (int, float)) and math.isfinite(k_path) and k_path > 0:
+        k_ref, k_bound = float(k_path), "K_path"
+    elif isinstance(k_star, (int, float)) and math.isfinite(k_star) and k_star > 0:
+        k_ref, k_bound = float(k_star), "K*"
+    else:
+        raise SpineInputError(
+            f"the corner needs K_path (drive_limits with path_starts) or a positive K*, got "
+            f"k_path={k_path!r}, k_star={k_star!r}"
+        )
+    k = _two_digits_up(margin * k_ref)
+    swing = spring_ie_limits(k, lc_over_ls, path_tolerance=path_tolerance / margin)
+    bounds = {"I_e*": ie_star / margin, **swing}
+    ie_bound = min(bounds, key=bounds.get)
+    ie = _one_digit_down(bounds[ie_bound])
+    swing_fp = math.sqrt(ie * k * lc_over_ls)
+    why = {
+        "I_e*": f"I_e* {ie_star:.3g}{f' ({ie_limit})' if ie_limit else ''} / {margin:g}",
+        "swing-path": f"the spring's position swing at {path_tolerance / margin:.3g} L_c",
+        "swing-force": f"the spring's force swing at {SWING_BOUND_FP:g} F_p",
+    }[ie_bound]
+    reason = (
+        f"I_e {ie:.3g}, K {k:.3g}: K = {margin:g} {k_bound} ({k_ref:.3g}), I_e set by {why}; "
+        f"swing {swing_fp:.2g} F_p"
+    )
+    return Corner(ie=ie, k=k, swing_fp=swing_fp, ie_bound=ie_bound, k_bound=k_bound, reason=reason)
 
 
 def kappa_fall(x, hold) -> np.ndarray:

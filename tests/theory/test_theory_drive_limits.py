@@ -14,16 +14,22 @@ from spine_mj.surfaces import GaussianSurface, Surface, corrugation
 from spine_mj.theory import streamline as sl
 from spine_mj.theory.compliant import compliant_streamlines
 from spine_mj.theory.drive_limits import (
+    CORNER_MARGIN,
     PATH_STIFFNESS_RESOLUTION,
+    SWING_BOUND_FP,
     crest_curvature,
     drive_limits,
     kappa_fall,
     path_criterion,
     path_stiffness,
+    quasistatic_corner,
     spring_ie_limits,
     spring_run_travel,
     trap_depths,
 )
+
+#: The path tolerance the corner's swing bound uses by default (the Frechet target, L_c).
+FRECHET_TARGET_LC = 0.1
 
 
 @dataclass(frozen=True, eq=False)
@@ -196,6 +202,85 @@ def test_the_spring_swing_limits_invert_the_spring_block_amplitudes():
     assert math.sqrt(lim["swing-path"] / (k * ratio)) == pytest.approx(t)
     assert lim["swing-path"] * lim["swing-force"] == pytest.approx(t**2)  # widest at K_c = 1 / t
     assert spring_ie_limits(float("nan"), ratio) == {"swing-path": math.inf, "swing-force": math.inf}
+
+
+def test_the_corner_margin_puts_first_order_errors_at_the_frechet_resolution():
+    from spine_mj.theory.targets import FRECHET_TARGET
+    from spine_mj.validate.theory_orders import FRECHET_FLOOR_LC, PREDICTED_ORDERS
+
+    # lag ~ I_e and compliant offset ~ 1 / K, both reaching the target at the limit
+    assert PREDICTED_ORDERS == {"ie": 1.0, "inverse_k": 1.0}
+    assert FRECHET_TARGET / CORNER_MARGIN == pytest.approx(FRECHET_FLOOR_LC)
+
+
+@pytest.mark.parametrize("amp, sigma", [(0.5, 1.0), (0.3, 0.6)])
+def test_corner_of_a_ridge_is_a_tenth_of_its_closed_form_lift_off(amp, sigma):
+    ridge = GaussianSurface(
+        amplitude=np.array([amp]),
+        center_x=np.array([0.0]),
+        center_y=np.array([0.0]),
+        sigma_x=np.array([sigma]),
+        sigma_y=np.array([1e6]),
+        bounds=(-5.0, 5.0, -1.0, 1.0),
+    )
+    mu = 10.0  # lag at 2 mu 0.1 = 2: lift-off sets I_e*
+    d = drive_limits(ridge, mu, n_starts=3, dl=0.01)
+    lift = 1.0 / (d.char_length * amp / sigma**2)  # -z'' = amp / sigma^2 on the crest
+    assert d.limit == "lift-off"
+    # a soft enough K (the ridge's L_c is its length, so K_c = K L_c / l_s is large)
+    ratio = d.char_length / d.slope_length
+    c = quasistatic_corner(ie_star=d.ie_star, k_path=math.nan, k_star=0.1, lc_over_ls=ratio, ie_limit=d.limit)
+    assert c.ie_bound == "I_e*" and c.k_bound == "K*" and c.k == 0.1 * CORNER_MARGIN
+    assert lift / CORNER_MARGIN / 2 < c.ie <= lift / CORNER_MARGIN * (1 + 1e-3)
+    assert f"{c.ie:.1g}" == f"{c.ie:.6g}"  # one digit
+    assert c.swing_fp == pytest.approx(spring_swing(c.ie, c.k, ratio))
+    assert c.swing_fp <= SWING_BOUND_FP and "lift-off" in c.reason
+
+
+def test_corner_k_is_the_margin_over_the_prandtl_tomlinson_fold():
+    s, mu = 0.3, 0.5
+    surf = corrugation(slope_amplitude=s, n_waves=4, points_per_wave=64)
+    d = drive_limits(surf, mu, n_starts=3)
+    u = np.linspace(0, 2 * np.pi, 100_001)
+    k_pt = d.slope_length * ((1 + mu * mu) * s * 2 * np.pi * np.sin(u) / (1 - mu * s * np.cos(u)) ** 2).max()
+    c = quasistatic_corner(
+        ie_star=d.ie_star, k_path=math.nan, k_star=d.k_star, lc_over_ls=d.char_length / d.slope_length
+    )
+    assert CORNER_MARGIN * k_pt <= c.k * (1 + 5e-3) and c.k <= CORNER_MARGIN * k_pt * 1.1  # two digits, up
+    # K_path, where given, is what K is the margin over
+    assert quasistatic_corner(ie_star=0.1, k_path=7.3, k_star=d.k_star, lc_over_ls=1.0).k == 73.0
+
+
+def test_corner_swing_bounds():
+    # a stiff K on a long L_c: the force swing sqrt(I_e K L_c / l_s) sets I_e at <= 1 F_p
+    c = quasistatic_corner(ie_star=1.0, k_path=300.0, lc_over_ls=24.0)
+    kc = c.k * 24.0
+    assert c.k == 3000.0 and c.ie_bound == "swing-force"
+    assert 0.5 / kc < c.ie <= 1.0 / kc and c.swing_fp <= SWING_BOUND_FP
+    # a soft K: the position swing L_c sqrt(I_e / K_c) at a tenth of the path tolerance
+    c = quasistatic_corner(ie_star=1.0, k_path=0.05, lc_over_ls=2.0)
+    kc = c.k * 2.0
+    assert c.ie_bound == "swing-path"
+    assert math.sqrt(c.ie / kc) <= FRECHET_TARGET_LC / CORNER_MARGIN < 2 * math.sqrt(c.ie / kc)
+    # every bound holds at once, whichever sets I_e
+    for ie_star, k_path, ratio in [(3e-5, 29.0, 24.0), (0.25, 2.0, 1.0), (1e-3, 100.0, 0.5)]:
+        c = quasistatic_corner(ie_star=ie_star, k_path=k_path, lc_over_ls=ratio)
+        assert c.ie <= ie_star / CORNER_MARGIN and c.swing_fp <= SWING_BOUND_FP
+        assert math.sqrt(c.ie / (c.k * ratio)) <= FRECHET_TARGET_LC / CORNER_MARGIN
+        assert c.as_dict()["ie"] == c.ie and c.as_dict()["K"] == c.k
+
+
+def test_corner_bad_input():
+    with pytest.raises(SpineInputError, match="ie_star"):
+        quasistatic_corner(ie_star=float("nan"), k_path=1.0, lc_over_ls=1.0)
+    with pytest.raises(SpineInputError, match="lc_over_ls"):
+        quasistatic_corner(ie_star=1e-3, k_path=1.0, lc_over_ls=-1.0)
+    with pytest.raises(SpineInputError, match="K_path"):
+        quasistatic_corner(ie_star=1e-3, k_path=float("nan"), k_star=0.0, lc_over_ls=1.0)
+    with pytest.raises(SpineInputError, match="margin"):
+        quasistatic_corner(ie_star=1e-3, k_path=1.0, lc_over_ls=1.0, margin=1.0)
+    # no limit from the geometry (a plane): the swing alone sets I_e
+    assert quasistatic_corner(ie_star=math.inf, k_path=1.0, lc_over_ls=1.0).ie_bound.startswith("swing")
 
 
 def test_finite_differences_on_closed_forms():
