@@ -87,16 +87,11 @@ SWING_BOUND_FP = 1.0
 #: its start to the domain's +x edge, plus the spring's stretch (:func:`spring_run_travel`).
 SPRING_TRAVEL_PAST_EDGE = 1.1
 
-#: How far inside its predicted limits a corner lies, in each of ``I_e`` and ``K``
-#: (:func:`quasistatic_corner`). Every error between the limit's path and the streamline is
-#: of first order in the distance from the limit (docs/physics.md §7): the lag of a turn
-#: grows like ``I_e L_c / (2 mu)``, the compliant offset like ``1 / K``, and at the limits
-#: they reach the path tolerance, the Frechet target of 0.1 L_c. A tenth of the way there
-#: they are 0.01 L_c, the Frechet distance's own resolution (half a sample of its L_c / 50
-#: resampling, :data:`spine_mj.validate.theory_orders.FRECHET_FLOOR_LC`): a corner whose
-#: dynamic and compliant errors the metric cannot tell from zero. For the thresholds that
-#: are not gradual (lift-off, a trap skipped) the tip then has a tenth of the kinetic energy
-#: that skips the shallowest trap, and a tenth of the crest speed squared that lifts it.
+#: How far inside its limits a corner lies in ``I_e`` and in ``K`` (:func:`quasistatic_corner`):
+#: the lag (``I_e L_c / (2 mu)``) and the compliant offset (``1 / K``) are first order and
+#: reach the Frechet target 0.1 L_c at the limits; a tenth of the way they are 0.01 L_c, what
+#: the Frechet distance resolves (``validate.theory_orders.FRECHET_FLOOR_LC``). At a threshold
+#: (lift-off, a trap skipped) the tip has a tenth of the kinetic energy that crosses it.
 CORNER_MARGIN = 10.0
 
 #: ``K_path`` is bracketed to this factor (the map's ladder steps are 3 and more).
@@ -183,24 +178,11 @@ class DriveLimits:
 
 @dataclass(frozen=True)
 class Corner:
-    """The quasistatic corner of a surface (:func:`quasistatic_corner`; dimensionless).
-
-    Attributes
-    ----------
-    ie : float
-        The drive's inertia number ``I_e``.
-    k : float
-        The spring's stiffness number ``K = k l_s / F_p``.
-    swing_fp : float
-        The spring-block force swing ``sqrt(I_e K L_c / l_s)`` at the corner [F_p].
-    ie_bound : str
-        What sets ``I_e``: ``"I_e*"`` (the surface's own limit over the margin),
-        ``"swing-path"`` (the position swing) or ``"swing-force"`` (:data:`SWING_BOUND_FP`).
-    k_bound : str
-        What ``K`` is the margin times: ``"K_path"`` or ``"K*"`` (no ``K_path`` given).
-    reason : str
-        One sentence: the corner and why.
-    """
+    """The quasistatic corner of a surface (:func:`quasistatic_corner`): the inertia number
+    ``ie``, the stiffness number ``k`` (``K = k l_s / F_p``), the force swing ``swing_fp``
+    ``sqrt(I_e K L_c / l_s)`` [F_p] there, what sets ``I_e`` (``ie_bound``: ``"I_e*"``,
+    ``"swing-path"`` or ``"swing-force"``), what ``K`` is the margin times (``k_bound``:
+    ``"K_path"`` or ``"K*"``), and ``reason``, one sentence."""
 
     ie: float
     k: float
@@ -210,28 +192,8 @@ class Corner:
     reason: str
 
     def as_dict(self) -> dict:
-        """``{"ie", "K", "swing_fp", "ie_bound", "k_bound", "reason"}`` (``validation.json``'s
-        ``corner``)."""
-        return {
-            "ie": self.ie,
-            "K": self.k,
-            "swing_fp": self.swing_fp,
-            "ie_bound": self.ie_bound,
-            "k_bound": self.k_bound,
-            "reason": self.reason,
-        }
-
-
-def _one_digit_down(v: float) -> float:
-    """``v`` rounded down to one significant digit (``2.46e-3 -> 2e-3``)."""
-    scale = 10.0 ** math.floor(math.log10(v))
-    return math.floor(v / scale * (1 + 1e-12)) * scale
-
-
-def _two_digits_up(v: float) -> float:
-    """``v`` rounded up to two significant digits (``291.3 -> 300``, ``70.4 -> 71``)."""
-    scale = 10.0 ** (math.floor(math.log10(v)) - 1)
-    return float(f"{math.ceil(v / scale * (1 - 1e-12)) * scale:.2g}")
+        """``validation.json``'s ``corner``: ``ie``, ``K`` and the rest by field name."""
+        return {"ie": self.ie, "K": self.k, **{k: v for k, v in asdict(self).items() if k not in ("ie", "k")}}
 
 
 def quasistatic_corner(
@@ -244,81 +206,55 @@ def quasistatic_corner(
     margin: float = CORNER_MARGIN,
     ie_limit: str = "",
 ) -> Corner:
-    """The corner ``(I_e, K)`` at which a spring drive on a surface is quasistatic, from the
-    surface's own predicted limits (:func:`drive_limits`, :func:`spring_ie_limits`).
+    """The corner ``(I_e, K)`` at which a spring drive on a surface is quasistatic, from its
+    own predicted limits (:func:`drive_limits`; for a family, its surfaces' lowest
+    ``ie_star`` and highest ``k_path`` and ``lc_over_ls``; docs/physics.md §8).
 
-    * ``K = margin K_path`` (``margin K*`` where ``K_path`` is not given), rounded up to two
-      digits: the compliant path's offset from the rigid one, first order in ``1 / K``,
-      is then a ``margin``-th of the path tolerance it reaches at ``K_path``.
-    * ``I_e`` the smallest of ``I_e* / margin`` (lift-off, trap skipping and lag: the lag
-      is first order in ``I_e``), ``t^2 K_c / margin^2`` (the spring-block's position swing
-      ``L_c sqrt(I_e / K_c)``, a ``margin``-th of the path tolerance ``t L_c``) and
-      ``SWING_BOUND_FP^2 / K_c`` (the force swing ``sqrt(I_e K_c)`` at most
-      :data:`SWING_BOUND_FP`), ``K_c = K L_c / l_s``; rounded down to one digit.
-
-    Parameters
-    ----------
-    ie_star : float
-        The surface's ``I_e*`` (:attr:`DriveLimits.ie_star`; the lowest of its surfaces'
-        for a family).
-    k_path : float
-        ``K_path`` of the measurement's starts (:attr:`DriveLimits.k_path`; the highest of
-        a family's); NaN: use ``k_star``.
-    lc_over_ls : float
-        ``L_c / l_s`` (the largest of a family's).
-    k_star : float
-        The fold ``K*``, used where ``k_path`` is NaN.
-    path_tolerance : float
-        ``t``, in ``L_c`` (default the Frechet target).
-    margin : float
-        How far inside the limits, > 1 (default :data:`CORNER_MARGIN`).
-    ie_limit : str
-        What set ``ie_star`` (``"trap"``, ...), for the reason.
-
-    Returns
-    -------
-    Corner
+    ``K = margin K_path`` (``margin K*`` where ``k_path`` is NaN), rounded up to two digits:
+    the compliant offset, first order in ``1 / K``, is a ``margin``-th of the path tolerance
+    ``t`` it reaches at ``K_path``. ``I_e`` the lowest of ``I_e* / margin`` (the lag is
+    first order in ``I_e``), ``(t / margin)^2 K_c`` (the position swing ``L_c sqrt(I_e /
+    K_c)`` a ``margin``-th of ``t L_c``) and ``SWING_BOUND_FP^2 / K_c`` (the force swing,
+    :func:`spring_ie_limits`), ``K_c = K L_c / l_s``, rounded down to one digit.
+    ``ie_limit`` names what set ``ie_star`` in the reason.
 
     Raises
     ------
     SpineInputError
-        A limit that is not a positive finite number (``ie_star`` may be inf: no limit
-        from the geometry), no usable ``K_path`` nor ``K*``, or ``margin <= 1``.
+        A limit that is not a positive number (``ie_star`` may be inf: no limit from the
+        geometry), neither a ``k_path`` nor a ``k_star`` > 0, or ``margin <= 1``.
     """
-    for name, v in (("ie_star", ie_star), ("lc_over_ls", lc_over_ls), ("path_tolerance", path_tolerance)):
-        if not (isinstance(v, (int, float)) and v > 0 and not math.isnan(v)):
+    checks = (
+        ("ie_star", ie_star, True),
+        ("lc_over_ls", lc_over_ls, False),
+        ("path_tolerance", path_tolerance, False),
+    )
+    for name, v, inf_ok in checks:
+        if not (isinstance(v, (int, float)) and v > 0 and (math.isfinite(v) or (inf_ok and v == math.inf))):
             raise SpineInputError(f"{name} must be a positive number, got {v!r}")
-    if not (math.isfinite(lc_over_ls) and math.isfinite(path_tolerance)):
-        raise SpineInputError(
-            f"lc_over_ls and path_tolerance must be finite, got {lc_over_ls!r}, {path_tolerance!r}"
-        )
     if not (isinstance(margin, (int, float)) and math.isfinite(margin) and margin > 1):
         raise SpineInputError(f"margin must be a finite number > 1, got {margin!r}")
-    if isinstance(k_path, (int, float)) and math.isfinite(k_path) and k_path > 0:
-        k_ref, k_bound = float(k_path), "K_path"
-    elif isinstance(k_star, (int, float)) and math.isfinite(k_star) and k_star > 0:
-        k_ref, k_bound = float(k_star), "K*"
-    else:
-        raise SpineInputError(
-            f"the corner needs K_path (drive_limits with path_starts) or a positive K*, got "
-            f"k_path={k_path!r}, k_star={k_star!r}"
-        )
-    k = _two_digits_up(margin * k_ref)
-    swing = spring_ie_limits(k, lc_over_ls, path_tolerance=path_tolerance / margin)
-    bounds = {"I_e*": ie_star / margin, **swing}
+    usable = [(float(v), n) for v, n in ((k_path, "K_path"), (k_star, "K*")) if math.isfinite(v) and v > 0]
+    if not usable:
+        raise SpineInputError(f"the corner needs K_path or a positive K*, got {k_path!r} and {k_star!r}")
+    k_ref, k_bound = usable[0]
+    scale = 10.0 ** (math.floor(math.log10(margin * k_ref)) - 1)
+    k = float(f"{math.ceil(margin * k_ref / scale * (1 - 1e-12)) * scale:.2g}")
+    bounds = {
+        "I_e*": ie_star / margin,
+        **spring_ie_limits(k, lc_over_ls, path_tolerance=path_tolerance / margin),
+    }
     ie_bound = min(bounds, key=bounds.get)
-    ie = _one_digit_down(bounds[ie_bound])
+    scale = 10.0 ** math.floor(math.log10(bounds[ie_bound]))
+    ie = math.floor(bounds[ie_bound] / scale * (1 + 1e-12)) * scale
     swing_fp = math.sqrt(ie * k * lc_over_ls)
     why = {
         "I_e*": f"I_e* {ie_star:.3g}{f' ({ie_limit})' if ie_limit else ''} / {margin:g}",
         "swing-path": f"the spring's position swing at {path_tolerance / margin:.3g} L_c",
         "swing-force": f"the spring's force swing at {SWING_BOUND_FP:g} F_p",
     }[ie_bound]
-    reason = (
-        f"I_e {ie:.3g}, K {k:.3g}: K = {margin:g} {k_bound} ({k_ref:.3g}), I_e set by {why}; "
-        f"swing {swing_fp:.2g} F_p"
-    )
-    return Corner(ie=ie, k=k, swing_fp=swing_fp, ie_bound=ie_bound, k_bound=k_bound, reason=reason)
+    reason = f"I_e {ie:.3g}, K {k:.3g}: K = {margin:g} {k_bound} ({k_ref:.3g}), I_e set by {why}"
+    return Corner(ie, k, swing_fp, ie_bound, k_bound, f"{reason}; swing {swing_fp:.2g} F_p")
 
 
 def kappa_fall(x, hold) -> np.ndarray:
