@@ -149,14 +149,17 @@ def _display_grid(surface: Surface, max_points: int) -> GridSurface:
     if isinstance(surface, GridSurface) and max(surface.shape) <= max_points:
         return surface
     if isinstance(surface, GridSurface):
-        step = int(np.ceil(max(surface.shape) / max_points))
+        sy, sx = (int(np.ceil(n / max_points)) for n in surface.shape)  # a narrow strip keeps its rows
         return GridSurface(
-            heights=surface.heights[::step, ::step],
-            x=surface.x[::step],
-            y=surface.y[::step],
+            heights=surface.heights[::sy, ::sx],
+            x=surface.x[::sx],
+            y=surface.y[::sy],
             unit=surface.unit,
         )
-    return surface.sample(max_points)
+    xmin, xmax, ymin, ymax = surface.bounds
+    long_side = max(xmax - xmin, ymax - ymin)
+    nx, ny = (max(4, round(max_points * side / long_side)) for side in (xmax - xmin, ymax - ymin))
+    return surface.sample(nx, ny)
 
 
 def _axes_units(surface: Surface, grid: GridSurface) -> tuple[float, str, float, str]:

@@ -50,8 +50,10 @@ def characteristic_length(surface: Surface) -> float:
 
     Rule: for a Gaussian sum, the mean of its widths ``(sigma_x + sigma_y) / 2``; for a
     grid, ``2 pi`` times the rms height over the rms slope (the wavelength of a sine with
-    the same rms height and slope), clipped to ``[4 dx, domain size]``; a plane (no
-    height variation) gives the domain size.
+    the same rms height and slope), clipped to ``[4 dx, domain length]``; a plane (no
+    height variation) gives the domain length. The domain length is its extent along the
+    drive (x): a narrow strip or a long track keeps the asperities it has along its length
+    instead of taking its width.
 
     Parameters
     ----------
@@ -63,8 +65,8 @@ def characteristic_length(surface: Surface) -> float:
     float
         ``L_c``, the length of the inertia number ``I_e = m v^2 / (F_p L_c)``.
     """
-    xmin, xmax, ymin, ymax = surface.bounds
-    span = float(min(xmax - xmin, ymax - ymin))
+    xmin, xmax, _, _ = surface.bounds
+    span = float(xmax - xmin)
     if isinstance(surface, GaussianSurface):
         return float(np.mean(0.5 * (surface.sigma_x + surface.sigma_y)))
     grid = surface if isinstance(surface, GridSurface) else surface.sample(201)
@@ -166,6 +168,16 @@ def slope_correlation_length(surface: Surface) -> float:
     return known
 
 
+def stiffness_length(surface: Surface) -> float:
+    """The length of the drive stiffness number ``K = k l / F_p``: ``l_s``
+    (:func:`slope_correlation_length`), or ``L_c`` (:func:`characteristic_length`) for a
+    surface without one (a plane, or slopes correlated across the whole domain)."""
+    try:
+        return slope_correlation_length(surface)
+    except SpineInputError:
+        return characteristic_length(surface)
+
+
 def _slope_correlation_length(surface: Surface) -> float:
     lags, corr = slope_autocorrelation(surface)
     below = np.flatnonzero(corr <= SLOPE_CORRELATION_LEVEL)
@@ -227,6 +239,9 @@ class Roughness:
         (``C ~ q^-(2H+2)``); NaN ("not estimated") when fewer than 4 rings are usable, or
         when the fit is no self-affine power law: H outside :data:`HURST_RANGE` or a fit
         explaining less than :data:`MIN_HURST_FIT_R2` of the log PSD's variance.
+    slope_correlation_note : str
+        Why ``slope_correlation_length`` is NaN (a plane, or slopes correlated across the
+        whole domain); empty when it was measured.
     psd_prefactor, fit_range : float, (float, float)
         The fit ``C = psd_prefactor q^-(2H+2)`` and the q range it was made over.
     q, psd : ndarray
@@ -244,6 +259,7 @@ class Roughness:
     fit_range: tuple[float, float]
     q: np.ndarray
     psd: np.ndarray
+    slope_correlation_note: str = ""
 
     def as_dict(self) -> dict:
         """Scalars only (for JSON and printing)."""
@@ -291,13 +307,18 @@ def summarize(surface: Surface) -> Roughness:
     topo = st.Topography(grid.heights.T, sizes, periodic=grid.periodic)
     q, psd = radial_psd(grid)
     hurst, prefactor, fit_range = _hurst_fit(q, psd)
+    try:
+        l_s, note = slope_correlation_length(surface), ""
+    except SpineInputError as exc:  # a plane: report what it has, and why it has no l_s
+        l_s, note = math.nan, str(exc)
     return Roughness(
         unit=surface.unit,
         rms_height=float(topo.rms_height_from_area()),
         rms_slope=float(topo.rms_gradient()),
         rms_curvature=float(topo.rms_curvature_from_area()),
         char_length=characteristic_length(surface),
-        slope_correlation_length=slope_correlation_length(surface),
+        slope_correlation_length=l_s,
+        slope_correlation_note=note,
         hurst=hurst,
         psd_prefactor=prefactor,
         fit_range=fit_range,

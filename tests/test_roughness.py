@@ -126,3 +126,34 @@ def test_a_surface_is_measured_once_its_answer_kept_while_it_lives():
     del surf, plane
     gc.collect()
     assert all(r() is None for r in refs)  # the answers do not keep their surfaces alive
+
+
+def test_a_plane_is_summarized_with_what_it_has():
+    """A plane has heights, slopes and L_c (the domain length), and no l_s: NaN and why."""
+    x = np.linspace(0, 4, 17)
+    plane = GridSurface(heights=np.zeros((17, 17)), x=x, y=x.copy(), unit="1")
+    rough = roughness.summarize(plane)
+    assert rough.rms_height == 0 and rough.rms_slope == 0 and rough.char_length == 4
+    assert math.isnan(rough.slope_correlation_length) and "plane" in rough.slope_correlation_note
+    assert roughness.stiffness_length(plane) == 4  # K's length falls back on L_c
+
+
+def test_lc_of_a_narrow_strip_follows_its_length_not_its_width():
+    """A strip 1 wide, 420 long, of waves 60 long: L_c is the sine's wavelength (2 pi
+    rms h / rms slope), not clipped to the width."""
+    lam = 60.0
+    x, y = np.linspace(0, 420, 8401), np.linspace(0, 1, 9)
+    strip = GridSurface(heights=np.sin(2 * np.pi * x / lam)[None, :] * np.ones((9, 1)), x=x, y=y)
+    assert roughness.characteristic_length(strip) == pytest.approx(lam, rel=0.01)
+
+
+def test_cli_surface_info_on_a_plane_reports_what_it_can(tmp_path):
+    from spine_mj.surface_io import save_surface
+
+    x = np.linspace(0, 4, 17)
+    path = save_surface(GridSurface(heights=np.zeros((17, 17)), x=x, y=x.copy()), tmp_path / "plane.npz")
+    result = CliRunner().invoke(main, ["surface", "info", str(path), "--mu", "0.5"])
+    assert result.exit_code == 0, result.output
+    assert "l_s (slope correlation)  none: surface has no slope variation (a plane)" in result.output
+    # no slope: no fold (K* 0), no crest, no trap; the lag 2 mu 0.1 sets I_e*
+    assert "quasistatic needs K > 0 and I_e < 0.1 (set by lag" in result.output

@@ -146,7 +146,9 @@ def surface_info(surface_spec, output, as_json, mu, tip_radius):
     click.echo(f"rms slope                {rough.rms_slope:.4g}")
     click.echo(f"rms curvature            {rough.rms_curvature:.4g}{'' if not unit else ' 1/' + info.unit}")
     click.echo(f"L_c (asperity length)    {rough.char_length:.4g}{unit}")
-    click.echo(f"l_s (slope correlation)  {rough.slope_correlation_length:.4g}{unit}")
+    l_s = rough.slope_correlation_length
+    l_s_text = f"{l_s:.4g}{unit}" if math.isfinite(l_s) else f"none: {rough.slope_correlation_note}"
+    click.echo(f"l_s (slope correlation)  {l_s_text}")
     hurst = f"{rough.hurst:.3g}" if math.isfinite(rough.hurst) else "not estimated (the PSD is no power law)"
     click.echo(f"Hurst estimate (PSD fit) {hurst}")
     if limits is None:

@@ -35,6 +35,10 @@ DEFAULT_LENGTH_SCALE_M = 0.01
 MAX_INERTIA_NUMBER = 1e4
 _MIN_SPACING_PER_TIP_RADIUS = 0.25  # finer hfields exceed MuJoCo's 50 contacts per geom pair
 _SCAN_TIP_SPACINGS = 2.0  # default tip radius of a measured scan, in lateral spacings
+#: A default tip is at most the domain's width over this many radii: a narrow strip or a
+#: long track keeps room for the tip to ride along it (the usual rule on a 1 unit wide
+#: strip of long waves would give a tip wider than the strip).
+DEFAULT_TIP_RADII_ACROSS = 8
 MAX_HFIELD_SIDE = 8192  # samples a side of an hfield (memory; MuJoCo's collision stays local)
 _MIN_ENGINE_RATIO = 1e-9  # smallest length ratio (tip / L_c, spacing / L_c) the engine resolves
 #: Physical range of lengths [m] (outside it the model means nothing).
@@ -171,7 +175,8 @@ class Scales:
         * tip radius (when ``tip.tip_radius_m`` is None): the surface's own ``metadata["params"]
           ["tip_radius_m"]`` (sandpaper); for a measured scan (a grid in a physical unit) the larger
           of two lateral spacings and ``L_c / 100`` (the sphere rests on several facets, never in
-          one pixel); else the larger of one hfield spacing and ``L_c / 100``; 3 significant digits.
+          one pixel); else the larger of one hfield spacing and ``L_c / 100``; at most the
+          domain's width over :data:`DEFAULT_TIP_RADII_ACROSS`; 3 significant digits.
         * hfield resolution: an hfield finer than a quarter tip radius is coarsened to that (MuJoCo
           keeps at most 50 contacts per geom pair: a tip over too many cells loses its deepest
           contacts); then refined ``hfield_refinement`` times (:func:`hfield_of`)
@@ -199,10 +204,11 @@ class Scales:
         hf = hfield_of(surface, hfield_resolution)
         spacing = hfield_spacing(hf, length_scale_m)
         radius = tip.tip_radius_m
-        if radius is None:
-            radius = default_tip_radius(surface, spacing, char_length_m)
         xmin, xmax, ymin, ymax = (length_scale_m * b for b in surface.bounds)
-        _check_sizes(radius, spacing, char_length_m, min(xmax - xmin, ymax - ymin))
+        width = min(xmax - xmin, ymax - ymin)
+        if radius is None:
+            radius = default_tip_radius(surface, spacing, char_length_m, width_m=width)
+        _check_sizes(radius, spacing, char_length_m, width, given=tip.tip_radius_m is not None)
         resolution = hfield_resolution
         if resolution is None and spacing < _MIN_SPACING_PER_TIP_RADIUS * radius:
             extent = 2 * max(hf.size[0], hf.size[1]) * length_scale_m
@@ -308,15 +314,19 @@ def check_physical_length(name: str, value: float) -> float:
     return value
 
 
-def default_tip_radius(surface: Surface, spacing_m: float, char_length_m: float) -> float:
-    """The default tip radius [m] (rule in :meth:`Scales.for_surface`)."""
+def default_tip_radius(
+    surface: Surface, spacing_m: float, char_length_m: float, *, width_m: float = math.inf
+) -> float:
+    """The default tip radius [m] (rule in :meth:`Scales.for_surface`; ``width_m`` the
+    domain's narrower side [m])."""
     params = surface.metadata.get("params", {}) if isinstance(surface.metadata, dict) else {}
     radius = params.get("tip_radius_m") if surface.unit != "1" else None
     if radius:
         return float(radius)
     scan = isinstance(surface, GridSurface) and surface.unit != "1"
     spacings = _SCAN_TIP_SPACINGS if scan else 1.0
-    return float(f"{max(spacings * spacing_m, 0.01 * char_length_m):.3g}")
+    radius = min(max(spacings * spacing_m, 0.01 * char_length_m), width_m / DEFAULT_TIP_RADII_ACROSS)
+    return float(f"{radius:.3g}")
 
 
 def fall_height(
@@ -363,12 +373,16 @@ def fall_height(
     return best
 
 
-def _check_sizes(radius: float, spacing: float, char_length: float, span: float) -> None:
-    """Tip, hfield spacing and L_c against each other and the domain (all in metres)."""
+def _check_sizes(
+    radius: float, spacing: float, char_length: float, span: float, *, given: bool = True
+) -> None:
+    """Tip, hfield spacing and L_c against each other and the domain (all in metres);
+    ``given``: the radius is the user's (a default one is named as such)."""
+    what = f"tip_radius_m {radius:.3g} m" if given else f"the default tip radius {radius:.3g} m"
     if 2 * radius >= span:
         raise SpineInputError(
-            f"tip_radius_m {radius:.3g} m is larger than the surface: its diameter must be "
-            f"smaller than the domain's width {span:.3g} m"
+            f"{what} is larger than the surface: its diameter must be smaller than the domain's "
+            f"width {span:.3g} m"
         )
     if min(radius, spacing) < _MIN_ENGINE_RATIO * char_length:
         raise SpineInputError(
@@ -377,7 +391,7 @@ def _check_sizes(radius: float, spacing: float, char_length: float, span: float)
         )
     if spacing > 2 * radius * (1 + 1e-9):
         raise SpineInputError(
-            f"surface too coarse for the tip: hfield spacing {spacing:.3g} m > 2 x tip_radius_m "
+            f"surface too coarse for the tip: hfield spacing {spacing:.3g} m > 2 x {what} "
             f"= {2 * radius:.3g} m; raise hfield_resolution or the tip radius"
         )
 

@@ -264,3 +264,19 @@ def test_a_step_factor_refines_only_the_step_and_tolerances_reach_the_model():
     assert rig.engine.timestep_s == pytest.approx(plain.engine.timestep_s / 2)
     with pytest.raises(SpineInputError, match="tolerance must be"):
         sim.EngineSettings(timestep_s=1e-4, solref=(2e-4, 1.0), tolerance=0.0)
+
+
+def test_a_narrow_strip_gets_a_tip_that_fits_across_it_and_a_tip_too_wide_is_refused_by_its_own_name():
+    """A strip 1 wide of waves 300 long: the usual default (L_c / 100 = 3) would be wider
+    than the strip; the default is at most the width over DEFAULT_TIP_RADII_ACROSS. A tip
+    the user gives too wide is refused with the user's number."""
+    from spine_mj.sim import Scales
+    from spine_mj.sim.scales import DEFAULT_TIP_RADII_ACROSS
+    from spine_mj.surfaces import GridSurface
+
+    x, y = np.arange(4001) * 0.125, np.arange(9) * 0.125
+    strip = GridSurface(heights=3 * np.sin(2 * np.pi * x / 300)[None, :] * np.ones((9, 1)), x=x, y=y)
+    scales = Scales.for_surface(strip)
+    assert scales.tip_radius_m <= 1.0 * scales.length_scale_m / DEFAULT_TIP_RADII_ACROSS
+    with pytest.raises(SpineInputError, match=r"tip_radius_m 0.006 m is larger than the surface"):
+        Scales.for_surface(strip, tip=TipParams(tip_radius_m=0.006))
