@@ -50,10 +50,8 @@ def characteristic_length(surface: Surface) -> float:
 
     Rule: for a Gaussian sum, the mean of its widths ``(sigma_x + sigma_y) / 2``; for a
     grid, ``2 pi`` times the rms height over the rms slope (the wavelength of a sine with
-    the same rms height and slope), clipped to ``[4 dx, domain length]``; a plane (no
-    height variation) gives the domain length. The domain length is its extent along the
-    drive (x): a narrow strip or a long track keeps the asperities it has along its length
-    instead of taking its width.
+    the same rms height and slope), clipped to ``[4 dx, domain size]``; a plane (no
+    height variation) gives the domain size.
 
     Parameters
     ----------
@@ -65,8 +63,8 @@ def characteristic_length(surface: Surface) -> float:
     float
         ``L_c``, the length of the inertia number ``I_e = m v^2 / (F_p L_c)``.
     """
-    xmin, xmax, _, _ = surface.bounds
-    span = float(xmax - xmin)
+    xmin, xmax, ymin, ymax = surface.bounds
+    span = float(min(xmax - xmin, ymax - ymin))
     if isinstance(surface, GaussianSurface):
         return float(np.mean(0.5 * (surface.sigma_x + surface.sigma_y)))
     grid = surface if isinstance(surface, GridSurface) else surface.sample(201)

@@ -138,15 +138,6 @@ def test_a_plane_is_summarized_with_what_it_has():
     assert roughness.stiffness_length(plane) == 4  # K's length falls back on L_c
 
 
-def test_lc_of_a_narrow_strip_follows_its_length_not_its_width():
-    """A strip 1 wide, 420 long, of waves 60 long: L_c is the sine's wavelength (2 pi
-    rms h / rms slope), not clipped to the width."""
-    lam = 60.0
-    x, y = np.linspace(0, 420, 8401), np.linspace(0, 1, 9)
-    strip = GridSurface(heights=np.sin(2 * np.pi * x / lam)[None, :] * np.ones((9, 1)), x=x, y=y)
-    assert roughness.characteristic_length(strip) == pytest.approx(lam, rel=0.01)
-
-
 def test_cli_surface_info_on_a_plane_reports_what_it_can(tmp_path):
     from spine_mj.surface_io import save_surface
 

@@ -18,9 +18,8 @@ def test_surface_info_prints_the_drive_limits_of_a_corrugation():
     result = run("surface", "info", "corrugation")
     assert result.exit_code == 0, result.output
     line = next(s for s in result.output.splitlines() if s.startswith("drive limits"))
-    # Prandtl-Tomlinson K*; I_e* set by the lag 2 mu 0.1 before lift-off at 0.526 (1 / (L_c
-    # z''_max), L_c = 1.006 of the sine along the strip 8 long, 1 wide: not clipped to the width)
-    assert "quasistatic needs K > 0.467 and I_e < 0.1 (set by lag; lift-off 0.526" in line
+    # Prandtl-Tomlinson K*; I_e* set by the lag 2 mu 0.1 before lift-off at 0.529
+    assert "quasistatic needs K > 0.467 and I_e < 0.1 (set by lag; lift-off 0.529" in line
     doc = json.loads(run("surface", "info", "corrugation", "--json").output)
     assert doc["drive_limits"]["k_star"] == pytest.approx(0.467, abs=0.002)
     assert doc["drive_limits"]["limit"] == "lag"
@@ -56,6 +55,6 @@ def test_surface_info_on_a_narrow_strip_of_long_waves(tmp_path):
     result = run("surface", "info", str(path), "--mu", "0.5", "--json")
     assert result.exit_code == 0, result.output
     doc = json.loads(result.output)
-    assert doc["char_length"] == pytest.approx(300, rel=0.1)  # the waves, not the width 1
+    assert doc["char_length"] == 1  # L_c is clipped to the domain's narrower side
     assert doc["slope_correlation_length"] == pytest.approx(0.190 * 300, rel=0.05)  # a sine's l_s
     assert doc["drive_limits"]["limit"] == "lag"
