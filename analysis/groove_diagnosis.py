@@ -25,11 +25,11 @@ import dataclasses
 
 import numpy as np
 
-from spine_mj import compare
 from spine_mj.sim.model import from_hfield
 from spine_mj.surfaces import TriangulatedSurface
 from spine_mj.sweep import ANALYSES, expand_cases, parse_config
 from spine_mj.sweep.analyses.mujoco import case_rig
+from spine_mj.theory import agreement
 from spine_mj.theory import streamline as sl
 from spine_mj.theory.engagement import kappa
 from spine_mj.validate.plans import FRACTAL, PLANS, SANDPAPER
@@ -112,7 +112,7 @@ def _finer_sampling(d, i):
     for m in (16, 32):
         finer = sl.dilate(d["facets"], d["radius"], spacing=d["radius"] / m)
         r = trace(finer, d["starts"][i : i + 1], d["params"], dl=min(d["dl"], *finer.spacing))
-        f = compare.path_frechet(d["mpaths"][i], _xy(r, 0), length_scale=lc)
+        f = agreement.path_frechet(d["mpaths"][i], _xy(r, 0), length_scale=lc)
         print(
             f"  facets dilated at R/{m}: {r.outcome_names[0]} end ({r.end_x[0] / lc:.3f}, "
             f"{r.end_y[0] / lc:.3f}) L_c, Frechet {f:.3f}, max kappa {r.max_kappa[0]:.3g}"
@@ -132,14 +132,14 @@ def _family(plan, fam):
                 "fixed dl/4": trace(contact, starts, params, max_halvings=0, dl=params.dl / 4),
             }
             agree = {
-                k: compare.outcome_agreement(
+                k: agreement.outcome_agreement(
                     r.self_locked, np.column_stack([r.end_x, r.end_y]), d["held"], d["end"], length_scale=lc
                 )["agree"]
                 for k, r in refs.items()
             }
             for i in range(len(starts)):
                 fr = {
-                    k: compare.path_frechet(d["mpaths"][i], _xy(r, i), length_scale=lc)
+                    k: agreement.path_frechet(d["mpaths"][i], _xy(r, i), length_scale=lc)
                     for k, r in refs.items()
                 }
                 for k in counts:

@@ -33,8 +33,9 @@ import time
 
 import numpy as np
 
-from spine_mj import compare, sim
+from spine_mj import sim
 from spine_mj.sim.ramp import cycle_breakaways, rows_to_reset
+from spine_mj.theory import agreement
 from spine_mj.validate.ramp_pilot import pilot_rig
 from spine_mj.validate.static_map import hold_force
 
@@ -123,7 +124,7 @@ def ramp_rows(res: int, ie: float, cycles: int) -> list[dict]:
                 "case": name,
                 "breakaways": f"{k}/{kp.size}",
                 "max_rel_diff": float(np.max(np.abs(kf[:k] / kp[:k] - 1))) if k else math.nan,
-                "frechet_lc": compare.path_frechet(
+                "frechet_lc": agreement.path_frechet(
                     fast.position_m[:n_f, :2], plain.position_m[:n_p, :2], length_scale=sc.char_length_m
                 ),
                 "end": f"{plain.end_reason.value}/{fast.end_reason.value}",

@@ -8,7 +8,7 @@ numbers ``K = k l_s / F_p`` on three families of surfaces, and recorded the shar
 whose outcome agrees with the streamline's. This script reads the committed
 ``validation.json`` of the full plan (no run: the map took minutes of sweeps) and draws the
 map, with the boundary ``I_e*(K)`` where the targets stop being met and the boundary
-predicted from the geometry alone (:mod:`spine_mj.drive_limits`). Each family has its own K
+predicted from the geometry alone (:mod:`spine_mj.theory.drive_limits`). Each family has its own K
 axis, set around its predicted K_path with its fold K* and 10 K*.
 
 Run from the repository's ``examples/`` folder, or point ``path`` at any

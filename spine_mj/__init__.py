@@ -6,13 +6,8 @@ imports without MuJoCo; the MuJoCo rig (:mod:`spine_mj.sim`) and the sweep runne
 
 Modules: :mod:`~spine_mj.surfaces`, :mod:`~spine_mj.surface_io`,
 :mod:`~spine_mj.presets`, :mod:`~spine_mj.theory` (engagement, streamlines, compliant drive,
-convexity, drive limits), :mod:`~spine_mj.compare`, :mod:`~spine_mj.sim`,
+convexity, drive limits, agreement metrics), :mod:`~spine_mj.sim`,
 :mod:`~spine_mj.sweep`, :mod:`~spine_mj.reproduce`, :mod:`~spine_mj.cli`.
-
-Modules that moved keep their old import paths (``import spine_mj.streamline``,
-``from spine_mj.engagement import kappa``): :data:`MOVED` maps each old name to its home,
-and an import finder hands out the module from there (the same module object, imported on
-first use).
 
 ``import spine_mj`` itself is light (no numba, pandas, SciPy or MuJoCo): every public name
 is imported from its home module on first use (:func:`__getattr__`, :data:`HOMES`), so the
@@ -20,54 +15,9 @@ command line starts at once and a user pays only for what they touch.
 """
 
 import importlib
-import importlib.abc
 import importlib.util
-import sys
 
 from spine_mj._version import __version__ as __version__
-
-#: Old module name -> the module's home (imports by the old name get the same module).
-MOVED = {
-    **{
-        f"spine_mj.{name}": f"spine_mj.theory.{name}"
-        for name in (
-            "engagement",
-            "streamline",
-            "compliant",
-            "convexity",
-            "multicontact",
-            "tomlinson",
-            "tomlinson_dynamics",
-            "drive_limits",
-            "energy",
-            "array_reference",
-            "_kernels",
-            "_compliant_kernel",
-        )
-    },
-    "spine_mj._contact_kernel": "spine_mj.surfaces._contact_kernel",
-    "spine_mj.array_outputs": "spine_mj.sim.array_outputs",
-    "spine_mj.sim.motion": "spine_mj.theory.motion",
-}
-
-
-class _MovedModules(importlib.abc.MetaPathFinder, importlib.abc.Loader):
-    """Import finder for :data:`MOVED`: the old name's entry in ``sys.modules`` is the module
-    at its home, so ``spine_mj.streamline is spine_mj.theory.streamline``."""
-
-    def find_spec(self, fullname, path=None, target=None):
-        return importlib.util.spec_from_loader(fullname, self) if fullname in MOVED else None
-
-    def create_module(self, spec):
-        return None
-
-    def exec_module(self, module):
-        # the import system returns what sys.modules holds under the name after this call
-        sys.modules[module.__name__] = importlib.import_module(MOVED[module.__name__])
-
-
-if not any(isinstance(f, _MovedModules) for f in sys.meta_path):
-    sys.meta_path.append(_MovedModules())
 
 #: Public name -> the module that defines it (imported on first use of the name).
 HOMES = {
@@ -79,7 +29,7 @@ HOMES = {
             "mean_lateral_deviation",
             "outcome_agreement",
         ),
-        "spine_mj.compare",
+        "spine_mj.theory.agreement",
     ),
     **dict.fromkeys(("CompliantResult", "compliant_streamlines"), "spine_mj.theory.compliant"),
     **dict.fromkeys(("classify_points", "hessian_class", "sectional_class"), "spine_mj.theory.convexity"),
@@ -132,15 +82,13 @@ HOMES = {
 
 
 def __getattr__(name):
-    """A public name from its home (:data:`HOMES`), or a submodule (``spine_mj.sim``, or a
-    moved one such as ``spine_mj.streamline``) on first use."""
+    """A public name from its home (:data:`HOMES`), or a submodule (``spine_mj.sim``) on
+    first use."""
     if name in HOMES:
         value = getattr(importlib.import_module(HOMES[name]), name)
         globals()[name] = value
         return value
-    if f"spine_mj.{name}" in MOVED or (
-        not name.startswith("_") and importlib.util.find_spec(f"spine_mj.{name}") is not None
-    ):
+    if not name.startswith("_") and importlib.util.find_spec(f"spine_mj.{name}") is not None:
         return importlib.import_module(f"spine_mj.{name}")
     raise AttributeError(f"module 'spine_mj' has no attribute {name!r}")
 

@@ -7,7 +7,7 @@ the kernel's out-of-memory killer. The budget is :data:`DEFAULT_FRACTION` of the
 physical memory unless the environment variable ``SPINE_MJ_MEMORY_BUDGET`` sets it (bytes,
 or a number with a suffix K, M, G or T in powers of 1024: ``SPINE_MJ_MEMORY_BUDGET=2G``).
 
-Work that can be cut into pieces (the path comparisons of :mod:`spine_mj.compare`) is
+Work that can be cut into pieces (the path comparisons of :mod:`spine_mj.theory.agreement`) is
 chunked by :data:`BLOCK_BYTES` instead, so it never comes near the budget.
 """
 

@@ -50,15 +50,15 @@ def test_a_path_flown_to_a_million_lc_and_back_is_compared_in_bounded_memory():
     out to 1e6 L_c and back, against a 400-point streamline."""
     m = _measure(
         """
-        from spine_mj import compare
+        from spine_mj.theory import agreement
         t = np.linspace(0.0, 1.0, 5000)
         wild = np.column_stack([1e6 * np.sin(np.pi * t), 0.3 * np.sin(40 * t)])
         ref = np.column_stack([np.linspace(0.0, 10.0, 400), np.zeros(400)])
-        compare.path_frechet(wild[:50], ref[:50], length_scale=1.0)  # compile
+        agreement.path_frechet(wild[:50], ref[:50], length_scale=1.0)  # compile
         """,
         """
-        fr = compare.path_frechet(wild, ref, length_scale=1.0)
-        lat = compare.mean_lateral_deviation(wild, ref, length_scale=1.0)
+        fr = agreement.path_frechet(wild, ref, length_scale=1.0)
+        lat = agreement.mean_lateral_deviation(wild, ref, length_scale=1.0)
         assert fr > 9e5 and lat > 4e5
         """,
     )

@@ -24,14 +24,14 @@ and ``L_c`` the surface's characteristic length (:func:`characteristic_length`):
 * ``dt = sqrt(0.005 min(r_tip, L_c) / L_c) tau`` (``a_p dt^2 = 0.005 min(r_tip, L_c)``),
   rounded in engine units: resting penetration ``2e-4 min(r_tip, L_c)``; shorter where
   impacts need it, so that a tip arriving at the drive's speed or landing from the
-  surface's fall (:func:`~spine_mj.sim.params.fall_height`: grit flanks, scan-line steps)
+  surface's fall (:func:`~spine_mj.sim.scales.fall_height`: grit flanks, scan-line steps)
   sinks at most half the penetration tolerance;
 * ``cone = elliptic`` with ``noslip_iterations = 3``: MuJoCo's friction is soft and creeps
   at any in-cone load without the noslip pass (docs/physics.md §5); ``impratio`` stays 1;
 * a run ends as engine trouble (:data:`~spine_mj.sim.detection.TROUBLES`) on a MuJoCo
   warning or a non-finite number anywhere, or, before any physical ending, on a speed
   beyond the energy bound, a tip far below or above the surface, or penetration above
-  :func:`~spine_mj.sim.params.penetration_tolerance_m`.
+  :func:`~spine_mj.sim.step_rule.penetration_tolerance_m`.
 
 Drives (docs/physics.md §4): :class:`SpringDrive` (a carriage moves at constant speed in +x and
 pulls the tip through a spring acting in x only), :class:`RampDrive` (force rises at a set
@@ -48,9 +48,8 @@ needs feedback and steps in Python. The ramp and the static probe fast-forward t
 stick phases (:mod:`~spine_mj.sim.fastforward`). Every run ends with a recorded
 :class:`EndReason`, never with an exception from the engine.
 
-Modules: :mod:`~spine_mj.sim.params` (tip, engine, scales and their rules, in one import:
-:mod:`~spine_mj.sim.records` the parameter records, :mod:`~spine_mj.sim.scales` the
-scales and hfield, :mod:`~spine_mj.sim.step_rule` the engine's step rule),
+Modules: :mod:`~spine_mj.sim.records` (the parameter records), :mod:`~spine_mj.sim.scales`
+(the scales and hfield), :mod:`~spine_mj.sim.step_rule` (the engine's step rule),
 :mod:`~spine_mj.sim.drives`, :mod:`~spine_mj.sim.model` (building the MuJoCo model),
 :mod:`~spine_mj.sim.placement`, :mod:`~spine_mj.sim.recording` (per-step columns),
 :mod:`~spine_mj.sim.detection` (events, end reasons), :mod:`~spine_mj.sim.results`,
@@ -59,12 +58,13 @@ controls and :mod:`~spine_mj.sim.lanes`' worker threads), :mod:`~spine_mj.sim.ra
 :mod:`~spine_mj.sim.fastforward` (the stick-phase fast-forward rule both use),
 :mod:`~spine_mj.sim.engines` (one rig, two engines: :func:`build_engine_rig`),
 :mod:`~spine_mj.sim.bullet` (the same rig in Bullet, hard contact; the ``[bullet]`` extra),
-:mod:`~spine_mj.sim.render`, :mod:`~spine_mj.sim.planes`, :mod:`~spine_mj.sim.rig`
+:mod:`~spine_mj.sim.render`, :mod:`~spine_mj.sim.rig`
 (:class:`Rig`, the object users hold) and :mod:`~spine_mj.sim.build` (:func:`build_rig` and
 :func:`build_drive`: a rig and a drive from dimensionless or SI inputs) and
 :mod:`~spine_mj.sim.holding` (an array's predicted holding excess and its default pace).
 """
 
+from spine_mj.roughness import characteristic_length
 from spine_mj.sim.array import ArrayResult, ArrayRig, ForcePull
 from spine_mj.sim.build import (
     ARRAY_DRIVES,
@@ -83,31 +83,28 @@ from spine_mj.sim.engines import DEFAULT_ENGINE, ENGINES, EngineRig, build_engin
 from spine_mj.sim.holding import HOLDING_TOLERANCE, array_ie, holding_excess
 from spine_mj.sim.layout import Layout, LayoutKind
 from spine_mj.sim.model import MODEL_PATH
-from spine_mj.sim.params import (
-    DEFAULT_LENGTH_SCALE_M,
-    LENGTH_UNITS_M,
-    MAX_INERTIA_NUMBER,
-    MAX_SPRING_OMEGA_DT,
-    SPRING_OMEGA_DT,
-    Cone,
-    EndReason,
-    EngineOverrides,
-    EngineSettings,
-    EngineUnits,
-    Integrator,
-    Scales,
-    TipParams,
-    characteristic_length,
-    default_engine,
-    hfield_of,
-    hfield_spacing,
-    penetration_tolerance_m,
-    spring_omega_dt,
-)
-from spine_mj.sim.planes import inclined_plane
+from spine_mj.sim.records import Cone, EndReason, EngineSettings, Integrator, TipParams
 from spine_mj.sim.results import RunResult
 from spine_mj.sim.rig import REFINE_TIMESTEP, Rig
 from spine_mj.sim.rollout import BatchOptions
+from spine_mj.sim.scales import (
+    DEFAULT_LENGTH_SCALE_M,
+    MAX_INERTIA_NUMBER,
+    EngineUnits,
+    Scales,
+    hfield_of,
+    hfield_spacing,
+)
+from spine_mj.sim.step_rule import (
+    MAX_SPRING_OMEGA_DT,
+    SPRING_OMEGA_DT,
+    EngineOverrides,
+    default_engine,
+    penetration_tolerance_m,
+    spring_omega_dt,
+)
+from spine_mj.surfaces import LENGTH_UNITS_M
+from spine_mj.surfaces.generators import inclined_plane
 from spine_mj.theory.motion import MOTION_NAMES, SLIDING, SLIPPING, STUCK, SlipEvent
 
 __all__ = [

@@ -1,7 +1,7 @@
 """Spine arrays in MuJoCo: many tips on one carriage, each on its own suspension.
 
 :class:`ArrayRig` turns a single-spine :class:`~spine_mj.sim.model.RigModel` (its surface,
-tip, scales and engine settings: the one rule of :mod:`spine_mj.sim.params`, taken as it
+tip, scales and engine settings: the one rule of :mod:`spine_mj.sim.scales`, taken as it
 is) into one MuJoCo model of ``N`` tips laid out by a :class:`~spine_mj.sim.layout.Layout`.
 Each tip is the single rig's sphere on x, y, z slide joints with its own preload; tips
 collide with the surface only, never with each other. Each is tied to the carriage by a
@@ -39,7 +39,7 @@ from spine_mj.sim.drives import SpringDrive, StaticProbe, rate_n_s, settle_steps
 from spine_mj.sim.lanes import NativeLanes, PythonLane
 from spine_mj.sim.layout import Layout
 from spine_mj.sim.model import RigModel, compile_spec, start_pair
-from spine_mj.sim.rollout import drive_steps
+from spine_mj.sim.open_loop import drive_steps
 
 #: Why arrays run in MuJoCo only: an array is one MuJoCo model (N tips on slide joints, their
 #: springs, a free carriage body tied to them by tendons under force control) stepped in

@@ -23,8 +23,8 @@ import numpy as np
 from spine_mj.sim.detection import Detection
 from spine_mj.sim.drives import SpringDrive, stiffness_n_m
 from spine_mj.sim.holding import holding_excess
-from spine_mj.sim.motion import STUCK_SPEED_FRACTION
-from spine_mj.sim.params import check_optional
+from spine_mj.sim.records import check_optional
+from spine_mj.theory.motion import STUCK_SPEED_FRACTION
 
 _CAP_SLACK = 1e-6
 #: Force control: a carriage this far (L_c) past where it last held has let go for good
@@ -100,7 +100,7 @@ class ArrayResult:
     holding_force_n : float
         Displacement control: the largest total force the spines carried while the array
         held, up to the last step before every spine moved faster than
-        :data:`~spine_mj.sim.motion.STUCK_SPEED_FRACTION` of the carriage speed (the whole
+        :data:`~spine_mj.theory.motion.STUCK_SPEED_FRACTION` of the carriage speed (the whole
         run if some spine never let go). Force control: the largest pull under which the
         carriage held, moving slower than the pull's equivalent speed ``L_c (dF/dt) / (N
         F_p)`` (faster, it has let go; a carriage caught again by re-engaging spines holds

@@ -5,7 +5,7 @@ things: a surface, a friction coefficient, a tip (radius, mass, preload), a leng
 and hfield resolution, engine overrides, and a drive either dimensionless (inertia number
 ``I_e``, stiffness number ``K``) or in SI (speed [m/s], stiffness [N/m], force rate
 [N/s]). :func:`build_rig` and :func:`build_drive` turn them into a :class:`Rig` and a
-drive by the rules of :class:`~spine_mj.sim.params.Scales`, so that ``spine-mj simulate``
+drive by the rules of :class:`~spine_mj.sim.scales.Scales`, so that ``spine-mj simulate``
 and a sweep case with the same inputs run the same model (tested).
 
 Two rules live here:
@@ -30,8 +30,10 @@ from spine_mj.sim.array_run import ArrayDrive, ForcePull
 from spine_mj.sim.drives import Drive, RampDrive, SpringDrive, StaticProbe, spring_stiffness_n_m
 from spine_mj.sim.holding import array_ie
 from spine_mj.sim.layout import Layout
-from spine_mj.sim.params import EngineOverrides, Scales, TipParams
+from spine_mj.sim.records import TipParams
 from spine_mj.sim.rig import Rig
+from spine_mj.sim.scales import Scales
+from spine_mj.sim.step_rule import EngineOverrides
 from spine_mj.surfaces import GridSurface, Surface
 
 __all__ = [

@@ -11,7 +11,7 @@ tip on three slide joints), gravity, preload, the three drives, and the same
 sensors and read by the same analysis (:class:`~spine_mj.sim.results.GroupAnalysis`:
 recordings, motion states, events, end reasons, ``engine_trouble``). Scales, engine units,
 drives, detection and the recorded time step are MuJoCo's rules, written once in
-:mod:`spine_mj.sim.params`, :mod:`spine_mj.sim.drives` and :mod:`spine_mj.sim.rollout`.
+:mod:`spine_mj.sim.scales`, :mod:`spine_mj.sim.step_rule`, :mod:`spine_mj.sim.drives` and :mod:`spine_mj.sim.rollout`.
 Needs the optional extra ``bullet`` (``pip install 'spine-mj[bullet]'``).
 
 Bullet's settings come from rules (:mod:`spine_mj.sim.bullet_settings`: the step, slop,
@@ -51,14 +51,12 @@ from spine_mj.sim.drives import (
     stiffness_n_m,
 )
 from spine_mj.sim.model import RigModel, start_pair
-from spine_mj.sim.params import (
-    MIN_TIMESTEP_TAU,
-    Scales,
-    TipParams,
-)
+from spine_mj.sim.open_loop import controls
 from spine_mj.sim.ramp import ResetController, ramp_duration_s
+from spine_mj.sim.records import TipParams
 from spine_mj.sim.results import GroupAnalysis, RunResult
-from spine_mj.sim.rollout import controls
+from spine_mj.sim.scales import Scales
+from spine_mj.sim.step_rule import MIN_TIMESTEP_TAU
 from spine_mj.surfaces import HField, Surface
 
 __all__ = ["BulletRig", "BulletSettings", "default_bullet_engine"]

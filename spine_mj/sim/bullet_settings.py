@@ -5,7 +5,7 @@ each derived and its pitfall measured (tests/sim/test_sim_bullet.py).
 All in engine units, so Bullet's absolute thresholds meet O(1) numbers at every physical
 scale:
 
-* **Recorded step** ``dt``: MuJoCo's step rule (:func:`~spine_mj.sim.params.default_engine`)
+* **Recorded step** ``dt``: MuJoCo's step rule (:func:`~spine_mj.sim.step_rule.default_engine`)
   so both engines record the same rows; Bullet runs ``substeps`` steps ``h = dt / n`` per row.
 * **Contact slop** (the depth Bullet leaves uncorrected) ``= 0.1`` penetration tolerance
   (``0.01 r_tip`` for small tips). Measured pitfall: a tip held by friction *creeps*
@@ -60,10 +60,11 @@ import dataclasses
 import math
 from dataclasses import dataclass
 
-from spine_mj.engagement import DEFAULT_KAPPA_CAP
 from spine_mj.errors import SpineInputError, check_positive
 from spine_mj.sim.drives import Drive, SpringDrive, stiffness_n_m
-from spine_mj.sim.params import Scales, default_engine, penetration_tolerance_m
+from spine_mj.sim.scales import Scales
+from spine_mj.sim.step_rule import default_engine, penetration_tolerance_m
+from spine_mj.theory.engagement import DEFAULT_KAPPA_CAP
 
 __all__ = ["BulletSettings", "default_bullet_engine", "spring_substeps"]
 
@@ -154,7 +155,7 @@ def default_bullet_engine(
     """Bullet's settings from the problem's scales (rules in the module docstring).
 
     ``speed_m_s`` and ``stiffness_n_m``: the drive's speed and spring, which bound the
-    recorded step as they do MuJoCo's (:func:`~spine_mj.sim.params.default_engine`).
+    recorded step as they do MuJoCo's (:func:`~spine_mj.sim.step_rule.default_engine`).
     ``overrides`` replace fields (a ``timestep_s`` alone re-derives the substeps).
     """
     # a given step or slop is checked before the substeps are derived from it (NaN, 0)

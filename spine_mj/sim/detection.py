@@ -22,8 +22,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from spine_mj.errors import check_positive
-from spine_mj.sim.params import EndReason, Scales, check_optional, penetration_tolerance_m
 from spine_mj.sim.recording import Recording
+from spine_mj.sim.records import EndReason, check_optional
+from spine_mj.sim.scales import Scales
+from spine_mj.sim.step_rule import penetration_tolerance_m
 from spine_mj.theory.engagement import DEFAULT_KAPPA_CAP, SELF_LOCK, kappa_of_normal
 
 #: Kinds of engine trouble: a non-finite number, a MuJoCo warning (the engine stopped or
@@ -50,7 +52,7 @@ class Detection:
         Self-lock when the drive force reaches ``kappa_cap * F_p`` while stuck.
     penetration_tol_m : float or None
         Engine trouble above this penetration (default
-        :func:`~spine_mj.sim.params.penetration_tolerance_m`).
+        :func:`~spine_mj.sim.step_rule.penetration_tolerance_m`).
     domain_margin_m : float or None
         The run ends when the tip centre comes closer than this to the domain's edge
         (default: the tip radius).

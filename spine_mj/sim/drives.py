@@ -11,7 +11,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from spine_mj.errors import SpineInputError, check_positive
-from spine_mj.sim.params import DEFAULT_STIFFNESS_NUMBER, Scales, check_optional
+from spine_mj.sim.records import check_optional
+from spine_mj.sim.scales import Scales
+from spine_mj.sim.step_rule import DEFAULT_STIFFNESS_NUMBER
 
 
 @dataclass(frozen=True)

@@ -2,7 +2,7 @@
 
 A rig is a surface as a heightfield, a spherical tip under gravity and preload, and the
 three drives (spring carriage, force ramp with reset, static probe), given in SI and run
-in the problem's engine units (:class:`~spine_mj.sim.params.EngineUnits`). Two engines
+in the problem's engine units (:class:`~spine_mj.sim.scales.EngineUnits`). Two engines
 implement it: ``"mujoco"`` (:class:`~spine_mj.sim.Rig`, soft convex contact, the default)
 and ``"bullet"`` (:class:`~spine_mj.sim.bullet.BulletRig`, hard contact and Coulomb
 friction by sequential impulses; the ``[bullet]`` extra). Both take the same inputs
@@ -20,8 +20,9 @@ from spine_mj.errors import SpineInputError
 from spine_mj.sim.build import _sized, build_rig, drive_speed_m_s
 from spine_mj.sim.detection import Detection
 from spine_mj.sim.drives import Drive, spring_stiffness_n_m
-from spine_mj.sim.params import EngineUnits, Scales, TipParams
+from spine_mj.sim.records import TipParams
 from spine_mj.sim.results import RunResult
+from spine_mj.sim.scales import EngineUnits, Scales
 from spine_mj.surfaces import Surface
 
 __all__ = ["DEFAULT_ENGINE", "ENGINES", "EngineRig", "build_engine_rig", "check_engine_name"]

@@ -39,8 +39,9 @@ from spine_mj.errors import SpineInputError
 from spine_mj.sim.detection import Detection
 from spine_mj.sim.drives import Drive, SpringDrive, settle_steps, stiffness_n_m
 from spine_mj.sim.model import RigModel
+from spine_mj.sim.open_loop import controls, drive_steps
 from spine_mj.sim.results import RunResult, analyse_group
-from spine_mj.sim.rollout import BatchOptions, batch_drives, controls, drive_steps, run_batch
+from spine_mj.sim.rollout import BatchOptions, batch_drives, run_batch
 
 # import name -> the PyPI package that provides it
 GPU_PACKAGES = {"warp": "warp-lang", "mujoco_warp": "mujoco-warp"}

@@ -11,7 +11,7 @@ Two dynamic excesses have closed forms, per spine in units of the preload ``F_p`
   units that amplitude is ``sqrt(I_e K L_c / l_s)`` (``K = k l_s / F_p``,
   ``I_e = m V^2 / (F_p L_c)``). The array's holding force under displacement control is
   read where the array lets go (:class:`~spine_mj.sim.array_run.ArrayResult`): at the last
-  step before every spine moves faster than :data:`~spine_mj.sim.motion.STUCK_SPEED_FRACTION`
+  step before every spine moves faster than :data:`~spine_mj.theory.motion.STUCK_SPEED_FRACTION`
   ``f V``. The tip's speed ``V (1 - cos(w t))`` reaches ``f V`` at ``cos(w t) = 1 - f``,
   where the spring has risen by ``sin(w t) = sqrt(2 f - f^2)`` of the swing: the reading's
   excess is ``sqrt(2 f - f^2) sqrt(I_e K L_c / l_s)`` (0.436 of the swing at ``f = 0.1``).
@@ -36,8 +36,8 @@ import math
 
 from spine_mj.errors import check_positive
 from spine_mj.sim.drives import DEFAULT_STIFFNESS_NUMBER
-from spine_mj.sim.motion import STUCK_SPEED_FRACTION
-from spine_mj.sim.params import Scales
+from spine_mj.sim.scales import Scales
+from spine_mj.theory.motion import STUCK_SPEED_FRACTION
 
 #: The predicted dynamic excess the default pace allows, as a fraction of ``mu F_p``.
 HOLDING_TOLERANCE = 0.01

@@ -1,11 +1,11 @@
 """The compiled MuJoCo model of one surface and one tip: building, surface swaps, export, placement.
 
 :class:`RigModel` loads ``models/spine_rig.xml`` with ``MjSpec``, sizes it from the
-:class:`~spine_mj.sim.params.Scales` (the rule lives in :mod:`spine_mj.sim.params`),
+:class:`~spine_mj.sim.scales.Scales` (the rule lives there),
 attaches the surface as an hfield, compiles, and knows its ids and sensor addresses;
 it places tips (:mod:`spine_mj.sim.placement`) and gives each drive its model.
 
-The model is built in engine units (:class:`~spine_mj.sim.params.EngineUnits`: length
+The model is built in engine units (:class:`~spine_mj.sim.scales.EngineUnits`: length
 ``L_c``, force ``F_p``, mass ``m``): ``rig.units`` converts. Everything that talks to MuJoCo
 (``model``, :meth:`RigModel.place`, the controls) is in those units; results are converted
 back to SI in one place (:meth:`~spine_mj.sim.recording.Recording.from_sensors`).
@@ -28,21 +28,19 @@ from spine_mj.errors import SpineInputError
 from spine_mj.resources import model_path
 from spine_mj.sim.drives import Drive, SpringDrive, speed_m_s, stiffness_n_m
 from spine_mj.sim.drives import stiffness_n_m as spring_stiffness_n_m
-from spine_mj.sim.params import (
+from spine_mj.sim.placement import Placer
+from spine_mj.sim.recording import SENSOR_NAMES
+from spine_mj.sim.records import EngineSettings, TipParams
+from spine_mj.sim.scales import Scales, hfield_of
+from spine_mj.sim.step_rule import (
     MAX_DRIVE_ADVANCE_PER_STEP,
     MAX_SPRING_OMEGA_DT,
-    EngineSettings,
-    Scales,
-    TipParams,
     check_drive_speed,
     check_engine_for,
     default_engine,
-    hfield_of,
     rest_depth_m,
     spring_omega_dt,
 )
-from spine_mj.sim.placement import Placer
-from spine_mj.sim.recording import SENSOR_NAMES
 from spine_mj.surfaces import BallOnFacets, HField, Surface, TriangulatedSurface, from_hfield
 
 MODEL_PATH = model_path()
@@ -321,7 +319,7 @@ class RigModel:
 
         The sphere centre is found by a safeguarded Newton search in z on the engine's own
         sphere-hfield distance (to 1e-7 tip radii), then lowered by the soft contact's resting depth
-        under one contact (:func:`~spine_mj.sim.params.rest_depth_m`): it starts at rest and in
+        under one contact (:func:`~spine_mj.sim.step_rule.rest_depth_m`): it starts at rest and in
         contact, never dropped (a start just above the surface falls for one step).
         """
         return self.place_many([(x0, y0)])[0]
@@ -376,7 +374,7 @@ class RigModel:
         was given (an I_e, a speed or a force rate), that advances more than
         :data:`MAX_DRIVE_ADVANCE_PER_STEP` L_c in one time step of this rig, or whose spring
         this rig's step cannot integrate (``omega dt`` above
-        :data:`~spine_mj.sim.params.MAX_SPRING_OMEGA_DT`)."""
+        :data:`~spine_mj.sim.step_rule.MAX_SPRING_OMEGA_DT`)."""
         speed = check_drive_speed(self.scales, self.speed_of(drive))
         dt, lc = self.engine.timestep_s, self.scales.char_length_m
         if speed * dt > MAX_DRIVE_ADVANCE_PER_STEP * lc:

@@ -52,9 +52,9 @@ import numpy as np
 from spine_mj.sim.detection import Detection, Event
 from spine_mj.sim.drives import RampDrive, rate_n_s, settle_steps
 from spine_mj.sim.fastforward import APPROACH_RATE, CHECKPOINT_STEPS, StickFastForward, fast_forward_on
+from spine_mj.sim.lanes import warning_text, warning_total
 from spine_mj.sim.model import RigModel, start_pair
 from spine_mj.sim.results import GroupAnalysis, RunResult
-from spine_mj.sim.rollout import warning_text, warning_total
 
 #: Steps between two early-termination checks.
 END_CHECK_STEPS = 256
@@ -328,7 +328,7 @@ def run_ramp(
     rig.check_drive(drive)
     det = (Detection() if detection is None else detection).resolve(rig.scales)
     start = start_pair(start)
-    u = rig.units  # the model is in engine units (spine_mj.sim.params.EngineUnits)
+    u = rig.units  # the model is in engine units (spine_mj.sim.scales.EngineUnits)
     qpos0 = rig.place(*start)
     m = rig.model_for(drive)
     d = mujoco.MjData(m)

@@ -5,7 +5,7 @@ runs of equal length) under the names :class:`~spine_mj.sim.RunResult` gives the
 the tangential speed the stick/slip states come from. It is built once per group from the
 rollout's state and sensordata (:meth:`Recording.from_sensors`) and passed whole to the
 event detection and to the result, instead of a dozen loose arrays. MuJoCo's numbers are
-in engine units (:class:`~spine_mj.sim.params.EngineUnits`); :meth:`Recording.from_sensors`
+in engine units (:class:`~spine_mj.sim.scales.EngineUnits`); :meth:`Recording.from_sensors`
 is the one place they become SI.
 """
 
@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from spine_mj.sim.params import EngineUnits
+from spine_mj.sim.scales import EngineUnits
 
 SENSOR_NAMES = ("tip_pos", "tip_vel", "contact_net", "contact_deepest", "spring_force", "push_force")
 

@@ -3,7 +3,7 @@
 :class:`TipParams` (the spine tip), :class:`EngineSettings` (MuJoCo settings, recorded with
 every run; the rule that derives them is :func:`~spine_mj.sim.step_rule.default_engine`),
 the enums they use (:class:`Cone`, :class:`Integrator`) and :class:`EndReason`, why a run
-ended. Nothing here needs MuJoCo; :mod:`spine_mj.sim.params` re-exports every name.
+ended. Nothing here needs MuJoCo.
 """
 
 from __future__ import annotations

@@ -35,8 +35,9 @@ from spine_mj.sim.detection import (
 )
 from spine_mj.sim.drives import Drive, SpringDrive, StaticProbe, settle_steps, stiffness_n_m
 from spine_mj.sim.model import RigModel
-from spine_mj.sim.params import EndReason, EngineSettings, Scales, TipParams
 from spine_mj.sim.recording import COLUMNS, RESULT_COLUMNS, SENSOR_NAMES, Recording, RunColumns
+from spine_mj.sim.records import EndReason, EngineSettings, TipParams
+from spine_mj.sim.scales import Scales
 from spine_mj.theory.engagement import DEFAULT_TOL
 from spine_mj.theory.motion import MOTION_NAMES, SlipEvent, motion_fractions, motion_states, slip_events
 

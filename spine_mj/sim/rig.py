@@ -17,10 +17,11 @@ from spine_mj.sim.detection import Detection
 from spine_mj.sim.drives import Drive, RampDrive
 from spine_mj.sim.gpu import run_batch_gpu
 from spine_mj.sim.model import RigModel
+from spine_mj.sim.open_loop import controls
 from spine_mj.sim.ramp import run_ramp
 from spine_mj.sim.render import render_frames
 from spine_mj.sim.results import RunResult
-from spine_mj.sim.rollout import BatchOptions, batch_drives, controls, run_batch
+from spine_mj.sim.rollout import BatchOptions, batch_drives, run_batch
 
 #: A run stopped on penetration is run once more at this fraction of the time step and
 #: contact time constant (``Rig.run_batch``, ``refine``). The engine rule bounds the
@@ -44,13 +45,13 @@ class Rig(RigModel):
         None: :func:`default_engine` of the scales.
     length_scale_m : float or None
         Metres per surface unit; None gives 0.01 for ``unit == "1"`` and the size of a
-        length unit otherwise (1e-6 for ``"um"``; :func:`~spine_mj.sim.params.surface_unit_m`).
+        length unit otherwise (1e-6 for ``"um"``; :func:`~spine_mj.sim.scales.surface_unit_m`).
     char_length_m : float or None
         L_c [m]; None: :func:`characteristic_length` times ``length_scale_m``.
     hfield_resolution : int or None
         Samples a side the hfield is resampled to (None: a grid keeps its own samples, an
         analytic surface gets 201; either coarsened to a quarter tip radius,
-        :meth:`~spine_mj.sim.params.Scales.with_hfield`).
+        :meth:`~spine_mj.sim.scales.Scales.with_hfield`).
     sized : (Scales, HField) or None
         ``Scales.with_hfield`` of this surface and tip when the caller already has them
         (:func:`~spine_mj.sim.build.build_rig`); None measures them here.
@@ -66,7 +67,7 @@ class Rig(RigModel):
     Default tip radius: ``surface.metadata["params"]["tip_radius_m"]`` if the surface has
     one (sandpaper), the larger of two lateral spacings and ``L_c / 100`` for a measured
     scan, else the larger of one hfield spacing and ``L_c / 100``
-    (:meth:`~spine_mj.sim.params.Scales.for_surface`).
+    (:meth:`~spine_mj.sim.scales.Scales.for_surface`).
     """
 
     def run(

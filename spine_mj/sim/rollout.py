@@ -73,11 +73,7 @@ from spine_mj.sim.drives import (
 )
 from spine_mj.sim.fastforward import QUIET_STEPS, RISE_STEPS, StickFastForward, fast_forward_on
 from spine_mj.sim.lanes import NativeLanes, PythonLane
-from spine_mj.sim.lanes import python_steps as python_steps  # re-exported (its old home)
-from spine_mj.sim.lanes import warning_text as warning_text
-from spine_mj.sim.lanes import warning_total as warning_total
 from spine_mj.sim.model import RigModel, start_pair
-from spine_mj.sim.open_loop import MAX_RUN_STEPS as MAX_RUN_STEPS  # re-exported (its old home)
 from spine_mj.sim.open_loop import (
     control_profile,
     drive_steps,
@@ -85,7 +81,6 @@ from spine_mj.sim.open_loop import (
     profile_key,
     start_offsets,
 )
-from spine_mj.sim.open_loop import controls as controls
 from spine_mj.sim.recording import Recording
 from spine_mj.sim.results import GroupAnalysis, RunResult
 

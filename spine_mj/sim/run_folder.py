@@ -27,7 +27,7 @@ from spine_mj.sim.build import build_drive
 from spine_mj.sim.drives import RampDrive, SpringDrive, StaticProbe
 from spine_mj.sim.engines import DEFAULT_ENGINE, build_engine_rig
 from spine_mj.sim.model import RigModel
-from spine_mj.sim.params import EngineSettings, TipParams
+from spine_mj.sim.records import EngineSettings, TipParams
 from spine_mj.sim.render import Track, write_mp4
 from spine_mj.sim.results import RunResult
 from spine_mj.surfaces import Surface

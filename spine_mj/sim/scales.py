@@ -5,7 +5,7 @@
 spacing and coarsening, the surface's fall height), :class:`EngineUnits` the units MuJoCo
 works in; the hfield helpers (:func:`hfield_of`, :func:`hfield_spacing`),
 :func:`surface_unit_m` and :func:`fall_height` are the rules they use. Nothing here needs
-MuJoCo; :mod:`spine_mj.sim.params` re-exports every name.
+MuJoCo.
 
 The scaling rule. MuJoCo sees the problem in its own units: length ``L_c``, force
 ``F_p = m g + preload``, mass ``m``, hence time ``tau = sqrt(m L_c / F_p)`` and speed

@@ -5,7 +5,7 @@
 speed or the surface's fall, and the drive spring's ``omega dt``; rule in
 :mod:`spine_mj.sim`'s docstring); :func:`check_engine_for`, :func:`rest_depth_m` and
 :func:`penetration_tolerance_m` hold a user's settings to the same bounds. Nothing here
-needs MuJoCo; :mod:`spine_mj.sim.params` re-exports every name.
+needs MuJoCo.
 """
 
 from __future__ import annotations

@@ -24,7 +24,6 @@ from spine_mj.surfaces.base import (
     check_grid_size,
     check_unit,
 )
-from spine_mj.surfaces.sandpaper import sandpaper as sandpaper  # re-exported (its old home)
 from spine_mj.surfaces.types import GaussianSurface, GridSurface
 
 

@@ -42,7 +42,6 @@ from spine_mj import examples, presets
 from spine_mj.errors import SpineInputError
 from spine_mj.jsonio import to_jsonable
 from spine_mj.sweep.digests import digest
-from spine_mj.sweep.digests import input_digests as input_digests  # re-exported (its old home)
 from spine_mj.sweep.registry import ANALYSES, PRESET_MU, REQUIRED, ParamSpec, param_specs
 from spine_mj.sweep.tables import (
     MAX_CASES,

@@ -38,7 +38,6 @@ from spine_mj.sweep.store import (
     store_lock,
     versions,
 )
-from spine_mj.workers import MAX_WORKERS_PER_CORE, check_workers  # noqa: F401 (re-exported)
 
 
 @dataclass(frozen=True)

@@ -36,7 +36,8 @@ from spine_mj.atomic import atomic_output
 from spine_mj.errors import SpineInputError
 from spine_mj.jsonio import write_json
 from spine_mj.sweep.cases import Case
-from spine_mj.sweep.config import SweepConfig, input_digests
+from spine_mj.sweep.config import SweepConfig
+from spine_mj.sweep.digests import input_digests
 from spine_mj.sweep.registry import ANALYSES
 
 MANIFEST = "manifest.json"

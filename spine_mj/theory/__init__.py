@@ -17,8 +17,7 @@ theory runs wherever numpy and numba do.
   slip events they make (of a MuJoCo run and of the reference integrator alike);
 - :mod:`~spine_mj.theory.energy`: energy budget of a stick-slip event;
 - :mod:`~spine_mj.theory.array_reference`: the quasistatic hold curve of a spine array;
-- :mod:`~spine_mj.theory.targets`: how close a dynamic run must come to count as agreeing.
-
-The same modules import by their old names (``spine_mj.streamline``, ``spine_mj.engagement``,
-...): :mod:`spine_mj` maps those onto these.
+- :mod:`~spine_mj.theory.targets`: how close a dynamic run must come to count as agreeing;
+- :mod:`~spine_mj.theory.agreement`: the metrics that say so (Frechet distance, outcome and
+  kappa agreement, capture rate, why a run and its reference part).
 """

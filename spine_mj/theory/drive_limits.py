@@ -52,10 +52,10 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from spine_mj import roughness
-from spine_mj.compare import outcome_agreement, path_frechet
 from spine_mj.errors import SpineInputError
 from spine_mj.surfaces import Surface
 from spine_mj.theory import streamline as sl
+from spine_mj.theory.agreement import outcome_agreement, path_frechet
 from spine_mj.theory.compliant import compliant_streamlines, hold_force
 from spine_mj.theory.engagement import DEFAULT_KAPPA_CAP, SELF_LOCK
 from spine_mj.theory.targets import FRECHET_TARGET, OUTCOME_TARGET
@@ -356,7 +356,7 @@ def path_criterion(rigid, compliant, char_length: float) -> tuple[float, float]:
     """Outcome agreement (share of starts) and median Frechet distance (in ``L_c``, x-y
     traces) of ``compliant`` paths against the ``rigid`` ones from the same starts: the
     comparison a spring-drive run meets against its streamline
-    (:func:`spine_mj.compare.outcome_agreement`, :func:`spine_mj.compare.path_frechet`; a
+    (:func:`spine_mj.theory.agreement.outcome_agreement`, :func:`spine_mj.theory.agreement.path_frechet`; a
     rigid path that stalled decided nothing and disagrees, as in the sweep's comparison)."""
     agree = outcome_agreement(
         rigid.self_locked,

@@ -52,7 +52,7 @@ class StreamlineRun:
 
     def table(self):
         """Both analyses as one long pandas DataFrame: the columns of
-        :meth:`~spine_mj.streamline.StreamlineResult.to_frame` (``trajectory`` names the
+        :meth:`~spine_mj.theory.streamline.StreamlineResult.to_frame` (``trajectory`` names the
         analysis) and ``mu``, ``tip_radius``."""
         import pandas as pd
 
@@ -89,11 +89,11 @@ def trace_starts(
     mu : float
         Static friction coefficient mu_s (> 0).
     dl : float or None
-        Step length (surface units); None: :func:`~spine_mj.streamline.default_step` of
+        Step length (surface units); None: :func:`~spine_mj.theory.streamline.default_step` of
         the surface.
     tip_radius : float
         Spherical tip radius R (>= 0, surface units): the paths ride ``surface`` dilated
-        by R (:func:`~spine_mj.streamline.dilate`).
+        by R (:func:`~spine_mj.theory.streamline.dilate`).
 
     Raises
     ------

@@ -164,7 +164,7 @@ class BoundaryResult:
 def boundary(plan: ValidationPlan, runner: StudyRunner) -> BoundaryResult:
     """Study 3: agreement against I_e for the spring and ramp drives, and I_e*.
 
-    Spring drive: per run, outcome agreement (``compare.outcome_agreement``: lock and trap)
+    Spring drive: per run, outcome agreement (``agreement.outcome_agreement``: lock and trap)
     and the Frechet deviation from the streamline. Ramp with reset: its ``I_e`` is the
     equivalent one, ``m v_eq^2 / (F_p L_c)`` with ``v_eq = L_c rate / F_p``; its duration is
     set from a pilot run's per-cycle slip so that the tip covers the path to the domain edge

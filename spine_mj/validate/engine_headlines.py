@@ -35,8 +35,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from spine_mj import compare, sim
+from spine_mj import sim
 from spine_mj.errors import non_negative_int
+from spine_mj.theory import agreement
 from spine_mj.validate.convergence import thin_starts
 from spine_mj.validate.ensembles import ensemble_family
 from spine_mj.validate.intervals import newcombe_difference
@@ -381,14 +382,14 @@ def _pairs(a: pd.DataFrame, b: pd.DataFrame) -> dict:
     """Over the starts well-conditioned and finished in both engines ``a`` and ``b`` (and on
     the reference): how many both agree with the streamline, only ``a`` (the closed form
     supports ``a``), only ``b``, neither; and how many the two engines end alike (held or
-    free, and where held the same trap: :func:`spine_mj.compare.outcome_agreement`)."""
+    free, and where held the same trap: :func:`spine_mj.theory.agreement.outcome_agreement`)."""
     both = a.merge(b, left_index=True, right_index=True, suffixes=("_a", "_b"))
     both = both[both["well_a"] & both["well_b"]]
     lc = both["lc_a"].to_numpy(float)
     same = np.zeros(len(both), bool)
     for scale in np.unique(lc):  # each surface's own L_c (a family's grits differ 10-fold)
         m = lc == scale
-        same[m] = compare.outcome_agreement(
+        same[m] = agreement.outcome_agreement(
             both["held_a"].to_numpy()[m],
             both[["end_x_a", "end_y_a"]].to_numpy()[m],
             both["held_b"].to_numpy()[m],

@@ -6,7 +6,7 @@ verdict drawn from one such run is a coin toss. So every start of the quasistati
 study runs as an ensemble: the start itself and ``members - 1`` starts on a circle of
 radius :data:`ENSEMBLE_RADIUS_LC` L_c around it (a fixed stencil: the ensemble is a
 function of the plan alone). The radius is far above rounding (1e-16 relative) and far
-below what tells traps apart (the end tolerance of :func:`spine_mj.compare.outcome_agreement`,
+below what tells traps apart (the end tolerance of :func:`spine_mj.theory.agreement.outcome_agreement`,
 0.25 L_c) and the hfield's spacing (~0.06 L_c on the fractal): two members that end in
 different traps say the start lies within 1e-3 L_c of a watershed, where another CPU's last
 bits may flip it. The machine-to-machine flips measured on the fractal (issue: separatrix
@@ -14,7 +14,7 @@ offsets 0.001-0.08 L_c) sit at that scale.
 
 A start is ill-conditioned on a side (MuJoCo, or the reference streamline) when its members
 there do not all end in the same outcome (held or free, and where held, the same trap:
-:func:`spine_mj.compare.outcome_agreement` between members, the comparison's own rule).
+:func:`spine_mj.theory.agreement.outcome_agreement` between members, the comparison's own rule).
 Agreement is then judged on the starts well-conditioned on both sides, where each side's
 outcome is one; the others are counted per side, with the overlap of the two outcome
 distributions (the share of MuJoCo-reference member pairs that agree).
@@ -28,8 +28,9 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from spine_mj import compare, presets, sim
+from spine_mj import presets, sim
 from spine_mj.surfaces import GridSurface
+from spine_mj.theory import agreement
 from spine_mj.validate.intervals import wilson
 from spine_mj.validate.paths import stored_paths
 from spine_mj.validate.plans import MASS_KG, FamilySpec
@@ -85,7 +86,7 @@ def ensemble_starts(table: dict, members: int, radius_xy: Sequence[float]) -> di
 
 def _same(a_held, a_end, b_held, b_end, lc: float) -> np.ndarray:
     """Outcome equality (held or not, and where held the same trap) of run pairs."""
-    return compare.outcome_agreement(a_held, a_end, b_held, b_end, length_scale=lc)["agree"]
+    return agreement.outcome_agreement(a_held, a_end, b_held, b_end, length_scale=lc)["agree"]
 
 
 def _split(held: np.ndarray, end: np.ndarray, lc: float) -> bool:

@@ -96,9 +96,9 @@ def estimate_ie_star(
     frechet : array_like, shape (n,), optional
         Mean Frechet deviation / L_c at each I_e.
     agree_min : float
-        The agreement target (default :data:`~spine_mj.compare.OUTCOME_TARGET`, 0.95).
+        The agreement target (default :data:`~spine_mj.theory.agreement.OUTCOME_TARGET`, 0.95).
     frechet_max : float
-        The Frechet target / L_c (default :data:`~spine_mj.compare.FRECHET_TARGET`, 0.1).
+        The Frechet target / L_c (default :data:`~spine_mj.theory.agreement.FRECHET_TARGET`, 0.1).
 
     Returns
     -------

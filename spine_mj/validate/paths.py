@@ -5,7 +5,7 @@ The quasistatic streamline runs on the surface dilated by the rig's tip radius
 (:func:`tip_radius`), on the smooth surface or on MuJoCo's triangulated hfield
 (:func:`triangulated_surface`), which separates the geometry error of the facets from the
 dynamics error. Deviations are resampled Frechet distances in units of ``L_c``
-(:func:`spine_mj.compare.path_frechet`).
+(:func:`spine_mj.theory.agreement.path_frechet`).
 """
 
 from __future__ import annotations
@@ -14,9 +14,10 @@ from pathlib import Path
 
 import numpy as np
 
-from spine_mj import compare, presets, sim, sweep
+from spine_mj import presets, sim, sweep
 from spine_mj.errors import SpineInputError
 from spine_mj.surfaces import GridSurface, TriangulatedSurface, from_hfield, to_hfield
+from spine_mj.theory import agreement
 from spine_mj.theory import streamline as sl
 from spine_mj.validate.plans import MASS_KG
 
@@ -109,8 +110,8 @@ def path_metrics(mpath: np.ndarray, qpath: np.ndarray, lc: float) -> tuple[float
     """
     if mpath.shape[0] < 2 or qpath.shape[0] < 2:
         return float("nan"), float("nan")
-    fr = compare.path_frechet(mpath, qpath, length_scale=lc)
-    return fr, float(compare.mean_lateral_deviation(mpath, qpath, length_scale=lc))
+    fr = agreement.path_frechet(mpath, qpath, length_scale=lc)
+    return fr, float(agreement.mean_lateral_deviation(mpath, qpath, length_scale=lc))
 
 
 def prefix_frechet(mpath: np.ndarray, qpath: np.ndarray, lc: float) -> float:
@@ -138,7 +139,7 @@ def prefix_frechet(mpath: np.ndarray, qpath: np.ndarray, lc: float) -> float:
     if q.shape[0] < 2:
         q = np.vstack([qpath[0], qpath[0]])
     spacing = max(min(lc / 50, arc_m / 20), 1e-9 * lc)
-    return compare.path_frechet(mpath, q, length_scale=lc, spacing=spacing)
+    return agreement.path_frechet(mpath, q, length_scale=lc, spacing=spacing)
 
 
 def mujoco_traces(store: Path, case_id: str) -> dict:

@@ -14,8 +14,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from spine_mj.compare import MISS_REASONS
 from spine_mj.presets import calibrated_mu
+from spine_mj.theory.agreement import MISS_REASONS
 from spine_mj.validate.convergence import REFINEMENTS, family_convergence, thin_starts
 from spine_mj.validate.ensembles import ensemble_family, ensemble_groups, ensemble_verdicts
 from spine_mj.validate.intervals import bootstrap, meets_target, wilson
@@ -97,9 +97,9 @@ class QuasistaticLimitResult:
         (against the smooth one), ``mean_geometry_frechet``, ``failed_runs`` (engine stops
         by status), ``reference_stalled`` (reference streamlines stalled in a groove),
         ``misses`` (disagreeing runs the engine finished, by
-        :func:`spine_mj.compare.miss_reason`, each with its offsets over L_c),
+        :func:`spine_mj.theory.agreement.miss_reason`, each with its offsets over L_c),
         ``slide_runs`` (runs whose reference slides under gravity somewhere:
-        :func:`spine_mj.compare.slide_fraction` > 0), ``median_tip_peak_ie`` (the engine
+        :func:`spine_mj.theory.agreement.slide_fraction` > 0), ``median_tip_peak_ie`` (the engine
         tip's own peak speed as an inertia number), ``meets_target``.
     runs : list of dict
         Per-run rows (:data:`RUN_COLUMNS`).

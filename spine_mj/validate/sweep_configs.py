@@ -12,7 +12,7 @@ from typing import Any
 
 from spine_mj import presets, sim, sweep
 from spine_mj.sim.drives import spring_stiffness_n_m
-from spine_mj.sim.params import surface_unit_m
+from spine_mj.sim.scales import surface_unit_m
 from spine_mj.surfaces import GridSurface
 from spine_mj.validate.plans import MASS_KG, FamilySpec, ValidationPlan
 

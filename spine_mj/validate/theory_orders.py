@@ -56,7 +56,7 @@ __all__ = [
 #: Orders the theory predicts (docs/physics.md §10): axis -> order of the gap.
 PREDICTED_ORDERS = {"ie": 1.0, "inverse_k": 1.0}
 
-#: The median Frechet distance's resolution in L_c: :func:`spine_mj.compare.path_frechet`
+#: The median Frechet distance's resolution in L_c: :func:`spine_mj.theory.agreement.path_frechet`
 #: resamples both paths at L_c / 50, and the discrete distance resolves half a sample (the
 #: corner's medians sit at 0.010 on every family where the paths coincide).
 FRECHET_FLOOR_LC = 0.01

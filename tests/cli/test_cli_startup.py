@@ -78,7 +78,7 @@ def test_the_public_names_still_import_from_the_package():
 
     code = f"from spine_mj import {', '.join(n for n in spine_mj.__all__ if n != '__version__')}"
     subprocess.run([sys.executable, "-c", code], check=True)
-    assert spine_mj.streamline.streamlines is spine_mj.streamlines  # a submodule on first use too
+    assert spine_mj.theory.streamline.streamlines is spine_mj.streamlines  # a submodule on first use too
 
 
 def test_the_root_lists_every_command_it_loads_lazily():

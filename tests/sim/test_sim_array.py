@@ -17,7 +17,7 @@ from spine_mj.sim.array import ArrayRig, ForcePull
 from spine_mj.sim.drives import DEFAULT_STIFFNESS_NUMBER, stiffness_n_m
 from spine_mj.sim.holding import ONSET_SHARE, spring_swing
 from spine_mj.sim.layout import Layout
-from spine_mj.sim.planes import inclined_plane
+from spine_mj.surfaces.generators import inclined_plane
 from spine_mj.theory.array_reference import force_control_release, profile_spine_curve, summed_curve
 
 

@@ -12,7 +12,7 @@ from spine_mj.errors import SpineInputError
 from spine_mj.sim.array import ArrayRig
 from spine_mj.sim.array_outputs import ARRAY_OUTPUTS, array_summary, write_array_outputs
 from spine_mj.sim.layout import Layout
-from spine_mj.sim.planes import inclined_plane
+from spine_mj.surfaces.generators import inclined_plane
 
 
 @pytest.fixture(scope="module")

@@ -16,11 +16,12 @@ import pytest
 from click.testing import CliRunner
 from sweep_support import write_config
 
-from spine_mj import engagement, extras, sim, sweep
+from spine_mj import extras, sim, sweep
 from spine_mj.cli import main
 from spine_mj.errors import SpineInputError
 from spine_mj.sim.run_folder import load_run
 from spine_mj.surfaces import GridSurface, TriangulatedSurface, from_hfield
+from spine_mj.theory import engagement
 
 pytest.importorskip("pybullet", reason="the Bullet engine needs the [bullet] extra (pybullet)")
 

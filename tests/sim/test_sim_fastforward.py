@@ -16,10 +16,11 @@ import numpy as np
 import pytest
 from sim_rigs import MU, PHI, flat_rig, plane_rig
 
-from spine_mj import compare, sim
+from spine_mj import sim
 from spine_mj.sim import EndReason, RampDrive, Rig, SpringDrive, TipParams
 from spine_mj.sim.ramp import cycle_breakaways, nominal_time_s, rows_to_reset
 from spine_mj.surfaces import corrugation
+from spine_mj.theory import agreement
 from spine_mj.theory.tomlinson import Corrugation
 
 
@@ -32,7 +33,7 @@ def _assert_same_physics(plain, fast, cycles):
         plain.position_m[: rows_to_reset(plain, cycles), :2],
         fast.position_m[: rows_to_reset(fast, cycles), :2],
     )
-    assert compare.path_frechet(b, a, length_scale=lc) <= 0.01
+    assert agreement.path_frechet(b, a, length_scale=lc) <= 0.01
 
 
 @pytest.mark.parametrize("slope", [-15.0, 0.0, 15.0, 25.0])
@@ -329,7 +330,7 @@ def test_fast_forward_keeps_spring_runs_on_a_fractal():
     for p, f in zip(plain, fast):
         assert p.end_reason is f.end_reason
         assert np.abs(f.position_m[-1] - p.position_m[-1]).max() < 0.01 * lc
-        assert compare.path_frechet(f.position_m[:, :2], p.position_m[:, :2], length_scale=lc) <= 0.01
+        assert agreement.path_frechet(f.position_m[:, :2], p.position_m[:, :2], length_scale=lc) <= 0.01
         assert _same_slips(p, f, force_rel=0.05, travel_lc=0.01, share=0.85)
     assert sum(len(f.slip_events) for f in fast) == pytest.approx(
         sum(len(p.slip_events) for p in plain), rel=0.05

@@ -23,7 +23,7 @@ def simulate(*args):
 
 def test_a_spring_the_step_cannot_integrate_is_refused_and_leaves_no_mujoco_log(in_tmp):
     # a 1e12 N/m spring with a 10 ms step blew up into MuJoCo's "Nan, Inf or huge value in
-    # QACC"; the step rule's bound (sim.params.MAX_SPRING_OMEGA_DT) refuses it before running
+    # QACC"; the step rule's bound (sim.step_rule.MAX_SPRING_OMEGA_DT) refuses it before running
     result = simulate("--stiffness", 1e12, "--timestep", 0.01, "--out", "run")
     assert result.exit_code == 2, result.output
     assert re.search(r"drive spring .* swings 1e\+05 rad in one time step .* at most 6e-08 s", result.output)
@@ -80,7 +80,7 @@ def test_a_fall_off_a_cliff_lands_within_the_tolerance_by_the_step_rule():
     the drive: the step the resting and drive-speed rules give (``fall_height_m`` zeroed)
     lets it sink 0.1-0.3 tip radii on landing, depending on where the last step before
     the floor falls, and stops most runs on penetration, which the detail calls a
-    landing. With the fall in the rule (sim.params.fall_height) every run lands within
+    landing. With the fall in the rule (sim.scales.fall_height) every run lands within
     the impact depth the rule aims at (5 % of the radius; measured up to 5.8 %)."""
     import dataclasses
 

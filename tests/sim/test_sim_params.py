@@ -132,7 +132,7 @@ def test_fall_height_is_the_landing_a_slip_can_make():
     a ramp steeper than friction (slope s > mu, run L) ending on a floor lands from
     ``(s - mu) L sin^2(arctan s)``; one gentler than friction never gains speed; a cliff
     of height H over one cell dx lands from ``(H - mu dx) sin^2`` of its turn."""
-    from spine_mj.sim.params import fall_height
+    from spine_mj.sim.scales import fall_height
 
     x = np.arange(200.0)  # spacing 1
     for slope in (0.0, 0.3, 2.0, -5.0):
@@ -162,7 +162,7 @@ def test_a_time_step_whose_contact_rests_the_tip_too_deep_is_refused_with_the_la
 
     import mujoco
 
-    from spine_mj.sim.params import MIN_TIMESTEP_TAU, penetration_tolerance_m, rest_depth_m
+    from spine_mj.sim.step_rule import MIN_TIMESTEP_TAU, penetration_tolerance_m, rest_depth_m
 
     base = flat_rig()
     surface, tip = base.surface, base.tip

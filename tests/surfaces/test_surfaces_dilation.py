@@ -93,4 +93,4 @@ def test_dilate_matches_the_brute_force_on_grids_and_analytic_surfaces():
     yw = got.y[0] + dy * np.arange(-ry, got.y.size + ry)
     wide = ball_dilation_reference(peak.height(xw[None, :], yw[:, None]), 0.5, spacing=(dx, dy))
     np.testing.assert_allclose(got.heights, wide[ry:-ry, rx:-rx], atol=1e-12)
-    assert dilate_in_streamline is dilate  # spine_mj.streamline.dilate still imports
+    assert dilate_in_streamline is dilate  # spine_mj.theory.streamline.dilate still imports

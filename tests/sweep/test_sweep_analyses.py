@@ -101,7 +101,7 @@ def test_mujoco_and_compare_runs_match_the_rig_run_directly(tmp_path):
 
 def test_a_scan_in_um_takes_its_tip_radius_in_um(tmp_path, topography_dir):
     """A sweep's ``tip_radius`` is in the surface's length unit: 5 on a surface kept in
-    the instrument's um is a 5 um tip (the rule of ``sim.params.surface_unit_m``)."""
+    the instrument's um is a 5 um tip (the rule of ``sim.scales.surface_unit_m``)."""
     from spine_mj.surface_io import import_topography, save_surface
     from spine_mj.sweep.analyses.mujoco import case_rig
 

@@ -8,7 +8,6 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from spine_mj.compare import path_frechet
 from spine_mj.errors import SpineInputError
 from spine_mj.surfaces import (
     BallOnFacets,
@@ -17,6 +16,7 @@ from spine_mj.surfaces import (
     corrugation,
     single_gaussian,
 )
+from spine_mj.theory.agreement import path_frechet
 from spine_mj.theory.compliant import MotionState, compliant_streamlines, hold_force
 from spine_mj.theory.engagement import kappa
 from spine_mj.theory.streamline import Outcome, StreamlineParams, streamlines

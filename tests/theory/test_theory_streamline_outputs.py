@@ -5,9 +5,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from spine_mj import streamline as sl
 from spine_mj.errors import SpineInputError
 from spine_mj.surfaces import corrugation, single_gaussian
+from spine_mj.theory import streamline as sl
 from spine_mj.theory.streamline_outputs import FIGURE_NAME, trace_starts, write_streamline_outputs
 
 STARTS = [(-3.0, -1.0), (-3.0, -2.0)]

@@ -12,7 +12,7 @@ from spine_mj.sim.array import ArrayRig
 from spine_mj.sim.drives import DEFAULT_STIFFNESS_NUMBER, stiffness_n_m
 from spine_mj.sim.holding import spring_swing
 from spine_mj.sim.layout import Layout
-from spine_mj.sim.planes import inclined_plane
+from spine_mj.surfaces.generators import inclined_plane
 from spine_mj.validate.array_study import (
     ARRAY_IE,
     PACE_RATIO,

@@ -2,7 +2,7 @@
 
 Each analysis touches the API of its module in one place (``quasistatic`` ->
 :mod:`spine_mj.theory.streamline`, ``mujoco`` -> :mod:`spine_mj.sim`, ``compare`` ->
-:mod:`spine_mj.compare`), so that a change there is a change here in one place. Importing
+:mod:`spine_mj.theory.agreement`), so that a change there is a change here in one place. Importing
 this package registers them, in this order (the run order: dependencies first).
 """
 

@@ -8,12 +8,12 @@ both sides share the geometry, the lock test and the domain. The comparison with
 quasistatic analysis's path (the smooth surface, or whatever it traced; retraced within
 the same domain) is kept beside it (``*_smooth``), and the gap between the two streamlines
 is the geometry part (``geometry_frechet``). A run that disagrees gets a ``miss_reason``
-(:func:`spine_mj.compare.miss_reason`: the reference restarted along its path). A spring
+(:func:`spine_mj.theory.agreement.miss_reason`: the reference restarted along its path). A spring
 drive is also compared with the compliant-drive streamline of its own spring
 (``compliant_frechet``, ``agree_compliant``; :mod:`spine_mj.theory.compliant`). A spring
 drive too fast for its stiffness to be quasistatic is refused before any run unless the
 grid's ``dynamic_drive`` asks for it (:func:`_check_case`). Touches
-the API of :mod:`spine_mj.compare` here only; needs the results of the ``quasistatic`` and
+the API of :mod:`spine_mj.theory.agreement` here only; needs the results of the ``quasistatic`` and
 ``mujoco`` analyses of the same case.
 """
 
@@ -23,13 +23,13 @@ import dataclasses
 
 import numpy as np
 
-from spine_mj import compare
 from spine_mj.errors import SpineInputError
 from spine_mj.sim.drives import stiffness_n_m
 from spine_mj.sim.holding import spring_swing
 from spine_mj.sweep.analyses.mujoco import case_drive, case_rig, peak_drive_over_fp
 from spine_mj.sweep.analyses.quasistatic import cached_trace, hfield_key, path_table, traced_surface
 from spine_mj.sweep.registry import Analysis, AnalysisResult, ParamSpec, register_analysis
+from spine_mj.theory import agreement
 from spine_mj.theory import streamline as sl
 from spine_mj.theory.compliant import compliant_streamlines
 from spine_mj.theory.drive_limits import SWING_BOUND_FP, spring_ie_limits
@@ -49,9 +49,9 @@ def _deviations(mpaths, qpaths: dict, lc: float, *, lateral: bool = True):
     for i, qpath in qpaths.items():
         if mpaths[i].shape[0] == 0:
             continue
-        frechet[i] = compare.path_frechet(mpaths[i], qpath, length_scale=lc)
+        frechet[i] = agreement.path_frechet(mpaths[i], qpath, length_scale=lc)
         if lateral:
-            side[i] = compare.mean_lateral_deviation(mpaths[i], qpath, length_scale=lc)
+            side[i] = agreement.mean_lateral_deviation(mpaths[i], qpath, length_scale=lc)
     return frechet, side
 
 
@@ -62,7 +62,7 @@ def _paths(res: sl.StreamlineResult, idx) -> dict:
 
 def _outcomes(qs: sl.StreamlineResult, mj_locked, mj_end, lc: float) -> dict[str, np.ndarray]:
     """Outcome agreement; a reference that stalled decided nothing, so its run disagrees."""
-    out = compare.outcome_agreement(
+    out = agreement.outcome_agreement(
         qs.self_locked, np.column_stack([qs.end_x, qs.end_y]), mj_locked, mj_end, length_scale=lc
     )
     out["agree"] = out["agree"] & (qs.outcome != sl.Outcome.STALLED)
@@ -70,7 +70,7 @@ def _outcomes(qs: sl.StreamlineResult, mj_locked, mj_end, lc: float) -> dict[str
 
 
 #: Checkpoints along a disagreeing MuJoCo path from which the reference is restarted to
-#: tell why it disagrees (:func:`spine_mj.compare.miss_reason`): evenly spaced in arc
+#: tell why it disagrees (:func:`spine_mj.theory.agreement.miss_reason`): evenly spaced in arc
 #: length, the first at the path's start, the last at its end.
 MISS_CHECKPOINTS = 16
 
@@ -103,7 +103,7 @@ def _miss_reasons(contact, params, trace, mpaths, facets, mj_locked, mj_end, lc,
     ]
     facet = float(contact.facets.x[1] - contact.facets.x[0]) / lc
     for n, i in enumerate(runs):
-        reason[i], offset[i] = compare.miss_reason(
+        reason[i], offset[i] = agreement.miss_reason(
             points[n],
             _xy(facets, i),
             reaches[n * k : (n + 1) * k],
@@ -152,7 +152,7 @@ def _compliant(
     out["agree_compliant"][idx] = _outcomes(ref, mj_locked[idx], mj_end[idx], lc)["agree"]
     out["compliant_jumps"][idx] = np.bincount(ref.folds.start, minlength=idx.size)
     out["stiffness_frechet"][idx] = [
-        compare.path_frechet(_xy(ref, j), _xy(facets, i), length_scale=lc) for j, i in enumerate(idx)
+        agreement.path_frechet(_xy(ref, j), _xy(facets, i), length_scale=lc) for j, i in enumerate(idx)
     ]
     return out
 
@@ -163,10 +163,10 @@ def _pace(facets, runs, scales) -> dict:
     go at gravity's pace, whatever the drive's)."""
     return {
         "reference_slide_fraction": np.array(
-            [compare.slide_fraction(_xy(facets, i), facets.path(i)["region"]) for i in range(len(facets))]
+            [agreement.slide_fraction(_xy(facets, i), facets.path(i)["region"]) for i in range(len(facets))]
         ),
         "tip_peak_ie": np.array(
-            [scales.inertia_number(compare.peak_speed(r.velocity_m_s[r.drive_start_index :])) for r in runs]
+            [scales.inertia_number(agreement.peak_speed(r.velocity_m_s[r.drive_start_index :])) for r in runs]
         ),
     }
 
@@ -220,7 +220,7 @@ def _compare(case, surface, starts, upstream):
     frechet, lateral = _deviations(mpaths, {int(i): _xy(facets, i) for i in idx}, lc)
     frechet_smooth, _ = _deviations(mpaths, smooth_paths, lc, lateral=False)
     geometry = np.full(len(runs), np.nan)
-    geometry[idx] = [compare.path_frechet(_xy(facets, i), smooth_paths[i], length_scale=lc) for i in idx]
+    geometry[idx] = [agreement.path_frechet(_xy(facets, i), smooth_paths[i], length_scale=lc) for i in idx]
     mj_locked = np.array([r.end_reason.value == "self_lock" for r in runs])
     mj_end = np.array([r.position_m[-1, :2] / s for r in runs])
     agree = _outcomes(facets, mj_locked, mj_end, lc)
@@ -234,7 +234,7 @@ def _compare(case, surface, starts, upstream):
         contact, params, starts, runs, rig.scales.preload_n, s, mpaths, facets, mj_locked, mj_end, lc, lead
     )
     peak = np.array([peak_drive_over_fp(r, rig.scales.preload_n) for r in runs])
-    kap = compare.kappa_agreement(facets.max_kappa, peak, kappa_cap=runs[0].detection.kappa_cap)
+    kap = agreement.kappa_agreement(facets.max_kappa, peak, kappa_cap=runs[0].detection.kappa_cap)
     metrics = {
         "frechet": frechet,
         "lateral_deviation": lateral,
@@ -331,7 +331,7 @@ register_analysis(
         doc="MuJoCo against the streamline traced on the rig's facets dilated by its tip "
         "(like for like), and against the quasistatic analysis's own path (*_smooth); "
         "why a run disagrees (miss_reason, miss_offset); "
-        "lengths over L_c: spine_mj.compare",
+        "lengths over L_c: spine_mj.theory.agreement",
         check_case=_check_case,
     )
 )

@@ -15,9 +15,9 @@ import numpy as np
 from spine_mj import sim
 from spine_mj.errors import SpineInputError
 from spine_mj.sim.holding import spring_swing
-from spine_mj.sim.params import surface_unit_m
+from spine_mj.sim.open_loop import drive_steps
 from spine_mj.sim.ramp import nominal_time_s
-from spine_mj.sim.rollout import drive_steps
+from spine_mj.sim.scales import surface_unit_m
 from spine_mj.sweep.registry import (
     CASE_THREADS,
     KAPPA_CAP_PARAM,

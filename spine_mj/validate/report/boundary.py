@@ -169,7 +169,7 @@ def _lines(boundary: BoundaryResult) -> list[str]:
         "## Agreement against I_e (boundary study)",
         "",
         f"Families: {', '.join(boundary.families)}. Spring: a run agrees when its "
-        "outcome agrees (`compare.outcome_agreement`); its deviation is the Frechet "
+        "outcome agrees (`agreement.outcome_agreement`); its deviation is the Frechet "
         "distance from the streamline. Ramp with reset: its I_e is the equivalent one, "
         "m v_eq^2 / (F_p L_c) with v_eq = L_c rate / F_p; its duration comes from a "
         "pilot run's per-cycle slip so that it would cover the path to the domain edge, "

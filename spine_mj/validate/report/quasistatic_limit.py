@@ -8,7 +8,6 @@ from pathlib import Path
 
 import numpy as np
 
-from spine_mj.compare import MISS_REASONS
 from spine_mj.plotting import (
     DIVERGING_CMAP,
     PATH_COLORS,
@@ -21,6 +20,7 @@ from spine_mj.plotting import (
 )
 from spine_mj.presets import make_surface
 from spine_mj.sweep.analyses.compare import MISS_CHECKPOINTS
+from spine_mj.theory.agreement import MISS_REASONS
 from spine_mj.validate.boundary import BoundaryResult
 from spine_mj.validate.convergence import HEADLINES, REFINEMENT_LABELS, unconverged_mark
 from spine_mj.validate.platform import platform_info
@@ -110,7 +110,7 @@ def _misses_note(limit: QuasistaticLimitResult) -> list[str]:
     meaning = "; ".join(f"*{k}*: {v}" for k, v in MISS_REASONS.items())
     return [
         "Why the runs the engine finished disagree (the reference restarted from "
-        f"{MISS_CHECKPOINTS} points along each MuJoCo path, `compare.miss_reason`): {meaning}.",
+        f"{MISS_CHECKPOINTS} points along each MuJoCo path, `agreement.miss_reason`): {meaning}.",
         "",
         *lines,
         "",
@@ -151,9 +151,9 @@ def falls_note(limit: QuasistaticLimitResult, boundary: BoundaryResult) -> list[
         "a descent is steeper than the friction angle (the slip region, docs/physics.md §2) "
         "gravity alone slides the tip: the quasistatic model has no rate there, and the "
         "engine's tip falls at the speed gravity gives it, whatever the drive's. Per run, the "
-        "share of the reference's arc length in the slip region (`compare.slide_fraction`) "
+        "share of the reference's arc length in the slip region (`agreement.slide_fraction`) "
         "and the tip's peak speed as an inertia number, m v_max^2 / (F_p L_c) "
-        f"(`compare.peak_speed`), split at the lower end of the spring drive's I_e* bracket "
+        f"(`agreement.peak_speed`), split at the lower end of the spring drive's I_e* bracket "
         f"({cell(cut)}): a tip that went faster than that, somewhere, left the quasistatic "
         "regime there.",
         "",

@@ -8,8 +8,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from spine_mj import SpineInputError, compare
-from spine_mj.compare import (
+from spine_mj import SpineInputError
+from spine_mj.theory import agreement
+from spine_mj.theory.agreement import (
     MAX_RESAMPLED_POINTS,
     capture_rate,
     frechet_distance,
@@ -104,12 +105,12 @@ def test_point_segment_distance_in_blocks_equals_the_plain_loop(monkeypatch, blo
     """Whatever the byte budget cuts the points x segments into (one pair a block, a few,
     all), the distances are those of the plain loop; repeated vertices (zero-length
     segments) included."""
-    monkeypatch.setattr(compare, "BLOCK_BYTES", block_bytes)
+    monkeypatch.setattr(agreement, "BLOCK_BYTES", block_bytes)
     rng = np.random.default_rng(5)
     ref = np.cumsum(rng.normal(size=(23, 2)), axis=0)
     ref[7] = ref[6]
     points = rng.normal(scale=3.0, size=(31, 2))
-    got = compare._point_segment_distance(points, ref[:-1], ref[1:])
+    got = agreement._point_segment_distance(points, ref[:-1], ref[1:])
     np.testing.assert_allclose(got, _segment_distance_by_point(points, ref), rtol=1e-12)
 
 
@@ -125,7 +126,7 @@ def test_a_path_flown_to_a_million_lc_and_back_is_compared_in_bounded_samples():
     ref = line(0.0, n=11, x0=0.0, x1=10.0)
     expected = (far - 10) ** 2 / (2 * far)
     assert mean_lateral_deviation(wild, ref) == pytest.approx(expected, rel=1e-3)
-    assert compare.path_frechet(wild, ref, length_scale=1.0) == pytest.approx(far - 10, rel=1e-3)
+    assert agreement.path_frechet(wild, ref, length_scale=1.0) == pytest.approx(far - 10, rel=1e-3)
 
 
 def test_outcome_agreement_cases():

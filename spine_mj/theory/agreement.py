@@ -29,10 +29,6 @@ from numba import njit
 from spine_mj.errors import SpineInputError
 from spine_mj.memory import BLOCK_BYTES
 from spine_mj.theory.engagement import SLIP
-from spine_mj.theory.targets import (  # their old home: still importable from here
-    FRECHET_TARGET,
-    OUTCOME_TARGET,
-)
 
 #: The most points :func:`resample_by_arclength` returns (2^16, 1 MiB of x-y): at the
 #: default spacing L_c / 50 a path over 1300 L_c long, hundreds of times any run across a
@@ -58,10 +54,8 @@ MISS_REASONS = {
 }
 
 __all__ = [
-    "FRECHET_TARGET",
     "MAX_RESAMPLED_POINTS",
     "MISS_REASONS",
-    "OUTCOME_TARGET",
     "capture_rate",
     "frechet_distance",
     "frechet_distance_reference",
