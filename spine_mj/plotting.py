@@ -247,7 +247,7 @@ def sim_run_figure(result, surface: Surface, *, length_scale_m: float, max_point
     ax2 = fig.add_subplot(1, 2, 2)
     fp = result.scales.preload_n
     ax2.plot(result.time_s, result.drive_force_n / fp, color=PROTOCOL_COLORS["spring"], lw=1, label="drive")
-    onsets = [e.onset for e in result.slip_events]  # slips relative to the drive (sim.motion)
+    onsets = [e.onset for e in result.slip_events]  # slips relative to the drive (theory.motion)
     if onsets:
         ax2.plot(
             result.time_s[onsets],

@@ -11,7 +11,8 @@ tip on three slide joints), gravity, preload, the three drives, and the same
 sensors and read by the same analysis (:class:`~spine_mj.sim.results.GroupAnalysis`:
 recordings, motion states, events, end reasons, ``engine_trouble``). Scales, engine units,
 drives, detection and the recorded time step are MuJoCo's rules, written once in
-:mod:`spine_mj.sim.scales`, :mod:`spine_mj.sim.step_rule`, :mod:`spine_mj.sim.drives` and :mod:`spine_mj.sim.rollout`.
+:mod:`spine_mj.sim.scales`, :mod:`spine_mj.sim.step_rule`, :mod:`spine_mj.sim.drives` and
+:mod:`spine_mj.sim.rollout`.
 Needs the optional extra ``bullet`` (``pip install 'spine-mj[bullet]'``).
 
 Bullet's settings come from rules (:mod:`spine_mj.sim.bullet_settings`: the step, slop,
