@@ -15,6 +15,8 @@ theory runs wherever numpy and numba do.
   forms and a reference integrator for the Prandtl-Tomlinson corrugation;
 - :mod:`~spine_mj.theory.motion`: stuck, sliding and slipping relative to the drive, and the
   slip events they make (of a MuJoCo run and of the reference integrator alike);
+- :mod:`~spine_mj.theory.avalanches`: the overdamped and inertial quasistatic references of
+  stick-slip on a landscape (the ABBM track's avalanches);
 - :mod:`~spine_mj.theory.energy`: energy budget of a stick-slip event;
 - :mod:`~spine_mj.theory.array_reference`: the quasistatic hold curve of a spine array;
 - :mod:`~spine_mj.theory.targets`: how close a dynamic run must come to count as agreeing;
