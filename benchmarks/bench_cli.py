@@ -16,6 +16,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from bench_common import target_cell
+
 SPINE = str(Path(sys.executable).with_name("spine-mj"))
 HELP_TARGET_S = 0.5
 COMMAND_TARGET_S = 1.5
@@ -70,8 +72,6 @@ def markdown(res: dict | None) -> list[str]:
     """The README table's rows for :func:`bench_cli`'s results."""
     if not res:
         return []
-    from run_all import target_cell
-
     ld = f"{res['load_before']}-{res['load_after']}"
     root, slowest = res["help"]["spine-mj --help"], res["help"][res["slowest_help"]]
     lines = [

@@ -228,5 +228,75 @@ def main() -> None:
         )
 
 
+def bench_fastforward(quick: bool) -> dict:
+    """The static probe at I_e 1e-3 and 1e-2, the ramp at I_e 1e-2 (2 cycles) and the spring
+    drive's cost grid (I_e 1e-4...1e-6, K 3...3000; quick: I_e 1e-4, 1e-5 and K 3, 30),
+    plain and fast-forwarded (see bench_fastforward.py)."""
+    out = {"probe": {str(ie): probe_rows(61, ie) for ie in (1e-3, 1e-2)}}
+    if not quick:
+        out["ramp"] = ramp_rows(61, 1e-2, 2)
+    out["spring"] = spring_rows(SPRING_IES[:2], SPRING_KS[:2]) if quick else spring_rows()
+    return out
+
+
+def markdown(ff: dict | None) -> list[str]:
+    """The fast-forward tables of the Performance page."""
+    if not ff:
+        return []
+    out = [
+        "",
+        "**Stick-phase fast-forward** (`benchmarks/bench_fastforward.py`; plain = `fast_forward=False`). "
+        "Static probe, the static map's probe on inclined planes (mu 0.5) and on the single peak "
+        "(hfield 61, mu 1.23):",
+        "",
+        "| I_e | case | end | kappa_mj plain / fast-forwarded | rel. diff | rows | simulated steps |",
+        "| --- | --- | --- | --- | --- | --- | --- |",
+    ]
+    for ie, rows in ff["probe"].items():
+        for r in rows:
+            out.append(
+                f"| {float(ie):g} | {r['case']} | {r['end']} | "
+                f"{r['kappa_plain']:.4f} / {r['kappa_fast']:.4f} | "
+                f"{r['rel_diff']:+.1e} | {r['rows_plain']} / {r['rows_fast']} | "
+                f"{r['steps_plain']} / {r['steps_fast']} |"
+            )
+    if ff.get("ramp"):
+        rows = ff["ramp"]
+        out.append(
+            f"\nForce ramp, I_e 1e-2, 2 cycles, {len(rows)} cases (planes -15...25 deg, single peak and "
+            f"valley from 4 starts each): breakaway forces within "
+            f"{max(r['max_rel_diff'] for r in rows):.2%} of the plain ramp's, paths within Frechet "
+            f"{max(r['frechet_lc'] for r in rows):.1e} L_c, steps to the second reset "
+            f"{sum(r['steps_plain'] for r in rows)} plain against {sum(r['steps_fast'] for r in rows)}."
+        )
+    out += _spring_markdown(ff.get("spring"))
+    out.append(f"\nLoad: {ff['load_before']}-{ff['load_after']}.")
+    return out
+
+
+def _spring_markdown(rows) -> list[str]:
+    if not rows:
+        return []
+    out = [
+        "",
+        "Spring drive, cost per run against I_e and K = k l_s / F_p, plain / fast-forwarded: the "
+        "paper fractal (seed 1, mu 0.5 and, at K 3, the preset's 1.25; 2 starts, 0.25 L_c of travel) "
+        "and the spring-block on a "
+        "flat plane (stuck until k V t = mu F_p, 91 % of the run). A spring run "
+        "fast-forwards only where a preload is over 400 of its steps' increments k V dt "
+        "(`rollout.SPRING_MIN_CLIMB_STEPS`); the end-point difference is in L_c:",
+        "",
+        "| surface | I_e | K | steps / run | ratio | CPU s / run | end | end-point diff. |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- |",
+    ]
+    for r in rows:
+        out.append(
+            f"| {r['surface']} | {r['ie']:g} | {r['K']:g} | {r['steps_plain']:.0f} / {r['steps_fast']:.0f} | "
+            f"{r['steps_plain'] / r['steps_fast']:.2f} | {r['cpu_s_plain']:.3f} / {r['cpu_s_fast']:.3f} | "
+            f"{', '.join(r['end_plain'])} / {', '.join(r['end_fast'])} | {r['end_dx_lc']:.1e} |"
+        )
+    return out
+
+
 if __name__ == "__main__":
     main()

@@ -28,6 +28,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from bench_common import target_cell
+
 SPINE = str(Path(sys.executable).with_name("spine-mj"))
 QUICK_WALL_TARGET_S = 140.0
 
@@ -88,8 +90,6 @@ def markdown(res: dict | None) -> list[str]:
     """The benchmark table's rows for :func:`bench_plan_cost`'s results."""
     if not res:
         return []
-    from run_all import target_cell
-
     ld = f"{res['load_before']}-{res['load_after']}"
     target = res.get("target_wall_s")
     goal = target_cell(res["command_wall_s"], "<=", target, " s") if target else ""

@@ -3,6 +3,7 @@
 import time
 
 import numpy as np
+from bench_common import fmt, target_cell
 
 from spine_mj.reproduce import fractal_hurst
 from spine_mj.surfaces import fractal_fbm, single_gaussian
@@ -37,6 +38,68 @@ def main():
         f"fractal-hurst full run (7 H x 300 surfaces, 2 workers): {time.perf_counter() - t:.1f} s "
         "(target 60 s)"
     )
+
+
+def bench_streamline(quick: bool) -> dict:
+    n = 500 if quick else 2000
+    n_np = 100 if quick else 300
+    y = np.linspace(-4.9, 4.9, n)
+    cases = {
+        "analytic single Gaussian": (
+            single_gaussian(sign=1),
+            np.c_[np.full(n, -4.9), y],
+            StreamlineParams(mu=1.23, dl=0.015),
+        ),
+        "gridded fractal 256^2": (
+            fractal_fbm(nx=256, size=20.0, hurst=0.8, rms_slope=0.5, rng=1),
+            np.c_[np.full(n, -9.9), 2 * y],
+            StreamlineParams(mu=1.0, dl=0.02),
+        ),
+    }
+    out = {}
+    for name, (surface, starts, params) in cases.items():
+        kernel = steps_per_second(surface, starts, params, repeat=3 if quick else 5)
+        sub = starts[:: max(1, n // n_np)]
+        numpy_rate = steps_per_second(surface, sub, params, repeat=2, backend="numpy")
+        out[name] = {
+            "starts": len(starts),
+            "kernel_steps_s": kernel,
+            "numpy_starts": len(sub),
+            "numpy_steps_s": numpy_rate,
+            "kernel_over_numpy": kernel / numpy_rate,
+        }
+    if not quick:
+        t0 = time.perf_counter()
+        fractal_hurst(workers=2)
+        out["fractal_hurst_full_s"] = time.perf_counter() - t0
+    return out
+
+
+def markdown(sl: dict | None) -> list[str]:
+    """The streamline rows of the Performance table."""
+    lines = []
+    if sl:
+        ld = f"{sl['load_before']}-{sl['load_after']}"
+        for name in ("analytic single Gaussian", "gridded fractal 256^2"):
+            r = sl[name]
+            target = 2e7 if name.startswith("analytic") else 5e6
+            lines.append(
+                f"| streamline kernel, {name}, {r['starts']} starts, one core | "
+                f"{fmt(r['kernel_steps_s'])} steps/s | "
+                f"{target_cell(r['kernel_steps_s'], '>=', target)} | {ld} |"
+            )
+            lines.append(
+                f"| plain numpy streamline (`backend='numpy'`), {name}, {r['numpy_starts']} starts | "
+                f"{fmt(r['numpy_steps_s'])} steps/s (kernel / numpy = "
+                f"{r['kernel_over_numpy']:.0f}x) | | {ld} |"
+            )
+        if "fractal_hurst_full_s" in sl:
+            lines.append(
+                f"| full Fig. 9 Monte Carlo (7 H x 300 surfaces, 2 workers) | "
+                f"{sl['fractal_hurst_full_s']:.1f} s | "
+                f"{target_cell(sl['fractal_hurst_full_s'], '<=', 60, ' s')} | {ld} |"
+            )
+    return lines
 
 
 if __name__ == "__main__":

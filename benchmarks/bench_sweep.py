@@ -23,6 +23,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from bench_common import target_cell
 
 from spine_mj import sweep
 
@@ -168,6 +169,50 @@ def main() -> None:
     )
     if args.out is None:
         shutil.rmtree(scratch, ignore_errors=True)
+
+
+def bench_sweep(quick: bool) -> dict:
+    from spine_mj.sweep.analyses import mujoco as an
+
+    n_ie = 2 if quick else 6
+    doc = dict(MUJOCO_CONFIG, grid={"mu": 1.23, "ie": {"logspace": [1e-3, 1e-1], "num": n_ie}})
+    config = sweep.parse_config(doc)
+    cases = sweep.expand_cases(config)
+    sweep.run_case(cases[0])  # warm caches outside the timings
+    scratch = Path(tempfile.mkdtemp(prefix="bench-sweep-"))
+    try:
+        bare = bare_rollout_time(config)
+        an.case_rig.cache_clear()
+        t1 = timed_sweep(config, scratch / "mj1", workers=1)
+        t2 = timed_sweep(config, scratch / "mj2", workers=2)
+        steps = int(sweep.load_runs(scratch / "mj1").n_steps.sum())
+    finally:
+        shutil.rmtree(scratch, ignore_errors=True)
+    return {
+        "cases": len(cases),
+        "runs": sum(c.starts.count for c in cases),
+        "recorded_steps": steps,
+        "bare_s": bare,
+        "sweep_1_worker_s": t1,
+        "sweep_2_workers_s": t2,
+        "bare_over_sweep": bare / t1,
+        "parallel_efficiency": t1 / (2 * t2),
+    }
+
+
+def markdown(sw: dict | None) -> list[str]:
+    """The sweep rows of the Performance table."""
+    lines = []
+    if sw:
+        ld = f"{sw['load_before']}-{sw['load_after']}"
+        lines += [
+            f"| sweep, 1 worker / bare rollout ({sw['runs']} runs, store included) | "
+            f"{sw['bare_over_sweep']:.3f} | {target_cell(sw['bare_over_sweep'], '>=', 0.9)} | {ld} |",
+            f"| sweep parallel efficiency, 2 workers, T1 / (2 T2) | "
+            f"{sw['parallel_efficiency']:.3f} | "
+            f"{target_cell(sw['parallel_efficiency'], '>=', 0.85)} | {ld} |",
+        ]
+    return lines
 
 
 if __name__ == "__main__":

@@ -1,14 +1,16 @@
-"""The benchmark report's statistics (``benchmarks/run_all.py``)."""
+"""The benchmark report's statistics (``benchmarks/bench_common.py``) and its driver
+(``benchmarks/run_all.py``)."""
 
 from __future__ import annotations
 
+import ast
 import sys
 from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
-from run_all import median_interval
+from bench_common import median_interval
 
 
 def test_median_interval_is_the_binomial_order_statistics_and_covers_the_median():
@@ -24,7 +26,7 @@ def test_median_interval_is_the_binomial_order_statistics_and_covers_the_median(
 
 
 def test_a_missed_target_is_marked_and_a_met_one_is_not():
-    from run_all import MISSED, target_cell
+    from bench_common import MISSED, target_cell
 
     assert target_cell(0.833, ">=", 0.85) == f">= 0.85 {MISSED}"
     assert target_cell(0.863, ">=", 0.85) == ">= 0.85"
@@ -52,9 +54,9 @@ def test_bench_writes_an_untracked_folder_unless_asked_to_update(tmp_path):
 
 
 def test_a_peak_grown_by_more_than_a_fifth_is_marked():
+    from bench_common import MISSED
     from bench_memory import GROWTH_LIMIT
     from bench_memory import markdown as memory_markdown
-    from run_all import MISSED
 
     jobs = {
         "kept": {"wall_s": 1.0, "peak_rss_mib": 119.0, "committed_peak_rss_mib": 100.0, "grew": False},
@@ -85,3 +87,30 @@ def test_the_plan_cost_puts_each_sweep_store_under_its_study():
         ("stiffness_map/paper-fractal-deep", "stiffness_map"),
     ]:
         assert study_of(store) == study and study in names
+
+
+def test_the_bench_modules_import_one_another_without_a_cycle():
+    # run_all drives the sections; a section module never imports run_all or a later driver
+    here = Path(__file__).resolve().parents[1] / "benchmarks"
+    names = {p.stem for p in here.glob("*.py")}
+    graph = {}
+    for path in here.glob("*.py"):
+        deps = set()
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.Import):
+                deps |= {a.name for a in node.names}
+            elif isinstance(node, ast.ImportFrom) and node.module:
+                deps.add(node.module)
+        graph[path.stem] = deps & names - {path.stem}
+    done: set[str] = set()
+
+    def reach(node, stack):
+        assert node not in stack, " -> ".join([*stack, node])
+        if node not in done:
+            for nxt in graph[node]:
+                reach(nxt, [*stack, node])
+            done.add(node)
+
+    for node in graph:
+        reach(node, [])
+    assert graph["run_all"] >= {"bench_streamline", "bench_rollout", "bench_common"}

@@ -113,7 +113,7 @@ def build_rig(
     **engine_overrides,
 ) -> Rig:
     """The rig of ``surface`` and a tip of friction ``mu`` (resolve it with
-    :func:`spine_mj.presets.friction_coefficient`); None leaves a parameter to its rule.
+    :func:`spine_mj.presets.resolve_mu`); None leaves a parameter to its rule.
 
     Parameters
     ----------

@@ -1,6 +1,6 @@
 """The validation harness: MuJoCo against the quasistatic streamline across inertia numbers.
 
-Seven studies, each a function that runs its MuJoCo cases through the
+Nine studies (the registry :data:`~spine_mj.validate.studies.STUDIES`), each a function that runs its MuJoCo cases through the
 sweep runner (:func:`spine_mj.sweep.run_sweep`, one resumable store per study under
 ``out/sweeps/``, so a killed validation resumes where it stopped) and returns a typed
 result with the numbers and the data of its figures (``as_dict()`` gives the keys of
@@ -26,6 +26,10 @@ result with the numbers and the data of its figures (``as_dict()`` gives the key
 7. :func:`stiffness_map` - the spring drive's agreement over (I_e, K), ``I_e*(K)`` per
    family, the elastic energy released at breakaway against the quasistatic work, and
    slip-size / force-drop distributions.
+8. :func:`ground_truth` - MuJoCo's spring drive against the closed forms of
+   :mod:`spine_mj.theory.tomlinson` (spring-block, Prandtl-Tomlinson, crest lift-off).
+9. :func:`array_study` - spine arrays dragged over rough surfaces, and the paper's
+   staggered-array conjecture in dynamics.
 
 :func:`run_validation` runs them all for a :class:`ValidationPlan` (``"quick"``, ``"full"``
 or the test-size ``"smoke"``), writes ``report.md`` with PNG figures and ``validation.json``.

@@ -73,6 +73,7 @@ def test_pairs_judge_each_surface_at_its_own_length_scale():
 
 
 def test_each_corner_sweep_runs_in_both_engines():
+    pytest.importorskip("pybullet", reason="a bullet case is refused without the [bullet] extra (pybullet)")
     from spine_mj.sweep import expand_cases, parse_config
 
     plan = dataclasses.replace(PLANS["quick"], families=PLANS["quick"].families[:1])
