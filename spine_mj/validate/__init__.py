@@ -1,7 +1,7 @@
 """The validation harness: MuJoCo against the quasistatic streamline across inertia numbers.
 
-Nine studies (the registry :data:`~spine_mj.validate.studies.STUDIES`), each a function that runs its MuJoCo cases through the
-sweep runner (:func:`spine_mj.sweep.run_sweep`, one resumable store per study under
+Nine studies (the registry :data:`~spine_mj.validate.studies.STUDIES`), each a function
+that runs its MuJoCo cases through the sweep runner (:func:`spine_mj.sweep.run_sweep`, one resumable store per study under
 ``out/sweeps/``, so a killed validation resumes where it stopped) and returns a typed
 result with the numbers and the data of its figures (``as_dict()`` gives the keys of
 ``validation.json``):
