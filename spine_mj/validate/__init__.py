@@ -1,10 +1,10 @@
 """The validation harness: MuJoCo against the quasistatic streamline across inertia numbers.
 
 Nine studies (the registry :data:`~spine_mj.validate.studies.STUDIES`), each a function
-that runs its MuJoCo cases through the sweep runner (:func:`spine_mj.sweep.run_sweep`, one resumable store per study under
-``out/sweeps/``, so a killed validation resumes where it stopped) and returns a typed
-result with the numbers and the data of its figures (``as_dict()`` gives the keys of
-``validation.json``):
+that runs its MuJoCo cases through the sweep runner (:func:`spine_mj.sweep.run_sweep`, one
+resumable store per study under ``out/sweeps/``, so a killed validation resumes where it
+stopped) and returns a typed result with the numbers and the data of its figures
+(``as_dict()`` gives the keys of ``validation.json``):
 
 1. :func:`static_map` - breakaway ratio ``kappa_mj / kappa`` of the static probe on inclined
    planes over slope angle and azimuth (engaged, self-lock and slip regions), per engine
