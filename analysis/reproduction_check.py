@@ -1,5 +1,5 @@
 """Do the committed quick-plan numbers reproduce on this machine? Put a new run's headline
-numbers beside the committed 95 % intervals (spine_mj.validate.reproducibility).
+numbers beside the committed 95 % intervals (spine_mj.validate.headlines).
 
     # on another CPU: run the quick plan there, then
     python analysis/reproduction_check.py demo-out/validation.json
@@ -32,7 +32,7 @@ from pathlib import Path
 
 from spine_mj.atomic import atomic_output
 from spine_mj.errors import OneLineParser, SpineInputError
-from spine_mj.validate.reproducibility import check_reproduction, headline_numbers
+from spine_mj.validate.headlines import check_reproduction, headline_numbers
 
 REPO = Path(__file__).resolve().parents[1]
 COMMITTED = REPO / "analysis" / "reports" / "validation-quick" / "validation.json"

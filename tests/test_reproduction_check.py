@@ -93,7 +93,7 @@ def test_no_argument_an_unknown_option_and_an_unwritable_report(script, tmp_path
 
 
 def test_the_committed_run_reproduces_itself(script, committed, tmp_path, capsys):
-    from spine_mj.validate.reproducibility import headline_numbers
+    from spine_mj.validate.headlines import headline_numbers
 
     n = len(headline_numbers(committed))
     report = tmp_path / "sub" / "report.md"

@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 from spine_mj.errors import SpineInputError
+from spine_mj.validate.headlines import check_reproduction, headline_numbers
 from spine_mj.validate.plans import PLANS, FamilySpec, relative_starts
 from spine_mj.validate.quasistatic_limit import quasistatic_limit
-from spine_mj.validate.reproducibility import check_reproduction, headline_numbers
 from spine_mj.validate.study_runner import StudyRunner
 
 #: A small plan of the quick plan's kind: the fractal corner (chaotic paths, creases) with
