@@ -169,6 +169,7 @@ class _Root(_Group):
         "reproduce": "theory",
         "sim": "sim",
         "simulate": "sim",
+        "stickslip": "stickslip",
         "streamline": "theory",
         "surface": "surface",
         "sweep": "sweep",

@@ -1,0 +1,167 @@
+"""Slip-event catalogs: every slip of every run, one row each, whatever made it (the
+overdamped and inertial quasistatic references, MuJoCo, Bullet), in one table with one set
+of units (docs/physics.md §12).
+
+Columns (:data:`COLUMNS`): ``source``, ``surface``, ``mu``, ``K``, ``ie``, ``start_x_lc``
+(where the slip starts, from the surface's origin, in L_c), ``start_time_s`` (from the
+drive's start), ``size_lc`` (the tip's travel along x in the slip), ``duration_s`` (time
+ahead of the carriage, as :mod:`spine_mj.theory.motion` counts it), ``force_drop_fp``,
+``peak_speed_v`` (the largest x-speed over the carriage's), ``dissipated_fp_lc`` (the
+spring's work in the slip minus the work against the load, in F_p L_c).
+
+The references run on the track's centre line (``y`` fixed; the surface must be uniform in
+y for them to be its exact answer), with the rig's tip radius, stiffness, mass and speed in
+the surface's units: ``k = K F_p / l_s``, ``m`` in ``F_p s^2 / unit``. The overdamped
+reference's mobility is the critical one, ``1 / sqrt(k m)`` (it sets its durations only).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from spine_mj.errors import SpineInputError
+from spine_mj.theory.avalanches import Landscape, Slips, inertial_slips, overdamped_slips
+
+__all__ = ["COLUMNS", "REFERENCES", "TrackUnits", "engine_rows", "reference_rows", "track_landscape"]
+
+COLUMNS = (
+    "source",
+    "surface",
+    "mu",
+    "K",
+    "ie",
+    "start_x_lc",
+    "start_time_s",
+    "size_lc",
+    "duration_s",
+    "force_drop_fp",
+    "peak_speed_v",
+    "dissipated_fp_lc",
+)
+#: The quasistatic references, by source name.
+REFERENCES = ("overdamped", "inertial")
+#: Landscape points per grid spacing of the surface along x.
+REFINEMENT = 4
+
+
+@dataclass(frozen=True)
+class TrackUnits:
+    """A rig's scales in the surface's own length unit: ``length_scale_m`` metres per unit,
+    ``char_length`` (L_c) and ``slope_length`` (l_s) in units, ``tip_radius`` in units,
+    ``preload_n`` (F_p = W), ``mass_kg`` and the drive's ``speed`` [units / s]."""
+
+    length_scale_m: float
+    char_length: float
+    slope_length: float
+    tip_radius: float
+    preload_n: float
+    mass_kg: float
+    speed: float
+
+    @classmethod
+    def of(cls, scales, ie: float) -> TrackUnits:
+        """From a rig's :class:`~spine_mj.sim.scales.Scales` and the drive's I_e."""
+        unit = scales.length_scale_m
+        return cls(
+            length_scale_m=unit,
+            char_length=scales.char_length_m / unit,
+            slope_length=scales.slope_length_m / unit,
+            tip_radius=scales.tip_radius_m / unit,
+            preload_n=scales.preload_n,
+            mass_kg=scales.mass_kg,
+            speed=scales.speed_for(ie) / unit,
+        )
+
+    def stiffness(self, stiffness_number: float) -> float:
+        """``k / W`` [1 / unit] of ``K = k l_s / F_p``."""
+        return stiffness_number / self.slope_length
+
+    @property
+    def mass(self) -> float:
+        """The tip's mass in ``W s^2 / unit``."""
+        return self.mass_kg * self.length_scale_m / self.preload_n
+
+
+def track_landscape(surface, mu: float, tip_radius: float, x_range: tuple[float, float], y: float = 0.0):
+    """The landscape of ``surface`` along the line ``y`` over ``x_range`` (surface units),
+    sampled at :data:`REFINEMENT` points per grid spacing from its spline (heights and
+    slopes), for a ball tip of ``tip_radius``."""
+    x0, x1 = x_range
+    xmin, xmax, _, _ = surface.bounds
+    if not (xmin <= x0 < x1 <= xmax):
+        raise SpineInputError(f"the track's x range must lie in [{xmin:g}, {xmax:g}], got [{x0:g}, {x1:g}]")
+    dx = surface.spacing[0] / REFINEMENT if hasattr(surface, "spacing") else (x1 - x0) / 20000
+    x = np.linspace(x0, x1, int(math.ceil((x1 - x0) / dx)) + 1)
+    yy = np.full_like(x, y)
+    z = surface.height(x, yy)
+    gx, _ = surface.gradient(x, yy)
+    return Landscape.from_profile(x, gx, z, mu, tip_radius)
+
+
+def reference_rows(landscape: Landscape, units: TrackUnits, stiffness_number: float, **labels) -> dict:
+    """Both references' slips on ``landscape`` at ``K = stiffness_number`` as catalog columns
+    (``labels``: ``surface``, ``mu``, ``ie``)."""
+    k = units.stiffness(stiffness_number)
+    m = units.mass
+    out = {}
+    for source in REFERENCES:
+        if source == "overdamped":
+            slips = overdamped_slips(landscape, k, mobility=1.0 / math.sqrt(k * m), slow=units.speed)
+        else:
+            slips = inertial_slips(landscape, k, mass=m, slow=units.speed)
+        out[source] = _rows(source, slips, units, stiffness_number, landscape.start, labels)
+    return out
+
+
+def _rows(
+    source: str, slips: Slips, units: TrackUnits, stiffness_number: float, start: float, labels
+) -> dict:
+    lc, n = units.char_length, slips.size.size
+    # the drive starts with the spring unloaded and the tip at the landscape's start
+    return {
+        "source": [source] * n,
+        "surface": [labels.get("surface", "")] * n,
+        "mu": np.full(n, labels.get("mu", math.nan)),
+        "K": np.full(n, float(stiffness_number)),
+        "ie": np.full(n, labels.get("ie", math.nan)),
+        "start_x_lc": slips.start_u / lc,
+        "start_time_s": (slips.start_carriage - start) / units.speed,
+        "size_lc": slips.size / lc,
+        "duration_s": slips.duration,
+        "force_drop_fp": slips.force_drop,
+        "peak_speed_v": slips.peak_speed / units.speed,
+        "dissipated_fp_lc": slips.dissipated / lc,
+    }
+
+
+def engine_rows(result, units: TrackUnits, source: str, stiffness_number: float, **labels) -> dict:
+    """The slip events of an engine's run (:attr:`RunResult.slip_events`) as catalog columns."""
+    events = result.slip_events
+    n = len(events)
+    unit, lc, fp = units.length_scale_m, units.char_length, units.preload_n
+    x = result.position_m[:, 0]
+    z = result.position_m[:, 2]
+    f = result.drive_force_n
+    t0 = float(result.time_s[result.drive_start_index]) if len(result.time_s) else 0.0
+    dissipated = []
+    for e in events:
+        seg = slice(e.onset, e.stop + 1)
+        work = float(np.sum(0.5 * (f[seg][1:] + f[seg][:-1]) * np.diff(x[seg])))
+        dissipated.append((work - fp * (z[e.stop] - z[e.onset])) / (fp * lc * unit))
+    return {
+        "source": [source] * n,
+        "surface": [labels.get("surface", "")] * n,
+        "mu": np.full(n, labels.get("mu", math.nan)),
+        "K": np.full(n, float(stiffness_number)),
+        "ie": np.full(n, labels.get("ie", math.nan)),
+        "start_x_lc": np.array([x[e.onset] / unit / lc for e in events]),
+        "start_time_s": np.array([e.onset_time_s - t0 for e in events]),
+        "size_lc": np.array([e.jump_length_m / unit / lc for e in events]),
+        "duration_s": np.array([e.duration_s for e in events]),
+        "force_drop_fp": np.array([e.force_drop_n / fp for e in events]),
+        "peak_speed_v": np.array([e.peak_speed_m_s / (units.speed * unit) for e in events]),
+        "dissipated_fp_lc": np.array(dissipated),
+    }

@@ -1,0 +1,300 @@
+"""What ``spine-mj stickslip`` writes: the slip catalog of the quasistatic references (and
+of an engine, when asked) on one track at several K, its statistics and figures
+(docs/physics.md §12).
+
+:func:`stickslip_to` runs, per K, the overdamped and inertial references over the track's
+centre line (:mod:`spine_mj.validate.slip_catalog`) and, with ``engine``, one spring drive
+of that engine over the same stretch, then writes ``events.parquet`` (the catalog),
+``summary.json`` (per source and K the event count, the truncated power law's ``tau``
+with its interval, the cutoff ``S_m`` in L_c, the pure power law's fit, its bootstrap and
+likelihood-ratio tests; per K the two-sample tests between sources, an engine's against
+the reference slips fast enough for its detector, ``peak_speed_v >=``
+:data:`~spine_mj.theory.motion.SLIP_SPEED_FACTOR`; for an ABBM track the
+predicted cutoff ``sigma / k^2``), ``distributions.png``, ``collapse.png`` and, with an
+engine, ``pulse.png`` (the mean slip pulse) - all or none of them.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from spine_mj.errors import SpineInputError, check_positive
+from spine_mj.theory.motion import SLIP_SPEED_FACTOR
+from spine_mj.validate import avalanche_stats as stats
+from spine_mj.validate.slip_catalog import (
+    COLUMNS,
+    REFERENCES,
+    TrackUnits,
+    engine_rows,
+    reference_rows,
+    track_landscape,
+)
+
+__all__ = ["OUTPUT_FILES", "StickSlipOutputs", "stickslip_to"]
+
+OUTPUT_FILES = ("events.parquet", "summary.json", "distributions.png", "collapse.png")
+#: Share of the track's length kept clear at each end by the default start and travel.
+EDGE_SHARE = 0.05
+
+
+@dataclass(frozen=True)
+class StickSlipOutputs:
+    """What :func:`stickslip_to` wrote: the ``summary`` dict and the ``files``."""
+
+    summary: dict
+    files: tuple[Path, ...]
+
+
+def _track(surface, start: float | None, travel: float | None) -> tuple[float, float]:
+    xmin, xmax, _, _ = surface.bounds
+    span = xmax - xmin
+    x0 = xmin + EDGE_SHARE * span if start is None else float(start)
+    end = xmax - EDGE_SHARE * span
+    length = end - x0 if travel is None else check_positive("travel", travel)
+    if not (xmin <= x0 and x0 + length <= xmax and length > 0):
+        raise SpineInputError(
+            f"--travel from the start x {x0:g} must end on the track [{xmin:g}, {xmax:g}], got {length:g}"
+        )
+    return x0, length
+
+
+def _abbm_cutoff_lc(surface, mu: float, k: float, lc: float) -> float | None:
+    meta = getattr(surface, "metadata", {}) or {}
+    if meta.get("generator") != "abbm_track":
+        return None
+    from spine_mj.surfaces import abbm_force_intensity
+
+    return abbm_force_intensity(meta["params"]["slope_intensity"], mu) / k**2 / lc
+
+
+def stickslip_to(
+    out_dir: str | Path,
+    surface,
+    *,
+    mu: float,
+    stiffness_numbers: Sequence[float],
+    ie: float,
+    surface_name: str = "",
+    engine: str | None = None,
+    start: float | None = None,
+    travel: float | None = None,
+    n_bootstrap: int = 100,
+    progress: Callable[[int, int, str], None] | None = None,
+    **rig_options,
+) -> StickSlipOutputs:
+    """The stick-slip study of one track: see the module's docstring.
+
+    Parameters
+    ----------
+    out_dir : path
+        The output folder.
+    surface : Surface
+        A track uniform in y (the references follow its line ``y = 0``).
+    mu, ie : float
+        Friction coefficient; the drive's inertia number (the references' speed, mass and
+        duration threshold, and the engine's pace).
+    stiffness_numbers : sequence of float
+        ``K = k l_s / F_p``, each > 0.
+    surface_name : str
+        The label of the catalog's ``surface`` column.
+    engine : {"mujoco", "bullet"}, optional
+        Also run this engine, one spring drive per K.
+    start, travel : float, optional
+        The stretch of track, in surface units (default: all but a twentieth at each end).
+    n_bootstrap : int
+        Synthetic samples of each goodness-of-fit test.
+    progress : callable, optional
+        ``progress(done, total, what)`` after each step.
+    **rig_options
+        :func:`~spine_mj.sim.build_rig`'s keywords (tip radius, mass, length scale, ...).
+    """
+    import pandas as pd
+
+    from spine_mj.sim.engines import build_engine_rig
+    from spine_mj.sim.scales import Scales
+
+    ks = [check_positive("--K", k) for k in stiffness_numbers]
+    if not ks:
+        raise SpineInputError("--K must name at least one stiffness number")
+    x0, length = _track(surface, start, travel)
+    labels = {"surface": surface_name, "mu": float(mu), "ie": float(ie)}
+    report = progress or (lambda done, total, what: None)
+    total = len(ks) * (2 if engine else 1) + 1
+    frames, units_by_k, pulses = [], {}, {}
+    done = 0
+    for k_number in ks:
+        if engine:
+            rig = build_engine_rig(
+                surface, engine=engine, mu=mu, ie=ie, stiffness_number=k_number, **rig_options
+            )
+            scales = rig.scales
+        else:
+            sizing = {
+                key: rig_options[key] for key in ("length_scale_m",) if rig_options.get(key) is not None
+            }
+            scales = Scales.for_surface(surface, **sizing)
+        units = TrackUnits.of(scales, ie)
+        units_by_k[k_number] = units
+        land = track_landscape(surface, mu, units.tip_radius, (x0, x0 + length))
+        for rows in reference_rows(land, units, k_number, **labels).values():
+            frames.append(pd.DataFrame(rows, columns=COLUMNS))
+        done += 1
+        report(done, total, f"references, K {k_number:g}")
+        if engine:
+            result = _engine_run(rig, units, land, k_number, ie, x0, length)
+            frames.append(
+                pd.DataFrame(engine_rows(result, units, engine, k_number, **labels), columns=COLUMNS)
+            )
+            pulses[k_number] = _pulse(result)
+            done += 1
+            report(done, total, f"{engine}, K {k_number:g}")
+    events = pd.concat(frames, ignore_index=True)
+    summary = _summary(events, surface, mu, ie, ks, units_by_k, engine, x0, length, n_bootstrap)
+    files = _write(Path(out_dir), events, summary, pulses)
+    report(total, total, "written")
+    return StickSlipOutputs(summary, files)
+
+
+def _engine_run(rig, units: TrackUnits, land, k_number: float, ie: float, x0: float, length: float):
+    """One spring drive from ``x0``: the carriage runs the track's ``length`` plus the
+    spring's stretch at the start's threshold (the stick phase before the first slide is
+    fast-forwarded)."""
+    from spine_mj.sim.build import build_drive
+
+    lead = float(land.force[0]) / units.stiffness(k_number)
+    duration = (length + lead) / units.speed
+    drive = build_drive(rig.scales, "spring", ie=ie, stiffness_number=k_number, duration_s=duration)
+    return rig.run(drive, start=(x0, 0.0))
+
+
+#: Points of the mean pulse's normalized time axis.
+PULSE_POINTS = 41
+
+
+def _pulse(result) -> np.ndarray:
+    """The mean x-speed of the run's slips against the time from onset over the duration,
+    each slip's speed over its peak: ``(PULSE_POINTS,)`` (NaN without slips)."""
+    grid = np.linspace(0.0, 1.0, PULSE_POINTS)
+    shapes = []
+    for e in result.slip_events:
+        t = result.time_s[e.onset : e.stop + 1]
+        v = result.velocity_m_s[e.onset : e.stop + 1, 0]
+        if t.size < 5 or not np.max(v) > 0:
+            continue
+        shapes.append(np.interp(grid, (t - t[0]) / (t[-1] - t[0]), v / np.max(v)))
+    return np.mean(shapes, axis=0) if shapes else np.full(PULSE_POINTS, math.nan)
+
+
+def _summary(events, surface, mu, ie, ks, units_by_k, engine, x0, length, n_bootstrap) -> dict:
+    sources = [*REFERENCES, *([engine] if engine else [])]
+    per_source: dict = {}
+    for source in sources:
+        per_source[source] = {}
+        for k in ks:
+            sizes = events.loc[(events["source"] == source) & (events["K"] == k), "size_lc"].to_numpy()
+            fit = stats.summarize_sizes(sizes, n_bootstrap=n_bootstrap)
+            entry = {"n_events": fit["n_events"]}
+            if "tau" in fit:
+                entry.update(
+                    tau=fit["tau"],
+                    tau_xmin_lc=fit["tau_xmin"],
+                    cutoff_lc=fit["cutoff"],
+                    power_law=fit["alpha"] | {"xmin_lc": fit["xmin"], "n_tail": fit["n_tail"]},
+                    goodness_of_fit=fit["gof"],
+                    likelihood_ratios=fit["likelihood_ratios"],
+                )
+            per_source[source][f"{k:g}"] = entry
+    comparisons: dict = {}
+    pairs = [("inertial", "overdamped")] + ([(engine, "inertial"), (engine, "overdamped")] if engine else [])
+    for k in ks:
+        at_k = events[events["K"] == k]
+        for a, b in pairs:
+            sa, sb = at_k[at_k["source"] == a], at_k[at_k["source"] == b]
+            if a == engine:  # the engine's detector sees a slip only once it outruns the carriage 5 times
+                sb = sb[sb["peak_speed_v"] >= SLIP_SPEED_FACTOR]
+            if len(sa) < 2 or len(sb) < 2:
+                continue
+            comparisons.setdefault(f"{k:g}", {})[f"{a}_vs_{b}"] = {
+                col: stats.two_sample(sa[col].to_numpy(), sb[col].to_numpy())
+                for col in ("size_lc", "force_drop_fp")
+            }
+    any_units = units_by_k[ks[0]]
+    predicted = {
+        f"{k:g}": _abbm_cutoff_lc(surface, mu, units_by_k[k].stiffness(k), units_by_k[k].char_length)
+        for k in ks
+    }
+    return {
+        "mu": float(mu),
+        "ie": float(ie),
+        "K": [float(k) for k in ks],
+        "engine": engine,
+        "track": {"start": x0, "travel": length, "L_c": any_units.char_length, "l_s": any_units.slope_length},
+        "sources": per_source,
+        "two_sample": comparisons,
+        "abbm_cutoff_lc": predicted if any(v is not None for v in predicted.values()) else None,
+    }
+
+
+def _write(out: Path, events, summary: dict, pulses: dict) -> tuple[Path, ...]:
+    from spine_mj.atomic import all_or_none, atomic_output
+    from spine_mj.jsonio import write_json
+
+    names = [*OUTPUT_FILES, *(["pulse.png"] if pulses else [])]
+    paths = [out / n for n in names]
+    with all_or_none(*paths):
+        with atomic_output(paths[0]) as tmp:
+            events.to_parquet(tmp, index=False)
+        write_json(paths[1], summary)
+        _figures(out, events, summary, pulses)
+    return tuple(paths)
+
+
+def _figures(out: Path, events, summary: dict, pulses: dict) -> None:
+    from spine_mj.plotting import new_figure, save_figure
+
+    ks = summary["K"]
+    sources = list(summary["sources"])
+    fig = new_figure(figsize=(4 * len(ks), 3.4), layout="constrained")
+    axes = fig.subplots(1, len(ks), squeeze=False)
+    for ax, k in zip(axes[0], ks):
+        for source in sources:
+            s = np.sort(events.loc[(events["source"] == source) & (events["K"] == k), "size_lc"].to_numpy())
+            if s.size:
+                ax.loglog(s, 1.0 - np.arange(s.size) / s.size, label=f"{source} ({s.size})")
+        ax.set_xlabel("slip size S / L_c")
+        ax.set_title(f"K = {k:g}")
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(fontsize=7)
+    axes[0][0].set_ylabel("P(size >= S)")
+    save_figure(fig, out / "distributions.png")
+    fig = new_figure(figsize=(4 * len(sources), 3.4), layout="constrained")
+    axes = fig.subplots(1, len(sources), squeeze=False)
+    for ax, source in zip(axes[0], sources):
+        series = {
+            k: events.loc[(events["source"] == source) & (events["K"] == k), "size_lc"].to_numpy() for k in ks
+        }
+        series = {k: s for k, s in series.items() if (s > 0).sum() >= 10}
+        for k, (x, y) in stats.collapse(series, 1.5).items():
+            ax.loglog(x, y, "o-", ms=3, label=f"K = {k:g}")
+        ax.set_xlabel("S / S_m")
+        ax.set_title(source)
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(fontsize=7)
+    axes[0][0].set_ylabel("S^3/2 P(S)")
+    save_figure(fig, out / "collapse.png")
+    if pulses:
+        fig = new_figure(figsize=(4.5, 3.4), layout="constrained")
+        ax = fig.subplots()
+        grid = np.linspace(0.0, 1.0, PULSE_POINTS)
+        for k, shape in pulses.items():
+            ax.plot(grid, shape, label=f"K = {k:g}")
+        ax.plot(grid, 4 * grid * (1 - grid), "k--", label="parabola (ABBM)")
+        ax.set_xlabel("t / T")
+        ax.set_ylabel("mean v / v_peak")
+        ax.legend(fontsize=7)
+        save_figure(fig, out / "pulse.png")

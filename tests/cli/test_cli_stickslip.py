@@ -1,0 +1,54 @@
+"""``spine-mj stickslip``: the references' catalog and statistics of an ABBM track, and one
+Error line for bad input with nothing written."""
+
+import json
+
+import pandas as pd
+import pytest
+from click.testing import CliRunner
+
+from spine_mj import surfaces
+from spine_mj.cli import main
+from spine_mj.surface_io import save_surface
+
+
+@pytest.fixture(scope="module")
+def track(tmp_path_factory):
+    surf = surfaces.abbm_track(
+        length=2000.0, points=20001, width=0.5, slope_intensity=1e-5, correlation_length=1000.0, rng=3
+    )
+    return save_surface(surf, tmp_path_factory.mktemp("track") / "abbm.npz")
+
+
+def test_stickslip_writes_the_catalog_and_tau(track, tmp_path):
+    out = tmp_path / "slips"
+    result = CliRunner().invoke(
+        main, ["stickslip", str(track), "--mu", "0.5", "--K", "1", "--bootstrap", "10", "--out", str(out)]
+    )
+    assert result.exit_code == 0, result.output
+    events = pd.read_parquet(out / "events.parquet")
+    assert {"source", "K", "ie", "size_lc", "duration_s", "force_drop_fp"} <= set(events.columns)
+    summary = json.loads((out / "summary.json").read_text())
+    od = summary["sources"]["overdamped"]["1"]
+    assert od["n_events"] >= 300
+    assert od["tau"]["low"] < od["tau"]["value"] < od["tau"]["high"]
+    assert set(od["likelihood_ratios"]) == {"lognormal", "exponential", "truncated_power_law"}
+    assert "overdamped" in result.output and "tau" in result.output
+    assert (out / "collapse.png").is_file() and (out / "distributions.png").is_file()
+
+
+@pytest.mark.parametrize(
+    ("args", "needle"),
+    [
+        (["--K", "0.5,x"], "--K"),
+        (["--K", "-1"], "--K"),
+        (["--K", "1", "--ie", "nan"], "--ie"),
+        (["--K", "1", "--travel", "1e9"], "--travel"),
+    ],
+)
+def test_bad_input_is_one_error_line_and_nothing_written(track, tmp_path, args, needle):
+    out = tmp_path / "slips"
+    result = CliRunner().invoke(main, ["stickslip", str(track), "--mu", "0.5", "--out", str(out), *args])
+    assert result.exit_code == 2
+    assert needle in result.output and "Traceback" not in result.output
+    assert not out.exists() or not any(out.iterdir())

@@ -1,0 +1,50 @@
+"""The slip catalog: MuJoCo's Prandtl-Tomlinson jumps on a corrugation land where the
+inertial reference says, not where the overdamped one does; every source fills the same
+columns in the same units."""
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from spine_mj import surfaces
+from spine_mj.validate.slip_catalog import COLUMNS
+from spine_mj.validate.stickslip_outputs import OUTPUT_FILES, stickslip_to
+
+
+@pytest.fixture(scope="module")
+def corrugation_study(tmp_path_factory):
+    out = tmp_path_factory.mktemp("pt")
+    surf = surfaces.corrugation(n_waves=4, points_per_wave=128, width=0.5)
+    # K 0.2 < K* 0.47: one jump a wavelength; I_e 1e-4, a tip of lambda / 100 (the ground truth's)
+    res = stickslip_to(
+        out, surf, mu=0.5, stiffness_numbers=[0.2], ie=1e-4, engine="mujoco", tip_radius_m=1e-4
+    )
+    return res, pd.read_parquet(out / "events.parquet")
+
+
+def test_mujoco_jumps_as_the_inertial_reference_not_the_overdamped(corrugation_study):
+    _, events = corrugation_study
+    assert tuple(events.columns) == COLUMNS
+    # past the first, partly loaded fold, and landing a wavelength (2 L_c) short of the grid's end
+    steady = events[(events["start_x_lc"] > 1.5) & (events["start_x_lc"] + events["size_lc"] < 6.0)]
+    size = {
+        s: steady.loc[steady["source"] == s, "size_lc"].to_numpy()
+        for s in ("overdamped", "inertial", "mujoco")
+    }
+    drop = {s: steady.loc[steady["source"] == s, "force_drop_fp"].to_numpy() for s in size}
+    assert size["mujoco"].size >= 2 and np.ptp(size["inertial"]) < 1e-2
+    assert np.abs(size["mujoco"] / size["inertial"].mean() - 1).max() < 0.1
+    assert np.abs(drop["mujoco"] / drop["inertial"].mean() - 1).max() < 0.1
+    assert size["inertial"].mean() > 1.3 * size["overdamped"].mean()  # inertia overshoots
+    for s in size:  # every slip is faster than the carriage, and dissipates
+        rows = steady[steady["source"] == s]
+        assert (rows["peak_speed_v"] > 5).all() and (rows["dissipated_fp_lc"] > 0).all()
+
+
+def test_study_writes_every_file_and_a_summary_per_source(corrugation_study):
+    res, _ = corrugation_study
+    assert [p.name for p in res.files] == [*OUTPUT_FILES, "pulse.png"]
+    assert all(p.is_file() for p in res.files)
+    assert set(res.summary["sources"]) == {"overdamped", "inertial", "mujoco"}
+    assert res.summary["sources"]["mujoco"]["0.2"]["n_events"] >= 3
+    assert "mujoco_vs_inertial" in res.summary["two_sample"]["0.2"]
