@@ -51,6 +51,29 @@ ARRAY_ENGINE_REFUSAL = (
 )
 
 
+def spines_on_surface(layout: Layout, spacing: float, offsets, centres, bounds, margin: float) -> np.ndarray:
+    """The spines' starts ``(n_centres, N, 2)`` (surface units) of arrays of ``offsets``
+    (the layout's at ``spacing``, surface units) centred at each of ``centres``, or the
+    refusal of the first spine outside ``bounds`` or closer to their edge than ``margin``
+    (two tip radii: :meth:`ArrayRig.starts`; the sweep's pre-run check of every centre)."""
+    centres = np.asarray(centres, dtype=float).reshape(-1, 2)
+    xy = np.asarray(offsets, dtype=float)[None, :, :] + centres[:, None, :]
+    xmin, xmax, ymin, ymax = bounds
+    x, y = xy[..., 0], xy[..., 1]
+    inside = (x >= xmin + margin) & (x <= xmax - margin) & (y >= ymin + margin) & (y <= ymax - margin)
+    if not inside.all():
+        c, i = np.unravel_index(int(np.argmin(inside)), inside.shape)
+        x0, y0 = xy[c, i]
+        cx, cy = centres[c]
+        lx, ly = layout.footprint(spacing)
+        raise SpineInputError(
+            f"spacing {layout.spacing:g} {layout.spacing_unit.value} puts spine ({x0:.4g}, "
+            f"{y0:.4g}) outside the surface {tuple(bounds)} (footprint {lx:.4g} x {ly:.4g} "
+            f"surface units, centre ({cx:.4g}, {cy:.4g})): lower the spacing or the number of spines"
+        )
+    return xy
+
+
 class ArrayRig:
     """One MuJoCo model of an array of spines on ``rig``'s surface (see the module docstring).
 
@@ -175,22 +198,10 @@ class ArrayRig:
         SpineInputError
             A spine outside the surface, or closer to its edge than a tip radius.
         """
-        cx, cy = start_pair(centre)
-        xy = np.add(self.offsets, [cx, cy])
-        xmin, xmax, ymin, ymax = self.rig.surface.bounds
-        m = 2 * self.rig.tip.tip_radius_m / self.rig.length_scale_m
-        inside = (
-            (xy[:, 0] >= xmin + m) & (xy[:, 0] <= xmax - m) & (xy[:, 1] >= ymin + m) & (xy[:, 1] <= ymax - m)
-        )
-        if not inside.all():
-            x0, y0 = xy[int(np.argmin(inside))]
-            lx, ly = self.layout.footprint(self.spacing)
-            raise SpineInputError(
-                f"spacing {self.layout.spacing:g} {self.layout.spacing_unit.value} puts spine ({x0:.4g}, "
-                f"{y0:.4g}) outside the surface {self.rig.surface.bounds} (footprint {lx:.4g} x {ly:.4g} "
-                f"surface units, centre ({cx:.4g}, {cy:.4g})): lower the spacing or the number of spines"
-            )
-        return xy
+        margin = 2 * self.rig.tip.tip_radius_m / self.rig.length_scale_m
+        return spines_on_surface(
+            self.layout, self.spacing, self.offsets, [start_pair(centre)], self.rig.surface.bounds, margin
+        )[0]
 
     def default_centre(self) -> tuple[float, float]:
         """The centre that puts the array's rearmost spines a tenth of the way in from the

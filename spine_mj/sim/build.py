@@ -30,22 +30,26 @@ from spine_mj.sim.array_run import ArrayDrive, ForcePull
 from spine_mj.sim.drives import Drive, RampDrive, SpringDrive, StaticProbe, spring_stiffness_n_m
 from spine_mj.sim.holding import array_ie
 from spine_mj.sim.layout import Layout
+from spine_mj.sim.model import check_drive_on
 from spine_mj.sim.records import TipParams
 from spine_mj.sim.rig import Rig
 from spine_mj.sim.scales import Scales
-from spine_mj.sim.step_rule import EngineOverrides
+from spine_mj.sim.step_rule import EngineOverrides, check_engine_for
 from spine_mj.surfaces import GridSurface, Surface
 
 __all__ = [
     "ARRAY_DRIVES",
     "DEFAULT_INERTIA_NUMBER",
     "PROTOCOLS",
+    "RigPlan",
     "build_array",
     "build_array_on",
     "build_drive",
     "build_rig",
     "drive_speed_m_s",
+    "plan_rig",
     "rig_scales",
+    "rig_sizing",
 ]
 
 #: The inertia number of a drive given no speed, rate or I_e.
@@ -162,17 +166,88 @@ def build_rig(
     >>> round(run.inertia_number, 6)
     0.001
     """
+    given = {k: v for k, v in locals().items() if k not in ("surface", "engine_overrides")}  # the keywords
+    plan = plan_rig(surface, **given, **engine_overrides)
+    return Rig(surface, tip=plan.tip, engine=plan.engine, sized=(plan.scales, plan.hfield))
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class RigPlan:
+    """The rig :func:`build_rig` would build, without its MuJoCo model: the surface, the
+    tip, the scales and hfield, and the engine settings (every sizing and step rule
+    applied, nothing compiled). It checks a drive as the rig would
+    (:func:`~spine_mj.sim.model.check_drive_on`) and counts an open-loop run's steps
+    (:func:`~spine_mj.sim.open_loop.drive_steps`): checks of many cases before any runs."""
+
+    surface: Surface
+    tip: TipParams
+    scales: Scales
+    hfield: object
+    engine: object
+
+    @property
+    def length_scale_m(self) -> float:
+        return self.scales.length_scale_m
+
+    @property
+    def bounds_m(self) -> tuple[float, float, float, float]:
+        return tuple(self.length_scale_m * b for b in self.surface.bounds)
+
+    def check_drive(self, drive: Drive) -> None:
+        check_drive_on(self, drive)
+
+
+def plan_rig(
+    surface: Surface,
+    *,
+    mu: float,
+    tip_radius_m: float | None = None,
+    mass_kg: float | None = None,
+    preload_n: float | None = None,
+    gravity_m_s2: float | None = None,
+    length_scale_m: float | None = None,
+    hfield_resolution: int | None = None,
+    hfield_refinement: int = 1,
+    ie: float | None = None,
+    speed_m_s: float | None = None,
+    rate_n_s: float | None = None,
+    stiffness_number: float | None = None,
+    stiffness_n_m: float | None = None,
+    driven: bool = True,
+    sized: tuple | None = None,
+    **engine_overrides,
+) -> RigPlan:
+    """The :class:`RigPlan` of :func:`build_rig`'s arguments (the same rules, the same
+    refusals, no model compiled). ``sized``: the ``(tip, scales, hfield)`` of the same
+    surface and tip sizing, measured before (:func:`rig_sizing`), so that plans differing
+    only in the drive or the engine settings measure the surface once."""
     overrides = EngineOverrides(**engine_overrides)
     tip = TipParams(
         tip_radius_m=tip_radius_m,
         mu_s=mu,
         **_given(mass_kg=mass_kg, preload_n=preload_n, gravity_m_s2=gravity_m_s2),
     )
-    tip, scales, hfield = _sized(surface, tip, length_scale_m, hfield_resolution, hfield_refinement)
+    if sized is None:
+        sized = _sized(surface, tip, length_scale_m, hfield_resolution, hfield_refinement)
+    tip, scales, hfield = sized
     speed = drive_speed_m_s(scales, ie=ie, speed_m_s=speed_m_s, rate_n_s=rate_n_s) if driven else None
     spring = spring_stiffness_n_m(scales, stiffness_number=stiffness_number, stiffness_n_m=stiffness_n_m)
     engine = overrides.engine(scales, speed_m_s=speed, stiffness_n_m=spring)
-    return Rig(surface, tip=tip, engine=engine, sized=(scales, hfield))
+    check_engine_for(engine, scales)
+    return RigPlan(surface, tip, scales, hfield, engine)
+
+
+def rig_sizing(
+    surface: Surface,
+    *,
+    tip: TipParams,
+    length_scale_m: float | None = None,
+    hfield_resolution: int | None = None,
+    hfield_refinement: int = 1,
+) -> tuple:
+    """``(tip, scales, hfield)``: the sizing :func:`plan_rig` takes as ``sized`` (the tip
+    carrying the scales' radius)."""
+    return _sized(surface, tip, length_scale_m, hfield_resolution, hfield_refinement)
 
 
 def rig_scales(

@@ -86,6 +86,36 @@ def start_pair(start) -> tuple[float, float]:
     return x0, y0
 
 
+def check_drive_on(rig, drive: Drive) -> None:
+    """Refuse a drive whose inertia number is beyond :data:`MAX_INERTIA_NUMBER`, however it
+    was given (an I_e, a speed or a force rate), that advances more than
+    :data:`MAX_DRIVE_ADVANCE_PER_STEP` L_c in one time step of this rig, or whose spring
+    this rig's step cannot integrate (``omega dt`` above
+    :data:`~spine_mj.sim.step_rule.MAX_SPRING_OMEGA_DT`).
+
+    ``rig`` is anything with the ``scales`` and ``engine`` of a rig: a :class:`RigModel`, or
+    the :class:`~spine_mj.sim.build.RigPlan` of one not built yet."""
+    speed = check_drive_speed(rig.scales, speed_m_s(drive, rig.scales))
+    dt, lc = rig.engine.timestep_s, rig.scales.char_length_m
+    if speed * dt > MAX_DRIVE_ADVANCE_PER_STEP * lc:
+        raise SpineInputError(
+            f"the drive advances {speed * dt / lc:.3g} L_c in one time step of {dt:.3g} s (speed "
+            f"{speed:.3g} m/s), more than {MAX_DRIVE_ADVANCE_PER_STEP:g}: use a time step of at most "
+            f"{MAX_DRIVE_ADVANCE_PER_STEP * lc / speed:.3g} s, or none (derived)"
+        )
+    if isinstance(drive, SpringDrive):
+        k = stiffness_n_m(drive, rig.scales)
+        wdt = spring_omega_dt(k, rig.scales.mass_kg, dt)
+        if wdt > MAX_SPRING_OMEGA_DT * (1 + 1e-9):
+            most = MAX_SPRING_OMEGA_DT / wdt * dt
+            raise SpineInputError(
+                f"the drive spring (K = {rig.scales.stiffness_number(k):.3g}, k = {k:.3g} N/m) swings "
+                f"{wdt:.3g} rad in one time step of {dt:.3g} s, more than {MAX_SPRING_OMEGA_DT:g}: the "
+                f"engine integrates it explicitly and would get it wrong; build the rig for this "
+                f"stiffness (build_rig(stiffness_number=...)) or use a time step of at most {most:.3g} s"
+            )
+
+
 class RigModel:
     """The MuJoCo model of one surface and one tip (parameters as for :class:`~spine_mj.sim.Rig`).
 
@@ -370,27 +400,5 @@ class RigModel:
         return self.scales.inertia_number(self.speed_of(drive))
 
     def check_drive(self, drive: Drive) -> None:
-        """Refuse a drive whose inertia number is beyond :data:`MAX_INERTIA_NUMBER`, however it
-        was given (an I_e, a speed or a force rate), that advances more than
-        :data:`MAX_DRIVE_ADVANCE_PER_STEP` L_c in one time step of this rig, or whose spring
-        this rig's step cannot integrate (``omega dt`` above
-        :data:`~spine_mj.sim.step_rule.MAX_SPRING_OMEGA_DT`)."""
-        speed = check_drive_speed(self.scales, self.speed_of(drive))
-        dt, lc = self.engine.timestep_s, self.scales.char_length_m
-        if speed * dt > MAX_DRIVE_ADVANCE_PER_STEP * lc:
-            raise SpineInputError(
-                f"the drive advances {speed * dt / lc:.3g} L_c in one time step of {dt:.3g} s (speed "
-                f"{speed:.3g} m/s), more than {MAX_DRIVE_ADVANCE_PER_STEP:g}: use a time step of at most "
-                f"{MAX_DRIVE_ADVANCE_PER_STEP * lc / speed:.3g} s, or none (derived)"
-            )
-        if isinstance(drive, SpringDrive):
-            k = stiffness_n_m(drive, self.scales)
-            wdt = spring_omega_dt(k, self.scales.mass_kg, dt)
-            if wdt > MAX_SPRING_OMEGA_DT * (1 + 1e-9):
-                most = MAX_SPRING_OMEGA_DT / wdt * dt
-                raise SpineInputError(
-                    f"the drive spring (K = {self.scales.stiffness_number(k):.3g}, k = {k:.3g} N/m) swings "
-                    f"{wdt:.3g} rad in one time step of {dt:.3g} s, more than {MAX_SPRING_OMEGA_DT:g}: the "
-                    f"engine integrates it explicitly and would get it wrong; build the rig for this "
-                    f"stiffness (build_rig(stiffness_number=...)) or use a time step of at most {most:.3g} s"
-                )
+        """Refuse a drive this rig cannot run (:func:`check_drive_on`)."""
+        check_drive_on(self, drive)

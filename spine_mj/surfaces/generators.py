@@ -400,8 +400,7 @@ def fractal_fbm(
     GridSurface
         Periodic (unless ``periodic=False``), zero mean, metadata recording every argument.
     """
-    periodic = _flag("periodic", periodic)
-    unit = check_unit(unit)
+    periodic, unit = _flag("periodic", periodic), check_unit(unit)
     nx, ny, lx, ly = _fbm_grid(nx, ny, size, periodic)
     hurst = _hurst(hurst)
     rms_height, rms_slope = _fbm_normalization(rms_height, rms_slope)

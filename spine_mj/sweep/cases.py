@@ -81,11 +81,13 @@ def expand_cases(config: SweepConfig) -> list[Case]:
             if (si < len(config.surface_starts) and config.surface_starts[si] is not None)
             else config.starts
         )
+        # read once per surface (a file has none: its config must give mu)
+        preset_mu = presets.preset_mu(surf.source) if from_preset and surf.kind == "preset" else None
         for combo in combos:
             params = applied_params(dict(zip(names, combo)), specs)
             for k in from_preset:
                 if params[k] is None:
-                    params[k] = presets.preset_mu(surf.source)
+                    params[k] = preset_mu
             case_id = _case_id(surf, starts, params)
             if case_id in seen:
                 raise SpineInputError(

@@ -4,50 +4,91 @@ A value that only a surface can judge (a time step too long for its contact, a s
 ``dl`` lost in the rounding of its coordinates, a run longer than the step limit at a tiny
 inertia number) used to be found when its case ran and recorded as a failed run, the
 sweep exiting 0. :func:`check_cases` asks every analysis to check (``check_case``, with
-the same functions its run uses) a set of cases that holds every value of every
-parameter on every surface source at least once, and refuses the config on the first
-problem, naming the case.
+the same functions its run uses) every combination of the grid on every surface, and
+refuses the config on the first problem, naming the case: a problem that only a
+combination makes (a spring drive swinging too far at the largest I_e and the stiffest
+K, the longest run at the smallest I_e and the smallest step factor) is found as surely
+as one a single value makes.
+
+It stays fast on large grids: each analysis checks each distinct combination of the
+parameters it reads (its own and those of the analyses it needs) once per surface and
+start set, and the checks are closed forms on the rig's scales and step rule
+(:class:`~spine_mj.sim.build.RigPlan`), no rig being built (the surface is measured once
+per tip sizing).
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import time
+from collections.abc import Callable, Sequence
 
 from spine_mj.errors import SpineInputError
 from spine_mj.sweep.cases import Case
 from spine_mj.sweep.registry import ANALYSES
 
-__all__ = ["check_cases", "covering_cases"]
+__all__ = ["check_cases", "checked_keys"]
+
+#: Seconds between two progress reports of a long check.
+_PROGRESS_EVERY_S = 1.0
 
 
-def covering_cases(cases: Sequence[Case]) -> list[Case]:
-    """The cases, in order, that first bring a surface source or a parameter value to it:
-    at most one per value of each parameter per surface source (seeds of one preset count
-    as one source)."""
-    picked, seen = [], set()
-    for case in cases:
-        source = (case.surface.kind, case.surface.source, case.surface.overrides)
-        keys = {(source, None, None)} | {(source, k, repr(v)) for k, v in case.params.items()}
-        if not keys <= seen:
-            picked.append(case)
-            seen |= keys
-    return picked
+def checked_keys(analysis: str) -> tuple[str, ...]:
+    """The parameters ``analysis``'s check reads: its ``check_reads``, else its own and
+    those of the analyses it needs (a check may build on theirs, as compare's on the
+    mujoco rig)."""
+    if ANALYSES[analysis].check_reads is not None:
+        return tuple(sorted(ANALYSES[analysis].check_reads))
+    names, todo = [], [analysis]
+    while todo:
+        a = ANALYSES[todo.pop()]
+        names += [s.name for s in a.parameters]
+        todo += list(a.requires)
+    return tuple(sorted(set(names)))
 
 
-def check_cases(cases: Sequence[Case], swept: Sequence[str] = ()) -> None:
+def check_cases(
+    cases: Sequence[Case], swept: Sequence[str] = (), progress: Callable[[int, int], None] | None = None
+) -> None:
     """Refuse, as one SpineInputError line naming the case, the first input error any
-    analysis would meet in the :func:`covering_cases` of ``cases``.
+    analysis would meet in any case of ``cases``.
 
     ``swept`` names the parameters with more than one value (shown in the message).
+    ``progress``, if given, is called as ``progress(checked, total)`` about once a second
+    while the check runs.
     """
-    for case in covering_cases(cases):
-        where = ", ".join([case.surface.label] + [f"{k} = {case.params[k]!r}" for k in swept])
-        try:
-            surface = case.surface.make()
-            starts = case.starts.resolve(surface.bounds, case.seed)
-            for name in case.analyses:
-                check = ANALYSES[name].check_case
-                if check is not None:
-                    check(case, surface, starts)
-        except SpineInputError as exc:
-            raise SpineInputError(f"sweep case ({where}): {exc}") from None
+    keys = {name: checked_keys(name) for name in ANALYSES}
+    seen: set = set()
+    last = time.monotonic()
+    for i, case in enumerate(cases):
+        if progress is not None and time.monotonic() - last > _PROGRESS_EVERY_S:
+            progress(i, len(cases))
+            last = time.monotonic()
+        # random starts are drawn from the case's seed: each case has its own
+        source = (case.surface, case.starts, case.seed if case.starts.random is not None else None)
+        todo = []
+        for name in case.analyses:
+            if ANALYSES[name].check_case is None:
+                continue
+            key = (name, source, tuple(repr(case.params.get(k)) for k in keys[name]))
+            if key not in seen:
+                seen.add(key)
+                todo.append(name)
+        if source not in seen:
+            seen.add(source)
+            todo = todo or [None]  # the surface and starts are made even without a check
+        if todo:
+            _check(case, todo, swept)
+    if progress is not None:
+        progress(len(cases), len(cases))
+
+
+def _check(case: Case, analyses, swept: Sequence[str]) -> None:
+    where = ", ".join([case.surface.label] + [f"{k} = {case.params[k]!r}" for k in swept])
+    try:
+        surface = case.surface.make()
+        starts = case.starts.resolve(surface.bounds, case.seed)
+        for name in analyses:
+            if name is not None:
+                ANALYSES[name].check_case(case, surface, starts)
+    except SpineInputError as exc:
+        raise SpineInputError(f"sweep case ({where}): {exc}") from None

@@ -208,6 +208,10 @@ class Analysis:
         One line for ``spine-mj sweep --help`` and the report.
     check_config, check_case : callable or None
         See above.
+    check_reads : tuple of str, optional
+        The parameters ``check_case`` reads (None: every parameter of this analysis and of
+        those it requires): the pre-run check calls it once per distinct combination of
+        them, so a grid over a parameter the check does not read costs nothing more.
     """
 
     name: str
@@ -217,6 +221,7 @@ class Analysis:
     doc: str = ""
     check_config: Callable[[Any], None] | None = None
     check_case: Callable[..., None] | None = None
+    check_reads: tuple[str, ...] | None = None
 
 
 #: Registry of analyses by name; :func:`register_analysis` adds to it.

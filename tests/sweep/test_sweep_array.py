@@ -70,11 +70,6 @@ def test_array_key_given_twice_is_refused(tmp_path):
             'layout = ["grid", "staggered"]\nlayout_seed = 5',
             r"layout_seed = \[5\]: the grid and staggered layout ignores",
         ),
-        # a random layout whose tips cannot stand apart at this spacing on the corrugation
-        (
-            'layout = "random"\nrows = 8\ncols = 8\nspacing = 0.001\nspacing_unit = "surface"',
-            r"config \[array\] on surface corrugation: spacing 0.001 is too small for 64 random spines",
-        ),
     ],
 )
 def test_array_layouts_the_command_refuses_are_refused_at_config_time(tmp_path, table, match):

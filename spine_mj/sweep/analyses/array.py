@@ -21,10 +21,10 @@ import numpy as np
 
 from spine_mj import sim
 from spine_mj.errors import SpineInputError
-from spine_mj.sim.array import ARRAY_ENGINE_REFUSAL
+from spine_mj.sim.array import ARRAY_ENGINE_REFUSAL, spines_on_surface
 from spine_mj.sim.drives import spring_stiffness_n_m
 from spine_mj.sim.layout import MAX_SPINES
-from spine_mj.sweep.analyses.mujoco import MUJOCO_PARAMS, case_rig, case_scales, check_speed
+from spine_mj.sweep.analyses.mujoco import CHECK_READS, MUJOCO_PARAMS, case_plan, case_rig, check_speed
 from spine_mj.sweep.registry import CASE_THREADS, Analysis, AnalysisResult, ParamSpec, register_analysis
 
 ARRAY_PARAMS = (
@@ -84,9 +84,9 @@ def _check_drive_keys(grid: dict) -> None:
 
 def _check_layouts(config) -> None:
     """Refuse at config time what ``spine-mj array`` refuses up front, rather than record
-    every run ``failed``: a layout of more than MAX_SPINES spines, ``layout_seed`` where no
-    random layout reads it, and a random layout whose spines cannot stand apart at its
-    spacing on a case's surface (placed as the run would, from the case's tip and scales)."""
+    every run ``failed``: the drive keys an array does not read, a layout of more than
+    MAX_SPINES spines and ``layout_seed`` where no random layout reads it (what needs a
+    case's surface, :func:`_check_case`)."""
     grid = dict(config.grid)
     if "bullet" in grid["engine"]:
         raise SpineInputError(ARRAY_ENGINE_REFUSAL)
@@ -102,27 +102,19 @@ def _check_layouts(config) -> None:
             _layout(dict(zip(_LAYOUT_KEYS, values, strict=True)))
         except SpineInputError as exc:
             raise SpineInputError(f"config [array]: {exc}") from None
-    if "random" not in grid["layout"]:
-        return
-    from spine_mj.sweep.cases import expand_cases
 
-    surfaces, checked = {}, set()
-    for case in expand_cases(config):
-        p = case.params
-        key = (
-            case.surface,
-            *(p[k] for k in (*_LAYOUT_KEYS, "tip_radius", "length_scale", "hfield_resolution")),
-        )
-        if p["layout"] != "random" or key in checked:
-            continue
-        checked.add(key)
-        sc = case_scales(case, surfaces.setdefault(case.surface, case.surface.make()))
-        layout, s = _layout(p), sc.length_scale_m
-        spacing = layout.spacing_in_surface_units(l_s=sc.slope_length_m / s, l_c=sc.char_length_m / s)
-        try:
-            layout.offsets(spacing, tip_radius=sc.tip_radius_m / s)
-        except SpineInputError as exc:
-            raise SpineInputError(f"config [array] on surface {case.surface.label}: {exc}") from None
+
+def _check_case(case, surface, starts) -> None:
+    """The refusals of ``spine-mj array`` a case's runs would meet, before any: spines
+    that cannot stand apart at the spacing (a random layout) or that land off the surface
+    from any of its centres (every start at once), placed as the run places them from the
+    case's tip and scales (:func:`~spine_mj.sweep.analyses.mujoco.case_plan`: no rig built)."""
+    plan = case_plan(case, surface)
+    sc, s = plan.scales, plan.length_scale_m
+    layout = _layout(case.params)
+    spacing = layout.spacing_in_surface_units(l_s=sc.slope_length_m / s, l_c=sc.char_length_m / s)
+    offsets = layout.offsets(spacing, tip_radius=plan.tip.tip_radius_m / s)
+    spines_on_surface(layout, spacing, offsets, starts, surface.bounds, 2 * plan.tip.tip_radius_m / s)
 
 
 def _array(case, surface, starts, upstream):
@@ -172,6 +164,8 @@ register_analysis(
         _array,
         ARRAY_PARAMS,
         check_config=_check_layouts,
+        check_case=_check_case,
+        check_reads=(*_LAYOUT_KEYS, *CHECK_READS),
         doc="an array of spines on one carriage centred at every start ([array] table): sim.ArrayRig",
     )
 )

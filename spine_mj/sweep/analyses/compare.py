@@ -26,7 +26,7 @@ import numpy as np
 from spine_mj.errors import SpineInputError
 from spine_mj.sim.drives import stiffness_n_m
 from spine_mj.sim.holding import spring_swing
-from spine_mj.sweep.analyses.mujoco import case_drive, case_rig, peak_drive_over_fp
+from spine_mj.sweep.analyses.mujoco import CHECK_READS, case_drive, case_plan, peak_drive_over_fp
 from spine_mj.sweep.analyses.quasistatic import cached_trace, hfield_key, path_table, traced_surface
 from spine_mj.sweep.registry import Analysis, AnalysisResult, ParamSpec, register_analysis
 from spine_mj.theory import agreement
@@ -279,7 +279,7 @@ def _check_case(case, surface, starts) -> None:
     agreed 34/36."""
     if case.params["protocol"] != "spring" or case.params["dynamic_drive"]:
         return
-    rig = case_rig(case, surface)
+    rig = case_plan(case, surface)
     drive = case_drive(rig, case.params)
     sc = rig.scales
     k_number = sc.stiffness_number(stiffness_n_m(drive, sc))
@@ -333,5 +333,6 @@ register_analysis(
         "why a run disagrees (miss_reason, miss_offset); "
         "lengths over L_c: spine_mj.theory.agreement",
         check_case=_check_case,
+        check_reads=(*CHECK_READS, "dynamic_drive"),
     )
 )

@@ -14,6 +14,7 @@ import numpy as np
 
 from spine_mj import sim
 from spine_mj.errors import SpineInputError
+from spine_mj.sim.build import plan_rig, rig_sizing
 from spine_mj.sim.holding import spring_swing
 from spine_mj.sim.open_loop import drive_steps
 from spine_mj.sim.ramp import nominal_time_s
@@ -245,7 +246,12 @@ def check_speed(config) -> None:
 def _rig(spec, key):
     """The rig of a surface and tip/engine parameters (cached: cases differing only in the
     protocol share it; the speed and the spring's stiffness set the engine step)."""
-    p = dict(key)
+    return sim.build_engine_rig(spec.make(), engine=dict(key)["engine"], **_rig_options(dict(key)))
+
+
+def _rig_options(p: dict) -> dict:
+    """The keywords of :func:`spine_mj.sim.build_engine_rig` (without the engine) of a
+    case's rig parameters ``p``: MuJoCo's own solver options only for MuJoCo."""
     mujoco_only = {
         "integrator": p["integrator"],
         "cone": p["cone"],
@@ -257,9 +263,7 @@ def _rig(spec, key):
         "solref_dampratio": p["solref_dampratio"],
         "timestep_factor": p["timestep_factor"],
     }
-    return sim.build_engine_rig(
-        spec.make(),
-        engine=p["engine"],
+    return dict(
         **(mujoco_only if p["engine"] == "mujoco" else {}),
         mu=p["mu"],
         tip_radius_m=p["tip_radius_m"],
@@ -286,7 +290,61 @@ def case_rig(case, surface=None):
     return _rig(case.surface, _rig_key(case.params, surface))
 
 
-case_rig.cache_clear = _rig.cache_clear
+def _clear_caches() -> None:
+    _rig.cache_clear()
+    _sizing.cache_clear()
+
+
+case_rig.cache_clear = _clear_caches
+
+
+_SIZING_KEYS = (
+    "tip_radius_m",
+    "mu",
+    "mass",
+    "preload",
+    "gravity",
+    "length_scale",
+    "hfield_resolution",
+    "hfield_refinement",
+)
+
+
+@functools.lru_cache(maxsize=4)
+def _sizing(spec, key):
+    """The ``(tip, scales, hfield)`` of a surface and a tip's sizing parameters (cached:
+    the cases of a grid that differ in the drive or the engine settings share it)."""
+    p = dict(key)
+    tip = sim.TipParams(
+        tip_radius_m=p["tip_radius_m"],
+        mu_s=p["mu"],
+        **{k: p[a] for k, a in (("mass_kg", "mass"), ("preload_n", "preload"), ("gravity_m_s2", "gravity"))},
+    )
+    return rig_sizing(
+        spec.make(),
+        tip=tip,
+        length_scale_m=p["length_scale"],
+        hfield_resolution=p["hfield_resolution"],
+        hfield_refinement=p["hfield_refinement"],
+    )
+
+
+def _plan(spec, key):
+    p = dict(key)
+    sized = _sizing(spec, tuple((k, p[k]) for k in _SIZING_KEYS))
+    return plan_rig(spec.make(), sized=sized, **_rig_options(p))
+
+
+def case_plan(case, surface=None):
+    """What :func:`case_rig` would build for ``case``, without compiling it: a MuJoCo case's
+    :class:`~spine_mj.sim.build.RigPlan` (its scales, tip and engine step; cached, the
+    surface sized once per tip), a Bullet case's rig itself. For the checks of a grid
+    before any case runs."""
+    surface = case.surface.make() if surface is None else surface
+    key = _rig_key(case.params, surface)
+    if dict(key)["engine"] != "mujoco":
+        return _rig(case.surface, key)
+    return _plan(case.surface, key)
 
 
 def case_scales(case, surface=None) -> sim.Scales:
@@ -375,10 +433,23 @@ def _runs(rig, p: dict, starts) -> list:
     return rig.run_batch(drive, pts, detection=det, nthread=CASE_THREADS.get())
 
 
+#: The parameters :func:`_check_case` reads: the rig's and the drive's.
+CHECK_READS = (
+    *_RIG_KEYS,
+    "tip_radius",
+    "protocol",
+    "duration",
+    "settle_time",
+    "start_force",
+    "slide_distance",
+    "kappa_cap",
+)
+
+
 def _check_case(case, surface, starts) -> None:
     """The inputs' errors a run would meet, without running: the rig (tip, scales, engine),
     the drive and, for the open-loop drives, the length of the run from the first start."""
-    rig = case_rig(case, surface)
+    rig = case_plan(case, surface)
     drive = case_drive(rig, case.params)
     rig.check_drive(drive)
     if case.params["protocol"] != "ramp" and len(starts):
@@ -516,5 +587,6 @@ register_analysis(
         doc="MuJoCo rig run from every start with the chosen drive: spine_mj.sim",
         check_config=check_speed,
         check_case=_check_case,
+        check_reads=CHECK_READS,
     )
 )

@@ -101,8 +101,10 @@ def _params(case, surface) -> sl.StreamlineParams:
 
 
 def _check_case(case, surface, starts) -> None:
-    """The inputs' errors a run would meet: the parameters and the step on this surface."""
-    sl.check_step(surface, _params(case, surface).dl)
+    """The inputs' errors a run would meet: the step on this surface (the parameters'
+    own ranges are the schema's)."""
+    dl = case.params["dl"]
+    sl.check_step(surface, dl if dl is not None else sl.default_step(surface))
 
 
 def _quasistatic(case, surface, starts, upstream):
@@ -149,5 +151,6 @@ register_analysis(
         QUASISTATIC_PARAMS,
         doc="quasistatic streamline (or ideal trajectory) from every start: spine_mj.theory.streamline",
         check_case=_check_case,
+        check_reads=("dl",),
     )
 )

@@ -1,0 +1,163 @@
+"""The pre-run check covers every combination of the grid: a sweep with one bad case is
+refused in one line naming it before any case runs (issue 44), and stays fast."""
+
+import pytest
+from sweep_support import write_config
+
+from spine_mj import sweep
+from spine_mj.errors import SpineInputError
+from spine_mj.sweep import preflight
+
+
+def _refused_before_any_run(tmp_path, text, *fragments):
+    out = tmp_path / "out"
+    with pytest.raises(SpineInputError) as err:
+        sweep.run_sweep(write_config(tmp_path, text), out, workers=1)
+    message = str(err.value)
+    assert "\n" not in message and message.startswith("sweep case ("), message
+    for fragment in fragments:
+        assert fragment in message, message
+    assert not list(out.glob("runs/*.parquet"))
+    return message
+
+
+FRACTAL = """
+[sweep]
+analyses = {analyses}
+[[surfaces]]
+preset = "paper-fractal"
+[starts]
+x = [0.05]
+y = [0.5]
+[drive]
+ie = [1e-4, 1e-3]
+K = [10, 100]
+"""
+
+
+def test_a_spring_swing_only_one_combination_makes_is_refused_before_any_run(tmp_path):
+    """On the paper fractal (L_c / l_s = 24) sqrt(I_e K L_c / l_s) is 0.15 to 0.49 F_p for
+    three of the four cases, 1.55 F_p at I_e = 1e-3 and K = 100: each value alone passes,
+    the combination is refused (it used to run and be compared)."""
+    text = FRACTAL.format(analyses='["quasistatic", "mujoco", "compare"]')
+    _refused_before_any_run(tmp_path, text, "ie = 0.001, K = 100", "spring drive at I_e = 0.001, K = 100")
+    # without the comparison every case is a legitimate dynamic run
+    cases = sweep.expand_cases(
+        sweep.load_config(write_config(tmp_path, FRACTAL.format(analyses='["mujoco"]')))
+    )
+    preflight.check_cases(cases)
+
+
+STEPS = """
+[sweep]
+analyses = ["mujoco"]
+[[surfaces]]
+preset = "paper-single-peak"
+[starts]
+x = [0.05]
+y = [0.5]
+[drive]
+ie = [1.0, 1e-3]
+[grid]
+timestep_factor = [1.0, 1e-3]
+"""
+
+
+def test_a_run_beyond_the_step_limit_only_one_combination_makes_is_refused(tmp_path):
+    _refused_before_any_run(tmp_path, STEPS, "ie = 1.0, timestep_factor = 0.001", "more than the limit")
+
+
+SIZES = """
+[sweep]
+analyses = ["mujoco"]
+[[surfaces]]
+preset = "paper-single-peak"
+[starts]
+x = [0.05]
+y = [0.5]
+[grid]
+hfield_resolution = [61, 1500]
+hfield_refinement = [1, 6]
+"""
+
+
+def test_an_hfield_only_one_combination_makes_too_large_is_refused(tmp_path):
+    _refused_before_any_run(
+        tmp_path, SIZES, "hfield_resolution = 1500, hfield_refinement = 6", "samples a side, more than"
+    )
+
+
+ARRAY = """
+[sweep]
+analyses = ["array"]
+[[surfaces]]
+preset = "corrugation"
+[starts]
+frame = "absolute"
+points = {points}
+[drive]
+ie = 1e-2
+duration = 0.02
+[array]
+{layout}
+spacing_unit = "surface"
+"""
+
+
+@pytest.mark.parametrize(
+    ("points", "layout", "fragment"),
+    [
+        ("[[1.0, 0.0]]", 'layout = "grid"\nrows = 2\ncols = 2\nspacing = 2.0', "outside the surface"),
+        ("[[1.0, 0.0]]", 'layout = "staggered"\nrows = 3\ncols = 40\nspacing = 0.2', "outside the surface"),
+        (
+            "[[1.0, 0.0], [7.99, 0.0]]",
+            'layout = "grid"\nrows = 1\ncols = 2\nspacing = 0.15',
+            "centre (7.99, 0)",
+        ),
+        (
+            "[[2.0, 0.0]]",
+            'layout = "random"\nrows = 8\ncols = 8\nspacing = 0.001',
+            "spacing 0.001 is too small for 64 random spines",
+        ),
+    ],
+)
+def test_array_layouts_off_the_surface_are_refused_before_any_run(tmp_path, points, layout, fragment):
+    _refused_before_any_run(tmp_path, ARRAY.format(points=points, layout=layout), fragment)
+
+
+def test_every_combination_is_checked_without_building_a_rig_or_repeating_a_check(tmp_path, monkeypatch):
+    """4000 MuJoCo cases (I_e x K x step factor) checked on the rig's plan, no rig built;
+    2000 quasistatic cases over mu x dl checked once per dl (the only key its check reads).
+    The time this takes is a benchmark's (benchmarks/), not a test's."""
+    text = STEPS.replace(
+        "ie = [1.0, 1e-3]", "ie = {logspace = [1e-4, 1e-2], num = 20}\nK = {logspace = [1, 100], num = 20}"
+    )
+    text = text.replace(
+        "timestep_factor = [1.0, 1e-3]", "timestep_factor = {linspace = [0.5, 1.0], num = 10}"
+    )
+    cases = sweep.expand_cases(sweep.load_config(write_config(tmp_path, text)))
+    from spine_mj.sweep.analyses import mujoco, quasistatic
+
+    mujoco.case_rig.cache_clear()
+    preflight.check_cases(cases)
+    assert len(cases) == 4000 and mujoco._rig.cache_info().misses == 0
+
+    steps = []
+    real = quasistatic.sl.check_step
+    monkeypatch.setattr(
+        quasistatic.sl, "check_step", lambda surface, dl: steps.append(dl) or real(surface, dl)
+    )
+    qs = """
+    [sweep]
+    analyses = ["quasistatic"]
+    [[surfaces]]
+    preset = "paper-single-peak"
+    [starts]
+    points = [[0.1, 0.5]]
+    [grid]
+    mu = {linspace = [0.1, 2.0], num = 1000}
+    dl = [0.01, 0.02]
+    """
+    cases = sweep.expand_cases(sweep.load_config(write_config(tmp_path, qs)))
+    preflight.check_cases(cases)
+    assert len(cases) == 2000 and sorted(steps) == [0.01, 0.02]
