@@ -63,6 +63,7 @@ import bench_gpu  # noqa: E402
 import bench_memory  # noqa: E402
 import bench_plan_cost  # noqa: E402
 import bench_rollout  # noqa: E402
+import bench_stickslip  # noqa: E402
 import bench_streamline  # noqa: E402
 import bench_sweep  # noqa: E402
 from bench_common import MISSED, load, section  # noqa: E402
@@ -84,6 +85,7 @@ SECTIONS = {
     "engines": bench_engines,
     "gpu": bench_gpu,
     "memory": bench_memory,
+    "stickslip": bench_stickslip,
 }
 REPORT_ORDER = (
     "streamline",
@@ -97,6 +99,7 @@ REPORT_ORDER = (
     "plan_cost",
     "gpu",
     "memory",
+    "stickslip",
 )
 
 
