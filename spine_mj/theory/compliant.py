@@ -36,7 +36,13 @@ import numpy as np
 from spine_mj.errors import SpineInputError
 from spine_mj.surfaces import BallOnFacets, Surface
 from spine_mj.theory.engagement import DEFAULT_TOL, ENGAGED, SELF_LOCK, SLIP, quadratic_coefficients
-from spine_mj.theory.streamline import Outcome, StreamlineParams, check_step, start_points
+from spine_mj.theory.streamline import (
+    Outcome,
+    StreamlineParams,
+    _surface_data,
+    check_step,
+    start_points,
+)
 
 __all__ = ["CompliantResult", "Fold", "MotionState", "compliant_streamlines", "hold_force"]
 
@@ -185,6 +191,11 @@ class CompliantResult:
 _GOLDEN_ITERATIONS = 40
 #: Bisections locating a landing: 2**-36 ~ 1.5e-11 of a step.
 _BISECTIONS = 36
+#: The surface kind of a ball on facets in :func:`spine_mj.theory._compliant_kernel.run_compliant`
+#: (0 and 1 are those of the rigid kernel: Gaussian sum, gridded spline).
+_KIND_FACETS = 2
+#: The fold table's columns after ``start``, as the compiled loop returns them.
+_FOLD_COLUMNS = ("x", "y", "carriage", "onset_force", "land_x", "land_y", "land_force", "jump_length")
 #: Where the probe sits along a slide step, from its end, as a fraction of the step.
 _PROBE = 1e-6
 
@@ -278,7 +289,13 @@ class _Lanes:
 
 
 def compliant_streamlines(
-    surface: Surface, starts, params: StreamlineParams, *, stiffness: float, carriage_end=None
+    surface: Surface,
+    starts,
+    params: StreamlineParams,
+    *,
+    stiffness: float,
+    carriage_end=None,
+    backend: str = "auto",
 ) -> CompliantResult:
     """Quasistatic paths of a tip pulled through a spring of stiffness ``k = stiffness W``.
 
@@ -296,6 +313,13 @@ def compliant_streamlines(
         Where the carriage stops (surface units, >= the start's x): a path whose hold
         needs the carriage further ends there (``Outcome.DRIVE_END``), the tip held short
         of its hold, as a run whose drive ends does. None: the carriage goes on.
+    backend : {"auto", "numba", "numpy"}
+        ``"numba"``: the compiled loop (:func:`spine_mj.theory._compliant_kernel.run_compliant`,
+        start by start) on a Gaussian sum, a gridded surface or a ball on compiled facets;
+        ``"numpy"``: the plain loop here, vectorized over starts, for any surface (the
+        reference the compiled one is tested against; about 0.3 ms of interpreter per
+        iteration, which a tip creeping along a crease repeats ~1e5 times); ``"auto"``:
+        the compiled loop where it applies.
 
     Returns
     -------
@@ -316,7 +340,72 @@ def compliant_streamlines(
         raise SpineInputError(
             "carriage_end must be >= each start's x (or None: no end), got " + repr(carriage_end)
         )
-    return _run(surface, xs, ys, params, float(c), np.array(end))
+    if backend not in ("auto", "numba", "numpy"):
+        raise SpineInputError(f"backend must be 'auto', 'numba' or 'numpy', got {backend!r}")
+    data = _kernel_surface(surface) if backend != "numpy" else None
+    if backend == "numba" and data is None:
+        raise SpineInputError(
+            "backend 'numba' supports GaussianSurface, GridSurface and compiled BallOnFacets, "
+            f"got {type(surface).__name__}"
+        )
+    if data is None:
+        return _run(surface, xs, ys, params, float(c), np.array(end))
+    return _run_compiled(data, surface, xs, ys, params, float(c), np.array(end))
+
+
+def _kernel_surface(surface):
+    """The surface as :func:`spine_mj.theory._compliant_kernel.run_compliant` takes it, or None."""
+    if isinstance(surface, BallOnFacets):
+        if not surface.compiled:
+            return None
+        return (_KIND_FACETS, np.zeros((5, 0)), np.zeros((1, 1)), np.zeros(8), *surface.kernel_args())
+    data = _surface_data(surface)
+    if data is None:
+        return None
+    return (*data, np.zeros((1, 1)), 0.0, 0.0, 1.0, 1.0, 0.0)
+
+
+def _run_compiled(data, surface, xs, ys, params, c, carriage_end) -> CompliantResult:
+    """:func:`_run` compiled, start by start (the same steps; fold rows in start order)."""
+    from spine_mj.theory._compliant_kernel import run_compliant
+
+    outcome, max_k, offsets, pts, states, fstart, fold = run_compliant(
+        data,
+        xs,
+        ys,
+        np.ascontiguousarray(carriage_end, dtype=float),
+        np.asarray(params.domain(surface), dtype=float),
+        c,
+        float(params.mu),
+        float(params.tol),
+        float(params.dl),
+        int(params.max_steps),
+        int(params.stall_window),
+        float(params.stall_distance_value),
+        int(params.max_halvings),
+        float(params.kappa_cap),
+        _GOLDEN_ITERATIONS,
+        _BISECTIONS,
+        _PROBE,
+    )
+    last = offsets[1:] - 1
+    folds = Fold(start=fstart, **{k: fold[:, j].copy() for j, k in enumerate(_FOLD_COLUMNS)})
+    cols = {k: pts[:, j].copy() for j, k in enumerate(("x", "y", "z", "kappa", "carriage", "force"))}
+    return CompliantResult(
+        params=params,
+        stiffness=c,
+        start_x=xs,
+        start_y=ys,
+        outcome=outcome,
+        end_x=cols["x"][last],
+        end_y=cols["y"][last],
+        n_steps=np.diff(offsets) - 1,
+        max_kappa=max_k,
+        offsets=offsets,
+        folds=folds,
+        state=states,
+        **cols,
+    )
 
 
 class _Record:
@@ -346,10 +435,13 @@ class _Record:
         return offsets, cols
 
     def fold_table(self):
+        """The jumps in start order, then along the path (as the compiled loop gives them)."""
         f = self.folds
+        start = np.asarray(f["start"], np.int64)
+        order = np.argsort(start, kind="stable")
         return Fold(
-            start=np.asarray(f["start"], np.int64),
-            **{k: np.asarray(f[k], float) for k in Fold.__dataclass_fields__ if k != "start"},
+            start=start[order],
+            **{k: np.asarray(f[k], float)[order] for k in Fold.__dataclass_fields__ if k != "start"},
         )
 
 
