@@ -164,7 +164,7 @@ def compliant_spine_curves(
     result, carriage: np.ndarray, *, kappa_cap: float
 ) -> tuple[np.ndarray, np.ndarray]:
     """Each spine's quasistatic force over preload at carriage displacements ``carriage``
-    from a :class:`~spine_mj.theory.compliant.CompliantResult` (one path per spine, spring relaxed
+    from a :class:`~spine_mj.theory.compliant_types.CompliantResult` (one path per spine, spring relaxed
     at the start).
 
     The spring stretches with the tip stuck until the first path point (``F = c X``),

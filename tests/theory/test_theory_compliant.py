@@ -17,7 +17,8 @@ from spine_mj.surfaces import (
     single_gaussian,
 )
 from spine_mj.theory.agreement import path_frechet
-from spine_mj.theory.compliant import MotionState, compliant_streamlines, hold_force
+from spine_mj.theory.compliant import compliant_streamlines, hold_force
+from spine_mj.theory.compliant_types import MotionState
 from spine_mj.theory.engagement import kappa
 from spine_mj.theory.streamline import Outcome, StreamlineParams, streamlines
 
