@@ -1,0 +1,284 @@
+"""Where a tip comes to rest after a fall: a rigid particle sliding under its load, a drive
+force and Coulomb friction on a surface ``z = f(x, y)``, until it sticks.
+
+The quasistatic streamline (paper Eq. 4) knows where a tip goes while every point is in
+balance; down a flank steeper than the friction angle (the slip region) nothing balances
+the load, the tip gains speed, and where it lands depends on its inertia: a streamline that
+steps down the slope direction and stops at the first point that holds is not the motion
+a tip with mass makes. This reference is that motion, in the same frame as the streamline
+(load ``W`` along -z, drive along +x, one friction coefficient as in MuJoCo), so that a
+comparison with MuJoCo after a fall is like for like (docs/physics.md §6, inertia).
+
+In contact the particle keeps to the surface; with ``n = (-f_x, -f_y, 1) / g``,
+``g = sqrt(1 + |grad f|^2)``, applied force ``A = (F, 0, -W)`` and ``H`` the Hessian, the
+constraint gives the normal force (the profile formula of
+:mod:`~spine_mj.theory.tomlinson_dynamics` in two dimensions)::
+
+    N = (W + f_x F + m v^T H v) / g        (v the horizontal velocity)
+
+and friction ``mu N`` opposes the sliding velocity. Each step (semi-implicit Euler) adds
+the tangential part of ``A`` to the 3-D velocity in the tangent plane, then takes away a
+friction impulse ``mu N dt`` along that velocity, clamped at rest: a particle at rest stays
+exactly while ``|A_t| <= mu N`` (the stick condition of paper Eq. 1-3), and one that slides
+stops where the friction impulse exceeds its momentum. Where ``N < 0``, or the surface a
+step ahead lies below a free fall's path (a ledge), it leaves the surface and flies
+(gravity and drive only) until it meets the surface again, where the
+landing removes the normal velocity (an inelastic, critically damped contact, as the rig's
+``solref = (2 dt, 1)``) and friction removes up to ``mu`` times that normal impulse from the
+tangential velocity.
+
+Closed forms (tested): on an incline of angle ``theta`` a particle at rest stays iff
+``tan(theta) <= mu``; otherwise it accelerates down at ``a (sin(theta) - mu cos(theta))``
+(``a = W / m``); one launched down at speed ``v`` with ``tan(theta) < mu`` stops after
+``v^2 / (2 a (mu cos(theta) - sin(theta)))``. The error is first order in the step.
+
+Pure numpy, vectorized over particles; the surface is anything with
+``evaluate(x, y, order=2) -> (f, f_x, f_y, f_xx, f_xy, f_yy)`` (every
+:class:`~spine_mj.surfaces.Surface`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from enum import IntEnum
+
+import numpy as np
+
+from spine_mj.errors import SpineInputError, check_positive
+
+__all__ = ["SlideOutcome", "SlideParams", "SlideResult", "slide_until_stuck"]
+
+
+class SlideOutcome(IntEnum):
+    """How a slide ended."""
+
+    STUCK = 0  # at rest where friction holds it
+    LEFT_DOMAIN = 1  # outside the surface's bounds
+    TIMED_OUT = 2  # still moving after ``max_time_s``
+
+
+@dataclass(frozen=True)
+class SlideParams:
+    """The particle, its drive and the integration.
+
+    Attributes
+    ----------
+    mu : float
+        Coulomb coefficient (static = kinetic, as MuJoCo's), >= 0.
+    load_n : float
+        The load ``W`` pressing along -z [N] (the preload F_p), > 0.
+    mass_kg : float
+        The particle's mass [kg], > 0.
+    drive_force_n : float
+        A constant drive force along +x [N] (0: gravity alone, a fall).
+    timestep_s : float
+        Integration step [s], > 0.
+    max_time_s : float
+        Longest slide [s]; a particle still moving then ends ``TIMED_OUT``.
+    """
+
+    mu: float
+    load_n: float
+    mass_kg: float
+    timestep_s: float
+    max_time_s: float
+    drive_force_n: float = 0.0
+
+    def __post_init__(self):
+        check_positive("mu", self.mu, allow_zero=True)
+        for name in ("load_n", "mass_kg", "timestep_s", "max_time_s"):
+            check_positive(name, getattr(self, name))
+        if not math.isfinite(self.drive_force_n):
+            raise SpineInputError(f"drive_force_n must be a finite force [N], got {self.drive_force_n!r}")
+        if self.max_time_s / self.timestep_s > 1e8:
+            raise SpineInputError(
+                "max_time_s / timestep_s must be at most 1e8 steps, "
+                f"got {self.max_time_s / self.timestep_s:.3g}"
+            )
+
+
+@dataclass(frozen=True)
+class SlideResult:
+    """Where each particle came to rest, ``(k,)`` arrays in the surface's units.
+
+    Attributes
+    ----------
+    x, y, z : ndarray
+        End position.
+    time_s : ndarray
+        Time of the ending [s].
+    path_length : ndarray
+        Length of the 3-D path travelled (flights included).
+    outcome : ndarray of int8
+        :class:`SlideOutcome` values.
+    max_speed_m_s : ndarray
+        Largest speed reached.
+    airborne_steps : ndarray of int64
+        Steps spent off the surface.
+    """
+
+    x: np.ndarray
+    y: np.ndarray
+    z: np.ndarray
+    time_s: np.ndarray
+    path_length: np.ndarray
+    outcome: np.ndarray
+    max_speed_m_s: np.ndarray
+    airborne_steps: np.ndarray
+
+
+def slide_until_stuck(
+    surface, starts, params: SlideParams, *, velocity_m_s=None, length_scale_m: float = 1.0
+) -> SlideResult:
+    """Slide particles from ``starts`` ``(k, 2)`` (surface units, on the surface) until each
+    sticks, leaves the surface's bounds or times out.
+
+    Parameters
+    ----------
+    surface : Surface
+        Anything with ``evaluate(x, y, order=2)`` and ``bounds`` (in its own units).
+    starts : array_like, shape (k, 2)
+        Start points (x, y).
+    params : SlideParams
+    velocity_m_s : array_like, shape (k, 2), optional
+        Initial horizontal velocity [m/s] (none: at rest); the vertical follows the surface.
+    length_scale_m : float
+        Metres per surface unit (forces and masses are SI, lengths are scaled once here).
+
+    Returns
+    -------
+    SlideResult
+    """
+    p = params
+    s = check_positive("length_scale_m", length_scale_m)
+    starts, v0 = _checked(starts, velocity_m_s)
+    k = len(starts)
+    dt = p.timestep_s
+    force = np.array([p.drive_force_n, 0.0, -p.load_n])  # the applied force A [N]
+
+    def ev(q, order=2):
+        return _surface_at(surface, q, s, order)
+
+    q = starts * s  # horizontal position [m]
+    here = ev(q)  # the surface under each particle, carried from step to step
+    z, fx0, fy0 = here[:3]
+    vel = np.column_stack([v0, fx0 * v0[:, 0] + fy0 * v0[:, 1]])  # 3-D velocity [m/s]
+    active = np.ones(k, bool)
+    airborne = np.zeros(k, bool)
+    outcome = np.full(k, SlideOutcome.TIMED_OUT, np.int8)
+    t_end = np.full(k, p.max_time_s)
+    length = np.zeros(k)
+    vmax = np.linalg.norm(vel, axis=1)
+    n_air = np.zeros(k, np.int64)
+    n_steps = int(math.ceil(p.max_time_s / dt))
+    for step in range(1, n_steps + 1):
+        idx = np.flatnonzero(active)
+        if not idx.size:
+            break
+        qa, va, za, air = q[idx], vel[idx], z[idx], airborne[idx]
+        new_q, new_z, new_v, flying, f_new = _advance(ev, qa, va, za, air, [c[idx] for c in here], force, p)
+        for c, c_new in zip(here, f_new):
+            c[idx] = c_new
+        landed = flying & (new_z <= f_new[0])  # a flight that meets the surface lands
+        new_z = np.where(~flying | landed, f_new[0], new_z)  # contact keeps to the surface
+        on_after = ~flying | landed
+        new_v[on_after] = _landed_velocity(
+            new_v[on_after], f_new[1][on_after], f_new[2][on_after], landed[on_after], p.mu
+        )
+        length[idx] += np.sqrt(np.sum((new_q - qa) ** 2, axis=1) + (new_z - za) ** 2)
+        q[idx], vel[idx], z[idx] = new_q, new_v, new_z
+        airborne[idx] = flying & ~landed
+        n_air[idx] += flying & ~landed
+        sp = np.linalg.norm(new_v, axis=1)
+        vmax[idx] = np.maximum(vmax[idx], sp)
+        t = step * dt
+        out = ~surface.contains(new_q[:, 0] / s, new_q[:, 1] / s)
+        stuck = ~out & on_after & (sp == 0)
+        for mask, kind in ((out, SlideOutcome.LEFT_DOMAIN), (stuck, SlideOutcome.STUCK)):
+            hit = idx[mask & active[idx]]
+            outcome[hit], t_end[hit], active[hit] = kind, t, False
+    return SlideResult(
+        x=q[:, 0] / s,
+        y=q[:, 1] / s,
+        z=z / s,
+        time_s=t_end,
+        path_length=length / s,
+        outcome=outcome,
+        max_speed_m_s=vmax,
+        airborne_steps=n_air,
+    )
+
+
+def _surface_at(surface, q: np.ndarray, s: float, order: int):
+    """Height [m] (order 0), or height, slopes and curvatures [1/m] (order 2) at ``q`` [m]."""
+    if order == 0:
+        return surface.evaluate(q[:, 0] / s, q[:, 1] / s, order=0)[0] * s
+    f, fx, fy, fxx, fxy, fyy = surface.evaluate(q[:, 0] / s, q[:, 1] / s, order=2)
+    return [np.array(c) for c in (f * s, fx, fy, fxx / s, fxy / s, fyy / s)]
+
+
+def _contact_velocity(v, n, normal, force, p: SlideParams) -> np.ndarray:
+    """One step's velocity in contact: the applied force's tangential part added, then the
+    friction impulse ``mu N dt`` taken away along the velocity, clamped at rest."""
+    u = v + p.timestep_s * force / p.mass_kg
+    u -= np.sum(u * n, axis=1)[:, None] * n  # in the tangent plane
+    speed = np.linalg.norm(u, axis=1)
+    cut = p.mu * normal * p.timestep_s / p.mass_kg
+    keep = np.where(speed > cut, 1 - cut / np.where(speed > 0, speed, 1.0), 0.0)
+    return u * keep[:, None]
+
+
+def _landed_velocity(v, fx, fy, landed, mu: float) -> np.ndarray:
+    """Velocities on the surface of slopes ``fx, fy``: in its tangent plane; where the
+    particle ``landed`` the normal velocity is lost and friction takes up to ``mu`` times
+    that impulse off the tangential one."""
+    n = np.column_stack([-fx, -fy, np.ones_like(fx)])
+    n /= np.linalg.norm(n, axis=1)[:, None]
+    vn = np.sum(v * n, axis=1)
+    ut = v - vn[:, None] * n
+    sp = np.linalg.norm(ut, axis=1)
+    cut = np.where(landed, mu * np.maximum(-vn, 0.0), 0.0)
+    keep = np.where(sp > cut, 1 - cut / np.where(sp > 0, sp, 1.0), 0.0)
+    return ut * keep[:, None]
+
+
+def _advance(ev, qa, va, za, air, here, force, p: SlideParams):
+    """One step of particles at ``qa, za`` with velocity ``va`` (``air``: flying) on the
+    surface ``here`` under them: new position, height and velocity, who flies, and the
+    surface (:func:`_surface_at`) at the new position."""
+    dt, m = p.timestep_s, p.mass_kg
+    _, fx, fy, fxx, fxy, fyy = here
+    g = np.sqrt(1 + fx * fx + fy * fy)
+    n = np.column_stack([-fx, -fy, np.ones_like(fx)]) / g[:, None]
+    vx, vy = va[:, 0], va[:, 1]
+    curv = fxx * vx * vx + 2 * fxy * vx * vy + fyy * vy * vy
+    normal = (p.load_n + fx * p.drive_force_n + m * curv) / g
+    # where the surface drops away faster than a free fall from here, the tip leaves it
+    # (the discrete N < 0: a step past a ledge narrower than the step)
+    free_v = va + dt * force / m
+    free_q = qa + dt * free_v[:, :2]
+    free_z = za + dt * free_v[:, 2]
+    leaves = ~air & ((normal < 0) | (ev(free_q, order=0) < free_z))
+    new_v = va.copy()
+    new_q, new_z = qa.copy(), za.copy()
+    flying = air | leaves
+    # flight: gravity and drive only
+    new_v[flying], new_q[flying], new_z[flying] = free_v[flying], free_q[flying], free_z[flying]
+    # contact: tangential force, then the friction impulse clamped at rest
+    on = ~flying
+    new_v[on] = _contact_velocity(va[on], n[on], normal[on], force, p)
+    new_q[on] += dt * new_v[on, :2]
+    return new_q, new_z, new_v, flying, ev(new_q)
+
+
+def _checked(starts, velocity_m_s) -> tuple[np.ndarray, np.ndarray]:
+    """``starts`` ``(k, 2)`` and the initial velocities ``(k, 2)`` (zero when none), finite."""
+    starts = np.asarray(starts, dtype=float)
+    if starts.ndim != 2 or starts.shape[1] != 2 or not np.isfinite(starts).all():
+        raise SpineInputError(f"starts must be finite (x, y) pairs of shape (k, 2), got shape {starts.shape}")
+    k = len(starts)
+    v0 = np.zeros((k, 2)) if velocity_m_s is None else np.asarray(velocity_m_s, dtype=float)
+    if v0.shape != (k, 2) or not np.isfinite(v0).all():
+        raise SpineInputError(f"velocity_m_s must be finite, of shape ({k}, 2), got shape {v0.shape}")
+    return starts, v0
