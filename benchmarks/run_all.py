@@ -20,6 +20,8 @@ Sections (each records the machine's load average before and after it):
 * ``sweep``: the one-worker sweep against bare rollout, and its two-worker efficiency.
 * ``cost``: steps per spring-drive run against I_e and the spring stiffness K on the single
   peak and on a fractal, with a fitted cost model (see :func:`fit_cost`).
+* ``compliant``: the compliant-drive reference's compiled loop against its numpy loop, and
+  the P600 sandpaper ``compare`` analysis it made slow (``benchmarks/bench_compliant.py``).
 * ``array``: an array of N spines against N single-spine runs of the same length
   (``benchmarks/bench_array.py``): the median wall-time ratio, target at most about 1.
 * ``cli``: wall time of ``spine-mj --help``, of every command's help and of the commands
@@ -56,6 +58,7 @@ sys.path.insert(0, str(HERE))  # the bench modules beside this file
 
 import bench_array  # noqa: E402
 import bench_cli  # noqa: E402
+import bench_compliant  # noqa: E402
 import bench_cost  # noqa: E402
 import bench_engines  # noqa: E402
 import bench_fastforward  # noqa: E402
@@ -78,6 +81,7 @@ SECTIONS = {
     "rollout": bench_rollout,
     "sweep": bench_sweep,
     "cost": bench_cost,
+    "compliant": bench_compliant,
     "fastforward": bench_fastforward,
     "array": bench_array,
     "cli": bench_cli,
@@ -92,6 +96,7 @@ REPORT_ORDER = (
     "rollout",
     "sweep",
     "cost",
+    "compliant",
     "array",
     "engines",
     "fastforward",
