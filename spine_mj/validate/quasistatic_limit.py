@@ -460,14 +460,71 @@ def _intervals(comp, summ: dict) -> dict:
     }
 
 
+#: The physical cause of each miss (:func:`miss_cause`), and what each means.
+MISS_CAUSES = {
+    "ill_conditioned": "the reference's outcome flips within one hfield spacing of its path "
+    "(miss reason separatrix): the start lies on a separatrix, no physics is missing",
+    "fall": "the paths parted where the tip fell: the reference slides under gravity alone "
+    "(a flank steeper than friction) or the tip's peak speed was a fall's (its inertia "
+    f"number above {100:g} times the drive's), where the quasistatic step does not say where "
+    "a tip with mass lands",
+    "inertia": "the paths parted by more than a facet without a fall (a jump of the spring)",
+    "wedge": "MuJoCo held at the force cap without a single contact normal in the self-lock "
+    "region: the tip wedged on several contacts where the reference moves on",
+    "soft_contact": "MuJoCo held on a single contact normal where the reference moves on, or "
+    "passed where the reference holds: the soft contact's tilted normals and creep",
+}
+
+#: A peak speed this many times the drive's in inertia number (10 times in speed) is a
+#: fall's or a jump's: a stable slide moves at most a few drive speeds (docs/physics.md §6).
+FALL_IE_FACTOR = 100.0
+
+
+def miss_cause(row) -> str:
+    """The physical cause (a key of :data:`MISS_CAUSES`) of one disagreeing run, from its
+    compare row: its ``miss_reason``, ``end_detail``, ``reference_slide_fraction``,
+    ``tip_peak_ie`` and ``inertia_number``."""
+    reason = row.get("miss_reason", "")
+    if reason == "separatrix":
+        return "ill_conditioned"
+    if reason == "engine_held":
+        return "wedge" if str(row.get("end_detail", "")).startswith("force cap") else "soft_contact"
+    if reason == "engine_passed":
+        return "soft_contact"
+    slid = float(row.get("reference_slide_fraction", 0.0) or 0.0) > 0
+    peak, drive = float(row.get("tip_peak_ie", np.nan)), float(row.get("inertia_number", np.nan))
+    fast = np.isfinite(peak) and np.isfinite(drive) and peak > FALL_IE_FACTOR * drive
+    return "fall" if slid or fast else "inertia"
+
+
 def _misses(comp) -> dict[str, dict]:
-    """Disagreeing runs by miss reason: count and offsets over L_c (separatrix, diverged)."""
+    """Disagreeing runs by miss reason: count and offsets over L_c (separatrix, diverged),
+    the runs by physical cause (:func:`miss_cause`) and each miss (``case_id``, ``start``,
+    ``cause``, ``offset``)."""
     out = {}
+    missed = comp[comp["miss_reason"].astype(str) != ""] if "miss_reason" in comp else comp.iloc[:0]
     for reason in MISS_REASONS:
-        rows = comp[comp["miss_reason"] == reason] if "miss_reason" in comp else comp.iloc[:0]
+        rows = missed[missed["miss_reason"] == reason]
         if len(rows):
-            offsets = [float(v) for v in rows["miss_offset"] if np.isfinite(v)]
-            out[reason] = {"runs": int(len(rows)), "offsets": sorted(offsets)}
+            each = [
+                {
+                    "case_id": str(r.get("case_id", "")),
+                    "start": int(r.get("start", -1)),
+                    "cause": miss_cause(r),
+                    "offset": _plain(r.get("miss_offset", np.nan)),
+                }
+                for _, r in rows.iterrows()
+            ]
+            out[reason] = {
+                "runs": int(len(rows)),
+                "offsets": sorted(float(v) for v in rows["miss_offset"] if np.isfinite(v)),
+                "causes": {
+                    c: sum(m["cause"] == c for m in each)
+                    for c in MISS_CAUSES
+                    if any(m["cause"] == c for m in each)
+                },
+                "misses": each,
+            }
     return out
 
 

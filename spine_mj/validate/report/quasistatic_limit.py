@@ -24,7 +24,7 @@ from spine_mj.theory.agreement import MISS_REASONS
 from spine_mj.validate.boundary import BoundaryResult
 from spine_mj.validate.convergence import HEADLINES, REFINEMENT_LABELS, unconverged_mark
 from spine_mj.validate.platform import platform_info
-from spine_mj.validate.quasistatic_limit import QuasistaticLimitResult
+from spine_mj.validate.quasistatic_limit import MISS_CAUSES, QuasistaticLimitResult
 from spine_mj.validate.report.boundary import star_to_draw
 from spine_mj.validate.report.common import ReportContext, assemble, cell, image, refinement_verdict, table
 from spine_mj.validate.report.verdicts import platform_line, verdicts_section
@@ -102,12 +102,18 @@ def _misses_note(limit: QuasistaticLimitResult) -> list[str]:
         parts = []
         for reason, m in v.get("misses", {}).items():
             offs = ", ".join(f"{o:.3g}" for o in m["offsets"])
-            parts.append(f"{reason} {m['runs']}" + (f" (offsets {offs} L_c)" if offs else ""))
+            causes = ", ".join(f"{c} {n}" for c, n in m.get("causes", {}).items())
+            parts.append(
+                f"{reason} {m['runs']}"
+                + (f" (offsets {offs} L_c)" if offs else "")
+                + (f" [causes: {causes}]" if causes else "")
+            )
         if parts:
             lines.append(f"* {fam}: " + "; ".join(parts))
     if not lines:
         return []
     meaning = "; ".join(f"*{k}*: {v}" for k, v in MISS_REASONS.items())
+    meaning += ". Causes: " + "; ".join(f"*{k}*: {v}" for k, v in MISS_CAUSES.items())
     return [
         "Why the runs the engine finished disagree (the reference restarted from "
         f"{MISS_CHECKPOINTS} points along each MuJoCo path, `agreement.miss_reason`): {meaning}.",
