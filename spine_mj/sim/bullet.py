@@ -26,8 +26,11 @@ tolerance, divergence; Bullet has no warnings of its own.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import math
+import os
+import sys
 from collections.abc import Callable, Sequence
 
 import numpy as np
@@ -286,12 +289,40 @@ class BulletRig:
         return n_settle + int(math.ceil(ramp_duration_s(drive, det, sc) / dt)), ctl
 
 
+def _pybullet():
+    """pybullet, imported without the "pybullet build time: ..." line its C code prints at
+    import (every Bullet run printed it): standard output and error point at /dev/null for
+    the import, C's buffers flushed before they are given back."""
+    if "pybullet" in sys.modules:
+        return sys.modules["pybullet"]
+    import ctypes
+
+    for stream in (sys.stdout, sys.stderr):
+        with contextlib.suppress(AttributeError, OSError, ValueError):
+            stream.flush()
+    saved = {}
+    try:
+        with open(os.devnull, "w") as null:
+            for fd in (1, 2):
+                with contextlib.suppress(OSError):
+                    saved[fd] = os.dup(fd)
+                    os.dup2(null.fileno(), fd)
+            import pybullet
+
+            with contextlib.suppress(OSError, AttributeError):
+                ctypes.CDLL(None).fflush(None)
+    finally:
+        for fd, copy in saved.items():
+            os.dup2(copy, fd)
+            os.close(copy)
+    return pybullet
+
+
 class _World:
     """One pybullet client in engine units: the heightfield, and the tip of the current run."""
 
     def __init__(self, rig: BulletRig):
-        import pybullet as pb
-
+        pb = _pybullet()
         self.pb, self.rig = pb, rig
         e, u, tip = rig.engine, rig.units, rig.tip
         self.cid = pb.connect(pb.DIRECT)

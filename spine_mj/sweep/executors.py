@@ -152,7 +152,12 @@ def run_dask(
 def _quiet_distributed():
     """Hold back Dask's own log lines while a sweep runs on its scheduler: a lost scheduler
     is one line of ours (:class:`SchedulerUnavailable`), not ``distributed.client - ERROR -
-    Failed to reconnect`` before it; what a case raises reaches us through its future."""
+    Failed to reconnect`` before it; what a case raises reaches us through its future.
+
+    After a lost scheduler the loggers stay quiet: the client's reconnect task is
+    cancelled on its own event loop after the client is closed, and would log its
+    30-line traceback just as the levels came back (3 of 3 tries, scheduler killed 10 s
+    in)."""
     names = [
         "distributed",
         *(n for n in list(logging.root.manager.loggerDict) if n.startswith("distributed.")),
@@ -163,9 +168,17 @@ def _quiet_distributed():
         lg.setLevel(logging.CRITICAL + 1)
     try:
         yield
-    finally:
-        for lg, level in zip(loggers, levels, strict=True):
-            lg.setLevel(level)
+    except SchedulerUnavailable:
+        raise
+    except BaseException:
+        _restore(loggers, levels)
+        raise
+    _restore(loggers, levels)
+
+
+def _restore(loggers, levels) -> None:
+    for lg, level in zip(loggers, levels, strict=True):
+        lg.setLevel(level)
 
 
 def _run_dask(todo, scheduler, handle, *, worker_wait_s, notice) -> None:

@@ -29,7 +29,7 @@ from spine_mj.sweep.registry import ANALYSES
 __all__ = ["check_cases", "checked_keys"]
 
 #: Seconds between two progress reports of a long check.
-_PROGRESS_EVERY_S = 1.0
+_PROGRESS_EVERY_S = 10.0
 
 
 def checked_keys(analysis: str) -> tuple[str, ...]:
@@ -53,7 +53,7 @@ def check_cases(
     analysis would meet in any case of ``cases``.
 
     ``swept`` names the parameters with more than one value (shown in the message).
-    ``progress``, if given, is called as ``progress(checked, total)`` about once a second
+    ``progress``, if given, is called as ``progress(checked, total)`` every ten seconds
     while the check runs.
     """
     keys = {name: checked_keys(name) for name in ANALYSES}

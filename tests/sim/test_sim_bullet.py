@@ -404,3 +404,11 @@ def test_a_sweep_over_both_engines_on_a_dask_cluster_stores_what_one_process_sto
     ref = metrics_frame(tmp_path / "w1")
     assert sorted(ref["engine"]) == ["bullet", "bullet", "mujoco", "mujoco"] and (ref["status"] == "ok").all()
     pd.testing.assert_frame_equal(metrics_frame(tmp_path / "dask"), ref)
+
+
+def test_pybullet_s_build_banner_does_not_reach_the_user(tmp_path):
+    """pybullet's C code prints "pybullet build time: ..." at import; a Bullet run's output
+    is ours alone."""
+    code = "from spine_mj.sim.bullet import _pybullet; _pybullet(); print('ours')"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout == "ours\n" and "build time" not in out.stderr

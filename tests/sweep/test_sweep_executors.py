@@ -3,6 +3,7 @@
 import json
 
 import pandas as pd
+import pytest
 from sweep_support import metrics_frame, write_config
 
 from spine_mj import sweep
@@ -108,3 +109,23 @@ def test_dask_log_lines_are_held_back_while_a_sweep_runs_on_a_scheduler():
     finally:
         client_log.removeHandler(keep)
         logging.getLogger("distributed").removeHandler(keep)
+
+
+def test_after_a_lost_scheduler_dask_stays_quiet():
+    """The client's reconnect task is cancelled on its own loop after the client closes and
+    logs a 30-line traceback: after SchedulerUnavailable the levels are not restored, so it
+    cannot reach the user before the sweep's one Error line."""
+    import logging
+
+    from spine_mj.sweep.executors import SchedulerUnavailable, _quiet_distributed
+
+    client_log = logging.getLogger("distributed.client")
+    level = client_log.level
+    try:
+        with pytest.raises(SchedulerUnavailable), _quiet_distributed():
+            raise SchedulerUnavailable("lost")
+        assert not client_log.isEnabledFor(logging.ERROR)
+        with pytest.raises(KeyError), _quiet_distributed():
+            raise KeyError("another error restores them")
+    finally:
+        client_log.setLevel(level)

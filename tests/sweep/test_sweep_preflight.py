@@ -161,3 +161,25 @@ def test_every_combination_is_checked_without_building_a_rig_or_repeating_a_chec
     cases = sweep.expand_cases(sweep.load_config(write_config(tmp_path, qs)))
     preflight.check_cases(cases)
     assert len(cases) == 2000 and sorted(steps) == [0.01, 0.02]
+
+
+def test_a_large_sweep_says_what_it_prepares_before_its_first_case(tmp_path, monkeypatch):
+    """Listing, checking and recording 999,999 cases takes a minute or more: a sweep of at
+    least PREPARE_NOTICE_CASES says each step (the threshold lowered here to 4 cases)."""
+    from sweep_support import peak_config
+
+    from spine_mj.sweep import session
+
+    monkeypatch.setattr(session, "PREPARE_NOTICE_CASES", 4)
+    said = []
+    sweep.run_sweep(peak_config(tmp_path, nmu=4, ny=1), tmp_path / "out", workers=1, notice=said.append)
+    assert said[:3] == [
+        "preparing 4 cases: listing them",
+        "preparing 4 cases: checking every one before the first runs",
+        "preparing 4 cases: writing the store's manifest",
+    ]
+    said.clear()
+    sweep.run_sweep(
+        peak_config(tmp_path, nmu=3, ny=1, name="small"), tmp_path / "small", workers=1, notice=said.append
+    )
+    assert not any("preparing" in s for s in said)
