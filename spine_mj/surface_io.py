@@ -421,8 +421,24 @@ def surface_mesh(
     return mesh
 
 
-def write_stl(surface: Surface, path: str | os.PathLike, **mesh_options) -> Path:
-    """Write :func:`surface_mesh` as binary STL, atomically; refuse a non-watertight mesh.
+#: Rows of the grid whose triangles are made and written at once (memory O(rows x nx)).
+_STL_ROWS = 64
+_STL_RECORD = np.dtype([("normal", "<f4", (3,)), ("vertices", "<f4", (3, 3)), ("attribute", "<u2")])
+
+
+def write_stl(
+    surface: Surface,
+    path: str | os.PathLike,
+    *,
+    resolution: int = 201,
+    base_thickness: float | None = None,
+    scale: float = 1.0,
+) -> Path:
+    """Write the solid of :func:`surface_mesh` as binary STL, atomically, streamed: the
+    triangles are made and written a few rows of the grid at a time, so memory stays that
+    of the heights (a 2048 x 2048 fractal took 9.2 GB through a whole mesh, 839 MB on disk).
+    The same vertices and faces as :func:`surface_mesh`, in the same winding (outward
+    normals): watertight by construction (tested against it).
 
     Parameters
     ----------
@@ -430,8 +446,8 @@ def write_stl(surface: Surface, path: str | os.PathLike, **mesh_options) -> Path
         The surface to print: a solid under its heights (mm for physical surfaces).
     path : str or os.PathLike
         The output ``.stl`` file.
-    **mesh_options
-        Passed on to :func:`surface_mesh`: ``resolution``, ``base_thickness``, ``scale``.
+    resolution, base_thickness, scale
+        As for :func:`surface_mesh`.
 
     Returns
     -------
@@ -441,16 +457,62 @@ def write_stl(surface: Surface, path: str | os.PathLike, **mesh_options) -> Path
     path = Path(path)
     if path.suffix.lower() != ".stl":
         raise SpineInputError(f"STL output must end in .stl, got {path.name!r}")
-    mesh = surface_mesh(surface, **mesh_options)
-    if not np.isfinite(np.asarray(mesh.vertices, dtype=np.float32)).all():  # STL stores float32
+    grid = surface if isinstance(surface, GridSurface) else surface.sample(resolution)
+    h = grid.heights
+    ny, nx = h.shape
+    span = max(grid.x[-1] - grid.x[0], grid.y[-1] - grid.y[0])
+    base_thickness = (
+        0.05 * span if base_thickness is None else check_positive("base_thickness", base_thickness)
+    )
+    scale = check_positive("scale", scale)
+    z_bottom = float(h.min() - base_thickness)
+    n_faces = 4 * (ny - 1) * (nx - 1) + 4 * (nx - 1 + ny - 1)
+    with atomic_output(path) as tmp, open(tmp, "wb") as fh:
+        fh.write(b"spine_mj surface solid".ljust(80, b" ") + np.uint32(n_faces).tobytes())
+        for i0 in range(0, ny - 1, _STL_ROWS):
+            rows = slice(i0, min(i0 + _STL_ROWS, ny - 1) + 1)
+            xx, yy = np.meshgrid(grid.x, grid.y[rows])
+            top = np.stack([xx, yy, h[rows]], axis=-1)
+            a, b, c, d = top[:-1, :-1], top[:-1, 1:], top[1:, :-1], top[1:, 1:]
+            tris = np.concatenate([np.stack([a, b, d], -2), np.stack([a, d, c], -2)]).reshape(-1, 3, 3)
+            _write_triangles(fh, tris, scale)
+            bottom = tris[:, ::-1].copy()
+            bottom[..., 2] = z_bottom
+            _write_triangles(fh, bottom, scale)
+        ring = np.concatenate(
+            [
+                np.column_stack([grid.x, np.full(nx, grid.y[0]), h[0]]),
+                np.column_stack([np.full(ny - 1, grid.x[-1]), grid.y[1:], h[1:, -1]]),
+                np.column_stack([grid.x[-2::-1], np.full(nx - 1, grid.y[-1]), h[-1, -2::-1]]),
+                np.column_stack([np.full(ny - 2, grid.x[0]), grid.y[-2:0:-1], h[-2:0:-1, 0]]),
+            ]
+        )
+        nxt = np.roll(ring, -1, axis=0)
+        low, nxt_low = ring.copy(), nxt.copy()
+        low[:, 2] = nxt_low[:, 2] = z_bottom
+        _write_triangles(
+            fh,
+            np.concatenate([np.stack([ring, low, nxt_low], -2), np.stack([ring, nxt_low, nxt], -2)]),
+            scale,
+        )
+    return path
+
+
+def _write_triangles(fh, tris: np.ndarray, scale: float) -> None:
+    """Triangles ``(n, 3, 3)`` as binary STL records (float32, unit normals by their
+    winding), refusing coordinates the STL's 32-bit floats cannot hold."""
+    v = tris * scale
+    v32 = v.astype(np.float32)
+    if not np.isfinite(v32).all():
         raise SpineInputError(
             "the mesh's coordinates overflow the STL's 32-bit floats: use a smaller --stl-scale or --base"
         )
-    if not mesh.is_watertight:
-        raise SpineInputError("internal mesh is not watertight; refusing to write an STL")
-    with atomic_output(path) as tmp:
-        mesh.export(tmp, file_type="stl")
-    return path
+    n = np.cross(v[:, 1] - v[:, 0], v[:, 2] - v[:, 0])
+    length = np.linalg.norm(n, axis=1, keepdims=True)
+    rec = np.zeros(len(v), _STL_RECORD)
+    rec["normal"] = np.divide(n, length, out=np.zeros_like(n), where=length > 0)
+    rec["vertices"] = v32
+    fh.write(rec.tobytes())
 
 
 def write_hfield(surface: Surface, path: str | os.PathLike, *, resolution: int | None = None) -> HField:

@@ -237,3 +237,25 @@ def test_load_refuses_a_zip_that_is_not_an_npz_of_arrays(tmp_path):
         z.writestr("hello.txt", "hello")
     with pytest.raises(SpineInputError, match=r"z\.npz is not a spine_mj \.npz surface: member 'hello\.txt'"):
         load_surface(path)
+
+
+@pytest.mark.parametrize("rows", [3, 64])
+def test_the_streamed_stl_is_the_meshs_solid(tmp_path, monkeypatch, rows):
+    """write_stl streams the triangles a few rows at a time: the file holds the faces of
+    surface_mesh (the reference, built whole by trimesh), outward, watertight, with its
+    volume, whether the rows come in several pieces or one."""
+    import trimesh
+
+    from spine_mj import surface_io
+
+    monkeypatch.setattr(surface_io, "_STL_ROWS", rows)
+    surf = fractal_fbm(nx=24, ny=17, hurst=0.8, rng=1)
+    reference = surface_mesh(surf, base_thickness=0.5, scale=2.0)
+    loaded = trimesh.load(write_stl(surf, tmp_path / "f.stl", base_thickness=0.5, scale=2.0))
+    assert loaded.is_watertight and loaded.is_volume and len(loaded.faces) == len(reference.faces)
+    assert loaded.volume == pytest.approx(reference.volume, rel=1e-5)  # float32 coordinates
+    # the same triangles, each with its vertices in the same (outward) order
+    def rows_of(tris):
+        return np.unique(np.round(np.asarray(tris).reshape(len(tris), -1), 3), axis=0)
+
+    np.testing.assert_allclose(rows_of(loaded.triangles), rows_of(reference.triangles), atol=2e-3)
