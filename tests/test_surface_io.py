@@ -254,6 +254,7 @@ def test_the_streamed_stl_is_the_meshs_solid(tmp_path, monkeypatch, rows):
     loaded = trimesh.load(write_stl(surf, tmp_path / "f.stl", base_thickness=0.5, scale=2.0))
     assert loaded.is_watertight and loaded.is_volume and len(loaded.faces) == len(reference.faces)
     assert loaded.volume == pytest.approx(reference.volume, rel=1e-5)  # float32 coordinates
+
     # the same triangles, each with its vertices in the same (outward) order
     def rows_of(tris):
         return np.unique(np.round(np.asarray(tris).reshape(len(tris), -1), 3), axis=0)
