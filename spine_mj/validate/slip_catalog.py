@@ -25,7 +25,15 @@ import numpy as np
 from spine_mj.errors import SpineInputError
 from spine_mj.theory.avalanches import Landscape, Slips, inertial_slips, overdamped_slips
 
-__all__ = ["COLUMNS", "REFERENCES", "TrackUnits", "engine_rows", "reference_rows", "track_landscape"]
+__all__ = [
+    "COLUMNS",
+    "REFERENCES",
+    "TrackUnits",
+    "engine_rows",
+    "reference_rows",
+    "store_catalog",
+    "track_landscape",
+]
 
 COLUMNS = (
     "source",
@@ -165,3 +173,60 @@ def engine_rows(result, units: TrackUnits, source: str, stiffness_number: float,
         "peak_speed_v": np.array([e.peak_speed_m_s / (units.speed * unit) for e in events]),
         "dissipated_fp_lc": np.array(dissipated),
     }
+
+
+def store_catalog(out_dir, analysis: str = "mujoco"):
+    """The catalog of every slip of every ``analysis`` run of a sweep store, rebuilt from
+    its stored trajectories by the runs' own rule (:func:`spine_mj.theory.motion.slip_events`
+    on the recorded motion states): it survives a kill and a resume as the trajectories do.
+    Exact for ``record_every = 1`` (a coarser record merges or drops rows). ``source`` is
+    the run's engine; ``peak_speed_v`` is the finite-difference x-speed over the drive's,
+    the surface's unit taken as ``length_scale`` (the default rule's metres for a
+    dimensionless surface); ``start_time_s`` counts from the run's start.
+
+    Returns a pandas DataFrame with the columns :data:`COLUMNS`."""
+    import pandas as pd
+
+    from spine_mj import sweep
+    from spine_mj.sim.scales import DEFAULT_LENGTH_SCALE_M
+    from spine_mj.theory.motion import slip_events
+
+    runs = sweep.load_runs(out_dir)
+    runs = runs[(runs["analysis"] == analysis) & (runs["status"] == "ok")]
+    frames = []
+    for case_id, case in runs.groupby("case_id", sort=False):
+        traj = sweep.load_trajectories(out_dir, case_id, analysis=analysis)
+        for _, run in case.iterrows():
+            tr = traj[traj["start"] == run["start"]].sort_values("step")
+            t, x, z = (tr[c].to_numpy(float) for c in ("time_s", "x", "z"))
+            f = tr["drive_force_n"].to_numpy(float)
+            vx = np.gradient(x, t) if t.size > 1 else np.zeros_like(x)
+            events = slip_events(tr["motion"].to_numpy(), t, x, f, vx)
+            unit = run["length_scale"] if np.isfinite(run["length_scale"]) else DEFAULT_LENGTH_SCALE_M
+            fp = run["mass"] * run["gravity"] + run["preload"]
+            lc, speed = run["char_length"], run["speed_m_s"] / unit
+            rows = {
+                "source": [run["engine"]] * len(events),
+                "surface": [run["surface"]] * len(events),
+                "mu": np.full(len(events), run["mu"]),
+                "K": np.full(len(events), run["stiffness_number"]),
+                "ie": np.full(len(events), run["inertia_number"]),
+                "start_x_lc": np.array([x[e.onset] / lc for e in events]),
+                "start_time_s": np.array([e.onset_time_s for e in events]),
+                "size_lc": np.array([e.jump_length_m / lc for e in events]),
+                "duration_s": np.array([e.duration_s for e in events]),
+                "force_drop_fp": np.array([e.force_drop_n / fp for e in events]),
+                "peak_speed_v": np.array([e.peak_speed_m_s / speed for e in events]),
+                "dissipated_fp_lc": np.array(
+                    [
+                        (
+                            np.trapezoid(f[e.onset : e.stop + 1], x[e.onset : e.stop + 1])
+                            - fp * (z[e.stop] - z[e.onset])
+                        )
+                        / (fp * lc)
+                        for e in events
+                    ]
+                ),
+            }
+            frames.append(pd.DataFrame(rows, columns=COLUMNS))
+    return pd.concat(frames, ignore_index=True) if frames else pd.DataFrame(columns=COLUMNS)
