@@ -3,9 +3,12 @@
 The count limits (:data:`spine_mj.surfaces.MAX_GRID_POINTS`, the step limits) bound how many
 things a request makes; this bounds the bytes an operation's arrays take together, so a
 command fails with one line naming the size instead of driving the machine into swap or
-the kernel's out-of-memory killer. The budget is :data:`DEFAULT_FRACTION` of the machine's
-physical memory unless the environment variable ``SPINE_MJ_MEMORY_BUDGET`` sets it (bytes,
-or a number with a suffix K, M, G or T in powers of 1024: ``SPINE_MJ_MEMORY_BUDGET=2G``).
+the kernel's out-of-memory killer. The budget is :data:`DEFAULT_FRACTION` of the memory
+available now (Linux's ``MemAvailable``: what can be had without swapping; the physical
+memory where that cannot be read) unless the environment variable ``SPINE_MJ_MEMORY_BUDGET``
+sets it (bytes, or a number with a suffix K, M, G or T in powers of 1024:
+``SPINE_MJ_MEMORY_BUDGET=2G``). Half the physical memory (12 GiB on a 24 GiB machine) was
+more than a laptop running a browser has free.
 
 Work that can be cut into pieces (the path comparisons of :mod:`spine_mj.theory.agreement`) is
 chunked by :data:`BLOCK_BYTES` instead, so it never comes near the budget.
@@ -21,8 +24,8 @@ from spine_mj.errors import SpineInputError
 
 __all__ = ["BLOCK_BYTES", "DEFAULT_FRACTION", "ENV_VAR", "check_memory", "format_bytes", "memory_budget"]
 
-#: Share of the machine's physical memory one operation may take by default.
-DEFAULT_FRACTION = 0.5
+#: Share of the machine's available memory one operation may take by default.
+DEFAULT_FRACTION = 0.8
 #: Environment variable that sets the budget.
 ENV_VAR = "SPINE_MJ_MEMORY_BUDGET"
 #: Temporaries of one block of chunked work (32 MiB): small against any budget, large
@@ -39,9 +42,22 @@ def _physical_memory() -> int:
         return 8 * 2**30
 
 
+def _available_memory() -> int:
+    """Bytes the machine can give now without swapping: ``MemAvailable`` of
+    ``/proc/meminfo``, else the physical memory."""
+    try:
+        with open("/proc/meminfo") as fh:
+            for line in fh:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    return _physical_memory()
+
+
 def memory_budget() -> int:
     """Bytes one operation may allocate: ``SPINE_MJ_MEMORY_BUDGET`` if set, else
-    :data:`DEFAULT_FRACTION` of the physical memory.
+    :data:`DEFAULT_FRACTION` of the memory available now.
 
     Raises
     ------
@@ -50,7 +66,7 @@ def memory_budget() -> int:
     """
     raw = os.environ.get(ENV_VAR, "").strip()
     if not raw:
-        return int(DEFAULT_FRACTION * _physical_memory())
+        return int(DEFAULT_FRACTION * _available_memory())
     m = re.fullmatch(r"([0-9]*\.?[0-9]+(?:[eE][+-]?[0-9]+)?)\s*([KMGT]?)i?B?", raw, flags=re.IGNORECASE)
     value = float(m.group(1)) * _UNITS[m.group(2).upper()] if m else math.nan
     if not (math.isfinite(value) and value >= 1):

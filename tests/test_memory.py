@@ -113,3 +113,17 @@ def test_a_command_over_the_budget_is_refused_before_it_allocates(monkeypatch, t
     assert result.exit_code == 2 and len(lines) == 1 and lines[0].startswith("Error: "), result.output
     assert "of memory, more than the budget of 64 KiB" in lines[0]
     assert not out.exists()
+
+
+def test_the_default_budget_is_a_share_of_the_memory_available_now(monkeypatch):
+    """Not of the physical memory: half of that (12 GiB of 24) was more than a loaded
+    laptop had free."""
+    from spine_mj import memory
+
+    monkeypatch.delenv(ENV_VAR, raising=False)
+    monkeypatch.setattr(memory, "_available_memory", lambda: 3 * 2**30)
+    assert memory_budget() == int(memory.DEFAULT_FRACTION * 3 * 2**30)
+    monkeypatch.undo()
+    monkeypatch.delenv(ENV_VAR, raising=False)
+    assert memory._available_memory() <= memory._physical_memory()
+    assert memory_budget() <= memory._physical_memory()
