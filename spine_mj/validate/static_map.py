@@ -24,7 +24,14 @@ from spine_mj.validate.sweep_configs import (
     rig_engine,
 )
 
-__all__ = ["PLANE_START", "StaticMapResult", "hold_force", "static_map"]
+__all__ = [
+    "PLANE_START",
+    "StaticMapResult",
+    "equivalent_tilt_deg",
+    "hold_force",
+    "kappa_tilt_gain",
+    "static_map",
+]
 
 #: Where the probe starts on every plane (metres).
 PLANE_START = (3.1e-4, 2.7e-4)
@@ -45,11 +52,14 @@ class StaticMapResult:
     rows : list of dict
         One per (plane, engine setting): ``engine``, ``slope_deg``, ``azimuth_deg``,
         ``region`` (``engaged`` / ``self_lock`` / ``slip``), ``kappa``, ``kappa_mj``,
-        ``ratio``, ``end_reason``, ``hold_over_w``, ``region_agrees``.
+        ``ratio``, ``kappa_gain_per_deg`` (:func:`kappa_tilt_gain`), ``equivalent_tilt_deg``
+        (:func:`equivalent_tilt_deg`: the plane's error as a tilt), ``end_reason``,
+        ``hold_over_w``, ``region_agrees``.
     per_engine : dict
         Engine label -> ``engaged_planes``, ``engaged_breakaways``, ``max_rel_error`` and
-        ``mean_rel_error`` of ``|kappa_mj / kappa - 1|`` over the engaged planes,
-        ``region_agreement``.
+        ``mean_rel_error`` of ``|kappa_mj / kappa - 1|`` over the engaged planes, the same
+        as tilts (``max_equivalent_tilt_deg``, ``mean_equivalent_tilt_deg``: the facet cause
+        quantified plane by plane), ``region_agreement``.
     mu : float
     static_kappa_max_rel_error : float
         ``max_rel_error`` of the default (first) setting; inf when an engaged plane did not
@@ -95,6 +105,34 @@ def hold_force(fx: float, fy: float, mu: float) -> tuple[float, float, int]:
         pos = [float(r.real) for r in np.atleast_1d(roots) if abs(r.imag) < 1e-12 and r.real > 0]
         low = min(pos) if pos else 0.0
     return float(k), low, int(region)
+
+
+def kappa_tilt_gain(slope_deg: float, azimuth_deg: float, mu: float, *, step_deg: float = 0.01) -> float:
+    """``d ln(kappa) / d(slope)`` [1/deg] of a plane tilted about its own azimuth: how much
+    relative error in kappa one degree of tilt makes. In the drive's section (azimuth 0)
+    ``kappa = tan(theta + phi)`` gives ``2 / sin(2 (theta + phi))`` per radian, which grows
+    without bound at the self-lock pole ``theta + phi -> 90 deg`` (and at the slip edge
+    ``theta + phi -> 0``): there a fixed small tilt of the contact normal (a facet's, the
+    soft contact's) makes a large relative error. NaN outside the engaged region."""
+    lo = hold_force(*_slopes(slope_deg - step_deg, azimuth_deg), mu)
+    hi = hold_force(*_slopes(slope_deg + step_deg, azimuth_deg), mu)
+    if lo[2] != engagement.ENGAGED or hi[2] != engagement.ENGAGED or not (lo[0] > 0 and hi[0] > 0):
+        return float("nan")
+    return (math.log(hi[0]) - math.log(lo[0])) / (2 * step_deg)
+
+
+def equivalent_tilt_deg(ratio: float, gain_per_deg: float) -> float:
+    """The tilt of the plane [deg] that would explain a breakaway ratio ``kappa_mj / kappa``
+    to first order, ``ln(ratio) / gain``: a number comparable across planes where the
+    relative error is not (it is amplified by :func:`kappa_tilt_gain` near the pole)."""
+    if not (np.isfinite(ratio) and ratio > 0 and np.isfinite(gain_per_deg) and gain_per_deg != 0):
+        return float("nan")
+    return math.log(ratio) / gain_per_deg
+
+
+def _slopes(slope_deg: float, azimuth_deg: float) -> tuple[float, float]:
+    t = math.tan(math.radians(slope_deg))
+    return t * math.cos(math.radians(azimuth_deg)), t * math.sin(math.radians(azimuth_deg))
 
 
 def static_map(plan: ValidationPlan, runner: StudyRunner, *, mu: float = 0.5) -> StaticMapResult:
@@ -171,9 +209,9 @@ def _plane_rows(plan: ValidationPlan, runner: StudyRunner, slope: float, az: flo
     """The probe on one plane under every engine setting of the plan."""
     region_names = engagement.REGION_NAMES
     engines = plan.static_engines
-    t = math.tan(math.radians(slope))
-    fx, fy = t * math.cos(math.radians(az)), t * math.sin(math.radians(az))
+    fx, fy = _slopes(slope, az)
     k, low, region = hold_force(fx, fy, mu)
+    gain = kappa_tilt_gain(slope, az, mu)
     hold = 0.5 * (low + k) if (low > 0 and np.isfinite(k)) else (1.5 * low if low > 0 else 0.0)
     keys = sorted({k_ for _, ov in engines for k_, _ in ov} - {*RELATIVE_ENGINE_KEYS, "hfield_factor"})
     rows = []
@@ -215,6 +253,7 @@ def _plane_rows(plan: ValidationPlan, runner: StudyRunner, slope: float, az: flo
         kmj = float(r.get("kappa_mj", np.nan))
         end = str(r.get("end_reason", r["status"]))
         mj_region = {"breakaway": "engaged", "self_lock": "self_lock", "slid": "slip"}.get(end, end)
+        ratio = kmj / k if (region == engagement.ENGAGED and k > 0) else float("nan")
         rows.append(
             {
                 "engine": label,
@@ -223,7 +262,11 @@ def _plane_rows(plan: ValidationPlan, runner: StudyRunner, slope: float, az: flo
                 "region": region_names[region],
                 "kappa": k,
                 "kappa_mj": kmj,
-                "ratio": kmj / k if (region == engagement.ENGAGED and k > 0) else float("nan"),
+                "ratio": ratio,
+                # the facet cause, plane by plane: the pole's amplification of a tilt and
+                # the tilt that explains this plane's error
+                "kappa_gain_per_deg": gain,
+                "equivalent_tilt_deg": equivalent_tilt_deg(ratio, gain),
                 "end_reason": end,
                 "hold_over_w": hold,
                 "region_agrees": mj_region == region_names[region],
@@ -247,7 +290,11 @@ def _engine_summary(sel: list[dict]) -> dict:
     """Breakaway errors over the engaged planes and region agreement of one setting's rows."""
     eng = [abs(r["ratio"] - 1) for r in sel if r["region"] == "engaged"]
     eng_f = [e for e in eng if np.isfinite(e)]
+    tilts = [abs(r.get("equivalent_tilt_deg", np.nan)) for r in sel if r["region"] == "engaged"]
+    tilts = [t for t in tilts if np.isfinite(t)]
     return {
+        "max_equivalent_tilt_deg": float(max(tilts)) if tilts else float("nan"),
+        "mean_equivalent_tilt_deg": float(np.mean(tilts)) if tilts else float("nan"),
         "engaged_planes": len(eng),
         "engaged_breakaways": len(eng_f),
         "max_rel_error": float(max(eng_f)) if eng_f else float("nan"),
