@@ -147,30 +147,62 @@ def _rows(
 
 def engine_rows(result, units: TrackUnits, source: str, stiffness_number: float, **labels) -> dict:
     """The slip events of an engine's run (:attr:`RunResult.slip_events`) as catalog columns."""
-    events = result.slip_events
-    n = len(events)
-    unit, lc, fp = units.length_scale_m, units.char_length, units.preload_n
-    x = result.position_m[:, 0]
-    z = result.position_m[:, 2]
-    f = result.drive_force_n
+    unit = units.length_scale_m
     t0 = float(result.time_s[result.drive_start_index]) if len(result.time_s) else 0.0
+    return event_rows(
+        result.slip_events,
+        result.position_m[:, 0] / unit,
+        result.position_m[:, 2] / unit,
+        result.drive_force_n,
+        source=source,
+        stiffness_number=stiffness_number,
+        char_length=units.char_length,
+        preload_n=units.preload_n,
+        speed=units.speed,
+        length_unit_m=unit,
+        start_time_s=t0,
+        **labels,
+    )
+
+
+def event_rows(
+    events,
+    x,
+    z,
+    force_n,
+    *,
+    source: str,
+    stiffness_number: float,
+    char_length: float,
+    preload_n: float,
+    speed: float,
+    length_unit_m: float,
+    start_time_s: float = 0.0,
+    **labels,
+) -> dict:
+    """Catalog columns of :class:`~spine_mj.theory.motion.SlipEvent` s of one run whose rows
+    have the tip's ``x`` and ``z`` (surface units) and the drive force [N]; ``speed`` is the
+    drive's in surface units per second, ``length_unit_m`` metres per unit (the events'
+    lengths and speeds are in metres)."""
+    n, lc, fp, unit = len(events), char_length, preload_n, length_unit_m
+    f = np.asarray(force_n, float)
     dissipated = []
     for e in events:
         seg = slice(e.onset, e.stop + 1)
         work = float(np.sum(0.5 * (f[seg][1:] + f[seg][:-1]) * np.diff(x[seg])))
-        dissipated.append((work - fp * (z[e.stop] - z[e.onset])) / (fp * lc * unit))
+        dissipated.append((work - fp * (z[e.stop] - z[e.onset])) / (fp * lc))
     return {
         "source": [source] * n,
         "surface": [labels.get("surface", "")] * n,
         "mu": np.full(n, labels.get("mu", math.nan)),
         "K": np.full(n, float(stiffness_number)),
         "ie": np.full(n, labels.get("ie", math.nan)),
-        "start_x_lc": np.array([x[e.onset] / unit / lc for e in events]),
-        "start_time_s": np.array([e.onset_time_s - t0 for e in events]),
+        "start_x_lc": np.array([x[e.onset] / lc for e in events]),
+        "start_time_s": np.array([e.onset_time_s - start_time_s for e in events]),
         "size_lc": np.array([e.jump_length_m / unit / lc for e in events]),
         "duration_s": np.array([e.duration_s for e in events]),
         "force_drop_fp": np.array([e.force_drop_n / fp for e in events]),
-        "peak_speed_v": np.array([e.peak_speed_m_s / (units.speed * unit) for e in events]),
+        "peak_speed_v": np.array([e.peak_speed_m_s / (speed * unit) for e in events]),
         "dissipated_fp_lc": np.array(dissipated),
     }
 
@@ -203,30 +235,21 @@ def store_catalog(out_dir, analysis: str = "mujoco"):
             vx = np.gradient(x, t) if t.size > 1 else np.zeros_like(x)
             events = slip_events(tr["motion"].to_numpy(), t, x, f, vx)
             unit = run["length_scale"] if np.isfinite(run["length_scale"]) else DEFAULT_LENGTH_SCALE_M
-            fp = run["mass"] * run["gravity"] + run["preload"]
-            lc, speed = run["char_length"], run["speed_m_s"] / unit
-            rows = {
-                "source": [run["engine"]] * len(events),
-                "surface": [run["surface"]] * len(events),
-                "mu": np.full(len(events), run["mu"]),
-                "K": np.full(len(events), run["stiffness_number"]),
-                "ie": np.full(len(events), run["inertia_number"]),
-                "start_x_lc": np.array([x[e.onset] / lc for e in events]),
-                "start_time_s": np.array([e.onset_time_s for e in events]),
-                "size_lc": np.array([e.jump_length_m / lc for e in events]),
-                "duration_s": np.array([e.duration_s for e in events]),
-                "force_drop_fp": np.array([e.force_drop_n / fp for e in events]),
-                "peak_speed_v": np.array([e.peak_speed_m_s / speed for e in events]),
-                "dissipated_fp_lc": np.array(
-                    [
-                        (
-                            np.trapezoid(f[e.onset : e.stop + 1], x[e.onset : e.stop + 1])
-                            - fp * (z[e.stop] - z[e.onset])
-                        )
-                        / (fp * lc)
-                        for e in events
-                    ]
-                ),
-            }
+            # the stored x is in surface units and the speeds derived from it too: unit 1
+            rows = event_rows(
+                events,
+                x,
+                z,
+                f,
+                source=run["engine"],
+                stiffness_number=run["stiffness_number"],
+                char_length=run["char_length"],
+                preload_n=run["mass"] * run["gravity"] + run["preload"],
+                speed=run["speed_m_s"] / unit,
+                length_unit_m=1.0,
+                surface=run["surface"],
+                mu=run["mu"],
+                ie=run["inertia_number"],
+            )
             frames.append(pd.DataFrame(rows, columns=COLUMNS))
     return pd.concat(frames, ignore_index=True) if frames else pd.DataFrame(columns=COLUMNS)
