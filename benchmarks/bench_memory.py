@@ -2,7 +2,9 @@
 
 Jobs (issue 36): ``simulate`` (one run), a sweep case (quasistatic + mujoco + compare, one
 worker), ``validate --quick`` (the full bench only: it takes minutes), the dilation of an
-801 x 801 grid by a tip 110 samples wide, and ``array``. Each runs as the command a user
+801 x 801 grid by a tip 110 samples wide, ``array``, and (issue 44) a 2048 x 2048 fractal
+made (predicted by ``fbm_bytes``: 288 MiB above the interpreter) and exported as a streamed
+STL. Each runs as the command a user
 types, in a temporary folder; its peak is the ``ru_maxrss`` that ``os.wait4`` returns for
 it: the largest resident set of the job's process or of any process it waited for (a
 sweep's workers). A job whose peak grew by more than :data:`GROWTH_LIMIT` against the
@@ -48,6 +50,12 @@ _DILATE = (
 )
 
 
+_STL = (
+    "from spine_mj.surfaces import fractal_fbm; from spine_mj.surface_io import write_stl; "
+    "write_stl(fractal_fbm(nx=2048, rng=0), 'f.stl')"
+)
+
+
 def _jobs(quick: bool) -> dict[str, list[str]]:
     cli = [sys.executable, "-m", "spine_mj.cli"]
     jobs = {
@@ -59,6 +67,12 @@ def _jobs(quick: bool) -> dict[str, list[str]]:
         "sweep case": [*cli, "sweep", "sweep.toml", "--out", "runs", "--workers", "1", "--quiet"],
         "dilate 801^2 by a 110-sample tip": [sys.executable, "-c", _DILATE],
         "array": [*cli, "array", "paper-random-concave", "--rows", "2", "--cols", "2", "--out", "arr"],
+        # issue 44: the large inputs, each within its predicted peak (fbm_bytes) or refused
+        "surface make paper-fractal nx=2048": [
+            *cli,
+            *("surface", "make", "paper-fractal", "--set", "nx=2048", "-o", "f2048.npz"),
+        ],
+        "fractal 2048^2 exported as STL (streamed)": [sys.executable, "-c", _STL],
     }
     if not quick:
         jobs["validate --quick"] = [*cli, "validate", "--quick", "--out", "val"]
