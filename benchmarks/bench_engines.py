@@ -24,12 +24,13 @@ def _cases():
 
 def bench_engines(quick: bool) -> dict:
     from spine_mj import sim
+    from spine_mj.choices import COMPARED_ENGINES
 
     rows = []
     for label, surf, mu, protocol, starts in _cases():
         row = {"case": label, "runs": len(starts)}
-        for engine in sim.ENGINES:
-            rig = sim.build_engine_rig(surf, engine=engine, mu=mu, ie=1e-3, hfield_resolution=101)
+        for engine in COMPARED_ENGINES:
+            rig = sim.build_rig(surf, engine=engine, mu=mu, ie=1e-3, hfield_resolution=101)
             sc = rig.scales
             kw = {"duration_s": sc.char_length_m / sc.speed_for(1e-3)} if protocol == "spring" else {}
             drive = sim.build_drive(sc, protocol, ie=1e-3 if protocol == "spring" else 1e-2, **kw)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import click
 
+from spine_mj.choices import ARRAY_DRIVES
 from spine_mj.cli.app import main, parse_start, refuse_options_not_for
 from spine_mj.cli.sim import _rig_inputs, _rig_options
 from spine_mj.errors import check_positive
@@ -29,7 +30,7 @@ from spine_mj.errors import check_positive
 )
 @click.option(
     "--drive",
-    type=click.Choice(["speed", "force"]),
+    type=click.Choice(ARRAY_DRIVES),
     default="speed",
     show_default=True,
     help="speed: the carriage moves at constant speed; force: a free carriage pulled by a rising force.",

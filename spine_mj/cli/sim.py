@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import click
 
+from spine_mj.choices import DEFAULT_ENGINE, ENGINES, PROTOCOLS, check_engine
 from spine_mj.cli.app import (
     InputError,
     Progress,
@@ -127,10 +128,16 @@ def sim_export(surface_spec, output, start, stiffness, **rig_opts):
     click.echo("in the viewer: Control panel, move 'spring' (carriage x) or 'push' to drive the tip")
 
 
+#: ``--engine``'s help: the registered engines (:data:`spine_mj.choices.ENGINES`).
+_ENGINE_HELP = (
+    "Physics engine, one of " + "; ".join(f"{e.name} ({e.summary})" for e in ENGINES.values()) + "."
+)
+
+
 @main.command("simulate")
 @click.argument("surface_spec", metavar="SURFACE")
 @click.option("--start", required=True, help="Start 'x0,y0' in surface units, e.g. -3,-1.")
-@click.option("--drive", type=click.Choice(["spring", "ramp", "static"]), default="spring", show_default=True)
+@click.option("--drive", type=click.Choice(PROTOCOLS), default="spring", show_default=True)
 @click.option(
     "--ie",
     type=float,
@@ -163,10 +170,9 @@ def sim_export(surface_spec, output, start, stiffness, **rig_opts):
 @click.option("--duration", type=float, default=None, help="Run time [s] (spring, ramp).")
 @click.option(
     "--engine",
-    type=click.Choice(["mujoco", "bullet"]),
-    default="mujoco",
+    default=DEFAULT_ENGINE,
     show_default=True,
-    help="Physics engine: MuJoCo (soft contact) or Bullet (hard contact; the [bullet] extra).",
+    help=_ENGINE_HELP,
 )
 @click.option(
     "--render",
@@ -206,8 +212,6 @@ def simulate(
     Example:
       spine-mj simulate paper-single-peak --start -3,-1 --drive spring --ie 1e-3 --K 10 --out out/
     """
-
-    from spine_mj import sim
     from spine_mj.sim.run_folder import simulate_to
 
     if render:
@@ -216,7 +220,7 @@ def simulate(
     _check_drive_options(
         drive, ie=ie, speed=speed, rate=rate, stiffness_number=stiffness_number, stiffness=stiffness
     )
-    sim.check_engine_name(engine, "--engine")
+    check_engine(engine, "--engine")
     surf, rig_kw = _rig_inputs(surface_spec, **rig_opts)
     with (
         Progress("simulating", unit="%") as bar,
@@ -256,13 +260,14 @@ def simulate(
 
 
 def _check_render(engine: str) -> None:
-    """Refuse --render where it cannot run (Bullet, no video extra); choose the GL backend."""
+    """Refuse --render where it cannot run (an engine other than MuJoCo, no video extra);
+    choose the GL backend."""
     from spine_mj import extras
     from spine_mj.sim.render import choose_gl_backend
 
-    if engine == "bullet":
+    if engine != "mujoco":
         raise SpineInputError(
-            "--render draws with MuJoCo's renderer, not with --engine bullet: run without it, "
+            f"--render draws with MuJoCo's renderer, not with --engine {engine}: run without it, "
             "then `spine-mj replay RUN_DIR --mp4 run.mp4` shows the run on MuJoCo's model"
         )
     extras.require("video", "--render")

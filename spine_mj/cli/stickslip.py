@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import click
 
+from spine_mj.choices import ENGINES
 from spine_mj.cli.app import InputError, Progress, main
 from spine_mj.errors import check_positive
 
@@ -27,7 +28,7 @@ def parse_stiffness_list(text: str) -> list[float]:
 @click.option("--ie", type=float, default=1e-4, show_default=True, help="Inertia number of the drive.")
 @click.option(
     "--engine",
-    type=click.Choice(["mujoco", "bullet"]),
+    type=click.Choice(tuple(ENGINES)),
     default=None,
     help="Also run this engine, one spring drive per K (default: the references only).",
 )

@@ -6,6 +6,7 @@ from pathlib import Path
 
 import click
 
+from spine_mj.choices import PLAN_NAMES
 from spine_mj.cli.app import Progress, main
 from spine_mj.errors import SpineInputError
 
@@ -26,7 +27,7 @@ from spine_mj.errors import SpineInputError
 @click.option(
     "--plan",
     "plan_name",
-    type=click.Choice(["smoke", "quick", "full"]),
+    type=click.Choice(PLAN_NAMES),
     default=None,
     hidden=True,
     help="Plan by name (smoke: a seconds-long test size).",

@@ -56,7 +56,7 @@ Modules: :mod:`~spine_mj.sim.records` (the parameter records), :mod:`~spine_mj.s
 :mod:`~spine_mj.sim.rollout` (open-loop batches, on :mod:`~spine_mj.sim.open_loop`'s
 controls and :mod:`~spine_mj.sim.lanes`' worker threads), :mod:`~spine_mj.sim.ramp` (closed loop),
 :mod:`~spine_mj.sim.fastforward` (the stick-phase fast-forward rule both use),
-:mod:`~spine_mj.sim.engines` (one rig, two engines: :func:`build_engine_rig`),
+:mod:`~spine_mj.sim.engine_rig` (:class:`EngineRig`, what a rig of every engine offers),
 :mod:`~spine_mj.sim.bullet` (the same rig in Bullet, hard contact; the ``[bullet]`` extra),
 :mod:`~spine_mj.sim.render`, :mod:`~spine_mj.sim.rig`
 (:class:`Rig`, the object users hold) and :mod:`~spine_mj.sim.build` (:func:`build_rig` and
@@ -67,9 +67,7 @@ controls and :mod:`~spine_mj.sim.lanes`' worker threads), :mod:`~spine_mj.sim.ra
 from spine_mj.roughness import characteristic_length
 from spine_mj.sim.array import ArrayResult, ArrayRig, ForcePull
 from spine_mj.sim.build import (
-    ARRAY_DRIVES,
     DEFAULT_INERTIA_NUMBER,
-    PROTOCOLS,
     build_array,
     build_array_on,
     build_drive,
@@ -79,7 +77,7 @@ from spine_mj.sim.build import (
 )
 from spine_mj.sim.detection import Detection, Event
 from spine_mj.sim.drives import Drive, RampDrive, SpringDrive, StaticProbe
-from spine_mj.sim.engines import DEFAULT_ENGINE, ENGINES, EngineRig, build_engine_rig, check_engine_name
+from spine_mj.sim.engine_rig import EngineRig
 from spine_mj.sim.holding import HOLDING_TOLERANCE, array_ie, holding_excess
 from spine_mj.sim.layout import Layout, LayoutKind
 from spine_mj.sim.model import MODEL_PATH
@@ -108,18 +106,14 @@ from spine_mj.surfaces.generators import inclined_plane
 from spine_mj.theory.motion import MOTION_NAMES, SLIDING, SLIPPING, STUCK, SlipEvent
 
 __all__ = [
-    "ARRAY_DRIVES",
-    "DEFAULT_ENGINE",
     "DEFAULT_INERTIA_NUMBER",
     "DEFAULT_LENGTH_SCALE_M",
-    "ENGINES",
     "HOLDING_TOLERANCE",
     "LENGTH_UNITS_M",
     "MAX_INERTIA_NUMBER",
     "MAX_SPRING_OMEGA_DT",
     "MODEL_PATH",
     "MOTION_NAMES",
-    "PROTOCOLS",
     "REFINE_TIMESTEP",
     "SLIDING",
     "SLIPPING",
@@ -153,10 +147,8 @@ __all__ = [
     "build_array",
     "build_array_on",
     "build_drive",
-    "build_engine_rig",
     "build_rig",
     "characteristic_length",
-    "check_engine_name",
     "default_engine",
     "drive_speed_m_s",
     "hfield_of",

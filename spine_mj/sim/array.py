@@ -46,8 +46,8 @@ from spine_mj.sim.open_loop import drive_steps
 #: batches by MuJoCo's rollout; Bullet's rig is one tip stepped in Python, and an array there
 #: would need its own N-body world and carriage coupling.
 ARRAY_ENGINE_REFUSAL = (
-    "engine bullet: spine arrays run in MuJoCo only (one MuJoCo model of N tips and their "
-    "carriage; Bullet's rig is one tip): use engine mujoco for arrays"
+    "engine {engine}: spine arrays run in MuJoCo only (one MuJoCo model of N tips and their "
+    "carriage; the {engine} rig is one tip): use engine mujoco for arrays"
 )
 
 
@@ -94,7 +94,7 @@ class ArrayRig:
 
     def __init__(self, rig: RigModel, layout: Layout, *, force_control: bool = False):
         if not isinstance(rig, RigModel):
-            raise SpineInputError(ARRAY_ENGINE_REFUSAL)
+            raise SpineInputError(ARRAY_ENGINE_REFUSAL.format(engine=type(rig).__name__))
         if not isinstance(layout, Layout):
             raise SpineInputError(f"layout must be a Layout, got {type(layout).__name__}")
         self.rig, self.layout, self.force_control = rig, layout, bool(force_control)

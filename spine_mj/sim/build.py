@@ -2,11 +2,12 @@
 
 Users, the sweep's ``mujoco`` analysis, the validation and the benchmarks give the same
 things: a surface, a friction coefficient, a tip (radius, mass, preload), a length scale
-and hfield resolution, engine overrides, and a drive either dimensionless (inertia number
-``I_e``, stiffness number ``K``) or in SI (speed [m/s], stiffness [N/m], force rate
-[N/s]). :func:`build_rig` and :func:`build_drive` turn them into a :class:`Rig` and a
-drive by the rules of :class:`~spine_mj.sim.scales.Scales`, so that ``spine-mj simulate``
-and a sweep case with the same inputs run the same model (tested).
+and hfield resolution, an engine and its options, and a drive either dimensionless
+(inertia number ``I_e``, stiffness number ``K``) or in SI (speed [m/s], stiffness [N/m],
+force rate [N/s]). :func:`build_rig` and :func:`build_drive` turn them into a rig of any
+registered engine (:data:`spine_mj.choices.ENGINES`) and a drive by the rules of
+:class:`~spine_mj.sim.scales.Scales`, so that ``spine-mj simulate`` and a sweep case with
+the same inputs run the same model (tested).
 
 Two rules live here:
 
@@ -24,23 +25,22 @@ from __future__ import annotations
 
 import dataclasses
 
+from spine_mj.choices import ARRAY_DRIVES, DEFAULT_ENGINE, PROTOCOLS, check_engine
 from spine_mj.errors import SpineInputError, check_positive
 from spine_mj.sim.array import ArrayRig
 from spine_mj.sim.array_run import ArrayDrive, ForcePull
 from spine_mj.sim.drives import Drive, RampDrive, SpringDrive, StaticProbe, spring_stiffness_n_m
+from spine_mj.sim.engine_rig import EngineRig
 from spine_mj.sim.holding import array_ie
 from spine_mj.sim.layout import Layout
 from spine_mj.sim.model import check_drive_on
 from spine_mj.sim.records import TipParams
 from spine_mj.sim.rig import Rig
 from spine_mj.sim.scales import Scales
-from spine_mj.sim.step_rule import EngineOverrides, check_engine_for
 from spine_mj.surfaces import GridSurface, Surface
 
 __all__ = [
-    "ARRAY_DRIVES",
     "DEFAULT_INERTIA_NUMBER",
-    "PROTOCOLS",
     "RigPlan",
     "build_array",
     "build_array_on",
@@ -54,12 +54,6 @@ __all__ = [
 
 #: The inertia number of a drive given no speed, rate or I_e.
 DEFAULT_INERTIA_NUMBER = 1e-3
-
-#: The drive protocols, by the names the CLI and sweep configs use.
-PROTOCOLS = ("spring", "ramp", "static")
-
-#: An array's carriage drives (``spine-mj array --drive``, a sweep's ``array_drive``).
-ARRAY_DRIVES = ("speed", "force")
 
 
 def drive_speed_m_s(
@@ -101,6 +95,7 @@ def build_rig(
     surface: Surface,
     *,
     mu: float,
+    engine: str = DEFAULT_ENGINE,
     tip_radius_m: float | None = None,
     mass_kg: float | None = None,
     preload_n: float | None = None,
@@ -114,10 +109,10 @@ def build_rig(
     stiffness_number: float | None = None,
     stiffness_n_m: float | None = None,
     driven: bool = True,
-    **engine_overrides,
-) -> Rig:
+    **engine_options,
+) -> EngineRig:
     """The rig of ``surface`` and a tip of friction ``mu`` (resolve it with
-    :func:`spine_mj.presets.resolve_mu`); None leaves a parameter to its rule.
+    :func:`spine_mj.presets.resolve_mu`) in ``engine``; None leaves a parameter to its rule.
 
     Parameters
     ----------
@@ -126,6 +121,8 @@ def build_rig(
         ``length_scale_m``).
     mu : float
         The tip's static friction coefficient mu_s.
+    engine : str
+        A registered engine (:data:`spine_mj.choices.ENGINES`; its extra must be installed).
     tip_radius_m, mass_kg, preload_n, gravity_m_s2
         The tip (:class:`TipParams`; None: its default, the radius from the surface).
     length_scale_m : float or None
@@ -142,14 +139,21 @@ def build_rig(
     driven : bool
         False for a model no drive of ours runs (``sim export``, the viewer: the user's sliders
         drive it): then only the surface's falls bound the step.
-    **engine_overrides
-        The fields of :class:`EngineOverrides` (``timestep_s``, ``integrator``, ``cone``,
-        ``impratio``, ``noslip_iterations``, ``solref_timeconst_s``, ``solref_dampratio``).
+    **engine_options
+        The engine's own options (its entry's ``options``; MuJoCo's are the fields of
+        :class:`~spine_mj.sim.step_rule.EngineOverrides`, Bullet reads ``timestep_s``); None
+        leaves one to the engine's rule.
+
+    Returns
+    -------
+    EngineRig
+        The engine's rig (:class:`~spine_mj.sim.Rig` for MuJoCo).
 
     Raises
     ------
     SpineInputError
-        Any parameter out of range (named), or a drive the engine cannot resolve.
+        An unknown engine or its extra missing, an option the engine does not read, any
+        parameter out of range (named), or a drive the engine cannot resolve.
 
     Examples
     --------
@@ -166,9 +170,10 @@ def build_rig(
     >>> round(run.inertia_number, 6)
     0.001
     """
-    given = {k: v for k, v in locals().items() if k not in ("surface", "engine_overrides")}  # the keywords
-    plan = plan_rig(surface, **given, **engine_overrides)
-    return Rig(surface, tip=plan.tip, engine=plan.engine, sized=(plan.scales, plan.hfield))
+    given = {k: v for k, v in locals().items() if k not in ("surface", "engine_options")}  # the keywords
+    plan = plan_rig(surface, **given, **engine_options)
+    rig_class = check_engine(engine).rig_class()
+    return rig_class(surface, tip=plan.tip, engine=plan.engine, sized=(plan.scales, plan.hfield))
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -201,6 +206,7 @@ def plan_rig(
     surface: Surface,
     *,
     mu: float,
+    engine: str = DEFAULT_ENGINE,
     tip_radius_m: float | None = None,
     mass_kg: float | None = None,
     preload_n: float | None = None,
@@ -215,13 +221,19 @@ def plan_rig(
     stiffness_n_m: float | None = None,
     driven: bool = True,
     sized: tuple | None = None,
-    **engine_overrides,
+    **engine_options,
 ) -> RigPlan:
     """The :class:`RigPlan` of :func:`build_rig`'s arguments (the same rules, the same
     refusals, no model compiled). ``sized``: the ``(tip, scales, hfield)`` of the same
     surface and tip sizing, measured before (:func:`rig_sizing`), so that plans differing
     only in the drive or the engine settings measure the surface once."""
-    overrides = EngineOverrides(**engine_overrides)
+    entry = check_engine(engine)
+    options = {k: v for k, v in engine_options.items() if v is not None}
+    unread = [k for k in options if k not in entry.options]
+    if unread:
+        raise SpineInputError(
+            f"{', '.join(unread)}: not read by engine {engine} (its options: {', '.join(entry.options)})"
+        )
     tip = TipParams(
         tip_radius_m=tip_radius_m,
         mu_s=mu,
@@ -232,9 +244,8 @@ def plan_rig(
     tip, scales, hfield = sized
     speed = drive_speed_m_s(scales, ie=ie, speed_m_s=speed_m_s, rate_n_s=rate_n_s) if driven else None
     spring = spring_stiffness_n_m(scales, stiffness_number=stiffness_number, stiffness_n_m=stiffness_n_m)
-    engine = overrides.engine(scales, speed_m_s=speed, stiffness_n_m=spring)
-    check_engine_for(engine, scales)
-    return RigPlan(surface, tip, scales, hfield, engine)
+    settings = entry.settings_factory()(scales, speed_m_s=speed, stiffness_n_m=spring, **options)
+    return RigPlan(surface, tip, scales, hfield, settings)
 
 
 def rig_sizing(

@@ -85,7 +85,7 @@ class BulletRig:
     ``engine`` a :class:`BulletSettings`; None: :func:`default_bullet_engine`).
 
     ``sized``, when given, is ``Scales.with_hfield`` of this surface and tip computed by the
-    caller (:func:`~spine_mj.sim.build_engine_rig` needs the scales for the settings
+    caller (:func:`~spine_mj.sim.build_rig` needs the scales for the settings
     first), as for MuJoCo's rig: the scales and the hfield are measured once.
 
     The attributes and checks that do not depend on the engine (``scales``, ``tip``,

@@ -20,12 +20,12 @@ import pyarrow
 
 from spine_mj import surface_io
 from spine_mj.atomic import all_or_none, atomic_output
+from spine_mj.choices import DEFAULT_ENGINE
 from spine_mj.errors import SpineInputError
 from spine_mj.jsonio import write_json
 from spine_mj.plotting import save_figure, sim_run_figure
-from spine_mj.sim.build import build_drive
+from spine_mj.sim.build import build_drive, build_rig
 from spine_mj.sim.drives import RampDrive, SpringDrive, StaticProbe
-from spine_mj.sim.engines import DEFAULT_ENGINE, build_engine_rig
 from spine_mj.sim.model import RigModel
 from spine_mj.sim.records import EngineSettings, TipParams
 from spine_mj.sim.render import Track, write_mp4
@@ -58,8 +58,8 @@ def load_run(run_dir: str | Path) -> tuple[RigModel, Track]:
         rig = RigModel(
             surface_io.load_surface(run_dir / "surface.npz"),
             tip=TipParams(**summary["tip"]),
-            # a Bullet run is shown on MuJoCo's model of the same surface (its derived settings)
-            engine=None if engine.get("engine") == "bullet" else EngineSettings(**engine),
+            # another engine's run is shown on MuJoCo's model of the same surface (its derived settings)
+            engine=EngineSettings(**engine) if engine.get("engine", "mujoco") == "mujoco" else None,
             length_scale_m=sc["length_scale_m"],
             char_length_m=sc["char_length_m"],
             hfield_resolution=sc.get("hfield_resolution"),
@@ -133,7 +133,7 @@ def simulate_to(
 ) -> tuple[RunResult, list[Path]]:
     """One drive on ``surface`` written as a run folder: what ``spine-mj simulate`` does.
 
-    The rig (:func:`~spine_mj.sim.build_engine_rig`, its step bounded by the drive's pace
+    The rig (:func:`~spine_mj.sim.build_rig`, its step bounded by the drive's pace
     and spring), the drive (:func:`~spine_mj.sim.build_drive`), the run from ``start``, and
     its folder (:func:`write_run`: every file or none).
 
@@ -149,8 +149,8 @@ def simulate_to(
         The start ``(x0, y0)`` in surface units.
     protocol : {"spring", "ramp", "static"}
         The drive.
-    engine : {"mujoco", "bullet"}
-        The engine that runs it.
+    engine : str
+        The engine that runs it, a registered one (:data:`spine_mj.choices.ENGINES`).
     ie, speed_m_s, rate_n_s, stiffness_number, stiffness_n_m, duration_s, start_force_n
         The drive, as for :func:`~spine_mj.sim.build_drive` (pace and spring also size the
         rig's step, as for :func:`~spine_mj.sim.build_rig`).
@@ -171,7 +171,7 @@ def simulate_to(
     """
     pace = {"ie": ie, "speed_m_s": speed_m_s, "rate_n_s": rate_n_s}
     spring = {"stiffness_number": stiffness_number, "stiffness_n_m": stiffness_n_m}
-    rig = build_engine_rig(surface, engine=engine, mu=mu, **pace, **spring, **rig_options)
+    rig = build_rig(surface, engine=engine, mu=mu, **pace, **spring, **rig_options)
     drive = build_drive(
         rig.scales, protocol, **pace, **spring, duration_s=duration_s, start_force_n=start_force_n
     )

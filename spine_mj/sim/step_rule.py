@@ -205,6 +205,17 @@ class EngineOverrides:
         return default_engine(scales, speed_m_s=speed_m_s, stiffness_n_m=stiffness_n_m, **given)
 
 
+def mujoco_settings(
+    scales: Scales, *, speed_m_s: float | None = None, stiffness_n_m: float | None = None, **options
+) -> EngineSettings:
+    """MuJoCo's settings factory in the engine registry (:data:`spine_mj.choices.ENGINES`):
+    :func:`default_engine` with ``options``, the fields of :class:`EngineOverrides`, checked
+    against the scales (:func:`check_engine_for`)."""
+    settings = EngineOverrides(**options).engine(scales, speed_m_s=speed_m_s, stiffness_n_m=stiffness_n_m)
+    check_engine_for(settings, scales)
+    return settings
+
+
 def _two_digits_down(x: float) -> float:
     """``x`` > 0 cut to two significant digits (never rounded up: the bound stays a bound)."""
     scale = 10.0 ** (math.floor(math.log10(x)) - 1)

@@ -18,6 +18,7 @@ import numpy as np
 from annotated_types import Interval
 from pydantic import AllowInfNan, Strict
 
+from spine_mj.choices import ENGINES
 from spine_mj.errors import SpineInputError
 from spine_mj.theory.engagement import DEFAULT_KAPPA_CAP
 
@@ -86,10 +87,11 @@ class ParamSpec:
         May also be given in the ``[drive]`` table.
     array : bool
         May also be given in the ``[array]`` table (the layout of the ``array`` analysis).
-    engines : tuple of str, optional
-        The engines that read it (None: every engine, or no engine). A case whose
-        ``engine`` is not one of them records it as None (:func:`applied_params`): a row
-        records only settings that were applied.
+    option : str, optional
+        The engine option of :func:`spine_mj.sim.build_rig` it sets (None: not an engine
+        option). An engine whose registry entry (:data:`spine_mj.choices.ENGINES`) does not
+        list it ignores it: a case of that engine records it as None
+        (:func:`applied_params`), a row records only settings that were applied.
     """
 
     name: str
@@ -102,7 +104,7 @@ class ParamSpec:
     drive: bool = False
     maximum: float | None = None
     array: bool = False
-    engines: tuple[str, ...] | None = None
+    option: str | None = None
 
     def expected(self) -> str:
         if self.choices:
@@ -249,11 +251,12 @@ def register_analysis(analysis: Analysis) -> Analysis:
 
 
 def applied_params(params: dict, specs: dict[str, ParamSpec]) -> dict:
-    """``params`` with None for every parameter that the case's ``engine`` does not read
-    (a :class:`ParamSpec` whose ``engines`` leaves it out)."""
-    engine = params.get("engine")
+    """``params`` with None for every engine option that the case's ``engine`` does not read
+    (a :class:`ParamSpec` whose ``option`` its registry entry leaves out)."""
+    entry = ENGINES.get(params.get("engine"))
+    reads = () if entry is None else entry.options
     return {
-        k: None if specs[k].engines is not None and engine not in specs[k].engines else v
+        k: None if specs[k].option is not None and specs[k].option not in reads else v
         for k, v in params.items()
     }
 

@@ -35,7 +35,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from spine_mj import sim
+from spine_mj.choices import COMPARED_ENGINES
 from spine_mj.errors import non_negative_int
 from spine_mj.theory import agreement
 from spine_mj.validate.convergence import thin_starts
@@ -249,7 +249,7 @@ def engine_headlines(
     starts_per_surface: int | None = None,
     rechecks: Sequence[MissStart] = SOFT_CONTACT_MISSES,
     recheck_plan: ValidationPlan = PLANS["full"],
-    engines: Sequence[str] = sim.ENGINES,
+    engines: Sequence[str] = COMPARED_ENGINES,
 ) -> EngineHeadlinesResult:
     """The corner agreement per family in every engine, and the soft-contact misses rechecked.
 

@@ -1,7 +1,7 @@
 """Study: the closed forms in both engines, MuJoCo (soft contact) beside Bullet (hard contact).
 
 Each check is a closed form the rig must reproduce, run the same way in both engines
-(:func:`spine_mj.sim.build_engine_rig`, the same surface, drive and detection), with the
+(:func:`spine_mj.sim.build_rig`, the same surface, drive and detection), with the
 tolerance the MuJoCo report states for it:
 
 * **static kappa** on inclined planes (Eqs. 1-3): breakaway force / W against
@@ -59,6 +59,7 @@ import numpy as np
 
 from spine_mj import presets, sim
 from spine_mj.atomic import atomic_output
+from spine_mj.choices import COMPARED_ENGINES
 from spine_mj.errors import OneLineParser, SpineInputError, non_negative_int
 from spine_mj.surfaces import GridSurface
 from spine_mj.theory import engagement
@@ -119,7 +120,7 @@ class EnginesResult:
 
 
 def _rig(engine, surface, mu=MU, **kw):
-    return sim.build_engine_rig(surface, engine=engine, mu=mu, **kw)
+    return sim.build_rig(surface, engine=engine, mu=mu, **kw)
 
 
 def _static_rows(engine: str) -> list[dict]:
@@ -434,7 +435,7 @@ def _creep_rows(engine: str) -> list[dict]:
 
 
 def engines_ground_truth(
-    *, quick: bool = False, engines=sim.ENGINES, progress: Callable[[str], None] | None = None
+    *, quick: bool = False, engines=COMPARED_ENGINES, progress: Callable[[str], None] | None = None
 ) -> EnginesResult:
     """Every check in every engine of ``engines``; rows merged by (check, case)."""
     by_key: dict[tuple, dict] = {}
@@ -567,14 +568,14 @@ def fractal_engines(
         "surfaces": surfaces,
         "starts": {"frame": "relative", "x": [0.05], "y": [0.5]},
         "drive": {"protocol": "spring", "ie": ie},
-        "grid": {"mu": calibrated_mu(PRESET), "tip_radius": tip, "engine": list(sim.ENGINES)},
+        "grid": {"mu": calibrated_mu(PRESET), "tip_radius": tip, "engine": list(COMPARED_ENGINES)},
     }
     runner = StudyRunner(Path(out_dir).resolve(), workers, None, time.perf_counter())
     runner.study = "engines"
     df, _ = runner(doc, "fractal-engines")
     rows = []
     for h in hursts:
-        for engine in sim.ENGINES:
+        for engine in COMPARED_ENGINES:
             sel = df[(df["engine"] == engine) & (df["surface_seed"].map(seed_hurst) == h)]
             rate = lock_rate(
                 sel["self_locked"].fillna(False).astype(bool).tolist(), (sel["status"] == "ok").tolist()

@@ -154,12 +154,12 @@ def spring_block_check(
     MuJoCo's velocity-dependent (soft) friction rows flatten it. The rig is built for the
     spring (the step rule's ``omega dt``), the run lasts until ``periods`` swings after the
     predicted breakaway. ``stiffness_number`` (K) replaces ``stiffness_n_m`` when given;
-    ``engine`` is one of :data:`spine_mj.sim.ENGINES`."""
+    ``engine`` is one of :data:`spine_mj.choices.ENGINES`."""
     surface = sim.inclined_plane(slope_deg=0.0, half_width=0.05, n=101)
     tip = sim.TipParams(tip_radius_m=5e-4, mu_s=mu, mass_kg=MASS_KG)
     scales = sim.Scales.for_surface(surface, tip=tip)
     k = scales.stiffness_for(stiffness_number) if stiffness_number is not None else stiffness_n_m
-    rig = sim.build_engine_rig(
+    rig = sim.build_rig(
         surface,
         engine=engine,
         tip_radius_m=5e-4,
@@ -382,7 +382,7 @@ def crest_check(width: float, factor: float, engine: str = "mujoco") -> tuple[fl
     )
     ie = factor * ie_star
     soft = {"solref_timeconst_s": RIDGE_SOLREF_S} if engine == "mujoco" else {}
-    rig = sim.build_engine_rig(
+    rig = sim.build_rig(
         surf, engine=engine, mu=0.3, tip_radius_m=RIDGE_TIP_M, timestep_s=RIDGE_TIMESTEP_S, ie=ie, **soft
     )
     res = rig.run(sim.build_drive(rig.scales, ie=ie, stiffness_number=RIDGE_K), start=(-2.0, 0.0))

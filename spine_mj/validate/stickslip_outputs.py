@@ -102,8 +102,9 @@ def stickslip_to(
         ``K = k l_s / F_p``, each > 0.
     surface_name : str
         The label of the catalog's ``surface`` column.
-    engine : {"mujoco", "bullet"}, optional
-        Also run this engine, one spring drive per K.
+    engine : str, optional
+        Also run this engine (a registered one, :data:`spine_mj.choices.ENGINES`), one
+        spring drive per K.
     start, travel : float, optional
         The stretch of track, in surface units (default: all but a twentieth at each end).
     n_bootstrap : int
@@ -115,7 +116,7 @@ def stickslip_to(
     """
     import pandas as pd
 
-    from spine_mj.sim.engines import build_engine_rig
+    from spine_mj.sim.build import build_rig
     from spine_mj.sim.scales import Scales
 
     ks = [check_positive("--K", k) for k in stiffness_numbers]
@@ -129,9 +130,7 @@ def stickslip_to(
     done = 0
     for k_number in ks:
         if engine:
-            rig = build_engine_rig(
-                surface, engine=engine, mu=mu, ie=ie, stiffness_number=k_number, **rig_options
-            )
+            rig = build_rig(surface, engine=engine, mu=mu, ie=ie, stiffness_number=k_number, **rig_options)
             scales = rig.scales
         else:
             sizing = {

@@ -16,7 +16,6 @@ CLI_MODULES = sorted(Path(spine_mj.cli.__file__).parent.glob("*.py"))
 #: What only the library may call: the rig, drive and model builders and the rigs' classes.
 BUILDERS = {
     "build_rig",
-    "build_engine_rig",
     "build_drive",
     "build_array",
     "build_array_on",

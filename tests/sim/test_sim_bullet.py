@@ -1,5 +1,6 @@
-"""The rig in Bullet (spine_mj.sim.bullet, spine_mj.sim.engines): the same surface, rules and
-results as MuJoCo's, the closed forms, and each Bullet pitfall measured with its fix."""
+"""The rig in Bullet (spine_mj.sim.bullet, built by spine_mj.sim.build_rig from the engine
+registry): the same surface, rules and results as MuJoCo's, the closed forms, and each
+Bullet pitfall measured with its fix."""
 
 import dataclasses
 import json
@@ -17,6 +18,7 @@ from click.testing import CliRunner
 from sweep_support import write_config
 
 from spine_mj import extras, sim, sweep
+from spine_mj.choices import COMPARED_ENGINES
 from spine_mj.cli import main
 from spine_mj.errors import SpineInputError
 from spine_mj.sim.run_folder import load_run
@@ -106,7 +108,7 @@ def test_friction_anchor_pitfall():
     slide); with anchors while held (the rule) it holds and breaks away at the wedge's kappa."""
     from spine_mj.validate.engines import flank_tilt, groove
 
-    rig = sim.build_engine_rig(groove(20.0, 30.0), engine="bullet", mu=MU, tip_radius_m=2e-3, ie=1e-2)
+    rig = sim.build_rig(groove(20.0, 30.0), engine="bullet", mu=MU, tip_radius_m=2e-3, ie=1e-2)
     assert rig.engine.friction_anchor == "held"
     wedge = math.tan(math.radians(20) + math.atan(MU / math.cos(flank_tilt(20.0, 30.0))))
     runs = {}
@@ -186,7 +188,7 @@ def test_spring_block_period_and_peak_speed():
     got = spring_block_check(stiffness_n_m=100.0, engine="bullet")
     assert abs(got["period_rel_error"]) < 0.01
     assert abs(got["peak_speed_rel_error"]) < 0.01
-    stiff = {e: spring_block_check(stiffness_n_m=1e4, engine=e) for e in sim.ENGINES}
+    stiff = {e: spring_block_check(stiffness_n_m=1e4, engine=e) for e in COMPARED_ENGINES}
     resolution = stiff["bullet"]["timestep_s"] / stiff["bullet"]["period_predicted_s"]
     assert abs(stiff["bullet"]["period_rel_error"]) < 0.01 + resolution
     assert stiff["bullet"]["peak_speed_v"] == pytest.approx(stiff["mujoco"]["peak_speed_v"], rel=0.05)
@@ -201,19 +203,19 @@ def test_the_force_ramp_with_reset_runs_and_resets():
     assert run.breakaway_kappas[:2] == pytest.approx(MU, rel=0.06)
 
 
-def test_build_engine_rig_gives_the_same_scales_and_step_in_both_engines():
+def test_build_rig_gives_the_same_scales_and_step_in_both_engines():
     surf = sim.inclined_plane(slope_deg=5.0)
-    rigs = {e: sim.build_engine_rig(surf, engine=e, mu=MU, ie=1e-3) for e in sim.ENGINES}
+    rigs = {e: sim.build_rig(surf, engine=e, mu=MU, ie=1e-3) for e in COMPARED_ENGINES}
     assert rigs["mujoco"].scales == rigs["bullet"].scales
     assert rigs["mujoco"].engine.timestep_s == rigs["bullet"].engine.timestep_s
-    with pytest.raises(SpineInputError, match="impratio: MuJoCo's solver options, not read by engine bullet"):
-        sim.build_engine_rig(surf, engine="bullet", mu=MU, impratio=10.0)
+    with pytest.raises(SpineInputError, match="impratio: not read by engine bullet"):
+        sim.build_rig(surf, engine="bullet", mu=MU, impratio=10.0)
     with pytest.raises(SpineInputError, match="engine must be one of mujoco, bullet, got 'ode'"):
-        sim.build_engine_rig(surf, engine="ode", mu=MU)
+        sim.build_rig(surf, engine="ode", mu=MU)
 
 
 def test_the_scales_and_hfield_are_measured_once_and_shared(monkeypatch):
-    """Bullet's rig takes the scales and hfield build_engine_rig measured (``sized=``), as
+    """Bullet's rig takes the scales and hfield build_rig measured (``sized=``), as
     MuJoCo's does: one measurement, the same hfield samples as MuJoCo's."""
     from spine_mj import presets
 
@@ -226,17 +228,17 @@ def test_the_scales_and_hfield_are_measured_once_and_shared(monkeypatch):
         return real(cls, *args, **kwargs)
 
     monkeypatch.setattr(sim.Scales, "with_hfield", classmethod(counted))
-    rig = sim.build_engine_rig(surf, engine="bullet", mu=MU, ie=1e-3, hfield_resolution=61)
+    rig = sim.build_rig(surf, engine="bullet", mu=MU, ie=1e-3, hfield_resolution=61)
     assert rig.hfield.nrow == 61
     assert calls == [61]
     assert rig.scales.hfield_resolution == 61 and not hasattr(rig.engine, "hfield_resolution")
-    mj = sim.build_engine_rig(surf, engine="mujoco", mu=MU, ie=1e-3, hfield_resolution=61)
+    mj = sim.build_rig(surf, engine="mujoco", mu=MU, ie=1e-3, hfield_resolution=61)
     np.testing.assert_array_equal(rig.hfield.data, mj.hfield.data)
 
 
 def test_simulate_engine_bullet_writes_the_same_run_folder(tmp_path):
     folders = {}
-    for engine in sim.ENGINES:
+    for engine in COMPARED_ENGINES:
         out = tmp_path / engine
         res = CliRunner().invoke(
             main,

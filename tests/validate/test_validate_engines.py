@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from spine_mj import sim
+from spine_mj.choices import COMPARED_ENGINES
 from spine_mj.validate import engines as study
 
 
@@ -30,14 +31,14 @@ def test_groove_is_a_v_rising_along_x():
 def test_dai_start_is_the_first_touch_of_the_faceted_sphere():
     tip = 1e-3
     surf = study.dai_surface(2e-3, tip)
-    ball = sim.build_engine_rig(surf, mu=0.5, tip_radius_m=tip, ie=1.0).contact_surface()
+    ball = sim.build_rig(surf, mu=0.5, tip_radius_m=tip, ie=1.0).contact_surface()
     x0, _ = study.dai_start(ball, 2e-3, tip)
     before = ball.height(np.array([x0 - 1e-3 * tip]), np.zeros(1))[0]
     at = ball.height(np.array([x0]), np.zeros(1))[0]
     assert before <= 1e-6 * tip < at
 
 
-@pytest.mark.parametrize("engine", sim.ENGINES)
+@pytest.mark.parametrize("engine", COMPARED_ENGINES)
 def test_the_wedge_holds_more_than_one_contact_in_both_engines(engine):
     if engine == "bullet":
         pytest.importorskip("pybullet", reason="the Bullet engine needs the [bullet] extra (pybullet)")

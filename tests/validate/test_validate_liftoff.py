@@ -4,11 +4,11 @@ runs per width), in MuJoCo and in Bullet."""
 
 import pytest
 
-from spine_mj import sim
+from spine_mj.choices import COMPARED_ENGINES
 from spine_mj.validate.ground_truth import LIFTOFF_ABOVE, LIFTOFF_BELOW, LIFTOFF_GAP_RADII, crest_check
 
 
-@pytest.mark.parametrize("engine", sim.ENGINES)
+@pytest.mark.parametrize("engine", COMPARED_ENGINES)
 @pytest.mark.parametrize("width", [0.35, 0.5])
 def test_the_tip_keeps_the_crest_below_ie_star_and_leaves_it_above(width, engine):
     if engine == "bullet":

@@ -20,6 +20,7 @@ import itertools
 import numpy as np
 
 from spine_mj import sim
+from spine_mj.choices import ARRAY_DRIVES, check_engine
 from spine_mj.errors import SpineInputError
 from spine_mj.sim.array import ARRAY_ENGINE_REFUSAL, spines_on_surface
 from spine_mj.sim.drives import spring_stiffness_n_m
@@ -42,7 +43,7 @@ ARRAY_PARAMS = (
         "str",
         "speed: the carriage moves at the drive speed; force: a free carriage pulled by a rising force",
         "speed",
-        choices=sim.ARRAY_DRIVES,
+        choices=ARRAY_DRIVES,
         array=True,
     ),
 )
@@ -88,8 +89,9 @@ def _check_layouts(config) -> None:
     MAX_SPINES spines and ``layout_seed`` where no random layout reads it (what needs a
     case's surface, :func:`_check_case`)."""
     grid = dict(config.grid)
-    if "bullet" in grid["engine"]:
-        raise SpineInputError(ARRAY_ENGINE_REFUSAL)
+    for engine in grid["engine"]:
+        if not check_engine(engine, "config key engine =").arrays:
+            raise SpineInputError(ARRAY_ENGINE_REFUSAL.format(engine=engine))
     _check_drive_keys(grid)
     check_speed(config)
     if grid["layout_seed"] != (0,) and "random" not in grid["layout"]:

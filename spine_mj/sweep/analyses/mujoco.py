@@ -13,6 +13,7 @@ import functools
 import numpy as np
 
 from spine_mj import sim
+from spine_mj.choices import DEFAULT_ENGINE, ENGINES, PROTOCOLS, check_engine
 from spine_mj.errors import SpineInputError
 from spine_mj.sim.build import plan_rig, rig_sizing
 from spine_mj.sim.holding import spring_swing
@@ -29,18 +30,15 @@ from spine_mj.sweep.registry import (
     register_analysis,
 )
 
-#: The engines that read MuJoCo's solver options (:data:`spine_mj.sim.engines.MUJOCO_ONLY`).
-_MUJOCO = ("mujoco",)
-
 MUJOCO_PARAMS = (
     MU_PARAM,
     ParamSpec(
         "engine",
         "str",
-        "physics engine: mujoco (soft contact) or bullet (hard contact; the [bullet] extra); "
-        "bullet reads none of MuJoCo's solver keys",
-        sim.DEFAULT_ENGINE,
-        choices=sim.ENGINES,
+        "physics engine, a registered one (spine_mj.choices.ENGINES: "
+        + "; ".join(f"{e.name}, {e.summary}" for e in ENGINES.values())
+        + "); an engine option the engine does not read is refused",
+        DEFAULT_ENGINE,
     ),
     ParamSpec(
         "tip_radius",
@@ -50,9 +48,7 @@ MUJOCO_PARAMS = (
         0.0,
         0.0,
     ),
-    ParamSpec(
-        "protocol", "str", "drive protocol", "spring", choices=("spring", "ramp", "static"), drive=True
-    ),
+    ParamSpec("protocol", "str", "drive protocol", "spring", choices=PROTOCOLS, drive=True),
     ParamSpec(
         "ie",
         "float",
@@ -124,7 +120,13 @@ MUJOCO_PARAMS = (
         exclusive=True,
     ),
     ParamSpec(
-        "timestep", "float", "MuJoCo time step [s] (default: from the scales)", None, 0.0, exclusive=True
+        "timestep",
+        "float",
+        "the engine's recorded time step [s] (default: from the scales)",
+        None,
+        0.0,
+        exclusive=True,
+        option="timestep_s",
     ),
     ParamSpec(
         "integrator",
@@ -132,13 +134,19 @@ MUJOCO_PARAMS = (
         "MuJoCo integrator",
         "implicitfast",
         choices=("euler", "implicitfast", "implicit", "rk4"),
-        engines=_MUJOCO,
+        option="integrator",
     ),
-    ParamSpec("cone", "str", "friction cone", "elliptic", choices=("elliptic", "pyramidal"), engines=_MUJOCO),
+    ParamSpec("cone", "str", "friction cone", "elliptic", choices=("elliptic", "pyramidal"), option="cone"),
     ParamSpec(
-        "impratio", "float", "frictional / normal impedance ratio", 1.0, 0.0, exclusive=True, engines=_MUJOCO
+        "impratio",
+        "float",
+        "frictional / normal impedance ratio",
+        1.0,
+        0.0,
+        exclusive=True,
+        option="impratio",
     ),
-    ParamSpec("noslip_iterations", "int", "noslip solver passes", 3, 0, engines=_MUJOCO),
+    ParamSpec("noslip_iterations", "int", "noslip solver passes", 3, 0, option="noslip_iterations"),
     ParamSpec(
         "tolerance",
         "float",
@@ -146,7 +154,7 @@ MUJOCO_PARAMS = (
         None,
         0.0,
         exclusive=True,
-        engines=_MUJOCO,
+        option="tolerance",
     ),
     ParamSpec(
         "noslip_tolerance",
@@ -155,7 +163,7 @@ MUJOCO_PARAMS = (
         None,
         0.0,
         exclusive=True,
-        engines=_MUJOCO,
+        option="noslip_tolerance",
     ),
     ParamSpec(
         "timestep_factor",
@@ -164,7 +172,7 @@ MUJOCO_PARAMS = (
         None,
         0.0,
         exclusive=True,
-        engines=_MUJOCO,
+        option="timestep_factor",
     ),
     ParamSpec(
         "solref_timeconst",
@@ -173,10 +181,16 @@ MUJOCO_PARAMS = (
         None,
         0.0,
         exclusive=True,
-        engines=_MUJOCO,
+        option="solref_timeconst_s",
     ),
     ParamSpec(
-        "solref_dampratio", "float", "contact damping ratio", 1.0, 0.0, exclusive=True, engines=_MUJOCO
+        "solref_dampratio",
+        "float",
+        "contact damping ratio",
+        1.0,
+        0.0,
+        exclusive=True,
+        option="solref_dampratio",
     ),
     ParamSpec(
         "hfield_resolution",
@@ -222,15 +236,8 @@ def check_speed(config) -> None:
                 f"config keys grid.{a} and grid.{b}: give one of them ({what}), got "
                 f"{a} = {list(grid[a])} and {b} = {list(grid[b])}"
             )
-    if "bullet" in grid["engine"]:
-        sim.check_engine_name("bullet", "config key engine =")
-        defaults = {s.name: s.default for s in MUJOCO_PARAMS if s.engines == _MUJOCO}
-        given = [f"{k} = {list(grid[k])}" for k, d in defaults.items() if grid[k] != (d,)]
-        if given:
-            raise SpineInputError(
-                f"config keys {', '.join(given)}: MuJoCo's solver options, not read by engine bullet; "
-                "remove them, or sweep engine = 'mujoco' separately"
-            )
+    for engine in grid["engine"]:
+        check_engine_options(engine, grid)
     defaults = {s.name: s.default for s in MUJOCO_PARAMS}
     protocols = grid["protocol"]
     for key, readers in PROTOCOL_KEYS.items():
@@ -242,29 +249,37 @@ def check_speed(config) -> None:
             )
 
 
+def check_engine_options(engine: str, grid: dict) -> None:
+    """Refuse an unknown ``engine`` (or its extra missing) and any engine option of ``grid``
+    set away from its default that ``engine`` does not read (its registry entry's options)."""
+    entry = check_engine(engine, "config key engine =")
+    given = [
+        f"{s.name} = {list(grid[s.name])}"
+        for s in MUJOCO_PARAMS
+        if s.option is not None and s.option not in entry.options and grid[s.name] != (s.default,)
+    ]
+    if given:
+        raise SpineInputError(
+            f"config keys {', '.join(given)}: not read by engine {engine} (its options: "
+            f"{', '.join(entry.options) or 'none'}); remove them, or sweep that engine separately"
+        )
+
+
 @functools.lru_cache(maxsize=4)
 def _rig(spec, key):
     """The rig of a surface and tip/engine parameters (cached: cases differing only in the
     protocol share it; the speed and the spring's stiffness set the engine step)."""
-    return sim.build_engine_rig(spec.make(), engine=dict(key)["engine"], **_rig_options(dict(key)))
+    return sim.build_rig(spec.make(), **_rig_options(dict(key)))
 
 
 def _rig_options(p: dict) -> dict:
-    """The keywords of :func:`spine_mj.sim.build_engine_rig` (without the engine) of a
-    case's rig parameters ``p``: MuJoCo's own solver options only for MuJoCo."""
-    mujoco_only = {
-        "integrator": p["integrator"],
-        "cone": p["cone"],
-        "impratio": p["impratio"],
-        "noslip_iterations": p["noslip_iterations"],
-        "tolerance": p["tolerance"],
-        "noslip_tolerance": p["noslip_tolerance"],
-        "solref_timeconst_s": p["solref_timeconst"],
-        "solref_dampratio": p["solref_dampratio"],
-        "timestep_factor": p["timestep_factor"],
-    }
+    """The keywords of :func:`spine_mj.sim.build_rig` of a case's rig parameters ``p``: its
+    engine, the engine options that engine reads (its registry entry's), the tip, sizing
+    and drive."""
+    reads = ENGINES[p["engine"]].options
     return dict(
-        **(mujoco_only if p["engine"] == "mujoco" else {}),
+        engine=p["engine"],
+        **{s.option: p[s.name] for s in MUJOCO_PARAMS if s.option in reads},
         mu=p["mu"],
         tip_radius_m=p["tip_radius_m"],
         mass_kg=p["mass"],
@@ -273,7 +288,6 @@ def _rig_options(p: dict) -> dict:
         length_scale_m=p["length_scale"],
         hfield_resolution=p["hfield_resolution"],
         hfield_refinement=p["hfield_refinement"],
-        timestep_s=p["timestep"],
         ie=p["ie"],
         speed_m_s=p["speed"],
         stiffness_number=p["K"],
