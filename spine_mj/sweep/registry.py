@@ -18,7 +18,7 @@ import numpy as np
 from annotated_types import Interval
 from pydantic import AllowInfNan, Strict
 
-from spine_mj.choices import ENGINES
+from spine_mj.choices import ENGINES, check_engine
 from spine_mj.errors import SpineInputError
 from spine_mj.theory.engagement import DEFAULT_KAPPA_CAP
 
@@ -259,6 +259,23 @@ def applied_params(params: dict, specs: dict[str, ParamSpec]) -> dict:
         k: None if specs[k].option is not None and specs[k].option not in reads else v
         for k, v in params.items()
     }
+
+
+def check_engine_options(engine: str, grid: dict, specs) -> None:
+    """Refuse an unknown ``engine`` (or its extra missing) and any engine option among
+    ``specs`` that ``grid`` sets away from its default and ``engine`` does not read (its
+    registry entry's options)."""
+    entry = check_engine(engine, "config key engine =")
+    given = [
+        f"{s.name} = {list(grid[s.name])}"
+        for s in specs
+        if s.option is not None and s.option not in entry.options and grid[s.name] != (s.default,)
+    ]
+    if given:
+        raise SpineInputError(
+            f"config keys {', '.join(given)}: not read by engine {engine} (its options: "
+            f"{', '.join(entry.options) or 'none'}); remove them, or sweep that engine separately"
+        )
 
 
 def param_specs(analyses: tuple[str, ...]) -> dict[str, ParamSpec]:

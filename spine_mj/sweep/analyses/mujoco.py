@@ -13,7 +13,7 @@ import functools
 import numpy as np
 
 from spine_mj import sim
-from spine_mj.choices import DEFAULT_ENGINE, ENGINES, PROTOCOLS, check_engine
+from spine_mj.choices import DEFAULT_ENGINE, ENGINES, PROTOCOLS
 from spine_mj.errors import SpineInputError
 from spine_mj.sim.build import plan_rig, rig_sizing
 from spine_mj.sim.holding import spring_swing
@@ -27,6 +27,7 @@ from spine_mj.sweep.registry import (
     Analysis,
     AnalysisResult,
     ParamSpec,
+    check_engine_options,
     register_analysis,
 )
 
@@ -237,7 +238,7 @@ def check_speed(config) -> None:
                 f"{a} = {list(grid[a])} and {b} = {list(grid[b])}"
             )
     for engine in grid["engine"]:
-        check_engine_options(engine, grid)
+        check_engine_options(engine, grid, MUJOCO_PARAMS)
     defaults = {s.name: s.default for s in MUJOCO_PARAMS}
     protocols = grid["protocol"]
     for key, readers in PROTOCOL_KEYS.items():
@@ -247,22 +248,6 @@ def check_speed(config) -> None:
                 f"config key {key} = {list(grid[key])}: the {' and '.join(ignoring)} drive ignores it "
                 f"(read only by {' and '.join(readers)}); remove it, or sweep that protocol separately"
             )
-
-
-def check_engine_options(engine: str, grid: dict) -> None:
-    """Refuse an unknown ``engine`` (or its extra missing) and any engine option of ``grid``
-    set away from its default that ``engine`` does not read (its registry entry's options)."""
-    entry = check_engine(engine, "config key engine =")
-    given = [
-        f"{s.name} = {list(grid[s.name])}"
-        for s in MUJOCO_PARAMS
-        if s.option is not None and s.option not in entry.options and grid[s.name] != (s.default,)
-    ]
-    if given:
-        raise SpineInputError(
-            f"config keys {', '.join(given)}: not read by engine {engine} (its options: "
-            f"{', '.join(entry.options) or 'none'}); remove them, or sweep that engine separately"
-        )
 
 
 @functools.lru_cache(maxsize=4)
