@@ -23,7 +23,7 @@ import time
 from pathlib import Path
 
 import numpy as np
-from spine_mj.sim.engines import build_engine_rig
+from spine_mj.sim.build import build_rig
 
 from spine_mj import presets
 from spine_mj.jsonio import write_json
@@ -36,15 +36,15 @@ MU = 0.5
 
 
 def _variant(engine: str, variant: str, ie: float, k: float, surf):
-    rig = build_engine_rig(surf, engine=engine, mu=MU, ie=ie, stiffness_number=k)
+    rig = build_rig(surf, engine=engine, mu=MU, ie=ie, stiffness_number=k)
     if variant == "base":
         return rig
     if variant == "dt2":
-        return build_engine_rig(
+        return build_rig(
             surf, engine=engine, mu=MU, ie=ie, stiffness_number=k, timestep_s=rig.engine.timestep_s / 2
         )
     if variant == "hfield2":
-        return build_engine_rig(surf, engine=engine, mu=MU, ie=ie, stiffness_number=k, hfield_refinement=2)
+        return build_rig(surf, engine=engine, mu=MU, ie=ie, stiffness_number=k, hfield_refinement=2)
     raise SystemExit(f"unknown variant {variant}")
 
 
