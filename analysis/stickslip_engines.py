@@ -23,10 +23,10 @@ import time
 from pathlib import Path
 
 import numpy as np
-from spine_mj.sim.build import build_rig
 
 from spine_mj import presets
 from spine_mj.jsonio import write_json
+from spine_mj.sim.build import build_rig
 from spine_mj.theory.motion import SLIP_SPEED_FACTOR, STUCK
 from spine_mj.validate.avalanche_stats import two_sample
 from spine_mj.validate.slip_catalog import TrackUnits, engine_rows, reference_rows, track_landscape
