@@ -84,6 +84,7 @@ def drive_speed_m_s(
     -------
     float
     """
+    _at_most_one(ie=ie, speed_m_s=speed_m_s, rate_n_s=rate_n_s)
     if speed_m_s is not None:
         return speed_m_s
     if rate_n_s is not None:
@@ -308,6 +309,16 @@ def _sized(surface: Surface, tip: TipParams, length_scale_m, hfield_resolution, 
     return tip, scales, hfield
 
 
+def _at_most_one(**given) -> None:
+    """Refuse two ways of giving one quantity (a pace, a stiffness): neither silently wins."""
+    named = {k: v for k, v in given.items() if v is not None}
+    if len(named) > 1:
+        raise SpineInputError(
+            f"give at most one of {', '.join(given)}, got "
+            + ", ".join(f"{k}={v!r}" for k, v in named.items())
+        )
+
+
 def build_drive(
     scales: Scales,
     protocol: str = "spring",
@@ -340,6 +351,8 @@ def build_drive(
     duration_s, settle_time_s, start_force_n, slide_distance_m
         As the drives take them (:class:`SpringDrive`, :class:`RampDrive`, :class:`StaticProbe`).
     """
+    _at_most_one(ie=ie, speed_m_s=speed_m_s, rate_n_s=rate_n_s)
+    _at_most_one(stiffness_number=stiffness_number, stiffness_n_m=stiffness_n_m)
     if rate_n_s is None:
         rate_n_s = scales.force_rate_for(drive_speed_m_s(scales, ie=ie, speed_m_s=speed_m_s))
     if stiffness_number is not None:

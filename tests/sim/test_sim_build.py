@@ -10,6 +10,7 @@ from click.testing import CliRunner
 
 from spine_mj import sim, sweep
 from spine_mj.cli import main
+from spine_mj.errors import SpineInputError
 from spine_mj.surface_io import save_surface
 from spine_mj.surfaces import fractal_fbm, single_gaussian
 from spine_mj.sweep.analyses.mujoco import case_drive, case_rig
@@ -141,3 +142,22 @@ def test_a_refined_hfield_keeps_every_sample_and_the_tip_on_a_grid_and_an_analyt
             {"mu": 0.8, "hfield_resolution": res or 41, "hfield_refinement": 2},
         )
         assert rig.hfield.ncol == n1 and rig.scales.tip_radius_m == base.scales.tip_radius_m
+
+
+@pytest.mark.parametrize(
+    ("given", "named"),
+    [
+        ({"ie": 1e-3, "speed_m_s": 0.01}, "ie, speed_m_s, rate_n_s"),
+        ({"ie": 1e-3, "rate_n_s": 1.0}, "ie, speed_m_s, rate_n_s"),
+        ({"stiffness_number": 10.0, "stiffness_n_m": 100.0}, "stiffness_number, stiffness_n_m"),
+    ],
+)
+def test_build_drive_refuses_a_pace_or_a_stiffness_given_twice(given, named):
+    # "at most one of speed and I_e": neither wins silently, in build_drive and build_rig alike
+    scales = sim.build_rig(sim.inclined_plane(slope_deg=0.0), mu=0.5, tip_radius_m=1e-3).scales
+    for protocol in ("spring", "ramp"):
+        with pytest.raises(SpineInputError, match=f"give at most one of {named}, got"):
+            sim.build_drive(scales, protocol, **given)
+    if "ie" in given:
+        with pytest.raises(SpineInputError, match=f"give at most one of {named}"):
+            sim.drive_speed_m_s(scales, **given)
