@@ -151,3 +151,20 @@ def test_the_fractal_s_predicted_peak_is_its_measured_one(n, periodic):
         [sys.executable, "-c", _FBM_PEAK, str(n), periodic], capture_output=True, text=True, check=True
     )
     assert 0.7 <= float(out.stdout) <= 1.3, out.stdout
+
+
+def test_bullet_s_heightfield_is_refused_before_it_is_built_when_over_the_budget(monkeypatch):
+    """pybullet's heightfield takes about 2.1 kB a sample (a 2048 x 2048 fractal peaked at
+    6.6 GB against MuJoCo's 0.57): a rig whose heightfield passes the budget is refused
+    while nothing is built."""
+    pytest.importorskip("pybullet")
+    from spine_mj import sim
+    from spine_mj.sim.bullet import BULLET_BYTES_PER_SAMPLE
+    from spine_mj.surfaces import fractal_fbm
+
+    surf = fractal_fbm(nx=128, rng=0)
+    monkeypatch.setenv(ENV_VAR, str(int(BULLET_BYTES_PER_SAMPLE * 128 * 128 * 0.9)))
+    with pytest.raises(SpineInputError, match=r"^Bullet's heightfield of 128 x 128 samples would need"):
+        sim.build_engine_rig(surf, engine="bullet", mu=0.5)
+    monkeypatch.setenv(ENV_VAR, str(int(BULLET_BYTES_PER_SAMPLE * 128 * 128 * 1.1)))
+    assert sim.build_engine_rig(surf, engine="bullet", mu=0.5).hfield.nrow == 128

@@ -37,6 +37,7 @@ import numpy as np
 
 from spine_mj import extras
 from spine_mj.errors import SpineInputError
+from spine_mj.memory import check_memory
 from spine_mj.sim.bullet_settings import (
     ANCHOR_RELEASE,
     WEDGE_COS,
@@ -78,6 +79,13 @@ SENSOR_ADR = {
 }
 _NSENS = 20
 _NSTATE = 7  # time, position, velocity
+
+
+#: Bytes per hfield sample that pybullet's heightfield takes (its collision shape 1.2 kB,
+#: its body 0.8 kB, internal-edge flag or not; measured at 512 and 1024 a side): about 50
+#: times MuJoCo's hfield (40 B a sample), pybullet's own copies, not ours. The rig is
+#: refused before it is built when that passes the memory budget.
+BULLET_BYTES_PER_SAMPLE = 2100
 
 
 class BulletRig:
@@ -131,6 +139,10 @@ class BulletRig:
                 f"timestep_s must be at least {MIN_TIMESTEP_TAU:g} of the time scale tau = "
                 f"{self.scales.time_s:.3g} s, or none (derived), got {self.engine.timestep_s:.3g}"
             )
+        check_memory(
+            BULLET_BYTES_PER_SAMPLE * self.hfield.nrow * self.hfield.ncol,
+            where=f"Bullet's heightfield of {self.hfield.nrow} x {self.hfield.ncol} samples",
+        )
         xmin, xmax, ymin, ymax = surface.bounds
         self.bounds_m = tuple(self.length_scale_m * b for b in (xmin, xmax, ymin, ymax))
         self.z_range_m = RigModel._z_range_m(self)
