@@ -11,12 +11,8 @@ the same inputs run the same model (tested).
 
 Two rules live here:
 
-* a gridded surface (fractal, sandpaper, measured scan, a saved grid) keeps its own
-  samples as the hfield: ``hfield_resolution`` resamples analytic surfaces only. MuJoCo
-  then collides with the heights the streamline reads, and a resampling cannot leave
-  facets coarser than a small tip (a sandpaper resampled to an analytic surface's 151 a
-  side left 33 um facets under a 25 um tip). The rig still coarsens a grid finer than a
-  quarter tip radius (:meth:`Scales.for_surface`).
+* a gridded surface keeps its own samples as the hfield: ``hfield_resolution`` resamples
+  analytic surfaces only (:func:`~spine_mj.sim.scales.grid_keeps_samples`, the rule's home).
 * a drive given neither an inertia number, nor a speed, nor a force rate runs at
   ``I_e = DEFAULT_INERTIA_NUMBER`` (slow: quasistatic on the paper's surfaces).
 """
@@ -36,8 +32,8 @@ from spine_mj.sim.layout import Layout
 from spine_mj.sim.model import check_drive_on
 from spine_mj.sim.records import TipParams
 from spine_mj.sim.rig import Rig
-from spine_mj.sim.scales import Scales
-from spine_mj.surfaces import GridSurface, Surface
+from spine_mj.sim.scales import Scales, grid_keeps_samples
+from spine_mj.surfaces import Surface
 
 __all__ = [
     "DEFAULT_INERTIA_NUMBER",
@@ -293,7 +289,7 @@ def _sized(surface: Surface, tip: TipParams, length_scale_m, hfield_resolution, 
     """``(tip, scales, hfield)`` of ``tip`` on ``surface``: the tip with the radius the rig
     was sized for (a gridded surface keeps its own samples: ``hfield_resolution`` ignored),
     on the hfield refined ``hfield_refinement`` times with that radius kept."""
-    resolution = None if isinstance(surface, GridSurface) else hfield_resolution
+    resolution = grid_keeps_samples(surface, hfield_resolution)
     scales, hfield = Scales.with_hfield(
         surface, tip=tip, length_scale_m=length_scale_m, hfield_resolution=resolution
     )

@@ -418,6 +418,18 @@ def _refined_hfield(surface: Surface, hf: HField, resolution: int | None, refine
     return hfield_of(surface, resolution, int(refinement))
 
 
+def grid_keeps_samples(surface: Surface, resolution: int | None) -> int | None:
+    """The hfield resolution a rig of ``surface`` asks for: ``resolution`` for an analytic
+    surface, None for a gridded one (fractal, sandpaper, measured scan, a saved grid), which
+    keeps its own samples as the hfield. MuJoCo then collides with the heights the
+    streamline reads, and a resampling cannot leave facets coarser than a small tip (a
+    sandpaper resampled to an analytic surface's 151 a side left 33 um facets under a 25 um
+    tip). The rig still coarsens a grid finer than a quarter tip radius
+    (:meth:`Scales.with_hfield`). The one home of this rule: the rig, the sweep's configs and
+    the validation's measurements all ask here."""
+    return None if isinstance(surface, GridSurface) else resolution
+
+
 def hfield_of(surface: Surface, resolution: int | None = None, refinement: int = 1) -> HField:
     """The surface as MuJoCo hfield data, resampled to ``resolution`` a side when given,
     then refined ``refinement`` times.

@@ -29,7 +29,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from spine_mj import presets, sim
-from spine_mj.surfaces import GridSurface
+from spine_mj.sim.scales import grid_keeps_samples
 from spine_mj.theory import agreement
 from spine_mj.validate.intervals import wilson
 from spine_mj.validate.paths import stored_paths
@@ -173,7 +173,7 @@ def _radius_xy(fam: FamilySpec, preset: str) -> tuple[float, float]:
     scales = sim.Scales.for_surface(
         surface,
         tip=sim.TipParams(mass_kg=MASS_KG),
-        hfield_resolution=None if isinstance(surface, GridSurface) else 101,
+        hfield_resolution=grid_keeps_samples(surface, 101),
     )
     r = ENSEMBLE_RADIUS_LC * scales.char_length_m / scales.length_scale_m
     if fam.starts_table().get("frame") == "relative":

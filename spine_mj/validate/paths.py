@@ -16,7 +16,8 @@ import numpy as np
 
 from spine_mj import presets, sim, sweep
 from spine_mj.errors import SpineInputError
-from spine_mj.surfaces import GridSurface, TriangulatedSurface, from_hfield, to_hfield
+from spine_mj.sim.scales import grid_keeps_samples
+from spine_mj.surfaces import TriangulatedSurface, from_hfield, to_hfield
 from spine_mj.theory import agreement
 from spine_mj.theory import streamline as sl
 from spine_mj.validate.plans import MASS_KG
@@ -50,7 +51,7 @@ def tip_radius(preset: str, seeds, resolution: int) -> float:
     scales = sim.Scales.for_surface(
         surface,
         tip=sim.TipParams(mass_kg=MASS_KG),
-        hfield_resolution=None if isinstance(surface, GridSurface) else resolution,
+        hfield_resolution=grid_keeps_samples(surface, resolution),
     )
     return float(f"{scales.tip_radius_m / scales.length_scale_m:.3g}")
 
@@ -89,11 +90,8 @@ def triangulated_surface(surface, resolution: int | None) -> TriangulatedSurface
     resolution : int or None
         Samples a side of an analytic surface's hfield.
     """
-    hf = (
-        to_hfield(surface)
-        if (isinstance(surface, GridSurface) or not resolution)
-        else (to_hfield(surface, nrow=resolution, ncol=resolution))
-    )
+    resolution = grid_keeps_samples(surface, resolution)
+    hf = to_hfield(surface) if not resolution else to_hfield(surface, nrow=resolution, ncol=resolution)
     return TriangulatedSurface.from_grid(from_hfield(hf, unit=surface.unit))
 
 

@@ -12,8 +12,7 @@ from typing import Any
 
 from spine_mj import presets, sim, sweep
 from spine_mj.sim.drives import spring_stiffness_n_m
-from spine_mj.sim.scales import surface_unit_m
-from spine_mj.surfaces import GridSurface
+from spine_mj.sim.scales import grid_keeps_samples, surface_unit_m
 from spine_mj.validate.plans import MASS_KG, FamilySpec, ValidationPlan
 
 __all__ = [
@@ -91,7 +90,7 @@ def rig_engine(
     scales = sim.Scales.for_surface(
         surface,
         tip=sim.TipParams(tip_radius_m=None if tip is None else tip * unit_m, mass_kg=MASS_KG, mu_s=mu),
-        hfield_resolution=None if isinstance(surface, GridSurface) else hfield_resolution,
+        hfield_resolution=grid_keeps_samples(surface, hfield_resolution),
     )
     speed = sim.drive_speed_m_s(scales, ie=ie)
     spring = spring_stiffness_n_m(scales, stiffness_number=stiffness_number)
