@@ -240,15 +240,19 @@ def compliant_streamlines(
 
 
 def _kernel_surface(surface):
-    """The surface as :func:`spine_mj.theory._compliant_kernel.run_compliant` takes it, or None."""
+    """The surface as :func:`spine_mj.theory._compliant_kernel.run_compliant` takes it, or None.
+    Its arrays writable and contiguous whatever the surface's: a read-only one is another
+    numba type, and each type compiles the loop anew (~10-25 CPU-s)."""
     if isinstance(surface, BallOnFacets):
         if not surface.compiled:
             return None
-        return (_KIND_FACETS, np.zeros((5, 0)), np.zeros((1, 1)), np.zeros(8), *surface.kernel_args())
-    data = _surface_data(surface)
-    if data is None:
-        return None
-    return (*data, np.zeros((1, 1)), 0.0, 0.0, 1.0, 1.0, 0.0)
+        data = (_KIND_FACETS, np.zeros((5, 0)), np.zeros((1, 1)), np.zeros(8), *surface.kernel_args())
+    else:
+        data = _surface_data(surface)
+        if data is None:
+            return None
+        data = (*data, np.zeros((1, 1)), 0.0, 0.0, 1.0, 1.0, 0.0)
+    return tuple(np.require(v, float, ["C", "W"]) if isinstance(v, np.ndarray) else v for v in data)
 
 
 def _run_compiled(data, surface, xs, ys, params, c, carriage_end) -> CompliantResult:
