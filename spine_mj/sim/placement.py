@@ -17,7 +17,7 @@ PLACE_CACHE_SIZE = 4096  # placements kept per rig (by start)
 #: MuJoCo keeps at most this many contacts of one geom pair (``mjMAXCONPAIR``): a probe that
 #: finds as many may have lost its deepest one.
 MAX_PAIR_CONTACTS = 50
-_MARGIN_RADII = 0.2  # the probe's contact margin, in tip radii: a gap above the surface reads
+_MARGIN_RADII = 0.2  # the probe's contact margin [tip radii]: a gap reads as a positive distance
 
 
 class Placer:

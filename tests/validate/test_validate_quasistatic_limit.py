@@ -22,6 +22,7 @@ def _rows():
         {"miss_reason": "diverged", "reference_slide_fraction": 0.05, "miss_offset": 0.2},
         {"miss_reason": "diverged", "tip_peak_ie": 2 * FALL_IE_FACTOR * ie, "miss_offset": 0.3},
         {"miss_reason": "diverged", "miss_offset": 0.1},
+        {"miss_reason": "reference_stalled", "miss_offset": np.nan},
         {"miss_reason": ""},  # agrees
     ]
     return pd.DataFrame([{**base, "case_id": "c", "start": i, **r} for i, r in enumerate(rows)])
@@ -30,7 +31,16 @@ def _rows():
 def test_every_miss_gets_its_cause():
     comp = _rows()
     causes = [miss_cause(r) for _, r in comp.iloc[:-1].iterrows()]
-    assert causes == ["ill_conditioned", "wedge", "soft_contact", "soft_contact", "fall", "fall", "inertia"]
+    assert causes == [
+        "ill_conditioned",
+        "wedge",
+        "soft_contact",
+        "soft_contact",
+        "fall",
+        "fall",
+        "inertia",
+        "reference_stalled",
+    ]
     assert set(causes) == set(MISS_CAUSES)
 
 
@@ -40,4 +50,4 @@ def test_misses_record_each_miss_with_its_cause_by_reason():
     assert out["diverged"]["runs"] == 3 and out["diverged"]["offsets"] == [0.1, 0.2, 0.3]
     assert out["diverged"]["causes"] == {"fall": 2, "inertia": 1}
     assert [m["start"] for m in out["diverged"]["misses"]] == [4, 5, 6]
-    assert sum(r["runs"] for r in out.values()) == 7  # the agreeing run is no miss
+    assert sum(r["runs"] for r in out.values()) == 8  # the agreeing run is no miss
