@@ -150,16 +150,9 @@ def _display_grid(surface: Surface, max_points: int) -> GridSurface:
         return surface
     if isinstance(surface, GridSurface):
         sy, sx = (int(np.ceil(n / max_points)) for n in surface.shape)  # a narrow strip keeps its rows
-        return GridSurface(
-            heights=surface.heights[::sy, ::sx],
-            x=surface.x[::sx],
-            y=surface.y[::sy],
-            unit=surface.unit,
-        )
-    xmin, xmax, ymin, ymax = surface.bounds
-    long_side = max(xmax - xmin, ymax - ymin)
-    nx, ny = (max(4, round(max_points * side / long_side)) for side in (xmax - xmin, ymax - ymin))
-    return surface.sample(nx, ny)
+        return GridSurface(surface.heights[::sy, ::sx], surface.x[::sx], surface.y[::sy], unit=surface.unit)
+    sides = np.diff(surface.bounds)[::2]  # x and y extents
+    return surface.sample(*(max(4, round(max_points * side / sides.max())) for side in sides))
 
 
 def _axes_units(surface: Surface, grid: GridSurface) -> tuple[float, str, float, str]:

@@ -163,6 +163,7 @@ class _Root(_Group):
     lazy_commands: ClassVar[dict[str, str]] = {
         "array": "array",
         "examples": "examples",
+        "hold": "hold",
         "kappa": "theory",
         "replay": "sim",
         "report": "sweep",

@@ -174,9 +174,8 @@ class Scales:
         * ``char_length_m``: None gives :func:`characteristic_length` in metres.
         * tip radius (when ``tip.tip_radius_m`` is None): the surface's own ``metadata["params"]
           ["tip_radius_m"]`` (sandpaper); for a measured scan (a grid in a physical unit) the larger
-          of two lateral spacings and ``L_c / 100`` (the sphere rests on several facets, never in
-          one pixel); else the larger of one hfield spacing and ``L_c / 100``; at most the
-          domain's width over :data:`DEFAULT_TIP_RADII_ACROSS`; 3 significant digits.
+          of two lateral spacings and ``L_c / 100`` (the sphere rests on several facets); else of
+          one hfield spacing and ``L_c / 100``; at most the width / 8 (a narrow strip); 3 digits.
         * hfield resolution: an hfield finer than a quarter tip radius is coarsened to that (MuJoCo
           keeps at most 50 contacts per geom pair: a tip over too many cells loses its deepest
           contacts); then refined ``hfield_refinement`` times (:func:`hfield_of`)
@@ -203,9 +202,8 @@ class Scales:
             raise SpineInputError(f"hfield_resolution must be <= {MAX_HFIELD_SIDE} samples a side, got {res}")
         hf = hfield_of(surface, hfield_resolution)
         spacing = hfield_spacing(hf, length_scale_m)
-        radius = tip.tip_radius_m
         xmin, xmax, ymin, ymax = (length_scale_m * b for b in surface.bounds)
-        width = min(xmax - xmin, ymax - ymin)
+        width, radius = min(xmax - xmin, ymax - ymin), tip.tip_radius_m
         if radius is None:
             radius = default_tip_radius(surface, spacing, char_length_m, width_m=width)
         _check_sizes(radius, spacing, char_length_m, width, given=tip.tip_radius_m is not None)

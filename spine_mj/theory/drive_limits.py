@@ -511,14 +511,6 @@ def _grid_starts(surface: Surface, n: int, margin: float) -> np.ndarray:
     return np.array([(a, b) for b in ys for a in xs])
 
 
-def _limits_step(surface: Surface, slope_length: float) -> float:
-    """The streamline step of :func:`drive_limits`: ``l_s / 40``, at most an eighth of the
-    domain's narrower side (a narrow strip whose slopes vary slowly along it would
-    otherwise step across its width at once)."""
-    xmin, xmax, ymin, ymax = surface.bounds
-    return min(slope_length / 40, min(xmax - xmin, ymax - ymin) / 8)
-
-
 def drive_limits(
     surface: Surface,
     mu: float,
@@ -563,13 +555,11 @@ def drive_limits(
         raise SpineInputError(f"surface must be a spine_mj Surface, got {type(surface).__name__}")
     if isinstance(n_starts, bool) or not isinstance(n_starts, (int, np.integer)) or n_starts < 1:
         raise SpineInputError(f"n_starts must be an integer >= 1, got {n_starts!r}")
-    l_s = float(roughness.stiffness_length(surface))
-    l_c = float(roughness.characteristic_length(surface))
+    l_s, l_c = float(roughness.stiffness_length(surface)), float(roughness.characteristic_length(surface))
     traced = sl.dilate(surface, tip_radius) if tip_radius > 0 else surface
     pts = _grid_starts(traced, int(n_starts), 0.05) if starts is None else starts
-    params = sl.StreamlineParams(
-        mu=mu, dl=_limits_step(traced, l_s) if dl is None else dl, kappa_cap=kappa_cap
-    )
+    dl = min(l_s / 40, min(np.diff(traced.bounds)[::2]) / 8) if dl is None else dl  # 1/8 of a strip's width
+    params = sl.StreamlineParams(mu=mu, dl=dl, kappa_cap=kappa_cap)
     res = sl.streamlines(traced, pts, params, store_paths=True)
     max_fall, max_curv, arrival = _path_statistics(traced, res, mu, kappa_cap)
     trapped = res.self_locked

@@ -1,0 +1,41 @@
+"""``spine-mj hold``'s refusals: one Error line, exit code 2, nothing written."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from spine_mj.cli import main
+
+
+def _refused(args, out):
+    res = CliRunner().invoke(main, ["hold", *args, "--out", str(out)])
+    assert res.exit_code == 2, res.output
+    lines = [line for line in res.output.splitlines() if line.strip()]
+    assert len(lines) == 1 and lines[0].startswith("Error: ") and "Traceback" not in res.output
+    assert not out.exists()
+    return lines[0]
+
+
+@pytest.mark.parametrize(
+    ("args", "match"),
+    [
+        (["paper-single-peak", "--mu", "nan"], "--mu"),
+        (["paper-single-peak", "--starts", "0"], "--starts must be an integer >= 1, got 0"),
+        (["no-such-surface.npz", "--mu", "0.5"], "no-such-surface.npz"),
+    ],
+)
+def test_bad_input_is_one_error_line_and_nothing_written(tmp_path, args, match):
+    assert match in _refused(args, tmp_path / "out")
+
+
+def test_a_tip_too_wide_for_a_narrow_strip_is_refused_with_the_users_number(tmp_path):
+    from spine_mj.surface_io import save_surface
+    from spine_mj.surfaces import GridSurface
+
+    x, y = np.linspace(0, 50, 1001), np.linspace(0, 1, 9)
+    strip = GridSurface(heights=0.2 * np.sin(x)[None, :] * np.ones((9, 1)), x=x, y=y)
+    path = save_surface(strip, tmp_path / "strip.npz")
+    line = _refused([str(path), "--mu", "0.5", "--tip-radius", "0.6"], tmp_path / "out")
+    assert "tip_radius_m 0.006 m is larger than the surface" in line

@@ -1,0 +1,76 @@
+"""spine-mj hold's library (spine_mj.validate.hold): the summary it writes, and a run killed
+between two levels that resumes from its stores."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import pytest
+from click.testing import CliRunner
+
+from spine_mj.cli import main
+from spine_mj.errors import SpineInputError
+from spine_mj.surface_io import save_surface
+from spine_mj.surfaces import single_gaussian
+from spine_mj.validate.hold import MIN_PAIRED_STARTS, HoldSettings, hold_to
+
+
+class _Killed(Exception):
+    pass
+
+
+@pytest.mark.slow
+def test_a_killed_hold_resumes_from_its_stores_and_writes_every_key(tmp_path):
+    """Killed as its first refinement starts, a hold leaves no summary; run again (from
+    the CLI), it reruns none of its corner's MuJoCo cases and writes the summary's keys."""
+    path = save_surface(single_gaussian(), tmp_path / "bump.npz")
+    out = tmp_path / "hold"
+
+    def kill(p):
+        if p.step == "dt_halved":
+            raise _Killed
+
+    settings = HoldSettings(mu=0.8, starts=2, reference_starts=12)
+    with pytest.raises(_Killed):
+        hold_to(single_gaussian(), out, settings, workers=1, progress=kill)
+    assert not (out / "summary.json").exists() and not (out / "report.md").exists()
+    base = sorted((out / "sweeps" / "base").glob("*/*.parquet"))  # the cases' runs and trajectories
+    assert len(base) >= 2
+    stamps = {p: p.stat().st_mtime_ns for p in base}
+
+    args = ["hold", str(path), "--mu", "0.8", "--out", str(out), "--starts", "2", "--reference-starts", "12"]
+    res = CliRunner().invoke(main, [*args, "--workers", "1", "--quiet"])
+    assert res.exit_code == 0, res.output
+    assert {p: p.stat().st_mtime_ns for p in base} == stamps  # the corner's cases were not run again
+    s = json.loads((out / "summary.json").read_text())
+    assert set(s["corner"]) >= {"ie", "K"} and s["corner"]["ie"] > 0 and s["corner"]["K"] > 0
+    assert set(s["self_lock_share"]) >= {"value", "low", "high", "n"} and s["self_lock_share"]["n"] == 12
+    assert set(s["agreement"]) >= {"value", "low", "high", "n_well_conditioned"}
+    share = s["self_lock_share"]
+    assert share["low"] <= share["value"] <= share["high"]
+    assert [r["level"] for r in s["refinements"]][:1] == ["dt / 2"]
+    assert all("change" in r for r in s["refinements"] if r["run"])
+    # two starts cannot make a verdict: the rule asks for 30 paired ones
+    assert s["converged"] is False and f"fewer than the {MIN_PAIRED_STARTS}" in s["why_unconverged"]
+    assert s["verdict"] in res.output and s["verdict"].endswith(".")
+    assert (out / "report.md").read_text().startswith("# Will a spine hold") and (
+        out / "hold.png"
+    ).stat().st_size
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"starts": 0}, "--starts must be an integer >= 1, got 0"),
+        (
+            {"starts": 20, "reference_starts": 10},
+            r"--reference-starts \(10\) must be at least --starts \(20\)",
+        ),
+        ({"budget_s": math.nan}, "--budget must be a finite number of seconds > 0, got nan"),
+        ({"tip_radius": -1.0}, "--tip-radius must be a finite number > 0, got -1.0"),
+    ],
+)
+def test_bad_settings_are_refused_by_the_options_name(kwargs, match):
+    with pytest.raises(SpineInputError, match=match):
+        HoldSettings(mu=0.5, **kwargs)
