@@ -119,3 +119,28 @@ def test_bad_landscapes_are_refused():
         Landscape.from_profile(x[::-1], np.zeros(10), x, MU)
     with pytest.raises(SpineInputError):
         overdamped_slips(_corrugation(16), -1.0)
+
+
+def _running_max_slips(land, k):
+    """The obvious overdamped reference: the slips are the excursions of g below its running
+    maximum, each landing where g first climbs back to the level it left."""
+    u = land.positions
+    g = land.force + k * (u - u[0])
+    below = g < np.maximum.accumulate(g)
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], below.astype(int), [0]])))
+    sizes = []
+    for a, b in zip(edges[0::2], edges[1::2]):  # g[a:b] below the level g[a - 1]
+        if b >= g.size:
+            break
+        level = g[a - 1]
+        land_u = u[b - 1] + (level - g[b - 1]) / (g[b] - g[b - 1]) * land.spacing
+        sizes.append(land_u - u[a - 1])
+    return np.array(sizes)
+
+
+def test_overdamped_walk_is_the_running_maximum_rule():
+    land, _ = _abbm_landscape(points=20_000, seed=4)
+    for k in (3e-4, 3e-3):
+        np.testing.assert_allclose(
+            overdamped_slips(land, k).size, _running_max_slips(land, k), rtol=1e-9, atol=1e-9
+        )
