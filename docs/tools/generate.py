@@ -39,6 +39,7 @@ FAMILY_NAMES = {
     "random_gaussian": "random Gaussian",
     "fractal": "fractal",
     "sandpaper": "sandpaper",
+    "measured": "measured (shipped scans)",
 }
 
 
@@ -129,27 +130,42 @@ def load_validation(folder: str) -> dict | None:
 def headline_table(validation: dict) -> list[str]:
     """The headline verdicts as Markdown lines: per family of the quasistatic corner the
     agreement on well-conditioned starts and the median Frechet distance with their 95 %
-    intervals, and whether the target is met."""
+    intervals, and whether the target is met, at the family's own corner (I_e, K). A number
+    that refinement moved outside its interval is not quoted: the cell says so."""
     cols = [
         "family",
+        "corner (I_e, K)",
         "agreement [95 % CI]",
         "well-conditioned / starts",
         "median Frechet / L_c [95 % CI]",
         "target",
         "under refinement",
     ]
-    rows = ["| " + " | ".join(cols) + " |", "|---|---|---|---|---|---|"]
+    rows = ["| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
     for key, fam in validation.get("limit_families", {}).items():
+        verdict = refinement_verdict(validation, key)
+        unconverged = verdict.startswith("unconverged")
+        corner = fam.get("corner") or (validation.get("corner") or {}).get(key)
+        if corner:
+            at = f"{_num(corner.get('ie'), 2)}, {_num(corner.get('K'), 2)}"
+        else:
+            at = f"{_num(validation.get('lowest_ie'))}, 30 (fixed)"
+        hidden = "not quoted (unconverged)"
         rows.append(
             "| "
             + " | ".join(
                 [
                     FAMILY_NAMES.get(key, key),
-                    _num(fam.get("agreement_well_conditioned")) + _ci(fam.get("agreement_ci")),
+                    at,
+                    hidden
+                    if unconverged
+                    else _num(fam.get("agreement_well_conditioned")) + _ci(fam.get("agreement_ci")),
                     f"{fam.get('well_conditioned_runs', '-')} / {fam.get('starts', fam.get('runs', '-'))}",
-                    _num(fam.get("median_frechet")) + _ci(fam.get("median_frechet_ci")),
-                    "met" if fam.get("meets_target") else "not met",
-                    refinement_verdict(validation, key),
+                    hidden
+                    if unconverged
+                    else _num(fam.get("median_frechet")) + _ci(fam.get("median_frechet_ci")),
+                    "no verdict" if unconverged else ("met" if fam.get("meets_target") else "not met"),
+                    verdict,
                 ]
             )
             + " |"

@@ -31,11 +31,21 @@ def table() -> str:
         [
             *generate.headline_table(validation),
             "",
-            f"Full plan of `spine-mj validate` at the quasistatic corner (I_e = "
-            f"{generate._num(validation.get('lowest_ie'))}), MuJoCo {plat.get('mujoco', '?')}; "
+            "Full plan of `spine-mj validate`, each family at "
+            + (
+                "its own quasistatic corner (I_e, K = k l_s / F_p: K ten times its predicted "
+                "K_path, I_e a tenth of its I_e* or less, the spring's swing at most 1 F_p; "
+                "`theory.drive_limits.quasistatic_corner`)"
+                if validation.get("corner")
+                else f"the fixed I_e = {generate._num(validation.get('lowest_ie'))} and K = 30 "
+                "(a report made before each family had its own corner)"
+            )
+            + f", MuJoCo {plat.get('mujoco', '?')}; "
             "agreement over the well-conditioned starts with its 95 % Wilson interval, the "
             "median Frechet distance with its bootstrap interval; under refinement: the "
-            "solution verification (step halved, hfield doubled)"
+            "solution verification (step halved and quartered, hfield doubled (and quadrupled on "
+            "gridded surfaces), tolerance / 100; a number a refinement moved outside its "
+            "interval is not quoted)"
             + (
                 "."
                 if validation.get("convergence")

@@ -246,7 +246,7 @@ def quasistatic_corner(
     }
     ie_bound = min(bounds, key=bounds.get)
     scale = 10.0 ** math.floor(math.log10(bounds[ie_bound]))
-    ie = math.floor(bounds[ie_bound] / scale * (1 + 1e-12)) * scale
+    ie = float(f"{math.floor(bounds[ie_bound] / scale * (1 + 1e-12)) * scale:.1g}")
     swing_fp = math.sqrt(ie * k * lc_over_ls)
     why = {
         "I_e*": f"I_e* {ie_star:.3g}{f' ({ie_limit})' if ie_limit else ''} / {margin:g}",

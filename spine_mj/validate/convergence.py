@@ -34,7 +34,11 @@ plus that change lies inside the headline's own 95 % interval (Wilson for the ag
 bootstrap for the median): the refinement moves it less than the sample already leaves
 open; or when the change is below what the metric resolves (:data:`RESOLUTIONS`). With
 three step levels the observed order and the Richardson estimate follow
-(:func:`observed_order`, :func:`richardson`).
+(:func:`observed_order`, :func:`richardson`), with Roache's grid convergence index
+(:func:`gci`); the same of three hfield levels where a gridded surface is refined four
+times too (``hfield_quadrupled``, through the same interpolant). Where three levels are run
+a headline is converged only when its *last* change (finest level minus the middle one)
+also lies inside its interval (:func:`family_convergence`).
 """
 
 from __future__ import annotations
@@ -52,15 +56,18 @@ from spine_mj.validate.plans import FamilySpec
 from spine_mj.validate.theory_orders import FRECHET_FLOOR_LC
 
 __all__ = [
+    "GRID_ONLY",
     "HEADLINES",
     "JUDGED",
     "REFINEMENTS",
     "REFINEMENT_LABELS",
     "family_convergence",
+    "gci",
     "headline_convergence",
     "is_converged",
     "observed_order",
     "paired_change",
+    "quoted",
     "refinement_note",
     "richardson",
     "thin_starts",
@@ -73,6 +80,7 @@ REFINEMENTS: dict[str, tuple[tuple[str, Any], ...]] = {
     "dt_halved": (("timestep_factor", 0.5),),
     "dt_quartered": (("timestep_factor", 0.25),),
     "hfield_doubled": (("hfield_factor", 2),),
+    "hfield_quadrupled": (("hfield_factor", 4),),
     "tolerance_tightened": (("tolerance", 1e-10), ("noslip_tolerance", 1e-8)),
 }
 
@@ -81,6 +89,7 @@ REFINEMENT_LABELS = {
     "dt_halved": "dt / 2",
     "dt_quartered": "dt / 4",
     "hfield_doubled": "hfield x 2",
+    "hfield_quadrupled": "hfield x 4",
     "tolerance_tightened": "tolerance / 100",
 }
 
@@ -137,6 +146,34 @@ def richardson(fine: float, medium: float, order: float, *, ratio: float = 2.0) 
     if not (math.isfinite(order) and order > 0):
         return math.nan
     return fine + (fine - medium) / (ratio**order - 1.0)
+
+
+#: Refinements only a gridded surface gets (through its interpolant; an analytic surface's
+#: hfield at four times its samples a side is 16 times the facets for no new geometry).
+GRID_ONLY = ("hfield_quadrupled",)
+
+#: Three-level series: (coarse-to-medium refinement, medium-to-fine refinement, key of the
+#: order in ``validation.json``). The levels are the corner's runs and the two refinements.
+SERIES = (("dt_halved", "dt_quartered", "dt_order"), ("hfield_doubled", "hfield_quadrupled", "hfield_order"))
+
+#: The formal orders the GCI assumes where no order is observed (Roache's two-level
+#: estimate): semi-implicit Euler's path error is first order in dt (docs/physics.md §7);
+#: a tip riding a facet edge instead of the surface errs by first order in the facet size.
+FORMAL_ORDER = 1.0
+#: Roache's safety factors: three levels that give an observed order, two levels.
+GCI_SAFETY = {3: 1.25, 2: 3.0}
+
+
+def gci(fine: float, medium: float, order: float, *, ratio: float = 2.0) -> float:
+    """Roache's grid convergence index ``Fs |(f1 - f2) / f1| / (r^p - 1)`` (docs/physics.md
+    §7): the relative band about the finest value ``fine``. ``Fs`` 1.25 with an observed
+    ``order``; with NaN (two levels, or three that gave none) 3 and :data:`FORMAL_ORDER`.
+    NaN where ``fine`` is 0 or either value is not finite."""
+    if not (math.isfinite(fine) and math.isfinite(medium)) or fine == 0:
+        return math.nan
+    observed = math.isfinite(order) and order > 0
+    p, fs = (order, GCI_SAFETY[3]) if observed else (FORMAL_ORDER, GCI_SAFETY[2])
+    return fs * abs((fine - medium) / fine) / (ratio**p - 1.0)
 
 
 def is_converged(
@@ -267,17 +304,37 @@ def family_convergence(summary: dict, base: pd.DataFrame, refined: dict[str, pd.
         verdicts = [entry[f"{headline}_converged"] for headline in JUDGED]
         entry["converged"] = None if any(v is None for v in verdicts) else all(verdicts)
         out[key] = entry
-    if out.get("dt_halved", {}).get("refined") and out.get("dt_quartered", {}).get("refined"):
-        out["dt_order"] = {
-            headline: _step_order(
-                out["dt_halved"][headline]["base"],
-                out["dt_halved"][headline]["refined"],
-                out["dt_quartered"][headline]["refined"],
-            )
-            for headline in HEADLINES
-        }
+    for medium_key, fine_key, order_key in SERIES:
+        medium, fine = out.get(medium_key, {}), out.get(fine_key, {})
+        if medium.get("refined") and fine.get("refined"):
+            out[order_key] = {
+                h: _step_order(medium[h]["base"], medium[h]["refined"], fine[h]["refined"]) for h in HEADLINES
+            }
+            _judge_last_change(summary, medium, fine)
+        elif medium.get("refined"):
+            out[order_key] = {
+                h: {
+                    "order": math.nan,
+                    "richardson": math.nan,
+                    "gci": gci(medium[h]["refined"], medium[h]["base"], math.nan),
+                }
+                for h in HEADLINES
+            }
     out["converged"] = _overall(out)
     return out
+
+
+def _judge_last_change(summary: dict, medium: dict, fine: dict) -> None:
+    """Judge the last change of a three-level series, the finest level minus the middle one
+    (paired on their own starts), and make ``fine``'s verdict need it as well."""
+    fine["last_change"] = {}
+    for headline, ci_key in HEADLINES.items():
+        last = fine[headline]["refined"] - medium[headline]["refined"]
+        ok = is_converged(summary[headline], last, summary[ci_key], resolution=RESOLUTIONS[headline])
+        fine["last_change"][headline] = last
+        fine[f"{headline}_last_converged"] = ok
+    verdicts = [fine[f"{h}_converged"] for h in JUDGED] + [fine[f"{h}_last_converged"] for h in JUDGED]
+    fine["converged"] = None if any(v is None for v in verdicts) else all(verdicts)
 
 
 def headline_convergence(
@@ -351,9 +408,9 @@ def headline_convergence(
 
 
 def _step_order(coarse: float, medium: float, fine: float) -> dict:
-    """The observed order of three step levels and the Richardson estimate."""
+    """The observed order of three levels, the Richardson estimate and the GCI."""
     p = observed_order(fine, medium, coarse)
-    return {"order": p, "richardson": richardson(fine, medium, p)}
+    return {"order": p, "richardson": richardson(fine, medium, p), "gci": gci(fine, medium, p)}
 
 
 def _overall(entries: dict) -> bool | None:
@@ -371,6 +428,14 @@ def unconverged_mark(convergence: dict | None, headline: str | None = None) -> s
     (:func:`headline_convergence`, ``headline`` None)."""
     moved = _judged(convergence, headline, False)
     return f" (unconverged: {', '.join(moved)})" if moved else ""
+
+
+def quoted(text: str, convergence: dict | None, headline: str | None = None) -> str:
+    """``text`` (a headline as written) where no refinement moved it, else ``"not quoted
+    (unconverged: dt / 2, ...)"`` in its place: an unconverged number is never quoted
+    (arguments as for :func:`unconverged_mark`)."""
+    mark = unconverged_mark(convergence, headline)
+    return f"not quoted{mark}" if mark else text
 
 
 def refinement_note(convergence: dict | None, headline: str | None = None) -> str:

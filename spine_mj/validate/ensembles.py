@@ -169,7 +169,7 @@ def _radius_xy(fam: FamilySpec, preset: str) -> tuple[float, float]:
     frame (surface units, or fractions of the bounds in the relative frame)."""
     kw = {} if fam.seeds is None else {"seed": fam.seeds[0]}
     kw.update(dict(fam.variants[0]))
-    surface = presets.make_surface(preset, **kw)
+    surface = presets.open_surface(preset, **kw)
     scales = sim.Scales.for_surface(
         surface,
         tip=sim.TipParams(mass_kg=MASS_KG),

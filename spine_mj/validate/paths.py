@@ -41,13 +41,13 @@ def tip_radius(preset: str, seeds, resolution: int) -> float:
     Parameters
     ----------
     preset : str
-        The surface's preset.
+        The surface's preset, or a surface file (``example:NAME``: :func:`spine_mj.presets.open_surface`).
     seeds : sequence of int or None
         Its seeds: the first one's surface is measured (None: the preset's seed).
     resolution : int
         Samples a side of an analytic surface's hfield.
     """
-    surface = presets.make_surface(preset, **({} if seeds is None else {"seed": seeds[0]}))
+    surface = presets.open_surface(preset, **({} if seeds is None else {"seed": seeds[0]}))
     scales = sim.Scales.for_surface(
         surface,
         tip=sim.TipParams(mass_kg=MASS_KG),

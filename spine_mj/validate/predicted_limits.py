@@ -25,11 +25,24 @@ import math
 import numpy as np
 
 from spine_mj import presets
-from spine_mj.theory.drive_limits import drive_limits
+from spine_mj.theory.drive_limits import drive_limits, quasistatic_corner
 from spine_mj.validate.paths import tip_radius
 from spine_mj.validate.plans import FamilySpec, ValidationPlan
 
-__all__ = ["family_k_axis", "family_limits", "k_ladder", "path_starts"]
+__all__ = [
+    "CORNER_GRID_STARTS",
+    "CORNER_PATH_STARTS",
+    "family_corner",
+    "family_k_axis",
+    "family_limits",
+    "k_ladder",
+    "path_starts",
+]
+
+#: Starts a side of the grid whose paths give a corner's ``I_e*`` (:func:`family_corner`).
+CORNER_GRID_STARTS = 6
+#: Most starts a corner's ``K_path`` is read on: the family's y range respread over them.
+CORNER_PATH_STARTS = 10
 
 
 def path_starts(fam: FamilySpec, surface, n: int) -> np.ndarray:
@@ -76,6 +89,59 @@ def family_limits(plan: ValidationPlan, fam: FamilySpec, *, n_starts: int = 8) -
         "limit": worst["limit"],
         "presets": per,
     }
+
+
+def family_corner(plan: ValidationPlan, fam: FamilySpec) -> dict:
+    """The quasistatic corner ``fam`` is judged at (:func:`~spine_mj.theory.drive_limits.quasistatic_corner`)
+    from its own predicted limits on every preset and generator variant at the first seed
+    (a generator's seeds are replicas of one roughness; its variants, a Hurst exponent, are
+    not): the lowest ``I_e*``, the highest ``K_path`` (on at most
+    :data:`CORNER_PATH_STARTS` of the family's starts, its y range respread, each carriage
+    stopping where a run's does) and ``L_c / l_s``, traced with the rig's tip and the
+    family's mu_s; paths from a :data:`CORNER_GRID_STARTS` square grid.
+
+    Returns
+    -------
+    dict
+        ``corner`` (:meth:`~spine_mj.theory.drive_limits.Corner.as_dict`: ``ie``, ``K``,
+        ``swing_fp``, ...) and ``surfaces``: per surface label its ``ie_star``, ``limit``,
+        ``k_star``, ``k_path`` and ``lc_over_ls``.
+    """
+    seed = fam.seeds[0] if fam.seeds else None
+    n_path = min(len(fam.starts_table()["y"]), CORNER_PATH_STARTS)
+    per = {}
+    for preset in fam.presets:
+        mu = fam.mu if fam.mu is not None else presets.calibrated_mu(preset)
+        tip = tip_radius(preset, None if seed is None else (seed,), plan.hfield_resolution)
+        for variant in fam.variants or ((),):
+            surface = presets.open_surface(
+                preset, **dict(variant, **({} if seed is None else {"seed": seed}))
+            )
+            d = drive_limits(
+                surface,
+                mu,
+                tip_radius=tip,
+                n_starts=CORNER_GRID_STARTS,
+                path_starts=path_starts(fam, surface, n_path),
+                carriage_edge=surface.bounds[1],
+            )
+            label = preset + "".join(f" {k}={v}" for k, v in variant)
+            per[label] = {
+                "ie_star": d.ie_star,
+                "limit": d.limit,
+                "k_star": d.k_star,
+                "k_path": d.k_path,
+                "lc_over_ls": d.char_length / d.slope_length,
+            }
+    worst = min(per.values(), key=lambda v: v["ie_star"])
+    corner = quasistatic_corner(
+        ie_star=worst["ie_star"],
+        k_path=max(v["k_path"] for v in per.values()),
+        k_star=max(v["k_star"] for v in per.values()),
+        lc_over_ls=max(v["lc_over_ls"] for v in per.values()),
+        ie_limit=worst["limit"],
+    )
+    return {"corner": corner.as_dict(), "surfaces": per}
 
 
 def family_k_axis(predicted: dict, factors) -> list[float]:

@@ -14,13 +14,15 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from spine_mj.presets import calibrated_mu
+from spine_mj.presets import calibrated_mu, open_surface
+from spine_mj.surfaces import GridSurface
 from spine_mj.theory.agreement import MISS_REASONS
-from spine_mj.validate.convergence import REFINEMENTS, family_convergence, thin_starts
+from spine_mj.validate.convergence import GRID_ONLY, REFINEMENTS, family_convergence, thin_starts
 from spine_mj.validate.ensembles import ensemble_family, ensemble_groups, ensemble_verdicts
 from spine_mj.validate.intervals import bootstrap, meets_target, wilson
 from spine_mj.validate.paths import stored_paths, tip_radius
 from spine_mj.validate.plans import FRECHET_TARGET, OUTCOME_TARGET, RECOMMENDED, FamilySpec, ValidationPlan
+from spine_mj.validate.predicted_limits import family_corner
 from spine_mj.validate.study_runner import StudyRunner
 from spine_mj.validate.sweep_configs import engine_grid, family_doc
 
@@ -108,6 +110,7 @@ class QuasistaticLimitResult:
     paths : dict
         Preset of the single peak/valley family -> list of :class:`LimitPath`.
     lowest_ie : float
+        The lowest I_e of the families' corners.
     convergence : dict
         Family -> its solution verification
         (:func:`~spine_mj.validate.convergence.family_convergence`): per refinement
@@ -121,12 +124,15 @@ class QuasistaticLimitResult:
     paths: dict[str, list[LimitPath]]
     lowest_ie: float
     convergence: dict = field(default_factory=dict)
+    corners: dict = field(default_factory=dict)
 
     def validation_keys(self) -> dict:
         """This study's keys of ``validation.json``."""
         fams = self.families
         return {
             "lowest_ie": self.lowest_ie,
+            "corner": {k: {"ie": v["corner"]["ie"], "K": v["corner"]["K"]} for k, v in self.corners.items()},
+            "corner_limits": self.corners,
             "outcome_agreement_at_lowest_ie": {k: v["outcome_agreement"] for k, v in fams.items()},
             "mean_frechet_at_lowest_ie": {k: v["mean_frechet"] for k, v in fams.items()},
             "median_frechet_at_lowest_ie": {k: v["median_frechet"] for k, v in fams.items()},
@@ -144,11 +150,16 @@ class QuasistaticLimitResult:
             "paths": {k: [p.as_dict() for p in v] for k, v in self.paths.items()},
             "lowest_ie": self.lowest_ie,
             "convergence": self.convergence,
+            "corners": self.corners,
         }
 
 
 def quasistatic_limit(plan: ValidationPlan, runner: StudyRunner) -> QuasistaticLimitResult:
-    """Study 2: spring drive at the lowest I_e against the streamline, per surface family.
+    """Study 2: spring drive at each family's own quasistatic corner against the streamline.
+
+    Each family runs at the corner ``(I_e, K)`` its own predicted limits give
+    (:func:`~spine_mj.validate.predicted_limits.family_corner`, the rule
+    :func:`~spine_mj.theory.drive_limits.quasistatic_corner`), its refinements too.
 
     For every run, three comparisons from the sweep's ``compare`` analysis (lengths over
     L_c): MuJoCo against the streamline traced on the surface its tip touches (the rig's
@@ -172,9 +183,14 @@ def quasistatic_limit(plan: ValidationPlan, runner: StudyRunner) -> QuasistaticL
     runner.study = "limit"
     families, runs_rows, paths = {}, [], {}
     corner = [plan.corner_family(fam) for fam in plan.families]
-    docs = [(fam, name, doc) for fam in corner for name, doc in limit_family_docs(plan, fam)]
-    variations = _variation_docs(plan)
-    refinements = _refinement_docs(plan, corner)
+    corners = {}
+    for fam in corner:
+        with runner.phase(f"the quasistatic corner of {fam.name}"):
+            corners[fam.name] = family_corner(plan, fam)
+    at = {name: c["corner"] for name, c in corners.items()}
+    docs = [(fam, name, doc) for fam in corner for name, doc in limit_family_docs(plan, fam, at[fam.name])]
+    variations = _variation_docs(plan, at[corner[0].name])
+    refinements = _refinement_docs(plan, corner, at)
     # every sweep of the study at once: the workers stay busy across the sweeps' ends
     done = runner.many(
         [(doc, f"limit/{name}") for _, name, doc in docs]
@@ -192,6 +208,7 @@ def quasistatic_limit(plan: ValidationPlan, runner: StudyRunner) -> QuasistaticL
         allc["well_conditioned"] = [
             well.get(f"{c}/{int(s)}", False) for c, s in zip(allc["case_id"], allc["start"])
         ]
+        summ["corner"] = at[fam.name]
         families[fam.name] = summ
         if plan.convergence_starts > 0:
             refined = _refined_rows(fam.name, plan.convergence_refinements, refinements, refined_done)
@@ -205,8 +222,9 @@ def quasistatic_limit(plan: ValidationPlan, runner: StudyRunner) -> QuasistaticL
         runs=runs_rows,
         variations=_variations(plan, variations, done[len(docs) : len(docs) + len(variations)], runs_rows),
         paths=paths,
-        lowest_ie=plan.lowest_ie,
+        lowest_ie=min(c["ie"] for c in at.values()),
         convergence=convergence,
+        corners=corners,
     )
 
 
@@ -282,21 +300,33 @@ def _limit_summary(allc: pd.DataFrame, groups: list[dict]) -> dict:
     return summ
 
 
-def _refinement_docs(plan: ValidationPlan, corner: list[FamilySpec]) -> list[tuple[str, str, str, dict]]:
+def _refinement_docs(
+    plan: ValidationPlan, corner: list[FamilySpec], at: dict | None = None
+) -> list[tuple[str, str, str, dict]]:
     """``(family, refinement key, store name, config)`` of every refinement of every corner
     family's thinned starts (:func:`~spine_mj.validate.convergence.thin_starts`), one per
-    preset (a gridded surface's hfield is refined through its interpolant,
-    :func:`spine_mj.surfaces.refine_grid`)."""
+    preset, at the family's corner ``at[family]`` (a gridded surface's hfield is refined
+    through its interpolant, :func:`spine_mj.surfaces.refine_grid`)."""
     if plan.convergence_starts <= 0:
         return []
     out = []
     for fam in corner:
-        thin = thin_starts(fam, plan.convergence_starts)
+        surfaces = len(fam.presets) * len(fam.seeds or (None,)) * len(fam.variants)
+        thin = thin_starts(fam, -(-plan.convergence_starts // surfaces))
         for key in plan.convergence_refinements:
             for preset in fam.presets:
-                doc = limit_doc(plan, thin, preset, f"limit-refined-{key}-{preset}", REFINEMENTS[key])
+                if key in GRID_ONLY and not _gridded(preset, fam):
+                    continue
+                name = f"limit-refined-{key}-{preset}"
+                doc = limit_doc(plan, thin, preset, name, REFINEMENTS[key], (at or {}).get(fam.name))
                 out.append((fam.name, key, f"limit-refined/{key}/{preset}", doc))
     return out
+
+
+def _gridded(preset: str, fam: FamilySpec) -> bool:
+    """Whether ``preset`` (at ``fam``'s first seed) is a grid (:class:`~spine_mj.surfaces.GridSurface`)."""
+    seed = {} if fam.seeds is None else {"seed": fam.seeds[0]}
+    return isinstance(open_surface(preset, **seed, **dict(fam.variants[0])), GridSurface)
 
 
 def _refined_rows(family: str, keys, refinements, results) -> dict[str, pd.DataFrame | None]:
@@ -313,9 +343,14 @@ def _refined_rows(family: str, keys, refinements, results) -> dict[str, pd.DataF
     return out
 
 
-def limit_doc(plan: ValidationPlan, fam: FamilySpec, preset: str, name: str, overrides=()) -> dict:
-    """The sweep config of one preset of ``fam`` at the lowest I_e with the rig's tip on
-    both sides (``overrides``: an engine variation)."""
+def limit_doc(
+    plan: ValidationPlan, fam: FamilySpec, preset: str, name: str, overrides=(), corner: dict | None = None
+) -> dict:
+    """The sweep config of one preset of ``fam`` at its ``corner`` (``{"ie", "K"}``; None:
+    the plan's ``lowest_ie`` and the default spring, the engines' cross-check's corner) with
+    the rig's tip on both sides (``overrides``: an engine variation)."""
+    ie = plan.lowest_ie if corner is None else float(corner["ie"])
+    k = None if corner is None else float(corner["K"])
     res = dict(overrides).get("hfield_resolution", plan.hfield_resolution)
     tip = tip_radius(preset, fam.seeds, res)
     mu = fam.mu if fam.mu is not None else calibrated_mu(preset)
@@ -323,7 +358,7 @@ def limit_doc(plan: ValidationPlan, fam: FamilySpec, preset: str, name: str, ove
         "mu": mu,
         "tip_radius": tip,
         "dl": tip / 2,
-        **engine_grid(plan, overrides, preset, fam.seeds, tip, mu=mu, ie=plan.lowest_ie),
+        **engine_grid(plan, overrides, preset, fam.seeds, tip, mu=mu, ie=ie, stiffness_number=k),
     }
     members = plan.ensemble_members if not overrides else 1
     if members > 1:
@@ -333,7 +368,7 @@ def limit_doc(plan: ValidationPlan, fam: FamilySpec, preset: str, name: str, ove
         fam,
         name=name,
         preset=preset,
-        drive={"protocol": "spring", "ie": plan.lowest_ie},
+        drive={"protocol": "spring", "ie": ie, **({} if k is None else {"K": k})},
         grid=grid,
         miss_reasons=not overrides,
     )
@@ -342,12 +377,16 @@ def limit_doc(plan: ValidationPlan, fam: FamilySpec, preset: str, name: str, ove
     return doc
 
 
-def limit_family_docs(plan: ValidationPlan, fam: FamilySpec) -> list[tuple[str, dict]]:
+def limit_family_docs(
+    plan: ValidationPlan, fam: FamilySpec, corner: dict | None = None
+) -> list[tuple[str, dict]]:
     """The sweeps of ``fam``'s corner as ``(name, config)``: one for the whole family where
     its presets share one grid (mu, tip radius, engine: so its cases share the workers, and
     one heavy case of one preset does not leave a core idle while the next preset waits),
-    else one per preset (:func:`limit_doc`)."""
-    docs = [(preset, limit_doc(plan, fam, preset, f"limit-{preset}")) for preset in fam.presets]
+    else one per preset (:func:`limit_doc`, at ``corner``)."""
+    docs = [
+        (preset, limit_doc(plan, fam, preset, f"limit-{preset}", corner=corner)) for preset in fam.presets
+    ]
     first = docs[0][1]
     own_starts = all("starts" in e for _, d in docs for e in d["surfaces"])
     if len(docs) == 1 or not (own_starts and all(d["grid"] == first["grid"] for _, d in docs)):
@@ -410,16 +449,20 @@ def _sweep_comparison(
     return comp
 
 
-def _variation_docs(plan: ValidationPlan) -> list[tuple[str, str, dict]]:
+def _variation_docs(plan: ValidationPlan, corner: dict | None = None) -> list[tuple[str, str, dict]]:
     """``(label, store name, config)`` of each engine variation of ``plan`` on the first
-    family's first preset."""
+    family's first preset, at that family's ``corner``."""
     fam0 = plan.corner_family(plan.families[0])
     preset = fam0.presets[0]
     out = []
     for label, ov in plan.limit_variations:
         tag = "-".join(f"{k}{v}" for k, v in ov)
         out.append(
-            (label, f"limit-var/{preset}-{tag}", limit_doc(plan, fam0, preset, f"limit-var-{label}", ov))
+            (
+                label,
+                f"limit-var/{preset}-{tag}",
+                limit_doc(plan, fam0, preset, f"limit-var-{label}", ov, corner),
+            )
         )
     return out
 

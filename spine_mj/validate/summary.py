@@ -19,8 +19,9 @@ def summary_lines(result: dict) -> list[str]:
     for fam, summ in result["limit_families"].items():
         stops = ", ".join(f"{k} {n}" for k, n in summ["failed_runs"].items()) or "none"
         conv = result.get("convergence", {}).get(fam)
+        at = (result.get("corner") or {}).get(fam) or {"ie": result["lowest_ie"], "K": 30.0}
         lines.append(
-            f"I_e = {result['lowest_ie']:g}, {fam}: outcome agreement {summ['outcome_agreement']:.0%}"
+            f"I_e = {at['ie']:g}, K = {at['K']:g}, {fam}: outcome agreement {summ['outcome_agreement']:.0%}"
             f"{unconverged_mark(conv, 'outcome_agreement')} of {summ['runs']}, median Frechet "
             f"{summ['median_frechet']:.3g} L_c{unconverged_mark(conv, 'median_frechet')}, "
             f"engine stops: {stops}"

@@ -10,7 +10,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from typing import Any
 
-from spine_mj import presets, sim, sweep
+from spine_mj import examples, presets, sim, sweep
 from spine_mj.sim.drives import spring_stiffness_n_m
 from spine_mj.sim.scales import grid_keeps_samples, surface_unit_m
 from spine_mj.validate.plans import MASS_KG, FamilySpec, ValidationPlan
@@ -29,11 +29,12 @@ __all__ = [
 
 def surfaces_table(presets_: Sequence[str], seeds, variants=((),)) -> list[dict]:
     """A sweep ``surfaces`` table: one entry per preset and generator parameter set
-    (``variants``, see :class:`FamilySpec`), with ``seeds`` when given."""
+    (``variants``, see :class:`FamilySpec`), with ``seeds`` when given; a shipped scan
+    (``example:NAME``) as a ``file`` entry."""
     out = []
     for p in presets_:
         for variant in variants:
-            entry = {"preset": p}
+            entry = {"file": p} if p.startswith(examples.PREFIX) else {"preset": p}
             if seeds is not None:
                 entry["seeds"] = list(seeds)
             if variant:
@@ -143,7 +144,7 @@ def engine_grid(
         relative_engine_keys(
             ov,
             lambda: rig_engine(
-                presets.make_surface(preset, **({} if seeds is None else {"seed": seeds[0]})),
+                presets.open_surface(preset, **({} if seeds is None else {"seed": seeds[0]})),
                 tip=tip,
                 mu=mu,
                 ie=ie,

@@ -11,6 +11,7 @@ import pytest
 
 from spine_mj import presets, sim
 from spine_mj.validate.convergence import (
+    GRID_ONLY,
     REFINEMENTS,
     family_convergence,
     headline_convergence,
@@ -258,17 +259,27 @@ def test_every_refined_sweep_of_the_plans_is_a_valid_config_that_changes_only_it
     corner = [plan.corner_family(f) for f in plan.families if plan_name == "quick" or f.name != "fractal"]
     docs = _refinement_docs(plan, corner)
     keys = {(fam, key) for fam, key, _, _ in docs}
+    from spine_mj.validate.quasistatic_limit import _gridded
+
     for fam in corner:
-        # every family's hfield is refined, a gridded one's through its spline
-        assert {(fam.name, k) for k in plan.convergence_refinements} <= keys
+        # every family's hfield is refined, a gridded one's through its spline (and four times)
+        grid_only = set() if _gridded(fam.presets[0], fam) else set(GRID_ONLY)
+        assert {(fam.name, k) for k in plan.convergence_refinements if k not in grid_only} <= keys
+        assert not {(fam.name, k) for k in grid_only} & keys
+        # at least convergence_starts paired starts a family, spread over its surfaces
+        one = next(doc for f, k, _, doc in docs if f == fam.name)
+        per_surface = len(one["starts"]["y"])
+        assert per_surface * len(fam.seeds or (None,)) * len(fam.variants) * len(fam.presets) >= min(
+            plan.convergence_starts, len(fam.starts_table()["y"]) * len(fam.presets)
+        )
     for _, key, _, doc in docs:
         sweep.parse_config(doc)
         grid = doc["grid"]
         assert grid["hfield_resolution"] == plan.hfield_resolution
         if key.startswith("dt_"):
             assert grid["timestep_factor"] == dict(REFINEMENTS[key])["timestep_factor"] < 1
-        elif key == "hfield_doubled":
-            assert grid["hfield_refinement"] == 2
+        elif key.startswith("hfield_"):
+            assert grid["hfield_refinement"] == dict(REFINEMENTS[key])["hfield_factor"] in (2, 4)
             assert "timestep" not in grid
         else:  # the solver's tolerances, a hundredth of MuJoCo's
             assert (grid["tolerance"], grid["noslip_tolerance"]) == (1e-10, 1e-8)
@@ -315,3 +326,66 @@ def test_a_rate_is_judged_on_its_paired_change_and_a_refinement_that_changes_not
     assert out["converged"] is True and "dt_order" not in out
     assert headline_convergence(0.5, (0.3, 0.7), {"hfield_doubled": None})["converged"] is None
     assert refinement_note(None) == "" and refinement_note({"hfield_doubled": out["hfield_doubled"]}) == ""
+
+
+def test_gci_is_roaches_band_with_its_safety_factors():
+    from spine_mj.validate.convergence import gci
+
+    # f = f* + c h^p at h = 4, 2, 1 with p = 2: the observed order is 2, GCI 1.25 |e| / 3
+    f = [1.0 + 0.01 * h**2 for h in (4.0, 2.0, 1.0)]
+    p = observed_order(f[2], f[1], f[0])
+    assert p == pytest.approx(2.0)
+    assert gci(f[2], f[1], p) == pytest.approx(1.25 * abs((f[2] - f[1]) / f[2]) / 3.0)
+    # the band covers the exact value's relative distance from the finest level
+    assert gci(f[2], f[1], p) * f[2] >= abs(f[2] - richardson(f[2], f[1], p))
+    # two levels: Fs 3 and the formal first order
+    assert gci(f[2], f[1], math.nan) == pytest.approx(3.0 * abs((f[2] - f[1]) / f[2]))
+    assert math.isnan(gci(0.0, 0.1, 1.0))
+
+
+def test_a_three_level_verdict_needs_its_last_change_inside_the_interval():
+    summary = {
+        "agreement_well_conditioned": 1.0,
+        "agreement_ci": [0.9, 1.0],
+        "outcome_agreement": 1.0,
+        "outcome_agreement_ci": [0.9, 1.0],
+        "median_frechet": 0.05,
+        "median_frechet_ci": [0.04, 0.06],
+    }
+
+    def rows(frechets):
+        return pd.DataFrame(
+            {
+                "surface": ["s"] * len(frechets),
+                "surface_lc": [1.0] * len(frechets),
+                "start_x": [0.0] * len(frechets),
+                "start_y": np.arange(len(frechets), dtype=float),
+                "agree": [True] * len(frechets),
+                "frechet": frechets,
+            }
+        )
+
+    base = rows([0.05] * 5)
+    # dt / 2 moves the median by +0.009 and dt / 4 by +0.018 from the base: each inside the
+    # interval [0.04, 0.06] alone; the last change, +0.009, too
+    out = family_convergence(
+        summary, base, {"dt_halved": rows([0.059] * 5), "dt_quartered": rows([0.068] * 5)}
+    )
+    assert out["dt_halved"]["converged"] is True
+    # dt / 4 against the base leaves it (0.068), so does not converge whatever its last change
+    assert out["dt_quartered"]["median_frechet_converged"] is False
+    assert out["dt_quartered"]["last_change"]["median_frechet"] == pytest.approx(0.009)
+    assert out["dt_quartered"]["converged"] is False and out["converged"] is False
+    # a series that settles: +0.008, then +0.001 (last change inside)
+    out = family_convergence(
+        summary, base, {"dt_halved": rows([0.058] * 5), "dt_quartered": rows([0.059] * 5)}
+    )
+    assert out["dt_quartered"]["median_frechet_last_converged"] is True and out["converged"] is True
+    o = out["dt_order"]["median_frechet"]
+    assert o["order"] == pytest.approx(math.log2(8.0)) and math.isfinite(o["gci"])
+    # a last change larger than the interval's width fails even where each level alone is in
+    wide = {**summary, "median_frechet_ci": [0.03, 0.07]}
+    out = family_convergence(wide, base, {"dt_halved": rows([0.035] * 5), "dt_quartered": rows([0.065] * 5)})
+    assert out["dt_halved"]["converged"] is True and out["dt_quartered"]["median_frechet_converged"] is True
+    assert out["dt_quartered"]["median_frechet_last_converged"] is False
+    assert out["dt_quartered"]["converged"] is False

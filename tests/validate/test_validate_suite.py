@@ -27,7 +27,16 @@ def test_smoke_validation_writes_report_and_json(tmp_path, monkeypatch):
         "engine_settings",
     ):
         assert key in doc
-    assert doc["lowest_ie"] == validate.PLANS["smoke"].lowest_ie
+    # the corner study runs each family at its own corner, from its predicted limits
+    corner = doc["corner"]["single_peak_valley"]
+    limits = doc["corner_limits"]["single_peak_valley"]
+    assert (
+        doc["lowest_ie"] == corner["ie"]
+        and doc["limit_families"]["single_peak_valley"]["corner"]["K"] == corner["K"]
+    )
+    worst = min(s["ie_star"] for s in limits["surfaces"].values())
+    assert corner["ie"] <= worst / 10 and limits["corner"]["swing_fp"] <= 1.0
+    assert corner["K"] >= 10 * max(s["k_path"] for s in limits["surfaces"].values())
     assert set(doc["outcome_agreement_at_lowest_ie"]) == {"single_peak_valley"}
     assert 0.0 <= doc["outcome_agreement_at_lowest_ie"]["single_peak_valley"] <= 1.0
     # runs the engine stopped, by status, per family (none expected on the smoke plan's peak)

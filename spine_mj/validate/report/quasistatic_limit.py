@@ -22,7 +22,7 @@ from spine_mj.presets import make_surface
 from spine_mj.sweep.analyses.compare import MISS_CHECKPOINTS
 from spine_mj.theory.agreement import MISS_REASONS
 from spine_mj.validate.boundary import BoundaryResult
-from spine_mj.validate.convergence import HEADLINES, REFINEMENT_LABELS, unconverged_mark
+from spine_mj.validate.convergence import HEADLINES, REFINEMENT_LABELS, quoted
 from spine_mj.validate.platform import platform_info
 from spine_mj.validate.quasistatic_limit import MISS_CAUSES, QuasistaticLimitResult
 from spine_mj.validate.report.boundary import star_to_draw
@@ -180,7 +180,7 @@ def falls_note(limit: QuasistaticLimitResult, boundary: BoundaryResult) -> list[
 
 def _marked(v: dict, conv: dict | None) -> dict:
     """The corner's headlines of a family as table cells, each marked where unconverged."""
-    return {h: f"{cell(v[h])}{unconverged_mark(conv, h)}" for h in HEADLINES if h in v}
+    return {h: quoted(cell(v[h]), conv, h) for h in HEADLINES if h in v}
 
 
 def convergence_lines(limit: QuasistaticLimitResult) -> list[str]:
@@ -201,8 +201,9 @@ def convergence_lines(limit: QuasistaticLimitResult) -> list[str]:
                         "verdict": refinement_verdict(e),
                     }
                 )
-        for h, o in conv.get("dt_order", {}).items():
-            orders.append({"family": fam, "headline": h, "order": o["order"], "richardson": o["richardson"]})
+        for series in ("dt_order", "hfield_order"):
+            for h, o in conv.get(series, {}).items():
+                orders.append({"family": fam, "levels": series.split("_")[0], "headline": h, **o})
     if not rows:
         return []
     lines = [
@@ -239,20 +240,46 @@ def convergence_lines(limit: QuasistaticLimitResult) -> list[str]:
     ]
     if orders:
         lines += [
-            "Three step levels (dt, dt / 2, dt / 4) on the same starts: the observed order "
-            "p = ln((f(dt) - f(dt/2)) / (f(dt/2) - f(dt/4))) / ln 2 (undefined, `-`, where "
-            "no run flipped or the changes alternate in sign) and the Richardson estimate of "
-            "the converged value (docs/physics.md §7: a semi-implicit Euler step adds a path "
-            "error of first order in dt).",
+            "Three step levels (dt, dt / 2, dt / 4) on the same starts, and three hfield levels "
+            "(x 1, 2, 4) on a gridded surface: the observed order "
+            "p = ln((f1 - f2) / (f2 - f3)) / ln 2 (undefined, `-`, where "
+            "no run flipped or the changes alternate in sign), the Richardson estimate of "
+            "the converged value and Roache's GCI, Fs |(f1 - f2) / f1| / (2^p - 1) (Fs 1.25; "
+            "where no order is observed Fs 3 and the formal order 1: docs/physics.md §7, a "
+            "semi-implicit Euler step adds a path error of first order in dt). With three levels "
+            "a headline is converged only when its last change (finest minus middle level) "
+            "also stays inside its interval.",
             "",
             table(
                 orders,
-                ["family", "headline", "order", "richardson"],
-                ["family", "headline", "observed order", "Richardson estimate"],
+                ["family", "levels", "headline", "order", "richardson", "gci"],
+                ["family", "levels", "headline", "observed order", "Richardson estimate", "GCI"],
             ),
             "",
         ]
     return lines
+
+
+def _corner_lines(limit: QuasistaticLimitResult) -> list[str]:
+    """The corner each family is judged at, and why
+    (:func:`spine_mj.theory.drive_limits.quasistatic_corner`)."""
+    rows = [{"family": fam, **c["corner"]} for fam, c in limit.corners.items()]
+    if not rows:
+        return [f"I_e = {limit.lowest_ie:g}, default drive (K = k l_s / F_p = 30).", ""]
+    return [
+        "Each family runs at the corner its own predicted limits give (the rule "
+        "`theory.drive_limits.quasistatic_corner`, docs/physics.md §8): K ten times its "
+        "K_path, I_e the lowest of a tenth of its I_e*, the spring's position swing at a "
+        "tenth of the path tolerance and its force swing at 1 F_p; the family's lowest I_e* "
+        "and highest K_path over its presets and generator variants.",
+        "",
+        table(
+            rows,
+            ["family", "ie", "K", "swing_fp", "reason"],
+            ["family", "I_e", "K = k l_s / F_p", "swing / F_p", "why"],
+        ),
+        "",
+    ]
 
 
 def _lines(limit: QuasistaticLimitResult, boundary: BoundaryResult) -> list[str]:
@@ -267,9 +294,10 @@ def _lines(limit: QuasistaticLimitResult, boundary: BoundaryResult) -> list[str]
         for k, v in limit.families.items()
     ]
     return [
-        "## Quasistatic limit (spring drive, lowest I_e)",
+        "## Quasistatic limit (spring drive, each family at its own corner)",
         "",
-        f"I_e = {limit.lowest_ie:g}, default drive (K = k l_s / F_p = 30) and engine. Like for "
+        *_corner_lines(limit),
+        "Default engine. Like for "
         "like: each MuJoCo path is compared with the streamline traced on the surface its tip "
         "touches (a ball of the tip's radius on MuJoCo's hfield facets, exactly: "
         "`surfaces.BallOnFacets`), ending where the engine's run ends, with the same force "

@@ -7,7 +7,7 @@ from __future__ import annotations
 import math
 
 from spine_mj.theory.targets import OUTCOME_TARGET
-from spine_mj.validate.convergence import unconverged_mark
+from spine_mj.validate.convergence import quoted
 from spine_mj.validate.ensembles import ENSEMBLE_RADIUS_LC
 from spine_mj.validate.intervals import TARGET_RULE, runs_to_meet
 
@@ -37,6 +37,7 @@ def verdicts_section(families: dict, convergence: dict | None = None) -> list[st
     convergence = convergence or {}
     head = [
         "family",
+        "corner I_e, K",
         "agreement, well-conditioned [95 % CI]",
         "well-conditioned / starts (a member stopped)",
         "ill-conditioned: MuJoCo / reference",
@@ -49,18 +50,31 @@ def verdicts_section(families: dict, convergence: dict | None = None) -> list[st
     for name, f in families.items():
         ill = f.get("ill_conditioned_share") or {}
         members.add(f.get("members", 1))
+        at = f.get("corner") or {}
         row = [
             name,
-            f"{_num(f.get('agreement_well_conditioned'))} {_ci(f.get('agreement_ci'))}"
-            + unconverged_mark(convergence.get(name), "agreement_well_conditioned"),
+            f"{_num(at.get('ie'))}, {_num(at.get('K'))}" if at else "-",
+            quoted(
+                f"{_num(f.get('agreement_well_conditioned'))} {_ci(f.get('agreement_ci'))}",
+                convergence.get(name),
+                "agreement_well_conditioned",
+            ),
             f"{f.get('well_conditioned_runs', '-')} / {f.get('starts', f['runs'])} "
             f"({f.get('stopped_starts', 0)})",
             f"{_num(ill.get('mujoco'))} / {_num(ill.get('reference'))}",
-            f"{_num(f['outcome_agreement'])} {_ci(f.get('outcome_agreement_ci'))}"
-            + unconverged_mark(convergence.get(name), "outcome_agreement"),
-            f"{_num(f['median_frechet'])} {_ci(f.get('median_frechet_ci'))}"
-            + unconverged_mark(convergence.get(name), "median_frechet"),
-            "yes" if f.get("meets_target") else "no",
+            quoted(
+                f"{_num(f['outcome_agreement'])} {_ci(f.get('outcome_agreement_ci'))}",
+                convergence.get(name),
+                "outcome_agreement",
+            ),
+            quoted(
+                f"{_num(f['median_frechet'])} {_ci(f.get('median_frechet_ci'))}",
+                convergence.get(name),
+                "median_frechet",
+            ),
+            "no verdict (unconverged)"
+            if (convergence.get(name) or {}).get("converged") is False
+            else ("yes" if f.get("meets_target") else "no"),
         ]
         table.append("| " + " | ".join(row) + " |")
     m = max(members, default=1)
