@@ -326,7 +326,114 @@ def probes(work: Path, novideo: str | None) -> list[tuple[str, list[str], str, s
         "ok",
         "wrote",
     )
+    _issue44(add, work, py)
     return out
+
+
+def _issue44(add, work: Path, py: str) -> None:
+    """Issue 44's families: planes' arguments, Bullet's step, the engines study's
+    arguments, nested JSON, engine and drive keys a sweep would not apply, refusals that
+    only a combination of the grid makes, and memory beyond the budget."""
+    plane = [*SPINE, "surface", "make", "plane", "-o", "p.npz", "--set"]
+    for setting, needle in (
+        ('slope_deg="steep"', "slope_deg"),
+        ("azimuth_deg=inf", "azimuth_deg"),
+        ("unit=banana", "unit"),
+        ("n=100000", "100000 x 100000"),
+    ):
+        add(f"surface make plane --set {setting}", [*plane, setting], "refuse", needle)
+    sim_bullet = [*SPINE, "simulate", "paper-single-peak", "--start", "-3,-1", "--out", "b"]
+    add(
+        "simulate --engine bullet --timestep nan",
+        [*sim_bullet, "--engine", "bullet", "--timestep", "nan"],
+        "refuse",
+        "timestep",
+    )
+    engines = [py, "-m", "spine_mj.validate.engines"]
+    (work / "a-file").write_text("")
+    for args, needle in (
+        (["--out", "e", "--fractal", "-1"], "--fractal"),
+        (["--out", "e", "--headlines", "-1"], "--headlines"),
+        (["--out", "e", "--workers", "0"], "--workers"),
+        ([], "--out"),
+        (["--out", "a-file"], "a-file"),
+    ):
+        add(f"validate.engines {' '.join(args) or '(no arguments)'}", [*engines, *args], "refuse", needle)
+    (work / "deep.json").write_text("[" * 100_000 + "]" * 100_000)
+    check = str(Path(__file__).with_name("reproduction_check.py"))
+    add("reproduction_check.py on deeply nested JSON", [py, check, "deep.json"], "refuse", "nested too deep")
+    base = """
+    [sweep]
+    analyses = {analyses}
+    [[surfaces]]
+    preset = "{preset}"
+    [starts]
+    x = [0.05]
+    y = [0.5]
+    {tables}
+    """
+    configs = {
+        "bullet with integrator": (
+            '["mujoco"]',
+            "paper-single-peak",
+            '[grid]\nengine = "bullet"\nintegrator = "euler"',
+            "engine bullet",
+        ),
+        "bullet with timestep_factor": (
+            '["mujoco"]',
+            "paper-single-peak",
+            '[grid]\nengine = "bullet"\ntimestep_factor = 0.5',
+            "engine bullet",
+        ),
+        "array protocol static": ('["array"]', "corrugation", '[drive]\nprotocol = "static"', "static"),
+        "array force with duration": (
+            '["array"]',
+            "corrugation",
+            '[drive]\nduration = 0.1\n[array]\narray_drive = "force"',
+            "force",
+        ),
+        "grid swing ie x K": (
+            '["quasistatic", "mujoco", "compare"]',
+            "paper-fractal",
+            "[drive]\nie = [1e-4, 1e-3]\nK = [10, 100]",
+            "K = 100",
+        ),
+        "grid steps ie x timestep_factor": (
+            '["mujoco"]',
+            "paper-single-peak",
+            "[drive]\nie = [1.0, 1e-3]\n[grid]\ntimestep_factor = [1.0, 1e-3]",
+            "steps",
+        ),
+        "grid sizes resolution x refinement": (
+            '["mujoco"]',
+            "paper-single-peak",
+            "[grid]\nhfield_resolution = [61, 1500]\nhfield_refinement = [1, 6]",
+            "samples a side",
+        ),
+        "array spines off the surface": (
+            '["array"]',
+            "corrugation",
+            '[array]\nspacing = 2.0\nspacing_unit = "surface"',
+            "outside the surface",
+        ),
+    }
+    for name, (analyses, preset, tables, needle) in configs.items():
+        body = base.format(analyses=analyses, preset=preset, tables=tables)
+        cfg = sweep_config(work, name.replace(" ", "-"), body)
+        add(
+            f"sweep: {name}",
+            [*SPINE, "sweep", cfg, "--out", "s44", "--workers", "1", "--quiet"],
+            "refuse",
+            needle,
+        )
+    small = {"SPINE_MJ_MEMORY_BUDGET": "1G"}
+    add(
+        "surface make paper-fractal nx=8192 (1 GiB budget)",
+        [*SPINE, "surface", "make", "paper-fractal", "--set", "nx=8192", "-o", "f.npz"],
+        "refuse",
+        "fBm synthesis",
+        small,
+    )
 
 
 def run_probe(work, name, args, expect, needle, env):

@@ -133,7 +133,7 @@ def _count_at_least(name: str, n, least: int) -> int:
     return int(n)
 
 
-def check_grid_size(nx: int, ny: int, *, where: str) -> None:
+def check_grid_size(nx: int, ny: int, *, where: str, nbytes: float | None = None) -> None:
     """Refuse a grid of more than :data:`MAX_GRID_POINTS` points, or one whose arrays
     (:data:`_GRID_ARRAYS` float64 arrays of its size: heights, spline coefficients and the
     temporaries of making them) would exceed the memory budget, before allocating it.
@@ -144,6 +144,9 @@ def check_grid_size(nx: int, ny: int, *, where: str) -> None:
         The grid's points along x and y.
     where : str
         What makes the grid, for the message (a generator, a resampling, a file).
+    nbytes : float, optional
+        The peak bytes of making it, where its maker predicts them (:func:`fractal_fbm`'s
+        synthesis); else :data:`_GRID_ARRAYS` float64 arrays of its size.
 
     Raises
     ------
@@ -159,7 +162,8 @@ def check_grid_size(nx: int, ny: int, *, where: str) -> None:
             f"{where}: a {_count(ny)} x {_count(nx)} grid has {points:.3g} points, more than the limit "
             f"{MAX_GRID_POINTS:.3g} ({gib:.3g} GiB per height array); use fewer points or a coarser spacing"
         )
-    check_memory(8.0 * _GRID_ARRAYS * points, where=f"{where}: a {_count(ny)} x {_count(nx)} grid")
+    nbytes = 8.0 * _GRID_ARRAYS * points if nbytes is None else nbytes
+    check_memory(nbytes, where=f"{where}: a {_count(ny)} x {_count(nx)} grid")
 
 
 def _count(n) -> str:

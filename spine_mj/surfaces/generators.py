@@ -10,7 +10,6 @@ import math
 import numpy as np
 
 from spine_mj.errors import SpineInputError, check_positive
-from spine_mj.memory import check_memory
 from spine_mj.surfaces.base import (
     _MIN_POINTS_PER_SIDE,
     MAX_PEAKS,
@@ -462,8 +461,8 @@ def _fbm_grid(nx, ny, size, periodic: bool) -> tuple[int, int, float, float]:
     is synthesized twice as large)."""
     nx = _grid_count("nx", nx)
     ny = nx if ny is None else _grid_count("ny", ny)
-    check_grid_size((1 if periodic else 2) * nx, (1 if periodic else 2) * ny, where="fractal_fbm")
-    check_memory(fbm_bytes(nx, ny, periodic), where=f"fractal_fbm: a {ny} x {nx} fBm synthesis")
+    fac = 1 if periodic else 2
+    check_grid_size(fac * nx, fac * ny, where="fractal_fbm", nbytes=fbm_bytes(nx, ny, periodic))
     lx, ly = (size, size) if np.isscalar(size) else _pair("size", size)
     return nx, ny, check_positive("size x", lx), check_positive("size y", ly)
 
