@@ -24,7 +24,7 @@ from spine_mj.errors import SpineInputError
     "--tip-radius", type=float, default=None, help="Tip radius (surface units; default: the rig's)."
 )
 @click.option(
-    "--starts", type=int, default=30, show_default=True, help="MuJoCo starts (paired under refinement)."
+    "--starts", type=int, default=40, show_default=True, help="MuJoCo starts (paired under refinement)."
 )
 @click.option(
     "--reference-starts",

@@ -90,7 +90,9 @@ class HoldSettings:
         Tip radius in the surface's length unit (None: the rig's default,
         :meth:`spine_mj.sim.scales.Scales.for_surface`).
     starts : int
-        MuJoCo starts (each an ensemble of ``members``; the refinements pair on them).
+        MuJoCo starts (each an ensemble of ``members``; the refinements pair on them). 40:
+        a verdict needs :data:`MIN_PAIRED_STARTS` well-conditioned ones, and a rough
+        surface puts some starts on a watershed (10 of 30 on the AFM scan di-1).
     reference_starts : int
         Places the self-lock share is traced from (the MuJoCo starts are the first of them).
     members : int
@@ -103,7 +105,7 @@ class HoldSettings:
 
     mu: float
     tip_radius: float | None = None
-    starts: int = 30
+    starts: int = 40
     reference_starts: int = 400
     members: int = 2
     budget_s: float = 3600.0
