@@ -384,18 +384,9 @@ _RIG_KEYS = (
     "preload",
     "gravity",
     "length_scale",
-    "timestep",
-    "integrator",
-    "cone",
-    "impratio",
-    "noslip_iterations",
-    "tolerance",
-    "noslip_tolerance",
-    "timestep_factor",
-    "solref_timeconst",
-    "solref_dampratio",
     "hfield_resolution",
     "hfield_refinement",
+    *(s.name for s in MUJOCO_PARAMS if s.option is not None),  # every engine option
 )
 
 
