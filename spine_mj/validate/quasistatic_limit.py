@@ -20,6 +20,7 @@ from spine_mj.theory.agreement import MISS_REASONS
 from spine_mj.validate.convergence import GRID_ONLY, REFINEMENTS, family_convergence, thin_starts
 from spine_mj.validate.ensembles import ensemble_family, ensemble_groups, ensemble_verdicts
 from spine_mj.validate.intervals import bootstrap, meets_target, wilson
+from spine_mj.validate.miss_causes import MISS_CAUSES, miss_cause
 from spine_mj.validate.paths import stored_paths, tip_radius
 from spine_mj.validate.plans import FRECHET_TARGET, OUTCOME_TARGET, RECOMMENDED, FamilySpec, ValidationPlan
 from spine_mj.validate.predicted_limits import family_corner
@@ -501,47 +502,6 @@ def _intervals(comp, summ: dict) -> dict:
         "outcome_agreement_ci": list(wilson(agree, n)),
         "median_frechet_ci": list(bootstrap(comp["frechet"].to_numpy(float))),
     }
-
-
-#: A peak speed this many times the drive's in inertia number (10 times in speed) is a
-#: fall's or a jump's: a stable slide moves at most a few drive speeds (docs/physics.md §6).
-FALL_IE_FACTOR = 100.0
-
-
-#: The physical cause of each miss (:func:`miss_cause`), and what each means.
-MISS_CAUSES = {
-    "ill_conditioned": "the reference's outcome flips within one hfield spacing of its path "
-    "(miss reason separatrix): the start lies on a separatrix, no physics is missing",
-    "fall": "the paths parted where the tip fell: the reference slides under gravity alone "
-    "(a flank steeper than friction) or the tip's peak speed was a fall's (its inertia "
-    f"number above {FALL_IE_FACTOR:g} times the drive's), where the quasistatic step does not say where "
-    "a tip with mass lands",
-    "inertia": "the paths parted by more than a facet without a fall (a jump of the spring)",
-    "wedge": "MuJoCo held at the force cap without a single contact normal in the self-lock "
-    "region: the tip wedged on several contacts where the reference moves on",
-    "soft_contact": "MuJoCo held on a single contact normal where the reference moves on, or "
-    "passed where the reference holds: the soft contact's tilted normals and creep",
-    "reference_stalled": "the reference made no progress: nothing to compare",
-}
-
-
-def miss_cause(row) -> str:
-    """The physical cause (a key of :data:`MISS_CAUSES`) of one disagreeing run, from its
-    compare row: its ``miss_reason``, ``end_detail``, ``reference_slide_fraction``,
-    ``tip_peak_ie`` and ``inertia_number``."""
-    reason = row.get("miss_reason", "")
-    if reason == "separatrix":
-        return "ill_conditioned"
-    if reason == "engine_held":
-        return "wedge" if str(row.get("end_detail", "")).startswith("force cap") else "soft_contact"
-    if reason == "engine_passed":
-        return "soft_contact"
-    if reason == "reference_stalled":
-        return "reference_stalled"
-    slid = float(row.get("reference_slide_fraction", 0.0) or 0.0) > 0
-    peak, drive = float(row.get("tip_peak_ie", np.nan)), float(row.get("inertia_number", np.nan))
-    fast = np.isfinite(peak) and np.isfinite(drive) and peak > FALL_IE_FACTOR * drive
-    return "fall" if slid or fast else "inertia"
 
 
 def _misses(comp) -> dict[str, dict]:

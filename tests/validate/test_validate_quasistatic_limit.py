@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from spine_mj.validate.quasistatic_limit import FALL_IE_FACTOR, MISS_CAUSES, _misses, miss_cause
+from spine_mj.validate.miss_causes import FALL_IE_FACTOR, MISS_CAUSES, miss_cause
+from spine_mj.validate.quasistatic_limit import _misses
 
 _CAP = "force cap: drive force reached kappa_cap * F_p = 1.962 N without slip (held with ...)"
 _RULE = "lock rule: stuck on a contact normal in the self-lock region while ..."
