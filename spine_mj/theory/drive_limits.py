@@ -205,6 +205,7 @@ def quasistatic_corner(
     path_tolerance: float = FRECHET_TARGET,
     margin: float = CORNER_MARGIN,
     ie_limit: str = "",
+    k_floor: float = 0.0,
 ) -> Corner:
     """The corner ``(I_e, K)`` at which a spring drive on a surface is quasistatic, from its
     own predicted limits (:func:`drive_limits`; for a family, its surfaces' lowest
@@ -216,7 +217,8 @@ def quasistatic_corner(
     first order in ``I_e``), ``(t / margin)^2 K_c`` (the position swing ``L_c sqrt(I_e /
     K_c)`` a ``margin``-th of ``t L_c``) and ``SWING_BOUND_FP^2 / K_c`` (the force swing,
     :func:`spring_ie_limits`), ``K_c = K L_c / l_s``, rounded down to one digit.
-    ``ie_limit`` names what set ``ie_star`` in the reason.
+    ``ie_limit`` names what set ``ie_star`` in the reason; ``K`` is at least ``k_floor`` (the
+    softest spring the engine runs cleanly: a path criterion met at any K gives no scale).
 
     Raises
     ------
@@ -239,7 +241,8 @@ def quasistatic_corner(
         raise SpineInputError(f"the corner needs K_path or a positive K*, got {k_path!r} and {k_star!r}")
     k_ref, k_bound = usable[0]
     scale = 10.0 ** (math.floor(math.log10(margin * k_ref)) - 1)
-    k = float(f"{math.ceil(margin * k_ref / scale * (1 - 1e-12)) * scale:.2g}")
+    k = max(float(f"{math.ceil(margin * k_ref / scale * (1 - 1e-12)) * scale:.2g}"), float(k_floor))
+    k_bound = k_bound if k > k_floor else "floor"
     bounds = {
         "I_e*": ie_star / margin,
         **spring_ie_limits(k, lc_over_ls, path_tolerance=path_tolerance / margin),

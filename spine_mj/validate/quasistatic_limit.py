@@ -14,8 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from spine_mj.presets import calibrated_mu, open_surface
-from spine_mj.surfaces import GridSurface
+from spine_mj.presets import calibrated_mu
 from spine_mj.theory.agreement import MISS_REASONS
 from spine_mj.validate.convergence import GRID_ONLY, REFINEMENTS, family_convergence, thin_starts
 from spine_mj.validate.ensembles import ensemble_family, ensemble_groups, ensemble_verdicts
@@ -25,7 +24,7 @@ from spine_mj.validate.paths import stored_paths, tip_radius
 from spine_mj.validate.plans import FRECHET_TARGET, OUTCOME_TARGET, RECOMMENDED, FamilySpec, ValidationPlan
 from spine_mj.validate.predicted_limits import family_corner
 from spine_mj.validate.study_runner import StudyRunner
-from spine_mj.validate.sweep_configs import engine_grid, family_doc
+from spine_mj.validate.sweep_configs import engine_grid, family_doc, gridded, refused_by_rig
 
 __all__ = [
     "LimitPath",
@@ -156,31 +155,13 @@ class QuasistaticLimitResult:
 
 
 def quasistatic_limit(plan: ValidationPlan, runner: StudyRunner) -> QuasistaticLimitResult:
-    """Study 2: spring drive at each family's own quasistatic corner against the streamline.
-
-    Each family runs at the corner ``(I_e, K)`` its own predicted limits give
-    (:func:`~spine_mj.validate.predicted_limits.family_corner`, the rule
-    :func:`~spine_mj.theory.drive_limits.quasistatic_corner`), its refinements too.
-
-    For every run, three comparisons from the sweep's ``compare`` analysis (lengths over
-    L_c): MuJoCo against the streamline traced on the surface its tip touches (the rig's
-    facets dilated by the tip: the like-for-like comparison the targets judge), MuJoCo
-    against the streamline on the smooth surface (the total), and the two streamlines
-    against each other (the geometry part). Runs the engine stopped count as
-    disagreements and are listed per family by status (``failed_runs``). Then on the single
-    peak the settings of ``plan.limit_variations`` one at a time.
-
-    Parameters
-    ----------
-    plan : ValidationPlan
-        The validation's sizes (:data:`PLANS`).
-    runner : StudyRunner
-        Runs the study's sweeps into resumable stores under the output folder.
-
-    Returns
-    -------
-    QuasistaticLimitResult
-    """
+    """Study 2: spring drive at each family's own corner ``(I_e, K)``, from its predicted
+    limits (:func:`~spine_mj.validate.predicted_limits.family_corner`; a corner the rig
+    refuses gives no verdict), against the streamline, with the three comparisons of the
+    module docstring per run (lengths over L_c; a run the engine stopped disagrees, listed
+    by status in ``failed_runs``), its refinements, then on the single peak the settings of
+    ``plan.limit_variations`` one at a time. ``runner`` runs the sweeps of ``plan`` into
+    resumable stores under the output folder."""
     runner.study = "limit"
     families, runs_rows, paths = {}, [], {}
     corner = [plan.corner_family(fam) for fam in plan.families]
@@ -190,6 +171,12 @@ def quasistatic_limit(plan: ValidationPlan, runner: StudyRunner) -> QuasistaticL
             corners[fam.name] = family_corner(plan, fam)
     at = {name: c["corner"] for name, c in corners.items()}
     docs = [(fam, name, doc) for fam in corner for name, doc in limit_family_docs(plan, fam, at[fam.name])]
+    for fam in corner:  # a corner the rig refuses (too many steps a run) gives no verdict
+        refused = refused_by_rig([doc for f, _, doc in docs if f is fam])
+        if refused:
+            corners[fam.name]["refused"] = refused
+    corner = [fam for fam in corner if "refused" not in corners[fam.name]]
+    docs = [d for d in docs if d[0] in corner]
     variations = _variation_docs(plan, at[corner[0].name])
     refinements = _refinement_docs(plan, corner, at)
     # every sweep of the study at once: the workers stay busy across the sweeps' ends
@@ -316,18 +303,12 @@ def _refinement_docs(
         thin = thin_starts(fam, -(-plan.convergence_starts // surfaces))
         for key in plan.convergence_refinements:
             for preset in fam.presets:
-                if key in GRID_ONLY and not _gridded(preset, fam):
+                if key in GRID_ONLY and not gridded(preset, fam):
                     continue
                 name = f"limit-refined-{key}-{preset}"
                 doc = limit_doc(plan, thin, preset, name, REFINEMENTS[key], (at or {}).get(fam.name))
                 out.append((fam.name, key, f"limit-refined/{key}/{preset}", doc))
     return out
-
-
-def _gridded(preset: str, fam: FamilySpec) -> bool:
-    """Whether ``preset`` (at ``fam``'s first seed) is a grid (:class:`~spine_mj.surfaces.GridSurface`)."""
-    seed = {} if fam.seeds is None else {"seed": fam.seeds[0]}
-    return isinstance(open_surface(preset, **seed, **dict(fam.variants[0])), GridSurface)
 
 
 def _refined_rows(family: str, keys, refinements, results) -> dict[str, pd.DataFrame | None]:

@@ -11,8 +11,10 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from spine_mj import examples, presets, sim, sweep
+from spine_mj.errors import SpineInputError
 from spine_mj.sim.drives import spring_stiffness_n_m
 from spine_mj.sim.scales import grid_keeps_samples, surface_unit_m
+from spine_mj.sweep.preflight import check_cases
 from spine_mj.validate.plans import MASS_KG, FamilySpec, ValidationPlan
 
 __all__ = [
@@ -20,7 +22,9 @@ __all__ = [
     "engine_default",
     "engine_grid",
     "family_doc",
+    "gridded",
     "refined_resolution",
+    "refused_by_rig",
     "relative_engine_keys",
     "rig_engine",
     "surfaces_table",
@@ -155,3 +159,22 @@ def engine_grid(
     )
     out.update(ov)
     return out
+
+
+def gridded(preset: str, fam: FamilySpec) -> bool:
+    """Whether ``preset`` (``fam``'s first seed and variant) is a grid, refined through its
+    interpolant (:func:`spine_mj.surfaces.refine_grid`)."""
+    seed = {} if fam.seeds is None else {"seed": fam.seeds[0]}
+    return grid_keeps_samples(presets.open_surface(preset, **seed, **dict(fam.variants[0])), 1) is None
+
+
+def refused_by_rig(docs: Sequence[dict]) -> str:
+    """Why the sweep's preflight refuses the configs ``docs`` (a corner whose runs need more
+    steps than a run may take), empty where it runs them."""
+    try:
+        for doc in docs:
+            config = sweep.parse_config(doc)
+            check_cases(sweep.expand_cases(config), config.swept, None)
+    except SpineInputError as exc:
+        return str(exc)
+    return ""

@@ -279,6 +279,9 @@ def test_corner_bad_input():
         quasistatic_corner(ie_star=1e-3, k_path=float("nan"), k_star=0.0, lc_over_ls=1.0)
     with pytest.raises(SpineInputError, match="margin"):
         quasistatic_corner(ie_star=1e-3, k_path=1.0, lc_over_ls=1.0, margin=1.0)
+    # a path criterion met at any K (K_path ~ 0) gives no scale: the floor sets K
+    c = quasistatic_corner(ie_star=0.1, k_path=1e-5, lc_over_ls=16.9, k_floor=30.0)
+    assert c.k == 30.0 and c.k_bound == "floor" and c.swing_fp <= SWING_BOUND_FP
     # no limit from the geometry (a plane): the swing alone sets I_e
     assert quasistatic_corner(ie_star=math.inf, k_path=1.0, lc_over_ls=1.0).ie_bound.startswith("swing")
 

@@ -259,11 +259,11 @@ def test_every_refined_sweep_of_the_plans_is_a_valid_config_that_changes_only_it
     corner = [plan.corner_family(f) for f in plan.families if plan_name == "quick" or f.name != "fractal"]
     docs = _refinement_docs(plan, corner)
     keys = {(fam, key) for fam, key, _, _ in docs}
-    from spine_mj.validate.quasistatic_limit import _gridded
+    from spine_mj.validate.sweep_configs import gridded
 
     for fam in corner:
         # every family's hfield is refined, a gridded one's through its spline (and four times)
-        grid_only = set() if _gridded(fam.presets[0], fam) else set(GRID_ONLY)
+        grid_only = set() if gridded(fam.presets[0], fam) else set(GRID_ONLY)
         assert {(fam.name, k) for k in plan.convergence_refinements if k not in grid_only} <= keys
         assert not {(fam.name, k) for k in grid_only} & keys
         # at least convergence_starts paired starts a family, spread over its surfaces

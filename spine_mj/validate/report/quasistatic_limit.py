@@ -264,7 +264,14 @@ def convergence_lines(limit: QuasistaticLimitResult) -> list[str]:
 def _corner_lines(limit: QuasistaticLimitResult) -> list[str]:
     """The corner each family is judged at, and why
     (:func:`spine_mj.theory.drive_limits.quasistatic_corner`)."""
-    rows = [{"family": fam, **c["corner"]} for fam, c in limit.corners.items()]
+    rows = [
+        {
+            "family": fam,
+            **c["corner"],
+            **({"reason": f"not run, no verdict: {c['refused']}"} if c.get("refused") else {}),
+        }
+        for fam, c in limit.corners.items()
+    ]
     if not rows:
         return [f"I_e = {limit.lowest_ie:g}, default drive (K = k l_s / F_p = 30).", ""]
     return [
