@@ -6,7 +6,8 @@ commands: :mod:`~spine_mj.cli.surface` (``surface make/show/info/export``),
 :mod:`~spine_mj.cli.theory` (``kappa``, ``streamline``, ``reproduce``),
 :mod:`~spine_mj.cli.sim` (``simulate``, ``replay``, ``view``, ``sim export``),
 :mod:`~spine_mj.cli.sweep` (``sweep run/status``, ``report``), :mod:`~spine_mj.cli.array`
-(``array``), :mod:`~spine_mj.cli.validate` (``validate``) and :mod:`~spine_mj.cli.examples`
+(``array``), :mod:`~spine_mj.cli.validate` (``validate``), :mod:`~spine_mj.cli.hold`
+(``hold``) and :mod:`~spine_mj.cli.examples`
 (``examples``).
 
 The CLI starts at once: a command's module is imported when the command is named (or its

@@ -25,8 +25,10 @@ read), ``sweeps/`` (the resumable stores), ``summary.json``, ``report.md`` and
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import math
+import shutil
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -159,14 +161,13 @@ def hold_to(
     tip, lc, limits, corner = _corner(surface, settings)
     places = _places(surface, tip, settings)
     mj_starts = places[: settings.starts]
-    writable_path(out / "summary.json")
     runner = StudyRunner(out, workers, progress, t0)
     runner.study = "hold"
     held, share = _self_lock_share(runner, surface, places, tip, settings.mu)
-    surface_file = save_surface(surface, out / "surface.npz")
     base_grid = {"mu": settings.mu, "tip_radius": tip, "dl": tip / 2}
     drive = {"protocol": "spring", "ie": corner.ie, "K": corner.k}
     table = {"frame": "absolute", "points": [tuple(map(float, p)) for p in mj_starts]}
+    surface_file = out / "surface.npz"
     doc = _doc(
         "hold-base",
         surface_file,
@@ -176,7 +177,10 @@ def hold_to(
         settings.members,
     )
     started = time.perf_counter()
-    df, store = runner(doc, "base")
+    with _undone_on_refusal(out):
+        writable_path(out / "summary.json")
+        save_surface(surface, surface_file)
+        df, store = runner(doc, "base")
     base_s = time.perf_counter() - started
     groups = ensemble_groups(df, store, settings.members)
     verdicts = ensemble_verdicts(groups)
@@ -201,6 +205,22 @@ def hold_to(
     return summary
 
 
+@contextlib.contextmanager
+def _undone_on_refusal(out: Path):
+    """Remove what this call wrote under ``out`` (the folder if it made it, else the surface
+    file it added) when the corner's sweep is refused before it runs (one Error line,
+    nothing half-written); a folder being resumed keeps what it had."""
+    made, had_surface = not out.exists(), (out / "surface.npz").exists()
+    try:
+        yield
+    except SpineInputError:
+        if made:
+            shutil.rmtree(out, ignore_errors=True)
+        elif not had_surface:
+            (out / "surface.npz").unlink(missing_ok=True)
+        raise
+
+
 def _corner(surface, settings: HoldSettings):
     """``(tip, L_c, limits, corner)``: the rig's tip radius and L_c (surface units), the
     surface's :func:`~spine_mj.theory.drive_limits.drive_limits` with that tip and the
@@ -218,6 +238,11 @@ def _corner(surface, settings: HoldSettings):
     scales = sim.Scales.for_surface(surface, tip=sim.TipParams(tip_radius_m=tip_m, mu_s=settings.mu))
     tip = scales.tip_radius_m / scales.length_scale_m
     limits = dlim.drive_limits(surface, settings.mu, tip_radius=tip)
+    if not limits.k_star > 0:
+        raise SpineInputError(
+            f"SURFACE: no path on it folds (K* = {limits.k_star:g}: its hold force never falls, a plane "
+            "or a slope without features), so there is no drive corner to check MuJoCo at"
+        )
     corner = dlim.quasistatic_corner(
         ie_star=limits.ie_star,
         k_path=math.nan,

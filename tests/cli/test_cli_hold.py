@@ -39,3 +39,13 @@ def test_a_tip_too_wide_for_a_narrow_strip_is_refused_with_the_users_number(tmp_
     path = save_surface(strip, tmp_path / "strip.npz")
     line = _refused([str(path), "--mu", "0.5", "--tip-radius", "0.6"], tmp_path / "out")
     assert "tip_radius_m 0.006 m is larger than the surface" in line
+
+
+def test_a_plane_is_refused_in_one_line_naming_why(tmp_path):
+    from spine_mj.surface_io import save_surface
+    from spine_mj.surfaces import GridSurface
+
+    x = np.linspace(0, 4, 17)
+    path = save_surface(GridSurface(heights=np.zeros((17, 17)), x=x, y=x.copy()), tmp_path / "plane.npz")
+    line = _refused([str(path), "--mu", "0.5", "--starts", "2", "--reference-starts", "5"], tmp_path / "out")
+    assert "no path on it folds (K* = 0" in line
