@@ -130,9 +130,8 @@ def build_rig(
         The drive's pace, as for :func:`build_drive`: its speed (:func:`drive_speed_m_s`)
         bounds the engine step for impacts.
     stiffness_number, stiffness_n_m
-        The drive spring's stiffness, as for :func:`build_drive` (none: K = 30): it bounds
-        the engine step (:func:`~spine_mj.sim.default_engine`), so a rig runs spring drives up to this
-        stiffness (a stiffer one is refused by :meth:`Rig.check_drive`).
+        The drive spring's stiffness, as for :func:`build_drive` (none: K = 30): it bounds the
+        engine step, so a rig runs springs up to it (stiffer: :meth:`Rig.check_drive` refuses).
     driven : bool
         False for a model no drive of ours runs (``sim export``, the viewer: the user's sliders
         drive it): then only the surface's falls bound the step.
@@ -149,13 +148,12 @@ def build_rig(
     Raises
     ------
     SpineInputError
-        An unknown engine or its extra missing, an option the engine does not read, any
-        parameter out of range (named), or a drive the engine cannot resolve.
+        An unknown engine or missing extra, an option the engine does not read, a parameter
+        out of range (named), or a drive the engine cannot resolve.
 
     Examples
     --------
-    A rig on the paper's single peak, one spring-drive run at ``I_e = 1e-3`` from a start
-    in front of the peak; results are in SI units.
+    A spring-drive run at ``I_e = 1e-3`` in front of the paper's single peak (SI units).
 
     >>> import spine_mj as sm
     >>> from spine_mj import sim

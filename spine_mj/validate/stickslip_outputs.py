@@ -116,9 +116,6 @@ def stickslip_to(
     """
     import pandas as pd
 
-    from spine_mj.sim.build import build_rig
-    from spine_mj.sim.scales import Scales
-
     ks = [check_positive("--K", k) for k in stiffness_numbers]
     if not ks:
         raise SpineInputError("--K must name at least one stiffness number")
@@ -129,14 +126,7 @@ def stickslip_to(
     frames, units_by_k, pulses = [], {}, {}
     done = 0
     for k_number in ks:
-        if engine:
-            rig = build_rig(surface, engine=engine, mu=mu, ie=ie, stiffness_number=k_number, **rig_options)
-            scales = rig.scales
-        else:
-            sizing = {
-                key: rig_options[key] for key in ("length_scale_m",) if rig_options.get(key) is not None
-            }
-            scales = Scales.for_surface(surface, **sizing)
+        rig, scales = _rig_and_scales(surface, engine, mu, ie, k_number, rig_options)
         units = TrackUnits.of(scales, ie)
         units_by_k[k_number] = units
         land = track_landscape(surface, mu, units.tip_radius, (x0, x0 + length))
@@ -157,6 +147,19 @@ def stickslip_to(
     files = _write(Path(out_dir), events, summary, pulses)
     report(total, total, "written")
     return StickSlipOutputs(summary, files)
+
+
+def _rig_and_scales(surface, engine, mu: float, ie: float, k_number: float, rig_options: dict):
+    """``(rig, scales)`` of one K: the engine's rig where one runs, else ``(None, the
+    surface's scales)`` for the references alone."""
+    from spine_mj.sim.build import build_rig
+    from spine_mj.sim.scales import Scales
+
+    if engine:
+        rig = build_rig(surface, engine=engine, mu=mu, ie=ie, stiffness_number=k_number, **rig_options)
+        return rig, rig.scales
+    sizing = {key: rig_options[key] for key in ("length_scale_m",) if rig_options.get(key) is not None}
+    return None, Scales.for_surface(surface, **sizing)
 
 
 def _engine_run(rig, units: TrackUnits, land, k_number: float, ie: float, x0: float, length: float):
