@@ -114,8 +114,7 @@ def build_rig(
     Parameters
     ----------
     surface : Surface
-        The surface the tip runs on (any length unit; dimensionless ones are scaled by
-        ``length_scale_m``).
+        The surface the tip runs on (any unit; dimensionless ones scaled by ``length_scale_m``).
     mu : float
         The tip's static friction coefficient mu_s.
     engine : str

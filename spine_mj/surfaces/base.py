@@ -54,7 +54,20 @@ def check_unit(unit, name: str = "unit") -> str:
     """``unit`` if a surface may carry it: ``"1"`` (dimensionless) or a length unit of
     :data:`LENGTH_UNITS_M` (in any spelling :func:`length_unit` knows), else a
     :class:`SpineInputError` naming ``name``: refused when a surface is made, not when a
-    command later reads its file."""
+    command later reads its file.
+
+    Parameters
+    ----------
+    unit : str
+        The unit to check.
+    name : str
+        The argument's name in the error message.
+
+    Returns
+    -------
+    str
+        ``unit``, unchanged.
+    """
     if unit != "1" and length_unit(unit) is None:
         raise SpineInputError(
             f"{name} must be '1' (dimensionless) or a length unit {sorted(LENGTH_UNITS_M)}, got {unit!r}"

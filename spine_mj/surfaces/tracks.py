@@ -43,7 +43,26 @@ def abbm_slope_walk(
     Ornstein-Uhlenbeck process, ``s[i+1] = a s[i] + sqrt(D xi (1 - a^2)) N(0, 1)``,
     ``a = exp(-spacing / xi)``, started from its stationary law N(0, D xi). Below ``xi``
     its increments have variance ``2 D |dx|`` (to first order in ``dx / xi``): a random
-    walk of intensity ``D = slope_intensity``."""
+    walk of intensity ``D = slope_intensity``.
+
+    Parameters
+    ----------
+    n : int
+        Number of slopes.
+    spacing : float
+        Distance between them, in surface units.
+    slope_intensity : float
+        ``D``, the walk's intensity (per surface unit).
+    correlation_length : float
+        ``xi``, in surface units: beyond it the slope stops wandering.
+    rng : numpy.random.Generator
+        The source of the walk's noise.
+
+    Returns
+    -------
+    numpy.ndarray
+        The ``n`` slopes.
+    """
     a = math.exp(-spacing / correlation_length)
     var = slope_intensity * correlation_length
     noise = rng.standard_normal(n)
@@ -138,7 +157,21 @@ def abbm_track(
 def abbm_force_intensity(slope_intensity: float, mu: float, load: float = 1.0) -> float:
     """``sigma = W^2 (1 + mu^2)^2 D``: the intensity of the landscape force's walk,
     ``<(F(x) - F(x'))^2> = 2 sigma |x - x'|``, from ``F = W tan(theta + arctan mu)``
-    linearized at zero slope (``dF/df' = W (1 + mu^2)``)."""
+    linearized at zero slope (``dF/df' = W (1 + mu^2)``).
+
+    Parameters
+    ----------
+    slope_intensity : float
+        ``D`` of the slope's walk (:func:`abbm_slope_walk`).
+    mu : float
+        The tip's friction coefficient.
+    load : float
+        The preload ``W`` (1: forces in units of ``F_p``).
+
+    Returns
+    -------
+    float
+    """
     return load * load * (1 + mu * mu) ** 2 * slope_intensity
 
 
@@ -146,5 +179,18 @@ def abbm_size_range(spacing: float, correlation_length: float) -> tuple[float, f
     """The slip sizes over which a track behaves as ABBM: above ten grid spacings (below,
     the spline's smooth slope replaces the walk) and below a tenth of the correlation length
     (beyond it, the slope stops wandering and the force becomes stationary). A study's
-    cutoff ``S_m = sigma / k^2`` should lie in this range."""
+    cutoff ``S_m = sigma / k^2`` should lie in this range.
+
+    Parameters
+    ----------
+    spacing : float
+        The track's grid spacing, in surface units.
+    correlation_length : float
+        The slope walk's correlation length, in surface units.
+
+    Returns
+    -------
+    tuple of float
+        ``(smallest, largest)`` slip size, in surface units.
+    """
     return 10.0 * spacing, 0.1 * correlation_length

@@ -160,8 +160,19 @@ def quasistatic_limit(plan: ValidationPlan, runner: StudyRunner) -> QuasistaticL
     refuses gives no verdict), against the streamline, with the three comparisons of the
     module docstring per run (lengths over L_c; a run the engine stopped disagrees, listed
     by status in ``failed_runs``), its refinements, then on the single peak the settings of
-    ``plan.limit_variations`` one at a time. ``runner`` runs the sweeps of ``plan`` into
-    resumable stores under the output folder."""
+    ``plan.limit_variations`` one at a time.
+
+    Parameters
+    ----------
+    plan : ValidationPlan
+        The families, their corners' sample sizes and the refinements.
+    runner : StudyRunner
+        Runs the sweeps of ``plan`` into resumable stores under the output folder.
+
+    Returns
+    -------
+    QuasistaticLimitResult
+    """
     runner.study = "limit"
     families, runs_rows, paths = {}, [], {}
     corner = [plan.corner_family(fam) for fam in plan.families]
