@@ -374,6 +374,18 @@ def _remove_plane(heights: np.ndarray) -> np.ndarray:
 # --------------------------------------------------------------------------- STL
 
 
+def _mesh_grid(surface, resolution: int, base_thickness, scale: float):
+    """``(grid, z_bottom, scale)`` of a mesh of ``surface``: a grid meshed at its own
+    samples, an analytic surface sampled ``resolution`` a side; the flat bottom
+    ``base_thickness`` below the lowest point (default 5 % of the larger side)."""
+    grid = surface if isinstance(surface, GridSurface) else surface.sample(resolution)
+    span = max(grid.x[-1] - grid.x[0], grid.y[-1] - grid.y[0])
+    base_thickness = (
+        0.05 * span if base_thickness is None else check_positive("base_thickness", base_thickness)
+    )
+    return grid, float(grid.heights.min() - base_thickness), check_positive("scale", scale)
+
+
 def surface_mesh(
     surface: Surface, *, resolution: int = 201, base_thickness: float | None = None, scale: float = 1.0
 ):
@@ -388,15 +400,9 @@ def surface_mesh(
     trimesh.Trimesh
     """
 
-    grid = surface if isinstance(surface, GridSurface) else surface.sample(resolution)
+    grid, z_bottom, scale = _mesh_grid(surface, resolution, base_thickness, scale)
     h = grid.heights
     ny, nx = h.shape
-    span = max(grid.x[-1] - grid.x[0], grid.y[-1] - grid.y[0])
-    base_thickness = (
-        0.05 * span if base_thickness is None else check_positive("base_thickness", base_thickness)
-    )
-    scale = check_positive("scale", scale)
-    z_bottom = h.min() - base_thickness
     xx, yy = np.meshgrid(grid.x, grid.y)
     top = np.column_stack([xx.ravel(), yy.ravel(), h.ravel()])
     bottom = np.column_stack([xx.ravel(), yy.ravel(), np.full(h.size, z_bottom)])
@@ -457,15 +463,9 @@ def write_stl(
     path = Path(path)
     if path.suffix.lower() != ".stl":
         raise SpineInputError(f"STL output must end in .stl, got {path.name!r}")
-    grid = surface if isinstance(surface, GridSurface) else surface.sample(resolution)
+    grid, z_bottom, scale = _mesh_grid(surface, resolution, base_thickness, scale)
     h = grid.heights
     ny, nx = h.shape
-    span = max(grid.x[-1] - grid.x[0], grid.y[-1] - grid.y[0])
-    base_thickness = (
-        0.05 * span if base_thickness is None else check_positive("base_thickness", base_thickness)
-    )
-    scale = check_positive("scale", scale)
-    z_bottom = float(h.min() - base_thickness)
     n_faces = 4 * (ny - 1) * (nx - 1) + 4 * (nx - 1 + ny - 1)
     with atomic_output(path) as tmp, open(tmp, "wb") as fh:
         fh.write(b"spine_mj surface solid".ljust(80, b" ") + np.uint32(n_faces).tobytes())
