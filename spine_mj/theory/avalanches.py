@@ -33,7 +33,14 @@ import numpy as np
 from spine_mj.errors import SpineInputError, check_positive
 from spine_mj.theory._avalanche_kernel import slip_walk
 
-__all__ = ["Landscape", "Slips", "abbm_cutoff", "inertial_slips", "overdamped_slips"]
+__all__ = [
+    "Landscape",
+    "Slips",
+    "abbm_cutoff",
+    "inertial_slips",
+    "overdamped_slips",
+    "quasistatic_path",
+]
 
 
 @dataclass(frozen=True)
@@ -192,6 +199,49 @@ def inertial_slips(landscape: Landscape, stiffness: float, *, mass: float = 1.0,
 
 def _slow(slow: float) -> float:
     return check_positive("slow", slow, allow_zero=True)
+
+
+def quasistatic_path(landscape: Landscape, stiffness: float, slips: Slips, carriage) -> np.ndarray:
+    """Where the tip of a reference run (``slips``, from :func:`overdamped_slips` or
+    :func:`inertial_slips` at ``stiffness``) rests at each carriage position: between
+    slips it holds where the last slip left it until the spring reaches the landscape's
+    threshold, then follows the rising stretch of ``g`` up to the next fold; a slip moves
+    it at one carriage position (the position of a slip's start gives where it stopped).
+
+    Parameters
+    ----------
+    landscape : Landscape
+    stiffness : float
+        ``k / W`` [1 / length], the one ``slips`` was computed at.
+    slips : Slips
+    carriage : (n,) array
+        Non-decreasing carriage positions ``X`` [length], from ``landscape.start`` on and
+        not past the last slip's.
+
+    Returns
+    -------
+    (n,) array
+        The tip's ``u``; the spring's force is ``k (X - u)`` [W].
+    """
+    k = check_positive("stiffness", stiffness)
+    x = np.asarray(carriage, float)
+    if x.ndim != 1 or not np.all(np.diff(x) >= 0):
+        raise SpineInputError("carriage must be a non-decreasing 1-D array")
+    u = landscape.positions - landscape.start
+    g = landscape.force + k * u
+    level = k * (x - landscape.start)
+    slip_level = k * (slips.start_carriage - landscape.start)
+    rest = np.concatenate([[0.0], slips.start_u - landscape.start + slips.size])
+    ends = np.concatenate([slips.start_u - landscape.start, [u[-1]]])
+    which = np.searchsorted(slip_level, level, side="right")
+    out = np.empty_like(x)
+    for i in np.unique(which):
+        sel = which == i
+        a, b = np.searchsorted(u, rest[i], side="right"), np.searchsorted(u, ends[i], side="right")
+        uu = np.concatenate([[rest[i]], u[a:b]])
+        gg = np.maximum.accumulate(np.concatenate([[np.interp(rest[i], u, g)], g[a:b]]))
+        out[sel] = np.maximum(rest[i], np.interp(level[sel], gg, uu))
+    return out + landscape.start
 
 
 def abbm_cutoff(force_intensity: float, stiffness: float) -> float:

@@ -23,13 +23,24 @@ from dataclasses import dataclass
 import numpy as np
 
 from spine_mj.errors import SpineInputError
-from spine_mj.theory.avalanches import Landscape, Slips, inertial_slips, overdamped_slips
+from spine_mj.theory.avalanches import (
+    Landscape,
+    Slips,
+    inertial_slips,
+    overdamped_slips,
+    quasistatic_path,
+)
+from spine_mj.theory.force_drops import drop_bounds
 
 __all__ = [
     "COLUMNS",
+    "DROP_FLOOR_FP",
     "REFERENCES",
     "TrackUnits",
+    "drop_rows",
+    "engine_drop_rows",
     "engine_rows",
+    "reference_drop_rows",
     "reference_rows",
     "store_catalog",
     "track_landscape",
@@ -53,6 +64,10 @@ COLUMNS = (
 REFERENCES = ("overdamped", "inertial")
 #: Landscape points per grid spacing of the surface along x.
 REFINEMENT = 4
+#: The force-drop rule's floor [F_p] (:mod:`spine_mj.theory.force_drops`): three orders
+#: above MuJoCo's resting jitter on the abbm track at I_e 1e-6 (99 % of its reversals under
+#: 3e-6 F_p, docs/physics.md §12) and, at K 0.5, a slip of 0.03 L_c.
+DROP_FLOOR_FP = 1e-3
 
 
 @dataclass(frozen=True)
@@ -143,6 +158,109 @@ def _rows(
         "peak_speed_v": slips.peak_speed / units.speed,
         "dissipated_fp_lc": slips.dissipated / lc,
     }
+
+
+def reference_path(landscape: Landscape, slips: Slips, stiffness: float):
+    """A reference run's tip ``u`` at carriage positions ``X`` (both [length]): a uniform
+    grid of the landscape's spacing from its start to the last slip, plus each slip's two
+    ends at its one carriage position (before, then after), in order."""
+    last = float(slips.start_carriage[-1]) if slips.size.size else landscape.start
+    grid = np.linspace(landscape.start, last, max(int((last - landscape.start) / landscape.spacing), 1) + 1)
+    u = quasistatic_path(landscape, stiffness, slips, grid)
+    x = np.concatenate([grid, slips.start_carriage, slips.start_carriage])
+    uu = np.concatenate([u, slips.start_u, slips.start_u + slips.size])
+    order = np.concatenate([np.ones(grid.size), np.zeros(slips.size.size), np.full(slips.size.size, 2.0)])
+    keep = np.lexsort((order, x))
+    return x[keep], uu[keep]
+
+
+def drop_rows(
+    x,
+    force_fp,
+    floor_fp: float,
+    *,
+    source: str,
+    stiffness_number: float,
+    char_length: float,
+    time_s=None,
+    velocity_v=None,
+    **labels,
+) -> dict:
+    """Catalog columns of the force drops deeper than ``floor_fp`` of one run
+    (:func:`~spine_mj.theory.force_drops.drop_bounds`): rows in time order with the tip's
+    ``x`` (surface units), the spring's force [F_p] and, where the source has them, the
+    time [s] and x-speed over the drive's (else those columns are NaN). The size is the
+    tip's travel from the peak to the trough, the duration their time apart."""
+    x, f = np.asarray(x, float), np.asarray(force_fp, float)
+    on, st = drop_bounds(f, floor_fp)
+    n, nan = on.size, np.full(on.size, math.nan)
+    t = None if time_s is None else np.asarray(time_s, float)
+    if velocity_v is None:
+        peak = nan
+    else:
+        v = np.asarray(velocity_v, float)
+        peak = np.array([v[a : b + 1].max() for a, b in zip(on, st)]) if n else nan
+    return {
+        "source": [source] * n,
+        "surface": [labels.get("surface", "")] * n,
+        "mu": np.full(n, labels.get("mu", math.nan)),
+        "K": np.full(n, float(stiffness_number)),
+        "ie": np.full(n, labels.get("ie", math.nan)),
+        "start_x_lc": x[on] / char_length,
+        "start_time_s": nan if t is None else t[on] - t[0],
+        "size_lc": (x[st] - x[on]) / char_length,
+        "duration_s": nan if t is None else t[st] - t[on],
+        "force_drop_fp": f[on] - f[st],
+        "peak_speed_v": peak,
+        "dissipated_fp_lc": nan,
+    }
+
+
+def reference_drop_rows(
+    landscape: Landscape,
+    units: TrackUnits,
+    stiffness_number: float,
+    floor_fp: float = DROP_FLOOR_FP,
+    **labels,
+) -> dict:
+    """Both references' force drops deeper than ``floor_fp`` at ``K = stiffness_number``:
+    the drop rule on each reference's force ``k (X - u)`` along its path
+    (:func:`reference_path`), as catalog columns per source."""
+    k = units.stiffness(stiffness_number)
+    out = {}
+    for source in REFERENCES:
+        slips = overdamped_slips(landscape, k) if source == "overdamped" else inertial_slips(landscape, k)
+        x, u = reference_path(landscape, slips, k)
+        out[source] = drop_rows(
+            u,
+            k * (x - u),
+            floor_fp,
+            source=source,
+            stiffness_number=stiffness_number,
+            char_length=units.char_length,
+            **labels,
+        )
+    return out
+
+
+def engine_drop_rows(
+    result, units: TrackUnits, source: str, stiffness_number: float, floor_fp: float = DROP_FLOOR_FP, **labels
+) -> dict:
+    """An engine run's force drops deeper than ``floor_fp`` from the drive's start, by the
+    rule the references' go by (:func:`reference_drop_rows`)."""
+    s = result.drive_start_index
+    unit = units.length_scale_m
+    return drop_rows(
+        result.position_m[s:, 0] / unit,
+        result.drive_force_n[s:] / units.preload_n,
+        floor_fp,
+        source=source,
+        stiffness_number=stiffness_number,
+        char_length=units.char_length,
+        time_s=result.time_s[s:],
+        velocity_v=result.velocity_m_s[s:, 0] / (units.speed * unit),
+        **labels,
+    )
 
 
 def engine_rows(result, units: TrackUnits, source: str, stiffness_number: float, **labels) -> dict:

@@ -90,3 +90,34 @@ def test_a_sweep_stores_the_catalog_and_a_resume_keeps_it(tmp_path, corrugation_
     stored = first[(first["start_x_lc"] > 1.5) & (first["start_x_lc"] + first["size_lc"] < 6.0)]
     assert len(stored) >= 2
     assert np.abs(stored["size_lc"] / inertial - 1).max() < 0.1
+
+
+def test_force_drop_rule_gives_mujoco_the_inertial_references_drops_on_a_corrugation():
+    """One rule for both sides: MuJoCo's force drops (peak of the spring's force to its
+    trough) on a corrugation are the inertial reference's, from the crest's force peak to
+    the slip's stop, within a tenth; the overdamped reference's are smaller. A floor of
+    0.01 F_p: MuJoCo's load passes the crest in a 1e-3 F_p wobble on the hfield's facets."""
+    from spine_mj.sim.build import build_rig
+    from spine_mj.validate.slip_catalog import (
+        TrackUnits,
+        engine_drop_rows,
+        reference_drop_rows,
+        track_landscape,
+    )
+    from spine_mj.validate.stickslip_outputs import _engine_run
+
+    surf = surfaces.corrugation(n_waves=4, points_per_wave=128, width=0.5)
+    rig = build_rig(surf, engine="mujoco", mu=0.5, ie=1e-4, stiffness_number=0.2, tip_radius_m=1e-4)
+    units = TrackUnits.of(rig.scales, 1e-4)
+    land = track_landscape(surf, 0.5, units.tip_radius, (0.25, 3.75))
+    refs = reference_drop_rows(land, units, 0.2, 0.01)
+    run = _engine_run(rig, units, land, 0.2, 1e-4, 0.25, 3.5)
+    eng = engine_drop_rows(run, units, "mujoco", 0.2, 0.01)
+    assert list(eng) == list(COLUMNS)
+    steady = {
+        s: np.asarray(r["force_drop_fp"])[np.asarray(r["start_x_lc"]) > 1.0]
+        for s, r in (refs | {"mujoco": eng}).items()
+    }
+    assert steady["mujoco"].size >= 2 and np.ptp(steady["inertial"]) < 1e-2
+    assert np.abs(steady["mujoco"] / steady["inertial"].mean() - 1).max() < 0.1
+    assert steady["inertial"].mean() > 1.2 * steady["overdamped"].mean()
