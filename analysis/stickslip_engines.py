@@ -4,32 +4,50 @@ For each engine, I_e and variant (``base``; ``dt2``: half the engine's step; ``h
 the hfield refined twice), one spring drive per K over the ``abbm`` preset (all but a
 twentieth at each end), its slips against the overdamped and inertial references' slips on
 the same stretch that the engine's detector would see (peak speed >= 5 V): the
-Kolmogorov-Smirnov distance and p-value of sizes and force drops; and the creep of the held
-tip, MuJoCo's soft friction: the tip's mean x-speed over V in the rows it is STUCK, and the
-share of its travel made while stuck. The order of the distance with I_e is the slope of
-``ln D`` against ``ln I_e``.
+Kolmogorov-Smirnov distance and p-value of sizes and force drops; the same for the force
+drops deeper than each ``--floors`` value [F_p] (:mod:`spine_mj.theory.force_drops`, one
+rule for the engine's steps and the references' paths, key ``drops``), with the engine's
+resting jitter (the 99th percentile of its elementary force drops); and the creep of the
+held tip, MuJoCo's soft friction: the tip's mean x-speed over V in the rows it is STUCK,
+and the share of its travel made while stuck. The order of the distance with I_e is the
+slope of ``ln D`` against ``ln I_e``.
 
 Run: ``nice -n 19 .venv/bin/python analysis/stickslip_engines.py [--ie 1e-4,1e-5]
 [--engines mujoco,bullet] [--variants base,dt2,hfield2] [--travel 150]
-[--out analysis/reports/stickslip]``;
-writes ``stickslip_engines.json`` and prints one line per run.
+[--floors 3e-4,1e-3] [--out analysis/reports/stickslip] [--tag NAME]``;
+writes ``stickslip_engines_<tag>.json`` after each run (a rerun skips the runs it holds)
+and the drop catalogs ``stickslip_drops_<tag>.parquet``, and prints one line per run.
 """
 
 from __future__ import annotations
 
 import argparse
+import itertools
+import json
 import math
 import time
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 
 from spine_mj import presets
+from spine_mj.atomic import atomic_output
 from spine_mj.jsonio import write_json
 from spine_mj.sim.build import build_rig
+from spine_mj.theory.force_drops import jitter_scale
 from spine_mj.theory.motion import SLIP_SPEED_FACTOR, STUCK
 from spine_mj.validate.avalanche_stats import two_sample
-from spine_mj.validate.slip_catalog import TrackUnits, engine_rows, reference_rows, track_landscape
+from spine_mj.validate.slip_catalog import (
+    COLUMNS,
+    REFERENCES,
+    TrackUnits,
+    engine_drop_rows,
+    engine_rows,
+    reference_drop_rows,
+    reference_rows,
+    track_landscape,
+)
 from spine_mj.validate.stickslip_outputs import EDGE_SHARE, _engine_run
 
 MU = 0.5
@@ -48,26 +66,67 @@ def _variant(engine: str, variant: str, ie: float, k: float, surf):
     raise SystemExit(f"unknown variant {variant}")
 
 
-def one(engine: str, variant: str, ie: float, k: float, travel: float | None = None) -> dict:
+def _pool(parts: list[dict]) -> dict:
+    """Catalog columns of several segments as one."""
+    return {c: np.concatenate([np.asarray(p[c]) for p in parts]) if parts else np.zeros(0) for c in COLUMNS}
+
+
+def one(
+    engine: str,
+    variant: str,
+    ie: float,
+    k: float,
+    travel: float | None = None,
+    floors=(),
+    catalogs=None,
+    segment: float = 80.0,
+) -> dict:
+    """One engine, variant, I_e and K over the track in runs of ``segment`` units (each
+    from rest, the references on the same stretch): the catalogs pooled over the runs."""
     surf = presets.make_surface("abbm")
     xmin, xmax, _, _ = surf.bounds
     x0, length = xmin + EDGE_SHARE * (xmax - xmin), (1 - 2 * EDGE_SHARE) * (xmax - xmin)
     length = length if travel is None else travel
     rig = _variant(engine, variant, ie, k, surf)
     units = TrackUnits.of(rig.scales, ie)
-    land = track_landscape(surf, MU, units.tip_radius, (x0, x0 + length))
-    refs = reference_rows(land, units, k)
-    c0 = time.process_time()
-    result = _engine_run(rig, units, land, k, ie, x0, length)
-    cpu = time.process_time() - c0
-    eng = engine_rows(result, units, engine, k)
+    count = max(1, math.ceil(length / segment - 1e-9))
+    bounds = x0 + length * np.arange(count + 1) / count
+    parts: dict = {"eng": [], "refs": {s: [] for s in REFERENCES}, "drops": {f: ([], {}) for f in floors}}
+    cpu, ends, stuck_v, creep, travel_sum, jitter = 0.0, [], [], 0.0, 0.0, []
+    for a, b in itertools.pairwise(bounds):
+        land = track_landscape(surf, MU, units.tip_radius, (a, b))
+        for source, r in reference_rows(land, units, k).items():
+            parts["refs"][source].append(r)
+        c0 = time.process_time()
+        result = _engine_run(rig, units, land, k, ie, a, b - a)
+        cpu += time.process_time() - c0
+        ends.append(result.end_reason.value)
+        parts["eng"].append(engine_rows(result, units, engine, k))
+        start = result.drive_start_index
+        stuck = np.asarray(result.motion)[start:] == STUCK
+        vx = result.velocity_m_s[start:, 0] / (units.speed * units.length_scale_m)
+        dx = np.diff(result.position_m[start:, 0], prepend=result.position_m[start, 0])
+        stuck_v.append(vx[stuck])
+        creep += float(dx[stuck].sum())
+        travel_sum += float(dx.sum())
+        jitter.append(jitter_scale(result.drive_force_n[start:] / units.preload_n))
+        for floor in floors:
+            eng_parts, ref_parts = parts["drops"][floor]
+            eng_parts.append(engine_drop_rows(result, units, engine, k, floor))
+            for source, r in reference_drop_rows(land, units, k, floor).items():
+                ref_parts.setdefault(source, []).append(r)
+        del result
+    eng = _pool(parts["eng"])
+    refs = {s: _pool(v) for s, v in parts["refs"].items()}
     row = {
         "engine": engine,
         "variant": variant,
         "ie": ie,
         "K": k,
+        "segments": count,
+        "segment_length": float(length / count),
         "cpu_s": cpu,
-        "end": result.end_reason.value,
+        "end": sorted(set(ends)),
     }
     row["n"] = {engine: len(eng["size_lc"])} | {s: int(np.size(r["size_lc"])) for s, r in refs.items()}
     for source, r in refs.items():
@@ -80,12 +139,28 @@ def one(engine: str, variant: str, ie: float, k: float, travel: float | None = N
             float(np.mean(np.asarray(r["size_lc"])[seen])) if seen.any() else math.nan
         )
     row[f"mean_size_{engine}"] = float(np.mean(eng["size_lc"])) if len(eng["size_lc"]) else math.nan
-    start = result.drive_start_index
-    stuck = np.asarray(result.motion)[start:] == STUCK
-    vx = result.velocity_m_s[start:, 0] / (units.speed * units.length_scale_m)
-    dx = np.diff(result.position_m[start:, 0], prepend=result.position_m[start, 0])
-    row["creep_speed_v"] = float(np.mean(vx[stuck])) if stuck.any() else math.nan
-    row["creep_share_of_travel"] = float(dx[stuck].sum() / max(dx.sum(), 1e-300))
+    stuck_v = np.concatenate(stuck_v)
+    row["creep_speed_v"] = float(np.mean(stuck_v)) if stuck_v.size else math.nan
+    row["creep_share_of_travel"] = creep / max(travel_sum, 1e-300)
+    row["jitter_fp"] = float(max(jitter))
+    row["drops"] = {}
+    for floor in floors:
+        eng_parts, ref_parts = parts["drops"][floor]
+        eng_d, ref_d = _pool(eng_parts), {s: _pool(v) for s, v in ref_parts.items()}
+        entry = {"n": {engine: len(eng_d["size_lc"])} | {s: len(r["size_lc"]) for s, r in ref_d.items()}}
+        for source, r in ref_d.items():
+            for col in ("size_lc", "force_drop_fp"):
+                if len(eng_d[col]) >= 2 and len(r[col]) >= 2:
+                    entry[f"{col}_vs_{source}"] = two_sample(eng_d[col], r[col])
+        entry["mean_size_lc"] = {
+            s: float(np.mean(r["size_lc"])) for s, r in (ref_d | {engine: eng_d}).items()
+        }
+        row["drops"][f"{floor:g}"] = entry
+        if catalogs is not None:
+            for r in (eng_d, *ref_d.values()):
+                frame = pd.DataFrame(r, columns=COLUMNS)
+                frame["variant"], frame["floor_fp"], frame["ie"] = variant, floor, ie
+                catalogs.append(frame)
     return row
 
 
@@ -96,15 +171,31 @@ def main(argv=None):
     ap.add_argument("--engines", default="mujoco")
     ap.add_argument("--variants", default="base")
     ap.add_argument("--travel", type=float, default=None, help="surface units (default: the track)")
+    ap.add_argument("--segment", type=float, default=80.0, help="surface units a run (from rest)")
+    ap.add_argument("--floors", default="3e-4,1e-3", help="force-drop floors [F_p]")
     ap.add_argument("--out", default="analysis/reports/stickslip")
+    ap.add_argument("--tag", default=None, help="output name (default: engines_variants)")
     a = ap.parse_args(argv)
-    rows = []
+    out = Path(a.out)
+    out.mkdir(parents=True, exist_ok=True)
+    tag = a.tag or f"{a.engines.replace(',', '_')}_{a.variants.replace(',', '_')}"
+    path, cat_path = out / f"stickslip_engines_{tag}.json", out / f"stickslip_drops_{tag}.parquet"
+    rows = json.loads(path.read_text()) if path.exists() else []
+    catalogs = [pd.read_parquet(cat_path)] if cat_path.exists() else []
+    floors = [float(v) for v in a.floors.split(",") if v.strip()]
     for engine in a.engines.split(","):
         for variant in a.variants.split(","):
             for ie in (float(v) for v in a.ie.split(",")):
                 for k in (float(v) for v in a.K.split(",")):
-                    row = one(engine, variant, ie, k, a.travel)
+                    if any(
+                        (r["engine"], r["variant"], r["ie"], r["K"]) == (engine, variant, ie, k) for r in rows
+                    ):
+                        continue
+                    row = one(engine, variant, ie, k, a.travel, floors, catalogs, a.segment)
                     rows.append(row)
+                    write_json(path, rows)
+                    with atomic_output(cat_path) as tmp:
+                        pd.concat(catalogs, ignore_index=True).to_parquet(tmp, index=False)
                     d = row.get("size_lc_vs_inertial", {})
                     print(
                         f"{engine} {variant} I_e {ie:g} K {k:g}: {row['n']} sizes vs inertial "
@@ -113,11 +204,14 @@ def main(argv=None):
                         f"{row['creep_share_of_travel']:.3g} of travel; {row['cpu_s']:.0f} CPU s",
                         flush=True,
                     )
-    out = Path(a.out)
-    out.mkdir(parents=True, exist_ok=True)
-    write_json(
-        out / f"stickslip_engines_{a.engines.replace(',', '_')}_{a.variants.replace(',', '_')}.json", rows
-    )
+                    for floor, e in row["drops"].items():
+                        d = e.get("size_lc_vs_inertial", {})
+                        print(
+                            f"  drops > {floor} F_p: {e['n']} sizes vs inertial "
+                            f"D {d.get('ks', math.nan):.3f} "
+                            f"p {d.get('ks_p', math.nan):.3g}; jitter {row['jitter_fp']:.3g} F_p",
+                            flush=True,
+                        )
 
 
 if __name__ == "__main__":
