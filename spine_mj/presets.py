@@ -399,13 +399,15 @@ def surface_info(
     surface: surfaces.Surface,
     *,
     mu: float | None = None,
-    tip_radius: float = 0.0,
+    tip_radius: float | None = None,
     psd_png: str | os.PathLike | None = None,
 ) -> SurfaceInfo:
     """:func:`~spine_mj.roughness.summarize` of ``surface`` and its
     :func:`~spine_mj.theory.drive_limits.drive_limits` with the one mu rule
     (:func:`resolve_mu`: ``mu``, else the preset's; no limits without either), and the PSD
-    plot written to ``psd_png`` if given (``spine-mj surface info``).
+    plot written to ``psd_png`` if given (``spine-mj surface info``). ``tip_radius`` [the
+    surface's length unit]: the tip the limits are of (the one tip rule,
+    :func:`spine_mj.sim.scales.resolve_tip_radius`: None the rig's default tip, 0 a point).
 
     Raises
     ------
@@ -414,14 +416,14 @@ def surface_info(
         command's ``--mu`` and ``--tip-radius``).
     """
     from spine_mj import roughness
+    from spine_mj.sim.scales import resolve_tip_radius
     from spine_mj.theory.drive_limits import drive_limits
 
     rough = roughness.summarize(surface)
     limits = None
     if mu is not None or preset_mu(surface) is not None:
         mu = resolve_mu(surface, mu, name="--mu")
-        if not (math.isfinite(tip_radius) and tip_radius >= 0):
-            raise SpineInputError(f"--tip-radius must be a finite number >= 0, got {tip_radius!r}")
+        tip_radius = resolve_tip_radius(surface, tip_radius, name="--tip-radius")
         limits = drive_limits(surface, mu, tip_radius=tip_radius)
     if psd_png:
         from spine_mj.plotting import roughness_figure, save_figure

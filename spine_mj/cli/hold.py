@@ -21,7 +21,11 @@ from spine_mj.errors import SpineInputError
     help="Output folder: summary.json, report.md, hold.png, surface.npz, sweeps/ (resumable).",
 )
 @click.option(
-    "--tip-radius", type=float, default=None, help="Tip radius (surface units; default: the rig's)."
+    "--tip-radius",
+    type=float,
+    default=None,
+    help="Tip radius in the surface's length unit (default: the rig's default tip; 0, a point, "
+    "is refused: the engine's tip is a ball).",
 )
 @click.option(
     "--starts", type=int, default=40, show_default=True, help="MuJoCo starts (paired under refinement)."

@@ -24,8 +24,9 @@ def _rig_options(f):
             "--tip-radius",
             type=float,
             default=None,
-            help="Tip radius [m] (default: the surface's own, 2 spacings for a scan, else "
-            "max(1 spacing, L_c / 100)).",
+            help="Tip radius in the surface's length unit (default: the rig's default tip: the "
+            "surface's own, 2 spacings for a scan, else max(1 spacing, L_c / 100); 0, a point, "
+            "is refused: the engine's tip is a ball).",
         ),
         click.option("--mass", type=float, default=0.01, show_default=True, help="m_eff [kg]."),
         click.option(
@@ -67,11 +68,14 @@ def _rig_inputs(
     (:func:`spine_mj.presets.open_surface`) and :func:`spine_mj.sim.build_rig`'s keywords
     (``mu`` resolved by the one mu rule)."""
     from spine_mj import presets
+    from spine_mj.sim.scales import engine_tip_radius_m
 
     surf = presets.open_surface(surface_spec)
     return surf, {
         "mu": presets.resolve_mu(surf, mu, name="--mu"),
-        "tip_radius_m": tip_radius,
+        "tip_radius_m": engine_tip_radius_m(
+            surf, tip_radius, length_scale_m=length_scale, name="--tip-radius"
+        ),
         "mass_kg": mass,
         "preload_n": preload,
         "length_scale_m": length_scale,

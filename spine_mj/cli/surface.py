@@ -117,7 +117,11 @@ def surface_show(surface_file, output):
 @click.option("--json", "as_json", is_flag=True, help="Print the numbers as JSON.")
 @click.option("--mu", type=float, help="mu_s for the drive limits (default: the preset's).")
 @click.option(
-    "--tip-radius", type=float, default=0.0, show_default=True, help="Tip radius for the drive limits."
+    "--tip-radius",
+    type=float,
+    default=None,
+    help="Tip radius of the drive limits, in the surface's length unit (default: the rig's default "
+    "tip; 0: a point).",
 )
 def surface_info(surface_spec, output, as_json, mu, tip_radius):
     """Roughness of SURFACE (preset, .npz or instrument file): rms height, slope and

@@ -47,9 +47,9 @@ def kappa_cmd(surface_spec, mu, output, resolution):
 @click.option(
     "--tip-radius",
     type=float,
-    default=0.0,
-    show_default=True,
-    help="Spherical tip radius R; the tip centre rides the surface dilated by R.",
+    default=None,
+    help="Spherical tip radius R in the surface's length unit; the tip centre rides the surface "
+    "dilated by R (default: the rig's default tip; 0: a point).",
 )
 @click.option(
     "--format",
@@ -76,11 +76,13 @@ def streamline_cmd(surface_spec, mu, starts, dl, tip_radius, fmt, out_dir):
     """
 
     from spine_mj import presets
+    from spine_mj.sim.scales import resolve_tip_radius
     from spine_mj.theory.streamline_outputs import streamline_to
 
     pts = [parse_start(s) for s in starts]
     surf = presets.open_surface(surface_spec)
     mu = presets.resolve_mu(surf, mu, name="--mu")
+    tip_radius = resolve_tip_radius(surf, tip_radius, name="--tip-radius")
     run, written = streamline_to(out_dir, surf, pts, mu=mu, fmt=fmt, dl=dl, tip_radius=tip_radius)
     for line in run.summary_lines():
         click.echo(line)

@@ -327,6 +327,66 @@ def default_tip_radius(
     return float(f"{radius:.3g}")
 
 
+def check_tip_radius(
+    tip_radius: float | None, name: str = "tip_radius", *, point: bool = True
+) -> float | None:
+    """A user's tip radius [the surface's length unit], checked: None (the rig's default
+    tip), 0 (a point) or a finite radius > 0. ``point`` False: a point is refused, as where
+    an engine runs (its tip is a ball). The one meaning of ``tip_radius`` in every command
+    and config key (:func:`resolve_tip_radius`, :func:`engine_tip_radius_m`)."""
+    if tip_radius is None:
+        return None
+    if isinstance(tip_radius, bool) or not (math.isfinite(tip_radius) and tip_radius >= 0):
+        raise SpineInputError(
+            f"{name} must be a finite number >= 0 in the surface's length unit (0: a point), "
+            f"got {tip_radius!r}"
+        )
+    if tip_radius == 0 and not point:
+        raise SpineInputError(
+            f"{name} 0 is a point tip, and an engine's tip is a ball: give a radius > 0 in the "
+            f"surface's length unit, or leave {name} out for the rig's default"
+        )
+    return float(tip_radius)
+
+
+def resolve_tip_radius(
+    surface: Surface,
+    tip_radius: float | None,
+    *,
+    length_scale_m: float | None = None,
+    hfield_resolution: int | None = None,
+    name: str = "tip_radius",
+) -> float:
+    """The tip radius [the surface's length unit] that ``tip_radius`` means: itself (0, a
+    point, included), or for None the radius a rig of ``surface`` takes at these sizing
+    inputs (:func:`default_tip_radius`; a grid keeps its own samples,
+    :func:`grid_keeps_samples`). So a streamline and an engine's run given the same
+    ``tip_radius``, or none, trace the same tip."""
+    radius = check_tip_radius(tip_radius, name)
+    if radius is not None:
+        return radius
+    unit_m = surface_unit_m(surface, length_scale_m)
+    spacing = hfield_spacing(hfield_of(surface, grid_keeps_samples(surface, hfield_resolution)), unit_m)
+    xmin, xmax, ymin, ymax = surface.bounds
+    width_m = min(xmax - xmin, ymax - ymin) * unit_m
+    char_length_m = characteristic_length(surface) * unit_m
+    return default_tip_radius(surface, spacing, char_length_m, width_m=width_m) / unit_m
+
+
+def engine_tip_radius_m(
+    surface: Surface,
+    tip_radius: float | None,
+    *,
+    length_scale_m: float | None = None,
+    name: str = "tip_radius",
+) -> float | None:
+    """What an engine's rig takes of a user's ``tip_radius`` [the surface's length unit]:
+    the radius in metres, or None for the rig's default (sized by :meth:`Scales.with_hfield`,
+    the same radius :func:`resolve_tip_radius` gives). A point (0) is refused."""
+    radius = check_tip_radius(tip_radius, name, point=False)
+    return None if radius is None else radius * surface_unit_m(surface, length_scale_m)
+
+
 def fall_height(
     heights: np.ndarray, spacing: tuple[float, float], *, mu: float, radius: float, rows: int = 512
 ) -> float:

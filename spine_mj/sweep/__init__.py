@@ -23,7 +23,7 @@ grid and the analyses to run on every case::
 
     [grid]
     mu = [0.3, 0.5, 0.8]              # a value, a list, or { linspace | logspace = [a, b], num = n }
-    tip_radius = 0.0
+    tip_radius = 0.05                 # surface units (absent: the rig's default tip; 0: a point)
 
 A *case* is one surface instance and one point of the grid, with all its starts; its id is
 a hash of those parameters, and its seed is derived from the master seed and that id, so a

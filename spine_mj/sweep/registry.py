@@ -149,6 +149,18 @@ MU_PARAM = ParamSpec(
 )
 
 
+#: The tip radius, shared by the streamline and the engine so that one config traces one tip
+#: in both (declared once; its meaning: :func:`spine_mj.sim.scales.check_tip_radius`).
+TIP_RADIUS_PARAM = ParamSpec(
+    "tip_radius",
+    "float",
+    "tip radius in the surface's length unit (default: the rig's default tip, the larger of one "
+    "hfield spacing and L_c / 100; 0: a point, which quasistatic traces and an engine refuses)",
+    None,
+    0.0,
+)
+
+
 #: The force cap, shared by the streamline and the engine so that both call "held" by the
 #: same test (declared once; :data:`spine_mj.theory.engagement.DEFAULT_KAPPA_CAP`).
 KAPPA_CAP_PARAM = ParamSpec(

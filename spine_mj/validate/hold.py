@@ -129,9 +129,9 @@ class HoldSettings:
             raise SpineInputError(f"--budget must be a finite number of seconds > 0, got {self.budget_s!r}")
         if not (isinstance(self.mu, (int, float)) and math.isfinite(self.mu) and self.mu > 0):
             raise SpineInputError(f"--mu must be a finite number > 0, got {self.mu!r}")
-        r = self.tip_radius
-        if r is not None and not (isinstance(r, (int, float)) and math.isfinite(r) and r > 0):
-            raise SpineInputError(f"--tip-radius must be a finite number > 0, got {r!r}")
+        from spine_mj.sim.scales import check_tip_radius
+
+        check_tip_radius(self.tip_radius, "--tip-radius", point=False)
 
 
 def hold_to(
@@ -233,8 +233,7 @@ def _corner(surface, settings: HoldSettings):
     from spine_mj import sim
     from spine_mj.theory import drive_limits as dlim
 
-    unit_m = sim.scales.surface_unit_m(surface, None)
-    tip_m = None if settings.tip_radius is None else settings.tip_radius * unit_m
+    tip_m = sim.scales.engine_tip_radius_m(surface, settings.tip_radius, name="--tip-radius")
     scales = sim.Scales.for_surface(surface, tip=sim.TipParams(tip_radius_m=tip_m, mu_s=settings.mu))
     tip = scales.tip_radius_m / scales.length_scale_m
     limits = dlim.drive_limits(surface, settings.mu, tip_radius=tip)

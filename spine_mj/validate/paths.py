@@ -14,13 +14,12 @@ from pathlib import Path
 
 import numpy as np
 
-from spine_mj import presets, sim, sweep
+from spine_mj import presets, sweep
 from spine_mj.errors import SpineInputError
-from spine_mj.sim.scales import grid_keeps_samples
+from spine_mj.sim.scales import grid_keeps_samples, resolve_tip_radius
 from spine_mj.surfaces import TriangulatedSurface, from_hfield, to_hfield
 from spine_mj.theory import agreement
 from spine_mj.theory import streamline as sl
-from spine_mj.validate.plans import MASS_KG
 
 __all__ = [
     "mujoco_traces",
@@ -34,9 +33,9 @@ __all__ = [
 
 
 def tip_radius(preset: str, seeds, resolution: int) -> float:
-    """The rig's default tip radius (:meth:`spine_mj.sim.Scales.for_surface`) in surface
-    units, so that the quasistatic streamline runs on the surface traced by the same sphere.
-    A grid keeps its own samples here; ``resolution`` applies to analytic surfaces.
+    """The rig's default tip radius in surface units (:func:`spine_mj.sim.scales.resolve_tip_radius`),
+    so that the quasistatic streamline runs on the surface traced by the same sphere. A grid
+    keeps its own samples; ``resolution`` applies to analytic surfaces.
 
     Parameters
     ----------
@@ -48,12 +47,7 @@ def tip_radius(preset: str, seeds, resolution: int) -> float:
         Samples a side of an analytic surface's hfield.
     """
     surface = presets.open_surface(preset, **({} if seeds is None else {"seed": seeds[0]}))
-    scales = sim.Scales.for_surface(
-        surface,
-        tip=sim.TipParams(mass_kg=MASS_KG),
-        hfield_resolution=grid_keeps_samples(surface, resolution),
-    )
-    return float(f"{scales.tip_radius_m / scales.length_scale_m:.3g}")
+    return float(f"{resolve_tip_radius(surface, None, hfield_resolution=resolution):.3g}")
 
 
 def streamline_paths(surface, starts, mu: float, dl: float, tip: float) -> sl.StreamlineResult:

@@ -13,7 +13,7 @@ from typing import Any
 from spine_mj import examples, presets, sim, sweep
 from spine_mj.errors import SpineInputError
 from spine_mj.sim.drives import spring_stiffness_n_m
-from spine_mj.sim.scales import grid_keeps_samples, surface_unit_m
+from spine_mj.sim.scales import engine_tip_radius_m, grid_keeps_samples
 from spine_mj.sweep.preflight import check_cases
 from spine_mj.validate.plans import MASS_KG, FamilySpec, ValidationPlan
 
@@ -91,10 +91,9 @@ def rig_engine(
     stiffness number ``stiffness_number`` (None: the default spring): the same rule
     (:func:`spine_mj.sim.default_engine`), from the same speed and stiffness, without
     compiling a model."""
-    unit_m = surface_unit_m(surface, None)
     scales = sim.Scales.for_surface(
         surface,
-        tip=sim.TipParams(tip_radius_m=None if tip is None else tip * unit_m, mass_kg=MASS_KG, mu_s=mu),
+        tip=sim.TipParams(tip_radius_m=engine_tip_radius_m(surface, tip), mass_kg=MASS_KG, mu_s=mu),
         hfield_resolution=grid_keeps_samples(surface, hfield_resolution),
     )
     speed = sim.drive_speed_m_s(scales, ie=ie)

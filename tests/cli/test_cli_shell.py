@@ -62,10 +62,10 @@ def test_the_check_sees_a_rig_built_in_a_command():
 
 
 #: Calls into the library that parse the command line rather than do the command's work:
-#: a SURFACE, example or CONFIG argument opened, the one mu rule, argument checks
+#: a SURFACE, example or CONFIG argument opened, the one mu and tip rules, argument checks
 #: (``check_*``, ``parse_*``, ``has_*``) and parameter records or errors (classes); and
 #: what formats a returned value for printing (``*_lines``).
-PARSING = {"open_surface", "resolve", "resolve_mu", "preset_mu", "load_config"}
+PARSING = {"open_surface", "resolve", "resolve_mu", "resolve_tip_radius", "preset_mu", "load_config"}
 
 
 def _is_parsing_or_printing(name: str) -> bool:

@@ -77,7 +77,7 @@ def test_cli_and_sweep_build_the_same_model_on_an_analytic_surface(tmp_path):
         tmp_path,
         "paper-single-peak",
         start,
-        ["--ie", 1e-3, "--K", 10, "--mu", 1.2, "--tip-radius", 2e-3, "--resolution", 41],
+        ["--ie", 1e-3, "--K", 10, "--mu", 1.2, "--tip-radius", 0.2, "--resolution", 41],
     )
     rig, drive = _sweep_case(
         tmp_path,

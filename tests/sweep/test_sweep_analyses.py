@@ -119,6 +119,58 @@ def test_a_scan_in_um_takes_its_tip_radius_in_um(tmp_path, topography_dir):
     assert rig.tip.tip_radius_m == pytest.approx(5e-6, rel=1e-12)
 
 
+@pytest.mark.parametrize("tip_radius", [None, 0.1])
+def test_one_config_gives_both_analyses_the_same_tip(tmp_path, tip_radius):
+    """``tip_radius`` has one meaning in both analyses: absent, the rig's default tip (the
+    quasistatic streamline traces the surface dilated by the ball MuJoCo runs), else that
+    radius in the surface's length unit, at any length scale."""
+    from spine_mj import presets
+    from spine_mj.sim.scales import resolve_tip_radius
+    from spine_mj.sweep.analyses.mujoco import case_rig
+    from spine_mj.sweep.analyses.quasistatic import case_tip_radius
+
+    grid = {"mu": 1.25, "length_scale": 0.02, "hfield_resolution": 61}
+    doc = {
+        "sweep": {"analyses": ["quasistatic", "mujoco"]},
+        "surfaces": [{"preset": "paper-single-peak"}],
+        "starts": {"points": [[0.1, 0.5]]},
+        "drive": {"protocol": "spring", "ie": 1e-3},
+        "grid": grid if tip_radius is None else {**grid, "tip_radius": tip_radius},
+    }
+    (case,) = sweep.expand_cases(sweep.parse_config(doc, base_dir=tmp_path))
+    surface = presets.make_surface("paper-single-peak")
+    rig = case_rig(case, surface)
+    traced = case_tip_radius(case, surface)
+    assert traced > 0
+    assert traced == pytest.approx(rig.tip.tip_radius_m / rig.length_scale_m, rel=1e-12)
+    if tip_radius is None:  # the rig's rule: one of its 61 samples' spacing, not 201's
+        given = {"length_scale_m": 0.02, "hfield_resolution": 61}
+        assert traced == pytest.approx(resolve_tip_radius(surface, None, **given), rel=1e-12)
+        assert traced > resolve_tip_radius(surface, None) * 1.5
+    else:
+        assert traced == tip_radius
+
+
+def test_a_point_tip_is_traced_by_the_streamline_and_refused_by_the_engine(tmp_path):
+    """``tip_radius = 0`` is a point: the quasistatic analysis traces the surface itself;
+    the engine's tip is a ball, so a config running it is refused in one line naming the key."""
+    from spine_mj.errors import SpineInputError
+    from spine_mj.sweep.analyses.quasistatic import traced_surface
+
+    doc = {
+        "sweep": {"analyses": ["quasistatic"]},
+        "surfaces": [{"preset": "paper-single-peak"}],
+        "starts": {"points": [[0.1, 0.5]]},
+        "grid": {"mu": 1.25, "tip_radius": 0.0},
+    }
+    (case,) = sweep.expand_cases(sweep.parse_config(doc, base_dir=tmp_path))
+    surface = case.surface.make()
+    assert traced_surface(case, surface) is surface
+    doc["sweep"]["analyses"] = ["quasistatic", "mujoco"]
+    with pytest.raises(SpineInputError, match=r"config key grid.tip_radius 0 is a point tip.*leave"):
+        sweep.parse_config(doc, base_dir=tmp_path)
+
+
 ENSEMBLE = """
 [sweep]
 name = "ensemble"

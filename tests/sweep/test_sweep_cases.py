@@ -57,9 +57,11 @@ def test_relative_and_random_starts():
 
 def test_config_hash_case_ids_and_seeds_are_pinned_so_existing_stores_resume():
     """Values a store resumes by: its config hash and case ids. The pydantic schema kept
-    those of the hand-written parser; they changed once since, on purpose, when the
+    those of the hand-written parser; they changed twice since, on purpose: when the
     quasistatic analysis took the shared force cap ``kappa_cap`` (its streamlines differ,
-    so a store computed without the cap must not resume)."""
+    so a store computed without the cap must not resume), and when an absent ``tip_radius``
+    became the rig's default tip for the quasistatic analysis too (it had been a point: the
+    second config's streamlines differ)."""
     doc = with_(grid__mu=[0.5, 1.0, 1.5], grid__tip_radius={"logspace": [0.01, 1.0], "num": 3})
     doc["grid"]["trajectory"] = ["streamline", "ideal"]
     doc["surfaces"] = [
@@ -89,9 +91,9 @@ def test_config_hash_case_ids_and_seeds_are_pinned_so_existing_stores_resume():
         }
     )
     cases = sweep.expand_cases(config)
-    assert config.hash == "c10df4628cdd1be7d829dbe258e7db8c17d4abc2019e0f5f5b468e4d09877e0b"
+    assert config.hash == "bc9917536ebcf6bac70af8d230b30807d8ee0b1e8a0c2402c9d3211bec5caafb"
     assert [c.case_id for c in cases[:2]] + [cases[-1].case_id] == [
-        "67006fc3e92157ca",
-        "7557fa0935f057dd",
-        "a3872ebaa66071e8",
+        "194a75e742494a6a",
+        "6628d07ed6d38034",
+        "5a53974cad264687",
     ]

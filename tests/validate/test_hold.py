@@ -68,7 +68,8 @@ def test_a_killed_hold_resumes_from_its_stores_and_writes_every_key(tmp_path):
             r"--reference-starts \(10\) must be at least --starts \(20\)",
         ),
         ({"budget_s": math.nan}, "--budget must be a finite number of seconds > 0, got nan"),
-        ({"tip_radius": -1.0}, "--tip-radius must be a finite number > 0, got -1.0"),
+        ({"tip_radius": -1.0}, "--tip-radius must be a finite number >= 0 in the surface's length unit"),
+        ({"tip_radius": 0.0}, "--tip-radius 0 is a point tip, and an engine's tip is a ball"),
     ],
 )
 def test_bad_settings_are_refused_by_the_options_name(kwargs, match):

@@ -27,7 +27,13 @@ from spine_mj.errors import SpineInputError
 from spine_mj.sim.drives import stiffness_n_m
 from spine_mj.sim.holding import spring_swing
 from spine_mj.sweep.analyses.mujoco import CHECK_READS, case_drive, case_plan, peak_drive_over_fp
-from spine_mj.sweep.analyses.quasistatic import cached_trace, hfield_key, path_table, traced_surface
+from spine_mj.sweep.analyses.quasistatic import (
+    cached_trace,
+    case_tip_radius,
+    hfield_key,
+    path_table,
+    traced_surface,
+)
 from spine_mj.sweep.registry import Analysis, AnalysisResult, ParamSpec, register_analysis
 from spine_mj.theory import agreement
 from spine_mj.theory import streamline as sl
@@ -183,7 +189,7 @@ def _references(case, surface, starts, quasistatic, rig, runs, lead):
         quasistatic.params, edge_margin=runs[0].detection.domain_margin_m / rig.length_scale_m
     )
     smooth_surface = traced_surface(case, surface)
-    smooth_key = (case.surface, case.params["tip_radius"])
+    smooth_key = (case.surface, case_tip_radius(case, surface))
     smooth = cached_trace(trace, smooth_key, smooth_surface, np.asarray(starts, float)[lead], margin)
     contact = rig.contact_surface()
     # steps no longer than an eighth of the tip radius: a longer step can jump a crease

@@ -19,11 +19,12 @@ from spine_mj.sim.build import plan_rig, rig_sizing
 from spine_mj.sim.holding import spring_swing
 from spine_mj.sim.open_loop import drive_steps
 from spine_mj.sim.ramp import nominal_time_s
-from spine_mj.sim.scales import surface_unit_m
+from spine_mj.sim.scales import check_tip_radius, engine_tip_radius_m
 from spine_mj.sweep.registry import (
     CASE_THREADS,
     KAPPA_CAP_PARAM,
     MU_PARAM,
+    TIP_RADIUS_PARAM,
     Analysis,
     AnalysisResult,
     ParamSpec,
@@ -41,14 +42,7 @@ MUJOCO_PARAMS = (
         + "); an engine option the engine does not read is refused",
         DEFAULT_ENGINE,
     ),
-    ParamSpec(
-        "tip_radius",
-        "float",
-        "tip radius in the surface's length unit (mujoco: 0 lets "
-        "the rig choose one hfield spacing or L_c / 100)",
-        0.0,
-        0.0,
-    ),
+    TIP_RADIUS_PARAM,
     ParamSpec("protocol", "str", "drive protocol", "spring", choices=PROTOCOLS, drive=True),
     ParamSpec(
         "ie",
@@ -224,8 +218,8 @@ PROTOCOL_KEYS = {
 
 
 def check_speed(config) -> None:
-    """One of ie/speed, K/stiffness and timestep/timestep_factor; no drive key that a
-    chosen protocol would ignore."""
+    """One of ie/speed, K/stiffness and timestep/timestep_factor; a tip that is a ball (no
+    point); no drive key that a chosen protocol would ignore."""
     grid = dict(config.grid)
     for a, b, what in (
         ("ie", "speed", "the inertia number or the speed"),
@@ -237,6 +231,8 @@ def check_speed(config) -> None:
                 f"config keys grid.{a} and grid.{b}: give one of them ({what}), got "
                 f"{a} = {list(grid[a])} and {b} = {list(grid[b])}"
             )
+    for radius in grid["tip_radius"]:
+        check_tip_radius(radius, "config key grid.tip_radius", point=False)
     for engine in grid["engine"]:
         check_engine_options(engine, grid, MUJOCO_PARAMS)
     defaults = {s.name: s.default for s in MUJOCO_PARAMS}
@@ -392,8 +388,9 @@ _RIG_KEYS = (
 
 def _rig_key(p: dict, surface) -> tuple:
     """The parameters of a case that make its rig, as a hashable key of :func:`_rig`."""
-    unit_m = surface_unit_m(surface, p["length_scale"])
-    tip_radius_m = p["tip_radius"] * unit_m if p["tip_radius"] > 0 else None
+    tip_radius_m = engine_tip_radius_m(
+        surface, p["tip_radius"], length_scale_m=p["length_scale"], name="config key grid.tip_radius"
+    )
     return tuple(sorted({"tip_radius_m": tip_radius_m, **{k: p[k] for k in _RIG_KEYS}}.items()))
 
 

@@ -12,9 +12,11 @@ import hashlib
 
 import numpy as np
 
+from spine_mj.sim.scales import resolve_tip_radius
 from spine_mj.sweep.registry import (
     KAPPA_CAP_PARAM,
     MU_PARAM,
+    TIP_RADIUS_PARAM,
     Analysis,
     AnalysisResult,
     ParamSpec,
@@ -24,7 +26,7 @@ from spine_mj.theory import streamline as sl
 
 QUASISTATIC_PARAMS = (
     MU_PARAM,
-    ParamSpec("tip_radius", "float", "tip radius in the surface's length unit (0: a point)", 0.0, 0.0),
+    TIP_RADIUS_PARAM,
     ParamSpec(
         "dl",
         "float",
@@ -55,6 +57,7 @@ _traces: collections.OrderedDict = collections.OrderedDict()
 def clear_cache() -> None:
     """Forget the dilated surfaces and the streamlines traced in this process."""
     _dilated.cache_clear()
+    _rig_tip_radius.cache_clear()
     _traces.clear()
 
 
@@ -86,10 +89,30 @@ def hfield_key(hfield, tip_radius: float) -> tuple:
     return (h.hexdigest(), tuple(hfield.size), tuple(hfield.pos), float(tip_radius))
 
 
+def case_tip_radius(case, surface) -> float:
+    """The tip radius of ``case`` [the surface's length unit]: its ``tip_radius``, or none
+    given the rig's default at the case's sizing keys where the sweep has them (the one rule,
+    :func:`spine_mj.sim.scales.resolve_tip_radius`): the tip the engine's analysis runs."""
+    p = case.params
+    if p["tip_radius"] is not None:
+        return p["tip_radius"]
+    return _rig_tip_radius(case.surface, p.get("length_scale"), p.get("hfield_resolution"))
+
+
+@functools.lru_cache(maxsize=8)
+def _rig_tip_radius(spec, length_scale_m, hfield_resolution) -> float:
+    return resolve_tip_radius(
+        spec.make(),
+        None,
+        length_scale_m=length_scale_m,
+        hfield_resolution=hfield_resolution,
+    )
+
+
 def traced_surface(case, surface):
     """The surface the quasistatic analysis traces on for ``case``: ``surface`` dilated by
-    the case's tip radius (when it has one)."""
-    r = case.params["tip_radius"]
+    the case's tip radius (:func:`case_tip_radius`; 0, a point, the surface itself)."""
+    r = case_tip_radius(case, surface)
     return _dilated(case.surface, r) if r > 0 else surface
 
 
@@ -113,7 +136,7 @@ def _quasistatic(case, surface, starts, upstream):
     params = _params(case, surface)
     dl = params.dl
     func = sl.streamlines if p["trajectory"] == "streamline" else sl.ideal_trajectories
-    res = cached_trace(func, (case.surface, p["tip_radius"]), surface, starts, params)
+    res = cached_trace(func, (case.surface, case_tip_radius(case, surface)), surface, starts, params)
     names = np.array(["", *[o.name.lower() for o in sl.Outcome]], dtype=object)
     metrics = {
         "outcome": names[res.outcome],
