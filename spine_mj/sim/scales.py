@@ -25,9 +25,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from spine_mj.errors import SpineInputError, check_positive
+from spine_mj.memory import check_memory
 from spine_mj.roughness import characteristic_length, slope_correlation_length
 from spine_mj.sim.records import TipParams
 from spine_mj.surfaces import LENGTH_UNITS_M, GridSurface, HField, Surface, length_unit, to_hfield
+from spine_mj.surfaces.hfield import DEFAULT_HFIELD_SIDE
 
 DEFAULT_LENGTH_SCALE_M = 0.01
 #: Largest inertia number a drive may have: beyond it the quasistatic question is moot and
@@ -40,6 +42,14 @@ _SCAN_TIP_SPACINGS = 2.0  # default tip radius of a measured scan, in lateral sp
 #: strip of long waves would give a tip wider than the strip).
 DEFAULT_TIP_RADII_ACROSS = 8
 MAX_HFIELD_SIDE = 8192  # samples a side of an hfield (memory; MuJoCo's collision stays local)
+#: Bytes per hfield sample a rig holds at its peak: the float64 evaluation of the surface on
+#: the samples (the points' x and y, the values and their join: 32; a grid's refinement the
+#: same through its interpolant) and the float32 hfield kept (4). The later stages take less:
+#: MjSpec's copy and the compiled model's (8), the run's model copy (4), the fall height's
+#: float64 copy and its scaled one (16). Measured 33-35 B a sample at 2048 a side, analytic
+#: or a refined fractal (tests/test_memory.py); a Python list of the samples for MjSpec took
+#: 32 B more (``simulate --resolution 8192`` peaked at 3.9 GB).
+HFIELD_BYTES_PER_SAMPLE = 36
 _MIN_ENGINE_RATIO = 1e-9  # smallest length ratio (tip / L_c, spacing / L_c) the engine resolves
 #: Physical range of lengths [m] (outside it the model means nothing).
 PHYSICAL_LENGTH_M = (1e-12, 1e3)
@@ -508,10 +518,16 @@ def hfield_of(surface: Surface, resolution: int | None = None, refinement: int =
     -------
     HField
     """
+    if resolution or not isinstance(surface, GridSurface):
+        ny = nx = resolution or DEFAULT_HFIELD_SIDE
+    else:
+        ny, nx = surface.shape
+    f = int(refinement)
+    ny, nx = (ny - 1) * f + 1, (nx - 1) * f + 1
+    check_memory(HFIELD_BYTES_PER_SAMPLE * float(nx) * ny, where=f"an hfield of {ny} x {nx} samples")
     hf = to_hfield(surface, nrow=resolution, ncol=resolution) if resolution else to_hfield(surface)
     if refinement == 1:
         return hf
-    f = int(refinement)
     return to_hfield(surface, nrow=(hf.nrow - 1) * f + 1, ncol=(hf.ncol - 1) * f + 1)
 
 

@@ -9,6 +9,9 @@ import numpy as np
 from spine_mj.errors import check_positive
 from spine_mj.surfaces.types import GridSurface, Surface
 
+#: Samples a side of an analytic surface's hfield when none are asked for.
+DEFAULT_HFIELD_SIDE = 201
+
 
 @dataclass(frozen=True)
 class HField:
@@ -71,7 +74,7 @@ def to_hfield(
     elif factor:
         grid = refine_grid(surface, factor)
     else:
-        ncol = 201 if ncol is None else ncol
+        ncol = DEFAULT_HFIELD_SIDE if ncol is None else ncol
         nrow = ncol if nrow is None else nrow
         grid = surface.sample(ncol, nrow)
     h = grid.heights
