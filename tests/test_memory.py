@@ -194,7 +194,8 @@ small.run(sim.build_drive(small.scales, "spring", ie=1e-3, duration_s=0.002), st
 base = peak()
 rig = sim.build_rig(surf, mu=0.5, hfield_resolution=n if kind == "peak" else None, hfield_refinement=f)
 x0, x1, y0, y1 = surf.bounds
-rig.run(sim.build_drive(rig.scales, "spring", ie=1e-3, duration_s=0.002), start=(0.8 * x0 + 0.2 * x1, 0.5 * (y0 + y1)))
+drive = sim.build_drive(rig.scales, "spring", ie=1e-3, duration_s=0.002)
+rig.run(drive, start=(0.8 * x0 + 0.2 * x1, 0.5 * (y0 + y1)))
 print((peak() - base) / (HFIELD_BYTES_PER_SAMPLE * rig.hfield.nrow * rig.hfield.ncol))
 """
 
