@@ -16,8 +16,12 @@ not cut it). The rule reads the force's curve, not the tip's speed, so
   catalogs built by it compare like with like, both cut at the same ``floor``.
 
 A drop includes a stable slide down a falling stretch of the landscape that runs into a
-slip (the force falls there too, slowly): on both sides alike. A drop still under way at
-the series' end is not an event (its trough is unknown).
+slip (the force falls there too, slowly): on both sides alike. Where the force stays level
+at its peak (a tip sliding along a facet of an engine's height field at a constant
+threshold) the drop starts at the plateau's end, the last point within
+:data:`PLATEAU_SHARE` ``floor`` of the peak; likewise it stops at the trough's first point
+within that of the lowest force. A drop still under way at the series' end is not an
+event (its trough is unknown).
 """
 
 from __future__ import annotations
@@ -27,7 +31,11 @@ from numba import njit
 
 from spine_mj.errors import SpineInputError, check_positive
 
-__all__ = ["drop_bounds", "jitter_scale"]
+__all__ = ["PLATEAU_SHARE", "drop_bounds", "jitter_scale"]
+
+#: A drop starts at the last point within this share of ``floor`` of its peak force, and
+#: stops at the first within it of its lowest: a level stretch's ends, not its arg-max.
+PLATEAU_SHARE = 0.1
 
 
 @njit(cache=True)
@@ -89,7 +97,23 @@ def drop_bounds(force, floor: float) -> tuple[np.ndarray, np.ndarray]:
     h = check_positive("floor", floor)
     if f.size < 2:
         return np.zeros(0, np.int64), np.zeros(0, np.int64)
-    return _drop_walk(f, h)
+    return _plateau_ends(f, *_drop_walk(f, h), PLATEAU_SHARE * h)
+
+
+@njit(cache=True)
+def _plateau_ends(force, onset, stop, tol):
+    """Each drop's start moved to the last point before its trough within ``tol`` of the
+    peak, its stop to the first point after its start within ``tol`` of the trough."""
+    for m in range(onset.size):
+        top, low = onset[m], stop[m]
+        i = top
+        while i + 1 < low and force[i + 1] >= force[top] - tol:
+            i += 1
+        j = i + 1
+        while j < low and force[j] > force[low] + tol:
+            j += 1
+        onset[m], stop[m] = i, j
+    return onset, stop
 
 
 def jitter_scale(force, quantile: float = 0.99) -> float:

@@ -11,14 +11,15 @@ from scipy.optimize import brentq, minimize_scalar
 
 from spine_mj.errors import SpineInputError
 from spine_mj.theory.avalanches import Landscape, inertial_slips, overdamped_slips, quasistatic_path
-from spine_mj.theory.force_drops import drop_bounds, jitter_scale
+from spine_mj.theory.force_drops import PLATEAU_SHARE, drop_bounds, jitter_scale
 from spine_mj.theory.motion import SLIPPING, motion_states
 from spine_mj.theory.tomlinson import Corrugation
 
 
 def _plain_drops(force, floor):
     """The rule written out: from each peak, a drop once the force is ``floor`` below it;
-    its trough is the lowest force before the force climbs ``floor`` above it."""
+    its trough is the lowest force before the force climbs ``floor`` above it; then the
+    level stretches' ends (within a tenth of ``floor`` of the peak and of the trough)."""
     f = list(force)
     events, i, n = [], 0, len(f)
     while i < n:
@@ -37,7 +38,12 @@ def _plain_drops(force, floor):
             j += 1
         if j >= n:
             break  # cut by the end
-        events.append((top, low))
+        tol = PLATEAU_SHARE * floor
+        start = top
+        while start + 1 < low and f[start + 1] >= f[top] - tol:
+            start += 1
+        end = next(m for m in range(start + 1, low + 1) if f[m] <= f[low] + tol)
+        events.append((start, end))
         i = low + int(np.argmax(f[low + 1 : j + 1])) + 1  # the next loading phase's highest so far
     return events
 
@@ -99,6 +105,12 @@ def test_the_speed_rule_fires_on_the_jitter_that_the_drop_rule_ignores():
     v[:, 0] = np.gradient(tip, dt)
     assert np.sum(motion_states(v, speed) == SLIPPING) > 0  # 5 V is 5e-3: jitter outruns it
     assert drop_bounds(x + f, 1e-3)[0].size == 0
+
+
+def test_a_level_peak_starts_its_drop_at_its_end_and_a_level_trough_stops_it_at_its_start():
+    f = [0.0, 1.0, 1.0, 1.0, 0.5, 0.2, 0.2, 0.2, 0.9]
+    on, st = drop_bounds(f, 0.3)
+    assert list(zip(on, st)) == [(3, 5)]
 
 
 def test_bad_input_is_refused():
