@@ -6,7 +6,9 @@ twentieth at each end), its slips against the overdamped and inertial references
 the same stretch that the engine's detector would see (peak speed >= 5 V): the
 Kolmogorov-Smirnov distance and p-value of sizes and force drops; the same for the force
 drops deeper than each ``--floors`` value [F_p] (:mod:`spine_mj.theory.force_drops`, one
-rule for the engine's steps and the references' paths, key ``drops``), with the engine's
+rule for the engine's steps and the references' paths, key ``drops``; the references also
+on the profile the engine's height field makes, straight between its nodes: sources
+``*_facets``), with the engine's
 resting jitter (the 99th percentile of its elementary force drops); and the creep of the
 held tip, MuJoCo's soft friction: the tip's mean x-speed over V in the rows it is STUCK,
 and the share of its travel made while stuck. The order of the distance with I_e is the
@@ -44,6 +46,7 @@ from spine_mj.validate.slip_catalog import (
     TrackUnits,
     engine_drop_rows,
     engine_rows,
+    facet_count,
     reference_drop_rows,
     reference_rows,
     track_landscape,
@@ -95,6 +98,7 @@ def one(
     cpu, ends, stuck_v, creep, travel_sum, jitter = 0.0, [], [], 0.0, 0.0, []
     for a, b in itertools.pairwise(bounds):
         land = track_landscape(surf, MU, units.tip_radius, (a, b))
+        faceted = track_landscape(surf, MU, units.tip_radius, (a, b), facets=facet_count(rig))
         for source, r in reference_rows(land, units, k).items():
             parts["refs"][source].append(r)
         c0 = time.process_time()
@@ -115,6 +119,9 @@ def one(
             eng_parts.append(engine_drop_rows(result, units, engine, k, floor))
             for source, r in reference_drop_rows(land, units, k, floor).items():
                 ref_parts.setdefault(source, []).append(r)
+            for source, r in reference_drop_rows(faceted, units, k, floor).items():
+                r["source"] = [f"{source}_facets"] * len(r["source"])
+                ref_parts.setdefault(f"{source}_facets", []).append(r)
         del result
     eng = _pool(parts["eng"])
     refs = {s: _pool(v) for s, v in parts["refs"].items()}

@@ -40,6 +40,7 @@ __all__ = [
     "drop_rows",
     "engine_drop_rows",
     "engine_rows",
+    "facet_count",
     "reference_drop_rows",
     "reference_rows",
     "store_catalog",
@@ -108,10 +109,27 @@ class TrackUnits:
         return self.mass_kg * self.length_scale_m / self.preload_n
 
 
-def track_landscape(surface, mu: float, tip_radius: float, x_range: tuple[float, float], y: float = 0.0):
+def track_landscape(
+    surface,
+    mu: float,
+    tip_radius: float,
+    x_range: tuple[float, float],
+    y: float = 0.0,
+    *,
+    facets: int | None = None,
+):
     """The landscape of ``surface`` along the line ``y`` over ``x_range`` (surface units),
     sampled at :data:`REFINEMENT` points per grid spacing from its spline (heights and
-    slopes), for a ball tip of ``tip_radius``."""
+    slopes), for a ball tip of ``tip_radius``. Where the radius exceeds a concave radius of
+    curvature of the line (a rough profile: the offset path would loop), the centre rides
+    the line's dilation by the ball's disk instead (it touches two points across each such
+    valley; :func:`~spine_mj.surfaces.dilation.ball_dilation` on the one row), and its
+    slope is the contact's.
+
+    ``facets``: the profile an engine's height field makes of the line instead, straight
+    between that many nodes over the surface's x extent (:func:`facet_count` of a rig),
+    its slope stepping at each node; the centre rides its dilation by the ball's disk.
+    An engine's slips start at those steps (docs/physics.md §12)."""
     x0, x1 = x_range
     xmin, xmax, _, _ = surface.bounds
     if not (xmin <= x0 < x1 <= xmax):
@@ -119,8 +137,20 @@ def track_landscape(surface, mu: float, tip_radius: float, x_range: tuple[float,
     dx = surface.spacing[0] / REFINEMENT if hasattr(surface, "spacing") else (x1 - x0) / 20000
     x = np.linspace(x0, x1, int(math.ceil((x1 - x0) / dx)) + 1)
     yy = np.full_like(x, y)
-    z = surface.height(x, yy)
-    gx, _ = surface.gradient(x, yy)
+    r = float(tip_radius)
+    if facets is not None:
+        nodes = np.linspace(xmin, xmax, int(facets))
+        z = np.interp(x, nodes, surface.height(nodes, np.full_like(nodes, y)))
+        gx = np.gradient(z, x[1] - x[0])
+    else:
+        z = surface.height(x, yy)
+        gx, _ = surface.gradient(x, yy)
+    if facets is not None or (r > 0 and not np.all(np.diff(x - r * gx / np.sqrt(1 + gx * gx)) > 0)):
+        from spine_mj.surfaces.dilation import ball_dilation
+
+        step = x[1] - x[0]
+        z = ball_dilation(z[None, :], r, spacing=(step, step))[0] + r
+        return Landscape.from_profile(x, np.gradient(z, step), z, mu, 0.0)
     return Landscape.from_profile(x, gx, z, mu, tip_radius)
 
 
@@ -158,6 +188,11 @@ def _rows(
         "peak_speed_v": slips.peak_speed / units.speed,
         "dissipated_fp_lc": slips.dissipated / lc,
     }
+
+
+def facet_count(rig) -> int:
+    """Nodes along x of ``rig``'s height field (:attr:`~spine_mj.surfaces.hfield.HField.ncol`)."""
+    return int(rig.hfield.ncol)
 
 
 def reference_path(landscape: Landscape, slips: Slips, stiffness: float):

@@ -158,7 +158,11 @@ def _rig_and_scales(surface, engine, mu: float, ie: float, k_number: float, rig_
     if engine:
         rig = build_rig(surface, engine=engine, mu=mu, ie=ie, stiffness_number=k_number, **rig_options)
         return rig, rig.scales
-    sizing = {key: rig_options[key] for key in ("length_scale_m",) if rig_options.get(key) is not None}
+    sizing = {
+        key: rig_options[key]
+        for key in ("length_scale_m", "hfield_resolution")
+        if rig_options.get(key) is not None
+    }
     return None, Scales.for_surface(surface, **sizing)
 
 

@@ -7,6 +7,7 @@ import pandas as pd
 import pytest
 
 from spine_mj import surfaces
+from spine_mj.errors import SpineInputError
 from spine_mj.validate.slip_catalog import COLUMNS
 from spine_mj.validate.stickslip_outputs import OUTPUT_FILES, stickslip_to
 
@@ -121,3 +122,40 @@ def test_force_drop_rule_gives_mujoco_the_inertial_references_drops_on_a_corruga
     assert steady["mujoco"].size >= 2 and np.ptp(steady["inertial"]) < 1e-2
     assert np.abs(steady["mujoco"] / steady["inertial"].mean() - 1).max() < 0.1
     assert steady["inertial"].mean() > 1.2 * steady["overdamped"].mean()
+
+
+def test_the_faceted_landscape_is_the_height_fields_straight_pieces():
+    """With ``facets``, the line is straight between the nodes: a point tip's threshold is
+    ``tan(theta + arctan mu)`` of each piece's slope, constant along it."""
+    from spine_mj.validate.slip_catalog import track_landscape
+
+    surf = surfaces.corrugation(n_waves=2, points_per_wave=16, width=0.5)
+    xmin, xmax, _, _ = surf.bounds
+    nodes = np.linspace(xmin, xmax, 33)
+    land = track_landscape(surf, 0.5, 0.0, (xmin, xmax), facets=33)
+    z = surf.height(nodes, np.zeros_like(nodes))
+    slope = np.diff(z) / np.diff(nodes)
+    u = land.positions
+    piece = np.clip(np.searchsorted(nodes, u) - 1, 0, 31)
+    inner = np.abs(u - nodes[piece] - 0.5 * (nodes[1] - nodes[0])) < 0.3 * (nodes[1] - nodes[0])
+    expected = (slope[piece] + 0.5) / (1 - 0.5 * slope[piece])
+    np.testing.assert_allclose(land.force[inner], expected[inner], rtol=1e-9, atol=1e-9)
+
+
+def test_a_ball_wider_than_a_valley_rides_the_lines_dilation():
+    """A rough line where the offset path would loop (from_profile refuses it): the centre
+    rides the disk's dilation, never below the line plus the radius straight under it, and
+    resting on it somewhere."""
+    from spine_mj.theory.avalanches import Landscape
+    from spine_mj.validate.slip_catalog import track_landscape
+
+    surf = surfaces.corrugation(n_waves=8, points_per_wave=64, width=0.5, wavelength=0.1)
+    xmin, xmax, _, _ = surf.bounds
+    x = np.linspace(xmin, xmax, 2000)
+    z, (gx, _) = surf.height(x, 0 * x), surf.gradient(x, 0 * x)
+    with pytest.raises(SpineInputError, match="radius of curvature"):
+        Landscape.from_profile(x, gx, z, 0.5, 0.08)
+    land = track_landscape(surf, 0.5, 0.08, (xmin, xmax))
+    base = surf.height(land.positions, 0 * land.positions) + 0.08
+    assert np.all(land.height >= base - 1e-9)
+    assert np.min(land.height - base) < 1e-6
