@@ -86,6 +86,14 @@ def _rig_inputs(
     }
 
 
+def _with_drive(rig_kw: dict, **drive):
+    """The :class:`~spine_mj.sim.RigInputs` of the shared rig options (:func:`_rig_inputs`)
+    and a command's engine and drive."""
+    from spine_mj.sim.rig_inputs import RigInputs
+
+    return RigInputs.from_keywords(**rig_kw, **drive)
+
+
 @main.group("sim", cls=_Group)
 def sim_group():
     """The MuJoCo rig: export the model of a surface."""
@@ -226,6 +234,10 @@ def simulate(
     )
     check_engine(engine, "--engine")
     surf, rig_kw = _rig_inputs(surface_spec, **rig_opts)
+    pace = {"ie": ie, "speed_m_s": speed, "rate_n_s": rate}
+    inputs = _with_drive(
+        rig_kw, engine=engine, stiffness_number=stiffness_number, stiffness_n_m=stiffness, **pace
+    )
     with (
         Progress("simulating", unit="%") as bar,
         Progress("rendering MP4", unit="frame", quiet=not render) as frames,
@@ -239,20 +251,14 @@ def simulate(
         result, written = simulate_to(
             out_dir,
             surf,
+            inputs,
             start=xy,
             protocol=drive,
-            engine=engine,
-            ie=ie,
-            speed_m_s=speed,
-            rate_n_s=rate,
-            stiffness_number=stiffness_number,
-            stiffness_n_m=stiffness,
             duration_s=duration,
             start_force_n=start_force,
             mp4=render,
             progress=lambda frac: bar.update(round(100 * frac, 1), 100),
             render_progress=rendering,
-            **rig_kw,
         )
         bar.complete()
     click.echo(

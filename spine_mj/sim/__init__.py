@@ -60,7 +60,8 @@ controls and :mod:`~spine_mj.sim.lanes`' worker threads), :mod:`~spine_mj.sim.ra
 :mod:`~spine_mj.sim.bullet` (the same rig in Bullet, hard contact; the ``[bullet]`` extra),
 :mod:`~spine_mj.sim.render`, :mod:`~spine_mj.sim.rig`
 (:class:`Rig`, the object users hold) and :mod:`~spine_mj.sim.build` (:func:`build_rig` and
-:func:`build_drive`: a rig and a drive from dimensionless or SI inputs) and
+:func:`build_drive`: a rig and a drive from dimensionless or SI inputs, the rig's in one
+record, :class:`RigInputs` of :mod:`~spine_mj.sim.rig_inputs`) and
 :mod:`~spine_mj.sim.holding` (an array's predicted holding excess and its default pace).
 """
 
@@ -68,6 +69,7 @@ from spine_mj.roughness import characteristic_length
 from spine_mj.sim.array import ArrayResult, ArrayRig, ForcePull
 from spine_mj.sim.build import (
     DEFAULT_INERTIA_NUMBER,
+    RigInputs,
     build_array,
     build_array_on,
     build_drive,
@@ -137,6 +139,7 @@ __all__ = [
     "LayoutKind",
     "RampDrive",
     "Rig",
+    "RigInputs",
     "RunResult",
     "Scales",
     "SlipEvent",

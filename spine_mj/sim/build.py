@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import dataclasses
 
-from spine_mj.choices import ARRAY_DRIVES, DEFAULT_ENGINE, PROTOCOLS, check_engine
+from spine_mj.choices import ARRAY_DRIVES, PROTOCOLS, check_engine
 from spine_mj.errors import SpineInputError, check_positive
 from spine_mj.sim.array import ArrayRig
 from spine_mj.sim.array_run import ArrayDrive, ForcePull
@@ -32,11 +32,13 @@ from spine_mj.sim.layout import Layout
 from spine_mj.sim.model import check_drive_on
 from spine_mj.sim.records import TipParams
 from spine_mj.sim.rig import Rig
+from spine_mj.sim.rig_inputs import RigInputs, at_most_one
 from spine_mj.sim.scales import Scales, grid_keeps_samples
 from spine_mj.surfaces import Surface
 
 __all__ = [
     "DEFAULT_INERTIA_NUMBER",
+    "RigInputs",
     "RigPlan",
     "build_array",
     "build_array_on",
@@ -80,7 +82,7 @@ def drive_speed_m_s(
     -------
     float
     """
-    _at_most_one(ie=ie, speed_m_s=speed_m_s, rate_n_s=rate_n_s)
+    at_most_one(ie=ie, speed_m_s=speed_m_s, rate_n_s=rate_n_s)
     if speed_m_s is not None:
         return speed_m_s
     if rate_n_s is not None:
@@ -88,56 +90,21 @@ def drive_speed_m_s(
     return scales.speed_for(DEFAULT_INERTIA_NUMBER if ie is None else check_positive("I_e", ie))
 
 
-def build_rig(
-    surface: Surface,
-    *,
-    mu: float,
-    engine: str = DEFAULT_ENGINE,
-    tip_radius_m: float | None = None,
-    mass_kg: float | None = None,
-    preload_n: float | None = None,
-    gravity_m_s2: float | None = None,
-    length_scale_m: float | None = None,
-    hfield_resolution: int | None = None,
-    hfield_refinement: int = 1,
-    ie: float | None = None,
-    speed_m_s: float | None = None,
-    rate_n_s: float | None = None,
-    stiffness_number: float | None = None,
-    stiffness_n_m: float | None = None,
-    driven: bool = True,
-    **engine_options,
-) -> EngineRig:
-    """The rig of ``surface`` and a tip of friction ``mu`` (resolve it with
-    :func:`spine_mj.presets.resolve_mu`) in ``engine``; None leaves a parameter to its rule.
+def build_rig(surface: Surface, inputs: RigInputs | None = None, /, **keywords) -> EngineRig:
+    """The rig of ``surface`` built from ``inputs`` (:class:`RigInputs`, the one record of a
+    rig's inputs), or from its fields given as keywords, any other keyword an engine option
+    (:meth:`RigInputs.from_keywords`); None leaves a value to its rule.
 
     Parameters
     ----------
     surface : Surface
         The surface the tip runs on (any unit; dimensionless ones scaled by ``length_scale_m``).
-    mu : float
-        The tip's static friction coefficient mu_s.
-    engine : str
-        A registered engine (:data:`spine_mj.choices.ENGINES`; its extra must be installed).
-    tip_radius_m, mass_kg, preload_n, gravity_m_s2
-        The tip (:class:`TipParams`; None: its default, the radius from the surface).
-    length_scale_m : float or None
-        Metres per surface unit (None: 0.01 for dimensionless surfaces, else the unit's).
-    hfield_resolution, hfield_refinement : int or None, int
-        An analytic surface's hfield samples a side (a grid keeps its own), refined so many times.
-    ie, speed_m_s, rate_n_s
-        The drive's pace, as for :func:`build_drive`: its speed (:func:`drive_speed_m_s`)
-        bounds the engine step for impacts.
-    stiffness_number, stiffness_n_m
-        The drive spring's stiffness, as for :func:`build_drive` (none: K = 30): it bounds the
-        engine step, so a rig runs springs up to it (stiffer: :meth:`Rig.check_drive` refuses).
-    driven : bool
-        False for a model no drive of ours runs (``sim export``, the viewer: the user's sliders
-        drive it): then only the surface's falls bound the step.
-    **engine_options
-        The engine's own options (its entry's ``options``; MuJoCo's are the fields of
-        :class:`~spine_mj.sim.step_rule.EngineOverrides`, Bullet reads ``timestep_s``); None
-        leaves one to the engine's rule.
+    inputs : RigInputs, optional
+        The friction coefficient (resolve a command's with :func:`spine_mj.presets.resolve_mu`),
+        the engine and its options, the tip, the sizing and the drive's pace and spring, which
+        bound the engine step (a stiffer spring: :meth:`Rig.check_drive` refuses).
+    **keywords
+        Instead of ``inputs``: ``mu=...``, ``engine=...``, ``tip_radius_m=...``, ...
 
     Returns
     -------
@@ -164,9 +131,12 @@ def build_rig(
     >>> round(run.inertia_number, 6)
     0.001
     """
-    given = {k: v for k, v in locals().items() if k not in ("surface", "engine_options")}  # the keywords
-    plan = plan_rig(surface, **given, **engine_options)
-    rig_class = check_engine(engine).rig_class()
+    if inputs is None:
+        inputs = RigInputs.from_keywords(**keywords)
+    elif keywords:
+        raise SpineInputError(f"build_rig: give RigInputs or keywords, not both (got {', '.join(keywords)})")
+    plan = plan_rig(surface, inputs)
+    rig_class = check_engine(inputs.engine).rig_class()
     return rig_class(surface, tip=plan.tip, engine=plan.engine, sized=(plan.scales, plan.hfield))
 
 
@@ -196,49 +166,18 @@ class RigPlan:
         check_drive_on(self, drive)
 
 
-def plan_rig(
-    surface: Surface,
-    *,
-    mu: float,
-    engine: str = DEFAULT_ENGINE,
-    tip_radius_m: float | None = None,
-    mass_kg: float | None = None,
-    preload_n: float | None = None,
-    gravity_m_s2: float | None = None,
-    length_scale_m: float | None = None,
-    hfield_resolution: int | None = None,
-    hfield_refinement: int = 1,
-    ie: float | None = None,
-    speed_m_s: float | None = None,
-    rate_n_s: float | None = None,
-    stiffness_number: float | None = None,
-    stiffness_n_m: float | None = None,
-    driven: bool = True,
-    sized: tuple | None = None,
-    **engine_options,
-) -> RigPlan:
-    """The :class:`RigPlan` of :func:`build_rig`'s arguments (the same rules, the same
+def plan_rig(surface: Surface, inputs: RigInputs, *, sized: tuple | None = None) -> RigPlan:
+    """The :class:`RigPlan` of :func:`build_rig`'s ``inputs`` (the same rules, the same
     refusals, no model compiled). ``sized``: the ``(tip, scales, hfield)`` of the same
     surface and tip sizing, measured before (:func:`rig_sizing`), so that plans differing
     only in the drive or the engine settings measure the surface once."""
-    entry = check_engine(engine)
-    options = {k: v for k, v in engine_options.items() if v is not None}
-    unread = [k for k in options if k not in entry.options]
-    if unread:
-        raise SpineInputError(
-            f"{', '.join(unread)}: not read by engine {engine} (its options: {', '.join(entry.options)})"
-        )
-    tip = TipParams(
-        tip_radius_m=tip_radius_m,
-        mu_s=mu,
-        **_given(mass_kg=mass_kg, preload_n=preload_n, gravity_m_s2=gravity_m_s2),
-    )
     if sized is None:
-        sized = _sized(surface, tip, length_scale_m, hfield_resolution, hfield_refinement)
+        sized = _sized(surface, inputs.tip, **inputs.sizing)
     tip, scales, hfield = sized
-    speed = drive_speed_m_s(scales, ie=ie, speed_m_s=speed_m_s, rate_n_s=rate_n_s) if driven else None
-    spring = spring_stiffness_n_m(scales, stiffness_number=stiffness_number, stiffness_n_m=stiffness_n_m)
-    settings = entry.settings_factory()(scales, speed_m_s=speed, stiffness_n_m=spring, **options)
+    speed = drive_speed_m_s(scales, **inputs.pace) if inputs.driven else None
+    spring = spring_stiffness_n_m(scales, **inputs.spring)
+    factory = check_engine(inputs.engine).settings_factory()
+    settings = factory(scales, speed_m_s=speed, stiffness_n_m=spring, **dict(inputs.engine_options))
     return RigPlan(surface, tip, scales, hfield, settings)
 
 
@@ -282,7 +221,9 @@ def rig_scales(
     return _sized(surface, tip, length_scale_m, hfield_resolution, hfield_refinement)[1]
 
 
-def _sized(surface: Surface, tip: TipParams, length_scale_m, hfield_resolution, hfield_refinement=1) -> tuple:
+def _sized(
+    surface: Surface, tip: TipParams, length_scale_m=None, hfield_resolution=None, hfield_refinement=1
+) -> tuple:
     """``(tip, scales, hfield)`` of ``tip`` on ``surface``: the tip with the radius the rig
     was sized for (a gridded surface keeps its own samples: ``hfield_resolution`` ignored),
     on the hfield refined ``hfield_refinement`` times with that radius kept."""
@@ -300,16 +241,6 @@ def _sized(surface: Surface, tip: TipParams, length_scale_m, hfield_resolution, 
             hfield_refinement=hfield_refinement,
         )
     return tip, scales, hfield
-
-
-def _at_most_one(**given) -> None:
-    """Refuse two ways of giving one quantity (a pace, a stiffness): neither silently wins."""
-    named = {k: v for k, v in given.items() if v is not None}
-    if len(named) > 1:
-        raise SpineInputError(
-            f"give at most one of {', '.join(given)}, got "
-            + ", ".join(f"{k}={v!r}" for k, v in named.items())
-        )
 
 
 def build_drive(
@@ -344,8 +275,8 @@ def build_drive(
     duration_s, settle_time_s, start_force_n, slide_distance_m
         As the drives take them (:class:`SpringDrive`, :class:`RampDrive`, :class:`StaticProbe`).
     """
-    _at_most_one(ie=ie, speed_m_s=speed_m_s, rate_n_s=rate_n_s)
-    _at_most_one(stiffness_number=stiffness_number, stiffness_n_m=stiffness_n_m)
+    at_most_one(ie=ie, speed_m_s=speed_m_s, rate_n_s=rate_n_s)
+    at_most_one(stiffness_number=stiffness_number, stiffness_n_m=stiffness_n_m)
     if rate_n_s is None:
         rate_n_s = scales.force_rate_for(drive_speed_m_s(scales, ie=ie, speed_m_s=speed_m_s))
     if stiffness_number is not None:
@@ -487,8 +418,3 @@ def build_array_on(
         rig, layout, drive, ie=ie, **springs, duration_s=duration_s, settle_time_s=settle_time_s
     )
     return arr, carriage, ie
-
-
-def _given(**values) -> dict:
-    """The ``values`` that are not None."""
-    return {k: v for k, v in values.items() if v is not None}

@@ -116,19 +116,15 @@ class BulletRig:
         *,
         tip: TipParams | None = None,
         engine: BulletSettings | None = None,
-        length_scale_m: float | None = None,
-        char_length_m: float | None = None,
-        hfield_resolution: int | None = None,
         sized: tuple[Scales, HField] | None = None,
+        **sizing,
     ):
         extras.require("bullet", "the Bullet engine")
         self.scales, self.hfield, self.tip = Scales.for_rig(
             surface,
             tip=tip,
             sized=sized,
-            length_scale_m=length_scale_m,
-            char_length_m=char_length_m,
-            hfield_resolution=hfield_resolution,
+            **sizing,
         )
         self.surface = surface
         self.length_scale_m = self.scales.length_scale_m

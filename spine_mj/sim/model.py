@@ -129,7 +129,7 @@ class RigModel:
     ``sized``, when given, is ``Scales.with_hfield`` of this surface and tip, computed by
     the caller (:func:`~spine_mj.sim.build.build_rig` needs the scales for the engine
     first): the rig then uses those scales and that hfield instead of measuring again
-    (``length_scale_m``, ``char_length_m`` and ``hfield_resolution`` are theirs)."""
+    (the ``sizing`` keywords are theirs)."""
 
     def __init__(
         self,
@@ -137,10 +137,8 @@ class RigModel:
         *,
         tip: TipParams | None = None,
         engine: EngineSettings | None = None,
-        length_scale_m: float | None = None,
-        char_length_m: float | None = None,
-        hfield_resolution: int | None = None,
         sized: tuple[Scales, HField] | None = None,
+        **sizing,
     ):
         import mujoco
 
@@ -148,9 +146,7 @@ class RigModel:
             surface,
             tip=tip,
             sized=sized,
-            length_scale_m=length_scale_m,
-            char_length_m=char_length_m,
-            hfield_resolution=hfield_resolution,
+            **sizing,
         )
         quiet_engine()
         self.surface = surface

@@ -43,18 +43,12 @@ class Rig(RigModel):
         The tip: radius, mass, friction, preload.
     engine : EngineSettings or None
         None: :func:`default_engine` of the scales.
-    length_scale_m : float or None
-        Metres per surface unit; None gives 0.01 for ``unit == "1"`` and the size of a
-        length unit otherwise (1e-6 for ``"um"``; :func:`~spine_mj.sim.scales.surface_unit_m`).
-    char_length_m : float or None
-        L_c [m]; None: :func:`characteristic_length` times ``length_scale_m``.
-    hfield_resolution : int or None
-        Samples a side the hfield is resampled to (None: a grid keeps its own samples, an
-        analytic surface gets 201; either coarsened to a quarter tip radius,
-        :meth:`~spine_mj.sim.scales.Scales.with_hfield`).
     sized : (Scales, HField) or None
         ``Scales.with_hfield`` of this surface and tip when the caller already has them
         (:func:`~spine_mj.sim.build.build_rig`); None measures them here.
+    **sizing
+        Without ``sized``, the keywords of :meth:`~spine_mj.sim.scales.Scales.with_hfield`
+        (``length_scale_m``, ``char_length_m``, ``hfield_resolution``; None: their rules).
 
     Raises
     ------

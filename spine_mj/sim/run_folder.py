@@ -20,7 +20,6 @@ import pyarrow
 
 from spine_mj import surface_io
 from spine_mj.atomic import all_or_none, atomic_output
-from spine_mj.choices import DEFAULT_ENGINE
 from spine_mj.errors import SpineInputError
 from spine_mj.jsonio import write_json
 from spine_mj.plotting import save_figure, sim_run_figure
@@ -30,6 +29,7 @@ from spine_mj.sim.model import RigModel
 from spine_mj.sim.records import EngineSettings, TipParams
 from spine_mj.sim.render import Track, write_mp4
 from spine_mj.sim.results import RunResult
+from spine_mj.sim.rig_inputs import RigInputs
 from spine_mj.surfaces import Surface
 
 __all__ = ["RUN_FILES", "load_run", "simulate_to", "write_run"]
@@ -114,28 +114,22 @@ def write_run(
 def simulate_to(
     out_dir: str | Path,
     surface: Surface,
+    inputs: RigInputs,
     *,
-    mu: float,
     start: tuple[float, float],
     protocol: str = "spring",
-    engine: str = DEFAULT_ENGINE,
-    ie: float | None = None,
-    speed_m_s: float | None = None,
-    rate_n_s: float | None = None,
-    stiffness_number: float | None = None,
-    stiffness_n_m: float | None = None,
     duration_s: float | None = None,
     start_force_n: float = 0.0,
     mp4: bool = False,
     progress: Callable[[float], None] | None = None,
     render_progress: Callable[[int, int], None] | None = None,
-    **rig_options,
 ) -> tuple[RunResult, list[Path]]:
     """One drive on ``surface`` written as a run folder: what ``spine-mj simulate`` does.
 
-    The rig (:func:`~spine_mj.sim.build_rig`, its step bounded by the drive's pace
-    and spring), the drive (:func:`~spine_mj.sim.build_drive`), the run from ``start``, and
-    its folder (:func:`write_run`: every file or none).
+    The rig of ``inputs`` (:func:`~spine_mj.sim.build_rig`, its step bounded by the drive's
+    pace and spring), the drive of the same pace and spring
+    (:func:`~spine_mj.sim.build_drive`), the run from ``start``, and its folder
+    (:func:`write_run`: every file or none).
 
     Parameters
     ----------
@@ -143,37 +137,34 @@ def simulate_to(
         The run folder.
     surface : Surface
         The surface the tip runs on.
-    mu : float
-        The tip's friction coefficient.
+    inputs : RigInputs
+        The rig's inputs: mu, engine, tip, sizing, and the drive's pace and spring.
     start : (float, float)
         The start ``(x0, y0)`` in surface units.
     protocol : {"spring", "ramp", "static"}
         The drive.
-    engine : str
-        The engine that runs it, a registered one (:data:`spine_mj.choices.ENGINES`).
-    ie, speed_m_s, rate_n_s, stiffness_number, stiffness_n_m, duration_s, start_force_n
-        The drive, as for :func:`~spine_mj.sim.build_drive` (pace and spring also size the
-        rig's step, as for :func:`~spine_mj.sim.build_rig`).
+    duration_s, start_force_n
+        The drive's, as for :func:`~spine_mj.sim.build_drive`.
     mp4 : bool
         Also write ``run.mp4``.
     progress : callable, optional
         Called with the run's fraction done while it runs.
     render_progress : callable, optional
         Called with ``(frames done, frames)`` while the MP4 is written.
-    **rig_options
-        :func:`~spine_mj.sim.build_rig`'s other keywords (tip, length scale, hfield,
-        engine overrides).
 
     Returns
     -------
     (RunResult, list of Path)
         The run and the files written.
     """
-    pace = {"ie": ie, "speed_m_s": speed_m_s, "rate_n_s": rate_n_s}
-    spring = {"stiffness_number": stiffness_number, "stiffness_n_m": stiffness_n_m}
-    rig = build_rig(surface, engine=engine, mu=mu, **pace, **spring, **rig_options)
+    rig = build_rig(surface, inputs)
     drive = build_drive(
-        rig.scales, protocol, **pace, **spring, duration_s=duration_s, start_force_n=start_force_n
+        rig.scales,
+        protocol,
+        **inputs.pace,
+        **inputs.spring,
+        duration_s=duration_s,
+        start_force_n=start_force_n,
     )
     result = rig.run(drive, start=start, progress=progress)
     return result, write_run(out_dir, rig, result, mp4=mp4, progress=render_progress)

@@ -19,6 +19,7 @@ from spine_mj.sim.build import plan_rig, rig_sizing
 from spine_mj.sim.holding import spring_swing
 from spine_mj.sim.open_loop import drive_steps
 from spine_mj.sim.ramp import nominal_time_s
+from spine_mj.sim.rig_inputs import RigInputs
 from spine_mj.sim.scales import check_tip_radius, engine_tip_radius_m
 from spine_mj.sweep.registry import (
     CASE_THREADS,
@@ -247,22 +248,28 @@ def check_speed(config) -> None:
 
 
 @functools.lru_cache(maxsize=4)
-def _rig(spec, key):
-    """The rig of a surface and tip/engine parameters (cached: cases differing only in the
-    protocol share it; the speed and the spring's stiffness set the engine step)."""
-    return sim.build_rig(spec.make(), **_rig_options(dict(key)))
+def _rig(spec, inputs: RigInputs):
+    """The rig of a surface and a case's :class:`RigInputs` (cached: cases differing only in
+    the protocol share it; the speed and the spring's stiffness set the engine step)."""
+    return sim.build_rig(spec.make(), inputs)
 
 
-def _rig_options(p: dict) -> dict:
-    """The keywords of :func:`spine_mj.sim.build_rig` of a case's rig parameters ``p``: its
-    engine, the engine options that engine reads (its registry entry's), the tip, sizing
-    and drive."""
+def case_inputs(case, surface=None) -> RigInputs:
+    """The :class:`RigInputs` of a sweep case: the one place a case's parameters become a
+    rig's inputs (its engine options, those its engine reads: its registry entry's).
+
+    ``surface`` is ``case.surface.make()``, passed when the caller already has it (the tip
+    radius is in its length unit)."""
+    surface = case.surface.make() if surface is None else surface
+    p = case.params
     reads = ENGINES[p["engine"]].options
-    return dict(
+    return RigInputs(
         engine=p["engine"],
-        **{s.option: p[s.name] for s in MUJOCO_PARAMS if s.option in reads},
+        engine_options={s.option: p[s.name] for s in MUJOCO_PARAMS if s.option in reads},
         mu=p["mu"],
-        tip_radius_m=p["tip_radius_m"],
+        tip_radius_m=engine_tip_radius_m(
+            surface, p["tip_radius"], length_scale_m=p["length_scale"], name="config key grid.tip_radius"
+        ),
         mass_kg=p["mass"],
         preload_n=p["preload"],
         gravity_m_s2=p["gravity"],
@@ -277,12 +284,11 @@ def _rig_options(p: dict) -> dict:
 
 
 def case_rig(case, surface=None):
-    """The (cached) rig a sweep case runs on: the one place a case's parameters become a Rig.
+    """The (cached) rig a sweep case runs on (:func:`case_inputs`).
 
     ``surface`` is ``case.surface.make()``, passed when the caller already has it.
     """
-    surface = case.surface.make() if surface is None else surface
-    return _rig(case.surface, _rig_key(case.params, surface))
+    return _rig(case.surface, case_inputs(case, surface))
 
 
 def _clear_caches() -> None:
@@ -293,41 +299,11 @@ def _clear_caches() -> None:
 case_rig.cache_clear = _clear_caches
 
 
-_SIZING_KEYS = (
-    "tip_radius_m",
-    "mu",
-    "mass",
-    "preload",
-    "gravity",
-    "length_scale",
-    "hfield_resolution",
-    "hfield_refinement",
-)
-
-
 @functools.lru_cache(maxsize=4)
-def _sizing(spec, key):
-    """The ``(tip, scales, hfield)`` of a surface and a tip's sizing parameters (cached:
+def _sizing(spec, tip, sizing: tuple):
+    """The ``(tip, scales, hfield)`` of a surface, a tip and its sizing keywords (cached:
     the cases of a grid that differ in the drive or the engine settings share it)."""
-    p = dict(key)
-    tip = sim.TipParams(
-        tip_radius_m=p["tip_radius_m"],
-        mu_s=p["mu"],
-        **{k: p[a] for k, a in (("mass_kg", "mass"), ("preload_n", "preload"), ("gravity_m_s2", "gravity"))},
-    )
-    return rig_sizing(
-        spec.make(),
-        tip=tip,
-        length_scale_m=p["length_scale"],
-        hfield_resolution=p["hfield_resolution"],
-        hfield_refinement=p["hfield_refinement"],
-    )
-
-
-def _plan(spec, key):
-    p = dict(key)
-    sized = _sizing(spec, tuple((k, p[k]) for k in _SIZING_KEYS))
-    return plan_rig(spec.make(), sized=sized, **_rig_options(p))
+    return rig_sizing(spec.make(), tip=tip, **dict(sizing))
 
 
 def case_plan(case, surface=None):
@@ -335,25 +311,19 @@ def case_plan(case, surface=None):
     :class:`~spine_mj.sim.build.RigPlan` (its scales, tip and engine step; cached, the
     surface sized once per tip), a Bullet case's rig itself. For the checks of a grid
     before any case runs."""
-    surface = case.surface.make() if surface is None else surface
-    key = _rig_key(case.params, surface)
-    if dict(key)["engine"] != "mujoco":
-        return _rig(case.surface, key)
-    return _plan(case.surface, key)
+    inputs = case_inputs(case, surface)
+    if inputs.engine != "mujoco":
+        return _rig(case.surface, inputs)
+    sized = _sizing(case.surface, inputs.tip, tuple(inputs.sizing.items()))
+    return plan_rig(case.surface.make(), inputs, sized=sized)
 
 
 def case_scales(case, surface=None) -> sim.Scales:
     """The scales of the rig :func:`case_rig` would build for ``case`` (its tip radius,
     L_c, l_s), without building it: for checks of a config before any case runs."""
     surface = case.surface.make() if surface is None else surface
-    p = dict(_rig_key(case.params, surface))
-    return sim.rig_scales(
-        surface,
-        tip=sim.TipParams(tip_radius_m=p["tip_radius_m"], mu_s=p["mu"]),
-        length_scale_m=p["length_scale"],
-        hfield_resolution=p["hfield_resolution"],
-        hfield_refinement=p["hfield_refinement"],
-    )
+    inputs = case_inputs(case, surface)
+    return sim.rig_scales(surface, tip=inputs.tip, **inputs.sizing)
 
 
 def _mujoco(case, surface, starts, upstream):
@@ -369,6 +339,7 @@ def _mujoco(case, surface, starts, upstream):
     )
 
 
+#: The parameters :func:`case_inputs` reads besides ``tip_radius``.
 _RIG_KEYS = (
     "engine",
     "ie",  # the drive speed limits the engine step (impacts)
@@ -384,14 +355,6 @@ _RIG_KEYS = (
     "hfield_refinement",
     *(s.name for s in MUJOCO_PARAMS if s.option is not None),  # every engine option
 )
-
-
-def _rig_key(p: dict, surface) -> tuple:
-    """The parameters of a case that make its rig, as a hashable key of :func:`_rig`."""
-    tip_radius_m = engine_tip_radius_m(
-        surface, p["tip_radius"], length_scale_m=p["length_scale"], name="config key grid.tip_radius"
-    )
-    return tuple(sorted({"tip_radius_m": tip_radius_m, **{k: p[k] for k in _RIG_KEYS}}.items()))
 
 
 def case_drive(rig, p: dict):

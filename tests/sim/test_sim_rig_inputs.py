@@ -1,0 +1,46 @@
+"""RigInputs, the one record of a rig's inputs (spine_mj.sim.rig_inputs): checked once when
+made, hashable, and the same rig whether it or build_rig's keywords are given."""
+
+import pytest
+
+from spine_mj import sim
+from spine_mj.errors import SpineInputError
+from spine_mj.sim.rig_inputs import RigInputs
+from spine_mj.surfaces import single_gaussian
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"ie": 1e-3, "speed_m_s": 0.01}, "give at most one of ie, speed_m_s, rate_n_s"),
+        ({"stiffness_number": 10.0, "stiffness_n_m": 5.0}, "give at most one of stiffness_number"),
+        ({"engine_options": {"no_such_option": 1}}, "no_such_option: not read by engine mujoco"),
+        ({"engine": "no-such-engine"}, "no-such-engine"),
+        ({"mass_kg": -1.0}, "mass_kg"),
+        ({"mu": -0.5}, "mu_s"),
+    ],
+)
+def test_bad_inputs_are_refused_when_the_record_is_made(kwargs, match):
+    with pytest.raises(SpineInputError, match=match):
+        RigInputs(**{"mu": 0.5, **kwargs})
+
+
+def test_options_are_one_sorted_tuple_and_equal_inputs_hash_alike():
+    a = RigInputs(mu=0.5, engine_options={"timestep_s": None, "impratio": 2.0, "noslip_iterations": 1})
+    b = RigInputs.from_keywords(mu=0.5, noslip_iterations=1, impratio=2.0)
+    assert a.engine_options == (("impratio", 2.0), ("noslip_iterations", 1))
+    assert a == b and hash(a) == hash(b) and len({a, b}) == 1
+    assert a.tip == sim.TipParams(mu_s=0.5)
+    assert RigInputs(mu=0.5, ie=1e-2).pace == {"ie": 1e-2, "speed_m_s": None, "rate_n_s": None}
+
+
+def test_build_rig_takes_the_record_or_its_keywords_alike():
+    surface = single_gaussian()
+    keywords = {"mu": 0.8, "ie": 1e-2, "stiffness_number": 10.0, "hfield_resolution": 41, "impratio": 2.0}
+    by_record = sim.build_rig(surface, RigInputs.from_keywords(**keywords))
+    by_keywords = sim.build_rig(surface, **keywords)
+    assert by_record.scales == by_keywords.scales
+    assert by_record.engine == by_keywords.engine and by_record.engine.impratio == 2.0
+    assert by_record.tip == by_keywords.tip
+    with pytest.raises(SpineInputError, match="give RigInputs or keywords, not both"):
+        sim.build_rig(surface, RigInputs(mu=0.8), ie=1e-2)
