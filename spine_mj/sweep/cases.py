@@ -13,10 +13,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from spine_mj import presets
 from spine_mj.errors import SpineInputError
 from spine_mj.jsonio import to_jsonable
-from spine_mj.sweep.config import StartsSpec, SurfaceSpec, SweepConfig, digest
+from spine_mj.sweep.config import StartsSpec, SurfaceSpec, SweepConfig, digest, surface_mu
 from spine_mj.sweep.registry import PRESET_MU, applied_params, param_specs
 
 
@@ -81,13 +80,13 @@ def expand_cases(config: SweepConfig) -> list[Case]:
             if (si < len(config.surface_starts) and config.surface_starts[si] is not None)
             else config.starts
         )
-        # read once per surface (a file has none: its config must give mu)
-        preset_mu = presets.preset_mu(surf.source) if from_preset and surf.kind == "preset" else None
+        default_mu = None  # the surface's, by the one mu rule, read once where needed
         for combo in combos:
             params = applied_params(dict(zip(names, combo)), specs)
             for k in from_preset:
                 if params[k] is None:
-                    params[k] = preset_mu
+                    default_mu = surface_mu(surf, k) if default_mu is None else default_mu
+                    params[k] = default_mu
             case_id = _case_id(surf, starts, params)
             if case_id in seen:
                 raise SpineInputError(

@@ -462,6 +462,22 @@ def parse_config(doc: Mapping, *, base_dir: str | os.PathLike = ".") -> SweepCon
     return config
 
 
+def surface_mu(surface: SurfaceSpec, key: str = "mu") -> float:
+    """The mu_s a config that does not give ``key`` runs ``surface`` with: the one mu rule of
+    every command (:func:`spine_mj.presets.resolve_mu`: its preset's calibrated mu, else
+    refused, named as the config key)."""
+    source = surface.source if surface.kind == "preset" else None
+    return presets.resolve_mu(source, None, name=f"config key grid.{key}")
+
+
+def _has_mu(surface: SurfaceSpec) -> bool:
+    try:
+        surface_mu(surface)
+    except SpineInputError:
+        return False
+    return True
+
+
 def _grid(params, analyses: tuple[str, ...], surfaces) -> tuple[tuple[str, tuple], ...]:
     """Every parameter of ``analyses`` with its values from [grid] or [drive], else its
     default (None for :data:`PRESET_MU`: each case's preset's, filled in by
@@ -475,9 +491,7 @@ def _grid(params, analyses: tuple[str, ...], surfaces) -> tuple[tuple[str, tuple
     grid = []
     for pname, spec in param_specs(analyses).items():
         if pname not in given and (spec.default is REQUIRED or spec.default is PRESET_MU):
-            lacking = spec.default is PRESET_MU and sorted(
-                {s.label for s in surfaces if s.kind != "preset" or presets.preset_mu(s.source) is None}
-            )
+            lacking = spec.default is PRESET_MU and sorted({s.label for s in surfaces if not _has_mu(s)})
             if spec.default is REQUIRED or lacking:
                 since = f" since {', '.join(lacking)} has no calibrated mu" if lacking else ""
                 raise SpineInputError(

@@ -132,10 +132,10 @@ class ParamSpec:
 #: ``ParamSpec.default`` of a parameter that every config must set.
 REQUIRED = object()
 
-#: ``ParamSpec.default`` of ``mu``: each case takes the calibrated mu_s of its surface's
-#: preset (``[engagement] mu``, :func:`spine_mj.presets.preset_mu`); a config must set it
-#: when a surface has none (a file, a preset without a calibration), and mu_s <= 0 is
-#: refused: the rule of every command (:func:`spine_mj.presets.resolve_mu`).
+#: ``ParamSpec.default`` of ``mu``: a case that is given none takes its surface's by the
+#: rule of every command (:func:`spine_mj.presets.resolve_mu`, through
+#: :func:`spine_mj.sweep.config.surface_mu`): its preset's calibrated ``[engagement] mu``; a
+#: config must set it when a surface has none (a file, a preset without a calibration).
 PRESET_MU = object()
 
 #: The friction coefficient, shared by every analysis that needs one (declared once).
