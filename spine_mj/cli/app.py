@@ -14,6 +14,7 @@ import importlib
 import os
 import signal
 import sys
+import time
 import warnings
 from pathlib import Path
 from typing import ClassVar
@@ -23,6 +24,8 @@ import click
 from spine_mj.errors import SpineInputError
 
 INPUT_ERROR_EXIT = 2
+#: A preparation shows its stages once it has taken this long [s] (quick ones print nothing).
+PREPARATION_DELAY_S = 2.0
 
 
 class Progress:
@@ -32,16 +35,18 @@ class Progress:
     (a new ``desc`` starts a fresh bar); used as a context manager it closes the bar. Once
     a SIGTERM came (:func:`run`), an update exits as the kill: a library that caught the
     handler's exit (measured: a run at I_e 1e-6 went on 120 s past its SIGTERM on a loaded
-    machine) stops at its next progress report.
+    machine) stops at its next progress report. With ``delay_s`` nothing shows until that
+    long after the display was made: a preparation that is quick stays silent.
     """
 
-    def __init__(self, desc: str, *, unit: str = "it", quiet: bool = False):
+    def __init__(self, desc: str, *, unit: str = "it", quiet: bool = False, delay_s: float = 0.0):
         self.desc, self.unit, self.quiet, self.bar = desc, unit, quiet, None
+        self.shown_from = time.monotonic() + delay_s
 
     def update(self, done: float, total: float, desc: str | None = None, **postfix) -> None:
         if _TERMINATED:  # a SIGTERM whose exit a library swallowed (numba compiling, a native call)
             raise SystemExit(128 + _TERMINATED[0])
-        if self.quiet:
+        if self.quiet or time.monotonic() < self.shown_from:
             return
         if self.bar is not None and desc is not None and desc != self.bar.desc:
             self.close()

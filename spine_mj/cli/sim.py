@@ -6,6 +6,7 @@ import click
 
 from spine_mj.choices import DEFAULT_ENGINE, ENGINES, PROTOCOLS, check_engine
 from spine_mj.cli.app import (
+    PREPARATION_DELAY_S,
     InputError,
     Progress,
     _Group,
@@ -239,9 +240,15 @@ def simulate(
         rig_kw, engine=engine, stiffness_number=stiffness_number, stiffness_n_m=stiffness, **pace
     )
     with (
+        Progress("preparing", delay_s=PREPARATION_DELAY_S) as preparing,
         Progress("simulating", unit="%") as bar,
         Progress("rendering MP4", unit="frame", quiet=not render) as frames,
     ):
+
+        def prepared(done, total, stage):
+            preparing.update(done, total, stage)
+            if done >= total:  # a stage's bar closes when it is done
+                preparing.close()
 
         def rendering(done, total):
             bar.complete()  # the run is over (a run that broke away early too)
@@ -259,6 +266,7 @@ def simulate(
             mp4=render,
             progress=lambda frac: bar.update(round(100 * frac, 1), 100),
             render_progress=rendering,
+            prepare_progress=prepared,
         )
         bar.complete()
     click.echo(

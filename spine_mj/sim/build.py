@@ -20,6 +20,7 @@ Two rules live here:
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 
 from spine_mj.choices import ARRAY_DRIVES, PROTOCOLS, check_engine
 from spine_mj.errors import SpineInputError, check_positive
@@ -90,7 +91,14 @@ def drive_speed_m_s(
     return scales.speed_for(DEFAULT_INERTIA_NUMBER if ie is None else check_positive("I_e", ie))
 
 
-def build_rig(surface: Surface, inputs: RigInputs | None = None, /, **keywords) -> EngineRig:
+def build_rig(
+    surface: Surface,
+    inputs: RigInputs | None = None,
+    /,
+    *,
+    progress: Callable[[float, float, str], None] | None = None,
+    **keywords,
+) -> EngineRig:
     """The rig of ``surface`` built from ``inputs`` (:class:`RigInputs`, the one record of a
     rig's inputs), or from its fields given as keywords, any other keyword an engine option
     (:meth:`RigInputs.from_keywords`); None leaves a value to its rule.
@@ -103,6 +111,8 @@ def build_rig(surface: Surface, inputs: RigInputs | None = None, /, **keywords) 
         The friction coefficient (resolve a command's with :func:`spine_mj.presets.resolve_mu`),
         the engine and its options, the tip, the sizing and the drive's pace and spring, which
         bound the engine step (a stiffer spring: :meth:`Rig.check_drive` refuses).
+    progress : callable, optional
+        Hears ``(done, total, stage)`` through the preparation (:meth:`Scales.with_hfield`).
     **keywords
         Instead of ``inputs``: ``mu=...``, ``engine=...``, ``tip_radius_m=...``, ...
 
@@ -135,9 +145,15 @@ def build_rig(surface: Surface, inputs: RigInputs | None = None, /, **keywords) 
         inputs = RigInputs.from_keywords(**keywords)
     elif keywords:
         raise SpineInputError(f"build_rig: give RigInputs or keywords, not both (got {', '.join(keywords)})")
-    plan = plan_rig(surface, inputs)
+    plan = plan_rig(surface, inputs, progress=progress)
     rig_class = check_engine(inputs.engine).rig_class()
-    return rig_class(surface, tip=plan.tip, engine=plan.engine, sized=(plan.scales, plan.hfield))
+    stage = f"building {inputs.engine}'s model"
+    if progress is not None:
+        progress(0, 1, stage)
+    rig = rig_class(surface, tip=plan.tip, engine=plan.engine, sized=(plan.scales, plan.hfield))
+    if progress is not None:
+        progress(1, 1, stage)
+    return rig
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -166,13 +182,20 @@ class RigPlan:
         check_drive_on(self, drive)
 
 
-def plan_rig(surface: Surface, inputs: RigInputs, *, sized: tuple | None = None) -> RigPlan:
+def plan_rig(
+    surface: Surface,
+    inputs: RigInputs,
+    *,
+    sized: tuple | None = None,
+    progress: Callable[[float, float, str], None] | None = None,
+) -> RigPlan:
     """The :class:`RigPlan` of :func:`build_rig`'s ``inputs`` (the same rules, the same
     refusals, no model compiled). ``sized``: the ``(tip, scales, hfield)`` of the same
     surface and tip sizing, measured before (:func:`rig_sizing`), so that plans differing
-    only in the drive or the engine settings measure the surface once."""
+    only in the drive or the engine settings measure the surface once; ``progress`` as for
+    :meth:`Scales.with_hfield`."""
     if sized is None:
-        sized = _sized(surface, inputs.tip, **inputs.sizing)
+        sized = _sized(surface, inputs.tip, **inputs.sizing, progress=progress)
     tip, scales, hfield = sized
     speed = drive_speed_m_s(scales, **inputs.pace) if inputs.driven else None
     spring = spring_stiffness_n_m(scales, **inputs.spring)
@@ -222,14 +245,19 @@ def rig_scales(
 
 
 def _sized(
-    surface: Surface, tip: TipParams, length_scale_m=None, hfield_resolution=None, hfield_refinement=1
+    surface: Surface,
+    tip: TipParams,
+    length_scale_m=None,
+    hfield_resolution=None,
+    hfield_refinement=1,
+    progress=None,
 ) -> tuple:
     """``(tip, scales, hfield)`` of ``tip`` on ``surface``: the tip with the radius the rig
     was sized for (a gridded surface keeps its own samples: ``hfield_resolution`` ignored),
     on the hfield refined ``hfield_refinement`` times with that radius kept."""
     resolution = grid_keeps_samples(surface, hfield_resolution)
     scales, hfield = Scales.with_hfield(
-        surface, tip=tip, length_scale_m=length_scale_m, hfield_resolution=resolution
+        surface, tip=tip, length_scale_m=length_scale_m, hfield_resolution=resolution, progress=progress
     )
     tip = dataclasses.replace(tip, tip_radius_m=scales.tip_radius_m)
     if hfield_refinement != 1:
@@ -239,6 +267,7 @@ def _sized(
             length_scale_m=length_scale_m,
             hfield_resolution=scales.hfield_resolution,
             hfield_refinement=hfield_refinement,
+            progress=progress,
         )
     return tip, scales, hfield
 

@@ -123,6 +123,7 @@ def simulate_to(
     mp4: bool = False,
     progress: Callable[[float], None] | None = None,
     render_progress: Callable[[int, int], None] | None = None,
+    prepare_progress: Callable[[float, float, str], None] | None = None,
 ) -> tuple[RunResult, list[Path]]:
     """One drive on ``surface`` written as a run folder: what ``spine-mj simulate`` does.
 
@@ -151,13 +152,15 @@ def simulate_to(
         Called with the run's fraction done while it runs.
     render_progress : callable, optional
         Called with ``(frames done, frames)`` while the MP4 is written.
+    prepare_progress : callable, optional
+        Called with ``(done, total, stage)`` while the rig is prepared (``build_rig``'s).
 
     Returns
     -------
     (RunResult, list of Path)
         The run and the files written.
     """
-    rig = build_rig(surface, inputs)
+    rig = build_rig(surface, inputs, progress=prepare_progress)
     drive = build_drive(
         rig.scales,
         protocol,

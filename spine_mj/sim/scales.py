@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -174,10 +175,11 @@ class Scales:
         char_length_m: float | None = None,
         hfield_resolution: int | None = None,
         hfield_refinement: int = 1,
+        progress: Callable[[float, float, str], None] | None = None,
     ) -> tuple[Scales, HField]:
         """The scales of ``tip`` on ``surface`` and the hfield they were measured on (the
         rig's model is built from that same hfield): the one place the rig's sizing rules
-        live.
+        live. ``progress(done, total, stage)`` hears each stage (minutes on 8192 a side).
 
         * ``length_scale_m``: None gives :data:`DEFAULT_LENGTH_SCALE_M` for a dimensionless
           surface (``unit == "1"``) and the unit's size (:data:`LENGTH_UNITS_M`) otherwise.
@@ -205,11 +207,9 @@ class Scales:
         if char_length_m is None:
             char_length_m = characteristic_length(surface) * length_scale_m
         char_length_m = check_physical_length("char_length_m", char_length_m)
-        res = hfield_resolution
-        if res is not None and (isinstance(res, bool) or int(res) != res or res < 4):
-            raise SpineInputError(f"hfield_resolution must be an integer >= 4 or None, got {res!r}")
-        if res is not None and res > MAX_HFIELD_SIDE:
-            raise SpineInputError(f"hfield_resolution must be <= {MAX_HFIELD_SIDE} samples a side, got {res}")
+        _check_resolution(hfield_resolution)
+        report = progress or _quiet
+        report(0, 1, "sampling the hfield")
         hf = hfield_of(surface, hfield_resolution)
         spacing = hfield_spacing(hf, length_scale_m)
         xmin, xmax, ymin, ymax = (length_scale_m * b for b in surface.bounds)
@@ -221,8 +221,8 @@ class Scales:
         if resolution is None and spacing < _MIN_SPACING_PER_TIP_RADIUS * radius:
             extent = 2 * max(hf.size[0], hf.size[1]) * length_scale_m
             resolution = math.ceil(extent / (_MIN_SPACING_PER_TIP_RADIUS * radius)) + 1
-            hf = hfield_of(surface, resolution)
-        hf = _refined_hfield(surface, hf, resolution, hfield_refinement)
+            hf = hfield_of(surface, resolution)  # still the stage "sampling the hfield"
+        hf = _refined_hfield(surface, hf, resolution, hfield_refinement, report)
         spacing = hfield_spacing(hf, length_scale_m)
         rx, ry, elevation = hf.size[0], hf.size[1], hf.size[2]
         fall = fall_height(
@@ -230,6 +230,7 @@ class Scales:
             (2 * rx / (hf.ncol - 1) * length_scale_m, 2 * ry / (hf.nrow - 1) * length_scale_m),
             mu=tip.mu_s,
             radius=radius,
+            progress=None if progress is None else lambda done, total: progress(done, total, "fall height"),
         )
         scales = cls(
             length_scale_m=length_scale_m,
@@ -398,7 +399,13 @@ def engine_tip_radius_m(
 
 
 def fall_height(
-    heights: np.ndarray, spacing: tuple[float, float], *, mu: float, radius: float, rows: int = 512
+    heights: np.ndarray,
+    spacing: tuple[float, float],
+    *,
+    mu: float,
+    radius: float,
+    rows: int = 512,
+    progress: Callable[[int, int], None] | None = None,
 ) -> float:
     """The height a slip can turn into an impact: the largest landing of a tip on ``heights``.
 
@@ -421,9 +428,11 @@ def fall_height(
         Grid spacings in the same unit.
     mu, radius : float
         The tip's friction coefficient and radius (same unit).
+    progress : callable, optional
+        Called with ``(lines done, lines)`` after each block of ``rows`` lines.
     """
     heights = np.asarray(heights, dtype=float)
-    best = 0.0
+    best, done, lines = 0.0, 0, sum(heights.shape)
     for grid, step in ((heights, spacing[0]), (heights.T, spacing[1])):
         m = max(1, round(radius / step))  # cells per tip radius
         n = grid.shape[1]
@@ -438,7 +447,22 @@ def fall_height(
                 out = np.arctan((a[:, 2 * m :] - a[:, m : n - m]) / (m * step))
                 turn = np.clip(out - into, 0.0, math.pi / 2)
                 best = max(best, float((drop[:, m : n - m] * np.sin(turn) ** 2).max()))
+            done += min(rows, grid.shape[0] - lo)
+            if progress is not None:
+                progress(done, lines)
     return best
+
+
+def _check_resolution(res) -> None:
+    """Refuse an hfield resolution that is neither None nor a whole count in [4, MAX_HFIELD_SIDE]."""
+    if res is not None and (isinstance(res, bool) or int(res) != res or res < 4):
+        raise SpineInputError(f"hfield_resolution must be an integer >= 4 or None, got {res!r}")
+    if res is not None and res > MAX_HFIELD_SIDE:
+        raise SpineInputError(f"hfield_resolution must be <= {MAX_HFIELD_SIDE} samples a side, got {res}")
+
+
+def _quiet(done: float, total: float, stage: str) -> None:
+    """A progress callback that hears nothing."""
 
 
 def _check_sizes(
@@ -472,10 +496,12 @@ def _slope_length(surface: Surface, length_scale_m: float, char_length_m: float)
         return char_length_m
 
 
-def _refined_hfield(surface: Surface, hf: HField, resolution: int | None, refinement) -> HField:
-    """``hf`` (``surface``'s at ``resolution``) refined ``refinement`` times (:func:`hfield_of`)."""
+def _refined_hfield(surface: Surface, hf: HField, resolution: int | None, refinement, report) -> HField:
+    """``hf`` (``surface``'s at ``resolution``) refined ``refinement`` times (:func:`hfield_of`),
+    the stage told to ``report``."""
     if refinement == 1:
         return hf
+    report(0, 1, "refining the hfield")
     if isinstance(refinement, bool) or int(refinement) != refinement or refinement < 1:
         raise SpineInputError(f"hfield_refinement must be an integer >= 1, got {refinement!r}")
     side = (max(hf.nrow, hf.ncol) - 1) * int(refinement) + 1

@@ -173,3 +173,17 @@ def test_a_sigterm_a_library_swallowed_stops_the_command_at_its_next_progress_re
     with pytest.raises(SystemExit) as stop:
         app.Progress("simulating", quiet=True).update(1, 10)
     assert stop.value.code == 128 + signal.SIGTERM
+
+
+def test_a_quick_preparation_prints_nothing_and_a_long_one_shows_its_stages(capsys):
+    """The CLI's progress display with a delay: updates before it show no bar (the small
+    cases' one-line refusals stay one line), after it they do."""
+    from spine_mj.cli import app
+
+    quick = app.Progress("preparing", delay_s=3600.0)
+    quick.update(0, 1, "sampling the hfield")
+    assert quick.bar is None and capsys.readouterr().err == ""
+    with app.Progress("preparing", delay_s=0.0) as shown:
+        shown.update(3, 6, "fall height")
+        assert shown.bar is not None
+    assert "fall height" in capsys.readouterr().err
