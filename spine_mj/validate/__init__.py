@@ -1,6 +1,6 @@
 """The validation harness: MuJoCo against the quasistatic streamline across inertia numbers.
 
-Nine studies (the registry :data:`~spine_mj.validate.studies.STUDIES`), each a function
+Ten studies (the registry :data:`~spine_mj.validate.studies.STUDIES`), each a function
 that runs its MuJoCo cases through the sweep runner (:func:`spine_mj.sweep.run_sweep`, one
 resumable store per study under ``out/sweeps/``, so a killed validation resumes where it
 stopped) and returns a typed result with the numbers and the data of its figures
@@ -30,6 +30,10 @@ stopped) and returns a typed result with the numbers and the data of its figures
    :mod:`spine_mj.theory.tomlinson` (spring-block, Prandtl-Tomlinson, crest lift-off).
 9. :func:`array_study` - spine arrays dragged over rough surfaces, and the paper's
    staggered-array conjecture in dynamics.
+10. :func:`~spine_mj.validate.engines.engines_study` - the closed forms (static kappa,
+    spring-block, Prandtl-Tomlinson, crest lift-off, V-groove and Dai wedges, creep) in
+    MuJoCo beside Bullet, where the ``[bullet]`` extra is installed (without it, one line
+    says so).
 
 :func:`run_validation` runs them all for a :class:`ValidationPlan` (``"quick"``, ``"full"``
 or the test-size ``"smoke"``), writes ``report.md`` with PNG figures and ``validation.json``.

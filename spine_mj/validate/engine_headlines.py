@@ -20,8 +20,9 @@ holds, the miss is MuJoCo's contact model.
 
 Run by ``python -m spine_mj.validate.engines --out DIR --headlines N`` (N y starts per
 surface of the plan's corner, :func:`~spine_mj.validate.convergence.thin_starts`), which
-writes :data:`RESULT_FILE` beside ``engines.json``; a validation report whose folder holds
-``engines/`` with it has the section (:func:`section`).
+writes :data:`RESULT_FILE` beside ``engines.json`` and its section (:func:`section`) into
+``engines.md`` (the committed ``analysis/reports/engines.md``); it is too long for a
+validation plan, whose engines study is the closed forms (:func:`spine_mj.validate.engines.engines_study`).
 """
 
 from __future__ import annotations
@@ -53,7 +54,6 @@ __all__ = [
     "EngineHeadlinesResult",
     "MissStart",
     "engine_headlines",
-    "load",
     "run_engine_headlines",
     "section",
 ]
@@ -436,14 +436,6 @@ def _recheck_row(miss: MissStart, engine: str, summ: dict, allc: pd.DataFrame) -
         "status": r["mujoco_status"],
         "miss_reason": r["miss_reason"] if isinstance(r["miss_reason"], str) else "",
     }
-
-
-def load(folder: Path) -> EngineHeadlinesResult | None:
-    """The result in ``folder`` (:data:`RESULT_FILE`), None where there is none."""
-    import json
-
-    path = Path(folder) / RESULT_FILE
-    return EngineHeadlinesResult.from_dict(json.loads(path.read_text())) if path.is_file() else None
 
 
 def add_arguments(ap) -> None:

@@ -38,12 +38,14 @@ facets' rule says; with them Bullet self-locks).
   (:mod:`spine_mj.validate.fractal_lock`) at its corner I_e in both engines, N surfaces per H,
   one sweep with ``engine = ["mujoco", "bullet"]``, rates with Wilson intervals.
 
-``python -m spine_mj.validate.engines --out DIR [--quick] [--fractal N] [--headlines N]`` runs
-it (Bullet needs the ``[bullet]`` extra; ``--headlines``: the quasistatic-limit corner per
-family in both engines, :mod:`spine_mj.validate.engine_headlines`) and writes ``engines.json``
-and ``engines.md``; the committed ``analysis/reports/engines.md`` is ``--fractal 6`` (the
-full plan's 30 took 855 s). With ``--out OUT/engines``, OUT a validation's output folder,
-the validation report written there next has the section.
+``spine-mj validate`` runs the closed forms as a study of its registry
+(:func:`engines_study`, the plan's ``engines_checks``), its section "Engines side by side"
+in ``report.md``, where the ``[bullet]`` extra is installed (without it the section says so
+in one line). The longer comparisons run apart:
+``python -m spine_mj.validate.engines --out DIR [--quick] [--fractal N] [--headlines N]``
+(``--headlines``: the quasistatic-limit corner per family in both engines,
+:mod:`spine_mj.validate.engine_headlines`) writes ``engines.json`` and ``engines.md``; the
+committed ``analysis/reports/engines.md`` is ``--fractal 6`` (the full plan's 30 took 855 s).
 """
 
 from __future__ import annotations
@@ -52,7 +54,7 @@ import math
 import sys
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -64,9 +66,10 @@ from spine_mj.errors import OneLineParser, SpineInputError, non_negative_int
 from spine_mj.surfaces import GridSurface
 from spine_mj.theory import engagement
 from spine_mj.theory.tomlinson import Corrugation
-from spine_mj.validate.report.engines import section
+from spine_mj.validate.plans import ValidationPlan
+from spine_mj.validate.study_runner import StudyRunner
 
-__all__ = ["EnginesResult", "dai_threshold", "engines_ground_truth", "section"]
+__all__ = ["CHECKS", "EnginesResult", "dai_threshold", "engines_ground_truth", "engines_study"]
 
 MU = 0.5
 STATIC_TOL = 0.05
@@ -96,26 +99,41 @@ def dai_threshold(mu: float) -> float:
 @dataclass(frozen=True)
 class EnginesResult:
     """Rows of every check: ``check``, ``case``, the closed form, the fair reference where
-    it differs, each engine's measurement and verdict, the tolerance; and the engines run."""
+    it differs, each engine's measurement and verdict, the tolerance; the engines run, their
+    wall and CPU seconds; and ``missing``, the extras whose absence left the study unrun
+    (``("bullet",)``: no rows)."""
 
     rows: list[dict]
     engines: tuple[str, ...]
     wall_s: dict
     fractal: list[dict] = ()
+    cpu_s: dict = field(default_factory=dict)
+    missing: tuple[str, ...] = ()
 
     def as_dict(self) -> dict:
         return {
             "rows": self.rows,
             "engines": list(self.engines),
             "wall_s": self.wall_s,
+            "cpu_s": self.cpu_s,
             "fractal": list(self.fractal),
+            "missing": list(self.missing),
         }
+
+    def validation_keys(self) -> dict:
+        """This study's keys of ``validation.json``."""
+        return {"engines": self.as_dict()}
 
     @classmethod
     def from_dict(cls, d: dict) -> EnginesResult:
         """The result :meth:`as_dict` wrote (``engines.json``)."""
         return cls(
-            rows=d["rows"], engines=tuple(d["engines"]), wall_s=d["wall_s"], fractal=d.get("fractal", [])
+            rows=d["rows"],
+            engines=tuple(d["engines"]),
+            wall_s=d["wall_s"],
+            fractal=d.get("fractal", []),
+            cpu_s=d.get("cpu_s", {}),
+            missing=tuple(d.get("missing", ())),
         )
 
 
@@ -435,11 +453,60 @@ def _creep_rows(engine: str) -> list[dict]:
 
 
 def engines_ground_truth(
-    *, quick: bool = False, engines=COMPARED_ENGINES, progress: Callable[[str], None] | None = None
+    *,
+    quick: bool = False,
+    engines=COMPARED_ENGINES,
+    checks: tuple[str, ...] | None = None,
+    progress: Callable[[str], None] | None = None,
 ) -> EnginesResult:
-    """Every check in every engine of ``engines``; rows merged by (check, case)."""
+    """Every check (or those named in ``checks``, keys of :data:`CHECKS`) in every engine of
+    ``engines``; rows merged by (check, case)."""
     by_key: dict[tuple, dict] = {}
-    wall = {}
+    wall, cpu = {}, {}
+    chosen = _checks(quick)
+    if checks is not None:
+        unknown = sorted(set(checks) - set(chosen))
+        if unknown:
+            raise SpineInputError(
+                f"engines checks must be among {', '.join(chosen)}, got {', '.join(unknown)}"
+            )
+        chosen = {k: v for k, v in chosen.items() if k in checks}
+    for engine in engines:
+        t0, c0 = time.perf_counter(), time.process_time()
+        for name, check in chosen.items():
+            if progress is not None:
+                progress(f"{engine}: {name}")
+            for row in check(engine):
+                key = (row["check"], row["case"])
+                merged = by_key.setdefault(
+                    key,
+                    {k: row[k] for k in ("check", "case", "closed_form", "tolerance") if k in row}
+                    | ({"facets": row["facets"]} if "facets" in row else {}),
+                )
+                for k in ("measured", "error", "ok", "detail", "ok_facets", "creep_radii_per_s"):
+                    if k in row:
+                        merged[f"{engine}_{k}"] = row[k]
+        wall[engine] = round(time.perf_counter() - t0, 1)
+        cpu[engine] = round(time.process_time() - c0, 1)
+    return EnginesResult(rows=list(by_key.values()), engines=tuple(engines), wall_s=wall, cpu_s=cpu)
+
+
+#: The names of the checks, in the order they run (:func:`engines_ground_truth`).
+CHECKS = (
+    "static kappa",
+    "spring-block",
+    "V-groove",
+    "V-groove, Bullet's friction anchors never",
+    "Dai interlock",
+    "Dai interlock, Bullet's internal edges off",
+    "crest lift-off",
+    "creep",
+    "Prandtl-Tomlinson",
+)
+
+
+def _checks(quick: bool) -> dict:
+    """Each check of :data:`CHECKS` as ``engine -> rows``."""
     checks = {
         "static kappa": _static_rows,
         "spring-block": _spring_block_rows,
@@ -455,23 +522,23 @@ def engines_ground_truth(
         "creep": _creep_rows,
         "Prandtl-Tomlinson": lambda e: _tomlinson_rows(e, quick),
     }
-    for engine in engines:
-        t0 = time.perf_counter()
-        for name, check in checks.items():
-            if progress is not None:
-                progress(f"{engine}: {name}")
-            for row in check(engine):
-                key = (row["check"], row["case"])
-                merged = by_key.setdefault(
-                    key,
-                    {k: row[k] for k in ("check", "case", "closed_form", "tolerance") if k in row}
-                    | ({"facets": row["facets"]} if "facets" in row else {}),
-                )
-                for k in ("measured", "error", "ok", "detail", "ok_facets", "creep_radii_per_s"):
-                    if k in row:
-                        merged[f"{engine}_{k}"] = row[k]
-        wall[engine] = round(time.perf_counter() - t0, 1)
-    return EnginesResult(rows=list(by_key.values()), engines=tuple(engines), wall_s=wall)
+    assert tuple(checks) == CHECKS
+    return checks
+
+
+def engines_study(plan: ValidationPlan, runner: StudyRunner) -> EnginesResult:
+    """The study in ``spine-mj validate``: :func:`engines_ground_truth` of the plan's checks
+    (``plan.engines_checks``; ``plan.engines_quick``: fewer corrugation wavelengths) in both
+    engines, where the ``[bullet]`` extra is installed; without it a result that says so
+    (``missing``) and runs nothing."""
+    from spine_mj import extras
+
+    runner.study = "engines"
+    if extras.missing("bullet"):
+        return EnginesResult(rows=[], engines=(), wall_s={}, missing=("bullet",))
+    checks = CHECKS if plan.engines_checks is None else plan.engines_checks
+    with runner.phase("closed forms in MuJoCo and Bullet", total=len(COMPARED_ENGINES) * len(checks)) as tick:
+        return engines_ground_truth(quick=plan.engines_quick, checks=checks, progress=lambda _: tick())
 
 
 def main(argv=None) -> int:
@@ -521,6 +588,7 @@ def _run(args) -> None:
 
     from spine_mj.jsonio import write_json
     from spine_mj.validate import engine_headlines
+    from spine_mj.validate.report.engines import section
 
     res = engines_ground_truth(quick=args.quick, progress=lambda s: print(s, flush=True))
     if args.fractal:

@@ -217,6 +217,11 @@ class ValidationPlan:
         The quasistatic-limit study's own seeds and starts table per family (the corner's
         sample size), where they differ from the family's (which the boundary study and the
         (I_e, K) map draw on); :meth:`corner_family`.
+    engines_checks : tuple of str or None
+        The checks of the engines study (names of :data:`spine_mj.validate.engines.CHECKS`;
+        None: all), run in MuJoCo and Bullet where the ``[bullet]`` extra is installed.
+    engines_quick : bool
+        The engines study's Prandtl-Tomlinson over fewer wavelengths (2, not 3).
     """
 
     name: str
@@ -267,6 +272,8 @@ class ValidationPlan:
     convergence_starts: int = 0
     convergence_refinements: tuple[str, ...] = ("dt_halved", "hfield_doubled")
     boundary_refinements: tuple[str, ...] = ()
+    engines_checks: tuple[str, ...] | None = None
+    engines_quick: bool = False
     extra: dict = field(default_factory=dict, compare=False)
 
     def deep_k_axis(self, family: str, ks: Sequence[float]) -> list[float]:
@@ -386,6 +393,9 @@ PLANS: dict[str, ValidationPlan] = {
         boundary_refinements=("dt_halved",),
         fractal_refinements=("dt_halved",),
         fractal_refined_surfaces=1,
+        # the engines study's two cheapest checks: 2.6 s of CPU in both engines
+        engines_checks=("static kappa", "spring-block"),
+        engines_quick=True,
     ),
     "quick": ValidationPlan(
         name="quick",
@@ -455,6 +465,9 @@ PLANS: dict[str, ValidationPlan] = {
         ground_truth_waves=4,
         ground_truth_ridge_widths=(0.35, 0.5),
         ground_truth_liftoff_factors=(0.5, 0.8, 1.1, 1.5),
+        # every engines check, Prandtl-Tomlinson over 2 wavelengths: 33 s of process CPU
+        # (MuJoCo 3.3 s, Bullet 23.3 s, imports the rest; measured on a loaded machine)
+        engines_quick=True,
     ),
     "full": ValidationPlan(
         name="full",

@@ -17,12 +17,14 @@ from typing import Any
 
 from spine_mj.validate.array_study import ArrayStudyResult, array_study
 from spine_mj.validate.boundary import BoundaryResult, boundary
+from spine_mj.validate.engines import EnginesResult, engines_study
 from spine_mj.validate.fractal_lock import FractalLockResult, fractal_lock
 from spine_mj.validate.ground_truth import GroundTruthResult, ground_truth
 from spine_mj.validate.plans import ValidationPlan
 from spine_mj.validate.quasistatic_limit import QuasistaticLimitResult, quasistatic_limit
 from spine_mj.validate.report import array_study as array_study_report
 from spine_mj.validate.report import boundary as boundary_report
+from spine_mj.validate.report import engines as engines_report
 from spine_mj.validate.report import fractal_lock as fractal_lock_report
 from spine_mj.validate.report import ground_truth as ground_truth_report
 from spine_mj.validate.report import quasistatic_limit as quasistatic_limit_report
@@ -72,4 +74,5 @@ STUDIES: tuple[Study, ...] = (
     Study("fractal_lock", fractal_lock, FractalLockResult, fractal_lock_report),
     Study("stiffness_map", stiffness_map, StiffnessMapResult, stiffness_map_report),
     Study("arrays", array_study, ArrayStudyResult, array_study_report),
+    Study("engines", engines_study, EnginesResult, engines_report),
 )

@@ -1,6 +1,7 @@
 """The validation's headline in a few lines of text (what ``spine-mj validate`` prints): the
 static kappa error, each family's agreement at the lowest inertia number, the fractal
-self-lock rates, the arrays' pooled differences and I_e* per protocol, read from the result
+self-lock rates, the arrays' pooled differences, I_e* per protocol and the engines side by
+side, read from the result
 :func:`~spine_mj.validate.run_validation` returns (the content of ``validation.json``)."""
 
 from __future__ import annotations
@@ -44,7 +45,20 @@ def summary_lines(result: dict) -> list[str]:
             )
     for proto, s in result["ie_star"].items():
         lines.extend(_ie_star_lines(proto, s))
+    if result.get("engines"):
+        lines.append(_engines_line(result["engines"]))
     return lines
+
+
+def _engines_line(eng: dict) -> str:
+    """The engines study in one line: per engine, the closed forms judged within tolerance."""
+    if eng.get("missing"):
+        return "engines side by side: not run, Bullet is not installed (pip install 'spine-mj[bullet]')"
+    counts = []
+    for e in eng["engines"]:
+        judged = [r[f"{e}_ok"] for r in eng["rows"] if r.get(f"{e}_ok") is not None]
+        counts.append(f"{e} {sum(judged)} of {len(judged)}")
+    return "engines side by side, closed forms within their tolerance: " + ", ".join(counts)
 
 
 def _ie_star_lines(proto: str, s: dict) -> list[str]:

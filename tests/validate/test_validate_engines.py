@@ -9,6 +9,7 @@ import pytest
 from spine_mj import sim
 from spine_mj.choices import COMPARED_ENGINES
 from spine_mj.validate import engines as study
+from spine_mj.validate.report.engines import section
 
 
 def test_dai_threshold_is_the_friction_angle_rule():
@@ -89,13 +90,13 @@ def test_section_sets_the_engines_side_by_side():
         engines=("mujoco", "bullet"),
         wall_s={"mujoco": 1.0, "bullet": 2.0},
     )
-    text = study.section(res)
+    text = section(res)
     assert "## Engines side by side: the closed forms" in text
     assert (
         "| static kappa | plane 0 deg | 0.5 | - | 0.5016 | +0.32% | yes | 0.4992 | -0.16% | yes | 5% |"
         in text
     )
-    assert study.section(None) == ""
+    assert section(None) == ""
 
 
 def test_the_result_round_trips_through_its_json():
@@ -131,19 +132,42 @@ def test_the_result_round_trips_through_its_json():
         ],
     )
     back = study.EnginesResult.from_dict(json.loads(json.dumps(res.as_dict())))
-    assert study.section(back) == study.section(res)
-    assert "| 0.8 | 0.3333 (0.06-0.79; 1 / 3; 0) | 0.3333 (0.06-0.79; 1 / 3; 0) |" in study.section(res)
+    assert section(back) == section(res)
+    assert "| 0.8 | 0.3333 (0.06-0.79; 1 / 3; 0) | 0.3333 (0.06-0.79; 1 / 3; 0) |" in section(res)
 
 
-def test_the_validation_report_has_the_section_when_the_study_ran_into_its_folder(tmp_path):
-    from spine_mj.jsonio import write_json
+def test_the_validation_report_has_the_section_of_the_studys_result(tmp_path):
+    """The engines study is a study of the registry: its result's section is in report.md,
+    no file beside it is read."""
     from spine_mj.validate.report.document import write_report
 
     summary = {"plan": "smoke", "engine_settings": {}, "timings_s": {}}
     assert "Engines side by side" not in write_report(tmp_path, summary, []).read_text()
     res = study.EnginesResult(rows=[], engines=("mujoco", "bullet"), wall_s={"mujoco": 1.0})
-    write_json(tmp_path / "engines" / "engines.json", res.as_dict())
-    assert study.section(res) in write_report(tmp_path, summary, []).read_text()
+    assert section(res) in write_report(tmp_path, summary, [res]).read_text()
+    assert res.validation_keys() == {"engines": res.as_dict()}
+
+
+def test_without_the_bullet_extra_the_validation_says_so_in_one_line(monkeypatch, tmp_path):
+    from spine_mj import extras
+    from spine_mj.validate.plans import PLANS
+    from spine_mj.validate.study_runner import StudyRunner
+
+    monkeypatch.setitem(extras.EXTRAS, "bullet", ("no_such_module_spine_mj",))
+    res = study.engines_study(PLANS["smoke"], StudyRunner(tmp_path, 1, None, 0.0))
+    assert res.missing == ("bullet",) and res.rows == []
+    (title, line) = [t for t in section(res).splitlines() if t]
+    assert title == "## Engines side by side: the closed forms"
+    assert line.startswith("Bullet is not installed (the [bullet] extra: pip install 'spine-mj[bullet]')")
+
+
+def test_the_plans_name_only_checks_the_study_has():
+    from spine_mj.validate.plans import PLANS
+
+    for plan in PLANS.values():
+        assert plan.engines_checks is None or set(plan.engines_checks) <= set(study.CHECKS)
+    with pytest.raises(study.SpineInputError, match="engines checks must be among"):
+        study.engines_ground_truth(checks=("no such check",), engines=())
 
 
 @pytest.mark.parametrize(

@@ -5,7 +5,8 @@ import json
 import pytest
 from click.testing import CliRunner
 
-from spine_mj import validate
+from spine_mj import extras, validate
+from spine_mj.choices import COMPARED_ENGINES
 from spine_mj.cli import main
 from spine_mj.errors import SpineInputError
 
@@ -63,6 +64,17 @@ def test_smoke_validation_writes_report_and_json(tmp_path, monkeypatch):
     assert (out / "figures" / "boundary.png").stat().st_size > 1000
     assert (out / "sweeps" / "boundary" / "spring-paper-single-peak" / "runs.parquet").is_file()
     assert "outcome agreement" in res.output
+    # the engines study: its section with the [bullet] extra, one line saying so without it
+    assert "## Engines side by side: the closed forms" in report
+    engines = doc["engines"]
+    if extras.missing("bullet"):
+        assert engines["missing"] == ["bullet"] and "Bullet is not installed" in report
+    else:
+        assert engines["engines"] == list(COMPARED_ENGINES)
+        checks = {"static kappa", "spring-block period", "spring-block peak speed"}
+        assert {r["check"] for r in engines["rows"]} == checks
+        assert all(f"{e}_measured" in r for r in engines["rows"] for e in COMPARED_ENGINES)
+    assert "engines side by side" in res.output
     # the fractal self-lock study: one row per H of the plan, every rate with its count
     fractal = doc["fractal_lock_rate"]
     plan = validate.PLANS["smoke"]

@@ -63,16 +63,6 @@ def write_report(out: Path, summary: dict, results: Iterable) -> Path:
     studies = [(s, given[s.name]) for s in STUDIES if s.name in given]
     headline = [line for s, res in studies for line in s.report.headline(res)]
     sections = [text for s, res in studies if (text := s.report.section(res, ctx)) is not None]
-    engines = out / "engines" / "engines.json"  # python -m spine_mj.validate.engines --out OUT/engines
-    if engines.is_file():
-        from spine_mj.validate.engines import EnginesResult
-        from spine_mj.validate.engines import section as engines_section
-
-        sections.append(engines_section(EnginesResult.from_dict(json.loads(engines.read_text()))))
-        from spine_mj.validate import engine_headlines  # written beside it by --headlines
-
-        if (headlines := engine_headlines.load(engines.parent)) is not None:
-            sections.append(engine_headlines.section(headlines))
     plan = summary["plan"]
     text = render(
         "validation_report.md.j2",

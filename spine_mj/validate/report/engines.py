@@ -7,7 +7,9 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["section"]
+__all__ = ["headline", "section"]
+
+TITLE = "## Engines side by side: the closed forms"
 
 
 def _fmt(v) -> str:
@@ -22,18 +24,30 @@ def _fmt(v) -> str:
     return f"{v:.4g}"
 
 
-def section(res) -> str:
+def headline(res) -> list[str]:
+    """The engines study adds no line to the report's headline (its verdicts are per check)."""
+    return []
+
+
+def section(res, ctx=None) -> str:
     """The report section "Engines side by side: the closed forms" of ``res``, an
-    :class:`~spine_mj.validate.engines.EnginesResult` ("" without one)."""
+    :class:`~spine_mj.validate.engines.EnginesResult` ("" without one; one line where a
+    missing extra left it unrun). ``ctx``: the report's context (the section draws no figure)."""
     if res is None:
         return ""
+    if res.missing:
+        extras = ", ".join(f"[{m}]" for m in res.missing)
+        return (
+            f"{TITLE}\n\nBullet is not installed (the {extras} extra: pip install 'spine-mj{extras}'), "
+            "so the closed forms ran in no second engine.\n"
+        )
     engines = res.engines
     head = ["check", "case", "closed form", "facets' rule"]
     for e in engines:
         head += [f"{e}", f"{e} error", f"{e} within"]
     head += ["tolerance"]
     lines = [
-        "## Engines side by side: the closed forms",
+        TITLE,
         "",
         "Each closed form run the same way in MuJoCo (soft contact) and Bullet (hard contact; "
         "docs/physics.md §11), with the tolerance the MuJoCo report states. The facets' rule is "
@@ -71,6 +85,8 @@ def section(res) -> str:
             + ".",
         ]
     lines += ["", "Wall time: " + ", ".join(f"{e} {s:g} s" for e, s in res.wall_s.items()) + "."]
+    if res.cpu_s:
+        lines[-1] += " CPU time: " + ", ".join(f"{e} {s:g} s" for e, s in res.cpu_s.items()) + "."
     lines += _fractal_lines(res.fractal)
     return "\n".join(lines) + "\n"
 

@@ -1,5 +1,5 @@
 """The report of the engines' headlines (spine_mj.validate.report.engine_headlines): its
-table rows from a hand-made result, and the validation report's section from the folder."""
+table rows from a hand-made result."""
 
 from spine_mj.validate import engine_headlines as study
 
@@ -27,11 +27,7 @@ def _summary(agreeing, well, starts):
     }
 
 
-def test_the_validation_report_has_the_section_when_the_study_ran_into_its_folder(tmp_path):
-    from spine_mj.jsonio import write_json
-    from spine_mj.validate.engines import EnginesResult
-    from spine_mj.validate.report.document import write_report
-
+def test_the_section_has_a_row_per_family_and_engine():
     res = study.EngineHeadlinesResult(
         plan="quick",
         lowest_ie=1e-4,
@@ -46,11 +42,3 @@ def test_the_validation_report_has_the_section_when_the_study_ran_into_its_folde
     text = study.section(res)
     assert "| fractal | streamline, >= 0.95 | mujoco | 0.900 [0.596, 0.982] | 9 / 10 (12) |" in text
     assert "| fractal | streamline, >= 0.95 | bullet | 1.000 [0.722, 1.000] | 10 / 10 (12) |" in text
-    summary = {"plan": "smoke", "engine_settings": {}, "timings_s": {}}
-    write_json(
-        tmp_path / "engines" / "engines.json",
-        EnginesResult(rows=[], engines=res.engines, wall_s={}).as_dict(),
-    )
-    assert "the headlines" not in write_report(tmp_path, summary, []).read_text()
-    write_json(tmp_path / "engines" / study.RESULT_FILE, res.as_dict())
-    assert text in write_report(tmp_path, summary, []).read_text()
