@@ -49,8 +49,8 @@ def stickslip_cmd(surface_spec, mu, stiffness, ie, engine, start, travel, bootst
 
     Writes events.parquet (one row per slip: source, K, ie, size_lc, duration_s,
     force_drop_fp, ...), summary.json (per source and K: n_events, tau {value, low, high},
-    cutoff_lc, the power-law tests; per K the two-sample tests), distributions.png,
-    collapse.png and, with an engine, pulse.png.
+    cutoff_lc, the power-law tests; per K the two-sample tests; per reference and K the
+    mean pulse), distributions.png, collapse.png and pulse.png.
 
     \b
     Example:

@@ -39,6 +39,7 @@ __all__ = [
     "abbm_cutoff",
     "inertial_slips",
     "overdamped_slips",
+    "pulse_shapes",
     "quasistatic_path",
 ]
 
@@ -242,6 +243,74 @@ def quasistatic_path(landscape: Landscape, stiffness: float, slips: Slips, carri
         gg = np.maximum.accumulate(np.concatenate([[np.interp(rest[i], u, g)], g[a:b]]))
         out[sel] = np.maximum(rest[i], np.interp(level[sel], gg, uu))
     return out + landscape.start
+
+
+def pulse_shapes(
+    landscape: Landscape,
+    stiffness: float,
+    slips: Slips,
+    *,
+    inertial: bool,
+    slow: float = 0.0,
+    points: int = 41,
+    min_segments: int = 8,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Each slip's speed against time, both normalized: ``v / (S / T)`` (over its mean
+    speed) at ``points`` times ``t / T`` from 0 to 1 (T the time spent faster than
+    ``slow``; the first and last samples are the first and last pieces' speeds), from the landscape
+    between its start and stop: overdamped ``v ~ L - g(u)``, inertial
+    ``v ~ sqrt(int_p^u (L - g))`` (the mobility and the mass scale v and t and drop out
+    of the shape; they only set what ``slow`` cuts). Midpoint speeds of the grid's pieces.
+
+    Parameters
+    ----------
+    landscape, stiffness, slips
+        As for :func:`quasistatic_path` (``slips`` of the reference named by ``inertial``).
+    inertial : bool
+    slow : float
+        Speeds at or below this (in the units ``L - g`` or ``sqrt(2 E)`` of a unit
+        mobility or mass) do not count: 0 counts all.
+    points : int
+        Samples of the normalized time axis, >= 2.
+    min_segments : int
+        Slips over fewer grid pieces are left out (their shape is the grid's).
+
+    Returns
+    -------
+    (shapes, durations) : ((m, points) array, (m,) array)
+        One row per slip kept, and its duration in the same units.
+    """
+    k = check_positive("stiffness", stiffness)
+    if int(points) < 2:
+        raise SpineInputError(f"points must be at least 2, got {points!r}")
+    u = landscape.positions - landscape.start
+    g = landscape.force + k * u
+    grid = np.linspace(0.0, 1.0, int(points))
+    shapes, durations = [], []
+    for p, size, x in zip(slips.start_u - landscape.start, slips.size, slips.start_carriage):
+        level = k * (x - landscape.start)
+        a, b = np.searchsorted(u, p, side="right"), np.searchsorted(u, p + size, side="left")
+        if b - a < min_segments:
+            continue
+        uu = np.concatenate([[p], u[a:b], [p + size]])
+        gg = np.concatenate([[np.interp(p, u, g)], g[a:b], [np.interp(p + size, u, g)]])
+        drive = level - gg
+        if inertial:
+            energy = np.concatenate([[0.0], np.cumsum(0.5 * (drive[1:] + drive[:-1]) * np.diff(uu))])
+            v = np.sqrt(np.maximum(0.5 * (energy[1:] + energy[:-1]), 0.0) * 2.0)
+        else:
+            v = np.maximum(0.5 * (drive[1:] + drive[:-1]), 0.0)
+        fast = v > slow
+        if fast.sum() < 2:
+            continue
+        dt = np.diff(uu)[fast] / v[fast]
+        t = np.cumsum(dt) - 0.5 * dt
+        span = float(dt.sum())
+        shapes.append(np.interp(grid * span, t, v[fast]) / (size / span))
+        durations.append(span)
+    if not shapes:
+        return np.zeros((0, grid.size)), np.zeros(0)
+    return np.array(shapes), np.array(durations)
 
 
 def abbm_cutoff(force_intensity: float, stiffness: float) -> float:

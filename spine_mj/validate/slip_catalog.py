@@ -28,6 +28,7 @@ from spine_mj.theory.avalanches import (
     Slips,
     inertial_slips,
     overdamped_slips,
+    pulse_shapes,
     quasistatic_path,
 )
 from spine_mj.theory.force_drops import drop_bounds
@@ -42,6 +43,7 @@ __all__ = [
     "engine_rows",
     "facet_count",
     "reference_drop_rows",
+    "reference_pulses",
     "reference_rows",
     "store_catalog",
     "track_landscape",
@@ -166,6 +168,37 @@ def reference_rows(landscape: Landscape, units: TrackUnits, stiffness_number: fl
         else:
             slips = inertial_slips(landscape, k, mass=m, slow=units.speed)
         out[source] = _rows(source, slips, units, stiffness_number, landscape.start, labels)
+    return out
+
+
+def reference_pulses(landscape: Landscape, units: TrackUnits, stiffness_number: float) -> dict:
+    """Per reference, the mean pulse of its slips at ``K = stiffness_number``
+    (:func:`~spine_mj.theory.avalanches.pulse_shapes`, speeds above the drive's counted):
+    ``{source: {"shape": v / (S / T) at 41 times t / T, normalized to its peak, "n": slips
+    averaged, "parabola_deviation": the largest distance from 4 x (1 - x) over t / T in
+    [0.1, 0.9]}}``, of the shorter half of the slips (ABBM's parabola is the shape at
+    durations below the cutoff's)."""
+    k = units.stiffness(stiffness_number)
+    m = units.mass
+    out = {}
+    for source in REFERENCES:
+        inertial = source == "inertial"
+        slips = inertial_slips(landscape, k, mass=m) if inertial else overdamped_slips(landscape, k)
+        # the speed scale of a unit mobility (critical, 1 / sqrt(k m)) or mass, as reference_rows
+        slow = units.speed * (math.sqrt(m) if inertial else math.sqrt(k * m))
+        shapes, durations = pulse_shapes(landscape, k, slips, inertial=inertial, slow=slow)
+        if not durations.size:
+            out[source] = {"shape": None, "n": 0, "parabola_deviation": None}
+            continue
+        mean = shapes[durations <= np.median(durations)].mean(axis=0)
+        mean = mean / mean.max()
+        x = np.linspace(0.0, 1.0, mean.size)
+        inner = (x >= 0.1) & (x <= 0.9)
+        out[source] = {
+            "shape": mean.tolist(),
+            "n": int((durations <= np.median(durations)).sum()),
+            "parabola_deviation": float(np.abs(mean - 4 * x * (1 - x))[inner].max()),
+        }
     return out
 
 

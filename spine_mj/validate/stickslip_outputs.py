@@ -10,8 +10,10 @@ with its interval, the cutoff ``S_m`` in L_c, the pure power law's fit, its boot
 likelihood-ratio tests; per K the two-sample tests between sources, an engine's against
 the reference slips fast enough for its detector, ``peak_speed_v >=``
 :data:`~spine_mj.theory.motion.SLIP_SPEED_FACTOR`; for an ABBM track the
-predicted cutoff ``sigma / k^2``), ``distributions.png``, ``collapse.png`` and, with an
-engine, ``pulse.png`` (the mean slip pulse) - all or none of them.
+predicted cutoff ``sigma / k^2``; per reference and K the mean pulse of its shorter half of
+slips and its distance from ABBM's parabola, :func:`~spine_mj.validate.slip_catalog.reference_pulses`),
+``distributions.png``, ``collapse.png`` and ``pulse.png`` (the mean slip pulses, an
+engine's too) - all or none of them.
 """
 
 from __future__ import annotations
@@ -31,13 +33,14 @@ from spine_mj.validate.slip_catalog import (
     REFERENCES,
     TrackUnits,
     engine_rows,
+    reference_pulses,
     reference_rows,
     track_landscape,
 )
 
 __all__ = ["OUTPUT_FILES", "StickSlipOutputs", "stickslip_to"]
 
-OUTPUT_FILES = ("events.parquet", "summary.json", "distributions.png", "collapse.png")
+OUTPUT_FILES = ("events.parquet", "summary.json", "distributions.png", "collapse.png", "pulse.png")
 #: Share of the track's length kept clear at each end by the default start and travel.
 EDGE_SHARE = 0.05
 
@@ -123,7 +126,7 @@ def stickslip_to(
     labels = {"surface": surface_name, "mu": float(mu), "ie": float(ie)}
     report = progress or (lambda done, total, what: None)
     total = len(ks) * (2 if engine else 1) + 1
-    frames, units_by_k, pulses = [], {}, {}
+    frames, units_by_k, pulses, ref_pulses = [], {}, {}, {}
     done = 0
     for k_number in ks:
         rig, scales = _rig_and_scales(surface, engine, mu, ie, k_number, rig_options)
@@ -132,6 +135,10 @@ def stickslip_to(
         land = track_landscape(surface, mu, units.tip_radius, (x0, x0 + length))
         for rows in reference_rows(land, units, k_number, **labels).values():
             frames.append(pd.DataFrame(rows, columns=COLUMNS))
+        for source, pulse in reference_pulses(land, units, k_number).items():
+            ref_pulses.setdefault(source, {})[f"{k_number:g}"] = pulse
+            if pulse["shape"] is not None:
+                pulses[(source, k_number)] = np.asarray(pulse["shape"])
         done += 1
         report(done, total, f"references, K {k_number:g}")
         if engine:
@@ -139,11 +146,12 @@ def stickslip_to(
             frames.append(
                 pd.DataFrame(engine_rows(result, units, engine, k_number, **labels), columns=COLUMNS)
             )
-            pulses[k_number] = _pulse(result)
+            pulses[(engine, k_number)] = _pulse(result)
             done += 1
             report(done, total, f"{engine}, K {k_number:g}")
     events = pd.concat(frames, ignore_index=True)
     summary = _summary(events, surface, mu, ie, ks, units_by_k, engine, x0, length, n_bootstrap)
+    summary["pulse"] = ref_pulses
     files = _write(Path(out_dir), events, summary, pulses)
     report(total, total, "written")
     return StickSlipOutputs(summary, files)
@@ -184,16 +192,24 @@ PULSE_POINTS = 41
 
 def _pulse(result) -> np.ndarray:
     """The mean x-speed of the run's slips against the time from onset over the duration,
-    each slip's speed over its peak: ``(PULSE_POINTS,)`` (NaN without slips)."""
+    as the references' (:func:`~spine_mj.validate.slip_catalog.reference_pulses`): each
+    slip's speed over its mean speed, the shorter half of the slips averaged, the mean
+    over its peak: ``(PULSE_POINTS,)`` (NaN without slips)."""
     grid = np.linspace(0.0, 1.0, PULSE_POINTS)
-    shapes = []
+    shapes, durations = [], []
     for e in result.slip_events:
         t = result.time_s[e.onset : e.stop + 1]
         v = result.velocity_m_s[e.onset : e.stop + 1, 0]
-        if t.size < 5 or not np.max(v) > 0:
+        if t.size < 5 or not np.max(v) > 0 or not e.jump_length_m > 0:
             continue
-        shapes.append(np.interp(grid, (t - t[0]) / (t[-1] - t[0]), v / np.max(v)))
-    return np.mean(shapes, axis=0) if shapes else np.full(PULSE_POINTS, math.nan)
+        span = t[-1] - t[0]
+        shapes.append(np.interp(grid, (t - t[0]) / span, v / (e.jump_length_m / span)))
+        durations.append(span)
+    if not shapes:
+        return np.full(PULSE_POINTS, math.nan)
+    durations = np.asarray(durations)
+    mean = np.asarray(shapes)[durations <= np.median(durations)].mean(axis=0)
+    return mean / mean.max()
 
 
 def _summary(events, surface, mu, ie, ks, units_by_k, engine, x0, length, n_bootstrap) -> dict:
@@ -250,8 +266,7 @@ def _write(out: Path, events, summary: dict, pulses: dict) -> tuple[Path, ...]:
     from spine_mj.atomic import all_or_none, atomic_output
     from spine_mj.jsonio import write_json
 
-    names = [*OUTPUT_FILES, *(["pulse.png"] if pulses else [])]
-    paths = [out / n for n in names]
+    paths = [out / n for n in OUTPUT_FILES]
     with all_or_none(*paths):
         with atomic_output(paths[0]) as tmp:
             events.to_parquet(tmp, index=False)
@@ -293,14 +308,13 @@ def _figures(out: Path, events, summary: dict, pulses: dict) -> None:
             ax.legend(fontsize=7)
     axes[0][0].set_ylabel("S^3/2 P(S)")
     save_figure(fig, out / "collapse.png")
-    if pulses:
-        fig = new_figure(figsize=(4.5, 3.4), layout="constrained")
-        ax = fig.subplots()
-        grid = np.linspace(0.0, 1.0, PULSE_POINTS)
-        for k, shape in pulses.items():
-            ax.plot(grid, shape, label=f"K = {k:g}")
-        ax.plot(grid, 4 * grid * (1 - grid), "k--", label="parabola (ABBM)")
-        ax.set_xlabel("t / T")
-        ax.set_ylabel("mean v / v_peak")
-        ax.legend(fontsize=7)
-        save_figure(fig, out / "pulse.png")
+    fig = new_figure(figsize=(4.5, 3.4), layout="constrained")
+    ax = fig.subplots()
+    grid = np.linspace(0.0, 1.0, PULSE_POINTS)
+    for (source, k), shape in pulses.items():
+        ax.plot(grid, shape, label=f"{source}, K = {k:g}")
+    ax.plot(grid, 4 * grid * (1 - grid), "k--", label="parabola (ABBM)")
+    ax.set_xlabel("t / T")
+    ax.set_ylabel("mean v / v_peak")
+    ax.legend(fontsize=6)
+    save_figure(fig, out / "pulse.png")

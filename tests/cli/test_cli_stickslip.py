@@ -35,6 +35,12 @@ def test_stickslip_writes_the_catalog_and_tau(track, tmp_path):
     assert set(od["likelihood_ratios"]) == {"lognormal", "exponential", "truncated_power_law"}
     assert "overdamped" in result.output and "tau" in result.output
     assert (out / "collapse.png").is_file() and (out / "distributions.png").is_file()
+    assert (out / "pulse.png").is_file()
+    pulse = summary["pulse"]["overdamped"]["1"]
+    assert len(pulse["shape"]) == 41 and max(pulse["shape"]) == pytest.approx(1.0)
+    assert pulse["parabola_deviation"] < 0.2  # ABBM's parabola
+    inertial = summary["pulse"]["inertial"]["1"]["shape"]
+    assert inertial.index(max(inertial)) > 0.6 * 40  # a tip with mass stops abruptly
 
 
 @pytest.mark.parametrize(

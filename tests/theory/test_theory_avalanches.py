@@ -11,7 +11,13 @@ from scipy.optimize import brentq, minimize_scalar
 
 from spine_mj.errors import SpineInputError
 from spine_mj.surfaces import abbm_force_intensity, abbm_slope_walk
-from spine_mj.theory.avalanches import Landscape, abbm_cutoff, inertial_slips, overdamped_slips
+from spine_mj.theory.avalanches import (
+    Landscape,
+    abbm_cutoff,
+    inertial_slips,
+    overdamped_slips,
+    pulse_shapes,
+)
 from spine_mj.theory.tomlinson import Corrugation
 from spine_mj.validate.avalanche_stats import cutoff_size, truncated_fit_by_ks
 
@@ -144,3 +150,19 @@ def test_overdamped_walk_is_the_running_maximum_rule():
         np.testing.assert_allclose(
             overdamped_slips(land, k).size, _running_max_slips(land, k), rtol=1e-9, atol=1e-9
         )
+
+
+def test_abbm_pulse_is_a_parabola_overdamped_and_skewed_with_inertia():
+    """ABBM: the mean shape of the overdamped slips of like duration is the parabola
+    ``4 x (1 - x)`` (here the shorter half, below the cutoff's time scale); a tip with mass
+    speeds up for most of its slip and stops abruptly (peak after 0.6 T)."""
+    land, _ = _abbm_landscape(points=200_000, seed=2)
+    k = 6e-4
+    x = np.linspace(0.0, 1.0, 41)
+    shapes, durations = pulse_shapes(land, k, overdamped_slips(land, k), inertial=False)
+    short = shapes[durations <= np.median(durations)].mean(axis=0)
+    inner = (x >= 0.1) & (x <= 0.9)
+    assert np.abs(short / short.max() - 4 * x * (1 - x))[inner].max() < 0.12
+    assert np.mean(shapes) == pytest.approx(1.0, abs=0.1)  # v / (S / T) averages to 1
+    shapes, _ = pulse_shapes(land, k, inertial_slips(land, k), inertial=True)
+    assert x[np.argmax(shapes.mean(axis=0))] > 0.6
