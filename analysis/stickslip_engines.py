@@ -83,10 +83,15 @@ def one(
     floors=(),
     catalogs=None,
     segment: float = 80.0,
+    track_length: float | None = None,
 ) -> dict:
     """One engine, variant, I_e and K over the track in runs of ``segment`` units (each
-    from rest, the references on the same stretch): the catalogs pooled over the runs."""
-    surf = presets.make_surface("abbm")
+    from rest, the references on the same stretch): the catalogs pooled over the runs.
+    ``track_length``: the abbm preset made that long (its spacing kept) instead."""
+    longer = (
+        {} if track_length is None else {"length": track_length, "points": int(round(track_length * 10)) + 1}
+    )
+    surf = presets.make_surface("abbm", **longer)
     xmin, xmax, _, _ = surf.bounds
     x0, length = xmin + EDGE_SHARE * (xmax - xmin), (1 - 2 * EDGE_SHARE) * (xmax - xmin)
     length = length if travel is None else travel
@@ -130,6 +135,7 @@ def one(
         "variant": variant,
         "ie": ie,
         "K": k,
+        "track_length": float(xmax - xmin),
         "segments": count,
         "segment_length": float(length / count),
         "cpu_s": cpu,
@@ -179,6 +185,7 @@ def main(argv=None):
     ap.add_argument("--variants", default="base")
     ap.add_argument("--travel", type=float, default=None, help="surface units (default: the track)")
     ap.add_argument("--segment", type=float, default=80.0, help="surface units a run (from rest)")
+    ap.add_argument("--track-length", type=float, default=None, help="abbm preset's length (default 400)")
     ap.add_argument("--floors", default="3e-4,1e-3", help="force-drop floors [F_p]")
     ap.add_argument("--out", default="analysis/reports/stickslip")
     ap.add_argument("--tag", default=None, help="output name (default: engines_variants)")
@@ -198,7 +205,7 @@ def main(argv=None):
                         (r["engine"], r["variant"], r["ie"], r["K"]) == (engine, variant, ie, k) for r in rows
                     ):
                         continue
-                    row = one(engine, variant, ie, k, a.travel, floors, catalogs, a.segment)
+                    row = one(engine, variant, ie, k, a.travel, floors, catalogs, a.segment, a.track_length)
                     rows.append(row)
                     write_json(path, rows)
                     with atomic_output(cat_path) as tmp:
