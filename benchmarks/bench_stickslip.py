@@ -1,5 +1,6 @@
 """Cost of the stick-slip study (``spine-mj stickslip``): the quasistatic references per
-slip, the statistics of one series, and MuJoCo per slip on the ABBM track.
+slip, their pulses, the force-drop rule per recorded row, the statistics of one series,
+and MuJoCo per slip on the ABBM track.
 
     python benchmarks/run_all.py --only stickslip
 """
@@ -22,7 +23,8 @@ def bench_stickslip(quick: bool) -> dict:
     """References' slips per CPU second, the statistics' CPU seconds per series, MuJoCo's CPU
     seconds per slip."""
     from spine_mj import presets, surfaces
-    from spine_mj.theory.avalanches import Landscape, inertial_slips, overdamped_slips
+    from spine_mj.theory.avalanches import Landscape, inertial_slips, overdamped_slips, pulse_shapes
+    from spine_mj.theory.force_drops import drop_bounds
     from spine_mj.validate.avalanche_stats import summarize_sizes
     from spine_mj.validate.stickslip_outputs import stickslip_to
 
@@ -40,7 +42,16 @@ def bench_stickslip(quick: bool) -> dict:
             "cpu_s": cpu,
             "slips_per_cpu_s": slips.size.size / max(cpu, 1e-9),
         }
-    sizes = overdamped_slips(land, 6e-4).size
+    slips = overdamped_slips(land, 6e-4)
+    c0 = time.process_time()
+    pulse_shapes(land, 6e-4, slips, inertial=False)
+    pulse_cpu = time.process_time() - c0
+    force = np.cumsum(np.random.default_rng(1).normal(size=n))  # a recorded force, n rows
+    drop_bounds(force[:100], 1.0)  # compiled once
+    c0 = time.process_time()
+    drop_bounds(force, 3.0)
+    drop_cpu = time.process_time() - c0
+    sizes = slips.size
     c0 = time.process_time()
     summarize_sizes(sizes, n_bootstrap=100)
     stats_cpu = time.process_time() - c0
@@ -56,6 +67,8 @@ def bench_stickslip(quick: bool) -> dict:
         "points": n,
         "references": refs,
         "stats": {"events": int(sizes.size), "cpu_s": stats_cpu},
+        "pulses": {"slips": int(sizes.size), "cpu_s": pulse_cpu},
+        "drops": {"rows": n, "cpu_s": drop_cpu},
         "mujoco": {"travel": 100.0, "ie": 1e-3, "K": 0.5, "slips": mj_slips, "cpu_s": mj_cpu},
     }
 
@@ -73,6 +86,15 @@ def markdown(res: dict | None) -> list[str]:
             f"{target_cell(r['slips_per_cpu_s'], '>=', REFERENCE_TARGET)} | {load} |"
         )
     st, mj = res["stats"], res["mujoco"]
+    if "pulses" in res:
+        pu, dr = res["pulses"], res["drops"]
+        rows.append(
+            f"| overdamped reference's pulses ({pu['slips']} slips) | {fmt(pu['cpu_s'])} CPU s | - | {load} |"
+        )
+        rows.append(
+            f"| force-drop rule (`theory.force_drops`), {dr['rows']:.0e} recorded rows | "
+            f"{fmt(dr['cpu_s'])} CPU s | - | {load} |"
+        )
     rows.append(
         f"| slip statistics of one series (truncated fit by KS, 100 bootstraps, likelihood ratios) | "
         f"{fmt(st['cpu_s'])} CPU s for {st['events']} slips | - | {load} |"
