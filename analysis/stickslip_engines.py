@@ -18,7 +18,8 @@ Run: ``nice -n 19 .venv/bin/python analysis/stickslip_engines.py [--ie 1e-4,1e-5
 [--engines mujoco,bullet] [--variants base,dt2,hfield2] [--travel 150]
 [--floors 3e-4,1e-3] [--out analysis/reports/stickslip] [--tag NAME]``;
 writes ``stickslip_engines_<tag>.json`` after each run (a rerun skips the runs it holds)
-and the drop catalogs ``stickslip_drops_<tag>.parquet``, and prints one line per run.
+and the drop catalogs ``stickslip_drops_<tag>.parquet``, and prints one line per run;
+``--report`` tabulates the saved catalogs into ``engines_drops.md`` (:func:`report`).
 """
 
 from __future__ import annotations
@@ -189,8 +190,12 @@ def main(argv=None):
     ap.add_argument("--floors", default="3e-4,1e-3", help="force-drop floors [F_p]")
     ap.add_argument("--out", default="analysis/reports/stickslip")
     ap.add_argument("--tag", default=None, help="output name (default: engines_variants)")
+    ap.add_argument("--report", action="store_true", help="only tabulate the saved drop catalogs")
     a = ap.parse_args(argv)
     out = Path(a.out)
+    if a.report:
+        print(report(out))
+        return
     out.mkdir(parents=True, exist_ok=True)
     tag = a.tag or f"{a.engines.replace(',', '_')}_{a.variants.replace(',', '_')}"
     path, cat_path = out / f"stickslip_engines_{tag}.json", out / f"stickslip_drops_{tag}.parquet"
@@ -226,6 +231,54 @@ def main(argv=None):
                             f"p {d.get('ks_p', math.nan):.3g}; jitter {row['jitter_fp']:.3g} F_p",
                             flush=True,
                         )
+
+
+def report(out: Path) -> str:
+    """The force-drop comparisons of every saved ``stickslip_drops_*.parquet`` under
+    ``out`` as a markdown table (written to ``engines_drops.md``): per run and floor the
+    counts, and the engine's sizes and force drops against each reference by
+    Kolmogorov-Smirnov (D, p) and Anderson-Darling (p). The force drops also at a fixed
+    carriage: an engine's drop plus ``k V T`` (its carriage moves ``V T`` during a drop of
+    duration T; the references' carriage stands still), in F_p."""
+    rows = [
+        "| run | K | I_e | floor [F_p] | engine drops | reference | reference drops "
+        "| sizes D, p (AD p) | drops D, p (AD p) | drops at fixed carriage D, p (AD p) |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |",
+    ]
+    for path in sorted(out.glob("stickslip_drops_*.parquet")):
+        cat = pd.read_parquet(path)
+        runs = json.loads(
+            (out / path.name.replace("stickslip_drops_", "stickslip_engines_"))
+            .with_suffix(".json")
+            .read_text()
+        )
+        for (variant, ie, k, floor), g in cat.groupby(["variant", "ie", "K", "floor_fp"]):
+            run = next(r for r in runs if (r["variant"], r["ie"], r["K"]) == (variant, ie, k))
+            engine = g[g["source"] == run["engine"]]
+            surf = presets.make_surface("abbm")
+            units = TrackUnits.of(
+                build_rig(surf, engine=run["engine"], mu=MU, ie=ie, stiffness_number=k).scales, ie
+            )
+            fixed = engine["force_drop_fp"] + units.stiffness(k) * units.speed * engine["duration_s"]
+            for source in sorted(set(g["source"]) - {run["engine"]}):
+                ref = g[g["source"] == source]
+                cells = [
+                    two_sample(a, ref[col])
+                    for a, col in (
+                        (engine["size_lc"], "size_lc"),
+                        (engine["force_drop_fp"], "force_drop_fp"),
+                        (fixed, "force_drop_fp"),
+                    )
+                ]
+                rows.append(
+                    f"| {path.stem.removeprefix('stickslip_drops_')} {variant} | {k:g} | {ie:g} | {floor:g} "
+                    f"| {len(engine)} | {source} | {len(ref)} | "
+                    + " | ".join(f"{c['ks']:.3f}, {c['ks_p']:.3g} ({c['ad_p']:.3g})" for c in cells)
+                    + " |"
+                )
+    text = "\n".join(rows) + "\n"
+    (out / "engines_drops.md").write_text(text)
+    return text
 
 
 if __name__ == "__main__":
