@@ -12,8 +12,9 @@ the reference slips fast enough for its detector, ``peak_speed_v >=``
 :data:`~spine_mj.theory.motion.SLIP_SPEED_FACTOR`; for an ABBM track the
 predicted cutoff ``sigma / k^2``; per reference and K the mean pulse of its shorter half of
 slips and its distance from ABBM's parabola, :func:`~spine_mj.validate.slip_catalog.reference_pulses`),
-``distributions.png``, ``collapse.png`` and ``pulse.png`` (the mean slip pulses, an
-engine's too) - all or none of them.
+``distributions.png``, ``collapse.png``, ``pulse.png`` (the mean slip pulses, an
+engine's too) and ``regime.png`` (the (I_e, K) map of :func:`regime_map`) - all or none
+of them.
 """
 
 from __future__ import annotations
@@ -38,9 +39,16 @@ from spine_mj.validate.slip_catalog import (
     track_landscape,
 )
 
-__all__ = ["OUTPUT_FILES", "StickSlipOutputs", "stickslip_to"]
+__all__ = ["OUTPUT_FILES", "StickSlipOutputs", "regime_map", "stickslip_to"]
 
-OUTPUT_FILES = ("events.parquet", "summary.json", "distributions.png", "collapse.png", "pulse.png")
+OUTPUT_FILES = (
+    "events.parquet",
+    "summary.json",
+    "distributions.png",
+    "collapse.png",
+    "pulse.png",
+    "regime.png",
+)
 #: Share of the track's length kept clear at each end by the default start and travel.
 EDGE_SHARE = 0.05
 
@@ -152,6 +160,7 @@ def stickslip_to(
     events = pd.concat(frames, ignore_index=True)
     summary = _summary(events, surface, mu, ie, ks, units_by_k, engine, x0, length, n_bootstrap)
     summary["pulse"] = ref_pulses
+    summary["regime"] = regime_map(land, events, units_by_k)
     files = _write(Path(out_dir), events, summary, pulses)
     report(total, total, "written")
     return StickSlipOutputs(summary, files)
@@ -210,6 +219,33 @@ def _pulse(result) -> np.ndarray:
     durations = np.asarray(durations)
     mean = np.asarray(shapes)[durations <= np.median(durations)].mean(axis=0)
     return mean / mean.max()
+
+
+def regime_map(landscape, events, units_by_k: dict) -> dict:
+    """The predicted (I_e, K) regimes of a spring drive on the track (docs/physics.md §12):
+
+    * ``K_star``: the fold criterion, ``l_s max(-dF/du) / W`` on the track's landscape;
+      above it the quasistatic tip slides steadily (no fold), below it sticks and slips;
+    * per K, ``swing_ie``: where the spring-block's force swing after a slip,
+      ``sqrt(I_e K_c) F_p`` (``K_c = K L_c / l_s``, :func:`~spine_mj.theory.drive_limits.spring_ie_limits`),
+      reaches the inertial reference's median force drop at that K: below it a slip ends
+      in a stick (stick-slip), above it the tip swings on through the next folds
+      (multiple slip);
+    * per K, ``quasistatic_ie``: the swing-force limit of the drive (its swing reaches
+      :data:`~spine_mj.theory.drive_limits.SWING_BOUND_FP`), above which no reference applies.
+    """
+    from spine_mj.theory.drive_limits import spring_ie_limits
+
+    any_units = next(iter(units_by_k.values()))
+    fall = float(np.max(-np.diff(landscape.force)) / landscape.spacing)
+    out = {"K_star": max(fall, 0.0) * any_units.slope_length, "swing_ie": {}, "quasistatic_ie": {}}
+    for k, units in units_by_k.items():
+        ratio = units.char_length / units.slope_length
+        drops = events.loc[(events["source"] == "inertial") & (events["K"] == k), "force_drop_fp"]
+        kc = k * ratio
+        out["swing_ie"][f"{k:g}"] = float(np.median(drops) ** 2 / kc) if len(drops) else None
+        out["quasistatic_ie"][f"{k:g}"] = spring_ie_limits(k, ratio)["swing-force"]
+    return out
 
 
 def _summary(events, surface, mu, ie, ks, units_by_k, engine, x0, length, n_bootstrap) -> dict:
@@ -308,6 +344,7 @@ def _figures(out: Path, events, summary: dict, pulses: dict) -> None:
             ax.legend(fontsize=7)
     axes[0][0].set_ylabel("S^3/2 P(S)")
     save_figure(fig, out / "collapse.png")
+    _regime_figure(out, summary)
     fig = new_figure(figsize=(4.5, 3.4), layout="constrained")
     ax = fig.subplots()
     grid = np.linspace(0.0, 1.0, PULSE_POINTS)
@@ -318,3 +355,23 @@ def _figures(out: Path, events, summary: dict, pulses: dict) -> None:
     ax.set_ylabel("mean v / v_peak")
     ax.legend(fontsize=6)
     save_figure(fig, out / "pulse.png")
+
+
+def _regime_figure(out: Path, summary: dict) -> None:
+    from spine_mj.plotting import new_figure, save_figure
+
+    reg, ie = summary["regime"], summary["ie"]
+    ks = np.array(summary["K"], float)
+    swing = np.array([reg["swing_ie"][f"{k:g}"] or np.nan for k in ks], float)
+    quasi = np.array([reg["quasistatic_ie"][f"{k:g}"] for k in ks], float)
+    fig = new_figure(figsize=(4.8, 3.6), layout="constrained")
+    ax = fig.subplots()
+    ax.loglog(ks, swing, "o-", label="swing = median slip drop (stick-slip below)")
+    ax.loglog(ks, quasi, "s--", label="swing = 1 F_p (quasistatic below)")
+    ax.axvline(reg["K_star"], color="k", ls=":", label=f"K* = {reg['K_star']:.3g} (steady sliding right)")
+    ax.scatter(ks, np.full(ks.size, ie), marker="x", color="r", label=f"this study (I_e {ie:g})")
+    ax.set_xlabel("K")
+    ax.set_ylabel("I_e")
+    ax.set_title("stick-slip below the swing line, multiple slip above", fontsize=8)
+    ax.legend(fontsize=6)
+    save_figure(fig, out / "regime.png")

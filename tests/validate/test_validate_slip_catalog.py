@@ -49,6 +49,10 @@ def test_study_writes_every_file_and_a_summary_per_source(corrugation_study):
     assert set(res.summary["sources"]) == {"overdamped", "inertial", "mujoco"}
     assert res.summary["sources"]["mujoco"]["0.2"]["n_events"] >= 3
     assert "mujoco_vs_inertial" in res.summary["two_sample"]["0.2"]
+    regime = res.summary["regime"]  # the corrugation's Prandtl-Tomlinson fold, K* 0.47
+    assert regime["K_star"] == pytest.approx(0.47, rel=0.05)
+    # the swing reaches the median drop far above this study's I_e 1e-4, below the 1 F_p bound
+    assert 1e-4 < regime["swing_ie"]["0.2"] < regime["quasistatic_ie"]["0.2"]
 
 
 SWEEP = """
