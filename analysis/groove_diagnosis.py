@@ -2,7 +2,7 @@
 
 Rebuilds, for the full plan's sandpaper and fractal families at the lowest I_e, what the
 sweep's ``compare`` analysis compared before its contact surface became exact
-(:class:`spine_mj.surfaces.BallOnFacets`): the MuJoCo runs (the ``mujoco`` analysis of each
+(:class:`spine_mj.surfaces.BallOnFacets`): the MuJoCo runs (the ``engine`` analysis of each
 case, about a minute for both families) and the reference streamline traced on the facets
 dilated by the tip and sampled at R/8 under a spline (``spine_mj.theory.streamline.dilate``), with
 the same mu_s, step and force cap. Then, per run that disagrees or whose reference stalls or holds:
@@ -28,7 +28,7 @@ import numpy as np
 from spine_mj.sim.model import from_hfield
 from spine_mj.surfaces import TriangulatedSurface
 from spine_mj.sweep import ANALYSES, expand_cases, parse_config
-from spine_mj.sweep.analyses.mujoco import case_rig
+from spine_mj.sweep.analyses.engine import case_rig
 from spine_mj.theory import agreement
 from spine_mj.theory import streamline as sl
 from spine_mj.theory.engagement import kappa
@@ -66,7 +66,7 @@ def _case(case):
     surface = case.surface.make()
     starts = case.starts.resolve(surface.bounds, case.seed)
     rig = case_rig(case, surface)
-    runs = ANALYSES["mujoco"].func(case, surface, starts, {}).data[1]
+    runs = ANALYSES["engine"].func(case, surface, starts, {}).data[1]
     s = rig.length_scale_m
     facets = TriangulatedSurface.from_grid(from_hfield(rig.hfield, unit=surface.unit))
     contact = sl.dilate(facets, rig.tip.tip_radius_m / s)  # the spline surface compare used to trace on

@@ -192,7 +192,7 @@ def probes(work: Path, novideo: str | None) -> list[tuple[str, list[str], str, s
             work,
             f"ign-{kv.split()[0]}",
             MUJOCO.format(
-                analysis="mujoco",
+                analysis="engine",
                 surface='preset = "paper-single-peak"',
                 table="drive",
                 key=f'protocol = "{protocol}"\n{kv}',
@@ -205,12 +205,12 @@ def probes(work: Path, novideo: str | None) -> list[tuple[str, list[str], str, s
             "ignores it",
         )
     for kv, analysis in (
-        ("hfield_resolution = 100000", "mujoco"),
-        ("timestep = 1.0", "mujoco"),
-        ("ie = 1e-30", "mujoco"),
-        ("gravity = 0.0", "mujoco"),
-        ("mass = 1e30", "mujoco"),
-        ("length_scale = 1e9", "mujoco"),
+        ("hfield_resolution = 100000", "engine"),
+        ("timestep = 1.0", "engine"),
+        ("ie = 1e-30", "engine"),
+        ("gravity = 0.0", "engine"),
+        ("mass = 1e30", "engine"),
+        ("length_scale = 1e9", "engine"),
         ("dl = 1e-300", "quasistatic"),
     ):
         cfg = sweep_config(
@@ -374,13 +374,13 @@ def _issue44(add, work: Path, py: str) -> None:
     """
     configs = {
         "bullet with integrator": (
-            '["mujoco"]',
+            '["engine"]',
             "paper-single-peak",
             '[grid]\nengine = "bullet"\nintegrator = "euler"',
             "engine bullet",
         ),
         "bullet with timestep_factor": (
-            '["mujoco"]',
+            '["engine"]',
             "paper-single-peak",
             '[grid]\nengine = "bullet"\ntimestep_factor = 0.5',
             "engine bullet",
@@ -393,19 +393,19 @@ def _issue44(add, work: Path, py: str) -> None:
             "force",
         ),
         "grid swing ie x K": (
-            '["quasistatic", "mujoco", "compare"]',
+            '["quasistatic", "engine", "compare"]',
             "paper-fractal",
             "[drive]\nie = [1e-4, 1e-3]\nK = [10, 100]",
             "K = 100",
         ),
         "grid steps ie x timestep_factor": (
-            '["mujoco"]',
+            '["engine"]',
             "paper-single-peak",
             "[drive]\nie = [1.0, 1e-3]\n[grid]\ntimestep_factor = [1.0, 1e-3]",
             "steps",
         ),
         "grid sizes resolution x refinement": (
-            '["mujoco"]',
+            '["engine"]',
             "paper-single-peak",
             "[grid]\nhfield_resolution = [61, 1500]\nhfield_refinement = [1, 6]",
             "samples a side",

@@ -73,7 +73,7 @@ def p600_compare(quick: bool) -> dict:
 
     n = 2 if quick else 12
     doc = {
-        "sweep": {"name": "p600-compare", "seed": 11, "analyses": ["quasistatic", "mujoco", "compare"]},
+        "sweep": {"name": "p600-compare", "seed": 11, "analyses": ["quasistatic", "engine", "compare"]},
         "surfaces": [{"preset": "sandpaper-P600"}],
         "starts": {"frame": "relative", "x": [0.25], "y": {"linspace": [0.2, 0.8], "num": n}},
         "drive": {"protocol": "spring", "ie": 1e-4},

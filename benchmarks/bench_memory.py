@@ -28,7 +28,7 @@ _SWEEP = """
 [sweep]
 name = "bench-memory"
 seed = 1
-analyses = ["quasistatic", "mujoco", "compare"]
+analyses = ["quasistatic", "engine", "compare"]
 
 [[surfaces]]
 preset = "paper-single-peak"

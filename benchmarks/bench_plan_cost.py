@@ -43,7 +43,7 @@ def study_of(store_name: str) -> str:
 
 def plan_cost(out_dir: Path) -> dict:
     """Per study of the validation in ``out_dir``: ``wall_s`` (``timings_s``), ``sweep_cpu_s``
-    and ``runs`` (MuJoCo runs: rows of the ``mujoco`` analysis) from its sweep stores."""
+    and ``runs`` (MuJoCo runs: rows of the ``engine`` analysis) from its sweep stores."""
     from spine_mj import sweep
 
     out_dir = Path(out_dir)
@@ -57,7 +57,7 @@ def plan_cost(out_dir: Path) -> dict:
             {"wall_s": None, "sweep_cpu_s": 0.0, "runs": 0},
         )
         row["sweep_cpu_s"] += float(df["cpu_s"].sum())
-        row["runs"] += int((df["analysis"] == "mujoco").sum())
+        row["runs"] += int((df["analysis"] == "engine").sum())
     for row in studies.values():
         row["sweep_cpu_s"] = round(row["sweep_cpu_s"], 1)
     return {"studies": studies, "wall_s": timings.get("total")}

@@ -28,7 +28,7 @@ from bench_common import target_cell
 from spine_mj import sweep
 
 MUJOCO_CONFIG = {
-    "sweep": {"name": "bench-mujoco", "analyses": ["mujoco"]},
+    "sweep": {"name": "bench-mujoco", "analyses": ["engine"]},
     "surfaces": [{"preset": "paper-single-peak"}, {"preset": "paper-single-valley"}],
     "starts": {"frame": "absolute", "x": [-3.0], "y": {"linspace": [-4.0, 0.0], "num": 8}},
     "drive": {"protocol": "spring"},
@@ -48,7 +48,7 @@ def bare_rollout_time(config: sweep.SweepConfig) -> float:
     from mujoco import rollout
 
     from spine_mj import sim
-    from spine_mj.sweep.analyses import mujoco as an
+    from spine_mj.sweep.analyses import engine as an
 
     total = 0.0
     for case in sweep.expand_cases(config):
@@ -109,7 +109,7 @@ def main() -> None:
     bare = bare_rollout_time(config)
     # the bare timing built and placed through the in-process rig cache: empty it, so the
     # one-worker sweep starts as cold as the two-worker one (rigs, placements)
-    from spine_mj.sweep.analyses import mujoco as an
+    from spine_mj.sweep.analyses import engine as an
 
     an.case_rig.cache_clear()
     t1 = timed_sweep(config, scratch / "mj1", workers=1)
@@ -172,7 +172,7 @@ def main() -> None:
 
 
 def bench_sweep(quick: bool) -> dict:
-    from spine_mj.sweep.analyses import mujoco as an
+    from spine_mj.sweep.analyses import engine as an
 
     n_ie = 2 if quick else 6
     doc = dict(MUJOCO_CONFIG, grid={"mu": 1.23, "ie": {"logspace": [1e-3, 1e-1], "num": n_ie}})

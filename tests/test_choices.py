@@ -89,7 +89,7 @@ def test_a_third_engine_runs_simulate(third_engine, tmp_path):
 SWEEP = """
 [sweep]
 name = "third-engine"
-analyses = ["mujoco"]
+analyses = ["engine"]
 [[surfaces]]
 preset = "paper-single-peak"
 [starts]

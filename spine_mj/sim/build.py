@@ -1,6 +1,6 @@
 """The one way from a problem's inputs to a rig and a drive.
 
-Users, the sweep's ``mujoco`` analysis, the validation and the benchmarks give the same
+Users, the sweep's ``engine`` analysis, the validation and the benchmarks give the same
 things: a surface, a friction coefficient, a tip (radius, mass, preload), a length scale
 and hfield resolution, an engine and its options, and a drive either dimensionless
 (inertia number ``I_e``, stiffness number ``K``) or in SI (speed [m/s], stiffness [N/m],

@@ -1,6 +1,6 @@
 """What a rig is built from: :class:`RigInputs`, the one record of a rig's inputs.
 
-``spine-mj simulate``, ``sim export`` and ``view``, the sweep's ``mujoco`` analysis, the
+``spine-mj simulate``, ``sim export`` and ``view``, the sweep's ``engine`` analysis, the
 validation and the benchmarks build their rigs from the same list of inputs: a friction
 coefficient, an engine and its options, a tip, a length scale and an hfield, and the pace
 and spring of the drive the engine's step must resolve. That list is written here once, as

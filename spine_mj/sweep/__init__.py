@@ -6,7 +6,7 @@ grid and the analyses to run on every case::
     [sweep]
     name = "quasistatic-mu"
     seed = 0                          # master seed; each case derives its own
-    analyses = ["quasistatic"]        # any of: quasistatic, mujoco, compare
+    analyses = ["quasistatic"]        # any of: quasistatic, engine, compare, array
 
     [[surfaces]]
     preset = "paper-random-convex"
@@ -53,7 +53,7 @@ case), :mod:`~spine_mj.sweep.store` (the result store and its readers),
 and :mod:`~spine_mj.sweep.analyses` (the built-in analyses, registered on import).
 """
 
-from spine_mj.sweep.analyses import MUJOCO_PARAMS, QUASISTATIC_PARAMS
+from spine_mj.sweep.analyses import ENGINE_PARAMS, QUASISTATIC_PARAMS
 from spine_mj.sweep.case_runs import run_case
 from spine_mj.sweep.cases import Case, expand_cases
 from spine_mj.sweep.config import StartsSpec, SurfaceSpec, SweepConfig, load_config, parse_config
@@ -75,7 +75,7 @@ from spine_mj.sweep.store import StoreStatus, consolidate, load_runs, load_traje
 __all__ = [
     "ANALYSES",
     "DEFAULT_WORKER_WAIT_S",
-    "MUJOCO_PARAMS",
+    "ENGINE_PARAMS",
     "QUASISTATIC_PARAMS",
     "REQUIRED",
     "STATUSES",

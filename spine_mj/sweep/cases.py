@@ -132,7 +132,7 @@ def case_cost(case: Case) -> float:
     cases changes no result). MuJoCo spring runs last ~ 1 / speed ~ I_e^-1/2."""
     p = case.params
     cost = 1.0
-    if "mujoco" in case.analyses and p.get("protocol", "spring") == "spring":
+    if "engine" in case.analyses and p.get("protocol", "spring") == "spring":
         if p.get("duration") is not None:
             cost = float(p["duration"])
         elif p.get("speed") is not None:

@@ -276,6 +276,11 @@ class _Sweep(Table):
         if not analyses:
             raise ValueError(f"must be a non-empty list of {names}, got []")
         for a in analyses:
+            if a == "mujoco" and a not in ANALYSES:
+                raise ValueError(
+                    "the analysis 'mujoco' is now 'engine' (it runs the grid's engine, MuJoCo or "
+                    "Bullet); write 'engine'"
+                )
             if a not in ANALYSES:
                 raise ValueError(f"allowed values are {names}, got {a!r}")
             missing = [r for r in ANALYSES[a].requires if r not in analyses]

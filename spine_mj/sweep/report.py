@@ -358,9 +358,9 @@ def _agreement_figure(ok: pd.DataFrame, by_k: bool, outcome_target: float, frech
 
 def _overlay_section(out_dir: Path, df: pd.DataFrame) -> dict | None:
     """A few MuJoCo paths over the streamline at the lowest and highest I_e (first surface)."""
-    if df.empty or not {"quasistatic", "mujoco"} <= set(df["analysis"]) or "ie" not in df.columns:
+    if df.empty or not {"quasistatic", "engine"} <= set(df["analysis"]) or "ie" not in df.columns:
         return None
-    mj = df[(df.analysis == "mujoco") & df["ie"].notna()]
+    mj = df[(df.analysis == "engine") & df["ie"].notna()]
     if mj.empty:
         return None
     surface = mj["surface"].iloc[0]
@@ -372,7 +372,7 @@ def _overlay_section(out_dir: Path, df: pd.DataFrame) -> dict | None:
         case_id = mj.loc[mj["ie"] == ie, "case_id"].iloc[0]
         try:
             qs = load_trajectories(out_dir, case_id, analysis="quasistatic", columns=["x", "y"])
-            mp = load_trajectories(out_dir, case_id, analysis="mujoco", columns=["x", "y"])
+            mp = load_trajectories(out_dir, case_id, analysis="engine", columns=["x", "y"])
         except Exception:  # a case without stored paths (record off, or a corrupt file)
             continue
         starts = sorted(set(qs["start"]))[:_OVERLAY_STARTS]

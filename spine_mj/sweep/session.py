@@ -22,7 +22,7 @@ import pyarrow.compute as pc
 
 from spine_mj.errors import SpineInputError
 from spine_mj.sweep.analyses import quasistatic
-from spine_mj.sweep.analyses.mujoco import case_rig
+from spine_mj.sweep.analyses.engine import case_rig
 from spine_mj.sweep.cases import expand_cases
 from spine_mj.sweep.config import SweepConfig, _make_surface, load_config
 from spine_mj.sweep.executors import DEFAULT_WORKER_WAIT_S, Backend

@@ -219,7 +219,7 @@ def boundary(plan: ValidationPlan, runner: StudyRunner) -> BoundaryResult:
 
 
 def _rows_of(proto: str, jobs, done, key: str | None = None) -> tuple[pd.DataFrame, pd.DataFrame]:
-    """The (``compare``, ``mujoco``) rows of ``proto``'s sweeps among ``jobs`` (``(proto,
+    """The (``compare``, ``engine``) rows of ``proto``'s sweeps among ``jobs`` (``(proto,
     job)``, or ``(proto, key, job)`` with the refinement ``key``) and their results
     ``done``."""
     comps, mjs = [], []
@@ -341,7 +341,7 @@ def _preset_jobs(
     plan: ValidationPlan, runner: StudyRunner, fam: FamilySpec, preset: str, proto: str, ramp_plans: dict
 ) -> list[tuple[dict, str, Callable]]:
     """One preset's sweeps under ``proto`` as ``(config, store name, rows)``: ``rows(df,
-    store)`` gives the sweep's (``compare``, ``mujoco``) rows."""
+    store)`` gives the sweep's (``compare``, ``engine``) rows."""
     grid = preset_grid(plan, fam, preset)
     mu, tip = grid["mu"], grid["tip_radius"]
     if proto == "ramp":
@@ -355,7 +355,7 @@ def _preset_jobs(
     )
 
     def rows(df, _store):
-        return df[df["analysis"] == "compare"], df[df["analysis"] == "mujoco"]
+        return df[df["analysis"] == "compare"], df[df["analysis"] == "engine"]
 
     return [(doc, f"boundary/{proto}-{preset}", rows)]
 
@@ -394,7 +394,7 @@ def _ramp_jobs(
 
     def rows(df, store):
         c = df[df["analysis"] == "compare"].copy()
-        m = df[df["analysis"] == "mujoco"]
+        m = df[df["analysis"] == "engine"]
         c["prefix_frechet"], c["coverage"], c["ie_achieved"] = _ramp_metrics(c, m, store, surface, rig)
         return c, m
 
@@ -423,7 +423,7 @@ def _ramp_metrics(c: pd.DataFrame, m: pd.DataFrame, store, surface, rig) -> tupl
     mi = m.set_index(["case_id", "start"])
     pf, cov, ach = [], [], []
     for case_id, grp in c.groupby("case_id", sort=False):
-        mp = stored_paths(store, case_id, "mujoco")
+        mp = stored_paths(store, case_id, "engine")
         qp = stored_paths(store, case_id, "quasistatic")
         for s in grp["start"].astype(int):
             row = mi.loc[(case_id, s)]

@@ -330,7 +330,7 @@ def _engine_half(result, engine: str):
 def _cpu(df: pd.DataFrame, engine: str) -> dict:
     """CPU seconds of ``engine``'s runs and of the streamlines compared with them, and runs."""
     d = df[df["engine"] == engine]
-    runs = d["analysis"] == "mujoco"
+    runs = d["analysis"] == "engine"
     return {
         "engine": float(d.loc[runs, "cpu_s"].sum()),
         "reference": float(d.loc[~runs, "cpu_s"].sum()),
@@ -369,7 +369,7 @@ def _start_outcomes(plan: ValidationPlan, halves, allc: pd.DataFrame, ill: dict)
     members = max(int(plan.ensemble_members), 1)
     runs = []
     for df, _ in halves:
-        mj = df[(df["analysis"] == "mujoco") & (df["start"].astype(int) % members == 0)].copy()
+        mj = df[(df["analysis"] == "engine") & (df["start"].astype(int) % members == 0)].copy()
         mj["start"] = mj["start"].astype(int) // members
         runs.append(mj)
     mj = pd.concat(runs, ignore_index=True).set_index(["case_id", "start"])

@@ -632,7 +632,7 @@ def fractal_engines(
     seed_hurst = {seed: s["set"]["hurst"] for s in surfaces for seed in s["seeds"]}
     tip = tip_radius(PRESET, None, None)
     doc = {
-        "sweep": {"name": "fractal-engines", "seed": 11, "analyses": ["mujoco"], "store_trajectories": False},
+        "sweep": {"name": "fractal-engines", "seed": 11, "analyses": ["engine"], "store_trajectories": False},
         "surfaces": surfaces,
         "starts": {"frame": "relative", "x": [0.05], "y": [0.5]},
         "drive": {"protocol": "spring", "ie": ie},

@@ -194,7 +194,7 @@ def ensemble_groups(df, store, members: int) -> list[dict]:
     """The ensembles of one limit sweep (its run table ``df`` and ``store``) as the groups
     of :func:`ensemble_verdicts`: MuJoCo's held flag and end from its rows, the reference's
     from the ``compare`` row and the end of its stored path."""
-    mj = df[df["analysis"] == "mujoco"]
+    mj = df[df["analysis"] == "engine"]
     comp = df[df["analysis"] == "compare"].set_index(["case_id", "start"])
     groups = []
     for case_id, rows in mj.groupby("case_id", sort=False):

@@ -190,8 +190,8 @@ def fractal_lock(plan: ValidationPlan, runner: StudyRunner) -> FractalLockResult
     """Study 6: self-lock rate against H, streamline and MuJoCo (corner and dynamic I_e).
 
     Two sweeps over the same surfaces and start: at ``plan.lowest_ie`` with the
-    quasistatic, mujoco (and, when ``plan.fractal_facets``, compare) analyses, and at
-    ``plan.fractal_dynamic_ie`` with the mujoco analysis alone. Default spring drive
+    quasistatic, engine (and, when ``plan.fractal_facets``, compare) analyses, and at
+    ``plan.fractal_dynamic_ie`` with the engine analysis alone. Default spring drive
     (K = 30), the rig's default tip and engine.
 
     Parameters
@@ -214,9 +214,9 @@ def fractal_lock(plan: ValidationPlan, runner: StudyRunner) -> FractalLockResult
     seed_hurst = {seed: s["set"]["hurst"] for s in surfaces for seed in s["seeds"]}
     grid = {"mu": mu, "tip_radius": tip}
     starts = {"frame": "relative", "x": [0.05], "y": [0.5]}
-    corner = ["quasistatic", "mujoco", *(["compare"] if plan.fractal_facets else [])]
+    corner = ["quasistatic", "engine", *(["compare"] if plan.fractal_facets else [])]
     records = []
-    series = (("corner", plan.lowest_ie, corner), ("dynamic", plan.fractal_dynamic_ie, ["mujoco"]))
+    series = (("corner", plan.lowest_ie, corner), ("dynamic", plan.fractal_dynamic_ie, ["engine"]))
     for label, ie, analyses in series:
         doc = {
             "sweep": {"name": f"fractal-lock-{label}", "seed": 11, "analyses": analyses},
@@ -265,7 +265,7 @@ def _refined_doc(key: str, label: str, ie: float, surfaces: list[dict], starts: 
     """The MuJoCo series ``label`` at ``ie`` on ``surfaces`` under refinement ``key``: its
     engine keys go to the sweep as they are, so that each case refines its own rig's."""
     return {
-        "sweep": {"name": f"fractal-lock-{label}-{key}", "seed": 11, "analyses": ["mujoco"]},
+        "sweep": {"name": f"fractal-lock-{label}-{key}", "seed": 11, "analyses": ["engine"]},
         "surfaces": surfaces,
         "starts": starts,
         "drive": {"protocol": "spring", "ie": ie},
@@ -318,7 +318,7 @@ def _records(df: pd.DataFrame, label: str, seed_hurst: dict) -> list[dict]:
             series, outcome = "facets", r.get("reference_outcome")
             ok = isinstance(outcome, str) and bool(outcome)
             locked = outcome in HELD_OUTCOMES
-        elif analysis == "mujoco":
+        elif analysis == "engine":
             series = f"mujoco_{label}"
             outcome = f"{r.get('end_reason')}: {r.get('end_detail')}" if ok else str(r.get("reason"))
             locked = bool(r["self_locked"]) if ok else False

@@ -126,7 +126,7 @@ def ground_truth(plan: ValidationPlan, runner: StudyRunner) -> GroundTruthResult
     done = runner.many(jobs, "Prandtl-Tomlinson corrugations")
     rows = []
     for c, (df, _) in zip(corrugations, done):
-        rows += _tomlinson(c, df[df["analysis"] == "mujoco"])
+        rows += _tomlinson(c, df[df["analysis"] == "engine"])
     lift = [_liftoff(plan, runner, w) for w in plan.ground_truth_ridge_widths]
     return GroundTruthResult(spring_block=block, tomlinson=rows, liftoff=lift, spring_block_ladder=ladder)
 
@@ -275,9 +275,9 @@ CORRUGATION_START = 0.75
 
 
 def corrugation_runs(runner: StudyRunner, name: str, s: float, mu: float, ks, ie, waves: int):
-    """The ``mujoco`` rows of :func:`corrugation_doc`'s sweep, stored as ``name``."""
+    """The ``engine`` rows of :func:`corrugation_doc`'s sweep, stored as ``name``."""
     df, _ = runner(corrugation_doc(name, s, mu, ks, ie, waves), name)
-    return df[df["analysis"] == "mujoco"]
+    return df[df["analysis"] == "engine"]
 
 
 def corrugation_doc(name: str, s: float, mu: float, ks, ie, waves: int) -> dict:
@@ -285,7 +285,7 @@ def corrugation_doc(name: str, s: float, mu: float, ks, ie, waves: int) -> dict:
     wavelength, :data:`POINTS_PER_WAVE`, ``waves`` wavelengths) at stiffness numbers ``ks``
     and I_e ``ie`` (one or a list), from :data:`CORRUGATION_START`."""
     return {
-        "sweep": {"name": name.replace("/", "-"), "seed": 1, "analyses": ["mujoco"]},
+        "sweep": {"name": name.replace("/", "-"), "seed": 1, "analyses": ["engine"]},
         "surfaces": [
             {
                 "preset": "corrugation",
@@ -324,7 +324,7 @@ def _liftoff(plan: ValidationPlan, runner: StudyRunner, width: float) -> dict:
     )
     ies = [float(f"{f * ie_star:.6g}") for f in plan.ground_truth_liftoff_factors]
     doc = {
-        "sweep": {"name": f"ridge-{width:g}", "seed": 1, "analyses": ["mujoco"]},
+        "sweep": {"name": f"ridge-{width:g}", "seed": 1, "analyses": ["engine"]},
         "surfaces": [{"file": str(Path(path).relative_to(runner.out_dir))}],
         "starts": {"frame": "absolute", "x": [-5.0], "y": [0.0]},
         "drive": {"protocol": "spring", "ie": ies, "K": RIDGE_K},
@@ -337,8 +337,8 @@ def _liftoff(plan: ValidationPlan, runner: StudyRunner, width: float) -> dict:
     }
     df, store = runner(doc, f"ground-truth/ridge-{width:g}")
     runs = []
-    for _, r in df[df["analysis"] == "mujoco"].iterrows():
-        tr = sweep.load_trajectories(store, r["case_id"], analysis="mujoco", columns=["x", "z", "time_s"])
+    for _, r in df[df["analysis"] == "engine"].iterrows():
+        tr = sweep.load_trajectories(store, r["case_id"], analysis="engine", columns=["x", "z", "time_s"])
         tr = tr.sort_values("step")
         x, z, t = tr["x"].to_numpy(), tr["z"].to_numpy(), tr["time_s"].to_numpy()
         crest = np.abs(x) < 0.1 * width

@@ -285,7 +285,7 @@ def _doc(name: str, surface_file: Path, starts: dict, drive: dict, grid: dict, m
     size = _CASE_STARTS * members
     chunks = [pts[i : i + size] for i in range(0, len(pts), size)]
     return {
-        "sweep": {"name": name, "seed": 11, "analyses": ["quasistatic", "mujoco", "compare"]},
+        "sweep": {"name": name, "seed": 11, "analyses": ["quasistatic", "engine", "compare"]},
         "surfaces": [
             {"file": str(surface_file), "starts": {"frame": "absolute", "points": c}} for c in chunks
         ],
@@ -300,7 +300,7 @@ def _rows(df: pd.DataFrame, members: int) -> pd.DataFrame:
     df = df[df["start"].astype(int) % members == 0].copy()
     df["start"] = df["start"].astype(int) // members
     comp = df[df["analysis"] == "compare"].copy()
-    mj = df[df["analysis"] == "mujoco"].set_index(["case_id", "start"])
+    mj = df[df["analysis"] == "engine"].set_index(["case_id", "start"])
     key = list(zip(comp["case_id"], comp["start"].astype(int)))
     comp["surface_lc"] = [mj.loc[k, "char_length"] for k in key]
     comp["mujoco_status"] = [mj.loc[k, "status"] for k in key]

@@ -139,7 +139,7 @@ def mujoco_traces(store: Path, case_id: str) -> dict:
     ``drive_force_n``, ``time_s``, ``motion``) sorted by step; empty without any."""
     try:
         tr = sweep.load_trajectories(
-            store, case_id, analysis="mujoco", columns=["x", "y", "drive_force_n", "time_s", "motion"]
+            store, case_id, analysis="engine", columns=["x", "y", "drive_force_n", "time_s", "motion"]
         )
     except SpineInputError:
         return {}

@@ -330,7 +330,7 @@ def _refined_rows(family: str, keys, refinements, results) -> dict[str, pd.DataF
     for (fam, key, _, _), (df, _) in zip(refinements, results):
         if fam == family:
             rows = df[df["analysis"] == "compare"].copy()
-            mj = df[df["analysis"] == "mujoco"].set_index(["case_id", "start"])
+            mj = df[df["analysis"] == "engine"].set_index(["case_id", "start"])
             rows["surface_lc"] = [mj.loc[k, "char_length"] for k in zip(rows["case_id"], rows["start"])]
             out[key] = rows if out[key] is None else pd.concat([out[key], rows], ignore_index=True)
     return out
@@ -420,7 +420,7 @@ def _sweep_comparison(
     df = df[df["start"].astype(int) % members == 0].copy()  # the runs: each ensemble's own start
     df["start"] = df["start"].astype(int) // members
     comp = df[df["analysis"] == "compare"].copy()
-    mj = df[df["analysis"] == "mujoco"].set_index(["case_id", "start"])
+    mj = df[df["analysis"] == "engine"].set_index(["case_id", "start"])
     key = list(zip(comp["case_id"], comp["start"].astype(int)))
     comp["family"] = fam.name
     # a preset surface's label is the preset's name, with "#seed" after a seeded one
@@ -433,7 +433,7 @@ def _sweep_comparison(
         for case_id, grp in comp.groupby("case_id", sort=False):
             smooth = stored_paths(store, case_id, "quasistatic")
             facets = stored_paths(store, case_id, "compare")
-            mpaths = stored_paths(store, case_id, "mujoco")
+            mpaths = stored_paths(store, case_id, "engine")
             for s, x0, y0 in zip(grp["start"].astype(int) * members, grp["start_x"], grp["start_y"]):
                 empty = np.zeros((0, 2))
                 paths.setdefault(grp["preset"].iloc[0], []).append(

@@ -68,7 +68,7 @@ def sandpaper(plan: ValidationPlan, runner: StudyRunner) -> SandpaperResult:
         # within one tip radius of the edge (the P600 patch is only 16 tip radii wide)
         x_rel = max(0.05, 4 * params.get("tip_radius_m", 25e-6) / params["size_m"])
         doc = {
-            "sweep": {"name": f"sandpaper-{grit}", "seed": 3, "analyses": ["mujoco"]},
+            "sweep": {"name": f"sandpaper-{grit}", "seed": 3, "analyses": ["engine"]},
             "surfaces": [{"preset": preset}],
             "starts": {
                 "frame": "relative",
@@ -79,12 +79,12 @@ def sandpaper(plan: ValidationPlan, runner: StudyRunner) -> SandpaperResult:
             "grid": {"mu": SANDPAPER_MU, "record_every": 5},
         }
         df, store = runner(doc, f"sandpaper/{grit}")
-        rows.append(_grit_row(grit, df[df["analysis"] == "mujoco"], store, paths))
+        rows.append(_grit_row(grit, df[df["analysis"] == "engine"], store, paths))
     return SandpaperResult(rows=rows, paths=paths, mu=SANDPAPER_MU)
 
 
 def _grit_row(grit: str, mj_all, store, paths: dict) -> dict:
-    """The row of one grit from its ``mujoco`` rows and stored paths (added to ``paths``)."""
+    """The row of one grit from its ``engine`` rows and stored paths (added to ``paths``)."""
     failed = sorted(set(mj_all.loc[mj_all["status"] != "ok", "reason"].astype(str)))
     mj = mj_all[mj_all["status"] == "ok"] if "tip_radius_m" in mj_all else mj_all.iloc[:0]
     if mj.empty:

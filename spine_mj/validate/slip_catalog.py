@@ -393,7 +393,7 @@ def event_rows(
     }
 
 
-def store_catalog(out_dir, analysis: str = "mujoco"):
+def store_catalog(out_dir, analysis: str = "engine"):
     """The catalog of every slip of every ``analysis`` run of a sweep store, rebuilt from
     its stored trajectories by the runs' own rule (:func:`spine_mj.theory.motion.slip_events`
     on the recorded motion states): it survives a kill and a resume as the trajectories do.

@@ -239,7 +239,7 @@ def _plane_rows(plan: ValidationPlan, runner: StudyRunner, slope: float, az: flo
             "sweep": {
                 "name": f"static-s{slope:g}-a{az:g}",
                 "seed": 1,
-                "analyses": ["mujoco"],
+                "analyses": ["engine"],
                 "store_trajectories": False,
             },
             "surfaces": [{"file": str(path)}],

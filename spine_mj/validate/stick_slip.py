@@ -213,7 +213,7 @@ def stick_slip(plan: ValidationPlan, runner: StudyRunner) -> StickSlipResult:
         grid=grid,
     )
     df, store = runner(doc, "stick-slip")
-    mj = df[df["analysis"] == "mujoco"]
+    mj = df[df["analysis"] == "engine"]
     comp = df[df["analysis"] == "compare"].set_index(["case_id", "start"])
     rows, traces = [], {}
     for (case_id, ie, k), grp in mj.groupby(["case_id", "ie", "stiffness"], sort=False):

@@ -310,7 +310,7 @@ def _run_rows(df: pd.DataFrame, store, family: str, preset: str, samples: dict) 
     without engine trouble go into ``samples`` under ``(ie, K)``."""
     fp = MASS_KG * GRAVITY
     unit_m = _length_m(preset)
-    mj = df[df["analysis"] == "mujoco"]
+    mj = df[df["analysis"] == "engine"]
     comp = df[df["analysis"] == "compare"].set_index(["case_id", "start"])
     rows = []
     for case_id, grp in mj.groupby("case_id", sort=False):

@@ -54,7 +54,7 @@ def family_doc(
     preset: str,
     drive: dict,
     grid: dict,
-    analyses=("quasistatic", "mujoco", "compare"),
+    analyses=("quasistatic", "engine", "compare"),
     miss_reasons: bool = False,
 ) -> dict:
     """The sweep config of one preset of ``fam`` with its starts, ``drive`` and ``grid``;
@@ -73,8 +73,8 @@ def family_doc(
 
 
 def engine_default(key: str):
-    """Default of the sweep's ``mujoco`` analysis parameter ``key``."""
-    return {p.name: p.default for p in sweep.ANALYSES["mujoco"].parameters}[key]
+    """Default of the sweep's ``engine`` analysis parameter ``key``."""
+    return {p.name: p.default for p in sweep.ANALYSES["engine"].parameters}[key]
 
 
 def rig_engine(

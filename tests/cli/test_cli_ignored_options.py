@@ -110,7 +110,7 @@ def test_sweep_refuses_a_drive_key_its_protocol_ignores(tmp_path_factory, data, 
     protocol = data.draw(st.sampled_from(ignoring))
     config = folder / "c.toml"
     config.write_text(
-        '[sweep]\nanalyses = ["mujoco"]\n[[surfaces]]\npreset = "paper-single-peak"\n'
+        '[sweep]\nanalyses = ["engine"]\n[[surfaces]]\npreset = "paper-single-peak"\n'
         f'[starts]\npoints = [[0.1, 0.5]]\n[drive]\nprotocol = "{protocol}"\n{key} = {value}\n'
     )
     result = CliRunner().invoke(main, ["sweep", str(config), "--out", str(folder / "out")])

@@ -81,7 +81,7 @@ def test_cli_refuses_another_config_in_dir(tmp_path):
 STIFF_SPRING = """
 [sweep]
 name = "stiff"
-analyses = ["quasistatic", "mujoco", "compare"]
+analyses = ["quasistatic", "engine", "compare"]
 [[surfaces]]
 preset = "paper-fractal"
 seeds = [1]
@@ -121,7 +121,7 @@ def test_cli_sweep_a_stiff_spring_on_the_fractal_runs_without_an_engine_stop(tmp
     rule resolves the spring (omega dt <= 0.3), so no run ends in engine trouble. At the
     contact's own step MuJoCo stopped 8 of 12 such runs near step 213 (issue 32)."""
     text = STIFF_SPRING.replace("K = 30000.0", "K = 3000.0\nduration = 0.1").replace("ie = 1e-4", "ie = 1e-5")
-    cfg = write_config(tmp_path, text.replace('"quasistatic", "mujoco", "compare"', '"mujoco"'))
+    cfg = write_config(tmp_path, text.replace('"quasistatic", "engine", "compare"', '"engine"'))
     out = tmp_path / "out"
     result = run_cli("sweep", cfg, "--out", out, "--workers", 1, "--quiet")
     assert result.exit_code == 0, result.output

@@ -13,7 +13,7 @@ from spine_mj.cli import main
 from spine_mj.errors import SpineInputError
 from spine_mj.surface_io import save_surface
 from spine_mj.surfaces import fractal_fbm, single_gaussian
-from spine_mj.sweep.analyses.mujoco import case_drive, case_rig
+from spine_mj.sweep.analyses.engine import case_drive, case_rig
 
 
 def _enc(obj) -> dict:
@@ -31,7 +31,7 @@ def _cli_summary(tmp_path, surface: str, start, args) -> dict:
 
 def _sweep_case(tmp_path, surface: dict, start, drive: dict, grid: dict):
     doc = {
-        "sweep": {"analyses": ["mujoco"]},
+        "sweep": {"analyses": ["engine"]},
         "surfaces": [surface],
         "starts": {"frame": "absolute", "points": [list(start)]},
         "drive": {"protocol": "spring", **drive},

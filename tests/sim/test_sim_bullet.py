@@ -314,7 +314,7 @@ def test_without_the_extra_bullet_is_one_error_line(monkeypatch, tmp_path):
 ENGINE_SWEEP = """
 [sweep]
 name = "engines"
-analyses = ["mujoco"]
+analyses = ["engine"]
 
 [[surfaces]]
 preset = "paper-single-peak"

@@ -66,7 +66,7 @@ def test_an_absurd_inertia_number_is_refused_before_running(in_tmp):
     assert not (in_tmp / "run").exists()
     config = in_tmp / "s.toml"
     config.write_text(
-        '[sweep]\nname = "x"\nanalyses = ["mujoco"]\n[[surfaces]]\npreset = "paper-single-peak"\n'
+        '[sweep]\nname = "x"\nanalyses = ["engine"]\n[[surfaces]]\npreset = "paper-single-peak"\n'
         '[starts]\nframe = "absolute"\npoints = [[-3.0, -1.0]]\n[drive]\nprotocol = "spring"\n'
         "[grid]\nie = [1e300]\n"
     )

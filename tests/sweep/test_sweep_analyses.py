@@ -1,4 +1,4 @@
-"""The built-in analyses: the mujoco and compare rows are the rig's own runs."""
+"""The built-in analyses: the engine and compare rows are the rig's own runs."""
 
 import numpy as np
 import pytest
@@ -10,7 +10,7 @@ from spine_mj import sweep
 MJ = """
 [sweep]
 name = "mujoco"
-analyses = ["quasistatic", "mujoco", "compare"]
+analyses = ["quasistatic", "engine", "compare"]
 [[surfaces]]
 preset = "paper-single-peak"
 [starts]
@@ -34,7 +34,7 @@ def test_mujoco_and_compare_runs_match_the_rig_run_directly(tmp_path):
     summary = sweep.run_sweep(cfg, out, workers=1)
     assert summary.total_runs == 12
     runs = sweep.load_runs(out)
-    mj = runs[runs.analysis == "mujoco"]
+    mj = runs[runs.analysis == "engine"]
     assert mj.status.isin(["ok", "nan", "engine_warning", "penetration", "diverged"]).all()
     np.testing.assert_allclose(mj.inertia_number, mj.ie, rtol=1e-9)
     # the start on the peak's ridge self-locks quasistatically; compare's outcome agreement
@@ -89,7 +89,7 @@ def test_mujoco_and_compare_runs_match_the_rig_run_directly(tmp_path):
     direct = rig.run_batch(sim.SpringDrive(speed_m_s=speed), [(-4.0, 1.0)], nthread=1)[0]
     row = mj[(mj.case_id == case_id) & (mj.start == 1)].iloc[0]
     assert row.end_x == pytest.approx(direct.position_m[-1, 0] / rig.length_scale_m, abs=1e-12)
-    traj = sweep.load_trajectories(out, case_id, analysis="mujoco", start=1, columns=["x"])
+    traj = sweep.load_trajectories(out, case_id, analysis="engine", start=1, columns=["x"])
     assert len(traj) == direct.n
     np.testing.assert_allclose(traj.x, direct.position_m[:, 0] / rig.length_scale_m)
     # the reference ends where the run does: the tip radius (the domain margin) from the edge
@@ -103,11 +103,11 @@ def test_a_scan_in_um_takes_its_tip_radius_in_um(tmp_path, topography_dir):
     """A sweep's ``tip_radius`` is in the surface's length unit: 5 on a surface kept in
     the instrument's um is a 5 um tip (the rule of ``sim.scales.surface_unit_m``)."""
     from spine_mj.surface_io import import_topography, save_surface
-    from spine_mj.sweep.analyses.mujoco import case_rig
+    from spine_mj.sweep.analyses.engine import case_rig
 
     save_surface(import_topography(topography_dir / "plu-1.plu"), tmp_path / "scan.npz")
     doc = {
-        "sweep": {"analyses": ["mujoco"]},
+        "sweep": {"analyses": ["engine"]},
         "surfaces": [{"file": "scan.npz"}],
         "starts": {"points": [[0.1, 0.5]]},
         "drive": {"protocol": "spring", "ie": 1e-3},
@@ -126,12 +126,12 @@ def test_one_config_gives_both_analyses_the_same_tip(tmp_path, tip_radius):
     radius in the surface's length unit, at any length scale."""
     from spine_mj import presets
     from spine_mj.sim.scales import resolve_tip_radius
-    from spine_mj.sweep.analyses.mujoco import case_rig
+    from spine_mj.sweep.analyses.engine import case_rig
     from spine_mj.sweep.analyses.quasistatic import case_tip_radius
 
     grid = {"mu": 1.25, "length_scale": 0.02, "hfield_resolution": 61}
     doc = {
-        "sweep": {"analyses": ["quasistatic", "mujoco"]},
+        "sweep": {"analyses": ["quasistatic", "engine"]},
         "surfaces": [{"preset": "paper-single-peak"}],
         "starts": {"points": [[0.1, 0.5]]},
         "drive": {"protocol": "spring", "ie": 1e-3},
@@ -166,7 +166,7 @@ def test_a_point_tip_is_traced_by_the_streamline_and_refused_by_the_engine(tmp_p
     (case,) = sweep.expand_cases(sweep.parse_config(doc, base_dir=tmp_path))
     surface = case.surface.make()
     assert traced_surface(case, surface) is surface
-    doc["sweep"]["analyses"] = ["quasistatic", "mujoco"]
+    doc["sweep"]["analyses"] = ["quasistatic", "engine"]
     with pytest.raises(SpineInputError, match=r"config key grid.tip_radius 0 is a point tip.*leave"):
         sweep.parse_config(doc, base_dir=tmp_path)
 
@@ -174,7 +174,7 @@ def test_a_point_tip_is_traced_by_the_streamline_and_refused_by_the_engine(tmp_p
 ENSEMBLE = """
 [sweep]
 name = "ensemble"
-analyses = ["quasistatic", "mujoco", "compare"]
+analyses = ["quasistatic", "engine", "compare"]
 [[surfaces]]
 preset = "paper-single-peak"
 [starts]
@@ -227,9 +227,9 @@ def test_compare_leaves_out_a_run_the_engine_failed(tmp_path):
     surface = case.surface.make()
     starts = case.starts.resolve(surface.bounds, case.seed)
     up = {"quasistatic": ANALYSES["quasistatic"].func(case, surface, starts, {})}
-    up["mujoco"] = ANALYSES["mujoco"].func(case, surface, starts, up)
+    up["engine"] = ANALYSES["engine"].func(case, surface, starts, up)
     before = ANALYSES["compare"].func(case, surface, starts, up)
-    rig, runs = up["mujoco"].data
+    rig, runs = up["engine"].data
     lc = rig.scales.char_length_m
     n = runs[1].position_m.shape[0]
     wild = runs[1].position_m.copy()
@@ -238,8 +238,8 @@ def test_compare_leaves_out_a_run_the_engine_failed(tmp_path):
     )
     runs = [runs[0], dataclasses.replace(runs[1], position_m=wild)]
     status = np.array(["ok", "diverged"], dtype=object)
-    up["mujoco"] = AnalysisResult(
-        up["mujoco"].metrics, status=status, reason=np.array(["", "diverged"]), data=(rig, runs)
+    up["engine"] = AnalysisResult(
+        up["engine"].metrics, status=status, reason=np.array(["", "diverged"]), data=(rig, runs)
     )
     tracemalloc.start()
     after = ANALYSES["compare"].func(case, surface, starts, up)
@@ -304,7 +304,7 @@ def test_cases_differing_only_in_their_drive_share_their_streamlines(tmp_path):
     moved = ANALYSES["quasistatic"].func(first, surface, starts + np.array([0.0, 0.25]), {}).data
     assert moved is not res[0] and not np.array_equal(moved.end_y, res[0].end_y)
     key = qs_analysis.hfield_key
-    rigs = [ANALYSES["mujoco"].func(c, surface, starts, {}).data[0] for c in (first, second)]
+    rigs = [ANALYSES["engine"].func(c, surface, starts, {}).data[0] for c in (first, second)]
     assert rigs[0] is not rigs[1]
     assert key(rigs[0].hfield, 0.1) == key(rigs[1].hfield, 0.1) != key(rigs[0].hfield, 0.2)
 
@@ -322,7 +322,7 @@ def test_miss_reasons_restart_a_run_that_left_the_domain_from_its_edge(tmp_path)
     surface = case.surface.make()
     starts = case.starts.resolve(surface.bounds, case.seed)
     up = {"quasistatic": ANALYSES["quasistatic"].func(case, surface, starts, {})}
-    rig, _ = ANALYSES["mujoco"].func(case, surface, starts, up).data
+    rig, _ = ANALYSES["engine"].func(case, surface, starts, up).data
     contact = rig.contact_surface()
     params = up["quasistatic"].data.params
     facets = sl.streamlines(contact, starts, params, store_paths=True)
@@ -363,7 +363,7 @@ K = {K!r}
 """
 
 
-def _fractal_cases(tmp_path, *, ie, K, analyses=("quasistatic", "mujoco", "compare"), extra=""):
+def _fractal_cases(tmp_path, *, ie, K, analyses=("quasistatic", "engine", "compare"), extra=""):
     text = FRACTAL_SPRING.format(analyses=list(analyses), ie=ie, K=K, extra=extra)
     return sweep.expand_cases(sweep.parse_config(tomllib.loads(text), base_dir=tmp_path))
 
@@ -373,7 +373,7 @@ def test_a_spring_drive_too_fast_for_its_stiffness_is_refused_before_the_compari
     exceeds SWING_BOUND_FP preloads, and accepts it where the swing is within the bound, as
     a dynamic study on purpose, and without the comparison."""
     from spine_mj.errors import SpineInputError
-    from spine_mj.sweep.analyses.mujoco import case_scales
+    from spine_mj.sweep.analyses.engine import case_scales
     from spine_mj.sweep.preflight import check_cases
     from spine_mj.theory.drive_limits import SWING_BOUND_FP
 
@@ -388,4 +388,4 @@ def test_a_spring_drive_too_fast_for_its_stiffness_is_refused_before_the_compari
     assert f"got {swing:.3g} F_p" in message and f"use I_e <= {ie_max:.3g}" in message
     check_cases(_fractal_cases(tmp_path, ie=0.99 * ie_max, K=3000.0))
     check_cases(_fractal_cases(tmp_path, ie=1e-4, K=3000.0, extra="[grid]\ndynamic_drive = true"))
-    check_cases(_fractal_cases(tmp_path, ie=1e-4, K=3000.0, analyses=("mujoco",)))
+    check_cases(_fractal_cases(tmp_path, ie=1e-4, K=3000.0, analyses=("engine",)))

@@ -11,7 +11,7 @@ from spine_mj.errors import SpineInputError
 ENGINES = """
 [sweep]
 name = "engines"
-analyses = ["mujoco"]
+analyses = ["engine"]
 [[surfaces]]
 preset = "paper-single-peak"
 [starts]

@@ -39,7 +39,7 @@ def test_array_sweep_records_the_summary_keys_per_layout_and_centre(tmp_path):
     assert set(runs.layout) == {"grid", "staggered"}
     np.testing.assert_allclose(runs.holding_ratio * 4 * 0.01 * 9.81, runs.holding_force_n, rtol=1e-9)
     # the grid case's rows are the ArrayRig's own runs on the case's rig
-    from spine_mj.sweep.analyses.mujoco import case_rig
+    from spine_mj.sweep.analyses.engine import case_rig
 
     cases = sweep.expand_cases(sweep.load_config(write_config(tmp_path, ARRAY)))
     case = next(c for c in cases if c.params["layout"] == "grid")

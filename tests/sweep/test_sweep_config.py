@@ -82,13 +82,13 @@ def test_config_hash_ignores_comments_and_key_order(tmp_path):
 
 
 def test_mujoco_config_checks():
-    doc = with_(sweep__analyses=["mujoco"], grid__ie=0.1, grid__speed=0.01)
+    doc = with_(sweep__analyses=["engine"], grid__ie=0.1, grid__speed=0.01)
     with pytest.raises(SpineInputError, match=r"grid.ie and grid.speed: give one of them"):
         sweep.parse_config(doc)
-    doc = with_(sweep__analyses=["mujoco"], grid__timestep=1e-4, grid__timestep_factor=0.5)
+    doc = with_(sweep__analyses=["engine"], grid__timestep=1e-4, grid__timestep_factor=0.5)
     with pytest.raises(SpineInputError, match=r"grid.timestep and grid.timestep_factor: give one of them"):
         sweep.parse_config(doc)
-    doc = with_(sweep__analyses=["mujoco"], drive__protocol="pull")
+    doc = with_(sweep__analyses=["engine"], drive__protocol="pull")
     with pytest.raises(SpineInputError, match=r"drive.protocol: must be one of 'spring', 'ramp'"):
         sweep.parse_config(doc)
     doc = with_(sweep__analyses=["quasistatic"], drive__protocol="spring")
@@ -173,7 +173,7 @@ def test_starts_spec_validates_when_made_directly():
     ],
 )
 def test_a_drive_key_that_the_protocol_ignores_is_refused(protocol, key, value):
-    doc = with_(sweep__analyses=["mujoco"], drive__protocol=protocol, **{f"drive__{key}": value})
+    doc = with_(sweep__analyses=["engine"], drive__protocol=protocol, **{f"drive__{key}": value})
     with pytest.raises(SpineInputError, match=rf"config key {key} = \[.*\]: the .* drive ignores it"):
         sweep.parse_config(doc)
 
@@ -185,19 +185,19 @@ def test_drive_keys_that_the_protocol_reads_are_accepted():
         ("static", "start_force", 0.1),
     ):
         sweep.parse_config(
-            with_(sweep__analyses=["mujoco"], drive__protocol=protocol, **{f"drive__{key}": value})
+            with_(sweep__analyses=["engine"], drive__protocol=protocol, **{f"drive__{key}": value})
         )
 
 
 @pytest.mark.parametrize(
     "analyses, key, value, message",
     [
-        (["mujoco"], "hfield_resolution", 100000, "hfield_resolution must be <= 8192"),
-        (["mujoco"], "timestep", 1.0, "rests the tip .* deep in the surface"),
-        (["mujoco"], "ie", 1e-30, "more than the limit"),
-        (["mujoco"], "gravity", 0.0, "the tip has no normal preload"),
-        (["mujoco"], "mass", 1e30, "mass_kg must lie in"),
-        (["mujoco"], "length_scale", 1e9, "length_scale_m must lie in"),
+        (["engine"], "hfield_resolution", 100000, "hfield_resolution must be <= 8192"),
+        (["engine"], "timestep", 1.0, "rests the tip .* deep in the surface"),
+        (["engine"], "ie", 1e-30, "more than the limit"),
+        (["engine"], "gravity", 0.0, "the tip has no normal preload"),
+        (["engine"], "mass", 1e30, "mass_kg must lie in"),
+        (["engine"], "length_scale", 1e9, "length_scale_m must lie in"),
         (["quasistatic"], "dl", 1e-300, "a step would be lost in rounding"),
     ],
 )
@@ -205,7 +205,7 @@ def test_a_value_error_a_run_would_meet_refuses_the_sweep_before_anything_is_wri
     tmp_path, analyses, key, value, message
 ):
     doc = with_(sweep__analyses=analyses, **{f"grid__{key}": [0.5, value] if key == "dl" else value})
-    if analyses == ["mujoco"]:
+    if analyses == ["engine"]:
         doc["grid"]["mu"] = 0.5
     out = tmp_path / "out"
     with pytest.raises(SpineInputError, match=rf"sweep case \(paper-single-peak.*\): .*{message}"):
@@ -226,3 +226,10 @@ def test_a_sweep_over_a_surface_file_with_an_unknown_unit_is_refused(tmp_path):
     with pytest.raises(SpineInputError, match="unit must be '1'"):
         sweep.run_sweep(sweep.parse_config(doc), tmp_path / "out", workers=1)
     assert not (tmp_path / "out").exists()
+
+
+def test_the_old_analysis_name_mujoco_is_refused_naming_engine():
+    """The analysis that runs the grid's engine (MuJoCo or Bullet) is ``engine``; a saved
+    config naming it ``mujoco`` gets one line saying what to write instead."""
+    with pytest.raises(SpineInputError, match=r"sweep.analyses: .*'mujoco' is now 'engine'.*write 'engine'"):
+        sweep.parse_config(with_(sweep__analyses=["quasistatic", "mujoco"]))

@@ -39,18 +39,18 @@ def test_a_spring_swing_only_one_combination_makes_is_refused_before_any_run(tmp
     """On the paper fractal (L_c / l_s = 24) sqrt(I_e K L_c / l_s) is 0.15 to 0.49 F_p for
     three of the four cases, 1.55 F_p at I_e = 1e-3 and K = 100: each value alone passes,
     the combination is refused (it used to run and be compared)."""
-    text = FRACTAL.format(analyses='["quasistatic", "mujoco", "compare"]')
+    text = FRACTAL.format(analyses='["quasistatic", "engine", "compare"]')
     _refused_before_any_run(tmp_path, text, "ie = 0.001, K = 100", "spring drive at I_e = 0.001, K = 100")
     # without the comparison every case is a legitimate dynamic run
     cases = sweep.expand_cases(
-        sweep.load_config(write_config(tmp_path, FRACTAL.format(analyses='["mujoco"]')))
+        sweep.load_config(write_config(tmp_path, FRACTAL.format(analyses='["engine"]')))
     )
     preflight.check_cases(cases)
 
 
 STEPS = """
 [sweep]
-analyses = ["mujoco"]
+analyses = ["engine"]
 [[surfaces]]
 preset = "paper-single-peak"
 [starts]
@@ -69,7 +69,7 @@ def test_a_run_beyond_the_step_limit_only_one_combination_makes_is_refused(tmp_p
 
 SIZES = """
 [sweep]
-analyses = ["mujoco"]
+analyses = ["engine"]
 [[surfaces]]
 preset = "paper-single-peak"
 [starts]
@@ -136,11 +136,11 @@ def test_every_combination_is_checked_without_building_a_rig_or_repeating_a_chec
         "timestep_factor = [1.0, 1e-3]", "timestep_factor = {linspace = [0.5, 1.0], num = 10}"
     )
     cases = sweep.expand_cases(sweep.load_config(write_config(tmp_path, text)))
-    from spine_mj.sweep.analyses import mujoco, quasistatic
+    from spine_mj.sweep.analyses import engine, quasistatic
 
-    mujoco.case_rig.cache_clear()
+    engine.case_rig.cache_clear()
     preflight.check_cases(cases)
-    assert len(cases) == 4000 and mujoco._rig.cache_info().misses == 0
+    assert len(cases) == 4000 and engine._rig.cache_info().misses == 0
 
     steps = []
     real = quasistatic.sl.check_step

@@ -155,7 +155,7 @@ def test_mujoco_static_probe_at_a_fractal_crease_breaks_away_near_the_two_contac
     alone moves at kappa 15.5 and 19.2, the pair holds to 30.6; MuJoCo's probe breaks away
     at 29.0 (measured): the wedge, within MuJoCo's soft contacts."""
     from spine_mj.sim import Detection, StaticProbe
-    from spine_mj.sweep.analyses.mujoco import case_rig
+    from spine_mj.sweep.analyses.engine import case_rig
     from spine_mj.sweep.cases import expand_cases
     from spine_mj.sweep.config import parse_config
     from spine_mj.validate.plans import PLANS

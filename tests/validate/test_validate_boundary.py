@@ -67,7 +67,7 @@ def test_ie_star_under_a_halved_step_reruns_the_window_at_half_each_paces_own_st
         refined = sweep.load_runs(
             tmp_path / "sweeps" / "boundary-refined" / "dt_halved" / f"spring-paper-single-peak-ie{ie:.3g}"
         )
-        mj = refined[refined["analysis"] == "mujoco"]
-        own = base[(base["analysis"] == "mujoco") & (base["ie"] == ie)]
+        mj = refined[refined["analysis"] == "engine"]
+        own = base[(base["analysis"] == "engine") & (base["ie"] == ie)]
         assert np.allclose(mj["timestep_s"], own["timestep_s"].iloc[0] / 2)
         assert sorted(mj["start_y"]) == sorted(own["start_y"])

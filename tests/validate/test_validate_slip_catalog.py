@@ -58,7 +58,7 @@ def test_study_writes_every_file_and_a_summary_per_source(corrugation_study):
 SWEEP = """
 [sweep]
 name = "pt"
-analyses = ["mujoco"]
+analyses = ["engine"]
 [[surfaces]]
 preset = "corrugation"
 set = { points_per_wave = 128, n_waves = 4, width = 0.5 }

@@ -2,9 +2,9 @@
 
 Its layout and drive are read from the config's ``[array]`` table (or ``[grid]``): the
 keys of ``spine-mj array`` (``layout``, ``rows``, ``cols``, ``spacing``, ``spacing_unit``,
-``layout_seed``, ``array_drive``); the tip, engine and drive speed are the ``mujoco``
-analysis's parameters (:data:`~spine_mj.sweep.analyses.mujoco.MUJOCO_PARAMS`, one rig per
-case: :func:`~spine_mj.sweep.analyses.mujoco.case_rig`). Per start it records the keys of
+``layout_seed``, ``array_drive``); the tip, engine and drive speed are the ``engine``
+analysis's parameters (:data:`~spine_mj.sweep.analyses.engine.ENGINE_PARAMS`, one rig per
+case: :func:`~spine_mj.sweep.analyses.engine.case_rig`). Per start it records the keys of
 the command's ``summary.json``: ``n_spines``, ``holding_force_n``, ``holding_ratio``, its
 predicted dynamic excess ``holding_excess_predicted`` (per spine, ``F_p``), ``peak_ratio``
 and ``locked_spines``. Without ``ie`` or ``speed`` the drive runs at the arrays' default
@@ -25,11 +25,11 @@ from spine_mj.errors import SpineInputError
 from spine_mj.sim.array import ARRAY_ENGINE_REFUSAL, spines_on_surface
 from spine_mj.sim.drives import spring_stiffness_n_m
 from spine_mj.sim.layout import MAX_SPINES
-from spine_mj.sweep.analyses.mujoco import CHECK_READS, MUJOCO_PARAMS, case_plan, case_rig, check_speed
+from spine_mj.sweep.analyses.engine import CHECK_READS, ENGINE_PARAMS, case_plan, case_rig, check_speed
 from spine_mj.sweep.registry import CASE_THREADS, Analysis, AnalysisResult, ParamSpec, register_analysis
 
 ARRAY_PARAMS = (
-    *MUJOCO_PARAMS,
+    *ENGINE_PARAMS,
     ParamSpec("layout", "str", "array layout", "grid", choices=("grid", "staggered", "random"), array=True),
     ParamSpec("rows", "int", "spines across the drive (y)", 2, 1, maximum=MAX_SPINES, array=True),
     ParamSpec("cols", "int", "spines along the drive (x)", 2, 1, maximum=MAX_SPINES, array=True),
@@ -110,7 +110,7 @@ def _check_case(case, surface, starts) -> None:
     """The refusals of ``spine-mj array`` a case's runs would meet, before any: spines
     that cannot stand apart at the spacing (a random layout) or that land off the surface
     from any of its centres (every start at once), placed as the run places them from the
-    case's tip and scales (:func:`~spine_mj.sweep.analyses.mujoco.case_plan`: no rig built)."""
+    case's tip and scales (:func:`~spine_mj.sweep.analyses.engine.case_plan`: no rig built)."""
     plan = case_plan(case, surface)
     sc, s = plan.scales, plan.length_scale_m
     layout = _layout(case.params)

@@ -14,7 +14,7 @@ drive is also compared with the compliant-drive streamline of its own spring
 drive too fast for its stiffness to be quasistatic is refused before any run unless the
 grid's ``dynamic_drive`` asks for it (:func:`_check_case`). Touches
 the API of :mod:`spine_mj.theory.agreement` here only; needs the results of the ``quasistatic`` and
-``mujoco`` analyses of the same case.
+``engine`` analyses of the same case.
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ import numpy as np
 from spine_mj.errors import SpineInputError
 from spine_mj.sim.drives import stiffness_n_m
 from spine_mj.sim.holding import spring_swing
-from spine_mj.sweep.analyses.mujoco import CHECK_READS, case_drive, case_plan, peak_drive_over_fp
+from spine_mj.sweep.analyses.engine import CHECK_READS, case_drive, case_plan, peak_drive_over_fp
 from spine_mj.sweep.analyses.quasistatic import (
     cached_trace,
     case_tip_radius,
@@ -201,7 +201,7 @@ def _references(case, surface, starts, quasistatic, rig, runs, lead):
 
 
 def _compare(case, surface, starts, upstream):
-    rig, runs = upstream["mujoco"].data
+    rig, runs = upstream["engine"].data
     s = rig.length_scale_m
     # an ensemble's perturbed members (every start but each group's first) decide only their
     # outcome on both sides (validate.ensembles): the paths' distances, the smooth surface's
@@ -213,7 +213,7 @@ def _compare(case, surface, starts, upstream):
     )
     lc = rig.scales.char_length_m / s
     status = np.array(
-        upstream["mujoco"].status if upstream["mujoco"].status is not None else np.full(len(runs), "ok"),
+        upstream["engine"].status if upstream["engine"].status is not None else np.full(len(runs), "ok"),
         dtype=object,
     )
     # a run the engine failed (diverged, stopped) has no path to compare: an empty one
@@ -262,7 +262,7 @@ def _compare(case, surface, starts, upstream):
         **_pace(facets, runs, rig.scales),
     }
     reason = np.where(
-        status == "ok", "", "mujoco run: " + np.asarray(upstream["mujoco"].reason, dtype=object)
+        status == "ok", "", "mujoco run: " + np.asarray(upstream["engine"].reason, dtype=object)
     ).astype(object)
     status = np.where(status == "ok", "ok", "dependency_failed").astype(object)
     # the trajectories are the facet-traced reference paths
@@ -333,7 +333,7 @@ register_analysis(
                 False,
             ),
         ),
-        requires=("quasistatic", "mujoco"),
+        requires=("quasistatic", "engine"),
         doc="MuJoCo against the streamline traced on the rig's facets dilated by its tip "
         "(like for like), and against the quasistatic analysis's own path (*_smooth); "
         "why a run disagrees (miss_reason, miss_offset); "

@@ -113,7 +113,7 @@ def _overlay_figure(out: Path, path: Path) -> Path | None:
         if not (store / "manifest.json").is_file():
             continue
         df = load_runs(store)
-        mj = df[(df.analysis == "mujoco") & (df.status == "ok")]
+        mj = df[(df.analysis == "engine") & (df.status == "ok")]
         comp = df[(df.analysis == "compare") & (df.status == "ok")].set_index(["case_id", "start"])
         if mj.empty:
             continue
@@ -123,7 +123,7 @@ def _overlay_figure(out: Path, path: Path) -> Path | None:
             case_id = mj.loc[mj["ie"] == ie, "case_id"].iloc[0]
             starts = sorted(mj.loc[mj["case_id"] == case_id, "start"].astype(int))[:3]
             qs = stored_paths(store, case_id, "quasistatic")
-            mp = stored_paths(store, case_id, "mujoco")
+            mp = stored_paths(store, case_id, "engine")
             pairs = [(qs[s], mp.get(s, np.zeros((0, 2)))) for s in starts if s in qs]
             n_agree = sum(bool(comp["agree"].get((case_id, s), False)) for s in starts)
             title = f"{preset}, spring, I_e = {sig(ie)}: {n_agree}/{len(starts)} agree"

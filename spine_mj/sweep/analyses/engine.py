@@ -1,4 +1,5 @@
-"""The ``mujoco`` analysis: a run of the MuJoCo rig from every start with the chosen drive.
+"""The ``engine`` analysis: a run of an engine's rig from every start with the chosen drive,
+in any registered engine (the grid's ``engine``: MuJoCo, Bullet, :data:`spine_mj.choices.ENGINES`).
 
 Touches the API of :mod:`spine_mj.sim` here only. The rig and drive of a case come from
 :func:`spine_mj.sim.build_rig` and :func:`spine_mj.sim.build_drive` (the builder
@@ -33,7 +34,7 @@ from spine_mj.sweep.registry import (
     register_analysis,
 )
 
-MUJOCO_PARAMS = (
+ENGINE_PARAMS = (
     MU_PARAM,
     ParamSpec(
         "engine",
@@ -235,8 +236,8 @@ def check_speed(config) -> None:
     for radius in grid["tip_radius"]:
         check_tip_radius(radius, "config key grid.tip_radius", point=False)
     for engine in grid["engine"]:
-        check_engine_options(engine, grid, MUJOCO_PARAMS)
-    defaults = {s.name: s.default for s in MUJOCO_PARAMS}
+        check_engine_options(engine, grid, ENGINE_PARAMS)
+    defaults = {s.name: s.default for s in ENGINE_PARAMS}
     protocols = grid["protocol"]
     for key, readers in PROTOCOL_KEYS.items():
         ignoring = [p for p in protocols if p not in readers]
@@ -265,7 +266,7 @@ def case_inputs(case, surface=None) -> RigInputs:
     reads = ENGINES[p["engine"]].options
     return RigInputs(
         engine=p["engine"],
-        engine_options={s.option: p[s.name] for s in MUJOCO_PARAMS if s.option in reads},
+        engine_options={s.option: p[s.name] for s in ENGINE_PARAMS if s.option in reads},
         mu=p["mu"],
         tip_radius_m=engine_tip_radius_m(
             surface, p["tip_radius"], length_scale_m=p["length_scale"], name="config key grid.tip_radius"
@@ -326,7 +327,7 @@ def case_scales(case, surface=None) -> sim.Scales:
     return sim.rig_scales(surface, tip=inputs.tip, **inputs.sizing)
 
 
-def _mujoco(case, surface, starts, upstream):
+def _engine(case, surface, starts, upstream):
     p = case.params
     rig = case_rig(case, surface)
     runs = _runs(rig, p, starts)
@@ -353,7 +354,7 @@ _RIG_KEYS = (
     "length_scale",
     "hfield_resolution",
     "hfield_refinement",
-    *(s.name for s in MUJOCO_PARAMS if s.option is not None),  # every engine option
+    *(s.name for s in ENGINE_PARAMS if s.option is not None),  # every engine option
 )
 
 
@@ -531,10 +532,11 @@ def _trajectories(runs, s: float, k: int) -> dict[str, np.ndarray]:
 
 register_analysis(
     Analysis(
-        "mujoco",
-        _mujoco,
-        MUJOCO_PARAMS,
-        doc="MuJoCo rig run from every start with the chosen drive: spine_mj.sim",
+        "engine",
+        _engine,
+        ENGINE_PARAMS,
+        doc="the rig of a registered engine (grid key engine) run from every start with the chosen "
+        "drive: spine_mj.sim",
         check_config=check_speed,
         check_case=_check_case,
         check_reads=CHECK_READS,
