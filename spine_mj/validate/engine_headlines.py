@@ -54,6 +54,7 @@ __all__ = [
     "EngineHeadlinesResult",
     "MissStart",
     "engine_headlines",
+    "load",
     "run_engine_headlines",
     "section",
 ]
@@ -436,6 +437,14 @@ def _recheck_row(miss: MissStart, engine: str, summ: dict, allc: pd.DataFrame) -
         "status": r["mujoco_status"],
         "miss_reason": r["miss_reason"] if isinstance(r["miss_reason"], str) else "",
     }
+
+
+def load(folder: Path) -> EngineHeadlinesResult | None:
+    """The result in ``folder`` (:data:`RESULT_FILE`), None where there is none."""
+    import json
+
+    path = Path(folder) / RESULT_FILE
+    return EngineHeadlinesResult.from_dict(json.loads(path.read_text())) if path.is_file() else None
 
 
 def add_arguments(ap) -> None:

@@ -63,13 +63,13 @@ from spine_mj import presets, sim
 from spine_mj.atomic import atomic_output
 from spine_mj.choices import COMPARED_ENGINES
 from spine_mj.errors import OneLineParser, SpineInputError, non_negative_int
-from spine_mj.surfaces import GridSurface
 from spine_mj.theory import engagement
 from spine_mj.theory.tomlinson import Corrugation
 from spine_mj.validate.plans import ValidationPlan
 from spine_mj.validate.study_runner import StudyRunner
+from spine_mj.validate.wedges import dai_start, dai_surface, dai_threshold, flank_tilt, groove
 
-__all__ = ["CHECKS", "EnginesResult", "dai_threshold", "engines_ground_truth", "engines_study"]
+__all__ = ["CHECKS", "EnginesResult", "engines_ground_truth", "engines_study"]
 
 MU = 0.5
 STATIC_TOL = 0.05
@@ -89,11 +89,6 @@ GROOVES = ((20.0, 30.0),)
 #: within 2 % of the fold (docs/physics.md §6), at the ground truth's I_e.
 ONSET_FACTOR = 0.25
 ONSET_TOL = 0.02
-
-
-def dai_threshold(mu: float) -> float:
-    """The smallest R / r at which a tip pushed into a half-embedded sphere can self-lock."""
-    return 1.0 / math.sin(math.atan(mu)) - 1.0
 
 
 @dataclass(frozen=True)
@@ -256,16 +251,6 @@ def _onset_row(engine: str, c: Corrugation, surf, waves: int) -> dict:
     }
 
 
-def groove(theta_deg: float, alpha_deg: float, half_width_m: float = 0.02, n: int = 81) -> GridSurface:
-    """``z = tan(theta) x + tan(alpha) |y|``: a V-groove along x rising at theta, flanks tilted by alpha."""
-    x = np.linspace(-half_width_m, half_width_m, n)
-    h = (
-        math.tan(math.radians(theta_deg)) * x[None, :]
-        + math.tan(math.radians(alpha_deg)) * np.abs(x)[:, None]
-    )
-    return GridSurface(heights=h, x=x, y=x.copy(), unit="m", metadata={"generator": "groove"})
-
-
 def _with_settings(rig, settings: dict):
     """``rig`` with ``settings`` replacing fields of its engine settings (its scales and
     hfield kept): the measured cause of a Bullet pitfall, run beside the rule's choice."""
@@ -317,34 +302,6 @@ def _groove_rows(engine: str, **settings) -> list[dict]:
             row.update(error=err, ok=bool(abs(err) <= STATIC_TOL))
         rows.append(row)
     return rows
-
-
-def flank_tilt(theta_deg: float, alpha_deg: float) -> float:
-    """The flanks' tilt [rad] of :func:`groove` in the groove's own inclined plane (the
-    closed form's alpha): ``tan(alpha') = tan(alpha) cos(theta)`` (the flank's normal
-    ``(-tan theta, -+tan alpha, 1)`` seen across the groove's line ``(1, 0, tan theta)``)."""
-    return math.atan(math.tan(math.radians(alpha_deg)) * math.cos(math.radians(theta_deg)))
-
-
-def dai_surface(sphere_m: float, tip_m: float) -> GridSurface:
-    """A half-embedded sphere of radius ``sphere_m`` on a floor, on a grid at a quarter of
-    the tip radius ``tip_m`` (the rig's finest)."""
-    step = tip_m / 4
-    half = 3 * (sphere_m + tip_m)
-    x = np.arange(-half, half + step / 2, step)
-    xx, yy = np.meshgrid(x, x)
-    h = np.sqrt(np.clip(sphere_m**2 - xx**2 - yy**2, 0.0, None))
-    return GridSurface(heights=h, x=x, y=x.copy(), unit="m", metadata={"generator": "dai"})
-
-
-def dai_start(ball, sphere_m: float, tip_m: float) -> tuple[float, float]:
-    """Where a tip sliding in +x along the floor first touches the faceted sphere (``ball``:
-    the rig's contact surface, metres): the first point, on a 1e-4 tip-radius grid, where
-    the ball rises off the floor."""
-    x_smooth = -math.sqrt((sphere_m + tip_m) ** 2 - tip_m**2)
-    xs = np.linspace(x_smooth - 0.5 * tip_m, x_smooth + 0.5 * tip_m, 10001)
-    lifted = np.flatnonzero(ball.height(xs, np.zeros_like(xs)) > 1e-6 * tip_m)
-    return float(xs[lifted[0]]), 0.0
 
 
 def _dai_rows(engine: str, factors=DAI_FACTORS, **settings) -> list[dict]:
@@ -588,6 +545,7 @@ def _run(args) -> None:
 
     from spine_mj.jsonio import write_json
     from spine_mj.validate import engine_headlines
+    from spine_mj.validate.fractal_lock import fractal_engines
     from spine_mj.validate.report.engines import section
 
     res = engines_ground_truth(quick=args.quick, progress=lambda s: print(s, flush=True))
@@ -602,54 +560,6 @@ def _run(args) -> None:
     with atomic_output(args.out / "engines.md") as tmp:
         tmp.write_text(text)
     print(text)
-
-
-#: The fractal self-lock comparison's Hurst exponents and I_e: the full validation plan's
-#: fractal study (its corner); surfaces per H are the caller's (``--fractal N``).
-FRACTAL_HURSTS = (0.65, 0.75, 0.8, 0.85, 0.95)
-FRACTAL_SURFACES = 30
-FRACTAL_IE = 1e-4
-
-
-def fractal_engines(
-    out_dir: Path,
-    *,
-    hursts=FRACTAL_HURSTS,
-    surfaces_per_hurst: int = FRACTAL_SURFACES,
-    ie: float = FRACTAL_IE,
-    workers: int | None = None,
-) -> list[dict]:
-    """The fractal self-lock rate against H in both engines (the validation's fractal study,
-    :mod:`spine_mj.validate.fractal_lock`: its surfaces, start, spring drive and lock rule),
-    one sweep with ``engine = ["mujoco", "bullet"]``; per H and engine the rate among the
-    runs without engine trouble with its Wilson interval. Stored under ``out_dir/sweeps``."""
-    from spine_mj.presets import calibrated_mu
-    from spine_mj.validate.fractal_lock import PRESET, lock_rate, surfaces_table
-    from spine_mj.validate.paths import tip_radius
-    from spine_mj.validate.study_runner import StudyRunner
-
-    surfaces = surfaces_table(hursts, surfaces_per_hurst)
-    seed_hurst = {seed: s["set"]["hurst"] for s in surfaces for seed in s["seeds"]}
-    tip = tip_radius(PRESET, None, None)
-    doc = {
-        "sweep": {"name": "fractal-engines", "seed": 11, "analyses": ["engine"], "store_trajectories": False},
-        "surfaces": surfaces,
-        "starts": {"frame": "relative", "x": [0.05], "y": [0.5]},
-        "drive": {"protocol": "spring", "ie": ie},
-        "grid": {"mu": calibrated_mu(PRESET), "tip_radius": tip, "engine": list(COMPARED_ENGINES)},
-    }
-    runner = StudyRunner(Path(out_dir).resolve(), workers, None, time.perf_counter())
-    runner.study = "engines"
-    df, _ = runner(doc, "fractal-engines")
-    rows = []
-    for h in hursts:
-        for engine in COMPARED_ENGINES:
-            sel = df[(df["engine"] == engine) & (df["surface_seed"].map(seed_hurst) == h)]
-            rate = lock_rate(
-                sel["self_locked"].fillna(False).astype(bool).tolist(), (sel["status"] == "ok").tolist()
-            )
-            rows.append({"hurst": float(h), "engine": engine, "ie": ie, **rate})
-    return rows
 
 
 if __name__ == "__main__":

@@ -27,12 +27,15 @@ stays inside the rate's Wilson interval
 
 from __future__ import annotations
 
+import time
 from collections.abc import Sequence
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
+from spine_mj.choices import COMPARED_ENGINES
 from spine_mj.presets import calibrated_mu, load_preset
 from spine_mj.reproduce import fig9_rms_height, fig9_seeds
 from spine_mj.validate.convergence import REFINEMENTS, headline_convergence
@@ -41,7 +44,7 @@ from spine_mj.validate.paths import tip_radius
 from spine_mj.validate.plans import ValidationPlan
 from spine_mj.validate.study_runner import StudyRunner
 
-__all__ = ["SERIES", "FractalLockResult", "fractal_lock", "hurst_rows", "lock_rate"]
+__all__ = ["SERIES", "FractalLockResult", "fractal_engines", "fractal_lock", "hurst_rows", "lock_rate"]
 
 #: The study's surface preset.
 PRESET = "paper-fractal"
@@ -335,3 +338,46 @@ def _records(df: pd.DataFrame, label: str, seed_hurst: dict) -> list[dict]:
             }
         )
     return out
+
+
+#: The fractal self-lock comparison's Hurst exponents and I_e: the full validation plan's
+#: fractal study (its corner); surfaces per H are the caller's (``--fractal N``).
+FRACTAL_HURSTS = (0.65, 0.75, 0.8, 0.85, 0.95)
+FRACTAL_SURFACES = 30
+FRACTAL_IE = 1e-4
+
+
+def fractal_engines(
+    out_dir: Path,
+    *,
+    hursts=FRACTAL_HURSTS,
+    surfaces_per_hurst: int = FRACTAL_SURFACES,
+    ie: float = FRACTAL_IE,
+    workers: int | None = None,
+) -> list[dict]:
+    """The fractal self-lock rate against H in both engines (the validation's fractal study,
+    :mod:`spine_mj.validate.fractal_lock`: its surfaces, start, spring drive and lock rule),
+    one sweep with ``engine = ["mujoco", "bullet"]``; per H and engine the rate among the
+    runs without engine trouble with its Wilson interval. Stored under ``out_dir/sweeps``."""
+    surfaces = surfaces_table(hursts, surfaces_per_hurst)
+    seed_hurst = {seed: s["set"]["hurst"] for s in surfaces for seed in s["seeds"]}
+    tip = tip_radius(PRESET, None, None)
+    doc = {
+        "sweep": {"name": "fractal-engines", "seed": 11, "analyses": ["engine"], "store_trajectories": False},
+        "surfaces": surfaces,
+        "starts": {"frame": "relative", "x": [0.05], "y": [0.5]},
+        "drive": {"protocol": "spring", "ie": ie},
+        "grid": {"mu": calibrated_mu(PRESET), "tip_radius": tip, "engine": list(COMPARED_ENGINES)},
+    }
+    runner = StudyRunner(Path(out_dir).resolve(), workers, None, time.perf_counter())
+    runner.study = "engines"
+    df, _ = runner(doc, "fractal-engines")
+    rows = []
+    for h in hursts:
+        for engine in COMPARED_ENGINES:
+            sel = df[(df["engine"] == engine) & (df["surface_seed"].map(seed_hurst) == h)]
+            rate = lock_rate(
+                sel["self_locked"].fillna(False).astype(bool).tolist(), (sel["status"] == "ok").tolist()
+            )
+            rows.append({"hurst": float(h), "engine": engine, "ie": ie, **rate})
+    return rows

@@ -106,7 +106,7 @@ def test_friction_anchor_pitfall():
     """A tip resting in a V-groove on two contacts: without friction anchors the load sits on
     one flank at a time and the tip creeps down the groove (a static probe reads it as a
     slide); with anchors while held (the rule) it holds and breaks away at the wedge's kappa."""
-    from spine_mj.validate.engines import flank_tilt, groove
+    from spine_mj.validate.wedges import flank_tilt, groove
 
     rig = sim.build_rig(groove(20.0, 30.0), engine="bullet", mu=MU, tip_radius_m=2e-3, ie=1e-2)
     assert rig.engine.friction_anchor == "held"

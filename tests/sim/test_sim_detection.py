@@ -125,7 +125,7 @@ def test_a_tip_wedged_in_a_v_groove_ends_held_never_as_engine_trouble(refinement
     import math
 
     from spine_mj import sim
-    from spine_mj.validate.engines import flank_tilt, groove
+    from spine_mj.validate.wedges import flank_tilt, groove
 
     mu = 0.5
     for theta, alpha in ((50.0, 70.0), (20.0, 30.0)):

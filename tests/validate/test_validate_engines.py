@@ -1,4 +1,5 @@
-"""The closed forms in both engines (spine_mj.validate.engines): the references, and the
+"""The closed forms in both engines (spine_mj.validate.engines, its wedges in
+spine_mj.validate.wedges): the references, and the
 cheap checks run in MuJoCo and Bullet."""
 
 import math
@@ -9,20 +10,21 @@ import pytest
 from spine_mj import sim
 from spine_mj.choices import COMPARED_ENGINES
 from spine_mj.validate import engines as study
+from spine_mj.validate import wedges
 from spine_mj.validate.report.engines import section
 
 
 def test_dai_threshold_is_the_friction_angle_rule():
     # self-lock iff the contact normal's elevation phi, sin(phi) = r / (R + r), is at most
     # the friction angle: R / r >= 1 / sin(arctan mu) - 1 (sqrt(5) - 1 for mu = 0.5)
-    assert study.dai_threshold(0.5) == pytest.approx(math.sqrt(5) - 1)
+    assert wedges.dai_threshold(0.5) == pytest.approx(math.sqrt(5) - 1)
     for mu in (0.3, 0.5, 1.0):
-        ratio = study.dai_threshold(mu)
+        ratio = wedges.dai_threshold(mu)
         assert math.asin(1 / (1 + ratio)) == pytest.approx(math.atan(mu))
 
 
 def test_groove_is_a_v_rising_along_x():
-    g = study.groove(20.0, 30.0, n=41)
+    g = wedges.groove(20.0, 30.0, n=41)
     x, y = g.x, g.y
     assert g.heights[20, 20] == pytest.approx(0.0)
     np.testing.assert_allclose(g.heights[20], math.tan(math.radians(20)) * x, atol=1e-15)
@@ -31,9 +33,9 @@ def test_groove_is_a_v_rising_along_x():
 
 def test_dai_start_is_the_first_touch_of_the_faceted_sphere():
     tip = 1e-3
-    surf = study.dai_surface(2e-3, tip)
+    surf = wedges.dai_surface(2e-3, tip)
     ball = sim.build_rig(surf, mu=0.5, tip_radius_m=tip, ie=1.0).contact_surface()
-    x0, _ = study.dai_start(ball, 2e-3, tip)
+    x0, _ = wedges.dai_start(ball, 2e-3, tip)
     before = ball.height(np.array([x0 - 1e-3 * tip]), np.zeros(1))[0]
     at = ball.height(np.array([x0]), np.zeros(1))[0]
     assert before <= 1e-6 * tip < at
@@ -55,9 +57,9 @@ def test_flank_tilt_is_the_groove_planes_angle():
     t, a, mu = math.tan(math.radians(20)), math.tan(math.radians(30)), study.MU
     c, s = math.hypot(1, t), math.sqrt(1 + t * t + a * a)
     balance = (t * c + mu * s) / (c - mu * t * s)
-    wedge = math.tan(math.radians(20) + math.atan(mu / math.cos(study.flank_tilt(20.0, 30.0))))
+    wedge = math.tan(math.radians(20) + math.atan(mu / math.cos(wedges.flank_tilt(20.0, 30.0))))
     assert wedge == pytest.approx(balance, rel=1e-12)
-    assert study.flank_tilt(0.0, 30.0) == pytest.approx(math.radians(30))
+    assert wedges.flank_tilt(0.0, 30.0) == pytest.approx(math.radians(30))
 
 
 def test_bullet_over_holds_dais_interlock_at_097_by_its_internal_edge_normals():

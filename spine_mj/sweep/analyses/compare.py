@@ -262,7 +262,9 @@ def _compare(case, surface, starts, upstream):
         **_pace(facets, runs, rig.scales),
     }
     reason = np.where(
-        status == "ok", "", "mujoco run: " + np.asarray(upstream["engine"].reason, dtype=object)
+        status == "ok",
+        "",
+        f"{case.params['engine']} run: " + np.asarray(upstream["engine"].reason, dtype=object),
     ).astype(object)
     status = np.where(status == "ok", "ok", "dependency_failed").astype(object)
     # the trajectories are the facet-traced reference paths
