@@ -147,7 +147,9 @@ def headline_table(validation: dict) -> list[str]:
         unconverged = verdict.startswith("unconverged")
         corner = fam.get("corner") or (validation.get("corner") or {}).get(key)
         if corner:
-            at = f"{_num(corner.get('ie'), 2)}, {_num(corner.get('K'), 2)}"
+            from spine_mj.validate.report.common import corner_text
+
+            at = corner_text(corner)
         else:
             at = f"{_num(validation.get('lowest_ie'))}, 30 (fixed)"
         hidden = "not quoted (unconverged)"

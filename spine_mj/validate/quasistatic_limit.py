@@ -131,7 +131,10 @@ class QuasistaticLimitResult:
         fams = self.families
         return {
             "lowest_ie": self.lowest_ie,
-            "corner": {k: {"ie": v["corner"]["ie"], "K": v["corner"]["K"]} for k, v in self.corners.items()},
+            "corner": {
+                fam: {preset: {"ie": c["ie"], "K": c["K"]} for preset, c in v["presets"].items()}
+                for fam, v in self.corners.items()
+            },
             "corner_limits": self.corners,
             "outcome_agreement_at_lowest_ie": {k: v["outcome_agreement"] for k, v in fams.items()},
             "mean_frechet_at_lowest_ie": {k: v["mean_frechet"] for k, v in fams.items()},
@@ -180,7 +183,7 @@ def quasistatic_limit(plan: ValidationPlan, runner: StudyRunner) -> QuasistaticL
     for fam in corner:
         with runner.phase(f"the quasistatic corner of {fam.name}"):
             corners[fam.name] = family_corner(plan, fam)
-    at = {name: c["corner"] for name, c in corners.items()}
+    at = {name: c["presets"] for name, c in corners.items()}
     docs = [(fam, name, doc) for fam in corner for name, doc in limit_family_docs(plan, fam, at[fam.name])]
     for fam in corner:  # a corner the rig refuses (too many steps a run) gives no verdict
         refused = refused_by_rig([doc for f, _, doc in docs if f is fam])
@@ -188,7 +191,7 @@ def quasistatic_limit(plan: ValidationPlan, runner: StudyRunner) -> QuasistaticL
             corners[fam.name]["refused"] = refused
     corner = [fam for fam in corner if "refused" not in corners[fam.name]]
     docs = [d for d in docs if d[0] in corner]
-    variations = _variation_docs(plan, at[corner[0].name])
+    variations = _variation_docs(plan, at[corner[0].name][corner[0].presets[0]])
     refinements = _refinement_docs(plan, corner, at)
     # every sweep of the study at once: the workers stay busy across the sweeps' ends
     done = runner.many(
@@ -207,7 +210,7 @@ def quasistatic_limit(plan: ValidationPlan, runner: StudyRunner) -> QuasistaticL
         allc["well_conditioned"] = [
             well.get(f"{c}/{int(s)}", False) for c, s in zip(allc["case_id"], allc["start"])
         ]
-        summ["corner"] = at[fam.name]
+        summ["corner"] = {preset: {"ie": c["ie"], "K": c["K"]} for preset, c in at[fam.name].items()}
         families[fam.name] = summ
         if plan.convergence_starts > 0:
             refined = _refined_rows(fam.name, plan.convergence_refinements, refinements, refined_done)
@@ -221,7 +224,7 @@ def quasistatic_limit(plan: ValidationPlan, runner: StudyRunner) -> QuasistaticL
         runs=runs_rows,
         variations=_variations(plan, variations, done[len(docs) : len(docs) + len(variations)], runs_rows),
         paths=paths,
-        lowest_ie=min(c["ie"] for c in at.values()),
+        lowest_ie=min(c["ie"] for own in at.values() for c in own.values()),
         convergence=convergence,
         corners=corners,
     )
@@ -304,7 +307,7 @@ def _refinement_docs(
 ) -> list[tuple[str, str, str, dict]]:
     """``(family, refinement key, store name, config)`` of every refinement of every corner
     family's thinned starts (:func:`~spine_mj.validate.convergence.thin_starts`), one per
-    preset, at the family's corner ``at[family]`` (a gridded surface's hfield is refined
+    preset, at the preset's corner ``at[family][preset]`` (a gridded surface's hfield is refined
     through its interpolant, :func:`spine_mj.surfaces.refine_grid`)."""
     if plan.convergence_starts <= 0:
         return []
@@ -317,7 +320,7 @@ def _refinement_docs(
                 if key in GRID_ONLY and not gridded(preset, fam):
                     continue
                 name = f"limit-refined-{key}-{preset}"
-                doc = limit_doc(plan, thin, preset, name, REFINEMENTS[key], (at or {}).get(fam.name))
+                doc = limit_doc(plan, thin, preset, name, REFINEMENTS[key], (at or {}).get(fam.name, {}).get(preset))
                 out.append((fam.name, key, f"limit-refined/{key}/{preset}", doc))
     return out
 
@@ -371,18 +374,21 @@ def limit_doc(
 
 
 def limit_family_docs(
-    plan: ValidationPlan, fam: FamilySpec, corner: dict | None = None
+    plan: ValidationPlan, fam: FamilySpec, corners: dict | None = None
 ) -> list[tuple[str, dict]]:
     """The sweeps of ``fam``'s corner as ``(name, config)``: one for the whole family where
-    its presets share one grid (mu, tip radius, engine: so its cases share the workers, and
-    one heavy case of one preset does not leave a core idle while the next preset waits),
-    else one per preset (:func:`limit_doc`, at ``corner``)."""
+    its presets share one grid (mu, tip radius, engine, drive: so its cases share the
+    workers, and one heavy case of one preset does not leave a core idle while the next
+    preset waits), else one per preset (:func:`limit_doc`, each at its corner
+    ``corners[preset]``; None: the plan's lowest I_e)."""
     docs = [
-        (preset, limit_doc(plan, fam, preset, f"limit-{preset}", corner=corner)) for preset in fam.presets
+        (preset, limit_doc(plan, fam, preset, f"limit-{preset}", corner=(corners or {}).get(preset)))
+        for preset in fam.presets
     ]
     first = docs[0][1]
     own_starts = all("starts" in e for _, d in docs for e in d["surfaces"])
-    if len(docs) == 1 or not (own_starts and all(d["grid"] == first["grid"] for _, d in docs)):
+    shared = all(d["grid"] == first["grid"] and d["drive"] == first["drive"] for _, d in docs)
+    if len(docs) == 1 or not (own_starts and shared):
         return docs
     merged = {**first, "sweep": {**first["sweep"], "name": f"limit-{fam.name}"}}
     merged["surfaces"] = [e for _, d in docs for e in d["surfaces"]]

@@ -7,6 +7,7 @@ side, read from the result
 from __future__ import annotations
 
 from spine_mj.validate.convergence import refinement_note, unconverged_mark
+from spine_mj.validate.report.common import corner_text
 
 __all__ = ["summary_lines"]
 
@@ -22,7 +23,7 @@ def summary_lines(result: dict) -> list[str]:
         conv = result.get("convergence", {}).get(fam)
         at = (result.get("corner") or {}).get(fam) or {"ie": result["lowest_ie"], "K": 30.0}
         lines.append(
-            f"I_e = {at['ie']:g}, K = {at['K']:g}, {fam}: outcome agreement {summ['outcome_agreement']:.0%}"
+            f"I_e, K = {corner_text(at)}, {fam}: outcome agreement {summ['outcome_agreement']:.0%}"
             f"{unconverged_mark(conv, 'outcome_agreement')} of {summ['runs']}, median Frechet "
             f"{summ['median_frechet']:.3g} L_c{unconverged_mark(conv, 'median_frechet')}, "
             f"engine stops: {stops}"

@@ -141,7 +141,7 @@ def test_k_path_is_where_the_compliant_paths_stop_meeting_the_criterion_below_th
     starts = _left_starts(surf, 3)
     ls, lc = roughness.slope_correlation_length(surf), roughness.characteristic_length(surf)
     params = sl.StreamlineParams(mu=mu, dl=ls / 40)
-    k_path, k_fold = path_stiffness(surf, starts, params, slope_length=ls, char_length=lc)
+    k_path, k_fold, _ = path_stiffness(surf, starts, params, slope_length=ls, char_length=lc)
     rigid = sl.streamlines(surf, starts, params, store_paths=True)
 
     def criterion(k):
@@ -171,11 +171,11 @@ def test_k_path_with_the_runs_travel_is_where_their_carriage_stops_short_of_a_ho
     edge, ls = wall.bounds[1], 0.7
     hold = (t + mu) / (1 - mu * t)
     k_travel = (hold - 1 - mu) * ls / (1.1 * (edge - x0) - (w - x0))
-    k_path, k_fold = path_stiffness(
+    k_path, k_fold, _ = path_stiffness(
         wall, starts, params, slope_length=ls, char_length=1.0, carriage_edge=edge
     )
     assert k_travel <= k_path <= k_travel * PATH_STIFFNESS_RESOLUTION
-    endless, _ = path_stiffness(wall, starts, params, slope_length=ls, char_length=1.0)
+    endless, _, _ = path_stiffness(wall, starts, params, slope_length=ls, char_length=1.0)
     assert endless < k_travel < k_fold
     # a softer spring stops the tip on the wall, where the stopped carriage holds it
     k = k_travel / 1.1
@@ -187,7 +187,7 @@ def test_k_path_with_the_runs_travel_is_where_their_carriage_stops_short_of_a_ho
     # kappa_cap F_p: the carriage need only reach kappa_cap l_s / K past it
     capped = dataclasses.replace(params, kappa_cap=5.0)
     k_cap = (5.0 - 1 - mu) * ls / (1.1 * (edge - x0) - (0.0 - x0))
-    k_path, _ = path_stiffness(wall, starts, capped, slope_length=ls, char_length=1.0, carriage_edge=edge)
+    k_path, _, _ = path_stiffness(wall, starts, capped, slope_length=ls, char_length=1.0, carriage_edge=edge)
     assert k_cap <= k_path <= k_cap * PATH_STIFFNESS_RESOLUTION
     assert spring_run_travel(2.0, 0.5, 0.3) == pytest.approx(1.1 * 2.0 + 1.3 * 0.5)
     assert spring_run_travel(-1.0, 0.5, 0.3) == pytest.approx(1.3 * 0.5)  # none past the edge

@@ -6,6 +6,7 @@ from pathlib import Path
 
 import pytest
 
+from spine_mj.validate.report.common import corner_text
 from spine_mj.validate.summary import summary_lines
 
 REPORTS = Path(__file__).parents[2] / "analysis" / "reports"
@@ -23,7 +24,7 @@ def test_summary_lines_state_the_headline_numbers(plan):
     families = [
         line
         for line in lines
-        if any(line.startswith(f"I_e = {c['ie']:g}, K = {c['K']:g}, {f}: ") for f, c in corners.items())
+        if any(line.startswith(f"I_e, K = {corner_text(c)}, {f}: ") for f, c in corners.items())
     ]
     assert len(families) == len(result["limit_families"])
     for (fam, summ), line in zip(result["limit_families"].items(), families, strict=True):

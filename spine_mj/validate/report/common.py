@@ -20,7 +20,16 @@ from typing import Any
 from spine_mj.plotting import sig
 from spine_mj.validate.convergence import REFINEMENT_LABELS
 
-__all__ = ["ReportContext", "assemble", "cell", "image", "refinement_rows", "refinement_verdict", "table"]
+__all__ = [
+    "ReportContext",
+    "assemble",
+    "cell",
+    "corner_text",
+    "image",
+    "refinement_rows",
+    "refinement_verdict",
+    "table",
+]
 
 
 @dataclass(frozen=True)
@@ -78,6 +87,28 @@ def image(alt: str, link: str | None, before: str = "") -> str | None:
 def assemble(text: str, *figures: str | None) -> str:
     """A section: its text, then each figure that was drawn, a blank line between them."""
     return "\n".join([text, *(f for f in figures if f is not None)])
+
+
+def corner_text(corner: dict | None) -> str:
+    """A family's corner as one cell: ``"I_e, K"`` where its presets share one, else
+    ``"label I_e, K; ..."`` per preset (``corner``: preset -> ``{"ie", "K"}``, as
+    ``validation.json``'s ``corner``; a report made before each preset had its own gives
+    ``{"ie", "K"}``); ``"-"`` for none."""
+    if not corner:
+        return "-"
+    if "ie" in corner:
+        corner = {"": corner}
+    pairs = {p: f"{sig(c['ie'], 2)}, {sig(c['K'], 2)}" for p, c in corner.items()}
+    if len(set(pairs.values())) == 1:
+        return next(iter(pairs.values()))
+    return "; ".join(f"{_short(p)} {v}" for p, v in pairs.items())
+
+
+def _short(preset: str) -> str:
+    """``sandpaper-P36`` -> ``P36``, ``example:di-1.di`` -> ``di-1``, ``paper-fractal`` -> ``fractal``."""
+    name = preset.split(":")[-1]
+    name = name.rsplit(".", 1)[0] if ":" in preset else name
+    return name.removeprefix("sandpaper-").removeprefix("paper-")
 
 
 def refinement_verdict(entry: dict) -> str:

@@ -24,6 +24,7 @@ from spine_mj.theory.agreement import MISS_REASONS
 from spine_mj.validate.boundary import BoundaryResult
 from spine_mj.validate.convergence import HEADLINES, REFINEMENT_LABELS, quoted
 from spine_mj.validate.miss_causes import MISS_CAUSES
+from spine_mj.validate.predicted_limits import CORNER_PATH_STARTS
 from spine_mj.validate.platform import platform_info
 from spine_mj.validate.quasistatic_limit import QuasistaticLimitResult
 from spine_mj.validate.report.boundary import star_to_draw
@@ -262,29 +263,45 @@ def convergence_lines(limit: QuasistaticLimitResult) -> list[str]:
 
 
 def _corner_lines(limit: QuasistaticLimitResult) -> list[str]:
-    """The corner each family is judged at, and why
+    """The corner each preset of each family is judged at, and why
     (:func:`spine_mj.theory.drive_limits.quasistatic_corner`)."""
     rows = [
         {
             "family": fam,
-            **c["corner"],
+            "preset": preset,
+            **corner,
             **({"reason": f"not run, no verdict: {c['refused']}"} if c.get("refused") else {}),
         }
         for fam, c in limit.corners.items()
+        for preset, corner in c["presets"].items()
     ]
+    left_out = {
+        label: s["k_path_left_out"]
+        for c in limit.corners.values()
+        for label, s in c["surfaces"].items()
+        if s.get("k_path_left_out")
+    }
     if not rows:
         return [f"I_e = {limit.lowest_ie:g}, default drive (K = k l_s / F_p = 30).", ""]
     return [
-        "Each family runs at the corner its own predicted limits give (the rule "
+        "Each surface runs at the corner its own predicted limits give (the rule "
         "`theory.drive_limits.quasistatic_corner`, docs/physics.md §8): K ten times its "
-        "K_path, I_e the lowest of a tenth of its I_e*, the spring's position swing at a "
-        "tenth of the path tolerance and its force swing at 1 F_p; the family's lowest I_e* "
-        "and highest K_path over its presets and generator variants.",
+        "K_path (at least 30), I_e the lowest of a tenth of its I_e*, the spring's position "
+        "swing at a tenth of the path tolerance and its force swing at 1 F_p; a preset's "
+        "lowest I_e* and highest K_path over its generator variants."
+        + (
+            " K_path leaves out the path starts whose compliant path misses the rigid one at "
+            "K* and 10 and 100 times it (a miss the spring cannot fix): "
+            + ", ".join(f"{label} {n} of {CORNER_PATH_STARTS}" for label, n in left_out.items())
+            + "."
+            if left_out
+            else ""
+        ),
         "",
         table(
             rows,
-            ["family", "ie", "K", "swing_fp", "reason"],
-            ["family", "I_e", "K = k l_s / F_p", "swing / F_p", "why"],
+            ["family", "preset", "ie", "K", "swing_fp", "reason"],
+            ["family", "preset", "I_e", "K = k l_s / F_p", "swing / F_p", "why"],
         ),
         "",
     ]

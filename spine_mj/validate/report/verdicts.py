@@ -10,6 +10,7 @@ from spine_mj.theory.targets import OUTCOME_TARGET
 from spine_mj.validate.convergence import quoted
 from spine_mj.validate.ensembles import ENSEMBLE_RADIUS_LC
 from spine_mj.validate.intervals import TARGET_RULE, runs_to_meet
+from spine_mj.validate.report.common import corner_text
 
 __all__ = ["platform_line", "verdicts_section"]
 
@@ -53,7 +54,7 @@ def verdicts_section(families: dict, convergence: dict | None = None) -> list[st
         at = f.get("corner") or {}
         row = [
             name,
-            f"{_num(at.get('ie'))}, {_num(at.get('K'))}" if at else "-",
+            corner_text(at),
             quoted(
                 f"{_num(f.get('agreement_well_conditioned'))} {_ci(f.get('agreement_ci'))}",
                 convergence.get(name),
