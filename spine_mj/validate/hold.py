@@ -2,9 +2,10 @@
 .npz, an instrument scan) judged as the validation judges its families (issue 41, 6).
 
 1. The corner: :func:`~spine_mj.theory.drive_limits.drive_limits` of the surface with the
-   rig's own tip, and :func:`~spine_mj.theory.drive_limits.quasistatic_corner` from them:
-   the spring drive ``(I_e, K)`` at which this surface's paths are quasistatic. The places
-   lie anywhere on the surface, so ``K`` is set from ``K*``, the first fold anywhere.
+   rig's own tip, and the validation's rule from them
+   (:func:`~spine_mj.validate.predicted_limits.surface_corner`): the spring drive
+   ``(I_e, K)`` at which this surface's paths are quasistatic, ``K_path`` read on the
+   first places.
 2. The self-lock share: quasistatic streamlines of the tip-dilated surface from
    ``reference_starts`` random places, pulled along +x; the share that ends held (the
    self-lock region, or the comparison's force cap), with its Wilson interval.
@@ -158,8 +159,7 @@ def hold_to(
 
     t0 = time.perf_counter()
     out = Path(out_dir).absolute()
-    tip, lc, limits, corner = _corner(surface, settings)
-    places = _places(surface, tip, settings)
+    tip, lc, places, limits, corner = _corner(surface, settings)
     mj_starts = places[: settings.starts]
     runner = StudyRunner(out, workers, progress, t0)
     runner.study = "hold"
@@ -222,34 +222,35 @@ def _undone_on_refusal(out: Path):
 
 
 def _corner(surface, settings: HoldSettings):
-    """``(tip, L_c, limits, corner)``: the rig's tip radius and L_c (surface units), the
-    surface's :func:`~spine_mj.theory.drive_limits.drive_limits` with that tip and the
-    corner placed inside them.
-
-    The places lie anywhere, so ``K`` is set from ``K*``, the first fold anywhere on the
-    surface (the rule's branch without ``K_path``: ``K_path`` of a few random starts on gentle
-    ground reads ~0, and ten times it asked for a spring so soft that a run would take 1e9
-    steps on a single Gaussian)."""
+    """``(tip, L_c, places, limits, corner)``: the rig's tip radius and L_c (surface units),
+    the random places (:func:`_places`), the surface's
+    :func:`~spine_mj.theory.drive_limits.drive_limits` with that tip and the corner placed
+    inside them by the validation's rule
+    (:func:`~spine_mj.validate.predicted_limits.surface_corner`), ``K_path`` read on the
+    first :data:`~spine_mj.validate.predicted_limits.CORNER_PATH_STARTS` places with each
+    carriage stopping where a run's does."""
     from spine_mj import sim
     from spine_mj.theory import drive_limits as dlim
+    from spine_mj.validate.predicted_limits import CORNER_PATH_STARTS, surface_corner
 
     tip_m = sim.scales.engine_tip_radius_m(surface, settings.tip_radius, name="--tip-radius")
     scales = sim.Scales.for_surface(surface, tip=sim.TipParams(tip_radius_m=tip_m, mu_s=settings.mu))
     tip = scales.tip_radius_m / scales.length_scale_m
-    limits = dlim.drive_limits(surface, settings.mu, tip_radius=tip)
+    places = _places(surface, tip, settings)
+    limits = dlim.drive_limits(
+        surface,
+        settings.mu,
+        tip_radius=tip,
+        path_starts=places[:CORNER_PATH_STARTS],
+        carriage_edge=surface.bounds[1],
+    )
     if not limits.k_star > 0:
         raise SpineInputError(
             f"SURFACE: no path on it folds (K* = {limits.k_star:g}: its hold force never falls, a plane "
             "or a slope without features), so there is no drive corner to check MuJoCo at"
         )
-    corner = dlim.quasistatic_corner(
-        ie_star=limits.ie_star,
-        k_path=math.nan,
-        k_star=limits.k_star,
-        lc_over_ls=limits.char_length / limits.slope_length,
-        ie_limit=limits.limit,
-    )
-    return tip, scales.char_length_m / scales.length_scale_m, limits, corner
+    corner = surface_corner([limits])
+    return tip, scales.char_length_m / scales.length_scale_m, places, limits, corner
 
 
 def _self_lock_share(runner, surface, places, tip: float, mu: float) -> tuple[np.ndarray, dict]:

@@ -26,7 +26,7 @@ import numpy as np
 
 from spine_mj import presets
 from spine_mj.sim.step_rule import DEFAULT_STIFFNESS_NUMBER
-from spine_mj.theory.drive_limits import drive_limits, quasistatic_corner
+from spine_mj.theory.drive_limits import Corner, DriveLimits, drive_limits, quasistatic_corner
 from spine_mj.validate.paths import tip_radius
 from spine_mj.validate.plans import FamilySpec, ValidationPlan
 
@@ -38,6 +38,7 @@ __all__ = [
     "family_limits",
     "k_ladder",
     "path_starts",
+    "surface_corner",
 ]
 
 #: Starts a side of the grid whose paths give a corner's ``I_e*`` (:func:`family_corner`).
@@ -134,26 +135,41 @@ def family_corner(plan: ValidationPlan, fam: FamilySpec) -> dict:
                 carriage_edge=surface.bounds[1],
             )
             label = preset + "".join(f" {k}={v}" for k, v in variant)
-            per[label] = {
-                "ie_star": d.ie_star,
-                "limit": d.limit,
-                "k_star": d.k_star,
-                "k_path": d.k_path,
-                "k_path_left_out": d.k_path_left_out,
-                "lc_over_ls": d.char_length / d.slope_length,
-            }
-            own.append(per[label])
-        worst = min(own, key=lambda v: v["ie_star"])
-        corners[preset] = quasistatic_corner(
-            ie_star=worst["ie_star"],
-            k_path=max(v["k_path"] for v in own),
-            k_star=max(v["k_star"] for v in own),
-            lc_over_ls=max(v["lc_over_ls"] for v in own),
-            ie_limit=worst["limit"],
-            # measured: K = 3 and 10 hop on landing (penetration) on the fractal, 30 runs clean
-            k_floor=DEFAULT_STIFFNESS_NUMBER,
-        ).as_dict()
+            per[label] = _limit_row(d)
+            own.append(d)
+        corners[preset] = surface_corner(own).as_dict()
     return {"presets": corners, "surfaces": per}
+
+
+def surface_corner(limits) -> Corner:
+    """The corner one surface is judged at, from its :class:`~spine_mj.theory.drive_limits.DriveLimits`
+    (one or several: a generator's variants, then the lowest ``I_e*`` and highest
+    ``K_path``, ``K*`` and ``L_c / l_s``), with ``K`` at least the default spring
+    (:func:`~spine_mj.theory.drive_limits.quasistatic_corner`; the rule of the validation's
+    families and of ``spine-mj hold``)."""
+    rows = [_limit_row(d) for d in limits]
+    worst = min(rows, key=lambda v: v["ie_star"])
+    return quasistatic_corner(
+        ie_star=worst["ie_star"],
+        k_path=max(v["k_path"] for v in rows),
+        k_star=max(v["k_star"] for v in rows),
+        lc_over_ls=max(v["lc_over_ls"] for v in rows),
+        ie_limit=worst["limit"],
+        # measured: K = 3 and 10 hop on landing (penetration) on the fractal, 30 runs clean
+        k_floor=DEFAULT_STIFFNESS_NUMBER,
+    )
+
+
+def _limit_row(d: DriveLimits) -> dict:
+    """What a corner reads of one surface's limits, as ``validation.json`` keeps it."""
+    return {
+        "ie_star": d.ie_star,
+        "limit": d.limit,
+        "k_star": d.k_star,
+        "k_path": d.k_path,
+        "k_path_left_out": d.k_path_left_out,
+        "lc_over_ls": d.char_length / d.slope_length,
+    }
 
 
 def family_k_axis(predicted: dict, factors) -> list[float]:
