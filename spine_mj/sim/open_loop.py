@@ -17,7 +17,7 @@ from spine_mj.errors import SpineInputError
 from spine_mj.sim.detection import Detection
 from spine_mj.sim.drives import Drive, SpringDrive, StaticProbe, rate_n_s, settle_steps, stiffness_n_m
 from spine_mj.sim.model import RigModel
-from spine_mj.theory.drive_limits import spring_run_travel
+from spine_mj.theory.path_stiffness import spring_run_travel
 
 #: Most steps an open-loop run may plan: its recording (~0.5 kB a step) stays within ~2 GiB.
 MAX_RUN_STEPS = 2**22

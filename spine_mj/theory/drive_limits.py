@@ -6,22 +6,24 @@ Both come from the rigid streamlines (paper Eq. 4) traced from a grid of starts 
 surface, pure numpy on the analytic side:
 
 * ``K* = l_s max(-dH/dx)`` along the paths, ``H`` the hold force per unit preload
-  (:func:`spine_mj.theory.compliant.hold_force`, kappa where engaged): below it the carriage
-  position that holds the tip, ``X = x + (W / k) H``, falls somewhere along a path, a fold
-  of the compliant-drive streamline (:mod:`spine_mj.theory.compliant`). On a corrugation this is
-  the Prandtl-Tomlinson ``K* = l_s max(-d kappa / dx)``. It is the first fold anywhere, a
-  sufficient condition; the comparison's criterion sees a fold only through what its jump
-  does to the path's trace and outcome (a jump along the path leaves the trace where it
-  was). ``K_path`` (:func:`path_stiffness`), given the starts of a measurement, is the
-  stiffness where the compliant-drive paths (the spring drive's ``I_e -> 0`` limit) meet
-  that criterion against the rigid ones: the boundary a measurement with that criterion
-  sees, ``<= K*`` on the same paths (no fold: the two paths coincide) where the carriage
-  is endless. A run's carriage is not: without a duration it stops
-  :func:`spring_run_travel` past its start (``1.1`` times the distance to the domain's
-  +x edge plus the spring's stretch at ``(1 + mu) F_p``), and a tip that must stop where
-  the spring has to be stretched further (a lock that is decided at ``kappa_cap F_p``, a
-  tip lagging the carriage by ``H l_s / K`` on its way to the edge) ends short of the
-  rigid path's end: given the domain's edge, ``K_path`` is measured with the runs' travel.
+  (:func:`spine_mj.theory.compliant.hold_force`, kappa where engaged): below it the
+  carriage position that holds the tip, ``X = x + (W / k) H``, falls somewhere along a
+  path, a fold of the compliant-drive streamline (:mod:`spine_mj.theory.compliant`). On a
+  corrugation this is the Prandtl-Tomlinson ``K* = l_s max(-d kappa / dx)``. It is the
+  first fold anywhere, a sufficient condition; the comparison's criterion sees a fold only
+  through what its jump does to the path's trace and outcome (a jump along the path leaves
+  the trace where it was). ``K_path``
+  (:func:`~spine_mj.theory.path_stiffness.path_stiffness`), given the starts of a
+  measurement, is the stiffness where the compliant-drive paths (the spring drive's
+  ``I_e -> 0`` limit) meet that criterion against the rigid ones: the boundary a measurement
+  with that criterion sees, ``<= K*`` on the same paths (no fold: the two paths coincide)
+  where the carriage is endless. A run's carriage is not: without a duration it stops
+  :func:`~spine_mj.theory.path_stiffness.spring_run_travel` past its start (``1.1`` times
+  the distance to the domain's +x edge plus the spring's stretch at ``(1 + mu) F_p``), and
+  a tip that must stop where the spring has to be stretched further (a lock that is
+  decided at ``kappa_cap F_p``, a tip lagging the carriage by ``H l_s / K`` on its way to
+  the edge) ends short of the rigid path's end: given the domain's edge, ``K_path`` is
+  measured with the runs' travel.
 * ``I_e*`` the lowest of three thresholds. *Lift-off*: a tip carried at horizontal speed
   ``v`` over a profile ``z(h)`` (h: horizontal arc length along the path) needs the
   vertical acceleration ``z'' v^2``; preload and gravity give at most ``F_p / m``, so it
@@ -59,27 +61,21 @@ from spine_mj import roughness
 from spine_mj.errors import SpineInputError
 from spine_mj.surfaces import Surface
 from spine_mj.theory import streamline as sl
-from spine_mj.theory.agreement import outcome_agreement, path_frechet
-from spine_mj.theory.compliant import compliant_streamlines, hold_force
+from spine_mj.theory.compliant import hold_force
 from spine_mj.theory.engagement import DEFAULT_KAPPA_CAP, SELF_LOCK
-from spine_mj.theory.targets import FRECHET_TARGET, OUTCOME_TARGET
+from spine_mj.theory.path_stiffness import kappa_fall, path_stiffness
+from spine_mj.theory.targets import FRECHET_TARGET
 
 __all__ = [
     "CORNER_MARGIN",
-    "SPRING_TRAVEL_PAST_EDGE",
     "SWING_BOUND_FP",
     "Corner",
     "DriveLimits",
     "ball_crest_bound",
     "crest_curvature",
     "drive_limits",
-    "kappa_fall",
-    "path_criterion",
-    "path_stiffness",
-    "start_scores",
     "quasistatic_corner",
     "spring_ie_limits",
-    "spring_run_travel",
     "trap_depths",
 ]
 
@@ -89,30 +85,12 @@ __all__ = [
 #: normal load is ``(W + F dz/dx) / sqrt(1 + |grad z|^2)``; docs/physics.md §8).
 SWING_BOUND_FP = 1.0
 
-#: A spring run without a duration moves its carriage this many times the distance from
-#: its start to the domain's +x edge, plus the spring's stretch (:func:`spring_run_travel`).
-SPRING_TRAVEL_PAST_EDGE = 1.1
-
 #: How far inside its limits a corner lies in ``I_e`` and in ``K`` (:func:`quasistatic_corner`):
 #: the lag (``I_e L_c / (2 mu)``) and the compliant offset (``1 / K``) are first order and
 #: reach the Frechet target 0.1 L_c at the limits; a tenth of the way they are 0.01 L_c, what
 #: the Frechet distance resolves (``validate.theory_orders.FRECHET_FLOOR_LC``). At a threshold
 #: (lift-off, a trap skipped) the tip has a tenth of the kinetic energy that crosses it.
 CORNER_MARGIN = 10.0
-
-#: ``K_path`` is bracketed to this factor (the map's ladder steps are 3 and more).
-PATH_STIFFNESS_RESOLUTION = 2 ** (1 / 4)
-#: The softest K ``path_stiffness`` tries, as a fraction of the first K that passes.
-PATH_STIFFNESS_RANGE = 1e-3
-#: The stiffest K ``path_stiffness`` tries, as a multiple of the paths' fold ``K*`` (or 1).
-PATH_STIFFNESS_CEILING = 2.0**20
-#: A start whose compliant path misses at each of these multiples of the fold ``K*`` (or 1)
-#: is left out of ``K_path`` (:func:`path_stiffness`). Measured on 20 starts, kappa cap 20:
-#: on sandpaper P36 and P60 the same 2 starts miss at K 30, 300 and 3000, each ending at the
-#: force cap a few tenths of L_c aside of the rigid path's lock, every other start agrees;
-#: on the scan di-1 every path leaves the domain on both sides and the median Frechet
-#: distance is 0.24, 0.17, 0.19 and 0.17 L_c at K 30 to 30000 (long paths over many ridges).
-PATH_STIFFNESS_PROBES = (1.0, 10.0, 100.0)
 
 
 @dataclass(frozen=True)
@@ -145,7 +123,7 @@ class DriveLimits:
     k_path : float
         ``K_path``: the smallest stiffness at which the compliant-drive paths from
         ``path_starts`` meet the comparison's criterion against the rigid ones
-        (:func:`path_stiffness`; NaN: not computed, no ``path_starts``).
+        (:func:`~spine_mj.theory.path_stiffness.path_stiffness`; NaN: not computed, no ``path_starts``).
     k_star_path_starts : float
         The fold ``K*`` on the paths from ``path_starts`` (NaN: not computed).
     k_path_endless : float
@@ -153,7 +131,7 @@ class DriveLimits:
         what the folds alone make the criterion see.
     k_path_left_out : int
         Path starts left out of ``k_path``: they miss at every stiffness probed
-        (:func:`path_stiffness`).
+        (:func:`~spine_mj.theory.path_stiffness.path_stiffness`).
     """
 
     k_star: float
@@ -277,16 +255,6 @@ def quasistatic_corner(
     return Corner(ie, k, swing_fp, ie_bound, k_bound, f"{reason}; swing {swing_fp:.2g} F_p")
 
 
-def kappa_fall(x, hold) -> np.ndarray:
-    """``-dH/dx`` between consecutive points of one path (shape ``(n - 1,)``); NaN where
-    ``x`` does not advance or either hold is not finite."""
-    x, hold = np.asarray(x, float), np.asarray(hold, float)
-    dx, dh = np.diff(x), np.diff(hold)
-    ok = (dx > 1e-12 * max(1.0, float(np.abs(x).max(initial=0.0)))) & np.isfinite(dh)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return np.where(ok, -dh / np.where(ok, dx, 1.0), np.nan)
-
-
 def crest_curvature(x, y, z) -> np.ndarray:
     """``-d^2 z / dh^2`` at the inner points of one path (shape ``(n - 2,)``), ``h`` its
     horizontal arc length (three-point formula on uneven steps); NaN at repeated points."""
@@ -299,7 +267,7 @@ def crest_curvature(x, y, z) -> np.ndarray:
     return np.where(ok, -d2, np.nan)
 
 
-def ball_crest_bound(x, y, fx, fy, tip_radius: float) -> np.ndarray:
+def ball_crest_bound(x, y, z, fx, fy, tip_radius: float) -> np.ndarray:
     """The sharpest crest ``-z''`` (along the horizontal arc length) that a surface dilated
     by a ball of radius ``R`` can have at the inner points of one path (shape ``(n - 2,)``;
     inf for ``R = 0``).
@@ -307,24 +275,26 @@ def ball_crest_bound(x, y, fx, fy, tip_radius: float) -> np.ndarray:
     The tip centre's surface is an upper envelope of balls, so at every point a ball of
     radius ``R`` lies below it and touches it (:func:`spine_mj.surfaces.dilate`). The
     path's vertical plane cuts that ball in a circle of radius ``rho = R sqrt(1 - q^2)``,
-    ``q`` the unit normal's component across the path; the section lies above the circle,
-    so it bends down no faster: ``-z'' <= (1 + s^2)^(3/2) / rho``, ``s`` the slope along the
-    path. A sampled dilation's interpolant can ring past this near the creases where two
-    balls meet; the bound is the exact dilation's.
+    ``q`` the unit normal's component across the path (from the gradient ``fx, fy``); the
+    section lies above the circle, so it bends down no faster: ``-z'' <= (1 + s^2)^(3/2) /
+    rho``, ``s`` the slope along the path (the chord of its neighbours: a sampled
+    dilation's interpolant rings, in slope and in curvature, near the creases where two
+    balls meet; the chord of the path's own heights rings least).
     """
-    x, y, fx, fy = (np.asarray(a, float) for a in (x, y, fx, fy))
+    x, y, z, fx, fy = (np.asarray(a, float) for a in (x, y, z, fx, fy))
     if not tip_radius > 0:
         return np.full(max(x.size - 2, 0), np.inf)
     ex, ey = x[2:] - x[:-2], y[2:] - y[:-2]
     norm = np.hypot(ex, ey)
+    ok = norm > 0
     with np.errstate(invalid="ignore", divide="ignore"):
         ex, ey = ex / norm, ey / norm
+        along = (z[2:] - z[:-2]) / np.where(ok, norm, 1.0)
     gx, gy = fx[1:-1], fy[1:-1]
-    along = gx * ex + gy * ey
     across = (gy * ex - gx * ey) / np.sqrt(1.0 + gx**2 + gy**2)
     rho = tip_radius * np.sqrt(np.clip(1.0 - across**2, 0.0, 1.0))
     with np.errstate(divide="ignore", invalid="ignore"):
-        return np.where(norm > 0, (1.0 + along**2) ** 1.5 / rho, np.nan)
+        return np.where(ok, (1.0 + along**2) ** 1.5 / rho, np.nan)
 
 
 def trap_depths(surface: Surface, x, y, f_arrival, mu: float, *, step: float, kappa_cap: float) -> np.ndarray:
@@ -381,174 +351,6 @@ def spring_ie_limits(
     return {"swing-path": path_tolerance**2 * kc, "swing-force": force_bound**2 / kc}
 
 
-def spring_run_travel(distance_to_edge, stretch_per_fp, mu: float):
-    """How far a spring run without a duration moves its carriage: ``1.1`` times the distance
-    from its start to the domain's +x edge (none past it), plus the spring's stretch at
-    ``(1 + mu) F_p`` (the drive of a slide up a 45 degree slope), in any one length unit.
-
-    Parameters
-    ----------
-    distance_to_edge : float or array_like
-        From the start to the domain's +x edge.
-    stretch_per_fp : float or array_like
-        ``F_p / k``, the spring's stretch per preload: ``l_s / K`` in surface units.
-    mu : float
-        mu_s.
-    """
-    return SPRING_TRAVEL_PAST_EDGE * np.maximum(distance_to_edge, 0.0) + (1.0 + mu) * np.asarray(
-        stretch_per_fp, float
-    )
-
-
-def path_criterion(rigid, compliant, char_length: float, keep=None) -> tuple[float, float]:
-    """Outcome agreement (share of starts) and median Frechet distance (in ``L_c``, x-y
-    traces) of ``compliant`` paths against the ``rigid`` ones from the same starts: the
-    comparison a spring-drive run meets against its streamline
-    (:func:`spine_mj.theory.agreement.outcome_agreement`, :func:`spine_mj.theory.agreement.path_frechet`; a
-    rigid path that stalled decided nothing and disagrees, as in the sweep's comparison),
-    over the starts ``keep`` marks (default all)."""
-    agree, frechet = start_scores(rigid, compliant, char_length)
-    keep = np.ones(len(rigid), bool) if keep is None else np.asarray(keep, bool)
-    return float(np.mean(agree[keep])), float(np.median(frechet[keep]))
-
-
-def start_scores(rigid, compliant, char_length: float) -> tuple[np.ndarray, np.ndarray]:
-    """Per start, whether the ``compliant`` path's outcome agrees with the ``rigid`` one's,
-    and their Frechet distance in ``L_c`` (:func:`path_criterion`'s two parts)."""
-    agree = outcome_agreement(
-        rigid.self_locked,
-        np.column_stack([rigid.end_x, rigid.end_y]),
-        compliant.self_locked,
-        np.column_stack([compliant.end_x, compliant.end_y]),
-        length_scale=char_length,
-    )["agree"] & (rigid.outcome != sl.Outcome.STALLED)
-    frechet = np.array(
-        [
-            path_frechet(
-                np.column_stack([compliant.path(i)["x"], compliant.path(i)["y"]]),
-                np.column_stack([rigid.path(i)["x"], rigid.path(i)["y"]]),
-                length_scale=char_length,
-            )
-            for i in range(len(rigid))
-        ]
-    )
-    return agree, frechet
-
-
-def path_stiffness(
-    surface: Surface,
-    starts,
-    params: sl.StreamlineParams,
-    *,
-    slope_length: float,
-    char_length: float,
-    frechet_target: float = FRECHET_TARGET,
-    outcome_target: float = OUTCOME_TARGET,
-    carriage_edge: float | None = None,
-) -> tuple[float, float, int]:
-    """``K_path``: the smallest ``K = k l_s / W`` at which the compliant-drive paths from
-    ``starts`` meet the comparison's criterion against the rigid streamlines (outcome
-    agreement >= ``outcome_target``, median Frechet <= ``frechet_target``; docs/physics.md §8).
-
-    With an endless carriage, above the fold ``K*`` of these paths (:func:`kappa_fall`
-    along them) no path folds and the compliant path is the rigid one, so the criterion
-    holds there; below it a fold's jump counts only through what it does to the trace (a
-    lateral offset, a branch of the flow left) and the outcome. With ``carriage_edge`` each
-    carriage stops where a run's does (:func:`spring_run_travel` from its start): a tip
-    that needs the spring stretched further (a hold of ``H`` at ``x`` needs the carriage at
-    ``x + H l_s / K``) ends there, short of the rigid path, at any K below
-    ``(H - 1 - mu) l_s / (1.1 d - (x - x0))`` (``d`` the start's distance to the edge),
-    fold or none. The search doubles ``K`` from the fold (or 1) to the first K that passes
-    where the carriage stops, halves it from there down to the stiffest K that fails (as a
-    measured boundary is the largest K that fails: softer springs can pass again, their
-    jumps running along the path), then bisects that halving to
-    :data:`PATH_STIFFNESS_RESOLUTION`. A start whose compliant path misses the rigid one's
-    outcome or lies further than ``frechet_target`` from it at every K of
-    :data:`PATH_STIFFNESS_PROBES` times the fold is left out of the criterion (with
-    ``carriage_edge``): a miss that a spring a hundred times stiffer keeps is not the
-    spring's to fix, and would push ``K_path`` to the search's ceiling.
-
-    Parameters
-    ----------
-    surface : Surface
-        The surface the tip's centre rides on (dilated by the tip radius where it has one).
-    starts : array_like, shape (n, 2)
-    params : StreamlineParams
-        Friction, step and force cap of both tracings.
-    slope_length, char_length : float
-        ``l_s`` (turns ``K`` into ``k / W``) and ``L_c`` (the Frechet distance's unit).
-    frechet_target, outcome_target : float
-        The criterion (default the comparison's, :mod:`spine_mj.theory.targets`).
-    carriage_edge : float, optional
-        The domain's +x edge of the runs whose carriage travel the compliant paths share
-        (:func:`spring_run_travel`); None: an endless carriage.
-
-    Returns
-    -------
-    k_path : float
-        The passing end of the bracket (the first halving below ``PATH_STIFFNESS_RANGE``
-        times the first K that passes where none fails; 0 with an endless carriage and no
-        fold on any path; inf where no K up to :data:`PATH_STIFFNESS_CEILING` times the
-        fold passes).
-    k_fold : float
-        The fold ``K*`` on these paths.
-    left_out : int
-        Starts left out of the criterion: they miss at every stiffness probed.
-    """
-    pts = np.asarray(starts, float)
-    rigid = sl.streamlines(surface, pts, params, store_paths=True)
-    k_fold = slope_length * max(0.0, _path_statistics(surface, rigid, params.mu, params.kappa_cap)[0])
-    if carriage_edge is None and not (k_fold > 0 and math.isfinite(k_fold)):
-        return 0.0, k_fold, 0
-
-    def compliant(k: float):
-        end = (
-            None
-            if carriage_edge is None
-            else pts[:, 0] + spring_run_travel(carriage_edge - pts[:, 0], slope_length / k, params.mu)
-        )
-        return compliant_streamlines(surface, pts, params, stiffness=k / slope_length, carriage_end=end)
-
-    top = k_fold if k_fold > 0 and math.isfinite(k_fold) else 1.0
-    misses = np.zeros(len(pts), bool)
-    if carriage_edge is not None:
-        misses[:] = True
-        for factor in PATH_STIFFNESS_PROBES:
-            agree, frechet = start_scores(rigid, compliant(factor * top), char_length)
-            misses &= ~agree | (frechet > frechet_target)
-    keep = ~misses
-    if not keep.any():
-        return math.inf, k_fold, len(pts)
-
-    def passes(k: float) -> bool:
-        agreement, frechet = path_criterion(rigid, compliant(k), char_length, keep)
-        return agreement >= outcome_target and frechet <= frechet_target
-
-    return _last_failure(passes, top, check_top=carriage_edge is not None), k_fold, int(misses.sum())
-
-
-def _last_failure(passes, top: float, *, check_top: bool) -> float:
-    """The passing end of the bracket of the stiffest K that fails ``passes``: up from
-    ``top`` in doublings to a K that passes (``check_top`` False: ``top`` passes), down in
-    halvings to the stiffest K that fails (a measured boundary is the largest K that fails,
-    too: softer springs can agree again, their jumps along the path), then that halving
-    bisected (see :func:`path_stiffness`)."""
-    hi = top
-    while check_top and not passes(hi):
-        if hi >= PATH_STIFFNESS_CEILING * top:
-            return math.inf
-        hi *= 2
-    first, lo = hi, hi / 2
-    while passes(lo):
-        if lo <= PATH_STIFFNESS_RANGE * first:
-            return lo
-        hi, lo = lo, lo / 2
-    while hi / lo > PATH_STIFFNESS_RESOLUTION:
-        mid = math.sqrt(lo * hi)
-        lo, hi = (lo, mid) if passes(mid) else (mid, hi)
-    return hi
-
-
 def _path_statistics(
     surface: Surface, res, mu: float, kappa_cap: float, tip_radius: float = 0.0
 ) -> tuple[float, float, np.ndarray]:
@@ -562,7 +364,7 @@ def _path_statistics(
         hold, _ = hold_force(fx, fy, mu)
         hold = np.where(hold > kappa_cap, np.nan, hold)
         fall.append(kappa_fall(p["x"], hold))
-        bound = ball_crest_bound(p["x"], p["y"], fx, fy, tip_radius)
+        bound = ball_crest_bound(p["x"], p["y"], p["z"], fx, fy, tip_radius)
         curv.append(np.minimum(crest_curvature(p["x"], p["y"], p["z"]), bound))
         finite = hold[np.isfinite(hold)]
         arrival[i] = finite[-1] if finite.size else 0.0
@@ -611,7 +413,6 @@ def drive_limits(
     ----------
     surface : Surface
     mu : float
-        Static friction coefficient mu_s.
     starts : array_like, shape (n, 2), optional
         Path starts; default an ``n_starts x n_starts`` grid over the domain (5 % margin).
     dl : float, optional
@@ -619,14 +420,11 @@ def drive_limits(
     tip_radius : float
         Trace on the surface dilated by a ball of this radius (the MuJoCo tip's centre).
     kappa_cap : float
-        Hold forces above it count as held (the comparison's force cap).
+        Hold forces above it count as held.
     path_tolerance : float
-        How far (in ``L_c``) a path may lag the streamline, for ``ie_lag``; default the
-        comparison's Frechet target (:data:`spine_mj.theory.targets.FRECHET_TARGET`, 0.1).
-    path_starts : array_like, shape (m, 2), optional
-        A measurement's starts: ``K_path`` and their paths' fold (:func:`path_stiffness`).
-    carriage_edge : float, optional
-        The runs' +x edge: ``K_path`` with their carriage travel (:func:`path_stiffness`).
+        How far (in ``L_c``) a path may lag the streamline, for ``ie_lag`` (the Frechet target).
+    path_starts, carriage_edge : array_like (m, 2), float, optional
+        A measurement's starts and its runs' +x edge: ``K_path`` (:mod:`~spine_mj.theory.path_stiffness`).
 
     Returns
     -------
@@ -652,7 +450,9 @@ def drive_limits(
     ie_lag = 2.0 * float(mu) * float(path_tolerance)
     limits = {"lift-off": ie_lift, "trap": ie_trap, "lag": ie_lag}
     limit = min(limits, key=limits.get)
-    k_path, k_fold_starts, k_endless, left_out = _path_stiffnesses(traced, path_starts, params, l_s, l_c, carriage_edge)
+    k_path, k_fold_starts, k_endless, left_out = _path_stiffnesses(
+        traced, path_starts, params, l_s, l_c, carriage_edge
+    )
     return DriveLimits(
         k_star=l_s * max(0.0, max_fall),
         ie_star=limits[limit],

@@ -7,12 +7,12 @@ family's mu_s and traced on the surface dilated by the rig's tip radius
 (:func:`spine_mj.validate.paths.tip_radius`), i.e. what the MuJoCo tip's centre rides on.
 The family's ``K*`` is the largest of its surfaces' and its ``I_e*`` the smallest.
 
-``k_path`` is the boundary the map's criterion sees (:func:`~spine_mj.theory.drive_limits.path_stiffness`):
+``k_path`` is the boundary the map's criterion sees (:func:`~spine_mj.theory.path_stiffness.path_stiffness`):
 the compliant-drive paths from the family's own starts (its x, its y range respread over as
 many rows as it has: the criterion's 95 % of outcomes tolerates one miss in 20, none in 15,
 so the count is the measurement's; measured on the fractal's map surface, K_path 29 from 8
 or 10 starts, 20 from its 30) against the rigid ones, each carriage stopping where the map's runs stop
-theirs (the sweep gives them no duration: :func:`~spine_mj.theory.drive_limits.spring_run_travel`
+theirs (the sweep gives them no duration: :func:`~spine_mj.theory.path_stiffness.spring_run_travel`
 to the surface's +x edge), the largest over its surfaces; ``k_path_endless`` the same with
 an endless carriage (the folds' part alone). ``lc_over_ls`` is the largest ``L_c / l_s`` of
 its surfaces (the spring-block swing's scale, :func:`spine_mj.sim.holding.spring_swing`).
@@ -174,7 +174,7 @@ def _limit_row(d: DriveLimits) -> dict:
 
 def family_k_axis(predicted: dict, factors) -> list[float]:
     """A family's K axis for the (I_e, K) map: ``factors`` x its ``k_path`` (the boundary the
-    map's criterion sees, :func:`~spine_mj.theory.drive_limits.path_stiffness`: the measured
+    map's criterion sees, :func:`~spine_mj.theory.path_stiffness.path_stiffness`: the measured
     boundary is judged against it within a factor of 2), with its fold ``k_star`` and ten
     times it rounded up (the map reaches at least a decade past the first fold anywhere);
     the fold's ladder alone where ``k_path`` is not finite, empty without factors."""

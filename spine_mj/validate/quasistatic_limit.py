@@ -320,7 +320,9 @@ def _refinement_docs(
                 if key in GRID_ONLY and not gridded(preset, fam):
                     continue
                 name = f"limit-refined-{key}-{preset}"
-                doc = limit_doc(plan, thin, preset, name, REFINEMENTS[key], (at or {}).get(fam.name, {}).get(preset))
+                doc = limit_doc(
+                    plan, thin, preset, name, REFINEMENTS[key], (at or {}).get(fam.name, {}).get(preset)
+                )
                 out.append((fam.name, key, f"limit-refined/{key}/{preset}", doc))
     return out
 

@@ -33,7 +33,8 @@ from collections.abc import Sequence
 import numpy as np
 from scipy import stats
 
-from spine_mj.theory.drive_limits import PATH_STIFFNESS_RESOLUTION, spring_ie_limits
+from spine_mj.theory.drive_limits import spring_ie_limits
+from spine_mj.theory.path_stiffness import PATH_STIFFNESS_RESOLUTION
 from spine_mj.validate.intervals import CONFIDENCE
 
 __all__ = [

@@ -15,17 +15,20 @@ from spine_mj.theory import streamline as sl
 from spine_mj.theory.compliant import compliant_streamlines
 from spine_mj.theory.drive_limits import (
     CORNER_MARGIN,
-    PATH_STIFFNESS_RESOLUTION,
     SWING_BOUND_FP,
+    ball_crest_bound,
     crest_curvature,
     drive_limits,
+    quasistatic_corner,
+    spring_ie_limits,
+    trap_depths,
+)
+from spine_mj.theory.path_stiffness import (
+    PATH_STIFFNESS_RESOLUTION,
     kappa_fall,
     path_criterion,
     path_stiffness,
-    quasistatic_corner,
-    spring_ie_limits,
     spring_run_travel,
-    trap_depths,
 )
 
 #: The path tolerance the corner's swing bound uses by default (the Frechet target, L_c).
@@ -299,3 +302,41 @@ def test_bad_input():
         drive_limits(corrugation(), 0.5, n_starts=0)
     with pytest.raises(SpineInputError, match="surface"):
         drive_limits("corrugation", 0.5)
+
+
+def test_the_ball_bound_is_the_section_of_the_tip_ball():
+    # a path along +x over a ball-dilated crest (a circle of radius R): the bound is the
+    # circle's own curvature -z'' = (1 + z'^2)^1.5 / R at every inner point
+    r = 0.5
+    x = np.linspace(-0.4, 0.4, 81)
+    z = np.sqrt(r**2 - x**2)
+    fx = -x / z
+    bound = ball_crest_bound(x, 0 * x, z, fx, 0 * x, r)
+    np.testing.assert_allclose(bound, (1 + fx[1:-1] ** 2) ** 1.5 / r, rtol=5e-3)
+    np.testing.assert_allclose(crest_curvature(x, 0 * x, z), bound, rtol=5e-3)
+    # across a slope the plane cuts the ball off its centre: a smaller circle, a higher bound
+    tilted = ball_crest_bound(x, 0 * x, 0 * x, 0 * x, np.full_like(x, 1.0), r)
+    np.testing.assert_allclose(tilted, 1 / (r * np.sqrt(0.5)), rtol=1e-12)
+    assert np.all(np.isinf(ball_crest_bound(x, 0 * x, z, fx, 0 * x, 0.0)))
+
+
+def test_lift_off_reads_no_crest_sharper_than_the_tip_ball():
+    # a triangle wave (slopes +-0.5) has kinked crests; dilated by a ball of radius R each
+    # crest is an arc of it, so the sharpest crest lies between 1 / R (its top) and
+    # 1.25^1.5 / R (its steepest point), whatever the sampled dilation's interpolant reads
+    from spine_mj.surfaces import GridSurface
+
+    x = np.linspace(0.0, 8.0, 801)
+    y = np.linspace(-0.5, 0.5, 21)
+    profile = 0.5 * np.abs(np.mod(x, 2.0) - 1.0)
+    surf = GridSurface(heights=np.tile(profile, (y.size, 1)), x=x, y=y)
+    tip = 0.25
+    start = np.array([[0.5, 0.0]])
+    d = drive_limits(surf, 0.3, tip_radius=tip, starts=start)
+    traced = sl.dilate(surf, tip)
+    path = sl.streamlines(traced, start, sl.StreamlineParams(mu=0.3, dl=0.2 / 40), store_paths=True).path(0)
+    rung = np.nanmax(crest_curvature(path["x"], path["y"], path["z"]))
+    assert rung > 3 * 1.25**1.5 / tip  # the interpolant's ringing next to the valleys' creases
+    # within 10 %: the interpolant's slope itself overshoots the flanks' 0.5 there
+    assert 0.9 / tip <= d.max_crest_curvature <= 1.1 * 1.25**1.5 / tip
+    assert d.ie_lift == pytest.approx(1.0 / (d.char_length * d.max_crest_curvature))

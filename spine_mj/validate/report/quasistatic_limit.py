@@ -24,8 +24,8 @@ from spine_mj.theory.agreement import MISS_REASONS
 from spine_mj.validate.boundary import BoundaryResult
 from spine_mj.validate.convergence import HEADLINES, REFINEMENT_LABELS, quoted
 from spine_mj.validate.miss_causes import MISS_CAUSES
-from spine_mj.validate.predicted_limits import CORNER_PATH_STARTS
 from spine_mj.validate.platform import platform_info
+from spine_mj.validate.predicted_limits import CORNER_PATH_STARTS
 from spine_mj.validate.quasistatic_limit import QuasistaticLimitResult
 from spine_mj.validate.report.boundary import star_to_draw
 from spine_mj.validate.report.common import ReportContext, assemble, cell, image, refinement_verdict, table
