@@ -158,6 +158,7 @@ register_engine(
             "noslip_tolerance",
             "solref_timeconst_s",
             "solref_dampratio",
+            "line",
         ),
         arrays=True,
     )

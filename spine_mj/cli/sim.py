@@ -200,6 +200,12 @@ _ENGINE_HELP = (
     type=click.Path(file_okay=False),
     help="Output folder (trajectory.parquet, summary.json, surface.npz, run.png, run.mp4).",
 )
+@click.option(
+    "--line",
+    is_flag=True,
+    help="Hold the tip on its start line (y fixed; MuJoCo): a narrow strip or long track whose y "
+    "slopes would carry the tip off it runs along x.",
+)
 @_rig_options
 def simulate(
     surface_spec,
@@ -215,6 +221,7 @@ def simulate(
     engine,
     render,
     out_dir,
+    line,
     **rig_opts,
 ):
     """Run one drive on SURFACE: writes trajectory.parquet, run.png, summary.json (and run.mp4).
@@ -237,7 +244,12 @@ def simulate(
     surf, rig_kw = _rig_inputs(surface_spec, **rig_opts)
     pace = {"ie": ie, "speed_m_s": speed, "rate_n_s": rate}
     inputs = _with_drive(
-        rig_kw, engine=engine, stiffness_number=stiffness_number, stiffness_n_m=stiffness, **pace
+        rig_kw,
+        engine=engine,
+        stiffness_number=stiffness_number,
+        stiffness_n_m=stiffness,
+        line=line or None,  # None: an engine without the option is not asked for it
+        **pace,
     )
     with (
         Progress("preparing", delay_s=PREPARATION_DELAY_S) as preparing,

@@ -97,6 +97,10 @@ class ArrayRig:
             raise SpineInputError(ARRAY_ENGINE_REFUSAL.format(engine=type(rig).__name__))
         if not isinstance(layout, Layout):
             raise SpineInputError(f"layout must be a Layout, got {type(layout).__name__}")
+        if rig.engine.line:
+            raise SpineInputError(
+                "line holds one tip on its line, not an array's spines: build the rig without it"
+            )
         self.rig, self.layout, self.force_control = rig, layout, bool(force_control)
         sc, s = rig.scales, rig.length_scale_m
         self.spacing = layout.spacing_in_surface_units(

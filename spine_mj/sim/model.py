@@ -116,6 +116,12 @@ def check_drive_on(rig, drive: Drive) -> None:
             )
 
 
+#: Damping of the tip's y joint that holds it on its line (``EngineSettings.line``), in engine
+#: units (F_p per L_c / tau): a lateral force F_y moves it at ``F_y / F_p / RAIL_DAMPING`` L_c
+#: per tau (3e-10 m over a 6 cm run across a 0.4-high y slope, tests/sim/test_sim_model.py).
+RAIL_DAMPING = 1e9
+
+
 def hfield_userdata(hf: HField) -> memoryview:
     """``hf``'s samples as MjSpec ``userdata`` wants them, as a buffer MuJoCo copies once
     (4 B a sample): a Python list of them took 32 B a sample more (0.85 GB at 4096 a side,
@@ -187,6 +193,8 @@ class RigModel:
         tip_geom.mass = tip.mass_kg / u.mass_kg
         car = spec.geom("carriage")
         car.size = [r, r, r]
+        if eng.line:
+            spec.joint("tip_y").damping = [RAIL_DAMPING, 0.0, 0.0]  # MuJoCo's (linear, 0, 0)
         hf = self.hfield
         rx, ry, elev, base = hf.size
         spec.add_hfield(

@@ -133,6 +133,11 @@ class EngineSettings:
         Contact reference; ``timeconst_s >= 2 timestep_s`` for stability.
     solimp : (dmin, dmax, width_m, midpoint, power)
         Contact impedance.
+    line : bool
+        Hold the tip on its start line ``y = y0`` (a rail across y: the run of a narrow strip
+        or long track whose y slopes would carry the tip off it). The tip's y joint is damped
+        at :data:`~spine_mj.sim.model.RAIL_DAMPING` in engine units, treated implicitly (not
+        with ``rk4``), so it creeps at most ``|F_y| / F_p`` over that many L_c per tau.
 
     The hfield's resolution is the rig's geometry, not an engine setting: it lives in
     :class:`Scales` (``hfield_resolution``).
@@ -147,6 +152,7 @@ class EngineSettings:
     noslip_tolerance: float = 1e-6
     solref: tuple[float, float] = (1e-3, 1.0)
     solimp: tuple[float, float, float, float, float] = (0.99, 0.99, 1e-3, 0.5, 2.0)
+    line: bool = False
 
     def __post_init__(self):
         object.__setattr__(self, "timestep_s", check_positive("timestep_s", self.timestep_s))
@@ -193,6 +199,13 @@ class EngineSettings:
                 f"0 < dmin, dmax < 1 and width_m > 0, got {self.solimp!r}"
             )
         object.__setattr__(self, "solimp", si)
+        if not isinstance(self.line, bool):
+            raise SpineInputError(f"line must be true or false, got {self.line!r}")
+        if self.line and self.integrator is Integrator.RK4:
+            raise SpineInputError(
+                "line holds the tip by a damper only an implicit integrator steps (euler, implicitfast, "
+                "implicit), got integrator rk4"
+            )
 
     def to_dict(self) -> dict:
         d = dataclasses.asdict(self)

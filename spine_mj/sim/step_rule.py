@@ -151,6 +151,8 @@ class EngineOverrides:
         The rule's step times this, the contact's time constant kept at the rule's: only
         the step changes (solution verification, :mod:`spine_mj.validate.convergence`);
         not with ``timestep_s``.
+    line : bool or None
+        Hold the tip on its start line (:class:`~spine_mj.sim.records.EngineSettings`).
     """
 
     timestep_s: float | None = None
@@ -163,6 +165,7 @@ class EngineOverrides:
     solref_timeconst_s: float | None = None
     solref_dampratio: float | None = None
     timestep_factor: float | None = None
+    line: bool | None = None
 
     def engine(
         self, scales: Scales, *, speed_m_s: float | None = None, stiffness_n_m: float | None = None

@@ -85,3 +85,35 @@ def test_cli_simulate_on_a_long_narrow_track(tmp_path):
     )
     assert res.exit_code == 0, res.output
     assert (out / "run.png").stat().st_size > 0 and "heights must have" not in res.output
+
+
+def test_cli_simulate_and_surface_info_on_a_y_varying_strip_with_the_tip_on_its_line(tmp_path):
+    """A strip 4 wide whose heights vary along y: `surface info` reports it, `simulate
+    --line` keeps the tip on y0 along the whole run (free, it left the strip), and Bullet,
+    which has no such rail, refuses --line in one line with nothing written."""
+    import json
+
+    import numpy as np
+    import pandas as pd
+    from click.testing import CliRunner
+
+    from spine_mj.cli import main
+    from spine_mj.surface_io import save_surface
+    from spine_mj.surfaces import GridSurface
+
+    x, y = np.linspace(0, 60, 1201), np.linspace(0, 4, 81)
+    heights = 0.3 * np.sin(1.3 * x)[None, :] + 0.4 * np.sin(2 * np.pi * y / 8)[:, None]
+    path = save_surface(GridSurface(heights=heights, x=x, y=y), tmp_path / "strip.npz")
+    info = CliRunner().invoke(main, ["surface", "info", str(path), "--mu", "0.5", "--json"])
+    assert info.exit_code == 0, info.output
+    assert json.loads(info.output)["slope_correlation_length"] > 0
+    run = ["simulate", str(path), "--mu", "0.5", "--start", "10,1", "--duration", "1", "--line"]
+    res = CliRunner().invoke(main, [*run, "--out", str(tmp_path / "run")])
+    assert res.exit_code == 0, res.output
+    y_m = pd.read_parquet(tmp_path / "run" / "trajectory.parquet")["position_y_m"].to_numpy()
+    assert np.abs(y_m / 0.01 - 1.0).max() < 1e-6  # a grid without a unit: 0.01 m a unit
+    res = CliRunner().invoke(main, [*run, "--engine", "bullet", "--out", str(tmp_path / "bullet")])
+    assert res.exit_code == 2 and res.output.strip().splitlines() == [
+        "Error: line: not read by engine bullet (its options: timestep_s)"
+    ], res.output
+    assert not (tmp_path / "bullet").exists()

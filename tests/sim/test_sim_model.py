@@ -174,3 +174,49 @@ def test_placement_on_a_grid_finer_than_the_contact_cap_rests_the_tip_at_its_res
         assert 0 < d.ncon < 50
         depth = -d.contact.dist[: d.ncon].min() * rig.units.length_m  # along the normal
         assert depth == pytest.approx(rest * math.cos(math.radians(10.0)), rel=1e-3)
+
+
+def _y_strip() -> GridSurface:
+    """A strip 4 wide and 60 long whose heights vary along y as much as along x: a tip
+    started on its flank (y = 1) is carried sideways."""
+    x, y = np.linspace(0.0, 60.0, 1201), np.linspace(0.0, 4.0, 81)
+    heights = (
+        0.3 * np.sin(1.3 * x)[None, :]
+        + 0.4 * np.sin(2 * np.pi * y / 8)[:, None]
+        + 0.2 * np.sin(0.7 * x)[None, :] * np.cos(2 * np.pi * y / 4)[:, None]
+    )
+    return GridSurface(heights=heights, x=x, y=y)
+
+
+def test_line_holds_the_tip_on_its_start_line_of_a_y_varying_strip():
+    """Free, the tip drifts across the strip (measured: 1 unit off its line, then off the
+    strip); held on its line it keeps y0 to 1e-6 units while the drive carries it along x,
+    and the setting is recorded with the run."""
+    from spine_mj import sim
+
+    surf, start = _y_strip(), (10.0, 1.0)
+    paths = {}
+    for line in (False, True):
+        rig = sim.build_rig(surf, mu=0.5, line=line or None)
+        drive = sim.build_drive(rig.scales, "spring", ie=1e-3, duration_s=1.5)
+        run = rig.run(drive, start=start)
+        paths[line] = run.table()[["position_x_m", "position_y_m"]].to_numpy() / rig.length_scale_m
+        assert run.summary()["engine"]["line"] is line
+    free, held = paths[False], paths[True]
+    assert np.abs(free[:, 1] - start[1]).max() > 0.1
+    assert np.abs(held[:, 1] - start[1]).max() < 1e-6
+    assert held[-1, 0] - start[0] > 1.0
+
+
+def test_line_is_refused_where_it_cannot_hold():
+    from spine_mj import sim
+    from spine_mj.errors import SpineInputError
+    from spine_mj.sim import Layout
+
+    surf = _y_strip()
+    with pytest.raises(SpineInputError, match=r"only an implicit integrator steps .* got integrator rk4"):
+        sim.build_rig(surf, mu=0.5, line=True, integrator="rk4")
+    with pytest.raises(SpineInputError, match="line must be true or false, got 'yes'"):
+        sim.build_rig(surf, mu=0.5, line="yes")
+    with pytest.raises(SpineInputError, match="not an array's spines"):
+        sim.ArrayRig(sim.build_rig(surf, mu=0.5, line=True), Layout())
