@@ -333,7 +333,8 @@ def probes(work: Path, novideo: str | None) -> list[tuple[str, list[str], str, s
 def _issue44(add, work: Path, py: str) -> None:
     """Issue 44's families: planes' arguments, Bullet's step, the engines study's
     arguments, nested JSON, engine and drive keys a sweep would not apply, refusals that
-    only a combination of the grid makes, and memory beyond the budget."""
+    only a combination of the grid makes, memory beyond the budget (the fractal's
+    synthesis, simulate's hfield), and a rail Bullet does not have."""
     plane = [*SPINE, "surface", "make", "plane", "-o", "p.npz", "--set"]
     for setting, needle in (
         ('slope_deg="steep"', "slope_deg"),
@@ -433,6 +434,19 @@ def _issue44(add, work: Path, py: str) -> None:
         "refuse",
         "fBm synthesis",
         small,
+    )
+    add(
+        "simulate --resolution 8192 (1 GiB budget)",
+        [*sim_bullet[:-2], "--resolution", "8192", "--out", "r8192"],
+        "refuse",
+        "an hfield of 8192 x 8192 samples",
+        small,
+    )
+    add(
+        "simulate --line --engine bullet",
+        [*sim_bullet, "--engine", "bullet", "--line"],
+        "refuse",
+        "line: not read by engine bullet",
     )
 
 
