@@ -34,7 +34,7 @@ from spine_mj.sim.model import check_drive_on
 from spine_mj.sim.records import TipParams
 from spine_mj.sim.rig import Rig
 from spine_mj.sim.rig_inputs import RigInputs, at_most_one
-from spine_mj.sim.scales import Scales, grid_keeps_samples
+from spine_mj.sim.scales import PROGRESS_MIN_SAMPLES, Scales, grid_keeps_samples
 from spine_mj.surfaces import Surface
 
 __all__ = [
@@ -147,11 +147,11 @@ def build_rig(
         raise SpineInputError(f"build_rig: give RigInputs or keywords, not both (got {', '.join(keywords)})")
     plan = plan_rig(surface, inputs, progress=progress)
     rig_class = check_engine(inputs.engine).rig_class()
-    stage = f"building {inputs.engine}'s model"
-    if progress is not None:
+    stage, big = f"building {inputs.engine}'s model", plan.hfield.data.size >= PROGRESS_MIN_SAMPLES
+    if progress is not None and big:
         progress(0, 1, stage)
     rig = rig_class(surface, tip=plan.tip, engine=plan.engine, sized=(plan.scales, plan.hfield))
-    if progress is not None:
+    if progress is not None and big:
         progress(1, 1, stage)
     return rig
 

@@ -51,6 +51,8 @@ MAX_HFIELD_SIDE = 8192  # samples a side of an hfield (memory; MuJoCo's collisio
 #: or a refined fractal (tests/test_memory.py); a Python list of the samples for MjSpec took
 #: 32 B more (``simulate --resolution 8192`` peaked at 3.9 GB).
 HFIELD_BYTES_PER_SAMPLE = 36
+#: Hfield samples from which a rig's preparation reports its stages (2048 a side: seconds).
+PROGRESS_MIN_SAMPLES = 2**22
 _MIN_ENGINE_RATIO = 1e-9  # smallest length ratio (tip / L_c, spacing / L_c) the engine resolves
 #: Physical range of lengths [m] (outside it the model means nothing).
 PHYSICAL_LENGTH_M = (1e-12, 1e3)
@@ -208,7 +210,7 @@ class Scales:
             char_length_m = characteristic_length(surface) * length_scale_m
         char_length_m = check_physical_length("char_length_m", char_length_m)
         _check_resolution(hfield_resolution)
-        report = progress or _quiet
+        report = _reporter(progress, surface, hfield_resolution, hfield_refinement)
         report(0, 1, "sampling the hfield")
         hf = hfield_of(surface, hfield_resolution)
         spacing = hfield_spacing(hf, length_scale_m)
@@ -230,7 +232,7 @@ class Scales:
             (2 * rx / (hf.ncol - 1) * length_scale_m, 2 * ry / (hf.nrow - 1) * length_scale_m),
             mu=tip.mu_s,
             radius=radius,
-            progress=None if progress is None else lambda done, total: progress(done, total, "fall height"),
+            progress=lambda done, total: report(done, total, "fall height"),
         )
         scales = cls(
             length_scale_m=length_scale_m,
@@ -465,6 +467,22 @@ def _quiet(done: float, total: float, stage: str) -> None:
     """A progress callback that hears nothing."""
 
 
+def _reporter(progress, surface: Surface, resolution: int | None, refinement) -> Callable:
+    """``progress`` for hfields of PROGRESS_MIN_SAMPLES or more, else :func:`_quiet` (quick: no bars)."""
+    ny, nx = _hfield_sides(surface, resolution, refinement)
+    return progress if progress is not None and nx * ny >= PROGRESS_MIN_SAMPLES else _quiet
+
+
+def _hfield_sides(surface: Surface, resolution: int | None, refinement) -> tuple[int, int]:
+    """``(nrow, ncol)`` of :func:`hfield_of`'s hfield, before it is made."""
+    if resolution or not isinstance(surface, GridSurface):
+        ny = nx = resolution or DEFAULT_HFIELD_SIDE
+    else:
+        ny, nx = surface.shape
+    f = int(refinement)
+    return (ny - 1) * f + 1, (nx - 1) * f + 1
+
+
 def _check_sizes(
     radius: float, spacing: float, char_length: float, span: float, *, given: bool = True
 ) -> None:
@@ -544,12 +562,8 @@ def hfield_of(surface: Surface, resolution: int | None = None, refinement: int =
     -------
     HField
     """
-    if resolution or not isinstance(surface, GridSurface):
-        ny = nx = resolution or DEFAULT_HFIELD_SIDE
-    else:
-        ny, nx = surface.shape
+    ny, nx = _hfield_sides(surface, resolution, refinement)
     f = int(refinement)
-    ny, nx = (ny - 1) * f + 1, (nx - 1) * f + 1
     check_memory(HFIELD_BYTES_PER_SAMPLE * float(nx) * ny, where=f"an hfield of {ny} x {nx} samples")
     hf = to_hfield(surface, nrow=resolution, ncol=resolution) if resolution else to_hfield(surface)
     if refinement == 1:

@@ -163,12 +163,18 @@ def test_build_drive_refuses_a_pace_or_a_stiffness_given_twice(given, named):
             sim.drive_speed_m_s(scales, **given)
 
 
-def test_a_rig_s_preparation_reports_each_stage_through_its_callback():
+def test_a_rig_s_preparation_reports_each_stage_through_its_callback(monkeypatch):
     """Long preparations show progress (8192 a side took 43 s before the run): every stage
     reaches the callback, the fall height line by line to its total, and the model's stage
-    ends done; the library prints nothing."""
-    heard = []
-    surf = fractal_fbm(nx=64, rng=0)
+    ends done; the library prints nothing. Only hfields of PROGRESS_MIN_SAMPLES report (a
+    small case's refusal stays one line): lowered here to this small one."""
+    from spine_mj.sim import build, scales
+
+    surf, quiet, heard = fractal_fbm(nx=64, rng=0), [], []
+    sim.build_rig(surf, mu=0.5, hfield_refinement=2, progress=lambda *a: quiet.append(a))
+    assert quiet == []
+    monkeypatch.setattr(scales, "PROGRESS_MIN_SAMPLES", 0)
+    monkeypatch.setattr(build, "PROGRESS_MIN_SAMPLES", 0)
     rig = sim.build_rig(surf, mu=0.5, hfield_refinement=2, progress=lambda *a: heard.append(a))
     stages = list(dict.fromkeys(stage for _, _, stage in heard))
     assert stages == ["sampling the hfield", "fall height", "refining the hfield", "building mujoco's model"]
