@@ -29,6 +29,7 @@ from spine_mj.theory.path_stiffness import (
     path_criterion,
     path_stiffness,
     spring_run_travel,
+    start_scores,
 )
 
 #: The path tolerance the corner's swing bound uses by default (the Frechet target, L_c).
@@ -340,3 +341,25 @@ def test_lift_off_reads_no_crest_sharper_than_the_tip_ball():
     # within 10 %: the interpolant's slope itself overshoots the flanks' 0.5 there
     assert 0.9 / tip <= d.max_crest_curvature <= 1.1 * 1.25**1.5 / tip
     assert d.ie_lift == pytest.approx(1.0 / (d.char_length * d.max_crest_curvature))
+
+
+def test_k_path_leaves_out_the_starts_that_miss_at_every_stiffness_probed():
+    # the wall above: both starts climb it at any K above the carriage's limit; against a
+    # Frechet target no path meets, every start misses at 1, 10 and 100 times the fold, so
+    # none is left to judge and K_path is the search's "none passes"
+    mu, t, w = 0.5, 1.5, 0.4
+    wall, x0 = Wall(t, w), -0.5
+    starts = np.array([(x0, 0.0), (x0, 0.2)])
+    params = sl.StreamlineParams(mu=mu, dl=0.01)
+    edge, ls = wall.bounds[1], 0.7
+    k_path, k_fold, left_out = path_stiffness(
+        wall, starts, params, slope_length=ls, char_length=1.0, carriage_edge=edge, frechet_target=-1.0
+    )
+    assert (k_path, left_out) == (np.inf, 2) and k_fold > 0
+    # with the comparison's target none is left out
+    assert path_stiffness(wall, starts, params, slope_length=ls, char_length=1.0, carriage_edge=edge)[2] == 0
+    # the criterion over the starts kept is theirs alone
+    rigid = sl.streamlines(wall, starts, params, store_paths=True)
+    soft = compliant_streamlines(wall, starts, params, stiffness=0.5 / ls)
+    agree, frechet = start_scores(rigid, soft, 1.0)
+    assert path_criterion(rigid, soft, 1.0, keep=[False, True]) == (float(agree[1]), float(frechet[1]))
