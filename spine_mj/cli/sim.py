@@ -29,7 +29,9 @@ def _rig_options(f):
             "surface's own, 2 spacings for a scan, else max(1 spacing, L_c / 100); 0, a point, "
             "is refused: the engine's tip is a ball).",
         ),
-        click.option("--mass", type=float, default=0.01, show_default=True, help="m_eff [kg]."),
+        click.option(
+            "--mass", type=float, default=None, help="m_eff [kg] (default: the tip's, sim.TipParams)."
+        ),
         click.option(
             "--mu",
             type=float,
@@ -38,7 +40,10 @@ def _rig_options(f):
             "for other surfaces).",
         ),
         click.option(
-            "--preload", type=float, default=0.0, show_default=True, help="Extra downward preload [N]."
+            "--preload",
+            type=float,
+            default=None,
+            help="Extra downward preload [N] (default: the tip's, sim.TipParams: none).",
         ),
         click.option(
             "--length-scale",

@@ -181,3 +181,31 @@ def test_a_rig_s_preparation_reports_each_stage_through_its_callback(monkeypatch
     lines = [(done, total) for done, total, stage in heard if stage == "fall height"]
     assert lines[-1] == (2 * rig.hfield.nrow, 2 * rig.hfield.nrow)  # both axes of the refined hfield
     assert heard[-1] == (1, 1, "building mujoco's model")
+
+
+def test_the_tips_defaults_have_one_home_for_every_command(tmp_path, monkeypatch):
+    """``simulate`` without --mass/--preload, a sweep without mass/preload/gravity and
+    ``build_rig`` without them all take sim.TipParams' defaults (the sweep's schema reads
+    them from its fields): a changed default there (here a patched TipParams whose mass
+    defaults to 0.02 kg) is the one RigInputs, and so build_rig and simulate, build with."""
+    import dataclasses
+
+    from spine_mj.sim import build, rig_inputs
+    from spine_mj.sweep.analyses import engine
+
+    summary = _cli_summary(tmp_path, "paper-single-peak", (-3.0, -1.0), ["--mu", 1.2, "--resolution", 41])
+    rig, _ = _sweep_case(tmp_path, {"preset": "paper-single-peak"}, (-3.0, -1.0), {"ie": 1e-3}, {"mu": 1.2})
+    default = sim.TipParams(mu_s=1.2)
+    assert summary["tip"]["mass_kg"] == rig.tip.mass_kg == default.mass_kg
+    assert summary["tip"]["preload_n"] == rig.tip.preload_n == default.preload_n
+    assert rig.tip.gravity_m_s2 == default.gravity_m_s2
+    heavier = dataclasses.make_dataclass(
+        "TipParams",
+        [("mass_kg", float, dataclasses.field(default=0.02))],
+        bases=(sim.TipParams,),
+        frozen=True,
+    )
+    monkeypatch.setattr(rig_inputs, "TipParams", heavier)
+    assert sim.build_rig(sim.inclined_plane(slope_deg=0.0), mu=0.5).tip.mass_kg == 0.02
+    assert engine._TIP["mass_kg"] == sim.TipParams.__dataclass_fields__["mass_kg"].default
+    assert build.RigInputs(mu=0.5).tip.mass_kg == 0.02

@@ -9,6 +9,7 @@ in the drive share it.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 
 import numpy as np
@@ -33,6 +34,9 @@ from spine_mj.sweep.registry import (
     check_engine_options,
     register_analysis,
 )
+
+#: The tip's defaults (:class:`spine_mj.sim.TipParams`), the sweep's too.
+_TIP = {f.name: f.default for f in dataclasses.fields(sim.TipParams)}
 
 ENGINE_PARAMS = (
     MU_PARAM,
@@ -105,9 +109,10 @@ ENGINE_PARAMS = (
         0.0,
         drive=True,
     ),
-    ParamSpec("mass", "float", "effective moving mass m_eff [kg]", 0.01, 0.0, exclusive=True),
-    ParamSpec("preload", "float", "extra downward preload [N] (added to m g)", 0.0, 0.0),
-    ParamSpec("gravity", "float", "gravitational acceleration [m/s^2]", 9.81, 0.0),
+    # the tip's defaults are sim.TipParams' (one home: a changed default changes every command)
+    ParamSpec("mass", "float", "effective moving mass m_eff [kg]", _TIP["mass_kg"], 0.0, exclusive=True),
+    ParamSpec("preload", "float", "extra downward preload [N] (added to m g)", _TIP["preload_n"], 0.0),
+    ParamSpec("gravity", "float", "gravitational acceleration [m/s^2]", _TIP["gravity_m_s2"], 0.0),
     ParamSpec(
         "length_scale",
         "float",
