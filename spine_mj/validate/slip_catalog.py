@@ -202,17 +202,24 @@ def reference_pulses(landscape: Landscape, units: TrackUnits, stiffness_number: 
     return out
 
 
-def _rows(
-    source: str, slips: Slips, units: TrackUnits, stiffness_number: float, start: float, labels
-) -> dict:
-    lc, n = units.char_length, slips.size.size
-    # the drive starts with the spring unloaded and the tip at the landscape's start
+def _label_columns(source: str, n: int, stiffness_number: float, labels) -> dict:
+    """The catalog's first columns, one value for all ``n`` rows of a run."""
     return {
         "source": [source] * n,
         "surface": [labels.get("surface", "")] * n,
         "mu": np.full(n, labels.get("mu", math.nan)),
         "K": np.full(n, float(stiffness_number)),
         "ie": np.full(n, labels.get("ie", math.nan)),
+    }
+
+
+def _rows(
+    source: str, slips: Slips, units: TrackUnits, stiffness_number: float, start: float, labels
+) -> dict:
+    lc, n = units.char_length, slips.size.size
+    # the drive starts with the spring unloaded and the tip at the landscape's start
+    return {
+        **_label_columns(source, n, stiffness_number, labels),
         "start_x_lc": slips.start_u / lc,
         "start_time_s": (slips.start_carriage - start) / units.speed,
         "size_lc": slips.size / lc,
@@ -269,11 +276,7 @@ def drop_rows(
         v = np.asarray(velocity_v, float)
         peak = np.array([v[a : b + 1].max() for a, b in zip(on, st)]) if n else nan
     return {
-        "source": [source] * n,
-        "surface": [labels.get("surface", "")] * n,
-        "mu": np.full(n, labels.get("mu", math.nan)),
-        "K": np.full(n, float(stiffness_number)),
-        "ie": np.full(n, labels.get("ie", math.nan)),
+        **_label_columns(source, n, stiffness_number, labels),
         "start_x_lc": x[on] / char_length,
         "start_time_s": nan if t is None else t[on] - t[0],
         "size_lc": (x[st] - x[on]) / char_length,
@@ -378,11 +381,7 @@ def event_rows(
         work = float(np.sum(0.5 * (f[seg][1:] + f[seg][:-1]) * np.diff(x[seg])))
         dissipated.append((work - fp * (z[e.stop] - z[e.onset])) / (fp * lc))
     return {
-        "source": [source] * n,
-        "surface": [labels.get("surface", "")] * n,
-        "mu": np.full(n, labels.get("mu", math.nan)),
-        "K": np.full(n, float(stiffness_number)),
-        "ie": np.full(n, labels.get("ie", math.nan)),
+        **_label_columns(source, n, stiffness_number, labels),
         "start_x_lc": np.array([x[e.onset] / lc for e in events]),
         "start_time_s": np.array([e.onset_time_s - start_time_s for e in events]),
         "size_lc": np.array([e.jump_length_m / unit / lc for e in events]),

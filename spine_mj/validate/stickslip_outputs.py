@@ -143,10 +143,7 @@ def stickslip_to(
         land = track_landscape(surface, mu, units.tip_radius, (x0, x0 + length))
         for rows in reference_rows(land, units, k_number, **labels).values():
             frames.append(pd.DataFrame(rows, columns=COLUMNS))
-        for source, pulse in reference_pulses(land, units, k_number).items():
-            ref_pulses.setdefault(source, {})[f"{k_number:g}"] = pulse
-            if pulse["shape"] is not None:
-                pulses[(source, k_number)] = np.asarray(pulse["shape"])
+        _add_pulses(land, units, k_number, ref_pulses, pulses)
         done += 1
         report(done, total, f"references, K {k_number:g}")
         if engine:
@@ -164,6 +161,15 @@ def stickslip_to(
     files = _write(Path(out_dir), events, summary, pulses)
     report(total, total, "written")
     return StickSlipOutputs(summary, files)
+
+
+def _add_pulses(land, units: TrackUnits, k_number: float, ref_pulses: dict, pulses: dict) -> None:
+    """The references' mean pulses at one K into the summary's ``ref_pulses`` (by source,
+    then K) and the figure's ``pulses`` (by source and K)."""
+    for source, pulse in reference_pulses(land, units, k_number).items():
+        ref_pulses.setdefault(source, {})[f"{k_number:g}"] = pulse
+        if pulse["shape"] is not None:
+            pulses[(source, k_number)] = np.asarray(pulse["shape"])
 
 
 def _rig_and_scales(surface, engine, mu: float, ie: float, k_number: float, rig_options: dict):
