@@ -17,6 +17,8 @@ from pathlib import Path
 
 import pytest
 
+from spine_mj.validate.report.common import preset_label
+
 ROOT = Path(__file__).resolve().parents[1]
 NUM = r"([0-9]+(?:\.[0-9]+)?(?:e[-+]?[0-9]+)?)"
 
@@ -46,12 +48,26 @@ def _unconverged(name: str) -> bool:
     )
 
 
+def _corner(name: str) -> tuple[str, list[str]]:
+    """The corner cell's pattern and paths: one ``I_e, K`` where the family's presets share
+    it, else ``label I_e, K`` per preset; a report before per-surface corners: its one
+    corner, or the fixed I_e at K 30 before any."""
+    corner = (_FULL.get("corner") or {}).get(name)
+    if not corner:
+        return rf"{NUM}, 30 \(fixed\)", ["lowest_ie"]
+    if "ie" in corner:
+        return rf"{NUM}, {NUM}", [f"corner/{name}/ie", f"corner/{name}/K"]
+    presets = list(corner)
+    if len({(c["ie"], c["K"]) for c in corner.values()}) == 1:
+        return rf"{NUM}, {NUM}", [f"corner/{name}/{presets[0]}/ie", f"corner/{name}/{presets[0]}/K"]
+    cells = [rf"{re.escape(preset_label(p))} {NUM}, {NUM}" for p in presets]
+    return "; ".join(cells), [f"corner/{name}/{p}/{k}" for p in presets for k in ("ie", "K")]
+
+
 def _row(label: str, name: str) -> tuple:
     """A family's row of README's headline table (docs/tools/readme_table.py writes it): its
     corner, then its agreement and Frechet distance, or "not quoted" where unconverged."""
-    has_corner = name in (_FULL.get("corner") or {})
-    corner = rf"{NUM}, {NUM}" if has_corner else rf"{NUM}, 30 \(fixed\)"
-    corner_paths = [f"corner/{name}/ie", f"corner/{name}/K"] if has_corner else ["lowest_ie"]
+    corner, corner_paths = _corner(name)
     counts = [f"limit_families/{name}/well_conditioned_runs", f"limit_families/{name}/starts"]
     if _unconverged(name):
         hidden = r"not quoted \(unconverged\)"

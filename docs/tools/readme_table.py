@@ -33,9 +33,10 @@ def table() -> str:
             "",
             "Full plan of `spine-mj validate`, each family at "
             + (
-                "its own quasistatic corner (I_e, K = k l_s / F_p: K ten times its predicted "
-                "K_path, I_e a tenth of its I_e* or less, the spring's swing at most 1 F_p; "
-                "`theory.drive_limits.quasistatic_corner`)"
+                "its own quasistatic corner, per surface where its surfaces differ (I_e, K = "
+                "k l_s / F_p: K ten times the surface's predicted K_path and at least 30, I_e "
+                "a tenth of its I_e* or less, the spring's swing at most 1 F_p; "
+                "`validate.predicted_limits.surface_corner`)"
                 if validation.get("corner")
                 else f"the fixed I_e = {generate._num(validation.get('lowest_ie'))} and K = 30 "
                 "(a report made before each family had its own corner)"

@@ -25,6 +25,7 @@ __all__ = [
     "assemble",
     "cell",
     "corner_text",
+    "preset_label",
     "image",
     "refinement_rows",
     "refinement_verdict",
@@ -101,10 +102,10 @@ def corner_text(corner: dict | None) -> str:
     pairs = {p: f"{sig(c['ie'], 2)}, {sig(c['K'], 2)}" for p, c in corner.items()}
     if len(set(pairs.values())) == 1:
         return next(iter(pairs.values()))
-    return "; ".join(f"{_short(p)} {v}" for p, v in pairs.items())
+    return "; ".join(f"{preset_label(p)} {v}" for p, v in pairs.items())
 
 
-def _short(preset: str) -> str:
+def preset_label(preset: str) -> str:
     """``sandpaper-P36`` -> ``P36``, ``example:di-1.di`` -> ``di-1``, ``paper-fractal`` -> ``fractal``."""
     name = preset.split(":")[-1]
     name = name.rsplit(".", 1)[0] if ":" in preset else name
