@@ -139,7 +139,8 @@ def report(out: Path, bootstrap: int) -> dict:
         for source, e in per.items()
         if isinstance(e, dict) and "cutoff_exponent" in e
     ]
-    (out / "classes.md").write_text("\n".join([*lines, "", *slopes, ""]))
+    title = ["# Stick-slip classes: slip statistics on stationary-slope profiles", ""]
+    (out / "classes.md").write_text("\n".join([*title, *lines, "", *slopes, ""]))
     return result
 
 

@@ -276,7 +276,7 @@ def report(out: Path) -> str:
                     + " | ".join(f"{c['ks']:.3f}, {c['ks_p']:.3g} ({c['ad_p']:.3g})" for c in cells)
                     + " |"
                 )
-    text = "\n".join(rows) + "\n"
+    text = "\n".join(["# Engines' force drops against the references", "", *rows]) + "\n"
     (out / "engines_drops.md").write_text(text)
     return text
 
