@@ -114,7 +114,7 @@ def family_corner(plan: ValidationPlan, fam: FamilySpec) -> dict:
         ``presets``: per preset its corner
         (:meth:`~spine_mj.theory.drive_limits.Corner.as_dict`: ``ie``, ``K``, ``swing_fp``,
         ...); ``surfaces``: per surface label its ``ie_star``, ``limit``, ``k_star``,
-        ``k_path`` and ``lc_over_ls``.
+        ``k_path``, ``k_path_left_out`` and ``lc_over_ls``.
     """
     seed = fam.seeds[0] if fam.seeds else None
     per, corners = {}, {}
