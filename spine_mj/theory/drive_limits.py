@@ -63,7 +63,7 @@ from spine_mj.surfaces import Surface
 from spine_mj.theory import streamline as sl
 from spine_mj.theory.compliant import hold_force
 from spine_mj.theory.engagement import DEFAULT_KAPPA_CAP, SELF_LOCK
-from spine_mj.theory.path_stiffness import kappa_fall, path_stiffness
+from spine_mj.theory.path_stiffness import max_fall, path_stiffness
 from spine_mj.theory.targets import FRECHET_TARGET
 
 __all__ = [
@@ -353,23 +353,20 @@ def spring_ie_limits(
 
 def _path_statistics(
     surface: Surface, res, mu: float, kappa_cap: float, tip_radius: float = 0.0
-) -> tuple[float, float, np.ndarray]:
-    """Over the paths of ``res``: the steepest fall of the hold force ``max(-dH/dx)``, the
-    sharpest crest ``max(-z'')`` (at most :func:`ball_crest_bound` on a surface dilated by
-    ``tip_radius``), and per path the last finite hold force (a trap's arrival drive)."""
-    fall, curv, arrival = [], [], np.full(len(res), np.nan)
+) -> tuple[float, np.ndarray]:
+    """Over the paths of ``res``: the sharpest crest ``max(-z'')`` (at most
+    :func:`ball_crest_bound` on a surface dilated by ``tip_radius``), and per path the last
+    finite hold force (a trap's arrival drive)."""
+    curv, arrival = [np.array([])], np.full(len(res), np.nan)
     for i in range(len(res)):
         p = res.path(i)
         _, fx, fy = surface.evaluate(p["x"], p["y"], order=1)
         hold, _ = hold_force(fx, fy, mu)
-        hold = np.where(hold > kappa_cap, np.nan, hold)
-        fall.append(kappa_fall(p["x"], hold))
+        finite = hold[np.isfinite(hold) & (hold <= kappa_cap)]
+        arrival[i] = finite[-1] if finite.size else 0.0
         bound = ball_crest_bound(p["x"], p["y"], p["z"], fx, fy, tip_radius)
         curv.append(np.minimum(crest_curvature(p["x"], p["y"], p["z"]), bound))
-        finite = hold[np.isfinite(hold)]
-        arrival[i] = finite[-1] if finite.size else 0.0
-    max_fall = float(np.nanmax(np.concatenate(fall), initial=0.0))
-    return max_fall, float(np.nanmax(np.concatenate(curv), initial=0.0)), arrival
+    return float(np.nanmax(np.concatenate(curv), initial=0.0)), arrival
 
 
 def _path_stiffnesses(traced, path_starts, params, l_s: float, l_c: float, carriage_edge):
@@ -440,7 +437,8 @@ def drive_limits(
     dl = min(l_s / 40, min(np.diff(traced.bounds)[::2]) / 8) if dl is None else dl  # 1/8 of a strip's width
     params = sl.StreamlineParams(mu=mu, dl=dl, kappa_cap=kappa_cap)
     res = sl.streamlines(traced, pts, params, store_paths=True)
-    max_fall, max_curv, arrival = _path_statistics(traced, res, mu, kappa_cap, tip_radius)
+    fall = max_fall(traced, res, mu, kappa_cap)
+    max_curv, arrival = _path_statistics(traced, res, mu, kappa_cap, tip_radius)
     trapped = res.self_locked
     xy = (res.end_x[trapped], res.end_y[trapped])
     depth = trap_depths(traced, *xy, arrival[trapped], mu, step=params.dl / 4, kappa_cap=kappa_cap)
@@ -454,7 +452,7 @@ def drive_limits(
         traced, path_starts, params, l_s, l_c, carriage_edge
     )
     return DriveLimits(
-        k_star=l_s * max(0.0, max_fall),
+        k_star=l_s * max(0.0, fall),
         ie_star=limits[limit],
         ie_lift=ie_lift,
         ie_trap=ie_trap,
@@ -463,7 +461,7 @@ def drive_limits(
         mu=float(mu),
         slope_length=l_s,
         char_length=l_c,
-        max_fall=max_fall,
+        max_fall=fall,
         max_crest_curvature=max_curv,
         min_trap_depth=min_depth,
         n_paths=len(res),
