@@ -190,14 +190,7 @@ def path_stiffness(
     if carriage_edge is None and not (k_fold > 0 and math.isfinite(k_fold)):
         return 0.0, k_fold, 0
 
-    def compliant(k: float):
-        end = (
-            None
-            if carriage_edge is None
-            else pts[:, 0] + spring_run_travel(carriage_edge - pts[:, 0], slope_length / k, params.mu)
-        )
-        return compliant_streamlines(surface, pts, params, stiffness=k / slope_length, carriage_end=end)
-
+    compliant = _compliant_tracer(surface, pts, params, slope_length, carriage_edge)
     top = k_fold if k_fold > 0 and math.isfinite(k_fold) else 1.0
     misses = np.zeros(len(pts), bool)
     if carriage_edge is not None:
@@ -211,6 +204,27 @@ def path_stiffness(
         return agreement >= outcome_target and frechet <= frechet_target
 
     return _last_failure(passes, top, check_top=carriage_edge is not None), k_fold, int(misses.sum())
+
+
+def _compliant_tracer(surface, pts, params, slope_length: float, carriage_edge):
+    """``K -> `` the compliant-drive paths from ``pts`` at stiffness ``K`` (each carriage
+    stopping where a run's does, with ``carriage_edge``), each K traced once: the probes
+    and the search meet at the fold."""
+    traced = {}
+
+    def compliant(k: float):
+        if k not in traced:
+            end = (
+                None
+                if carriage_edge is None
+                else pts[:, 0] + spring_run_travel(carriage_edge - pts[:, 0], slope_length / k, params.mu)
+            )
+            traced[k] = compliant_streamlines(
+                surface, pts, params, stiffness=k / slope_length, carriage_end=end
+            )
+        return traced[k]
+
+    return compliant
 
 
 def _missed_at_every_probe(rigid, compliant, top: float, char_length: float, frechet_target: float):

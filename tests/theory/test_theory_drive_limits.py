@@ -162,17 +162,25 @@ def test_k_path_is_where_the_compliant_paths_stop_meeting_the_criterion_below_th
     assert between.folds.start.size > 0
 
 
+WALL_MU, WALL_SLOPE, WALL_WIDTH, WALL_X0 = 0.5, 1.5, 0.4, -0.5
+
+
+def _wall_case():
+    """``(wall, starts, params, edge, l_s)``: two starts before a wall of slope 1.5 and width
+    0.4 on flat ground, mu 0.5, l_s 0.7 (the K_path tests' case)."""
+    wall = Wall(WALL_SLOPE, WALL_WIDTH)
+    starts = np.array([(WALL_X0, 0.0), (WALL_X0, 0.2)])
+    return wall, starts, sl.StreamlineParams(mu=WALL_MU, dl=0.01), wall.bounds[1], 0.7
+
+
 def test_k_path_with_the_runs_travel_is_where_their_carriage_stops_short_of_a_hold():
     # a wall of hold H = (t + mu) / (1 - mu t) = 8 > 1 + mu between flat ground: the tip
     # climbs it with the carriage at x + H l_s / K, and a run's carriage, stopped
     # 1.1 d + (1 + mu) l_s / K past the start (d: to the +x edge), leaves it at the wall's
     # top (x = w) below K = (H - 1 - mu) l_s / (1.1 d - (w - x0)), where the rigid path
     # goes on to the edge; the fold at the top (H falls to mu) jumps along the path
-    mu, t, w = 0.5, 1.5, 0.4
-    wall, x0 = Wall(t, w), -0.5
-    starts = np.array([(x0, 0.0), (x0, 0.2)])
-    params = sl.StreamlineParams(mu=mu, dl=0.01)
-    edge, ls = wall.bounds[1], 0.7
+    mu, t, w, x0 = WALL_MU, WALL_SLOPE, WALL_WIDTH, WALL_X0
+    wall, starts, params, edge, ls = _wall_case()
     hold = (t + mu) / (1 - mu * t)
     k_travel = (hold - 1 - mu) * ls / (1.1 * (edge - x0) - (w - x0))
     k_path, k_fold, _ = path_stiffness(
@@ -347,11 +355,7 @@ def test_k_path_leaves_out_the_starts_that_miss_at_every_stiffness_probed():
     # the wall above: both starts climb it at any K above the carriage's limit; against a
     # Frechet target no path meets, every start misses at 1, 10 and 100 times the fold, so
     # none is left to judge and K_path is the search's "none passes"
-    mu, t, w = 0.5, 1.5, 0.4
-    wall, x0 = Wall(t, w), -0.5
-    starts = np.array([(x0, 0.0), (x0, 0.2)])
-    params = sl.StreamlineParams(mu=mu, dl=0.01)
-    edge, ls = wall.bounds[1], 0.7
+    wall, starts, params, edge, ls = _wall_case()
     k_path, k_fold, left_out = path_stiffness(
         wall, starts, params, slope_length=ls, char_length=1.0, carriage_edge=edge, frechet_target=-1.0
     )
