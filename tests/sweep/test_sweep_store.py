@@ -114,7 +114,8 @@ def test_kill_9_midway_then_resume_loses_and_duplicates_nothing(tmp_path):
         rows, _ = sweep.run_case(case)
         ref = rows.to_pandas().set_index("run_id")
         got = runs.set_index("run_id").loc[ref.index]
-        np.testing.assert_array_equal(got.end_x, ref.end_x)
+        # worker processes may differ from this one in the last bits (numpy's SIMD paths)
+        np.testing.assert_allclose(got.end_x, ref.end_x, rtol=1e-12, atol=0)
         np.testing.assert_array_equal(got.n_steps, ref.n_steps)
 
 
