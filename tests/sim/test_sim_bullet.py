@@ -389,7 +389,9 @@ def test_a_sweep_over_both_engines_killed_midway_resumes_to_the_same_results(tmp
     assert len(runs) == 16 and runs.run_id.is_unique and (runs["status"] == "ok").all()
     assert sorted(runs["engine"].unique()) == ["bullet", "mujoco"]
     alone = _run_cases_alone(cfg)
-    np.testing.assert_allclose(runs.set_index("run_id").loc[list(alone), "end_x"], list(alone.values()), rtol=1e-9)
+    np.testing.assert_allclose(
+        runs.set_index("run_id").loc[list(alone), "end_x"], list(alone.values()), rtol=1e-9
+    )
 
 
 def test_a_sweep_over_both_engines_on_a_dask_cluster_stores_what_one_process_stores(tmp_path):
