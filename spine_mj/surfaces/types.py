@@ -293,7 +293,7 @@ class GridSurface(Surface):
     def __post_init__(self):
         if np.iscomplexobj(self.heights):  # a cast would drop the imaginary part with a warning
             raise SpineInputError("heights must be real numbers, got complex values")
-        heights = np.array(self.heights, dtype=float)
+        heights = np.array(self.heights, dtype=float, order="C")  # the kernels take C order
         if heights.ndim != 2:
             raise SpineInputError(f"heights must be a 2-D array (ny, nx), got shape {heights.shape}")
         ny, nx = heights.shape

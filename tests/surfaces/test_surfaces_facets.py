@@ -82,3 +82,15 @@ def test_ball_on_facets_rejects_bad_input():
         BallOnFacets(single_gaussian(), 0.1)
     with pytest.raises(SpineInputError, match="Hessian"):
         BallOnFacets(tri, 0.1).hessian(0.5, 0.5)
+
+
+def test_a_fortran_ordered_grid_reaches_the_kernels_without_a_copy():
+    """A scan's heights may arrive transposed (Fortran order); the grid keeps them in C order
+    once, so each kernel call takes the array as it is (a copy per call was 26 of the 89
+    CPU-s of comparing 12 starts on di-1)."""
+    h = np.asfortranarray(np.random.default_rng(0).normal(size=(40, 30)))
+    fac = TriangulatedSurface(heights=h, x=np.arange(30.0), y=np.arange(40.0))
+    assert fac.heights.flags.c_contiguous
+    np.testing.assert_array_equal(fac.heights, h)
+    ball = BallOnFacets(fac, radius=1.5)
+    assert ball.kernel_args()[0] is ball.kernel_args()[0]
