@@ -89,8 +89,7 @@ def test_cli_simulate_on_a_long_narrow_track(tmp_path):
 
 def test_cli_simulate_and_surface_info_on_a_y_varying_strip_with_the_tip_on_its_line(tmp_path):
     """A strip 4 wide whose heights vary along y: `surface info` reports it, `simulate
-    --line` keeps the tip on y0 along the whole run (free, it left the strip), and Bullet,
-    which has no such rail, refuses --line in one line with nothing written."""
+    --line` keeps the tip on y0 along the whole run (free, it left the strip)."""
     import json
 
     import numpy as np
@@ -112,6 +111,15 @@ def test_cli_simulate_and_surface_info_on_a_y_varying_strip_with_the_tip_on_its_
     assert res.exit_code == 0, res.output
     y_m = pd.read_parquet(tmp_path / "run" / "trajectory.parquet")["position_y_m"].to_numpy()
     assert np.abs(y_m / 0.01 - 1.0).max() < 1e-6  # a grid without a unit: 0.01 m a unit
+
+
+def test_bullet_which_has_no_rail_refuses_line_in_one_line_with_nothing_written(tmp_path):
+    from click.testing import CliRunner
+
+    from spine_mj.cli import main
+
+    pytest.importorskip("pybullet", reason="the Bullet engine needs the [bullet] extra (pybullet)")
+    run = ["simulate", "paper-single-peak", "--start", "-3,-1", "--duration", "0.01", "--line"]
     res = CliRunner().invoke(main, [*run, "--engine", "bullet", "--out", str(tmp_path / "bullet")])
     assert res.exit_code == 2 and res.output.strip().splitlines() == [
         "Error: line: not read by engine bullet (its options: timestep_s)"
