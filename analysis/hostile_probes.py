@@ -350,7 +350,7 @@ def _issue44(add, work: Path, py: str) -> None:
         "refuse",
         "timestep",
     )
-    engines = [py, "-m", "spine_mj.validate.engines"]
+    engines = [*SPINE, "compare-engines"]
     (work / "a-file").write_text("")
     for args, needle in (
         (["--out", "e", "--fractal", "-1"], "--fractal"),
@@ -359,7 +359,7 @@ def _issue44(add, work: Path, py: str) -> None:
         ([], "--out"),
         (["--out", "a-file"], "a-file"),
     ):
-        add(f"validate.engines {' '.join(args) or '(no arguments)'}", [*engines, *args], "refuse", needle)
+        add(f"compare-engines {' '.join(args) or '(no arguments)'}", [*engines, *args], "refuse", needle)
     (work / "deep.json").write_text("[" * 100_000 + "]" * 100_000)
     check = str(Path(__file__).with_name("reproduction_check.py"))
     add("reproduction_check.py on deeply nested JSON", [py, check, "deep.json"], "refuse", "nested too deep")

@@ -1,5 +1,5 @@
 """The one exception type spine_mj raises for bad input, the check of a positive number, and
-the argument parser of the ``python -m`` studies and scripts that reports as the CLI does.
+the argument parser of the analysis scripts that reports as the CLI does.
 
 Every check of user input raises :class:`SpineInputError` with a message that names the
 argument, what was expected and what arrived. The CLI turns it into one line on stderr and
@@ -11,7 +11,7 @@ from __future__ import annotations
 import argparse
 import math
 
-__all__ = ["OneLineParser", "SpineInputError", "check_positive", "non_negative_int"]
+__all__ = ["OneLineParser", "SpineInputError", "check_positive"]
 
 
 class SpineInputError(ValueError):
@@ -45,14 +45,3 @@ class OneLineParser(argparse.ArgumentParser):
 
     def error(self, message):
         self.exit(2, f"Error: {message} (see --help)\n")
-
-
-def non_negative_int(text: str) -> int:
-    """An argparse ``type``: ``text`` as an integer >= 0 (argparse names the option)."""
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"must be an integer >= 0, got {text!r}") from None
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"must be an integer >= 0, got {text!r}")
-    return value

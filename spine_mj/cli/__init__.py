@@ -6,7 +6,7 @@ commands: :mod:`~spine_mj.cli.surface` (``surface make/show/info/export``),
 :mod:`~spine_mj.cli.theory` (``kappa``, ``streamline``, ``reproduce``),
 :mod:`~spine_mj.cli.sim` (``simulate``, ``replay``, ``view``, ``sim export``),
 :mod:`~spine_mj.cli.sweep` (``sweep run/status``, ``report``), :mod:`~spine_mj.cli.array`
-(``array``), :mod:`~spine_mj.cli.validate` (``validate``), :mod:`~spine_mj.cli.hold`
+(``array``), :mod:`~spine_mj.cli.validate` (``validate``, ``compare-engines``), :mod:`~spine_mj.cli.hold`
 (``hold``) and :mod:`~spine_mj.cli.examples`
 (``examples``).
 

@@ -167,6 +167,7 @@ class _Root(_Group):
     #: command name -> the module of :mod:`spine_mj.cli` that registers it on :func:`main`
     lazy_commands: ClassVar[dict[str, str]] = {
         "array": "array",
+        "compare-engines": "validate",
         "examples": "examples",
         "hold": "hold",
         "kappa": "theory",

@@ -1,4 +1,5 @@
-"""``spine-mj validate``: the validation suite, MuJoCo against the quasistatic streamline."""
+"""``spine-mj validate``: the validation suite, MuJoCo against the quasistatic streamline; and
+``spine-mj compare-engines``: MuJoCo beside Bullet, the comparisons too long for a plan."""
 
 from __future__ import annotations
 
@@ -71,3 +72,63 @@ def validate_cmd(out_dir, quick, plan_name, workers, quiet):
     click.echo(
         f"wrote {out / 'report.md'} and {out / 'validation.json'} ({result['timings_s']['total']:.0f} s)"
     )
+
+
+@main.command("compare-engines")
+@click.option(
+    "--out",
+    "out_dir",
+    required=True,
+    type=click.Path(),
+    help="Output folder: engines.json, engines.md (with --headlines headlines.json), sweeps/ (resumable).",
+)
+@click.option("--quick", is_flag=True, help="Prandtl-Tomlinson over fewer corrugation wavelengths.")
+@click.option(
+    "--fractal",
+    type=click.IntRange(min=0),
+    default=0,
+    metavar="N",
+    help="Also the fractal self-lock rate against H in both engines, N surfaces per H.",
+)
+@click.option(
+    "--headlines",
+    type=click.IntRange(min=0),
+    default=0,
+    metavar="N",
+    help="Also the quasistatic-limit corner per family in both engines, N y starts per surface "
+    "(and the full report's soft-contact misses rerun).",
+)
+@click.option(
+    "--headlines-plan",
+    type=click.Choice(PLAN_NAMES),
+    default="quick",
+    show_default=True,
+    help="The plan whose corner --headlines runs.",
+)
+@click.option(
+    "--workers",
+    type=click.IntRange(min=1),
+    default=None,
+    help="Worker processes for the sweeps (default: all cores).",
+)
+def compare_engines_cmd(out_dir, quick, fractal, headlines, headlines_plan, workers):
+    """MuJoCo beside Bullet: the closed forms in both engines (the validation's engines study),
+    and with --fractal and --headlines the comparisons too long for a validation plan; writes
+    --out/engines.json and --out/engines.md. Needs the [bullet] extra.
+
+    \b
+    Example:
+      spine-mj compare-engines --out engines-out --fractal 6
+    """
+    from spine_mj.validate.engines import compare_engines
+
+    text = compare_engines(
+        Path(out_dir),
+        quick=quick,
+        fractal_surfaces=fractal,
+        headlines_starts=headlines,
+        headlines_plan=headlines_plan,
+        workers=workers,
+        progress=lambda line: click.echo(line, err=True),
+    )
+    click.echo(text)

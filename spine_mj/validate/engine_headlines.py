@@ -18,18 +18,19 @@ reference, restarted at MuJoCo's end, moves on) rerun from the same starts with 
 plan's settings in both engines: where Bullet agrees with the reference and MuJoCo still
 holds, the miss is MuJoCo's contact model.
 
-Run by ``python -m spine_mj.validate.engines --out DIR --headlines N`` (N y starts per
-surface of the plan's corner, :func:`~spine_mj.validate.convergence.thin_starts`), which
-writes :data:`RESULT_FILE` beside ``engines.json`` and its section (:func:`section`) into
-``engines.md`` (the committed ``analysis/reports/engines.md``); it is too long for a
-validation plan, whose engines study is the closed forms (:func:`spine_mj.validate.engines.engines_study`).
+Run by ``spine-mj compare-engines --out DIR --headlines N`` (N y starts per surface of the
+plan's corner, :func:`~spine_mj.validate.convergence.thin_starts`), which writes
+:data:`RESULT_FILE` beside ``engines.json`` and its section
+(:func:`spine_mj.validate.report.engine_headlines.section`) into ``engines.md`` (the
+committed ``analysis/reports/engines-headlines.md``); it is too long for a validation plan,
+whose engines study is the closed forms (:func:`spine_mj.validate.engines.engines_study`).
 """
 
 from __future__ import annotations
 
 import dataclasses
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -37,14 +38,12 @@ import numpy as np
 import pandas as pd
 
 from spine_mj.choices import COMPARED_ENGINES
-from spine_mj.errors import non_negative_int
 from spine_mj.theory import agreement
 from spine_mj.validate.convergence import thin_starts
 from spine_mj.validate.ensembles import ensemble_family
 from spine_mj.validate.intervals import newcombe_difference
 from spine_mj.validate.plans import PLANS, FamilySpec, ValidationPlan, paper_starts, relative_starts
 from spine_mj.validate.quasistatic_limit import corner_summary, limit_doc, limit_family_docs
-from spine_mj.validate.report.engine_headlines import section
 from spine_mj.validate.study_runner import StudyRunner
 
 __all__ = [
@@ -56,7 +55,6 @@ __all__ = [
     "engine_headlines",
     "load",
     "run_engine_headlines",
-    "section",
 ]
 
 #: The study's result, in the folder of ``engines.json``.
@@ -445,35 +443,3 @@ def load(folder: Path) -> EngineHeadlinesResult | None:
 
     path = Path(folder) / RESULT_FILE
     return EngineHeadlinesResult.from_dict(json.loads(path.read_text())) if path.is_file() else None
-
-
-def add_arguments(ap) -> None:
-    """The study's options of ``python -m spine_mj.validate.engines``."""
-    ap.add_argument(
-        "--headlines",
-        type=non_negative_int,
-        default=0,
-        metavar="N",
-        help="also the quasistatic-limit corner per family in both engines, N y starts per surface "
-        "(and the full report's soft-contact misses rerun)",
-    )
-    ap.add_argument(
-        "--headlines-plan", default="quick", choices=sorted(PLANS), help="whose corner (default quick)"
-    )
-
-
-def from_arguments(args, progress: Callable[[str], None] | None = None) -> EngineHeadlinesResult | None:
-    """Run the study as ``args`` (:func:`add_arguments`) ask, into ``args.out``; None without
-    ``--headlines``. Writes :data:`RESULT_FILE` there."""
-    if not args.headlines:
-        return None
-    from spine_mj.jsonio import write_json
-
-    if progress is not None:
-        progress("headlines: the corner per family and the soft-contact misses, both engines")
-    res = run_engine_headlines(
-        args.out, plan=args.headlines_plan, starts_per_surface=args.headlines, workers=args.workers
-    )
-    args.out.mkdir(parents=True, exist_ok=True)
-    write_json(args.out / RESULT_FILE, res.as_dict())
-    return res

@@ -41,8 +41,8 @@ facets' rule says; with them Bullet self-locks).
 ``spine-mj validate`` runs the closed forms as a study of its registry
 (:func:`engines_study`, the plan's ``engines_checks``), its section "Engines side by side"
 in ``report.md``, where the ``[bullet]`` extra is installed (without it the section says so
-in one line). The longer comparisons run apart:
-``python -m spine_mj.validate.engines --out DIR [--quick] [--fractal N] [--headlines N]``
+in one line). The longer comparisons run apart (:func:`compare_engines`):
+``spine-mj compare-engines --out DIR [--quick] [--fractal N] [--headlines N]``
 (``--headlines``: the quasistatic-limit corner per family in both engines,
 :mod:`spine_mj.validate.engine_headlines`) writes ``engines.json`` and ``engines.md``; the
 committed ``analysis/reports/engines.md`` is ``--fractal 6`` (the full plan's 30 took 855 s).
@@ -51,7 +51,6 @@ committed ``analysis/reports/engines.md`` is ``--fractal 6`` (the full plan's 30
 from __future__ import annotations
 
 import math
-import sys
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -62,14 +61,21 @@ import numpy as np
 from spine_mj import presets, sim
 from spine_mj.atomic import atomic_output
 from spine_mj.choices import COMPARED_ENGINES
-from spine_mj.errors import OneLineParser, SpineInputError, non_negative_int
+from spine_mj.errors import SpineInputError
 from spine_mj.theory import engagement
 from spine_mj.theory.tomlinson import Corrugation
 from spine_mj.validate.plans import ValidationPlan
 from spine_mj.validate.study_runner import StudyRunner
 from spine_mj.validate.wedges import dai_start, dai_surface, dai_threshold, flank_tilt, groove
 
-__all__ = ["CHECKS", "EnginesResult", "engines_ground_truth", "engines_study"]
+__all__ = [
+    "CHECKS",
+    "COMPARISON_FILES",
+    "EnginesResult",
+    "compare_engines",
+    "engines_ground_truth",
+    "engines_study",
+]
 
 MU = 0.5
 STATIC_TOL = 0.05
@@ -498,69 +504,78 @@ def engines_study(plan: ValidationPlan, runner: StudyRunner) -> EnginesResult:
         return engines_ground_truth(quick=plan.engines_quick, checks=checks, progress=lambda _: tick())
 
 
-def main(argv=None) -> int:
-    """``python -m spine_mj.validate.engines``: every argument, the output folder and the
-    ``[bullet]`` extra checked before any work; a bad one is one ``Error:`` line, exit 2."""
-    ap = OneLineParser(description="The closed forms in both engines (MuJoCo and Bullet).")
-    ap.add_argument("--out", type=Path, required=True, help="folder for engines.json and engines.md")
-    ap.add_argument("--quick", action="store_true", help="fewer corrugation wavelengths")
-    ap.add_argument(
-        "--fractal",
-        type=non_negative_int,
-        default=0,
-        metavar="N",
-        help="also the fractal self-lock rate, N surfaces per H",
-    )
-    ap.add_argument("--workers", type=int, default=None, help="worker processes of the fractal sweep")
-    from spine_mj.validate import engine_headlines
-
-    engine_headlines.add_arguments(ap)
-    args = ap.parse_args(argv)
-    try:
-        _check_arguments(args)
-        _run(args)
-    except SpineInputError as exc:
-        print(f"Error: {exc}", file=sys.stderr)
-        return 2
-    return 0
+#: What :func:`compare_engines` writes into its folder (beside its resumable ``sweeps/``).
+COMPARISON_FILES = ("engines.json", "engines.md")
 
 
-def _check_arguments(args) -> None:
-    """What the study would refuse midway, refused before its first run."""
-    from spine_mj import extras
-    from spine_mj.atomic import writable_path
-    from spine_mj.workers import check_workers
+def compare_engines(
+    out: Path,
+    *,
+    quick: bool = False,
+    fractal_surfaces: int = 0,
+    headlines_starts: int = 0,
+    headlines_plan: str = "quick",
+    workers: int | None = None,
+    progress: Callable[[str], None] | None = None,
+) -> str:
+    """``spine-mj compare-engines``: the comparisons too long for a validation plan.
 
-    if args.workers is not None:
-        check_workers(args.workers)
-    if args.out.exists() and not args.out.is_dir():
-        raise SpineInputError(f"--out {args.out}: is a file, expected a folder")
-    extras.require("bullet", "python -m spine_mj.validate.engines (it runs both engines)")
-    for name in ("engines.json", "engines.md"):
-        writable_path(args.out / name)
+    The closed forms in both engines (:func:`engines_ground_truth`; ``quick``: fewer
+    corrugation wavelengths), with ``fractal_surfaces`` > 0 the fractal self-lock rate
+    against H in both engines (:func:`~spine_mj.validate.fractal_lock.fractal_engines`, that
+    many surfaces per H) and with ``headlines_starts`` > 0 the quasistatic-limit corner per
+    family in both engines and the full report's soft-contact misses rerun
+    (:mod:`spine_mj.validate.engine_headlines`, that many y starts per surface of
+    ``headlines_plan``'s corner, written to its :data:`~spine_mj.validate.engine_headlines.RESULT_FILE`).
+    Writes :data:`COMPARISON_FILES` into ``out`` and returns the markdown of ``engines.md``.
 
-
-def _run(args) -> None:
+    Every argument, the folder and the ``[bullet]`` extra are checked before any work
+    (:class:`~spine_mj.errors.SpineInputError`); ``progress`` hears a line per step.
+    """
     import dataclasses
 
+    from spine_mj import extras
+    from spine_mj.atomic import writable_path
+    from spine_mj.choices import PLAN_NAMES
     from spine_mj.jsonio import write_json
     from spine_mj.validate import engine_headlines
     from spine_mj.validate.fractal_lock import fractal_engines
+    from spine_mj.validate.report.engine_headlines import section as headlines_section
     from spine_mj.validate.report.engines import section
+    from spine_mj.workers import check_workers
 
-    res = engines_ground_truth(quick=args.quick, progress=lambda s: print(s, flush=True))
-    if args.fractal:
+    out = Path(out)
+    for name, value in (("--fractal", fractal_surfaces), ("--headlines", headlines_starts)):
+        if isinstance(value, bool) or not isinstance(value, int) or value < 0:
+            raise SpineInputError(f"{name}: must be an integer >= 0, got {value!r}")
+    if headlines_plan not in PLAN_NAMES:
+        raise SpineInputError(
+            f"--headlines-plan must be one of {', '.join(PLAN_NAMES)}, got {headlines_plan!r}"
+        )
+    if workers is not None:
+        check_workers(workers)
+    if out.exists() and not out.is_dir():
+        raise SpineInputError(f"--out {out}: is a file, expected a folder")
+    extras.require("bullet", "compare-engines (it runs both engines)")
+    for name in COMPARISON_FILES:
+        writable_path(out / name)
+    say = progress or (lambda _: None)
+
+    res = engines_ground_truth(quick=quick, progress=say)
+    if fractal_surfaces:
         t0 = time.perf_counter()
-        fractal = fractal_engines(args.out, surfaces_per_hurst=args.fractal, workers=args.workers)
+        fractal = fractal_engines(out, surfaces_per_hurst=fractal_surfaces, workers=workers)
         wall = dict(res.wall_s, fractal=round(time.perf_counter() - t0, 1))
         res = dataclasses.replace(res, fractal=fractal, wall_s=wall)
-    headlines = engine_headlines.from_arguments(args, progress=lambda s: print(s, flush=True))
-    write_json(args.out / "engines.json", res.as_dict())
-    text = section(res) + engine_headlines.section(headlines)
-    with atomic_output(args.out / "engines.md") as tmp:
+    headlines = None
+    if headlines_starts:
+        say("headlines: the corner per family and the soft-contact misses, both engines")
+        headlines = engine_headlines.run_engine_headlines(
+            out, plan=headlines_plan, starts_per_surface=headlines_starts, workers=workers
+        )
+        write_json(out / engine_headlines.RESULT_FILE, headlines.as_dict())
+    write_json(out / "engines.json", res.as_dict())
+    text = section(res) + headlines_section(headlines)
+    with atomic_output(out / "engines.md") as tmp:
         tmp.write_text(text)
-    print(text)
-
-
-if __name__ == "__main__":
-    sys.exit(main())
+    return text

@@ -12,6 +12,7 @@ from spine_mj import presets
 from spine_mj.validate import engine_headlines as study
 from spine_mj.validate.ensembles import ensemble_family
 from spine_mj.validate.plans import PLANS, FamilySpec, paper_starts
+from spine_mj.validate.report.engine_headlines import section
 
 
 def _surface_units(fam, miss, point):
@@ -114,7 +115,7 @@ def test_the_corner_and_a_miss_run_in_both_engines(tmp_path):
         ("bullet", miss.label),
     ]
     write_json(tmp_path / study.RESULT_FILE, res.as_dict())
-    text = study.section(study.load(tmp_path))
-    assert text == study.section(res)  # the report from the file is the one from the run
+    text = section(study.load(tmp_path))
+    assert text == section(res)  # the report from the file is the one from the run
     assert "## Engines side by side: the headlines" in text
     assert text.count("| single_peak_valley | streamline") == 2

@@ -2,10 +2,11 @@
 table rows from a hand-made result."""
 
 from spine_mj.validate import engine_headlines as study
+from spine_mj.validate.report.engine_headlines import section
 
 
 def test_no_result_no_section():
-    assert study.section(None) == ""
+    assert section(None) == ""
 
 
 def _summary(agreeing, well, starts):
@@ -39,6 +40,6 @@ def test_the_section_has_a_row_per_family_and_engine():
         cpu_s={"fractal": {e: {"engine": 2.0, "reference": 3.0, "runs": 36} for e in ("mujoco", "bullet")}},
         wall_s=10.0,
     )
-    text = study.section(res)
+    text = section(res)
     assert "| fractal | streamline, >= 0.95 | mujoco | 0.900 [0.596, 0.982] | 9 / 10 (12) |" in text
     assert "| fractal | streamline, >= 0.95 | bullet | 1.000 [0.722, 1.000] | 10 / 10 (12) |" in text
