@@ -26,7 +26,8 @@ import numpy as np
 from spine_mj.presets import load_preset
 from spine_mj.reproduce import calibrate_single_peak_mu, fractal_hurst, random_gaussian, single_peak
 from spine_mj.surfaces import single_gaussian
-from spine_mj.theory.streamline import StreamlineParams, ideal_trajectories, streamlines
+from spine_mj.theory.streamline import ideal_trajectories, streamlines
+from spine_mj.theory.streamline_types import StreamlineParams
 
 OUT = Path(__file__).parent / "reports"
 PAPER_RG = {

@@ -4,7 +4,7 @@ Rebuilds, for the full plan's sandpaper and fractal families at the lowest I_e, 
 sweep's ``compare`` analysis compared before its contact surface became exact
 (:class:`spine_mj.surfaces.BallOnFacets`): the MuJoCo runs (the ``engine`` analysis of each
 case, about a minute for both families) and the reference streamline traced on the facets
-dilated by the tip and sampled at R/8 under a spline (``spine_mj.theory.streamline.dilate``), with
+dilated by the tip and sampled at R/8 under a spline (``spine_mj.surfaces.dilation.dilate``), with
 the same mu_s, step and force cap. Then, per run that disagrees or whose reference stalls or holds:
 
 * the reference with fixed steps (``max_halvings = 0``, the integrator before the step
@@ -27,18 +27,20 @@ import numpy as np
 
 from spine_mj.sim.model import from_hfield
 from spine_mj.surfaces import TriangulatedSurface
+from spine_mj.surfaces.dilation import dilate
 from spine_mj.sweep import ANALYSES, expand_cases, parse_config
 from spine_mj.sweep.analyses.engine import case_rig
 from spine_mj.theory import agreement
 from spine_mj.theory import streamline as sl
 from spine_mj.theory.engagement import kappa
+from spine_mj.theory.streamline_types import StreamlineParams
 from spine_mj.validate.plans import FRACTAL, PLANS, SANDPAPER
 from spine_mj.validate.quasistatic_limit import limit_doc
 
 
 def exact_contact(facets, c, radius, n=321):
     """Height of the dilated facets at ``c`` (shifted down by the radius, as
-    :func:`spine_mj.theory.streamline.dilate`) and the slope from the highest contact, by brute
+    :func:`spine_mj.surfaces.dilation.dilate`) and the slope from the highest contact, by brute
     force over ``n x n`` points of the tip's footprint."""
     u = np.linspace(-radius, radius, n)
     x, y = np.meshgrid(c[0] + u, c[1] + u)
@@ -69,7 +71,7 @@ def _case(case):
     runs = ANALYSES["engine"].func(case, surface, starts, {}).data[1]
     s = rig.length_scale_m
     facets = TriangulatedSurface.from_grid(from_hfield(rig.hfield, unit=surface.unit))
-    contact = sl.dilate(facets, rig.tip.tip_radius_m / s)  # the spline surface compare used to trace on
+    contact = dilate(facets, rig.tip.tip_radius_m / s)  # the spline surface compare used to trace on
     p = case.params
     return {
         "tag": f"{case.surface.label} {dict(case.surface.overrides) or ''}".strip(),
@@ -81,9 +83,7 @@ def _case(case):
         "contact": contact,
         "facets": facets,
         "radius": rig.tip.tip_radius_m / s,
-        "params": sl.StreamlineParams(
-            mu=p["mu"], dl=min(p["dl"], *contact.spacing), kappa_cap=p["kappa_cap"]
-        ),
+        "params": StreamlineParams(mu=p["mu"], dl=min(p["dl"], *contact.spacing), kappa_cap=p["kappa_cap"]),
         "dl": p["dl"],
     }
 
@@ -110,7 +110,7 @@ def _finer_sampling(d, i):
     """The fractal miss's reference on the facets dilated at R/16 and R/32."""
     lc = d["lc"]
     for m in (16, 32):
-        finer = sl.dilate(d["facets"], d["radius"], spacing=d["radius"] / m)
+        finer = dilate(d["facets"], d["radius"], spacing=d["radius"] / m)
         r = trace(finer, d["starts"][i : i + 1], d["params"], dl=min(d["dl"], *finer.spacing))
         f = agreement.path_frechet(d["mpaths"][i], _xy(r, 0), length_scale=lc)
         print(

@@ -44,7 +44,7 @@ def bench_engines(quick: bool) -> dict:
             row[f"{engine}_s_per_run"] = best / len(starts)
             row[f"{engine}_rows_per_s"] = recorded / best
             if engine == "bullet":
-                from spine_mj.sim.bullet import spring_substeps
+                from spine_mj.sim.bullet_settings import spring_substeps
 
                 n = spring_substeps(rig.engine, drive, sc)
                 row["bullet_substeps"] = n

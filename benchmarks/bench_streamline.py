@@ -7,7 +7,8 @@ from bench_common import fmt, target_cell
 
 from spine_mj.reproduce import fractal_hurst
 from spine_mj.surfaces import fractal_fbm, single_gaussian
-from spine_mj.theory.streamline import StreamlineParams, streamlines
+from spine_mj.theory.streamline import streamlines
+from spine_mj.theory.streamline_types import StreamlineParams
 
 
 def steps_per_second(surface, starts, params, repeat=5, backend="auto"):

@@ -38,10 +38,9 @@ HOMES = {
     **dict.fromkeys(("ENGAGED", "SELF_LOCK", "SLIP", "kappa"), "spine_mj.theory.engagement"),
     "SpineInputError": "spine_mj.errors",
     **dict.fromkeys(("list_presets", "load_preset", "make_surface", "open_surface"), "spine_mj.presets"),
-    **dict.fromkeys(
-        ("Outcome", "StreamlineParams", "StreamlineResult", "dilate", "ideal_trajectories", "streamlines"),
-        "spine_mj.theory.streamline",
-    ),
+    **dict.fromkeys(("Outcome", "StreamlineParams", "StreamlineResult"), "spine_mj.theory.streamline_types"),
+    **dict.fromkeys(("ideal_trajectories", "streamlines"), "spine_mj.theory.streamline"),
+    "dilate": "spine_mj.surfaces.dilation",
     **dict.fromkeys(
         ("import_topography", "load_surface", "save_surface", "write_stl"), "spine_mj.surface_io"
     ),

@@ -91,7 +91,8 @@ def test_cli_streamline_writes_a_table(tmp_path):
 
 def test_random_surface_single_peak_normalization_and_finite_max_kappa():
     from spine_mj.reproduce.random_gaussian import _max_kappa, _random_surface
-    from spine_mj.theory.streamline import StreamlineParams, streamlines
+    from spine_mj.theory.streamline import streamlines
+    from spine_mj.theory.streamline_types import StreamlineParams
 
     gen = {"n_peaks": 20, "sign": -1, "sigma_range": (0.5, 1.5), "overlap": True, "k_range": (1.0, 2.0)}
     surf = _random_surface(gen, 3)

@@ -7,7 +7,7 @@ import math
 from collections.abc import Callable
 
 from spine_mj.presets import load_preset, resolve_mu
-from spine_mj.theory.streamline import Outcome
+from spine_mj.theory.streamline_types import Outcome
 
 Progress = Callable[[int, int], None] | None
 FIVE_Y0 = (-0.5, -1.0, -2.0, -3.0, -4.0)

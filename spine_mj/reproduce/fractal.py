@@ -14,7 +14,8 @@ from spine_mj.plotting import (
 from spine_mj.reproduce._common import Progress, _nan_none, _settings
 from spine_mj.surfaces import fractal_fbm
 from spine_mj.theory.convexity import CONCAVE, CONVEX, SADDLE, hessian_class, sectional_class
-from spine_mj.theory.streamline import StreamlineParams, ideal_trajectories, streamlines
+from spine_mj.theory.streamline import ideal_trajectories, streamlines
+from spine_mj.theory.streamline_types import StreamlineParams
 from spine_mj.workers import check_workers
 
 # --------------------------------------------------------------------------- Figs. 7E, 9

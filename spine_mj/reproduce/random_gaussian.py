@@ -13,7 +13,8 @@ from spine_mj.plotting import (
 from spine_mj.reproduce._common import Progress, _finite_or_str, _settings
 from spine_mj.surfaces import GaussianSurface, random_gaussians
 from spine_mj.theory.engagement import ENGAGED, SLIP, kappa
-from spine_mj.theory.streamline import StreamlineParams, ideal_trajectories, streamlines
+from spine_mj.theory.streamline import ideal_trajectories, streamlines
+from spine_mj.theory.streamline_types import StreamlineParams
 
 # --------------------------------------------------------------------------- Fig. 5
 

@@ -16,7 +16,8 @@ from spine_mj.plotting import (
 from spine_mj.reproduce._common import FIVE_Y0, Progress, _finite_or_str, _outcome_name, _settings
 from spine_mj.surfaces import single_gaussian
 from spine_mj.theory.engagement import REGION_NAMES, kappa_grid
-from spine_mj.theory.streamline import StreamlineParams, ideal_trajectories, streamlines
+from spine_mj.theory.streamline import ideal_trajectories, streamlines
+from spine_mj.theory.streamline_types import StreamlineParams
 
 # --------------------------------------------------------------------------- Figs. 3-4
 

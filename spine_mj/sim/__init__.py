@@ -66,7 +66,8 @@ record, :class:`RigInputs` of :mod:`~spine_mj.sim.rig_inputs`) and
 """
 
 from spine_mj.roughness import characteristic_length
-from spine_mj.sim.array import ArrayResult, ArrayRig, ForcePull
+from spine_mj.sim.array import ArrayRig
+from spine_mj.sim.array_run import ArrayResult, ForcePull
 from spine_mj.sim.build import (
     DEFAULT_INERTIA_NUMBER,
     RigInputs,

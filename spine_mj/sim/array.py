@@ -276,4 +276,4 @@ def _state_size(model) -> int:
     return mujoco.mj_stateSize(model, mujoco.mjtState.mjSTATE_FULLPHYSICS)
 
 
-__all__ = ["ArrayDrive", "ArrayResult", "ArrayRig", "ForcePull"]
+__all__ = ["ArrayRig"]

@@ -39,7 +39,6 @@ from spine_mj.surfaces import Surface
 
 __all__ = [
     "DEFAULT_INERTIA_NUMBER",
-    "RigInputs",
     "RigPlan",
     "build_array",
     "build_array_on",

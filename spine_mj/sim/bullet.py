@@ -64,7 +64,7 @@ from spine_mj.sim.scales import Scales
 from spine_mj.sim.step_rule import MIN_TIMESTEP_TAU
 from spine_mj.surfaces import HField, Surface
 
-__all__ = ["BulletRig", "BulletSettings", "default_bullet_engine"]
+__all__ = ["BulletRig"]
 
 #: Rows simulated between two looks at a run's end conditions.
 WINDOW_ROWS = 512

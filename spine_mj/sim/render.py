@@ -22,7 +22,9 @@ from spine_mj.atomic import atomic_output
 from spine_mj.errors import SpineInputError
 from spine_mj.sim.drives import Drive
 from spine_mj.sim.model import RigModel
+from spine_mj.surfaces.dilation import dilate
 from spine_mj.theory import streamline as sl
+from spine_mj.theory.streamline_types import StreamlineParams
 
 TRAIL_RGBA = (1.0, 0.55, 0.0, 1.0)
 STREAMLINE_RGBA = (0.0, 0.8, 0.9, 0.9)
@@ -96,8 +98,8 @@ def streamline_path_m(rig: RigModel, start: tuple[float, float]) -> np.ndarray:
     rig's mu_s, on the surface dilated by the tip radius (what the rig's sphere rides on)."""
     s = rig.length_scale_m
     radius = rig.tip.tip_radius_m / s
-    params = sl.StreamlineParams(mu=rig.tip.mu_s, dl=sl.default_step(rig.surface))
-    path = sl.streamlines(sl.dilate(rig.surface, radius), [start], params).path(0)
+    params = StreamlineParams(mu=rig.tip.mu_s, dl=sl.default_step(rig.surface))
+    path = sl.streamlines(dilate(rig.surface, radius), [start], params).path(0)
     return s * np.column_stack([path["x"], path["y"], path["z"] + radius])
 
 

@@ -99,7 +99,7 @@ class BallOnFacets(Surface):
     what the engine's contact reports, with no interpolation between samples. Where two
     contacts tie (a concave crease) the slope is that of one of them.
 
-    This is the exact form of ``spine_mj.theory.streamline.dilate(facets, radius)``, which samples
+    This is the exact form of ``spine_mj.surfaces.dilation.dilate(facets, radius)``, which samples
     the same height on a grid and interpolates it by a spline: at steep kinks (grit walls)
     the spline overshoots, and the sampled dilation sits up to slope x spacing low
     (docs/physics.md §4). Points whose ball reaches beyond the facets see only the facets

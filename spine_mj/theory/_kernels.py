@@ -4,7 +4,7 @@
 next start): per iteration every lane gets its height and slopes, then kappa, region and
 slip direction in branch-free loops over the lanes that LLVM vectorizes (AVX2: 4 lanes per
 instruction), then a scalar pass controls the step (a point where the slip direction
-reverses is rejected and the step halves; see :class:`spine_mj.theory.streamline.StreamlineParams`
+reverses is rejected and the step halves; see :class:`spine_mj.theory.streamline_types.StreamlineParams`
 ``max_halvings``), records, stops and steps. The trajectories are independent
 and each is computed with the same operations as one at a time, so the result does not
 depend on ``lanes``. A single Gaussian has its own path (exp through libm, the rest

@@ -178,7 +178,7 @@ def compliant_spine_curves(
     locked : (N,) bool
         Spines that reach ``kappa_cap`` within ``carriage``.
     """
-    from spine_mj.theory.streamline import Outcome
+    from spine_mj.theory.streamline_types import Outcome
 
     carriage = np.asarray(carriage, dtype=float)
     c = float(result.stiffness)

@@ -20,7 +20,7 @@ that crossed it, the landing by bisection on ``c (X - x(s)) - H(s)``, both to ~1
 along the path, so the onset force ``H`` at the fold, the carriage position there and the
 jump length do not depend on the step (:class:`Fold`). Regions, the self-lock rule, the
 step control and the stall test are those of :mod:`spine_mj.theory.streamline` (same
-:class:`~spine_mj.theory.streamline.StreamlineParams`); above ``K*`` (no fold) the path is the
+:class:`~spine_mj.theory.streamline_types.StreamlineParams`); above ``K*`` (no fold) the path is the
 rigid streamline's and only the carriage differs. The spring never pushes the tip off
 the surface here: lift-off is an inertial effect (:mod:`spine_mj.theory.drive_limits`).
 Unlike the rigid streamline it has no two-contact state: a tip that slips into a concave
@@ -38,13 +38,8 @@ from spine_mj.errors import SpineInputError
 from spine_mj.surfaces import BallOnFacets, Surface
 from spine_mj.theory.compliant_types import CompliantResult, Fold, MotionState
 from spine_mj.theory.engagement import DEFAULT_TOL, ENGAGED, SELF_LOCK, SLIP, quadratic_coefficients
-from spine_mj.theory.streamline import (
-    Outcome,
-    StreamlineParams,
-    _surface_data,
-    check_step,
-    start_points,
-)
+from spine_mj.theory.streamline import _surface_data, check_step, start_points
+from spine_mj.theory.streamline_types import Outcome, StreamlineParams
 
 __all__ = ["compliant_streamlines", "hold_force"]
 

@@ -73,8 +73,8 @@ class CompliantResult:
     stiffness : float
         ``c = k / W`` (1 / surface length).
     start_x, start_y, outcome, end_x, end_y, n_steps, max_kappa : ndarray, shape (n,)
-        As in :class:`spine_mj.theory.streamline.StreamlineResult` (``outcome``:
-        :class:`~spine_mj.theory.streamline.Outcome` codes).
+        As in :class:`spine_mj.theory.streamline_types.StreamlineResult` (``outcome``:
+        :class:`~spine_mj.theory.streamline_types.Outcome` codes).
     offsets : ndarray of int64, shape (n + 1,)
     x, y, z, kappa : ndarray, shape (total,)
         Path points and kappa there (NaN in the slip region).

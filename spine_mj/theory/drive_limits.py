@@ -60,10 +60,12 @@ import numpy as np
 from spine_mj import roughness
 from spine_mj.errors import SpineInputError
 from spine_mj.surfaces import Surface
+from spine_mj.surfaces.dilation import dilate
 from spine_mj.theory import streamline as sl
 from spine_mj.theory.compliant import hold_force
 from spine_mj.theory.engagement import DEFAULT_KAPPA_CAP, SELF_LOCK
 from spine_mj.theory.path_stiffness import max_fall, path_stiffness
+from spine_mj.theory.streamline_types import StreamlineParams
 from spine_mj.theory.targets import FRECHET_TARGET
 
 __all__ = [
@@ -432,10 +434,10 @@ def drive_limits(
     if isinstance(n_starts, bool) or not isinstance(n_starts, (int, np.integer)) or n_starts < 1:
         raise SpineInputError(f"n_starts must be an integer >= 1, got {n_starts!r}")
     l_s, l_c = float(roughness.stiffness_length(surface)), float(roughness.characteristic_length(surface))
-    traced = sl.dilate(surface, tip_radius) if tip_radius > 0 else surface
+    traced = dilate(surface, tip_radius) if tip_radius > 0 else surface
     pts = _grid_starts(traced, int(n_starts), 0.05) if starts is None else starts
     dl = min(l_s / 40, min(np.diff(traced.bounds)[::2]) / 8) if dl is None else dl  # 1/8 of a strip's width
-    params = sl.StreamlineParams(mu=mu, dl=dl, kappa_cap=kappa_cap)
+    params = StreamlineParams(mu=mu, dl=dl, kappa_cap=kappa_cap)
     res = sl.streamlines(traced, pts, params, store_paths=True)
     fall = max_fall(traced, res, mu, kappa_cap)
     max_curv, arrival = _path_statistics(traced, res, mu, kappa_cap, tip_radius)

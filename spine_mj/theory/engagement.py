@@ -54,7 +54,7 @@ REGION_NAMES = {SLIP: "slip", ENGAGED: "engaged", SELF_LOCK: "self_lock"}
 #: The force cap both sides of a MuJoCo-vs-streamline comparison share (docs/physics.md §4):
 #: a drive that needs more than ``DEFAULT_KAPPA_CAP`` times the normal load counts as held,
 #: on the engine (:class:`spine_mj.sim.Detection`) and on the streamline
-#: (:class:`spine_mj.theory.streamline.StreamlineParams` ``kappa_cap``) alike. A safety net for what
+#: (:class:`spine_mj.theory.streamline_types.StreamlineParams` ``kappa_cap``) alike. A safety net for what
 #: the self-lock region does not catch: a tip wedged between facets, a path of near-infinite
 #: kappa.
 DEFAULT_KAPPA_CAP = 20.0

@@ -19,6 +19,7 @@ from spine_mj.surfaces import Surface
 from spine_mj.theory import streamline as sl
 from spine_mj.theory.agreement import outcome_agreement, path_frechet
 from spine_mj.theory.compliant import compliant_streamlines, hold_force
+from spine_mj.theory.streamline_types import Outcome, StreamlineParams
 from spine_mj.theory.targets import FRECHET_TARGET, OUTCOME_TARGET
 
 __all__ = [
@@ -118,7 +119,7 @@ def start_scores(rigid, compliant, char_length: float) -> tuple[np.ndarray, np.n
         compliant.self_locked,
         np.column_stack([compliant.end_x, compliant.end_y]),
         length_scale=char_length,
-    )["agree"] & (rigid.outcome != sl.Outcome.STALLED)
+    )["agree"] & (rigid.outcome != Outcome.STALLED)
     frechet = np.array(
         [
             path_frechet(
@@ -135,7 +136,7 @@ def start_scores(rigid, compliant, char_length: float) -> tuple[np.ndarray, np.n
 def path_stiffness(
     surface: Surface,
     starts,
-    params: sl.StreamlineParams,
+    params: StreamlineParams,
     *,
     slope_length: float,
     char_length: float,

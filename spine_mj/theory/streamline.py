@@ -25,7 +25,7 @@ against). The records (:class:`Outcome`, :class:`StreamlineParams`,
 holds the entry points.
 
 A finite tip of radius R rides with its centre on the surface dilated by a ball of radius
-R: :func:`~spine_mj.surfaces.dilation.dilate` (re-exported here) builds that surface, on
+R: :func:`~spine_mj.surfaces.dilation.dilate` builds that surface, on
 which the same streamline rules apply.
 """
 
@@ -35,19 +35,14 @@ import numpy as np
 
 from spine_mj.errors import SpineInputError
 from spine_mj.surfaces import GaussianSurface, GridSurface, Surface
-from spine_mj.surfaces.dilation import dilate
 from spine_mj.theory._kernels import run_trajectories
 from spine_mj.theory._streamline_numpy import run_numpy
-from spine_mj.theory.streamline_types import Outcome, StreamlineParams, StreamlineResult
+from spine_mj.theory.streamline_types import StreamlineParams, StreamlineResult
 
 __all__ = [
     "DEFAULT_STEP_FRACTION",
-    "Outcome",
-    "StreamlineParams",
-    "StreamlineResult",
     "check_step",
     "default_step",
-    "dilate",
     "ideal_trajectories",
     "start_points",
     "streamlines",

@@ -16,7 +16,9 @@ from pathlib import Path
 from spine_mj.atomic import all_or_none, atomic_output
 from spine_mj.errors import SpineInputError
 from spine_mj.surfaces import Surface
+from spine_mj.surfaces.dilation import dilate
 from spine_mj.theory import streamline as sl
+from spine_mj.theory.streamline_types import StreamlineParams, StreamlineResult
 
 #: The table formats :func:`write_streamline_outputs` writes.
 TABLE_FORMATS = ("parquet", "csv")
@@ -47,12 +49,12 @@ class StreamlineRun:
     starts: list[tuple[float, float]]
     mu: float
     tip_radius: float
-    stream: sl.StreamlineResult
-    ideal: sl.StreamlineResult
+    stream: StreamlineResult
+    ideal: StreamlineResult
 
     def table(self):
         """Both analyses as one long pandas DataFrame: the columns of
-        :meth:`~spine_mj.theory.streamline.StreamlineResult.to_frame` (``trajectory`` names the
+        :meth:`~spine_mj.theory.streamline_types.StreamlineResult.to_frame` (``trajectory`` names the
         analysis) and ``mu``, ``tip_radius``."""
         import pandas as pd
 
@@ -93,15 +95,15 @@ def trace_starts(
         the surface.
     tip_radius : float
         Spherical tip radius R (>= 0, surface units): the paths ride ``surface`` dilated
-        by R (:func:`~spine_mj.theory.streamline.dilate`).
+        by R (:func:`~spine_mj.surfaces.dilation.dilate`).
 
     Raises
     ------
     SpineInputError
         A parameter out of range or a start outside the surface (named).
     """
-    params = sl.StreamlineParams(mu=mu, dl=sl.default_step(surface) if dl is None else dl)
-    ridden = sl.dilate(surface, tip_radius) if tip_radius else surface
+    params = StreamlineParams(mu=mu, dl=sl.default_step(surface) if dl is None else dl)
+    ridden = dilate(surface, tip_radius) if tip_radius else surface
     points = [(float(x), float(y)) for x, y in starts]
     return StreamlineRun(
         surface=ridden,

@@ -53,6 +53,7 @@ module) and :mod:`~spine_mj.validate.suite` (:func:`run_validation`).
 """
 
 from spine_mj.presets import calibrated_mu
+from spine_mj.theory.targets import FRECHET_TARGET, OUTCOME_TARGET
 from spine_mj.validate.boundary import BoundaryCurve, BoundaryResult, boundary
 from spine_mj.validate.fractal_lock import FractalLockResult, fractal_lock
 from spine_mj.validate.ie_star import (
@@ -72,10 +73,8 @@ from spine_mj.validate.paths import (
     triangulated_surface,
 )
 from spine_mj.validate.plans import (
-    FRECHET_TARGET,
     GRAVITY,
     MASS_KG,
-    OUTCOME_TARGET,
     PLANS,
     RAMP_MIN_COVERAGE,
     SANDPAPER_MU,

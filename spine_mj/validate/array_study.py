@@ -58,9 +58,10 @@ from scipy.stats import bootstrap
 from spine_mj import presets, sim
 from spine_mj.sim.drives import stiffness_n_m
 from spine_mj.sim.holding import spring_swing
+from spine_mj.surfaces.dilation import dilate
 from spine_mj.theory.array_reference import compliant_spine_curves
 from spine_mj.theory.compliant import compliant_streamlines
-from spine_mj.theory.streamline import StreamlineParams, dilate
+from spine_mj.theory.streamline_types import StreamlineParams
 from spine_mj.theory.targets import OUTCOME_TARGET
 from spine_mj.validate.convergence import is_converged, observed_order, richardson
 from spine_mj.validate.fractal_lock import CONFIDENCE, lock_rate
@@ -74,7 +75,6 @@ __all__ = [
     "ArrayStudyResult",
     "array_study",
     "extrapolate_to_rest",
-    "newcombe_difference",
 ]
 
 #: Inertia number of the arrays' fastest pace (per spine, as the single rig's I_e).

@@ -22,6 +22,7 @@ import pandas as pd
 
 from spine_mj import presets, sim
 from spine_mj.presets import calibrated_mu
+from spine_mj.theory.targets import FRECHET_TARGET
 from spine_mj.validate.convergence import REFINEMENTS, headline_convergence
 from spine_mj.validate.ie_star import (
     IE_STAR_CRITERIA,
@@ -32,7 +33,7 @@ from spine_mj.validate.ie_star import (
     quiet_nan_warnings,
 )
 from spine_mj.validate.paths import prefix_frechet, stored_paths, tip_radius
-from spine_mj.validate.plans import FRECHET_TARGET, RAMP_MIN_COVERAGE, FamilySpec, ValidationPlan
+from spine_mj.validate.plans import RAMP_MIN_COVERAGE, FamilySpec, ValidationPlan
 from spine_mj.validate.ramp_pilot import pilot_rig, ramp_duration
 from spine_mj.validate.study_runner import StudyRunner
 from spine_mj.validate.sweep_configs import engine_grid, family_doc

@@ -256,11 +256,13 @@ def _corner(surface, settings: HoldSettings):
 def _self_lock_share(runner, surface, places, tip: float, mu: float) -> tuple[np.ndarray, dict]:
     """Whether each place's quasistatic streamline on the tip-dilated surface ends held, and
     the held share with its Wilson interval."""
+    from spine_mj.surfaces.dilation import dilate
     from spine_mj.theory import streamline as sl
+    from spine_mj.theory.streamline_types import StreamlineParams
 
     with runner.phase("self-lock share") as tick:
-        traced = sl.dilate(surface, tip)
-        params = sl.StreamlineParams(mu=mu, dl=tip / 2, edge_margin=tip)
+        traced = dilate(surface, tip)
+        params = StreamlineParams(mu=mu, dl=tip / 2, edge_margin=tip)
         ref = sl.streamlines(traced, places, params, store_paths=False)
         tick()
     held = np.asarray(ref.self_locked, bool)

@@ -18,7 +18,7 @@ import numpy as np
 from scipy import stats
 
 from spine_mj.errors import SpineInputError
-from spine_mj.validate.plans import FRECHET_TARGET, OUTCOME_TARGET
+from spine_mj.theory.targets import FRECHET_TARGET, OUTCOME_TARGET
 
 __all__ = [
     "DEPARTURE",

@@ -18,8 +18,10 @@ from spine_mj import presets, sweep
 from spine_mj.errors import SpineInputError
 from spine_mj.sim.scales import grid_keeps_samples, resolve_tip_radius
 from spine_mj.surfaces import TriangulatedSurface, from_hfield, to_hfield
+from spine_mj.surfaces.dilation import dilate
 from spine_mj.theory import agreement
 from spine_mj.theory import streamline as sl
+from spine_mj.theory.streamline_types import StreamlineParams, StreamlineResult
 
 __all__ = [
     "mujoco_traces",
@@ -50,9 +52,9 @@ def tip_radius(preset: str, seeds, resolution: int) -> float:
     return float(f"{resolve_tip_radius(surface, None, hfield_resolution=resolution):.3g}")
 
 
-def streamline_paths(surface, starts, mu: float, dl: float, tip: float) -> sl.StreamlineResult:
+def streamline_paths(surface, starts, mu: float, dl: float, tip: float) -> StreamlineResult:
     """Streamlines (with paths) from ``starts`` on ``surface`` dilated by ``tip``
-    (:func:`spine_mj.theory.streamline.dilate`: MuJoCo's facets are sampled at ``tip / 8``, finer
+    (:func:`spine_mj.surfaces.dilation.dilate`: MuJoCo's facets are sampled at ``tip / 8``, finer
     than the hfield, before the dilation).
 
     Parameters
@@ -68,8 +70,8 @@ def streamline_paths(surface, starts, mu: float, dl: float, tip: float) -> sl.St
     tip : float
         Tip radius (surface units); 0 traces the surface itself.
     """
-    traced = sl.dilate(surface, tip) if tip > 0 else surface
-    params = sl.StreamlineParams(mu=mu, dl=dl)
+    traced = dilate(surface, tip) if tip > 0 else surface
+    params = StreamlineParams(mu=mu, dl=dl)
     return sl.streamlines(traced, np.asarray(starts, float), params, store_paths=True)
 
 

@@ -17,18 +17,14 @@ from typing import Any
 
 import numpy as np
 
-from spine_mj.theory.targets import FRECHET_TARGET, OUTCOME_TARGET
-
 __all__ = [
     "DT_HALVED",
-    "FRECHET_TARGET",
     "GRAVITY",
     "HFIELD_DOUBLED",
     "IMPRATIO",
     "MASS_KG",
     "MEASURED",
     "NO_NOSLIP",
-    "OUTCOME_TARGET",
     "PLANS",
     "RAMP_MIN_COVERAGE",
     "RECOMMENDED",

@@ -16,12 +16,13 @@ import pandas as pd
 
 from spine_mj.presets import calibrated_mu
 from spine_mj.theory.agreement import MISS_REASONS
+from spine_mj.theory.targets import FRECHET_TARGET, OUTCOME_TARGET
 from spine_mj.validate.convergence import GRID_ONLY, REFINEMENTS, family_convergence, thin_starts
 from spine_mj.validate.ensembles import ensemble_family, ensemble_groups, ensemble_verdicts
 from spine_mj.validate.intervals import bootstrap, meets_target, wilson
 from spine_mj.validate.miss_causes import MISS_CAUSES, miss_cause
 from spine_mj.validate.paths import stored_paths, tip_radius
-from spine_mj.validate.plans import FRECHET_TARGET, OUTCOME_TARGET, RECOMMENDED, FamilySpec, ValidationPlan
+from spine_mj.validate.plans import RECOMMENDED, FamilySpec, ValidationPlan
 from spine_mj.validate.predicted_limits import family_corner
 from spine_mj.validate.study_runner import StudyRunner
 from spine_mj.validate.sweep_configs import engine_grid, family_doc, gridded, refused_by_rig

@@ -15,15 +15,9 @@ from spine_mj.atomic import remove_temporaries
 from spine_mj.errors import SpineInputError
 from spine_mj.jsonio import write_json
 from spine_mj.surfaces import single_gaussian
+from spine_mj.theory.targets import FRECHET_TARGET, OUTCOME_TARGET
 from spine_mj.validate.intervals import TARGET_RULE
-from spine_mj.validate.plans import (
-    FRECHET_TARGET,
-    MASS_KG,
-    OUTCOME_TARGET,
-    PLANS,
-    STATIC_TARGET,
-    ValidationPlan,
-)
+from spine_mj.validate.plans import MASS_KG, PLANS, STATIC_TARGET, ValidationPlan
 from spine_mj.validate.platform import platform_info
 from spine_mj.validate.report.document import write_report
 from spine_mj.validate.studies import STUDIES

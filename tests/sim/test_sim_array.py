@@ -13,7 +13,8 @@ from sim_rigs import MU, R_TIP
 
 from spine_mj import sim, surfaces
 from spine_mj.errors import SpineInputError
-from spine_mj.sim.array import ArrayRig, ForcePull
+from spine_mj.sim.array import ArrayRig
+from spine_mj.sim.array_run import ForcePull
 from spine_mj.sim.drives import DEFAULT_STIFFNESS_NUMBER, stiffness_n_m
 from spine_mj.sim.holding import ONSET_SHARE, spring_swing
 from spine_mj.sim.layout import Layout

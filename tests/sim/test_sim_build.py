@@ -190,7 +190,7 @@ def test_the_tips_defaults_have_one_home_for_every_command(tmp_path, monkeypatch
     defaults to 0.02 kg) is the one RigInputs, and so build_rig and simulate, build with."""
     import dataclasses
 
-    from spine_mj.sim import build, rig_inputs
+    from spine_mj.sim import rig_inputs
     from spine_mj.sweep.analyses import engine
 
     summary = _cli_summary(tmp_path, "paper-single-peak", (-3.0, -1.0), ["--mu", 1.2, "--resolution", 41])
@@ -208,4 +208,4 @@ def test_the_tips_defaults_have_one_home_for_every_command(tmp_path, monkeypatch
     monkeypatch.setattr(rig_inputs, "TipParams", heavier)
     assert sim.build_rig(sim.inclined_plane(slope_deg=0.0), mu=0.5).tip.mass_kg == 0.02
     assert engine._TIP["mass_kg"] == sim.TipParams.__dataclass_fields__["mass_kg"].default
-    assert build.RigInputs(mu=0.5).tip.mass_kg == 0.02
+    assert rig_inputs.RigInputs(mu=0.5).tip.mass_kg == 0.02

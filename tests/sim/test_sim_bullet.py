@@ -27,7 +27,8 @@ from spine_mj.theory import engagement
 
 pytest.importorskip("pybullet", reason="the Bullet engine needs the [bullet] extra (pybullet)")
 
-from spine_mj.sim.bullet import BulletRig, default_bullet_engine
+from spine_mj.sim.bullet import BulletRig
+from spine_mj.sim.bullet_settings import default_bullet_engine
 
 MU = 0.5
 

@@ -8,7 +8,6 @@ import pytest
 
 from spine_mj.errors import SpineInputError
 from spine_mj.surfaces import GridSurface, ball_dilation, ball_dilation_reference, dilate, single_gaussian
-from spine_mj.theory.streamline import dilate as dilate_in_streamline
 
 
 def _rough(rng, ny, nx, scale):
@@ -93,4 +92,3 @@ def test_dilate_matches_the_brute_force_on_grids_and_analytic_surfaces():
     yw = got.y[0] + dy * np.arange(-ry, got.y.size + ry)
     wide = ball_dilation_reference(peak.height(xw[None, :], yw[:, None]), 0.5, spacing=(dx, dy))
     np.testing.assert_allclose(got.heights, wide[ry:-ry, rx:-rx], atol=1e-12)
-    assert dilate_in_streamline is dilate  # spine_mj.theory.streamline.dilate still imports

@@ -100,7 +100,7 @@ def test_compliant_spine_curves_follow_the_prandtl_tomlinson_curve_on_a_corrugat
     from spine_mj.surfaces import corrugation
     from spine_mj.theory.array_reference import compliant_spine_curves
     from spine_mj.theory.compliant import compliant_streamlines
-    from spine_mj.theory.streamline import StreamlineParams
+    from spine_mj.theory.streamline_types import StreamlineParams
 
     surf = corrugation(n_waves=4, width=0.5, points_per_wave=64)
     starts = np.array([[1.1, 0.0], [1.4, 0.0]])

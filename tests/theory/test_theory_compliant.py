@@ -20,7 +20,8 @@ from spine_mj.theory.agreement import path_frechet
 from spine_mj.theory.compliant import compliant_streamlines, hold_force
 from spine_mj.theory.compliant_types import MotionState
 from spine_mj.theory.engagement import kappa
-from spine_mj.theory.streamline import Outcome, StreamlineParams, streamlines
+from spine_mj.theory.streamline import streamlines
+from spine_mj.theory.streamline_types import Outcome, StreamlineParams
 
 L_S = 0.190  # slope correlation length of a corrugation, in wavelengths
 

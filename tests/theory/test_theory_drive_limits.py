@@ -11,6 +11,7 @@ from spine_mj import roughness
 from spine_mj.errors import SpineInputError
 from spine_mj.sim.holding import spring_swing
 from spine_mj.surfaces import GaussianSurface, Surface, corrugation
+from spine_mj.surfaces.dilation import dilate
 from spine_mj.theory import streamline as sl
 from spine_mj.theory.compliant import compliant_streamlines
 from spine_mj.theory.drive_limits import (
@@ -31,6 +32,7 @@ from spine_mj.theory.path_stiffness import (
     spring_run_travel,
     start_scores,
 )
+from spine_mj.theory.streamline_types import StreamlineParams
 
 #: The path tolerance the corner's swing bound uses by default (the Frechet target, L_c).
 FRECHET_TARGET_LC = 0.1
@@ -130,7 +132,7 @@ def test_a_jump_along_a_corrugation_leaves_the_trace_and_the_outcome_as_they_wer
     # runs along the path: the criterion cannot see it (K_path is no boundary at all there)
     surf = corrugation(slope_amplitude=0.5, n_waves=3, points_per_wave=64)
     mu, starts = 0.8, _left_starts(surf, 2)
-    params = sl.StreamlineParams(mu=mu, dl=0.005)
+    params = StreamlineParams(mu=mu, dl=0.005)
     rigid = sl.streamlines(surf, starts, params, store_paths=True)
     k_star = drive_limits(surf, mu, n_starts=2, dl=0.005).k_star
     ls = roughness.slope_correlation_length(surf)
@@ -144,7 +146,7 @@ def test_k_path_is_where_the_compliant_paths_stop_meeting_the_criterion_below_th
     surf, mu = Tilted(), 0.8
     starts = _left_starts(surf, 3)
     ls, lc = roughness.slope_correlation_length(surf), roughness.characteristic_length(surf)
-    params = sl.StreamlineParams(mu=mu, dl=ls / 40)
+    params = StreamlineParams(mu=mu, dl=ls / 40)
     k_path, k_fold, _ = path_stiffness(surf, starts, params, slope_length=ls, char_length=lc)
     rigid = sl.streamlines(surf, starts, params, store_paths=True)
 
@@ -170,7 +172,7 @@ def _wall_case():
     0.4 on flat ground, mu 0.5, l_s 0.7 (the K_path tests' case)."""
     wall = Wall(WALL_SLOPE, WALL_WIDTH)
     starts = np.array([(WALL_X0, 0.0), (WALL_X0, 0.2)])
-    return wall, starts, sl.StreamlineParams(mu=WALL_MU, dl=0.01), wall.bounds[1], 0.7
+    return wall, starts, StreamlineParams(mu=WALL_MU, dl=0.01), wall.bounds[1], 0.7
 
 
 def test_k_path_with_the_runs_travel_is_where_their_carriage_stops_short_of_a_hold():
@@ -342,8 +344,8 @@ def test_lift_off_reads_no_crest_sharper_than_the_tip_ball():
     tip = 0.25
     start = np.array([[0.5, 0.0]])
     d = drive_limits(surf, 0.3, tip_radius=tip, starts=start)
-    traced = sl.dilate(surf, tip)
-    path = sl.streamlines(traced, start, sl.StreamlineParams(mu=0.3, dl=0.2 / 40), store_paths=True).path(0)
+    traced = dilate(surf, tip)
+    path = sl.streamlines(traced, start, StreamlineParams(mu=0.3, dl=0.2 / 40), store_paths=True).path(0)
     rung = np.nanmax(crest_curvature(path["x"], path["y"], path["z"]))
     assert rung > 3 * 1.25**1.5 / tip  # the interpolant's ringing next to the valleys' creases
     # within 10 %: the interpolant's slope itself overshoots the flanks' 0.5 there

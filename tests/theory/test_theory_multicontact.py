@@ -131,22 +131,23 @@ def test_a_streamline_crossing_a_wedging_crease_is_held_there(radius):
     """Each flank alone moves at kappa 15.5 and 19.2, below the cap of 20; the two together
     hold to 30.6: a path on single contacts zig-zags across the crease and goes on."""
     from spine_mj.theory import streamline as sl
+    from spine_mj.theory.streamline_types import Outcome, StreamlineParams
 
     surface = _asymmetric_groove(radius)
     ks = kappa(np.array([0.7336, 0.7336]), np.array([-0.2964, 0.199]), 1.25)[0]
     assert np.all(ks < 20.0)
     pair = float(two_contact_kappa(0.7336, -0.2964, 0.7336, 0.199, 1.25)[0])
     assert pair > 20.0
-    params = sl.StreamlineParams(mu=1.25, dl=0.01, kappa_cap=20.0)
+    params = StreamlineParams(mu=1.25, dl=0.01, kappa_cap=20.0)
     res = sl.streamlines(surface, [(-0.8, -0.2), (-0.8, 0.12)], params)
-    assert [sl.Outcome(o) for o in res.outcome] == [sl.Outcome.FORCE_CAP] * 2
+    assert [Outcome(o) for o in res.outcome] == [Outcome.FORCE_CAP] * 2
     # held at the crease (within a step of the tip's contact line), far from the edge
     assert np.all(np.abs(res.end_y) < 0.05)
     assert np.all(res.end_x < 0.5)
     assert np.allclose(res.max_kappa, pair, rtol=1e-6)
     # a cap above the pair's hold lets the path go on, up the crease to the domain's edge
     free = sl.streamlines(surface, [(-0.8, -0.2)], dataclasses.replace(params, kappa_cap=40.0))
-    assert sl.Outcome(free.outcome[0]) is sl.Outcome.LEFT_DOMAIN
+    assert Outcome(free.outcome[0]) is Outcome.LEFT_DOMAIN
 
 
 def test_mujoco_static_probe_at_a_fractal_crease_breaks_away_near_the_two_contact_kappa():

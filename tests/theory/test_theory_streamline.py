@@ -8,14 +8,10 @@ from scipy.spatial import cKDTree
 from spine_mj.errors import SpineInputError
 from spine_mj.presets import load_preset, make_surface
 from spine_mj.surfaces import GridSurface, fractal_fbm, random_gaussians, single_gaussian
+from spine_mj.surfaces.dilation import dilate
 from spine_mj.theory.engagement import ENGAGED, SELF_LOCK
-from spine_mj.theory.streamline import (
-    Outcome,
-    StreamlineParams,
-    dilate,
-    ideal_trajectories,
-    streamlines,
-)
+from spine_mj.theory.streamline import ideal_trajectories, streamlines
+from spine_mj.theory.streamline_types import Outcome, StreamlineParams
 
 FIVE_STARTS = [(-3.0, y) for y in (-4.0, -3.0, -2.0, -1.0, -0.5)]
 MU = load_preset("paper-single-peak").extras["engagement"]["mu"]

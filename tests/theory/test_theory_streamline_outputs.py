@@ -7,8 +7,10 @@ import pytest
 
 from spine_mj.errors import SpineInputError
 from spine_mj.surfaces import corrugation, single_gaussian
+from spine_mj.surfaces.dilation import dilate
 from spine_mj.theory import streamline as sl
 from spine_mj.theory.streamline_outputs import FIGURE_NAME, trace_starts, write_streamline_outputs
+from spine_mj.theory.streamline_types import StreamlineParams
 
 STARTS = [(-3.0, -1.0), (-3.0, -2.0)]
 
@@ -23,7 +25,7 @@ def test_the_default_step_is_a_thousandth_of_the_shorter_side():
 def test_the_run_equals_the_two_analyses_run_apart():
     surf = single_gaussian()
     run = trace_starts(surf, STARTS, mu=1.2)
-    params = sl.StreamlineParams(mu=1.2, dl=sl.default_step(surf))
+    params = StreamlineParams(mu=1.2, dl=sl.default_step(surf))
     direct = sl.streamlines(surf, STARTS, params)
     np.testing.assert_array_equal(run.stream.end_x, direct.end_x)
     np.testing.assert_array_equal(run.ideal.outcome, sl.ideal_trajectories(surf, STARTS, params).outcome)
@@ -37,7 +39,7 @@ def test_the_run_equals_the_two_analyses_run_apart():
 def test_a_tip_rides_the_dilated_surface():
     surf = single_gaussian()
     run = trace_starts(surf, STARTS[:1], mu=1.2, tip_radius=0.3)
-    np.testing.assert_array_equal(run.surface.heights, sl.dilate(surf, 0.3).heights)
+    np.testing.assert_array_equal(run.surface.heights, dilate(surf, 0.3).heights)
     assert run.tip_radius == 0.3 and (run.table().tip_radius == 0.3).all()
 
 

@@ -13,14 +13,9 @@ from spine_mj.sim.drives import DEFAULT_STIFFNESS_NUMBER, stiffness_n_m
 from spine_mj.sim.holding import spring_swing
 from spine_mj.sim.layout import Layout
 from spine_mj.surfaces.generators import inclined_plane
-from spine_mj.validate.array_study import (
-    ARRAY_IE,
-    PACE_RATIO,
-    array_study,
-    extrapolate_to_rest,
-    newcombe_difference,
-)
+from spine_mj.validate.array_study import ARRAY_IE, PACE_RATIO, array_study, extrapolate_to_rest
 from spine_mj.validate.fractal_lock import lock_rate
+from spine_mj.validate.intervals import newcombe_difference
 from spine_mj.validate.plans import PLANS
 from spine_mj.validate.report.array_study import array_figure, array_section
 

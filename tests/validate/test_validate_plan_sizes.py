@@ -6,8 +6,9 @@ import itertools
 
 import pytest
 
+from spine_mj.theory.targets import OUTCOME_TARGET
 from spine_mj.validate.intervals import runs_to_meet
-from spine_mj.validate.plans import OUTCOME_TARGET, PLANS
+from spine_mj.validate.plans import PLANS
 from spine_mj.validate.stiffness_map import subset_starts
 
 

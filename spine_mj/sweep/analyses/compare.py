@@ -39,9 +39,10 @@ from spine_mj.theory import agreement
 from spine_mj.theory import streamline as sl
 from spine_mj.theory.compliant import compliant_streamlines
 from spine_mj.theory.drive_limits import SWING_BOUND_FP, spring_ie_limits
+from spine_mj.theory.streamline_types import Outcome, StreamlineResult
 
 
-def _xy(res: sl.StreamlineResult, i: int) -> np.ndarray:
+def _xy(res: StreamlineResult, i: int) -> np.ndarray:
     """Path ``i`` of ``res`` as ``(n, 2)`` x, y."""
     q = res.path(i)
     return np.column_stack([q["x"], q["y"]])
@@ -61,17 +62,17 @@ def _deviations(mpaths, qpaths: dict, lc: float, *, lateral: bool = True):
     return frechet, side
 
 
-def _paths(res: sl.StreamlineResult, idx) -> dict:
+def _paths(res: StreamlineResult, idx) -> dict:
     """Path ``j`` of ``res`` under the run index ``idx[j]``."""
     return {int(i): _xy(res, j) for j, i in enumerate(idx)}
 
 
-def _outcomes(qs: sl.StreamlineResult, mj_locked, mj_end, lc: float) -> dict[str, np.ndarray]:
+def _outcomes(qs: StreamlineResult, mj_locked, mj_end, lc: float) -> dict[str, np.ndarray]:
     """Outcome agreement; a reference that stalled decided nothing, so its run disagrees."""
     out = agreement.outcome_agreement(
         qs.self_locked, np.column_stack([qs.end_x, qs.end_y]), mj_locked, mj_end, length_scale=lc
     )
-    out["agree"] = out["agree"] & (qs.outcome != sl.Outcome.STALLED)
+    out["agree"] = out["agree"] & (qs.outcome != Outcome.STALLED)
     return out
 
 
@@ -88,7 +89,7 @@ def _miss_reasons(contact, params, trace, mpaths, facets, mj_locked, mj_end, lc,
     that, the engine's tip cannot follow it."""
     reason = np.full(len(mpaths), "", dtype=object)
     offset = np.full(len(mpaths), np.nan)
-    stalled = miss & (facets.outcome == sl.Outcome.STALLED)
+    stalled = miss & (facets.outcome == Outcome.STALLED)
     reason[stalled] = "reference_stalled"
     runs = [i for i in np.flatnonzero(miss & ~stalled) if mpaths[i].shape[0] > 0]
     if not runs:

@@ -13,6 +13,7 @@ import hashlib
 import numpy as np
 
 from spine_mj.sim.scales import resolve_tip_radius
+from spine_mj.surfaces.dilation import dilate
 from spine_mj.sweep.registry import (
     KAPPA_CAP_PARAM,
     MU_PARAM,
@@ -23,6 +24,7 @@ from spine_mj.sweep.registry import (
     register_analysis,
 )
 from spine_mj.theory import streamline as sl
+from spine_mj.theory.streamline_types import Outcome, StreamlineParams, StreamlineResult
 
 QUASISTATIC_PARAMS = (
     MU_PARAM,
@@ -44,7 +46,7 @@ QUASISTATIC_PARAMS = (
 
 @functools.lru_cache(maxsize=8)  # the presets of sweeps run together (the map: five)
 def _dilated(spec, radius: float):
-    return sl.dilate(spec.make(), radius)
+    return dilate(spec.make(), radius)
 
 
 #: Streamline results a worker process keeps (:func:`cached_trace`), enough for three traces
@@ -61,7 +63,7 @@ def clear_cache() -> None:
     _traces.clear()
 
 
-def cached_trace(trace, surface_key, surface, starts, params: sl.StreamlineParams) -> sl.StreamlineResult:
+def cached_trace(trace, surface_key, surface, starts, params: StreamlineParams) -> StreamlineResult:
     """``trace(surface, starts, params, store_paths=True)``, remembered in this process.
 
     Cases of a sweep that differ only in their drive (the boundary study's I_e ladder, the
@@ -116,11 +118,11 @@ def traced_surface(case, surface):
     return _dilated(case.surface, r) if r > 0 else surface
 
 
-def _params(case, surface) -> sl.StreamlineParams:
+def _params(case, surface) -> StreamlineParams:
     """The streamline parameters of ``case`` on ``surface`` (the traced one)."""
     p = case.params
     dl = p["dl"] if p["dl"] is not None else sl.default_step(surface)
-    return sl.StreamlineParams(mu=p["mu"], dl=dl, max_steps=p["max_steps"], kappa_cap=p["kappa_cap"])
+    return StreamlineParams(mu=p["mu"], dl=dl, max_steps=p["max_steps"], kappa_cap=p["kappa_cap"])
 
 
 def _check_case(case, surface, starts) -> None:
@@ -137,7 +139,7 @@ def _quasistatic(case, surface, starts, upstream):
     dl = params.dl
     func = sl.streamlines if p["trajectory"] == "streamline" else sl.ideal_trajectories
     res = cached_trace(func, (case.surface, case_tip_radius(case, surface)), surface, starts, params)
-    names = np.array(["", *[o.name.lower() for o in sl.Outcome]], dtype=object)
+    names = np.array(["", *[o.name.lower() for o in Outcome]], dtype=object)
     metrics = {
         "outcome": names[res.outcome],
         "self_locked": res.self_locked,  # held: the self-lock region or the force cap
@@ -152,7 +154,7 @@ def _quasistatic(case, surface, starts, upstream):
     return AnalysisResult(metrics=metrics, trajectories=path_table(res), data=res)
 
 
-def path_table(res: sl.StreamlineResult) -> dict[str, np.ndarray]:
+def path_table(res: StreamlineResult) -> dict[str, np.ndarray]:
     """The stored paths of ``res`` as a long table: ``start``, ``step``, ``x``, ``y``, ``z``,
     ``kappa``, ``region`` (surface units)."""
     counts = np.diff(res.offsets)

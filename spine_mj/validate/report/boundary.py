@@ -19,10 +19,10 @@ from spine_mj.plotting import (
 )
 from spine_mj.presets import list_presets, make_surface
 from spine_mj.sweep.store import load_runs
+from spine_mj.theory.targets import FRECHET_TARGET, OUTCOME_TARGET
 from spine_mj.validate.boundary import BoundaryCurve, BoundaryResult
 from spine_mj.validate.convergence import refinement_note
 from spine_mj.validate.paths import stored_paths
-from spine_mj.validate.plans import FRECHET_TARGET, OUTCOME_TARGET
 from spine_mj.validate.report.common import ReportContext, assemble, cell, image, refinement_rows, table
 
 

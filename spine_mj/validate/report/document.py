@@ -15,7 +15,8 @@ from pathlib import Path
 from spine_mj.atomic import atomic_output
 from spine_mj.plotting import sig
 from spine_mj.templates import render
-from spine_mj.validate.plans import FRECHET_TARGET, OUTCOME_TARGET, STATIC_TARGET
+from spine_mj.theory.targets import FRECHET_TARGET, OUTCOME_TARGET
+from spine_mj.validate.plans import STATIC_TARGET
 from spine_mj.validate.report.common import ReportContext
 from spine_mj.validate.studies import STUDIES
 

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 
-from spine_mj.validate.plans import FRECHET_TARGET, OUTCOME_TARGET
+from spine_mj.theory.targets import FRECHET_TARGET, OUTCOME_TARGET
 from spine_mj.validate.report.common import table
 
 __all__ = ["section"]

@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 
 from spine_mj.plotting import SERIES_COLORS, new_figure, save_figure, sig, styled
-from spine_mj.validate.plans import FRECHET_TARGET
+from spine_mj.theory.targets import FRECHET_TARGET
 from spine_mj.validate.report.common import cell, table
 from spine_mj.validate.stiffness_map import StiffnessMapResult
 from spine_mj.validate.theory_orders import FRECHET_FLOOR_LC, PREDICTION_FACTOR
