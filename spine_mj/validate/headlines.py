@@ -11,25 +11,13 @@ is the same. :func:`headline_numbers` lists the numbers that carry an interval i
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 from spine_mj.errors import SpineInputError
+from spine_mj.validate import studies
+from spine_mj.validate.report.common import Headline, read_table
 
-__all__ = ["Headline", "ReproductionRow", "check_reproduction", "headline_numbers"]
-
-
-@dataclass(frozen=True)
-class Headline:
-    """One headline number of a ``validation.json`` with its 95 % interval.
-
-    ``interval`` is ``(low, high)``; ``verdict`` the family's target verdict where the
-    number decides one (None otherwise)."""
-
-    key: str
-    value: float | None
-    interval: tuple[float, float] | None
-    verdict: bool | None = None
+__all__ = ["ReproductionRow", "check_reproduction", "headline_numbers"]
 
 
 @dataclass(frozen=True)
@@ -48,42 +36,17 @@ class ReproductionRow:
         return self.inside and self.verdict_kept
 
 
-def _num(v) -> float | None:
-    return None if v is None or (isinstance(v, float) and math.isnan(v)) else float(v)
-
-
-def _number(where: str, v, *, missing: bool = False) -> float | None:
-    """``v`` as a finite number; None (or NaN) only where ``missing`` values are allowed."""
-    if missing and _num(v) is None:
-        return None
-    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-        raise SpineInputError(f"{where} must be a finite number, got {v!r}")
-    return float(v)
-
-
-def _table(where: str, v) -> dict:
-    if not isinstance(v, dict):
-        raise SpineInputError(f"{where} must be a JSON object, got {type(v).__name__} {v!r:.60}")
-    return v
-
-
-def _interval(where: str, v, *, missing: bool = False) -> tuple[float, float] | None:
-    if not (isinstance(v, (list, tuple)) and len(v) == 2):
-        raise SpineInputError(f"{where} must be a pair [low, high], got {v!r:.60}")
-    lo, hi = (_number(f"{where}[{i}]", x, missing=missing) for i, x in enumerate(v))
-    return None if lo is None or hi is None else (lo, hi)
-
-
 def headline_numbers(validation: dict) -> dict[str, Headline]:
-    """The numbers of ``validation`` (a loaded ``validation.json``) that carry an interval.
+    """The numbers of ``validation`` (a loaded ``validation.json``) that carry an interval:
+    each study's own (:meth:`~spine_mj.validate.studies.Study.headline_numbers`), in the
+    order of the registry.
 
-    Per family of the quasistatic-limit corner (``limit_families``): the well-conditioned
-    agreement (``agreement_ci``, Wilson), the agreement over all runs
+    I_e* of each drive (``ie_star``, bootstrap over starts; None or NaN where it lies outside
+    the grid); per family of the quasistatic-limit corner (``limit_families``) the
+    well-conditioned agreement (``agreement_ci``, Wilson), the agreement over all runs
     (``outcome_agreement_ci``) and the median Frechet distance (``median_frechet_ci``,
-    bootstrap); the family's ``meets_target`` is the verdict. I_e* of each drive
-    (``ie_star``, bootstrap over starts; None or NaN where it lies outside the grid). The
-    fractal self-lock rates per H and series (Wilson). Keys read
-    ``limit.fractal.agreement_well_conditioned`` and so on.
+    bootstrap), the family's ``meets_target`` the verdict; the fractal self-lock rates per H
+    and series (Wilson). Keys read ``limit.fractal.agreement_well_conditioned`` and so on.
 
     Raises
     ------
@@ -94,47 +57,9 @@ def headline_numbers(validation: dict) -> dict[str, Headline]:
     """
     if not isinstance(validation, dict) or "limit_families" not in validation:
         raise SpineInputError("validation must be a loaded validation.json (with limit_families)")
-    families = _table("limit_families", validation["limit_families"])
-    if not families:
+    if not read_table("limit_families", validation["limit_families"]):
         raise SpineInputError("limit_families must hold at least one family, got none")
-    out: dict[str, Headline] = {}
-    for fam, s in families.items():
-        s = _table(f"limit_families.{fam}", s)
-        verdict = s.get("meets_target")
-        if verdict is not None and not isinstance(verdict, bool):
-            raise SpineInputError(f"limit_families.{fam}.meets_target must be true or false, got {verdict!r}")
-        for name, ci in (
-            ("agreement_well_conditioned", "agreement_ci"),
-            ("outcome_agreement", "outcome_agreement_ci"),
-            ("median_frechet", "median_frechet_ci"),
-        ):
-            if name in s and ci in s:
-                key = f"limit.{fam}.{name}"
-                where = f"limit_families.{fam}."
-                out[key] = Headline(
-                    key, _number(where + name, s[name]), _interval(where + ci, s[ci]), verdict
-                )
-    for drive, est in _table("ie_star", validation.get("ie_star") or {}).items():
-        est = _table(f"ie_star.{drive}", est)
-        if "ci_low" in est:
-            key, where = f"ie_star.{drive}", f"ie_star.{drive}."
-            value = _number(where + "value", est.get("value"), missing=True)
-            interval = _interval(where + "ci_low/ci_high", [est["ci_low"], est.get("ci_high")], missing=True)
-            out[key] = Headline(key, value, interval)
-    lock = _table("fractal_lock_rate", validation.get("fractal_lock_rate") or {})
-    rows = lock.get("rows", [])
-    if not isinstance(rows, list):
-        raise SpineInputError(f"fractal_lock_rate.rows must be a list, got {rows!r:.60}")
-    for i, row in enumerate(rows):
-        row = _table(f"fractal_lock_rate.rows[{i}]", row)
-        for series in ("streamline", "mujoco_corner", "mujoco_dynamic"):
-            if f"rate_{series}" in row:
-                key = f"fractal_lock.H{row.get('hurst')}.{series}"
-                where = f"fractal_lock_rate.rows[{i}]."
-                value = _number(where + f"rate_{series}", row[f"rate_{series}"])
-                pair = [row.get(f"ci_low_{series}"), row.get(f"ci_high_{series}")]
-                out[key] = Headline(key, value, _interval(where + f"ci_low/high_{series}", pair))
-    return out
+    return {key: h for study in studies.STUDIES for key, h in study.headline_numbers(validation).items()}
 
 
 def check_reproduction(new: dict, committed: dict) -> list[ReproductionRow]:

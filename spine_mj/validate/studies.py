@@ -4,8 +4,10 @@ Each :class:`Study` names its run function (``(plan, runner) -> result``), the t
 its result (whose ``validation_keys()`` are its keys of ``validation.json``) and its
 report module (:mod:`spine_mj.validate.report`). :func:`spine_mj.validate.run_validation`
 runs the studies in this order and :func:`spine_mj.validate.write_report` puts their
-sections into ``report.md`` in the same order. A new study is one study module, one report
-module and one line here.
+sections into ``report.md`` in the same order; the lines ``spine-mj validate`` prints
+(:func:`spine_mj.validate.summary.summary_lines`) and the headline numbers a reproduction
+is checked on (:func:`spine_mj.validate.headlines.headline_numbers`) are the studies' own, in
+the same order too. A new study is one study module, one report module and one line here.
 """
 
 from __future__ import annotations
@@ -54,13 +56,27 @@ class Study:
     result : type
         The type of its result.
     report : module
-        Its report module: ``headline(result)`` and ``section(result, ctx)``.
+        Its report module: ``headline(result)`` and ``section(result, ctx)``, and where the
+        study has any, ``summary_lines(validation)`` and ``headline_numbers(validation)``
+        (:mod:`spine_mj.validate.report.common`).
     """
 
     name: str
     run: Callable[[ValidationPlan, StudyRunner], Any]
     result: type
     report: ModuleType
+
+    def summary_lines(self, validation: dict) -> list[str]:
+        """The study's lines of what ``spine-mj validate`` prints, from its keys of the loaded
+        ``validation.json`` (none where its report module has no ``summary_lines``)."""
+        lines = getattr(self.report, "summary_lines", None)
+        return lines(validation) if lines is not None else []
+
+    def headline_numbers(self, validation: dict) -> dict:
+        """The study's numbers with an interval in the loaded ``validation.json``, by key
+        (none where its report module has no ``headline_numbers``)."""
+        numbers = getattr(self.report, "headline_numbers", None)
+        return numbers(validation) if numbers is not None else {}
 
 
 #: The studies, in the order they run and appear in the report (the I_e* headline first).

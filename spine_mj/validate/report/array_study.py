@@ -13,7 +13,7 @@ from spine_mj.plotting import new_figure, save_figure, sig, styled
 from spine_mj.validate.array_study import ArrayStudyResult
 from spine_mj.validate.report.common import ReportContext, table
 
-__all__ = ["array_figure", "array_section", "headline", "section"]
+__all__ = ["array_figure", "array_section", "headline", "section", "summary_lines"]
 
 _COLORS = {"grid": "#1f77b4", "staggered": "#d62728", "random": "#2ca02c"}
 
@@ -246,6 +246,21 @@ def _verdict(res: ArrayStudyResult) -> str:
 
 def headline(res: ArrayStudyResult) -> list[str]:
     return []
+
+
+def summary_lines(validation: dict) -> list[str]:
+    """Per layout the pooled difference of P(at least one spine locks) from the aligned one,
+    with its interval."""
+    lines = []
+    for kind, pool in validation.get("arrays", {}).get("pooled", {}).items():
+        if pool.get("diff"):
+            d = pool["diff"]
+            lines.append(
+                f"arrays: P(at least one spine locks), {kind} - aligned = {d['diff']:+.3f} "
+                f"[{d['ci_low']:+.3f}, {d['ci_high']:+.3f}] ({pool['locked']}/{pool['n_ok']} against "
+                f"{pool['locked_grid']}/{pool['n_ok_grid']})"
+            )
+    return lines
 
 
 def section(res: ArrayStudyResult, ctx: ReportContext) -> str:

@@ -23,7 +23,18 @@ from spine_mj.theory.targets import FRECHET_TARGET, OUTCOME_TARGET
 from spine_mj.validate.boundary import BoundaryCurve, BoundaryResult
 from spine_mj.validate.convergence import refinement_note
 from spine_mj.validate.paths import stored_paths
-from spine_mj.validate.report.common import ReportContext, assemble, cell, image, refinement_rows, table
+from spine_mj.validate.report.common import (
+    Headline,
+    ReportContext,
+    assemble,
+    cell,
+    image,
+    read_interval,
+    read_number,
+    read_table,
+    refinement_rows,
+    table,
+)
 
 
 def star_to_draw(star: dict) -> dict | None:
@@ -131,6 +142,42 @@ def _overlay_figure(out: Path, path: Path) -> Path | None:
     if not panels:
         return None
     return save_figure(path_overlay_figure(panels), path)
+
+
+def summary_lines(validation: dict) -> list[str]:
+    """Per protocol its I_e* by the main criterion and by departure where it has one, each
+    criterion on its line and the estimate indented under it (or why there is none)."""
+    lines = []
+    for proto, s in validation.get("ie_star", {}).items():
+        if s.get("valid") is False:
+            lines.append(f"I_e* ({proto}) {s['note']}")
+            continue
+        for star in (s, s["by_criterion"].get("departure")):
+            if star is None:
+                continue
+            lines.append(f"I_e* ({proto}) criterion: {star['criterion']}")
+            note = refinement_note(s.get("convergence")) if star is s else ""
+            if star["kind"] == "bracketed":
+                lines.append(f"  I_e* = {star['value']:.3g} in [{star['low']:.3g}, {star['high']:.3g}]{note}")
+            elif star["kind"] == "above":
+                lines.append(f"  I_e* > {star['low']:.3g} (agreement holds on the whole grid){note}")
+            else:
+                lines.append(f"  I_e* < {star['high']:.3g} (no agreement at the lowest I_e){note}")
+    return lines
+
+
+def headline_numbers(validation: dict) -> dict[str, Headline]:
+    """Per drive its I_e* with the bootstrap interval over starts (``ie_star``; None or NaN
+    where it lies outside the grid), keyed ``ie_star.DRIVE``."""
+    out: dict[str, Headline] = {}
+    for drive, est in read_table("ie_star", validation.get("ie_star") or {}).items():
+        est = read_table(f"ie_star.{drive}", est)
+        if "ci_low" in est:
+            key, where = f"ie_star.{drive}", f"ie_star.{drive}."
+            value = read_number(where + "value", est.get("value"), missing=True)
+            pair = [est["ci_low"], est.get("ci_high")]
+            out[key] = Headline(key, value, read_interval(where + "ci_low/ci_high", pair, missing=True))
+    return out
 
 
 def headline(boundary: BoundaryResult) -> list[str]:

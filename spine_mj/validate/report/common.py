@@ -8,25 +8,41 @@ registry (:data:`spine_mj.validate.studies.STUDIES`):
 * ``headline(result) -> list[str]``: lines for the report's headline list (most give none);
 * ``section(result, ctx) -> str | None``: its Markdown section with the figures it drew
   under ``ctx.figures`` (:func:`assemble`), or None for no section at all.
+
+and, where the study has any, two that read its keys of a loaded ``validation.json``
+(:meth:`spine_mj.validate.studies.Study.summary_lines` and ``headline_numbers`` call them;
+a study whose keys are absent gives nothing):
+
+* ``summary_lines(validation) -> list[str]``: its lines of what ``spine-mj validate`` prints
+  (:func:`spine_mj.validate.summary.summary_lines`);
+* ``headline_numbers(validation) -> dict[str, Headline]``: its numbers that carry an interval
+  (:func:`spine_mj.validate.headlines.headline_numbers`), read by :func:`read_number`,
+  :func:`read_interval` and :func:`read_table`, which name a malformed field.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from spine_mj.errors import SpineInputError
 from spine_mj.plotting import sig
 from spine_mj.validate.convergence import REFINEMENT_LABELS
 
 __all__ = [
+    "Headline",
     "ReportContext",
     "assemble",
     "cell",
     "corner_text",
     "image",
     "preset_label",
+    "read_interval",
+    "read_number",
+    "read_table",
     "refinement_rows",
     "refinement_verdict",
     "table",
@@ -136,3 +152,45 @@ def refinement_rows(convergence: dict, **fields) -> list[dict]:
         for key, e in convergence.items()
         if key in REFINEMENT_LABELS
     ]
+
+
+@dataclass(frozen=True)
+class Headline:
+    """One headline number of a ``validation.json`` with its 95 % interval.
+
+    ``interval`` is ``(low, high)``; ``verdict`` the family's target verdict where the
+    number decides one (None otherwise)."""
+
+    key: str
+    value: float | None
+    interval: tuple[float, float] | None
+    verdict: bool | None = None
+
+
+def _missing(v) -> bool:
+    return v is None or (isinstance(v, float) and math.isnan(v))
+
+
+def read_number(where: str, v, *, missing: bool = False) -> float | None:
+    """``v`` as a finite number; None (for None or NaN) only where ``missing`` values are
+    allowed; else a :class:`~spine_mj.errors.SpineInputError` naming the field ``where``."""
+    if missing and _missing(v):
+        return None
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+        raise SpineInputError(f"{where} must be a finite number, got {v!r}")
+    return float(v)
+
+
+def read_table(where: str, v) -> dict:
+    """``v`` if it is a JSON object, else an error naming the field ``where``."""
+    if not isinstance(v, dict):
+        raise SpineInputError(f"{where} must be a JSON object, got {type(v).__name__} {v!r:.60}")
+    return v
+
+
+def read_interval(where: str, v, *, missing: bool = False) -> tuple[float, float] | None:
+    """``v`` as a pair ``(low, high)`` of :func:`read_number`; None where a bound is missing."""
+    if not (isinstance(v, (list, tuple)) and len(v) == 2):
+        raise SpineInputError(f"{where} must be a pair [low, high], got {v!r:.60}")
+    lo, hi = (read_number(f"{where}[{i}]", x, missing=missing) for i, x in enumerate(v))
+    return None if lo is None or hi is None else (lo, hi)

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["headline", "section"]
+__all__ = ["headline", "section", "summary_lines"]
 
 TITLE = "## Engines side by side: the closed forms"
 
@@ -27,6 +27,21 @@ def _fmt(v) -> str:
 def headline(res) -> list[str]:
     """The engines study adds no line to the report's headline (its verdicts are per check)."""
     return []
+
+
+def summary_lines(validation: dict) -> list[str]:
+    """The study in one line: per engine, the closed forms judged within tolerance (or that
+    Bullet is not installed)."""
+    eng = validation.get("engines")
+    if not eng:
+        return []
+    if eng.get("missing"):
+        return ["engines side by side: not run, Bullet is not installed (pip install 'spine-mj[bullet]')"]
+    counts = []
+    for e in eng["engines"]:
+        judged = [r[f"{e}_ok"] for r in eng["rows"] if r.get(f"{e}_ok") is not None]
+        counts.append(f"{e} {sum(judged)} of {len(judged)}")
+    return ["engines side by side, closed forms within their tolerance: " + ", ".join(counts)]
 
 
 def section(res, ctx=None) -> str:

@@ -8,15 +8,27 @@ from pathlib import Path
 
 import numpy as np
 
+from spine_mj.errors import SpineInputError
 from spine_mj.plotting import (
     new_figure,
     save_figure,
     sig,
     styled,
 )
-from spine_mj.validate.convergence import refinement_note
+from spine_mj.validate.convergence import refinement_note, unconverged_mark
 from spine_mj.validate.fractal_lock import MUJOCO_SERIES, SERIES, FractalLockResult
-from spine_mj.validate.report.common import ReportContext, assemble, cell, image, refinement_rows, table
+from spine_mj.validate.report.common import (
+    Headline,
+    ReportContext,
+    assemble,
+    cell,
+    image,
+    read_interval,
+    read_number,
+    read_table,
+    refinement_rows,
+    table,
+)
 
 
 #: Legend labels of the fractal study's series (:data:`spine_mj.validate.fractal_lock.SERIES`).
@@ -163,6 +175,45 @@ def _fractal_sentence(fr: FractalLockResult) -> str:
 
 def headline(fr: FractalLockResult) -> list[str]:
     return []
+
+
+#: The series whose rates are headlines (the facets' streamline is the report's alone).
+HEADLINE_SERIES = ("streamline", "mujoco_corner", "mujoco_dynamic")
+
+
+def summary_lines(validation: dict) -> list[str]:
+    """Per H the self-lock rate of each series of :data:`HEADLINE_SERIES`, marked where
+    unconverged."""
+    lines = []
+    for row in validation.get("fractal_lock_rate", {}).get("rows", []):
+        rates = ", ".join(
+            f"{k} {row[f'rate_{k}']:.2f} ({row[f'locked_{k}']}/{row[f'n_ok_{k}']})"
+            + unconverged_mark(row.get(f"convergence_{k}"))
+            for k in HEADLINE_SERIES
+            if f"rate_{k}" in row
+        )
+        lines.append(f"fractal self-lock rate, H = {row['hurst']:g}: {rates}")
+    return lines
+
+
+def headline_numbers(validation: dict) -> dict[str, Headline]:
+    """Per H and series of :data:`HEADLINE_SERIES` the self-lock rate with its Wilson
+    interval, keyed ``fractal_lock.H<hurst>.<series>``."""
+    lock = read_table("fractal_lock_rate", validation.get("fractal_lock_rate") or {})
+    rows = lock.get("rows", [])
+    if not isinstance(rows, list):
+        raise SpineInputError(f"fractal_lock_rate.rows must be a list, got {rows!r:.60}")
+    out: dict[str, Headline] = {}
+    for i, row in enumerate(rows):
+        row = read_table(f"fractal_lock_rate.rows[{i}]", row)
+        for series in HEADLINE_SERIES:
+            if f"rate_{series}" in row:
+                key = f"fractal_lock.H{row.get('hurst')}.{series}"
+                where = f"fractal_lock_rate.rows[{i}]."
+                value = read_number(where + f"rate_{series}", row[f"rate_{series}"])
+                pair = [row.get(f"ci_low_{series}"), row.get(f"ci_high_{series}")]
+                out[key] = Headline(key, value, read_interval(where + f"ci_low/high_{series}", pair))
+    return out
 
 
 def section(fr: FractalLockResult, ctx: ReportContext) -> str:

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
+from spine_mj.errors import SpineInputError
 from spine_mj.plotting import (
     DIVERGING_CMAP,
     PATH_COLORS,
@@ -22,13 +23,25 @@ from spine_mj.presets import make_surface
 from spine_mj.sweep.analyses.compare import MISS_CHECKPOINTS
 from spine_mj.theory.agreement import MISS_REASONS
 from spine_mj.validate.boundary import BoundaryResult
-from spine_mj.validate.convergence import HEADLINES, REFINEMENT_LABELS, quoted
+from spine_mj.validate.convergence import HEADLINES, REFINEMENT_LABELS, quoted, unconverged_mark
 from spine_mj.validate.miss_causes import MISS_CAUSES
 from spine_mj.validate.platform import platform_info
 from spine_mj.validate.predicted_limits import CORNER_PATH_STARTS
 from spine_mj.validate.quasistatic_limit import QuasistaticLimitResult
 from spine_mj.validate.report.boundary import star_to_draw
-from spine_mj.validate.report.common import ReportContext, assemble, cell, image, refinement_verdict, table
+from spine_mj.validate.report.common import (
+    Headline,
+    ReportContext,
+    assemble,
+    cell,
+    corner_text,
+    image,
+    read_interval,
+    read_number,
+    read_table,
+    refinement_verdict,
+    table,
+)
 from spine_mj.validate.report.verdicts import platform_line, verdicts_section
 
 
@@ -420,6 +433,50 @@ def _variations_and_runs(limit: QuasistaticLimitResult) -> list[str]:
 
 def headline(limit: QuasistaticLimitResult) -> list[str]:
     return []
+
+
+def summary_lines(validation: dict) -> list[str]:
+    """Per family at its corner: the outcome agreement, the median Frechet distance (each
+    marked where unconverged) and the engine's stops."""
+    lines = []
+    for fam, summ in validation.get("limit_families", {}).items():
+        stops = ", ".join(f"{k} {n}" for k, n in summ["failed_runs"].items()) or "none"
+        conv = validation.get("convergence", {}).get(fam)
+        at = (validation.get("corner") or {}).get(fam) or {"ie": validation["lowest_ie"], "K": 30.0}
+        lines.append(
+            f"I_e, K = {corner_text(at)}, {fam}: outcome agreement {summ['outcome_agreement']:.0%}"
+            f"{unconverged_mark(conv, 'outcome_agreement')} of {summ['runs']}, median Frechet "
+            f"{summ['median_frechet']:.3g} L_c{unconverged_mark(conv, 'median_frechet')}, "
+            f"engine stops: {stops}"
+        )
+    return lines
+
+
+#: A family's headline numbers and the keys of their intervals in ``limit_families``.
+LIMIT_HEADLINES = (
+    ("agreement_well_conditioned", "agreement_ci"),
+    ("outcome_agreement", "outcome_agreement_ci"),
+    ("median_frechet", "median_frechet_ci"),
+)
+
+
+def headline_numbers(validation: dict) -> dict[str, Headline]:
+    """Per family of the corner (``limit_families``) the numbers of :data:`LIMIT_HEADLINES`
+    with their intervals (Wilson; bootstrap for the Frechet distance) and the family's
+    ``meets_target`` as verdict, keyed ``limit.FAMILY.NAME``."""
+    out: dict[str, Headline] = {}
+    for fam, s in read_table("limit_families", validation.get("limit_families") or {}).items():
+        s = read_table(f"limit_families.{fam}", s)
+        verdict = s.get("meets_target")
+        if verdict is not None and not isinstance(verdict, bool):
+            raise SpineInputError(f"limit_families.{fam}.meets_target must be true or false, got {verdict!r}")
+        for name, ci in LIMIT_HEADLINES:
+            if name in s and ci in s:
+                key, where = f"limit.{fam}.{name}", f"limit_families.{fam}."
+                out[key] = Headline(
+                    key, read_number(where + name, s[name]), read_interval(where + ci, s[ci]), verdict
+                )
+    return out
 
 
 def section(limit: QuasistaticLimitResult, ctx: ReportContext) -> str:

@@ -103,6 +103,14 @@ def headline(static: StaticMapResult) -> list[str]:
     return []
 
 
+def summary_lines(validation: dict) -> list[str]:
+    """The largest static kappa error, engaged, at the default settings."""
+    if "static_kappa_max_rel_error" not in validation:
+        return []
+    error = validation["static_kappa_max_rel_error"]
+    return [f"static kappa max rel. error (engaged, default settings): {error:.3g}"]
+
+
 def section(static: StaticMapResult, ctx: ReportContext) -> str:
     fig = ctx.draw(_static_figure, static, "static_map.png")
     return assemble("\n".join(_lines(static)), image("Static breakaway ratio on inclined planes", fig))
