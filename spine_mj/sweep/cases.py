@@ -9,6 +9,8 @@ orders them for the workers by a rough cost (the order changes no result).
 from __future__ import annotations
 
 import itertools
+import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -17,6 +19,9 @@ from spine_mj.errors import SpineInputError
 from spine_mj.jsonio import to_jsonable
 from spine_mj.sweep.config import StartsSpec, SurfaceSpec, SweepConfig, digest, surface_mu
 from spine_mj.sweep.registry import PRESET_MU, applied_params, param_specs
+
+#: Seconds between two progress reports of a long preparation (listing or checking cases).
+PROGRESS_EVERY_S = 10.0
 
 
 @dataclass(frozen=True)
@@ -50,13 +55,16 @@ class Case:
     store_trajectories: bool = True
 
 
-def expand_cases(config: SweepConfig) -> list[Case]:
+def expand_cases(config: SweepConfig, progress: Callable[[int, int], None] | None = None) -> list[Case]:
     """The cases of ``config``: surfaces x grid (product of all parameter lists), in order.
 
     Parameters
     ----------
     config : SweepConfig
         A validated config.
+    progress : callable, optional
+        Called as ``progress(listed, total)`` every :data:`PROGRESS_EVERY_S` seconds while
+        the cases are listed (a million take minutes).
 
     Returns
     -------
@@ -74,20 +82,25 @@ def expand_cases(config: SweepConfig) -> list[Case]:
     specs = param_specs(config.analyses)
     from_preset = [k for k in names if specs[k].default is PRESET_MU]
     cases, seen = [], set()
+    total, last, jsonable = len(config.surfaces) * len(combos), time.monotonic(), _memo_jsonable()
     for si, surf in enumerate(config.surfaces):
         starts = (
             config.surface_starts[si]
             if (si < len(config.surface_starts) and config.surface_starts[si] is not None)
             else config.starts
         )
+        where = {"surface": surf.as_dict(), "starts": starts.as_dict()}
         default_mu = None  # the surface's, by the one mu rule, read once where needed
         for combo in combos:
+            if progress is not None and time.monotonic() - last > PROGRESS_EVERY_S:
+                progress(len(cases), total)
+                last = time.monotonic()
             params = applied_params(dict(zip(names, combo)), specs)
             for k in from_preset:
                 if params[k] is None:
                     default_mu = surface_mu(surf, k) if default_mu is None else default_mu
                     params[k] = default_mu
-            case_id = _case_id(surf, starts, params)
+            case_id = digest({**where, "params": {k: jsonable(v) for k, v in params.items()}})[:16]
             if case_id in seen:
                 raise SpineInputError(
                     f"config produces the same case twice (surface {surf.label}, parameters {params})"
@@ -108,15 +121,19 @@ def expand_cases(config: SweepConfig) -> list[Case]:
     return cases
 
 
-def _case_id(surface: SurfaceSpec, starts: StartsSpec, params: dict) -> str:
-    """16 hex digits of the sha256 of the case's surface, starts and parameters."""
-    return digest(
-        {
-            "surface": surface.as_dict(),
-            "starts": starts.as_dict(),
-            "params": {k: to_jsonable(v) for k, v in params.items()},
-        }
-    )[:16]
+def _memo_jsonable() -> Callable:
+    """:func:`~spine_mj.jsonio.to_jsonable` remembering the values it has seen: a grid's
+    million cases repeat a few values per key (a third of the listing's time was spent
+    converting them again)."""
+    memo: dict = {}
+
+    def jsonable(value):
+        key = (type(value), repr(value))  # repr keeps -0.0 apart from 0.0
+        if key not in memo:
+            memo[key] = to_jsonable(value)
+        return memo[key]
+
+    return jsonable
 
 
 def case_seed(master_seed: int, case_id: str) -> int:

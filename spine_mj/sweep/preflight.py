@@ -23,13 +23,10 @@ import time
 from collections.abc import Callable, Sequence
 
 from spine_mj.errors import SpineInputError
-from spine_mj.sweep.cases import Case
+from spine_mj.sweep.cases import PROGRESS_EVERY_S, Case
 from spine_mj.sweep.registry import ANALYSES
 
 __all__ = ["check_cases", "checked_keys"]
-
-#: Seconds between two progress reports of a long check.
-_PROGRESS_EVERY_S = 10.0
 
 
 def checked_keys(analysis: str) -> tuple[str, ...]:
@@ -60,7 +57,7 @@ def check_cases(
     seen: set = set()
     last = time.monotonic()
     for i, case in enumerate(cases):
-        if progress is not None and time.monotonic() - last > _PROGRESS_EVERY_S:
+        if progress is not None and time.monotonic() - last > PROGRESS_EVERY_S:
             progress(i, len(cases))
             last = time.monotonic()
         # random starts are drawn from the case's seed: each case has its own

@@ -192,8 +192,9 @@ def _checked_inputs(config, out_dir) -> tuple[SweepConfig, Path]:
     return config, out_dir
 
 
-#: A sweep of at least this many cases says what it prepares (listing, checking and
-#: recording its cases takes about 0.2 ms each: a minute for the largest).
+#: A sweep of at least this many cases says what it prepares (listing its cases takes
+#: about 0.16 ms each, checking one whose drive is distinct 0.45 ms, CPU on a loaded
+#: 2-core machine: minutes for the largest), with a count every PROGRESS_EVERY_S.
 PREPARE_NOTICE_CASES = 20_000
 
 
@@ -211,7 +212,8 @@ def _checked_cases(config: SweepConfig, say: Callable[[str], None] | None = None
     error refuses the config, not every run. ``say`` hears of each step of a long one."""
     if say is not None:
         say("listing them")
-    cases = expand_cases(config)
+    listed = None if say is None else (lambda i, n: say(f"listed {i:,} of {n:,}"))
+    cases = expand_cases(config, listed)
     clear_caches()
     if say is not None:
         say("checking every one before the first runs")

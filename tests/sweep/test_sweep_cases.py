@@ -7,6 +7,7 @@ import pytest
 from sweep_support import with_
 
 from spine_mj import sweep
+from spine_mj.jsonio import to_jsonable
 
 
 def test_grid_expansion_counts_ids_and_seeds():
@@ -97,3 +98,29 @@ def test_config_hash_case_ids_and_seeds_are_pinned_so_existing_stores_resume():
         "6628d07ed6d38034",
         "5a53974cad264687",
     ]
+
+
+def test_listing_reports_progress_and_keeps_each_value_apart(monkeypatch):
+    """A million cases take minutes to list: expand_cases reports (listed, total) every
+    PROGRESS_EVERY_S (here every case); its memo of converted values keeps 0.0 and -0.0
+    (and 1 and 1.0) apart, as converting each value afresh did."""
+    from spine_mj.sweep import cases as cases_module
+
+    monkeypatch.setattr(cases_module, "PROGRESS_EVERY_S", -1.0)
+    seen = []
+    config = sweep.parse_config(with_(grid__mu=[0.5, 1.0], grid__dl=[0.01, 0.02, 0.03]))
+    cases = sweep.expand_cases(config, lambda i, n: seen.append((i, n)))
+    assert seen == [(i, 6) for i in range(6)]
+    reference = [
+        sweep.digests.digest(
+            {
+                "surface": c.surface.as_dict(),
+                "starts": c.starts.as_dict(),
+                "params": {k: to_jsonable(v) for k, v in c.params.items()},
+            }
+        )[:16]
+        for c in cases
+    ]
+    assert [c.case_id for c in cases] == reference
+    jsonable = cases_module._memo_jsonable()
+    assert [json.dumps(jsonable(v)) for v in (0.0, -0.0, 1, 1.0, 1)] == ["0.0", "-0.0", "1", "1.0", "1"]
