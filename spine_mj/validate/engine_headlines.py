@@ -43,6 +43,7 @@ from spine_mj.validate.convergence import thin_starts
 from spine_mj.validate.ensembles import ensemble_family
 from spine_mj.validate.intervals import newcombe_difference
 from spine_mj.validate.plans import PLANS, FamilySpec, ValidationPlan, paper_starts, relative_starts
+from spine_mj.validate.predicted_limits import family_corner
 from spine_mj.validate.quasistatic_limit import corner_summary, limit_doc, limit_family_docs
 from spine_mj.validate.study_runner import StudyRunner
 
@@ -147,6 +148,7 @@ class EngineHeadlinesResult:
     plan : str
         The plan whose corner ran.
     lowest_ie : float
+        The lowest I_e of the corners.
     starts_per_surface : int or None
         Y starts per surface (None: the corner's own).
     engines : tuple of str
@@ -162,6 +164,9 @@ class EngineHeadlinesResult:
         Family (and ``rechecks``) -> engine -> ``engine`` (the engine's runs) and
         ``reference`` (the streamlines compared with them) CPU seconds, and ``runs``.
     wall_s : float
+    corners : dict
+        Family -> preset -> ``{"ie", "K"}``: each surface's own corner (empty in a result
+        made when every family ran at the plan's lowest I_e and the default spring).
     """
 
     plan: str
@@ -173,6 +178,7 @@ class EngineHeadlinesResult:
     recheck_plan: str
     cpu_s: dict
     wall_s: float
+    corners: dict = dataclasses.field(default_factory=dict)
 
     def as_dict(self) -> dict:
         return {**dataclasses.asdict(self), "engines": list(self.engines)}
@@ -188,19 +194,26 @@ def _both_engines(doc: dict, name: str, engines: Sequence[str]) -> dict:
     return {**doc, "sweep": {**doc["sweep"], "name": name}, "grid": {**doc["grid"], "engine": list(engines)}}
 
 
-def _corner_docs(plan: ValidationPlan, starts: int | None, engines) -> list[tuple[FamilySpec, str, dict]]:
-    """``(corner family, store name, config)`` of every limit sweep of the plan's corner, its
-    y starts thinned to ``starts`` per surface (None: all), in every engine."""
-    out = []
+def _corner_docs(
+    plan: ValidationPlan, starts: int | None, engines
+) -> tuple[list[tuple[FamilySpec, str, dict]], dict]:
+    """``(corner family, store name, config)`` of every limit sweep of the plan's corner, each
+    surface at its own corner (I_e, K) as the quasistatic-limit study runs it
+    (:func:`~spine_mj.validate.predicted_limits.family_corner`), its y starts thinned to
+    ``starts`` per surface (None: all), in every engine; and those corners, family -> preset
+    -> ``{"ie", "K"}``."""
+    out, corners = [], {}
     for fam in plan.families:
         corner = plan.corner_family(fam)
+        own = family_corner(plan, corner)["presets"]
+        corners[fam.name] = {p: {"ie": c["ie"], "K": c["K"]} for p, c in own.items()}
         if starts is not None:
             corner = thin_starts(corner, starts)
-        for name, doc in limit_family_docs(plan, corner):
+        for name, doc in limit_family_docs(plan, corner, own):
             out.append(
                 (corner, f"engines-limit/{name}", _both_engines(doc, f"engines-limit-{name}", engines))
             )
-    return out
+    return out, corners
 
 
 def miss_family(plan: ValidationPlan, miss: MissStart) -> FamilySpec:
@@ -286,7 +299,7 @@ def engine_headlines(
     """
     t0 = time.perf_counter()
     runner.study = "engines"
-    corner = _corner_docs(plan, starts_per_surface, engines)
+    corner, corners = _corner_docs(plan, starts_per_surface, engines)
     misses = [
         (m, f"engines-miss/{k}", _miss_doc(recheck_plan, m, k, engines)) for k, m in enumerate(rechecks)
     ]
@@ -309,7 +322,7 @@ def engine_headlines(
         cpu["rechecks"] = miss_cpu
     return EngineHeadlinesResult(
         plan=plan.name,
-        lowest_ie=plan.lowest_ie,
+        lowest_ie=min(c["ie"] for own in corners.values() for c in own.values()),
         starts_per_surface=starts_per_surface,
         engines=tuple(engines),
         families=families,
@@ -317,6 +330,7 @@ def engine_headlines(
         recheck_plan=recheck_plan.name,
         cpu_s=cpu,
         wall_s=round(time.perf_counter() - t0, 1),
+        corners=corners,
     )
 
 

@@ -78,8 +78,12 @@ def test_each_corner_sweep_runs_in_both_engines():
     from spine_mj.sweep import expand_cases, parse_config
 
     plan = dataclasses.replace(PLANS["quick"], families=PLANS["quick"].families[:1])
-    docs = study._corner_docs(plan, 2, ("mujoco", "bullet"))
-    assert [f.name for f, _, _ in docs] == ["single_peak_valley"]
+    docs, corners = study._corner_docs(plan, 2, ("mujoco", "bullet"))
+    assert set(corners["single_peak_valley"]) == {"paper-single-peak", "paper-single-valley"}
+    assert {f.name for f, _, _ in docs} == {"single_peak_valley"}
+    # each surface at its own corner, as the quasistatic-limit study runs it
+    drives = {(d["drive"]["ie"], d["drive"]["K"]) for _, _, d in docs}
+    assert drives == {(c["ie"], c["K"]) for c in corners["single_peak_valley"].values()}
     for fam, name, doc in docs:
         assert name.startswith("engines-limit/")
         assert len(fam.starts_table()["y"]) == 2

@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 
 from spine_mj.theory.targets import FRECHET_TARGET, OUTCOME_TARGET
-from spine_mj.validate.report.common import table
+from spine_mj.validate.report.common import corner_text, table
 
 __all__ = ["section"]
 
@@ -40,7 +40,7 @@ def section(res) -> str:
     size = "all" if res.starts_per_surface is None else f"{res.starts_per_surface}"
     parts = [
         "## Engines side by side: the headlines",
-        f"The corner of the quasistatic-limit study (plan `{res.plan}`, I_e = {res.lowest_ie:g}, "
+        f"The corner of the quasistatic-limit study (plan `{res.plan}`, {_corners(res)}, "
         f"{size} y starts per surface, every start an ensemble of its own and its neighbours "
         "1e-3 L_c away) run in both engines on the same surfaces and starts, one sweep per family "
         "with `engine = [mujoco, bullet]`. The theory is the streamline on the rig's facets "
@@ -54,6 +54,15 @@ def section(res) -> str:
         *_cost(res),
     ]
     return "\n\n".join(parts) + "\n"
+
+
+def _corners(res) -> str:
+    """Where the corner ran: each surface's own (I_e, K), or the one I_e of an older result."""
+    if not res.corners:
+        return f"I_e = {res.lowest_ie:g}"
+    return "each surface at its own (I_e, K): " + "; ".join(
+        f"{fam} {corner_text(c)}" for fam, c in res.corners.items()
+    )
 
 
 def _agreement_table(res) -> str:
