@@ -371,7 +371,7 @@ def run_compliant(
                     slipping = slip
                     has_prev = True
                     steps += 1
-                    arc += dl if reversed_ else hn  # a forced step across a crease: a full one
+                    arc += hn
                     until -= 1
                     if until == 0:
                         need = stall_dist * arc / (stall_window * dl)

@@ -23,9 +23,6 @@ step control and the stall test are those of :mod:`spine_mj.theory.streamline` (
 :class:`~spine_mj.theory.streamline_types.StreamlineParams`); above ``K*`` (no fold) the path is the
 rigid streamline's and only the carriage differs. The spring never pushes the tip off
 the surface here: lift-off is an inertial effect (:mod:`spine_mj.theory.drive_limits`).
-Unlike the rigid streamline it has no two-contact state: a tip that slips into a concave
-crease (the floor of a groove between facets) zig-zags across it at the shortest step and
-ends STALLED within two progress windows, where the rigid path follows the crease.
 """
 
 from __future__ import annotations
@@ -429,7 +426,7 @@ def _step(L, a, vx, vy, slip, reversed_, params, domain):
     L.slipping[go] = slip[g]
     L.has_prev[go] = True
     L.n_steps[go] += 1
-    L.arc[go] += np.where(reversed_[g], dl, hn[g])  # a forced step across a crease: a full one
+    L.arc[go] += hn[g]
     L.until[go] -= 1
     return a[out]
 
