@@ -183,3 +183,40 @@ def test_a_large_sweep_says_what_it_prepares_before_its_first_case(tmp_path, mon
         peak_config(tmp_path, nmu=3, ny=1, name="small"), tmp_path / "small", workers=1, notice=said.append
     )
     assert not any("preparing" in s for s in said)
+
+
+def test_engines_of_one_sizing_measure_the_surface_once_before_any_run(tmp_path, monkeypatch):
+    """A grid over both engines checks each engine's case on one measurement of the surface
+    (its hfield sampled, its fall height traced: a minute at 8000 a side), as MuJoCo's
+    cases alone did; Bullet's rig was built afresh, measuring it again. The Bullet case is
+    still checked as its rig (its heightfield's memory: refused here under a 1 MiB budget)."""
+    pytest.importorskip("pybullet")
+    from spine_mj.sim.scales import Scales
+
+    calls = []
+    measure = Scales.with_hfield.__func__
+
+    def counted(cls, surface, **kw):
+        calls.append(kw.get("hfield_resolution"))
+        return measure(cls, surface, **kw)
+
+    monkeypatch.setattr(Scales, "with_hfield", classmethod(counted))
+    sweep.session.clear_caches()
+    text = """
+    [sweep]
+    analyses = ["engine"]
+    [[surfaces]]
+    preset = "paper-single-peak"
+    [starts]
+    x = [0.05]
+    y = [0.5]
+    [grid]
+    engine = ["mujoco", "bullet"]
+    hfield_resolution = 101
+    """
+    cases = sweep.expand_cases(sweep.load_config(write_config(tmp_path, text)))
+    preflight.check_cases(cases, ("engine",))
+    assert calls == [101]
+    monkeypatch.setenv("SPINE_MJ_MEMORY_BUDGET", "1M")
+    with pytest.raises(SpineInputError, match=r"engine = 'bullet'.*Bullet's heightfield of 101 x 101"):
+        preflight.check_cases(cases, ("engine",))

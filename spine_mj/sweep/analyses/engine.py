@@ -314,14 +314,19 @@ def _sizing(spec, tip, sizing: tuple):
 
 def case_plan(case, surface=None):
     """What :func:`case_rig` would build for ``case``, without compiling it: a MuJoCo case's
-    :class:`~spine_mj.sim.build.RigPlan` (its scales, tip and engine step; cached, the
-    surface sized once per tip), a Bullet case's rig itself. For the checks of a grid
-    before any case runs."""
+    :class:`~spine_mj.sim.build.RigPlan` (its scales, tip and engine step), another
+    engine's rig itself (Bullet's checks its heightfield's memory; its world is made at
+    its first run). The surface is sized once per tip for every engine (cached: a grid over
+    both engines measured an 8000-a-side hfield twice). For the checks of a grid before
+    any case runs."""
+    surface = case.surface.make() if surface is None else surface
     inputs = case_inputs(case, surface)
-    if inputs.engine != "mujoco":
-        return _rig(case.surface, inputs)
     sized = _sizing(case.surface, inputs.tip, tuple(inputs.sizing.items()))
-    return plan_rig(case.surface.make(), inputs, sized=sized)
+    plan = plan_rig(surface, inputs, sized=sized)
+    if inputs.engine == "mujoco":
+        return plan
+    rig_class = ENGINES[inputs.engine].rig_class()
+    return rig_class(surface, tip=plan.tip, engine=plan.engine, sized=(plan.scales, plan.hfield))
 
 
 def case_scales(case, surface=None) -> sim.Scales:
