@@ -187,7 +187,8 @@ class EngineOverrides:
         -------
         EngineSettings
         """
-        given = {k: v for k, v in dataclasses.asdict(self).items() if v is not None}
+        given = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}  # asdict deep-copies
+        given = {k: v for k, v in given.items() if v is not None}
         timeconst_s, dampratio = given.pop("solref_timeconst_s", None), given.pop("solref_dampratio", None)
         factor = given.pop("timestep_factor", None)
         if factor is not None:

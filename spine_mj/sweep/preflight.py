@@ -55,6 +55,7 @@ def check_cases(
     """
     keys = {name: checked_keys(name) for name in ANALYSES}
     seen: set = set()
+    resolved: dict = {}  # the start points of each source, resolved once
     last = time.monotonic()
     for i, case in enumerate(cases):
         if progress is not None and time.monotonic() - last > PROGRESS_EVERY_S:
@@ -74,16 +75,18 @@ def check_cases(
             seen.add(source)
             todo = todo or [None]  # the surface and starts are made even without a check
         if todo:
-            _check(case, todo, swept)
+            _check(case, todo, swept, resolved, source)
     if progress is not None:
         progress(len(cases), len(cases))
 
 
-def _check(case: Case, analyses, swept: Sequence[str]) -> None:
+def _check(case: Case, analyses, swept: Sequence[str], resolved: dict, source) -> None:
     where = ", ".join([case.surface.label] + [f"{k} = {case.params[k]!r}" for k in swept])
     try:
         surface = case.surface.make()
-        starts = case.starts.resolve(surface.bounds, case.seed)
+        if source not in resolved:
+            resolved[source] = case.starts.resolve(surface.bounds, case.seed)
+        starts = resolved[source]
         for name in analyses:
             if name is not None:
                 ANALYSES[name].check_case(case, surface, starts)
