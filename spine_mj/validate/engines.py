@@ -39,7 +39,7 @@ facets' rule says; with them Bullet self-locks).
   one sweep with ``engine = ["mujoco", "bullet"]``, rates with Wilson intervals.
 
 ``spine-mj validate`` runs the closed forms as a study of its registry
-(:func:`engines_study`, the plan's ``engines_checks``), its section "Engines side by side"
+(:func:`engines_study`, the plan's ``engines.checks``), its section "Engines side by side"
 in ``report.md``, where the ``[bullet]`` extra is installed (without it the section says so
 in one line). The longer comparisons run apart (:func:`compare_engines`):
 ``spine-mj compare-engines --out DIR [--quick] [--fractal N] [--headlines N]``
@@ -491,7 +491,7 @@ def _checks(quick: bool) -> dict:
 
 def engines_study(plan: ValidationPlan, runner: StudyRunner) -> EnginesResult:
     """The study in ``spine-mj validate``: :func:`engines_ground_truth` of the plan's checks
-    (``plan.engines_checks``; ``plan.engines_quick``: fewer corrugation wavelengths) in both
+    (``plan.engines.checks``; ``plan.engines.quick``: fewer corrugation wavelengths) in both
     engines, where the ``[bullet]`` extra is installed; without it a result that says so
     (``missing``) and runs nothing."""
     from spine_mj import extras
@@ -499,9 +499,9 @@ def engines_study(plan: ValidationPlan, runner: StudyRunner) -> EnginesResult:
     runner.study = "engines"
     if extras.missing("bullet"):
         return EnginesResult(rows=[], engines=(), wall_s={}, missing=("bullet",))
-    checks = CHECKS if plan.engines_checks is None else plan.engines_checks
+    checks = CHECKS if plan.engines.checks is None else plan.engines.checks
     with runner.phase("closed forms in MuJoCo and Bullet", total=len(COMPARED_ENGINES) * len(checks)) as tick:
-        return engines_ground_truth(quick=plan.engines_quick, checks=checks, progress=lambda _: tick())
+        return engines_ground_truth(quick=plan.engines.quick, checks=checks, progress=lambda _: tick())
 
 
 #: What :func:`compare_engines` writes into its folder (beside its resumable ``sweeps/``).
@@ -538,7 +538,7 @@ def compare_engines(
     from spine_mj.atomic import writable_path
     from spine_mj.choices import PLAN_NAMES
     from spine_mj.jsonio import write_json
-    from spine_mj.validate import engine_headlines
+    from spine_mj.validate.engine_headlines import RESULT_FILE, run_engine_headlines
     from spine_mj.validate.fractal_lock import fractal_engines
     from spine_mj.validate.report.engine_headlines import section as headlines_section
     from spine_mj.validate.report.engines import section
@@ -570,10 +570,10 @@ def compare_engines(
     headlines = None
     if headlines_starts:
         say("headlines: the corner per family and the soft-contact misses, both engines")
-        headlines = engine_headlines.run_engine_headlines(
+        headlines = run_engine_headlines(
             out, plan=headlines_plan, starts_per_surface=headlines_starts, workers=workers
         )
-        write_json(out / engine_headlines.RESULT_FILE, headlines.as_dict())
+        write_json(out / RESULT_FILE, headlines.as_dict())
     write_json(out / "engines.json", res.as_dict())
     text = section(res) + headlines_section(headlines)
     with atomic_output(out / "engines.md") as tmp:

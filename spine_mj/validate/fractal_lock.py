@@ -15,9 +15,9 @@ drive at the plan's lowest I_e and at one dynamic I_e (held: ended by the lock r
 force cap). Every rate comes with its count, its Wilson interval and the runs the engine
 stopped (``failed_runs``), which are reported, not dropped silently.
 
-Solution verification (``plan.fractal_refinements``, keys of
+Solution verification (``plan.fractal.refinements``, keys of
 :data:`~spine_mj.validate.convergence.REFINEMENTS`): both MuJoCo series rerun on the first
-``plan.fractal_refined_surfaces`` surfaces of every H under each refinement, each case at
+``plan.fractal.refined_surfaces`` surfaces of every H under each refinement, each case at
 its own rig's step refined (the sweep's ``timestep_factor``: the surfaces' steps differ by
 up to a quarter); a rate's change is paired (the refined runs' rate minus the same
 surfaces' own, over the surfaces both ran cleanly) and *converged* when the rate plus it
@@ -193,8 +193,8 @@ def fractal_lock(plan: ValidationPlan, runner: StudyRunner) -> FractalLockResult
     """Study 6: self-lock rate against H, streamline and MuJoCo (corner and dynamic I_e).
 
     Two sweeps over the same surfaces and start: at ``plan.lowest_ie`` with the
-    quasistatic, engine (and, when ``plan.fractal_facets``, compare) analyses, and at
-    ``plan.fractal_dynamic_ie`` with the engine analysis alone. Default spring drive
+    quasistatic, engine (and, when ``plan.fractal.facets``, compare) analyses, and at
+    ``plan.fractal.dynamic_ie`` with the engine analysis alone. Default spring drive
     (K = 30), the rig's default tip and engine.
 
     Parameters
@@ -209,17 +209,17 @@ def fractal_lock(plan: ValidationPlan, runner: StudyRunner) -> FractalLockResult
     FractalLockResult
     """
     runner.study = "fractal_lock"
-    hursts = tuple(float(h) for h in plan.fractal_hursts)
-    n = int(plan.fractal_surfaces)
+    hursts = tuple(float(h) for h in plan.fractal.hursts)
+    n = int(plan.fractal.surfaces)
     mu = calibrated_mu(PRESET)
     tip = tip_radius(PRESET, None, plan.hfield_resolution)
     surfaces = surfaces_table(hursts, n)
     seed_hurst = {seed: s["set"]["hurst"] for s in surfaces for seed in s["seeds"]}
     grid = {"mu": mu, "tip_radius": tip}
     starts = {"frame": "relative", "x": [0.05], "y": [0.5]}
-    corner = ["quasistatic", "engine", *(["compare"] if plan.fractal_facets else [])]
+    corner = ["quasistatic", "engine", *(["compare"] if plan.fractal.facets else [])]
     records = []
-    series = (("corner", plan.lowest_ie, corner), ("dynamic", plan.fractal_dynamic_ie, ["engine"]))
+    series = (("corner", plan.lowest_ie, corner), ("dynamic", plan.fractal.dynamic_ie, ["engine"]))
     for label, ie, analyses in series:
         doc = {
             "sweep": {"name": f"fractal-lock-{label}", "seed": 11, "analyses": analyses},
@@ -236,9 +236,9 @@ def fractal_lock(plan: ValidationPlan, runner: StudyRunner) -> FractalLockResult
         records += _records(df, label, seed_hurst)
     runs = pd.DataFrame.from_records(records)
     rows = hurst_rows(runs)
-    keys = list(plan.fractal_refinements)
-    if keys and plan.fractal_refined_surfaces > 0:
-        thin = [{**s, "seeds": s["seeds"][: plan.fractal_refined_surfaces]} for s in surfaces]
+    keys = list(plan.fractal.refinements)
+    if keys and plan.fractal.refined_surfaces > 0:
+        thin = [{**s, "seeds": s["seeds"][: plan.fractal.refined_surfaces]} for s in surfaces]
         jobs = [
             (key, label, _refined_doc(key, label, ie, thin, starts, grid))
             for key in keys
@@ -251,11 +251,11 @@ def fractal_lock(plan: ValidationPlan, runner: StudyRunner) -> FractalLockResult
             (key, label): pd.DataFrame.from_records(_records(df, label, seed_hurst))
             for (key, label, _), (df, _) in zip(jobs, done)
         }
-        _add_convergence(rows, runs, refined, plan.fractal_refinements)
+        _add_convergence(rows, runs, refined, plan.fractal.refinements)
     return FractalLockResult(
         rows=rows,
         corner_ie=float(plan.lowest_ie),
-        dynamic_ie=float(plan.fractal_dynamic_ie),
+        dynamic_ie=float(plan.fractal.dynamic_ie),
         surfaces_per_hurst=n,
         confidence=CONFIDENCE,
         mu=float(mu),
@@ -305,7 +305,7 @@ def _add_convergence(rows: list[dict], runs: pd.DataFrame, refined: dict, keys) 
                 row[f"rate_{series}"],
                 (row[f"ci_low_{series}"], row[f"ci_high_{series}"]),
                 by_key,
-                note="not in the plan's fractal_refinements",
+                note="not in the plan's fractal.refinements",
             )
 
 

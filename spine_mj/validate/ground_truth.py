@@ -110,16 +110,16 @@ def ground_truth(plan: ValidationPlan, runner: StudyRunner) -> GroundTruthResult
         ladder = spring_block_ladder()
     corrugations = [
         Corrugation(s, mu, tip_radius=TOMLINSON_TIP)
-        for s in plan.ground_truth_slopes
-        for mu in plan.ground_truth_mus
+        for s in plan.ground_truth.slopes
+        for mu in plan.ground_truth.mus
     ]
     ks = [
-        [float(f"{f * c.critical_stiffness():.6g}") for f in plan.ground_truth_k_factors]
+        [float(f"{f * c.critical_stiffness():.6g}") for f in plan.ground_truth.k_factors]
         for c in corrugations
     ]
     names = [f"ground-truth/pt-s{c.slope_amplitude:g}-mu{c.mu:g}" for c in corrugations]
     jobs = [
-        (corrugation_doc(name, c.slope_amplitude, c.mu, k, TOMLINSON_IE, plan.ground_truth_waves), name)
+        (corrugation_doc(name, c.slope_amplitude, c.mu, k, TOMLINSON_IE, plan.ground_truth.waves), name)
         for c, k, name in zip(corrugations, ks, names)
     ]
     # the corrugations' sweeps at once: the workers stay busy across the sweeps' ends
@@ -127,7 +127,7 @@ def ground_truth(plan: ValidationPlan, runner: StudyRunner) -> GroundTruthResult
     rows = []
     for c, (df, _) in zip(corrugations, done):
         rows += _tomlinson(c, df[df["analysis"] == "engine"])
-    lift = [_liftoff(plan, runner, w) for w in plan.ground_truth_ridge_widths]
+    lift = [_liftoff(plan, runner, w) for w in plan.ground_truth.ridge_widths]
     return GroundTruthResult(spring_block=block, tomlinson=rows, liftoff=lift, spring_block_ladder=ladder)
 
 
@@ -322,7 +322,7 @@ def _liftoff(plan: ValidationPlan, runner: StudyRunner, width: float) -> dict:
     ie_star = liftoff_inertia_number(
         gaussian_ridge_path_curvature(RIDGE_HEIGHT * unit, width * unit, RIDGE_TIP_M), lc_m
     )
-    ies = [float(f"{f * ie_star:.6g}") for f in plan.ground_truth_liftoff_factors]
+    ies = [float(f"{f * ie_star:.6g}") for f in plan.ground_truth.liftoff_factors]
     doc = {
         "sweep": {"name": f"ridge-{width:g}", "seed": 1, "analyses": ["engine"]},
         "surfaces": [{"file": str(Path(path).relative_to(runner.out_dir))}],

@@ -1,8 +1,10 @@
 """Sizes and targets of a validation run: the plans, their surface families and engine variations.
 
 A :class:`ValidationPlan` fixes every grid of the studies (planes, families, I_e
-values, stiffnesses, grits, bootstrap size, ramp caps, the fractal self-lock study, the
-(I_e, K) map); :data:`PLANS` holds the ``smoke``
+values, bootstrap size, ramp caps), with one section per study whose sizes are its own
+(:class:`StickSlipPlan`, :class:`SandpaperPlan`, :class:`FractalPlan`,
+:class:`StiffnessMapPlan`, :class:`GroundTruthPlan`, :class:`EnginesPlan`: ``plan.fractal.surfaces``);
+:data:`PLANS` holds the ``smoke``
 (test size), ``quick`` and ``full`` plans. The agreement targets and the physical
 constants every study shares (tip mass, gravity, the sandpaper mu) live here, so that the
 studies, the summary and the report read one value.
@@ -31,7 +33,13 @@ __all__ = [
     "SANDPAPER_MU",
     "STATIC_TARGET",
     "TOLERANCE_TIGHTENED",
+    "EnginesPlan",
     "FamilySpec",
+    "FractalPlan",
+    "GroundTruthPlan",
+    "SandpaperPlan",
+    "StickSlipPlan",
+    "StiffnessMapPlan",
     "ValidationPlan",
     "paper_starts",
     "relative_starts",
@@ -96,6 +104,185 @@ def relative_starts(n: int, x: float = 0.05) -> tuple:
 
 
 @dataclass(frozen=True)
+class StickSlipPlan:
+    """The stick-slip study's sizes (:mod:`spine_mj.validate.stick_slip`).
+
+    Attributes
+    ----------
+    ie : tuple of float
+    stiffness : tuple of float
+        Spring stiffness in units of ``F_p / L_c``.
+    starts : int
+    k_ie, k_factors : tuple of float
+        The stick-slip study's K scan on a corrugation: I_e values and K in units of K*.
+    """
+
+    ie: tuple[float, ...] = (1e-3, 1e-1, 1.0)
+    stiffness: tuple[float, ...] = (2.0, 10.0, 50.0)
+    starts: int = 3
+    k_ie: tuple[float, ...] = (1e-4, 1e-2)
+    k_factors: tuple[float, ...] = (0.125, 0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 4.0, 8.0)
+
+
+@dataclass(frozen=True)
+class SandpaperPlan:
+    """The sandpaper study's sizes (:mod:`spine_mj.validate.sandpaper`).
+
+    Attributes
+    ----------
+    grits : tuple of str
+    starts : int
+    ie : float
+    """
+
+    grits: tuple[str, ...] = ("P36", "P60", "P600")
+    starts: int = 3
+    ie: float = 1e-3
+
+
+@dataclass(frozen=True)
+class FractalPlan:
+    """The fractal self-lock study's sizes (:mod:`spine_mj.validate.fractal_lock`).
+
+    Attributes
+    ----------
+    hursts : tuple of float
+        Hurst exponents of the fractal self-lock study (Figs. 7E and 9 in dynamics); the
+        default five lie in the preset's Fig. 9 list, so their surfaces are a Fig. 9 run's.
+    surfaces : int
+        Fractal surfaces per H (one start each): enough for a rate with a usable binomial
+        interval in the full plan (>= 30), fewer in the quick one.
+    dynamic_ie : float
+        The I_e of the study's dynamic MuJoCo series (its other one runs at ``lowest_ie``).
+    refinements : tuple of str
+        Refinements of the fractal self-lock rates (keys of
+        :data:`spine_mj.validate.convergence.REFINEMENTS`; empty: none): both MuJoCo series
+        rerun on the first ``refined_surfaces`` surfaces of each H
+        (:mod:`spine_mj.validate.fractal_lock`).
+    refined_surfaces : int
+    facets : bool
+        Also count the streamline traced on MuJoCo's facets (the ``compare`` analysis's
+        reference, ~1.4 s of CPU per surface measured on the fractal preset, twice the
+        MuJoCo runs' cost there).
+    """
+
+    hursts: tuple[float, ...] = (0.65, 0.75, 0.8, 0.85, 0.95)
+    surfaces: int = 30
+    dynamic_ie: float = 0.1
+    facets: bool = True
+    refinements: tuple[str, ...] = ()
+    refined_surfaces: int = 0
+
+
+@dataclass(frozen=True)
+class StiffnessMapPlan:
+    """The (I_e, K) map's sizes (:mod:`spine_mj.validate.stiffness_map`).
+
+    Attributes
+    ----------
+    ie, k : tuple of float
+        Grid of the (I_e, K) map of the spring drive, K = k l_s / F_p (empty: no map).
+    k_factors : tuple of float
+        The map's K axis relative to each family's predicted K*
+        (:mod:`spine_mj.validate.predicted_limits`): K = factor x K*, two digits (empty: the
+        absolute ``k`` on every family).
+    deep_ie : tuple of float
+        I_e values below the map's grid, run at each family's stiffest K only: the gap to
+        the streamline against I_e where the spring's offset is smallest (the convergence
+        to the theory, :mod:`spine_mj.validate.theory_orders`).
+    deep_starts : int
+        Starts per preset of those deep runs (0: the map's): a run at I_e = 1e-6 is slow
+        (a carriage 100 times slower than at 1e-2).
+    deep_every_k : tuple of str
+        Families (by name) whose deep I_e runs at every K of their axis, not the stiffest
+        only: where every K fails at the grid's lowest I_e the K boundary can be read on
+        the deep cells alone (the fractal: every K fails at 1e-4, 10 K* included; a deep
+        fractal run costs 0.5 to 1.4 s of CPU, a single peak/valley or random Gaussian one
+        3 to 7 s).
+    families : tuple of str
+        Families (by name) of the map.
+    starts : int
+        Starts per preset of the map (a subset of the family's): the lowest I_e and the
+        many K values make the map's expensive corner, so it runs from few starts.
+    runs : int
+        Runs per (I_e, K) point and family the map needs at least (0: the family's own
+        starts, ``starts`` of them; :meth:`map_family`).
+    """
+
+    ie: tuple[float, ...] = ()
+    k: tuple[float, ...] = ()
+    families: tuple[str, ...] = ()
+    k_factors: tuple[float, ...] = ()
+    deep_ie: tuple[float, ...] = ()
+    deep_starts: int = 0
+    deep_every_k: tuple[str, ...] = ()
+    starts: int = 2
+    runs: int = 0
+
+    def deep_k_axis(self, family: str, ks: Sequence[float]) -> list[float]:
+        """The K values of ``family``'s deep I_e runs (``deep_ie``): its whole
+        axis ``ks`` where ``deep_every_k`` names it, else its stiffest K."""
+        return sorted(ks) if family in self.deep_every_k else [max(ks)]
+
+    def map_family(self, fam: FamilySpec) -> FamilySpec:
+        """``fam`` for the (I_e, K) map: with ``runs`` > 0, its y starts
+        respread over the same range, as many as that many runs per (I_e, K) point need on
+        the map's one surface per preset (``starts``, at least as many, then
+        keeps them all)."""
+        if self.runs <= 0:
+            return fam
+        t = dict(fam.starts)
+        ys = [float(v) for v in t["y"]]
+        n = -(-self.runs // len(fam.presets))
+        t["y"] = tuple(float(v) for v in np.linspace(min(ys), max(ys), n).round(4))
+        return dataclasses.replace(fam, starts=tuple(t.items()))
+
+
+@dataclass(frozen=True)
+class GroundTruthPlan:
+    """The ground-truth study's sizes (:mod:`spine_mj.validate.ground_truth`).
+
+    Attributes
+    ----------
+    slopes, mus : tuple of float
+        Corrugations of the ground-truth study's Prandtl-Tomlinson check (slope amplitude
+        x mu, each slope below each mu).
+    k_factors : tuple of float
+        Stiffness numbers of that check in units of each corrugation's K*.
+    waves : int
+        Wavelengths of those corrugations.
+    ridge_widths : tuple of float
+        Gaussian ridge widths (height 0.5) of the lift-off check.
+    liftoff_factors : tuple of float
+        I_e of the lift-off scans in units of each ridge's predicted I_e*.
+    """
+
+    slopes: tuple[float, ...] = (0.1, 0.2, 0.3)
+    mus: tuple[float, ...] = (0.5, 0.8)
+    k_factors: tuple[float, ...] = (0.25, 0.5, 2.0, 4.0)
+    waves: int = 6
+    ridge_widths: tuple[float, ...] = (0.35, 0.5, 0.7)
+    liftoff_factors: tuple[float, ...] = (0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1.2, 1.5)
+
+
+@dataclass(frozen=True)
+class EnginesPlan:
+    """The engines study's checks (:mod:`spine_mj.validate.engines`).
+
+    Attributes
+    ----------
+    checks : tuple of str or None
+        The checks of the engines study (names of :data:`spine_mj.validate.engines.CHECKS`;
+        None: all), run in MuJoCo and Bullet where the ``[bullet]`` extra is installed.
+    quick : bool
+        The engines study's Prandtl-Tomlinson over fewer wavelengths (2, not 3).
+    """
+
+    checks: tuple[str, ...] | None = None
+    quick: bool = False
+
+
+@dataclass(frozen=True)
 class ValidationPlan:
     """Sizes of a validation run.
 
@@ -118,13 +305,6 @@ class ValidationPlan:
     boundary_families : tuple of str
         Families (by name) of the boundary study.
     protocols : tuple of str
-    stick_slip_ie : tuple of float
-    stick_slip_stiffness : tuple of float
-        Spring stiffness in units of ``F_p / L_c``.
-    stick_slip_starts : int
-    sandpaper_grits : tuple of str
-    sandpaper_starts : int
-    sandpaper_ie : float
     bootstrap : int
         Bootstrap resamples of the starts for the I_e* uncertainty.
     ramp_max_steps : int
@@ -136,64 +316,6 @@ class ValidationPlan:
         (the step of the paper's algorithm). The paper's dl = 0.01 sigma would need ~500
         cycles per path here; 0.1 L_c keeps a run affordable and is compared with the
         streamline stepped at its own, converged dl.
-    fractal_hursts : tuple of float
-        Hurst exponents of the fractal self-lock study (Figs. 7E and 9 in dynamics); the
-        default five lie in the preset's Fig. 9 list, so their surfaces are a Fig. 9 run's.
-    fractal_surfaces : int
-        Fractal surfaces per H (one start each): enough for a rate with a usable binomial
-        interval in the full plan (>= 30), fewer in the quick one.
-    fractal_dynamic_ie : float
-        The I_e of the study's dynamic MuJoCo series (its other one runs at ``lowest_ie``).
-    fractal_refinements : tuple of str
-        Refinements of the fractal self-lock rates (keys of
-        :data:`spine_mj.validate.convergence.REFINEMENTS`; empty: none): both MuJoCo series
-        rerun on the first ``fractal_refined_surfaces`` surfaces of each H
-        (:mod:`spine_mj.validate.fractal_lock`).
-    fractal_refined_surfaces : int
-    fractal_facets : bool
-        Also count the streamline traced on MuJoCo's facets (the ``compare`` analysis's
-        reference, ~1.4 s of CPU per surface measured on the fractal preset, twice the
-        MuJoCo runs' cost there).
-    stiffness_map_ie, stiffness_map_k : tuple of float
-        Grid of the (I_e, K) map of the spring drive, K = k l_s / F_p (empty: no map).
-    stiffness_map_k_factors : tuple of float
-        The map's K axis relative to each family's predicted K*
-        (:mod:`spine_mj.validate.predicted_limits`): K = factor x K*, two digits (empty: the
-        absolute ``stiffness_map_k`` on every family).
-    stiffness_map_deep_ie : tuple of float
-        I_e values below the map's grid, run at each family's stiffest K only: the gap to
-        the streamline against I_e where the spring's offset is smallest (the convergence
-        to the theory, :mod:`spine_mj.validate.theory_orders`).
-    stiffness_map_deep_starts : int
-        Starts per preset of those deep runs (0: the map's): a run at I_e = 1e-6 is slow
-        (a carriage 100 times slower than at 1e-2).
-    stiffness_map_deep_every_k : tuple of str
-        Families (by name) whose deep I_e runs at every K of their axis, not the stiffest
-        only: where every K fails at the grid's lowest I_e the K boundary can be read on
-        the deep cells alone (the fractal: every K fails at 1e-4, 10 K* included; a deep
-        fractal run costs 0.5 to 1.4 s of CPU, a single peak/valley or random Gaussian one
-        3 to 7 s).
-    stiffness_map_families : tuple of str
-        Families (by name) of the map.
-    stiffness_map_starts : int
-        Starts per preset of the map (a subset of the family's): the lowest I_e and the
-        many K values make the map's expensive corner, so it runs from few starts.
-    stick_slip_k_ie, stick_slip_k_factors : tuple of float
-        The stick-slip study's K scan on a corrugation: I_e values and K in units of K*.
-    ground_truth_slopes, ground_truth_mus : tuple of float
-        Corrugations of the ground-truth study's Prandtl-Tomlinson check (slope amplitude
-        x mu, each slope below each mu).
-    ground_truth_k_factors : tuple of float
-        Stiffness numbers of that check in units of each corrugation's K*.
-    ground_truth_waves : int
-        Wavelengths of those corrugations.
-    ground_truth_ridge_widths : tuple of float
-        Gaussian ridge widths (height 0.5) of the lift-off check.
-    ground_truth_liftoff_factors : tuple of float
-        I_e of the lift-off scans in units of each ridge's predicted I_e*.
-    stiffness_map_runs : int
-        Runs per (I_e, K) point and family the map needs at least (0: the family's own
-        starts, ``stiffness_map_starts`` of them; :meth:`map_family`).
     ensemble_members : int
         Runs per start of the quasistatic-limit study, on each side: the start and
         ``ensemble_members - 1`` starts around it (:mod:`spine_mj.validate.ensembles`);
@@ -213,11 +335,18 @@ class ValidationPlan:
         The quasistatic-limit study's own seeds and starts table per family (the corner's
         sample size), where they differ from the family's (which the boundary study and the
         (I_e, K) map draw on); :meth:`corner_family`.
-    engines_checks : tuple of str or None
-        The checks of the engines study (names of :data:`spine_mj.validate.engines.CHECKS`;
-        None: all), run in MuJoCo and Bullet where the ``[bullet]`` extra is installed.
-    engines_quick : bool
-        The engines study's Prandtl-Tomlinson over fewer wavelengths (2, not 3).
+    stick_slip : StickSlipPlan
+        The stick-slip study's sizes (:mod:`spine_mj.validate.stick_slip`).
+    sandpaper : SandpaperPlan
+        The sandpaper study's sizes (:mod:`spine_mj.validate.sandpaper`).
+    fractal : FractalPlan
+        The fractal self-lock study's sizes (:mod:`spine_mj.validate.fractal_lock`).
+    stiffness_map : StiffnessMapPlan
+        The (I_e, K) map's sizes (:mod:`spine_mj.validate.stiffness_map`).
+    ground_truth : GroundTruthPlan
+        The ground-truth study's sizes (:mod:`spine_mj.validate.ground_truth`).
+    engines : EnginesPlan
+        The engines study's checks (:mod:`spine_mj.validate.engines`).
     """
 
     name: str
@@ -231,64 +360,21 @@ class ValidationPlan:
     ie_values: tuple[float, ...]
     boundary_families: tuple[str, ...]
     protocols: tuple[str, ...] = ("spring", "ramp")
-    stick_slip_ie: tuple[float, ...] = (1e-3, 1e-1, 1.0)
-    stick_slip_stiffness: tuple[float, ...] = (2.0, 10.0, 50.0)
-    stick_slip_starts: int = 3
-    sandpaper_grits: tuple[str, ...] = ("P36", "P60", "P600")
-    sandpaper_starts: int = 3
-    sandpaper_ie: float = 1e-3
+    stick_slip: StickSlipPlan = field(default_factory=StickSlipPlan)
+    sandpaper: SandpaperPlan = field(default_factory=SandpaperPlan)
+    fractal: FractalPlan = field(default_factory=FractalPlan)
+    stiffness_map: StiffnessMapPlan = field(default_factory=StiffnessMapPlan)
+    ground_truth: GroundTruthPlan = field(default_factory=GroundTruthPlan)
+    engines: EnginesPlan = field(default_factory=EnginesPlan)
     bootstrap: int = 200
     ramp_max_steps: int = 20000
     ramp_slide_lc: float = 0.1
-    fractal_hursts: tuple[float, ...] = (0.65, 0.75, 0.8, 0.85, 0.95)
-    fractal_surfaces: int = 30
-    fractal_dynamic_ie: float = 0.1
-    fractal_facets: bool = True
-    fractal_refinements: tuple[str, ...] = ()
-    fractal_refined_surfaces: int = 0
-    stiffness_map_ie: tuple[float, ...] = ()
-    stiffness_map_k: tuple[float, ...] = ()
-    stiffness_map_families: tuple[str, ...] = ()
-    stiffness_map_k_factors: tuple[float, ...] = ()
-    stiffness_map_deep_ie: tuple[float, ...] = ()
-    stiffness_map_deep_starts: int = 0
-    stiffness_map_deep_every_k: tuple[str, ...] = ()
-    stiffness_map_starts: int = 2
-    stick_slip_k_ie: tuple[float, ...] = (1e-4, 1e-2)
-    stick_slip_k_factors: tuple[float, ...] = (0.125, 0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 4.0, 8.0)
-    ground_truth_slopes: tuple[float, ...] = (0.1, 0.2, 0.3)
-    ground_truth_mus: tuple[float, ...] = (0.5, 0.8)
-    ground_truth_k_factors: tuple[float, ...] = (0.25, 0.5, 2.0, 4.0)
-    ground_truth_waves: int = 6
-    ground_truth_ridge_widths: tuple[float, ...] = (0.35, 0.5, 0.7)
-    ground_truth_liftoff_factors: tuple[float, ...] = (0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1.2, 1.5)
-    stiffness_map_runs: int = 0
     ensemble_members: int = 1
     corner: tuple[tuple[str, Any, tuple], ...] = ()
     convergence_starts: int = 0
     convergence_refinements: tuple[str, ...] = ("dt_halved", "hfield_doubled")
     boundary_refinements: tuple[str, ...] = ()
-    engines_checks: tuple[str, ...] | None = None
-    engines_quick: bool = False
     extra: dict = field(default_factory=dict, compare=False)
-
-    def deep_k_axis(self, family: str, ks: Sequence[float]) -> list[float]:
-        """The K values of ``family``'s deep I_e runs (``stiffness_map_deep_ie``): its whole
-        axis ``ks`` where ``stiffness_map_deep_every_k`` names it, else its stiffest K."""
-        return sorted(ks) if family in self.stiffness_map_deep_every_k else [max(ks)]
-
-    def map_family(self, fam: FamilySpec) -> FamilySpec:
-        """``fam`` for the (I_e, K) map: with ``stiffness_map_runs`` > 0, its y starts
-        respread over the same range, as many as that many runs per (I_e, K) point need on
-        the map's one surface per preset (``stiffness_map_starts``, at least as many, then
-        keeps them all)."""
-        if self.stiffness_map_runs <= 0:
-            return fam
-        t = dict(fam.starts)
-        ys = [float(v) for v in t["y"]]
-        n = -(-self.stiffness_map_runs // len(fam.presets))
-        t["y"] = tuple(float(v) for v in np.linspace(min(ys), max(ys), n).round(4))
-        return dataclasses.replace(fam, starts=tuple(t.items()))
 
     def corner_family(self, fam: FamilySpec) -> FamilySpec:
         """``fam`` with the seeds and starts of the quasistatic-limit corner (``corner``)."""
@@ -364,34 +450,46 @@ PLANS: dict[str, ValidationPlan] = {
         ie_values=(1e-2, 1.0),
         boundary_families=("single_peak_valley",),
         protocols=("spring",),
-        stick_slip_ie=(1e-1,),
-        stick_slip_stiffness=(10.0,),
-        stick_slip_starts=1,
-        sandpaper_grits=(),
         bootstrap=20,
         ramp_max_steps=2000,
-        fractal_hursts=(0.65, 0.95),
-        fractal_surfaces=1,
-        fractal_facets=False,
-        stiffness_map_ie=(1e-1, 1.0),
-        stiffness_map_k=(30.0,),
-        stiffness_map_families=("single_peak_valley",),
-        stiffness_map_starts=1,
-        stick_slip_k_ie=(1e-2,),
-        stick_slip_k_factors=(0.25, 4.0),
-        ground_truth_slopes=(0.3,),
-        ground_truth_mus=(0.5,),
-        ground_truth_k_factors=(0.25, 4.0),
-        ground_truth_waves=3,
-        ground_truth_ridge_widths=(0.5,),
-        ground_truth_liftoff_factors=(0.5, 1.5),
         convergence_starts=1,
         boundary_refinements=("dt_halved",),
-        fractal_refinements=("dt_halved",),
-        fractal_refined_surfaces=1,
-        # the engines study's two cheapest checks: 2.6 s of CPU in both engines
-        engines_checks=("static kappa", "spring-block"),
-        engines_quick=True,
+        stick_slip=StickSlipPlan(
+            ie=(1e-1,),
+            stiffness=(10.0,),
+            starts=1,
+            k_ie=(1e-2,),
+            k_factors=(0.25, 4.0),
+        ),
+        sandpaper=SandpaperPlan(
+            grits=(),
+        ),
+        fractal=FractalPlan(
+            hursts=(0.65, 0.95),
+            surfaces=1,
+            facets=False,
+            refinements=("dt_halved",),
+            refined_surfaces=1,
+        ),
+        stiffness_map=StiffnessMapPlan(
+            ie=(1e-1, 1.0),
+            k=(30.0,),
+            families=("single_peak_valley",),
+            starts=1,
+        ),
+        ground_truth=GroundTruthPlan(
+            slopes=(0.3,),
+            mus=(0.5,),
+            k_factors=(0.25, 4.0),
+            waves=3,
+            ridge_widths=(0.5,),
+            liftoff_factors=(0.5, 1.5),
+        ),
+        engines=EnginesPlan(
+            # the engines study's two cheapest checks: 2.6 s of CPU in both engines
+            checks=("static kappa", "spring-block"),
+            quick=True,
+        ),
     ),
     "quick": ValidationPlan(
         name="quick",
@@ -418,16 +516,8 @@ PLANS: dict[str, ValidationPlan] = {
         # the spring drive's boundary only: the ramp's pilots run one by one (78 of the
         # boundary's 113 s measured), and the full plan has both drives
         protocols=("spring",),
-        stick_slip_ie=(1e-2, 1.0),
-        stick_slip_stiffness=(2.0, 50.0),
-        stick_slip_starts=2,
-        sandpaper_grits=("P36", "P600"),
-        sandpaper_starts=2,
         bootstrap=200,
         ramp_max_steps=60000,
-        fractal_surfaces=6,
-        # the facet streamline (~1.4 s per surface, measured) would double the study's time
-        fractal_facets=False,
         # two runs a start (the full plan's three: the start and its neighbours on either
         # side along x): a split is looked for on one side only, so the demo's
         # ill-conditioned shares are lower bounds beside the full plan's. The ensembles'
@@ -447,23 +537,43 @@ PLANS: dict[str, ValidationPlan] = {
         # solution verification on 6 paired starts a family (the demo's budget; the full
         # plan's 30 give the verdicts)
         convergence_starts=6,
-        # I_e low enough that the stiffer K are read where their spring-block swing is
-        # small (theory_orders.k_readings), one deeper at the stiffest (10 K*)
-        stiffness_map_ie=(1e-3, 1e-1),
-        # a reduced ladder around each family's K_path, with its fold K* and 10 K*
-        stiffness_map_k_factors=(0.3, 1.0, 3.0),
-        stiffness_map_deep_ie=(1e-4,),
-        stiffness_map_families=("single_peak_valley", "random_gaussian", "fractal"),
-        stiffness_map_starts=2,
-        stick_slip_k_ie=(1e-4,),
-        stick_slip_k_factors=(0.25, 0.5, 1.0, 2.0, 4.0),
-        ground_truth_k_factors=(0.25, 4.0),
-        ground_truth_waves=4,
-        ground_truth_ridge_widths=(0.35, 0.5),
-        ground_truth_liftoff_factors=(0.5, 0.8, 1.1, 1.5),
-        # every engines check, Prandtl-Tomlinson over 2 wavelengths: 33 s of process CPU
-        # (MuJoCo 3.3 s, Bullet 23.3 s, imports the rest; measured on a loaded machine)
-        engines_quick=True,
+        stick_slip=StickSlipPlan(
+            ie=(1e-2, 1.0),
+            stiffness=(2.0, 50.0),
+            starts=2,
+            k_ie=(1e-4,),
+            k_factors=(0.25, 0.5, 1.0, 2.0, 4.0),
+        ),
+        sandpaper=SandpaperPlan(
+            grits=("P36", "P600"),
+            starts=2,
+        ),
+        fractal=FractalPlan(
+            surfaces=6,
+            # the facet streamline (~1.4 s per surface, measured) would double the study's time
+            facets=False,
+        ),
+        stiffness_map=StiffnessMapPlan(
+            # I_e low enough that the stiffer K are read where their spring-block swing is
+            # small (theory_orders.k_readings), one deeper at the stiffest (10 K*)
+            ie=(1e-3, 1e-1),
+            # a reduced ladder around each family's K_path, with its fold K* and 10 K*
+            k_factors=(0.3, 1.0, 3.0),
+            deep_ie=(1e-4,),
+            families=("single_peak_valley", "random_gaussian", "fractal"),
+            starts=2,
+        ),
+        ground_truth=GroundTruthPlan(
+            k_factors=(0.25, 4.0),
+            waves=4,
+            ridge_widths=(0.35, 0.5),
+            liftoff_factors=(0.5, 0.8, 1.1, 1.5),
+        ),
+        engines=EnginesPlan(
+            # every engines check, Prandtl-Tomlinson over 2 wavelengths: 33 s of process CPU
+            # (MuJoCo 3.3 s, Bullet 23.3 s, imports the rest; measured on a loaded machine)
+            quick=True,
+        ),
     ),
     "full": ValidationPlan(
         name="full",
@@ -497,29 +607,8 @@ PLANS: dict[str, ValidationPlan] = {
         # the random Gaussian boundary (20 runs x 11 I_e x 2 drives) would double the run
         # time past ~45 min on 2 cores: the full plan keeps the single peak/valley there
         boundary_families=("single_peak_valley",),
-        stick_slip_ie=(1e-3, 1e-2, 1e-1, 1.0),
-        stick_slip_stiffness=(2.0, 10.0, 50.0),
-        stick_slip_starts=3,
-        sandpaper_starts=4,
         bootstrap=500,
         ramp_max_steps=200_000,
-        stiffness_map_ie=(1e-4, 1e-3, 1e-2, 1e-1, 1.0),
-        # K / K* to 10 on every family, by factors of at most 2 around K* (the predicted K*
-        # is judged within a factor of 2); I_e down to 1e-6 at the stiffest K, on the fractal
-        # at every K (stiffness_map_deep_every_k). Measured on the fractal at K = 1000, one
-        # start, busy machine: 3.0 s at I_e 1e-4, 47 s at 1e-5 (its stick phases too short
-        # for the fast-forward), 1.6 s at 1e-6 (fast-forwarded; 36 s without): the ladder
-        # skips 1e-5
-        # K / K_path by factors of at most 2 around K_path (judged within a factor of 2),
-        # with each family's fold K* and 10 K* (family_k_axis)
-        stiffness_map_k_factors=(0.1, 0.3, 0.5, 1.0, 2.0, 3.0),
-        stiffness_map_deep_ie=(1e-6,),
-        stiffness_map_deep_starts=10,
-        stiffness_map_deep_every_k=("fractal",),
-        stiffness_map_families=("single_peak_valley", "random_gaussian", "fractal"),
-        # at least 30 runs per (I_e, K) point and family (map_family)
-        stiffness_map_starts=30,
-        stiffness_map_runs=30,
         ensemble_members=3,
         # at least 60 well-conditioned starts per family (issue 41: 60 of 60 has a 95 % lower
         # bound of 0.94), over several surfaces: 64 where one start in a hundred was
@@ -546,10 +635,39 @@ PLANS: dict[str, ValidationPlan] = {
         # of CPU for both, estimated from a reduced run (spring 0.45-0.5 s a run, ramp 1.1-1.8
         # s); dt / 4 for an observed order would add ~170 s
         boundary_refinements=("dt_halved", "hfield_doubled"),
-        # both MuJoCo series on 15 of the 30 surfaces per H: ~0.53 s a surface with dt / 2,
-        # ~0.35 s with the tolerances / 100 (measured, busy machine): ~67 s of CPU; dt / 4
-        # (an observed order) would add ~80 s
-        fractal_refinements=("dt_halved", "tolerance_tightened"),
-        fractal_refined_surfaces=15,
+        stick_slip=StickSlipPlan(
+            ie=(1e-3, 1e-2, 1e-1, 1.0),
+            stiffness=(2.0, 10.0, 50.0),
+            starts=3,
+        ),
+        sandpaper=SandpaperPlan(
+            starts=4,
+        ),
+        stiffness_map=StiffnessMapPlan(
+            ie=(1e-4, 1e-3, 1e-2, 1e-1, 1.0),
+            # K / K* to 10 on every family, by factors of at most 2 around K* (the predicted K*
+            # is judged within a factor of 2); I_e down to 1e-6 at the stiffest K, on the fractal
+            # at every K (deep_every_k). Measured on the fractal at K = 1000, one
+            # start, busy machine: 3.0 s at I_e 1e-4, 47 s at 1e-5 (its stick phases too short
+            # for the fast-forward), 1.6 s at 1e-6 (fast-forwarded; 36 s without): the ladder
+            # skips 1e-5
+            # K / K_path by factors of at most 2 around K_path (judged within a factor of 2),
+            # with each family's fold K* and 10 K* (family_k_axis)
+            k_factors=(0.1, 0.3, 0.5, 1.0, 2.0, 3.0),
+            deep_ie=(1e-6,),
+            deep_starts=10,
+            deep_every_k=("fractal",),
+            families=("single_peak_valley", "random_gaussian", "fractal"),
+            # at least 30 runs per (I_e, K) point and family (StiffnessMapPlan.map_family)
+            starts=30,
+            runs=30,
+        ),
+        fractal=FractalPlan(
+            # both MuJoCo series on 15 of the 30 surfaces per H: ~0.53 s a surface with dt / 2,
+            # ~0.35 s with the tolerances / 100 (measured, busy machine): ~67 s of CPU; dt / 4
+            # (an observed order) would add ~80 s
+            refinements=("dt_halved", "tolerance_tightened"),
+            refined_surfaces=15,
+        ),
     ),
 }

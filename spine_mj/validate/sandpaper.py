@@ -61,7 +61,7 @@ def sandpaper(plan: ValidationPlan, runner: StudyRunner) -> SandpaperResult:
     """
     runner.study = "sandpaper"
     rows, paths = [], {}
-    for grit in plan.sandpaper_grits:
+    for grit in plan.sandpaper.grits:
         preset = f"sandpaper-{grit}"
         params = presets.load_preset(preset).params
         # start at least four tip radii inside the patch: the rig ends a run whose tip comes
@@ -73,9 +73,9 @@ def sandpaper(plan: ValidationPlan, runner: StudyRunner) -> SandpaperResult:
             "starts": {
                 "frame": "relative",
                 "x": [round(x_rel, 4)],
-                "y": list(np.linspace(0.25, 0.75, plan.sandpaper_starts).round(4)),
+                "y": list(np.linspace(0.25, 0.75, plan.sandpaper.starts).round(4)),
             },
-            "drive": {"protocol": "spring", "ie": plan.sandpaper_ie},
+            "drive": {"protocol": "spring", "ie": plan.sandpaper.ie},
             "grid": {"mu": SANDPAPER_MU, "record_every": 5},
         }
         df, store = runner(doc, f"sandpaper/{grit}")

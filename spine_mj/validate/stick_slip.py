@@ -193,12 +193,12 @@ def stick_slip(plan: ValidationPlan, runner: StudyRunner) -> StickSlipResult:
         (I_e, stiffness); drive-force curves of the first start for the figure.
     """
     runner.study = "stick_slip"
-    fam = FamilySpec("stick", (PRESET,), (1,), relative_starts(plan.stick_slip_starts, 0.1))
+    fam = FamilySpec("stick", (PRESET,), (1,), relative_starts(plan.stick_slip.starts, 0.1))
     tip = tip_radius(PRESET, fam.seeds, plan.hfield_resolution)
     lc_units = sim.characteristic_length(presets.make_surface(PRESET, seed=1))
     fp = MASS_KG * GRAVITY
     lc_m = lc_units * sim.DEFAULT_LENGTH_SCALE_M
-    stiff = [float(f"{k * fp / lc_m:.6g}") for k in plan.stick_slip_stiffness]
+    stiff = [float(f"{k * fp / lc_m:.6g}") for k in plan.stick_slip.stiffness]
     grid = {
         "mu": calibrated_mu(PRESET),
         "tip_radius": tip,
@@ -209,7 +209,7 @@ def stick_slip(plan: ValidationPlan, runner: StudyRunner) -> StickSlipResult:
         fam,
         name="stick-slip",
         preset=PRESET,
-        drive={"protocol": "spring", "ie": list(plan.stick_slip_ie), "stiffness": stiff},
+        drive={"protocol": "spring", "ie": list(plan.stick_slip.ie), "stiffness": stiff},
         grid=grid,
     )
     df, store = runner(doc, "stick-slip")
@@ -247,12 +247,12 @@ def stick_slip(plan: ValidationPlan, runner: StudyRunner) -> StickSlipResult:
 
 
 def k_scan(plan: ValidationPlan, runner: StudyRunner) -> tuple[list[dict], float]:
-    """The spring drive on the corrugation :data:`K_SCAN_SURFACE` over ``plan.stick_slip_k_ie``
-    x ``plan.stick_slip_k_factors`` K*: one row per run, and K*."""
+    """The spring drive on the corrugation :data:`K_SCAN_SURFACE` over ``plan.stick_slip.k_ie``
+    x ``plan.stick_slip.k_factors`` K*: one row per run, and K*."""
     s, mu = K_SCAN_SURFACE
     k_star = Corrugation(s, mu, tip_radius=TOMLINSON_TIP).critical_stiffness()
-    ks = [float(f"{f * k_star:.6g}") for f in plan.stick_slip_k_factors]
-    mj = corrugation_runs(runner, "stick-slip/corrugation", s, mu, ks, list(plan.stick_slip_k_ie), 4)
+    ks = [float(f"{f * k_star:.6g}") for f in plan.stick_slip.k_factors]
+    mj = corrugation_runs(runner, "stick-slip/corrugation", s, mu, ks, list(plan.stick_slip.k_ie), 4)
     rows = []
     for _, r in mj.sort_values(["ie", "K"]).iterrows():
         travel = float(r["end_x"]) - CORRUGATION_START

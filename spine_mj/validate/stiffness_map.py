@@ -19,7 +19,7 @@ the plan's families and reports, from the same runs:
   drive limits predicted from each family's geometry (``predicted``,
   :mod:`spine_mj.validate.predicted_limits`) beside the measured boundary.
 
-Each preset runs from few starts (``plan.stiffness_map_starts``): the lowest I_e and the
+Each preset runs from few starts (``plan.stiffness_map.starts``): the lowest I_e and the
 many K values make the expensive corner (drive cost grows as I_e^-1/2).
 """
 
@@ -188,8 +188,8 @@ def subset_starts(fam: FamilySpec, n: int) -> FamilySpec:
 
 
 def stiffness_map(plan: ValidationPlan, runner: StudyRunner) -> StiffnessMapResult:
-    """Study 7: the spring drive over ``plan.stiffness_map_ie`` x ``plan.stiffness_map_k``
-    on ``plan.stiffness_map_families`` (an empty grid runs nothing).
+    """Study 7: the spring drive over ``plan.stiffness_map.ie`` x ``plan.stiffness_map.k``
+    on ``plan.stiffness_map.families`` (an empty grid runs nothing).
 
     Parameters
     ----------
@@ -203,29 +203,29 @@ def stiffness_map(plan: ValidationPlan, runner: StudyRunner) -> StiffnessMapResu
     StiffnessMapResult
     """
     runner.study = "stiffness_map"
-    ies = [float(v) for v in plan.stiffness_map_ie]
-    ks = [float(v) for v in plan.stiffness_map_k]
-    fams = [f for f in plan.families if f.name in plan.stiffness_map_families]
-    empty = StiffnessMapResult(ies, ks, [f.name for f in fams], plan.stiffness_map_starts, {}, [], [])
-    if not ies or not (ks or plan.stiffness_map_k_factors) or not fams:
+    ies = [float(v) for v in plan.stiffness_map.ie]
+    ks = [float(v) for v in plan.stiffness_map.k]
+    fams = [f for f in plan.families if f.name in plan.stiffness_map.families]
+    empty = StiffnessMapResult(ies, ks, [f.name for f in fams], plan.stiffness_map.starts, {}, [], [])
+    if not ies or not (ks or plan.stiffness_map.k_factors) or not fams:
         return empty
     runs, samples, predicted, jobs, k_by_family = [], {}, {}, [], {}
     for fam in fams:
-        sub = subset_starts(plan.map_family(fam), plan.stiffness_map_starts)
+        sub = subset_starts(plan.stiffness_map.map_family(fam), plan.stiffness_map.starts)
         deep = (
-            subset_starts(sub, plan.stiffness_map_deep_starts) if plan.stiffness_map_deep_starts > 0 else sub
+            subset_starts(sub, plan.stiffness_map.deep_starts) if plan.stiffness_map.deep_starts > 0 else sub
         )
         with runner.phase(f"predicted drive limits of {fam.name}"):
             predicted[fam.name] = family_limits(plan, sub)
-        fks = family_k_axis(predicted[fam.name], plan.stiffness_map_k_factors) or ks
+        fks = family_k_axis(predicted[fam.name], plan.stiffness_map.k_factors) or ks
         k_by_family[fam.name] = fks
         for preset in fam.presets:
             drives = [("", {"protocol": "spring", "ie": ies, "K": fks})]
-            if deep_ie := list(plan.stiffness_map_deep_ie):
-                deep_k = plan.deep_k_axis(fam.name, fks)
+            if deep_ie := list(plan.stiffness_map.deep_ie):
+                deep_k = plan.stiffness_map.deep_k_axis(fam.name, fks)
                 drives.append(("-deep", {"protocol": "spring", "ie": deep_ie, "K": deep_k}))
             for tag, drive in drives:
-                starts = sub if not tag or plan.stiffness_map_deep_starts <= 0 else deep
+                starts = sub if not tag or plan.stiffness_map.deep_starts <= 0 else deep
                 doc = family_doc(
                     starts,
                     name=f"stiffness-map-{preset}{tag}",
@@ -244,10 +244,10 @@ def stiffness_map(plan: ValidationPlan, runner: StudyRunner) -> StiffnessMapResu
     pooled = {k: {n: np.concatenate(v) for n, v in d.items()} for k, d in samples.items()}
     slip = slip_rows(table)
     return StiffnessMapResult(
-        ie=sorted(set(ies) | {float(v) for v in plan.stiffness_map_deep_ie}),
+        ie=sorted(set(ies) | {float(v) for v in plan.stiffness_map.deep_ie}),
         stiffness_numbers=sorted({k for v in k_by_family.values() for k in v}),
         families=[f.name for f in fams],
-        starts_per_preset=plan.stiffness_map_starts,
+        starts_per_preset=plan.stiffness_map.starts,
         agreement=agreement,
         energy=energy_rows(table),
         slip=slip,
@@ -260,7 +260,7 @@ def stiffness_map(plan: ValidationPlan, runner: StudyRunner) -> StiffnessMapResu
         ),
         predicted=predicted,
         k_by_family=k_by_family,
-        k_factors=[float(f) for f in plan.stiffness_map_k_factors],
+        k_factors=[float(f) for f in plan.stiffness_map.k_factors],
         orders=order_rows(agreement, predicted),
         prediction_check=prediction_check(agreement, predicted),
     )

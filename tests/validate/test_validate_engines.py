@@ -167,6 +167,6 @@ def test_the_plans_name_only_checks_the_study_has():
     from spine_mj.validate.plans import PLANS
 
     for plan in PLANS.values():
-        assert plan.engines_checks is None or set(plan.engines_checks) <= set(study.CHECKS)
+        assert plan.engines.checks is None or set(plan.engines.checks) <= set(study.CHECKS)
     with pytest.raises(study.SpineInputError, match="engines checks must be among"):
         study.engines_ground_truth(checks=("no such check",), engines=())

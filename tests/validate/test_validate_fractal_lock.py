@@ -72,15 +72,15 @@ def test_hurst_rows_group_by_h_and_series():
 
 def test_surfaces_are_fig9s_with_h_set_and_distinct_seeds():
     plan = PLANS["full"]
-    table = surfaces_table(plan.fractal_hursts, plan.fractal_surfaces)
-    assert len(plan.fractal_hursts) >= 5 and plan.fractal_surfaces >= 30
-    assert all(0.6 <= h <= 0.95 for h in plan.fractal_hursts)
+    table = surfaces_table(plan.fractal.hursts, plan.fractal.surfaces)
+    assert len(plan.fractal.hursts) >= 5 and plan.fractal.surfaces >= 30
+    assert all(0.6 <= h <= 0.95 for h in plan.fractal.hursts)
     seeds = [s for entry in table for s in entry["seeds"]]
-    assert len(seeds) == len(set(seeds)) == len(plan.fractal_hursts) * plan.fractal_surfaces
+    assert len(seeds) == len(set(seeds)) == len(plan.fractal.hursts) * plan.fractal.surfaces
     entry = table[0]
-    assert entry["set"]["hurst"] == plan.fractal_hursts[0] and entry["set"]["rms_slope"] is None
+    assert entry["set"]["hurst"] == plan.fractal.hursts[0] and entry["set"]["rms_slope"] is None
     # H = 0.65 is the first H of the preset's Fig. 9 list: the same seeds and height scale
-    assert entry["seeds"] == list(fig9_seeds(0, plan.fractal_surfaces))
+    assert entry["seeds"] == list(fig9_seeds(0, plan.fractal.surfaces))
     rms = fig9_rms_height(0.65, 256, 20.0, "pixel", 0.0014)
     assert entry["set"]["rms_height"] == pytest.approx(rms, rel=1e-5)
     heights = [e["set"]["rms_height"] for e in table]

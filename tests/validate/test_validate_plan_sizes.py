@@ -48,33 +48,33 @@ def test_every_family_has_enough_starts_at_the_corner_each_an_ensemble(plan, lea
 def test_the_full_maps_every_ie_k_point_has_30_runs_per_family():
     p = PLANS["full"]
     for fam in p.families:
-        if fam.name in p.stiffness_map_families:
-            sub = subset_starts(p.map_family(fam), p.stiffness_map_starts)
+        if fam.name in p.stiffness_map.families:
+            sub = subset_starts(p.stiffness_map.map_family(fam), p.stiffness_map.starts)
             assert len(sub.starts_table()["y"]) * len(sub.presets) * len(sub.variants) >= 30, fam.name
 
 
 def test_the_corner_and_the_map_leave_the_family_for_the_other_studies():
     p = PLANS["quick"]
     for fam in p.families:
-        assert p.map_family(fam) == fam  # no map sample size asked for: the family's own
+        assert p.stiffness_map.map_family(fam) == fam  # no map sample size asked for: the family's own
     assert PLANS["smoke"].corner_family(PLANS["smoke"].families[0]) == PLANS["smoke"].families[0]
 
 
 def test_the_full_map_reaches_ten_k_star_and_ie_1e_6_with_factor_2_steps_around_k_star():
     p = PLANS["full"]
-    f = sorted(p.stiffness_map_k_factors)
+    f = sorted(p.stiffness_map.k_factors)
     assert f[0] <= 0.1  # and family_k_axis adds the fold K* and 10 K*
     near = [v for v in f if 0.3 <= v <= 3]
     assert all(b / a <= 2.0 + 1e-9 for a, b in itertools.pairwise(near))  # K* judged within a factor 2
-    assert min(p.stiffness_map_deep_ie) <= 1e-6
+    assert min(p.stiffness_map.deep_ie) <= 1e-6
     assert "dt_quartered" in p.convergence_refinements  # three step levels: an observed order
     q = PLANS["quick"]
-    assert max(q.stiffness_map_k_factors) >= 3 and q.convergence_starts > 0
+    assert max(q.stiffness_map.k_factors) >= 3 and q.convergence_starts > 0
 
 
 def test_the_deep_ie_runs_on_every_k_of_the_families_the_plan_names_else_on_the_stiffest():
     full = PLANS["full"]
-    assert full.stiffness_map_deep_every_k == ("fractal",)
-    assert full.deep_k_axis("fractal", [100.0, 2.9, 1000.0]) == [2.9, 100.0, 1000.0]
-    assert full.deep_k_axis("random_gaussian", [1.6, 190.0, 19.0]) == [190.0]
-    assert PLANS["quick"].deep_k_axis("fractal", [3.0, 30.0]) == [30.0]
+    assert full.stiffness_map.deep_every_k == ("fractal",)
+    assert full.stiffness_map.deep_k_axis("fractal", [100.0, 2.9, 1000.0]) == [2.9, 100.0, 1000.0]
+    assert full.stiffness_map.deep_k_axis("random_gaussian", [1.6, 190.0, 19.0]) == [190.0]
+    assert PLANS["quick"].stiffness_map.deep_k_axis("fractal", [3.0, 30.0]) == [30.0]

@@ -77,12 +77,12 @@ def test_smoke_validation_writes_report_and_json(tmp_path, monkeypatch):
     # the fractal self-lock study: one row per H of the plan, every rate with its count
     fractal = doc["fractal_lock_rate"]
     plan = validate.PLANS["smoke"]
-    assert [r["hurst"] for r in fractal["rows"]] == list(plan.fractal_hursts)
+    assert [r["hurst"] for r in fractal["rows"]] == list(plan.fractal.hursts)
     for row in fractal["rows"]:
         for series in ("streamline", "mujoco_corner", "mujoco_dynamic"):
-            assert row[f"n_{series}"] == plan.fractal_surfaces
-            assert row[f"n_ok_{series}"] + row[f"failed_runs_{series}"] == plan.fractal_surfaces
-    assert fractal["corner_ie"] == plan.lowest_ie and fractal["dynamic_ie"] == plan.fractal_dynamic_ie
+            assert row[f"n_{series}"] == plan.fractal.surfaces
+            assert row[f"n_ok_{series}"] + row[f"failed_runs_{series}"] == plan.fractal.surfaces
+    assert fractal["corner_ie"] == plan.lowest_ie and fractal["dynamic_ie"] == plan.fractal.dynamic_ie
     assert "fractal_lock" in doc["timings_s"]
     assert "Self-lock rate against the Hurst exponent" in report and "figures/fractal_lock_rate.png" in report
     assert (out / "figures" / "fractal_lock_rate.png").stat().st_size > 1000
@@ -90,7 +90,7 @@ def test_smoke_validation_writes_report_and_json(tmp_path, monkeypatch):
     star = doc["ie_star_by_stiffness"]["single_peak_valley"]["30"]
     assert {"value", "low", "high", "ci_low", "ci_high", "kind"} <= set(star)
     cell = doc["stiffness_map"]["agreement"]["single_peak_valley"]["30"]
-    assert cell["ie"] == list(validate.PLANS["smoke"].stiffness_map_ie) and cell["n"] == [1, 1]
+    assert cell["ie"] == list(validate.PLANS["smoke"].stiffness_map.ie) and cell["n"] == [1, 1]
     assert doc["stiffness_map"]["energy"][0]["K"] == 30.0
     assert "stiffness_map" in doc["timings_s"]
     assert "over (I_e, K)" in report and "figures/ie_k_map.png" in report
@@ -111,7 +111,7 @@ def test_smoke_validation_writes_report_and_json(tmp_path, monkeypatch):
     for row in fractal["rows"]:
         for series in ("mujoco_corner", "mujoco_dynamic"):
             entry = row[f"convergence_{series}"]["dt_halved"]
-            assert entry["runs"] == plan.fractal_refined_surfaces and entry["converged"] is not None
+            assert entry["runs"] == plan.fractal.refined_surfaces and entry["converged"] is not None
     assert "Solution verification of the MuJoCo rates" in report
     # the map's convergence to the theory and the predicted limits against the measured
     assert {r["axis"] for r in doc["convergence_to_theory"]} == {"ie", "inverse_k"}
