@@ -23,7 +23,7 @@ import pyarrow.compute as pc
 from spine_mj.errors import SpineInputError
 from spine_mj.sweep.analyses import quasistatic
 from spine_mj.sweep.analyses.engine import case_rig
-from spine_mj.sweep.cases import expand_cases
+from spine_mj.sweep.cases import check_cases_memory, expand_cases
 from spine_mj.sweep.config import SweepConfig, _make_surface, load_config
 from spine_mj.sweep.executors import DEFAULT_WORKER_WAIT_S, Backend
 from spine_mj.sweep.preflight import check_cases
@@ -210,6 +210,7 @@ def _preparing(config: SweepConfig, notice) -> Callable[[str], None] | None:
 def _checked_cases(config: SweepConfig, say: Callable[[str], None] | None = None) -> list:
     """The cases of ``config``, read afresh (:func:`clear_caches`) and checked: an input
     error refuses the config, not every run. ``say`` hears of each step of a long one."""
+    check_cases_memory(config)  # before the first notice: a refusal is one line
     if say is not None:
         say("listing them")
     listed = None if say is None else (lambda i, n: say(f"listed {i:,} of {n:,}"))
