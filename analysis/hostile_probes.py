@@ -442,6 +442,18 @@ def _issue44(add, work: Path, py: str) -> None:
         "an hfield of 8192 x 8192 samples",
         small,
     )
+    ie = [round(1e-5 * (1 + i * 1e-3), 9) for i in range(999)]
+    stiff = [round(30 + 0.01 * i, 4) for i in range(1001)]
+    body = base.format(
+        analyses='["engine"]', preset="paper-single-peak", tables=f"[drive]\nie = {ie}\nK = {stiff}"
+    )
+    add(
+        "sweep of 999,999 cases (64 MiB budget)",
+        [*SPINE, "sweep", sweep_config(work, "million", body), "--out", "s1m", "--quiet"],
+        "refuse",
+        "preparing the sweep's 999,999 cases",
+        {"SPINE_MJ_MEMORY_BUDGET": "64M"},
+    )
     add(
         "simulate --line --engine bullet",
         [*sim_bullet, "--engine", "bullet", "--line"],
