@@ -237,21 +237,40 @@ def paired_change(base: pd.DataFrame, refined: pd.DataFrame) -> dict:
 
     ``base`` may carry ``well_conditioned`` (bool: the start's ensemble ended in one outcome
     on both sides, none stopped): the well-conditioned agreement is then paired on those
-    starts only (``well_conditioned_runs`` of them; without the column, on all)."""
+    starts only (``well_conditioned_runs`` of them; without the column, on all).
+
+    A start whose reference stalled at either level (``reference_outcome`` "stalled": the
+    reference has no answer there, as on a stalled start of the corner itself,
+    :mod:`spine_mj.validate.ensembles`) leaves every headline's pairs, and is counted in
+    ``reference_stalled``: a refinement that resolves a pit the reference cannot leave
+    (measured: sandpaper P600's hfield x 2, 12 of 40 references stalled where MuJoCo's tip
+    climbed out at 4-5 F_p) changes the reference's coverage, which the count reports, not
+    MuJoCo's agreement."""
     b = base.assign(_key=_keys(base)).drop_duplicates("_key").set_index("_key")
     r = refined.assign(_key=_keys(refined)).drop_duplicates("_key").set_index("_key")
     common = b.index.intersection(r.index)
     b, r = b.loc[common], r.loc[common]
-    if "well_conditioned" in b:
-        r = r.assign(well_conditioned=b["well_conditioned"].astype(bool))
+    answered = _answered(b) & _answered(r)
+    wc = b["well_conditioned"].astype(bool) if "well_conditioned" in b else pd.Series(True, index=common)
     out: dict[str, Any] = {
         "runs": int(len(common)),
-        "well_conditioned_runs": int(b["well_conditioned"].sum()) if "well_conditioned" in b else len(common),
+        "well_conditioned_runs": int((wc & answered).sum()),
+        "reference_stalled": int((wc & ~answered).sum()),
     }
+    b, r = b[answered], r[answered]
+    if "well_conditioned" in b:
+        r = r.assign(well_conditioned=b["well_conditioned"].astype(bool))
     for headline in HEADLINES:
         before, after = _statistic(b, headline), _statistic(r, headline)
         out[headline] = {"base": before, "refined": after, "change": after - before}
     return out
+
+
+def _answered(rows: pd.DataFrame) -> pd.Series:
+    """Rows whose reference did not stall (all, without a ``reference_outcome`` column)."""
+    if "reference_outcome" not in rows:
+        return pd.Series(True, index=rows.index)
+    return rows["reference_outcome"] != "stalled"
 
 
 def family_convergence(summary: dict, base: pd.DataFrame, refined: dict[str, pd.DataFrame | None]) -> dict:
@@ -271,7 +290,8 @@ def family_convergence(summary: dict, base: pd.DataFrame, refined: dict[str, pd.
     -------
     dict
         Per refinement: ``refined`` (bool), ``runs`` (paired) and
-        ``well_conditioned_runs``, ``agreement_change`` (the well-conditioned agreement's),
+        ``well_conditioned_runs``, ``reference_stalled`` (:func:`paired_change`),
+        ``agreement_change`` (the well-conditioned agreement's),
         ``agreement_change_all_starts``, ``median_frechet_change`` (NaN where not refined),
         per headline (:data:`HEADLINES`) its base / refined values on the paired starts and
         ``*_converged`` (:func:`is_converged`), and ``converged``: the headlines the targets
@@ -295,6 +315,7 @@ def family_convergence(summary: dict, base: pd.DataFrame, refined: dict[str, pd.
         pc = paired_change(base, rows)
         entry["runs"] = pc["runs"]
         entry["well_conditioned_runs"] = pc["well_conditioned_runs"]
+        entry["reference_stalled"] = pc["reference_stalled"]
         for headline, ci_key in HEADLINES.items():
             change = pc[headline]["change"]
             ok = is_converged(summary[headline], change, summary[ci_key], resolution=RESOLUTIONS[headline])

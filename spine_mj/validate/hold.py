@@ -364,8 +364,12 @@ def _refine(runner, summ: dict, base: pd.DataFrame, make_doc, *, budget_left: fl
             reasons.append(f"{last['label']} still moved {moved} (from {last['from']}), past its interval")
     paired = min((lv["well_conditioned_runs"] for lv in levels if lv["run"]), default=0)
     if paired < MIN_PAIRED_STARTS:
+        stalled = [
+            f"{lv['reference_stalled']} at {lv['label']}" for lv in levels if lv.get("reference_stalled")
+        ]
         reasons.append(
             f"{paired} paired well-conditioned starts, fewer than the {MIN_PAIRED_STARTS} a verdict needs"
+            + (f" (references stalled, no quasistatic answer: {', '.join(stalled)})" if stalled else "")
         )
     return levels, not reasons, "; ".join(reasons)
 
@@ -384,6 +388,7 @@ def _level(
         "from": before_label,
         "runs": pc["runs"],
         "well_conditioned_runs": pc["well_conditioned_runs"],
+        "reference_stalled": pc["reference_stalled"],
         "failed_runs": int((rows["mujoco_status"] != "ok").sum()),
     }
     for headline, ci in HEADLINES.items():

@@ -155,6 +155,33 @@ def test_the_judged_agreement_changes_on_the_well_conditioned_starts_only():
     assert paired_change(base.drop(columns="well_conditioned"), refined)["well_conditioned_runs"] == 10
 
 
+def test_a_start_whose_reference_stalls_at_either_level_leaves_the_pairs_and_is_counted():
+    # 10 well-conditioned starts, all agreeing at the corner; the refined facets resolve a
+    # pit on 3 of them, where the reference stalls (no answer: agree False, a long Frechet
+    # to the stopped path), and 1 start stalled already at the corner. The headlines pair
+    # the 6 starts answered at both levels; the 4 are counted, not read as MuJoCo's misses.
+    ys = np.linspace(-1, -4, 10)
+    stalled_base = np.array([False] * 9 + [True])
+    stalled_refined = np.array([True] * 3 + [False] * 7)
+    base = _rows("P600", ys, ~stalled_base, np.where(stalled_base, 5.0, 0.02)).assign(
+        well_conditioned=True, reference_outcome=np.where(stalled_base, "stalled", "left_domain")
+    )
+    refined = _rows("P600", ys, ~stalled_refined, np.where(stalled_refined, 5.0, 0.03)).assign(
+        reference_outcome=np.where(stalled_refined, "stalled", "left_domain")
+    )
+    pc = paired_change(base, refined)
+    assert pc["runs"] == 10 and pc["well_conditioned_runs"] == 6 and pc["reference_stalled"] == 4
+    assert pc["agreement_well_conditioned"] == {"base": 1.0, "refined": 1.0, "change": 0.0}
+    assert pc["median_frechet"]["change"] == pytest.approx(0.01)
+    # without the column every reference answered
+    assert (
+        paired_change(base.drop(columns="reference_outcome"), refined.drop(columns="reference_outcome"))[
+            "reference_stalled"
+        ]
+        == 0
+    )
+
+
 def test_a_refinement_not_run_says_so():
     base = _rows("fractal", [0.2, 0.8], [True, True], [0.01, 0.01])
     summary = {
