@@ -211,6 +211,7 @@ def convergence_lines(limit: QuasistaticLimitResult) -> list[str]:
                         "family": fam,
                         "refinement": REFINEMENT_LABELS[key],
                         "runs": e.get("runs", 0),
+                        "stalled": e.get("reference_stalled", "-"),
                         "agreement_change": e.get("agreement_change"),
                         "median_frechet_change": e.get("median_frechet_change"),
                         "verdict": refinement_verdict(e),
@@ -233,7 +234,9 @@ def convergence_lines(limit: QuasistaticLimitResult) -> list[str]:
         "The change is paired: the refined runs' number "
         "minus the corner's own runs' from the same starts, like for like: the agreement "
         "change is the well-conditioned agreement's (what the target judges), on the paired "
-        "starts well-conditioned on both sides. A headline is converged when it "
+        "starts well-conditioned on both sides; a start whose reference stalled at either level "
+        "has no quasistatic answer there and leaves the pair (counted: stalled references). "
+        "A headline is converged when it "
         "plus the change stays inside its own 95 % interval; where it does not, it is marked "
         "unconverged wherever it is quoted. Where the plan asks, the solver's tolerances are "
         "tightened a hundredfold (tolerance / 100: MuJoCo's 1e-8 and noslip 1e-6 to 1e-10 and "
@@ -241,11 +244,20 @@ def convergence_lines(limit: QuasistaticLimitResult) -> list[str]:
         "",
         table(
             rows,
-            ["family", "refinement", "runs", "agreement_change", "median_frechet_change", "verdict"],
+            [
+                "family",
+                "refinement",
+                "runs",
+                "stalled",
+                "agreement_change",
+                "median_frechet_change",
+                "verdict",
+            ],
             [
                 "family",
                 "refinement",
                 "paired runs",
+                "stalled references",
                 "agreement change",
                 "median Frechet change / L_c",
                 "verdict",
