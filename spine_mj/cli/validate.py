@@ -11,6 +11,14 @@ from spine_mj.choices import PLAN_NAMES
 from spine_mj.cli.app import Progress, main
 from spine_mj.errors import SpineInputError
 
+#: ``--workers`` of both commands: the sweeps' worker processes.
+_workers_option = click.option(
+    "--workers",
+    type=click.IntRange(min=1),
+    default=None,
+    help="Worker processes for the sweeps (default: all cores).",
+)
+
 
 @main.command("validate")
 @click.option(
@@ -33,12 +41,7 @@ from spine_mj.errors import SpineInputError
     hidden=True,
     help="Plan by name (smoke: a seconds-long test size).",
 )
-@click.option(
-    "--workers",
-    type=click.IntRange(min=1),
-    default=None,
-    help="Worker processes for the sweeps (default: all cores).",
-)
+@_workers_option
 @click.option("--quiet", is_flag=True, help="No progress lines.")
 def validate_cmd(out_dir, quick, plan_name, workers, quiet):
     """Run the validation suite (MuJoCo against the quasistatic streamline across inertia
@@ -105,12 +108,7 @@ def validate_cmd(out_dir, quick, plan_name, workers, quiet):
     show_default=True,
     help="The plan whose corner --headlines runs.",
 )
-@click.option(
-    "--workers",
-    type=click.IntRange(min=1),
-    default=None,
-    help="Worker processes for the sweeps (default: all cores).",
-)
+@_workers_option
 def compare_engines_cmd(out_dir, quick, fractal, headlines, headlines_plan, workers):
     """MuJoCo beside Bullet: the closed forms in both engines (the validation's engines study),
     and with --fractal and --headlines the comparisons too long for a validation plan; writes

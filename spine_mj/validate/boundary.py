@@ -1,7 +1,7 @@
 """Study 3: the quasistatic boundary. Agreement against I_e for the spring and ramp drives,
 and the I_e* where it breaks, with a bracketing interval and a bootstrap over starts.
 
-Solution verification of I_e* (``plan.boundary_refinements``, keys of
+Solution verification of I_e* (``plan.boundary.refinements``, keys of
 :data:`~spine_mj.validate.convergence.REFINEMENTS`): every start rerun under the refinement
 at the grid values of the headline's bracket and :data:`IE_WINDOW` either side of it (where
 I_e* is decided; a run there is fast, the carriage at I_e ~ 0.1), the refined I_e* read from
@@ -169,7 +169,7 @@ def boundary(plan: ValidationPlan, runner: StudyRunner) -> BoundaryResult:
     and the Frechet deviation from the streamline. Ramp with reset: its ``I_e`` is the
     equivalent one, ``m v_eq^2 / (F_p L_c)`` with ``v_eq = L_c rate / F_p``; its duration is
     set from a pilot run's per-cycle slip so that the tip covers the path to the domain edge
-    (:func:`ramp_duration`), capped at ``plan.ramp_max_steps``. A capped ramp covers only a
+    (:func:`ramp_duration`), capped at ``plan.boundary.ramp_max_steps``. A capped ramp covers only a
     prefix of the path, so a ramp run agrees when it has no engine trouble, does not
     self-lock where the streamline does not, and its path deviates from the streamline cut
     at the same arc length by <= 0.1 L_c (prefix Frechet); the covered fraction is reported.
@@ -190,12 +190,12 @@ def boundary(plan: ValidationPlan, runner: StudyRunner) -> BoundaryResult:
     BoundaryResult
     """
     runner.study = "boundary"
-    fams = [f for f in plan.families if f.name in plan.boundary_families]
+    fams = [f for f in plan.families if f.name in plan.boundary.families]
     curves, stars, skip = {}, {}, {}
-    ramp_plans = {proto: {} for proto in plan.protocols}
+    ramp_plans = {proto: {} for proto in plan.boundary.protocols}
     jobs = [
         (proto, job)
-        for proto in plan.protocols
+        for proto in plan.boundary.protocols
         for fam in fams
         for preset in fam.presets
         for job in _preset_jobs(plan, runner, fam, preset, proto, ramp_plans[proto])
@@ -203,7 +203,7 @@ def boundary(plan: ValidationPlan, runner: StudyRunner) -> BoundaryResult:
     # every drive's sweeps at once: the workers stay busy across the sweeps' ends
     done = runner.many([(doc, name) for _, (doc, name, _) in jobs], "spring and ramp sweeps")
     matrices = {}
-    for proto in plan.protocols:
+    for proto in plan.boundary.protocols:
         comp, mj = _rows_of(proto, jobs, done)
         curves[proto], skip[proto], amat, fmat = _curve(plan, proto, comp, mj, ramp_plans[proto])
         stars[proto] = _protocol_ie_star(plan, curves[proto], amat, fmat)
@@ -211,7 +211,7 @@ def boundary(plan: ValidationPlan, runner: StudyRunner) -> BoundaryResult:
     refined = _refined_jobs(plan, fams, jobs, curves, stars)
     if refined:
         rdone = runner.many([(doc, name) for _, _, (doc, name, _) in refined], "I_e* under refinement")
-        for proto in plan.protocols:
+        for proto in plan.boundary.protocols:
             if stars[proto].get("valid") is not False:
                 stars[proto]["convergence"] = _ie_star_convergence(
                     plan, proto, curves[proto], matrices[proto], refined, rdone, ramp_plans[proto]
@@ -256,12 +256,12 @@ def refinement_window(ie, star: dict) -> list[float]:
 
 def _refined_jobs(plan: ValidationPlan, fams, jobs, curves, stars) -> list[tuple[str, str, tuple]]:
     """``(protocol, refinement key, (config, store name, rows))`` of every refinement of
-    ``plan.boundary_refinements``: each sweep of ``jobs`` once per I_e of its protocol's
+    ``plan.boundary.refinements``: each sweep of ``jobs`` once per I_e of its protocol's
     :func:`refinement_window`, with the refinement's engine keys at that I_e (the step is
     the rig's own at that pace, :func:`~spine_mj.validate.sweep_configs.engine_grid`)."""
     seeds = {p: f.seeds for f in fams for p in f.presets}
     out = []
-    for key in plan.boundary_refinements:
+    for key in plan.boundary.refinements:
         for proto, (doc, name, rows) in jobs:
             star = stars[proto]
             window = refinement_window(star.get("ie_used", curves[proto].ie), star)
@@ -298,7 +298,7 @@ def _ie_star_convergence(
     base = grid_point(criterion_ie_star(ies, a_base, f_base, HEADLINE_CRITERION))
     by_key: dict[str, dict | None] = {}
     window: list[float] = []
-    for key in plan.boundary_refinements:
+    for key in plan.boundary.refinements:
         comp, mj = _rows_of(proto, refined, rdone, key)
         if comp.empty:
             by_key[key] = None
@@ -313,7 +313,7 @@ def _ie_star_convergence(
         window = [float(v) for v in rc.ie]
         star = criterion_ie_star(ies, a, f, HEADLINE_CRITERION)
         by_key[key] = {"base": base, "refined": grid_point(star), "runs": int(len(comp))}
-    conv = headline_convergence(base, ci95, by_key, log=True, note="not in the plan's boundary_refinements")
+    conv = headline_convergence(base, ci95, by_key, log=True, note="not in the plan's boundary.refinements")
     return {**conv, "ie_refined": window, "ci95": list(ci95)}
 
 
@@ -351,7 +351,7 @@ def _preset_jobs(
         fam,
         name=f"boundary-{proto}-{preset}",
         preset=preset,
-        drive={"protocol": proto, "ie": list(plan.ie_values)},
+        drive={"protocol": proto, "ie": list(plan.boundary.ie_values)},
         grid=grid,
     )
 
@@ -379,15 +379,15 @@ def _ramp_jobs(
     lc = sim.characteristic_length(surface)
     sx, sy = fam.first_start(surface)
     by_dur: dict[float, list[float]] = {}
-    with runner.phase(f"ramp pilots on {preset}", len(plan.ie_values)) as tick:
-        for v in plan.ie_values:
+    with runner.phase(f"ramp pilots on {preset}", len(plan.boundary.ie_values)) as tick:
+        for v in plan.boundary.ie_values:
             rp = ramp_duration(
                 rig,
                 (sx, sy),
                 v,
                 target_lc=(surface.bounds[1] - sx) / lc,
-                max_steps=plan.ramp_max_steps,
-                slide_lc=plan.ramp_slide_lc,
+                max_steps=plan.boundary.ramp_max_steps,
+                slide_lc=plan.boundary.ramp_slide_lc,
             )
             ramp_plans.setdefault(preset, {})[float(v)] = rp.as_dict()
             by_dur.setdefault(rp.duration_s, []).append(float(v))
@@ -409,7 +409,7 @@ def _ramp_jobs(
                 "protocol": "ramp",
                 "ie": ies_,
                 "duration": dur,
-                "slide_distance": plan.ramp_slide_lc * rig.scales.char_length_m,
+                "slide_distance": plan.boundary.ramp_slide_lc * rig.scales.char_length_m,
             },
             grid=grid,
         )
@@ -490,7 +490,7 @@ def _curve(
                 "coverage": cov,
                 "ie_achieved": ach,
                 "ie_kind": "equivalent: m v_eq^2 / (F_p L_c), v_eq = L_c rate / F_p",
-                "ramp_max_steps": plan.ramp_max_steps,
+                "ramp_max_steps": plan.boundary.ramp_max_steps,
                 "ramp_plans": ramp_plans,
             }
             if ramp

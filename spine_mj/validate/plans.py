@@ -1,9 +1,10 @@
 """Sizes and targets of a validation run: the plans, their surface families and engine variations.
 
-A :class:`ValidationPlan` fixes every grid of the studies (planes, families, I_e
-values, bootstrap size, ramp caps), with one section per study whose sizes are its own
-(:class:`StickSlipPlan`, :class:`SandpaperPlan`, :class:`FractalPlan`,
-:class:`StiffnessMapPlan`, :class:`GroundTruthPlan`, :class:`EnginesPlan`: ``plan.fractal.surfaces``);
+A :class:`ValidationPlan` fixes what the studies share (families, the corner's I_e and
+sample sizes, the bootstrap size) and has one section per study whose sizes are its own
+(:class:`StaticPlan`, :class:`BoundaryPlan`, :class:`StickSlipPlan`, :class:`SandpaperPlan`,
+:class:`FractalPlan`, :class:`StiffnessMapPlan`, :class:`GroundTruthPlan`,
+:class:`EnginesPlan`: ``plan.fractal.surfaces``);
 :data:`PLANS` holds the ``smoke``
 (test size), ``quick`` and ``full`` plans. The agreement targets and the physical
 constants every study shares (tip mass, gravity, the sandpaper mu) live here, so that the
@@ -33,11 +34,13 @@ __all__ = [
     "SANDPAPER_MU",
     "STATIC_TARGET",
     "TOLERANCE_TIGHTENED",
+    "BoundaryPlan",
     "EnginesPlan",
     "FamilySpec",
     "FractalPlan",
     "GroundTruthPlan",
     "SandpaperPlan",
+    "StaticPlan",
     "StickSlipPlan",
     "StiffnessMapPlan",
     "ValidationPlan",
@@ -283,30 +286,33 @@ class EnginesPlan:
 
 
 @dataclass(frozen=True)
-class ValidationPlan:
-    """Sizes of a validation run.
+class StaticPlan:
+    """The static map's planes and engine settings (:mod:`spine_mj.validate.static_map`).
 
     Attributes
     ----------
-    name : str
     slopes_deg, azimuths_deg : tuple of float
         Inclined planes of the static map (azimuth 0: rising in the drive direction +x).
-    static_engines : tuple of (label, ((key, value), ...))
+    engines : tuple of (label, ((key, value), ...))
         Engine settings of the static map as sweep grid keys; the first is the default.
-    families : tuple of FamilySpec
-        Quasistatic-limit families.
-    lowest_ie : float
-    hfield_resolution : int
-        Samples per side of analytic surfaces (grid surfaces keep their own).
-    limit_variations : tuple of (label, ((key, value), ...))
-        Settings varied one at a time on the single peak at the lowest I_e.
+    """
+
+    slopes_deg: tuple[float, ...]
+    azimuths_deg: tuple[float, ...]
+    engines: tuple[tuple[str, tuple[tuple[str, Any], ...]], ...]
+
+
+@dataclass(frozen=True)
+class BoundaryPlan:
+    """The boundary study's grid, drives and ramp (:mod:`spine_mj.validate.boundary`).
+
+    Attributes
+    ----------
     ie_values : tuple of float
         Boundary study grid.
-    boundary_families : tuple of str
+    families : tuple of str
         Families (by name) of the boundary study.
     protocols : tuple of str
-    bootstrap : int
-        Bootstrap resamples of the starts for the I_e* uncertainty.
     ramp_max_steps : int
         Time cap of a ramp-with-reset run in engine steps (after the settle phase). The
         ramp's duration is the time its measured per-cycle slip needs to cover the path to
@@ -316,6 +322,40 @@ class ValidationPlan:
         (the step of the paper's algorithm). The paper's dl = 0.01 sigma would need ~500
         cycles per path here; 0.1 L_c keeps a run affordable and is compared with the
         streamline stepped at its own, converged dl.
+    refinements : tuple of str
+        The refinements of the boundary study's I_e* (keys of
+        :data:`spine_mj.validate.convergence.REFINEMENTS`; empty: none): every start rerun
+        at the I_e values around the headline's bracket (:mod:`spine_mj.validate.boundary`).
+    """
+
+    ie_values: tuple[float, ...]
+    families: tuple[str, ...]
+    protocols: tuple[str, ...] = ("spring", "ramp")
+    ramp_max_steps: int = 20000
+    ramp_slide_lc: float = 0.1
+    refinements: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class ValidationPlan:
+    """Sizes of a validation run.
+
+    Attributes
+    ----------
+    name : str
+    families : tuple of FamilySpec
+        Quasistatic-limit families.
+    lowest_ie : float
+    hfield_resolution : int
+        Samples per side of analytic surfaces (grid surfaces keep their own).
+    limit_variations : tuple of (label, ((key, value), ...))
+        Settings varied one at a time on the single peak at the lowest I_e.
+    static : StaticPlan
+        The static map's planes and engine settings (:mod:`spine_mj.validate.static_map`).
+    boundary : BoundaryPlan
+        The boundary study's grid, drives and ramp (:mod:`spine_mj.validate.boundary`).
+    bootstrap : int
+        Bootstrap resamples of the starts for the I_e* uncertainty.
     ensemble_members : int
         Runs per start of the quasistatic-limit study, on each side: the start and
         ``ensemble_members - 1`` starts around it (:mod:`spine_mj.validate.ensembles`);
@@ -327,10 +367,6 @@ class ValidationPlan:
     convergence_refinements : tuple of str
         The refinements (keys of :data:`spine_mj.validate.convergence.REFINEMENTS`); with
         ``dt_quartered`` beside ``dt_halved`` three step levels give an observed order.
-    boundary_refinements : tuple of str
-        The refinements of the boundary study's I_e* (keys of
-        :data:`spine_mj.validate.convergence.REFINEMENTS`; empty: none): every start rerun
-        at the I_e values around the headline's bracket (:mod:`spine_mj.validate.boundary`).
     corner : tuple of (family name, seeds, starts)
         The quasistatic-limit study's own seeds and starts table per family (the corner's
         sample size), where they differ from the family's (which the boundary study and the
@@ -350,30 +386,23 @@ class ValidationPlan:
     """
 
     name: str
-    slopes_deg: tuple[float, ...]
-    azimuths_deg: tuple[float, ...]
-    static_engines: tuple[tuple[str, tuple[tuple[str, Any], ...]], ...]
     families: tuple[FamilySpec, ...]
     lowest_ie: float
     hfield_resolution: int
     limit_variations: tuple[tuple[str, tuple[tuple[str, Any], ...]], ...]
-    ie_values: tuple[float, ...]
-    boundary_families: tuple[str, ...]
-    protocols: tuple[str, ...] = ("spring", "ramp")
+    static: StaticPlan
+    boundary: BoundaryPlan
+    bootstrap: int = 200
+    ensemble_members: int = 1
+    corner: tuple[tuple[str, Any, tuple], ...] = ()
+    convergence_starts: int = 0
+    convergence_refinements: tuple[str, ...] = ("dt_halved", "hfield_doubled")
     stick_slip: StickSlipPlan = field(default_factory=StickSlipPlan)
     sandpaper: SandpaperPlan = field(default_factory=SandpaperPlan)
     fractal: FractalPlan = field(default_factory=FractalPlan)
     stiffness_map: StiffnessMapPlan = field(default_factory=StiffnessMapPlan)
     ground_truth: GroundTruthPlan = field(default_factory=GroundTruthPlan)
     engines: EnginesPlan = field(default_factory=EnginesPlan)
-    bootstrap: int = 200
-    ramp_max_steps: int = 20000
-    ramp_slide_lc: float = 0.1
-    ensemble_members: int = 1
-    corner: tuple[tuple[str, Any, tuple], ...] = ()
-    convergence_starts: int = 0
-    convergence_refinements: tuple[str, ...] = ("dt_halved", "hfield_doubled")
-    boundary_refinements: tuple[str, ...] = ()
     extra: dict = field(default_factory=dict, compare=False)
 
     def corner_family(self, fam: FamilySpec) -> FamilySpec:
@@ -438,22 +467,14 @@ PEAK_VALLEY = FamilySpec(
 PLANS: dict[str, ValidationPlan] = {
     "smoke": ValidationPlan(
         name="smoke",
-        slopes_deg=(20.0, 70.0),
-        azimuths_deg=(0.0,),
-        static_engines=(RECOMMENDED, DT_HALVED, HFIELD_DOUBLED),
         families=(
             FamilySpec("single_peak_valley", ("paper-single-peak",), None, paper_starts([-2.0, -4.0])),
         ),
         lowest_ie=1e-2,
         hfield_resolution=101,
         limit_variations=(),
-        ie_values=(1e-2, 1.0),
-        boundary_families=("single_peak_valley",),
-        protocols=("spring",),
         bootstrap=20,
-        ramp_max_steps=2000,
         convergence_starts=1,
-        boundary_refinements=("dt_halved",),
         stick_slip=StickSlipPlan(
             ie=(1e-1,),
             stiffness=(10.0,),
@@ -490,12 +511,21 @@ PLANS: dict[str, ValidationPlan] = {
             checks=("static kappa", "spring-block"),
             quick=True,
         ),
+        static=StaticPlan(
+            slopes_deg=(20.0, 70.0),
+            azimuths_deg=(0.0,),
+            engines=(RECOMMENDED, DT_HALVED, HFIELD_DOUBLED),
+        ),
+        boundary=BoundaryPlan(
+            ie_values=(1e-2, 1.0),
+            families=("single_peak_valley",),
+            protocols=("spring",),
+            ramp_max_steps=2000,
+            refinements=("dt_halved",),
+        ),
     ),
     "quick": ValidationPlan(
         name="quick",
-        slopes_deg=(0.0, 15.0, 30.0, 45.0, 60.0, 75.0),
-        azimuths_deg=(0.0, 60.0, 120.0, 180.0),
-        static_engines=(RECOMMENDED, NO_NOSLIP, DT_HALVED),
         families=(
             PEAK_VALLEY,
             FamilySpec(
@@ -509,15 +539,7 @@ PLANS: dict[str, ValidationPlan] = {
         hfield_resolution=151,
         # the engine settings' variations are the full plan's (the demo's budget)
         limit_variations=(),
-        # the boundary lies at 1e-2 to 1 on the single peak and valley: 1e-4 (the corner
-        # study's I_e) brackets nothing there and its ramp pilot was the boundary's slowest
-        ie_values=(1e-3, 1e-2, 1e-1, 1.0, 10.0),
-        boundary_families=("single_peak_valley",),
-        # the spring drive's boundary only: the ramp's pilots run one by one (78 of the
-        # boundary's 113 s measured), and the full plan has both drives
-        protocols=("spring",),
         bootstrap=200,
-        ramp_max_steps=60000,
         # two runs a start (the full plan's three: the start and its neighbours on either
         # side along x): a split is looked for on one side only, so the demo's
         # ill-conditioned shares are lower bounds beside the full plan's. The ensembles'
@@ -574,12 +596,24 @@ PLANS: dict[str, ValidationPlan] = {
             # (MuJoCo 3.3 s, Bullet 23.3 s, imports the rest; measured on a loaded machine)
             quick=True,
         ),
+        static=StaticPlan(
+            slopes_deg=(0.0, 15.0, 30.0, 45.0, 60.0, 75.0),
+            azimuths_deg=(0.0, 60.0, 120.0, 180.0),
+            engines=(RECOMMENDED, NO_NOSLIP, DT_HALVED),
+        ),
+        boundary=BoundaryPlan(
+            # the boundary lies at 1e-2 to 1 on the single peak and valley: 1e-4 (the corner
+            # study's I_e) brackets nothing there and its ramp pilot was the boundary's slowest
+            ie_values=(1e-3, 1e-2, 1e-1, 1.0, 10.0),
+            families=("single_peak_valley",),
+            # the spring drive's boundary only: the ramp's pilots run one by one (78 of the
+            # boundary's 113 s measured), and the full plan has both drives
+            protocols=("spring",),
+            ramp_max_steps=60000,
+        ),
     ),
     "full": ValidationPlan(
         name="full",
-        slopes_deg=tuple(np.arange(0.0, 76.0, 7.5)),
-        azimuths_deg=(0.0, 30.0, 60.0, 90.0, 120.0, 150.0, 180.0),
-        static_engines=(RECOMMENDED, NO_NOSLIP, IMPRATIO, DT_HALVED, HFIELD_DOUBLED, TOLERANCE_TIGHTENED),
         families=(
             PEAK_VALLEY,
             FamilySpec(
@@ -603,12 +637,7 @@ PLANS: dict[str, ValidationPlan] = {
             # dt_halved: the same settings on every family), not repeated here
             ("soft contact (timeconst 10 dt)", (("solref_timeconst_factor", 10.0),)),
         ),
-        ie_values=tuple(float(v) for v in np.logspace(-4, 1, 11)),
-        # the random Gaussian boundary (20 runs x 11 I_e x 2 drives) would double the run
-        # time past ~45 min on 2 cores: the full plan keeps the single peak/valley there
-        boundary_families=("single_peak_valley",),
         bootstrap=500,
-        ramp_max_steps=200_000,
         ensemble_members=3,
         # at least 60 well-conditioned starts per family (issue 41: 60 of 60 has a 95 % lower
         # bound of 0.94), over several surfaces: 64 where one start in a hundred was
@@ -631,10 +660,6 @@ PLANS: dict[str, ValidationPlan] = {
             "hfield_quadrupled",
             "tolerance_tightened",
         ),
-        # I_e* rerun around its bracket (4 I_e x 10 starts x 2 drives a refinement): ~155 s
-        # of CPU for both, estimated from a reduced run (spring 0.45-0.5 s a run, ramp 1.1-1.8
-        # s); dt / 4 for an observed order would add ~170 s
-        boundary_refinements=("dt_halved", "hfield_doubled"),
         stick_slip=StickSlipPlan(
             ie=(1e-3, 1e-2, 1e-1, 1.0),
             stiffness=(2.0, 10.0, 50.0),
@@ -668,6 +693,22 @@ PLANS: dict[str, ValidationPlan] = {
             # (an observed order) would add ~80 s
             refinements=("dt_halved", "tolerance_tightened"),
             refined_surfaces=15,
+        ),
+        static=StaticPlan(
+            slopes_deg=tuple(np.arange(0.0, 76.0, 7.5)),
+            azimuths_deg=(0.0, 30.0, 60.0, 90.0, 120.0, 150.0, 180.0),
+            engines=(RECOMMENDED, NO_NOSLIP, IMPRATIO, DT_HALVED, HFIELD_DOUBLED, TOLERANCE_TIGHTENED),
+        ),
+        boundary=BoundaryPlan(
+            ie_values=tuple(float(v) for v in np.logspace(-4, 1, 11)),
+            # the random Gaussian boundary (20 runs x 11 I_e x 2 drives) would double the run
+            # time past ~45 min on 2 cores: the full plan keeps the single peak/valley there
+            families=("single_peak_valley",),
+            ramp_max_steps=200_000,
+            # I_e* rerun around its bracket (4 I_e x 10 starts x 2 drives a refinement): ~155 s
+            # of CPU for both, estimated from a reduced run (spring 0.45-0.5 s a run, ramp 1.1-1.8
+            # s); dt / 4 for an observed order would add ~170 s
+            refinements=("dt_halved", "hfield_doubled"),
         ),
     ),
 }

@@ -157,15 +157,15 @@ def static_map(plan: ValidationPlan, runner: StudyRunner, *, mu: float = 0.5) ->
     """
     runner.study = "static"
     rows = []
-    for slope in plan.slopes_deg:
-        for az in plan.azimuths_deg:
-            if slope == 0.0 and az != plan.azimuths_deg[0]:
+    for slope in plan.static.slopes_deg:
+        for az in plan.static.azimuths_deg:
+            if slope == 0.0 and az != plan.static.azimuths_deg[0]:
                 continue
             rows += _plane_rows(plan, runner, slope, az, mu)
     per_engine = {
-        label: _engine_summary([r for r in rows if r["engine"] == label]) for label, _ in plan.static_engines
+        label: _engine_summary([r for r in rows if r["engine"] == label]) for label, _ in plan.static.engines
     }
-    first = per_engine[plan.static_engines[0][0]]
+    first = per_engine[plan.static.engines[0][0]]
     max_err = first["max_rel_error"]
     if first["engaged_breakaways"] < first["engaged_planes"]:
         max_err = float("inf")  # an engaged plane that did not break away is no agreement
@@ -185,9 +185,9 @@ def static_convergence(plan: ValidationPlan, per_engine: dict) -> dict:
     when the error moves by at most the target rule's slack on a length,
     ``TARGET_SLACK x STATIC_TARGET`` (one probe per plane: no interval of its own), and no
     plane changes region."""
-    base = per_engine[plan.static_engines[0][0]]
+    base = per_engine[plan.static.engines[0][0]]
     out = {}
-    for label, ov in plan.static_engines[1:]:
+    for label, ov in plan.static.engines[1:]:
         key = next((k for k, v in REFINEMENTS.items() if tuple(v) == tuple(ov)), None)
         if key is None:
             continue
@@ -208,7 +208,7 @@ def static_convergence(plan: ValidationPlan, per_engine: dict) -> dict:
 def _plane_rows(plan: ValidationPlan, runner: StudyRunner, slope: float, az: float, mu: float) -> list[dict]:
     """The probe on one plane under every engine setting of the plan."""
     region_names = engagement.REGION_NAMES
-    engines = plan.static_engines
+    engines = plan.static.engines
     fx, fy = _slopes(slope, az)
     k, low, region = hold_force(fx, fy, mu)
     gain = kappa_tilt_gain(slope, az, mu)

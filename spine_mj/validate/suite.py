@@ -116,7 +116,7 @@ def _engine_settings(plan: ValidationPlan) -> dict:
         },
         "rule": "dt = min(1 ms, sqrt(0.005 min(r_tip, L_c) m / F_p)), solref = (2 dt, 1), "
         "elliptic cone, noslip_iterations = 3, impratio = 1 (spine_mj.sim)",
-        "static_variants": {label: dict(ov) for label, ov in plan.static_engines},
+        "static_variants": {label: dict(ov) for label, ov in plan.static.engines},
         "hfield_resolution": plan.hfield_resolution,
         "mass_kg": MASS_KG,
         "length_scale_m": sim.DEFAULT_LENGTH_SCALE_M,

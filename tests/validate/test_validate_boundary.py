@@ -17,9 +17,9 @@ def test_spring_and_ramp_sweeps_each_give_their_drives_curve(tmp_path):
     plan = dataclasses.replace(
         PLANS["smoke"],
         families=(fam,),
-        protocols=("spring", "ramp"),
-        ie_values=(1e-2, 1.0),
-        ramp_max_steps=2000,
+        boundary=dataclasses.replace(
+            PLANS["smoke"].boundary, protocols=("spring", "ramp"), ie_values=(1e-2, 1.0), ramp_max_steps=2000
+        ),
     )
     res = boundary(plan, StudyRunner(tmp_path, 2, None, time.perf_counter()))
     assert set(res.curves) == {"spring", "ramp"}
@@ -50,9 +50,9 @@ def test_ie_star_under_a_halved_step_reruns_the_window_at_half_each_paces_own_st
     plan = dataclasses.replace(
         PLANS["smoke"],
         families=(fam,),
-        protocols=("spring",),
-        ie_values=(1e-2, 1.0),
-        boundary_refinements=("dt_halved",),
+        boundary=dataclasses.replace(
+            PLANS["smoke"].boundary, protocols=("spring",), ie_values=(1e-2, 1.0), refinements=("dt_halved",)
+        ),
     )
     res = boundary(plan, StudyRunner(tmp_path, 2, None, time.perf_counter()))
     star = res.ie_star["spring"]

@@ -259,7 +259,7 @@ def test_the_static_error_is_converged_when_a_halved_step_moves_it_less_than_the
     from spine_mj.validate.static_map import static_convergence
 
     plan = PLANS["smoke"]
-    assert plan.static_engines == (RECOMMENDED, DT_HALVED, HFIELD_DOUBLED)
+    assert plan.static.engines == (RECOMMENDED, DT_HALVED, HFIELD_DOUBLED)
 
     def per_engine(err_halved, regions_halved=1.0):
         return {

@@ -7,15 +7,14 @@ import time
 import pytest
 
 from spine_mj import sweep
-from spine_mj.validate.plans import HFIELD_DOUBLED, PLANS, RECOMMENDED
+from spine_mj.validate.plans import HFIELD_DOUBLED, PLANS, RECOMMENDED, StaticPlan
 from spine_mj.validate.static_map import static_map
 from spine_mj.validate.study_runner import StudyRunner
 
 
 def test_the_hfield_doubled_probe_runs_on_the_same_plane_and_tip_with_its_hfield_refined(tmp_path):
-    plan = dataclasses.replace(
-        PLANS["smoke"], slopes_deg=(20.0,), azimuths_deg=(0.0,), static_engines=(RECOMMENDED, HFIELD_DOUBLED)
-    )
+    static = StaticPlan(slopes_deg=(20.0,), azimuths_deg=(0.0,), engines=(RECOMMENDED, HFIELD_DOUBLED))
+    plan = dataclasses.replace(PLANS["smoke"], static=static)
     res = static_map(plan, StudyRunner(tmp_path, 1, None, time.perf_counter()))
     stores = sorted((tmp_path / "sweeps" / "static").iterdir())
     assert len(stores) == 2

@@ -104,8 +104,8 @@ def test_smoke_validation_writes_report_and_json(tmp_path, monkeypatch):
     assert "Solution verification" in report
     # and of I_e*: the smoke grid's two I_e values rerun with the step halved
     star_conv = doc["ie_star"]["spring"]["convergence"]
-    assert star_conv["dt_halved"]["runs"] == len(plan.ie_values) * 2
-    assert star_conv["ie_refined"] == list(plan.ie_values)
+    assert star_conv["dt_halved"]["runs"] == len(plan.boundary.ie_values) * 2
+    assert star_conv["ie_refined"] == list(plan.boundary.ie_values)
     assert "Solution verification of I_e*" in report
     # and of the fractal lock rates: both MuJoCo series, each surface's own step halved
     for row in fractal["rows"]:
