@@ -7,7 +7,8 @@ import time
 import pytest
 
 from spine_mj import sweep
-from spine_mj.validate.plans import HFIELD_DOUBLED, PLANS, RECOMMENDED, StaticPlan
+from spine_mj.validate.plan_sections import StaticPlan
+from spine_mj.validate.plans import HFIELD_DOUBLED, PLANS, RECOMMENDED
 from spine_mj.validate.static_map import static_map
 from spine_mj.validate.study_runner import StudyRunner
 
