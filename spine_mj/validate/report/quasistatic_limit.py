@@ -198,6 +198,27 @@ def _marked(v: dict, conv: dict | None) -> dict:
     return {h: quoted(cell(v[h]), conv, h) for h in HEADLINES if h in v}
 
 
+#: How the report's solution verification is made, above its table.
+_CONVERGENCE_RULE = (
+    "Each family's corner rerun from a subset of its starts (the same points, one run "
+    "each) with the engine's step halved (each run's own rig step, the contact's time "
+    "constant kept, so only the step changes) and with an analytic surface's hfield at "
+    "twice the samples "
+    "a side (every old sample and the tip kept; a gridded surface, the fractal and the "
+    "sandpapers, refined through the spline it is defined by: only the facets change). "
+    "The change is paired: the refined runs' number "
+    "minus the corner's own runs' from the same starts, like for like: the agreement "
+    "change is the well-conditioned agreement's (what the target judges), on the paired "
+    "starts well-conditioned on both sides; a start whose reference stalled at either level "
+    "has no quasistatic answer there and leaves the pair (counted: stalled references). "
+    "A headline is converged when it "
+    "plus the change stays inside its own 95 % interval; where it does not, it is marked "
+    "unconverged wherever it is quoted. Where the plan asks, the solver's tolerances are "
+    "tightened a hundredfold (tolerance / 100: MuJoCo's 1e-8 and noslip 1e-6 to 1e-10 and "
+    "1e-8)."
+)
+
+
 def convergence_lines(limit: QuasistaticLimitResult) -> list[str]:
     """The solution verification of the corner's headlines (empty where the plan refined
     nothing): per family and refinement the paired change of each headline and the verdict,
@@ -225,22 +246,7 @@ def convergence_lines(limit: QuasistaticLimitResult) -> list[str]:
     lines = [
         "### Solution verification: the corner under a finer step and a finer hfield",
         "",
-        "Each family's corner rerun from a subset of its starts (the same points, one run "
-        "each) with the engine's step halved (each run's own rig step, the contact's time "
-        "constant kept, so only the step changes) and with an analytic surface's hfield at "
-        "twice the samples "
-        "a side (every old sample and the tip kept; a gridded surface, the fractal and the "
-        "sandpapers, refined through the spline it is defined by: only the facets change). "
-        "The change is paired: the refined runs' number "
-        "minus the corner's own runs' from the same starts, like for like: the agreement "
-        "change is the well-conditioned agreement's (what the target judges), on the paired "
-        "starts well-conditioned on both sides; a start whose reference stalled at either level "
-        "has no quasistatic answer there and leaves the pair (counted: stalled references). "
-        "A headline is converged when it "
-        "plus the change stays inside its own 95 % interval; where it does not, it is marked "
-        "unconverged wherever it is quoted. Where the plan asks, the solver's tolerances are "
-        "tightened a hundredfold (tolerance / 100: MuJoCo's 1e-8 and noslip 1e-6 to 1e-10 and "
-        "1e-8).",
+        _CONVERGENCE_RULE,
         "",
         table(
             rows,
