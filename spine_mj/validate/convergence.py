@@ -241,7 +241,8 @@ def paired_change(base: pd.DataFrame, refined: pd.DataFrame) -> dict:
 
     A start whose reference stalled at either level (``reference_outcome`` "stalled": the
     reference has no answer there, as on a stalled start of the corner itself,
-    :mod:`spine_mj.validate.ensembles`) leaves every headline's pairs, and is counted in
+    :mod:`spine_mj.validate.ensembles`) leaves the well-conditioned agreement's and the median
+    Frechet distance's pairs (the all-starts agreement keeps it, a miss), and is counted in
     ``reference_stalled``: a refinement that resolves a pit the reference cannot leave
     (measured: sandpaper P600's hfield x 2, 12 of 40 references stalled where MuJoCo's tip
     climbed out at 4-5 F_p) changes the reference's coverage, which the count reports, not
@@ -257,11 +258,11 @@ def paired_change(base: pd.DataFrame, refined: pd.DataFrame) -> dict:
         "well_conditioned_runs": int((wc & answered).sum()),
         "reference_stalled": int((wc & ~answered).sum()),
     }
-    b, r = b[answered], r[answered]
-    if "well_conditioned" in b:
-        r = r.assign(well_conditioned=b["well_conditioned"].astype(bool))
+    b, r = b.assign(well_conditioned=wc & answered), r.assign(well_conditioned=wc & answered)
     for headline in HEADLINES:
-        before, after = _statistic(b, headline), _statistic(r, headline)
+        # the all-starts agreement keeps every start: a stall is its miss at either level
+        on = slice(None) if headline == "outcome_agreement" else answered
+        before, after = _statistic(b[on], headline), _statistic(r[on], headline)
         out[headline] = {"base": before, "refined": after, "change": after - before}
     return out
 

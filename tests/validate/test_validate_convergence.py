@@ -158,7 +158,7 @@ def test_the_judged_agreement_changes_on_the_well_conditioned_starts_only():
 def test_a_start_whose_reference_stalls_at_either_level_leaves_the_pairs_and_is_counted():
     # 10 well-conditioned starts, all agreeing at the corner; the refined facets resolve a
     # pit on 3 of them, where the reference stalls (no answer: agree False, a long Frechet
-    # to the stopped path), and 1 start stalled already at the corner. The headlines pair
+    # to the stopped path), and 1 start stalled already at the corner. The judged headlines pair
     # the 6 starts answered at both levels; the 4 are counted, not read as MuJoCo's misses.
     ys = np.linspace(-1, -4, 10)
     stalled_base = np.array([False] * 9 + [True])
@@ -173,6 +173,8 @@ def test_a_start_whose_reference_stalls_at_either_level_leaves_the_pairs_and_is_
     assert pc["runs"] == 10 and pc["well_conditioned_runs"] == 6 and pc["reference_stalled"] == 4
     assert pc["agreement_well_conditioned"] == {"base": 1.0, "refined": 1.0, "change": 0.0}
     assert pc["median_frechet"]["change"] == pytest.approx(0.01)
+    # the all-starts agreement keeps them: a stall is its miss (9 / 10 to 7 / 10)
+    assert pc["outcome_agreement"]["change"] == pytest.approx(-0.2)
     # without the column every reference answered
     assert (
         paired_change(base.drop(columns="reference_outcome"), refined.drop(columns="reference_outcome"))[
