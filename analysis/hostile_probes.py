@@ -432,7 +432,7 @@ def _issue44(add, work: Path, py: str) -> None:
         "surface make paper-fractal nx=8192 (1 GiB budget)",
         [*SPINE, "surface", "make", "paper-fractal", "--set", "nx=8192", "-o", "f.npz"],
         "refuse",
-        "fBm synthesis",
+        "fractal_fbm: a 8192 x 8192 grid would need",
         small,
     )
     add(
