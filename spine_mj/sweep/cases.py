@@ -36,10 +36,15 @@ def cases_bytes(n_cases: int, n_params: int) -> int:
     return n_cases * (CASE_BYTES + CASE_BYTES_PER_PARAM * n_params)
 
 
+def case_count(config: SweepConfig) -> int:
+    """How many cases ``config`` expands to (surfaces x grid points), none made."""
+    return len(config.surfaces) * math.prod(len(v) for _, v in config.grid)
+
+
 def check_cases_memory(config: SweepConfig) -> None:
     """Refuse (SpineInputError, :func:`~spine_mj.memory.check_memory`) a config whose
     cases would take more than the memory budget to prepare, before any is made."""
-    total = len(config.surfaces) * math.prod(len(v) for _, v in config.grid)
+    total = case_count(config)
     check_memory(cases_bytes(total, len(config.grid)), where=f"preparing the sweep's {total:,} cases")
 
 
