@@ -48,7 +48,7 @@ def test_a_spring_swing_only_one_combination_makes_is_refused_before_any_run(tmp
     preflight.check_cases(cases)
 
 
-STEPS = """
+PEAK_ENGINE = """
 [sweep]
 analyses = ["engine"]
 [[surfaces]]
@@ -56,11 +56,17 @@ preset = "paper-single-peak"
 [starts]
 x = [0.05]
 y = [0.5]
+"""
+
+STEPS = (
+    PEAK_ENGINE
+    + """
 [drive]
 ie = [1.0, 1e-3]
 [grid]
 timestep_factor = [1.0, 1e-3]
 """
+)
 
 
 def test_a_run_beyond_the_step_limit_only_one_combination_makes_is_refused(tmp_path):
@@ -202,18 +208,7 @@ def test_engines_of_one_sizing_measure_the_surface_once_before_any_run(tmp_path,
 
     monkeypatch.setattr(Scales, "with_hfield", classmethod(counted))
     sweep.session.clear_caches()
-    text = """
-    [sweep]
-    analyses = ["engine"]
-    [[surfaces]]
-    preset = "paper-single-peak"
-    [starts]
-    x = [0.05]
-    y = [0.5]
-    [grid]
-    engine = ["mujoco", "bullet"]
-    hfield_resolution = 101
-    """
+    text = PEAK_ENGINE + '[grid]\nengine = ["mujoco", "bullet"]\nhfield_resolution = 101\n'
     cases = sweep.expand_cases(sweep.load_config(write_config(tmp_path, text)))
     preflight.check_cases(cases, ("engine",))
     assert calls == [101]
