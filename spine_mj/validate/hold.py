@@ -424,6 +424,8 @@ def _summary(label, settings, corner, limits, tip, share, summ, verdicts, levels
                 {
                     "from": lv["from"],
                     "runs": lv["runs"],
+                    "well_conditioned_runs": lv["well_conditioned_runs"],
+                    "reference_stalled": lv["reference_stalled"],
                     "change": lv["agreement_well_conditioned"]["change"],
                     "median_frechet_change": lv["median_frechet"]["change"],
                     "failed_runs": lv["failed_runs"],
