@@ -43,7 +43,7 @@ from spine_mj.validate.convergence import thin_starts
 from spine_mj.validate.ensembles import ensemble_family
 from spine_mj.validate.intervals import newcombe_difference
 from spine_mj.validate.plans import PLANS, FamilySpec, ValidationPlan, paper_starts, relative_starts
-from spine_mj.validate.predicted_limits import family_corner
+from spine_mj.validate.predicted_limits import corner_drives, family_corner
 from spine_mj.validate.quasistatic_limit import corner_summary, limit_doc, limit_family_docs
 from spine_mj.validate.study_runner import StudyRunner
 
@@ -206,7 +206,7 @@ def _corner_docs(
     for fam in plan.families:
         corner = plan.corner_family(fam)
         own = family_corner(plan, corner)["presets"]
-        corners[fam.name] = {p: {"ie": c["ie"], "K": c["K"]} for p, c in own.items()}
+        corners[fam.name] = corner_drives(own)
         if starts is not None:
             corner = thin_starts(corner, starts)
         for name, doc in limit_family_docs(plan, corner, own):

@@ -33,6 +33,7 @@ from spine_mj.validate.plans import FamilySpec, ValidationPlan
 __all__ = [
     "CORNER_GRID_STARTS",
     "CORNER_PATH_STARTS",
+    "corner_drives",
     "family_corner",
     "family_k_axis",
     "family_limits",
@@ -93,6 +94,12 @@ def family_limits(plan: ValidationPlan, fam: FamilySpec, *, n_starts: int = 8) -
         "limit": worst["limit"],
         "presets": per,
     }
+
+
+def corner_drives(presets: dict) -> dict:
+    """Each preset's drive at its corner, ``{preset: {"ie", "K"}}``, from
+    :func:`family_corner`'s ``presets`` (what ``validation.json``'s ``corner`` records)."""
+    return {preset: {"ie": c["ie"], "K": c["K"]} for preset, c in presets.items()}
 
 
 def family_corner(plan: ValidationPlan, fam: FamilySpec) -> dict:

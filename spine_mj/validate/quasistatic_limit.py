@@ -23,7 +23,7 @@ from spine_mj.validate.intervals import bootstrap, meets_target, wilson
 from spine_mj.validate.miss_causes import MISS_CAUSES, miss_cause
 from spine_mj.validate.paths import stored_paths, tip_radius
 from spine_mj.validate.plans import RECOMMENDED, FamilySpec, ValidationPlan
-from spine_mj.validate.predicted_limits import family_corner
+from spine_mj.validate.predicted_limits import corner_drives, family_corner
 from spine_mj.validate.study_runner import StudyRunner
 from spine_mj.validate.sweep_configs import engine_grid, family_doc, gridded, refused_by_rig
 
@@ -132,10 +132,7 @@ class QuasistaticLimitResult:
         fams = self.families
         return {
             "lowest_ie": self.lowest_ie,
-            "corner": {
-                fam: {preset: {"ie": c["ie"], "K": c["K"]} for preset, c in v["presets"].items()}
-                for fam, v in self.corners.items()
-            },
+            "corner": {fam: corner_drives(v["presets"]) for fam, v in self.corners.items()},
             "corner_limits": self.corners,
             "outcome_agreement_at_lowest_ie": {k: v["outcome_agreement"] for k, v in fams.items()},
             "mean_frechet_at_lowest_ie": {k: v["mean_frechet"] for k, v in fams.items()},
@@ -211,7 +208,7 @@ def quasistatic_limit(plan: ValidationPlan, runner: StudyRunner) -> QuasistaticL
         allc["well_conditioned"] = [
             well.get(f"{c}/{int(s)}", False) for c, s in zip(allc["case_id"], allc["start"])
         ]
-        summ["corner"] = {preset: {"ie": c["ie"], "K": c["K"]} for preset, c in at[fam.name].items()}
+        summ["corner"] = corner_drives(at[fam.name])
         families[fam.name] = summ
         if plan.convergence_starts > 0:
             refined = _refined_rows(fam.name, plan.convergence_refinements, refinements, refined_done)
