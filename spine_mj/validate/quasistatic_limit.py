@@ -360,6 +360,8 @@ def limit_doc(
     if members > 1:
         fam = ensemble_family(fam, preset, members)
         grid["ensemble_members"] = members
+    if overrides:  # a variation or refinement level is judged on the rigid reference alone
+        grid["compliant_reference"] = False
     doc = family_doc(
         fam,
         name=name,

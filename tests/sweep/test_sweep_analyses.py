@@ -187,20 +187,30 @@ ie = 0.01
 mu = 1.25
 dl = 0.02
 ensemble_members = {members}
+compliant_reference = {compliant}
 """
 
 
 def test_an_ensembles_copies_get_their_outcome_and_its_first_member_everything(tmp_path):
     """With ``ensemble_members`` = 3 the first start of each three gets the whole comparison,
-    the same as without ensembles; the copies get their outcome on both sides only."""
+    the same as without ensembles; the copies get their outcome on both sides only. With
+    ``compliant_reference`` off, every start gets all but the compliant comparison."""
     rows = {}
-    for members in (1, 3):
-        cfg = write_config(tmp_path, ENSEMBLE.format(members=members), name=f"e{members}.toml")
-        out = tmp_path / f"out{members}"
+    for members, compliant in ((1, "true"), (3, "true"), (1, "false")):
+        doc = ENSEMBLE.format(members=members, compliant=compliant)
+        cfg = write_config(tmp_path, doc, name=f"e{members}{compliant}.toml")
+        out = tmp_path / f"out{members}{compliant}"
         sweep.run_sweep(cfg, out, workers=1)
         runs = sweep.load_runs(out)
-        rows[members] = runs[runs.analysis == "compare"].set_index("start").sort_index()
-    full, ens = rows[1], rows[3]
+        rows[members, compliant] = runs[runs.analysis == "compare"].set_index("start").sort_index()
+    full, ens = rows[1, "true"], rows[3, "true"]
+    # without the compliant reference (a refinement level): its columns empty, the rest alike
+    rigid = rows[1, "false"]
+    for col in ("compliant_frechet", "agree_compliant", "compliant_jumps", "stiffness_frechet"):
+        assert full[col].notna().all() and rigid[col].isna().all(), col
+    for col in ("frechet", "lateral_deviation", "frechet_smooth", "geometry_frechet"):
+        np.testing.assert_allclose(rigid[col], full[col], rtol=1e-12, err_msg=col)
+    assert (rigid.agree == full.agree).all()
     lead = ens.index % 3 == 0
     for col in ("frechet", "lateral_deviation", "frechet_smooth", "geometry_frechet", "compliant_frechet"):
         np.testing.assert_allclose(ens[col][lead], full[col][lead], rtol=1e-9, err_msg=col)

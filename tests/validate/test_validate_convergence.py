@@ -249,6 +249,8 @@ def test_a_doubled_hfield_nests_the_old_samples_and_keeps_the_tip():
     assert finer["grid"]["hfield_refinement"] == 2
     assert finer["grid"]["hfield_resolution"] == base["grid"]["hfield_resolution"]
     assert finer["grid"]["tip_radius"] == base["grid"]["tip_radius"]
+    # a level is judged on the rigid reference: the compliant one runs at the corner alone
+    assert finer["grid"]["compliant_reference"] is False and "compliant_reference" not in base["grid"]
     assert (
         finer["starts"]
         == base["starts"]

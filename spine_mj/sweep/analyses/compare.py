@@ -127,7 +127,8 @@ def _compliant(
     """MuJoCo against the compliant-drive streamline of the run's own spring
     (:mod:`spine_mj.theory.compliant`, ``k / W`` from the run), traced like the rigid reference:
     what stiffness does is predicted there, what is left over is inertia. NaN for drives
-    without a spring and for the starts not in ``lead`` (an ensemble's perturbed members).
+    without a spring and for the starts not in ``lead`` (an ensemble's perturbed members, or every
+    start where ``compliant_reference`` is off).
     ``stiffness_frechet`` is the compliant reference's distance from the rigid one,
     ``compliant_jumps`` its folds. The reference's carriage stops where the run's does
     (``carriage_end``)."""
@@ -238,7 +239,18 @@ def _compare(case, surface, starts, upstream):
         contact, params, trace, mpaths, facets, mj_locked, mj_end, lc, explain
     )
     compliant = _compliant(
-        contact, params, starts, runs, rig.scales.preload_n, s, mpaths, facets, mj_locked, mj_end, lc, lead
+        contact,
+        params,
+        starts,
+        runs,
+        rig.scales.preload_n,
+        s,
+        mpaths,
+        facets,
+        mj_locked,
+        mj_end,
+        lc,
+        lead & bool(case.params["compliant_reference"]),
     )
     peak = np.array([peak_drive_over_fp(r, rig.scales.preload_n) for r in runs])
     kap = agreement.kappa_agreement(facets.max_kappa, peak, kappa_cap=runs[0].detection.kappa_cap)
@@ -316,6 +328,16 @@ register_analysis(
                 "bool",
                 "tell why each disagreeing run disagrees (miss_reason): the reference restarted "
                 f"from {MISS_CHECKPOINTS} points of its MuJoCo path, a trace each",
+                True,
+            ),
+            ParamSpec(
+                "compliant_reference",
+                "bool",
+                "also compare with the compliant-drive streamline of the run's own spring "
+                "(agree_compliant, compliant_frechet, compliant_jumps, stiffness_frechet); off: "
+                "those columns NaN (a refinement level, judged on the rigid reference alone: "
+                "on a grit's facets the compliant reference creeps along creases and is most "
+                "of a case's time)",
                 True,
             ),
             ParamSpec(
