@@ -42,13 +42,21 @@ def parse_stiffness_list(text: str) -> list[float]:
 @click.option(
     "--bootstrap", type=click.IntRange(min=10), default=100, show_default=True, help="Bootstrap samples."
 )
+@click.option(
+    "--drop-floor",
+    type=float,
+    default=None,
+    help="Smallest force drop (and reload) that counts in drops.parquet [F_p] "
+    "(default: slip_catalog.DROP_FLOOR_FP, 1e-3).",
+)
 @click.option("--out", "out_dir", required=True, type=click.Path(file_okay=False), help="Output folder.")
-def stickslip_cmd(surface_spec, mu, stiffness, ie, engine, start, travel, bootstrap, out_dir):
+def stickslip_cmd(surface_spec, mu, stiffness, ie, engine, start, travel, bootstrap, drop_floor, out_dir):
     """Slip events on SURFACE (a track uniform in y, e.g. the abbm preset) at each K: the
     overdamped and inertial quasistatic references, and an engine with --engine.
 
     Writes events.parquet (one row per slip: source, K, ie, size_lc, duration_s,
-    force_drop_fp, ...), summary.json (per source and K: n_events, tau {value, low, high},
+    force_drop_fp, ...), drops.parquet (every source's slips as force drops, one rule for
+    all), summary.json (per source and K: n_events, tau {value, low, high},
     cutoff_lc, the power-law tests; per K the two-sample tests; per reference and K the
     mean pulse), distributions.png, collapse.png and pulse.png.
 
@@ -61,6 +69,8 @@ def stickslip_cmd(surface_spec, mu, stiffness, ie, engine, start, travel, bootst
 
     ks = parse_stiffness_list(stiffness)
     check_positive("--ie", ie)
+    if drop_floor is not None:
+        check_positive("--drop-floor", drop_floor)
     surf = presets.open_surface(surface_spec)
     mu = presets.resolve_mu(surf, mu, name="--mu")
     with Progress("stickslip", unit="step") as bar:
@@ -75,6 +85,7 @@ def stickslip_cmd(surface_spec, mu, stiffness, ie, engine, start, travel, bootst
             start=start,
             travel=travel,
             n_bootstrap=bootstrap,
+            drop_floor_fp=drop_floor,
             progress=lambda done, total, what: bar.update(done, total, step=what),
         )
     for line in summary_lines(out.summary):
@@ -82,7 +93,8 @@ def stickslip_cmd(surface_spec, mu, stiffness, ie, engine, start, travel, bootst
 
 
 def summary_lines(summary: dict) -> list[str]:
-    """One line per source and K: events, tau with its interval, S_m."""
+    """One line per source and K: events, tau with its interval, S_m; with an engine, one
+    line per K and reference: its force drops' sizes against the reference's (KS)."""
     lines = []
     for source, per_k in summary["sources"].items():
         for k, entry in per_k.items():
@@ -94,4 +106,11 @@ def summary_lines(summary: dict) -> list[str]:
                     f"  S_m {cut['value']:.3g} L_c [{cut['low']:.3g}, {cut['high']:.3g}]"
                 )
             lines.append(line)
+    for k, tests in summary["drops"]["two_sample"].items():
+        for pair, test in tests.items():
+            size = test["size_lc"]
+            lines.append(
+                f"drops  K {k:>6}  {pair}: sizes KS D {size['ks']:.3f} p {size['ks_p']:.3g}"
+                f"  ({'agree' if size['agree'] else 'differ'})"
+            )
     return lines

@@ -15,6 +15,13 @@ slips and its distance from ABBM's parabola, :func:`~spine_mj.validate.slip_cata
 ``distributions.png``, ``collapse.png``, ``pulse.png`` (the mean slip pulses, an
 engine's too) and ``regime.png`` (the (I_e, K) map of :func:`regime_map`) - all or none
 of them.
+
+``drops.parquet`` is every source's catalog by one rule, the spring force's drops deeper
+than ``drop_floor_fp`` (:mod:`spine_mj.theory.force_drops`): the references' force along
+their quasistatic paths, an engine's recorded force, and with an engine also the references
+on the profile its height field makes (``*_facets``). ``summary["drops"]`` holds their
+counts and the engine's two-sample tests against each, the like-for-like verdict: the speed
+rule fires on a resting tip's jitter at small I_e, the drop rule does not.
 """
 
 from __future__ import annotations
@@ -31,18 +38,23 @@ from spine_mj.theory.motion import SLIP_SPEED_FACTOR
 from spine_mj.validate import avalanche_stats as stats
 from spine_mj.validate.slip_catalog import (
     COLUMNS,
+    DROP_FLOOR_FP,
     REFERENCES,
     TrackUnits,
+    engine_drop_rows,
     engine_rows,
+    facet_count,
+    reference_drop_rows,
     reference_pulses,
     reference_rows,
     track_landscape,
 )
 
-__all__ = ["OUTPUT_FILES", "StickSlipOutputs", "regime_map", "stickslip_to"]
+__all__ = ["OUTPUT_FILES", "StickSlipOutputs", "drop_summary", "regime_map", "stickslip_to"]
 
 OUTPUT_FILES = (
     "events.parquet",
+    "drops.parquet",
     "summary.json",
     "distributions.png",
     "collapse.png",
@@ -95,6 +107,7 @@ def stickslip_to(
     start: float | None = None,
     travel: float | None = None,
     n_bootstrap: int = 100,
+    drop_floor_fp: float | None = None,
     progress: Callable[[int, int, str], None] | None = None,
     **rig_options,
 ) -> StickSlipOutputs:
@@ -120,6 +133,9 @@ def stickslip_to(
         The stretch of track, in surface units (default: all but a twentieth at each end).
     n_bootstrap : int
         Synthetic samples of each goodness-of-fit test.
+    drop_floor_fp : float
+        The force-drop rule's floor and hysteresis [F_p] (``drops.parquet``), > 0
+        (default :data:`~spine_mj.validate.slip_catalog.DROP_FLOOR_FP`).
     progress : callable, optional
         ``progress(done, total, what)`` after each step.
     **rig_options
@@ -131,36 +147,114 @@ def stickslip_to(
     if not ks:
         raise SpineInputError("--K must name at least one stiffness number")
     x0, length = _track(surface, start, travel)
+    floor = DROP_FLOOR_FP if drop_floor_fp is None else check_positive("--drop-floor", drop_floor_fp)
     labels = {"surface": surface_name, "mu": float(mu), "ie": float(ie)}
     report = progress or (lambda done, total, what: None)
     total = len(ks) * (2 if engine else 1) + 1
-    frames, units_by_k, pulses, ref_pulses = [], {}, {}, {}
-    done = 0
+    steps = iter(range(1, total))
+
+    def tick(what: str) -> None:
+        report(next(steps), total, what)
+
+    frames, drops, units_by_k, pulses, ref_pulses = [], [], {}, {}, {}
     for k_number in ks:
-        rig, scales = _rig_and_scales(surface, engine, mu, ie, k_number, rig_options)
-        units = TrackUnits.of(scales, ie)
+        units, land, frames_k, drops_k = _catalogs_at(
+            surface, k_number, (x0, x0 + length), floor, labels, engine, rig_options, pulses, ref_pulses, tick
+        )
         units_by_k[k_number] = units
-        land = track_landscape(surface, mu, units.tip_radius, (x0, x0 + length))
-        for rows in reference_rows(land, units, k_number, **labels).values():
-            frames.append(pd.DataFrame(rows, columns=COLUMNS))
-        _add_pulses(land, units, k_number, ref_pulses, pulses)
-        done += 1
-        report(done, total, f"references, K {k_number:g}")
-        if engine:
-            result = _engine_run(rig, units, land, k_number, ie, x0, length)
-            frames.append(
-                pd.DataFrame(engine_rows(result, units, engine, k_number, **labels), columns=COLUMNS)
-            )
-            pulses[(engine, k_number)] = _pulse(result)
-            done += 1
-            report(done, total, f"{engine}, K {k_number:g}")
+        frames, drops = frames + frames_k, drops + drops_k
     events = pd.concat(frames, ignore_index=True)
+    drop_events = pd.concat(drops, ignore_index=True)
     summary = _summary(events, surface, mu, ie, ks, units_by_k, engine, x0, length, n_bootstrap)
+    summary["drops"] = drop_summary(drop_events, engine, ks, units_by_k, floor)
     summary["pulse"] = ref_pulses
     summary["regime"] = regime_map(land, events, units_by_k)
-    files = _write(Path(out_dir), events, summary, pulses)
+    files = _write(Path(out_dir), events, drop_events, summary, pulses)
     report(total, total, "written")
     return StickSlipOutputs(summary, files)
+
+
+def _catalogs_at(surface, k_number, x_range, floor, labels, engine, rig_options, pulses, ref_pulses, tick):
+    """One K's catalogs (:func:`stickslip_to`): ``(units, landscape, slip frames, drop
+    frames)``, its mean pulses into ``pulses`` and ``ref_pulses``, ``tick(what)`` after the
+    references and after the engine."""
+    x0, x1 = x_range
+    ie = labels["ie"]
+    rig, scales = _rig_and_scales(surface, engine, labels["mu"], ie, k_number, rig_options)
+    units = TrackUnits.of(scales, ie)
+    land = track_landscape(surface, labels["mu"], units.tip_radius, x_range)
+    frames, drops = _reference_frames(land, units, k_number, floor, labels)
+    _add_pulses(land, units, k_number, ref_pulses, pulses)
+    tick(f"references, K {k_number:g}")
+    if engine:
+        result = _engine_run(rig, units, land, k_number, ie, x0, x1 - x0)
+        pulses[(engine, k_number)] = _pulse(result)
+        own, own_drops = _engine_frames(result, rig, surface, units, k_number, x_range, engine, floor, labels)
+        frames, drops = frames + own, drops + own_drops
+        tick(f"{engine}, K {k_number:g}")
+    return units, land, frames, drops
+
+
+def _reference_frames(land, units, k_number: float, floor: float, labels: dict) -> tuple[list, list]:
+    """Both references' catalogs at one K on ``land``: their slips, and their force drops
+    deeper than ``floor``, as lists of catalog frames."""
+    import pandas as pd
+
+    slips = reference_rows(land, units, k_number, **labels).values()
+    drops = reference_drop_rows(land, units, k_number, floor, **labels).values()
+    return [pd.DataFrame(r, columns=COLUMNS) for r in slips], [
+        pd.DataFrame(r, columns=COLUMNS) for r in drops
+    ]
+
+
+def _engine_frames(
+    result, rig, surface, units, k_number, x_range, engine, floor, labels
+) -> tuple[list, list]:
+    """An engine run's catalogs: its slips (speed rule), and its force drops with both
+    references' on the profile its height field makes over ``x_range`` (sources
+    ``*_facets``), as lists of catalog frames."""
+    import pandas as pd
+
+    faceted = track_landscape(surface, labels["mu"], units.tip_radius, x_range, facets=facet_count(rig))
+    slips = pd.DataFrame(engine_rows(result, units, engine, k_number, **labels), columns=COLUMNS)
+    drops = [
+        pd.DataFrame(engine_drop_rows(result, units, engine, k_number, floor, **labels), columns=COLUMNS)
+    ]
+    for source, rows in reference_drop_rows(faceted, units, k_number, floor, **labels).items():
+        rows["source"] = [f"{source}_facets"] * len(rows["source"])
+        drops.append(pd.DataFrame(rows, columns=COLUMNS))
+    return [slips], drops
+
+
+def drop_summary(drops, engine: str | None, ks: Sequence[float], units_by_k: dict, floor: float) -> dict:
+    """``summary["drops"]``: the rule's ``floor_fp``, per source and K the drop count, and
+    per K the engine's two-sample tests against each reference source: ``size_lc``,
+    ``force_drop_fp`` and ``force_drop_fixed_carriage_fp``, the engine's drop plus
+    ``k V T`` (its carriage moves ``V T`` during a drop of duration T, the references'
+    stands still; the term vanishes as ``sqrt(I_e)``, docs/physics.md §12)."""
+    counts: dict = {}
+    for (source, k), g in drops.groupby(["source", "K"], sort=False):
+        counts.setdefault(source, {})[f"{k:g}"] = len(g)
+    tests: dict = {}
+    for k in ks if engine else ():
+        at_k = drops[drops["K"] == k]
+        eng = at_k[at_k["source"] == engine]
+        units = units_by_k[k]
+        fixed = eng["force_drop_fp"] + units.stiffness(k) * units.speed * eng["duration_s"]
+        for source in sorted(set(at_k["source"]) - {engine}):
+            ref = at_k[at_k["source"] == source]
+            if len(eng) < 2 or len(ref) < 2:
+                continue
+            tests.setdefault(f"{k:g}", {})[f"{engine}_vs_{source}"] = {
+                "size_lc": stats.two_sample(eng["size_lc"].to_numpy(), ref["size_lc"].to_numpy()),
+                "force_drop_fp": stats.two_sample(
+                    eng["force_drop_fp"].to_numpy(), ref["force_drop_fp"].to_numpy()
+                ),
+                "force_drop_fixed_carriage_fp": stats.two_sample(
+                    fixed.to_numpy(), ref["force_drop_fp"].to_numpy()
+                ),
+            }
+    return {"floor_fp": float(floor), "n_events": counts, "two_sample": tests}
 
 
 def _add_pulses(land, units: TrackUnits, k_number: float, ref_pulses: dict, pulses: dict) -> None:
@@ -304,7 +398,7 @@ def _summary(events, surface, mu, ie, ks, units_by_k, engine, x0, length, n_boot
     }
 
 
-def _write(out: Path, events, summary: dict, pulses: dict) -> tuple[Path, ...]:
+def _write(out: Path, events, drops, summary: dict, pulses: dict) -> tuple[Path, ...]:
     from spine_mj.atomic import all_or_none, atomic_output
     from spine_mj.jsonio import write_json
 
@@ -312,7 +406,9 @@ def _write(out: Path, events, summary: dict, pulses: dict) -> tuple[Path, ...]:
     with all_or_none(*paths):
         with atomic_output(paths[0]) as tmp:
             events.to_parquet(tmp, index=False)
-        write_json(paths[1], summary)
+        with atomic_output(paths[1]) as tmp:
+            drops.to_parquet(tmp, index=False)
+        write_json(paths[2], summary)
         _figures(out, events, summary, pulses)
     return tuple(paths)
 

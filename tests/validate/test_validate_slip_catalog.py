@@ -49,6 +49,27 @@ def test_study_writes_every_file_and_a_summary_per_source(corrugation_study):
     assert set(res.summary["sources"]) == {"overdamped", "inertial", "mujoco"}
     assert res.summary["sources"]["mujoco"]["0.2"]["n_events"] >= 3
     assert "mujoco_vs_inertial" in res.summary["two_sample"]["0.2"]
+    drops = pd.read_parquet(res.files[1])
+    assert tuple(drops.columns) == COLUMNS
+    assert set(drops["source"]) == {
+        "overdamped",
+        "inertial",
+        "mujoco",
+        "overdamped_facets",
+        "inertial_facets",
+    }
+    counts = res.summary["drops"]["n_events"]
+    assert all(counts[s]["0.2"] == (drops["source"] == s).sum() for s in counts)
+    assert set(res.summary["drops"]["two_sample"]["0.2"]) == {
+        f"mujoco_vs_{s}" for s in ("overdamped", "inertial", "overdamped_facets", "inertial_facets")
+    }
+    # by one rule on both sides MuJoCo's slips over a crest (past the first, partly loaded
+    # fold) are the faceted inertial reference's
+    crest = (drops["force_drop_fp"] > 0.1) & (drops["start_x_lc"] > 1.5)
+    big = {s: drops.loc[crest & (drops["source"] == s), "size_lc"] for s in counts}
+    assert big["mujoco"].size >= 2
+    assert np.abs(big["mujoco"] / big["inertial_facets"].mean() - 1).max() < 0.1
+    assert big["inertial_facets"].mean() > 1.2 * big["overdamped_facets"].mean()
     regime = res.summary["regime"]  # the corrugation's Prandtl-Tomlinson fold, K* 0.47
     assert regime["K_star"] == pytest.approx(0.47, rel=0.05)
     # the swing reaches the median drop far above this study's I_e 1e-4, below the 1 F_p bound
@@ -126,6 +147,36 @@ def test_force_drop_rule_gives_mujoco_the_inertial_references_drops_on_a_corruga
     assert steady["mujoco"].size >= 2 and np.ptp(steady["inertial"]) < 1e-2
     assert np.abs(steady["mujoco"] / steady["inertial"].mean() - 1).max() < 0.1
     assert steady["inertial"].mean() > 1.2 * steady["overdamped"].mean()
+
+
+def test_drop_summary_puts_the_carriages_advance_back_at_a_fixed_carriage():
+    """An engine's drop is the reference's less ``k V T`` (its carriage moves during the
+    drop, the reference's does not): the raw drops differ, the drops at a fixed carriage are
+    the same sample (KS distance 0)."""
+    from spine_mj.validate.slip_catalog import TrackUnits
+    from spine_mj.validate.stickslip_outputs import drop_summary
+
+    rng = np.random.default_rng(0)
+    units = TrackUnits(1e-3, 4.0, 2.0, 0.01, 1.0, 1e-3, speed=0.02)
+    k_number, n = 1.0, 400
+    ref = 0.01 + rng.exponential(0.05, n)  # every drop deeper than k V T (under 0.01)
+    duration = rng.uniform(0.5, 1.0, n)
+    engine = ref - units.stiffness(k_number) * units.speed * duration
+    frame = pd.DataFrame(
+        {
+            "source": ["inertial"] * n + ["mujoco"] * n,
+            "K": k_number,
+            "size_lc": np.concatenate([ref, ref]),
+            "duration_s": np.concatenate([np.full(n, np.nan), duration]),
+            "force_drop_fp": np.concatenate([ref, engine]),
+        }
+    )
+    out = drop_summary(frame, "mujoco", [k_number], {k_number: units}, 1e-3)
+    test = out["two_sample"]["1"]["mujoco_vs_inertial"]
+    assert out["n_events"] == {"inertial": {"1": n}, "mujoco": {"1": n}}
+    assert test["size_lc"]["ks"] == 0.0
+    assert test["force_drop_fp"]["ks"] > 0.1 and not test["force_drop_fp"]["agree"]
+    assert test["force_drop_fixed_carriage_fp"]["ks"] < 2 / n  # equal up to rounding
 
 
 def test_the_faceted_landscape_is_the_height_fields_straight_pieces():
