@@ -32,6 +32,7 @@ from spine_mj.memory import check_memory
 from spine_mj.surfaces import GaussianSurface, GridSurface, Surface, check_grid_size
 
 __all__ = [
+    "PLANE_NOTE",
     "Roughness",
     "characteristic_length",
     "radial_psd",
@@ -49,6 +50,8 @@ _GAUSSIAN_SAMPLES_PER_SIGMA = 10
 #: (tests/test_memory.py); `surface info` on a 4096 x 4096 fractal peaked at 2.85 GB.
 SUMMARY_BYTES_PER_POINT = 150
 _PLANE_SLOPE_SPREAD = 1e-4  # slope spread below this fraction of the mean slope: a plane
+#: Why a plane has no slope correlation length (:attr:`Roughness.slope_correlation_note`).
+PLANE_NOTE = "surface has no slope variation (a plane): no slope correlation length"
 
 
 def characteristic_length(surface: Surface) -> float:
@@ -130,7 +133,7 @@ def slope_autocorrelation(surface: Surface) -> tuple[np.ndarray, np.ndarray]:
     gx, gy, dx, periodic = _gradient_grid(surface)
     spread = math.sqrt(gx.var() + gy.var())
     if spread <= _PLANE_SLOPE_SPREAD * max(math.hypot(gx.mean(), gy.mean()), 1e-300):
-        raise SpineInputError("surface has no slope variation (a plane): no slope correlation length")
+        raise SpineInputError(PLANE_NOTE)
     nx = gx.shape[1]
     size = nx if periodic else 2 * nx
     power = np.zeros(size // 2 + 1)
@@ -242,7 +245,8 @@ class Roughness:
         ``-(s + 2) / 2`` from the log-log slope ``s`` of the PSD over its middle decade(s)
         (``C ~ q^-(2H+2)``); NaN ("not estimated") when fewer than 4 rings are usable, or
         when the fit is no self-affine power law: H outside :data:`HURST_RANGE` or a fit
-        explaining less than :data:`MIN_HURST_FIT_R2` of the log PSD's variance.
+        explaining less than :data:`MIN_HURST_FIT_R2` of the log PSD's variance; NaN on a
+        plane (a tilted one's PSD is its edges' ``q^-3`` step, which read H 0.45).
     slope_correlation_note : str
         Why ``slope_correlation_length`` is NaN (a plane, or slopes correlated across the
         whole domain); empty when it was measured.
@@ -310,14 +314,17 @@ def summarize(surface: Surface) -> Roughness:
     grid = surface if isinstance(surface, GridSurface) else surface.sample(201)
     ny, nx = grid.shape
     dx, dy = grid.spacing
-    sizes = (nx * dx, ny * dy) if grid.periodic else ((nx - 1) * dx, (ny - 1) * dy)
-    topo = st.Topography(grid.heights.T, sizes, periodic=grid.periodic)
+    # SurfaceTopography's pixel is physical size / points, periodic or not: (nx - 1) dx
+    # made a 9-row strip's y slopes 9/8 too steep
+    topo = st.Topography(grid.heights.T, (nx * dx, ny * dy), periodic=grid.periodic)
     q, psd = radial_psd(grid)
     hurst, prefactor, fit_range = _hurst_fit(q, psd)
     try:
         l_s, note = slope_correlation_length(surface), ""
     except SpineInputError as exc:  # a plane: report what it has, and why it has no l_s
         l_s, note = math.nan, str(exc)
+    if note == PLANE_NOTE:
+        hurst, prefactor, fit_range = math.nan, math.nan, (math.nan, math.nan)
     return Roughness(
         unit=surface.unit,
         rms_height=float(topo.rms_height_from_area()),

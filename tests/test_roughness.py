@@ -148,3 +148,30 @@ def test_cli_surface_info_on_a_plane_reports_what_it_can(tmp_path):
     assert "l_s (slope correlation)  none: surface has no slope variation (a plane)" in result.output
     # no slope: no fold (K* 0), no crest, no trap; the lag 2 mu 0.1 sets I_e*
     assert "quasistatic needs K > 0 and I_e < 0.1 (set by lag" in result.output
+
+
+def test_a_tilted_plane_has_no_hurst_estimate(tmp_path):
+    """A plane at 20 deg: its PSD is the q^-3 of its edges' step, which the fit read as
+    H 0.45; a plane has no roughness spectrum, so no H, and `surface info` says why."""
+    from spine_mj.surface_io import save_surface
+
+    x = np.linspace(0, 4, 65)
+    tilted = GridSurface(heights=np.tan(np.radians(20)) * x[None, :] * np.ones((65, 1)), x=x, y=x.copy())
+    rough = roughness.summarize(tilted)
+    assert rough.slope_correlation_note == roughness.PLANE_NOTE
+    assert math.isnan(rough.hurst) and rough.rms_slope == pytest.approx(np.tan(np.radians(20)), rel=1e-6)
+    result = CliRunner().invoke(main, ["surface", "info", str(save_surface(tilted, tmp_path / "t.npz"))])
+    assert result.exit_code == 0, result.output
+    assert "Hurst estimate (PSD fit) not estimated (a plane)" in result.output
+
+
+def test_rms_slope_and_curvature_of_a_few_samples_are_the_closed_forms():
+    """A ramp 9 samples across (slope 0.5 along y) and a parabola: rms slope 0.5 and
+    curvature (Laplacian / 2) 1 exactly, on grids of few samples; SurfaceTopography's
+    pixel is size / points, periodic or not (given (n - 1) dx, the ramp read 9/8 of 0.5)."""
+    x, y = np.linspace(0, 50, 401), np.linspace(0, 1, 9)
+    ramp = GridSurface(heights=0.5 * y[:, None] * np.ones((1, 401)), x=x, y=y)
+    assert roughness.summarize(ramp).rms_slope == pytest.approx(0.5, rel=1e-9)
+    u = np.linspace(-1, 1, 11)
+    bowl = GridSurface(heights=(u[None, :] ** 2 + 0 * u[:, None]), x=u, y=u.copy())
+    assert roughness.summarize(bowl).rms_curvature == pytest.approx(1.0, rel=1e-9)

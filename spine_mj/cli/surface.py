@@ -133,7 +133,7 @@ def surface_info(surface_spec, output, as_json, mu, tip_radius):
     Example:
       spine-mj surface info example:plu-1.plu --mu 0.5 -o psd.png
     """
-    from spine_mj import presets
+    from spine_mj import presets, roughness
 
     if output:
         check_suffix(output, ".png", "-o/--output")
@@ -153,7 +153,8 @@ def surface_info(surface_spec, output, as_json, mu, tip_radius):
     l_s = rough.slope_correlation_length
     l_s_text = f"{l_s:.4g}{unit}" if math.isfinite(l_s) else f"none: {rough.slope_correlation_note}"
     click.echo(f"l_s (slope correlation)  {l_s_text}")
-    hurst = f"{rough.hurst:.3g}" if math.isfinite(rough.hurst) else "not estimated (the PSD is no power law)"
+    why = "a plane" if rough.slope_correlation_note == roughness.PLANE_NOTE else "the PSD is no power law"
+    hurst = f"{rough.hurst:.3g}" if math.isfinite(rough.hurst) else f"not estimated ({why})"
     click.echo(f"Hurst estimate (PSD fit) {hurst}")
     if limits is None:
         click.echo("drive limits             give --mu (no preset mu_s)")
