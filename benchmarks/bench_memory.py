@@ -4,7 +4,8 @@ Jobs (issue 36): ``simulate`` (one run), a sweep case (quasistatic + mujoco + co
 worker), ``validate --quick`` (the full bench only: it takes minutes), the dilation of an
 801 x 801 grid by a tip 110 samples wide, ``array``, and (issue 44) a 2048 x 2048 fractal
 made (predicted by ``fbm_bytes``: 288 MiB above the interpreter) and exported as a streamed
-STL. Each runs as the command a user
+STL, and one run in each engine on a 1448 x 1448 fractal (Bullet's heightfield takes about
+30 times MuJoCo's hfield: pybullet's rendering mesh). Each runs as the command a user
 types, in a temporary folder; its peak is the ``ru_maxrss`` that ``os.wait4`` returns for
 it: the largest resident set of the job's process or of any process it waited for (a
 sweep's workers). A job whose peak grew by more than :data:`GROWTH_LIMIT` against the
@@ -20,6 +21,8 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+
+from spine_mj import extras
 
 #: A peak more than this factor above the committed one is marked as grown.
 GROWTH_LIMIT = 1.2
@@ -74,6 +77,18 @@ def _jobs(quick: bool) -> dict[str, list[str]]:
         ],
         "fractal 2048^2 exported as STL (streamed)": [sys.executable, "-c", _STL],
     }
+    # issue 44: one run in each engine on a fractal of 1448 x 1448 samples, the most that
+    # pybullet's heightfield takes (Bullet's run on 2048 a side peaked at 6.8 GB before)
+    jobs["surface make paper-fractal nx=1448"] = [
+        *cli,
+        *("surface", "make", "paper-fractal", "--set", "nx=1448", "-o", "f1448.npz"),
+    ]
+    run = ["f1448.npz", "--start", "-5,0", "--mu", "1.25", "--duration", "0.05"]
+    for engine in ["mujoco"] + ([] if extras.missing("bullet") else ["bullet"]):
+        jobs[f"simulate on the fractal 1448^2 ({engine})"] = [
+            *cli,
+            *("simulate", *run, "--engine", engine, "--out", f"sim-{engine}"),
+        ]
     if not quick:
         jobs["validate --quick"] = [*cli, "validate", "--quick", "--out", "val"]
     return jobs

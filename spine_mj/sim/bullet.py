@@ -81,11 +81,40 @@ _NSENS = 20
 _NSTATE = 7  # time, position, velocity
 
 
-#: Bytes per hfield sample that pybullet's heightfield takes (its collision shape 1.2 kB,
-#: its body 0.8 kB, internal-edge flag or not; measured at 512 and 1024 a side): about 50
-#: times MuJoCo's hfield (40 B a sample), pybullet's own copies, not ours. The rig is
-#: refused before it is built when that passes the memory budget.
-BULLET_BYTES_PER_SAMPLE = 2100
+#: Bytes per hfield sample that building Bullet's heightfield adds at its peak, measured
+#: at 384 to 1024 a side (tests/test_memory.py): pybullet keeps every cell's two triangles
+#: as a rendering mesh (6 vertices of position, normal and uv in doubles, 0.58 kB a sample),
+#: and holds two copies of it while it makes the shape (1.16 kB); the float samples, their
+#: list and copies take the rest. The mesh is pybullet's own, made whatever the flags; its
+#: renderer's copy of it (0.33 kB more) is avoided by giving the body a visual shape.
+BULLET_BYTES_PER_SAMPLE = 1240
+#: Bytes a pybullet client takes before any shape (measured on a 64 x 64 heightfield).
+BULLET_CLIENT_BYTES = 40 * 2**20
+
+
+#: The most samples pybullet takes in one heightfield: its client copies the float32 heights
+#: through a stream buffer of 8 MiB (1 MiB on macOS), cuts longer data there, and its
+#: server then reads past the buffer: measured, 1024 x 2048 samples gave the heights given,
+#: 1024 x 2049 an AABB of +-2e12 that no ray hit, and a 2048 x 2048 fractal (1767 x 1767
+#: samples in the hfield) ended every run in engine trouble, the tip falling through.
+BULLET_MAX_SAMPLES = (2**20 if sys.platform == "darwin" else 2**23) // 4
+
+
+def check_bullet_samples(nrow: int, ncol: int) -> None:
+    """Refuse a heightfield of more than :data:`BULLET_MAX_SAMPLES` samples in one line."""
+    if nrow * ncol > BULLET_MAX_SAMPLES:
+        side = math.isqrt(BULLET_MAX_SAMPLES)
+        raise SpineInputError(
+            f"Bullet's heightfield of {nrow} x {ncol} samples is more than pybullet takes, "
+            f"{BULLET_MAX_SAMPLES:,} (its upload buffer; beyond it the heights it reads are "
+            f"garbage and the tip falls through): use a coarser grid, at most {side} samples a side"
+        )
+
+
+def bullet_heightfield_bytes(nrow: int, ncol: int) -> float:
+    """The peak memory that Bullet's heightfield of ``nrow x ncol`` samples adds (its
+    client, and :data:`BULLET_BYTES_PER_SAMPLE` a sample)."""
+    return BULLET_CLIENT_BYTES + BULLET_BYTES_PER_SAMPLE * float(nrow) * ncol
 
 
 class BulletRig:
@@ -135,8 +164,9 @@ class BulletRig:
                 f"timestep_s must be at least {MIN_TIMESTEP_TAU:g} of the time scale tau = "
                 f"{self.scales.time_s:.3g} s, or none (derived), got {self.engine.timestep_s:.3g}"
             )
+        check_bullet_samples(self.hfield.nrow, self.hfield.ncol)
         check_memory(
-            BULLET_BYTES_PER_SAMPLE * self.hfield.nrow * self.hfield.ncol,
+            bullet_heightfield_bytes(self.hfield.nrow, self.hfield.ncol),
             where=f"Bullet's heightfield of {self.hfield.nrow} x {self.hfield.ncol} samples",
         )
         xmin, xmax, ymin, ymax = surface.bounds
@@ -368,21 +398,31 @@ class _World:
         dx, dy = 2 * rx * s / (hf.ncol - 1), 2 * ry * s / (hf.nrow - 1)
         # Bullet splits each cell from (x+1, y) to (x, y+1) of its own grid; its local x is
         # world y and its local y world -x, which makes that MuJoCo's (x, y) to (x+1, y+1)
-        local = heights[:, ::-1].T
+        centre = [hf.pos[0] * s, hf.pos[1] * s, 0.5 * (heights.min() + heights.max())]
+        data = heights[:, ::-1].T.ravel().tolist()  # pybullet reads a sequence of floats
+        del heights  # only the list while pybullet builds the shape (its peak)
         flags = pb.GEOM_CONCAVE_INTERNAL_EDGE if rig.engine.internal_edges else 0
         shape = pb.createCollisionShape(
             pb.GEOM_HEIGHTFIELD,
             flags=flags,
             meshScale=[dy, dx, 1.0],
-            heightfieldData=local.ravel().tolist(),
+            heightfieldData=data,
             numHeightfieldRows=hf.nrow,
             numHeightfieldColumns=hf.ncol,
             physicsClientId=self.cid,
         )
-        centre = [hf.pos[0] * s, hf.pos[1] * s, 0.5 * (heights.min() + heights.max())]
+        del data
         quarter = pb.getQuaternionFromEuler([0.0, 0.0, math.pi / 2])
+        # a body without a visual shape gets its collision triangles copied into pybullet's
+        # renderer (0.33 kB a sample, measured at 2048 a side); a point's visual holds none
+        unseen = pb.createVisualShape(pb.GEOM_SPHERE, radius=1e-9, physicsClientId=self.cid)
         body = pb.createMultiBody(
-            0, shape, basePosition=centre, baseOrientation=quarter, physicsClientId=self.cid
+            0,
+            shape,
+            baseVisualShapeIndex=unseen,
+            basePosition=centre,
+            baseOrientation=quarter,
+            physicsClientId=self.cid,
         )
         pb.changeDynamics(
             body,

@@ -417,3 +417,42 @@ def test_pybullet_s_build_banner_does_not_reach_the_user(tmp_path):
     code = "from spine_mj.sim.bullet import _pybullet; _pybullet(); print('ours')"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout == "ours\n" and "build time" not in out.stderr
+
+
+def test_a_heightfield_past_pybullet_s_upload_buffer_is_refused_in_one_line(tmp_path):
+    """pybullet copies a heightfield's float32 heights through an 8 MiB buffer and reads
+    garbage past it (a 2048 x 2048 fractal's 1767 x 1767 hfield: every run fell through):
+    1024 x 2048 samples pass, one more column is refused, naming the user's grid, before
+    the client is built; in a sweep, before the first run."""
+    from spine_mj import presets
+    from spine_mj.sim.bullet import BULLET_MAX_SAMPLES, check_bullet_samples
+
+    if sys.platform != "darwin":
+        assert BULLET_MAX_SAMPLES == 1024 * 2048
+    check_bullet_samples(1, BULLET_MAX_SAMPLES)
+    with pytest.raises(SpineInputError, match="of 1 x 2097153 samples is more than pybullet takes"):
+        check_bullet_samples(1, BULLET_MAX_SAMPLES + 1)
+    side = math.isqrt(BULLET_MAX_SAMPLES) + 1
+    surf = presets.make_surface("paper-single-peak")
+    refused = rf"^Bullet's heightfield of {side} x {side} samples .* at most"
+    with pytest.raises(SpineInputError, match=refused):
+        sim.build_rig(surf, engine="bullet", mu=1.0, hfield_resolution=side)
+    cfg = write_config(
+        tmp_path,
+        f"""
+        [sweep]
+        analyses = ["engine"]
+        [[surfaces]]
+        preset = "paper-single-peak"
+        [starts]
+        x = [0.05]
+        y = [0.5]
+        [grid]
+        engine = "bullet"
+        hfield_resolution = [41, {side}]
+        """,
+    )
+    res = CliRunner().invoke(main, ["sweep", str(cfg), "--out", str(tmp_path / "runs"), "--quiet"])
+    assert res.exit_code == 2 and res.output.count("\n") == 1, res.output
+    assert f"Bullet's heightfield of {side} x {side} samples" in res.output
+    assert not (tmp_path / "runs").exists()
