@@ -77,6 +77,9 @@ _LEVEL_COST = {"timestep_factor": lambda f: 1.0 / f, "hfield_refinement": lambda
 #: or more paired starts); fewer run, and are reported, but leave the verdict unconverged.
 MIN_PAIRED_STARTS = 30
 
+#: Rounds of starts added where too few paired well-conditioned ones are left (:func:`_more_starts`).
+POWER_ROUNDS = 2
+
 #: Starts (whole ensembles) per sweep case: the cases keep the workers busy.
 _CASE_STARTS = 12
 
@@ -156,53 +159,149 @@ def hold_to(
     """
     from spine_mj.atomic import all_or_none, writable_path
     from spine_mj.surface_io import save_surface
+    from spine_mj.validate.report.hold import write_hold
 
     t0 = time.perf_counter()
     out = Path(out_dir).absolute()
     tip, lc, places, limits, corner = _corner(surface, settings)
-    mj_starts = places[: settings.starts]
     runner = StudyRunner(out, workers, progress, t0)
     runner.study = "hold"
     held, share = _self_lock_share(runner, surface, places, tip, settings.mu)
-    base_grid = {"mu": settings.mu, "tip_radius": tip, "dl": tip / 2}
-    drive = {"protocol": "spring", "ie": corner.ie, "K": corner.k}
-    table = {"frame": "absolute", "points": [tuple(map(float, p)) for p in mj_starts]}
-    surface_file = out / "surface.npz"
-    doc = _doc(
-        "hold-base",
-        surface_file,
-        ensemble_starts(table, settings.members, (ENSEMBLE_RADIUS_LC * lc,) * 2),
-        drive,
-        {**base_grid, "ensemble_members": settings.members},
-        settings.members,
+    batches = _Batches(
+        runner,
+        out / "surface.npz",
+        {"protocol": "spring", "ie": corner.ie, "K": corner.k},
+        {"mu": settings.mu, "tip_radius": tip, "dl": tip / 2},
+        (ENSEMBLE_RADIUS_LC * lc,) * 2,
+        [places[: settings.starts]],
     )
-    started = time.perf_counter()
     with _undone_on_refusal(out):
         writable_path(out / "summary.json")
-        save_surface(surface, surface_file)
-        df, store = runner(doc, "base")
-    base_s = time.perf_counter() - started
-    groups = ensemble_groups(df, store, settings.members)
-    verdicts = ensemble_verdicts(groups)
-    base = _rows(df, settings.members)
-    base["well_conditioned"] = [
-        verdicts["well_conditioned"].get(f"{c}/{int(s)}", False)
-        for c, s in zip(base["case_id"], base["start"])
-    ]
-    summ = _headlines(base, verdicts)
-    levels, converged, why = _refine(
-        runner,
-        summ,
-        base,
-        lambda name, grid: _doc(name, surface_file, table, drive, {**base_grid, **grid}, 1),
-        budget_left=settings.budget_s - (time.perf_counter() - t0),
-        base_s=base_s / settings.members,
+        save_surface(surface, batches.surface_file)
+        base = batches.base(settings.members)
+    while True:
+        judged = _judge(batches, base, settings, budget_left=settings.budget_s - (time.perf_counter() - t0))
+        n_run = batches.starts()
+        add, note = _more_starts(
+            judged["paired"],
+            n_run,
+            len(places),
+            settings.budget_s - (time.perf_counter() - t0),
+            (time.perf_counter() - base["started"]) / max(len(batches.points[-1]), 1),
+        )
+        if judged["converged"] or add == 0 or len(batches.points) > POWER_ROUNDS:
+            why = "; ".join(w for w in (judged["why"], note) if w)
+            break
+        batches.points.append(places[n_run : n_run + add])
+        base = batches.base(settings.members)
+    summ, verdicts, levels = judged["summ"], judged["verdicts"], judged["levels"]
+    summary = _summary(
+        label, settings, corner, limits, tip, share, summ, verdicts, levels, judged["converged"], why
     )
-    summary = _summary(label, settings, corner, limits, tip, share, summ, verdicts, levels, converged, why)
-    summary["timings_s"] = {"total": time.perf_counter() - t0, "base_level": base_s}
+    summary["mujoco_starts"] = {
+        "run": n_run,
+        "asked": settings.starts,
+        "added_rounds": len(batches.points) - 1,
+    }
+    summary["timings_s"] = {"total": time.perf_counter() - t0, "base_level": base["seconds"]}
     with all_or_none(out / "summary.json", out / "report.md", out / "hold.png"):
-        _write(out, summary, surface, places, held, mj_starts)
+        write_hold(out, summary, surface, places, held, places[:n_run])
     return summary
+
+
+@dataclasses.dataclass
+class _Batches:
+    """The hold's sweeps over its batches of MuJoCo starts: the starts asked for, then each
+    round of added ones (:func:`_more_starts`), each batch its own store (resumed where it
+    ran), the run tables concatenated."""
+
+    runner: StudyRunner
+    surface_file: Path
+    drive: dict
+    grid: dict
+    radius: tuple
+    points: list
+
+    def starts(self) -> int:
+        return sum(len(p) for p in self.points)
+
+    def run(self, name: str, grid: dict, members: int, key: str) -> list:
+        """``[(df, store)]`` of the sweep ``name`` (``grid`` over the base's) on each batch,
+        stored under ``sweeps/<key>`` (the first batch) and ``sweeps/<key>-<n>``."""
+        jobs = [
+            (
+                _doc(
+                    name,
+                    self.surface_file,
+                    _ensembles(pts, members, self.radius),
+                    self.drive,
+                    {**self.grid, **grid},
+                    members,
+                ),
+                key if b == 0 else f"{key}-{b + 1}",
+            )
+            for b, pts in enumerate(self.points)
+        ]
+        return self.runner.many(jobs, key)
+
+    def base(self, members: int) -> dict:
+        """The corner's ensembles on every batch, with when it started and its seconds."""
+        started = time.perf_counter()
+        ran = self.run("hold-base", {"ensemble_members": members}, members, "base")
+        return {"ran": ran, "started": started, "seconds": time.perf_counter() - started}
+
+    def level(self, key: str, grid: dict) -> pd.DataFrame:
+        """A refinement level's run table: one run a start, every batch."""
+        return pd.concat([df for df, _ in self.run(f"hold-{key}", grid, 1, key)], ignore_index=True)
+
+
+def _judge(batches: _Batches, base: dict, settings: HoldSettings, *, budget_left: float) -> dict:
+    """One round's verdict: the corner's headlines over the well-conditioned ensembles, and
+    the refinement ladders climbed on the same starts (:func:`_refine`)."""
+    ran, members = base["ran"], settings.members
+    verdicts = ensemble_verdicts([g for df, st in ran for g in ensemble_groups(df, st, members)])
+    rows = pd.concat([_rows(df, members) for df, _ in ran], ignore_index=True)
+    rows["well_conditioned"] = [
+        verdicts["well_conditioned"].get(f"{c}/{int(s)}", False)
+        for c, s in zip(rows["case_id"], rows["start"])
+    ]
+    summ = _headlines(rows, verdicts)
+    levels, converged, why, paired = _refine(
+        batches.level, summ, rows, budget_left=budget_left, base_s=base["seconds"] / members
+    )
+    return {
+        "summ": summ,
+        "verdicts": verdicts,
+        "levels": levels,
+        "converged": converged,
+        "why": why,
+        "paired": paired,
+    }
+
+
+def _ensembles(points, members: int, radius) -> dict:
+    """The starts table of ``points``, each the first of an ensemble of ``members``."""
+    table = {"frame": "absolute", "points": [tuple(map(float, p)) for p in points]}
+    return ensemble_starts(table, members, radius) if members > 1 else table
+
+
+def _more_starts(paired: int, n_run: int, n_places: int, budget_left: float, per_start_s: float):
+    """``(starts to add, note)`` where fewer than :data:`MIN_PAIRED_STARTS` paired
+    well-conditioned starts are left (stalled references, watersheds): enough more, at the
+    yield so far and a quarter over, that the next round reaches them; 0 with the reason
+    where the places or the budget (``per_start_s`` each, every level) do not allow."""
+    if paired >= MIN_PAIRED_STARTS:
+        return 0, ""
+    want = math.ceil(MIN_PAIRED_STARTS * 1.25 * n_run / max(paired, 1)) - n_run
+    want = min(want, n_run, n_places - n_run)
+    if want <= 0:
+        return 0, f"no more places to add starts from (--reference-starts {n_places})"
+    if want * per_start_s > budget_left:
+        return 0, (
+            f"{want} more starts would take {want * per_start_s:.0f} s, past the budget "
+            f"({budget_left:.0f} s left)"
+        )
+    return want, ""
 
 
 @contextlib.contextmanager
@@ -329,12 +428,14 @@ def _headlines(rows: pd.DataFrame, verdicts: dict) -> dict:
     }
 
 
-def _refine(runner, summ: dict, base: pd.DataFrame, make_doc, *, budget_left: float, base_s: float):
-    """Climb each ladder of :data:`LADDERS` until its last change is inside the intervals.
+def _refine(run_level, summ: dict, base: pd.DataFrame, *, budget_left: float, base_s: float):
+    """Climb each ladder of :data:`LADDERS` until its last change is inside the intervals;
+    ``run_level(key, grid)`` gives a level's run table.
 
-    Returns ``(levels, converged, why)``: one entry per level run or skipped (key, label,
-    runs, per headline its base, refined and change, ``converged``), whether every axis
-    converged, and what left it unconverged (empty when converged)."""
+    Returns ``(levels, converged, why, paired)``: one entry per level run or skipped (key,
+    label, runs, per headline its base, refined and change, ``converged``), whether every
+    axis converged, what left it unconverged (empty when converged), and the fewest paired
+    well-conditioned starts of a level run."""
     levels, reasons = [], []
     wc = base[["start_x", "start_y", "well_conditioned"]]
     for ladder in LADDERS.values():
@@ -348,7 +449,7 @@ def _refine(runner, summ: dict, base: pd.DataFrame, make_doc, *, budget_left: fl
                 )
                 break
             started = time.perf_counter()
-            df, _ = runner(make_doc(f"hold-{key}", grid), key)
+            df = run_level(key, grid)
             budget_left -= time.perf_counter() - started
             rows = _rows(df, 1).merge(wc, on=["start_x", "start_y"], how="left")
             rows["well_conditioned"] = rows["well_conditioned"].fillna(False).astype(bool)
@@ -372,7 +473,7 @@ def _refine(runner, summ: dict, base: pd.DataFrame, make_doc, *, budget_left: fl
             f"{paired} paired well-conditioned starts, fewer than the {MIN_PAIRED_STARTS} a verdict needs"
             + (f" (references stalled, no quasistatic answer: {', '.join(stalled)})" if stalled else "")
         )
-    return levels, not reasons, "; ".join(reasons)
+    return levels, not reasons, "; ".join(reasons), paired
 
 
 def _level(
@@ -471,82 +572,3 @@ def verdict_sentence(s: dict) -> str:
     if s["converged"]:
         return f"{hold.capitalize()}; {check}, converged under {', '.join(run)}."
     return f"{hold.capitalize()}; {check}, not converged: {s['why_unconverged']}."
-
-
-def _write(out: Path, summary: dict, surface, places, held, mj_starts) -> None:
-    from spine_mj.jsonio import write_json
-    from spine_mj.plotting import save_figure, styled
-
-    save_figure(styled(_figure)(surface, places, held, mj_starts, summary), out / "hold.png")
-    write_json(out / "summary.json", summary)
-    (out / "report.md").write_text(_report(summary))
-
-
-def _report(s: dict) -> str:
-    sh, ag, c, mf = s["self_lock_share"], s["agreement"], s["corner"], s["median_frechet"]
-    lines = [
-        f"# Will a spine hold on {s['surface']}?",
-        "",
-        s["verdict"],
-        "",
-        "![places and refinement](hold.png)",
-        "",
-        "| quantity | value | 95 % interval | n |",
-        "|---|---|---|---|",
-        f"| self-lock share (quasistatic) | {sh['value']:.3f} | [{sh['low']:.3f}, {sh['high']:.3f}] "
-        f"| {sh['n']} |",
-        f"| agreement (well-conditioned) | {ag['value']:.3f} | [{ag['low']:.3f}, {ag['high']:.3f}] "
-        f"| {ag['n_well_conditioned']} |",
-        f"| median Frechet [L_c] | {mf['value']:.3g} | [{mf['low']:.3g}, {mf['high']:.3g}] "
-        f"| {ag['starts']} |",
-        "",
-        f"Corner: {c['reason']}. Tip radius {s['tip_radius']:.3g} (surface units), mu_s {s['mu']:g}.",
-        "",
-        "| refinement | from | paired starts | agreement change | median Frechet change | converged |",
-        "|---|---|---|---|---|---|",
-    ]
-    for r in s["refinements"]:
-        if r["run"]:
-            lines.append(
-                f"| {r['level']} | {r['from']} | {r['runs']} | {r['change']:+.3f} "
-                f"| {r['median_frechet_change']:+.3g} | {'yes' if r['converged'] else 'no'} |"
-            )
-        else:
-            lines.append(f"| {r['level']} | | | not run: {r['note']} | | |")
-    return "\n".join(lines) + "\n"
-
-
-def _figure(surface, places, held, mujoco_starts, summary: dict, *, max_points: int = 300):
-    """``spine-mj hold``'s figure: the places traced on the height map (held: crosses, free:
-    dots; the MuJoCo starts ringed), and the agreement of each refinement level on its
-    paired starts against the corner's own 95 % interval (shaded)."""
-    from spine_mj import plotting as pl
-
-    grid = pl._display_grid(surface, max_points)
-    units = pl._axes_units(surface, grid)
-    lf = units[0]
-    fig = pl.new_figure(figsize=(12, 4.5), layout="constrained")
-    ax, bx = fig.add_subplot(1, 2, 1), fig.add_subplot(1, 2, 2)
-    pl._height_map(fig, ax, grid, units)
-    places, held = np.asarray(places, float) * lf, np.asarray(held, bool)
-    ax.plot(*places[~held].T, ".", ms=3, color="#cccccc", label="free")
-    ax.plot(*places[held].T, "x", ms=5, color=pl.PATH_COLORS["mujoco"], label="held (quasistatic)")
-    ring = np.asarray(mujoco_starts, float) * lf
-    ax.plot(*ring.T, "o", mfc="none", ms=7, color=pl.PATH_COLORS["facets"], label="MuJoCo starts")
-    ax.legend(loc="upper right", fontsize="small")
-    share = summary["self_lock_share"]
-    ax.set_title(f"held from {share['value']:.1%} of {share['n']} places")
-    ag = summary["agreement"]
-    labels, values = ["corner"], [ag["value"]]
-    for r in summary["refinements"]:
-        if r.get("run"):
-            labels.append(r["level"])
-            values.append(values[labels.index(r["from"]) if r["from"] in labels else 0] + r["change"])
-    bx.axhspan(ag["low"], ag["high"], color="#dddddd", label="corner's 95 % interval")
-    bx.plot(range(len(values)), values, "o-", color=pl.SERIES_COLORS[0], label="agreement")
-    bx.set_xticks(range(len(values)), labels, rotation=20)
-    bx.set_ylim(min(0.0, min(values)) - 0.02, 1.02)
-    bx.set_ylabel("agreement (well-conditioned starts)")
-    bx.set_title("converged" if summary["converged"] else "not converged")
-    bx.legend(loc="lower left", fontsize="small")
-    return fig

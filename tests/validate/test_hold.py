@@ -23,7 +23,8 @@ class _Killed(Exception):
 @pytest.mark.slow
 def test_a_killed_hold_resumes_from_its_stores_and_writes_every_key(tmp_path):
     """Killed as its first refinement starts, a hold leaves no summary; run again (from
-    the CLI), it reruns none of its corner's MuJoCo cases and writes the summary's keys."""
+    the CLI), it reruns none of its corner's MuJoCo cases, adds starts where too few are
+    paired, and writes the summary's keys."""
     path = save_surface(single_gaussian(), tmp_path / "bump.npz")
     out = tmp_path / "hold"
 
@@ -31,7 +32,7 @@ def test_a_killed_hold_resumes_from_its_stores_and_writes_every_key(tmp_path):
         if p.step == "dt_halved":
             raise _Killed
 
-    settings = HoldSettings(mu=0.8, starts=2, reference_starts=12)
+    settings = HoldSettings(mu=0.8, starts=2, reference_starts=4)
     with pytest.raises(_Killed):
         hold_to(single_gaussian(), out, settings, workers=1, progress=kill)
     assert not (out / "summary.json").exists() and not (out / "report.md").exists()
@@ -39,13 +40,13 @@ def test_a_killed_hold_resumes_from_its_stores_and_writes_every_key(tmp_path):
     assert len(base) >= 2
     stamps = {p: p.stat().st_mtime_ns for p in base}
 
-    args = ["hold", str(path), "--mu", "0.8", "--out", str(out), "--starts", "2", "--reference-starts", "12"]
+    args = ["hold", str(path), "--mu", "0.8", "--out", str(out), "--starts", "2", "--reference-starts", "4"]
     res = CliRunner().invoke(main, [*args, "--workers", "1", "--quiet"])
     assert res.exit_code == 0, res.output
     assert {p: p.stat().st_mtime_ns for p in base} == stamps  # the corner's cases were not run again
     s = json.loads((out / "summary.json").read_text())
     assert set(s["corner"]) >= {"ie", "K"} and s["corner"]["ie"] > 0 and s["corner"]["K"] > 0
-    assert set(s["self_lock_share"]) >= {"value", "low", "high", "n"} and s["self_lock_share"]["n"] == 12
+    assert set(s["self_lock_share"]) >= {"value", "low", "high", "n"} and s["self_lock_share"]["n"] == 4
     assert set(s["agreement"]) >= {"value", "low", "high", "n_well_conditioned"}
     share = s["self_lock_share"]
     assert share["low"] <= share["value"] <= share["high"]
@@ -55,12 +56,28 @@ def test_a_killed_hold_resumes_from_its_stores_and_writes_every_key(tmp_path):
         for r in s["refinements"]
         if r["run"]
     )
-    # two starts cannot make a verdict: the rule asks for 30 paired ones
+    # two starts cannot make a verdict: the rule asks for 30 paired ones; the hold adds
+    # starts from its places (at most doubling a round) until none are left
     assert s["converged"] is False and f"fewer than the {MIN_PAIRED_STARTS}" in s["why_unconverged"]
+    assert s["mujoco_starts"] == {"run": 4, "asked": 2, "added_rounds": 1}
+    assert s["agreement"]["starts"] == 4 and "no more places" in s["why_unconverged"]
     assert s["verdict"] in res.output and s["verdict"].endswith(".")
     assert (out / "report.md").read_text().startswith("# Will a spine hold") and (
         out / "hold.png"
     ).stat().st_size
+
+
+def test_starts_are_added_at_the_yield_so_far_until_30_paired_or_the_budget_says_no():
+    from spine_mj.validate.hold import _more_starts
+
+    assert _more_starts(30, 40, 400, 1e9, 1.0) == (0, "")
+    # 27 of 40 paired: 40 * 1.25 * 30 / 27 = 55.6 -> 16 more
+    assert _more_starts(27, 40, 400, 1e9, 1.0) == (16, "")
+    assert _more_starts(0, 40, 400, 1e9, 1.0)[0] == 40  # at most doubling a round
+    assert _more_starts(27, 40, 45, 1e9, 1.0)[0] == 5  # the places left
+    add, why = _more_starts(27, 40, 400, 100.0, 10.0)
+    assert add == 0 and why == "16 more starts would take 160 s, past the budget (100 s left)"
+    assert _more_starts(27, 40, 40, 1e9, 1.0) == (0, "no more places to add starts from (--reference-starts 40)")
 
 
 @pytest.mark.parametrize(
