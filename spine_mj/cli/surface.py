@@ -7,7 +7,7 @@ import math
 
 import click
 
-from spine_mj.cli.app import _Group, check_suffix, main, refuse_options_not_for
+from spine_mj.cli.app import PREPARATION_DELAY_S, Progress, _Group, check_suffix, main, refuse_options_not_for
 from spine_mj.errors import SpineInputError
 
 
@@ -140,7 +140,14 @@ def surface_info(surface_spec, output, as_json, mu, tip_radius):
     surf = presets.open_surface(surface_spec)
     if mu is None and presets.preset_mu(surf) is None:  # no drive limits: nothing uses the tip
         refuse_options_not_for("surface info without a mu_s (no --mu, no preset's)", ["tip_radius"])
-    info = presets.surface_info(surf, mu=mu, tip_radius=tip_radius, psd_png=output)
+    with Progress("preparing", delay_s=PREPARATION_DELAY_S) as bar:
+
+        def stage(done, total, name):
+            bar.update(done, total, name)
+            if done >= total:  # a stage's bar closes when it is done
+                bar.close()
+
+        info = presets.surface_info(surf, mu=mu, tip_radius=tip_radius, psd_png=output, progress=stage)
     if as_json:
         click.echo(json.dumps(info.as_dict(), indent=2))
         return

@@ -4,7 +4,14 @@ from __future__ import annotations
 
 import click
 
-from spine_mj.cli.app import Progress, check_suffix, main, parse_start, refuse_options_not_for
+from spine_mj.cli.app import (
+    PREPARATION_DELAY_S,
+    Progress,
+    check_suffix,
+    main,
+    parse_start,
+    refuse_options_not_for,
+)
 
 
 @main.command("kappa")
@@ -83,7 +90,10 @@ def streamline_cmd(surface_spec, mu, starts, dl, tip_radius, fmt, out_dir):
     surf = presets.open_surface(surface_spec)
     mu = presets.resolve_mu(surf, mu, name="--mu")
     tip_radius = resolve_tip_radius(surf, tip_radius, name="--tip-radius")
-    run, written = streamline_to(out_dir, surf, pts, mu=mu, fmt=fmt, dl=dl, tip_radius=tip_radius)
+    with Progress("dilating by the tip", unit="row", delay_s=PREPARATION_DELAY_S) as bar:
+        run, written = streamline_to(
+            out_dir, surf, pts, mu=mu, fmt=fmt, dl=dl, tip_radius=tip_radius, progress=bar.update
+        )
     for line in run.summary_lines():
         click.echo(line)
     click.echo(f"wrote {written[0]} and {written[1]}")

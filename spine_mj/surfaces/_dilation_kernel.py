@@ -19,7 +19,7 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["ball_dilation"]
+__all__ = ["ball_rows", "footprint_rows"]
 
 
 @njit(cache=True)
@@ -69,15 +69,20 @@ def _line(f, n, dx, r, out, v, z):
         out[i] = f[v[k]] + math.sqrt(max(r2 - u * u, 0.0))
 
 
-@njit(cache=True)
-def ball_dilation(heights, radius, dx, dy, wrap):
-    """``max_{u^2 + v^2 <= R^2} f(x + u, y + v) + sqrt(R^2 - u^2 - v^2) - R`` at every
-    sample; beyond the edges the grid wraps (``wrap``) or repeats its edge values (the
-    nearest copy of a sample always dominates the farther ones, so only in-range samples,
-    or one period's, are visited)."""
-    ny, nx = heights.shape
+def footprint_rows(radius, dy, ny, wrap):
+    """The footprint's rows ``k = 0 .. n - 1`` (each ``+-k dy``) that :func:`ball_rows` visits."""
     kmax = int(math.floor(radius / dy))
-    kmax = min(kmax, ny // 2) if wrap else min(kmax, ny - 1)
+    return (min(kmax, ny // 2) if wrap else min(kmax, ny - 1)) + 1
+
+
+@njit(cache=True)
+def ball_rows(heights, radius, dx, dy, wrap, k0, k1, out):
+    """``out = max(out, max_{k0 <= |k| < k1} D_{r_k}[f](x, y + k dy))``: the footprint's
+    rows ``k0 .. k1 - 1`` of ``max_{u^2 + v^2 <= R^2} f(x + u, y + v) + sqrt(R^2 - u^2 -
+    v^2)`` at every sample, accumulated into ``out``; beyond the edges the grid wraps
+    (``wrap``) or repeats its edge values (the nearest copy of a sample always dominates
+    the farther ones, so only in-range samples, or one period's, are visited)."""
+    ny, nx = heights.shape
     pmax = min(int(math.floor(radius / dx)), nx // 2) if wrap else 0
     m = nx + 2 * pmax
     line = np.empty(m)
@@ -85,8 +90,7 @@ def ball_dilation(heights, radius, dx, dy, wrap):
     v = np.empty(m, dtype=np.int64)
     z = np.empty(m + 1)
     rows = np.empty((ny, nx))
-    out = np.full((ny, nx), -np.inf)
-    for k in range(kmax + 1):
+    for k in range(k0, k1):
         r = math.sqrt(max(radius * radius - (k * dy) ** 2, 0.0))
         for s in range(ny):
             for i in range(m):
@@ -106,7 +110,3 @@ def ball_dilation(heights, radius, dx, dy, wrap):
                 for i in range(nx):
                     if rows[s, i] > out[t, i]:
                         out[t, i] = rows[s, i]
-    for t in range(ny):
-        for i in range(nx):
-            out[t, i] -= radius
-    return out

@@ -13,6 +13,7 @@ memory grows with grid points x footprint.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 
@@ -23,6 +24,9 @@ from spine_mj.surfaces.facets import TriangulatedSurface
 from spine_mj.surfaces.types import GridSurface, Surface
 
 __all__ = ["ball_dilation", "ball_dilation_reference", "dilate"]
+
+#: A dilation's progress callback: ``(rows of the footprint done, rows in all)``.
+Progress = Callable[[int, int], None]
 
 # arrays of the grid's size ball_dilation holds at once: the input, the result, one row pass
 _GRID_ARRAYS = 3
@@ -56,7 +60,9 @@ def _check_footprint(radius: float, dx: float, dy: float) -> None:
     )
 
 
-def ball_dilation(heights, radius: float, *, spacing, periodic: bool = False) -> np.ndarray:
+def ball_dilation(
+    heights, radius: float, *, spacing, periodic: bool = False, progress: Progress | None = None
+) -> np.ndarray:
     """Grey-scale dilation of sampled heights by a ball of radius R, shifted down by R.
 
     ``g[i, j] = max f[i + k, j + m] + sqrt(R^2 - (m dx)^2 - (k dy)^2) - R`` over the samples
@@ -75,6 +81,9 @@ def ball_dilation(heights, radius: float, *, spacing, periodic: bool = False) ->
     periodic : bool
         Wrap around the edges; otherwise beyond an edge the edge values repeat
         (``scipy.ndimage``'s ``mode="nearest"``).
+    progress : callable, optional
+        Hears ``(done, total)`` after each row of the footprint (a pass over the grid: a
+        2048 x 2048 grid by a tip 51 rows wide took 14 CPU-s).
 
     Returns
     -------
@@ -92,9 +101,17 @@ def ball_dilation(heights, radius: float, *, spacing, periodic: bool = False) ->
         return h.copy()
     _check_footprint(radius, dx, dy)
     check_memory(_GRID_ARRAYS * h.nbytes, where=f"dilating a {h.shape[0]} x {h.shape[1]} grid by a tip")
-    from spine_mj.surfaces._dilation_kernel import ball_dilation as kernel
+    from spine_mj.surfaces._dilation_kernel import ball_rows, footprint_rows
 
-    return kernel(np.ascontiguousarray(h), radius, dx, dy, bool(periodic))
+    h = np.ascontiguousarray(h)
+    out = np.full(h.shape, -np.inf)
+    n = footprint_rows(radius, dy, h.shape[0], bool(periodic))
+    for k in range(n):
+        ball_rows(h, radius, dx, dy, bool(periodic), k, k + 1, out)
+        if progress is not None:
+            progress(k + 1, n)
+    out -= radius
+    return out
 
 
 def ball_dilation_reference(heights, radius: float, *, spacing, periodic: bool = False) -> np.ndarray:
@@ -131,7 +148,9 @@ def ball_dilation_reference(heights, radius: float, *, spacing, periodic: bool =
     )
 
 
-def dilate(surface: Surface, radius: float, *, spacing: float | None = None) -> GridSurface:
+def dilate(
+    surface: Surface, radius: float, *, spacing: float | None = None, progress: Progress | None = None
+) -> GridSurface:
     """Surface traced by a spherical tip of radius R, shifted down by R (R -> 0: the surface).
 
     ``g(x, y) = max_{u^2 + v^2 <= R^2} [f(x + u, y + v) + sqrt(R^2 - u^2 - v^2)] - R`` is the
@@ -150,6 +169,8 @@ def dilate(surface: Surface, radius: float, *, spacing: float | None = None) -> 
         Tip radius R >= 0 in the surface's length unit; 0 returns the sampled surface.
     spacing : float, optional
         Sample spacing; defaults to ``min(R / 8, extent / 400)`` for analytic surfaces.
+    progress : callable, optional
+        Hears ``(done, total)`` through the dilation (:func:`ball_dilation`).
 
     Returns
     -------
@@ -173,7 +194,9 @@ def dilate(surface: Surface, radius: float, *, spacing: float | None = None) -> 
     dx, dy = grid.spacing
     _check_footprint(radius, dx, dy)
     if grid.periodic or isinstance(surface, (GridSurface, TriangulatedSurface)):
-        heights = ball_dilation(grid.heights, radius, spacing=(dx, dy), periodic=grid.periodic)
+        heights = ball_dilation(
+            grid.heights, radius, spacing=(dx, dy), periodic=grid.periodic, progress=progress
+        )
     else:
         # an analytic surface: sample a margin of R outside so the edge sees the true neighbourhood
         rx, ry = int(math.floor(radius / dx)), int(math.floor(radius / dy))
@@ -183,7 +206,8 @@ def dilate(surface: Surface, radius: float, *, spacing: float | None = None) -> 
         xw = grid.x[0] + dx * np.arange(-rx, grid.x.size + rx)
         yw = grid.y[0] + dy * np.arange(-ry, grid.y.size + ry)
         wide = surface.height(xw[None, :], yw[:, None])
-        heights = ball_dilation(wide, radius, spacing=(dx, dy))[ry : ry + grid.y.size, rx : rx + grid.x.size]
+        heights = ball_dilation(wide, radius, spacing=(dx, dy), progress=progress)
+        heights = heights[ry : ry + grid.y.size, rx : rx + grid.x.size]
     meta = dict(surface.metadata, tip_radius=radius)
     return GridSurface(
         heights=heights, x=grid.x, y=grid.y, periodic=grid.periodic, unit=surface.unit, metadata=meta

@@ -10,6 +10,7 @@ figure into one folder, both or neither.
 from __future__ import annotations
 
 import os
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -81,6 +82,7 @@ def trace_starts(
     mu: float,
     dl: float | None = None,
     tip_radius: float = 0.0,
+    progress: Callable[[int, int], None] | None = None,
 ) -> StreamlineRun:
     """Streamlines and ideal trajectories from every start of ``starts`` (``(n, 2)``).
 
@@ -96,6 +98,8 @@ def trace_starts(
     tip_radius : float
         Spherical tip radius R (>= 0, surface units): the paths ride ``surface`` dilated
         by R (:func:`~spine_mj.surfaces.dilation.dilate`).
+    progress : callable, optional
+        Hears ``(done, total)`` through that dilation (seconds to minutes on a big grid).
 
     Raises
     ------
@@ -103,7 +107,7 @@ def trace_starts(
         A parameter out of range or a start outside the surface (named).
     """
     params = StreamlineParams(mu=mu, dl=sl.default_step(surface) if dl is None else dl)
-    ridden = dilate(surface, tip_radius) if tip_radius else surface
+    ridden = dilate(surface, tip_radius, progress=progress) if tip_radius else surface
     points = [(float(x), float(y)) for x, y in starts]
     return StreamlineRun(
         surface=ridden,
@@ -144,6 +148,6 @@ def streamline_to(
 ) -> tuple[StreamlineRun, list[Path]]:
     """:func:`trace_starts` from ``starts`` and :func:`write_streamline_outputs` into
     ``out_dir`` (``spine-mj streamline``); ``trace_options`` are :func:`trace_starts`'s
-    ``dl`` and ``tip_radius``. Returns the run and the paths written."""
+    ``dl``, ``tip_radius`` and ``progress``. Returns the run and the paths written."""
     run = trace_starts(surface, starts, mu=mu, **trace_options)
     return run, write_streamline_outputs(run, out_dir, fmt=fmt)

@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from spine_mj.surfaces import ball_dilation_reference
-from spine_mj.surfaces._dilation_kernel import _line, ball_dilation
+from spine_mj.surfaces import ball_dilation, ball_dilation_reference
+from spine_mj.surfaces._dilation_kernel import _line, ball_rows, footprint_rows
 
 
 def _line_brute(f, dx, r):
@@ -44,9 +44,19 @@ def test_equal_heights_tie_and_a_lone_sample_is_its_own_cap():
 
 
 @pytest.mark.parametrize("wrap", [False, True])
-def test_the_kernel_equals_the_reference(wrap):
+def test_the_kernel_equals_the_reference_and_reports_each_row_of_the_footprint(wrap):
+    """The footprint's rows one call each (as ball_dilation reports them) or all in one
+    call give the reference's dilation; progress hears every row, the last as done."""
     rng = np.random.default_rng(3)
     h = rng.normal(size=(13, 17))
-    fast = ball_dilation(h, 2.5, 0.7, 0.9, wrap)
+    heard = []
+    fast = ball_dilation(
+        h, 2.5, spacing=(0.7, 0.9), periodic=wrap, progress=lambda d, t: heard.append((d, t))
+    )
     slow = ball_dilation_reference(h, 2.5, spacing=(0.7, 0.9), periodic=wrap)
     np.testing.assert_allclose(fast, slow, rtol=0, atol=1e-12)
+    n = footprint_rows(2.5, 0.9, 13, wrap)
+    assert n == 3 and heard == [(k, n) for k in range(1, n + 1)]
+    whole = np.full(h.shape, -np.inf)
+    ball_rows(h, 2.5, 0.7, 0.9, wrap, 0, n, whole)
+    np.testing.assert_allclose(whole - 2.5, slow, rtol=0, atol=1e-12)
