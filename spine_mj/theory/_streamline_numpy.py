@@ -7,8 +7,8 @@ from __future__ import annotations
 import numpy as np
 
 from spine_mj.surfaces import BallOnFacets, TriangulatedSurface
-from spine_mj.theory.engagement import SELF_LOCK, SLIP, crease_engagement, kappa, slip_direction
-from spine_mj.theory.multicontact import two_contact_kappa
+from spine_mj.theory.engagement import DEFAULT_TOL, ENGAGED, SELF_LOCK, SLIP, kappa
+from spine_mj.theory.multicontact import hold_kappa, normals_of_slopes
 from spine_mj.theory.streamline_types import Outcome
 
 __all__ = ["CREASE_KINK", "run_numpy"]
@@ -40,11 +40,46 @@ def _wedged(xa, ya, fx, fy, prev, params) -> tuple[np.ndarray, np.ndarray, np.nd
     kt = np.full(i.size, np.nan)
     rt = np.zeros(i.size, np.int8)
     if i.size:
-        kt, rt = two_contact_kappa(pfx[i], pfy[i], fx[i], fy[i], params.mu)
+        kt, rt = _two_contact_kappa(pfx[i], pfy[i], fx[i], fy[i], params.mu)
         hold = (rt == SELF_LOCK) | (kt > params.kappa_cap)
         held[i[hold]] = True
         kt, rt = kt[hold], rt[hold]
     return held, kt, rt
+
+
+def _single_contact(fx, fy, mu, tol):
+    """:func:`spine_mj.theory.engagement.kappa` and :func:`~spine_mj.theory.engagement.slip_direction`
+    (a self-locked point's as if it slipped) on 1-d arrays, compiled
+    (:func:`spine_mj.theory._multicontact_kernel.single_contact`, the same numbers)."""
+    from spine_mj.theory._multicontact_kernel import single_contact
+
+    fx, fy = np.ascontiguousarray(fx, dtype=float), np.ascontiguousarray(fy, dtype=float)
+    return single_contact(fx, fy, float(mu), float(tol))
+
+
+def _crease_engagement(fx_a, fy_a, fx_b, fy_b, mu):
+    """:func:`spine_mj.theory.engagement.crease_engagement` on 1-d arrays, compiled
+    (:func:`spine_mj.theory._multicontact_kernel.crease`: the same numbers, without numpy's
+    per-call overhead on the few points a step asks about)."""
+    from spine_mj.theory._multicontact_kernel import crease
+
+    args = (np.ascontiguousarray(v, dtype=float) for v in (fx_a, fy_a, fx_b, fy_b))
+    return crease(*args, float(mu), DEFAULT_TOL)
+
+
+def _two_contact_kappa(fx_a, fy_a, fx_b, fy_b, mu):
+    """:func:`spine_mj.theory.multicontact.two_contact_kappa` on 1-d arrays, compiled
+    (:func:`spine_mj.theory._multicontact_kernel.two_contact`), the friction-cone bound of the
+    points where no motion counts from :func:`~spine_mj.theory.multicontact.hold_kappa`."""
+    from spine_mj.theory._multicontact_kernel import two_contact
+
+    fx_a, fy_a, fx_b, fy_b = (np.ascontiguousarray(v, dtype=float) for v in (fx_a, fy_a, fx_b, fy_b))
+    k, region, bound = two_contact(fx_a, fy_a, fx_b, fy_b, float(mu), DEFAULT_TOL)
+    for i in np.flatnonzero(bound):
+        na, nb = normals_of_slopes(fx_a[i], fy_a[i]), normals_of_slopes(fx_b[i], fy_b[i])
+        k[i] = hold_kappa(np.array([na, nb]), float(mu))
+        region[i] = SLIP if np.isnan(k[i]) else (SELF_LOCK if np.isinf(k[i]) else ENGAGED)
+    return k, region
 
 
 def run_numpy(surface, xs, ys, params, *, ideal, store):
@@ -132,12 +167,12 @@ class _Walk:
         against the last accepted point's, and whether the tip rests in a crease (wedged on
         facets, :func:`_wedged`, or following one, :func:`_on_crease`)."""
         params = self.params
-        k, reg = kappa(fx, fy, params.mu, tol=params.tol)
-        locked = reg == SELF_LOCK
         if ideal:
+            k, reg = kappa(fx, fy, params.mu, tol=params.tol)
             vx, vy = 1.0 / np.sqrt(1.0 + fx * fx), np.zeros_like(fx)
         else:
-            vx, vy, _ = slip_direction(fx, fy, k, np.where(locked, SLIP, reg))
+            k, reg, vx, vy = _single_contact(fx, fy, params.mu, params.tol)
+        locked = reg == SELF_LOCK
         finite = np.isfinite(vx) & np.isfinite(vy)
         with np.errstate(invalid="ignore"):
             turned = vx * self.pvx[active] + vy * self.pvy[active] < 0.0
@@ -221,14 +256,16 @@ def _on_crease(r, active, prev_slopes, sides, mu, point, crease) -> None:
     last point's slopes ``prev_slopes`` and the current ones, else the crease's other side
     from ``sides``; written into ``point`` = (fx, fy, k, reg, locked, vx, vy, finite),
     ``sides`` and ``crease`` where two contacts hold (:func:`run_numpy`)."""
+    if not r.size:
+        return
     pfx, pfy = prev_slopes
     fx, fy, k, reg, locked, vx, vy, finite = point
     other = np.column_stack([pfx[active[r]], pfy[active[r]]])
-    got = crease_engagement(other[:, 0], other[:, 1], fx[r], fy[r], mu)
+    got = _crease_engagement(other[:, 0], other[:, 1], fx[r], fy[r], mu)
     for c in (0, 2):  # on the same side as the last point: the crease's other side
         again = got[1] < 0
         retry = sides[active[r], c : c + 2]
-        alt = crease_engagement(retry[:, 0], retry[:, 1], fx[r], fy[r], mu)
+        alt = _crease_engagement(retry[:, 0], retry[:, 1], fx[r], fy[r], mu)
         got = tuple(np.where(again, b, a) for a, b in zip(got, alt))
         other = np.where(again[:, None], retry, other)
     kc, rc, cvx, cvy = got

@@ -180,3 +180,65 @@ def test_mujoco_static_probe_at_a_fractal_crease_breaks_away_near_the_two_contac
     )
     assert res.kappa_mj == pytest.approx(pair, rel=0.1)
     assert res.kappa_mj > 1.3 * single.max()
+
+
+def _slope_pairs(n: int = 4000):
+    """Random contact pairs over every regime (flat to steep, opposed and alike), with the
+    degenerate ones: equal slopes (no crease), mirrored walls, a flat floor."""
+    rng = np.random.default_rng(7)
+    fa = rng.normal(scale=rng.choice([0.1, 1.0, 5.0], size=(n, 1)), size=(n, 2))
+    fb = rng.normal(scale=rng.choice([0.1, 1.0, 5.0], size=(n, 1)), size=(n, 2))
+    fb[:50] = fa[:50]
+    fb[50:100] = -fa[50:100]
+    fa[100:150] = 0.0
+    return fa[:, 0].copy(), fa[:, 1].copy(), fb[:, 0].copy(), fb[:, 1].copy()
+
+
+@pytest.mark.parametrize("mu", [0.3, 0.8, 2.5])
+def test_the_compiled_crease_rule_gives_the_numpy_rules_numbers(mu):
+    from spine_mj.theory._multicontact_kernel import crease
+    from spine_mj.theory.engagement import DEFAULT_TOL, crease_engagement
+
+    args = _slope_pairs()
+    got, want = crease(*args, mu, DEFAULT_TOL), crease_engagement(*args, mu)
+    for g, w, name in zip(got, want, ("kappa", "region", "vx", "vy"), strict=True):
+        np.testing.assert_array_equal(g, w, err_msg=name)
+
+
+@pytest.mark.parametrize("mu", [0.3, 0.8, 2.5])
+def test_the_compiled_two_contact_rule_gives_the_numpy_rules_numbers(mu):
+    from spine_mj.theory._multicontact_kernel import two_contact
+    from spine_mj.theory._streamline_numpy import _two_contact_kappa
+    from spine_mj.theory.engagement import DEFAULT_TOL
+
+    args = _slope_pairs(1500)
+    k, region, bound = two_contact(*args, mu, DEFAULT_TOL)
+    want_k, want_region = two_contact_kappa(*args, mu)
+    # where a motion counts the kernel decides alone; elsewhere the caller's linear program
+    assert bound.any() and (~bound).sum() > 1000
+    np.testing.assert_array_equal(k[~bound], want_k[~bound])
+    np.testing.assert_array_equal(region[~bound], want_region[~bound])
+    got_k, got_region = _two_contact_kappa(*args, mu)
+    np.testing.assert_array_equal(got_k, want_k)
+    np.testing.assert_array_equal(got_region, want_region)
+
+
+@pytest.mark.parametrize("mu", [0.3, 0.8, 2.5])
+def test_the_compiled_single_contact_rule_gives_kappa_and_the_slip_direction(mu):
+    from spine_mj.theory._multicontact_kernel import single_contact
+    from spine_mj.theory.engagement import DEFAULT_TOL, slip_direction
+
+    fx, fy, _, _ = _slope_pairs()
+    k, region, vx, vy = single_contact(fx, fy, mu, DEFAULT_TOL)
+    want_k, want_region = kappa(fx, fy, mu)
+    want_vx, want_vy, _ = slip_direction(
+        fx, fy, want_k, np.where(want_region == SELF_LOCK, SLIP, want_region)
+    )
+    assert set(np.unique(region)) == {SLIP, ENGAGED, SELF_LOCK}
+    for got, want, name in (
+        (k, want_k, "kappa"),
+        (region, want_region, "region"),
+        (vx, want_vx, "vx"),
+        (vy, want_vy, "vy"),
+    ):
+        np.testing.assert_array_equal(got, want, err_msg=name)

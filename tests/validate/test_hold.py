@@ -77,7 +77,10 @@ def test_starts_are_added_at_the_yield_so_far_until_30_paired_or_the_budget_says
     assert _more_starts(27, 40, 45, 1e9, 1.0)[0] == 5  # the places left
     add, why = _more_starts(27, 40, 400, 100.0, 10.0)
     assert add == 0 and why == "16 more starts would take 160 s, past the budget (100 s left)"
-    assert _more_starts(27, 40, 40, 1e9, 1.0) == (0, "no more places to add starts from (--reference-starts 40)")
+    assert _more_starts(27, 40, 40, 1e9, 1.0) == (
+        0,
+        "no more places to add starts from (--reference-starts 40)",
+    )
 
 
 @pytest.mark.parametrize(
