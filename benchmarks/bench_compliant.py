@@ -89,7 +89,7 @@ def p600_compare(quick: bool) -> dict:
         "starts": n,
         "sweep_wall_s": round(wall, 1),
         "compare_cpu_s": round(float(cpu.get("compare", np.nan)), 1),
-        "mujoco_cpu_s": round(float(cpu.get("mujoco", np.nan)), 1),
+        "mujoco_cpu_s": round(float(cpu.get("engine", np.nan)), 1),
         "quasistatic_cpu_s": round(float(cpu.get("quasistatic", np.nan)), 1),
     }
 
