@@ -360,7 +360,7 @@ def limit_doc(
     if members > 1:
         fam = ensemble_family(fam, preset, members)
         grid["ensemble_members"] = members
-    if overrides:  # a variation or refinement level is judged on the rigid reference alone
+    if overrides or not plan.compliant_reference:  # a variation or refinement level: the rigid one alone
         grid["compliant_reference"] = False
     doc = family_doc(
         fam,

@@ -360,7 +360,8 @@ def _lines(limit: QuasistaticLimitResult, boundary: BoundaryResult) -> list[str]
         "cap on both sides (a path needing more than the cap times F_p is held). A run the "
         "engine stopped, or whose reference stalled, counts as a disagreement. Beside it: the "
         "comparison with the compliant-drive streamline of the run's spring on the same facets "
-        "(docs/physics.md §7: what the spring itself does, jumps at folds, predicted), with the "
+        "(docs/physics.md §7: what the spring itself does, jumps at folds, predicted; `-` where "
+        "the plan leaves it out, as the quick plan does for its cost), with the "
         "streamline on the smooth surface, and the geometry part (smooth vs facet streamline).",
         "",
         table(
