@@ -1,25 +1,26 @@
 """MuJoCo (and Bullet) slips on the ABBM track against the quasistatic references (issue 42).
 
-For each engine, I_e and variant (``base``; ``dt2``: half the engine's step; ``hfield2``:
-the hfield refined twice), one spring drive per K over the ``abbm`` preset (all but a
-twentieth at each end), its slips against the overdamped and inertial references' slips on
-the same stretch that the engine's detector would see (peak speed >= 5 V): the
-Kolmogorov-Smirnov distance and p-value of sizes and force drops; the same for the force
-drops deeper than each ``--floors`` value [F_p] (:mod:`spine_mj.theory.force_drops`, one
-rule for the engine's steps and the references' paths, key ``drops``; the references also
-on the profile the engine's height field makes, straight between its nodes: sources
-``*_facets``), with the engine's
-resting jitter (the 99th percentile of its elementary force drops); and the creep of the
-held tip, MuJoCo's soft friction: the tip's mean x-speed over V in the rows it is STUCK,
-and the share of its travel made while stuck. The order of the distance with I_e is the
-slope of ``ln D`` against ``ln I_e``.
+For each engine, I_e and variant (``base``; ``dt2``, ``dt4``: half, a quarter of the
+engine's step; ``hfield2``: the hfield refined twice), one spring drive per K over the
+``abbm`` preset (all but a twentieth at each end, in runs of ``--segment`` units from rest),
+its slips against the overdamped and inertial references' slips on the same stretch that
+the engine's detector would see (peak speed >= 5 V): the Kolmogorov-Smirnov distance and
+p-value of sizes and force drops; the same for the force drops deeper than each
+``--floors`` value [F_p] (:mod:`spine_mj.theory.force_drops`, one rule for the engine's
+steps and the references' paths, key ``drops``; the references also on the profile the
+engine's height field makes, straight between its nodes: sources ``*_facets``), with the
+engine's resting jitter (the 99th percentile of its elementary force drops); and the creep
+of the held tip, MuJoCo's soft friction: the tip's mean x-speed over V in the rows it is
+STUCK, and the share of its travel made while stuck. The order of the distance with I_e is
+the slope of ``ln D`` against ``ln I_e`` (:func:`order_lines`).
 
 Run: ``nice -n 19 .venv/bin/python analysis/stickslip_engines.py [--ie 1e-4,1e-5]
-[--engines mujoco,bullet] [--variants base,dt2,hfield2] [--travel 150]
+[--engines mujoco,bullet] [--variants base,dt2,dt4,hfield2] [--travel 150] [--segment 36]
 [--floors 3e-4,1e-3] [--out analysis/reports/stickslip] [--tag NAME]``;
 writes ``stickslip_engines_<tag>.json`` after each run (a rerun skips the runs it holds)
 and the drop catalogs ``stickslip_drops_<tag>.parquet``, and prints one line per run;
-``--report`` tabulates the saved catalogs into ``engines_drops.md`` (:func:`report`).
+``--report`` tabulates the saved catalogs into ``engines_drops.md`` (:func:`report`), with
+the distance's order in I_e (:func:`order_lines`).
 """
 
 from __future__ import annotations
@@ -61,9 +62,14 @@ def _variant(engine: str, variant: str, ie: float, k: float, surf):
     rig = build_rig(surf, engine=engine, mu=MU, ie=ie, stiffness_number=k)
     if variant == "base":
         return rig
-    if variant == "dt2":
+    if variant in ("dt2", "dt4"):
         return build_rig(
-            surf, engine=engine, mu=MU, ie=ie, stiffness_number=k, timestep_s=rig.engine.timestep_s / 2
+            surf,
+            engine=engine,
+            mu=MU,
+            ie=ie,
+            stiffness_number=k,
+            timestep_s=rig.engine.timestep_s / int(variant[2]),
         )
     if variant == "hfield2":
         return build_rig(surf, engine=engine, mu=MU, ie=ie, stiffness_number=k, hfield_refinement=2)
@@ -255,11 +261,7 @@ def report(out: Path) -> str:
         for (variant, ie, k, floor), g in cat.groupby(["variant", "ie", "K", "floor_fp"]):
             run = next(r for r in runs if (r["variant"], r["ie"], r["K"]) == (variant, ie, k))
             engine = g[g["source"] == run["engine"]]
-            surf = presets.make_surface("abbm")
-            units = TrackUnits.of(
-                build_rig(surf, engine=run["engine"], mu=MU, ie=ie, stiffness_number=k).scales, ie
-            )
-            fixed = engine["force_drop_fp"] + units.stiffness(k) * units.speed * engine["duration_s"]
+            fixed = engine["force_drop_fp"] + _carriage_rate(run["engine"], ie, k) * engine["duration_s"]
             for source in sorted(set(g["source"]) - {run["engine"]}):
                 ref = g[g["source"] == source]
                 cells = [
@@ -276,9 +278,105 @@ def report(out: Path) -> str:
                     + " | ".join(f"{c['ks']:.3f}, {c['ks_p']:.3g} ({c['ad_p']:.3g})" for c in cells)
                     + " |"
                 )
-    text = "\n".join(["# Engines' force drops against the references", "", *rows]) + "\n"
+    text = (
+        "\n".join(["# Engines' force drops against the references", "", *rows, "", *order_lines(out)]) + "\n"
+    )
     (out / "engines_drops.md").write_text(text)
     return text
+
+
+#: Kolmogorov-Smirnov's 95 % critical distance of two samples is this times sqrt((n + m) / (n m)).
+KS_95 = 1.358
+
+
+def _carriage_rate(engine: str, ie: float, k: float) -> float:
+    """``k V`` [F_p / s] of the abbm preset's drive at ``ie`` and ``K = k``: an engine's drop
+    plus this times its duration is its drop at a fixed carriage, as the references'."""
+    units = TrackUnits.of(
+        build_rig(presets.make_surface("abbm"), engine=engine, mu=MU, ie=ie, stiffness_number=k).scales, ie
+    )
+    return units.stiffness(k) * units.speed
+
+
+def _order(ies, engine_sizes, ref_sizes) -> float:
+    """The slope of ``ln D`` against ``ln I_e``, D the KS distance of each engine sample
+    from the reference's sample at the same I_e."""
+    d = [two_sample(e, r)["ks"] for e, r in zip(engine_sizes, ref_sizes)]
+    return float(np.polyfit(np.log(ies), np.log(d), 1)[0])
+
+
+def _order_cells(by_ie: dict, engine: str, ref: str, rng, n_boot: int, kv=None) -> tuple[list[str], str]:
+    """One series' cells of :func:`order_lines`: per I_e (falling) the counts, D, D_95 and
+    p; the order over the leading I_e values whose D exceeds D_95 (from the largest I_e
+    down to the last before D first meets the sampling floor), with its bootstrap interval.
+    Sizes, or with ``kv`` (I_e -> ``k V`` [F_p / s]) the force drops at a fixed carriage."""
+    cells, used = [], []
+    for ie, h in sorted(by_ie.items(), reverse=True):
+        if kv is None:
+            eng, refs = (h.loc[h["source"] == s, "size_lc"].to_numpy() for s in (engine, ref))
+        else:
+            e = h[h["source"] == engine]
+            eng = (e["force_drop_fp"] + kv[ie] * e["duration_s"]).to_numpy()
+            refs = h.loc[h["source"] == ref, "force_drop_fp"].to_numpy()
+        if eng.size < 2 or refs.size < 2:
+            continue
+        t = two_sample(eng, refs)
+        crit = KS_95 * math.sqrt((eng.size + refs.size) / (eng.size * refs.size))
+        cells.append(f"{ie:g}: {eng.size} / {refs.size}, {t['ks']:.3f} ({crit:.3f}, {t['ks_p']:.2g})")
+        if t["ks"] > crit and len(used) == len(cells) - 1:  # the leading run above the floor
+            used.append((ie, eng, refs))
+    if len(used) < 2:
+        return cells, "-"
+    ies, engs, refs = zip(*used)
+    boot = [
+        _order(ies, [rng.choice(e, e.size) for e in engs], [rng.choice(r, r.size) for r in refs])
+        for _ in range(n_boot)
+    ]
+    low, high = np.percentile(boot, [2.5, 97.5])
+    return cells, f"{_order(ies, engs, refs):.2f} [{low:.2f}, {high:.2f}] over I_e {ies[-1]:g}-{ies[0]:g}"
+
+
+def order_lines(out: Path, n_boot: int = 400, seed: int = 0) -> list[str]:
+    """The distance of an engine's drop sizes from each reference's against I_e, from every
+    saved ``stickslip_drops_*.parquet`` under ``out`` (one row per variant, K, floor and
+    reference; each I_e against the reference's catalog on the same stretches; a run that
+    two files hold, the first file's). Per I_e the counts, the KS
+    distance D, its p-value and its 95 % critical value D_95 (the sampling floor: below it
+    D is noise); per series the order ``p`` of ``D ~ I_e^p``, fitted by least squares in
+    logs over the I_e values whose D exceeds D_95 from the largest down (where the distance
+    falls, before it reaches the floor), with a 95 % bootstrap interval (the catalogs
+    resampled ``n_boot`` times). A D above D_95 again at smaller I_e is in the cells."""
+    frames, seen = [], set()
+    for path in sorted(out.glob("stickslip_drops_*.parquet")):  # a run repeated in a later file: the first
+        for key, g in pd.read_parquet(path).groupby(["variant", "ie", "K", "floor_fp"]):
+            if key not in seen:
+                seen.add(key)
+                frames.append(g)
+    if not frames:
+        return []
+    cat = pd.concat(frames, ignore_index=True)
+    rng = np.random.default_rng(seed)
+    lines = [
+        "## The distance against I_e",
+        "",
+        "| variant | K | floor [F_p] | reference | of | I_e: engine / reference drops, KS D (D_95, p) "
+        "| order p of D ~ I_e^p [95 %] |",
+        "| --- | --- | --- | --- | --- | --- | --- |",
+    ]
+    facets = {f"{r}_facets" for r in REFERENCES}
+    for (variant, k, floor), g in cat.groupby(["variant", "K", "floor_fp"]):
+        engines = sorted(set(g["source"]) - set(REFERENCES) - facets)
+        if len(engines) != 1 or g["ie"].nunique() < 2:
+            continue
+        by_ie = dict(tuple(g.groupby("ie")))
+        kv = {ie: _carriage_rate(engines[0], ie, k) for ie in by_ie}
+        for ref in sorted(set(g["source"]) - set(engines)):
+            for of, rate in (("sizes", None), ("drops, fixed carriage", kv)):
+                cells, order = _order_cells(by_ie, engines[0], ref, rng, n_boot, rate)
+                lines.append(
+                    f"| {variant} | {k:g} | {floor:g} | {ref} | {of} | " + "; ".join(cells) + f" | {order} |"
+                )
+    return lines
 
 
 if __name__ == "__main__":
