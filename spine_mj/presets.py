@@ -409,7 +409,7 @@ def surface_info(
     plot written to ``psd_png`` if given (``spine-mj surface info``). ``tip_radius`` [the
     surface's length unit]: the tip the limits are of (the one tip rule,
     :func:`spine_mj.sim.scales.resolve_tip_radius`: None the rig's default tip, 0 a point).
-    ``progress(done, total, stage)`` hears the roughness, then the limits' stages.
+    ``progress(done, total)`` hears a big dilation by the tip (the limits').
 
     Raises
     ------
@@ -421,15 +421,12 @@ def surface_info(
     from spine_mj.sim.scales import resolve_tip_radius
     from spine_mj.theory.drive_limits import drive_limits
 
-    report = progress or (lambda done, total, stage: None)
-    report(0, 1, "roughness")
     rough = roughness.summarize(surface)
-    report(1, 1, "roughness")
     limits = None
     if mu is not None or preset_mu(surface) is not None:
         mu = resolve_mu(surface, mu, name="--mu")
         tip_radius = resolve_tip_radius(surface, tip_radius, name="--tip-radius")
-        limits = drive_limits(surface, mu, tip_radius=tip_radius, progress=report)
+        limits = drive_limits(surface, mu, tip_radius=tip_radius, progress=progress)
     if psd_png:
         from spine_mj.plotting import roughness_figure, save_figure
 

@@ -140,14 +140,8 @@ def surface_info(surface_spec, output, as_json, mu, tip_radius):
     surf = presets.open_surface(surface_spec)
     if mu is None and presets.preset_mu(surf) is None:  # no drive limits: nothing uses the tip
         refuse_options_not_for("surface info without a mu_s (no --mu, no preset's)", ["tip_radius"])
-    with Progress("preparing", delay_s=PREPARATION_DELAY_S) as bar:
-
-        def stage(done, total, name):
-            bar.update(done, total, name)
-            if done >= total:  # a stage's bar closes when it is done
-                bar.close()
-
-        info = presets.surface_info(surf, mu=mu, tip_radius=tip_radius, psd_png=output, progress=stage)
+    with Progress("dilating by the tip", unit="row", delay_s=PREPARATION_DELAY_S) as bar:
+        info = presets.surface_info(surf, mu=mu, tip_radius=tip_radius, psd_png=output, progress=bar.update)
     if as_json:
         click.echo(json.dumps(info.as_dict(), indent=2))
         return

@@ -394,14 +394,6 @@ def _grid_starts(surface: Surface, n: int, margin: float) -> np.ndarray:
     return np.array([(a, b) for b in ys for a in xs])
 
 
-#: :func:`drive_limits`' stages, as its ``progress`` hears them.
-DILATING, TRACING = "dilating by the tip", "tracing the paths"
-
-
-def _quiet(done: float, total: float, stage: str) -> None:
-    """No progress reports."""
-
-
 def _lengths(surface: Surface, n_starts) -> tuple[float, float]:
     """``(l_s, L_c)`` of :func:`drive_limits`' ``surface``, its arguments checked first."""
     if not isinstance(surface, Surface):
@@ -412,14 +404,8 @@ def _lengths(surface: Surface, n_starts) -> tuple[float, float]:
 
 
 def _traced(surface: Surface, tip_radius: float, progress) -> Surface:
-    """The surface the tip's centre rides (``surface`` dilated by ``tip_radius``; 0: itself),
-    its dilation heard by ``progress`` as :data:`DILATING`; then :data:`TRACING` begins (a
-    2048 x 2048 fractal, a tip 21 rows wide: 23 CPU-s in all, no display before)."""
-    traced = surface
-    if tip_radius > 0:
-        traced = dilate(surface, tip_radius, progress=lambda done, total: progress(done, total, DILATING))
-    progress(0, 1, TRACING)
-    return traced
+    """The surface the tip's centre rides (``surface`` dilated by ``tip_radius``; 0: itself)."""
+    return dilate(surface, tip_radius, progress=progress) if tip_radius > 0 else surface
 
 
 def drive_limits(
@@ -434,7 +420,7 @@ def drive_limits(
     path_tolerance: float = FRECHET_TARGET,
     path_starts=None,
     carriage_edge: float | None = None,
-    progress: Callable[[float, float, str], None] = _quiet,
+    progress: Callable[[int, int], None] | None = None,
 ) -> DriveLimits:
     """Predict ``K*`` and ``I_e*`` of ``surface`` from its quasistatic paths (module doc).
 
@@ -455,7 +441,7 @@ def drive_limits(
     path_starts, carriage_edge : array_like (m, 2), float, optional
         A measurement's starts and its runs' +x edge: ``K_path`` (:mod:`~spine_mj.theory.path_stiffness`).
     progress : callable, optional
-        Hears ``(done, total, stage)``: the dilation by the tip row by row, then the paths.
+        Hears a big dilation by the tip row by row (:func:`~spine_mj.surfaces.dilate`).
 
     Returns
     -------
@@ -481,7 +467,6 @@ def drive_limits(
     k_path, k_fold_starts, k_endless, left_out = _path_stiffnesses(
         traced, path_starts, params, l_s, l_c, carriage_edge
     )
-    progress(1, 1, TRACING)
     return DriveLimits(
         k_star=l_s * max(0.0, fall),
         ie_star=limits[limit],

@@ -100,20 +100,20 @@ def test_corrugation_k_star_is_prandtl_tomlinson(s, mu):
     assert "quasistatic needs K > " in d.sentence()
 
 
-def test_progress_hears_the_dilation_row_by_row_then_the_paths_and_changes_nothing():
-    """A tip 3 rows of samples wide: rows 1..3 of 3, then the paths 0 and 1 of 1; the
-    limits are those computed without a listener."""
-    from spine_mj.theory.drive_limits import DILATING, TRACING
+def test_progress_hears_a_big_dilation_row_by_row_and_changes_nothing(monkeypatch):
+    """A tip 3 rows of samples wide: rows 1..3 of 3 once the dilation counts as big (a
+    small one is silent), and the limits are those computed without a listener."""
+    from spine_mj.surfaces import dilation
 
     surf = corrugation(slope_amplitude=0.3, n_waves=4, points_per_wave=64)
+    tip = 2.5 * surf.spacing[1]
     heard = []
-    d = drive_limits(
-        surf, 0.5, n_starts=2, tip_radius=2.5 * surf.spacing[1], progress=lambda *a: heard.append(a)
-    )
-    rows = [h for h in heard if h[2] == DILATING]
-    assert rows == [(k, 3, DILATING) for k in (1, 2, 3)]
-    assert heard[len(rows) :] == [(0, 1, TRACING), (1, 1, TRACING)]
-    assert d == drive_limits(surf, 0.5, n_starts=2, tip_radius=2.5 * surf.spacing[1])
+    quiet = drive_limits(surf, 0.5, n_starts=2, tip_radius=tip, progress=lambda *a: heard.append(a))
+    assert heard == []
+    monkeypatch.setattr(dilation, "PROGRESS_MIN_WORK", 0)
+    d = drive_limits(surf, 0.5, n_starts=2, tip_radius=tip, progress=lambda *a: heard.append(a))
+    assert heard == [(1, 3), (2, 3), (3, 3)]
+    assert d == quiet
 
 
 @pytest.mark.parametrize("amp, sigma", [(0.5, 1.0), (0.3, 0.6)])
