@@ -334,7 +334,8 @@ def _issue44(add, work: Path, py: str) -> None:
     """Issue 44's families: planes' arguments, Bullet's step, the engines study's
     arguments, nested JSON, engine and drive keys a sweep would not apply, refusals that
     only a combination of the grid makes, memory beyond the budget (the fractal's
-    synthesis, simulate's hfield), and a rail Bullet does not have."""
+    synthesis, simulate's hfield), narrow strips and planes that must run, a heightfield
+    past pybullet's limit and a rail Bullet does not have."""
     plane = [*SPINE, "surface", "make", "plane", "-o", "p.npz", "--set"]
     for setting, needle in (
         ('slope_deg="steep"', "slope_deg"),
@@ -481,6 +482,12 @@ def _issue44(add, work: Path, py: str) -> None:
             "ok",
             "no slope correlation length",
         )
+    add(
+        "simulate --engine bullet --resolution 1449 (past pybullet's upload buffer)",
+        [*sim_bullet[:-2], "--engine", "bullet", "--resolution", "1449", "--out", "b1449"],
+        "refuse",
+        "1449 x 1449 samples is more than pybullet takes",
+    )
     add(
         "simulate --line --engine bullet",
         [*sim_bullet, "--engine", "bullet", "--line"],
