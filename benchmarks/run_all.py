@@ -22,6 +22,8 @@ Sections (each records the machine's load average before and after it):
   peak and on a fractal, with a fitted cost model (see :func:`fit_cost`).
 * ``compliant``: the compliant-drive reference's compiled loop against its numpy loop, and
   the P600 sandpaper ``compare`` analysis it made slow (``benchmarks/bench_compliant.py``).
+* ``hold``: ``spine-mj hold sandpaper-P600 --mu 0.5`` as a user runs it: wall time, CPU
+  seconds, the starts it ran and its verdict (``benchmarks/bench_hold.py``).
 * ``array``: an array of N spines against N single-spine runs of the same length
   (``benchmarks/bench_array.py``): the median wall-time ratio, target at most about 1.
 * ``cli``: wall time of ``spine-mj --help``, of every command's help and of the commands
@@ -63,6 +65,7 @@ import bench_cost  # noqa: E402
 import bench_engines  # noqa: E402
 import bench_fastforward  # noqa: E402
 import bench_gpu  # noqa: E402
+import bench_hold  # noqa: E402
 import bench_memory  # noqa: E402
 import bench_plan_cost  # noqa: E402
 import bench_rollout  # noqa: E402
@@ -82,6 +85,7 @@ SECTIONS = {
     "sweep": bench_sweep,
     "cost": bench_cost,
     "compliant": bench_compliant,
+    "hold": bench_hold,
     "fastforward": bench_fastforward,
     "array": bench_array,
     "cli": bench_cli,
@@ -97,6 +101,7 @@ REPORT_ORDER = (
     "sweep",
     "cost",
     "compliant",
+    "hold",
     "array",
     "engines",
     "fastforward",
