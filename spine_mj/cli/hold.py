@@ -28,7 +28,12 @@ from spine_mj.errors import SpineInputError
     "is refused: the engine's tip is a ball).",
 )
 @click.option(
-    "--starts", type=int, default=40, show_default=True, help="MuJoCo starts (paired under refinement)."
+    "--starts",
+    type=int,
+    default=40,
+    show_default=True,
+    help="MuJoCo starts (paired under refinement); more are added from the places where too "
+    "few paired well-conditioned ones are left for a verdict, as far as --budget allows.",
 )
 @click.option(
     "--reference-starts",
