@@ -18,10 +18,10 @@ lowest I_e, :mod:`spine_mj.validate.quasistatic_limit`) are recomputed under ref
   generated fractal, a scan) refined through the interpolant it is defined by
   (:func:`spine_mj.surfaces.refine_grid`: only the facets change, not the surface).
 
-A refinement reruns a subset of the corner's starts (``plan.convergence_starts`` y starts
-per surface, the same points, one run each), and the change of a headline is the paired
-change on those starts: the refined runs' number minus the same number of the corner's own
-runs from those starts, like for like. The corner's agreement headline, the one its target
+A refinement reruns a subset of the corner's starts (``plan.limit.convergence_starts`` y
+starts per surface, the same points, one run each), and the change of a headline is the
+paired change on those starts: the refined runs' number minus the same number of the
+corner's own runs from those starts, like for like. The corner's agreement headline, the one its target
 judges, is over the starts well-conditioned on both sides
 (:mod:`spine_mj.validate.ensembles`): its change is paired on the subset's well-conditioned
 starts only. An ill-conditioned start lies within 1e-3 L_c of a watershed, so any change of

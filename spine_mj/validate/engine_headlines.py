@@ -130,11 +130,14 @@ SOFT_CONTACT_MISSES = (
 #: corner and sample, issue 41): the starts :data:`SOFT_CONTACT_MISSES` index.
 REPORTED_FULL = dataclasses.replace(
     PLANS["full"],
-    corner=(
-        ("single_peak_valley", None, paper_starts(np.linspace(-0.25, -5.0, 55).round(4))),
-        ("random_gaussian", (1, 2), relative_starts(28)),
-        ("fractal", (1, 2, 3, 4, 5), relative_starts(12)),
-        ("sandpaper", None, relative_starts(12, 0.25)),
+    limit=dataclasses.replace(
+        PLANS["full"].limit,
+        corner=(
+            ("single_peak_valley", None, paper_starts(np.linspace(-0.25, -5.0, 55).round(4))),
+            ("random_gaussian", (1, 2), relative_starts(28)),
+            ("fractal", (1, 2, 3, 4, 5), relative_starts(12)),
+            ("sandpaper", None, relative_starts(12, 0.25)),
+        ),
     ),
 )
 
@@ -204,7 +207,7 @@ def _corner_docs(
     -> ``{"ie", "K"}``."""
     out, corners = [], {}
     for fam in plan.families:
-        corner = plan.corner_family(fam)
+        corner = plan.limit.corner_family(fam)
         own = family_corner(plan, corner)["presets"]
         corners[fam.name] = corner_drives(own)
         if starts is not None:
@@ -221,8 +224,8 @@ def miss_family(plan: ValidationPlan, miss: MissStart) -> FamilySpec:
     the one the plan ran (:func:`~spine_mj.validate.ensembles.ensemble_family` over the
     whole family: the stencil's radius is its first surface's), as explicit points."""
     (fam,) = [f for f in plan.families if f.name == miss.family]
-    corner = plan.corner_family(fam)
-    members = max(int(plan.ensemble_members), 1)
+    corner = plan.limit.corner_family(fam)
+    members = max(int(plan.limit.ensemble_members), 1)
     table = ensemble_family(corner, miss.preset, members).starts_table() if members > 1 else None
     if table is None:
         t = dict(corner.starts)
@@ -241,9 +244,14 @@ def miss_family(plan: ValidationPlan, miss: MissStart) -> FamilySpec:
 
 def _miss_doc(plan: ValidationPlan, miss: MissStart, k: int, engines) -> dict:
     """The sweep of one soft-contact miss: its ensemble's points run as the plan ran them."""
-    members = max(int(plan.ensemble_members), 1)
+    members = max(int(plan.limit.ensemble_members), 1)
     fam = miss_family(plan, miss)
-    doc = limit_doc(dataclasses.replace(plan, ensemble_members=1), fam, miss.preset, f"engines-miss-{k}")
+    doc = limit_doc(
+        dataclasses.replace(plan, limit=dataclasses.replace(plan.limit, ensemble_members=1)),
+        fam,
+        miss.preset,
+        f"engines-miss-{k}",
+    )
     doc["grid"]["ensemble_members"] = members
     return _both_engines(doc, f"engines-miss-{k}", engines)
 
@@ -379,7 +387,7 @@ def _start_outcomes(plan: ValidationPlan, halves, allc: pd.DataFrame, ill: dict)
     whether the start is well-conditioned and finished on every side, the engine's held flag
     and end, L_c; indexed by the surface, its L_c and the start point (the same in every
     engine)."""
-    members = max(int(plan.ensemble_members), 1)
+    members = max(int(plan.limit.ensemble_members), 1)
     runs = []
     for df, _ in halves:
         mj = df[(df["analysis"] == "engine") & (df["start"].astype(int) % members == 0)].copy()

@@ -8,15 +8,19 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from spine_mj.validate.plans import FamilySpec
 
 __all__ = [
     "BoundaryPlan",
     "EnginesPlan",
     "FractalPlan",
     "GroundTruthPlan",
+    "LimitPlan",
     "SandpaperPlan",
     "StaticPlan",
     "StickSlipPlan",
@@ -43,6 +47,52 @@ class StickSlipPlan:
     starts: int = 3
     k_ie: tuple[float, ...] = (1e-4, 1e-2)
     k_factors: tuple[float, ...] = (0.125, 0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 4.0, 8.0)
+
+
+@dataclass(frozen=True)
+class LimitPlan:
+    """The quasistatic-limit study's sizes (:mod:`spine_mj.validate.quasistatic_limit`).
+
+    Attributes
+    ----------
+    variations : tuple of (label, ((key, value), ...))
+        Engine settings (sweep grid keys) varied one at a time on the first family's first
+        preset at its corner; empty: none.
+    ensemble_members : int
+        Runs per start, on each side: the start and ``ensemble_members - 1`` starts around
+        it (:mod:`spine_mj.validate.ensembles`); 1: no ensembles (no start is found
+        ill-conditioned).
+    corner : tuple of (family name, seeds, starts)
+        The study's own seeds and starts table per family (the corner's sample size), where
+        they differ from the family's (which the boundary study and the (I_e, K) map draw
+        on); :meth:`corner_family`.
+    convergence_starts : int
+        Paired starts per corner family rerun under refinement, at least (solution
+        verification, :mod:`spine_mj.validate.convergence`: the same number of y starts on
+        each of its surfaces; 0: none).
+    convergence_refinements : tuple of str
+        The refinements (keys of :data:`spine_mj.validate.convergence.REFINEMENTS`); with
+        ``dt_quartered`` beside ``dt_halved`` three step levels give an observed order.
+    compliant_reference : bool
+        Whether the corner's runs are also compared with the compliant-drive streamline of
+        their own spring (the sweep's ``compare`` key; the refinement levels and engine
+        variations never are: they are judged on the rigid reference alone).
+    """
+
+    variations: tuple[tuple[str, tuple[tuple[str, Any], ...]], ...] = ()
+    ensemble_members: int = 1
+    corner: tuple[tuple[str, Any, tuple], ...] = ()
+    convergence_starts: int = 0
+    convergence_refinements: tuple[str, ...] = ("dt_halved", "hfield_doubled")
+    compliant_reference: bool = True
+
+    def corner_family(self, fam: FamilySpec) -> FamilySpec:
+        """``fam`` with the seeds and starts of its corner (``corner``; as it is where
+        ``corner`` has no entry for it)."""
+        for name, seeds, starts in self.corner:
+            if name == fam.name:
+                return dataclasses.replace(fam, seeds=seeds, starts=starts)
+        return fam
 
 
 @dataclass(frozen=True)

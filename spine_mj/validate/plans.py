@@ -1,9 +1,9 @@
 """Sizes and targets of a validation run: the plans, their surface families and engine variations.
 
-A :class:`ValidationPlan` fixes what the studies share (families, the corner's I_e and
-sample sizes, the bootstrap size) and has one section per study whose sizes are its own
-(:mod:`spine_mj.validate.plan_sections`: ``plan.fractal.surfaces``);
-:data:`PLANS` holds the ``smoke``
+A :class:`ValidationPlan` fixes what the studies share (families, the lowest I_e, the
+analytic surfaces' grid, the bootstrap size) and has one section per study whose sizes are
+its own (:mod:`spine_mj.validate.plan_sections`: ``plan.fractal.surfaces``,
+``plan.limit.corner``); :data:`PLANS` holds the ``smoke``
 (test size), ``quick`` and ``full`` plans. The agreement targets and the physical
 constants every study shares (tip mass, gravity, the sandpaper mu) live here, so that the
 studies, the summary and the report read one value.
@@ -11,7 +11,6 @@ studies, the summary and the report read one value.
 
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -23,6 +22,7 @@ from spine_mj.validate.plan_sections import (
     EnginesPlan,
     FractalPlan,
     GroundTruthPlan,
+    LimitPlan,
     SandpaperPlan,
     StaticPlan,
     StickSlipPlan,
@@ -119,33 +119,15 @@ class ValidationPlan:
     lowest_ie : float
     hfield_resolution : int
         Samples per side of analytic surfaces (grid surfaces keep their own).
-    limit_variations : tuple of (label, ((key, value), ...))
-        Settings varied one at a time on the single peak at the lowest I_e.
     static : StaticPlan
         The static map's planes and engine settings (:mod:`spine_mj.validate.static_map`).
     boundary : BoundaryPlan
         The boundary study's grid, drives and ramp (:mod:`spine_mj.validate.boundary`).
     bootstrap : int
         Bootstrap resamples of the starts for the I_e* uncertainty.
-    ensemble_members : int
-        Runs per start of the quasistatic-limit study, on each side: the start and
-        ``ensemble_members - 1`` starts around it (:mod:`spine_mj.validate.ensembles`);
-        1: no ensembles (no start is found ill-conditioned).
-    convergence_starts : int
-        Paired starts per corner family rerun under refinement, at least (solution
-        verification, :mod:`spine_mj.validate.convergence`: the same number of y starts on
-        each of its surfaces; 0: none).
-    convergence_refinements : tuple of str
-        The refinements (keys of :data:`spine_mj.validate.convergence.REFINEMENTS`); with
-        ``dt_quartered`` beside ``dt_halved`` three step levels give an observed order.
-    compliant_reference : bool
-        Whether the corner's runs are also compared with the compliant-drive streamline of
-        their own spring (the sweep's ``compare`` key; the refinement levels and engine
-        variations never are: they are judged on the rigid reference alone).
-    corner : tuple of (family name, seeds, starts)
-        The quasistatic-limit study's own seeds and starts table per family (the corner's
-        sample size), where they differ from the family's (which the boundary study and the
-        (I_e, K) map draw on); :meth:`corner_family`.
+    limit : LimitPlan
+        The quasistatic-limit study's sizes: its corner's starts, ensembles, refinements
+        and engine variations (:mod:`spine_mj.validate.quasistatic_limit`).
     stick_slip : StickSlipPlan
         The stick-slip study's sizes (:mod:`spine_mj.validate.stick_slip`).
     sandpaper : SandpaperPlan
@@ -164,15 +146,10 @@ class ValidationPlan:
     families: tuple[FamilySpec, ...]
     lowest_ie: float
     hfield_resolution: int
-    limit_variations: tuple[tuple[str, tuple[tuple[str, Any], ...]], ...]
     static: StaticPlan
     boundary: BoundaryPlan
     bootstrap: int = 200
-    ensemble_members: int = 1
-    corner: tuple[tuple[str, Any, tuple], ...] = ()
-    convergence_starts: int = 0
-    convergence_refinements: tuple[str, ...] = ("dt_halved", "hfield_doubled")
-    compliant_reference: bool = True
+    limit: LimitPlan = field(default_factory=LimitPlan)
     stick_slip: StickSlipPlan = field(default_factory=StickSlipPlan)
     sandpaper: SandpaperPlan = field(default_factory=SandpaperPlan)
     fractal: FractalPlan = field(default_factory=FractalPlan)
@@ -180,13 +157,6 @@ class ValidationPlan:
     ground_truth: GroundTruthPlan = field(default_factory=GroundTruthPlan)
     engines: EnginesPlan = field(default_factory=EnginesPlan)
     extra: dict = field(default_factory=dict, compare=False)
-
-    def corner_family(self, fam: FamilySpec) -> FamilySpec:
-        """``fam`` with the seeds and starts of the quasistatic-limit corner (``corner``)."""
-        for name, seeds, starts in self.corner:
-            if name == fam.name:
-                return dataclasses.replace(fam, seeds=seeds, starts=starts)
-        return fam
 
 
 #: Engine variations: (label, sweep grid overrides); the first is the rig's default.
@@ -248,9 +218,10 @@ PLANS: dict[str, ValidationPlan] = {
         ),
         lowest_ie=1e-2,
         hfield_resolution=101,
-        limit_variations=(),
         bootstrap=20,
-        convergence_starts=1,
+        limit=LimitPlan(
+            convergence_starts=1,
+        ),
         stick_slip=StickSlipPlan(
             ie=(1e-1,),
             stiffness=(10.0,),
@@ -313,31 +284,33 @@ PLANS: dict[str, ValidationPlan] = {
         ),
         lowest_ie=1e-4,
         hfield_resolution=151,
-        # the engine settings' variations are the full plan's (the demo's budget)
-        limit_variations=(),
         bootstrap=200,
-        # two runs a start (the full plan's three: the start and its neighbours on either
-        # side along x): a split is looked for on one side only, so the demo's
-        # ill-conditioned shares are lower bounds beside the full plan's. The ensembles'
-        # third runs were a third of the demo's MuJoCo time (43 of 130 s of CPU, measured)
-        ensemble_members=2,
-        # at least 36 starts per family (issue 41: 30 well-conditioned at least): 35 agreeing
-        # ones are the fewest whose Wilson interval can meet the 95 % target
-        # (intervals.runs_to_meet), one more leaves room for a start found ill-conditioned;
-        # the fractal, with one start in eight ill-conditioned (full report), 42
-        corner=(
-            ("single_peak_valley", None, paper_starts(np.linspace(-0.5, -4.0, 18).round(4))),
-            ("random_gaussian", (1,), relative_starts(18)),
-            ("fractal", (1, 2, 3), relative_starts(7)),
-            ("sandpaper", None, relative_starts(12, 0.25)),
-            ("measured", None, relative_starts(18, 0.5)),
+        limit=LimitPlan(
+            # the engine settings' variations are the full plan's (the demo's budget)
+            variations=(),
+            # two runs a start (the full plan's three: the start and its neighbours on either
+            # side along x): a split is looked for on one side only, so the demo's
+            # ill-conditioned shares are lower bounds beside the full plan's. The ensembles'
+            # third runs were a third of the demo's MuJoCo time (43 of 130 s of CPU, measured)
+            ensemble_members=2,
+            # at least 36 starts per family (issue 41: 30 well-conditioned at least): 35 agreeing
+            # ones are the fewest whose Wilson interval can meet the 95 % target
+            # (intervals.runs_to_meet), one more leaves room for a start found ill-conditioned;
+            # the fractal, with one start in eight ill-conditioned (full report), 42
+            corner=(
+                ("single_peak_valley", None, paper_starts(np.linspace(-0.5, -4.0, 18).round(4))),
+                ("random_gaussian", (1,), relative_starts(18)),
+                ("fractal", (1, 2, 3), relative_starts(7)),
+                ("sandpaper", None, relative_starts(12, 0.25)),
+                ("measured", None, relative_starts(18, 0.5)),
+            ),
+            # solution verification on 6 paired starts a family (the demo's budget; the full
+            # plan's 30 give the verdicts)
+            convergence_starts=6,
+            # the compliant reference creeps along the creases of the scan di-1 and the grits'
+            # facets: 6 di-1 starts took 72.8 CPU-s with it and 16.7 without (the full plan has it)
+            compliant_reference=False,
         ),
-        # solution verification on 6 paired starts a family (the demo's budget; the full
-        # plan's 30 give the verdicts)
-        convergence_starts=6,
-        # the compliant reference creeps along the creases of the scan di-1 and the grits'
-        # facets: 6 di-1 starts took 72.8 CPU-s with it and 16.7 without (the full plan has it)
-        compliant_reference=False,
         stick_slip=StickSlipPlan(
             ie=(1e-2, 1.0),
             stiffness=(2.0, 50.0),
@@ -407,37 +380,39 @@ PLANS: dict[str, ValidationPlan] = {
         ),
         lowest_ie=1e-4,
         hfield_resolution=201,
-        limit_variations=(
-            NO_NOSLIP,
-            IMPRATIO,
-            ("no noslip, impratio 100", (("noslip_iterations", 0), ("impratio", 100.0))),
-            ("hfield 101", (("hfield_resolution", 101),)),
-            # hfield 401 and timestep / 2 are the corner's own refinements (hfield_doubled,
-            # dt_halved: the same settings on every family), not repeated here
-            ("soft contact (timeconst 10 dt)", (("solref_timeconst_factor", 10.0),)),
-        ),
         bootstrap=500,
-        ensemble_members=3,
-        # at least 60 well-conditioned starts per family (issue 41: 60 of 60 has a 95 % lower
-        # bound of 0.94), over several surfaces: 64 where one start in a hundred was
-        # ill-conditioned (the paper families), 80 on the fractal (5 seeds x 2 H; one in
-        # eight), 78 on the sandpaper (one in nine ill-conditioned or stopped), 68 on the scans
-        corner=(
-            ("single_peak_valley", None, paper_starts(np.linspace(-0.25, -5.0, 32).round(4))),
-            ("random_gaussian", (1, 2), relative_starts(16)),
-            ("fractal", (1, 2, 3, 4, 5), relative_starts(8)),
-            ("sandpaper", None, relative_starts(26, 0.25)),
-            ("measured", None, relative_starts(34, 0.5)),
-        ),
-        # solution verification on 30 paired starts a family, three step levels and (on the
-        # gridded surfaces) three hfield levels for observed orders and GCIs
-        convergence_starts=30,
-        convergence_refinements=(
-            "dt_halved",
-            "dt_quartered",
-            "hfield_doubled",
-            "hfield_quadrupled",
-            "tolerance_tightened",
+        limit=LimitPlan(
+            variations=(
+                NO_NOSLIP,
+                IMPRATIO,
+                ("no noslip, impratio 100", (("noslip_iterations", 0), ("impratio", 100.0))),
+                ("hfield 101", (("hfield_resolution", 101),)),
+                # hfield 401 and timestep / 2 are the corner's own refinements (hfield_doubled,
+                # dt_halved: the same settings on every family), not repeated here
+                ("soft contact (timeconst 10 dt)", (("solref_timeconst_factor", 10.0),)),
+            ),
+            ensemble_members=3,
+            # at least 60 well-conditioned starts per family (issue 41: 60 of 60 has a 95 % lower
+            # bound of 0.94), over several surfaces: 64 where one start in a hundred was
+            # ill-conditioned (the paper families), 80 on the fractal (5 seeds x 2 H; one in
+            # eight), 78 on the sandpaper (one in nine ill-conditioned or stopped), 68 on the scans
+            corner=(
+                ("single_peak_valley", None, paper_starts(np.linspace(-0.25, -5.0, 32).round(4))),
+                ("random_gaussian", (1, 2), relative_starts(16)),
+                ("fractal", (1, 2, 3, 4, 5), relative_starts(8)),
+                ("sandpaper", None, relative_starts(26, 0.25)),
+                ("measured", None, relative_starts(34, 0.5)),
+            ),
+            # solution verification on 30 paired starts a family, three step levels and (on the
+            # gridded surfaces) three hfield levels for observed orders and GCIs
+            convergence_starts=30,
+            convergence_refinements=(
+                "dt_halved",
+                "dt_quartered",
+                "hfield_doubled",
+                "hfield_quadrupled",
+                "tolerance_tightened",
+            ),
         ),
         stick_slip=StickSlipPlan(
             ie=(1e-3, 1e-2, 1e-1, 1.0),

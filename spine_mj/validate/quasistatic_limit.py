@@ -161,7 +161,7 @@ def quasistatic_limit(plan: ValidationPlan, runner: StudyRunner) -> QuasistaticL
     refuses gives no verdict), against the streamline, with the three comparisons of the
     module docstring per run (lengths over L_c; a run the engine stopped disagrees, listed
     by status in ``failed_runs``), its refinements, then on the single peak the settings of
-    ``plan.limit_variations`` one at a time.
+    ``plan.limit.variations`` one at a time.
 
     Parameters
     ----------
@@ -176,7 +176,7 @@ def quasistatic_limit(plan: ValidationPlan, runner: StudyRunner) -> QuasistaticL
     """
     runner.study = "limit"
     families, runs_rows, paths = {}, [], {}
-    corner = [plan.corner_family(fam) for fam in plan.families]
+    corner = [plan.limit.corner_family(fam) for fam in plan.families]
     corners = {}
     for fam in corner:
         with runner.phase(f"the quasistatic corner of {fam.name}"):
@@ -210,8 +210,8 @@ def quasistatic_limit(plan: ValidationPlan, runner: StudyRunner) -> QuasistaticL
         ]
         summ["corner"] = corner_drives(at[fam.name])
         families[fam.name] = summ
-        if plan.convergence_starts > 0:
-            refined = _refined_rows(fam.name, plan.convergence_refinements, refinements, refined_done)
+        if plan.limit.convergence_starts > 0:
+            refined = _refined_rows(fam.name, plan.limit.convergence_refinements, refinements, refined_done)
             convergence[fam.name] = family_convergence(summ, allc, refined)
         for _, r in allc.iterrows():
             row = {k: _plain(r[k]) for k in RUN_COLUMNS if k != "ill_conditioned"}
@@ -236,9 +236,9 @@ def corner_summary(
     Parameters
     ----------
     plan : ValidationPlan
-        The plan the sweeps were written for (its ``ensemble_members``).
+        The plan the sweeps were written for (its ``limit.ensemble_members``).
     fam : FamilySpec
-        The family (its corner: :meth:`ValidationPlan.corner_family`).
+        The family (its corner: :meth:`~spine_mj.validate.plan_sections.LimitPlan.corner_family`).
     results : sequence of (DataFrame, Path)
         Run table and store of each of the family's limit sweeps (of one engine).
     paths : dict, optional
@@ -307,13 +307,13 @@ def _refinement_docs(
     family's thinned starts (:func:`~spine_mj.validate.convergence.thin_starts`), one per
     preset, at the preset's corner ``at[family][preset]`` (a gridded surface's hfield is refined
     through its interpolant, :func:`spine_mj.surfaces.refine_grid`)."""
-    if plan.convergence_starts <= 0:
+    if plan.limit.convergence_starts <= 0:
         return []
     out = []
     for fam in corner:
         surfaces = len(fam.presets) * len(fam.seeds or (None,)) * len(fam.variants)
-        thin = thin_starts(fam, -(-plan.convergence_starts // surfaces))
-        for key in plan.convergence_refinements:
+        thin = thin_starts(fam, -(-plan.limit.convergence_starts // surfaces))
+        for key in plan.limit.convergence_refinements:
             for preset in fam.presets:
                 if key in GRID_ONLY and not gridded(preset, fam):
                     continue
@@ -356,11 +356,12 @@ def limit_doc(
         "dl": tip / 2,
         **engine_grid(plan, overrides, preset, fam.seeds, tip, mu=mu, ie=ie, stiffness_number=k),
     }
-    members = plan.ensemble_members if not overrides else 1
+    members = plan.limit.ensemble_members if not overrides else 1
     if members > 1:
         fam = ensemble_family(fam, preset, members)
         grid["ensemble_members"] = members
-    if overrides or not plan.compliant_reference:  # a variation or refinement level: the rigid one alone
+    # a variation or refinement level, or a plan that leaves it out: the rigid reference alone
+    if overrides or not plan.limit.compliant_reference:
         grid["compliant_reference"] = False
     doc = family_doc(
         fam,
@@ -423,7 +424,7 @@ def _sweep_comparison(
     ensemble's own start) with the MuJoCo row's end and status and the row's preset; the
     ensembles' outcomes go into ``groups`` (:func:`~spine_mj.validate.ensembles.ensemble_verdicts`),
     the single peak/valley family's paths into ``paths``."""
-    members = max(int(plan.ensemble_members), 1)
+    members = max(int(plan.limit.ensemble_members), 1)
     groups.extend(ensemble_groups(df, store, members))
     df = df[df["start"].astype(int) % members == 0].copy()  # the runs: each ensemble's own start
     df["start"] = df["start"].astype(int) // members
@@ -453,10 +454,10 @@ def _sweep_comparison(
 def _variation_docs(plan: ValidationPlan, corner: dict | None = None) -> list[tuple[str, str, dict]]:
     """``(label, store name, config)`` of each engine variation of ``plan`` on the first
     family's first preset, at that family's ``corner``."""
-    fam0 = plan.corner_family(plan.families[0])
+    fam0 = plan.limit.corner_family(plan.families[0])
     preset = fam0.presets[0]
     out = []
-    for label, ov in plan.limit_variations:
+    for label, ov in plan.limit.variations:
         tag = "-".join(f"{k}{v}" for k, v in ov)
         out.append(
             (
@@ -472,10 +473,10 @@ def _variations(plan: ValidationPlan, docs, results, runs_rows: list[dict]) -> d
     """The engine variations (``docs`` of :func:`_variation_docs` and their sweeps'
     ``results``) after the recommended settings (summarised from ``runs_rows``)."""
     variations = {}
-    preset = plan.corner_family(plan.families[0]).presets[0]
+    preset = plan.limit.corner_family(plan.families[0]).presets[0]
     for (label, _, _), (df, _) in zip(docs, results):
         comp = df[df["analysis"] == "compare"]
-        settings = dict(dict(plan.limit_variations)[label])
+        settings = dict(dict(plan.limit.variations)[label])
         variations[label] = {**_family_summary(comp), "settings": settings, "surface": preset}
     base = [r for r in runs_rows if r["preset"] == preset]
     return {

@@ -291,7 +291,9 @@ def test_every_refined_sweep_of_the_plans_is_a_valid_config_that_changes_only_it
 
     plan = PLANS[plan_name]
     # the analytic families (the quick plan: all; each fractal seed costs a surface)
-    corner = [plan.corner_family(f) for f in plan.families if plan_name == "quick" or f.name != "fractal"]
+    corner = [
+        plan.limit.corner_family(f) for f in plan.families if plan_name == "quick" or f.name != "fractal"
+    ]
     docs = _refinement_docs(plan, corner)
     keys = {(fam, key) for fam, key, _, _ in docs}
     from spine_mj.validate.sweep_configs import gridded
@@ -299,13 +301,13 @@ def test_every_refined_sweep_of_the_plans_is_a_valid_config_that_changes_only_it
     for fam in corner:
         # every family's hfield is refined, a gridded one's through its spline (and four times)
         grid_only = set() if gridded(fam.presets[0], fam) else set(GRID_ONLY)
-        assert {(fam.name, k) for k in plan.convergence_refinements if k not in grid_only} <= keys
+        assert {(fam.name, k) for k in plan.limit.convergence_refinements if k not in grid_only} <= keys
         assert not {(fam.name, k) for k in grid_only} & keys
         # at least convergence_starts paired starts a family, spread over its surfaces
         one = next(doc for f, k, _, doc in docs if f == fam.name)
         per_surface = len(one["starts"]["y"])
         assert per_surface * len(fam.seeds or (None,)) * len(fam.variants) * len(fam.presets) >= min(
-            plan.convergence_starts, len(fam.starts_table()["y"]) * len(fam.presets)
+            plan.limit.convergence_starts, len(fam.starts_table()["y"]) * len(fam.presets)
         )
     for _, key, _, doc in docs:
         sweep.parse_config(doc)

@@ -28,14 +28,14 @@ def test_each_soft_contact_miss_is_the_full_reports_start_with_its_ensemble(miss
     full = study.REPORTED_FULL  # the sample the committed full report ran
     fam = study.miss_family(full, miss)
     pts = fam.starts_table()["points"]
-    assert len(pts) == full.ensemble_members and fam.presets == (miss.preset,)
+    assert len(pts) == full.limit.ensemble_members and fam.presets == (miss.preset,)
     # the start the report's run table shows, to its rounding
     x, y = _surface_units(fam, miss, pts[0])
     assert (round(x, 2), round(y, 2)) == pytest.approx(miss.shown)
     # and the very ensemble the plan ran: the whole family's stencil
     (whole,) = [f for f in full.families if f.name == miss.family]
-    members = full.ensemble_members
-    ens = ensemble_family(full.corner_family(whole), miss.preset, members).starts_table()["points"]
+    members = full.limit.ensemble_members
+    ens = ensemble_family(full.limit.corner_family(whole), miss.preset, members).starts_table()["points"]
     assert [tuple(p) for p in pts] == [
         tuple(p) for p in ens[miss.start * members : (miss.start + 1) * members]
     ]
@@ -98,7 +98,9 @@ def test_the_corner_and_a_miss_run_in_both_engines(tmp_path):
     from spine_mj.validate.study_runner import StudyRunner
 
     fam = FamilySpec("single_peak_valley", ("paper-single-peak",), None, paper_starts([-2.0]))
-    plan = dataclasses.replace(PLANS["smoke"], families=(fam,), ensemble_members=2)
+    plan = dataclasses.replace(
+        PLANS["smoke"], families=(fam,), limit=dataclasses.replace(PLANS["smoke"].limit, ensemble_members=2)
+    )
     miss = study.MissStart("single_peak_valley", "paper-single-peak", None, (), 0, (-3.0, -2.0))
     res = study.engine_headlines(
         plan, StudyRunner(tmp_path, 1, None, time.perf_counter()), rechecks=(miss,), recheck_plan=plan

@@ -84,7 +84,9 @@ def test_the_limit_study_runs_each_start_as_an_ensemble_on_both_sides(tmp_path):
     from spine_mj.validate.study_runner import StudyRunner
 
     fam = FamilySpec("single_peak_valley", ("paper-single-peak",), None, paper_starts([-2.0, -4.0]))
-    plan = dataclasses.replace(PLANS["smoke"], families=(fam,), ensemble_members=3)
+    plan = dataclasses.replace(
+        PLANS["smoke"], families=(fam,), limit=dataclasses.replace(PLANS["smoke"].limit, ensemble_members=3)
+    )
     res = quasistatic_limit(plan, StudyRunner(tmp_path, 1, None, time.perf_counter()))
     f = res.families["single_peak_valley"]
     assert f["runs"] == 2 and f["starts"] == 2 and f["members"] == 3  # runs: the starts themselves
@@ -110,7 +112,9 @@ def test_a_familys_presets_share_one_sweep_in_cases_of_whole_ensembles():
     fam = FamilySpec(
         "single_peak_valley", ("paper-single-peak", "paper-single-valley"), None, paper_starts(ys)
     )
-    plan = dataclasses.replace(PLANS["smoke"], families=(fam,), ensemble_members=3)
+    plan = dataclasses.replace(
+        PLANS["smoke"], families=(fam,), limit=dataclasses.replace(PLANS["smoke"].limit, ensemble_members=3)
+    )
     ((name, doc),) = limit_family_docs(plan, fam)
     assert name == "single_peak_valley"
     cases = expand_cases(parse_config(doc))
@@ -124,5 +128,5 @@ def test_a_familys_presets_share_one_sweep_in_cases_of_whole_ensembles():
         assert max(len(c.starts.as_dict()["points"]) for c in mine) == 3 * CASE_STARTS
     assert {c.params["ensemble_members"] for c in cases} == {3}
     # without ensembles every preset keeps its own sweep of the family's starts
-    single = dataclasses.replace(plan, ensemble_members=1)
+    single = dataclasses.replace(plan, limit=dataclasses.replace(plan.limit, ensemble_members=1))
     assert [n for n, _ in limit_family_docs(single, fam)] == list(fam.presets)

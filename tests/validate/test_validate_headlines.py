@@ -21,10 +21,8 @@ FAMILY = FamilySpec("fractal", ("paper-fractal",), (2,), relative_starts(4), var
 PLAN = dataclasses.replace(
     PLANS["quick"],
     families=(FAMILY,),
-    limit_variations=(),
     hfield_resolution=101,
-    ensemble_members=3,
-    corner=(),
+    limit=dataclasses.replace(PLANS["quick"].limit, variations=(), ensemble_members=3, corner=()),
 )
 
 

@@ -13,7 +13,7 @@ from spine_mj.validate.stiffness_map import subset_starts
 
 
 def _corner_starts(plan, fam) -> int:
-    c = plan.corner_family(fam)
+    c = plan.limit.corner_family(fam)
     t = c.starts_table()
     per_surface = len(t["points"]) if "points" in t else len(t["x"]) * len(t["y"])
     return per_surface * len(c.presets) * len(c.variants) * (len(c.seeds) if c.seeds else 1)
@@ -26,7 +26,7 @@ def test_every_family_has_enough_starts_at_the_corner_each_an_ensemble(plan, lea
     ill-conditioned ones; every family, the sandpaper and the shipped scans included."""
     p = PLANS[plan]
     # the full plan's ensembles look on either side of a start along x; the demo's on one
-    assert p.ensemble_members >= (3 if plan == "full" else 2)
+    assert p.limit.ensemble_members >= (3 if plan == "full" else 2)
     assert {f.name for f in p.families} >= {
         "single_peak_valley",
         "random_gaussian",
@@ -38,10 +38,10 @@ def test_every_family_has_enough_starts_at_the_corner_each_an_ensemble(plan, lea
         # and at least as many as can meet the target at all (35 all agreeing)
         assert _corner_starts(p, fam) >= max(least, runs_to_meet(OUTCOME_TARGET)), fam.name
         # over several surface instances
-        c = p.corner_family(fam)
+        c = p.limit.corner_family(fam)
         assert len(c.presets) * len(c.variants) * len(c.seeds or (None,)) >= 2, fam.name
     if plan == "full":
-        fractal = p.corner_family(next(f for f in p.families if f.name == "fractal"))
+        fractal = p.limit.corner_family(next(f for f in p.families if f.name == "fractal"))
         assert len(fractal.seeds) >= 5 and len(fractal.variants) >= 2
 
 
@@ -57,7 +57,7 @@ def test_the_corner_and_the_map_leave_the_family_for_the_other_studies():
     p = PLANS["quick"]
     for fam in p.families:
         assert p.stiffness_map.map_family(fam) == fam  # no map sample size asked for: the family's own
-    assert PLANS["smoke"].corner_family(PLANS["smoke"].families[0]) == PLANS["smoke"].families[0]
+    assert PLANS["smoke"].limit.corner_family(PLANS["smoke"].families[0]) == PLANS["smoke"].families[0]
 
 
 def test_the_full_map_reaches_ten_k_star_and_ie_1e_6_with_factor_2_steps_around_k_star():
@@ -67,9 +67,9 @@ def test_the_full_map_reaches_ten_k_star_and_ie_1e_6_with_factor_2_steps_around_
     near = [v for v in f if 0.3 <= v <= 3]
     assert all(b / a <= 2.0 + 1e-9 for a, b in itertools.pairwise(near))  # K* judged within a factor 2
     assert min(p.stiffness_map.deep_ie) <= 1e-6
-    assert "dt_quartered" in p.convergence_refinements  # three step levels: an observed order
+    assert "dt_quartered" in p.limit.convergence_refinements  # three step levels: an observed order
     q = PLANS["quick"]
-    assert max(q.stiffness_map.k_factors) >= 3 and q.convergence_starts > 0
+    assert max(q.stiffness_map.k_factors) >= 3 and q.limit.convergence_starts > 0
 
 
 def test_the_deep_ie_runs_on_every_k_of_the_families_the_plan_names_else_on_the_stiffest():

@@ -100,7 +100,7 @@ def test_smoke_validation_writes_report_and_json(tmp_path, monkeypatch):
     conv = doc["convergence"]["single_peak_valley"]
     for key in ("dt_halved", "hfield_doubled"):
         assert {"agreement_change", "median_frechet_change", "converged"} <= set(conv[key])
-        assert conv[key]["refined"] and conv[key]["runs"] == plan.convergence_starts
+        assert conv[key]["refined"] and conv[key]["runs"] == plan.limit.convergence_starts
     assert "Solution verification" in report
     # and of I_e*: the smoke grid's two I_e values rerun with the step halved
     star_conv = doc["ie_star"]["spring"]["convergence"]
