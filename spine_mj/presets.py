@@ -304,7 +304,7 @@ def make_surface(preset: Preset | str, **overrides) -> surfaces.Surface:
     return surface
 
 
-def open_surface(spec: str, **overrides) -> surfaces.Surface:
+def open_surface(spec: str, *, fill: str = "refuse", **overrides) -> surfaces.Surface:
     """The surface a SURFACE argument or a sweep's ``[[surfaces]]`` entry names: a shipped
     example (``example:plu-1.plu``), a saved ``.npz``, a preset (a name of
     :func:`list_presets` or a ``.toml`` recipe, made with ``overrides`` as in
@@ -315,17 +315,25 @@ def open_surface(spec: str, **overrides) -> surfaces.Surface:
     spec : str
         ``example:NAME``, a ``.npz`` path, a preset's name or ``.toml`` path, or an instrument
         file's path.
+    fill : str
+        How an instrument file's missing points are filled
+        (:func:`~spine_mj.surface_io.import_topography`: ``refuse``, ``harmonic``, ``nearest``,
+        ``mean``); only an instrument file has missing points.
     **overrides
         Generator parameters (and ``seed``) replaced in a preset; none for a file.
 
     Raises
     ------
     SpineInputError
-        ``spec`` names none of these, or ``overrides`` are given for a file (only a preset
-        has generator parameters).
+        ``spec`` names none of these, ``overrides`` are given for a file (only a preset
+        has generator parameters), or a ``fill`` for anything but an instrument file.
     """
     spec = examples.resolve(spec)
     path = Path(spec)
+    if fill != "refuse" and (spec in list_presets() or path.suffix in (".toml", ".npz")):
+        raise SpineInputError(
+            f"fill is for an instrument file's missing points, got fill={fill!r} for {spec!r}"
+        )
     if spec in list_presets() or path.suffix == ".toml":
         return make_surface(spec, **overrides)
     if overrides:
@@ -335,7 +343,7 @@ def open_surface(spec: str, **overrides) -> surfaces.Surface:
     if path.suffix == ".npz":
         return surface_io.load_surface(path)
     if path.is_file():
-        return surface_io.import_topography(path)
+        return surface_io.import_topography(path, fill=fill)
     raise SpineInputError(
         f"SURFACE must be a .npz file, a preset ({', '.join(list_presets())}), an "
         f"instrument file or an example (spine-mj examples), got {spec!r}"

@@ -48,8 +48,15 @@ from spine_mj.errors import SpineInputError
 @click.option(
     "--workers", type=click.IntRange(min=1), default=None, help="Worker processes (default: all cores)."
 )
+@click.option(
+    "--fill",
+    type=click.Choice(["refuse", "harmonic", "nearest", "mean"]),
+    default="refuse",
+    show_default=True,
+    help="Missing points of an instrument file (as `surface make --fill`).",
+)
 @click.option("--quiet", is_flag=True, help="No progress bar.")
-def hold_cmd(surface_spec, mu, out_dir, tip_radius, starts, reference_starts, budget, workers, quiet):
+def hold_cmd(surface_spec, mu, out_dir, tip_radius, starts, reference_starts, budget, workers, fill, quiet):
     """Will a spine hold on SURFACE (preset, .npz or instrument scan)? Chooses the drive's
     corner from the surface's own limits, traces the self-lock share with its interval,
     checks it in MuJoCo and refines until converged.
@@ -64,7 +71,7 @@ def hold_cmd(surface_spec, mu, out_dir, tip_radius, starts, reference_starts, bu
     out = Path(out_dir)
     if out.exists() and not out.is_dir():
         raise SpineInputError(f"--out {out} exists and is not a folder")
-    surf = presets.open_surface(surface_spec)
+    surf = presets.open_surface(surface_spec, fill=fill)
     settings = HoldSettings(
         mu=presets.resolve_mu(surf, mu, name="--mu"),
         tip_radius=tip_radius,

@@ -49,3 +49,21 @@ def test_a_plane_is_refused_in_one_line_naming_why(tmp_path):
     path = save_surface(GridSurface(heights=np.zeros((17, 17)), x=x, y=x.copy()), tmp_path / "plane.npz")
     line = _refused([str(path), "--mu", "0.5", "--starts", "2", "--reference-starts", "5"], tmp_path / "out")
     assert "no path on it folds (K* = 0" in line
+
+
+def test_a_scan_with_missing_points_needs_fill_and_a_preset_takes_none(tmp_path):
+    import SurfaceTopography as st
+
+    h = np.add.outer(np.linspace(0, 1, 40), np.linspace(0, 2, 30))
+    masked = np.ma.masked_array(h, mask=np.zeros_like(h, dtype=bool))
+    masked.mask[10:13, 5:9] = True
+    scan = tmp_path / "holey.x3p"
+    st.Topography(masked, (40.0, 30.0), unit="um").to_x3p(str(scan))
+    line = _refused([str(scan), "--mu", "0.5"], tmp_path / "out")
+    assert "12 missing points" in line and "fill" in line
+    line = _refused(["paper-single-peak", "--mu", "0.5", "--fill", "harmonic"], tmp_path / "out")
+    assert "fill is for an instrument file's missing points" in line
+    from spine_mj.presets import open_surface
+
+    filled = open_surface(str(scan), fill="harmonic")
+    assert np.isfinite(filled.heights).all() and filled.metadata["missing_points"] == 12
