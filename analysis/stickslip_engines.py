@@ -1,8 +1,10 @@
 """MuJoCo (and Bullet) slips on the ABBM track against the quasistatic references (issue 42).
 
 For each engine, I_e and variant (``base``; ``dt2``, ``dt4``: half, a quarter of the
-engine's step; ``hfield2``: the hfield refined twice), one spring drive per K over the
-``abbm`` preset (all but a twentieth at each end, in runs of ``--segment`` units from rest),
+engine's step, and with it the rule's contact time constant, 2 dt; ``step2``, ``step4``:
+the step alone, the contact's time constant kept; ``hfield2``: the hfield refined twice),
+one spring drive per K over the ``abbm`` preset (all but a twentieth at each end, in runs
+of ``--segment`` units from rest),
 its slips against the overdamped and inertial references' slips on the same stretch that
 the engine's detector would see (peak speed >= 5 V): the Kolmogorov-Smirnov distance and
 p-value of sizes and force drops; the same for the force drops deeper than each
@@ -62,7 +64,11 @@ def _variant(engine: str, variant: str, ie: float, k: float, surf):
     rig = build_rig(surf, engine=engine, mu=MU, ie=ie, stiffness_number=k)
     if variant == "base":
         return rig
-    if variant in ("dt2", "dt4"):
+    if variant in ("step2", "step4"):  # only the step: the contact's time constant kept
+        return build_rig(
+            surf, engine=engine, mu=MU, ie=ie, stiffness_number=k, timestep_factor=1 / int(variant[4])
+        )
+    if variant in ("dt2", "dt4"):  # the step, and with it the rule's contact time constant (2 dt)
         return build_rig(
             surf,
             engine=engine,

@@ -50,6 +50,7 @@ def test_stickslip_writes_the_catalog_and_tau(track, tmp_path):
         (["--K", "-1"], "--K"),
         (["--K", "1", "--ie", "nan"], "--ie"),
         (["--K", "1", "--travel", "1e9"], "--travel"),
+        (["--K", "1", "--drop-floor", "0"], "--drop-floor"),
     ],
 )
 def test_bad_input_is_one_error_line_and_nothing_written(track, tmp_path, args, needle):
