@@ -13,6 +13,10 @@
    ``starts``), each run as an ensemble (:mod:`~spine_mj.validate.ensembles`), through the
    sweep machinery (:class:`~spine_mj.validate.study_runner.StudyRunner`: a killed run
    resumes where it stopped); the agreement over the well-conditioned starts, Wilson.
+   Where fewer than :data:`MIN_PAIRED_STARTS` of them are left paired at every level (starts
+   on watersheds, references stalled in pits), more places are added as starts
+   (:func:`_more_starts`: by their count, never by their outcome) and everything is judged
+   again on all of them.
 4. Refinement until converged (:mod:`~spine_mj.validate.convergence`): along each axis of
    :data:`LADDERS` (the step, the hfield, the solver's tolerance) the next level runs on the
    same starts until its change from the level before lies inside the agreement's (and the
@@ -189,7 +193,9 @@ def hold_to(
             settings.budget_s - (time.perf_counter() - t0),
             (time.perf_counter() - base["started"]) / max(len(batches.points[-1]), 1),
         )
-        if judged["converged"] or add == 0 or len(batches.points) > POWER_ROUNDS:
+        if add and len(batches.points) > POWER_ROUNDS:
+            note = f"{POWER_ROUNDS} rounds of added starts were not enough"
+        if judged["converged"] or note or not add:
             why = "; ".join(w for w in (judged["why"], note) if w)
             break
         batches.points.append(places[n_run : n_run + add])
