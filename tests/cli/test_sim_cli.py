@@ -105,7 +105,7 @@ def test_cli_simulate_and_surface_info_on_a_y_varying_strip_with_the_tip_on_its_
     path = save_surface(GridSurface(heights=heights, x=x, y=y), tmp_path / "strip.npz")
     info = CliRunner().invoke(main, ["surface", "info", str(path), "--mu", "0.5", "--json"])
     assert info.exit_code == 0, info.output
-    assert json.loads(info.output)["slope_correlation_length"] > 0
+    assert json.loads(info.stdout)["slope_correlation_length"] > 0
     run = ["simulate", str(path), "--mu", "0.5", "--start", "10,1", "--duration", "1", "--line"]
     res = CliRunner().invoke(main, [*run, "--out", str(tmp_path / "run")])
     assert res.exit_code == 0, res.output
