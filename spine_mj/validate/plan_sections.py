@@ -8,12 +8,9 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
-
-if TYPE_CHECKING:
-    from spine_mj.validate.plans import FamilySpec
 
 __all__ = [
     "BoundaryPlan",
@@ -86,9 +83,9 @@ class LimitPlan:
     convergence_refinements: tuple[str, ...] = ("dt_halved", "hfield_doubled")
     compliant_reference: bool = True
 
-    def corner_family(self, fam: FamilySpec) -> FamilySpec:
-        """``fam`` with the seeds and starts of its corner (``corner``; as it is where
-        ``corner`` has no entry for it)."""
+    def corner_family(self, fam):
+        """``fam`` (a :class:`~spine_mj.validate.plans.FamilySpec`) with the seeds and starts
+        of its corner (``corner``; as it is where ``corner`` has no entry for it)."""
         for name, seeds, starts in self.corner:
             if name == fam.name:
                 return dataclasses.replace(fam, seeds=seeds, starts=starts)
