@@ -56,8 +56,8 @@ class Study:
     result : type
         The type of its result.
     report : module
-        Its report module: ``headline(result)`` and ``section(result, ctx)``, and where the
-        study has any, ``summary_lines(validation)`` and ``headline_numbers(validation)``
+        Its report module: ``section(result, ctx)``, and where the study has any,
+        ``headline(result)``, ``summary_lines(validation)`` and ``headline_numbers(validation)``
         (:mod:`spine_mj.validate.report.common`).
     """
 
@@ -65,6 +65,12 @@ class Study:
     run: Callable[[ValidationPlan, StudyRunner], Any]
     result: type
     report: ModuleType
+
+    def headline(self, result: Any) -> list[str]:
+        """The study's lines of the report's headline list, from its result (none where its
+        report module has no ``headline``)."""
+        lines = getattr(self.report, "headline", None)
+        return lines(result) if lines is not None else []
 
     def summary_lines(self, validation: dict) -> list[str]:
         """The study's lines of what ``spine-mj validate`` prints, from its keys of the loaded

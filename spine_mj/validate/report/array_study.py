@@ -13,7 +13,7 @@ from spine_mj.plotting import new_figure, save_figure, sig, styled
 from spine_mj.validate.array_study import ArrayStudyResult
 from spine_mj.validate.report.common import ReportContext, table
 
-__all__ = ["array_figure", "array_section", "headline", "section", "summary_lines"]
+__all__ = ["array_figure", "array_section", "section", "summary_lines"]
 
 _COLORS = {"grid": "#1f77b4", "staggered": "#d62728", "random": "#2ca02c"}
 
@@ -242,10 +242,6 @@ def _verdict(res: ArrayStudyResult) -> str:
             else "."
         )
     )
-
-
-def headline(res: ArrayStudyResult) -> list[str]:
-    return []
 
 
 def summary_lines(validation: dict) -> list[str]:

@@ -4,6 +4,7 @@ I_e per drive protocol, the I_e* headline, and MuJoCo's paths over the streamlin
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import numpy as np
@@ -144,25 +145,43 @@ def _overlay_figure(out: Path, path: Path) -> Path | None:
     return save_figure(path_overlay_figure(panels), path)
 
 
+def _estimates(ie_star: dict) -> Iterator[tuple[str, dict | None, str]]:
+    """Per protocol of ``ie_star`` (the study's ``ie_star``, its key of ``validation.json``)
+    ``(protocol, estimate, note)`` for its I_e* by the main criterion, then by departure where
+    it has one; ``note`` is the main estimate's refinement note, or for a protocol not
+    measured (estimate None) why."""
+    for proto, s in ie_star.items():
+        if s.get("valid") is False:
+            yield proto, None, s.get("note", "")
+            continue
+        for star in (s, s.get("by_criterion", {}).get("departure")):
+            if star:
+                yield proto, star, refinement_note(s.get("convergence")) if star is s else ""
+
+
+def _estimate_text(star: dict, num: Callable[[float], str]) -> str:
+    """An I_e* estimate in words, its numbers written by ``num``: bracketed, above or below
+    the grid."""
+    if star["kind"] == "bracketed":
+        value, low, high = (num(star[k]) for k in ("value", "low", "high"))
+        return f"I_e* = {value} in [{low}, {high}]"
+    if star["kind"] == "above":
+        return f"I_e* > {num(star['low'])} (agreement holds on the whole grid)"
+    return f"I_e* < {num(star['high'])} (no agreement at the lowest I_e)"
+
+
 def summary_lines(validation: dict) -> list[str]:
     """Per protocol its I_e* by the main criterion and by departure where it has one, each
     criterion on its line and the estimate indented under it (or why there is none)."""
     lines = []
-    for proto, s in validation.get("ie_star", {}).items():
-        if s.get("valid") is False:
-            lines.append(f"I_e* ({proto}) {s['note']}")
-            continue
-        for star in (s, s["by_criterion"].get("departure")):
-            if star is None:
-                continue
-            lines.append(f"I_e* ({proto}) criterion: {star['criterion']}")
-            note = refinement_note(s.get("convergence")) if star is s else ""
-            if star["kind"] == "bracketed":
-                lines.append(f"  I_e* = {star['value']:.3g} in [{star['low']:.3g}, {star['high']:.3g}]{note}")
-            elif star["kind"] == "above":
-                lines.append(f"  I_e* > {star['low']:.3g} (agreement holds on the whole grid){note}")
-            else:
-                lines.append(f"  I_e* < {star['high']:.3g} (no agreement at the lowest I_e){note}")
+    for proto, star, note in _estimates(validation.get("ie_star", {})):
+        if star is None:
+            lines.append(f"I_e* ({proto}) {note}")
+        else:
+            lines += [
+                f"I_e* ({proto}) criterion: {star['criterion']}",
+                f"  {_estimate_text(star, '{:.3g}'.format)}{note}",
+            ]
     return lines
 
 
@@ -181,28 +200,13 @@ def headline_numbers(validation: dict) -> dict[str, Headline]:
 
 
 def headline(boundary: BoundaryResult) -> list[str]:
-    """One line per protocol: its I_e* (or why there is none)."""
+    """One line per protocol and criterion: its I_e* (or why there is none)."""
     lines = []
-    for proto, s in boundary.ie_star.items():
-        if s.get("valid") is False:
-            lines.append(f"{proto}: I_e* not measured ({s.get('note', '')})")
-            continue
-        for star in (s, s.get("by_criterion", {}).get("departure")):
-            if not star:
-                continue
-            crit = star.get("criterion", "")
-            note = refinement_note(s.get("convergence")) if star is s else ""
-            if star["kind"] == "bracketed":
-                value, low, high = (sig(star[k]) for k in ("value", "low", "high"))
-                lines.append(f"{proto} ({crit}): I_e* = {value} in [{low}, {high}]{note}")
-            elif star["kind"] == "above":
-                lines.append(
-                    f"{proto} ({crit}): I_e* > {sig(star['low'])} (agreement holds on the whole grid){note}"
-                )
-            else:
-                lines.append(
-                    f"{proto} ({crit}): I_e* < {sig(star['high'])} (no agreement at the lowest I_e){note}"
-                )
+    for proto, star, note in _estimates(boundary.ie_star):
+        if star is None:
+            lines.append(f"{proto}: I_e* not measured ({note})")
+        else:
+            lines.append(f"{proto} ({star.get('criterion', '')}): {_estimate_text(star, sig)}{note}")
     return lines
 
 

@@ -1,13 +1,15 @@
 """What every study's report module shares: table cells, Markdown tables and figure links,
 and the :class:`ReportContext` a module gets (the output folder and every study's result).
 
-A study's report module (:mod:`spine_mj.validate.report`) defines two functions, which
-:func:`~spine_mj.validate.report.document.write_report` calls in the order of the
-registry (:data:`spine_mj.validate.studies.STUDIES`):
+A study's report module (:mod:`spine_mj.validate.report`) defines, from the study's result,
+what :func:`~spine_mj.validate.report.document.write_report` puts into ``report.md`` in the
+order of the registry (:data:`spine_mj.validate.studies.STUDIES`):
 
-* ``headline(result) -> list[str]``: lines for the report's headline list (most give none);
 * ``section(result, ctx) -> str | None``: its Markdown section with the figures it drew
-  under ``ctx.figures`` (:func:`assemble`), or None for no section at all.
+  under ``ctx.figures`` (:func:`assemble`), or None for no section at all;
+* where the study has any, ``headline(result) -> list[str]``: its lines of the report's
+  headline list (the boundary study's I_e*; :meth:`spine_mj.validate.studies.Study.headline`
+  gives none for a module without it).
 
 and, where the study has any, two that read its keys of a loaded ``validation.json``
 (:meth:`spine_mj.validate.studies.Study.summary_lines` and ``headline_numbers`` call them;

@@ -2,8 +2,9 @@
 
 :func:`write_report` hands every study's result to its report module
 (:data:`spine_mj.validate.studies.STUDIES`), which draws its figures under
-``out/figures`` and returns its section; the header, the headline and the engine settings
-come from the summary that ``validation.json`` holds, so that both say the same numbers.
+``out/figures`` and returns its section, and where it has any its lines of the headline
+(:meth:`~spine_mj.validate.studies.Study.headline`); the header, the engine settings and the
+timings come from the summary that ``validation.json`` holds, so that both say the same numbers.
 """
 
 from __future__ import annotations
@@ -16,9 +17,9 @@ from spine_mj.atomic import atomic_output
 from spine_mj.plotting import sig
 from spine_mj.templates import render
 from spine_mj.theory.targets import FRECHET_TARGET, OUTCOME_TARGET
+from spine_mj.validate import studies
 from spine_mj.validate.plans import STATIC_TARGET
 from spine_mj.validate.report.common import ReportContext
-from spine_mj.validate.studies import STUDIES
 
 __all__ = ["PLAN_NOTES", "write_report"]
 
@@ -56,14 +57,14 @@ def write_report(out: Path, summary: dict, results: Iterable) -> Path:
     figs.mkdir(parents=True, exist_ok=True)
     given = {}
     for res in results:
-        study = next((s for s in STUDIES if isinstance(res, s.result)), None)
+        study = next((s for s in studies.STUDIES if isinstance(res, s.result)), None)
         if study is None:
             raise TypeError(f"no study of spine_mj.validate.studies returns a {type(res).__name__}")
         given[study.name] = res
     ctx = ReportContext(out=out, figures=figs, results=given)
-    studies = [(s, given[s.name]) for s in STUDIES if s.name in given]
-    headline = [line for s, res in studies for line in s.report.headline(res)]
-    sections = [text for s, res in studies if (text := s.report.section(res, ctx)) is not None]
+    ran = [(s, given[s.name]) for s in studies.STUDIES if s.name in given]
+    headline = [line for s, res in ran for line in s.headline(res)]
+    sections = [text for s, res in ran if (text := s.report.section(res, ctx)) is not None]
     plan = summary["plan"]
     text = render(
         "validation_report.md.j2",

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["headline", "section", "summary_lines"]
+__all__ = ["section", "summary_lines"]
 
 TITLE = "## Engines side by side: the closed forms"
 
@@ -22,11 +22,6 @@ def _fmt(v) -> str:
     if isinstance(v, float) and not math.isfinite(v):
         return "n/a"
     return f"{v:.4g}"
-
-
-def headline(res) -> list[str]:
-    """The engines study adds no line to the report's headline (its verdicts are per check)."""
-    return []
 
 
 def summary_lines(validation: dict) -> list[str]:

@@ -173,10 +173,6 @@ def _fractal_sentence(fr: FractalLockResult) -> str:
     )
 
 
-def headline(fr: FractalLockResult) -> list[str]:
-    return []
-
-
 #: The series whose rates are headlines (the facets' streamline is the report's alone).
 HEADLINE_SERIES = ("streamline", "mujoco_corner", "mujoco_dynamic")
 

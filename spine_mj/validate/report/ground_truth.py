@@ -12,15 +12,11 @@ from spine_mj.theory.motion import SLIP_SPEED_FACTOR, STUCK_SPEED_FRACTION
 from spine_mj.validate.ground_truth import LIFTOFF_GAP_RADII, POINTS_PER_WAVE, TOMLINSON_IE, GroundTruthResult
 from spine_mj.validate.report.common import ReportContext, cell, table
 
-__all__ = ["ground_truth_section", "headline", "section"]
+__all__ = ["ground_truth_section", "section"]
 
 
 def _pct(v: float) -> str:
     return "n/a" if v is None or not math.isfinite(v) else f"{100 * v:+.1f} %"
-
-
-def headline(gt: GroundTruthResult) -> list[str]:
-    return []
 
 
 def section(gt: GroundTruthResult, ctx: ReportContext) -> str:

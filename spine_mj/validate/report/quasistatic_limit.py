@@ -450,10 +450,6 @@ def _variations_and_runs(limit: QuasistaticLimitResult) -> list[str]:
     ]
 
 
-def headline(limit: QuasistaticLimitResult) -> list[str]:
-    return []
-
-
 def summary_lines(validation: dict) -> list[str]:
     """Per family at its corner: the outcome agreement, the median Frechet distance (each
     marked where unconverged) and the engine's stops."""

@@ -63,10 +63,6 @@ def _lines(sand: SandpaperResult) -> list[str]:
     ]
 
 
-def headline(sand: SandpaperResult) -> list[str]:
-    return []
-
-
 def section(sand: SandpaperResult, ctx: ReportContext) -> str:
     fig = ctx.draw(_sand_figure, sand, "sandpaper.png")
     return assemble("\n".join(_lines(sand)), image("Sandpaper paths and drive force", fig))

@@ -99,10 +99,6 @@ def _convergence_note(static: StaticMapResult) -> str:
     return f" ({'; '.join(parts)})" if parts else ""
 
 
-def headline(static: StaticMapResult) -> list[str]:
-    return []
-
-
 def summary_lines(validation: dict) -> list[str]:
     """The largest static kappa error, engaged, at the default settings."""
     if "static_kappa_max_rel_error" not in validation:

@@ -128,10 +128,6 @@ def k_scan_section(stick: StickSlipResult) -> list[str]:
     return lines
 
 
-def headline(stick: StickSlipResult) -> list[str]:
-    return []
-
-
 def section(stick: StickSlipResult, ctx: ReportContext) -> str:
     fig = ctx.draw(_stick_figure, stick, "stick_slip.png")
     return assemble("\n".join(_lines(stick)), image("Drive force of the spring drive against time", fig))

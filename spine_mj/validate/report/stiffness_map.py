@@ -553,10 +553,6 @@ def _prediction_text(km: StiffnessMapResult) -> list[str]:
     ]
 
 
-def headline(km: StiffnessMapResult) -> list[str]:
-    return []
-
-
 def section(km: StiffnessMapResult, ctx: ReportContext) -> str | None:
     """The map's sections (I_e*(K), energy, slip), or None without a map."""
     if not km.agreement:
