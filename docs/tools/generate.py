@@ -251,42 +251,9 @@ def convergence_section(validation: dict) -> list[str]:
     return [*lines, ""]
 
 
-def _ie_star_lines(validation: dict) -> list[str]:
-    ie = validation.get("ie_star") or {}
-    if not ie:
-        return []
-    lines = [
-        "## Where the quasistatic picture breaks: I_e*",
-        "",
-        "| drive | criterion | I_e* | bracket | bootstrap interval |",
-        "|---|---|---|---|---|",
-    ]
-    for drive, s in ie.items():
-        if not isinstance(s, dict):
-            continue
-        lines.append(
-            f"| {drive} | {s.get('criterion', '')} | {_num(s.get('value'))} | "
-            f"[{_num(s.get('low'))}, {_num(s.get('high'))}] | "
-            f"[{_num(s.get('ci_low'))}, {_num(s.get('ci_high'))}] |"
-        )
-    return [*lines, ""]
-
-
-def _static_lines(validation: dict) -> list[str]:
-    err = validation.get("static_kappa_max_rel_error")
-    if err is None:
-        return []
-    return [
-        "## Static breakaway",
-        "",
-        f"Largest relative error of MuJoCo's breakaway force against `tan(theta + arctan mu)` "
-        f"over the engaged planes: {_num(err)} (`static_kappa_max_rel_error`).",
-        "",
-    ]
-
-
 def results_page(plan: str, folder: str, command: str, validation: dict) -> str:
     """The Markdown of one plan's results page."""
+    from spine_mj.validate import studies
     from spine_mj.validate.report.verdicts import platform_line, verdicts_section
 
     timings = validation.get("timings_s") or {}
@@ -304,8 +271,7 @@ def results_page(plan: str, folder: str, command: str, validation: dict) -> str:
         *headline_table(validation),
         "",
         *verdicts_section(validation.get("limit_families", {})),
-        *_ie_star_lines(validation),
-        *_static_lines(validation),
+        *(line for study in studies.STUDIES for line in study.results_lines(validation)),
         *convergence_section(validation),
     ]
     if total is not None:

@@ -7,7 +7,9 @@ runs the studies in this order and :func:`spine_mj.validate.write_report` puts t
 sections into ``report.md`` in the same order; the lines ``spine-mj validate`` prints
 (:func:`spine_mj.validate.summary.summary_lines`) and the headline numbers a reproduction
 is checked on (:func:`spine_mj.validate.headlines.headline_numbers`) are the studies' own, in
-the same order too. A new study is one study module, one report module and one line here.
+the same order too, as are the blocks of the site's results pages (``docs/tools/generate.py``).
+A new study is one study module, one report module and one line here
+(``docs/developer/layout.md``, "Adding a study").
 """
 
 from __future__ import annotations
@@ -57,8 +59,9 @@ class Study:
         The type of its result.
     report : module
         Its report module: ``section(result, ctx)``, and where the study has any,
-        ``headline(result)``, ``summary_lines(validation)`` and ``headline_numbers(validation)``
-        (:mod:`spine_mj.validate.report.common`).
+        ``headline(result)``, ``summary_lines(validation)``, ``headline_numbers(validation)``
+        and ``results_lines(validation)`` (:mod:`spine_mj.validate.report.common`); the
+        methods below give none of a kind the module does not state.
     """
 
     name: str
@@ -66,23 +69,29 @@ class Study:
     result: type
     report: ModuleType
 
+    def _stated(self, name: str, arg: Any, none: Any) -> Any:
+        """What the report module's function ``name`` says of ``arg``, or ``none`` where
+        the module has no such function (the study has nothing of that kind)."""
+        state = getattr(self.report, name, None)
+        return state(arg) if state is not None else none
+
     def headline(self, result: Any) -> list[str]:
-        """The study's lines of the report's headline list, from its result (none where its
-        report module has no ``headline``)."""
-        lines = getattr(self.report, "headline", None)
-        return lines(result) if lines is not None else []
+        """The study's lines of the report's headline list, from its result."""
+        return self._stated("headline", result, [])
 
     def summary_lines(self, validation: dict) -> list[str]:
         """The study's lines of what ``spine-mj validate`` prints, from its keys of the loaded
-        ``validation.json`` (none where its report module has no ``summary_lines``)."""
-        lines = getattr(self.report, "summary_lines", None)
-        return lines(validation) if lines is not None else []
+        ``validation.json``."""
+        return self._stated("summary_lines", validation, [])
 
     def headline_numbers(self, validation: dict) -> dict:
-        """The study's numbers with an interval in the loaded ``validation.json``, by key
-        (none where its report module has no ``headline_numbers``)."""
-        numbers = getattr(self.report, "headline_numbers", None)
-        return numbers(validation) if numbers is not None else {}
+        """The study's numbers with an interval in the loaded ``validation.json``, by key."""
+        return self._stated("headline_numbers", validation, {})
+
+    def results_lines(self, validation: dict) -> list[str]:
+        """The study's Markdown block of the site's results page (``docs/tools/generate.py``),
+        from its keys of the loaded ``validation.json``."""
+        return self._stated("results_lines", validation, [])
 
 
 #: The studies, in the order they run and appear in the report (the I_e* headline first).

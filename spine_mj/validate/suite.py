@@ -16,11 +16,11 @@ from spine_mj.errors import SpineInputError
 from spine_mj.jsonio import write_json
 from spine_mj.surfaces import single_gaussian
 from spine_mj.theory.targets import FRECHET_TARGET, OUTCOME_TARGET
+from spine_mj.validate import studies
 from spine_mj.validate.intervals import TARGET_RULE
 from spine_mj.validate.plans import MASS_KG, PLANS, STATIC_TARGET, ValidationPlan
 from spine_mj.validate.platform import platform_info
 from spine_mj.validate.report.document import write_report
-from spine_mj.validate.studies import STUDIES
 from spine_mj.validate.study_runner import StudyRunner, ValidationProgress
 from spine_mj.workers import check_workers
 
@@ -72,7 +72,7 @@ def run_validation(
     runner = StudyRunner(out, workers, progress, t0)
     timings = {}
     results = []
-    for study in STUDIES:
+    for study in studies.STUDIES:
         t = time.perf_counter()
         results.append(study.run(plan, runner))
         timings[study.name] = round(time.perf_counter() - t, 2)

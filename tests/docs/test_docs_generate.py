@@ -68,3 +68,31 @@ def test_every_public_name_is_on_one_api_page(tmp_path):
         for name in importlib.import_module(package).__all__:
             if not name.startswith("_"):
                 assert f"   {name}\n" in text[package] or f"{name}`" in text[package], f"{package}.{name}"
+
+
+def test_the_i_e_star_and_static_blocks_are_the_studies_own_with_the_json_numbers(monkeypatch):
+    """The page's I_e* table and static line come from the boundary and static studies' report
+    modules (``results_lines``) and hold the JSON numbers; a study registered with a block of
+    its own shows it after theirs, with no other file touched."""
+    import types
+
+    from spine_mj.validate import studies
+
+    page = generate.results_page("full", "validation-full", "x", FULL)
+    rows = page.splitlines()
+    for drive, s in FULL["ie_star"].items():
+        row = next(r for r in rows if r.startswith(f"| {drive} | "))
+        cells = [c.strip() for c in row.strip("|").split("|")]
+        assert cells[1] == s["criterion"] and cells[2] == f"{s['value']:.3g}"
+        assert cells[4] == f"[{s['ci_low']:.3g}, {s['ci_high']:.3g}]"
+    static = (
+        f"over the engaged planes: {FULL['static_kappa_max_rel_error']:.3g} (`static_kappa_max_rel_error`)."
+    )
+    assert static in page
+    assert page.index("## Where the quasistatic picture breaks") < page.index("## Static breakaway")
+    report = types.SimpleNamespace(results_lines=lambda v: ["## Creep", "", f"rate {v['creep']} per s", ""])
+    creep = studies.Study("creep", lambda plan, runner: None, type(None), report)
+    monkeypatch.setattr(studies, "STUDIES", (*studies.STUDIES, creep))
+    page = generate.results_page("full", "validation-full", "x", {**FULL, "creep": 0.25})
+    assert "## Creep\n\nrate 0.25 per s\n" in page
+    assert page.index("## Static breakaway") < page.index("## Creep")

@@ -199,6 +199,29 @@ def headline_numbers(validation: dict) -> dict[str, Headline]:
     return out
 
 
+def results_lines(validation: dict) -> list[str]:
+    """The I_e* table of the site's results page: per drive its I_e* by the main criterion,
+    the grid's bracket and the bootstrap interval over starts (``ie_star``); none without it."""
+    ie = validation.get("ie_star") or {}
+    if not ie:
+        return []
+    lines = [
+        "## Where the quasistatic picture breaks: I_e*",
+        "",
+        "| drive | criterion | I_e* | bracket | bootstrap interval |",
+        "|---|---|---|---|---|",
+    ]
+    for drive, s in ie.items():
+        if isinstance(s, dict):
+            value, low, high, ci_low, ci_high = (
+                cell(s.get(k)) for k in ("value", "low", "high", "ci_low", "ci_high")
+            )
+            lines.append(
+                f"| {drive} | {s.get('criterion', '')} | {value} | [{low}, {high}] | [{ci_low}, {ci_high}] |"
+            )
+    return [*lines, ""]
+
+
 def headline(boundary: BoundaryResult) -> list[str]:
     """One line per protocol and criterion: its I_e* (or why there is none)."""
     lines = []

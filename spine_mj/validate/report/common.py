@@ -11,15 +11,17 @@ order of the registry (:data:`spine_mj.validate.studies.STUDIES`):
   headline list (the boundary study's I_e*; :meth:`spine_mj.validate.studies.Study.headline`
   gives none for a module without it).
 
-and, where the study has any, two that read its keys of a loaded ``validation.json``
-(:meth:`spine_mj.validate.studies.Study.summary_lines` and ``headline_numbers`` call them;
-a study whose keys are absent gives nothing):
+and, where the study has any, three that read its keys of a loaded ``validation.json``
+(:meth:`spine_mj.validate.studies.Study.summary_lines`, ``headline_numbers`` and
+``results_lines`` call them; a study whose keys are absent gives nothing):
 
 * ``summary_lines(validation) -> list[str]``: its lines of what ``spine-mj validate`` prints
   (:func:`spine_mj.validate.summary.summary_lines`);
 * ``headline_numbers(validation) -> dict[str, Headline]``: its numbers that carry an interval
   (:func:`spine_mj.validate.headlines.headline_numbers`), read by :func:`read_number`,
-  :func:`read_interval` and :func:`read_table`, which name a malformed field.
+  :func:`read_interval` and :func:`read_table`, which name a malformed field;
+* ``results_lines(validation) -> list[str]``: its Markdown block of the site's results page
+  of a committed run (``docs/tools/generate.py``), after the page's headline verdicts.
 """
 
 from __future__ import annotations

@@ -107,6 +107,21 @@ def summary_lines(validation: dict) -> list[str]:
     return [f"static kappa max rel. error (engaged, default settings): {error:.3g}"]
 
 
+def results_lines(validation: dict) -> list[str]:
+    """The static breakaway of the site's results page: the largest relative error of
+    MuJoCo's breakaway force over the engaged planes (``static_kappa_max_rel_error``)."""
+    err = validation.get("static_kappa_max_rel_error")
+    if err is None:
+        return []
+    return [
+        "## Static breakaway",
+        "",
+        f"Largest relative error of MuJoCo's breakaway force against `tan(theta + arctan mu)` "
+        f"over the engaged planes: {cell(err)} (`static_kappa_max_rel_error`).",
+        "",
+    ]
+
+
 def section(static: StaticMapResult, ctx: ReportContext) -> str:
     fig = ctx.draw(_static_figure, static, "static_map.png")
     return assemble("\n".join(_lines(static)), image("Static breakaway ratio on inclined planes", fig))
