@@ -6,7 +6,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed-stamp
 DEMO_OUT ?= demo-out
 
-.PHONY: demo test lint bench wheel-check docs clean
+.PHONY: demo test lint bench wheel-check docs clean clean-cache
 
 $(STAMP): pyproject.toml setup.py
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -76,5 +76,10 @@ docs: $(DOCS_STAMP)
 	$(BIN)/sphinx-build -W --keep-going -q -b html docs docs/_build/html
 	$(BIN)/python -m pytest -q -n 2 --dist loadfile -m docs tests/docs
 
-clean:
+clean: clean-cache
 	rm -rf $(VENV) $(DEMO_OUT) .pytest_cache .ruff_cache build docs/_build
+
+# numba's kernel caches (docs/user_guide/performance.md: a kernel that compiles in another
+# file's kernels is not recompiled when only that file changes)
+clean-cache:
+	find spine_mj -name '*.nbi' -delete -o -name '*.nbc' -delete
