@@ -41,12 +41,12 @@ def headline_numbers(validation: dict) -> dict[str, Headline]:
     each study's own (:meth:`~spine_mj.validate.studies.Study.headline_numbers`), in the
     order of the registry.
 
-    I_e* of each drive (``ie_star``, bootstrap over starts; None or NaN where it lies outside
-    the grid); per family of the quasistatic-limit corner (``limit_families``) the
-    well-conditioned agreement (``agreement_ci``, Wilson), the agreement over all runs
-    (``outcome_agreement_ci``) and the median Frechet distance (``median_frechet_ci``,
-    bootstrap), the family's ``meets_target`` the verdict; the fractal self-lock rates per H
-    and series (Wilson). Keys read ``limit.fractal.agreement_well_conditioned`` and so on.
+    Today the boundary study's I_e* per drive (``ie_star.spring``), the quasistatic limit's
+    agreement and median Frechet distance per family with its verdict
+    (``limit.fractal.agreement_well_conditioned``) and the fractal self-lock rates
+    (``fractal_lock.H0.65.streamline``); each report module's ``headline_numbers`` says what
+    its numbers and intervals are. ``limit_families`` is what marks a ``validation.json``:
+    every plan runs that study.
 
     Raises
     ------
