@@ -73,6 +73,10 @@ class Engine:
         Whether it runs arrays of tips (``spine-mj array``, the sweep's ``array`` analysis).
     static_probe : bool
         Whether it runs the static probe.
+    hfield_check : str or callable or None
+        ``"module:function"`` refusing a heightfield of ``(nrow, ncol)`` samples the engine
+        cannot take (its size limit, its memory), called with the sides the sizing rule
+        predicts before any surface is sampled; None for none.
     """
 
     name: str
@@ -83,6 +87,7 @@ class Engine:
     extra: str | None = None
     arrays: bool = False
     static_probe: bool = True
+    hfield_check: str | Callable | None = None
 
     def rig_class(self):
         """The rig class (imports its module)."""
@@ -91,6 +96,10 @@ class Engine:
     def settings_factory(self):
         """The settings factory (imports its module)."""
         return _load(self.settings)
+
+    def hfield_limit(self) -> Callable[[int, int], None] | None:
+        """The heightfield check (imports its module), or None."""
+        return None if self.hfield_check is None else _load(self.hfield_check)
 
 
 def _load(path):
@@ -171,5 +180,6 @@ register_engine(
         settings="spine_mj.sim.bullet_settings:default_bullet_engine",
         options=("timestep_s",),
         extra="bullet",
+        hfield_check="spine_mj.sim.bullet:check_bullet_hfield",
     )
 )

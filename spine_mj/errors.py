@@ -11,7 +11,7 @@ from __future__ import annotations
 import argparse
 import math
 
-__all__ = ["OneLineParser", "SpineInputError", "check_positive"]
+__all__ = ["OneLineParser", "SpineInputError", "check_count", "check_positive"]
 
 
 class SpineInputError(ValueError):
@@ -36,6 +36,21 @@ def check_positive(name: str, value, *, allow_zero: bool = False) -> float:
             f"{name} must be a finite number {'>= 0' if allow_zero else '> 0'}, got {value!r}"
         )
     return v
+
+
+def check_count(name: str, value, *, least: int = 1, most: int | None = None) -> int:
+    """``int(value)`` if it is a whole number (an integer, or a float without a fraction; not
+    a bool) in ``[least, most]``, else a :class:`SpineInputError` naming ``name``, the
+    expectation and what arrived (a string, NaN or 2.5 included: never ``int()``'s error)."""
+    try:
+        whole = not isinstance(value, (bool, str)) and type(value).__name__ not in ("bool", "bool_")
+        whole = whole and math.isfinite(float(value)) and float(value) == int(value)
+    except (TypeError, ValueError, OverflowError):
+        whole = False
+    span = f">= {least}" if most is None else f"in [{least}, {most}]"
+    if not whole or not (least <= int(value) and (most is None or int(value) <= most)):
+        raise SpineInputError(f"{name} must be a whole number {span}, got {value!r}")
+    return int(value)
 
 
 class OneLineParser(argparse.ArgumentParser):

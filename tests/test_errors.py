@@ -1,12 +1,13 @@
 """Atomic output: all or nothing, with ordinary file permissions."""
 
 import os
+import re
 import stat
 
 import pytest
 
 from spine_mj.atomic import all_or_none, atomic_output, writable_path
-from spine_mj.errors import SpineInputError
+from spine_mj.errors import SpineInputError, check_count
 
 
 def test_atomic_output_writes_on_success_with_umask_permissions(tmp_path):
@@ -110,3 +111,19 @@ def test_atomic_output_temporaries_are_what_remove_temporaries_removes(tmp_path)
     tmp = writer.__enter__()
     assert tmp.exists()
     assert remove_temporaries(tmp_path) == [tmp]
+
+
+@pytest.mark.parametrize("value", ["3", 2.5, float("nan"), float("inf"), True, None, 0, 11, [3]])
+def test_check_count_refuses_what_is_no_whole_number_in_range_in_one_named_line(value):
+    with pytest.raises(
+        SpineInputError, match=rf"^n must be a whole number in \[1, 10\], got {re.escape(repr(value))}$"
+    ):
+        check_count("n", value, most=10)
+
+
+def test_check_count_takes_integers_and_whole_floats_of_any_kind():
+    import numpy as np
+
+    assert [check_count("n", v) for v in (3, 3.0, np.int64(3), np.float32(3.0))] == [3, 3, 3, 3]
+    with pytest.raises(SpineInputError, match=r"n must be a whole number >= 1, got (np\.)?True"):
+        check_count("n", np.bool_(True))

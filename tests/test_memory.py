@@ -213,7 +213,7 @@ def test_bullet_s_predicted_peak_is_its_measured_one(n):
 _RIG_PEAK = """
 import sys
 from spine_mj import presets, sim
-from spine_mj.sim.scales import HFIELD_BYTES_PER_SAMPLE
+from spine_mj.sim.rig_hfield import HFIELD_BYTES_PER_SAMPLE
 from spine_mj.surfaces import fractal_fbm
 
 def peak():

@@ -87,14 +87,13 @@ from spine_mj.sim.model import MODEL_PATH
 from spine_mj.sim.records import Cone, EndReason, EngineSettings, Integrator, TipParams
 from spine_mj.sim.results import RunResult
 from spine_mj.sim.rig import REFINE_TIMESTEP, Rig
+from spine_mj.sim.rig_hfield import hfield_of, hfield_spacing
 from spine_mj.sim.rollout import BatchOptions
 from spine_mj.sim.scales import (
     DEFAULT_LENGTH_SCALE_M,
     MAX_INERTIA_NUMBER,
     EngineUnits,
     Scales,
-    hfield_of,
-    hfield_spacing,
 )
 from spine_mj.sim.step_rule import (
     MAX_SPRING_OMEGA_DT,

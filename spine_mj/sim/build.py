@@ -12,7 +12,7 @@ the same inputs run the same model (tested).
 Two rules live here:
 
 * a gridded surface keeps its own samples as the hfield: ``hfield_resolution`` resamples
-  analytic surfaces only (:func:`~spine_mj.sim.scales.grid_keeps_samples`, the rule's home).
+  analytic surfaces only (:func:`~spine_mj.sim.rig_hfield.grid_keeps_samples`, the rule's home).
 * a drive given neither an inertia number, nor a speed, nor a force rate runs at
   ``I_e = DEFAULT_INERTIA_NUMBER`` (slow: quasistatic on the paper's surfaces).
 """
@@ -33,8 +33,9 @@ from spine_mj.sim.layout import Layout
 from spine_mj.sim.model import check_drive_on
 from spine_mj.sim.records import TipParams
 from spine_mj.sim.rig import Rig
+from spine_mj.sim.rig_hfield import grid_keeps_samples, hfield_sides
 from spine_mj.sim.rig_inputs import RigInputs, at_most_one
-from spine_mj.sim.scales import PROGRESS_MIN_SAMPLES, Scales, grid_keeps_samples
+from spine_mj.sim.scales import PROGRESS_MIN_SAMPLES, Scales, planned_hfield_sides
 from spine_mj.surfaces import Surface
 
 __all__ = [
@@ -194,6 +195,7 @@ def plan_rig(
     only in the drive or the engine settings measure the surface once; ``progress`` as for
     :meth:`Scales.with_hfield`."""
     if sized is None:
+        _check_engine_hfield(surface, inputs)
         sized = _sized(surface, inputs.tip, **inputs.sizing, progress=progress)
     tip, scales, hfield = sized
     speed = drive_speed_m_s(scales, **inputs.pace) if inputs.driven else None
@@ -201,6 +203,22 @@ def plan_rig(
     factory = check_engine(inputs.engine).settings_factory()
     settings = factory(scales, speed_m_s=speed, stiffness_n_m=spring, **dict(inputs.engine_options))
     return RigPlan(surface, tip, scales, hfield, settings)
+
+
+def _check_engine_hfield(surface: Surface, inputs: RigInputs) -> None:
+    """The engine's ``hfield_check`` (Bullet's sample limit and memory) on the sides the
+    sizing rule will give (:func:`~spine_mj.sim.scales.planned_hfield_sides`), before any
+    sampling: the uncoarsened sides first (no L_c measured), the rule's only when those fail
+    (its coarsening of a fine grid can bring them under the limit)."""
+    check = check_engine(inputs.engine).hfield_limit()
+    if check is None:
+        return
+    resolution = grid_keeps_samples(surface, inputs.hfield_resolution)
+    try:
+        check(*hfield_sides(surface, resolution, inputs.hfield_refinement))
+    except SpineInputError:
+        sizing = {"length_scale_m": inputs.length_scale_m, "hfield_refinement": inputs.hfield_refinement}
+        check(*planned_hfield_sides(surface, tip=inputs.tip, hfield_resolution=resolution, **sizing))
 
 
 def rig_sizing(

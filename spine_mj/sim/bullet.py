@@ -100,8 +100,11 @@ BULLET_CLIENT_BYTES = 40 * 2**20
 BULLET_MAX_SAMPLES = (2**20 if sys.platform == "darwin" else 2**23) // 4
 
 
-def check_bullet_samples(nrow: int, ncol: int) -> None:
-    """Refuse a heightfield of more than :data:`BULLET_MAX_SAMPLES` samples in one line."""
+def check_bullet_hfield(nrow: int, ncol: int) -> None:
+    """Refuse in one line a heightfield of more than :data:`BULLET_MAX_SAMPLES` samples, or
+    one whose peak (:func:`bullet_heightfield_bytes`) exceeds the memory budget: the
+    engine's ``hfield_check``, run on the sizing rule's predicted sides before any sampling
+    (:func:`~spine_mj.sim.build.plan_rig`) and again on the rig's hfield."""
     if nrow * ncol > BULLET_MAX_SAMPLES:
         side = math.isqrt(BULLET_MAX_SAMPLES)
         raise SpineInputError(
@@ -109,6 +112,8 @@ def check_bullet_samples(nrow: int, ncol: int) -> None:
             f"{BULLET_MAX_SAMPLES:,} (its upload buffer; beyond it the heights it reads are "
             f"garbage and the tip falls through): use a coarser grid, at most {side} samples a side"
         )
+    where = f"Bullet's heightfield of {nrow} x {ncol} samples"
+    check_memory(bullet_heightfield_bytes(nrow, ncol), where=where)
 
 
 def bullet_heightfield_bytes(nrow: int, ncol: int) -> float:
@@ -164,11 +169,7 @@ class BulletRig:
                 f"timestep_s must be at least {MIN_TIMESTEP_TAU:g} of the time scale tau = "
                 f"{self.scales.time_s:.3g} s, or none (derived), got {self.engine.timestep_s:.3g}"
             )
-        check_bullet_samples(self.hfield.nrow, self.hfield.ncol)
-        check_memory(
-            bullet_heightfield_bytes(self.hfield.nrow, self.hfield.ncol),
-            where=f"Bullet's heightfield of {self.hfield.nrow} x {self.hfield.ncol} samples",
-        )
+        check_bullet_hfield(self.hfield.nrow, self.hfield.ncol)
         xmin, xmax, ymin, ymax = surface.bounds
         self.bounds_m = tuple(self.length_scale_m * b for b in (xmin, xmax, ymin, ymax))
         self.z_range_m = RigModel._z_range_m(self)

@@ -31,7 +31,8 @@ from spine_mj.sim.drives import stiffness_n_m as spring_stiffness_n_m
 from spine_mj.sim.placement import Placer
 from spine_mj.sim.recording import SENSOR_NAMES
 from spine_mj.sim.records import EngineSettings, TipParams
-from spine_mj.sim.scales import Scales, hfield_of
+from spine_mj.sim.rig_hfield import hfield_of
+from spine_mj.sim.scales import Scales
 from spine_mj.sim.step_rule import (
     MAX_DRIVE_ADVANCE_PER_STEP,
     MAX_SPRING_OMEGA_DT,

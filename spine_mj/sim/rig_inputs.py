@@ -19,6 +19,7 @@ from typing import Any
 from spine_mj.choices import DEFAULT_ENGINE, check_engine
 from spine_mj.errors import SpineInputError
 from spine_mj.sim.records import TipParams
+from spine_mj.sim.rig_hfield import check_hfield_refinement, check_hfield_resolution
 
 __all__ = ["RigInputs", "at_most_one"]
 
@@ -36,8 +37,9 @@ def at_most_one(**given) -> None:
 @dataclass(frozen=True)
 class RigInputs:
     """The inputs of one rig, checked once here: an unknown engine or missing extra, an
-    engine option the engine does not read, two paces or two stiffnesses, and a tip out of
-    range (:class:`TipParams`) are refused, named, when the record is made. None leaves a
+    engine option the engine does not read, two paces or two stiffnesses, an hfield
+    resolution or refinement that is no whole count, and a tip out of range
+    (:class:`TipParams`) are refused, named, when the record is made. None leaves a
     value to its rule. Hashable: equal inputs build equal rigs.
 
     Attributes
@@ -104,6 +106,8 @@ class RigInputs:
                 f"{', '.join(unread)}: not read by engine {self.engine} "
                 f"(its options: {', '.join(entry.options)})"
             )
+        object.__setattr__(self, "hfield_resolution", check_hfield_resolution(self.hfield_resolution))
+        object.__setattr__(self, "hfield_refinement", check_hfield_refinement(self.hfield_refinement))
         at_most_one(ie=self.ie, speed_m_s=self.speed_m_s, rate_n_s=self.rate_n_s)
         at_most_one(stiffness_number=self.stiffness_number, stiffness_n_m=self.stiffness_n_m)
         self.tip  # noqa: B018 (the tip's own checks, once)

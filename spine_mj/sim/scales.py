@@ -3,8 +3,8 @@
 :class:`Scales` derives the problem's scales from a surface and a tip
 (:meth:`Scales.for_surface`: length scale, ``L_c``, ``l_s``, default tip radius, hfield
 spacing and coarsening, the surface's fall height), :class:`EngineUnits` the units MuJoCo
-works in; the hfield helpers (:func:`hfield_of`, :func:`hfield_spacing`),
-:func:`surface_unit_m` and :func:`fall_height` are the rules they use. Nothing here needs
+works in; :func:`surface_unit_m` and :func:`fall_height` are rules they use, and the hfield
+they are measured on is :mod:`spine_mj.sim.rig_hfield`'s. Nothing here needs
 MuJoCo.
 
 The scaling rule. MuJoCo sees the problem in its own units: length ``L_c``, force
@@ -26,11 +26,20 @@ from dataclasses import dataclass
 import numpy as np
 
 from spine_mj.errors import SpineInputError, check_positive
-from spine_mj.memory import check_memory
 from spine_mj.roughness import characteristic_length, slope_correlation_length
 from spine_mj.sim.records import TipParams
-from spine_mj.surfaces import LENGTH_UNITS_M, GridSurface, HField, Surface, length_unit, to_hfield
-from spine_mj.surfaces.hfield import DEFAULT_HFIELD_SIDE
+from spine_mj.sim.rig_hfield import (
+    MAX_HFIELD_SIDE,
+    check_hfield_refinement,
+    check_hfield_resolution,
+    grid_keeps_samples,
+    hfield_of,
+    hfield_sides,
+    hfield_spacing,
+    planned_spacing,
+)
+from spine_mj.surfaces import LENGTH_UNITS_M, GridSurface, HField, Surface, length_unit
+from spine_mj.surfaces.hfield import hfield_half_extents
 
 DEFAULT_LENGTH_SCALE_M = 0.01
 #: Largest inertia number a drive may have: beyond it the quasistatic question is moot and
@@ -42,15 +51,6 @@ _SCAN_TIP_SPACINGS = 2.0  # default tip radius of a measured scan, in lateral sp
 #: long track keeps room for the tip to ride along it (the usual rule on a 1 unit wide
 #: strip of long waves would give a tip wider than the strip).
 DEFAULT_TIP_RADII_ACROSS = 8
-MAX_HFIELD_SIDE = 8192  # samples a side of an hfield (memory; MuJoCo's collision stays local)
-#: Bytes per hfield sample a rig holds at its peak: the float64 evaluation of the surface on
-#: the samples (the points' x and y, the values and their join: 32; a grid's refinement the
-#: same through its interpolant) and the float32 hfield kept (4). The later stages take less:
-#: MjSpec's copy and the compiled model's (8), the run's model copy (4), the fall height's
-#: float64 copy and its scaled one (16). Measured 33-35 B a sample at 2048 a side, analytic
-#: or a refined fractal (tests/test_memory.py); a Python list of the samples for MjSpec took
-#: 32 B more (``simulate --resolution 8192`` peaked at 3.9 GB).
-HFIELD_BYTES_PER_SAMPLE = 36
 #: Hfield samples from which a rig's preparation reports its stages (2048 a side: seconds).
 PROGRESS_MIN_SAMPLES = 2**22
 _MIN_ENGINE_RATIO = 1e-9  # smallest length ratio (tip / L_c, spacing / L_c) the engine resolves
@@ -205,27 +205,14 @@ class Scales:
         if not isinstance(surface, Surface):
             raise SpineInputError(f"surface must be a spine_mj Surface, got {type(surface).__name__}")
         tip = TipParams() if tip is None else tip
-        length_scale_m = surface_unit_m(surface, length_scale_m)
-        if char_length_m is None:
-            char_length_m = characteristic_length(surface) * length_scale_m
-        char_length_m = check_physical_length("char_length_m", char_length_m)
-        _check_resolution(hfield_resolution)
+        hfield_refinement = check_hfield_refinement(hfield_refinement)
+        length_scale_m, char_length_m, radius, resolution = _planned_sizing(
+            surface, tip, length_scale_m, char_length_m, check_hfield_resolution(hfield_resolution)
+        )
         report = _reporter(progress, surface, hfield_resolution, hfield_refinement)
-        report(0, 1, "sampling the hfield")
-        hf = hfield_of(surface, hfield_resolution)
+        hf = _sampled_hfield(surface, resolution, hfield_refinement, report)
         spacing = hfield_spacing(hf, length_scale_m)
         xmin, xmax, ymin, ymax = (length_scale_m * b for b in surface.bounds)
-        width, radius = min(xmax - xmin, ymax - ymin), tip.tip_radius_m
-        if radius is None:
-            radius = default_tip_radius(surface, spacing, char_length_m, width_m=width)
-        _check_sizes(radius, spacing, char_length_m, width, given=tip.tip_radius_m is not None)
-        resolution = hfield_resolution
-        if resolution is None and spacing < _MIN_SPACING_PER_TIP_RADIUS * radius:
-            extent = 2 * max(hf.size[0], hf.size[1]) * length_scale_m
-            resolution = math.ceil(extent / (_MIN_SPACING_PER_TIP_RADIUS * radius)) + 1
-            hf = hfield_of(surface, resolution)  # still the stage "sampling the hfield"
-        hf = _refined_hfield(surface, hf, resolution, hfield_refinement, report)
-        spacing = hfield_spacing(hf, length_scale_m)
         rx, ry, elevation = hf.size[0], hf.size[1], hf.size[2]
         fall = fall_height(
             hf.data.astype(float) * (elevation * length_scale_m),  # float64: the same at every scale
@@ -455,32 +442,14 @@ def fall_height(
     return best
 
 
-def _check_resolution(res) -> None:
-    """Refuse an hfield resolution that is neither None nor a whole count in [4, MAX_HFIELD_SIDE]."""
-    if res is not None and (isinstance(res, bool) or int(res) != res or res < 4):
-        raise SpineInputError(f"hfield_resolution must be an integer >= 4 or None, got {res!r}")
-    if res is not None and res > MAX_HFIELD_SIDE:
-        raise SpineInputError(f"hfield_resolution must be <= {MAX_HFIELD_SIDE} samples a side, got {res}")
-
-
 def _quiet(done: float, total: float, stage: str) -> None:
     """A progress callback that hears nothing."""
 
 
 def _reporter(progress, surface: Surface, resolution: int | None, refinement) -> Callable:
     """``progress`` for hfields of PROGRESS_MIN_SAMPLES or more, else :func:`_quiet` (quick: no bars)."""
-    ny, nx = _hfield_sides(surface, resolution, refinement)
+    ny, nx = hfield_sides(surface, resolution, refinement)
     return progress if progress is not None and nx * ny >= PROGRESS_MIN_SAMPLES else _quiet
-
-
-def _hfield_sides(surface: Surface, resolution: int | None, refinement) -> tuple[int, int]:
-    """``(nrow, ncol)`` of :func:`hfield_of`'s hfield, before it is made."""
-    if resolution or not isinstance(surface, GridSurface):
-        ny = nx = resolution or DEFAULT_HFIELD_SIDE
-    else:
-        ny, nx = surface.shape
-    f = int(refinement)
-    return (ny - 1) * f + 1, (nx - 1) * f + 1
 
 
 def _check_sizes(
@@ -514,79 +483,57 @@ def _slope_length(surface: Surface, length_scale_m: float, char_length_m: float)
         return char_length_m
 
 
-def _refined_hfield(surface: Surface, hf: HField, resolution: int | None, refinement, report) -> HField:
-    """``hf`` (``surface``'s at ``resolution``) refined ``refinement`` times (:func:`hfield_of`),
-    the stage told to ``report``."""
+def _sampled_hfield(surface: Surface, resolution: int | None, refinement: int, report) -> HField:
+    """:func:`hfield_of` ``surface`` at ``resolution`` refined ``refinement`` times, its stage
+    told to ``report``; a refinement past MAX_HFIELD_SIDE a side refused before sampling."""
     if refinement == 1:
-        return hf
+        report(0, 1, "sampling the hfield")
+        return hfield_of(surface, resolution)
     report(0, 1, "refining the hfield")
-    if isinstance(refinement, bool) or int(refinement) != refinement or refinement < 1:
-        raise SpineInputError(f"hfield_refinement must be an integer >= 1, got {refinement!r}")
-    side = (max(hf.nrow, hf.ncol) - 1) * int(refinement) + 1
+    side = max(hfield_sides(surface, resolution, refinement))
     if side > MAX_HFIELD_SIDE:
         raise SpineInputError(
             f"hfield_refinement {refinement} gives {side} samples a side, more than {MAX_HFIELD_SIDE}"
         )
-    return hfield_of(surface, resolution, int(refinement))
+    return hfield_of(surface, resolution, refinement)
 
 
-def grid_keeps_samples(surface: Surface, resolution: int | None) -> int | None:
-    """The hfield resolution a rig of ``surface`` asks for: ``resolution`` for an analytic
-    surface, None for a gridded one (fractal, sandpaper, measured scan, a saved grid), which
-    keeps its own samples as the hfield. MuJoCo then collides with the heights the
-    streamline reads, and a resampling cannot leave facets coarser than a small tip (a
-    sandpaper resampled to an analytic surface's 151 a side left 33 um facets under a 25 um
-    tip). The rig still coarsens a grid finer than a quarter tip radius
-    (:meth:`Scales.with_hfield`). The one home of this rule: the rig, the sweep's configs and
-    the validation's measurements all ask here."""
-    return None if isinstance(surface, GridSurface) else resolution
+def _planned_sizing(surface: Surface, tip: TipParams, length_scale_m, char_length_m, resolution) -> tuple:
+    """``(length_scale_m, char_length_m, radius [m], resolution)`` of :meth:`Scales.with_hfield`'s
+    rule, before any hfield is sampled: the unit, L_c, the tip's radius (its default where
+    None) checked against the hfield's spacing and the domain, and the resolution (a grid
+    finer than a quarter tip radius coarsened to that)."""
+    length_scale_m = surface_unit_m(surface, length_scale_m)
+    if char_length_m is None:
+        char_length_m = characteristic_length(surface) * length_scale_m
+    char_length_m = check_physical_length("char_length_m", char_length_m)
+    spacing = planned_spacing(surface, resolution, 1, length_scale_m)
+    xmin, xmax, ymin, ymax = (length_scale_m * b for b in surface.bounds)
+    width, radius = min(xmax - xmin, ymax - ymin), tip.tip_radius_m
+    if radius is None:
+        radius = default_tip_radius(surface, spacing, char_length_m, width_m=width)
+    _check_sizes(radius, spacing, char_length_m, width, given=tip.tip_radius_m is not None)
+    if resolution is None and spacing < _MIN_SPACING_PER_TIP_RADIUS * radius:
+        extent = 2 * max(hfield_half_extents(surface)) * length_scale_m
+        resolution = math.ceil(extent / (_MIN_SPACING_PER_TIP_RADIUS * radius)) + 1
+    return length_scale_m, char_length_m, radius, resolution
 
 
-def hfield_of(surface: Surface, resolution: int | None = None, refinement: int = 1) -> HField:
-    """The surface as MuJoCo hfield data, resampled to ``resolution`` a side when given,
-    then refined ``refinement`` times.
-
-    Parameters
-    ----------
-    surface : Surface
-        Any surface.
-    resolution : int, optional
-        Samples a side (None: a grid surface's own, 201 for an analytic one).
-    refinement : int
-        That hfield's ``n`` samples a side become ``(n - 1) refinement + 1``, every one
-        kept: an analytic surface (or a resampled grid) sampled that densely over the same
-        bounds, a grid at its own samples refined through its interpolant
-        (:func:`spine_mj.surfaces.refine_grid`).
-
-    Returns
-    -------
-    HField
-    """
-    ny, nx = _hfield_sides(surface, resolution, refinement)
-    f = int(refinement)
-    check_memory(HFIELD_BYTES_PER_SAMPLE * float(nx) * ny, where=f"an hfield of {ny} x {nx} samples")
-    hf = to_hfield(surface, nrow=resolution, ncol=resolution) if resolution else to_hfield(surface)
-    if refinement == 1:
-        return hf
-    return to_hfield(surface, nrow=(hf.nrow - 1) * f + 1, ncol=(hf.ncol - 1) * f + 1)
-
-
-def hfield_spacing(hfield: HField, length_scale_m: float = 1.0) -> float:
-    """The larger of an hfield's two sample spacings, in metres.
-
-    Parameters
-    ----------
-    hfield : HField
-        MuJoCo height field data.
-    length_scale_m : float
-        Metres per surface unit.
-
-    Returns
-    -------
-    float
-    """
-    rx, ry = hfield.size[0], hfield.size[1]
-    return length_scale_m * 2 * max(rx / (hfield.ncol - 1), ry / (hfield.nrow - 1))
+def planned_hfield_sides(
+    surface: Surface,
+    *,
+    tip: TipParams | None = None,
+    length_scale_m: float | None = None,
+    hfield_resolution: int | None = None,
+    hfield_refinement: int = 1,
+) -> tuple[int, int]:
+    """``(nrow, ncol)`` of the hfield :meth:`Scales.with_hfield` would sample for these
+    inputs (the same rule, the coarsening included), measuring only L_c: an engine's limit
+    on its heightfield and a memory budget are checked before seconds of sizing."""
+    tip = TipParams() if tip is None else tip
+    resolution = check_hfield_resolution(hfield_resolution)
+    resolution = _planned_sizing(surface, tip, length_scale_m, None, resolution)[3]
+    return hfield_sides(surface, resolution, check_hfield_refinement(hfield_refinement))
 
 
 def check_inertia_number(inertia_number: float, what: str = "inertia number I_e") -> float:

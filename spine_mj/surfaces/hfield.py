@@ -90,6 +90,16 @@ def to_hfield(
     return HField(data=data, size=(rx, ry, elevation, base), pos=pos)
 
 
+def hfield_half_extents(surface: Surface, *, nrow: int | None = None, ncol: int | None = None) -> tuple:
+    """``(radius_x, radius_y)`` of :func:`to_hfield`'s hfield with the same arguments (its
+    ``size[:2]``), without sampling: a grid's first to last sample where it keeps or refines
+    them, else the bounds. What the rig's sizing reads before any hfield is made."""
+    if isinstance(surface, GridSurface) and (nrow is ncol is None or _nesting_factor(surface, nrow, ncol)):
+        return 0.5 * float(surface.x[-1] - surface.x[0]), 0.5 * float(surface.y[-1] - surface.y[0])
+    xmin, xmax, ymin, ymax = surface.bounds
+    return 0.5 * float(xmax - xmin), 0.5 * float(ymax - ymin)
+
+
 def refine_grid(surface: GridSurface, factor: int) -> GridSurface:
     """``surface`` at ``factor`` times the samples a side, every old sample kept: its C2
     spline (which passes through every sample) evaluated on ``(n - 1) factor + 1`` points

@@ -29,7 +29,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from spine_mj import presets, sim
-from spine_mj.sim.scales import grid_keeps_samples
+from spine_mj.sim.rig_hfield import grid_keeps_samples
 from spine_mj.theory import agreement
 from spine_mj.validate.intervals import wilson
 from spine_mj.validate.paths import stored_paths

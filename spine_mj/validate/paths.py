@@ -16,7 +16,8 @@ import numpy as np
 
 from spine_mj import presets, sweep
 from spine_mj.errors import SpineInputError
-from spine_mj.sim.scales import grid_keeps_samples, resolve_tip_radius
+from spine_mj.sim.rig_hfield import grid_keeps_samples
+from spine_mj.sim.scales import resolve_tip_radius
 from spine_mj.surfaces import TriangulatedSurface, from_hfield, to_hfield
 from spine_mj.surfaces.dilation import dilate
 from spine_mj.theory import agreement

@@ -13,7 +13,8 @@ from typing import Any
 from spine_mj import examples, presets, sim, sweep
 from spine_mj.errors import SpineInputError
 from spine_mj.sim.drives import spring_stiffness_n_m
-from spine_mj.sim.scales import engine_tip_radius_m, grid_keeps_samples
+from spine_mj.sim.rig_hfield import grid_keeps_samples
+from spine_mj.sim.scales import engine_tip_radius_m
 from spine_mj.sweep.preflight import check_cases
 from spine_mj.validate.plans import MASS_KG, FamilySpec, ValidationPlan
 

@@ -419,24 +419,40 @@ def test_pybullet_s_build_banner_does_not_reach_the_user(tmp_path):
     assert out.stdout == "ours\n" and "build time" not in out.stderr
 
 
-def test_a_heightfield_past_pybullet_s_upload_buffer_is_refused_in_one_line(tmp_path):
+def test_a_heightfield_past_pybullet_s_upload_buffer_is_refused_in_one_line(tmp_path, monkeypatch):
     """pybullet copies a heightfield's float32 heights through an 8 MiB buffer and reads
     garbage past it (a 2048 x 2048 fractal's 1767 x 1767 hfield: every run fell through):
     1024 x 2048 samples pass, one more column is refused, naming the user's grid, before
-    the client is built; in a sweep, before the first run."""
+    the surface is sampled (the sizing's stages, each reported here, are never heard: it
+    took 4-7 CPU-s on a 2048 x 2048 fractal); in a sweep, before the first run."""
     from spine_mj import presets
-    from spine_mj.sim.bullet import BULLET_MAX_SAMPLES, check_bullet_samples
+    from spine_mj.sim import build, scales
+    from spine_mj.sim.bullet import BULLET_MAX_SAMPLES, check_bullet_hfield
 
     if sys.platform != "darwin":
         assert BULLET_MAX_SAMPLES == 1024 * 2048
-    check_bullet_samples(1, BULLET_MAX_SAMPLES)
+    check_bullet_hfield(1, BULLET_MAX_SAMPLES)
     with pytest.raises(SpineInputError, match="of 1 x 2097153 samples is more than pybullet takes"):
-        check_bullet_samples(1, BULLET_MAX_SAMPLES + 1)
+        check_bullet_hfield(1, BULLET_MAX_SAMPLES + 1)
+    monkeypatch.setattr(scales, "PROGRESS_MIN_SAMPLES", 0)
+    monkeypatch.setattr(build, "PROGRESS_MIN_SAMPLES", 0)
+    heard = []
     side = math.isqrt(BULLET_MAX_SAMPLES) + 1
     surf = presets.make_surface("paper-single-peak")
     refused = rf"^Bullet's heightfield of {side} x {side} samples .* at most"
     with pytest.raises(SpineInputError, match=refused):
-        sim.build_rig(surf, engine="bullet", mu=1.0, hfield_resolution=side)
+        sim.build_rig(
+            surf, engine="bullet", mu=1.0, hfield_resolution=side, progress=lambda *a: heard.append(a)
+        )
+    x = np.linspace(0.0, 10.0, side)  # a grid keeps its samples
+    grid = GridSurface(np.sin(30 * x)[None, :] * np.cos(30 * x)[:, None], x, x)  # L_c / 100 < a spacing
+    with pytest.raises(SpineInputError, match=refused):
+        sim.build_rig(grid, engine="bullet", mu=1.0, progress=lambda *a: heard.append(a))
+    assert heard == []
+    # a tip wide enough that the rule coarsens the grid under the limit passes the early check
+    inputs = sim.RigInputs(mu=1.0, engine="bullet", tip_radius_m=10 * 10.0 / side * 0.01)
+    build._check_engine_hfield(grid, inputs)
+    assert max(scales.planned_hfield_sides(grid, tip=inputs.tip)) < side
     cfg = write_config(
         tmp_path,
         f"""

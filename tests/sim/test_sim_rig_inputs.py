@@ -25,6 +25,29 @@ def test_bad_inputs_are_refused_when_the_record_is_made(kwargs, match):
         RigInputs(**{"mu": 0.5, **kwargs})
 
 
+@pytest.mark.parametrize("value", ["x", 0, -1, 2.5, float("nan"), float("inf"), True, None, "2"])
+def test_a_nonsense_hfield_refinement_is_refused_naming_it_before_any_sizing(value):
+    """build_rig(hfield_refinement='x') raised int()'s bare ValueError, True ran as 1."""
+    with pytest.raises(
+        SpineInputError, match=rf"hfield_refinement .* must be a whole number in \[1, 8192\], got {value!r}"
+    ):
+        sim.build_rig(single_gaussian(), mu=0.5, hfield_refinement=value)
+
+
+@pytest.mark.parametrize("value", ["x", 3, 40.5, float("nan"), False, 10**6])
+def test_a_nonsense_hfield_resolution_is_refused_naming_it(value):
+    with pytest.raises(
+        SpineInputError, match=rf"hfield_resolution .* must be a whole number in \[4, 8192\], got {value!r}"
+    ):
+        RigInputs(mu=0.5, hfield_resolution=value)
+
+
+def test_whole_floats_count_as_their_integers():
+    inputs = RigInputs(mu=0.5, hfield_resolution=41.0, hfield_refinement=2.0)
+    assert (inputs.hfield_resolution, inputs.hfield_refinement) == (41, 2)
+    assert type(inputs.hfield_resolution) is int and type(inputs.hfield_refinement) is int
+
+
 def test_options_are_one_sorted_tuple_and_equal_inputs_hash_alike():
     a = RigInputs(mu=0.5, engine_options={"timestep_s": None, "impratio": 2.0, "noslip_iterations": 1})
     b = RigInputs.from_keywords(mu=0.5, noslip_iterations=1, impratio=2.0)
