@@ -280,6 +280,24 @@ class RigModel:
             self._contact = cached
         return cached[1]
 
+    def contacts_at(self, position_m) -> tuple[np.ndarray, np.ndarray]:
+        """The contacts MuJoCo's collision finds with the tip's centre at ``position_m``
+        ``(3,)`` [m]: their depths ``(k,)`` [m, > 0 inside] and outward unit normals ``(k,
+        3)``. One per hfield prism the tip overlaps (docs/physics.md §5), each with the normal
+        of its own prism's penetration, not of the facet's plane: near a cell's edge a
+        prism's side wall tilts it (what holds a tip beyond a plane's kappa, the static map's
+        edge catch)."""
+        import mujoco
+
+        d = mujoco.MjData(self.model)
+        d.qpos[:3] = np.asarray(position_m, dtype=float) / self.units.length_m
+        mujoco.mj_kinematics(self.model, d)
+        mujoco.mj_collision(self.model, d)
+        normals = np.array([c.frame[:3] for c in d.contact[: d.ncon]]).reshape(-1, 3)
+        normals *= np.where(normals[:, 2:] < 0, -1.0, 1.0)  # out of the surface (a height field's: z > 0)
+        depths = np.array([-c.dist for c in d.contact[: d.ncon]], dtype=float) * self.units.length_m
+        return depths, normals
+
     def default_start(self) -> tuple[float, float]:
         """The export's and viewer's start (surface units): a tenth of the way in from the
         -x edge, at mid y, so a +x drive has the whole surface ahead of it."""

@@ -220,3 +220,31 @@ def test_line_is_refused_where_it_cannot_hold():
         sim.build_rig(surf, mu=0.5, line="yes")
     with pytest.raises(SpineInputError, match="not an array's spines"):
         sim.ArrayRig(sim.build_rig(surf, mu=0.5, line=True), Layout())
+
+
+def test_contacts_at_counts_one_per_overlapped_prism_with_the_planes_normal_inside_a_cell():
+    """A tip resting on a tilted plane: inside a cell one contact with the plane's normal and
+    the placement's rest depth; centred over a grid vertex, one per prism it overlaps
+    (docs/physics.md §5: up to six), every normal within a few degrees of the plane's."""
+    from spine_mj.sim import inclined_plane
+
+    slope = 20.0
+    rig = Rig(inclined_plane(slope_deg=slope, half_width=0.02, n=41), tip=TipParams(tip_radius_m=2e-3))
+    plane_n = np.array([-math.tan(math.radians(slope)), 0.0, 1.0])
+    plane_n /= np.linalg.norm(plane_n)
+    spacing = 0.04 / 40
+    r = rig.tip.tip_radius_m
+    # the contact point lies r sin(slope) ahead of the centre in +x: put it mid-cell
+    foot = np.array([0.3 * spacing, 0.6 * spacing])
+    q = rig.place(*(foot - [r * math.sin(math.radians(slope)), 0.0])) * rig.units.length_m
+    depths, normals = rig.contacts_at(q)
+    assert len(depths) == 1
+    np.testing.assert_allclose(normals[0], plane_n, atol=1e-6)
+    assert 0 < depths[0] < 0.01 * r  # the soft contact's rest depth, well under 1 % of the tip
+    # pressed deeper at a vertex, the tip overlaps the prisms around it
+    q_v = rig.place(-r * math.sin(math.radians(slope)), 0.0) * rig.units.length_m - 2e-5 * plane_n
+    depths_v, normals_v = rig.contacts_at(q_v)
+    assert 2 <= len(depths_v) <= 6
+    assert np.all(depths_v > 0)
+    tilts = np.degrees(np.arccos(np.clip(normals_v @ plane_n, -1, 1)))
+    assert tilts.min() < 1e-3 and tilts.max() < 10.0
