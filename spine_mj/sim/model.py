@@ -170,6 +170,7 @@ class RigModel:
         self._ids()
         self._placer: Placer | None = None
         self._contact = None  # (hfield, its contact surface), see contact_surface
+        self._collision_data = None  # (model, MjData) of contacts_at
 
     # ----------------------------------------------------------------- model building
 
@@ -289,7 +290,9 @@ class RigModel:
         edge catch)."""
         import mujoco
 
-        d = mujoco.MjData(self.model)
+        if self._collision_data is None or self._collision_data[0] is not self.model:
+            self._collision_data = (self.model, mujoco.MjData(self.model))
+        d = self._collision_data[1]
         d.qpos[:3] = np.asarray(position_m, dtype=float) / self.units.length_m
         mujoco.mj_kinematics(self.model, d)
         mujoco.mj_collision(self.model, d)

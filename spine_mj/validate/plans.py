@@ -33,6 +33,7 @@ __all__ = [
     "DT_HALVED",
     "GRAVITY",
     "HFIELD_DOUBLED",
+    "HFIELD_QUADRUPLED",
     "IMPRATIO",
     "MASS_KG",
     "MEASURED",
@@ -167,6 +168,8 @@ IMPRATIO = ("no noslip, impratio 10", (("noslip_iterations", 0), ("impratio", 10
 DT_HALVED = ("time step / 2 (contact solref kept)", (("timestep_factor", 0.5),))
 #: The surface's grid at twice the samples a side (solution verification of the static map).
 HFIELD_DOUBLED = ("hfield x 2", (("hfield_factor", 2),))
+#: ... and at four times (the static map's third level: a plane's last change x 2 -> x 4).
+HFIELD_QUADRUPLED = ("hfield x 4", (("hfield_factor", 4),))
 #: MuJoCo's solver tolerances a hundredth of their defaults (solution verification).
 TOLERANCE_TIGHTENED = ("tolerance / 100", (("tolerance", 1e-10), ("noslip_tolerance", 1e-8)))
 
@@ -456,7 +459,15 @@ PLANS: dict[str, ValidationPlan] = {
         static=StaticPlan(
             slopes_deg=tuple(np.arange(0.0, 76.0, 7.5)),
             azimuths_deg=(0.0, 30.0, 60.0, 90.0, 120.0, 150.0, 180.0),
-            engines=(RECOMMENDED, NO_NOSLIP, IMPRATIO, DT_HALVED, HFIELD_DOUBLED, TOLERANCE_TIGHTENED),
+            engines=(
+                RECOMMENDED,
+                NO_NOSLIP,
+                IMPRATIO,
+                DT_HALVED,
+                HFIELD_DOUBLED,
+                HFIELD_QUADRUPLED,
+                TOLERANCE_TIGHTENED,
+            ),
         ),
         boundary=BoundaryPlan(
             ie_values=tuple(float(v) for v in np.logspace(-4, 1, 11)),
