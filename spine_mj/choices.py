@@ -1,5 +1,5 @@
-"""What a user chooses among by name: the engines (their registry), the drive protocols and
-the validation plans.
+"""What a user chooses among by name: the engines (their registry), the drive protocols,
+the fill methods of a scan's missing points and the validation plans.
 
 The command line, the sweep configs and the validation read their name lists here, so a
 name is written once. Nothing here imports numpy, MuJoCo or the rest of the package: the
@@ -27,6 +27,7 @@ __all__ = [
     "COMPARED_ENGINES",
     "DEFAULT_ENGINE",
     "ENGINES",
+    "FILL_METHODS",
     "PLAN_NAMES",
     "PROTOCOLS",
     "Engine",
@@ -37,6 +38,9 @@ __all__ = [
 
 #: The drive protocols of a single spine: spring carriage, force ramp with reset, static probe.
 PROTOCOLS = ("spring", "ramp", "static")
+#: How a measured scan's missing (NaN / masked) points are treated on import
+#: (:func:`spine_mj.surface_io.import_topography`, ``--fill`` of ``surface make`` and ``hold``).
+FILL_METHODS = ("refuse", "harmonic", "nearest", "mean")
 #: An array's carriage drives (``spine-mj array --drive``, a sweep's ``array_drive``).
 ARRAY_DRIVES = ("speed", "force")
 #: The validation plans, smallest first (their contents: :data:`spine_mj.validate.plans.PLANS`).

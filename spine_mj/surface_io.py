@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from spine_mj.atomic import atomic_output
+from spine_mj.choices import FILL_METHODS
 from spine_mj.errors import SpineInputError, check_positive
 from spine_mj.jsonio import to_jsonable
 from spine_mj.surfaces import (
@@ -49,9 +50,6 @@ __all__ = [
 
 FORMAT = "spine_mj.surface/1"
 _GAUSS_KEYS = ("amplitude", "center_x", "center_y", "sigma_x", "sigma_y")
-
-#: How :func:`import_topography` treats missing (NaN / masked) points.
-FILL_METHODS = ("refuse", "harmonic", "nearest", "mean")
 
 
 def save_surface(surface: Surface, path: str | os.PathLike) -> Path:

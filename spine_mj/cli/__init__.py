@@ -1,7 +1,8 @@
 """The ``spine-mj`` command line (click).
 
 Modules: :mod:`~spine_mj.cli.app` (the root group :func:`main`, the program :func:`run`,
-one-line errors, progress and shared argument parsing), and one module per family of
+one-line errors, progress and shared argument parsing), :mod:`~spine_mj.cli.options` (the
+options several commands share, such as ``--fill``), and one module per family of
 commands: :mod:`~spine_mj.cli.surface` (``surface make/show/info/export``),
 :mod:`~spine_mj.cli.theory` (``kappa``, ``streamline``, ``reproduce``),
 :mod:`~spine_mj.cli.sim` (``simulate``, ``replay``, ``view``, ``sim export``),

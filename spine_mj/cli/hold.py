@@ -7,6 +7,7 @@ from pathlib import Path
 import click
 
 from spine_mj.cli.app import Progress, main
+from spine_mj.cli.options import fill_option
 from spine_mj.errors import SpineInputError
 
 
@@ -48,13 +49,7 @@ from spine_mj.errors import SpineInputError
 @click.option(
     "--workers", type=click.IntRange(min=1), default=None, help="Worker processes (default: all cores)."
 )
-@click.option(
-    "--fill",
-    type=click.Choice(["refuse", "harmonic", "nearest", "mean"]),
-    default="refuse",
-    show_default=True,
-    help="Missing points of an instrument file (as `surface make --fill`).",
-)
+@fill_option("Missing points of an instrument file (as `surface make --fill`).")
 @click.option("--quiet", is_flag=True, help="No progress bar.")
 def hold_cmd(surface_spec, mu, out_dir, tip_radius, starts, reference_starts, budget, workers, fill, quiet):
     """Will a spine hold on SURFACE (preset, .npz or instrument scan)? Chooses the drive's

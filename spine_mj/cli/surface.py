@@ -8,6 +8,7 @@ import math
 import click
 
 from spine_mj.cli.app import PREPARATION_DELAY_S, Progress, _Group, check_suffix, main, refuse_options_not_for
+from spine_mj.cli.options import fill_option
 from spine_mj.errors import SpineInputError
 
 
@@ -43,13 +44,7 @@ def surface_list():
     metavar="KEY=VALUE",
     help="Override any generator parameter (TOML value), repeatable.",
 )
-@click.option(
-    "--fill",
-    type=click.Choice(["refuse", "harmonic", "nearest", "mean"]),
-    default="refuse",
-    show_default=True,
-    help="Missing points in imported files.",
-)
+@fill_option("Missing points in imported files.")
 @click.option("--no-level", is_flag=True, help="Keep the tilt of an imported file.")
 @click.option("--spacing", type=float, help="Resample an imported file to this spacing [m].")
 @click.option("--channel", type=int, default=0, show_default=True, help="Data channel of an imported file.")
