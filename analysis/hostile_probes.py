@@ -494,6 +494,71 @@ def _issue44(add, work: Path, py: str) -> None:
         "refuse",
         "line: not read by engine bullet",
     )
+    _issue44_leftovers(add, work, base)
+
+
+def _issue44_leftovers(add, work: Path, base: str) -> None:
+    """Issue 44's last round: starts on the domain's edge (a run ended left_domain at once),
+    a nonsense hfield_refinement, hfield limits refused on the predicted sides before any
+    sizing (Bullet's on a fractal grid, the memory of a refined hfield in both engines),
+    and the shared --fill option."""
+    edge = [*SPINE, "simulate", "paper-single-peak", "--ie", "1e-2"]
+    for start, needle in (("-5,-1", "on the edge of the surface's domain"), ("-4.99,-1", "within 0.05")):
+        add(
+            f"simulate --start {start} (domain x in [-5, 5])",
+            [*edge, "--start", start, "--out", "e"],
+            "refuse",
+            needle,
+        )
+    configs = {
+        "start on the domain's edge": (
+            base.replace("x = [0.05]\n    y = [0.5]", 'frame = "absolute"\n    points = [[-5.0, -1.0]]'),
+            "on the edge",
+            {},
+        ),
+        "hfield_refinement 'x'": (
+            base.format(
+                analyses='["engine"]', preset="paper-single-peak", tables='[grid]\nhfield_refinement = "x"'
+            ),
+            "hfield_refinement",
+            {},
+        ),
+        "4000 x refinement 2, both engines (300 MiB budget)": (
+            base.format(
+                analyses='["engine"]',
+                preset="paper-single-peak",
+                tables='[grid]\nengine = ["mujoco", "bullet"]\n'
+                "hfield_resolution = 4000\nhfield_refinement = 2",
+            ),
+            "an hfield of 7999 x 7999 samples",
+            {"SPINE_MJ_MEMORY_BUDGET": "300M"},
+        ),
+    }
+    for name, (body, needle, env) in configs.items():
+        if "{analyses}" in body:
+            body = body.format(analyses='["engine"]', preset="paper-single-peak", tables="")
+        cfg = sweep_config(work, "left-" + "".join(c if c.isalnum() else "-" for c in name), body)
+        add(
+            f"sweep: {name}",
+            [*SPINE, "sweep", cfg, "--out", "s44b", "--workers", "1", "--quiet"],
+            "refuse",
+            needle,
+            env,
+        )
+    made = [*SPINE, "surface", "make", "paper-fractal", "--set", "nx=2048", "-o", "f2048.npz"]
+    subprocess.run(made, cwd=work, check=True, capture_output=True)
+    add(
+        "simulate --engine bullet on a 2048 x 2048 fractal (1767 a side after coarsening)",
+        [*SPINE, "simulate", "f2048.npz", "--engine", "bullet", "--start", "0.1,0.5", "--out", "bf"],
+        "refuse",
+        "1767 x 1767 samples is more than pybullet takes",
+    )
+    add(
+        "hold --fill zero",
+        [*SPINE, "hold", "paper-fractal", "--fill", "zero", "--out", "h"],
+        "refuse",
+        "--fill",
+    )
 
 
 def run_probe(work, name, args, expect, needle, env):

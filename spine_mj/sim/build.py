@@ -30,10 +30,10 @@ from spine_mj.sim.drives import Drive, RampDrive, SpringDrive, StaticProbe, spri
 from spine_mj.sim.engine_rig import EngineRig
 from spine_mj.sim.holding import array_ie
 from spine_mj.sim.layout import Layout
-from spine_mj.sim.model import check_drive_on
+from spine_mj.sim.model import check_drive_on, check_starts_on
 from spine_mj.sim.records import TipParams
 from spine_mj.sim.rig import Rig
-from spine_mj.sim.rig_hfield import grid_keeps_samples, hfield_sides
+from spine_mj.sim.rig_hfield import check_hfield_size, grid_keeps_samples, hfield_sides
 from spine_mj.sim.rig_inputs import RigInputs, at_most_one
 from spine_mj.sim.scales import PROGRESS_MIN_SAMPLES, Scales, planned_hfield_sides
 from spine_mj.surfaces import Surface
@@ -45,6 +45,7 @@ __all__ = [
     "build_array_on",
     "build_drive",
     "build_rig",
+    "check_planned_hfield",
     "drive_speed_m_s",
     "plan_rig",
     "rig_scales",
@@ -181,6 +182,10 @@ class RigPlan:
     def check_drive(self, drive: Drive) -> None:
         check_drive_on(self, drive)
 
+    def check_starts(self, starts, margin_m: float) -> None:
+        """Refuse starts a run would end at once (:func:`~spine_mj.sim.model.check_starts_on`)."""
+        check_starts_on(self.surface, starts, margin_m / self.length_scale_m)
+
 
 def plan_rig(
     surface: Surface,
@@ -195,7 +200,7 @@ def plan_rig(
     only in the drive or the engine settings measure the surface once; ``progress`` as for
     :meth:`Scales.with_hfield`."""
     if sized is None:
-        _check_engine_hfield(surface, inputs)
+        check_planned_hfield(surface, inputs)
         sized = _sized(surface, inputs.tip, **inputs.sizing, progress=progress)
     tip, scales, hfield = sized
     speed = drive_speed_m_s(scales, **inputs.pace) if inputs.driven else None
@@ -205,14 +210,19 @@ def plan_rig(
     return RigPlan(surface, tip, scales, hfield, settings)
 
 
-def _check_engine_hfield(surface: Surface, inputs: RigInputs) -> None:
-    """The engine's ``hfield_check`` (Bullet's sample limit and memory) on the sides the
-    sizing rule will give (:func:`~spine_mj.sim.scales.planned_hfield_sides`), before any
-    sampling: the uncoarsened sides first (no L_c measured), the rule's only when those fail
-    (its coarsening of a fine grid can bring them under the limit)."""
-    check = check_engine(inputs.engine).hfield_limit()
-    if check is None:
-        return
+def check_planned_hfield(surface: Surface, inputs: RigInputs) -> None:
+    """The hfield's size limits (:func:`~spine_mj.sim.rig_hfield.check_hfield_size`: sides,
+    memory) and the engine's ``hfield_check`` (Bullet's sample limit and memory) on the
+    sides the sizing rule will give (:func:`~spine_mj.sim.scales.planned_hfield_sides`),
+    before any sampling: the uncoarsened sides first (no L_c measured), the rule's only when
+    those fail (its coarsening of a fine grid can bring them under a limit)."""
+    engine_check = check_engine(inputs.engine).hfield_limit()
+
+    def check(nrow, ncol):
+        check_hfield_size(nrow, ncol, inputs.hfield_refinement)
+        if engine_check is not None:
+            engine_check(nrow, ncol)
+
     resolution = grid_keeps_samples(surface, inputs.hfield_resolution)
     try:
         check(*hfield_sides(surface, resolution, inputs.hfield_refinement))

@@ -262,6 +262,7 @@ class BulletRig:
     def _run(self, drive, start, detection, progress, *, stop_early: bool) -> RunResult:
         self.check_drive(drive)
         det = (Detection() if detection is None else detection).resolve(self.scales)
+        self.check_starts([start_pair(start)], det.domain_margin_m)
         qpos0 = self.place(*start)
         u = self.units
         ramp = isinstance(drive, RampDrive)

@@ -153,7 +153,7 @@ def run_batch_gpu(
     wp, mjw = require_packages()
     drives, starts = batch_drives(drives, starts)
     det = (Detection() if opt.detection is None else opt.detection).resolve(rig.scales)
-    rig.check_starts(starts)
+    rig.check_starts(starts, det.domain_margin_m)
     dev = device or "cuda:0"
     dt, s = rig.engine.timestep_s, rig.length_scale_m
     lengths = [settle_steps(d, dt) + drive_steps(rig, d, x0 * s, det) for d, (x0, _) in zip(drives, starts)]

@@ -87,6 +87,38 @@ def start_pair(start) -> tuple[float, float]:
     return x0, y0
 
 
+def check_starts_on(surface, starts, margin: float = 0.0) -> None:
+    """Refuse, naming the first, a start ``(x0, y0)`` (surface units) that is not strictly
+    inside ``surface``'s domain by more than ``margin`` (surface units): a run ends
+    (``left_domain``) where its tip's centre comes within
+    :attr:`~spine_mj.sim.detection.Detection.domain_margin_m` (the tip radius) of an edge,
+    so a start on the edge, or nearer than that, would end before it began. Placement
+    checks with no margin; a run's entry points, and the sweep's pre-run check, with its
+    detection's (:class:`~spine_mj.sim.build.RigPlan`)."""
+    xy = np.asarray(starts, dtype=float)
+    if xy.size == 0:
+        return
+    if xy.ndim != 2 or xy.shape[1] != 2:
+        raise SpineInputError(f"starts must be (x0, y0) pairs, got an array of shape {xy.shape}")
+    xmin, xmax, ymin, ymax = surface.bounds
+    x, y = xy[:, 0], xy[:, 1]
+    inside = (x > xmin + margin) & (x < xmax - margin) & (y > ymin + margin) & (y < ymax - margin)
+    if inside.all():
+        return
+    x0, y0 = xy[int(np.argmin(inside))]
+    domain = f"the surface's domain x in [{xmin:g}, {xmax:g}], y in [{ymin:g}, {ymax:g}]"
+    if not surface.contains(x0, y0):
+        raise SpineInputError(f"start ({x0:g}, {y0:g}) lies outside {domain}")
+    why = f"a run ends (left_domain) where the tip's centre comes within {margin:.3g} (a tip radius) of it"
+    if min(x0 - xmin, xmax - x0, y0 - ymin, ymax - y0) == 0:
+        more = f" by more than {margin:.3g}: {why}" if margin > 0 else ""
+        raise SpineInputError(f"start ({x0:g}, {y0:g}) lies on the edge of {domain}; start inside it{more}")
+    raise SpineInputError(
+        f"start ({x0:g}, {y0:g}) lies within {margin:.3g} of the edge of {domain}: {why}; "
+        "start farther inside"
+    )
+
+
 def check_drive_on(rig, drive: Drive) -> None:
     """Refuse a drive whose inertia number is beyond :data:`MAX_INERTIA_NUMBER`, however it
     was given (an I_e, a speed or a force rate), that advances more than
@@ -404,23 +436,14 @@ class RigModel:
             )
         return self._placer.place_many(starts)
 
-    def check_start(self, x0: float, y0: float) -> None:
-        """Raise :class:`SpineInputError` unless ``(x0, y0)`` (surface units) lies on the surface."""
-        self.check_starts([(x0, y0)])
+    def check_start(self, x0: float, y0: float, margin_m: float = 0.0) -> None:
+        """Raise :class:`SpineInputError` unless ``(x0, y0)`` (surface units) lies inside the
+        surface's domain, farther than ``margin_m`` from its edges (:func:`check_starts_on`)."""
+        self.check_starts([(x0, y0)], margin_m)
 
-    def check_starts(self, starts) -> None:
-        """:meth:`check_start` of many ``(x0, y0)`` at once (the first outside is named)."""
-        xy = np.asarray(starts, dtype=float)
-        if xy.size == 0:
-            return
-        if xy.ndim != 2 or xy.shape[1] != 2:
-            raise SpineInputError(f"starts must be (x0, y0) pairs, got an array of shape {xy.shape}")
-        inside = self.surface.contains(xy[:, 0], xy[:, 1])
-        if not inside.all():
-            x0, y0 = xy[int(np.argmin(inside))]
-            raise SpineInputError(
-                f"start ({x0:g}, {y0:g}) lies outside the surface bounds {self.surface.bounds}"
-            )
+    def check_starts(self, starts, margin_m: float = 0.0) -> None:
+        """:meth:`check_start` of many ``(x0, y0)`` at once (the first refused is named)."""
+        check_starts_on(self.surface, starts, margin_m / self.length_scale_m)
 
     # ----------------------------------------------------------------- drive parameters
 

@@ -7,7 +7,7 @@ and the coarsening, lives there); nothing here needs MuJoCo.
 
 from __future__ import annotations
 
-from spine_mj.errors import check_count
+from spine_mj.errors import SpineInputError, check_count
 from spine_mj.memory import check_memory
 from spine_mj.surfaces import GridSurface, HField, Surface, to_hfield
 from spine_mj.surfaces.hfield import DEFAULT_HFIELD_SIDE, hfield_half_extents
@@ -17,6 +17,7 @@ __all__ = [
     "MAX_HFIELD_SIDE",
     "check_hfield_refinement",
     "check_hfield_resolution",
+    "check_hfield_size",
     "grid_keeps_samples",
     "hfield_of",
     "hfield_sides",
@@ -47,6 +48,18 @@ def check_hfield_refinement(refinement) -> int:
     """A user's hfield refinement: a whole factor in [1, MAX_HFIELD_SIDE] (the hfield at that
     many times its samples a side), else SpineInputError naming ``hfield_refinement``."""
     return check_count("hfield_refinement (a factor on the samples a side)", refinement, most=MAX_HFIELD_SIDE)
+
+
+def check_hfield_size(nrow: int, ncol: int, refinement: int = 1) -> None:
+    """Refuse an hfield of ``nrow x ncol`` samples past MAX_HFIELD_SIDE a side (naming the
+    refinement that made it) or past the memory budget (HFIELD_BYTES_PER_SAMPLE a sample),
+    before it is sampled."""
+    side = max(nrow, ncol)
+    if refinement != 1 and side > MAX_HFIELD_SIDE:
+        raise SpineInputError(
+            f"hfield_refinement {refinement} gives {side} samples a side, more than {MAX_HFIELD_SIDE}"
+        )
+    check_memory(HFIELD_BYTES_PER_SAMPLE * float(nrow) * ncol, where=f"an hfield of {nrow} x {ncol} samples")
 
 
 def hfield_sides(surface: Surface, resolution: int | None, refinement) -> tuple[int, int]:
@@ -93,7 +106,7 @@ def hfield_of(surface: Surface, resolution: int | None = None, refinement: int =
     """
     ny, nx = hfield_sides(surface, resolution, refinement)
     f = int(refinement)
-    check_memory(HFIELD_BYTES_PER_SAMPLE * float(nx) * ny, where=f"an hfield of {ny} x {nx} samples")
+    check_hfield_size(ny, nx, f)
     hf = to_hfield(surface, nrow=resolution, ncol=resolution) if resolution else to_hfield(surface)
     if refinement == 1:
         return hf

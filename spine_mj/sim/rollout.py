@@ -186,7 +186,7 @@ def run_batch(
     if opt.backend not in ("rollout", "python"):
         raise SpineInputError(f"backend must be 'rollout' or 'python', got {opt.backend!r}")
     det = (Detection() if opt.detection is None else opt.detection).resolve(rig.scales)
-    rig.check_starts(starts)
+    rig.check_starts(starts, det.domain_margin_m)
     runner = _BatchRunner(rig, drives, starts, det)
     nthread = (os.cpu_count() or 1) if opt.nthread is None else max(1, int(opt.nthread))
     lanes = NativeLanes(nthread) if opt.backend == "rollout" else PythonLane()

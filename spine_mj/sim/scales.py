@@ -29,7 +29,6 @@ from spine_mj.errors import SpineInputError, check_positive
 from spine_mj.roughness import characteristic_length, slope_correlation_length
 from spine_mj.sim.records import TipParams
 from spine_mj.sim.rig_hfield import (
-    MAX_HFIELD_SIDE,
     check_hfield_refinement,
     check_hfield_resolution,
     grid_keeps_samples,
@@ -485,16 +484,8 @@ def _slope_length(surface: Surface, length_scale_m: float, char_length_m: float)
 
 def _sampled_hfield(surface: Surface, resolution: int | None, refinement: int, report) -> HField:
     """:func:`hfield_of` ``surface`` at ``resolution`` refined ``refinement`` times, its stage
-    told to ``report``; a refinement past MAX_HFIELD_SIDE a side refused before sampling."""
-    if refinement == 1:
-        report(0, 1, "sampling the hfield")
-        return hfield_of(surface, resolution)
-    report(0, 1, "refining the hfield")
-    side = max(hfield_sides(surface, resolution, refinement))
-    if side > MAX_HFIELD_SIDE:
-        raise SpineInputError(
-            f"hfield_refinement {refinement} gives {side} samples a side, more than {MAX_HFIELD_SIDE}"
-        )
+    told to ``report``."""
+    report(0, 1, "sampling the hfield" if refinement == 1 else "refining the hfield")
     return hfield_of(surface, resolution, refinement)
 
 

@@ -451,7 +451,7 @@ def test_a_heightfield_past_pybullet_s_upload_buffer_is_refused_in_one_line(tmp_
     assert heard == []
     # a tip wide enough that the rule coarsens the grid under the limit passes the early check
     inputs = sim.RigInputs(mu=1.0, engine="bullet", tip_radius_m=10 * 10.0 / side * 0.01)
-    build._check_engine_hfield(grid, inputs)
+    build.check_planned_hfield(grid, inputs)
     assert max(scales.planned_hfield_sides(grid, tip=inputs.tip)) < side
     cfg = write_config(
         tmp_path,

@@ -248,3 +248,43 @@ def test_contacts_at_counts_one_per_overlapped_prism_with_the_planes_normal_insi
     assert np.all(depths_v > 0)
     tilts = np.degrees(np.arccos(np.clip(normals_v @ plane_n, -1, 1)))
     assert tilts.min() < 1e-3 and tilts.max() < 10.0
+
+
+@pytest.mark.parametrize(
+    ("start", "margin", "fragment"),
+    [
+        (
+            (-5.0, -1.0),
+            0.0,
+            r"lies on the edge of the surface's domain x in \[-5, 5\], y in \[-5, 5\]; start inside",
+        ),
+        ((1.0, 5.0), 0.05, r"on the edge of .*by more than 0.05: a run ends \(left_domain\)"),
+        ((-4.99, -1.0), 0.05, r"\(-4.99, -1\) lies within 0.05 of the edge of the surface's domain"),
+        ((-5.01, -1.0), 0.05, r"\(-5.01, -1\) lies outside the surface's domain x in \[-5, 5\]"),
+        ((0.0, float("nan")), 0.0, r"\(0, nan\) lies outside"),
+    ],
+)
+def test_a_start_a_run_would_end_at_once_is_refused_naming_it_and_the_domain(start, margin, fragment):
+    """A start on the domain's edge ran and ended left_domain at once; within the run's
+    margin (a tip radius) the same. Starts strictly inside by more than it pass."""
+    from spine_mj.errors import SpineInputError
+    from spine_mj.sim.model import check_starts_on
+
+    surface = single_gaussian()  # bounds (-5, 5, -5, 5)
+    with pytest.raises(SpineInputError, match=fragment):
+        check_starts_on(surface, [(0.0, 0.0), start], margin)
+    check_starts_on(surface, [(-4.9, -1.0), (4.94, 4.94)], 0.05)
+
+
+def test_a_run_refuses_a_start_within_its_detection_margin_and_takes_one_beyond_it():
+    from spine_mj.errors import SpineInputError
+    from spine_mj.sim import Detection, SpringDrive
+
+    rig = plane_rig(0.0)
+    xmin = rig.surface.bounds[0]
+    margin = 4 * rig.tip.tip_radius_m
+    drive = SpringDrive(speed_m_s=1e-3, stiffness_n_m=100.0, duration_s=1e-3)
+    start = (xmin + 2 * rig.tip.tip_radius_m / rig.length_scale_m, 0.0)
+    with pytest.raises(SpineInputError, match="lies within"):
+        rig.run(drive, start=start, detection=Detection(domain_margin_m=margin))
+    assert rig.run(drive, start=start).end_reason.name != "LEFT_DOMAIN"  # the default margin: a tip radius

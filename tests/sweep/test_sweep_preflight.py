@@ -215,3 +215,22 @@ def test_engines_of_one_sizing_measure_the_surface_once_before_any_run(tmp_path,
     monkeypatch.setenv("SPINE_MJ_MEMORY_BUDGET", "1M")
     with pytest.raises(SpineInputError, match=r"engine = 'bullet'.*Bullet's heightfield of 101 x 101"):
         preflight.check_cases(cases, ("engine",))
+
+
+def test_a_start_on_the_domain_s_edge_is_refused_before_any_run(tmp_path):
+    """It ran, every run ending left_domain at once (a run ends a tip radius from an edge)."""
+    text = PEAK_ENGINE.replace(
+        "[starts]\nx = [0.05]\ny = [0.5]", '[starts]\nframe = "absolute"\npoints = [[-5.0, -1.0]]'
+    )
+    _refused_before_any_run(tmp_path, text, "start (-5, -1) lies on the edge", "x in [-5, 5], y in [-5, 5]")
+
+
+def test_an_hfield_past_the_budget_is_refused_on_its_predicted_sides_before_any_sizing(tmp_path, monkeypatch):
+    """4000 a side refined twice, both engines: the 7999-a-side hfield is refused by its
+    predicted size (the sizing would have sampled and named the 4000-a-side one first)."""
+    monkeypatch.setenv("SPINE_MJ_MEMORY_BUDGET", "300M")
+    text = (
+        PEAK_ENGINE
+        + '[grid]\nengine = ["mujoco", "bullet"]\nhfield_resolution = 4000\nhfield_refinement = 2\n'
+    )
+    _refused_before_any_run(tmp_path, text, "an hfield of 7999 x 7999 samples would need")

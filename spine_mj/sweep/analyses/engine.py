@@ -17,7 +17,7 @@ import numpy as np
 from spine_mj import sim
 from spine_mj.choices import DEFAULT_ENGINE, ENGINES, PROTOCOLS
 from spine_mj.errors import SpineInputError
-from spine_mj.sim.build import plan_rig, rig_sizing
+from spine_mj.sim.build import check_planned_hfield, plan_rig, rig_sizing
 from spine_mj.sim.holding import spring_swing
 from spine_mj.sim.open_loop import drive_steps
 from spine_mj.sim.ramp import nominal_time_s
@@ -321,6 +321,7 @@ def case_plan(case, surface=None):
     any case runs."""
     surface = case.surface.make() if surface is None else surface
     inputs = case_inputs(case, surface)
+    check_planned_hfield(surface, inputs)  # before the sizing: its limits on the predicted sides
     sized = _sizing(case.surface, inputs.tip, tuple(inputs.sizing.items()))
     plan = plan_rig(surface, inputs, sized=sized)
     if inputs.engine == "mujoco":
@@ -413,8 +414,9 @@ def _check_case(case, surface, starts) -> None:
     rig = case_plan(case, surface)
     drive = case_drive(rig, case.params)
     rig.check_drive(drive)
+    det = sim.Detection(kappa_cap=case.params["kappa_cap"]).resolve(rig.scales)
+    rig.check_starts(starts, det.domain_margin_m)
     if case.params["protocol"] != "ramp" and len(starts):
-        det = sim.Detection(kappa_cap=case.params["kappa_cap"]).resolve(rig.scales)
         x0 = float(min(s[0] for s in starts)) * rig.length_scale_m
         drive_steps(rig, drive, x0, det)
 
