@@ -95,8 +95,13 @@ def _crease_one(fxa, fya, fxb, fyb, mu, tol):
     a0, a1 = (az - d * bz) / den, (-ax + d * bx) / den
     b0, b1 = (bz - d * az) / den, (-bx + d * ax) / den
     s0, s1 = a0 + b0, a1 + b1
-    slides = np.abs(cz) > mu * s0
-    lock = (not slides) and (cx - mu * s1 < tol)
+    up = cx + mu * s1  # the drive's pull back up the crease per kappa, net of its friction
+    fwd = cx - mu * s1
+    held_back = (
+        (cz > mu * s0) and (up > tol) and ((fwd < tol) or ((cz - mu * s0) / up <= (cz + mu * s0) / fwd))
+    )
+    slides = (np.abs(cz) > mu * s0) and not held_back
+    lock = (not slides) and (fwd < tol)
     k = np.nan if (slides or lock) else (cz + mu * s0) / (cx - mu * s1)
     k_at = k if np.isfinite(k) else 0.0
     pressed = (a0 + k_at * a1 >= 0) and (b0 + k_at * b1 >= 0)

@@ -231,14 +231,20 @@ def crease_engagement(fx_a, fy_a, fx_b, fy_b, mu, *, tol: float = DEFAULT_TOL):
     F across the crease, ``N_a n_a + N_b n_b = -(F - (F.c) c)``, each linear in kappa; the
     friction of both contacts, at most ``mu (N_a + N_b)``, opposes the part along it,
     ``F.c = W (kappa c_x - c_z)``. A V-groove of flank angle theta along the drive gives
-    the wedge's ``kappa = mu / cos(theta)``.
+    the wedge's ``kappa = mu / cos(theta)``. A crease that rises along the drive more
+    steeply than friction holds (``c_z > mu s0``) would let gravity alone slide the tip back
+    down it; the drive holds it there from ``kappa_lo = (c_z - mu s0) / (c_x + mu s1)`` on,
+    as it holds a tip on a single wall steeper than friction (:func:`kappa`), and the tip
+    moves on up the crease at the usual onset: a V-groove of flank angle theta whose axis
+    rises at beta gives ``kappa = tan(beta + arctan(mu / cos(theta)))``. Only where no drive
+    holds it (``c_x + mu s1 <= 0``) does it slide back.
 
     Returns
     -------
     kappa : ndarray
         The drive at which the tip slides along the crease (``ENGAGED``); ``+inf`` where no
-        drive can (``SELF_LOCK``); NaN where gravity alone slides it along (``SLIP``) or
-        where the two-contact state does not hold (a normal force would be negative, the
+        drive can (``SELF_LOCK``); NaN where gravity slides it along whatever the drive
+        (``SLIP``) or where the two-contact state does not hold (a normal force would be negative, the
         crease is vertical or the contacts are parallel: ``region`` -1).
     region : ndarray of int8
         ``SLIP``, ``ENGAGED``, ``SELF_LOCK``, or -1 (no two-contact state).
@@ -264,8 +270,13 @@ def crease_engagement(fx_a, fy_a, fx_b, fy_b, mu, *, tol: float = DEFAULT_TOL):
         a0, a1 = (az - d * bz) / den, (-ax + d * bx) / den
         b0, b1 = (bz - d * az) / den, (-bx + d * ax) / den
         s0, s1 = a0 + b0, a1 + b1
-        slides = np.abs(cz) > mu * s0  # gravity alone, downhill along the crease
-        lock = ~slides & (cx - mu * s1 < tol)
+        # gravity alone slides the tip along the crease, unless it slides it back up the
+        # drive, which holds it there from kappa_lo = (c_z - mu s0) / (c_x + mu s1) on
+        up, fwd = cx + mu * s1, cx - mu * s1
+        held_back = (cz > mu * s0) & (up > tol)
+        held_back &= (fwd < tol) | ((cz - mu * s0) / up <= (cz + mu * s0) / fwd)
+        slides = (np.abs(cz) > mu * s0) & ~held_back
+        lock = ~slides & (fwd < tol)
         k = np.where(slides | lock, np.nan, (cz + mu * s0) / (cx - mu * s1))
         # both contacts pressed where the tip slides (a contact that gravity alone leaves
         # unloaded, a wall beside a flat floor, is pressed by the drive); held or sliding

@@ -162,10 +162,9 @@ def two_contact_kappa(fx_a, fy_a, fx_b, fy_b, mu) -> tuple[np.ndarray, np.ndarra
     of theta 0.3, alpha 0.8, mu 0.7, MuJoCo's static probe broke away at 1.906 F_p, the
     closed form gives 1.907, the feasibility 3.18). Where no motion counts at its onset, the
     feasibility's kappa is the bound: the tip holds at least up to the smallest onset drive,
-    and at most up to that bound. Where gravity alone slides the tip down the crease, that
-    comes first (slip), as in :func:`~spine_mj.theory.engagement.crease_engagement`: measured on
-    sandpaper P36 and P60 grit walls, a crease taken as locked there (the drive's precedence
-    of the single-contact rule) held the reference where MuJoCo's tip moves on.
+    and at most up to that bound. Where gravity slides the tip down the crease whatever the
+    drive, that comes first (slip; :func:`~spine_mj.theory.engagement.crease_engagement`: up a
+    crease steeper than friction the drive holds it, as on one steep wall).
 
     Parameters
     ----------

@@ -65,6 +65,26 @@ def test_a_v_groove_self_locks_once_theta_plus_the_wedge_friction_angle_reaches_
     assert int(region) == SLIP and math.isnan(float(k))
 
 
+@pytest.mark.parametrize(("alpha", "mu"), [(0.5, 0.3), (0.8, 0.5), (0.3, 0.2)])
+def test_a_groove_rising_steeper_than_its_friction_is_held_by_the_drive(alpha, mu):
+    """Up a V-groove whose rise theta exceeds the wedge's friction angle phi, gravity alone
+    slides the tip back down; a drive already pushing it holds it from tan(theta - phi) and
+    moves it on at the wedge's tan(theta + phi) (self-lock from theta + phi = 90 deg), as one
+    contact of friction mu / cos(alpha) would; down a steep groove the preload slides it
+    whatever the drive."""
+    phi = math.atan(mu / math.cos(alpha))
+    for theta in np.linspace(phi + 0.02, math.pi / 2 - phi - 0.02, 5):
+        fx, fy = _slopes(wedge_normals(theta, alpha))
+        k, region = two_contact_kappa(fx[0], fy[0], fx[1], fy[1], mu)
+        assert int(region) == ENGAGED
+        assert float(k) == pytest.approx(math.tan(theta + phi), rel=1e-9)
+        assert float(k) == pytest.approx(float(wedge_kappa(theta, alpha, mu)), rel=1e-12)
+    fx, fy = _slopes(wedge_normals(math.pi / 2 - phi + 0.02, alpha))
+    assert int(two_contact_kappa(fx[0], fy[0], fx[1], fy[1], mu)[1]) == SELF_LOCK
+    fx, fy = _slopes(wedge_normals(-phi - 0.05, alpha))
+    assert int(two_contact_kappa(fx[0], fy[0], fx[1], fy[1], mu)[1]) == SLIP
+
+
 def test_one_contact_feasibility_is_the_single_contact_kappa():
     rng = np.random.default_rng(3)
     fx, fy = rng.uniform(-0.6, 1.2, 20), rng.uniform(-0.8, 0.8, 20)
@@ -148,6 +168,30 @@ def test_a_streamline_crossing_a_wedging_crease_is_held_there(radius):
     # a cap above the pair's hold lets the path go on, up the crease to the domain's edge
     free = sl.streamlines(surface, [(-0.8, -0.2)], dataclasses.replace(params, kappa_cap=40.0))
     assert Outcome(free.outcome[0]) is Outcome.LEFT_DOMAIN
+
+
+def test_a_streamline_up_a_crease_steeper_than_friction_climbs_it():
+    """Two facets of the scan di-1 (slopes (0.455, 0.504) and (0.668, -0.459), mu 0.5) meet in
+    a crease rising along the drive more steeply than the pair's friction holds: gravity alone
+    would slide the tip back down it. A ball driven into it slid back down, climbed a flank
+    again and came back: 6 of 9 paths stalled, 3 slid out at -x (on the scan a third of the
+    quick plan's paths stalled so). The drive holds it in the crease (from kappa_lo) and moves
+    it up at the pair's kappa, as on one steep wall: every path climbs and leaves at +x."""
+    from spine_mj.surfaces import BallOnFacets, TriangulatedSurface
+    from spine_mj.theory import streamline as sl
+    from spine_mj.theory.engagement import crease_engagement
+    from spine_mj.theory.streamline_types import Outcome, StreamlineParams
+
+    a, b, mu = (0.455, 0.504), (0.668, -0.459), 0.5
+    k, region, vx, _ = crease_engagement(*a, *b, mu)
+    assert int(region) == ENGAGED and 0 < float(k) < 20.0 and float(vx) > 0
+    x = np.linspace(-1.0, 1.0, 81)
+    h = np.maximum(a[0] * x[None, :] + a[1] * x[:, None], b[0] * x[None, :] + b[1] * x[:, None])
+    surface = BallOnFacets(TriangulatedSurface(heights=h, x=x, y=x.copy(), unit="1"), 0.05)
+    starts = np.column_stack([np.full(9, -0.6), np.linspace(-0.5, 0.3, 9)])
+    res = sl.streamlines(surface, starts, StreamlineParams(mu=mu, dl=0.01, kappa_cap=20.0))
+    assert [Outcome(o) for o in res.outcome] == [Outcome.LEFT_DOMAIN] * 9
+    assert np.all(res.end_x > 0.9)
 
 
 def test_mujoco_static_probe_at_a_fractal_crease_breaks_away_near_the_two_contact_kappa():
