@@ -24,6 +24,9 @@ setup(
     packages=[*find_packages(include=["spine_mj", "spine_mj.*"]), *DATA],
     package_dir=DATA,
     package_data={
+        # the public names of each package (read by lazy_loader, type checkers and the docs)
+        "": ["*.pyi"],
+        "spine_mj": ["py.typed"],
         "spine_mj._data.models": ["*.xml"],
         "spine_mj._data.surfaces": ["*.toml"],
         "spine_mj._data.scans": ["*.plu", "*.di", "README.md"],

@@ -11,6 +11,7 @@
 from __future__ import annotations
 
 import importlib
+import inspect
 import json
 import math
 import shutil
@@ -44,13 +45,20 @@ FAMILY_NAMES = {
 
 
 # --------------------------------------------------------------------------- API reference
+def public_names(mod) -> list[str]:
+    """The names of a package's ``__all__`` that an API page lists: not private, and not its
+    subpackages and modules (``spine_mj.sim`` is in ``spine_mj.__all__`` so that it loads on
+    first use, and has its own page)."""
+    return [n for n in mod.__all__ if not n.startswith("_") and not inspect.ismodule(getattr(mod, n))]
+
+
 def _owners() -> dict[int, str]:
     """For each public object, the package whose page documents it: the most specific one
     that exports it (``spine_mj.Rig`` is documented as ``spine_mj.sim.Rig``)."""
     owners: dict[int, str] = {}
     for name in reversed(list(PACKAGES)):  # the subpackages first, spine_mj last
         mod = importlib.import_module(name)
-        for n in mod.__all__:
+        for n in public_names(mod):
             obj = getattr(mod, n)
             if callable(obj) or isinstance(obj, type):
                 owners.setdefault(id(obj), name)
@@ -67,9 +75,7 @@ def api_pages(out: Path) -> list[Path]:
     for name, blurb in PACKAGES.items():
         mod = importlib.import_module(name)
         own, elsewhere = [], []
-        for n in mod.__all__:
-            if n.startswith("_"):
-                continue
+        for n in public_names(mod):
             owner = owners.get(id(getattr(mod, n)), name)
             if owner == name:
                 own.append(n)

@@ -73,9 +73,7 @@ def test_every_public_name_has_a_page():
     missing = []
     for package in generate.PACKAGES:
         mod = importlib.import_module(package)
-        for name in mod.__all__:
-            if name.startswith("_"):
-                continue
+        for name in generate.public_names(mod):
             candidates = [HTML / "api" / "generated" / f"{p}.{name}.html" for p in generate.PACKAGES]
             if not any(c.is_file() for c in candidates):
                 missing.append(f"{package}.{name}")
