@@ -21,9 +21,10 @@ from pathlib import Path
 
 import numpy as np
 
-from spine_mj import presets, sim
+from spine_mj import presets
 from spine_mj import validate as V
 from spine_mj.jsonio import write_json
+from spine_mj.roughness import characteristic_length
 from spine_mj.surfaces import GridSurface
 
 RESOLUTIONS = (151, 201, 401, 801)
@@ -46,7 +47,7 @@ def main(argv=None):
         mu = V.calibrated_mu(preset)
         for seed in seeds:
             surface = presets.make_surface(preset, seed=seed)
-            lc = sim.characteristic_length(surface)
+            lc = characteristic_length(surface)
             starts = _starts(surface)
             tip151 = V.tip_radius(preset, (seed,), 151)
             grid = isinstance(surface, GridSurface)

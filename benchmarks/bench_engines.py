@@ -11,13 +11,15 @@ from __future__ import annotations
 
 import time
 
+from spine_mj.surfaces import inclined_plane
+
 
 def _cases():
-    from spine_mj import presets, sim
+    from spine_mj import presets
 
     peak = presets.make_surface("paper-single-peak")
     mu = presets.preset_mu(peak) or 0.5
-    plane = sim.inclined_plane(slope_deg=10.0)
+    plane = inclined_plane(slope_deg=10.0)
     yield "spring, single peak", peak, mu, "spring", [(-3.0, y) for y in (-1.0, 0.0, 1.0)]
     yield "static probe, 10 deg plane", plane, 0.5, "static", [(0.0, 0.0)] * 3
 

@@ -35,6 +35,7 @@ import numpy as np
 
 from spine_mj import sim
 from spine_mj.sim.ramp import cycle_breakaways, rows_to_reset
+from spine_mj.surfaces import inclined_plane
 from spine_mj.theory import agreement
 from spine_mj.validate.ramp_pilot import pilot_rig
 from spine_mj.validate.static_map import hold_force
@@ -47,7 +48,7 @@ PROBE_PEAK_STARTS = ((-3.0, -1.0), (-2.0, -2.0), (-3.0, 1.0), (-1.0, 1.5), (2.0,
 
 def _cases(res: int):
     for slope in (-15.0, 0.0, 10.0, 20.0, 25.0):
-        rig = sim.Rig(sim.inclined_plane(slope_deg=slope), tip=sim.TipParams(tip_radius_m=5e-4, mu_s=0.5))
+        rig = sim.Rig(inclined_plane(slope_deg=slope), tip=sim.TipParams(tip_radius_m=5e-4, mu_s=0.5))
         yield f"plane {slope:g} deg", rig, (-0.01, 0.0)
     for preset, mu in (("paper-single-peak", 1.23), ("paper-single-valley", 1.23)):
         rig, _ = pilot_rig(preset, None, mu, 0.1, res)
@@ -58,7 +59,7 @@ def _cases(res: int):
 def _probe_cases(res: int, ie: float):
     """(name, rig, start, probe) of the probe comparison."""
     for slope, az in PROBE_PLANES:
-        rig = sim.Rig(sim.inclined_plane(slope_deg=slope, azimuth_deg=az), tip=sim.TipParams(mu_s=0.5))
+        rig = sim.Rig(inclined_plane(slope_deg=slope, azimuth_deg=az), tip=sim.TipParams(mu_s=0.5))
         t = math.tan(math.radians(slope))
         k, low, _ = hold_force(t * math.cos(math.radians(az)), t * math.sin(math.radians(az)), 0.5)
         sc = rig.scales
@@ -160,7 +161,7 @@ def _spring_cases(ies, ks):
                 )
                 yield f"paper fractal, mu {mu:g}", ie, kf, rig, drive, starts
     rig = sim.Rig(
-        sim.inclined_plane(slope_deg=0.0, half_width=0.05, n=101),
+        inclined_plane(slope_deg=0.0, half_width=0.05, n=101),
         tip=sim.TipParams(tip_radius_m=5e-4, mu_s=0.5),
     )
     sc = rig.scales

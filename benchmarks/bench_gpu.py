@@ -32,7 +32,8 @@ def bench_gpu(quick: bool) -> dict:
     """Static kappa error of each engine setting, and GPU against CPU throughput."""
     import dataclasses
 
-    from spine_mj.sim import Rig, TipParams, gpu, inclined_plane
+    from spine_mj.sim import Rig, TipParams, gpu
+    from spine_mj.surfaces import inclined_plane
 
     mu, slopes = 0.5, [0.0, 10.0, 20.0, 25.0]  # below arctan(mu) = 26.6 deg: no start force needed
     high_impratio = 100.0

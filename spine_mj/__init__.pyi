@@ -28,7 +28,6 @@ from .sim import SpringDrive as SpringDrive
 from .sim import StaticProbe as StaticProbe
 from .sim import TipParams as TipParams
 from .sim import default_engine as default_engine
-from .sim import inclined_plane as inclined_plane
 from .surface_io import import_topography as import_topography
 from .surface_io import load_surface as load_surface
 from .surface_io import save_surface as save_surface
@@ -40,6 +39,7 @@ from .surfaces import Surface as Surface
 from .surfaces import TriangulatedSurface as TriangulatedSurface
 from .surfaces import fractal_fbm as fractal_fbm
 from .surfaces import from_hfield as from_hfield
+from .surfaces import inclined_plane as inclined_plane
 from .surfaces import random_gaussians as random_gaussians
 from .surfaces import sandpaper as sandpaper
 from .surfaces import single_gaussian as single_gaussian

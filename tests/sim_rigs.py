@@ -7,8 +7,8 @@ import math
 import mujoco
 import numpy as np
 
-from spine_mj.sim import Rig, TipParams, inclined_plane
-from spine_mj.surfaces import GridSurface
+from spine_mj.sim import Rig, TipParams
+from spine_mj.surfaces import GridSurface, inclined_plane
 
 MU = 0.5
 PHI = math.atan(MU)

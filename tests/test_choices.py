@@ -14,6 +14,7 @@ from spine_mj import choices, sim, sweep
 from spine_mj.cli import main
 from spine_mj.errors import SpineInputError
 from spine_mj.sim.step_rule import mujoco_settings
+from spine_mj.surfaces import inclined_plane
 
 
 def rk4_settings(scales, *, speed_m_s=None, stiffness_n_m=None, **options):
@@ -47,7 +48,7 @@ def test_the_name_lists_match_what_they_name():
     assert choices.ENGINES["mujoco"].rig_class() is sim.Rig
     # MuJoCo's options are exactly the fields of its overrides record
     assert set(choices.ENGINES["mujoco"].options) == set(sim.EngineOverrides.__dataclass_fields__)
-    surf = sim.inclined_plane(slope_deg=10.0)
+    surf = inclined_plane(slope_deg=10.0)
     for protocol in choices.PROTOCOLS:
         sim.build_drive(sim.build_rig(surf, mu=0.5, tip_radius_m=1e-3).scales, protocol)
 
@@ -60,7 +61,7 @@ def test_the_names_module_loads_nothing_heavy():
 
 
 def test_an_unknown_engine_and_an_option_it_does_not_read_are_refused(third_engine):
-    surf = sim.inclined_plane(slope_deg=10.0)
+    surf = inclined_plane(slope_deg=10.0)
     with pytest.raises(SpineInputError, match=r"engine must be one of mujoco, .*mujoco-rk4, got 'ode'"):
         sim.build_rig(surf, engine="ode", mu=0.5)
     with pytest.raises(SpineInputError, match="impratio: not read by engine mujoco-rk4"):
@@ -80,8 +81,8 @@ def test_a_third_engine_runs_simulate(third_engine, tmp_path):
     summary = json.loads((out / "summary.json").read_text())
     assert summary["engine"]["integrator"] == "rk4"
     # the same inputs in MuJoCo give the same rig but for the integrator
-    base = sim.build_rig(sim.inclined_plane(slope_deg=0.0), mu=0.5, tip_radius_m=1e-3)
-    rk4 = sim.build_rig(sim.inclined_plane(slope_deg=0.0), engine="mujoco-rk4", mu=0.5, tip_radius_m=1e-3)
+    base = sim.build_rig(inclined_plane(slope_deg=0.0), mu=0.5, tip_radius_m=1e-3)
+    rk4 = sim.build_rig(inclined_plane(slope_deg=0.0), engine="mujoco-rk4", mu=0.5, tip_radius_m=1e-3)
     assert rk4.engine.timestep_s == base.engine.timestep_s
     assert (rk4.engine.integrator.value, base.engine.integrator.value) == ("rk4", "implicitfast")
 

@@ -111,14 +111,34 @@ def test_shipped_files_are_found_through_the_package():
     assert set(presets.list_presets()) == names
 
 
+def _stub_homes(root: Path) -> dict[str, dict[str, str]]:
+    """Package -> {public name: the module it loads from}, read from the package's
+    ``__init__.pyi`` (what ``lazy_loader.attach_stub`` imports on first use of the name)."""
+    homes = {}
+    for stub in root.rglob("__init__.pyi"):
+        package = ".".join(stub.parent.relative_to(root.parent).parts)
+        homes[package] = {
+            alias.asname or alias.name: f"{package}.{node.module}"
+            if node.module
+            else f"{package}.{alias.name}"
+            for node in ast.parse(stub.read_text()).body
+            if isinstance(node, ast.ImportFrom)
+            for alias in node.names
+        }
+    return homes
+
+
 def _package_imports() -> dict[str, set[str]]:
-    """Module name -> the spine_mj modules it imports (at top level or inside functions)."""
+    """Module name -> the spine_mj modules it imports (at top level or inside functions); a
+    name taken from a package with a stub is an arrow to the module the stub loads it from,
+    and the package itself has an arrow to every module its stub names."""
     root = Path(spine_mj.__file__).parent
     modules = {}
     for path in root.rglob("*.py"):
         parts = path.relative_to(root.parent).with_suffix("").parts
         name = ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
         modules[name] = path
+    homes = _stub_homes(root)
     graph = {}
     for name, path in modules.items():
         is_pkg = path.name == "__init__.py"
@@ -132,10 +152,17 @@ def _package_imports() -> dict[str, set[str]]:
                 if node.level:
                     anchor = package.rsplit(".", node.level - 1)[0] if node.level > 1 else package
                     base = f"{anchor}.{base}" if base else anchor
-                targets = [f"{base}.{a.name}" if f"{base}.{a.name}" in modules else base for a in node.names]
+                targets = [
+                    f"{base}.{a.name}"
+                    if f"{base}.{a.name}" in modules
+                    else homes.get(base, {}).get(a.name, base)
+                    for a in node.names
+                ]
             else:
                 continue
             edges |= {t for t in targets if t in modules and t != name}
+        # a package with a stub loads its names on first use: an arrow to each of their modules
+        edges |= {m for m in homes.get(name, {}).values() if m in modules and m != name}
         graph[name] = edges
     return graph
 

@@ -15,7 +15,7 @@ print are the same kind of model; ``rig.model``, :meth:`Rig.place` and :meth:`Ri
 are in engine units, everything in a :class:`RunResult` is SI.
 
 Scales and default engine settings (:func:`default_engine`). With ``a_p = F_p / mass_kg``
-and ``L_c`` the surface's characteristic length (:func:`characteristic_length`):
+and ``L_c`` the surface's characteristic length (:func:`spine_mj.roughness.characteristic_length`):
 
 * contacts use ``solref = (2 dt, 1)`` (the stiffest stable time constant, critically
   damped) and ``solimp = (0.99, 0.99, ...)``; the resting depth is then
@@ -65,100 +65,6 @@ record, :class:`RigInputs` of :mod:`~spine_mj.sim.rig_inputs`) and
 :mod:`~spine_mj.sim.holding` (an array's predicted holding excess and its default pace).
 """
 
-from spine_mj.roughness import characteristic_length
-from spine_mj.sim.array import ArrayRig
-from spine_mj.sim.array_run import ArrayResult, ForcePull
-from spine_mj.sim.build import (
-    DEFAULT_INERTIA_NUMBER,
-    RigInputs,
-    build_array,
-    build_array_on,
-    build_drive,
-    build_rig,
-    drive_speed_m_s,
-    rig_scales,
-)
-from spine_mj.sim.detection import Detection, Event
-from spine_mj.sim.drives import Drive, RampDrive, SpringDrive, StaticProbe
-from spine_mj.sim.engine_rig import EngineRig
-from spine_mj.sim.holding import HOLDING_TOLERANCE, array_ie, holding_excess
-from spine_mj.sim.layout import Layout, LayoutKind
-from spine_mj.sim.model import MODEL_PATH
-from spine_mj.sim.records import Cone, EndReason, EngineSettings, Integrator, TipParams
-from spine_mj.sim.results import RunResult
-from spine_mj.sim.rig import REFINE_TIMESTEP, Rig
-from spine_mj.sim.rig_hfield import hfield_of, hfield_spacing
-from spine_mj.sim.rollout import BatchOptions
-from spine_mj.sim.scales import (
-    DEFAULT_LENGTH_SCALE_M,
-    MAX_INERTIA_NUMBER,
-    EngineUnits,
-    Scales,
-)
-from spine_mj.sim.step_rule import (
-    MAX_SPRING_OMEGA_DT,
-    SPRING_OMEGA_DT,
-    EngineOverrides,
-    default_engine,
-    penetration_tolerance_m,
-    spring_omega_dt,
-)
-from spine_mj.surfaces import LENGTH_UNITS_M
-from spine_mj.surfaces.generators import inclined_plane
-from spine_mj.theory.motion import MOTION_NAMES, SLIDING, SLIPPING, STUCK, SlipEvent
+import lazy_loader as _lazy
 
-__all__ = [
-    "DEFAULT_INERTIA_NUMBER",
-    "DEFAULT_LENGTH_SCALE_M",
-    "HOLDING_TOLERANCE",
-    "LENGTH_UNITS_M",
-    "MAX_INERTIA_NUMBER",
-    "MAX_SPRING_OMEGA_DT",
-    "MODEL_PATH",
-    "MOTION_NAMES",
-    "REFINE_TIMESTEP",
-    "SLIDING",
-    "SLIPPING",
-    "SPRING_OMEGA_DT",
-    "STUCK",
-    "ArrayResult",
-    "ArrayRig",
-    "BatchOptions",
-    "Cone",
-    "Detection",
-    "Drive",
-    "EndReason",
-    "EngineOverrides",
-    "EngineRig",
-    "EngineSettings",
-    "EngineUnits",
-    "Event",
-    "ForcePull",
-    "Integrator",
-    "Layout",
-    "LayoutKind",
-    "RampDrive",
-    "Rig",
-    "RigInputs",
-    "RunResult",
-    "Scales",
-    "SlipEvent",
-    "SpringDrive",
-    "StaticProbe",
-    "TipParams",
-    "array_ie",
-    "build_array",
-    "build_array_on",
-    "build_drive",
-    "build_rig",
-    "characteristic_length",
-    "default_engine",
-    "drive_speed_m_s",
-    "hfield_of",
-    "hfield_spacing",
-    "holding_excess",
-    "inclined_plane",
-    "penetration_tolerance_m",
-    "rig_scales",
-    "spring_omega_dt",
-]
+__getattr__, __dir__, __all__ = _lazy.attach_stub(__name__, __file__)

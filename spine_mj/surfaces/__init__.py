@@ -27,58 +27,6 @@ Modules: :mod:`~spine_mj.surfaces.base` (units, size limits, argument checks),
 Every public name is importable from ``spine_mj.surfaces``.
 """
 
-from spine_mj.surfaces.base import (
-    GRIT_PARTICLE_DIAMETER_M,
-    LENGTH_UNITS_M,
-    MAX_GRID_POINTS,
-    MAX_PEAKS,
-    check_grid_size,
-    check_unit,
-    length_unit,
-)
-from spine_mj.surfaces.dilation import ball_dilation, ball_dilation_reference, dilate
-from spine_mj.surfaces.facets import BallOnFacets, TriangulatedSurface
-from spine_mj.surfaces.generators import (
-    corrugation,
-    fractal_fbm,
-    inclined_plane,
-    random_gaussians,
-    single_gaussian,
-)
-from spine_mj.surfaces.hfield import HField, from_hfield, refine_grid, to_hfield
-from spine_mj.surfaces.sandpaper import sandpaper
-from spine_mj.surfaces.tracks import abbm_force_intensity, abbm_size_range, abbm_slope_walk, abbm_track
-from spine_mj.surfaces.types import BSplineGrid, GaussianSurface, GridSurface, Surface
+import lazy_loader as _lazy
 
-__all__ = [
-    "GRIT_PARTICLE_DIAMETER_M",
-    "LENGTH_UNITS_M",
-    "MAX_GRID_POINTS",
-    "MAX_PEAKS",
-    "BSplineGrid",
-    "BallOnFacets",
-    "GaussianSurface",
-    "GridSurface",
-    "HField",
-    "Surface",
-    "TriangulatedSurface",
-    "abbm_force_intensity",
-    "abbm_size_range",
-    "abbm_slope_walk",
-    "abbm_track",
-    "ball_dilation",
-    "ball_dilation_reference",
-    "check_grid_size",
-    "check_unit",
-    "corrugation",
-    "dilate",
-    "fractal_fbm",
-    "from_hfield",
-    "inclined_plane",
-    "length_unit",
-    "random_gaussians",
-    "refine_grid",
-    "sandpaper",
-    "single_gaussian",
-    "to_hfield",
-]
+__getattr__, __dir__, __all__ = _lazy.attach_stub(__name__, __file__)

@@ -53,54 +53,6 @@ case), :mod:`~spine_mj.sweep.store` (the result store and its readers),
 and :mod:`~spine_mj.sweep.analyses` (the built-in analyses, registered on import).
 """
 
-from spine_mj.sweep.analyses import ENGINE_PARAMS, QUASISTATIC_PARAMS
-from spine_mj.sweep.case_runs import run_case
-from spine_mj.sweep.cases import Case, expand_cases
-from spine_mj.sweep.config import StartsSpec, SurfaceSpec, SweepConfig, load_config, parse_config
-from spine_mj.sweep.executors import DEFAULT_WORKER_WAIT_S, SchedulerUnavailable
-from spine_mj.sweep.pool import WorkersCannotStart
-from spine_mj.sweep.registry import (
-    ANALYSES,
-    REQUIRED,
-    STATUSES,
-    Analysis,
-    AnalysisResult,
-    ParamSpec,
-    register_analysis,
-)
-from spine_mj.sweep.report import write_report
-from spine_mj.sweep.session import Progress, SweepSummary, run_sweep, run_sweeps
-from spine_mj.sweep.store import StoreStatus, consolidate, load_runs, load_trajectories, store_status
+import lazy_loader as _lazy
 
-__all__ = [
-    "ANALYSES",
-    "DEFAULT_WORKER_WAIT_S",
-    "ENGINE_PARAMS",
-    "QUASISTATIC_PARAMS",
-    "REQUIRED",
-    "STATUSES",
-    "Analysis",
-    "AnalysisResult",
-    "Case",
-    "ParamSpec",
-    "Progress",
-    "SchedulerUnavailable",
-    "StartsSpec",
-    "StoreStatus",
-    "SurfaceSpec",
-    "SweepConfig",
-    "SweepSummary",
-    "WorkersCannotStart",
-    "consolidate",
-    "expand_cases",
-    "load_config",
-    "load_runs",
-    "load_trajectories",
-    "parse_config",
-    "register_analysis",
-    "run_case",
-    "run_sweep",
-    "run_sweeps",
-    "store_status",
-    "write_report",
-]
+__getattr__, __dir__, __all__ = _lazy.attach_stub(__name__, __file__)

@@ -72,7 +72,7 @@ class EnergyBudget:
 def elastic_release_j(drive_force_n, stiffness_n_m: float, spans) -> float:
     """Spring energy released over the slip events of a run [J].
 
-    ``spans``: ``(onset, stop)`` rows of each slip (:class:`spine_mj.sim.SlipEvent`'s
+    ``spans``: ``(onset, stop)`` rows of each slip (:class:`spine_mj.theory.motion.SlipEvent`'s
     ``onset`` and ``stop``); each releases ``(F_onset^2 - F_stop^2) / (2 k)``, an increase
     of the stored energy counting 0.
     """

@@ -39,7 +39,7 @@ stopped) and returns a typed result with the numbers and the data of its figures
 or the test-size ``"smoke"``), writes ``report.md`` with PNG figures and ``validation.json``.
 
 Lengths in the metrics are in units of the surface's characteristic length ``L_c``
-(:func:`spine_mj.sim.characteristic_length`), forces in units of the preload ``F_p``.
+(:func:`spine_mj.roughness.characteristic_length`), forces in units of the preload ``F_p``.
 
 Modules: :mod:`~spine_mj.validate.plans` (plans, targets, constants),
 :mod:`~spine_mj.validate.study_runner` (runs a study's sweep configs into resumable
@@ -52,97 +52,6 @@ study, :mod:`~spine_mj.validate.report` (one report module per study, named like
 module) and :mod:`~spine_mj.validate.suite` (:func:`run_validation`).
 """
 
-from spine_mj.presets import calibrated_mu
-from spine_mj.theory.targets import FRECHET_TARGET, OUTCOME_TARGET
-from spine_mj.validate.boundary import BoundaryCurve, BoundaryResult, boundary
-from spine_mj.validate.fractal_lock import FractalLockResult, fractal_lock
-from spine_mj.validate.ie_star import (
-    DEPARTURE,
-    IE_STAR_CRITERIA,
-    IeStar,
-    bootstrap_ie_star,
-    departure_ie_star,
-    estimate_ie_star,
-    ie_star_by_criterion,
-)
-from spine_mj.validate.paths import (
-    path_metrics,
-    prefix_frechet,
-    streamline_paths,
-    tip_radius,
-    triangulated_surface,
-)
-from spine_mj.validate.plans import (
-    GRAVITY,
-    MASS_KG,
-    PLANS,
-    RAMP_MIN_COVERAGE,
-    SANDPAPER_MU,
-    STATIC_TARGET,
-    FamilySpec,
-    ValidationPlan,
-)
-from spine_mj.validate.quasistatic_limit import LimitPath, QuasistaticLimitResult, quasistatic_limit
-from spine_mj.validate.ramp_pilot import RampPlan, pilot_rig, ramp_duration
-from spine_mj.validate.report.document import write_report
-from spine_mj.validate.sandpaper import SandpaperResult, sandpaper
-from spine_mj.validate.static_map import PLANE_START, StaticMapResult, static_map
-from spine_mj.validate.stick_slip import SlipStats, StickSlipResult, slip_statistics, stick_slip
-from spine_mj.validate.stiffness_map import StiffnessMapResult, stiffness_map
-from spine_mj.validate.studies import STUDIES, Study
-from spine_mj.validate.study_runner import StudyRunner, ValidationProgress
-from spine_mj.validate.suite import run_validation
+import lazy_loader as _lazy
 
-__all__ = [
-    "DEPARTURE",
-    "FRECHET_TARGET",
-    "GRAVITY",
-    "IE_STAR_CRITERIA",
-    "MASS_KG",
-    "OUTCOME_TARGET",
-    "PLANE_START",
-    "PLANS",
-    "RAMP_MIN_COVERAGE",
-    "SANDPAPER_MU",
-    "STATIC_TARGET",
-    "STUDIES",
-    "BoundaryCurve",
-    "BoundaryResult",
-    "FamilySpec",
-    "FractalLockResult",
-    "IeStar",
-    "LimitPath",
-    "QuasistaticLimitResult",
-    "RampPlan",
-    "SandpaperResult",
-    "SlipStats",
-    "StaticMapResult",
-    "StickSlipResult",
-    "StiffnessMapResult",
-    "Study",
-    "StudyRunner",
-    "ValidationPlan",
-    "ValidationProgress",
-    "bootstrap_ie_star",
-    "boundary",
-    "calibrated_mu",
-    "departure_ie_star",
-    "estimate_ie_star",
-    "fractal_lock",
-    "ie_star_by_criterion",
-    "path_metrics",
-    "pilot_rig",
-    "prefix_frechet",
-    "quasistatic_limit",
-    "ramp_duration",
-    "run_validation",
-    "sandpaper",
-    "slip_statistics",
-    "static_map",
-    "stick_slip",
-    "stiffness_map",
-    "streamline_paths",
-    "tip_radius",
-    "triangulated_surface",
-    "write_report",
-]
+__getattr__, __dir__, __all__ = _lazy.attach_stub(__name__, __file__)

@@ -20,8 +20,9 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from spine_mj import presets, sim
+from spine_mj import presets
 from spine_mj.presets import calibrated_mu
+from spine_mj.roughness import characteristic_length
 from spine_mj.theory.targets import FRECHET_TARGET
 from spine_mj.validate.convergence import REFINEMENTS, headline_convergence
 from spine_mj.validate.ie_star import (
@@ -376,7 +377,7 @@ def _ramp_jobs(
     seed = None if fam.seeds is None else fam.seeds[0]
     rig, _ = pilot_rig(preset, seed, mu, tip, plan.hfield_resolution)
     surface = presets.make_surface(preset, **({} if seed is None else {"seed": int(seed)}))
-    lc = sim.characteristic_length(surface)
+    lc = characteristic_length(surface)
     sx, sy = fam.first_start(surface)
     by_dur: dict[float, list[float]] = {}
     with runner.phase(f"ramp pilots on {preset}", len(plan.boundary.ie_values)) as tick:

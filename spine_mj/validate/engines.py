@@ -62,6 +62,7 @@ from spine_mj import presets, sim
 from spine_mj.atomic import atomic_output
 from spine_mj.choices import COMPARED_ENGINES
 from spine_mj.errors import SpineInputError
+from spine_mj.surfaces import inclined_plane
 from spine_mj.theory import engagement
 from spine_mj.theory.tomlinson import Corrugation
 from spine_mj.validate.plans import ValidationPlan
@@ -150,7 +151,7 @@ def _static_rows(engine: str) -> list[dict]:
         t = math.tan(math.radians(slope))
         k, low, _ = hold_force(t * math.cos(math.radians(az)), t * math.sin(math.radians(az)), MU)
         hold = 0.5 * (low + k) if low > 0 else 0.0  # as the static map: where gravity alone slides
-        rig = _rig(engine, sim.inclined_plane(slope_deg=slope, azimuth_deg=az), ie=1e-2)
+        rig = _rig(engine, inclined_plane(slope_deg=slope, azimuth_deg=az), ie=1e-2)
         drive = sim.build_drive(rig.scales, "static", ie=1e-2, start_force_n=hold * rig.scales.preload_n)
         run = rig.run(drive, start=(0.0, 0.0))
         rows.append(
@@ -397,7 +398,7 @@ def _creep(run, held) -> float:
 
 
 def _creep_rows(engine: str) -> list[dict]:
-    rig = _rig(engine, sim.inclined_plane(slope_deg=20.0), ie=1e-2)
+    rig = _rig(engine, inclined_plane(slope_deg=20.0), ie=1e-2)
     drive = sim.SpringDrive(speed_m_s=1e-9, stiffness_n_m=1e-9, duration_s=0.5)
     run = rig.run(drive, start=(0.0, 0.0))
     speed = _creep(run, ~run.moving[run.drive_start_index :])

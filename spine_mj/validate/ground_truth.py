@@ -20,8 +20,9 @@ from pathlib import Path
 import numpy as np
 
 from spine_mj import sim, sweep
+from spine_mj.roughness import characteristic_length
 from spine_mj.surface_io import save_surface
-from spine_mj.surfaces import GridSurface
+from spine_mj.surfaces import GridSurface, inclined_plane
 from spine_mj.theory.tomlinson import (
     SLOPE_LENGTH_PER_WAVELENGTH,
     Corrugation,
@@ -155,7 +156,7 @@ def spring_block_check(
     spring (the step rule's ``omega dt``), the run lasts until ``periods`` swings after the
     predicted breakaway. ``stiffness_number`` (K) replaces ``stiffness_n_m`` when given;
     ``engine`` is one of :data:`spine_mj.choices.ENGINES`."""
-    surface = sim.inclined_plane(slope_deg=0.0, half_width=0.05, n=101)
+    surface = inclined_plane(slope_deg=0.0, half_width=0.05, n=101)
     tip = sim.TipParams(tip_radius_m=5e-4, mu_s=mu, mass_kg=MASS_KG)
     scales = sim.Scales.for_surface(surface, tip=tip)
     k = scales.stiffness_for(stiffness_number) if stiffness_number is not None else stiffness_n_m
@@ -318,7 +319,7 @@ def _liftoff(plan: ValidationPlan, runner: StudyRunner, width: float) -> dict:
     folder.mkdir(parents=True, exist_ok=True)
     path = save_surface(surf, folder / f"ridge-{width:g}.npz")
     unit = sim.DEFAULT_LENGTH_SCALE_M
-    lc_m = sim.characteristic_length(surf) * unit
+    lc_m = characteristic_length(surf) * unit
     ie_star = liftoff_inertia_number(
         gaussian_ridge_path_curvature(RIDGE_HEIGHT * unit, width * unit, RIDGE_TIP_M), lc_m
     )
@@ -378,7 +379,7 @@ def crest_check(width: float, factor: float, engine: str = "mujoco") -> tuple[fl
     unit = sim.DEFAULT_LENGTH_SCALE_M
     ie_star = liftoff_inertia_number(
         gaussian_ridge_path_curvature(RIDGE_HEIGHT * unit, width * unit, RIDGE_TIP_M),
-        sim.characteristic_length(surf) * unit,
+        characteristic_length(surf) * unit,
     )
     ie = factor * ie_star
     soft = {"solref_timeconst_s": RIDGE_SOLREF_S} if engine == "mujoco" else {}

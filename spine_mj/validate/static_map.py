@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from spine_mj import sim, surface_io, sweep
+from spine_mj.surfaces import inclined_plane
 from spine_mj.sweep.analyses.engine import case_rig
 from spine_mj.theory import engagement, multicontact
 from spine_mj.validate.convergence import REFINEMENTS
@@ -531,7 +532,7 @@ def _plane_file(out_dir, slope: float, az: float):
     name = f"plane_s{slope:g}_a{az:g}" + (f"_n{n}" if n != 41 else "")
     path = out_dir / "surfaces" / f"{name}.npz"
     if not path.is_file():
-        surface_io.save_surface(sim.inclined_plane(slope_deg=slope, azimuth_deg=az, n=n), path)
+        surface_io.save_surface(inclined_plane(slope_deg=slope, azimuth_deg=az, n=n), path)
     return path
 
 

@@ -11,6 +11,7 @@ import numpy as np
 from spine_mj import presets, sim
 from spine_mj.errors import SpineInputError
 from spine_mj.presets import calibrated_mu
+from spine_mj.roughness import characteristic_length
 from spine_mj.theory.motion import slip_events
 from spine_mj.theory.tomlinson import Corrugation
 from spine_mj.validate.ground_truth import CORRUGATION_START, TOMLINSON_TIP, corrugation_runs
@@ -195,7 +196,7 @@ def stick_slip(plan: ValidationPlan, runner: StudyRunner) -> StickSlipResult:
     runner.study = "stick_slip"
     fam = FamilySpec("stick", (PRESET,), (1,), relative_starts(plan.stick_slip.starts, 0.1))
     tip = tip_radius(PRESET, fam.seeds, plan.hfield_resolution)
-    lc_units = sim.characteristic_length(presets.make_surface(PRESET, seed=1))
+    lc_units = characteristic_length(presets.make_surface(PRESET, seed=1))
     fp = MASS_KG * GRAVITY
     lc_m = lc_units * sim.DEFAULT_LENGTH_SCALE_M
     stiff = [float(f"{k * fp / lc_m:.6g}") for k in plan.stick_slip.stiffness]

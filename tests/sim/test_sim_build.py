@@ -12,7 +12,7 @@ from spine_mj import sim, sweep
 from spine_mj.cli import main
 from spine_mj.errors import SpineInputError
 from spine_mj.surface_io import save_surface
-from spine_mj.surfaces import fractal_fbm, single_gaussian
+from spine_mj.surfaces import fractal_fbm, inclined_plane, single_gaussian
 from spine_mj.sweep.analyses.engine import case_drive, case_rig
 
 
@@ -154,7 +154,7 @@ def test_a_refined_hfield_keeps_every_sample_and_the_tip_on_a_grid_and_an_analyt
 )
 def test_build_drive_refuses_a_pace_or_a_stiffness_given_twice(given, named):
     # "at most one of speed and I_e": neither wins silently, in build_drive and build_rig alike
-    scales = sim.build_rig(sim.inclined_plane(slope_deg=0.0), mu=0.5, tip_radius_m=1e-3).scales
+    scales = sim.build_rig(inclined_plane(slope_deg=0.0), mu=0.5, tip_radius_m=1e-3).scales
     for protocol in ("spring", "ramp"):
         with pytest.raises(SpineInputError, match=f"give at most one of {named}, got"):
             sim.build_drive(scales, protocol, **given)
@@ -206,6 +206,6 @@ def test_the_tips_defaults_have_one_home_for_every_command(tmp_path, monkeypatch
         frozen=True,
     )
     monkeypatch.setattr(rig_inputs, "TipParams", heavier)
-    assert sim.build_rig(sim.inclined_plane(slope_deg=0.0), mu=0.5).tip.mass_kg == 0.02
+    assert sim.build_rig(inclined_plane(slope_deg=0.0), mu=0.5).tip.mass_kg == 0.02
     assert engine._TIP["mass_kg"] == sim.TipParams.__dataclass_fields__["mass_kg"].default
     assert rig_inputs.RigInputs(mu=0.5).tip.mass_kg == 0.02

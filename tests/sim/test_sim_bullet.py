@@ -22,7 +22,7 @@ from spine_mj.choices import COMPARED_ENGINES
 from spine_mj.cli import main
 from spine_mj.errors import SpineInputError
 from spine_mj.sim.run_folder import load_run
-from spine_mj.surfaces import GridSurface, TriangulatedSurface, from_hfield
+from spine_mj.surfaces import GridSurface, TriangulatedSurface, from_hfield, inclined_plane
 from spine_mj.theory import engagement
 
 pytest.importorskip("pybullet", reason="the Bullet engine needs the [bullet] extra (pybullet)")
@@ -34,7 +34,7 @@ MU = 0.5
 
 
 def plane_rig(slope_deg=0.0, azimuth_deg=0.0, **engine):
-    surf = sim.inclined_plane(slope_deg=slope_deg, azimuth_deg=azimuth_deg)
+    surf = inclined_plane(slope_deg=slope_deg, azimuth_deg=azimuth_deg)
     tip = sim.TipParams(mu_s=MU)
     if not engine:
         return BulletRig(surf, tip=tip)
@@ -134,7 +134,7 @@ def test_internal_edge_pitfall():
     kick it up (measured: 5 % of its speed at 3 L_c / tau)."""
     import pybullet as pb
 
-    surf = sim.inclined_plane(slope_deg=0.0)
+    surf = inclined_plane(slope_deg=0.0)
     tip = sim.TipParams(mu_s=0.0)
     sc = sim.Scales.for_surface(surf, tip=tip)
     hops = {}
@@ -205,7 +205,7 @@ def test_the_force_ramp_with_reset_runs_and_resets():
 
 
 def test_build_rig_gives_the_same_scales_and_step_in_both_engines():
-    surf = sim.inclined_plane(slope_deg=5.0)
+    surf = inclined_plane(slope_deg=5.0)
     rigs = {e: sim.build_rig(surf, engine=e, mu=MU, ie=1e-3) for e in COMPARED_ENGINES}
     assert rigs["mujoco"].scales == rigs["bullet"].scales
     assert rigs["mujoco"].engine.timestep_s == rigs["bullet"].engine.timestep_s

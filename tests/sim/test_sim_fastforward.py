@@ -19,7 +19,7 @@ from sim_rigs import MU, PHI, flat_rig, plane_rig
 from spine_mj import sim
 from spine_mj.sim import EndReason, RampDrive, Rig, SpringDrive, TipParams
 from spine_mj.sim.ramp import cycle_breakaways, nominal_time_s, rows_to_reset
-from spine_mj.surfaces import corrugation
+from spine_mj.surfaces import corrugation, inclined_plane
 from spine_mj.theory import agreement
 from spine_mj.theory.tomlinson import Corrugation
 
@@ -74,7 +74,7 @@ def test_fast_forward_breaks_away_where_the_plain_ramp_does_on_the_single_peak(y
 
 def _lock_rig():
     # slope 30 deg > arctan(1 / mu): the drive pushes inside the friction cone
-    return sim.Rig(sim.inclined_plane(slope_deg=30.0), tip=sim.TipParams(tip_radius_m=5e-4, mu_s=3.0))
+    return sim.Rig(inclined_plane(slope_deg=30.0), tip=sim.TipParams(tip_radius_m=5e-4, mu_s=3.0))
 
 
 def test_a_self_locked_tip_reaches_the_cap_in_one_phase_with_the_plain_ramps_verdict():
@@ -169,7 +169,7 @@ def _probe(rig, ie, fx, fy):
 )
 @pytest.mark.parametrize("ie", [1e-2, 1e-3])
 def test_probe_fast_forward_breaks_away_where_the_plain_probe_does_on_planes(slope, azimuth, saves, ie):
-    rig = sim.Rig(sim.inclined_plane(slope_deg=slope, azimuth_deg=azimuth), tip=sim.TipParams(mu_s=0.5))
+    rig = sim.Rig(inclined_plane(slope_deg=slope, azimuth_deg=azimuth), tip=sim.TipParams(mu_s=0.5))
     t = math.tan(math.radians(slope))
     probe = _probe(rig, ie, t * math.cos(math.radians(azimuth)), t * math.sin(math.radians(azimuth)))
     plain = rig.run(dataclasses.replace(probe, fast_forward=False), start=(0.0, 0.0))

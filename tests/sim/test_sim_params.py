@@ -68,7 +68,8 @@ def test_engine_settings_are_recorded_with_every_run():
 def test_scales_for_surface_are_the_rigs_scales_without_building_a_model():
     """Scales.for_surface is the one sizing rule: a rig's scales equal it, and the default
     tip radius is max(one hfield spacing, L_c / 100) in metres for a dimensionless surface."""
-    from spine_mj.sim import DEFAULT_LENGTH_SCALE_M, Scales, characteristic_length
+    from spine_mj.roughness import characteristic_length
+    from spine_mj.sim import DEFAULT_LENGTH_SCALE_M, Scales
 
     surf = single_gaussian()
     tip = TipParams(mass_kg=0.02)

@@ -6,6 +6,7 @@ from sweep_support import write_config
 
 from spine_mj import sweep
 from spine_mj.errors import SpineInputError
+from spine_mj.surfaces import inclined_plane
 
 ARRAY = """
 [sweep]
@@ -100,6 +101,6 @@ def test_arrays_on_bullet_are_refused_in_one_line(tmp_path):
     with pytest.raises(SpineInputError, match=r"^engine bullet: spine arrays run in MuJoCo only") as err:
         sweep.load_config(write_config(tmp_path, doc))
     assert "\n" not in str(err.value)
-    rig = sim.build_rig(sim.inclined_plane(slope_deg=0.0), engine="bullet", mu=0.5)
+    rig = sim.build_rig(inclined_plane(slope_deg=0.0), engine="bullet", mu=0.5)
     with pytest.raises(SpineInputError, match="spine arrays run in MuJoCo only"):
         sim.ArrayRig(rig, sim.Layout(rows=2, cols=2))

@@ -3,12 +3,13 @@
 import pytest
 
 from spine_mj import validate
+from spine_mj.surfaces import inclined_plane
 
 
 def test_ramp_duration_covers_the_target_from_the_measured_slip_per_cycle():
     from spine_mj import sim
 
-    rig = sim.Rig(sim.inclined_plane(slope_deg=0.0, azimuth_deg=0.0), tip=sim.TipParams(mu_s=0.5))
+    rig = sim.Rig(inclined_plane(slope_deg=0.0, azimuth_deg=0.0), tip=sim.TipParams(mu_s=0.5))
     rp = validate.ramp_duration(rig, validate.PLANE_START, 1.0, target_lc=0.5, max_steps=4000)
     assert rp.ie_equivalent == pytest.approx(1.0, rel=1e-9)
     assert rp.slip_per_cycle_lc > 0 and rp.cycle_s > 0

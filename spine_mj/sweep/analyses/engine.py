@@ -34,6 +34,7 @@ from spine_mj.sweep.registry import (
     check_engine_options,
     register_analysis,
 )
+from spine_mj.theory.motion import MOTION_NAMES
 
 #: The tip's defaults (:class:`spine_mj.sim.TipParams`), the sweep's too.
 _TIP = {f.name: f.default for f in dataclasses.fields(sim.TipParams)}
@@ -506,7 +507,7 @@ def _slip_metrics(runs) -> dict[str, np.ndarray]:
         "slip_onset_fp_mean": onset(np.mean),
         "slip_onset_fp_max": onset(np.max),
     }
-    for name in sim.MOTION_NAMES:
+    for name in MOTION_NAMES:
         cols[f"{name}_fraction"] = np.array([d["motion_fractions"][name] for d in sums])
     cols["max_speed_over_drive"] = np.array([d["max_speed_over_drive"] for d in sums])
     return cols
