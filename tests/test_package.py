@@ -265,3 +265,36 @@ def test_the_tests_mirror_the_surfaces_package_and_the_modules_once_untested():
     direct = ["sim/test_sim_array_outputs.py", "test_jsonio.py", "test_workers.py"]
     direct += ["surfaces/test_surfaces_contact_kernel.py", "validate/report/test_validate_report_document.py"]
     assert all((tests / d).is_file() for d in direct), [d for d in direct if not (tests / d).is_file()]
+
+
+def test_each_public_package_lists_its_names_in_its_stub_at_their_homes():
+    """One form of the public API: a package's ``__all__`` is its stub's names, each class and
+    function named at the module that defines it (what type checkers and the docs read), and
+    importing the package imports none of its modules."""
+    import importlib
+    import inspect
+
+    root = Path(spine_mj.__file__).parent
+    homes = _stub_homes(root)
+    assert set(homes) >= {
+        "spine_mj",
+        "spine_mj.surfaces",
+        "spine_mj.sim",
+        "spine_mj.sweep",
+        "spine_mj.validate",
+    }
+    for package, names in homes.items():
+        mod = importlib.import_module(package)
+        assert sorted(mod.__all__) == sorted(names), package
+        for name, home in names.items():
+            obj = getattr(mod, name)
+            if inspect.ismodule(obj):
+                assert obj.__name__ == home, (package, name)
+            elif inspect.isclass(obj) or inspect.isfunction(obj):
+                assert obj.__module__ == home, (package, name, obj.__module__)
+    code = (
+        "import sys, spine_mj.sim, spine_mj.sweep, spine_mj.validate, spine_mj.surfaces\n"
+        "print(sorted(n for n in sys.modules if n.startswith('spine_mj.') and n.count('.') > 1))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[]"
