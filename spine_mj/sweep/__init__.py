@@ -55,4 +55,8 @@ and :mod:`~spine_mj.sweep.analyses` (the built-in analyses, registered on import
 
 import lazy_loader as _lazy
 
+# the built-in analyses register themselves on import; every reader of the registry (the
+# config check, preflight, a case run in a worker process) relies on them being there
+from spine_mj.sweep import analyses as _analyses  # noqa: F401
+
 __getattr__, __dir__, __all__ = _lazy.attach_stub(__name__, __file__)
