@@ -226,7 +226,7 @@ def test_contacts_at_counts_one_per_overlapped_prism_with_the_planes_normal_insi
     """A tip resting on a tilted plane: inside a cell one contact with the plane's normal and
     the placement's rest depth; centred over a grid vertex, one per prism it overlaps
     (docs/physics.md §5: up to six), every normal within a few degrees of the plane's."""
-    from spine_mj.sim import inclined_plane
+    from spine_mj.surfaces import inclined_plane
 
     slope = 20.0
     rig = Rig(inclined_plane(slope_deg=slope, half_width=0.02, n=41), tip=TipParams(tip_radius_m=2e-3))
