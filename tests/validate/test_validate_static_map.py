@@ -156,3 +156,25 @@ def test_a_tip_that_slipped_and_was_held_again_by_tilted_contacts_is_an_edge_cat
     assert setting_cause({**caught, "first_slip_kappa": 5.464 - 0.01}).startswith("tilted contacts")
     assert setting_cause(_setting(RECOMMENDED[0], 1.0, 1.06)).startswith("one contact")
     assert setting_cause(_setting(RECOMMENDED[0], 1.0, float("nan"))) == "no breakaway"
+
+
+def test_the_52_5_deg_plane_slips_at_the_closed_form_and_is_held_again_by_a_tilted_prism_contact(tmp_path):
+    """The full plan's largest error, measured: on the 52.5 deg plane (azimuth 0) the tip
+    slips within its ramp step of tan(theta + arctan mu), and what holds it beyond kappa is
+    a contact whose normal is tilted from the plane's: the breakaway lies between the plane's
+    kappa and the multi-contact lock of the contacts found, and the plane tilt that would
+    explain the error is no larger than the largest tilt of those contacts."""
+    import math
+
+    static = StaticPlan(slopes_deg=(52.5,), azimuths_deg=(0.0,), engines=(RECOMMENDED,))
+    plan = dataclasses.replace(PLANS["smoke"], static=static)
+    res = static_map(plan, StudyRunner(tmp_path, 1, None, time.perf_counter()))
+    (plane,) = res.planes
+    (row,) = res.rows
+    kappa = math.tan(math.radians(52.5) + math.atan(0.5))
+    step = plane["force_step_fp"]
+    assert plane["first_slip_kappa"] == pytest.approx(kappa, abs=3 * step)
+    assert plane["held_contacts"] >= 2 and plane["contact_tilt_deg"] > 1.0
+    assert kappa < plane["kappa_mj"] <= plane["contacts_lock_kappa"] * 1.0015 + step
+    assert 0 < row["equivalent_tilt_deg"] <= plane["contact_tilt_deg"]
+    assert plane["slid_before_r_tip"] > 0 and "edge catch" in plane["cause"]
