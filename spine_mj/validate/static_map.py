@@ -54,7 +54,7 @@ PLANE_SAMPLES = 41
 #: ``delta / (sin psi cos psi) = delta (1 + kappa^2) / kappa``. That relative gain is least,
 #: 2 per radian, at ``kappa = 1`` and twice that at ``kappa = 2 -+ sqrt 3``; below the
 #: floor it grows as ``1 / kappa`` (a relative error near ``kappa = 0`` is ill-conditioned)
-#: while the absolute gain stays within 7 % of 1. Above ``2 + sqrt 3`` the relative gain
+#: while the absolute gain stays within 8 % of 1. Above ``2 + sqrt 3`` the relative gain
 #: grows too, but a holding force's error counts in proportion to it: the error stays
 #: relative there and its amplification is stated as a tilt (:func:`equivalent_tilt_deg`).
 KAPPA_FLOOR = 2.0 - math.sqrt(3.0)
