@@ -24,12 +24,20 @@ def test_committed_plans_render():
 
 
 def test_headline_table_numbers_are_the_json_numbers():
+    """A converged family's row quotes the report's numbers; an unconverged one's none."""
     rows = generate.headline_table(FULL)
     assert len(rows) == 2 + len(FULL["limit_families"])
-    fam = FULL["limit_families"]["fractal"]
-    row = next(r for r in rows if r.startswith("| fractal |"))
-    assert f"{fam['agreement_well_conditioned']:.3g}" in row
-    assert f"{fam['median_frechet_ci'][1]:.3g}" in row
+    quoted = 0
+    for name, fam in FULL["limit_families"].items():
+        row = next(r for r in rows if r.startswith(f"| {generate.FAMILY_NAMES.get(name, name)} |"))
+        levels = (FULL.get("convergence") or {}).get(name) or {}
+        unconverged = any(isinstance(v, dict) and v.get("converged") is False for v in levels.values())
+        assert ("not quoted (unconverged)" in row) is unconverged
+        if not unconverged:
+            quoted += 1
+            assert f"{fam['agreement_well_conditioned']:.3g}" in row
+            assert f"{fam['median_frechet_ci'][1]:.3g}" in row
+    assert quoted
 
 
 def test_convergence_absent_renders_nothing():
