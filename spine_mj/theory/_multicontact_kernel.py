@@ -102,7 +102,7 @@ def _crease_one(fxa, fya, fxb, fyb, mu, tol):
     )
     slides = (np.abs(cz) > mu * s0) and not held_back
     lock = (not slides) and (fwd < tol)
-    k = np.nan if (slides or lock) else (cz + mu * s0) / (cx - mu * s1)
+    k = np.nan if (slides or lock) else (cz + mu * s0) / fwd
     k_at = k if np.isfinite(k) else 0.0
     pressed = (a0 + k_at * a1 >= 0) and (b0 + k_at * b1 >= 0)
     pressed = pressed and (np.isfinite(k) or ((a0 >= 0) and (b0 >= 0)))

@@ -270,14 +270,14 @@ def crease_engagement(fx_a, fy_a, fx_b, fy_b, mu, *, tol: float = DEFAULT_TOL):
         a0, a1 = (az - d * bz) / den, (-ax + d * bx) / den
         b0, b1 = (bz - d * az) / den, (-bx + d * ax) / den
         s0, s1 = a0 + b0, a1 + b1
-        # gravity alone slides the tip along the crease, unless it slides it back up the
-        # drive, which holds it there from kappa_lo = (c_z - mu s0) / (c_x + mu s1) on
+        # gravity alone slides the tip along the crease, unless it slides it back against
+        # the drive, which holds it there from kappa_lo = (c_z - mu s0) / (c_x + mu s1) on
         up, fwd = cx + mu * s1, cx - mu * s1
         held_back = (cz > mu * s0) & (up > tol)
         held_back &= (fwd < tol) | ((cz - mu * s0) / up <= (cz + mu * s0) / fwd)
         slides = (np.abs(cz) > mu * s0) & ~held_back
         lock = ~slides & (fwd < tol)
-        k = np.where(slides | lock, np.nan, (cz + mu * s0) / (cx - mu * s1))
+        k = np.where(slides | lock, np.nan, (cz + mu * s0) / fwd)
         # both contacts pressed where the tip slides (a contact that gravity alone leaves
         # unloaded, a wall beside a flat floor, is pressed by the drive); held or sliding
         # under gravity alone: pressed without drive
