@@ -55,6 +55,7 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -65,9 +66,12 @@ from spine_mj.errors import SpineInputError
 from spine_mj.surfaces import inclined_plane
 from spine_mj.theory import engagement
 from spine_mj.theory.tomlinson import Corrugation
-from spine_mj.validate.plans import ValidationPlan
-from spine_mj.validate.study_runner import StudyRunner
 from spine_mj.validate.wedges import dai_start, dai_surface, dai_threshold, flank_tilt, groove
+
+if TYPE_CHECKING:  # the study's runner imports the sweep's analyses (4 CPU-s), which
+    # compare_engines needs only once its arguments have passed
+    from spine_mj.validate.plans import ValidationPlan
+    from spine_mj.validate.study_runner import StudyRunner
 
 __all__ = [
     "CHECKS",
@@ -538,11 +542,6 @@ def compare_engines(
     from spine_mj import extras
     from spine_mj.atomic import writable_path
     from spine_mj.choices import PLAN_NAMES
-    from spine_mj.jsonio import write_json
-    from spine_mj.validate.engine_headlines import RESULT_FILE, run_engine_headlines
-    from spine_mj.validate.fractal_lock import fractal_engines
-    from spine_mj.validate.report.engine_headlines import section as headlines_section
-    from spine_mj.validate.report.engines import section
     from spine_mj.workers import check_workers
 
     out = Path(out)
@@ -560,8 +559,14 @@ def compare_engines(
     extras.require("bullet", "compare-engines (it runs both engines)")
     for name in COMPARISON_FILES:
         writable_path(out / name)
-    say = progress or (lambda _: None)
+    # the studies' modules only now: importing them takes seconds the checks must not wait for
+    from spine_mj.jsonio import write_json
+    from spine_mj.validate.engine_headlines import RESULT_FILE, run_engine_headlines
+    from spine_mj.validate.fractal_lock import fractal_engines
+    from spine_mj.validate.report.engine_headlines import section as headlines_section
+    from spine_mj.validate.report.engines import section
 
+    say = progress or (lambda _: None)
     res = engines_ground_truth(quick=quick, progress=say)
     if fractal_surfaces:
         t0 = time.perf_counter()

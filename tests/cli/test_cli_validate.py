@@ -3,6 +3,8 @@ extra refused in one Error line before any work, nothing written."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 from click.testing import CliRunner
 
@@ -54,3 +56,31 @@ def test_without_the_bullet_extra_the_command_is_refused_before_any_work(monkeyp
         "(no_such_module_spine_mj not installed): pip install 'spine-mj[bullet]'"
     )
     assert not (tmp_path / "out").exists()
+
+
+def _unwritable_folders(tmp_path):
+    """Folders no user can write, root included: procfs takes no new files (Linux); and, for
+    a user other than root, a folder without write permission."""
+    import os
+    import sys
+
+    if sys.platform.startswith("linux"):
+        yield Path(f"/proc/{os.getpid()}/spine_mj_out")
+    if hasattr(os, "geteuid") and os.geteuid() != 0:
+        locked = tmp_path / "locked"
+        locked.mkdir(mode=0o500)
+        yield locked / "out"
+
+
+def test_an_unwritable_out_is_one_error_line_before_any_work(tmp_path):
+    pytest.importorskip("pybullet", reason="the missing [bullet] extra is refused before this")
+    folders = list(_unwritable_folders(tmp_path))
+    if not folders:
+        pytest.skip("no folder this user cannot write on this system")
+    for out in folders:
+        res = CliRunner().invoke(main, ["compare-engines", "--out", str(out)])
+        assert res.exit_code == 2, res.output
+        assert res.stdout == ""  # no check ran, no progress line came
+        (line,) = res.stderr.splitlines()
+        assert line.startswith(f"Error: cannot write {out / 'engines.json'}: "), line  # + the system's reason
+        assert not out.exists()
