@@ -585,3 +585,14 @@ def compare_engines(
     with atomic_output(out / "engines.md") as tmp:
         tmp.write_text(text)
     return text
+
+
+if __name__ == "__main__":  # the study's entry point before it became a command
+    import sys
+
+    sys.stderr.write(
+        "Error: python -m spine_mj.validate.engines is no longer a command, got "
+        f"{' '.join(sys.argv[1:]) or 'no arguments'}: run `spine-mj compare-engines` with the "
+        "same options (spine-mj compare-engines --help)\n"
+    )
+    raise SystemExit(2)

@@ -170,3 +170,19 @@ def test_the_plans_name_only_checks_the_study_has():
         assert plan.engines.checks is None or set(plan.engines.checks) <= set(study.CHECKS)
     with pytest.raises(study.SpineInputError, match="engines checks must be among"):
         study.engines_ground_truth(checks=("no such check",), engines=())
+
+
+def test_the_old_python_m_entry_point_is_one_error_line_naming_the_command():
+    # `python -m spine_mj.validate.engines --fractal 6` made the committed reports; it now
+    # says where the comparisons went instead of exiting 0 having run nothing
+    import subprocess
+    import sys
+
+    out = subprocess.run(
+        [sys.executable, "-m", "spine_mj.validate.engines", "--fractal", "6"],
+        capture_output=True,
+        text=True,
+    )
+    assert out.returncode == 2 and out.stdout == ""
+    (line,) = out.stderr.splitlines()
+    assert line.startswith("Error: ") and "--fractal 6" in line and "spine-mj compare-engines" in line
