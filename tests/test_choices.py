@@ -85,6 +85,15 @@ def test_a_third_engine_runs_simulate(third_engine, tmp_path):
     rk4 = sim.build_rig(inclined_plane(slope_deg=0.0), engine="mujoco-rk4", mu=0.5, tip_radius_m=1e-3)
     assert rk4.engine.timestep_s == base.engine.timestep_s
     assert (rk4.engine.integrator.value, base.engine.integrator.value) == ("rk4", "implicitfast")
+    # its rig is MuJoCo's model, so --render draws it (refused only for want of the video
+    # extra, a name not an engine's) and a replay plays it on its own settings
+    from spine_mj.sim.model import has_mujoco_model
+    from spine_mj.sim.run_folder import load_run
+
+    assert has_mujoco_model("mujoco-rk4") and has_mujoco_model("mujoco")
+    assert not has_mujoco_model("bullet")
+    rig, _ = load_run(out)
+    assert rig.engine.integrator.value == "rk4"
 
 
 SWEEP = """
@@ -109,10 +118,18 @@ def test_a_third_engine_runs_a_sweep_case(third_engine, tmp_path):
     with pytest.raises(SpineInputError, match=r"impratio = \[10.0\]: not read by engine mujoco-rk4"):
         sweep.load_config(write_config(tmp_path, SWEEP + "impratio = 10\n"))
     out = tmp_path / "out"
-    sweep.run_sweep(write_config(tmp_path, SWEEP), out, workers=1)
+    config = write_config(tmp_path, SWEEP)
+    sweep.run_sweep(config, out, workers=1)
     runs = sweep.load_runs(out).set_index("engine")
     assert (runs.status == "ok").all()
     assert runs.loc["mujoco", "integrator"] == "implicitfast"
     # the integrator key is not an option of the third engine: its row records none applied
     assert pd.isna(runs.loc["mujoco-rk4", "integrator"])
     assert runs.loc["mujoco-rk4", "hfield_resolution"] == 41
+    # on MuJoCo's rig class, its cases are checked before any run as MuJoCo's are: planned,
+    # nothing compiled
+    from spine_mj.sim.build import RigPlan
+    from spine_mj.sweep.analyses.engine import case_plan
+
+    plans = {c.params["engine"]: case_plan(c) for c in sweep.expand_cases(sweep.load_config(config))}
+    assert all(isinstance(p, RigPlan) for p in plans.values()) and set(plans) == {"mujoco", "mujoco-rk4"}

@@ -239,13 +239,13 @@ def simulate(
     """
     from spine_mj.sim.run_folder import simulate_to
 
+    check_engine(engine, "--engine")
     if render:
         _check_render(engine)
     xy = parse_start(start)
     _check_drive_options(
         drive, ie=ie, speed=speed, rate=rate, stiffness_number=stiffness_number, stiffness=stiffness
     )
-    check_engine(engine, "--engine")
     surf, rig_kw = _rig_inputs(surface_spec, **rig_opts)
     pace = {"ie": ie, "speed_m_s": speed, "rate_n_s": rate}
     inputs = _with_drive(
@@ -295,12 +295,13 @@ def simulate(
 
 
 def _check_render(engine: str) -> None:
-    """Refuse --render where it cannot run (an engine other than MuJoCo, no video extra);
-    choose the GL backend."""
+    """Refuse --render where it cannot run (an engine whose rig is not a MuJoCo model, no
+    video extra); choose the GL backend."""
     from spine_mj import extras
+    from spine_mj.sim.model import has_mujoco_model
     from spine_mj.sim.render import choose_gl_backend
 
-    if engine != "mujoco":
+    if not has_mujoco_model(engine):
         raise SpineInputError(
             f"--render draws with MuJoCo's renderer, not with --engine {engine}: run without it, "
             "then `spine-mj replay RUN_DIR --mp4 run.mp4` shows the run on MuJoCo's model"

@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from spine_mj.atomic import atomic_output
+from spine_mj.choices import ENGINES
 from spine_mj.errors import SpineInputError
 from spine_mj.resources import model_path
 from spine_mj.sim.drives import Drive, SpringDrive, speed_m_s, stiffness_n_m
@@ -458,3 +459,11 @@ class RigModel:
     def check_drive(self, drive: Drive) -> None:
         """Refuse a drive this rig cannot run (:func:`check_drive_on`)."""
         check_drive_on(self, drive)
+
+
+def has_mujoco_model(engine: str) -> bool:
+    """Whether the registered ``engine``'s rig (:data:`spine_mj.choices.ENGINES`) is a MuJoCo
+    model, a :class:`RigModel`: MuJoCo's renderer draws its runs (``simulate --render``), and
+    a :class:`~spine_mj.sim.build.RigPlan` checks its cases as its rig would, with nothing
+    compiled. MuJoCo's is; Bullet's is not; a third engine on MuJoCo's rig class is too."""
+    return issubclass(ENGINES[engine].rig_class(), RigModel)

@@ -58,8 +58,9 @@ def load_run(run_dir: str | Path) -> tuple[RigModel, Track]:
         rig = RigModel(
             surface_io.load_surface(run_dir / "surface.npz"),
             tip=TipParams(**summary["tip"]),
+            # MuJoCo's settings name no engine (a run on MuJoCo's step rule is played with them);
             # another engine's run is shown on MuJoCo's model of the same surface (its derived settings)
-            engine=EngineSettings(**engine) if engine.get("engine", "mujoco") == "mujoco" else None,
+            engine=EngineSettings(**engine) if "engine" not in engine else None,
             length_scale_m=sc["length_scale_m"],
             char_length_m=sc["char_length_m"],
             hfield_resolution=sc.get("hfield_resolution"),

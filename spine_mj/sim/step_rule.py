@@ -47,6 +47,8 @@ SPRING_OMEGA_DT = 0.3
 #: user's step: twice the rule's, where the spring-block's period is still within 1.5 % and
 #: its peak speed within 2.3 % (beyond it the run is refused, never run inaccurately).
 MAX_SPRING_OMEGA_DT = 2 * SPRING_OMEGA_DT
+#: The contact's damping ratio in the rule's ``solref = (2 dt, 1)``: critically damped.
+SOLREF_DAMPRATIO = 1.0
 
 
 def default_engine(
@@ -117,11 +119,11 @@ def default_engine(
         )
     base = {
         "timestep_s": dt,
-        "solref": (2 * dt, 1.0),
+        "solref": (2 * dt, SOLREF_DAMPRATIO),
         "solimp": (0.99, 0.99, 0.01 * scales.tip_radius_m, 0.5, 2.0),
     }
     if "timestep_s" in overrides and "solref" not in overrides:
-        base["solref"] = (2 * float(overrides["timestep_s"]), 1.0)
+        base["solref"] = (2 * float(overrides["timestep_s"]), SOLREF_DAMPRATIO)
     base.update(overrides)
     return EngineSettings(**base)
 

@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from spine_mj import sim, sweep
+from spine_mj.choices import DEFAULT_ENGINE, ENGINES
 from spine_mj.roughness import characteristic_length
 from spine_mj.surface_io import save_surface
 from spine_mj.surfaces import GridSurface, inclined_plane
@@ -144,7 +145,7 @@ def spring_block_check(
     *,
     stiffness_number: float | None = None,
     periods: int = 12,
-    engine: str = "mujoco",
+    engine: str = DEFAULT_ENGINE,
 ) -> dict:
     """The spring-block on a flat plane after breakaway: the period of the speed swing
     (autocorrelation's first peak, refined between steps by a parabola through its three
@@ -370,11 +371,11 @@ def _liftoff(plan: ValidationPlan, runner: StudyRunner, width: float) -> dict:
     }
 
 
-def crest_check(width: float, factor: float, engine: str = "mujoco") -> tuple[float, float, float]:
+def crest_check(width: float, factor: float, engine: str = DEFAULT_ENGINE) -> tuple[float, float, float]:
     """One carriage over :func:`ridge` of ``width`` at ``factor`` times the predicted I_e* in
-    ``engine`` (the scan's tip, spring, mu and step; MuJoCo also its contact time constant):
-    ``(crest I_e / I_e*, largest crest gap [tip radii], longest flight [widths])``, the
-    crest I_e that of the speed measured at the crest."""
+    ``engine`` (the scan's tip, spring, mu and step; its contact time constant where the
+    engine reads one): ``(crest I_e / I_e*, largest crest gap [tip radii], longest flight
+    [widths])``, the crest I_e that of the speed measured at the crest."""
     surf = ridge(width)
     unit = sim.DEFAULT_LENGTH_SCALE_M
     ie_star = liftoff_inertia_number(
@@ -382,7 +383,7 @@ def crest_check(width: float, factor: float, engine: str = "mujoco") -> tuple[fl
         characteristic_length(surf) * unit,
     )
     ie = factor * ie_star
-    soft = {"solref_timeconst_s": RIDGE_SOLREF_S} if engine == "mujoco" else {}
+    soft = {"solref_timeconst_s": RIDGE_SOLREF_S} if "solref_timeconst_s" in ENGINES[engine].options else {}
     rig = sim.build_rig(
         surf, engine=engine, mu=0.3, tip_radius_m=RIDGE_TIP_M, timestep_s=RIDGE_TIMESTEP_S, ie=ie, **soft
     )

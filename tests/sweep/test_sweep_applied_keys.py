@@ -90,3 +90,26 @@ spacing_unit = "surface"
 def test_array_drive_keys_the_array_does_not_read_are_refused(tmp_path, lines, named):
     with pytest.raises(SpineInputError, match=named):
         sweep.load_config(write_config(tmp_path, ARRAY + lines + "\n"))
+
+
+def test_the_sweeps_solver_defaults_are_the_step_rules():
+    """MuJoCo's solver defaults have one home (``EngineSettings`` and the step rule): a
+    sweep's engine keys left out are the settings ``simulate`` runs with no option, and
+    their choices are the settings' own."""
+    from spine_mj import sim
+    from spine_mj.surfaces import inclined_plane
+    from spine_mj.sweep.analyses.engine import ENGINE_PARAMS
+
+    rule = sim.default_engine(sim.build_rig(inclined_plane(slope_deg=0.0), mu=0.5, tip_radius_m=1e-3).scales)
+    rule_value = {"solref_dampratio": rule.solref[1], "solref_timeconst_s": rule.solref[0]}
+    checked = []
+    for spec in ENGINE_PARAMS:
+        if spec.option is None or spec.default is None:
+            continue
+        value = rule_value.get(spec.option, getattr(rule, spec.option, None))
+        assert getattr(value, "value", value) == spec.default, spec.name
+        checked.append(spec.name)
+    assert set(checked) == {"integrator", "cone", "impratio", "noslip_iterations", "solref_dampratio"}
+    by_name = {s.name: s for s in ENGINE_PARAMS}
+    assert by_name["integrator"].choices == tuple(i.value for i in sim.Integrator)
+    assert by_name["cone"].choices == tuple(c.value for c in sim.Cone)

@@ -19,10 +19,12 @@ from spine_mj.choices import DEFAULT_ENGINE, ENGINES, PROTOCOLS
 from spine_mj.errors import SpineInputError
 from spine_mj.sim.build import check_planned_hfield, plan_rig, rig_sizing
 from spine_mj.sim.holding import spring_swing
+from spine_mj.sim.model import has_mujoco_model
 from spine_mj.sim.open_loop import drive_steps
 from spine_mj.sim.ramp import nominal_time_s
 from spine_mj.sim.rig_inputs import RigInputs
 from spine_mj.sim.scales import check_tip_radius, engine_tip_radius_m
+from spine_mj.sim.step_rule import SOLREF_DAMPRATIO
 from spine_mj.sweep.registry import (
     CASE_THREADS,
     KAPPA_CAP_PARAM,
@@ -38,6 +40,9 @@ from spine_mj.theory.motion import MOTION_NAMES
 
 #: The tip's defaults (:class:`spine_mj.sim.TipParams`), the sweep's too.
 _TIP = {f.name: f.default for f in dataclasses.fields(sim.TipParams)}
+#: MuJoCo's solver settings that the step rule leaves at their defaults
+#: (:class:`spine_mj.sim.EngineSettings`), the sweep's too.
+_SOLVER = {f.name: f.default for f in dataclasses.fields(sim.EngineSettings)}
 
 ENGINE_PARAMS = (
     MU_PARAM,
@@ -135,25 +140,39 @@ ENGINE_PARAMS = (
         "integrator",
         "str",
         "MuJoCo integrator",
-        "implicitfast",
-        choices=("euler", "implicitfast", "implicit", "rk4"),
+        _SOLVER["integrator"].value,
+        choices=tuple(i.value for i in sim.Integrator),
         option="integrator",
     ),
-    ParamSpec("cone", "str", "friction cone", "elliptic", choices=("elliptic", "pyramidal"), option="cone"),
+    ParamSpec(
+        "cone",
+        "str",
+        "friction cone",
+        _SOLVER["cone"].value,
+        choices=tuple(c.value for c in sim.Cone),
+        option="cone",
+    ),
     ParamSpec(
         "impratio",
         "float",
         "frictional / normal impedance ratio",
-        1.0,
+        _SOLVER["impratio"],
         0.0,
         exclusive=True,
         option="impratio",
     ),
-    ParamSpec("noslip_iterations", "int", "noslip solver passes", 3, 0, option="noslip_iterations"),
+    ParamSpec(
+        "noslip_iterations",
+        "int",
+        "noslip solver passes",
+        _SOLVER["noslip_iterations"],
+        0,
+        option="noslip_iterations",
+    ),
     ParamSpec(
         "tolerance",
         "float",
-        "MuJoCo solver tolerance (default MuJoCo's, 1e-8)",
+        f"MuJoCo solver tolerance (default {_SOLVER['tolerance']:g})",
         None,
         0.0,
         exclusive=True,
@@ -162,7 +181,7 @@ ENGINE_PARAMS = (
     ParamSpec(
         "noslip_tolerance",
         "float",
-        "MuJoCo noslip solver tolerance (default MuJoCo's, 1e-6)",
+        f"MuJoCo noslip solver tolerance (default {_SOLVER['noslip_tolerance']:g})",
         None,
         0.0,
         exclusive=True,
@@ -190,7 +209,7 @@ ENGINE_PARAMS = (
         "solref_dampratio",
         "float",
         "contact damping ratio",
-        1.0,
+        SOLREF_DAMPRATIO,
         0.0,
         exclusive=True,
         option="solref_dampratio",
@@ -325,7 +344,7 @@ def case_plan(case, surface=None):
     check_planned_hfield(surface, inputs)  # before the sizing: its limits on the predicted sides
     sized = _sizing(case.surface, inputs.tip, tuple(inputs.sizing.items()))
     plan = plan_rig(surface, inputs, sized=sized)
-    if inputs.engine == "mujoco":
+    if has_mujoco_model(inputs.engine):
         return plan
     rig_class = ENGINES[inputs.engine].rig_class()
     return rig_class(surface, tip=plan.tip, engine=plan.engine, sized=(plan.scales, plan.hfield))
