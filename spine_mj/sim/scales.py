@@ -365,11 +365,9 @@ def resolve_tip_radius(
     if radius is not None:
         return radius
     unit_m = surface_unit_m(surface, length_scale_m)
-    spacing = hfield_spacing(hfield_of(surface, grid_keeps_samples(surface, hfield_resolution)), unit_m)
-    xmin, xmax, ymin, ymax = surface.bounds
-    width_m = min(xmax - xmin, ymax - ymin) * unit_m
+    resolution = grid_keeps_samples(surface, check_hfield_resolution(hfield_resolution))
     char_length_m = characteristic_length(surface) * unit_m
-    return default_tip_radius(surface, spacing, char_length_m, width_m=width_m) / unit_m
+    return _tip_rule(surface, None, unit_m, char_length_m, resolution)[2] / unit_m
 
 
 def engine_tip_radius_m(
@@ -498,16 +496,26 @@ def _planned_sizing(surface: Surface, tip: TipParams, length_scale_m, char_lengt
     if char_length_m is None:
         char_length_m = characteristic_length(surface) * length_scale_m
     char_length_m = check_physical_length("char_length_m", char_length_m)
-    spacing = planned_spacing(surface, resolution, 1, length_scale_m)
-    xmin, xmax, ymin, ymax = (length_scale_m * b for b in surface.bounds)
-    width, radius = min(xmax - xmin, ymax - ymin), tip.tip_radius_m
-    if radius is None:
-        radius = default_tip_radius(surface, spacing, char_length_m, width_m=width)
+    spacing, width, radius = _tip_rule(surface, tip.tip_radius_m, length_scale_m, char_length_m, resolution)
     _check_sizes(radius, spacing, char_length_m, width, given=tip.tip_radius_m is not None)
     if resolution is None and spacing < _MIN_SPACING_PER_TIP_RADIUS * radius:
         extent = 2 * max(hfield_half_extents(surface)) * length_scale_m
         resolution = math.ceil(extent / (_MIN_SPACING_PER_TIP_RADIUS * radius)) + 1
     return length_scale_m, char_length_m, radius, resolution
+
+
+def _tip_rule(
+    surface: Surface, tip_radius_m, length_scale_m: float, char_length_m: float, resolution
+) -> tuple:
+    """``(spacing, width, radius)`` [m] of the sizing rule before any hfield is sampled: the
+    planned hfield's spacing, the domain's narrower side, and ``tip_radius_m`` or, where None,
+    :func:`default_tip_radius` of those (the rig's sizing and :func:`resolve_tip_radius` alike)."""
+    spacing = planned_spacing(surface, resolution, 1, length_scale_m)
+    xmin, xmax, ymin, ymax = (length_scale_m * b for b in surface.bounds)
+    width = min(xmax - xmin, ymax - ymin)
+    if tip_radius_m is None:
+        tip_radius_m = default_tip_radius(surface, spacing, char_length_m, width_m=width)
+    return spacing, width, tip_radius_m
 
 
 def planned_hfield_sides(
