@@ -27,10 +27,28 @@ landing removes the normal velocity (an inelastic, critically damped contact, as
 ``solref = (2 dt, 1)``) and friction removes up to ``mu`` times that normal impulse from the
 tangential velocity.
 
+A spring of stiffness ``k`` along x from a carriage at ``X`` (staying, or moving along +x
+at a constant speed) adds ``k (X - x)`` to the drive, as the rig's spring carriage does
+(the spring acts in x only, the particle is free in y and z). A particle at rest then ends
+its slide only where ``held(x, y)`` says so (default: wherever it rests); elsewhere the
+carriage's advance may set it sliding again.
+
+On a surface without a Hessian (a ball on facets: flat faces, edges rounded over the tip
+radius) the curvature term is taken as zero, and where a step brings the particle against
+a concave crease the velocity into the new face is lost as at a landing, friction taking
+up to ``mu`` times that impulse: the crease's ``m v^T H v`` as one impulse.
+
 Closed forms (tested): on an incline of angle ``theta`` a particle at rest stays iff
 ``tan(theta) <= mu``; otherwise it accelerates down at ``a (sin(theta) - mu cos(theta))``
 (``a = W / m``); one launched down at speed ``v`` with ``tan(theta) < mu`` stops after
-``v^2 / (2 a (mu cos(theta) - sin(theta)))``. The error is first order in the step.
+``v^2 / (2 a (mu cos(theta) - sin(theta)))``. Released at rest with a spring force
+``F_0`` from a carriage that stays, on an incline of angle ``theta`` along x (flat:
+``theta = 0``) it slides a harmonic half-period ``pi / omega_e``, ``omega_e^2 = k_e / m``,
+``k_e = k cos(theta) (cos(theta) - mu sin(theta))``, and stops ``2 u*`` along the slope,
+``u* = (F_0 (cos(theta) - mu sin(theta)) - W (sin(theta) + mu cos(theta))) / k_e``.
+Released on flat ground at exactly ``F_0 = mu W`` from a carriage moving at ``v``, it
+moves as ``x_0 + v t - (v / omega) sin(omega t)`` (``omega^2 = k / m``) and first rests at
+``t = 2 pi / omega``. The error is first order in the step.
 
 Pure numpy, vectorized over particles; the surface is anything with
 ``evaluate(x, y, order=2) -> (f, f_x, f_y, f_xx, f_xy, f_yy)`` (every
@@ -70,12 +88,16 @@ class SlideParams:
         The load ``W`` pressing along -z [N] (the preload F_p), > 0.
     mass_kg : float
         The particle's mass [kg], > 0.
-    drive_force_n : float
-        A constant drive force along +x [N] (0: gravity alone, a fall).
     timestep_s : float
         Integration step [s], > 0.
     max_time_s : float
         Longest slide [s]; a particle still moving then ends ``TIMED_OUT``.
+    drive_force_n : float
+        A constant drive force along +x [N] (0: gravity alone, a fall), besides the spring.
+    spring_n_m : float
+        Stiffness ``k`` [N/m] of a spring along x from the carriage to the particle (0: none).
+    carriage_speed_m_s : float
+        The carriage's speed along +x [m/s] (0: it stays where it is).
     """
 
     mu: float
@@ -84,11 +106,15 @@ class SlideParams:
     timestep_s: float
     max_time_s: float
     drive_force_n: float = 0.0
+    spring_n_m: float = 0.0
+    carriage_speed_m_s: float = 0.0
 
     def __post_init__(self):
         check_positive("mu", self.mu, allow_zero=True)
         for name in ("load_n", "mass_kg", "timestep_s", "max_time_s"):
             check_positive(name, getattr(self, name))
+        for name in ("spring_n_m", "carriage_speed_m_s"):
+            check_positive(name, getattr(self, name), allow_zero=True)
         if not math.isfinite(self.drive_force_n):
             raise SpineInputError(f"drive_force_n must be a finite force [N], got {self.drive_force_n!r}")
         if self.max_time_s / self.timestep_s > 1e8:
@@ -116,6 +142,11 @@ class SlideResult:
         Largest speed reached.
     airborne_steps : ndarray of int64
         Steps spent off the surface.
+    spring_force_n : ndarray
+        The spring's pull along +x at the end [N] (0 without a spring).
+    paths : list of ndarray or None
+        With ``store_paths``: each particle's horizontal path ``(n_i, 2)``, one point a
+        step, from its start to its end.
     """
 
     x: np.ndarray
@@ -126,18 +157,30 @@ class SlideResult:
     outcome: np.ndarray
     max_speed_m_s: np.ndarray
     airborne_steps: np.ndarray
+    spring_force_n: np.ndarray
+    paths: list | None = None
 
 
 def slide_until_stuck(
-    surface, starts, params: SlideParams, *, velocity_m_s=None, length_scale_m: float = 1.0
+    surface,
+    starts,
+    params: SlideParams,
+    *,
+    velocity_m_s=None,
+    length_scale_m: float = 1.0,
+    carriage_x=None,
+    held=None,
+    bounds=None,
+    store_paths: bool = False,
 ) -> SlideResult:
     """Slide particles from ``starts`` ``(k, 2)`` (surface units, on the surface) until each
-    sticks, leaves the surface's bounds or times out.
+    sticks, leaves the bounds or times out.
 
     Parameters
     ----------
     surface : Surface
-        Anything with ``evaluate(x, y, order=2)`` and ``bounds`` (in its own units).
+        Anything with ``evaluate(x, y, order)`` (order 2, or 1 where it has no Hessian)
+        and ``bounds`` (in its own units).
     starts : array_like, shape (k, 2)
         Start points (x, y).
     params : SlideParams
@@ -145,6 +188,17 @@ def slide_until_stuck(
         Initial horizontal velocity [m/s] (none: at rest); the vertical follows the surface.
     length_scale_m : float
         Metres per surface unit (forces and masses are SI, lengths are scaled once here).
+    carriage_x : array_like, shape (k,), optional
+        Each spring's carriage at the start (surface units; none: above the start, the
+        spring slack).
+    held : callable, optional
+        ``held(x, y) -> bool (m,)`` (surface units): where a particle at rest ends its
+        slide; none: wherever it rests.
+    bounds : tuple of float, optional
+        ``(xmin, xmax, ymin, ymax)``: a particle outside ends ``LEFT_DOMAIN`` (none: the
+        surface's bounds).
+    store_paths : bool
+        Keep each particle's path (:attr:`SlideResult.paths`).
 
     Returns
     -------
@@ -155,10 +209,22 @@ def slide_until_stuck(
     starts, v0 = _checked(starts, velocity_m_s)
     k = len(starts)
     dt = p.timestep_s
-    force = np.array([p.drive_force_n, 0.0, -p.load_n])  # the applied force A [N]
+    anchor = starts[:, 0].copy() if carriage_x is None else np.asarray(carriage_x, dtype=float).reshape(-1)
+    if anchor.shape != (k,) or not np.isfinite(anchor).all():
+        raise SpineInputError(f"carriage_x must be {k} finite positions, got shape {anchor.shape}")
+    anchor = anchor * s  # [m]
+    xmin, xmax, ymin, ymax = surface.bounds if bounds is None else bounds
+    hessian = _has_hessian(surface, starts)
 
     def ev(q, order=2):
-        return _surface_at(surface, q, s, order)
+        return _surface_at(surface, q, s, order, hessian)
+
+    def applied(i, x, t):  # the applied force A [N] on particles i at x [m], time t [s]
+        f = np.empty((i.size, 3))
+        f[:, 0] = p.drive_force_n + p.spring_n_m * (anchor[i] + p.carriage_speed_m_s * t - x)
+        f[:, 1] = 0.0
+        f[:, 2] = -p.load_n
+        return f
 
     q = starts * s  # horizontal position [m]
     here = ev(q)  # the surface under each particle, carried from step to step
@@ -171,20 +237,26 @@ def slide_until_stuck(
     length = np.zeros(k)
     vmax = np.linalg.norm(vel, axis=1)
     n_air = np.zeros(k, np.int64)
+    steps = [] if store_paths else None
     n_steps = int(math.ceil(p.max_time_s / dt))
     for step in range(1, n_steps + 1):
         idx = np.flatnonzero(active)
         if not idx.size:
             break
         qa, va, za, air = q[idx], vel[idx], z[idx], airborne[idx]
-        new_q, new_z, new_v, flying, f_new = _advance(ev, qa, va, za, air, [c[idx] for c in here], force, p)
+        force = applied(idx, qa[:, 0], (step - 1) * dt)
+        new_q, new_z, new_v, flying, f_new = _advance(
+            ev, qa, va, za, air, [c[idx] for c in here], force, p, hessian
+        )
         for c, c_new in zip(here, f_new):
             c[idx] = c_new
         landed = flying & (new_z <= f_new[0])  # a flight that meets the surface lands
         new_z = np.where(~flying | landed, f_new[0], new_z)  # contact keeps to the surface
         on_after = ~flying | landed
+        # without a Hessian a step onto a face tilted into the velocity is a crease's impact
+        impact = landed if hessian else on_after
         new_v[on_after] = _landed_velocity(
-            new_v[on_after], f_new[1][on_after], f_new[2][on_after], landed[on_after], p.mu
+            new_v[on_after], f_new[1][on_after], f_new[2][on_after], impact[on_after], p.mu
         )
         length[idx] += np.sqrt(np.sum((new_q - qa) ** 2, axis=1) + (new_z - za) ** 2)
         q[idx], vel[idx], z[idx] = new_q, new_v, new_z
@@ -192,12 +264,22 @@ def slide_until_stuck(
         n_air[idx] += flying & ~landed
         sp = np.linalg.norm(new_v, axis=1)
         vmax[idx] = np.maximum(vmax[idx], sp)
+        if store_paths:
+            steps.append((idx, new_q / s))
         t = step * dt
-        out = ~surface.contains(new_q[:, 0] / s, new_q[:, 1] / s)
+        out = ~(
+            (new_q[:, 0] >= xmin * s)
+            & (new_q[:, 0] <= xmax * s)
+            & (new_q[:, 1] >= ymin * s)
+            & (new_q[:, 1] <= ymax * s)
+        )
         stuck = ~out & on_after & (sp == 0)
+        if held is not None and stuck.any():
+            stuck[stuck] = np.asarray(held(new_q[stuck, 0] / s, new_q[stuck, 1] / s), dtype=bool)
         for mask, kind in ((out, SlideOutcome.LEFT_DOMAIN), (stuck, SlideOutcome.STUCK)):
             hit = idx[mask & active[idx]]
             outcome[hit], t_end[hit], active[hit] = kind, t, False
+    spring = p.spring_n_m * (anchor + p.carriage_speed_m_s * t_end - q[:, 0])
     return SlideResult(
         x=q[:, 0] / s,
         y=q[:, 1] / s,
@@ -207,13 +289,41 @@ def slide_until_stuck(
         outcome=outcome,
         max_speed_m_s=vmax,
         airborne_steps=n_air,
+        spring_force_n=spring,
+        paths=None if steps is None else _assemble(starts, steps),
     )
 
 
-def _surface_at(surface, q: np.ndarray, s: float, order: int):
-    """Height [m] (order 0), or height, slopes and curvatures [1/m] (order 2) at ``q`` [m]."""
+def _assemble(starts: np.ndarray, steps: list) -> list[np.ndarray]:
+    """Each particle's path ``(n_i, 2)``: its start, then its position after each step it took."""
+    if not steps:
+        return [row[None, :].copy() for row in starts]
+    idx = np.concatenate([i for i, _ in steps])
+    pts = np.vstack([q for _, q in steps])
+    order = np.argsort(idx, kind="stable")
+    idx, pts = idx[order], pts[order]
+    cuts = np.searchsorted(idx, np.arange(len(starts) + 1))
+    return [np.vstack([starts[i], pts[cuts[i] : cuts[i + 1]]]) for i in range(len(starts))]
+
+
+def _has_hessian(surface, starts: np.ndarray) -> bool:
+    """Whether ``surface`` evaluates curvatures (order 2); a ball on facets does not."""
+    try:
+        surface.evaluate(starts[:1, 0], starts[:1, 1], order=2)
+    except SpineInputError:
+        return False
+    return True
+
+
+def _surface_at(surface, q: np.ndarray, s: float, order: int, hessian: bool = True):
+    """Height [m] (order 0), or height, slopes and curvatures [1/m] (order 2; zero curvatures
+    where the surface has no Hessian) at ``q`` [m]."""
     if order == 0:
         return surface.evaluate(q[:, 0] / s, q[:, 1] / s, order=0)[0] * s
+    if not hessian:
+        f, fx, fy = surface.evaluate(q[:, 0] / s, q[:, 1] / s, order=1)
+        zero = np.zeros_like(np.asarray(f, dtype=float))
+        return [np.array(c) for c in (f * s, fx, fy, zero, zero, zero)]
     f, fx, fy, fxx, fxy, fyy = surface.evaluate(q[:, 0] / s, q[:, 1] / s, order=2)
     return [np.array(c) for c in (f * s, fx, fy, fxx / s, fxy / s, fyy / s)]
 
@@ -231,8 +341,8 @@ def _contact_velocity(v, n, normal, force, p: SlideParams) -> np.ndarray:
 
 def _landed_velocity(v, fx, fy, landed, mu: float) -> np.ndarray:
     """Velocities on the surface of slopes ``fx, fy``: in its tangent plane; where the
-    particle ``landed`` the normal velocity is lost and friction takes up to ``mu`` times
-    that impulse off the tangential one."""
+    particle ``landed`` the normal velocity into the surface is lost and friction takes up
+    to ``mu`` times that impulse off the tangential one."""
     n = np.column_stack([-fx, -fy, np.ones_like(fx)])
     n /= np.linalg.norm(n, axis=1)[:, None]
     vn = np.sum(v * n, axis=1)
@@ -243,17 +353,18 @@ def _landed_velocity(v, fx, fy, landed, mu: float) -> np.ndarray:
     return ut * keep[:, None]
 
 
-def _advance(ev, qa, va, za, air, here, force, p: SlideParams):
+def _advance(ev, qa, va, za, air, here, force, p: SlideParams, hessian: bool = True):
     """One step of particles at ``qa, za`` with velocity ``va`` (``air``: flying) on the
-    surface ``here`` under them: new position, height and velocity, who flies, and the
-    surface (:func:`_surface_at`) at the new position."""
+    surface ``here`` under them, under the applied forces ``force`` ``(m, 3)``: new
+    position, height and velocity, who flies, and the surface (:func:`_surface_at`) at the
+    new position."""
     dt, m = p.timestep_s, p.mass_kg
     _, fx, fy, fxx, fxy, fyy = here
     g = np.sqrt(1 + fx * fx + fy * fy)
     n = np.column_stack([-fx, -fy, np.ones_like(fx)]) / g[:, None]
     vx, vy = va[:, 0], va[:, 1]
     curv = fxx * vx * vx + 2 * fxy * vx * vy + fyy * vy * vy
-    normal = (p.load_n + fx * p.drive_force_n + m * curv) / g
+    normal = (-force[:, 2] + fx * force[:, 0] + m * curv) / g
     # where the surface drops away faster than a free fall from here, the tip leaves it
     # (the discrete N < 0: a step past a ledge narrower than the step)
     free_v = va + dt * force / m
@@ -267,7 +378,7 @@ def _advance(ev, qa, va, za, air, here, force, p: SlideParams):
     new_v[flying], new_q[flying], new_z[flying] = free_v[flying], free_q[flying], free_z[flying]
     # contact: tangential force, then the friction impulse clamped at rest
     on = ~flying
-    new_v[on] = _contact_velocity(va[on], n[on], normal[on], force, p)
+    new_v[on] = _contact_velocity(va[on], n[on], np.maximum(normal[on], 0.0), force[on], p)
     new_q[on] += dt * new_v[on, :2]
     return new_q, new_z, new_v, flying, ev(new_q)
 

@@ -100,3 +100,66 @@ def test_bad_input_is_refused():
         SlideParams(MU, W, M, 1e-3, 1.0, drive_force_n=math.nan)
     with pytest.raises(SpineInputError, match="starts"):
         slide_until_stuck(_plane(0.0), [(0.0, math.nan)], SlideParams(MU, W, M, 1e-3, 1.0))
+
+
+@pytest.mark.parametrize("theta_deg", [0.0, 15.0, -35.0])
+def test_a_block_released_on_a_spring_stops_where_the_closed_form_says(theta_deg):
+    """Released at rest with a spring force F_0 from a carriage that stays, on an incline
+    along x: half a period of the spring's stiffness along the slope k_e, stopping 2 u* on."""
+    th = math.radians(theta_deg)
+    k, f0 = 400.0, 1.6 * W
+    ke = k * math.cos(th) * (math.cos(th) - MU * math.sin(th))
+    u_star = (f0 * (math.cos(th) - MU * math.sin(th)) - W * (math.sin(th) + MU * math.cos(th))) / ke
+    assert u_star > 0
+    half_period = math.pi * math.sqrt(M / ke)
+    x0 = -0.5
+    for steps in (100, 200):  # steps a half period
+        p = SlideParams(MU, W, M, half_period / steps, 1.0, spring_n_m=k)
+        res = slide_until_stuck(_plane(theta_deg), [(x0, 0.3)], p, carriage_x=[x0 + f0 / k])
+        assert res.outcome[0] == SlideOutcome.STUCK
+        # at 2 u* the spring pulls back F_0 - 2 k cos(theta) u*, which friction still holds
+        assert (res.x[0] - x0) / math.cos(th) == pytest.approx(2 * u_star, rel=3 / steps)
+        assert res.time_s[0] == pytest.approx(half_period, rel=3 / steps)
+        assert res.spring_force_n[0] == pytest.approx(k * (x0 + f0 / k - res.x[0]), rel=1e-12)
+        assert res.y[0] == pytest.approx(0.3, abs=1e-12)
+
+
+def test_a_block_on_a_moving_carriage_follows_the_closed_form_and_rests_after_one_period():
+    """On flat ground at the breakaway force mu W from a carriage moving at v:
+    x = x_0 + v t - (v / omega) sin(omega t), at rest again at t = 2 pi / omega."""
+    k, v = 400.0, 0.05
+    omega = math.sqrt(k / M)
+    period = 2 * math.pi / omega
+    x0 = -0.5
+    p = SlideParams(MU, W, M, period / 500, 1.0, spring_n_m=k, carriage_speed_m_s=v)
+    res = slide_until_stuck(
+        _plane(0.0), [(x0, 0.0)], p, carriage_x=[x0 + MU * W / k * (1 + 1e-9)], store_paths=True
+    )
+    assert res.outcome[0] == SlideOutcome.STUCK
+    assert res.time_s[0] == pytest.approx(period, rel=1e-2)
+    assert res.x[0] - x0 == pytest.approx(v * period, rel=1e-2)
+    path = res.paths[0]
+    t = np.arange(path.shape[0]) * p.timestep_s
+    closed = x0 + v * t - v / omega * np.sin(omega * t)
+    assert np.max(np.abs(path[:, 0] - closed)) < 1e-2 * v * period
+
+
+def test_a_block_at_rest_on_a_moving_carriage_ends_only_where_held_says():
+    """At rest short of breakaway, a moving carriage loads the spring until the block goes:
+    with ``held`` false everywhere it keeps going until the bounds."""
+    k, v = 400.0, 2.0
+    p = SlideParams(MU, W, M, 5e-3, 3.0, spring_n_m=k, carriage_speed_m_s=v)
+    waits = slide_until_stuck(_plane(0.0), [(-1.5, 0.0)], p)
+    assert waits.outcome[0] == SlideOutcome.STUCK and waits.time_s[0] == pytest.approx(5e-3)
+    goes = slide_until_stuck(_plane(0.0), [(-1.5, 0.0)], p, held=lambda x, y: np.zeros(x.shape, bool))
+    assert goes.outcome[0] == SlideOutcome.LEFT_DOMAIN and goes.x[0] > 1.9
+
+
+def test_paths_start_at_the_start_and_end_at_the_end():
+    res = slide_until_stuck(
+        _plane(40.0), [(0.5, 0.1), (0.2, 0.0)], SlideParams(MU, W, M, 1e-3, 0.05), store_paths=True
+    )
+    for i, path in enumerate(res.paths):
+        assert path.shape == (51, 2)
+        assert tuple(path[-1]) == (res.x[i], res.y[i])
+    assert tuple(res.paths[0][0]) == (0.5, 0.1)
