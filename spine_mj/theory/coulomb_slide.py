@@ -30,8 +30,9 @@ tangential velocity.
 A spring of stiffness ``k`` along x from a carriage at ``X`` (staying, or moving along +x
 at a constant speed) adds ``k (X - x)`` to the drive, as the rig's spring carriage does
 (the spring acts in x only, the particle is free in y and z). A particle at rest then ends
-its slide only where ``held(x, y)`` says so (default: wherever it rests); elsewhere the
-carriage's advance may set it sliding again.
+its slide only where ``held(x, y)`` says so (default: wherever it rests; optionally at a
+speed of at most ``settled_speed_m_s``); elsewhere the carriage's advance may set it
+sliding again.
 
 On a surface without a Hessian (a ball on facets: flat faces, edges rounded over the tip
 radius) the curvature term is taken as zero, and where a step brings the particle against
@@ -170,6 +171,7 @@ def slide_until_stuck(
     length_scale_m: float = 1.0,
     carriage_x=None,
     held=None,
+    settled_speed_m_s: float = 0.0,
     bounds=None,
     store_paths: bool = False,
 ) -> SlideResult:
@@ -194,6 +196,11 @@ def slide_until_stuck(
     held : callable, optional
         ``held(x, y) -> bool (m,)`` (surface units): where a particle at rest ends its
         slide; none: wherever it rests.
+    settled_speed_m_s : float
+        A particle on the surface at most this fast counts as at rest (0: only at rest).
+        With a moving carriage and a spring without damping, a particle may slide on with
+        the carriage for good, its speed swinging between 0 and ``2 v`` (it never rests
+        where steady sliding is the quasistatic motion): ``2 v`` ends it there.
     bounds : tuple of float, optional
         ``(xmin, xmax, ymin, ymax)``: a particle outside ends ``LEFT_DOMAIN`` (none: the
         surface's bounds).
@@ -215,6 +222,7 @@ def slide_until_stuck(
     anchor = anchor * s  # [m]
     xmin, xmax, ymin, ymax = surface.bounds if bounds is None else bounds
     hessian = _has_hessian(surface, starts)
+    settled = check_positive("settled_speed_m_s", settled_speed_m_s, allow_zero=True)
 
     def ev(q, order=2):
         return _surface_at(surface, q, s, order, hessian)
@@ -273,7 +281,7 @@ def slide_until_stuck(
             & (new_q[:, 1] >= ymin * s)
             & (new_q[:, 1] <= ymax * s)
         )
-        stuck = ~out & on_after & (sp == 0)
+        stuck = ~out & on_after & (sp <= settled)
         if held is not None and stuck.any():
             stuck[stuck] = np.asarray(held(new_q[stuck, 0] / s, new_q[stuck, 1] / s), dtype=bool)
         for mask, kind in ((out, SlideOutcome.LEFT_DOMAIN), (stuck, SlideOutcome.STUCK)):
