@@ -214,92 +214,97 @@ def slide_until_stuck(
     p = params
     s = check_positive("length_scale_m", length_scale_m)
     starts, v0 = _checked(starts, velocity_m_s)
-    k = len(starts)
-    dt = p.timestep_s
     anchor = starts[:, 0].copy() if carriage_x is None else np.asarray(carriage_x, dtype=float).reshape(-1)
-    if anchor.shape != (k,) or not np.isfinite(anchor).all():
-        raise SpineInputError(f"carriage_x must be {k} finite positions, got shape {anchor.shape}")
-    anchor = anchor * s  # [m]
-    xmin, xmax, ymin, ymax = surface.bounds if bounds is None else bounds
-    hessian = _has_hessian(surface, starts)
+    if anchor.shape != (len(starts),) or not np.isfinite(anchor).all():
+        raise SpineInputError(f"carriage_x must be {len(starts)} finite positions, got shape {anchor.shape}")
     settled = check_positive("settled_speed_m_s", settled_speed_m_s, allow_zero=True)
+    run = _Run(surface, p, s, starts, v0, anchor * s, surface.bounds if bounds is None else bounds)
+    steps = [] if store_paths else None
+    for step in range(1, int(math.ceil(p.max_time_s / p.timestep_s)) + 1):
+        if not run.step(step, held, settled, steps):
+            break
+    return run.result(None if steps is None else _assemble(starts, steps))
 
-    def ev(q, order=2):
-        return _surface_at(surface, q, s, order, hessian)
 
-    def applied(i, x, t):  # the applied force A [N] on particles i at x [m], time t [s]
-        f = np.empty((i.size, 3))
-        f[:, 0] = p.drive_force_n + p.spring_n_m * (anchor[i] + p.carriage_speed_m_s * t - x)
-        f[:, 1] = 0.0
+class _Run:
+    """The particles' state through a slide (:func:`slide_until_stuck`), SI."""
+
+    def __init__(self, surface, p: SlideParams, s: float, starts, v0, anchor, bounds):
+        self.surface, self.p, self.s, self.anchor, self.bounds = surface, p, s, anchor, bounds
+        self.hessian = _has_hessian(surface, starts)
+        k = len(starts)
+        self.q = starts * s  # horizontal position [m]
+        self.here = self.ev(self.q)  # the surface under each particle, carried from step to step
+        self.z, fx0, fy0 = self.here[:3]
+        self.vel = np.column_stack([v0, fx0 * v0[:, 0] + fy0 * v0[:, 1]])  # 3-D velocity [m/s]
+        self.active = np.ones(k, bool)
+        self.airborne = np.zeros(k, bool)
+        self.outcome = np.full(k, SlideOutcome.TIMED_OUT, np.int8)
+        self.t_end = np.full(k, p.max_time_s)
+        self.length = np.zeros(k)
+        self.vmax = np.linalg.norm(self.vel, axis=1)
+        self.n_air = np.zeros(k, np.int64)
+
+    def ev(self, q, order=2):
+        return _surface_at(self.surface, q, self.s, order, self.hessian)
+
+    def applied(self, i, x, t) -> np.ndarray:
+        """The applied force A [N] ``(m, 3)`` on particles ``i`` at ``x`` [m] at time ``t`` [s]."""
+        p = self.p
+        f = np.zeros((i.size, 3))
+        f[:, 0] = p.drive_force_n + p.spring_n_m * (self.anchor[i] + p.carriage_speed_m_s * t - x)
         f[:, 2] = -p.load_n
         return f
 
-    q = starts * s  # horizontal position [m]
-    here = ev(q)  # the surface under each particle, carried from step to step
-    z, fx0, fy0 = here[:3]
-    vel = np.column_stack([v0, fx0 * v0[:, 0] + fy0 * v0[:, 1]])  # 3-D velocity [m/s]
-    active = np.ones(k, bool)
-    airborne = np.zeros(k, bool)
-    outcome = np.full(k, SlideOutcome.TIMED_OUT, np.int8)
-    t_end = np.full(k, p.max_time_s)
-    length = np.zeros(k)
-    vmax = np.linalg.norm(vel, axis=1)
-    n_air = np.zeros(k, np.int64)
-    steps = [] if store_paths else None
-    n_steps = int(math.ceil(p.max_time_s / dt))
-    for step in range(1, n_steps + 1):
-        idx = np.flatnonzero(active)
+    def step(self, step: int, held, settled: float, steps) -> bool:
+        """Advance the active particles one step (the ``step``-th); False when none is left."""
+        p, s, idx = self.p, self.s, np.flatnonzero(self.active)
         if not idx.size:
-            break
-        qa, va, za, air = q[idx], vel[idx], z[idx], airborne[idx]
-        force = applied(idx, qa[:, 0], (step - 1) * dt)
-        new_q, new_z, new_v, flying, f_new = _advance(
-            ev, qa, va, za, air, [c[idx] for c in here], force, p, hessian
-        )
-        for c, c_new in zip(here, f_new):
+            return False
+        qa, va, za, air = self.q[idx], self.vel[idx], self.z[idx], self.airborne[idx]
+        force = self.applied(idx, qa[:, 0], (step - 1) * p.timestep_s)
+        here = [c[idx] for c in self.here]
+        new_q, new_z, new_v, flying, f_new = _advance(self.ev, qa, va, za, air, here, force, p)
+        for c, c_new in zip(self.here, f_new):
             c[idx] = c_new
         landed = flying & (new_z <= f_new[0])  # a flight that meets the surface lands
         new_z = np.where(~flying | landed, f_new[0], new_z)  # contact keeps to the surface
-        on_after = ~flying | landed
+        on = ~flying | landed
         # without a Hessian a step onto a face tilted into the velocity is a crease's impact
-        impact = landed if hessian else on_after
-        new_v[on_after] = _landed_velocity(
-            new_v[on_after], f_new[1][on_after], f_new[2][on_after], impact[on_after], p.mu
-        )
-        length[idx] += np.sqrt(np.sum((new_q - qa) ** 2, axis=1) + (new_z - za) ** 2)
-        q[idx], vel[idx], z[idx] = new_q, new_v, new_z
-        airborne[idx] = flying & ~landed
-        n_air[idx] += flying & ~landed
+        impact = landed if self.hessian else on
+        new_v[on] = _landed_velocity(new_v[on], f_new[1][on], f_new[2][on], impact[on], p.mu)
+        self.length[idx] += np.sqrt(np.sum((new_q - qa) ** 2, axis=1) + (new_z - za) ** 2)
+        self.q[idx], self.vel[idx], self.z[idx] = new_q, new_v, new_z
+        self.airborne[idx] = flying & ~landed
+        self.n_air[idx] += flying & ~landed
         sp = np.linalg.norm(new_v, axis=1)
-        vmax[idx] = np.maximum(vmax[idx], sp)
-        if store_paths:
+        self.vmax[idx] = np.maximum(self.vmax[idx], sp)
+        if steps is not None:
             steps.append((idx, new_q / s))
-        t = step * dt
-        out = ~(
-            (new_q[:, 0] >= xmin * s)
-            & (new_q[:, 0] <= xmax * s)
-            & (new_q[:, 1] >= ymin * s)
-            & (new_q[:, 1] <= ymax * s)
-        )
-        stuck = ~out & on_after & (sp <= settled)
+        xmin, xmax, ymin, ymax = (b * s for b in self.bounds)
+        out = ~((new_q[:, 0] >= xmin) & (new_q[:, 0] <= xmax) & (new_q[:, 1] >= ymin) & (new_q[:, 1] <= ymax))
+        stuck = ~out & on & (sp <= settled)
         if held is not None and stuck.any():
             stuck[stuck] = np.asarray(held(new_q[stuck, 0] / s, new_q[stuck, 1] / s), dtype=bool)
         for mask, kind in ((out, SlideOutcome.LEFT_DOMAIN), (stuck, SlideOutcome.STUCK)):
-            hit = idx[mask & active[idx]]
-            outcome[hit], t_end[hit], active[hit] = kind, t, False
-    spring = p.spring_n_m * (anchor + p.carriage_speed_m_s * t_end - q[:, 0])
-    return SlideResult(
-        x=q[:, 0] / s,
-        y=q[:, 1] / s,
-        z=z / s,
-        time_s=t_end,
-        path_length=length / s,
-        outcome=outcome,
-        max_speed_m_s=vmax,
-        airborne_steps=n_air,
-        spring_force_n=spring,
-        paths=None if steps is None else _assemble(starts, steps),
-    )
+            hit = idx[mask]
+            self.outcome[hit], self.t_end[hit], self.active[hit] = kind, step * p.timestep_s, False
+        return True
+
+    def result(self, paths) -> SlideResult:
+        p, s, q = self.p, self.s, self.q
+        return SlideResult(
+            x=q[:, 0] / s,
+            y=q[:, 1] / s,
+            z=self.z / s,
+            time_s=self.t_end,
+            path_length=self.length / s,
+            outcome=self.outcome,
+            max_speed_m_s=self.vmax,
+            airborne_steps=self.n_air,
+            spring_force_n=p.spring_n_m * (self.anchor + p.carriage_speed_m_s * self.t_end - q[:, 0]),
+            paths=paths,
+        )
 
 
 def _assemble(starts: np.ndarray, steps: list) -> list[np.ndarray]:
@@ -361,7 +366,7 @@ def _landed_velocity(v, fx, fy, landed, mu: float) -> np.ndarray:
     return ut * keep[:, None]
 
 
-def _advance(ev, qa, va, za, air, here, force, p: SlideParams, hessian: bool = True):
+def _advance(ev, qa, va, za, air, here, force, p: SlideParams):
     """One step of particles at ``qa, za`` with velocity ``va`` (``air``: flying) on the
     surface ``here`` under them, under the applied forces ``force`` ``(m, 3)``: new
     position, height and velocity, who flies, and the surface (:func:`_surface_at`) at the

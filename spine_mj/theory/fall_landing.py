@@ -121,7 +121,25 @@ def landing_streamlines(
         raise SpineInputError(f"fall must be FallParams, got {type(fall).__name__}")
     trace = sl.streamlines if trace is None else trace
     starts = np.asarray(starts, dtype=float).reshape(-1, 2)
-    n = len(starts)
+    book = _Paths(len(starts))
+    active, points, first = np.arange(len(starts)), starts, True
+    while active.size:
+        res = trace(surface, points, params, store_paths=True)
+        go, at, force = book.split(res, active, first, fall.max_falls)
+        first = False
+        if not go.size:
+            break
+        landed = _slide(surface, params, fall, at, force)
+        book.land(go, landed, params.dl)
+        again = landed.outcome == SlideOutcome.STUCK
+        active = go[again]
+        points = np.column_stack([landed.x[again], landed.y[again]])
+    return book.result(surface, starts, params)
+
+
+def _slide(surface, params: StreamlineParams, fall: FallParams, at: np.ndarray, kappa: np.ndarray):
+    """The falls from ``at`` ``(m, 2)``, the spring holding ``kappa W`` at each start, to
+    where each comes to rest where a pull is needed to move it on (module docstring)."""
     mu, s = params.mu, fall.length_scale_m
     slide = SlideParams(
         mu,
@@ -132,78 +150,84 @@ def landing_streamlines(
         spring_n_m=fall.spring_n_m,
         carriage_speed_m_s=fall.speed_m_s,
     )
-    domain = params.domain(surface)
 
     def held(x, y):
         _, fx, fy = surface.evaluate(x, y, order=1)
         return hold_force(fx, fy, mu)[1] != SLIP
 
-    pieces = [[] for _ in range(n)]  # (x, y, kappa, region) arrays
-    outcome = np.zeros(n, np.int8)
-    max_kappa = np.full(n, np.nan)
-    falls = np.zeros(n, np.int64)
-    landings = [[] for _ in range(n)]
-    fall_time = np.zeros(n)
-    peak = np.zeros(n)
-    active = np.arange(n)
-    points = starts
-    first = True
-    while active.size:
-        res = trace(surface, points, params, store_paths=True)
-        max_kappa[active] = np.fmax(max_kappa[active], res.max_kappa)
+    return slide_until_stuck(
+        surface,
+        at,
+        slide,
+        length_scale_m=s,
+        carriage_x=at[:, 0] + kappa * fall.load_n / (fall.spring_n_m * s),
+        held=held,
+        settled_speed_m_s=2 * fall.speed_m_s,
+        bounds=params.domain(surface),
+        store_paths=True,
+    )
+
+
+class _Paths:
+    """The landing reference's paths as they grow: streamline pieces and falls."""
+
+    def __init__(self, n: int):
+        self.pieces = [[] for _ in range(n)]  # (x, y, kappa, region) arrays
+        self.outcome = np.zeros(n, np.int8)
+        self.max_kappa = np.full(n, np.nan)
+        self.falls = np.zeros(n, np.int64)
+        self.landings = [[] for _ in range(n)]
+        self.fall_time = np.zeros(n)
+        self.peak = np.zeros(n)
+
+    def split(self, res: StreamlineResult, active: np.ndarray, first: bool, max_falls: int):
+        """Keep each streamline of ``res`` (path ``j`` is path ``active[j]``'s next piece) up
+        to its first slip point; return the paths that fall there, the points and the
+        spring's force there over the load (kappa of the last engaged point; 0 at a start)."""
+        self.max_kappa[active] = np.fmax(self.max_kappa[active], res.max_kappa)
         go, at, force = [], [], []
+        k0 = 0 if first else 1  # a restart's first point is the landing, already kept
         for j, i in enumerate(active):
             path = res.path(j)
-            k0 = 0 if first else 1  # a restart's first point is the landing, already kept
             slip = np.flatnonzero(path["region"] == SLIP)
+            f = int(slip[0]) if slip.size else len(path["x"]) - 1
+            self.pieces[i].append([path[c][k0 : f + 1] for c in ("x", "y", "kappa", "region")])
             if not slip.size:
-                pieces[i].append([path[c][k0:] for c in ("x", "y", "kappa", "region")])
-                outcome[i] = res.outcome[j]
-                continue
-            f = int(slip[0])
-            pieces[i].append([path[c][k0 : f + 1] for c in ("x", "y", "kappa", "region")])
-            if f == 0 and not first:  # a landing held by the slide's rule, not by the streamline's
-                outcome[i] = Outcome.STALLED
-                continue
-            if falls[i] >= fall.max_falls:
-                outcome[i] = Outcome.STEP_CAP
-                continue
-            kap = float(path["kappa"][f - 1]) if f > 0 else 0.0
-            go.append(i)
-            at.append((path["x"][f], path["y"][f]))
-            force.append(kap * fall.load_n if math.isfinite(kap) and kap > 0 else 0.0)
-        first = False
-        if not go:
-            break
-        go, at = np.array(go), np.array(at)
-        carriage = at[:, 0] + np.array(force) / (fall.spring_n_m * s)
-        landed = slide_until_stuck(
-            surface,
-            at,
-            slide,
-            length_scale_m=s,
-            carriage_x=carriage,
-            held=held,
-            settled_speed_m_s=2 * fall.speed_m_s,
-            bounds=domain,
-            store_paths=True,
-        )
-        falls[go] += 1
-        fall_time[go] += landed.time_s
-        peak[go] = np.maximum(peak[go], landed.max_speed_m_s)
+                self.outcome[i] = res.outcome[j]
+            elif f == 0 and not first:  # a landing held by the slide's rule, not by the streamline's
+                self.outcome[i] = Outcome.STALLED
+            elif self.falls[i] >= max_falls:
+                self.outcome[i] = Outcome.STEP_CAP
+            else:
+                kap = float(path["kappa"][f - 1]) if f > 0 else 0.0
+                go.append(i)
+                at.append((path["x"][f], path["y"][f]))
+                force.append(kap if math.isfinite(kap) and kap > 0 else 0.0)
+        return np.array(go, np.int64), np.array(at).reshape(-1, 2), np.array(force)
+
+    def land(self, go: np.ndarray, landed, dl: float) -> None:
+        """Add the falls of paths ``go`` (:class:`~spine_mj.theory.coulomb_slide.SlideResult`),
+        one point a streamline step ``dl``."""
+        self.falls[go] += 1
+        self.fall_time[go] += landed.time_s
+        self.peak[go] = np.maximum(self.peak[go], landed.max_speed_m_s)
         for j, i in enumerate(go):
-            landings[i].append((float(landed.x[j]), float(landed.y[j])))
-            p = _thinned(landed.paths[j], params.dl)[1:]
-            pieces[i].append([p[:, 0], p[:, 1], np.full(len(p), np.nan), np.full(len(p), SLIP, np.int8)])
+            self.landings[i].append((float(landed.x[j]), float(landed.y[j])))
+            p = _thinned(landed.paths[j], dl)[1:]
+            self.pieces[i].append([p[:, 0], p[:, 1], np.full(len(p), np.nan), np.full(len(p), SLIP, np.int8)])
             if landed.outcome[j] == SlideOutcome.LEFT_DOMAIN:
-                outcome[i] = Outcome.LEFT_DOMAIN
+                self.outcome[i] = Outcome.LEFT_DOMAIN
             elif landed.outcome[j] == SlideOutcome.TIMED_OUT:
-                outcome[i] = Outcome.STEP_CAP
-        again = landed.outcome == SlideOutcome.STUCK
-        active = go[again]
-        points = np.column_stack([landed.x[again], landed.y[again]])
-    meta = {"falls": falls, "fall_time_s": fall_time, "fall_peak_speed_m_s": peak, "landings": landings}
-    return _result(surface, starts, params, pieces, outcome, max_kappa, meta)
+                self.outcome[i] = Outcome.STEP_CAP
+
+    def result(self, surface, starts, params) -> StreamlineResult:
+        meta = {
+            "falls": self.falls,
+            "fall_time_s": self.fall_time,
+            "fall_peak_speed_m_s": self.peak,
+            "landings": self.landings,
+        }
+        return _result(surface, starts, params, self.pieces, self.outcome, self.max_kappa, meta)
 
 
 def _thinned(path: np.ndarray, spacing: float) -> np.ndarray:
