@@ -353,14 +353,26 @@ def _issue44(add, work: Path, py: str) -> None:
     )
     engines = [*SPINE, "compare-engines"]
     (work / "a-file").write_text("")
-    for args, needle in (
+    engine_args = [
         (["--out", "e", "--fractal", "-1"], "--fractal"),
         (["--out", "e", "--headlines", "-1"], "--headlines"),
         (["--out", "e", "--workers", "0"], "--workers"),
+        (["--out", "e", "--fractal", "abc"], "--fractal"),
+        (["--out", "e", "--bogus"], "--bogus"),
         ([], "--out"),
         (["--out", "a-file"], "a-file"),
-    ):
+        (["--out", "a-file/e"], "a-file"),
+    ]
+    if sys.platform.startswith("linux"):  # procfs takes no new file, not even root's
+        engine_args.append((["--out", "/proc/self/e"], "cannot write /proc/self/e/engines.json"))
+    for args, needle in engine_args:
         add(f"compare-engines {' '.join(args) or '(no arguments)'}", [*engines, *args], "refuse", needle)
+    add(
+        "python -m spine_mj.validate.engines (the study's old entry point)",
+        [py, "-m", "spine_mj.validate.engines", "--out", "e", "--fractal", "-1"],
+        "refuse",
+        "spine-mj compare-engines",
+    )
     (work / "deep.json").write_text("[" * 100_000 + "]" * 100_000)
     check = str(Path(__file__).with_name("reproduction_check.py"))
     add("reproduction_check.py on deeply nested JSON", [py, check, "deep.json"], "refuse", "nested too deep")
@@ -387,6 +399,20 @@ def _issue44(add, work: Path, py: str) -> None:
             '[grid]\nengine = "bullet"\ntimestep_factor = 0.5',
             "engine bullet",
         ),
+        **{
+            f"bullet with {key}": (
+                '["engine"]',
+                "paper-single-peak",
+                f'[grid]\nengine = "bullet"\n{key} = {value}',
+                "engine bullet",
+            )
+            for key, value in (
+                ("noslip_iterations", "5"),
+                ("tolerance", "1e-9"),
+                ("solref_dampratio", "0.5"),
+                ("cone", '"pyramidal"'),
+            )
+        },
         "array protocol static": ('["array"]', "corrugation", '[drive]\nprotocol = "static"', "static"),
         "array force with duration": (
             '["array"]',
@@ -417,6 +443,18 @@ def _issue44(add, work: Path, py: str) -> None:
             "corrugation",
             '[array]\nspacing = 2.0\nspacing_unit = "surface"',
             "outside the surface",
+        ),
+        "array staggered 3 x 40 off the surface": (
+            '["array"]',
+            "corrugation",
+            '[array]\nlayout = "staggered"\nrows = 3\ncols = 40\nspacing = 0.2\nspacing_unit = "surface"',
+            "outside the surface",
+        ),
+        "array random 8 x 8 at spacing 0.001": (
+            '["array"]',
+            "corrugation",
+            '[array]\nlayout = "random"\nrows = 8\ncols = 8\nspacing = 0.001\nspacing_unit = "surface"',
+            "too small for 64 random spines",
         ),
     }
     for name, (analyses, preset, tables, needle) in configs.items():
@@ -589,11 +627,20 @@ def run_probe(work, name, args, expect, needle, env):
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--novideo", help="bin/ folder of an environment without the video extra")
+    ap.add_argument(
+        "--only",
+        action="append",
+        metavar="TEXT",
+        help="run only the probes whose name holds TEXT (repeatable; the set-up still runs, and a "
+        "probe that reads an earlier probe's output needs that one selected too)",
+    )
     args = ap.parse_args(argv)
     work = Path(tempfile.mkdtemp(prefix="spine-mj-probes-"))
     try:
         results = []
         for name, cmd, expect, needle, env in probes(work, args.novideo):
+            if args.only and not any(text in name for text in args.only):
+                continue
             good, detail = run_probe(work, name, cmd, expect, needle, env)
             results.append(good)
             print(f"{'PASS' if good else 'FAIL'}  {name}: {detail}", flush=True)
