@@ -450,25 +450,41 @@ def _reporter(progress, surface: Surface, resolution: int | None, refinement) ->
 
 
 def _check_sizes(
-    radius: float, spacing: float, char_length: float, span: float, *, given: bool = True
+    radius: float,
+    spacing: float,
+    char_length: float,
+    span: float,
+    *,
+    given: bool = True,
+    length_scale_m: float = 1.0,
+    unit: str = "m",
 ) -> None:
     """Tip, hfield spacing and L_c against each other and the domain (all in metres);
-    ``given``: the radius is the user's (a default one is named as such)."""
-    what = f"tip_radius_m {radius:.3g} m" if given else f"the default tip radius {radius:.3g} m"
+    ``given``: the radius is the user's (a default one is named as such). Each length is
+    named in metres and, for a surface in another ``unit`` (``length_scale_m`` metres), in
+    the surface's unit too: the CLI takes the tip radius in it."""
+
+    def length(value_m: float) -> str:
+        if unit == "m" and length_scale_m == 1.0:
+            return f"{value_m:.3g} m"
+        return f"{value_m:.3g} m ({value_m / length_scale_m:.3g} {'surface units' if unit == '1' else unit})"
+
+    what = f"tip_radius_m {length(radius)}" if given else f"the default tip radius {length(radius)}"
     if 2 * radius >= span:
         raise SpineInputError(
             f"{what} is larger than the surface: its diameter must be smaller than the domain's "
-            f"width {span:.3g} m"
+            f"width {length(span)}"
         )
-    if min(radius, spacing) < _MIN_ENGINE_RATIO * char_length:
+    floor = _MIN_ENGINE_RATIO * char_length
+    if min(radius, spacing) < floor:
         raise SpineInputError(
-            f"tip_radius_m {radius:.3g} m or hfield spacing {spacing:.3g} m is finer than the engine "
-            f"resolves: both must exceed {_MIN_ENGINE_RATIO:g} L_c = {_MIN_ENGINE_RATIO * char_length:.3g} m"
+            f"tip_radius_m {length(radius)} or hfield spacing {length(spacing)} is finer than the "
+            f"engine resolves: both must exceed {_MIN_ENGINE_RATIO:g} L_c = {length(floor)}"
         )
     if spacing > 2 * radius * (1 + 1e-9):
         raise SpineInputError(
-            f"surface too coarse for the tip: hfield spacing {spacing:.3g} m > 2 x {what} "
-            f"= {2 * radius:.3g} m; raise hfield_resolution or the tip radius"
+            f"surface too coarse for the tip: hfield spacing {length(spacing)} > 2 x {what} "
+            f"= {length(2 * radius)}; raise hfield_resolution or the tip radius"
         )
 
 
@@ -497,7 +513,15 @@ def _planned_sizing(surface: Surface, tip: TipParams, length_scale_m, char_lengt
         char_length_m = characteristic_length(surface) * length_scale_m
     char_length_m = check_physical_length("char_length_m", char_length_m)
     spacing, width, radius = _tip_rule(surface, tip.tip_radius_m, length_scale_m, char_length_m, resolution)
-    _check_sizes(radius, spacing, char_length_m, width, given=tip.tip_radius_m is not None)
+    _check_sizes(
+        radius,
+        spacing,
+        char_length_m,
+        width,
+        given=tip.tip_radius_m is not None,
+        length_scale_m=length_scale_m,
+        unit=surface.unit,
+    )
     if resolution is None and spacing < _MIN_SPACING_PER_TIP_RADIUS * radius:
         extent = 2 * max(hfield_half_extents(surface)) * length_scale_m
         resolution = math.ceil(extent / (_MIN_SPACING_PER_TIP_RADIUS * radius)) + 1

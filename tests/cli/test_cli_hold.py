@@ -38,7 +38,7 @@ def test_a_tip_too_wide_for_a_narrow_strip_is_refused_with_the_users_number(tmp_
     strip = GridSurface(heights=0.2 * np.sin(x)[None, :] * np.ones((9, 1)), x=x, y=y)
     path = save_surface(strip, tmp_path / "strip.npz")
     line = _refused([str(path), "--mu", "0.5", "--tip-radius", "0.6"], tmp_path / "out")
-    assert "tip_radius_m 0.006 m is larger than the surface" in line
+    assert "tip_radius_m 0.006 m (0.6 surface units) is larger than the surface" in line
 
 
 def test_a_plane_is_refused_in_one_line_naming_why(tmp_path):

@@ -26,7 +26,8 @@ from spine_mj.surfaces import GridSurface, single_gaussian
         (lambda: TipParams(gravity_m_s2=0.0), r"no normal preload"),
         (
             lambda: Rig(single_gaussian(), tip=TipParams(tip_radius_m=1e-5)),
-            r"surface too coarse for the tip: hfield spacing 0\.0005 m > 2 x tip_radius_m",
+            r"surface too coarse for the tip: hfield spacing 0\.0005 m \(0\.05 surface units\) "
+            r"> 2 x tip_radius_m 1e-05 m \(0\.001 surface units\)",
         ),
         (lambda: flat_rig().run(StaticProbe(), start=(1.0, 0.0)), r"start \(1, 0\) lies outside"),
         (  # a batch's starts are checked at once; the first bad one is named
@@ -279,5 +280,22 @@ def test_a_narrow_strip_gets_a_tip_that_fits_across_it_and_a_tip_too_wide_is_ref
     strip = GridSurface(heights=3 * np.sin(2 * np.pi * x / 300)[None, :] * np.ones((9, 1)), x=x, y=y)
     scales = Scales.for_surface(strip)
     assert scales.tip_radius_m <= 1.0 * scales.length_scale_m / DEFAULT_TIP_RADII_ACROSS
-    with pytest.raises(SpineInputError, match=r"tip_radius_m 0.006 m is larger than the surface"):
+    with pytest.raises(
+        SpineInputError, match=r"tip_radius_m 0\.006 m \(0\.6 surface units\) is larger than the surface"
+    ):
         Scales.for_surface(strip, tip=TipParams(tip_radius_m=0.006))
+
+
+def test_a_size_refusal_names_its_lengths_in_the_surfaces_own_unit_too():
+    """The CLI takes the tip radius in the surface's unit: a refusal in metres alone named
+    numbers its user never gave (--tip-radius 0.6 on a dimensionless strip read 0.006 m)."""
+    from spine_mj.sim import Scales
+
+    x = np.linspace(0.0, 10.0, 41)
+    surf = GridSurface(heights=0.5 * np.sin(x)[None, :] * np.ones((41, 1)), x=x, y=x, unit="mm")
+    with pytest.raises(
+        SpineInputError,
+        match=r"^tip_radius_m 0\.02 m \(20 mm\) is larger than the surface: its diameter must be "
+        r"smaller than the domain's width 0\.01 m \(10 mm\)$",
+    ):
+        Scales.for_surface(surf, tip=TipParams(tip_radius_m=0.02))

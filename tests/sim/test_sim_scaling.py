@@ -100,7 +100,10 @@ def test_micrometre_and_nanometre_tips_compile_with_order_one_engine_numbers():
 @pytest.mark.parametrize(
     ("kwargs", "match"),
     [
-        ({"tip": TipParams(tip_radius_m=0.2)}, r"tip_radius_m 0\.2 m is larger than the surface"),
+        (
+            {"tip": TipParams(tip_radius_m=0.2)},
+            r"tip_radius_m 0\.2 m \(20 surface units\) is larger than the surface",
+        ),
         ({"length_scale_m": 1e-30}, r"length_scale_m must lie in \[1e-12, 1000\] m .*got 1e-30"),
         ({"tip": TipParams(tip_radius_m=1e-13)}, r"finer than the engine resolves"),
     ],
