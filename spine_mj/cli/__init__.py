@@ -13,16 +13,11 @@ commands: :mod:`~spine_mj.cli.surface` (``surface make/show/info/export``),
 
 The CLI starts at once: a command's module is imported when the command is named (or its
 help listed), and each module imports the library inside its commands, so ``spine-mj
---help`` loads neither numpy nor MuJoCo (``tests/cli/test_cli_startup.py``).
+--help`` loads neither numpy nor MuJoCo (``tests/cli/test_cli_startup.py``). Its public
+names are listed in ``__init__.pyi`` and load from :mod:`~spine_mj.cli.app` on first use,
+as every public package's do.
 """
 
-from spine_mj.cli.app import INPUT_ERROR_EXIT, InputError, Progress, _exit_on_sigterm, main, run
+import lazy_loader as _lazy
 
-__all__ = [
-    "INPUT_ERROR_EXIT",
-    "InputError",
-    "Progress",
-    "_exit_on_sigterm",
-    "main",
-    "run",
-]
+__getattr__, __dir__, __all__ = _lazy.attach_stub(__name__, __file__)

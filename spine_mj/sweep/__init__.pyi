@@ -1,8 +1,8 @@
 """The public names of :mod:`spine_mj.sweep`, for type checkers and the docs; ``__init__.py``
 loads each from its home on first use (``lazy_loader.attach_stub`` reads this file)."""
 
-from .analyses import ENGINE_PARAMS as ENGINE_PARAMS
-from .analyses import QUASISTATIC_PARAMS as QUASISTATIC_PARAMS
+from .analyses.engine import ENGINE_PARAMS as ENGINE_PARAMS
+from .analyses.quasistatic import QUASISTATIC_PARAMS as QUASISTATIC_PARAMS
 from .case_runs import run_case as run_case
 from .cases import Case as Case
 from .cases import expand_cases as expand_cases

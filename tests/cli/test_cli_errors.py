@@ -213,7 +213,7 @@ def test_sigterm_removes_a_temporary_output(tmp_path):
     script = f"""
 import os, signal, time
 from pathlib import Path
-from spine_mj.cli import _exit_on_sigterm
+from spine_mj.cli.app import _exit_on_sigterm
 from spine_mj.atomic import atomic_output
 signal.signal(signal.SIGTERM, _exit_on_sigterm)
 with atomic_output(Path({str(tmp_path / "out.txt")!r})) as tmp:

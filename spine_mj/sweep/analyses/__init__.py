@@ -10,7 +10,5 @@ from spine_mj.sweep.analyses import quasistatic  # noqa: I001  (registration ord
 from spine_mj.sweep.analyses import engine
 from spine_mj.sweep.analyses import compare
 from spine_mj.sweep.analyses import array
-from spine_mj.sweep.analyses.engine import ENGINE_PARAMS
-from spine_mj.sweep.analyses.quasistatic import QUASISTATIC_PARAMS
 
-__all__ = ["ENGINE_PARAMS", "QUASISTATIC_PARAMS", "array", "compare", "engine", "quasistatic"]
+__all__ = ["array", "compare", "engine", "quasistatic"]
