@@ -19,6 +19,22 @@ locks the tip, and the references do not apply: it is skipped and counted
 
 Run: ``nice -n 19 .venv/bin/python analysis/stickslip_classes.py run`` (about 6 CPU
 minutes on one core), then ``... report``.
+
+Grid convergence: ``... run --refinement 2`` writes the same catalogs on the references'
+landscape sampled twice as finely (``landscape_refinement``: the surface, its scales and
+the stretch unchanged; folders under ``classes_refined2/``), and ``... compare
+--refinement 2`` sets each family's pooled ``tau`` and ``S_m`` (and the exponent of
+``S_m`` against K) beside the base run's, flagging every value that leaves the other's
+interval (``classes_refined2.md``, ``classes_refined2.json``).
+
+Track to track: ``... abbm --seeds 4242,4243`` runs both references on the ``abbm``
+preset drawn with each seed and made ``--length`` units long (its spacing, intensity and
+correlation length kept; the first 400 units are the preset's track of that seed, the one
+an engine runs on, and K is read with that track's scales), at :data:`ABBM_K` (a decade),
+and gives per seed, source and K the slip count, the truncated power law's ``tau``, ``S_m``
+against ``sigma / k^2``, and ``S_m``'s exponent against K over the decade and over the K
+whose ``sigma / k^2`` lies in the ABBM range (``abbm_tracks.md``, ``.json``; catalogs
+``abbm_tracks/seed<s>.parquet``, kept on a rerun).
 """
 
 from __future__ import annotations
@@ -35,7 +51,7 @@ from spine_mj import presets
 from spine_mj.errors import SpineInputError
 from spine_mj.jsonio import write_json
 from spine_mj.validate import avalanche_stats as stats
-from spine_mj.validate.stickslip_outputs import stickslip_to
+from spine_mj.validate.stickslip_outputs import EDGE_SHARE, _abbm_cutoff_lc, stickslip_to
 
 RECIPES = Path(__file__).parent / "stickslip_classes"
 #: Family -> (recipe, seeds, analytic hfield samples a side or None).
@@ -51,14 +67,18 @@ MU = 0.5
 SURVIVE_P = 0.1
 
 
-def _folder(out: Path, family: str, seed: int) -> Path:
-    return out / "classes" / f"{family.replace(' ', '_')}_seed{seed}"
+def _tree(refinement: int) -> str:
+    return "classes" if refinement == 1 else f"classes_refined{refinement}"
 
 
-def run(out: Path) -> None:
+def _folder(out: Path, family: str, seed: int, refinement: int = 1) -> Path:
+    return out / _tree(refinement) / f"{family.replace(' ', '_')}_seed{seed}"
+
+
+def run(out: Path, refinement: int = 1) -> None:
     for family, (recipe, seeds, resolution) in FAMILIES.items():
         for seed in seeds:
-            folder = _folder(out, family, seed)
+            folder = _folder(out, family, seed, refinement)
             if (folder / "summary.json").is_file() or (folder / "locked.json").is_file():
                 continue
             surf = presets.open_surface(str(RECIPES / recipe), seed=seed)
@@ -72,6 +92,7 @@ def run(out: Path) -> None:
                     ie=1e-4,
                     surface_name=f"{family} seed {seed}",
                     n_bootstrap=20,  # each folder's own summary; report() pools the seeds
+                    landscape_refinement=refinement,
                     **extra,
                 )
             except SpineInputError as exc:  # a slope past 1 / mu: the tip locks, no reference
@@ -83,6 +104,101 @@ def run(out: Path) -> None:
             print(f"{family} seed {seed}: written", flush=True)
 
 
+#: The ABBM tracks' stiffness numbers: a decade, through the engines' K 1 and 2.
+ABBM_K = (0.2, 0.35, 0.6, 1.0, 2.0)
+
+
+def abbm_tracks(out: Path, seeds, length: float) -> dict:
+    """Both references on the ``abbm`` preset drawn with each of ``seeds``, ``length`` units
+    long (the module's docstring): per seed the catalogs, then per source and K ``tau`` and
+    ``S_m`` with their intervals, ``S_m`` over ``sigma / k^2``, and ``S_m``'s exponent."""
+    from spine_mj.sim.scales import Scales
+    from spine_mj.surfaces import abbm_size_range
+    from spine_mj.validate.slip_catalog import TrackUnits, reference_rows, track_landscape
+
+    folder = out / "abbm_tracks"
+    folder.mkdir(parents=True, exist_ok=True)
+    result: dict = {"length": length, "K": list(ABBM_K), "seeds": {}}
+    for seed in seeds:
+        path = folder / f"seed{seed}.parquet"
+        short = presets.make_surface("abbm", seed=seed)
+        units = TrackUnits.of(Scales.for_surface(short), 1e-6)
+        if not path.is_file():
+            pts = int(round(length / short.spacing[0])) + 1
+            surf = presets.make_surface("abbm", seed=seed, length=length, points=pts)
+            xmin, xmax, _, _ = surf.bounds
+            x0, x1 = xmin + EDGE_SHARE * (xmax - xmin), xmax - EDGE_SHARE * (xmax - xmin)
+            land = track_landscape(surf, MU, units.tip_radius, (x0, x1))
+            frames = [
+                pd.DataFrame(rows)
+                for k in ABBM_K
+                for rows in reference_rows(
+                    land, units, k, surface=f"abbm seed {seed}", mu=MU, ie=1e-6
+                ).values()
+            ]
+            pd.concat(frames, ignore_index=True).to_parquet(path, index=False)
+        events = pd.read_parquet(path)
+        params = short.metadata["params"]
+        low, high = (
+            v / units.char_length for v in abbm_size_range(short.spacing[0], params["correlation_length"])
+        )
+        entry: dict = {"L_c": units.char_length, "l_s": units.slope_length, "abbm_range_lc": [low, high]}
+        for source, by_source in events.groupby("source"):
+            cells: dict = {}
+            for k, rows in by_source.groupby("K"):
+                sizes = rows["size_lc"].to_numpy()
+                tr = stats.truncated_fit_by_ks(sizes)
+                cut = stats.cutoff_size(sizes)
+                predicted = _abbm_cutoff_lc(short, MU, units.stiffness(k), units.char_length)
+                cells[f"{k:g}"] = {
+                    "n_events": int(sizes.size),
+                    "tau": {"value": tr["tau"], "low": tr["low"], "high": tr["high"]},
+                    "cutoff_lc": cut,
+                    "predicted_cutoff_lc": predicted,
+                    "in_abbm_range": bool(low <= predicted <= high),
+                }
+            for name, ks in (
+                ("decade", [float(k) for k in cells]),
+                ("abbm_range", [float(k) for k, c in cells.items() if c["in_abbm_range"]]),
+            ):
+                if len(ks) >= 2:
+                    y = np.log([cells[f"{k:g}"]["cutoff_lc"]["value"] for k in ks])
+                    coef, cov = np.polyfit(np.log(ks), y, 1, cov=len(ks) > 2)
+                    se = float(math.sqrt(cov[0, 0])) if len(ks) > 2 else math.nan
+                    cells[f"exponent_{name}"] = {"value": float(coef[0]), "se": se, "K": ks}
+            entry[source] = cells
+        result["seeds"][str(seed)] = entry
+    write_json(out / "abbm_tracks.json", result)
+    (out / "abbm_tracks.md").write_text(_abbm_table(result))
+    return result
+
+
+def _abbm_table(result: dict) -> str:
+    lines = [
+        f"# Both references on fresh ABBM tracks ({result['length']:g} units, the abbm preset's parameters)",
+        "",
+        "| seed | source | K | slips | tau [95 %] | S_m [L_c] | sigma / k^2 [L_c] | in ABBM range |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- |",
+    ]
+    slopes = []
+    for seed, entry in result["seeds"].items():
+        for source in ("overdamped", "inertial"):
+            for k, c in entry.get(source, {}).items():
+                if k.startswith("exponent_"):
+                    slopes.append(
+                        f"- seed {seed}, {source}, {k.removeprefix('exponent_')} "
+                        f"(K {c['K'][0]:g}-{c['K'][-1]:g}): S_m ~ K^{c['value']:.2f} (+- {c['se']:.2f})"
+                    )
+                    continue
+                t, m = c["tau"], c["cutoff_lc"]
+                lines.append(
+                    f"| {seed} | {source} | {k} | {c['n_events']} | {t['value']:.3f} [{t['low']:.3f}, "
+                    f"{t['high']:.3f}] | {m['value']:.3g} [{m['low']:.3g}, {m['high']:.3g}] | "
+                    f"{c['predicted_cutoff_lc']:.3g} | {'yes' if c['in_abbm_range'] else 'no'} |"
+                )
+    return "\n".join([*lines, "", *slopes, ""])
+
+
 def _survives(fit: dict) -> bool:
     if "gof" not in fit or fit["gof"]["p"] <= SURVIVE_P:
         return False
@@ -90,6 +206,24 @@ def _survives(fit: dict) -> bool:
 
 
 def report(out: Path, bootstrap: int) -> dict:
+    result, lines = pooled(out, bootstrap)
+    out.mkdir(parents=True, exist_ok=True)
+    write_json(out / "classes.json", result)
+    slopes = [
+        f"- {family}, {source}: S_m ~ K^{e['cutoff_exponent']['value']:.2f} "
+        f"(+- {e['cutoff_exponent']['se']:.2f}); ABBM's is K^-2"
+        for family, per in result.items()
+        for source, e in per.items()
+        if isinstance(e, dict) and "cutoff_exponent" in e
+    ]
+    title = ["# Stick-slip classes: slip statistics on stationary-slope profiles", ""]
+    (out / "classes.md").write_text("\n".join([*title, *lines, "", *slopes, ""]))
+    return result
+
+
+def pooled(out: Path, bootstrap: int, refinement: int = 1) -> tuple[dict, list[str]]:
+    """Each family's seeds pooled, per source and K (the module's docstring): the result
+    dict and its table's lines."""
     result: dict = {}
     lines = [
         "| family | source | K | slips | tau (truncated) | power-law exponent | power law survives "
@@ -97,15 +231,12 @@ def report(out: Path, bootstrap: int) -> dict:
         "| --- | --- | --- | --- | --- | --- | --- | --- |",
     ]
     for family, (_, seeds, _) in FAMILIES.items():
-        frames = [
-            pd.read_parquet(_folder(out, family, s) / "events.parquet")
-            for s in seeds
-            if (_folder(out, family, s) / "events.parquet").is_file()
-        ]
+        folders = [_folder(out, family, s, refinement) for s in seeds]
+        frames = [pd.read_parquet(f / "events.parquet") for f in folders if (f / "events.parquet").is_file()]
         if not frames:
             continue
         events = pd.concat(frames, ignore_index=True)
-        locked = sum((_folder(out, family, s) / "locked.json").is_file() for s in seeds)
+        locked = sum((f / "locked.json").is_file() for f in folders)
         result[family] = {"seeds": len(frames), "seeds_locked": locked}
         for source, by_source in events.groupby("source"):
             entry: dict = {}
@@ -130,18 +261,77 @@ def report(out: Path, bootstrap: int) -> dict:
                 coef, cov = np.polyfit(np.log(ks), cut, 1, cov=True)
                 entry["cutoff_exponent"] = {"value": float(coef[0]), "se": float(math.sqrt(cov[0, 0]))}
             result[family][source] = entry
-    out.mkdir(parents=True, exist_ok=True)
-    write_json(out / "classes.json", result)
-    slopes = [
-        f"- {family}, {source}: S_m ~ K^{e['cutoff_exponent']['value']:.2f} "
-        f"(+- {e['cutoff_exponent']['se']:.2f}); ABBM's is K^-2"
-        for family, per in result.items()
-        for source, e in per.items()
-        if isinstance(e, dict) and "cutoff_exponent" in e
+    return result, lines
+
+
+def _outside(a: dict, b: dict) -> str:
+    """Which of two ``{value, low, high}`` leaves the other's interval: ``""``, ``"refined"``
+    (b's value outside a's interval), ``"base"`` or ``"both"``."""
+    b_out = not a["low"] <= b["value"] <= a["high"]
+    a_out = not b["low"] <= a["value"] <= b["high"]
+    return {(False, False): "", (True, False): "refined", (False, True): "base"}.get((b_out, a_out), "both")
+
+
+def compare(out: Path, bootstrap: int, refinement: int) -> dict:
+    """The base run's pooled ``tau``, ``S_m`` and ``S_m``'s exponent against K beside the
+    run on the landscape refined ``refinement`` times (the module's docstring), with the
+    slip counts and every value that leaves the other's interval (the exponent's interval:
+    its value +- 2 standard errors); writes ``classes_refined<f>.md`` and ``.json``."""
+    base, _ = pooled(out, bootstrap)
+    fine, _ = pooled(out, bootstrap, refinement)
+    rows, moved = [], {"tau": 0, "S_m": 0, "cells": 0}
+    lines = [
+        f"| family | source | K | slips (x 1 / x {refinement}) | tau x 1 | tau x {refinement} | moved "
+        f"| S_m x 1 [L_c] | S_m x {refinement} | moved |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |",
     ]
-    title = ["# Stick-slip classes: slip statistics on stationary-slope profiles", ""]
-    (out / "classes.md").write_text("\n".join([*title, *lines, "", *slopes, ""]))
+    for family, per in base.items():
+        for source, entry in per.items():
+            if not isinstance(entry, dict) or source not in fine.get(family, {}):
+                continue
+            other = fine[family][source]
+            for k, cell in entry.items():
+                if k == "cutoff_exponent" or k not in other:
+                    continue
+                two = other[k]
+                counts = [cell["n_events"], two["n_events"]]
+                row = {"family": family, "source": source, "K": float(k), "n": counts}
+                cells = [f"{cell['n_events']} / {two['n_events']}"]
+                for key, name, fmt in (("tau", "tau", ".2f"), ("cutoff_lc", "S_m", ".3g")):
+                    if key in cell and key in two:
+                        flag = _outside(cell[key], two[key])
+                        row[name] = {"base": cell[key], "refined": two[key], "outside": flag}
+                        moved[name] += bool(flag)
+                        cells += [_interval(cell[key], fmt), _interval(two[key], fmt), flag or "-"]
+                    else:
+                        cells += ["-", "-", "-"]
+                moved["cells"] += "tau" in row
+                rows.append(row)
+                lines.append(f"| {family} | {source} | {float(k):g} | " + " | ".join(cells) + " |")
+            if "cutoff_exponent" in entry and "cutoff_exponent" in other:
+                a, b = (
+                    {"value": e["value"], "low": e["value"] - 2 * e["se"], "high": e["value"] + 2 * e["se"]}
+                    for e in (entry["cutoff_exponent"], other["cutoff_exponent"])
+                )
+                rows.append({"family": family, "source": source, "S_m_exponent": {"base": a, "refined": b}})
+                lines.append(
+                    f"| {family} | {source} | S_m ~ K^p | | {_interval(a, '.2f')} | {_interval(b, '.2f')} "
+                    f"| {_outside(a, b) or '-'} | | | |"
+                )
+    result = {"refinement": refinement, "moved": moved, "rows": rows}
+    write_json(out / f"classes_refined{refinement}.json", result)
+    title = [f"# Stick-slip classes under the references' landscape refined x {refinement}", ""]
+    summary = [
+        f"Fitted cells: {moved['cells']}; tau leaves an interval in {moved['tau']}, "
+        f'S_m in {moved["S_m"]} ("refined": the refined value outside the base\'s interval, '
+        '"base": the reverse, "both").'
+    ]
+    (out / f"classes_refined{refinement}.md").write_text("\n".join([*title, *lines, "", *summary, ""]))
     return result
+
+
+def _interval(v: dict, fmt: str) -> str:
+    return f"{v['value']:{fmt}} [{v['low']:{fmt}}, {v['high']:{fmt}}]"
 
 
 def _line(family: str, source: str, k: float, cell: dict) -> str:
@@ -158,13 +348,21 @@ def _line(family: str, source: str, k: float, cell: dict) -> str:
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("step", choices=("run", "report"))
+    ap.add_argument("step", choices=("run", "report", "compare", "abbm"))
+    ap.add_argument("--seeds", default="4242", help="abbm: the tracks' seeds")
+    ap.add_argument("--length", type=float, default=4000.0, help="abbm: the tracks' length")
     ap.add_argument("--out", default="analysis/reports/stickslip")
     ap.add_argument("--bootstrap", type=int, default=100)
+    ap.add_argument("--refinement", type=int, default=1, help="landscape sampled this much finer")
     a = ap.parse_args(argv)
     out = Path(a.out)
     if a.step == "run":
-        run(out)
+        run(out, a.refinement)
+    elif a.step == "abbm":
+        seeds = [int(v) for v in a.seeds.split(",")]
+        print(_abbm_table(abbm_tracks(out, seeds, a.length)))
+    elif a.step == "compare":
+        print(json.dumps(compare(out, a.bootstrap, a.refinement)["moved"]))
     else:
         print(json.dumps(report(out, a.bootstrap), indent=1)[:2000])
 

@@ -3,8 +3,8 @@
 For each engine, I_e and variant (``base``; ``dt2``, ``dt4``: half, a quarter of the
 engine's step, and with it the rule's contact time constant, 2 dt; ``step2``, ``step4``:
 the step alone, the contact's time constant kept; ``hfield2``: the hfield refined twice),
-one spring drive per K over the ``abbm`` preset (all but a twentieth at each end, in runs
-of ``--segment`` units from rest),
+one spring drive per K over the ``abbm`` preset (drawn with ``--seed``, default the
+preset's 1; all but a twentieth at each end, in runs of ``--segment`` units from rest),
 its slips against the overdamped and inertial references' slips on the same stretch that
 the engine's detector would see (peak speed >= 5 V): the Kolmogorov-Smirnov distance and
 p-value of sizes and force drops; the same for the force drops deeper than each
@@ -18,7 +18,7 @@ the slope of ``ln D`` against ``ln I_e`` (:func:`order_lines`).
 
 Run: ``nice -n 19 .venv/bin/python analysis/stickslip_engines.py [--ie 1e-4,1e-5]
 [--engines mujoco,bullet] [--variants base,dt2,dt4,hfield2] [--travel 150] [--segment 36]
-[--floors 3e-4,1e-3] [--out analysis/reports/stickslip] [--tag NAME]``;
+[--floors 3e-4,1e-3] [--seed 1] [--out analysis/reports/stickslip] [--tag NAME]``;
 writes ``stickslip_engines_<tag>.json`` after each run (a rerun skips the runs it holds)
 and the drop catalogs ``stickslip_drops_<tag>.parquet``, and prints one line per run;
 ``--report`` tabulates the saved catalogs into ``engines_drops.md`` (:func:`report`), with
@@ -97,14 +97,16 @@ def one(
     catalogs=None,
     segment: float = 80.0,
     track_length: float | None = None,
+    seed: int = 1,
 ) -> dict:
     """One engine, variant, I_e and K over the track in runs of ``segment`` units (each
     from rest, the references on the same stretch): the catalogs pooled over the runs.
-    ``track_length``: the abbm preset made that long (its spacing kept) instead."""
+    ``track_length``: the abbm preset made that long (its spacing kept) instead; ``seed``:
+    the preset's draw."""
     longer = (
         {} if track_length is None else {"length": track_length, "points": int(round(track_length * 10)) + 1}
     )
-    surf = presets.make_surface("abbm", **longer)
+    surf = presets.make_surface("abbm", seed=seed, **longer)
     xmin, xmax, _, _ = surf.bounds
     x0, length = xmin + EDGE_SHARE * (xmax - xmin), (1 - 2 * EDGE_SHARE) * (xmax - xmin)
     length = length if travel is None else travel
@@ -148,6 +150,7 @@ def one(
         "variant": variant,
         "ie": ie,
         "K": k,
+        "seed": seed,
         "track_length": float(xmax - xmin),
         "segments": count,
         "segment_length": float(length / count),
@@ -185,7 +188,7 @@ def one(
         if catalogs is not None:
             for r in (eng_d, *ref_d.values()):
                 frame = pd.DataFrame(r, columns=COLUMNS)
-                frame["variant"], frame["floor_fp"], frame["ie"] = variant, floor, ie
+                frame["variant"], frame["floor_fp"], frame["ie"], frame["seed"] = variant, floor, ie, seed
                 catalogs.append(frame)
     return row
 
@@ -200,6 +203,7 @@ def main(argv=None):
     ap.add_argument("--segment", type=float, default=80.0, help="surface units a run (from rest)")
     ap.add_argument("--track-length", type=float, default=None, help="abbm preset's length (default 400)")
     ap.add_argument("--floors", default="3e-4,1e-3", help="force-drop floors [F_p]")
+    ap.add_argument("--seed", type=int, default=1, help="the abbm preset's seed")
     ap.add_argument("--out", default="analysis/reports/stickslip")
     ap.add_argument("--tag", default=None, help="output name (default: engines_variants)")
     ap.add_argument("--report", action="store_true", help="only tabulate the saved drop catalogs")
@@ -219,17 +223,21 @@ def main(argv=None):
             for ie in (float(v) for v in a.ie.split(",")):
                 for k in (float(v) for v in a.K.split(",")):
                     if any(
-                        (r["engine"], r["variant"], r["ie"], r["K"]) == (engine, variant, ie, k) for r in rows
+                        (r["engine"], r["variant"], r["ie"], r["K"], r.get("seed", 1))
+                        == (engine, variant, ie, k, a.seed)
+                        for r in rows
                     ):
                         continue
-                    row = one(engine, variant, ie, k, a.travel, floors, catalogs, a.segment, a.track_length)
+                    row = one(
+                        engine, variant, ie, k, a.travel, floors, catalogs, a.segment, a.track_length, a.seed
+                    )
                     rows.append(row)
                     write_json(path, rows)
                     with atomic_output(cat_path) as tmp:
                         pd.concat(catalogs, ignore_index=True).to_parquet(tmp, index=False)
                     d = row.get("size_lc_vs_inertial", {})
                     print(
-                        f"{engine} {variant} I_e {ie:g} K {k:g}: {row['n']} sizes vs inertial "
+                        f"{engine} {variant} seed {a.seed} I_e {ie:g} K {k:g}: {row['n']} sizes vs inertial "
                         f"D {d.get('ks', math.nan):.3f} p {d.get('ks_p', math.nan):.3g}; "
                         f"creep {row['creep_speed_v']:.3g} V, "
                         f"{row['creep_share_of_travel']:.3g} of travel; {row['cpu_s']:.0f} CPU s",
@@ -258,16 +266,20 @@ def report(out: Path) -> str:
         "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |",
     ]
     for path in sorted(out.glob("stickslip_drops_*.parquet")):
-        cat = pd.read_parquet(path)
+        cat = _with_seed(pd.read_parquet(path))
         runs = json.loads(
             (out / path.name.replace("stickslip_drops_", "stickslip_engines_"))
             .with_suffix(".json")
             .read_text()
         )
-        for (variant, ie, k, floor), g in cat.groupby(["variant", "ie", "K", "floor_fp"]):
-            run = next(r for r in runs if (r["variant"], r["ie"], r["K"]) == (variant, ie, k))
+        for (variant, ie, k, floor, seed), g in cat.groupby(["variant", "ie", "K", "floor_fp", "seed"]):
+            run = next(
+                r for r in runs if (r["variant"], r["ie"], r["K"], r.get("seed", 1)) == (variant, ie, k, seed)
+            )
             engine = g[g["source"] == run["engine"]]
-            fixed = engine["force_drop_fp"] + _carriage_rate(run["engine"], ie, k) * engine["duration_s"]
+            fixed = (
+                engine["force_drop_fp"] + _carriage_rate(run["engine"], ie, k, seed) * engine["duration_s"]
+            )
             for source in sorted(set(g["source"]) - {run["engine"]}):
                 ref = g[g["source"] == source]
                 cells = [
@@ -279,7 +291,8 @@ def report(out: Path) -> str:
                     )
                 ]
                 rows.append(
-                    f"| {path.stem.removeprefix('stickslip_drops_')} {variant} | {k:g} | {ie:g} | {floor:g} "
+                    f"| {path.stem.removeprefix('stickslip_drops_')} {variant}{_seed_label(seed)} | {k:g} "
+                    f"| {ie:g} | {floor:g} "
                     f"| {len(engine)} | {source} | {len(ref)} | "
                     + " | ".join(f"{c['ks']:.3f}, {c['ks_p']:.3g} ({c['ad_p']:.3g})" for c in cells)
                     + " |"
@@ -295,13 +308,22 @@ def report(out: Path) -> str:
 KS_95 = 1.358
 
 
-def _carriage_rate(engine: str, ie: float, k: float) -> float:
-    """``k V`` [F_p / s] of the abbm preset's drive at ``ie`` and ``K = k``: an engine's drop
-    plus this times its duration is its drop at a fixed carriage, as the references'."""
-    units = TrackUnits.of(
-        build_rig(presets.make_surface("abbm"), engine=engine, mu=MU, ie=ie, stiffness_number=k).scales, ie
-    )
+def _carriage_rate(engine: str, ie: float, k: float, seed: int = 1) -> float:
+    """``k V`` [F_p / s] of the abbm preset's drive (drawn with ``seed``) at ``ie`` and
+    ``K = k``: an engine's drop plus this times its duration is its drop at a fixed
+    carriage, as the references'."""
+    surf = presets.make_surface("abbm", seed=int(seed))
+    units = TrackUnits.of(build_rig(surf, engine=engine, mu=MU, ie=ie, stiffness_number=k).scales, ie)
     return units.stiffness(k) * units.speed
+
+
+def _with_seed(cat: pd.DataFrame) -> pd.DataFrame:
+    """A saved catalog with its ``seed`` column (catalogs written before it: the preset's 1)."""
+    return cat if "seed" in cat else cat.assign(seed=1)
+
+
+def _seed_label(seed) -> str:
+    return "" if int(seed) == 1 else f" (seed {int(seed)})"
 
 
 def _order(ies, engine_sizes, ref_sizes) -> float:
@@ -354,7 +376,7 @@ def order_lines(out: Path, n_boot: int = 400, seed: int = 0) -> list[str]:
     resampled ``n_boot`` times). A D above D_95 again at smaller I_e is in the cells."""
     frames, seen = [], set()
     for path in sorted(out.glob("stickslip_drops_*.parquet")):  # a run repeated in a later file: the first
-        for key, g in pd.read_parquet(path).groupby(["variant", "ie", "K", "floor_fp"]):
+        for key, g in _with_seed(pd.read_parquet(path)).groupby(["variant", "ie", "K", "floor_fp", "seed"]):
             if key not in seen:
                 seen.add(key)
                 frames.append(g)
@@ -370,17 +392,19 @@ def order_lines(out: Path, n_boot: int = 400, seed: int = 0) -> list[str]:
         "| --- | --- | --- | --- | --- | --- | --- |",
     ]
     facets = {f"{r}_facets" for r in REFERENCES}
-    for (variant, k, floor), g in cat.groupby(["variant", "K", "floor_fp"]):
+    for (variant, k, floor, seed), g in cat.groupby(["variant", "K", "floor_fp", "seed"]):
         engines = sorted(set(g["source"]) - set(REFERENCES) - facets)
         if len(engines) != 1 or g["ie"].nunique() < 2:
             continue
         by_ie = dict(tuple(g.groupby("ie")))
-        kv = {ie: _carriage_rate(engines[0], ie, k) for ie in by_ie}
+        kv = {ie: _carriage_rate(engines[0], ie, k, seed) for ie in by_ie}
         for ref in sorted(set(g["source"]) - set(engines)):
             for of, rate in (("sizes", None), ("drops, fixed carriage", kv)):
                 cells, order = _order_cells(by_ie, engines[0], ref, rng, n_boot, rate)
                 lines.append(
-                    f"| {variant} | {k:g} | {floor:g} | {ref} | {of} | " + "; ".join(cells) + f" | {order} |"
+                    f"| {variant}{_seed_label(seed)} | {k:g} | {floor:g} | {ref} | {of} | "
+                    + "; ".join(cells)
+                    + f" | {order} |"
                 )
     return lines
 

@@ -67,6 +67,8 @@ COLUMNS = (
 REFERENCES = ("overdamped", "inertial")
 #: Landscape points per grid spacing of the surface along x.
 REFINEMENT = 4
+#: Landscape points over the track's stretch on an analytic surface (no grid spacing).
+ANALYTIC_POINTS = 20000
 #: The force-drop rule's floor [F_p] (:mod:`spine_mj.theory.force_drops`): three orders
 #: above MuJoCo's resting jitter on the abbm track at I_e 1e-6 (99 % of its reversals under
 #: 3e-6 F_p, docs/physics.md §12) and, at K 0.5, a slip of 0.03 L_c.
@@ -119,10 +121,13 @@ def track_landscape(
     y: float = 0.0,
     *,
     facets: int | None = None,
+    refinement: int = 1,
 ):
     """The landscape of ``surface`` along the line ``y`` over ``x_range`` (surface units),
     sampled at :data:`REFINEMENT` points per grid spacing from its spline (heights and
-    slopes), for a ball tip of ``tip_radius``. Where the radius exceeds a concave radius of
+    slopes; an analytic surface at :data:`ANALYTIC_POINTS` over the stretch), times
+    ``refinement`` (the references' grid refined: the surface and its scales unchanged),
+    for a ball tip of ``tip_radius``. Where the radius exceeds a concave radius of
     curvature of the line (a rough profile: the offset path would loop), the centre rides
     the line's dilation by the ball's disk instead (it touches two points across each such
     valley; :func:`~spine_mj.surfaces.dilation.ball_dilation` on the one row), and its
@@ -136,7 +141,10 @@ def track_landscape(
     xmin, xmax, _, _ = surface.bounds
     if not (xmin <= x0 < x1 <= xmax):
         raise SpineInputError(f"the track's x range must lie in [{xmin:g}, {xmax:g}], got [{x0:g}, {x1:g}]")
-    dx = surface.spacing[0] / REFINEMENT if hasattr(surface, "spacing") else (x1 - x0) / 20000
+    if isinstance(refinement, bool) or int(refinement) != refinement or refinement < 1:
+        raise SpineInputError(f"the landscape's refinement must be an integer >= 1, got {refinement!r}")
+    dx = surface.spacing[0] / REFINEMENT if hasattr(surface, "spacing") else (x1 - x0) / ANALYTIC_POINTS
+    dx /= int(refinement)
     x = np.linspace(x0, x1, int(math.ceil((x1 - x0) / dx)) + 1)
     yy = np.full_like(x, y)
     r = float(tip_radius)

@@ -108,6 +108,7 @@ def stickslip_to(
     travel: float | None = None,
     n_bootstrap: int = 100,
     drop_floor_fp: float | None = None,
+    landscape_refinement: int = 1,
     progress: Callable[[int, int, str], None] | None = None,
     **rig_options,
 ) -> StickSlipOutputs:
@@ -136,6 +137,10 @@ def stickslip_to(
     drop_floor_fp : float
         The force-drop rule's floor and hysteresis [F_p] (``drops.parquet``), > 0
         (default :data:`~spine_mj.validate.slip_catalog.DROP_FLOOR_FP`).
+    landscape_refinement : int
+        The references' landscape sampled this many times finer
+        (:func:`~spine_mj.validate.slip_catalog.track_landscape`'s ``refinement``): their
+        grid convergence, the surface, its scales and an engine's hfield unchanged.
     progress : callable, optional
         ``progress(done, total, what)`` after each step.
     **rig_options
@@ -159,13 +164,24 @@ def stickslip_to(
     frames, drops, units_by_k, pulses, ref_pulses = [], [], {}, {}, {}
     for k_number in ks:
         units, land, frames_k, drops_k = _catalogs_at(
-            surface, k_number, (x0, x0 + length), floor, labels, engine, rig_options, pulses, ref_pulses, tick
+            surface,
+            k_number,
+            (x0, x0 + length),
+            floor,
+            labels,
+            engine,
+            rig_options,
+            pulses,
+            ref_pulses,
+            tick,
+            landscape_refinement,
         )
         units_by_k[k_number] = units
         frames, drops = frames + frames_k, drops + drops_k
     events = pd.concat(frames, ignore_index=True)
     drop_events = pd.concat(drops, ignore_index=True)
     summary = _summary(events, surface, mu, ie, ks, units_by_k, engine, x0, length, n_bootstrap)
+    summary["track"]["landscape_refinement"] = int(landscape_refinement)
     summary["drops"] = drop_summary(drop_events, engine, ks, units_by_k, floor)
     summary["pulse"] = ref_pulses
     summary["regime"] = regime_map(land, events, units_by_k)
@@ -174,7 +190,9 @@ def stickslip_to(
     return StickSlipOutputs(summary, files)
 
 
-def _catalogs_at(surface, k_number, x_range, floor, labels, engine, rig_options, pulses, ref_pulses, tick):
+def _catalogs_at(
+    surface, k_number, x_range, floor, labels, engine, rig_options, pulses, ref_pulses, tick, refinement=1
+):
     """One K's catalogs (:func:`stickslip_to`): ``(units, landscape, slip frames, drop
     frames)``, its mean pulses into ``pulses`` and ``ref_pulses``, ``tick(what)`` after the
     references and after the engine."""
@@ -182,7 +200,7 @@ def _catalogs_at(surface, k_number, x_range, floor, labels, engine, rig_options,
     ie = labels["ie"]
     rig, scales = _rig_and_scales(surface, engine, labels["mu"], ie, k_number, rig_options)
     units = TrackUnits.of(scales, ie)
-    land = track_landscape(surface, labels["mu"], units.tip_radius, x_range)
+    land = track_landscape(surface, labels["mu"], units.tip_radius, x_range, refinement=refinement)
     frames, drops = _reference_frames(land, units, k_number, floor, labels)
     _add_pulses(land, units, k_number, ref_pulses, pulses)
     tick(f"references, K {k_number:g}")

@@ -214,3 +214,25 @@ def test_a_ball_wider_than_a_valley_rides_the_lines_dilation():
     base = surf.height(land.positions, 0 * land.positions) + 0.08
     assert np.all(land.height >= base - 1e-9)
     assert np.min(land.height - base) < 1e-6
+
+
+def test_a_refined_landscape_keeps_the_references_jumps_and_refuses_a_fraction():
+    """``refinement`` samples the same line finer (the references' grid convergence): on a
+    coarse corrugation each reference's jumps, one a wavelength, move by less than a tenth of the
+    coarse grid's step under refinement x 2; a refinement that is no whole number >= 1 is
+    refused."""
+    from spine_mj.validate.slip_catalog import REFINEMENT, TrackUnits, reference_rows, track_landscape
+
+    surf = surfaces.corrugation(n_waves=4, points_per_wave=16, width=0.5)
+    units = TrackUnits(1.0, 1.0, 1 / (2 * np.pi), 0.0, 1.0, 1e-3, speed=0.01)
+    coarse, fine = (track_landscape(surf, 0.5, 0.0, (0.25, 3.75), refinement=f) for f in (1, 2))
+    assert fine.positions.size - 1 == 2 * (coarse.positions.size - 1)
+    step = surf.spacing[0] / REFINEMENT
+    a, b = (reference_rows(land, units, 0.2) for land in (coarse, fine))
+    for source in a:
+        sa, sb = (np.asarray(r[source]["size_lc"]) for r in (a, b))
+        assert sa.size == sb.size >= 3
+        np.testing.assert_allclose(sb, sa, atol=0.1 * step)
+    for bad in (0, 1.5, True):
+        with pytest.raises(SpineInputError, match="refinement"):
+            track_landscape(surf, 0.5, 0.0, (0.25, 3.75), refinement=bad)
