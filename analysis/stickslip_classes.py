@@ -34,7 +34,10 @@ an engine runs on, and K is read with that track's scales), at :data:`ABBM_K` (a
 and gives per seed, source and K the slip count, the truncated power law's ``tau``, ``S_m``
 against ``sigma / k^2``, and ``S_m``'s exponent against K over the decade and over the K
 whose ``sigma / k^2`` lies in the ABBM range (``abbm_tracks.md``, ``.json``; catalogs
-``abbm_tracks/seed<s>.parquet``, kept on a rerun).
+``abbm_tracks/seed<s>.parquet``, kept on a rerun). ``... walk --seeds ...`` does the
+same for the overdamped reference on the walk of docs/physics §12's test
+(:data:`WALK`: an ABBM range of three decades, 2e6 points) at :data:`WALK_K`, k in W per
+unit length (``abbm_walks.md``, ``.json``).
 """
 
 from __future__ import annotations
@@ -136,7 +139,8 @@ def abbm_tracks(out: Path, seeds, length: float) -> dict:
                     land, units, k, surface=f"abbm seed {seed}", mu=MU, ie=1e-6
                 ).values()
             ]
-            pd.concat(frames, ignore_index=True).to_parquet(path, index=False)
+            kept = ["source", "K", "start_x_lc", "size_lc", "duration_s", "force_drop_fp"]
+            pd.concat(frames, ignore_index=True)[kept].to_parquet(path, index=False, compression="zstd")
         events = pd.read_parquet(path)
         params = short.metadata["params"]
         low, high = (
@@ -163,13 +167,81 @@ def abbm_tracks(out: Path, seeds, length: float) -> dict:
             ):
                 if len(ks) >= 2:
                     y = np.log([cells[f"{k:g}"]["cutoff_lc"]["value"] for k in ks])
-                    coef, cov = np.polyfit(np.log(ks), y, 1, cov=len(ks) > 2)
-                    se = float(math.sqrt(cov[0, 0])) if len(ks) > 2 else math.nan
-                    cells[f"exponent_{name}"] = {"value": float(coef[0]), "se": se, "K": ks}
+                    slope = float(np.polyfit(np.log(ks), y, 1)[0])
+                    se = (
+                        float(math.sqrt(np.polyfit(np.log(ks), y, 1, cov=True)[1][0, 0]))
+                        if len(ks) > 2
+                        else math.nan
+                    )
+                    cells[f"exponent_{name}"] = {"value": slope, "se": se, "K": ks}
             entry[source] = cells
         result["seeds"][str(seed)] = entry
     write_json(out / "abbm_tracks.json", result)
     (out / "abbm_tracks.md").write_text(_abbm_table(result))
+    return result
+
+
+#: The walk of docs/physics §12's test: spacing, intensity D, correlation length, points.
+WALK = {"dx": 0.02, "slope_intensity": 1e-6, "correlation_length": 1e4, "points": 2_000_000}
+#: Its stiffnesses k [W / unit]: a decade, sigma / k^2 from 39 to 0.39.
+WALK_K = (2e-4, 6e-4, 2e-3)
+
+
+def abbm_walks(out: Path, seeds) -> dict:
+    """The overdamped reference on :data:`WALK` drawn with each seed, at :data:`WALK_K`:
+    per seed and k the slip count, ``tau`` (truncated power law, cutoff by KS) and ``S_m``
+    with their intervals against ``sigma / k^2``, and ``S_m``'s exponent against k."""
+    from spine_mj.surfaces import abbm_force_intensity, abbm_slope_walk
+    from spine_mj.theory.avalanches import Landscape, overdamped_slips
+
+    w = WALK
+    sigma = abbm_force_intensity(w["slope_intensity"], MU)
+    result: dict = {"walk": w, "mu": MU, "k": list(WALK_K), "seeds": {}}
+    for seed in seeds:
+        s = abbm_slope_walk(
+            w["points"], w["dx"], w["slope_intensity"], w["correlation_length"], np.random.default_rng(seed)
+        )
+        land = Landscape.from_profile(w["dx"] * np.arange(s.size), s, np.cumsum(s) * w["dx"], MU)
+        cells: dict = {}
+        for k in WALK_K:
+            sizes = overdamped_slips(land, k).size
+            tr = stats.truncated_fit_by_ks(sizes)
+            cells[f"{k:g}"] = {
+                "n_events": int(sizes.size),
+                "tau": {"value": tr["tau"], "low": tr["low"], "high": tr["high"]},
+                "cutoff": stats.cutoff_size(sizes),
+                "predicted_cutoff": sigma / k**2,
+            }
+        y = np.log([cells[f"{k:g}"]["cutoff"]["value"] for k in WALK_K])
+        coef, cov = np.polyfit(np.log(WALK_K), y, 1, cov=True)
+        cells["exponent"] = {"value": float(coef[0]), "se": float(math.sqrt(cov[0, 0]))}
+        cells["mean_slope"] = float(np.mean(s))
+        result["seeds"][str(seed)] = cells
+    write_json(out / "abbm_walks.json", result)
+    lines = [
+        "# The overdamped reference on fresh draws of the §12 walk (dx 0.02, D 1e-6, xi 1e4, 2e6 points)",
+        "",
+        "| seed | k [W / unit] | slips | tau [95 %] | tau in [1.4, 1.6], 1.5 inside | S_m [95 %] "
+        "| sigma / k^2 |",
+        "| --- | --- | --- | --- | --- | --- | --- |",
+    ]
+    slopes = []
+    for seed, cells in result["seeds"].items():
+        for k in WALK_K:
+            c = cells[f"{k:g}"]
+            t, m = c["tau"], c["cutoff"]
+            ok = 1.4 <= t["value"] <= 1.6 and t["low"] <= 1.5 <= t["high"]
+            lines.append(
+                f"| {seed} | {k:g} | {c['n_events']} | {t['value']:.3f} [{t['low']:.3f}, {t['high']:.3f}] "
+                f"| {'yes' if ok else 'no'} | {m['value']:.3g} [{m['low']:.3g}, {m['high']:.3g}] "
+                f"| {c['predicted_cutoff']:.3g} |"
+            )
+        e = cells["exponent"]
+        slopes.append(
+            f"- seed {seed}: S_m ~ k^{e['value']:.2f} (+- {e['se']:.2f}); "
+            f"mean slope {cells['mean_slope']:.3f}"
+        )
+    (out / "abbm_walks.md").write_text("\n".join([*lines, "", *slopes, ""]))
     return result
 
 
@@ -221,9 +293,9 @@ def report(out: Path, bootstrap: int) -> dict:
     return result
 
 
-def pooled(out: Path, bootstrap: int, refinement: int = 1) -> tuple[dict, list[str]]:
+def pooled(out: Path, bootstrap: int, refinement: int = 1, only=None) -> tuple[dict, list[str]]:
     """Each family's seeds pooled, per source and K (the module's docstring): the result
-    dict and its table's lines."""
+    dict and its table's lines. ``only``: family -> the seeds to pool (default all)."""
     result: dict = {}
     lines = [
         "| family | source | K | slips | tau (truncated) | power-law exponent | power law survives "
@@ -231,13 +303,15 @@ def pooled(out: Path, bootstrap: int, refinement: int = 1) -> tuple[dict, list[s
         "| --- | --- | --- | --- | --- | --- | --- | --- |",
     ]
     for family, (_, seeds, _) in FAMILIES.items():
+        seeds = seeds if only is None else only.get(family, ())
         folders = [_folder(out, family, s, refinement) for s in seeds]
         frames = [pd.read_parquet(f / "events.parquet") for f in folders if (f / "events.parquet").is_file()]
         if not frames:
             continue
         events = pd.concat(frames, ignore_index=True)
         locked = sum((f / "locked.json").is_file() for f in folders)
-        result[family] = {"seeds": len(frames), "seeds_locked": locked}
+        done = [s for s, f in zip(seeds, folders) if (f / "events.parquet").is_file()]
+        result[family] = {"seeds": len(frames), "seeds_locked": locked, "seed_list": done}
         for source, by_source in events.groupby("source"):
             entry: dict = {}
             for k, rows in by_source.groupby("K"):
@@ -264,7 +338,7 @@ def pooled(out: Path, bootstrap: int, refinement: int = 1) -> tuple[dict, list[s
     return result, lines
 
 
-def _outside(a: dict, b: dict) -> str:
+def interval_outside(a: dict, b: dict) -> str:
     """Which of two ``{value, low, high}`` leaves the other's interval: ``""``, ``"refined"``
     (b's value outside a's interval), ``"base"`` or ``"both"``."""
     b_out = not a["low"] <= b["value"] <= a["high"]
@@ -276,15 +350,17 @@ def compare(out: Path, bootstrap: int, refinement: int) -> dict:
     """The base run's pooled ``tau``, ``S_m`` and ``S_m``'s exponent against K beside the
     run on the landscape refined ``refinement`` times (the module's docstring), with the
     slip counts and every value that leaves the other's interval (the exponent's interval:
-    its value +- 2 standard errors); writes ``classes_refined<f>.md`` and ``.json``."""
-    base, _ = pooled(out, bootstrap)
+    its value +- 2 standard errors); writes ``classes_refined<f>.md`` and ``.json``. Both
+    pool the seeds the refined run holds (a partial run compares like with like)."""
     fine, _ = pooled(out, bootstrap, refinement)
+    base, _ = pooled(out, bootstrap, only={f: tuple(e["seed_list"]) for f, e in fine.items()})
     rows, moved = [], {"tau": 0, "S_m": 0, "cells": 0}
     lines = [
         f"| family | source | K | slips (x 1 / x {refinement}) | tau x 1 | tau x {refinement} | moved "
         f"| S_m x 1 [L_c] | S_m x {refinement} | moved |",
         "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |",
     ]
+    seeds = {family: per["seed_list"] for family, per in fine.items()}
     for family, per in base.items():
         for source, entry in per.items():
             if not isinstance(entry, dict) or source not in fine.get(family, {}):
@@ -299,7 +375,7 @@ def compare(out: Path, bootstrap: int, refinement: int) -> dict:
                 cells = [f"{cell['n_events']} / {two['n_events']}"]
                 for key, name, fmt in (("tau", "tau", ".2f"), ("cutoff_lc", "S_m", ".3g")):
                     if key in cell and key in two:
-                        flag = _outside(cell[key], two[key])
+                        flag = interval_outside(cell[key], two[key])
                         row[name] = {"base": cell[key], "refined": two[key], "outside": flag}
                         moved[name] += bool(flag)
                         cells += [_interval(cell[key], fmt), _interval(two[key], fmt), flag or "-"]
@@ -316,15 +392,17 @@ def compare(out: Path, bootstrap: int, refinement: int) -> dict:
                 rows.append({"family": family, "source": source, "S_m_exponent": {"base": a, "refined": b}})
                 lines.append(
                     f"| {family} | {source} | S_m ~ K^p | | {_interval(a, '.2f')} | {_interval(b, '.2f')} "
-                    f"| {_outside(a, b) or '-'} | | | |"
+                    f"| {interval_outside(a, b) or '-'} | | | |"
                 )
-    result = {"refinement": refinement, "moved": moved, "rows": rows}
+    result = {"refinement": refinement, "seeds": seeds, "moved": moved, "rows": rows}
     write_json(out / f"classes_refined{refinement}.json", result)
     title = [f"# Stick-slip classes under the references' landscape refined x {refinement}", ""]
     summary = [
+        "Seeds pooled on both sides: " + "; ".join(f"{f} {s}" for f, s in seeds.items()) + ".",
+        "",
         f"Fitted cells: {moved['cells']}; tau leaves an interval in {moved['tau']}, "
         f'S_m in {moved["S_m"]} ("refined": the refined value outside the base\'s interval, '
-        '"base": the reverse, "both").'
+        '"base": the reverse, "both").',
     ]
     (out / f"classes_refined{refinement}.md").write_text("\n".join([*title, *lines, "", *summary, ""]))
     return result
@@ -348,7 +426,7 @@ def _line(family: str, source: str, k: float, cell: dict) -> str:
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("step", choices=("run", "report", "compare", "abbm"))
+    ap.add_argument("step", choices=("run", "report", "compare", "abbm", "walk"))
     ap.add_argument("--seeds", default="4242", help="abbm: the tracks' seeds")
     ap.add_argument("--length", type=float, default=4000.0, help="abbm: the tracks' length")
     ap.add_argument("--out", default="analysis/reports/stickslip")
@@ -358,6 +436,9 @@ def main(argv=None):
     out = Path(a.out)
     if a.step == "run":
         run(out, a.refinement)
+    elif a.step == "walk":
+        abbm_walks(out, [int(v) for v in a.seeds.split(",")])
+        print((out / "abbm_walks.md").read_text())
     elif a.step == "abbm":
         seeds = [int(v) for v in a.seeds.split(",")]
         print(_abbm_table(abbm_tracks(out, seeds, a.length)))
