@@ -100,6 +100,9 @@ def _crease_one(fxa, fya, fxb, fyb, mu, tol):
     held_back = (
         (cz > mu * s0) and (up > tol) and ((fwd < tol) or ((cz - mu * s0) / up <= (cz + mu * s0) / fwd))
     )
+    if held_back:  # both contacts still pressed at kappa_lo
+        k_lo = (cz - mu * s0) / up
+        held_back = (a0 + k_lo * a1 >= 0) and (b0 + k_lo * b1 >= 0)
     slides = (np.abs(cz) > mu * s0) and not held_back
     lock = (not slides) and (fwd < tol)
     k = np.nan if (slides or lock) else (cz + mu * s0) / fwd

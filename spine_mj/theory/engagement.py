@@ -237,7 +237,9 @@ def crease_engagement(fx_a, fy_a, fx_b, fy_b, mu, *, tol: float = DEFAULT_TOL):
     as it holds a tip on a single wall steeper than friction (:func:`kappa`), and the tip
     moves on up the crease at the usual onset: a V-groove of flank angle theta whose axis
     rises at beta gives ``kappa = tan(beta + arctan(mu / cos(theta)))``. Only where no drive
-    holds it (``c_x + mu s1 <= 0``) does it slide back.
+    holds it (``c_x + mu s1 <= 0``), or where a contact has lifted off by ``kappa_lo`` (a
+    nearly flat crease across the drive, whose hold would need a squeeze the tip's weight
+    cannot give), does it slide back.
 
     Returns
     -------
@@ -275,6 +277,10 @@ def crease_engagement(fx_a, fy_a, fx_b, fy_b, mu, *, tol: float = DEFAULT_TOL):
         up, fwd = cx + mu * s1, cx - mu * s1
         held_back = (cz > mu * s0) & (up > tol)
         held_back &= (fwd < tol) | ((cz - mu * s0) / up <= (cz + mu * s0) / fwd)
+        # ... with both contacts still pressed at kappa_lo: across a nearly flat crease the
+        # drive lifts the tip off one side long before its friction could hold it there
+        k_lo = (cz - mu * s0) / up
+        held_back &= (a0 + k_lo * a1 >= 0) & (b0 + k_lo * b1 >= 0)
         slides = (np.abs(cz) > mu * s0) & ~held_back
         lock = ~slides & (fwd < tol)
         k = np.where(slides | lock, np.nan, (cz + mu * s0) / fwd)

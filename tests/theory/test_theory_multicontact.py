@@ -194,6 +194,32 @@ def test_a_streamline_up_a_crease_steeper_than_friction_climbs_it():
     assert np.all(res.end_x > 0.9)
 
 
+def test_a_nearly_flat_crease_down_a_slope_steeper_than_friction_does_not_hold_the_tip():
+    """Two facets of the scan di-1 at hfield x 2 (slopes (-0.0047, -0.626) and (0.0256,
+    -0.626), mu 0.5): a crease across the drive, kinked by 0.03 rad, running down a slope
+    steeper than friction. The drive holds a tip in a crease only while both sides stay
+    pressed; here the pair's hold would need kappa_lo = 24, where the first side's normal
+    force is -934 W: the drive has lifted the tip off it long before. Gravity slides the tip
+    down the crease (+y), as on either facet alone; the rule that called it a self-lock held
+    7 of 15 reference paths on di-1's refined facets where MuJoCo passed."""
+    from spine_mj.surfaces import BallOnFacets, TriangulatedSurface
+    from spine_mj.theory import streamline as sl
+    from spine_mj.theory.engagement import crease_engagement
+    from spine_mj.theory.streamline_types import Outcome, StreamlineParams
+
+    a, b, mu = (-0.0047, -0.6257), (0.0256, -0.6257), 0.5
+    k, region, _vx, vy = crease_engagement(*a, *b, mu)
+    assert int(region) == SLIP and np.isnan(k) and float(vy) > 0.99
+    k2, region2 = two_contact_kappa(*a, *b, mu)
+    assert int(region2) == SLIP and np.isnan(k2)
+    x = np.linspace(-1.0, 1.0, 81)
+    h = np.maximum(a[0] * x[None, :] + a[1] * x[:, None], b[0] * x[None, :] + b[1] * x[:, None])
+    surface = BallOnFacets(TriangulatedSurface(heights=h, x=x, y=x.copy(), unit="1"), 0.05)
+    starts = np.column_stack([np.full(5, -0.3), np.linspace(-0.6, -0.2, 5)])
+    res = sl.streamlines(surface, starts, StreamlineParams(mu=mu, dl=0.01, kappa_cap=20.0))
+    assert Outcome.SELF_LOCKED not in [Outcome(o) for o in res.outcome]
+
+
 def test_mujoco_static_probe_at_a_fractal_crease_breaks_away_near_the_two_contact_kappa():
     """A crease of the quick plan's fractal (seed 2, H 0.7, hfield 151) where MuJoCo's
     spring run held at the force cap while the single-contact reference moved on: each side
