@@ -226,11 +226,12 @@ def test_a_start_on_the_domain_s_edge_is_refused_before_any_run(tmp_path):
 
 
 def test_an_hfield_past_the_budget_is_refused_on_its_predicted_sides_before_any_sizing(tmp_path, monkeypatch):
-    """4000 a side refined twice, both engines: the 7999-a-side hfield is refused by its
-    predicted size (the sizing would have sampled and named the 4000-a-side one first)."""
+    """4000 a side refined twice, both engines (MuJoCo alone without the [bullet] extra): the
+    7999-a-side hfield is refused by its predicted size (the sizing would have sampled and
+    named the 4000-a-side one first)."""
+    from spine_mj import extras
+
     monkeypatch.setenv("SPINE_MJ_MEMORY_BUDGET", "300M")
-    text = (
-        PEAK_ENGINE
-        + '[grid]\nengine = ["mujoco", "bullet"]\nhfield_resolution = 4000\nhfield_refinement = 2\n'
-    )
+    engines = '"mujoco"' if extras.missing("bullet") else '["mujoco", "bullet"]'
+    text = PEAK_ENGINE + f"[grid]\nengine = {engines}\nhfield_resolution = 4000\nhfield_refinement = 2\n"
     _refused_before_any_run(tmp_path, text, "an hfield of 7999 x 7999 samples would need")
