@@ -37,7 +37,6 @@ from spine_mj.surfaces import (
 )
 
 __all__ = [
-    "FILL_METHODS",
     "export_surface",
     "import_topography",
     "load_surface",
