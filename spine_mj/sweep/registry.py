@@ -206,7 +206,10 @@ class Analysis:
     SpineInputError for a combination of values its parameters cannot check one by one.
     ``check_case``, if given, is ``check_case(case, surface, starts)``: it raises the
     SpineInputError that ``func`` would raise for the case's inputs, without running it
-    (:mod:`spine_mj.sweep.preflight` calls it before a sweep starts).
+    (:mod:`spine_mj.sweep.preflight` calls it before a sweep starts). ``precheck_case``, if
+    given, is the part of it that takes no sizing (the planned hfield's limits): the
+    pre-run check runs it on the whole grid first, so a limit one combination breaks is
+    refused before seconds of another combination's sizing.
 
     Attributes
     ----------
@@ -226,6 +229,10 @@ class Analysis:
         The parameters ``check_case`` reads (None: every parameter of this analysis and of
         those it requires): the pre-run check calls it once per distinct combination of
         them, so a grid over a parameter the check does not read costs nothing more.
+    precheck_case : callable or None
+        ``precheck_case(case, surface)``, see above.
+    precheck_reads : tuple of str
+        The parameters ``precheck_case`` reads (it runs once per distinct combination).
     """
 
     name: str
@@ -236,6 +243,8 @@ class Analysis:
     check_config: Callable[[Any], None] | None = None
     check_case: Callable[..., None] | None = None
     check_reads: tuple[str, ...] | None = None
+    precheck_case: Callable[..., None] | None = None
+    precheck_reads: tuple[str, ...] = ()
 
 
 #: Registry of analyses by name; :func:`register_analysis` adds to it.

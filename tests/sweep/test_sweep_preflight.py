@@ -93,6 +93,21 @@ def test_an_hfield_only_one_combination_makes_too_large_is_refused(tmp_path):
     )
 
 
+def test_a_limit_one_engine_breaks_is_refused_before_any_case_is_sized(tmp_path):
+    """MuJoCo takes a 1500-a-side hfield, pybullet at most 1448: the Bullet case is refused
+    before the MuJoCo case's sizing (an 8000-a-side grid over both engines sized MuJoCo's
+    hfield, 29 CPU-s and 2.3 GB, before refusing Bullet's)."""
+    pytest.importorskip("pybullet")
+    from spine_mj.sweep.analyses import engine
+
+    text = PEAK_ENGINE + '[grid]\nengine = ["mujoco", "bullet"]\nhfield_resolution = 1500\n'
+    cases = sweep.expand_cases(sweep.load_config(write_config(tmp_path, text)))
+    engine.case_rig.cache_clear()
+    with pytest.raises(SpineInputError, match=r"^sweep case \(paper-single-peak, engine = 'bullet'\): "):
+        preflight.check_cases(cases, swept=["engine"])
+    assert engine._sizing.cache_info().misses == 0
+
+
 ARRAY = """
 [sweep]
 analyses = ["array"]

@@ -25,7 +25,15 @@ from spine_mj.errors import SpineInputError
 from spine_mj.sim.array import ARRAY_ENGINE_REFUSAL, spines_on_surface
 from spine_mj.sim.drives import spring_stiffness_n_m
 from spine_mj.sim.layout import MAX_SPINES
-from spine_mj.sweep.analyses.engine import CHECK_READS, ENGINE_PARAMS, case_plan, case_rig, check_speed
+from spine_mj.sweep.analyses.engine import (
+    CHECK_READS,
+    ENGINE_PARAMS,
+    PRECHECK_READS,
+    case_plan,
+    case_rig,
+    check_speed,
+    precheck_case,
+)
 from spine_mj.sweep.registry import CASE_THREADS, Analysis, AnalysisResult, ParamSpec, register_analysis
 
 ARRAY_PARAMS = (
@@ -168,6 +176,8 @@ register_analysis(
         check_config=_check_layouts,
         check_case=_check_case,
         check_reads=(*_LAYOUT_KEYS, *CHECK_READS),
+        precheck_case=precheck_case,
+        precheck_reads=PRECHECK_READS,
         doc="an array of spines on one carriage centred at every start ([array] table): sim.ArrayRig",
     )
 )

@@ -428,6 +428,18 @@ CHECK_READS = (
 )
 
 
+#: The parameters :func:`precheck_case` reads: the hfield's sizing and the engine taking it.
+PRECHECK_READS = ("engine", "tip_radius", "length_scale", "hfield_resolution", "hfield_refinement")
+
+
+def precheck_case(case, surface) -> None:
+    """The hfield's limits (sides, memory, the engine's own) on the sides the sizing rule
+    will give (:func:`~spine_mj.sim.build.check_planned_hfield`), without sizing: run on
+    every combination of a grid before any case is sized (a grid over both engines at an
+    8000-a-side hfield sized MuJoCo's, 29 CPU-s and 2.3 GB, before refusing Bullet's)."""
+    check_planned_hfield(surface, case_inputs(case, surface))
+
+
 def _check_case(case, surface, starts) -> None:
     """The inputs' errors a run would meet, without running: the rig (tip, scales, engine),
     the drive and, for the open-loop drives, the length of the run from the first start."""
@@ -572,5 +584,7 @@ register_analysis(
         check_config=check_speed,
         check_case=_check_case,
         check_reads=CHECK_READS,
+        precheck_case=precheck_case,
+        precheck_reads=PRECHECK_READS,
     )
 )
