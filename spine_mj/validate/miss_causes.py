@@ -18,12 +18,15 @@ FALL_IE_FACTOR = 100.0
 
 #: The physical cause of each miss (:func:`miss_cause`), and what each means.
 MISS_CAUSES = {
+    "fall_landed": "the streamline missed where the tip fell, and the fall-landing reference "
+    "(the fall replaced by the inertial tip on the run's spring until it lands: "
+    "spine_mj.theory.fall_landing) agrees: explained by where a tip with mass lands",
     "ill_conditioned": "the reference's outcome flips within one hfield spacing of its path "
     "(miss reason separatrix): the start lies on a separatrix, no physics is missing",
     "fall": "the paths parted where the tip fell: the reference slides under gravity alone "
     "(a flank steeper than friction) or the tip's peak speed was a fall's (its inertia "
     f"number above {FALL_IE_FACTOR:g} times the drive's), where the quasistatic step does not say where "
-    "a tip with mass lands",
+    "a tip with mass lands, and the fall-landing reference (where it was traced) misses too",
     "inertia": "the paths parted by more than a facet without a fall (a jump of the spring)",
     "wedge": "MuJoCo held at the force cap without a single contact normal in the self-lock "
     "region: the tip wedged on several contacts where the reference moves on",
@@ -34,9 +37,12 @@ MISS_CAUSES = {
 
 
 def miss_cause(row) -> str:
-    """The physical cause (a key of :data:`MISS_CAUSES`) of one disagreeing run, from its
-    compare row: its ``miss_reason``, ``end_detail``, ``reference_slide_fraction``,
-    ``tip_peak_ie`` and ``inertia_number``."""
+    """The physical cause (a key of :data:`MISS_CAUSES`) of one run that disagrees with the
+    streamline, from its compare row: its ``agree_landing`` (the fall-landing reference's
+    verdict, where its reference falls), ``miss_reason``, ``end_detail``,
+    ``reference_slide_fraction``, ``tip_peak_ie`` and ``inertia_number``."""
+    if row.get("agree_landing") == 1:
+        return "fall_landed"
     reason = row.get("miss_reason", "")
     if reason == "separatrix":
         return "ill_conditioned"

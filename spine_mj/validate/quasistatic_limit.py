@@ -55,6 +55,11 @@ RUN_COLUMNS = (
     "agree_smooth",
     "frechet_smooth",
     "geometry_frechet",
+    "agree_streamline",
+    "frechet_streamline",
+    "agree_landing",
+    "frechet_landing",
+    "landing_falls",
     "miss_reason",
     "miss_offset",
     "reference_slide_fraction",
@@ -94,7 +99,11 @@ class QuasistaticLimitResult:
     families : dict
         Family name -> summary: ``runs``, ``ok_runs``, ``outcome_agreement``,
         ``mean_frechet``, ``median_frechet``, ``mean_lateral_deviation`` (against the
-        facet-traced streamline), ``outcome_agreement_compliant`` and
+        facet-traced streamline, and where it falls the fall-landing reference:
+        :func:`landing_judged`; ``landing_runs`` so judged, ``outcome_agreement_streamline``
+        and ``median_frechet_streamline`` the plain streamline's, ``landing_explained`` its
+        misses the landing agrees with, ``landing_lost`` its agreements the landing does
+        not), ``outcome_agreement_compliant`` and
         ``median_frechet_compliant`` (against the compliant-drive streamline of the run's
         spring), ``outcome_agreement_smooth``, ``median_frechet_smooth``
         (against the smooth one), ``mean_geometry_frechet``, ``failed_runs`` (engine stops
@@ -281,6 +290,7 @@ def _limit_summary(allc: pd.DataFrame, groups: list[dict]) -> dict:
             "reference_stalled": int((allc["reference_outcome"] == "stalled").sum()),
             "misses": _misses(allc),
             "slide_runs": int((allc["reference_slide_fraction"] > 0).sum()),
+            **_landing_summary(allc),
             "median_tip_peak_ie": float(np.nanmedian(allc["tip_peak_ie"])),
         }
     )
@@ -332,7 +342,7 @@ def _refined_rows(family: str, keys, refinements, results) -> dict[str, pd.DataF
     out: dict[str, pd.DataFrame | None] = {key: None for key in keys}
     for (fam, key, _, _), (df, _) in zip(refinements, results):
         if fam == family:
-            rows = df[df["analysis"] == "compare"].copy()
+            rows = landing_judged(df[df["analysis"] == "compare"])
             mj = df[df["analysis"] == "engine"].set_index(["case_id", "start"])
             rows["surface_lc"] = [mj.loc[k, "char_length"] for k in zip(rows["case_id"], rows["start"])]
             out[key] = rows if out[key] is None else pd.concat([out[key], rows], ignore_index=True)
@@ -417,6 +427,48 @@ def _chunked(surfaces: list[dict], starts: dict, size: int) -> list[dict]:
     ]
 
 
+#: The columns of the fall-landing reference in ``compare`` rows (NaN where it was not traced).
+LANDING_COLUMNS = ("agree_landing", "frechet_landing", "landing_falls")
+
+
+def landing_judged(rows: pd.DataFrame) -> pd.DataFrame:
+    """``compare`` rows judged like for like: a run whose reference falls
+    (``reference_slide_fraction`` > 0, where ``compare`` traced the fall-landing reference,
+    :mod:`spine_mj.theory.fall_landing`) gets that reference's ``agree`` and ``frechet``; the
+    plain streamline's stay in ``agree_streamline`` and ``frechet_streamline``. Rows of a
+    store written before ``compare`` had it keep the streamline's verdict (NaN landing
+    columns)."""
+    out = rows.copy()
+    for c in LANDING_COLUMNS:
+        if c not in out:
+            out[c] = np.nan
+    out["agree_streamline"] = out["agree"]
+    out["frechet_streamline"] = out["frechet"]
+    landed = out["agree_landing"].notna()
+    out["agree"] = np.where(landed, out["agree_landing"] == 1, out["agree"].astype(bool))
+    out["frechet"] = np.where(landed, out["frechet_landing"], out["frechet"])
+    return out
+
+
+def _landing_summary(comp) -> dict:
+    """What judging the falling runs against the fall-landing reference changed: the runs so
+    judged, the streamline's verdicts (``outcome_agreement_streamline``,
+    ``median_frechet_streamline``), its misses the landing explains and its agreements the
+    landing loses."""
+    landed = comp["agree_landing"].notna()
+    plain = comp["agree_streamline"].fillna(False).astype(bool)
+    agree = comp["agree_landing"] == 1
+    return {
+        "landing_runs": int(landed.sum()),
+        "outcome_agreement_streamline": float(plain.mean()) if len(comp) else float("nan"),
+        "median_frechet_streamline": float(np.nanmedian(comp["frechet_streamline"]))
+        if comp["frechet_streamline"].notna().any()
+        else float("nan"),
+        "landing_explained": int((landed & ~plain & agree).sum()),
+        "landing_lost": int((landed & plain & ~agree).sum()),
+    }
+
+
 def _sweep_comparison(
     plan: ValidationPlan, fam: FamilySpec, df: pd.DataFrame, store, paths: dict, groups: list
 ) -> pd.DataFrame:
@@ -428,7 +480,7 @@ def _sweep_comparison(
     groups.extend(ensemble_groups(df, store, members))
     df = df[df["start"].astype(int) % members == 0].copy()  # the runs: each ensemble's own start
     df["start"] = df["start"].astype(int) // members
-    comp = df[df["analysis"] == "compare"].copy()
+    comp = landing_judged(df[df["analysis"] == "compare"])
     mj = df[df["analysis"] == "engine"].set_index(["case_id", "start"])
     key = list(zip(comp["case_id"], comp["start"].astype(int)))
     comp["family"] = fam.name

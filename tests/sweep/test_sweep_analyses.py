@@ -307,7 +307,7 @@ def test_cases_differing_only_in_their_drive_share_their_streamlines(tmp_path):
     fresh = sl.streamlines(
         qs_analysis.traced_surface(first, surface),
         starts,
-        qs_analysis._params(first, surface),
+        qs_analysis.streamline_params(first, surface),
         store_paths=True,
     )
     np.testing.assert_array_equal(res[0].x, fresh.x)

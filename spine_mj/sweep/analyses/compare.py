@@ -10,7 +10,10 @@ the same domain) is kept beside it (``*_smooth``), and the gap between the two s
 is the geometry part (``geometry_frechet``). A run that disagrees gets a ``miss_reason``
 (:func:`spine_mj.theory.agreement.miss_reason`: the reference restarted along its path). A spring
 drive is also compared with the compliant-drive streamline of its own spring
-(``compliant_frechet``, ``agree_compliant``; :mod:`spine_mj.theory.compliant`). A spring
+(``compliant_frechet``, ``agree_compliant``; :mod:`spine_mj.theory.compliant`), and where its
+reference falls (``reference_slide_fraction`` > 0) with the fall-landing reference, each
+fall replaced by the inertial tip on that spring until it lands (``agree_landing``,
+``frechet_landing``, ``landing_falls``; :mod:`spine_mj.theory.fall_landing`). A spring
 drive too fast for its stiffness to be quasistatic is refused before any run unless the
 grid's ``dynamic_drive`` asks for it (:func:`_check_case`). Touches
 the API of :mod:`spine_mj.theory.agreement` here only; needs the results of the ``quasistatic`` and
@@ -32,6 +35,7 @@ from spine_mj.sweep.analyses.quasistatic import (
     case_tip_radius,
     hfield_key,
     path_table,
+    streamline_params,
     traced_surface,
 )
 from spine_mj.sweep.registry import Analysis, AnalysisResult, ParamSpec, register_analysis
@@ -39,6 +43,7 @@ from spine_mj.theory import agreement
 from spine_mj.theory import streamline as sl
 from spine_mj.theory.compliant import compliant_streamlines
 from spine_mj.theory.drive_limits import SWING_BOUND_FP, spring_ie_limits
+from spine_mj.theory.fall_landing import FallParams, landing_streamlines
 from spine_mj.theory.streamline_types import Outcome, StreamlineResult
 
 
@@ -165,6 +170,71 @@ def _compliant(
     return out
 
 
+def fall_params(scales, *, stiffness_n_m, speed_m_s, timestep_s, length_scale_m, duration_s) -> FallParams:
+    """The falls of a spring-drive run's landing reference
+    (:mod:`spine_mj.theory.fall_landing`): the rig's own tip mass, load ``F_p``, spring and
+    carriage pace, integrated at the engine's step, none longer than the run."""
+    return FallParams(
+        mass_kg=scales.mass_kg,
+        load_n=scales.preload_n,
+        spring_n_m=stiffness_n_m,
+        speed_m_s=speed_m_s,
+        length_scale_m=length_scale_m,
+        timestep_s=timestep_s,
+        max_fall_s=max(duration_s, timestep_s),
+    )
+
+
+def landing_verdicts(contact, params, trace, starts, fall: FallParams, mj_locked, mj_end, mpaths, lc) -> dict:
+    """MuJoCo against the fall-landing reference from ``starts`` ``(m, 2)`` (traced with
+    ``trace`` and ``params`` on ``contact``, as the facets' reference): ``agree_landing``
+    (the outcome rule of :func:`_outcomes`), ``frechet_landing`` (over L_c) and
+    ``landing_falls`` (falls the reference took), ``(m,)`` each; ``mj_locked``, ``mj_end``
+    and ``mpaths`` are the runs' of those starts."""
+    ref = landing_streamlines(contact, np.asarray(starts, float), params, fall, trace=trace)
+    frechet = _deviations(mpaths, {j: _xy(ref, j) for j in range(len(ref))}, lc, lateral=False)[0]
+    return {
+        "agree_landing": _outcomes(ref, mj_locked, mj_end, lc)["agree"].astype(float),
+        "frechet_landing": frechet,
+        "landing_falls": ref.meta["falls"].astype(float),
+    }
+
+
+def _landing(contact, params, trace, starts, runs, rig, slides, mj_locked, mj_end, mpaths, lc, lead) -> dict:
+    """The spring-drive runs whose facets' reference falls somewhere (``slides`` > 0, the
+    ensembles' first members) against the fall-landing reference (:func:`landing_verdicts`);
+    NaN for the others and for drives without a spring."""
+    n = len(runs)
+    out = {k: np.full(n, np.nan) for k in ("agree_landing", "frechet_landing", "landing_falls")}
+    idx = np.flatnonzero(lead & (np.nan_to_num(slides) > 0))
+    k = runs[0].stiffness_n_m if n else 0.0
+    if not (k > 0) or not idx.size:
+        return out
+    r = runs[0]
+    fall = fall_params(
+        rig.scales,
+        stiffness_n_m=k,
+        speed_m_s=r.speed_m_s,
+        timestep_s=r.engine.timestep_s,
+        length_scale_m=rig.length_scale_m,
+        duration_s=max(float(run.time_s[-1]) for run in runs),
+    )
+    got = landing_verdicts(
+        contact,
+        params,
+        trace,
+        np.asarray(starts, float)[idx],
+        fall,
+        mj_locked[idx],
+        mj_end[idx],
+        [mpaths[i] for i in idx],
+        lc,
+    )
+    for key, v in got.items():
+        out[key][idx] = v
+    return out
+
+
 def _pace(facets, runs, scales) -> dict:
     """Whether the paths are quasistatic at all: the share of the reference's path that
     gravity slides alone, and the engine tip's own peak speed as an inertia number (falls
@@ -194,12 +264,30 @@ def _references(case, surface, starts, quasistatic, rig, runs, lead):
     smooth_key = (case.surface, case_tip_radius(case, surface))
     smooth = cached_trace(trace, smooth_key, smooth_surface, np.asarray(starts, float)[lead], margin)
     contact = rig.contact_surface()
-    # steps no longer than an eighth of the tip radius: a longer step can jump a crease
-    # between facets where the engine's tip wedges (measured on a fractal: dl = R/2 passed
-    # a crease of kappa > 20 where MuJoCo held; R/8 held within 0.003 L_c)
-    params = dataclasses.replace(margin, dl=min(margin.dl, contact.radius / 8))
+    params = facet_params(margin, contact)
     facets = cached_trace(trace, hfield_key(rig.hfield, contact.radius), contact, starts, params)
     return trace, smooth, contact, params, facets
+
+
+def facet_params(params, contact):
+    """The facets' reference's parameters: ``params`` (with the run's domain margin as
+    ``edge_margin``) with steps no longer than an eighth of the tip radius of ``contact``: a
+    longer step can jump a crease between facets where the engine's tip wedges (measured on a
+    fractal: dl = R/2 passed a crease of kappa > 20 where MuJoCo held; R/8 held within 0.003
+    L_c)."""
+    return dataclasses.replace(params, dl=min(params.dl, contact.radius / 8))
+
+
+def facet_reference(case, surface, rig, domain_margin: float):
+    """``(trace, contact, params)`` of the facets' reference of a stored ``case`` on its
+    ``rig`` (:func:`spine_mj.sweep.analyses.engine.case_rig`), ending ``domain_margin``
+    (surface units: the runs' domain margin) from the edges, as :func:`_compare` traces it:
+    to judge stored runs again without running them."""
+    traced = traced_surface(case, surface)
+    trace = sl.streamlines if case.params["trajectory"] == "streamline" else sl.ideal_trajectories
+    margin = dataclasses.replace(streamline_params(case, traced), edge_margin=domain_margin)
+    contact = rig.contact_surface()
+    return trace, contact, facet_params(margin, contact)
 
 
 def _compare(case, surface, starts, upstream):
@@ -252,6 +340,21 @@ def _compare(case, surface, starts, upstream):
         lc,
         lead & bool(case.params["compliant_reference"]),
     )
+    pace = _pace(facets, runs, rig.scales)
+    landing = _landing(
+        contact,
+        params,
+        trace,
+        starts,
+        runs,
+        rig,
+        pace["reference_slide_fraction"],
+        mj_locked,
+        mj_end,
+        mpaths,
+        lc,
+        lead & bool(case.params["landing_reference"]) & (status == "ok"),
+    )
     peak = np.array([peak_drive_over_fp(r, rig.scales.preload_n) for r in runs])
     kap = agreement.kappa_agreement(facets.max_kappa, peak, kappa_cap=runs[0].detection.kappa_cap)
     metrics = {
@@ -272,7 +375,8 @@ def _compare(case, surface, starts, upstream):
         **compliant,
         "kappa_ratio": kap["ratio"],
         "inertia_number": np.array([r.inertia_number for r in runs]),
-        **_pace(facets, runs, rig.scales),
+        **pace,
+        **landing,
     }
     reason = np.where(
         status == "ok",
@@ -338,6 +442,15 @@ register_analysis(
                 "those columns NaN (a refinement level, judged on the rigid reference alone: "
                 "on a grit's facets the compliant reference creeps along creases and is most "
                 "of a case's time)",
+                True,
+            ),
+            ParamSpec(
+                "landing_reference",
+                "bool",
+                "also compare the runs whose reference falls (reference_slide_fraction > 0) "
+                "with the fall-landing reference, each fall replaced by the inertial tip on the "
+                "run's spring until it lands (agree_landing, frechet_landing, landing_falls; "
+                "spine_mj.theory.fall_landing); off: those columns NaN",
                 True,
             ),
             ParamSpec(

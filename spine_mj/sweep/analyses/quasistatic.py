@@ -118,7 +118,7 @@ def traced_surface(case, surface):
     return _dilated(case.surface, r) if r > 0 else surface
 
 
-def _params(case, surface) -> StreamlineParams:
+def streamline_params(case, surface) -> StreamlineParams:
     """The streamline parameters of ``case`` on ``surface`` (the traced one)."""
     p = case.params
     dl = p["dl"] if p["dl"] is not None else sl.default_step(surface)
@@ -135,7 +135,7 @@ def _check_case(case, surface, starts) -> None:
 def _quasistatic(case, surface, starts, upstream):
     p = case.params
     surface = traced_surface(case, surface)
-    params = _params(case, surface)
+    params = streamline_params(case, surface)
     dl = params.dl
     func = sl.streamlines if p["trajectory"] == "streamline" else sl.ideal_trajectories
     res = cached_trace(func, (case.surface, case_tip_radius(case, surface)), surface, starts, params)

@@ -156,6 +156,8 @@ def falls_note(limit: QuasistaticLimitResult, boundary: BoundaryResult) -> list[
             "family": fam,
             "slides": f"{v.get('slide_runs', 0)}/{len(runs)}",
             "peak": f"{cell(np.nanmedian(peak))} ({cell(np.nanmin(peak))}-{cell(np.nanmax(peak))})",
+            "landing": f"{v.get('landing_runs', 0)}: +{v.get('landing_explained', 0)} / "
+            f"-{v.get('landing_lost', 0)} (streamline {cell(v.get('outcome_agreement_streamline', np.nan))})",
         }
         for side, keep in (("slow", peak <= cut), ("fast", peak > cut)):
             sel = [r for r, k in zip(runs, keep) if k]
@@ -176,17 +178,22 @@ def falls_note(limit: QuasistaticLimitResult, boundary: BoundaryResult) -> list[
         "and the tip's peak speed as an inertia number, m v_max^2 / (F_p L_c) "
         f"(`agreement.peak_speed`), split at the lower end of the spring drive's I_e* bracket "
         f"({cell(cut)}): a tip that went faster than that, somewhere, left the quasistatic "
-        "regime there.",
+        "regime there. A run whose reference falls is judged against the fall-landing reference "
+        "(each fall replaced by the inertial tip on the run's spring until it lands, "
+        "`theory.fall_landing`, docs/physics/inertia.md): the runs so judged, the streamline's "
+        "misses it explains (+), its agreements it loses (-), and the streamline's own outcome "
+        "agreement over all runs.",
         "",
         table(
             rows,
-            ["family", "slides", "peak", "slow", "fast"],
+            ["family", "slides", "peak", "slow", "fast", "landing"],
             [
                 "family",
                 "runs with gravity slides",
                 "tip peak I_e: median (range)",
                 f"peak I_e <= {cell(cut)}: agree, median Frechet",
                 f"peak I_e > {cell(cut)}: agree, median Frechet",
+                "judged on the landing reference: +explained / -lost",
             ],
         ),
         "",
