@@ -60,7 +60,7 @@ def _config(doc: dict) -> SweepConfig:
     )
 
 
-def _store_rows(store: Path) -> list[dict]:
+def _store_rows(store: Path, dt_factor: float = 1.0) -> list[dict]:
     manifest = json.loads((store / "manifest.json").read_text())
     cases = {c.case_id: c for c in sweep.expand_cases(_config(manifest["config"]))}
     runs = sweep.load_runs(store)
@@ -94,7 +94,7 @@ def _store_rows(store: Path) -> list[dict]:
             rig.scales,
             stiffness_n_m=float(e["stiffness_n_m"].iloc[0]),
             speed_m_s=float(e["speed_m_s"].iloc[0]),
-            timestep_s=float(e["timestep_s"].iloc[0]),
+            timestep_s=float(e["timestep_s"].iloc[0]) * dt_factor,
             length_scale_m=s,
             duration_s=float(e["end_time_s"].max()),
         )
@@ -127,13 +127,16 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("stores", nargs="+", type=Path)
     ap.add_argument("--out", type=Path, default=None, help="CSV of the per-run rows")
+    ap.add_argument(
+        "--dt-factor", type=float, default=1.0, help="the falls' step over the engine's (0.5: its refinement)"
+    )
     args = ap.parse_args(argv)
     rows = []
     for store in args.stores:
         if not (store / "manifest.json").is_file():
             print(f"Error: {store} is not a sweep store (no manifest.json)", file=sys.stderr)
             return 2
-        got = _store_rows(store)
+        got = _store_rows(store, args.dt_factor)
         rows += got
         df = pd.DataFrame(got)
         if df.empty:
