@@ -126,17 +126,19 @@ def _miss_reasons(contact, params, trace, mpaths, facets, mj_locked, mj_end, lc,
     return reason, offset
 
 
-def _compliant(
-    contact, params, starts, runs, preload_n, s, mpaths, facets, mj_locked, mj_end, lc, lead
-) -> dict:
-    """MuJoCo against the compliant-drive streamline of the run's own spring
+def _compliant(reference, starts, runs, rig, mujoco, lead) -> dict:
+    """MuJoCo (``mujoco``: the runs' ``(locked, end, paths, L_c)``) against the
+    compliant-drive streamline of the run's own spring
     (:mod:`spine_mj.theory.compliant`, ``k / W`` from the run), traced like the rigid reference:
     what stiffness does is predicted there, what is left over is inertia. NaN for drives
     without a spring and for the starts not in ``lead`` (an ensemble's perturbed members, or every
     start where ``compliant_reference`` is off).
     ``stiffness_frechet`` is the compliant reference's distance from the rigid one,
     ``compliant_jumps`` its folds. The reference's carriage stops where the run's does
-    (``carriage_end``)."""
+    (``carriage_end``); ``reference`` is the rigid one's ``(trace, contact, params, result)``."""
+    _, contact, params, facets = reference
+    mj_locked, mj_end, mpaths, lc = mujoco
+    preload_n, s = rig.scales.preload_n, rig.length_scale_m
     n = len(runs)
     out = {
         k: np.full(n, np.nan)
@@ -200,13 +202,21 @@ def landing_verdicts(contact, params, trace, starts, fall: FallParams, mj_locked
     }
 
 
-def _landing(contact, params, trace, starts, runs, rig, slides, mj_locked, mj_end, mpaths, lc, lead) -> dict:
-    """The spring-drive runs whose facets' reference falls somewhere (``slides`` > 0, the
-    ensembles' first members) against the fall-landing reference (:func:`landing_verdicts`);
-    NaN for the others and for drives without a spring."""
+def _landing(reference, starts, runs, rig, mujoco, lead) -> dict:
+    """The spring-drive runs of ``lead`` whose facets' reference (``(trace, contact, params,
+    result)``) falls somewhere (:func:`spine_mj.theory.agreement.slide_fraction` > 0) against
+    the fall-landing reference (:func:`landing_verdicts`; ``mujoco``: the runs' ``(locked,
+    end, paths, L_c)``); NaN for the others and for drives without a spring."""
+    trace, contact, params, facets = reference
+    mj_locked, mj_end, mpaths, lc = mujoco
     n = len(runs)
     out = {k: np.full(n, np.nan) for k in ("agree_landing", "frechet_landing", "landing_falls")}
-    idx = np.flatnonzero(lead & (np.nan_to_num(slides) > 0))
+    falls = [
+        i
+        for i in np.flatnonzero(lead)
+        if agreement.slide_fraction(_xy(facets, i), facets.path(i)["region"]) > 0
+    ]
+    idx = np.array(falls, dtype=np.int64)
     k = runs[0].stiffness_n_m if n else 0.0
     if not (k > 0) or not idx.size:
         return out
@@ -326,35 +336,8 @@ def _compare(case, surface, starts, upstream):
     miss_reason, miss_offset = _miss_reasons(
         contact, params, trace, mpaths, facets, mj_locked, mj_end, lc, explain
     )
-    compliant = _compliant(
-        contact,
-        params,
-        starts,
-        runs,
-        rig.scales.preload_n,
-        s,
-        mpaths,
-        facets,
-        mj_locked,
-        mj_end,
-        lc,
-        lead & bool(case.params["compliant_reference"]),
-    )
-    pace = _pace(facets, runs, rig.scales)
-    landing = _landing(
-        contact,
-        params,
-        trace,
-        starts,
-        runs,
-        rig,
-        pace["reference_slide_fraction"],
-        mj_locked,
-        mj_end,
-        mpaths,
-        lc,
-        lead & bool(case.params["landing_reference"]) & (status == "ok"),
-    )
+    ref, mine = (trace, contact, params, facets), (mj_locked, mj_end, mpaths, lc)
+    compliant = _compliant(ref, starts, runs, rig, mine, lead & bool(case.params["compliant_reference"]))
     peak = np.array([peak_drive_over_fp(r, rig.scales.preload_n) for r in runs])
     kap = agreement.kappa_agreement(facets.max_kappa, peak, kappa_cap=runs[0].detection.kappa_cap)
     metrics = {
@@ -375,8 +358,10 @@ def _compare(case, surface, starts, upstream):
         **compliant,
         "kappa_ratio": kap["ratio"],
         "inertia_number": np.array([r.inertia_number for r in runs]),
-        **pace,
-        **landing,
+        **_pace(facets, runs, rig.scales),
+        **_landing(
+            ref, starts, runs, rig, mine, lead & bool(case.params["landing_reference"]) & (status == "ok")
+        ),
     }
     reason = np.where(
         status == "ok",
