@@ -399,3 +399,34 @@ def test_a_spring_drive_too_fast_for_its_stiffness_is_refused_before_the_compari
     check_cases(_fractal_cases(tmp_path, ie=0.99 * ie_max, K=3000.0))
     check_cases(_fractal_cases(tmp_path, ie=1e-4, K=3000.0, extra="[grid]\ndynamic_drive = true"))
     check_cases(_fractal_cases(tmp_path, ie=1e-4, K=3000.0, analyses=("engine",)))
+
+
+def test_landing_verdicts_judge_a_run_against_where_its_fall_lands():
+    """A ramp steeper than friction onto a floor: the landing reference falls once, lands on
+    the floor and moves on to the domain's edge; a run that ended there agrees, one held on
+    the ramp does not."""
+    import math
+
+    from spine_mj.surfaces import BallOnFacets, GridSurface, TriangulatedSurface
+    from spine_mj.sweep.analyses.compare import fall_params, landing_verdicts
+    from spine_mj.theory import streamline as sl
+    from spine_mj.theory.streamline_types import StreamlineParams
+
+    x = np.linspace(-1.0, 1.0, 101)
+    row = np.where(x < 0, -math.tan(math.radians(40.0)) * x, 0.0)
+    grid = GridSurface(heights=np.tile(row, (5, 1)), x=x, y=np.linspace(-0.2, 0.2, 5), unit="m")
+    contact = BallOnFacets(TriangulatedSurface.from_grid(grid), 0.01)
+    scales = type("S", (), {"mass_kg": 1e-3, "preload_n": 1.0})()  # only these two are read
+    fall = fall_params(
+        scales, stiffness_n_m=1e-9, speed_m_s=0.0, timestep_s=1e-3, length_scale_m=1.0, duration_s=5.0
+    )
+    assert (fall.max_fall_s, fall.load_n, fall.mass_kg, fall.timestep_s) == (5.0, 1.0, 1e-3, 1e-3)
+    params = StreamlineParams(mu=0.5, dl=0.02, edge_margin=0.05)
+    end = np.array([[0.95, 0.0], [-0.5, 0.0]])
+    mpaths = [np.array([[-0.5, 0.0], [0.95, 0.0]]), np.array([[-0.5, 0.0], [-0.5, 0.0]])]
+    got = landing_verdicts(
+        contact, params, sl.streamlines, [(-0.5, 0.0)] * 2, fall, np.array([False, True]), end, mpaths, 1.0
+    )
+    assert list(got["landing_falls"]) == [1.0, 1.0]
+    assert list(got["agree_landing"]) == [1.0, 0.0]
+    assert got["frechet_landing"][0] < 0.05 < got["frechet_landing"][1]
