@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import click
 
-from spine_mj.choices import ENGINES
+from spine_mj.choices import ENGINES, check_engine
 from spine_mj.cli.app import InputError, Progress, main
 from spine_mj.errors import check_positive
 
@@ -28,9 +28,10 @@ def parse_stiffness_list(text: str) -> list[float]:
 @click.option("--ie", type=float, default=1e-4, show_default=True, help="Inertia number of the drive.")
 @click.option(
     "--engine",
-    type=click.Choice(tuple(ENGINES)),
     default=None,
-    help="Also run this engine, one spring drive per K (default: the references only).",
+    help="Also run this engine, one spring drive per K (default: the references only); one of "
+    + ", ".join(ENGINES)
+    + ".",
 )
 @click.option("--start", type=float, default=None, help="Start x in surface units (default: 5 % in).")
 @click.option(
@@ -67,6 +68,8 @@ def stickslip_cmd(surface_spec, mu, stiffness, ie, engine, start, travel, bootst
     from spine_mj import presets
     from spine_mj.validate.stickslip_outputs import stickslip_to
 
+    if engine is not None:
+        check_engine(engine, "--engine")
     ks = parse_stiffness_list(stiffness)
     check_positive("--ie", ie)
     if drop_floor is not None:

@@ -59,3 +59,18 @@ def test_bad_input_is_one_error_line_and_nothing_written(track, tmp_path, args, 
     assert result.exit_code == 2
     assert needle in result.output and "Traceback" not in result.output
     assert not out.exists() or not any(out.iterdir())
+
+
+def test_an_unknown_engine_is_one_error_line_naming_the_registry(monkeypatch, tmp_path):
+    """--engine is checked against the registry when the command runs, as simulate's is: an
+    engine registered after the CLI loaded is accepted, an unknown name refused."""
+    from spine_mj import choices
+
+    third = choices.Engine("third", "a third engine", rig="x:Y", settings="x:y", options=())
+    monkeypatch.setitem(choices.ENGINES, third.name, third)
+    res = CliRunner().invoke(
+        main, ["stickslip", "abbm", "--K", "0.5", "--engine", "ode", "--out", str(tmp_path / "o")]
+    )
+    assert res.exit_code == 2 and res.output.count("\n") == 1, res.output
+    assert res.output.startswith("Error: --engine must be one of mujoco, bullet, third, got 'ode'")
+    assert not (tmp_path / "o").exists()
