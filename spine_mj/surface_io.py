@@ -31,6 +31,7 @@ from spine_mj.surfaces import (
     GridSurface,
     HField,
     Surface,
+    check_grid_size,
     check_unit,
     length_unit,
     to_hfield,
@@ -180,8 +181,10 @@ def load_surface(path: str | os.PathLike) -> Surface:
 
 def _read_npz(path: Path) -> dict[str, np.ndarray]:
     """The arrays of the .npz file at ``path``, each checked for size from its header before
-    a compressed array is inflated; SpineInputError for a file that is no readable .npz of
-    .npy arrays."""
+    a compressed array is inflated, and a grid's heights against the memory budget as the
+    grid they make (:func:`~spine_mj.surfaces.check_grid_size`: a 4096 x 4096 grid loaded
+    took 514 MiB, four arrays of its size); SpineInputError for a file that is no readable
+    .npz of .npy arrays."""
     try:
         with np.load(path, allow_pickle=False) as npz:
             for name in npz.files:  # sizes from the headers, before a compressed array is inflated
@@ -194,6 +197,8 @@ def _read_npz(path: Path) -> dict[str, np.ndarray]:
                     raise SpineInputError(
                         f"{path}: array {name!r} has shape {shape}, more than {MAX_GRID_POINTS} values"
                     )
+                if name == "heights" and len(shape) == 2:
+                    check_grid_size(shape[1], shape[0], where=str(path))
             return {k: npz[k] for k in npz.files}
     except SpineInputError:
         raise
