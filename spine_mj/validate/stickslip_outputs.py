@@ -146,8 +146,6 @@ def stickslip_to(
     **rig_options
         :func:`~spine_mj.sim.build_rig`'s keywords (tip radius, mass, length scale, ...).
     """
-    import pandas as pd
-
     ks = [check_positive("--K", k) for k in stiffness_numbers]
     if not ks:
         raise SpineInputError("--K must name at least one stiffness number")
@@ -161,25 +159,9 @@ def stickslip_to(
     def tick(what: str) -> None:
         report(next(steps), total, what)
 
-    frames, drops, units_by_k, pulses, ref_pulses = [], [], {}, {}, {}
-    for k_number in ks:
-        units, land, frames_k, drops_k = _catalogs_at(
-            surface,
-            k_number,
-            (x0, x0 + length),
-            floor,
-            labels,
-            engine,
-            rig_options,
-            pulses,
-            ref_pulses,
-            tick,
-            landscape_refinement,
-        )
-        units_by_k[k_number] = units
-        frames, drops = frames + frames_k, drops + drops_k
-    events = pd.concat(frames, ignore_index=True)
-    drop_events = pd.concat(drops, ignore_index=True)
+    events, drop_events, units_by_k, land, pulses, ref_pulses = _catalogs(
+        surface, ks, (x0, x0 + length), floor, labels, engine, rig_options, tick, landscape_refinement
+    )
     summary = _summary(events, surface, mu, ie, ks, units_by_k, engine, x0, length, n_bootstrap)
     summary["track"]["landscape_refinement"] = int(landscape_refinement)
     summary["drops"] = drop_summary(drop_events, engine, ks, units_by_k, floor)
@@ -190,12 +172,28 @@ def stickslip_to(
     return StickSlipOutputs(summary, files)
 
 
-def _catalogs_at(
-    surface, k_number, x_range, floor, labels, engine, rig_options, pulses, ref_pulses, tick, refinement=1
-):
+def _catalogs(surface, ks, x_range, floor, labels, engine, rig_options, tick, refinement):
+    """Every K's catalogs (:func:`_catalogs_at`) joined: ``(events, drop events, units by K,
+    the last landscape, engine pulses, reference pulses)``."""
+    import pandas as pd
+
+    frames, drops, units_by_k, pulses, ref_pulses = [], [], {}, {}, {}
+    maps, land = (pulses, ref_pulses), None
+    for k_number in ks:
+        units, land, frames_k, drops_k = _catalogs_at(
+            surface, k_number, x_range, floor, labels, engine, rig_options, maps, tick, refinement
+        )
+        units_by_k[k_number] = units
+        frames, drops = frames + frames_k, drops + drops_k
+    events = pd.concat(frames, ignore_index=True)
+    return events, pd.concat(drops, ignore_index=True), units_by_k, land, pulses, ref_pulses
+
+
+def _catalogs_at(surface, k_number, x_range, floor, labels, engine, rig_options, maps, tick, refinement=1):
     """One K's catalogs (:func:`stickslip_to`): ``(units, landscape, slip frames, drop
-    frames)``, its mean pulses into ``pulses`` and ``ref_pulses``, ``tick(what)`` after the
-    references and after the engine."""
+    frames)``, its mean pulses into ``maps`` (the figure's and the references'),
+    ``tick(what)`` after the references and after the engine."""
+    pulses, ref_pulses = maps
     x0, x1 = x_range
     ie = labels["ie"]
     rig, scales = _rig_and_scales(surface, engine, labels["mu"], ie, k_number, rig_options)
