@@ -435,8 +435,10 @@ register_analysis(
                 "also compare the runs whose reference falls (reference_slide_fraction > 0) "
                 "with the fall-landing reference, each fall replaced by the inertial tip on the "
                 "run's spring until it lands (agree_landing, frechet_landing, landing_falls; "
-                "spine_mj.theory.fall_landing); off: those columns NaN",
-                True,
+                "spine_mj.theory.fall_landing); off (the default): those columns NaN. It "
+                "steps each fall at the engine's step in Python: on the scan di-1 it took "
+                "2187 of the quick plan's 2284 CPU-s",
+                False,
             ),
             ParamSpec(
                 "ensemble_members",
