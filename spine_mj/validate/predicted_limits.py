@@ -98,8 +98,17 @@ def family_limits(plan: ValidationPlan, fam: FamilySpec, *, n_starts: int = 8) -
 
 def corner_drives(presets: dict) -> dict:
     """Each preset's drive at its corner, ``{preset: {"ie", "K"}}``, from
-    :func:`family_corner`'s ``presets`` (what ``validation.json``'s ``corner`` records)."""
-    return {preset: {"ie": c["ie"], "K": c["K"]} for preset, c in presets.items()}
+    :func:`family_corner`'s ``presets`` (what ``validation.json``'s ``corner`` records), with
+    the family's ``timestep_factor`` where its step is not the rule's
+    (:class:`~spine_mj.validate.plans.FamilySpec`)."""
+    return {
+        preset: {"ie": c["ie"], "K": c["K"], **_own_step(c.get("timestep_factor", 1.0))}
+        for preset, c in presets.items()
+    }
+
+
+def _own_step(factor: float) -> dict:
+    return {} if factor == 1.0 else {"timestep_factor": factor}
 
 
 def family_corner(plan: ValidationPlan, fam: FamilySpec) -> dict:

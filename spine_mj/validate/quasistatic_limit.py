@@ -191,6 +191,8 @@ def quasistatic_limit(plan: ValidationPlan, runner: StudyRunner) -> QuasistaticL
     for fam in corner:
         with runner.phase(f"the quasistatic corner of {fam.name}"):
             corners[fam.name] = family_corner(plan, fam)
+        for c in corners[fam.name]["presets"].values():
+            c["timestep_factor"] = fam.timestep_factor
     at = {name: c["presets"] for name, c in corners.items()}
     docs = [(fam, name, doc) for fam in corner for name, doc in limit_family_docs(plan, fam, at[fam.name])]
     for fam in corner:  # a corner the rig refuses (too many steps a run) gives no verdict
@@ -367,6 +369,9 @@ def limit_doc(
         "dl": tip / 2,
         **engine_grid(plan, overrides, preset, fam.seeds, tip, mu=mu, ie=ie, stiffness_number=k),
     }
+    step_factor = fam.timestep_factor * float(dict(overrides).get("timestep_factor", 1.0))
+    if step_factor != 1.0:  # the family's own step, a refinement's relative to it
+        grid["timestep_factor"] = step_factor
     members = plan.limit.ensemble_members if not overrides else 1
     if members > 1:
         fam = ensemble_family(fam, preset, members)

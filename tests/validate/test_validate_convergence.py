@@ -3,6 +3,7 @@ the paired change, and the refined sweeps' engine keys."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -10,6 +11,7 @@ import pandas as pd
 import pytest
 
 from spine_mj import presets, sim
+from spine_mj.errors import SpineInputError
 from spine_mj.validate.convergence import (
     GRID_ONLY,
     REFINEMENTS,
@@ -309,12 +311,16 @@ def test_every_refined_sweep_of_the_plans_is_a_valid_config_that_changes_only_it
         assert per_surface * len(fam.seeds or (None,)) * len(fam.variants) * len(fam.presets) >= min(
             plan.limit.convergence_starts, len(fam.starts_table()["y"]) * len(fam.presets)
         )
-    for _, key, _, doc in docs:
+    own_step = {fam.name: fam.timestep_factor for fam in corner}
+    for fam_name, key, _, doc in docs:
         sweep.parse_config(doc)
         grid = doc["grid"]
         assert grid["hfield_resolution"] == plan.hfield_resolution
+        # a refinement of the step is relative to the family's own (the rule's, or a fraction)
+        step = own_step[fam_name] * dict(REFINEMENTS[key]).get("timestep_factor", 1.0)
+        assert grid.get("timestep_factor", 1.0) == step
         if key.startswith("dt_"):
-            assert grid["timestep_factor"] == dict(REFINEMENTS[key])["timestep_factor"] < 1
+            assert step < own_step[fam_name]
         elif key.startswith("hfield_"):
             assert grid["hfield_refinement"] == dict(REFINEMENTS[key])["hfield_factor"] in (2, 4)
             assert "timestep" not in grid
@@ -426,3 +432,28 @@ def test_a_three_level_verdict_needs_its_last_change_inside_the_interval():
     assert out["dt_halved"]["converged"] is True and out["dt_quartered"]["median_frechet_converged"] is True
     assert out["dt_quartered"]["median_frechet_last_converged"] is False
     assert out["dt_quartered"]["converged"] is False
+
+
+def test_a_family_at_its_own_step_runs_its_corner_and_refinements_relative_to_it():
+    """A family whose rule's step did not converge (FamilySpec.timestep_factor) runs its
+    corner at that fraction of the rule's step and halves and quarters from there; a family
+    at the rule's step adds no key (its stores keep their configs)."""
+    from spine_mj.validate.plans import PEAK_VALLEY
+    from spine_mj.validate.quasistatic_limit import _refinement_docs, limit_family_docs
+
+    plan = PLANS["smoke"]
+    own = dataclasses.replace(PEAK_VALLEY, presets=("paper-single-peak",), timestep_factor=0.5)
+    corner = {"paper-single-peak": {"ie": 0.01, "K": 30.0}}
+    ((_, doc),) = limit_family_docs(plan, own, corner)
+    assert doc["grid"]["timestep_factor"] == 0.5
+    steps = {
+        key: d["grid"].get("timestep_factor", 1.0)
+        for _, key, _, d in _refinement_docs(plan, [own], {own.name: corner})
+    }
+    assert steps == {key: 0.5 * dict(REFINEMENTS[key]).get("timestep_factor", 1.0) for key in steps}
+    rule = dataclasses.replace(own, timestep_factor=1.0)
+    ((_, doc),) = limit_family_docs(plan, rule, corner)
+    assert "timestep_factor" not in doc["grid"]
+    for bad in (0.0, 1.5, math.nan):
+        with pytest.raises(SpineInputError, match="timestep_factor must be in"):
+            FamilySpec("x", ("paper-single-peak",), None, PEAK_VALLEY.starts, timestep_factor=bad)

@@ -114,12 +114,17 @@ def corner_text(corner: dict | None) -> str:
     """A family's corner as one cell: ``"I_e, K"`` where its presets share one, else
     ``"label I_e, K; ..."`` per preset (``corner``: preset -> ``{"ie", "K"}``, as
     ``validation.json``'s ``corner``; a report made before each preset had its own gives
-    ``{"ie", "K"}``); ``"-"`` for none."""
+    ``{"ie", "K"}``), with ``", dt x f"`` where a family runs at ``f`` times the step rule's
+    step (its ``timestep_factor``); ``"-"`` for none."""
     if not corner:
         return "-"
     if "ie" in corner:
         corner = {"": corner}
-    pairs = {p: f"{sig(c['ie'], 2)}, {sig(c['K'], 2)}" for p, c in corner.items()}
+    pairs = {
+        p: f"{sig(c['ie'], 2)}, {sig(c['K'], 2)}"
+        + (f", dt x {sig(c['timestep_factor'], 2)}" if "timestep_factor" in c else "")
+        for p, c in corner.items()
+    }
     if len(set(pairs.values())) == 1:
         return next(iter(pairs.values()))
     return "; ".join(f"{preset_label(p)} {v}" for p, v in pairs.items())
