@@ -67,6 +67,13 @@ class LimitPlan:
         Paired starts per corner family rerun under refinement, at least (solution
         verification, :mod:`spine_mj.validate.convergence`: the same number of y starts on
         each of its surfaces; 0: none).
+    convergence_all_starts : tuple of str
+        Families whose refinements rerun every start of their corner, not
+        ``convergence_starts`` of them: where a rate's changes come in flips of one run, a
+        flip on 30 paired starts is 0.033, coarser than the headline's interval on 60-80
+        starts can take twice (the fractal: 2 of 28 flipped under dt / 4, +0.071 against
+        an interval of [0.83, 0.96]); on every start the change is the headline's own, like
+        for like. For the families whose refined runs are cheap.
     convergence_refinements : tuple of str
         The refinements (keys of :data:`spine_mj.validate.convergence.REFINEMENTS`); with
         ``dt_quartered`` beside ``dt_halved`` three step levels give an observed order.
@@ -80,6 +87,7 @@ class LimitPlan:
     ensemble_members: int = 1
     corner: tuple[tuple[str, Any, tuple], ...] = ()
     convergence_starts: int = 0
+    convergence_all_starts: tuple[str, ...] = ()
     convergence_refinements: tuple[str, ...] = ("dt_halved", "hfield_doubled")
     compliant_reference: bool = True
 

@@ -434,6 +434,9 @@ PLANS: dict[str, ValidationPlan] = {
             # solution verification on 30 paired starts a family, three step levels and (on the
             # gridded surfaces) three hfield levels for observed orders and GCIs
             convergence_starts=30,
+            # ... and on every start where the refined runs are cheap (the fractal's dt / 4
+            # took 41 CPU-s for 30 runs; a grit's 168)
+            convergence_all_starts=("single_peak_valley", "random_gaussian", "fractal"),
             convergence_refinements=(
                 "dt_halved",
                 "dt_quartered",

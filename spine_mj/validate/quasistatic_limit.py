@@ -325,7 +325,13 @@ def _refinement_docs(
     out = []
     for fam in corner:
         surfaces = len(fam.presets) * len(fam.seeds or (None,)) * len(fam.variants)
-        thin = thin_starts(fam, -(-plan.limit.convergence_starts // surfaces))
+        every = len(fam.starts_table()["y"])
+        thin = thin_starts(
+            fam,
+            every
+            if fam.name in plan.limit.convergence_all_starts
+            else -(-plan.limit.convergence_starts // surfaces),
+        )
         for key in plan.limit.convergence_refinements:
             for preset in fam.presets:
                 if key in GRID_ONLY and not gridded(preset, fam):

@@ -311,6 +311,9 @@ def test_every_refined_sweep_of_the_plans_is_a_valid_config_that_changes_only_it
         assert per_surface * len(fam.seeds or (None,)) * len(fam.variants) * len(fam.presets) >= min(
             plan.limit.convergence_starts, len(fam.starts_table()["y"]) * len(fam.presets)
         )
+        # ... and every start of the corner where the plan asks for all of them
+        if fam.name in plan.limit.convergence_all_starts:
+            assert one["starts"]["y"] == list(fam.starts_table()["y"])
     own_step = {fam.name: fam.timestep_factor for fam in corner}
     for fam_name, key, _, doc in docs:
         sweep.parse_config(doc)
