@@ -137,7 +137,12 @@ def headline_table(validation: dict) -> list[str]:
     """The headline verdicts as Markdown lines: per family of the quasistatic corner the
     agreement on well-conditioned starts and the median Frechet distance with their 95 %
     intervals, and whether the target is met, at the family's own corner (I_e, K). A number
-    that refinement moved outside its interval is not quoted: the cell says so."""
+    that refinement moved outside its interval is not quoted (each headline on its own
+    refinements, :func:`spine_mj.validate.convergence.quoted`): the cell says so, and the
+    target, which judges both, gets no verdict."""
+    from spine_mj.validate.convergence import quoted
+    from spine_mj.validate.report.common import corner_text
+
     cols = [
         "family",
         "corner (I_e, K)",
@@ -151,27 +156,26 @@ def headline_table(validation: dict) -> list[str]:
     for key, fam in validation.get("limit_families", {}).items():
         verdict = refinement_verdict(validation, key)
         unconverged = verdict.startswith("unconverged")
+        conv = (validation.get("convergence") or {}).get(key)
         corner = fam.get("corner") or (validation.get("corner") or {}).get(key)
-        if corner:
-            from spine_mj.validate.report.common import corner_text
-
-            at = corner_text(corner)
-        else:
-            at = f"{_num(validation.get('lowest_ie'))}, 30 (fixed)"
-        hidden = "not quoted (unconverged)"
+        at = corner_text(corner) if corner else f"{_num(validation.get('lowest_ie'))}, 30 (fixed)"
         rows.append(
             "| "
             + " | ".join(
                 [
                     FAMILY_NAMES.get(key, key),
                     at,
-                    hidden
-                    if unconverged
-                    else _num(fam.get("agreement_well_conditioned")) + _ci(fam.get("agreement_ci")),
+                    quoted(
+                        _num(fam.get("agreement_well_conditioned")) + _ci(fam.get("agreement_ci")),
+                        conv,
+                        "agreement_well_conditioned",
+                    ),
                     f"{fam.get('well_conditioned_runs', '-')} / {fam.get('starts', fam.get('runs', '-'))}",
-                    hidden
-                    if unconverged
-                    else _num(fam.get("median_frechet")) + _ci(fam.get("median_frechet_ci")),
+                    quoted(
+                        _num(fam.get("median_frechet")) + _ci(fam.get("median_frechet_ci")),
+                        conv,
+                        "median_frechet",
+                    ),
                     "no verdict" if unconverged else ("met" if fam.get("meets_target") else "not met"),
                     verdict,
                 ]

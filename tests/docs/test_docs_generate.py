@@ -24,19 +24,28 @@ def test_committed_plans_render():
 
 
 def test_headline_table_numbers_are_the_json_numbers():
-    """A converged family's row quotes the report's numbers; an unconverged one's none."""
+    """Each headline is quoted where its own refinements left it inside its interval, and
+    only there; a family with an unconverged headline gets no target verdict."""
     rows = generate.headline_table(FULL)
     assert len(rows) == 2 + len(FULL["limit_families"])
     quoted = 0
     for name, fam in FULL["limit_families"].items():
         row = next(r for r in rows if r.startswith(f"| {generate.FAMILY_NAMES.get(name, name)} |"))
+        cells = [c.strip() for c in row.strip("|").split("|")]
         levels = (FULL.get("convergence") or {}).get(name) or {}
-        unconverged = any(isinstance(v, dict) and v.get("converged") is False for v in levels.values())
-        assert ("not quoted (unconverged)" in row) is unconverged
-        if not unconverged:
-            quoted += 1
-            assert f"{fam['agreement_well_conditioned']:.3g}" in row
-            assert f"{fam['median_frechet_ci'][1]:.3g}" in row
+        for headline, cell, number in (
+            ("agreement_well_conditioned", cells[2], f"{fam['agreement_well_conditioned']:.3g}"),
+            ("median_frechet", cells[4], f"{fam['median_frechet_ci'][1]:.3g}"),
+        ):
+            moved = any(
+                isinstance(v, dict) and v.get(f"{headline}_converged") is False for v in levels.values()
+            )
+            assert cell.startswith("not quoted (unconverged: ") is moved
+            if not moved:
+                quoted += 1
+                assert number in cell
+        family_moved = any(isinstance(v, dict) and v.get("converged") is False for v in levels.values())
+        assert (cells[5] == "no verdict") is family_moved
     assert quoted
 
 
