@@ -8,7 +8,10 @@ orders them for the workers by a rough cost (the order changes no result).
 
 from __future__ import annotations
 
+import functools
+import hashlib
 import itertools
+import json
 import math
 import time
 from collections.abc import Callable
@@ -63,8 +66,11 @@ class Case:
     params : dict
         Every parameter of the sweep's analyses (one value each; None for one the case's
         engine does not read).
+    master_seed : int
+        The sweep's seed.
     seed : int
-        Derived from the master seed and ``case_id``: the only randomness of the case.
+        Derived from ``master_seed`` and ``case_id`` (:func:`case_seed`, when first read):
+        the only randomness of the case.
     analyses : tuple of str
     store_trajectories : bool
     """
@@ -74,9 +80,13 @@ class Case:
     surface: SurfaceSpec
     starts: StartsSpec
     params: dict = field(hash=False)
-    seed: int = 0
+    master_seed: int = 0
     analyses: tuple[str, ...] = ()
     store_trajectories: bool = True
+
+    @functools.cached_property
+    def seed(self) -> int:
+        return case_seed(self.master_seed, self.case_id)
 
 
 def expand_cases(config: SweepConfig, progress: Callable[[int, int], None] | None = None) -> list[Case]:
@@ -88,45 +98,58 @@ def expand_cases(config: SweepConfig, progress: Callable[[int, int], None] | Non
         A validated config.
     progress : callable, optional
         Called as ``progress(listed, total)`` every :data:`PROGRESS_EVERY_S` seconds while
-        the cases are listed (a million take minutes).
+        the cases are listed.
 
     Returns
     -------
     list of Case
         Each with its id (a hash of its parameters) and its seed (from the master seed and
-        that id).
+        that id, computed when first read).
 
     Raises
     ------
     SpineInputError
         When two cases have the same parameters.
+
+    Notes
+    -----
+    A million cases are listed in seconds: the canonical JSON the id hashes
+    (:func:`~spine_mj.sweep.digests.digest` of the case's surface, starts and parameters)
+    is joined from each parameter's text, written once per distinct value
+    (:func:`_case_text`; the same bytes, so the same ids), and the seed (a SeedSequence,
+    33 us) is drawn only when a case's starts or rows need it.
     """
     check_cases_memory(config)
     names = [k for k, _ in config.grid]
-    combos = list(itertools.product(*(v for _, v in config.grid)))
-    total = len(config.surfaces) * len(combos)
+    total = case_count(config)
     specs = param_specs(config.analyses)
     from_preset = [k for k in names if specs[k].default is PRESET_MU]
+    nulled = _unread_options(config, specs)
+    order = sorted(range(len(names)), key=names.__getitem__)  # the canonical JSON's key order
+    fragment = _memo_fragments()
     cases, seen = [], set()
-    last, jsonable = time.monotonic(), _memo_jsonable()
+    last = time.monotonic()
     for si, surf in enumerate(config.surfaces):
         starts = (
             config.surface_starts[si]
             if (si < len(config.surface_starts) and config.surface_starts[si] is not None)
             else config.starts
         )
-        where = {"surface": surf.as_dict(), "starts": starts.as_dict()}
+        head, tail = _case_text_ends(surf, starts)
         default_mu = None  # the surface's, by the one mu rule, read once where needed
-        for combo in combos:
+        for combo in itertools.product(*(v for _, v in config.grid)):
             if progress is not None and time.monotonic() - last > PROGRESS_EVERY_S:
                 progress(len(cases), total)
                 last = time.monotonic()
-            params = applied_params(dict(zip(names, combo)), specs)
+            params = dict(zip(names, combo))
+            for k in nulled.get(params.get("engine"), ()):
+                params[k] = None
             for k in from_preset:
                 if params[k] is None:
                     default_mu = surface_mu(surf, k) if default_mu is None else default_mu
                     params[k] = default_mu
-            case_id = digest({**where, "params": {k: jsonable(v) for k, v in params.items()}})[:16]
+            text = head + ",".join([fragment(names[i], params[names[i]]) for i in order]) + tail
+            case_id = hashlib.sha256(text.encode()).hexdigest()[:16]
             if case_id in seen:
                 raise SpineInputError(
                     f"config produces the same case twice (surface {surf.label}, parameters {params})"
@@ -139,7 +162,7 @@ def expand_cases(config: SweepConfig, progress: Callable[[int, int], None] | Non
                     surface=surf,
                     starts=starts,
                     params=params,
-                    seed=case_seed(config.seed, case_id),
+                    master_seed=config.seed,
                     analyses=config.analyses,
                     store_trajectories=config.store_trajectories,
                 )
@@ -147,19 +170,52 @@ def expand_cases(config: SweepConfig, progress: Callable[[int, int], None] | Non
     return cases
 
 
-def _memo_jsonable() -> Callable:
-    """:func:`~spine_mj.jsonio.to_jsonable` remembering the values it has seen: a grid's
-    million cases repeat a few values per key (a third of the listing's time was spent
-    converting them again)."""
+def _unread_options(config: SweepConfig, specs: dict) -> dict[str, list[str]]:
+    """The parameters that are None in a case of each engine of ``config``'s grid: the
+    options that engine does not read (the one rule: :func:`applied_params`)."""
+    grid = dict(config.grid)
+    out = {}
+    for engine in grid.get("engine", ()):
+        applied = applied_params({**dict.fromkeys(grid, 0), "engine": engine}, specs)
+        out[engine] = [k for k, v in applied.items() if v is None]
+    return out
+
+
+def _case_text_ends(surf: SurfaceSpec, starts: StartsSpec) -> tuple[str, str]:
+    """The canonical JSON (:func:`~spine_mj.sweep.digests.digest`'s) of a case's
+    ``{"params": ..., "starts": ..., "surface": ...}`` before and after its parameters
+    (sorted keys: ``params`` comes first)."""
+    rest = json.dumps(
+        {"starts": starts.as_dict(), "surface": surf.as_dict()},
+        sort_keys=True,
+        separators=(",", ":"),
+        allow_nan=True,
+    )
+    return '{"params":{', "}," + rest[1:]
+
+
+def case_id_of(surf: SurfaceSpec, starts: StartsSpec, params: dict) -> str:
+    """The id of the case of ``params`` on ``surf`` from ``starts``, by its definition: 16
+    hex digits of :func:`~spine_mj.sweep.digests.digest` of them (what
+    :func:`expand_cases` computes faster, joining each parameter's text)."""
+    where = {"surface": surf.as_dict(), "starts": starts.as_dict()}
+    return digest({**where, "params": {k: to_jsonable(v) for k, v in params.items()}})[:16]
+
+
+def _memo_fragments() -> Callable[[str, object], str]:
+    """``fragment(key, value)``: ``"key":value`` as the canonical JSON writes it, each
+    distinct pair written once (a grid's million cases repeat a few values per key)."""
     memo: dict = {}
 
-    def jsonable(value):
-        key = (type(value), repr(value))  # repr keeps -0.0 apart from 0.0
-        if key not in memo:
-            memo[key] = to_jsonable(value)
-        return memo[key]
+    def fragment(key, value):
+        k = (key, type(value), repr(value))  # repr keeps -0.0 apart from 0.0
+        if k not in memo:
+            memo[k] = json.dumps(
+                {key: to_jsonable(value)}, sort_keys=True, separators=(",", ":"), allow_nan=True
+            )[1:-1]
+        return memo[k]
 
-    return jsonable
+    return fragment
 
 
 def case_seed(master_seed: int, case_id: str) -> int:

@@ -102,7 +102,8 @@ def test_config_hash_case_ids_and_seeds_are_pinned_so_existing_stores_resume():
 
 def test_listing_reports_progress_and_keeps_each_value_apart(monkeypatch):
     """A million cases take minutes to list: expand_cases reports (listed, total) every
-    PROGRESS_EVERY_S (here every case); its memo of converted values keeps 0.0 and -0.0
+    PROGRESS_EVERY_S (here every case); its ids, joined from each value's text written
+    once, are those of the canonical JSON of each case, and that memo keeps 0.0 and -0.0
     (and 1 and 1.0) apart, as converting each value afresh did."""
     from spine_mj.sweep import cases as cases_module
 
@@ -122,5 +123,38 @@ def test_listing_reports_progress_and_keeps_each_value_apart(monkeypatch):
         for c in cases
     ]
     assert [c.case_id for c in cases] == reference
-    jsonable = cases_module._memo_jsonable()
-    assert [json.dumps(jsonable(v)) for v in (0.0, -0.0, 1, 1.0, 1)] == ["0.0", "-0.0", "1", "1.0", "1"]
+    fragment = cases_module._memo_fragments()
+    texts = [fragment("x", v) for v in (0.0, -0.0, 1, 1.0, 1)]
+    assert texts == ['"x":0.0', '"x":-0.0', '"x":1', '"x":1.0', '"x":1']
+
+
+def test_ids_and_seeds_of_a_mixed_engine_grid_are_those_of_their_definitions():
+    """The fast listing (each value's text joined, seeds drawn when read) against the
+    definitions, case by case: the digest of each case's canonical JSON and
+    :func:`~spine_mj.sweep.cases.case_seed`, on a grid over both engines (Bullet's unread
+    MuJoCo options None), the preset's mu, two surfaces with their own starts."""
+    pytest.importorskip("pybullet")
+    from spine_mj.sweep.cases import case_seed
+
+    doc = with_(sweep__analyses=["engine"], grid__mu=None, sweep__seed=11)
+    doc["surfaces"] = [
+        {"preset": "paper-single-peak"},
+        {"preset": "paper-single-valley", "starts": {"frame": "absolute", "points": [[-3.0, -1.0]]}},
+    ]
+    doc["grid"] = {"engine": ["mujoco", "bullet"], "settle_time": [0.0, 0.01]}
+    doc["drive"] = {"ie": [1e-3, 1e-2], "K": [10, 30.0]}
+    cases = sweep.expand_cases(sweep.parse_config(doc))
+    assert len(cases) == 2 * 2 * 2 * 2 * 2
+    for c in cases:
+        canonical = {
+            "surface": c.surface.as_dict(),
+            "starts": c.starts.as_dict(),
+            "params": {k: to_jsonable(v) for k, v in c.params.items()},
+        }
+        assert c.case_id == sweep.digests.digest(canonical)[:16]
+        assert c.seed == case_seed(11, c.case_id)
+        if c.params["engine"] == "bullet":
+            assert c.params["integrator"] is None and c.params["timestep"] is None
+        else:
+            assert c.params["integrator"] == "implicitfast"
+    assert len({c.case_id for c in cases}) == len(cases)
