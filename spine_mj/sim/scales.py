@@ -458,9 +458,12 @@ def _check_sizes(
     given: bool = True,
     length_scale_m: float = 1.0,
     unit: str = "m",
+    gridded: bool = False,
 ) -> None:
     """Tip, hfield spacing and L_c against each other and the domain (all in metres);
-    ``given``: the radius is the user's (a default one is named as such). Each length is
+    ``given``: the radius is the user's (a default one is named as such); ``gridded``: the
+    surface keeps its own samples (:func:`~spine_mj.sim.rig_hfield.grid_keeps_samples`: no
+    ``hfield_resolution`` changes its spacing). Each length is
     named in metres and, for a surface in another ``unit`` (``length_scale_m`` metres), in
     the surface's unit too: the CLI takes the tip radius in it."""
 
@@ -482,9 +485,15 @@ def _check_sizes(
             f"engine resolves: both must exceed {_MIN_ENGINE_RATIO:g} L_c = {length(floor)}"
         )
     if spacing > 2 * radius * (1 + 1e-9):
+        remedy = (
+            f"a gridded surface (a file, a scan) keeps its own samples, so hfield_resolution does not "
+            f"apply: use a tip radius of at least {length(spacing / 2)}, or the surface on a finer grid"
+            if gridded
+            else "raise hfield_resolution or the tip radius"
+        )
         raise SpineInputError(
             f"surface too coarse for the tip: hfield spacing {length(spacing)} > 2 x {what} "
-            f"= {length(2 * radius)}; raise hfield_resolution or the tip radius"
+            f"= {length(2 * radius)}; {remedy}"
         )
 
 
@@ -521,6 +530,7 @@ def _planned_sizing(surface: Surface, tip: TipParams, length_scale_m, char_lengt
         given=tip.tip_radius_m is not None,
         length_scale_m=length_scale_m,
         unit=surface.unit,
+        gridded=grid_keeps_samples(surface, 0) is None,
     )
     if resolution is None and spacing < _MIN_SPACING_PER_TIP_RADIUS * radius:
         extent = 2 * max(hfield_half_extents(surface)) * length_scale_m

@@ -13,6 +13,11 @@ from spine_mj.sim import EngineSettings, RampDrive, Rig, SpringDrive, StaticProb
 from spine_mj.surfaces import GridSurface, single_gaussian
 
 
+def _coarse_grid() -> GridSurface:
+    x = np.linspace(-5.0, 5.0, 41)  # 0.25 apart
+    return GridSurface(heights=0.5 * np.sin(x)[None, :] * np.cos(x)[:, None], x=x, y=x)
+
+
 @pytest.mark.parametrize(
     ("make", "match"),
     [
@@ -27,7 +32,14 @@ from spine_mj.surfaces import GridSurface, single_gaussian
         (
             lambda: Rig(single_gaussian(), tip=TipParams(tip_radius_m=1e-5)),
             r"surface too coarse for the tip: hfield spacing 0\.0005 m \(0\.05 surface units\) "
-            r"> 2 x tip_radius_m 1e-05 m \(0\.001 surface units\)",
+            r"> 2 x tip_radius_m 1e-05 m \(0\.001 surface units\).*; raise hfield_resolution or the tip",
+        ),
+        (  # a gridded surface keeps its own samples: no hfield_resolution refines it
+            lambda: Rig(_coarse_grid(), tip=TipParams(tip_radius_m=1e-3)),
+            r"surface too coarse for the tip: hfield spacing 0\.0025 m \(0\.25 surface units\) > 2 x "
+            r"tip_radius_m 0\.001 m .*; a gridded surface \(a file, a scan\) keeps its own samples, so "
+            r"hfield_resolution does not apply: use a tip radius of at least 0\.00125 m \(0\.125 surface "
+            r"units\), or the surface on a finer grid$",
         ),
         (lambda: flat_rig().run(StaticProbe(), start=(1.0, 0.0)), r"start \(1, 0\) lies outside"),
         (  # a batch's starts are checked at once; the first bad one is named
