@@ -15,6 +15,7 @@ and one :func:`register_engine` call.
 
 from __future__ import annotations
 
+import functools
 import importlib
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -106,8 +107,10 @@ class Engine:
         return None if self.hfield_check is None else _load(self.hfield_check)
 
 
+@functools.cache
 def _load(path):
-    """The object ``"module:name"`` names (imported now), or ``path`` itself if not a string."""
+    """The object ``"module:name"`` names (imported now, looked up once: a grid's checks ask
+    for a case's engine a million times), or ``path`` itself if not a string."""
     if not isinstance(path, str):
         return path
     module, _, name = path.partition(":")

@@ -48,6 +48,7 @@ __all__ = [
     "check_planned_hfield",
     "drive_speed_m_s",
     "plan_rig",
+    "plan_settings",
     "rig_scales",
     "rig_sizing",
 ]
@@ -203,11 +204,26 @@ def plan_rig(
         check_planned_hfield(surface, inputs)
         sized = _sized(surface, inputs.tip, **inputs.sizing, progress=progress)
     tip, scales, hfield = sized
-    speed = drive_speed_m_s(scales, **inputs.pace) if inputs.driven else None
-    spring = spring_stiffness_n_m(scales, **inputs.spring)
+    return RigPlan(surface, tip, scales, hfield, plan_settings(scales, inputs))
+
+
+def plan_settings(scales: Scales, inputs: RigInputs, *, pace: dict | None = None, spring: dict | None = None):
+    """The engine settings of ``inputs`` on ``scales``: its engine's settings factory with
+    its options, the step bounded by the drive's speed and spring. ``pace`` and ``spring``
+    (:attr:`RigInputs.pace`, :attr:`RigInputs.spring`), when given, replace those of
+    ``inputs``: a grid's checks plan the cases that differ only in the drive on one
+    record of the rest (:func:`~spine_mj.sweep.analyses.engine.case_plan`)."""
+    pace = inputs.pace if pace is None else pace
+    spring = inputs.spring if spring is None else spring
+    at_most_one(**spring)
+    speed = drive_speed_m_s(scales, **pace) if inputs.driven else None
     factory = check_engine(inputs.engine).settings_factory()
-    settings = factory(scales, speed_m_s=speed, stiffness_n_m=spring, **dict(inputs.engine_options))
-    return RigPlan(surface, tip, scales, hfield, settings)
+    return factory(
+        scales,
+        speed_m_s=speed,
+        stiffness_n_m=spring_stiffness_n_m(scales, **spring),
+        **dict(inputs.engine_options),
+    )
 
 
 def check_planned_hfield(surface: Surface, inputs: RigInputs) -> None:

@@ -11,6 +11,7 @@ needs MuJoCo.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from dataclasses import dataclass
 
@@ -106,17 +107,36 @@ def default_engine(
     -------
     EngineSettings
     """
+    dt = rule_timestep_s(scales, speed_m_s=speed_m_s, stiffness_n_m=stiffness_n_m)
+    _check_rule_step(dt, speed_m_s, given_step="timestep_s" in overrides)
+    return _at_step(scales, dt, overrides)
+
+
+def rule_timestep_s(
+    scales: Scales, *, speed_m_s: float | None = None, stiffness_n_m: float | None = None
+) -> float:
+    """The rule's time step [s] of :func:`default_engine` (the contact's, impacts at
+    ``speed_m_s`` and the spring of ``stiffness_n_m`` bounding it): every setting of the
+    rule follows from it, so the settings of a grid's million drives are made once per
+    step (:func:`mujoco_settings`). 0 where impacts would need a step below the rule's
+    two digits."""
     dt_contact = _contact_step_tau(scales, speed_m_s)  # engine units
     if stiffness_n_m is None:
         stiffness_n_m = scales.stiffness_for(DEFAULT_STIFFNESS_NUMBER)
     omega_tau = math.sqrt(check_positive("stiffness_n_m", stiffness_n_m) / scales.mass_kg) * scales.time_s
-    dt_tau = min(dt_contact, _two_digits_down(SPRING_OMEGA_DT / omega_tau))
-    dt = dt_tau * scales.time_s
-    if not dt > 0 and "timestep_s" not in overrides:
+    return min(dt_contact, _two_digits_down(SPRING_OMEGA_DT / omega_tau)) * scales.time_s
+
+
+def _check_rule_step(dt: float, speed_m_s: float | None, *, given_step: bool) -> None:
+    if not dt > 0 and not given_step:
         raise SpineInputError(
             f"impacts at drive speed {speed_m_s!r} m/s (or a fall down the surface) would need a time "
             f"step of {dt:.3g} s: lower the speed (I_e)"
         )
+
+
+def _at_step(scales: Scales, dt: float, overrides: dict) -> EngineSettings:
+    """:func:`default_engine`'s settings at the rule's step ``dt`` [s] with ``overrides``."""
     base = {
         "timestep_s": dt,
         "solref": (2 * dt, SOLREF_DAMPRATIO),
@@ -125,7 +145,23 @@ def default_engine(
     if "timestep_s" in overrides and "solref" not in overrides:
         base["solref"] = (2 * float(overrides["timestep_s"]), SOLREF_DAMPRATIO)
     base.update(overrides)
-    return EngineSettings(**base)
+    return _settings(base)
+
+
+def _settings(fields: dict) -> EngineSettings:
+    """``EngineSettings(**fields)``, made (and validated) once per distinct ``fields``: the
+    checks of a grid plan a million cases whose steps, rounded by the rule, take a few
+    values (frozen: one record serves them all)."""
+    key = tuple((k, type(v), v) for k, v in fields.items())  # the type: True is no 1
+    try:
+        return _cached_settings(key)
+    except TypeError:  # an unhashable value (a list): made afresh
+        return EngineSettings(**fields)
+
+
+@functools.lru_cache(maxsize=1024)
+def _cached_settings(key: tuple) -> EngineSettings:
+    return EngineSettings(**{k: v for k, _, v in key})
 
 
 @dataclass(frozen=True)
@@ -189,8 +225,13 @@ class EngineOverrides:
         -------
         EngineSettings
         """
-        given = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}  # asdict deep-copies
-        given = {k: v for k, v in given.items() if v is not None}
+        dt = rule_timestep_s(scales, speed_m_s=speed_m_s, stiffness_n_m=stiffness_n_m)
+        _check_rule_step(dt, speed_m_s, given_step=self.timestep_s is not None)
+        return self.at_step(scales, dt)
+
+    def at_step(self, scales: Scales, dt: float) -> EngineSettings:
+        """:meth:`engine` where the rule's step is ``dt`` [s] (:func:`rule_timestep_s`)."""
+        given = {k: v for k in _OVERRIDES if (v := getattr(self, k)) is not None}  # asdict deep-copies
         timeconst_s, dampratio = given.pop("solref_timeconst_s", None), given.pop("solref_dampratio", None)
         factor = given.pop("timestep_factor", None)
         if factor is not None:
@@ -199,16 +240,22 @@ class EngineOverrides:
                     f"timestep_s and timestep_factor: give one of them, got {given['timestep_s']!r} "
                     f"and {factor!r}"
                 )
-            rule = default_engine(scales, speed_m_s=speed_m_s, stiffness_n_m=stiffness_n_m, **given)
+            rule = _at_step(scales, dt, given)
             given["timestep_s"] = rule.timestep_s * check_positive("timestep_factor", factor)
             given["solref"] = rule.solref
-        if timeconst_s is not None or dampratio is not None:
-            rule = default_engine(scales, speed_m_s=speed_m_s, stiffness_n_m=stiffness_n_m, **given)
-            given["solref"] = (
-                rule.solref[0] if timeconst_s is None else timeconst_s,
-                rule.solref[1] if dampratio is None else dampratio,
-            )
-        return default_engine(scales, speed_m_s=speed_m_s, stiffness_n_m=stiffness_n_m, **given)
+        rule = _at_step(scales, dt, given)
+        if timeconst_s is None and dampratio is None:
+            return rule
+        solref = (
+            rule.solref[0] if timeconst_s is None else timeconst_s,
+            rule.solref[1] if dampratio is None else dampratio,
+        )
+        # _at_step with ``solref=solref`` too: a given solref replaces the rule's as is
+        return _settings({**{k: getattr(rule, k) for k in _SETTINGS}, "solref": solref})
+
+
+_OVERRIDES = tuple(f.name for f in dataclasses.fields(EngineOverrides))
+_SETTINGS = tuple(f.name for f in dataclasses.fields(EngineSettings))
 
 
 def mujoco_settings(
@@ -217,7 +264,22 @@ def mujoco_settings(
     """MuJoCo's settings factory in the engine registry (:data:`spine_mj.choices.ENGINES`):
     :func:`default_engine` with ``options``, the fields of :class:`EngineOverrides`, checked
     against the scales (:func:`check_engine_for`)."""
-    settings = EngineOverrides(**options).engine(scales, speed_m_s=speed_m_s, stiffness_n_m=stiffness_n_m)
+    overrides = EngineOverrides(**options)
+    dt = rule_timestep_s(scales, speed_m_s=speed_m_s, stiffness_n_m=stiffness_n_m)
+    _check_rule_step(dt, speed_m_s, given_step=overrides.timestep_s is not None)
+    key = tuple((type(v), v) for v in map(overrides.__getattribute__, _OVERRIDES))  # True is no 1
+    try:
+        return _checked_at_step(overrides, key, scales, dt)
+    except TypeError:  # an unhashable option (a list): made afresh
+        return _checked_at_step.__wrapped__(overrides, key, scales, dt)
+
+
+@functools.lru_cache(maxsize=1024)
+def _checked_at_step(overrides: EngineOverrides, key: tuple, scales: Scales, dt: float) -> EngineSettings:
+    """:func:`mujoco_settings` at the rule's step ``dt``, once per options (``key``: their
+    values with their types), scales and step: the rule rounds a grid's million drives to a
+    few steps."""
+    settings = overrides.at_step(scales, dt)
     check_engine_for(settings, scales)
     return settings
 

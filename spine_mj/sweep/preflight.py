@@ -21,12 +21,11 @@ half a minute, and a grid over both engines spent it on MuJoCo's before refusing
 
 from __future__ import annotations
 
-import hashlib
 import time
 from collections.abc import Callable, Sequence
 
 from spine_mj.errors import SpineInputError
-from spine_mj.sweep.cases import PROGRESS_EVERY_S, Case
+from spine_mj.sweep.cases import PROGRESS_EVERY_S, Case, values_key
 from spine_mj.sweep.registry import ANALYSES
 
 __all__ = ["check_cases", "checked_keys"]
@@ -65,16 +64,14 @@ def check_cases(
         if progress is not None and time.monotonic() - last > PROGRESS_EVERY_S:
             progress(i, len(cases))
             last = time.monotonic()
-        # random starts are drawn from the case's seed: each case has its own
-        source = (case.surface, case.starts, case.seed if case.starts.random is not None else None)
+        # random starts are drawn from the case's seed: each case has its own (the specs by
+        # identity, as values_key names values: the cases hold them)
+        source = (id(case.surface), id(case.starts), case.seed if case.starts.random is not None else None)
         todo = []
         for name in case.analyses:
             if ANALYSES[name].check_case is None:
                 continue
-            # 16 bytes of the values' digest, not their reprs: 2.3 kB a case for the engine's
-            # 38 parameters (a million cases held 2.3 GB of keys)
-            values = "\0".join(repr(case.params.get(k)) for k in keys[name])
-            key = (name, source, hashlib.blake2b(values.encode(), digest_size=16).digest())
+            key = (name, source, values_key(case.params, keys[name]))
             if key not in seen:
                 seen.add(key)
                 todo.append(name)
@@ -96,7 +93,7 @@ def _prechecks(cases: Sequence[Case], swept: Sequence[str]) -> None:
             analysis = ANALYSES[name]
             if analysis.precheck_case is None:
                 continue
-            key = (name, case.surface, tuple(repr(case.params.get(k)) for k in analysis.precheck_reads))
+            key = (name, id(case.surface), values_key(case.params, analysis.precheck_reads))
             if key not in seen:
                 seen.add(key)
                 try:
@@ -111,7 +108,6 @@ def _where(case: Case, swept: Sequence[str]) -> str:
 
 
 def _check(case: Case, analyses, swept: Sequence[str], resolved: dict, source) -> None:
-    where = _where(case, swept)
     try:
         surface = case.surface.make()
         if source not in resolved:
@@ -121,4 +117,4 @@ def _check(case: Case, analyses, swept: Sequence[str], resolved: dict, source) -
             if name is not None:
                 ANALYSES[name].check_case(case, surface, starts)
     except SpineInputError as exc:
-        raise SpineInputError(f"sweep case ({where}): {exc}") from None
+        raise SpineInputError(f"sweep case ({_where(case, swept)}): {exc}") from None

@@ -250,3 +250,104 @@ def test_an_hfield_past_the_budget_is_refused_on_its_predicted_sides_before_any_
     engines = '"mujoco"' if extras.missing("bullet") else '["mujoco", "bullet"]'
     text = PEAK_ENGINE + f"[grid]\nengine = {engines}\nhfield_resolution = 4000\nhfield_refinement = 2\n"
     _refused_before_any_run(tmp_path, text, "an hfield of 7999 x 7999 samples would need")
+
+
+def test_one_bad_combination_buried_in_a_large_grid_is_refused_naming_it(tmp_path):
+    """2480 cases over I_e x K on the paper fractal (L_c / l_s about 29): the spring-block
+    swing sqrt(I_e K L_c / l_s) is below 1 F_p in every case but I_e = 1e-3 with K = 100
+    (1.7 F_p), both in the middle of their lists: the memoized check still finds it."""
+    ie = [round(1e-5 * (1 + 0.3 * i), 9) for i in range(30)]
+    ie.insert(15, 1e-3)
+    stiff = [round(10 + 0.25 * i, 4) for i in range(79)]
+    stiff.insert(40, 100.0)
+    text = FRACTAL.format(analyses='["quasistatic", "engine", "compare"]')
+    text = text.replace("ie = [1e-4, 1e-3]\nK = [10, 100]", f"ie = {ie}\nK = {stiff}")
+    _refused_before_any_run(tmp_path, text, "ie = 0.001, K = 100.0", "spring drive at I_e = 0.001, K = 100")
+
+
+MIXED = """
+[sweep]
+analyses = ["quasistatic", "engine", "compare"]
+[[surfaces]]
+preset = "paper-single-peak"
+[[surfaces]]
+preset = "paper-single-valley"
+starts = {random = 2}
+[starts]
+x = [0.05, 0.9]
+y = [0.5]
+[drive]
+ie = [1.0, 1e-3, 1e-5]
+K = [3, 3000]
+[grid]
+timestep_factor = [1.0, 1e-3]
+tip_radius = [0.05, 0.1]
+"""
+
+
+def _plain_check(case) -> str | None:
+    """The slow, obvious reference: every analysis's checks on ``case`` alone, every cache
+    and memo of the checks emptied first; the refusal's text, or None."""
+    from spine_mj.sim import step_rule
+    from spine_mj.sweep.registry import ANALYSES
+
+    sweep.session.clear_caches()
+    step_rule._checked_at_step.cache_clear()
+    step_rule._cached_settings.cache_clear()
+    surface = case.surface.make()
+    starts = case.starts.resolve(surface.bounds, case.seed)
+    try:
+        for name in case.analyses:
+            analysis = ANALYSES[name]
+            if analysis.precheck_case is not None:
+                analysis.precheck_case(case, surface)
+            if analysis.check_case is not None:
+                analysis.check_case(case, surface, starts)
+    except SpineInputError as exc:
+        return str(exc)
+    return None
+
+
+def test_the_memoized_check_refuses_exactly_the_cases_the_plain_check_refuses(tmp_path):
+    """48 cases over two surfaces (one with random starts, its own per case), I_e, K, the
+    step factor and the tip, refused for three reasons (a swing too large to compare, a run
+    past the step limit, a random start on the domain's edge) or not. The grid's check,
+    its memos kept from one pass to the next, refuses the first bad case in order, and with
+    that case removed the next, exactly the cases and messages of the plain check."""
+    config = sweep.load_config(write_config(tmp_path, MIXED))
+    cases = sweep.expand_cases(config)
+    reference = [(c.case_id, why) for c in cases if (why := _plain_check(c)) is not None]
+    kinds = {
+        kind for _, why in reference for kind in ("must swing", "more than the limit", "edge") if kind in why
+    }
+    assert len(cases) == 48 and 3 < len(reference) < 45 and len(kinds) == 3
+
+    sweep.session.clear_caches()
+    left, refused = list(cases), []
+    while True:
+        try:
+            preflight.check_cases(left, config.swept)
+            break
+        except SpineInputError as exc:
+            bad = next(c for c in left if f"sweep case ({preflight._where(c, config.swept)}): " in str(exc))
+            refused.append((bad.case_id, str(exc).split("): ", 1)[1]))
+            left.remove(bad)
+    assert refused == reference
+
+
+def test_a_case_s_plan_is_the_plan_of_its_inputs(tmp_path):
+    """case_plan (the inputs without the drive checked once, the engine settings per case,
+    made once per rounded step) against plan_rig of the case's own RigInputs, case by case."""
+    from spine_mj.sim.build import plan_rig, rig_sizing
+    from spine_mj.sweep.analyses import engine
+
+    cases = sweep.expand_cases(sweep.load_config(write_config(tmp_path, MIXED)))
+    sweep.session.clear_caches()
+    sized = {}
+    for case in cases:
+        surface = case.surface.make()
+        inputs = engine.case_inputs(case, surface)
+        key = (case.surface.label, inputs.tip)
+        sized.setdefault(key, rig_sizing(surface, tip=inputs.tip, **inputs.sizing))
+        plain, fast = plan_rig(surface, inputs, sized=sized[key]), engine.case_plan(case, surface)
+        assert (fast.engine, fast.scales, fast.tip) == (plain.engine, plain.scales, plain.tip)

@@ -17,7 +17,7 @@ import numpy as np
 from spine_mj import sim
 from spine_mj.choices import DEFAULT_ENGINE, ENGINES, PROTOCOLS
 from spine_mj.errors import SpineInputError
-from spine_mj.sim.build import check_planned_hfield, plan_rig, rig_sizing
+from spine_mj.sim.build import RigPlan, check_planned_hfield, plan_settings, rig_sizing
 from spine_mj.sim.holding import spring_swing
 from spine_mj.sim.model import has_mujoco_model
 from spine_mj.sim.open_loop import drive_steps
@@ -25,6 +25,7 @@ from spine_mj.sim.ramp import nominal_time_s
 from spine_mj.sim.rig_inputs import RigInputs
 from spine_mj.sim.scales import check_tip_radius, engine_tip_radius_m
 from spine_mj.sim.step_rule import SOLREF_DAMPRATIO
+from spine_mj.sweep.cases import values_key
 from spine_mj.sweep.registry import (
     CASE_THREADS,
     KAPPA_CAP_PARAM,
@@ -286,8 +287,10 @@ def case_inputs(case, surface=None) -> RigInputs:
 
     ``surface`` is ``case.surface.make()``, passed when the caller already has it (the tip
     radius is in its length unit)."""
-    surface = case.surface.make() if surface is None else surface
-    p = case.params
+    return _inputs(case.params, case.surface.make() if surface is None else surface)
+
+
+def _inputs(p: dict, surface) -> RigInputs:
     reads = ENGINES[p["engine"]].options
     return RigInputs(
         engine=p["engine"],
@@ -320,6 +323,8 @@ def case_rig(case, surface=None):
 def _clear_caches() -> None:
     _rig.cache_clear()
     _sizing.cache_clear()
+    _BASE_PLANS.clear()
+    _STARTS_CHECKED.clear()
 
 
 case_rig.cache_clear = _clear_caches
@@ -336,18 +341,49 @@ def case_plan(case, surface=None):
     """What :func:`case_rig` would build for ``case``, without compiling it: a MuJoCo case's
     :class:`~spine_mj.sim.build.RigPlan` (its scales, tip and engine step), another
     engine's rig itself (Bullet's checks its heightfield's memory; its world is made at
-    its first run). The surface is sized once per tip for every engine (cached: a grid over
-    both engines measured an 8000-a-side hfield twice). For the checks of a grid before
-    any case runs."""
+    its first run). For the checks of a grid before any case runs.
+
+    The cases of a grid that differ only in the drive's pace and spring (``ie``, ``speed``,
+    ``K``, ``stiffness``, which bound the engine step) share everything else: its inputs
+    checked, the hfield's limits and the surface's sizing (once per tip for every
+    engine: a grid over both engines measured an 8000-a-side hfield twice), cached by
+    :func:`_base_plan`; only the engine settings are made per case
+    (:func:`~spine_mj.sim.build.plan_settings`). The same plan as
+    :func:`~spine_mj.sim.build.plan_rig` of :func:`case_inputs` (tested)."""
     surface = case.surface.make() if surface is None else surface
-    inputs = case_inputs(case, surface)
-    check_planned_hfield(surface, inputs)  # before the sizing: its limits on the predicted sides
-    sized = _sizing(case.surface, inputs.tip, tuple(inputs.sizing.items()))
-    plan = plan_rig(surface, inputs, sized=sized)
+    p = case.params
+    key = values_key(p, _BASE_KEYS) + id(case.surface).to_bytes(8, "little")
+    if key not in _BASE_PLANS:
+        if len(_BASE_PLANS) >= 4096:  # bounded: a grid over many sizings plans each once anyway
+            _BASE_PLANS.clear()
+        base = {k: p[k] for k in _BASE_KEYS}
+        _BASE_PLANS[key] = (case.surface, base, *_base_plan(case.surface, surface, base))  # held
+    inputs, sized = _BASE_PLANS[key][2:]
+    tip, scales, hfield = sized
+    pace = {"ie": p["ie"], "speed_m_s": p["speed"], "rate_n_s": None}
+    spring = {"stiffness_number": p["K"], "stiffness_n_m": p["stiffness"]}
+    plan = RigPlan(surface, tip, scales, hfield, plan_settings(scales, inputs, pace=pace, spring=spring))
     if has_mujoco_model(inputs.engine):
         return plan
     rig_class = ENGINES[inputs.engine].rig_class()
     return rig_class(surface, tip=plan.tip, engine=plan.engine, sized=(plan.scales, plan.hfield))
+
+
+#: :func:`case_plan`'s :func:`_base_plan` by the identities of the values and surface (held).
+_BASE_PLANS: dict = {}
+#: :func:`_on_starts` by the ids of the starts and scales (held, so the ids stay theirs):
+#: a grid's cases share a few start sets (resolved once per source) and scales.
+_STARTS_CHECKED: dict = {}
+
+
+def _base_plan(spec, surface, base: dict) -> tuple:
+    """``(inputs, sized)`` of a case's parameters ``base`` (:data:`_BASE_KEYS`) on
+    ``surface`` (``spec.make()``): its :class:`RigInputs` without the drive's pace and
+    spring, checked, and the surface's sizing, after the hfield's limits on the predicted
+    sides."""
+    inputs = _inputs({**base, **dict.fromkeys(_PACE_KEYS)}, surface)
+    check_planned_hfield(surface, inputs)  # before the sizing: its limits on the predicted sides
+    return inputs, _sizing(spec, inputs.tip, tuple(inputs.sizing.items()))
 
 
 def case_scales(case, surface=None) -> sim.Scales:
@@ -387,6 +423,10 @@ _RIG_KEYS = (
     "hfield_refinement",
     *(s.name for s in ENGINE_PARAMS if s.option is not None),  # every engine option
 )
+#: The drive's pace and spring among them: the keys a grid's cases differ in most.
+_PACE_KEYS = ("ie", "speed", "K", "stiffness")
+#: The other keys of a case's rig (:func:`_base_plan`).
+_BASE_KEYS = tuple(k for k in (*_RIG_KEYS, "tip_radius") if k not in _PACE_KEYS)
 
 
 def case_drive(rig, p: dict):
@@ -446,11 +486,22 @@ def _check_case(case, surface, starts) -> None:
     rig = case_plan(case, surface)
     drive = case_drive(rig, case.params)
     rig.check_drive(drive)
-    det = sim.Detection(kappa_cap=case.params["kappa_cap"]).resolve(rig.scales)
-    rig.check_starts(starts, det.domain_margin_m)
-    if case.params["protocol"] != "ramp" and len(starts):
-        x0 = float(min(s[0] for s in starts)) * rig.length_scale_m
+    det, x0 = _on_starts(rig, starts, case.params["kappa_cap"])
+    if case.params["protocol"] != "ramp" and x0 is not None:
         drive_steps(rig, drive, x0, det)
+
+
+def _on_starts(rig, starts, kappa_cap) -> tuple:
+    """``(detection, x0)``: the detection resolved on ``rig``'s scales and the first start's
+    x [m] (None without starts), after refusing starts a run would end at once; once per
+    start set, scales and cap (a grid's cases share a few)."""
+    key = (id(starts), id(rig.scales), type(kappa_cap), kappa_cap)
+    if key not in _STARTS_CHECKED:
+        det = sim.Detection(kappa_cap=kappa_cap).resolve(rig.scales)
+        rig.check_starts(starts, det.domain_margin_m)
+        x0 = float(min(s[0] for s in starts)) * rig.length_scale_m if len(starts) else None
+        _STARTS_CHECKED[key] = (starts, rig.scales, det, x0)  # held: the ids stay theirs
+    return _STARTS_CHECKED[key][2:]
 
 
 def peak_drive_over_fp(run, preload_n: float) -> float:
