@@ -28,6 +28,9 @@ Sections (each records the machine's load average before and after it):
   (``benchmarks/bench_array.py``): the median wall-time ratio, target at most about 1.
 * ``cli``: wall time of ``spine-mj --help``, of every command's help and of the commands
   that touch no engine (``benchmarks/bench_cli.py``): targets 0.5 s and 1.5 s.
+* ``prepare``: what a sweep of 999,999 cases (``--quick``: 99,999) costs before its first
+  case: listing, checking every combination and writing the manifest, CPU seconds and peak
+  memory (``benchmarks/bench_prepare.py``): target 60 us a case.
 * ``plan_cost``: ``spine-mj validate --quick`` (``--quick``: the smoke plan) as a user runs
   it, its wall time and CPU seconds, and each study's CPU seconds from its sweeps' runs
   (``benchmarks/bench_plan_cost.py``): target ``make demo`` within 5 min.
@@ -68,6 +71,7 @@ import bench_gpu  # noqa: E402
 import bench_hold  # noqa: E402
 import bench_memory  # noqa: E402
 import bench_plan_cost  # noqa: E402
+import bench_prepare  # noqa: E402
 import bench_rollout  # noqa: E402
 import bench_stickslip  # noqa: E402
 import bench_streamline  # noqa: E402
@@ -89,6 +93,7 @@ SECTIONS = {
     "fastforward": bench_fastforward,
     "array": bench_array,
     "cli": bench_cli,
+    "prepare": bench_prepare,
     "plan_cost": bench_plan_cost,
     "engines": bench_engines,
     "gpu": bench_gpu,
@@ -106,6 +111,7 @@ REPORT_ORDER = (
     "engines",
     "fastforward",
     "cli",
+    "prepare",
     "plan_cost",
     "gpu",
     "memory",

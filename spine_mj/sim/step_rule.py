@@ -264,21 +264,27 @@ def mujoco_settings(
     """MuJoCo's settings factory in the engine registry (:data:`spine_mj.choices.ENGINES`):
     :func:`default_engine` with ``options``, the fields of :class:`EngineOverrides`, checked
     against the scales (:func:`check_engine_for`)."""
-    overrides = EngineOverrides(**options)
     dt = rule_timestep_s(scales, speed_m_s=speed_m_s, stiffness_n_m=stiffness_n_m)
-    _check_rule_step(dt, speed_m_s, given_step=overrides.timestep_s is not None)
-    key = tuple((type(v), v) for v in map(overrides.__getattribute__, _OVERRIDES))  # True is no 1
+    _check_rule_step(dt, speed_m_s, given_step=options.get("timestep_s") is not None)
+    key = (id(scales), dt, *((k, type(v), v) for k, v in options.items()))  # the type: True is no 1
     try:
-        return _checked_at_step(overrides, key, scales, dt)
+        hit = _AT_STEP.get(key)
     except TypeError:  # an unhashable option (a list): made afresh
-        return _checked_at_step.__wrapped__(overrides, key, scales, dt)
+        return _checked_at_step(EngineOverrides(**options), scales, dt)
+    if hit is None:
+        if len(_AT_STEP) >= 1024:
+            _AT_STEP.clear()
+        hit = _AT_STEP[key] = (scales, _checked_at_step(EngineOverrides(**options), scales, dt))  # held
+    return hit[1]
 
 
-@functools.lru_cache(maxsize=1024)
-def _checked_at_step(overrides: EngineOverrides, key: tuple, scales: Scales, dt: float) -> EngineSettings:
-    """:func:`mujoco_settings` at the rule's step ``dt``, once per options (``key``: their
-    values with their types), scales and step: the rule rounds a grid's million drives to a
-    few steps."""
+#: :func:`mujoco_settings` by the id of the scales (held with the settings, so the id stays
+#: theirs), the rule's step and the options: the rule rounds a grid's million drives to a
+#: few steps, each made and checked once.
+_AT_STEP: dict = {}
+
+
+def _checked_at_step(overrides: EngineOverrides, scales: Scales, dt: float) -> EngineSettings:
     settings = overrides.at_step(scales, dt)
     check_engine_for(settings, scales)
     return settings

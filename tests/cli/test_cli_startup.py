@@ -189,3 +189,17 @@ def test_a_quick_preparation_prints_nothing_and_a_long_one_shows_its_stages(caps
         shown.update(3, 6, "fall height")
         assert shown.bar is not None
     assert "fall height" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("module", ["spine_mj", "spine_mj.cli"])
+def test_python_m_runs_the_program(module, tmp_path):
+    """``python -m spine_mj`` is ``spine-mj``: its help, and a refusal in one line, exit 2."""
+    out = subprocess.run([sys.executable, "-m", module, "--help"], capture_output=True, text=True)
+    assert out.returncode == 0 and "simulate" in out.stdout, out.stderr
+    bad = subprocess.run(
+        [sys.executable, "-m", module, "surface", "info", str(tmp_path / "missing.npz")],
+        capture_output=True,
+        text=True,
+    )
+    lines = (bad.stdout + bad.stderr).strip().splitlines()
+    assert bad.returncode == 2 and len(lines) == 1 and lines[0].startswith("Error:"), lines

@@ -292,7 +292,7 @@ def _plain_check(case) -> str | None:
     from spine_mj.sweep.registry import ANALYSES
 
     sweep.session.clear_caches()
-    step_rule._checked_at_step.cache_clear()
+    step_rule._AT_STEP.clear()
     step_rule._cached_settings.cache_clear()
     surface = case.surface.make()
     starts = case.starts.resolve(surface.bounds, case.seed)
