@@ -107,77 +107,96 @@ def run(out: Path, refinement: int = 1) -> None:
             print(f"{family} seed {seed}: written", flush=True)
 
 
-#: The ABBM tracks' stiffness numbers: a decade, through the engines' K 1 and 2.
-ABBM_K = (0.2, 0.35, 0.6, 1.0, 2.0)
+def abbm_tracks(out: Path, seeds, preset: str = "abbm", tag: str = "abbm_tracks") -> dict:
+    """Both references on ``preset`` drawn with each of ``seeds`` (the module's docstring),
+    at :func:`~spine_mj.surfaces.abbm_stiffness_numbers`: per seed the catalogs, then per source and K ``tau``
+    and ``S_m`` with their intervals, ``S_m`` over ``sigma / k^2``, whether ``sigma / k^2``
+    lies in the ABBM range, and ``S_m``'s exponent against K; with the CPU seconds of each
+    seed's references. Written to ``<tag>.json``, ``<tag>.md``, catalogs
+    ``<tag>/seed<s>.parquet`` (kept on a rerun)."""
+    import time
 
-
-def abbm_tracks(out: Path, seeds, length: float) -> dict:
-    """Both references on the ``abbm`` preset drawn with each of ``seeds``, ``length`` units
-    long (the module's docstring): per seed the catalogs, then per source and K ``tau`` and
-    ``S_m`` with their intervals, ``S_m`` over ``sigma / k^2``, and ``S_m``'s exponent."""
     from spine_mj.sim.scales import Scales
-    from spine_mj.surfaces import abbm_size_range
+    from spine_mj.surfaces import abbm_size_range, abbm_smallest_slip, abbm_stiffness_numbers
     from spine_mj.validate.slip_catalog import TrackUnits, reference_rows, track_landscape
 
-    folder = out / "abbm_tracks"
+    folder = out / tag
     folder.mkdir(parents=True, exist_ok=True)
-    result: dict = {"length": length, "K": list(ABBM_K), "seeds": {}}
+    result: dict = {"preset": preset, "seeds": {}}
     for seed in seeds:
         path = folder / f"seed{seed}.parquet"
-        short = presets.make_surface("abbm", seed=seed)
-        units = TrackUnits.of(Scales.for_surface(short), 1e-6)
+        surf = presets.make_surface(preset, seed=seed)
+        ks = abbm_stiffness_numbers(surf, MU)
+        result["K"] = ks
+        units = TrackUnits.of(Scales.for_surface(surf), 1e-6)
+        cpu = None
         if not path.is_file():
-            pts = int(round(length / short.spacing[0])) + 1
-            surf = presets.make_surface("abbm", seed=seed, length=length, points=pts)
+            c0 = time.process_time()
             xmin, xmax, _, _ = surf.bounds
             x0, x1 = xmin + EDGE_SHARE * (xmax - xmin), xmax - EDGE_SHARE * (xmax - xmin)
             land = track_landscape(surf, MU, units.tip_radius, (x0, x1))
-            frames = [
-                pd.DataFrame(rows)
-                for k in ABBM_K
-                for rows in reference_rows(
-                    land, units, k, surface=f"abbm seed {seed}", mu=MU, ie=1e-6
-                ).values()
-            ]
             kept = ["source", "K", "start_x_lc", "size_lc", "duration_s", "force_drop_fp"]
-            pd.concat(frames, ignore_index=True)[kept].to_parquet(path, index=False, compression="zstd")
+            frames = []
+            for k in ks:
+                for rows in reference_rows(
+                    land, units, k, surface=f"{preset} seed {seed}", mu=MU, ie=1e-6
+                ).values():
+                    frames.append(pd.DataFrame(rows)[kept])
+                print(f"seed {seed}: K {k:g} done", flush=True)
+            del land
+            pd.concat(frames, ignore_index=True).to_parquet(path, index=False, compression="zstd")
+            cpu = time.process_time() - c0
         events = pd.read_parquet(path)
-        params = short.metadata["params"]
+        params = surf.metadata["params"]
         low, high = (
-            v / units.char_length for v in abbm_size_range(short.spacing[0], params["correlation_length"])
+            v / units.char_length for v in abbm_size_range(surf.spacing[0], params["correlation_length"])
         )
-        entry: dict = {"L_c": units.char_length, "l_s": units.slope_length, "abbm_range_lc": [low, high]}
+        smallest = abbm_smallest_slip(surf.spacing[0]) / units.char_length
+        entry: dict = {
+            "L_c": units.char_length,
+            "l_s": units.slope_length,
+            "abbm_range_lc": [low, high],
+            "references_cpu_s": cpu,
+            "mean_slope": float(np.mean(np.diff(surf.heights[0]) / surf.spacing[0])),
+        }
         for source, by_source in events.groupby("source"):
             cells: dict = {}
             for k, rows in by_source.groupby("K"):
                 sizes = rows["size_lc"].to_numpy()
-                tr = stats.truncated_fit_by_ks(sizes)
+                free = stats.truncated_fit_by_ks(sizes)
+                tr = stats.truncated_fit_by_ks(sizes, xmin_floor=smallest)
                 cut = stats.cutoff_size(sizes)
-                predicted = _abbm_cutoff_lc(short, MU, units.stiffness(k), units.char_length)
+                predicted = _abbm_cutoff_lc(surf, MU, units.stiffness(k), units.char_length)
                 cells[f"{k:g}"] = {
                     "n_events": int(sizes.size),
-                    "tau": {"value": tr["tau"], "low": tr["low"], "high": tr["high"]},
+                    "tau": {"value": tr["tau"], "low": tr["low"], "high": tr["high"], "xmin_lc": tr["xmin"]},
+                    "tau_free_xmin": {
+                        "value": free["tau"],
+                        "low": free["low"],
+                        "high": free["high"],
+                        "xmin_lc": free["xmin"],
+                    },
                     "cutoff_lc": cut,
                     "predicted_cutoff_lc": predicted,
-                    "in_abbm_range": bool(low <= predicted <= high),
+                    "in_abbm_range": bool(low <= predicted * (1 + 1e-9) and predicted <= high * (1 + 1e-9)),
                 }
-            for name, ks in (
+            for name, kk in (
                 ("decade", [float(k) for k in cells]),
                 ("abbm_range", [float(k) for k, c in cells.items() if c["in_abbm_range"]]),
             ):
-                if len(ks) >= 2:
-                    y = np.log([cells[f"{k:g}"]["cutoff_lc"]["value"] for k in ks])
-                    slope = float(np.polyfit(np.log(ks), y, 1)[0])
+                if len(kk) >= 2:
+                    y = np.log([cells[f"{k:g}"]["cutoff_lc"]["value"] for k in kk])
+                    slope = float(np.polyfit(np.log(kk), y, 1)[0])
                     se = (
-                        float(math.sqrt(np.polyfit(np.log(ks), y, 1, cov=True)[1][0, 0]))
-                        if len(ks) > 2
+                        float(math.sqrt(np.polyfit(np.log(kk), y, 1, cov=True)[1][0, 0]))
+                        if len(kk) > 2
                         else math.nan
                     )
-                    cells[f"exponent_{name}"] = {"value": slope, "se": se, "K": ks}
+                    cells[f"exponent_{name}"] = {"value": slope, "se": se, "K": kk}
             entry[source] = cells
         result["seeds"][str(seed)] = entry
-    write_json(out / "abbm_tracks.json", result)
-    (out / "abbm_tracks.md").write_text(_abbm_table(result))
+        write_json(out / f"{tag}.json", result)
+    (out / f"{tag}.md").write_text(_abbm_table(result))
     return result
 
 
@@ -247,13 +266,19 @@ def abbm_walks(out: Path, seeds) -> dict:
 
 def _abbm_table(result: dict) -> str:
     lines = [
-        f"# Both references on fresh ABBM tracks ({result['length']:g} units, the abbm preset's parameters)",
+        f"# Both references on the `{result.get('preset', 'abbm')}` preset drawn with each seed",
         "",
-        "| seed | source | K | slips | tau [95 %] | S_m [L_c] | sigma / k^2 [L_c] | in ABBM range |",
-        "| --- | --- | --- | --- | --- | --- | --- | --- |",
+        "tau: the truncated power law's, its lower cutoff chosen by KS distance above the smallest",
+        "slip that follows S^-3/2 (30 grid spacings, `abbm_smallest_slip`); free xmin: the same with",
+        "no floor. 1.5 in: whether the interval contains 3/2.",
+        "",
+        "| seed | source | K | slips | tau [95 %] | 1.5 in | free xmin: tau [95 %] (xmin [dx]) | S_m [L_c] "
+        "| sigma / k^2 [L_c] | in ABBM range |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |",
     ]
     slopes = []
     for seed, entry in result["seeds"].items():
+        dx_lc = entry["abbm_range_lc"][0] / 50.0 if "abbm_range_lc" in entry else math.nan
         for source in ("overdamped", "inertial"):
             for k, c in entry.get(source, {}).items():
                 if k.startswith("exponent_"):
@@ -263,9 +288,17 @@ def _abbm_table(result: dict) -> str:
                     )
                     continue
                 t, m = c["tau"], c["cutoff_lc"]
+                inside = "yes" if t["low"] <= 1.5 <= t["high"] else "no"
+                f = c.get("tau_free_xmin")
+                free = (
+                    f"{f['value']:.3f} [{f['low']:.3f}, {f['high']:.3f}] ({f['xmin_lc'] / dx_lc:.0f})"
+                    if f
+                    else ""
+                )
                 lines.append(
                     f"| {seed} | {source} | {k} | {c['n_events']} | {t['value']:.3f} [{t['low']:.3f}, "
-                    f"{t['high']:.3f}] | {m['value']:.3g} [{m['low']:.3g}, {m['high']:.3g}] | "
+                    f"{t['high']:.3f}] | {inside} | {free} | "
+                    f"{m['value']:.3g} [{m['low']:.3g}, {m['high']:.3g}] | "
                     f"{c['predicted_cutoff_lc']:.3g} | {'yes' if c['in_abbm_range'] else 'no'} |"
                 )
     return "\n".join([*lines, "", *slopes, ""])
@@ -428,7 +461,8 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("step", choices=("run", "report", "compare", "abbm", "walk"))
     ap.add_argument("--seeds", default="4242", help="abbm: the tracks' seeds")
-    ap.add_argument("--length", type=float, default=4000.0, help="abbm: the tracks' length")
+    ap.add_argument("--preset", default="abbm", help="abbm: the track's preset")
+    ap.add_argument("--tag", default="abbm_tracks", help="abbm: the outputs' name")
     ap.add_argument("--out", default="analysis/reports/stickslip")
     ap.add_argument("--bootstrap", type=int, default=100)
     ap.add_argument("--refinement", type=int, default=1, help="landscape sampled this much finer")
@@ -441,7 +475,7 @@ def main(argv=None):
         print((out / "abbm_walks.md").read_text())
     elif a.step == "abbm":
         seeds = [int(v) for v in a.seeds.split(",")]
-        print(_abbm_table(abbm_tracks(out, seeds, a.length)))
+        print(_abbm_table(abbm_tracks(out, seeds, a.preset, a.tag)))
     elif a.step == "compare":
         print(json.dumps(compare(out, a.bootstrap, a.refinement)["moved"]))
     else:

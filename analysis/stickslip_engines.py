@@ -109,7 +109,7 @@ def one(
     longer = (
         {} if track_length is None else {"length": track_length, "points": int(round(track_length * 10)) + 1}
     )
-    surf = presets.make_surface("abbm", seed=seed, **longer)
+    surf = presets.make_surface("abbm-short", seed=seed, **longer)
     xmin, xmax, _, _ = surf.bounds
     x0, length = xmin + EDGE_SHARE * (xmax - xmin), (1 - 2 * EDGE_SHARE) * (xmax - xmin)
     length = length if travel is None else travel
@@ -383,7 +383,7 @@ def _carriage_rate(engine: str, ie: float, k: float, seed: int = 1) -> float:
     """``k V`` [F_p / s] of the abbm preset's drive (drawn with ``seed``) at ``ie`` and
     ``K = k``: an engine's drop plus this times its duration is its drop at a fixed
     carriage, as the references'."""
-    surf = presets.make_surface("abbm", seed=int(seed))
+    surf = presets.make_surface("abbm-short", seed=int(seed))
     units = TrackUnits.of(build_rig(surf, engine=engine, mu=MU, ie=ie, stiffness_number=k).scales, ie)
     return units.stiffness(k) * units.speed
 

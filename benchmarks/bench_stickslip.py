@@ -55,7 +55,7 @@ def bench_stickslip(quick: bool) -> dict:
     c0 = time.process_time()
     summarize_sizes(sizes, n_bootstrap=100)
     stats_cpu = time.process_time() - c0
-    surf = presets.make_surface("abbm")
+    surf = presets.make_surface("abbm-short")
     c0 = time.process_time()
     with tempfile.TemporaryDirectory() as tmp:
         out = stickslip_to(
@@ -100,7 +100,8 @@ def markdown(res: dict | None) -> list[str]:
         f"{fmt(st['cpu_s'])} CPU s for {st['events']} slips | - | {load} |"
     )
     rows.append(
-        f"| `stickslip abbm --engine mujoco`, K {mj['K']:g}, I_e {mj['ie']:g}, {mj['travel']:g} units | "
+        f"| `stickslip abbm-short --engine mujoco`, K {mj['K']:g}, I_e {mj['ie']:g}, "
+        f"{mj['travel']:g} units | "
         f"{fmt(mj['cpu_s'])} CPU s, {mj['slips']} MuJoCo slips | - | {load} |"
     )
     return rows

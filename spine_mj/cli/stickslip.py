@@ -24,7 +24,13 @@ def parse_stiffness_list(text: str) -> list[float]:
 @main.command("stickslip")
 @click.argument("surface_spec", metavar="SURFACE")
 @click.option("--mu", type=float, default=None, help="Friction coefficient (default: the preset's).")
-@click.option("--K", "stiffness", required=True, help="Stiffness numbers K = k l_s / F_p, comma-separated.")
+@click.option(
+    "--K",
+    "stiffness",
+    default=None,
+    help="Stiffness numbers K = k l_s / F_p, comma-separated (default on an ABBM track: a decade "
+    "over its ABBM range, spine_mj.surfaces.abbm_stiffness_numbers; required elsewhere).",
+)
 @click.option("--ie", type=float, default=1e-4, show_default=True, help="Inertia number of the drive.")
 @click.option(
     "--engine",
@@ -70,12 +76,16 @@ def stickslip_cmd(surface_spec, mu, stiffness, ie, engine, start, travel, bootst
 
     if engine is not None:
         check_engine(engine, "--engine")
-    ks = parse_stiffness_list(stiffness)
+    ks = None if stiffness is None else parse_stiffness_list(stiffness)
     check_positive("--ie", ie)
     if drop_floor is not None:
         check_positive("--drop-floor", drop_floor)
     surf = presets.open_surface(surface_spec)
     mu = presets.resolve_mu(surf, mu, name="--mu")
+    if ks is None:
+        from spine_mj.surfaces import abbm_stiffness_numbers
+
+        ks = abbm_stiffness_numbers(surf, mu)
     with Progress("stickslip", unit="step") as bar:
         out = stickslip_to(
             out_dir,

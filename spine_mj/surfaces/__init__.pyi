@@ -24,8 +24,12 @@ from .hfield import refine_grid as refine_grid
 from .hfield import to_hfield as to_hfield
 from .sandpaper import sandpaper as sandpaper
 from .tracks import abbm_force_intensity as abbm_force_intensity
+from .tracks import abbm_length as abbm_length
 from .tracks import abbm_size_range as abbm_size_range
 from .tracks import abbm_slope_walk as abbm_slope_walk
+from .tracks import abbm_smallest_slip as abbm_smallest_slip
+from .tracks import abbm_stiffness_numbers as abbm_stiffness_numbers
+from .tracks import abbm_stiffness_range as abbm_stiffness_range
 from .tracks import abbm_track as abbm_track
 from .types import BSplineGrid as BSplineGrid
 from .types import GaussianSurface as GaussianSurface

@@ -9,8 +9,32 @@ A tip pulled along x over a profile ``z = f(x)`` meets the landscape force
 Alessandro-Beatrice-Bertotti-Montorsi (ABBM) model, whose slips have closed-form
 statistics. An unbounded walk would steepen the track without limit, so the slope here is
 an Ornstein-Uhlenbeck process of correlation length ``xi``: a random walk of intensity
-``D`` below ``xi``, stationary with rms ``sqrt(D xi)`` beyond it. ABBM holds for slips
-between the grid spacing and ``xi`` (:func:`abbm_size_range`).
+``D`` below ``xi``, stationary with rms ``s = sqrt(D xi)`` beyond it.
+
+**The track's scales, from ABBM's own** (:func:`abbm_size_range`,
+:func:`abbm_stiffness_range`, :func:`abbm_length`). ABBM has one length at each spring,
+the cutoff ``S_m = sigma / k^2``. A track reproduces it between two bounds:
+
+- below, the grid: under the spacing ``dx`` the spline's slope is smooth, not a walk. A
+  slip that starts with a force overshoot ``a`` has the first-passage law of a drifted
+  walk, ``P(S) ~ a S^-3/2 exp(-(a - k S)^2 / (4 sigma S))``, whose local exponent is
+  ``3/2 - a^2 / (4 sigma S)``; on the grid ``a^2 ~ sigma dx``, so ``S^-3/2`` holds from
+  :data:`POWER_LAW_SPACINGS` spacings (:func:`abbm_smallest_slip`), and the stiffest
+  spring's ``S_m`` at :data:`GRID_SPACINGS` spacings leaves sizes up to ``4 S_m = 200 dx``;
+- above, the mean reversion: the slope's drift ``-s / xi`` is an extra stiffness of rms
+  ``sqrt(sigma / xi)`` on the force, and slips pooled over a track measure
+  ``sigma <k_eff^-2> = (sigma / k^2) (1 + 3 S_m / xi)``: 5 % at ``S_m = xi /``
+  :data:`XI_FRACTION`.
+
+The stiffness number is ``K = k l_s / W`` with ``l_s = xi`` (the 1/e length of the
+slope's correlation ``exp(-r / xi)``, exact for the ensemble and stated in the surface's
+metadata, where a track a few ``xi`` long measures anything from 0.4 to 1.1 ``xi``). So
+``S_m / xi = ((1 + mu^2) s / K)^2``: the upper bound sets the softest spring
+``K_lo = (1 + mu^2) s sqrt(64)`` and a decade of K (two decades of ``S_m``) needs
+``xi / dx >= 100 x 50 x 64``. The length follows from ``S_m``'s own scatter: its 95 %
+interval is about ``6 / sqrt(L / S_m)`` relative (the §12 walk: 25 % at 900 cutoffs,
+7 % at 7000), so :data:`CUTOFFS_PER_TRACK` cutoffs of the softest spring give it to
+21 % and the exponent of ``S_m`` against K, over a decade, to about 0.06.
 """
 
 from __future__ import annotations
@@ -29,11 +53,32 @@ from spine_mj.surfaces.base import (
 )
 from spine_mj.surfaces.types import GridSurface
 
-__all__ = ["abbm_force_intensity", "abbm_size_range", "abbm_slope_walk", "abbm_track"]
+__all__ = [
+    "abbm_force_intensity",
+    "abbm_length",
+    "abbm_size_range",
+    "abbm_slope_walk",
+    "abbm_smallest_slip",
+    "abbm_stiffness_numbers",
+    "abbm_stiffness_range",
+    "abbm_track",
+]
 
 #: Largest rms slope of a track: slopes stay well inside (-mu, 1 / mu) at every mu >= 0.5
 #: over ten standard deviations (engaged, never self-locking).
 MAX_RMS_SLOPE = 0.15
+#: The smallest slip that follows ``S^-3/2``, in grid spacings (:func:`abbm_smallest_slip`).
+POWER_LAW_SPACINGS = 30.0
+#: The stiffest spring's cutoff ``S_m``, in grid spacings: on the §12 walk ``tau`` left its
+#: interval (about 0.02 wide on 1e5 slips) at 20 spacings in 2 of 5 draws, at 220 in none.
+GRID_SPACINGS = 50.0
+#: The softest spring's cutoff is ``xi`` over this: the mean reversion raises ``S_m`` by
+#: ``3 S_m / xi``, 5 %.
+XI_FRACTION = 64.0
+#: A track's length in cutoffs ``S_m`` of its softest spring: ``S_m`` to about 21 %.
+CUTOFFS_PER_TRACK = 800.0
+#: A study's stiffness numbers per decade of K (:func:`abbm_stiffness_numbers`).
+K_PER_DECADE = 3
 
 
 def abbm_slope_walk(
@@ -150,7 +195,8 @@ def abbm_track(
             width=w,
             slope_intensity=d,
             correlation_length=xi,
-        ),
+        )
+        | {"slope_length": xi},
     )
 
 
@@ -176,10 +222,10 @@ def abbm_force_intensity(slope_intensity: float, mu: float, load: float = 1.0) -
 
 
 def abbm_size_range(spacing: float, correlation_length: float) -> tuple[float, float]:
-    """The slip sizes over which a track behaves as ABBM: above ten grid spacings (below,
-    the spline's smooth slope replaces the walk) and below a tenth of the correlation length
-    (beyond it, the slope stops wandering and the force becomes stationary). A study's
-    cutoff ``S_m = sigma / k^2`` should lie in this range.
+    """The cutoffs ``S_m = sigma / k^2`` over which a track behaves as ABBM (the module's
+    docstring): from :data:`GRID_SPACINGS` grid spacings (below, the spline's smooth slope
+    shortens the ``S^-3/2`` range) to the correlation length over :data:`XI_FRACTION`
+    (beyond, the mean reversion raises ``S_m`` by more than 5 %).
 
     Parameters
     ----------
@@ -191,6 +237,104 @@ def abbm_size_range(spacing: float, correlation_length: float) -> tuple[float, f
     Returns
     -------
     tuple of float
-        ``(smallest, largest)`` slip size, in surface units.
+        ``(smallest, largest)`` cutoff, in surface units.
     """
-    return 10.0 * spacing, 0.1 * correlation_length
+    return GRID_SPACINGS * spacing, correlation_length / XI_FRACTION
+
+
+def abbm_stiffness_range(
+    spacing: float, slope_intensity: float, correlation_length: float, mu: float
+) -> tuple[float, float]:
+    """The stiffness numbers ``K = k xi / W`` whose cutoff ``S_m = sigma / k^2`` lies in
+    :func:`abbm_size_range`: ``K = (1 + mu^2) xi sqrt(D / S_m)`` at its two ends.
+
+    Parameters
+    ----------
+    spacing, slope_intensity, correlation_length : float
+        The track's ``dx``, ``D`` and ``xi`` (:func:`abbm_track`).
+    mu : float
+        The tip's friction coefficient.
+
+    Returns
+    -------
+    tuple of float
+        ``(softest, stiffest)`` K.
+    """
+    low, high = abbm_size_range(spacing, correlation_length)
+    scale = (1 + mu * mu) * correlation_length * math.sqrt(slope_intensity)
+    return scale / math.sqrt(high), scale / math.sqrt(low)
+
+
+def abbm_length(
+    slope_intensity: float, correlation_length: float, mu: float, stiffness_number: float
+) -> float:
+    """The track length that holds :data:`CUTOFFS_PER_TRACK` cutoffs ``S_m`` of the spring
+    ``K = stiffness_number`` (``k = K W / xi``), in surface units.
+
+    Parameters
+    ----------
+    slope_intensity, correlation_length : float
+        The track's ``D`` and ``xi``.
+    mu : float
+        The tip's friction coefficient.
+    stiffness_number : float
+        The softest K of a study.
+
+    Returns
+    -------
+    float
+    """
+    k = stiffness_number / correlation_length
+    return CUTOFFS_PER_TRACK * abbm_force_intensity(slope_intensity, mu) / (k * k)
+
+
+def abbm_stiffness_numbers(surface: GridSurface, mu: float) -> list[float]:
+    """A study's K on an ABBM track: log-spaced, :data:`K_PER_DECADE` a decade, over
+    :func:`abbm_stiffness_range` (1, 2.15, 4.64 and 10 on the ``abbm`` preset at mu 0.5),
+    to three significant figures.
+
+    Parameters
+    ----------
+    surface : GridSurface
+        A track made by :func:`abbm_track`.
+    mu : float
+        The tip's friction coefficient.
+
+    Returns
+    -------
+    list of float
+
+    Raises
+    ------
+    SpineInputError
+        For a surface that is not an ABBM track.
+    """
+    meta = surface.metadata if isinstance(surface.metadata, dict) else {}
+    if meta.get("generator") != "abbm_track":
+        kind = meta.get("generator") or type(surface).__name__
+        raise SpineInputError(f"default stiffness numbers need an ABBM track, got a {kind} surface: give --K")
+    params = meta["params"]
+    lo, hi = abbm_stiffness_range(
+        surface.spacing[0], params["slope_intensity"], params["correlation_length"], mu
+    )
+    n = max(2, int(round(K_PER_DECADE * math.log10(hi / lo))) + 1)
+    return [float(f"{v:.3g}") for v in np.geomspace(lo, hi, n)]
+
+
+def abbm_smallest_slip(spacing: float) -> float:
+    """The smallest slip size that follows ABBM's ``S^-3/2`` on a track of grid ``spacing``:
+    :data:`POWER_LAW_SPACINGS` spacings (the module's docstring: the start's overshoot
+    bends the law by ``a^2 / (4 sigma S)``, ``a^2 ~ sigma dx``). A fit's lower cutoff
+    belongs above it.
+
+    Parameters
+    ----------
+    spacing : float
+        The track's grid spacing, in surface units.
+
+    Returns
+    -------
+    float
+        In surface units.
+    """
+    return POWER_LAW_SPACINGS * spacing

@@ -163,13 +163,17 @@ def truncated_fit(x, xmin: float) -> dict:
     }
 
 
-def truncated_fit_by_ks(x, candidates: int = 12) -> dict:
+def truncated_fit_by_ks(x, candidates: int = 12, xmin_floor: float = 0.0) -> dict:
     """:func:`truncated_fit` above the ``xmin`` whose fitted law lies closest to the data in
-    KS distance, over ``candidates`` quantiles from the smallest value to the one that
-    keeps :data:`~spine_mj.validate.slip_tails.MIN_TAIL` values (the truncated law's own
-    cutoff rule: a pure power law's would push ``xmin`` into the exponential tail)."""
+    KS distance, over ``candidates`` quantiles from the smallest value at least
+    ``xmin_floor`` to the one that keeps :data:`~spine_mj.validate.slip_tails.MIN_TAIL`
+    values (the truncated law's own cutoff rule: a pure power law's would push ``xmin``
+    into the exponential tail). ``xmin_floor``: where the law is known to start, below which
+    no ``xmin`` is tried (an ABBM track's :func:`~spine_mj.surfaces.abbm_smallest_slip`);
+    fewer than ``4 MIN_TAIL`` values above it leave the floor out."""
     xs = _positive(x)
-    grid = np.unique(np.quantile(xs[: xs.size - 4 * MIN_TAIL + 1], np.linspace(0.0, 1.0, candidates)))
+    above = xs[xs >= xmin_floor] if np.count_nonzero(xs >= xmin_floor) >= 4 * MIN_TAIL else xs
+    grid = np.unique(np.quantile(above[: above.size - 4 * MIN_TAIL + 1], np.linspace(0.0, 1.0, candidates)))
     fits = [truncated_fit(xs, float(xmin)) for xmin in grid]
     return min(fits, key=lambda f: f["ks"])
 
@@ -283,9 +287,10 @@ def two_sample(a, b) -> dict:
     }
 
 
-def summarize_sizes(sizes, n_bootstrap: int = 100, rng: int = 0) -> dict:
+def summarize_sizes(sizes, n_bootstrap: int = 100, rng: int = 0, xmin_floor: float = 0.0) -> dict:
     """Every statistic of one series of sizes: ``n_events``, ``tau`` (the truncated power
-    law's, ``{value, low, high}``), ``alpha`` (the pure power law's), ``cutoff`` (``S_m``),
+    law's, ``{value, low, high}``, its ``xmin`` at least ``xmin_floor``:
+    :func:`truncated_fit_by_ks`), ``alpha`` (the pure power law's), ``cutoff`` (``S_m``),
     ``xmin``, ``gof`` and ``likelihood_ratios``; ``n_events`` alone below
     :data:`~spine_mj.validate.slip_tails.MIN_EVENTS` events."""
     from spine_mj.validate.slip_tails import MIN_EVENTS
@@ -295,7 +300,7 @@ def summarize_sizes(sizes, n_bootstrap: int = 100, rng: int = 0) -> dict:
     if s.size < MIN_EVENTS or np.unique(s).size < 10:
         return out
     pl = power_law_fit(s)
-    tr = truncated_fit_by_ks(s)
+    tr = truncated_fit_by_ks(s, xmin_floor=xmin_floor)
     out.update(
         tau={"value": tr["tau"], "low": tr["low"], "high": tr["high"]},
         alpha={"value": pl["alpha"], "low": pl["low"], "high": pl["high"]},

@@ -95,6 +95,16 @@ def _abbm_cutoff_lc(surface, mu: float, k: float, lc: float) -> float | None:
     return abbm_force_intensity(meta["params"]["slope_intensity"], mu) / k**2 / lc
 
 
+def _abbm_smallest_lc(surface, lc: float) -> float:
+    """An ABBM track's smallest slip that follows ``S^-3/2`` [L_c]; 0 on any other track."""
+    meta = getattr(surface, "metadata", {}) or {}
+    if meta.get("generator") != "abbm_track":
+        return 0.0
+    from spine_mj.surfaces import abbm_smallest_slip
+
+    return abbm_smallest_slip(surface.spacing[0]) / lc
+
+
 def stickslip_to(
     out_dir: str | Path,
     surface,
@@ -371,7 +381,11 @@ def _summary(events, surface, mu, ie, ks, units_by_k, engine, x0, length, n_boot
         per_source[source] = {}
         for k in ks:
             sizes = events.loc[(events["source"] == source) & (events["K"] == k), "size_lc"].to_numpy()
-            fit = stats.summarize_sizes(sizes, n_bootstrap=n_bootstrap)
+            fit = stats.summarize_sizes(
+                sizes,
+                n_bootstrap=n_bootstrap,
+                xmin_floor=_abbm_smallest_lc(surface, units_by_k[k].char_length),
+            )
             entry = {"n_events": fit["n_events"]}
             if "tau" in fit:
                 entry.update(
