@@ -185,7 +185,7 @@ def test_every_combination_is_checked_without_building_a_rig_or_repeating_a_chec
 
 
 def test_a_large_sweep_says_what_it_prepares_before_its_first_case(tmp_path, monkeypatch):
-    """Listing, checking and recording 999,999 cases takes a minute or more: a sweep of at
+    """Listing, checking and recording 999,999 cases takes minutes: a sweep of at
     least PREPARE_NOTICE_CASES says each step (the threshold lowered here to 4 cases)."""
     from sweep_support import peak_config
 
