@@ -14,7 +14,12 @@ It stays fast on large grids: each analysis checks each distinct combination of 
 parameters it reads (its own and those of the analyses it needs) once per surface and
 start set, and the checks are closed forms on the rig's scales and step rule
 (:class:`~spine_mj.sim.build.RigPlan`), no rig being built (the surface is measured once
-per tip sizing). The checks that need no sizing (an analysis's ``precheck_case``: the
+per tip sizing). Within a check, what reads fewer keys is done once per distinct
+combination of those (a case's rig inputs, hfield limits, sizing and starts,
+:func:`~spine_mj.sweep.analyses.engine.case_plan`; MuJoCo's settings once per rounded rule
+step, :func:`~spine_mj.sim.step_rule.mujoco_settings`), so an I_e x K grid's cases cost
+their drive's checks alone (~130 us a case, 2026-11: 166 CPU-s listing and checking
+999,999, ``make bench``'s ``prepare``). The checks that need no sizing (an analysis's ``precheck_case``: the
 planned hfield's limits) run on the whole grid first: sizing an 8000-a-side hfield takes
 half a minute, and a grid over both engines spent it on MuJoCo's before refusing Bullet's.
 """
