@@ -65,7 +65,7 @@ def bench_prepare(quick: bool) -> dict:
     cpu = (after.ru_utime + after.ru_stime) - (before.ru_utime + before.ru_stime)
     res.update(
         process_cpu_s=round(cpu, 1),
-        us_per_case=round(1e6 * cpu / res["cases"], 1),
+        us_per_case=round(1e6 * res["total_s"] / res["cases"], 1),  # not the start-up's imports
     )
     return res
 
@@ -78,7 +78,7 @@ def markdown(res: dict | None) -> list[str]:
     return [
         f"| preparing a sweep of {res['cases']:,} cases before its first (listing {res['list_s']:.1f}, "
         f"checking {res['check_s']:.1f}, manifest {res['store_s']:.1f} CPU-s; peak "
-        f"{res['peak_rss_mb']:,} MB) | {res['process_cpu_s']:.1f} CPU-s, "
-        f"{res['us_per_case']:.0f} us a case | "
+        f"{res['peak_rss_mb']:,} MB; the process {res['process_cpu_s']:.1f} CPU-s) | "
+        f"{res['total_s']:.1f} CPU-s, {res['us_per_case']:.0f} us a case | "
         f"{target_cell(res['us_per_case'], '<=', TARGET_US_PER_CASE, ' us')} | {ld} |"
     ]
