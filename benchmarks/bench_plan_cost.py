@@ -2,12 +2,12 @@
 
 ``spine-mj validate --quick`` (``--quick`` here: the ``smoke`` plan) runs as a user runs it,
 in a fresh process, into a temporary folder. Reported per study: its wall time (the
-report's ``timings_s``), the CPU seconds its sweeps' cases took (the stores' per-run
-``cpu_s``, summed: engine, references and comparisons, whichever worker ran them) and its
-runs; and for the whole command its wall time and CPU seconds (the command and its worker
-processes, from ``getrusage``). What the cases do not account for is the main process's
-own work (sweep preflight, predicted limits, the arrays, bootstraps, figures, imports) and
-the workers' start-up (imports, numba kernels compiled or loaded).
+report's ``timings_s``), its CPU seconds (the report's ``cpu_s``: the command's process and
+the workers it forked, whatever they did: sweeps, predicted limits, bootstraps, figures,
+numba kernels compiled or loaded), the CPU seconds its sweeps' cases took (the stores'
+per-run ``cpu_s``, summed: engine, references and comparisons, whichever worker ran them)
+and its runs; and for the whole command its wall time and CPU seconds (from
+``getrusage``: its imports and start-up included).
 
 Target: the quick plan within :data:`QUICK_WALL_TARGET_S` on an idle 2-core machine with
 AVX-512, which leaves ``make demo`` (the virtualenv from the pip cache, ~40 s, and the
@@ -42,19 +42,27 @@ def study_of(store_name: str) -> str:
 
 
 def plan_cost(out_dir: Path) -> dict:
-    """Per study of the validation in ``out_dir``: ``wall_s`` (``timings_s``), ``sweep_cpu_s``
-    and ``runs`` (MuJoCo runs: rows of the ``engine`` analysis) from its sweep stores."""
+    """Per study of the validation in ``out_dir``: ``wall_s`` (``timings_s``), ``cpu_s`` (its
+    ``cpu_s``, None in a report without them), ``sweep_cpu_s`` and ``runs`` (MuJoCo runs: rows
+    of the ``engine`` analysis) from its sweep stores."""
     from spine_mj import sweep
 
     out_dir = Path(out_dir)
-    timings = json.loads((out_dir / "validation.json").read_text())["timings_s"]
-    studies = {k: {"wall_s": v, "sweep_cpu_s": 0.0, "runs": 0} for k, v in timings.items() if k != "total"}
+    doc = json.loads((out_dir / "validation.json").read_text())
+    timings, cpu = doc["timings_s"], doc.get("cpu_s", {})  # cpu_s: reports written since 2026-11-29
+    studies = {
+        k: {"wall_s": v, "cpu_s": cpu.get(k), "sweep_cpu_s": 0.0, "runs": 0}
+        for k, v in timings.items()
+        if k != "total"
+    }
+    if "report" in cpu:  # the figures and report.md, after the studies
+        studies["report"] = {"wall_s": None, "cpu_s": cpu["report"], "sweep_cpu_s": 0.0, "runs": 0}
     for manifest in sorted((out_dir / "sweeps").rglob("manifest.json")):
         store = manifest.parent
         df = sweep.load_runs(store, columns=["analysis", "cpu_s"])
         row = studies.setdefault(
             study_of(str(store.relative_to(out_dir / "sweeps"))),
-            {"wall_s": None, "sweep_cpu_s": 0.0, "runs": 0},
+            {"wall_s": None, "cpu_s": None, "sweep_cpu_s": 0.0, "runs": 0},
         )
         row["sweep_cpu_s"] += float(df["cpu_s"].sum())
         row["runs"] += int((df["analysis"] == "engine").sum())
@@ -102,15 +110,9 @@ def markdown(res: dict | None) -> list[str]:
     ]
     for name, r in res["studies"].items():
         wall = f"{r['wall_s']:.0f} s wall" if r["wall_s"] is not None else "no wall time"
-        if not r["runs"]:  # no sweep: the study runs in the command's own process
-            rows.append(
-                f"| {res['plan']} plan, study `{name}`: no sweep (in the command) | {wall} | | {ld} |"
-            )
-            continue
-        rows.append(
-            f"| {res['plan']} plan, study `{name}` ({wall}, {r['runs']} MuJoCo runs): CPU of its cases | "
-            f"{r['sweep_cpu_s']:.0f} s | | {ld} |"
-        )
+        cases = f"{r['sweep_cpu_s']:.0f} s in {r['runs']} MuJoCo runs' cases" if r["runs"] else "no sweep"
+        cpu = f"{r['cpu_s']:.0f} s" if r.get("cpu_s") is not None else "not recorded"
+        rows.append(f"| {res['plan']} plan, study `{name}` ({wall}; {cases}): CPU | {cpu} | | {ld} |")
     return rows
 
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import dataclasses
 import os
+import resource
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -50,7 +51,8 @@ def run_validation(
     Returns
     -------
     dict
-        The content of ``validation.json``.
+        The content of ``validation.json``; per study (and ``report``, ``total``) its wall
+        seconds in ``timings_s`` and its CPU seconds in ``cpu_s`` (the process and the workers it forked).
 
     Raises
     ------
@@ -70,19 +72,33 @@ def run_validation(
     remove_temporaries(out)  # of a killed run this one resumes
     t0 = time.perf_counter()
     runner = StudyRunner(out, workers, progress, t0)
-    timings = {}
+    timings, cpu = {}, {}
+    c0 = _cpu_seconds()
     results = []
     for study in studies.STUDIES:
-        t = time.perf_counter()
+        t, c = time.perf_counter(), _cpu_seconds()
         results.append(study.run(plan, runner))
         timings[study.name] = round(time.perf_counter() - t, 2)
+        cpu[study.name] = round(_cpu_seconds() - c, 2)
     runner.study = "report"
     with runner.phase("figures and report"):
+        c = _cpu_seconds()
         result = _summary(plan, results, timings)
         write_report(out, result, results)
+        cpu["report"] = round(_cpu_seconds() - c, 2)
     result["timings_s"]["total"] = round(time.perf_counter() - t0, 2)
+    cpu["total"] = round(_cpu_seconds() - c0, 2)
+    result["cpu_s"] = cpu
     write_json(out / "validation.json", result)
     return result
+
+
+def _cpu_seconds() -> float:
+    """CPU seconds of this process (every thread) and of its finished child processes (the
+    sweeps' local workers, forked and joined): what a study costs on any machine, where its
+    wall time depends on the load and the cores (``validation.json``'s ``cpu_s``, per study)."""
+    children = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return time.process_time() + children.ru_utime + children.ru_stime
 
 
 def _summary(plan: ValidationPlan, results: list, timings: dict) -> dict:

@@ -84,6 +84,10 @@ def test_smoke_validation_writes_report_and_json(tmp_path, monkeypatch):
             assert row[f"n_ok_{series}"] + row[f"failed_runs_{series}"] == plan.fractal.surfaces
     assert fractal["corner_ie"] == plan.lowest_ie and fractal["dynamic_ie"] == plan.fractal.dynamic_ie
     assert "fractal_lock" in doc["timings_s"]
+    # CPU seconds per study, the workers' included: the studies and the report add up to the total
+    cpu = doc["cpu_s"]
+    assert set(cpu) == set(doc["timings_s"]) | {"report"} and cpu["limit"] > 0
+    assert sum(v for k, v in cpu.items() if k != "total") == pytest.approx(cpu["total"], abs=0.1)
     assert "Self-lock rate against the Hurst exponent" in report and "figures/fractal_lock_rate.png" in report
     assert (out / "figures" / "fractal_lock_rate.png").stat().st_size > 1000
     # the (I_e, K) map: I_e* per family and K, its heat map, no CCDF without rough families
