@@ -12,6 +12,7 @@ from __future__ import annotations
 import concurrent.futures as cf
 import contextlib
 import dataclasses
+import functools
 import importlib
 import logging
 import math
@@ -60,15 +61,17 @@ def run_here(todo: list[Case], handle, *, threads: int = 1) -> None:
         CASE_THREADS.reset(token)
 
 
-def run_processes(todo: list[Case], n_workers: int, handle) -> None:
-    """``n_workers`` local worker processes, taking the cases in the order of ``todo``."""
+def run_processes(todo: list, n_workers: int, handle, work=None, on_death=None) -> None:
+    """``n_workers`` local worker processes, taking the cases in the order of ``todo``
+    (``work(case)`` in a worker, by default :func:`encoded_case`; ``on_death(case, reason)``
+    here for a case whose worker failed, by default :func:`dead_worker_case`)."""
     # one BLAS thread per worker process (idle BLAS threads spinning in every worker cost a
     # third of the throughput on 2 cores); the worker server reads these when it starts
     saved = {k: os.environ.get(k) for k in _ONE_THREAD}
     for k in _ONE_THREAD:
         os.environ.setdefault(k, "1")
     try:
-        _run_pool(todo, n_workers, handle)
+        _run_pool(todo, n_workers, handle, work or encoded_case, on_death or dead_worker_case)
     finally:
         for k, v in saved.items():
             if v is None:
@@ -77,10 +80,39 @@ def run_processes(todo: list[Case], n_workers: int, handle) -> None:
                 os.environ[k] = v
 
 
+def map_processes(work: Callable, items, n_workers: int) -> list:
+    """``[work(item) for item in items]`` on ``n_workers`` local worker processes (the
+    sweeps' pool: :func:`run_processes`), in the order of ``items``; one worker or one item
+    runs here. ``work`` must be a module-level function and the items and results
+    picklable. Raises RuntimeError (after the other items finished) where an item's
+    ``work`` raised or its worker died, naming why."""
+    items = list(items)
+    if n_workers <= 1 or len(items) <= 1:
+        return [work(item) for item in items]
+    got: dict[int, tuple] = {}
+    run_processes(
+        list(enumerate(items)),
+        n_workers,
+        lambda res: got.__setitem__(res[0], res[1:]),
+        functools.partial(_indexed, work),
+        lambda job, reason: (job[0], False, reason),
+    )
+    failed = [f"item {i}: {got[i][1]}" for i in sorted(got) if not got[i][0]]
+    if failed:
+        raise RuntimeError(f"{work.__name__} failed on {len(failed)} of {len(items)} items; " + failed[0])
+    return [got[i][1] for i in range(len(items))]
+
+
+def _indexed(work: Callable, job: tuple) -> tuple:
+    """``(index, True, work(item))`` of ``job = (index, item)`` (a worker's task in
+    :func:`map_processes`)."""
+    return job[0], True, work(job[1])
+
+
 _ONE_THREAD = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
 
 
-def _run_pool(todo: list[Case], n_workers: int, handle) -> None:
+def _run_pool(todo: list, n_workers: int, handle, work, on_death) -> None:
     if threading.active_count() == 1 and "fork" in multiprocessing.get_all_start_methods():
         # a single-threaded process forks safely, and its workers inherit every module it
         # has imported: no second start-up (about 1 s of imports on one core per pool)
@@ -91,7 +123,7 @@ def _run_pool(todo: list[Case], n_workers: int, handle) -> None:
         # a server that has imported these once
         ctx, parent = multiprocessing.get_context("forkserver"), None
         ctx.set_forkserver_preload(list(_WORKER_MODULES))
-    run_pool(todo, n_workers, ctx, encoded_case, dead_worker_case, handle, parent_pid=parent)
+    run_pool(todo, n_workers, ctx, work, on_death, handle, parent_pid=parent)
 
 
 def dead_worker_case(case: Case, reason: str) -> tuple:

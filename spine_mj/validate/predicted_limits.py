@@ -26,6 +26,7 @@ import numpy as np
 
 from spine_mj import presets
 from spine_mj.sim.step_rule import DEFAULT_STIFFNESS_NUMBER
+from spine_mj.sweep.executors import map_processes
 from spine_mj.theory.drive_limits import Corner, DriveLimits, drive_limits, quasistatic_corner
 from spine_mj.validate.paths import tip_radius
 from spine_mj.validate.plans import FamilySpec, ValidationPlan
@@ -35,6 +36,7 @@ __all__ = [
     "CORNER_PATH_STARTS",
     "corner_drives",
     "family_corner",
+    "family_corners",
     "family_k_axis",
     "family_limits",
     "k_ladder",
@@ -132,29 +134,45 @@ def family_corner(plan: ValidationPlan, fam: FamilySpec) -> dict:
         ...); ``surfaces``: per surface label its ``ie_star``, ``limit``, ``k_star``,
         ``k_path``, ``k_path_left_out`` and ``lc_over_ls``.
     """
+    return family_corners(plan, [fam])[fam.name]
+
+
+def family_corners(plan: ValidationPlan, fams, *, workers: int = 1) -> dict:
+    """:func:`family_corner` of each family of ``fams``, by name, every surface's limits
+    predicted on ``workers`` local processes at once (each surface's own numbers, as one by
+    one: the corners are the quasistatic-limit study's serial start, ~50 s on one core)."""
+    jobs = [(plan, fam, preset, v) for fam in fams for preset in fam.presets for v in fam.variants or ((),)]
+    limits = iter(map_processes(_surface_limits, jobs, workers))
+    out = {}
+    for fam in fams:
+        per, corners = {}, {}
+        for preset in fam.presets:
+            own = []
+            for variant in fam.variants or ((),):
+                d = next(limits)
+                per[preset + "".join(f" {k}={v}" for k, v in variant)] = _limit_row(d)
+                own.append(d)
+            corners[preset] = surface_corner(own).as_dict()
+        out[fam.name] = {"presets": corners, "surfaces": per}
+    return out
+
+
+def _surface_limits(job) -> DriveLimits:
+    """The predicted limits of one surface of a corner (:func:`family_corner`), ``job`` its
+    ``(plan, family, preset, generator variant)``."""
+    plan, fam, preset, variant = job
     seed = fam.seeds[0] if fam.seeds else None
-    per, corners = {}, {}
-    for preset in fam.presets:
-        mu = fam.mu if fam.mu is not None else presets.calibrated_mu(preset)
-        tip = tip_radius(preset, None if seed is None else (seed,), plan.hfield_resolution)
-        own = []
-        for variant in fam.variants or ((),):
-            surface = presets.open_surface(
-                preset, **dict(variant, **({} if seed is None else {"seed": seed}))
-            )
-            d = drive_limits(
-                surface,
-                mu,
-                tip_radius=tip,
-                n_starts=CORNER_GRID_STARTS,
-                path_starts=path_starts(fam, surface, CORNER_PATH_STARTS),
-                carriage_edge=surface.bounds[1],
-            )
-            label = preset + "".join(f" {k}={v}" for k, v in variant)
-            per[label] = _limit_row(d)
-            own.append(d)
-        corners[preset] = surface_corner(own).as_dict()
-    return {"presets": corners, "surfaces": per}
+    mu = fam.mu if fam.mu is not None else presets.calibrated_mu(preset)
+    tip = tip_radius(preset, None if seed is None else (seed,), plan.hfield_resolution)
+    surface = presets.open_surface(preset, **dict(variant, **({} if seed is None else {"seed": seed})))
+    return drive_limits(
+        surface,
+        mu,
+        tip_radius=tip,
+        n_starts=CORNER_GRID_STARTS,
+        path_starts=path_starts(fam, surface, CORNER_PATH_STARTS),
+        carriage_edge=surface.bounds[1],
+    )
 
 
 def surface_corner(limits) -> Corner:

@@ -78,6 +78,11 @@ class StudyRunner:
         self.t0 = t0
         self.study = ""
 
+    @property
+    def n_workers(self) -> int:
+        """The worker processes a sweep of several cases runs on (``workers``, else every core)."""
+        return self.workers or os.cpu_count() or 1
+
     @contextlib.contextmanager
     def phase(self, step: str, total: int = 1) -> Iterator[Callable[[], None]]:
         """A phase that runs no sweep (``step``), of ``total`` parts: reported at 0 as it
@@ -122,8 +127,7 @@ class StudyRunner:
 
         # not capped at the case count: a sweep of one case steps its engine batch on the
         # workers' threads instead of starting processes
-        w = workers if workers is not None else self.workers
-        w = w or os.cpu_count() or 1
+        w = workers or self.n_workers
         sweep.run_sweep(config, store, workers=w, overwrite=True, progress=self._sweep_progress(name))
         return sweep.load_runs(store), store
 
@@ -140,7 +144,7 @@ class StudyRunner:
         configs = [sweep.parse_config(doc, base_dir=self.out_dir) for doc, _ in jobs]
         stores = [self.out_dir / "sweeps" / name for _, name in jobs]
 
-        w = self.workers or os.cpu_count() or 1
+        w = self.n_workers
         progress = self._sweep_progress(step)
         sweep.run_sweeps(list(zip(configs, stores)), workers=w, overwrite=True, progress=progress)
         return [(sweep.load_runs(store), store) for store in stores]

@@ -129,3 +129,18 @@ def test_after_a_lost_scheduler_dask_stays_quiet():
             raise KeyError("another error restores them")
     finally:
         client_log.setLevel(level)
+
+
+def _square_or_fail(x):
+    if x == 3:
+        raise ValueError("three is refused")
+    return x * x
+
+
+def test_map_processes_keeps_the_order_and_names_a_failure():
+    from spine_mj.sweep.executors import map_processes
+
+    assert map_processes(_square_or_fail, [5, 1, 4, 2], 2) == [25, 1, 16, 4]
+    assert map_processes(_square_or_fail, [5, 1, 4, 2], 1) == [25, 1, 16, 4]
+    with pytest.raises(RuntimeError, match="ValueError: three is refused"):
+        map_processes(_square_or_fail, [1, 3, 2], 2)

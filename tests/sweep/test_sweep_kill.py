@@ -182,13 +182,13 @@ def test_a_sweep_whose_workers_cannot_start_ends_in_one_line_and_resumes(tmp_pat
     from spine_mj.cli import main
     from spine_mj.sweep import executors
 
-    def dying_pool(todo, n_workers, handle):  # workers that exit before their first case
+    def dying_pool(todo, n_workers, handle, work, on_death):  # workers that exit before their first case
         run_pool(
             todo,
             n_workers,
             _StartsInstead(os._exit, (3,)),
-            executors.encoded_case,
-            executors.dead_worker_case,
+            work,
+            on_death,
             handle,
             parent_pid=os.getpid(),
         )
