@@ -35,6 +35,7 @@ __all__ = [
     "CORNER_GRID_STARTS",
     "CORNER_PATH_STARTS",
     "corner_drives",
+    "families_limits",
     "family_corner",
     "family_corners",
     "family_k_axis",
@@ -69,33 +70,50 @@ def family_limits(plan: ValidationPlan, fam: FamilySpec, *, n_starts: int = 8) -
     {preset: DriveLimits.as_dict()}}`` of ``fam`` on its first seed and variant (see
     module), from ``n_starts x n_starts`` paths per surface and ``K_path`` from as many
     starts as the family has."""
+    return families_limits(plan, [fam], n_starts=n_starts)[fam.name]
+
+
+def families_limits(plan: ValidationPlan, fams, *, n_starts: int = 8, workers: int = 1) -> dict:
+    """:func:`family_limits` of each family of ``fams``, by name, every surface's limits
+    predicted on ``workers`` local processes at once (each surface's own numbers, as one by
+    one)."""
+    jobs = [(plan, fam, preset, n_starts) for fam in fams for preset in fam.presets]
+    limits = iter(map_processes(_preset_limits, jobs, workers))
+    out = {}
+    for fam in fams:
+        per = {preset: next(limits) for preset in fam.presets}
+        worst = min(per.values(), key=lambda d: d["ie_star"])
+        out[fam.name] = {
+            "k_star": max(d["k_star"] for d in per.values()),
+            "k_path": max(d["k_path"] for d in per.values()),
+            "k_path_endless": max(d["k_path_endless"] for d in per.values()),
+            "lc_over_ls": max(d["char_length"] / d["slope_length"] for d in per.values()),
+            "ie_star": worst["ie_star"],
+            "limit": worst["limit"],
+            "presets": per,
+        }
+    return out
+
+
+def _preset_limits(job) -> dict:
+    """One preset's limits of :func:`family_limits` (``DriveLimits.as_dict()`` with its
+    ``tip_radius``), ``job`` its ``(plan, family, preset, n_starts)``."""
+    plan, fam, preset, n_starts = job
     seed = fam.seeds[0] if fam.seeds else None
     variant = dict(fam.variants[0]) if fam.variants else {}
-    per = {}
-    for preset in fam.presets:
-        overrides = dict(variant, **({} if seed is None else {"seed": seed}))
-        surface = presets.make_surface(preset, **overrides)
-        mu = fam.mu if fam.mu is not None else presets.calibrated_mu(preset)
-        tip = tip_radius(preset, None if seed is None else (seed,), plan.hfield_resolution)
-        limits = drive_limits(
-            surface,
-            mu,
-            tip_radius=tip,
-            n_starts=n_starts,
-            path_starts=path_starts(fam, surface, len(fam.starts_table()["y"])),
-            carriage_edge=surface.bounds[1],
-        )
-        per[preset] = dict(limits.as_dict(), tip_radius=tip)
-    worst = min(per.values(), key=lambda d: d["ie_star"])
-    return {
-        "k_star": max(d["k_star"] for d in per.values()),
-        "k_path": max(d["k_path"] for d in per.values()),
-        "k_path_endless": max(d["k_path_endless"] for d in per.values()),
-        "lc_over_ls": max(d["char_length"] / d["slope_length"] for d in per.values()),
-        "ie_star": worst["ie_star"],
-        "limit": worst["limit"],
-        "presets": per,
-    }
+    overrides = dict(variant, **({} if seed is None else {"seed": seed}))
+    surface = presets.make_surface(preset, **overrides)
+    mu = fam.mu if fam.mu is not None else presets.calibrated_mu(preset)
+    tip = tip_radius(preset, None if seed is None else (seed,), plan.hfield_resolution)
+    limits = drive_limits(
+        surface,
+        mu,
+        tip_radius=tip,
+        n_starts=n_starts,
+        path_starts=path_starts(fam, surface, len(fam.starts_table()["y"])),
+        carriage_edge=surface.bounds[1],
+    )
+    return dict(limits.as_dict(), tip_radius=tip)
 
 
 def corner_drives(presets: dict) -> dict:

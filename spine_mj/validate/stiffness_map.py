@@ -40,7 +40,7 @@ from spine_mj.validate.convergence import thin_starts
 from spine_mj.validate.ie_star import ie_star_by_criterion, passes_criterion, quiet_nan_warnings
 from spine_mj.validate.paths import mujoco_traces
 from spine_mj.validate.plans import GRAVITY, MASS_KG, FamilySpec, ValidationPlan
-from spine_mj.validate.predicted_limits import family_k_axis, family_limits
+from spine_mj.validate.predicted_limits import families_limits, family_k_axis
 from spine_mj.validate.slip_tails import fit_tail
 from spine_mj.validate.stick_slip import slip_statistics
 from spine_mj.validate.study_runner import StudyRunner
@@ -209,14 +209,17 @@ def stiffness_map(plan: ValidationPlan, runner: StudyRunner) -> StiffnessMapResu
     empty = StiffnessMapResult(ies, ks, [f.name for f in fams], plan.stiffness_map.starts, {}, [], [])
     if not ies or not (ks or plan.stiffness_map.k_factors) or not fams:
         return empty
-    runs, samples, predicted, jobs, k_by_family = [], {}, {}, [], {}
+    runs, samples, jobs, k_by_family = [], {}, [], {}
+    subs = {
+        fam.name: subset_starts(plan.stiffness_map.map_family(fam), plan.stiffness_map.starts) for fam in fams
+    }
+    with runner.phase("predicted drive limits of the families"):
+        predicted = families_limits(plan, list(subs.values()), workers=runner.n_workers)
     for fam in fams:
-        sub = subset_starts(plan.stiffness_map.map_family(fam), plan.stiffness_map.starts)
+        sub = subs[fam.name]
         deep = (
             subset_starts(sub, plan.stiffness_map.deep_starts) if plan.stiffness_map.deep_starts > 0 else sub
         )
-        with runner.phase(f"predicted drive limits of {fam.name}"):
-            predicted[fam.name] = family_limits(plan, sub)
         fks = family_k_axis(predicted[fam.name], plan.stiffness_map.k_factors) or ks
         k_by_family[fam.name] = fks
         for preset in fam.presets:
