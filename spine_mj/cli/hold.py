@@ -44,7 +44,12 @@ from spine_mj.errors import SpineInputError
     help="Places the quasistatic self-lock share is traced from.",
 )
 @click.option(
-    "--budget", type=float, default=3600.0, show_default=True, help="Seconds the MuJoCo levels may take."
+    "--budget",
+    type=float,
+    default=3600.0,
+    show_default=True,
+    help="Wall seconds from the start; a refinement level or round of added starts predicted to end "
+    "past them is not run (the corner's limits and its first MuJoCo runs always run, and count).",
 )
 @click.option(
     "--workers", type=click.IntRange(min=1), default=None, help="Worker processes (default: all cores)."

@@ -108,7 +108,9 @@ class HoldSettings:
     members : int
         Ensemble members per MuJoCo start (:mod:`spine_mj.validate.ensembles`).
     budget_s : float
-        Wall seconds the MuJoCo levels may take; a level predicted to end past it is not run.
+        Wall seconds from the start: a refinement level or a round of added starts predicted
+        to end past them is not run. The corner's limits, the self-lock share and the base
+        level's MuJoCo runs always run (and count): the budget cannot shorten them.
     seed : int
         Seed of the random places.
     """
