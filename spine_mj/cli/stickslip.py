@@ -82,10 +82,6 @@ def stickslip_cmd(surface_spec, mu, stiffness, ie, engine, start, travel, bootst
         check_positive("--drop-floor", drop_floor)
     surf = presets.open_surface(surface_spec)
     mu = presets.resolve_mu(surf, mu, name="--mu")
-    if ks is None:
-        from spine_mj.surfaces import abbm_stiffness_numbers
-
-        ks = abbm_stiffness_numbers(surf, mu)
     with Progress("stickslip", unit="step") as bar:
         out = stickslip_to(
             out_dir,

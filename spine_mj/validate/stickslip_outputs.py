@@ -110,7 +110,7 @@ def stickslip_to(
     surface,
     *,
     mu: float,
-    stiffness_numbers: Sequence[float],
+    stiffness_numbers: Sequence[float] | None = None,
     ie: float,
     surface_name: str = "",
     engine: str | None = None,
@@ -133,8 +133,9 @@ def stickslip_to(
     mu, ie : float
         Friction coefficient; the drive's inertia number (the references' speed, mass and
         duration threshold, and the engine's pace).
-    stiffness_numbers : sequence of float
-        ``K = k l_s / F_p``, each > 0.
+    stiffness_numbers : sequence of float, optional
+        ``K = k l_s / F_p``, each > 0 (None: an ABBM track's own range,
+        :func:`~spine_mj.surfaces.abbm_stiffness_numbers`, which refuses any other surface).
     surface_name : str
         The label of the catalog's ``surface`` column.
     engine : str, optional
@@ -156,9 +157,7 @@ def stickslip_to(
     **rig_options
         :func:`~spine_mj.sim.build_rig`'s keywords (tip radius, mass, length scale, ...).
     """
-    ks = [check_positive("--K", k) for k in stiffness_numbers]
-    if not ks:
-        raise SpineInputError("--K must name at least one stiffness number")
+    ks = _stiffness_numbers(surface, mu, stiffness_numbers)
     x0, length = _track(surface, start, travel)
     floor = DROP_FLOOR_FP if drop_floor_fp is None else check_positive("--drop-floor", drop_floor_fp)
     labels = {"surface": surface_name, "mu": float(mu), "ie": float(ie)}
@@ -180,6 +179,18 @@ def stickslip_to(
     files = _write(Path(out_dir), events, drop_events, summary, pulses)
     report(total, total, "written")
     return StickSlipOutputs(summary, files)
+
+
+def _stiffness_numbers(surface, mu: float, given) -> list[float]:
+    """The study's K values: ``given``, each checked, or an ABBM track's own range."""
+    if given is None:
+        from spine_mj.surfaces import abbm_stiffness_numbers
+
+        given = abbm_stiffness_numbers(surface, mu)
+    ks = [check_positive("--K", k) for k in given]
+    if not ks:
+        raise SpineInputError("--K must name at least one stiffness number")
+    return ks
 
 
 def _catalogs(surface, ks, x_range, floor, labels, engine, rig_options, tick, refinement):

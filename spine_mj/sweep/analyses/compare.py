@@ -29,7 +29,8 @@ import numpy as np
 from spine_mj.errors import SpineInputError
 from spine_mj.sim.drives import stiffness_n_m
 from spine_mj.sim.holding import spring_swing
-from spine_mj.sweep.analyses.engine import CHECK_READS, case_drive, case_plan, peak_drive_over_fp
+from spine_mj.sweep.analyses.engine import CHECK_READS, case_drive, case_plan
+from spine_mj.sweep.analyses.engine_metrics import peak_drive_over_fp
 from spine_mj.sweep.analyses.quasistatic import (
     cached_trace,
     case_tip_radius,
