@@ -307,9 +307,15 @@ def _more_starts(paired: int, n_run: int, n_places: int, budget_left: float, per
     if want * per_start_s > budget_left:
         return 0, (
             f"{want} more starts would take {want * per_start_s:.0f} s, past the budget "
-            f"({budget_left:.0f} s left)"
+            f"({_left(budget_left)})"
         )
     return want, ""
+
+
+def _left(budget_left: float) -> str:
+    """What is left of the budget, in words: ``"120 s left"``, or ``"spent 30 s over"`` where
+    the corner and the base level (which always run) took more than all of it."""
+    return f"{budget_left:.0f} s left" if budget_left >= 0 else f"spent {-budget_left:.0f} s over"
 
 
 @contextlib.contextmanager
@@ -453,7 +459,7 @@ def _refine(run_level, summ: dict, base: pd.DataFrame, *, budget_left: float, ba
             if cost > budget_left:
                 levels.append({"key": key, "label": label, "run": False, "note": f"predicted {cost:.0f} s"})
                 reasons.append(
-                    f"{label} did not fit the budget ({cost:.0f} s predicted, {budget_left:.0f} s left)"
+                    f"{label} did not fit the budget ({cost:.0f} s predicted, {_left(budget_left)})"
                 )
                 break
             started = time.perf_counter()

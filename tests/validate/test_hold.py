@@ -77,6 +77,9 @@ def test_starts_are_added_at_the_yield_so_far_until_30_paired_or_the_budget_says
     assert _more_starts(27, 40, 45, 1e9, 1.0)[0] == 5  # the places left
     add, why = _more_starts(27, 40, 400, 100.0, 10.0)
     assert add == 0 and why == "16 more starts would take 160 s, past the budget (100 s left)"
+    # a budget the corner and base level already overran is said so, never as negative seconds
+    add, why = _more_starts(27, 40, 400, -2784.4, 10.0)
+    assert add == 0 and why.endswith("past the budget (spent 2784 s over)")
     assert _more_starts(27, 40, 40, 1e9, 1.0) == (
         0,
         "no more places to add starts from (--reference-starts 40)",
