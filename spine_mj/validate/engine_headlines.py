@@ -193,8 +193,13 @@ class EngineHeadlinesResult:
 
 
 def _both_engines(doc: dict, name: str, engines: Sequence[str]) -> dict:
-    """``doc`` run in every engine of ``engines`` (the sweep key ``engine``), named ``name``."""
-    return {**doc, "sweep": {**doc["sweep"], "name": name}, "grid": {**doc["grid"], "engine": list(engines)}}
+    """``doc`` run in every engine of ``engines`` (the sweep key ``engine``), named ``name``,
+    each engine at its own step rule: a family's ``timestep_factor`` (MuJoCo's step refined
+    where its sliding hops left the Frechet distance unconverged) is a MuJoCo setting that
+    Bullet's sweep refuses, and the study compares agreements, which that step leaves
+    unchanged (the single peak and valley: 64 of 64 at both)."""
+    grid = {k: v for k, v in doc["grid"].items() if k != "timestep_factor"}
+    return {**doc, "sweep": {**doc["sweep"], "name": name}, "grid": {**grid, "engine": list(engines)}}
 
 
 def _corner_docs(
@@ -204,13 +209,10 @@ def _corner_docs(
     surface at its own corner (I_e, K) as the quasistatic-limit study runs it
     (:func:`~spine_mj.validate.predicted_limits.family_corner`), its y starts thinned to
     ``starts`` per surface (None: all), in every engine; and those corners, family -> preset
-    -> ``{"ie", "K"}``. Each engine at its own step rule: a family's ``timestep_factor``
-    (MuJoCo's step refined where its sliding hops left the Frechet distance unconverged) is
-    a MuJoCo setting that Bullet's sweep refuses, and the study compares agreements, which
-    that step leaves unchanged (the single peak and valley: 64 of 64 at both)."""
+    -> ``{"ie", "K"}``; each engine at its own step rule (:func:`_both_engines`)."""
     out, corners = [], {}
     for fam in plan.families:
-        corner = dataclasses.replace(plan.limit.corner_family(fam), timestep_factor=1.0)
+        corner = plan.limit.corner_family(fam)
         own = family_corner(plan, corner)["presets"]
         corners[fam.name] = corner_drives(own)
         if starts is not None:
@@ -238,7 +240,6 @@ def miss_family(plan: ValidationPlan, miss: MissStart) -> FamilySpec:
         starts = (("frame", table["frame"]), ("points", pts))
     return dataclasses.replace(
         corner,
-        timestep_factor=1.0,  # each engine at its own step rule (:func:`_corner_docs`)
         presets=(miss.preset,),
         seeds=None if miss.seed is None else (miss.seed,),
         variants=(tuple(miss.variant),),
