@@ -17,7 +17,7 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["crease", "single_contact", "two_contact"]
+__all__ = ["crease", "single_contact", "two_contact", "two_contact_one"]
 
 _SLIP, _ENGAGED, _SELF_LOCK = 0, 1, 2
 
@@ -147,6 +147,29 @@ def _leaves(fx, fy, ox, oy, oz, mu, tol):
 
 
 @njit(cache=True, error_model="numpy")
+def two_contact_one(fxa, fya, fxb, fyb, mu, tol):
+    """:func:`two_contact` at one pair of contacts: ``(kappa, region, bound)`` (for compiled
+    callers that step along a path, :mod:`spine_mj.theory._facet_streamline_kernel`)."""
+    na = _normal_of_slopes(fxa, fya)
+    nb = _normal_of_slopes(fxb, fyb)
+    kc, rc, _, _ = _crease_one(fxa, fya, fxb, fyb, mu, tol)
+    slides = rc == _SLIP
+    onset = (np.inf if rc == _SELF_LOCK else kc) if rc >= 0 else np.nan
+    counts = rc >= 0
+    for side in range(2):
+        fx, fy = (fxa, fya) if side == 0 else (fxb, fyb)
+        ox, oy, oz = nb if side == 0 else na
+        k, reg, leaves = _leaves(fx, fy, ox, oy, oz, mu, tol)
+        slides = slides or (leaves and reg == _SLIP)
+        if leaves and reg == _ENGAGED:
+            onset = np.fmin(onset, k)
+        counts = counts or leaves
+    o = np.nan if slides else onset
+    region = _SLIP if np.isnan(o) else (_SELF_LOCK if np.isinf(o) else _ENGAGED)
+    return o, region, not counts
+
+
+@njit(cache=True, error_model="numpy")
 def two_contact(fxa, fya, fxb, fyb, mu, tol):
     """:func:`~spine_mj.theory.multicontact.two_contact_kappa` on arrays (1-d, one length):
     ``(kappa, region, bound)``, ``bound`` True where no motion counts at its onset and the
@@ -156,24 +179,7 @@ def two_contact(fxa, fya, fxb, fyb, mu, tol):
     region = np.empty(n, np.int8)
     bound = np.zeros(n, np.bool_)
     for i in range(n):
-        na = _normal_of_slopes(fxa[i], fya[i])
-        nb = _normal_of_slopes(fxb[i], fyb[i])
-        kc, rc, _, _ = _crease_one(fxa[i], fya[i], fxb[i], fyb[i], mu, tol)
-        slides = rc == _SLIP
-        onset = (np.inf if rc == _SELF_LOCK else kc) if rc >= 0 else np.nan
-        counts = rc >= 0
-        for side in range(2):
-            fx, fy = (fxa[i], fya[i]) if side == 0 else (fxb[i], fyb[i])
-            ox, oy, oz = nb if side == 0 else na
-            k, reg, leaves = _leaves(fx, fy, ox, oy, oz, mu, tol)
-            slides = slides or (leaves and reg == _SLIP)
-            if leaves and reg == _ENGAGED:
-                onset = np.fmin(onset, k)
-            counts = counts or leaves
-        o = np.nan if slides else onset
-        bound[i] = not counts
-        out[i] = o
-        region[i] = _SLIP if np.isnan(o) else (_SELF_LOCK if np.isinf(o) else _ENGAGED)
+        out[i], region[i], bound[i] = two_contact_one(fxa[i], fya[i], fxb[i], fyb[i], mu, tol)
     return out, region, bound
 
 

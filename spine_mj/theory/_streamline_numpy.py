@@ -87,10 +87,11 @@ def run_numpy(surface, xs, ys, params, *, ideal, store):
 
     A reversal at the shortest step (or on a crease already followed) is a tip resting in a
     concave crease on two contacts: the path follows the crease at the two-contact kappa of
-    its sides (:func:`spine_mj.theory.engagement.crease_engagement`) with whole steps. Only this
-    backend has the crease state; the compiled kernel traces smooth surfaces (Gaussian sums,
-    splines) and takes such a reversal as it is. On facets (a ball on them or bare), a step
-    that crosses a concave crease tests the two contacts' hold there
+    its sides (:func:`spine_mj.theory.engagement.crease_engagement`) with whole steps. The
+    compiled kernel of smooth surfaces (Gaussian sums, splines) has no crease state and takes
+    such a reversal as it is; the compiled facet walk
+    (:mod:`spine_mj.theory._facet_streamline_kernel`) has this backend's. On facets (a ball on
+    them or bare), a step that crosses a concave crease tests the two contacts' hold there
     (:func:`spine_mj.theory.multicontact.two_contact_kappa`, :func:`_wedged`): a tip wedged beyond
     the force cap, or for every drive, is held where a path on single contacts would
     zig-zag across the crease and go on.

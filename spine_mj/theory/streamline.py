@@ -17,8 +17,10 @@ the section; kappa is evaluated on it and it stops on self-lock as well.
 
 Two backends give the same numbers: ``"numba"`` (compiled kernels for
 :class:`~spine_mj.surfaces.GaussianSurface` and :class:`~spine_mj.surfaces.GridSurface`,
-one core, :mod:`spine_mj.theory._kernels`) and ``"numpy"`` (a plain loop over steps,
-vectorized over starts, for any :class:`~spine_mj.surfaces.Surface`,
+one core, :mod:`spine_mj.theory._kernels`; and for a compiled
+:class:`~spine_mj.surfaces.BallOnFacets`, the engine's own contact, with the crease rules of
+the reference, :mod:`spine_mj.theory._facet_streamline_kernel`) and ``"numpy"`` (a plain loop
+over steps, vectorized over starts, for any :class:`~spine_mj.surfaces.Surface`,
 :mod:`spine_mj.theory._streamline_numpy`; the reference the tests check the kernels
 against). The records (:class:`Outcome`, :class:`StreamlineParams`,
 :class:`StreamlineResult`) live in :mod:`spine_mj.theory.streamline_types`; this module
@@ -34,9 +36,10 @@ from __future__ import annotations
 import numpy as np
 
 from spine_mj.errors import SpineInputError
-from spine_mj.surfaces import GaussianSurface, GridSurface, Surface
+from spine_mj.surfaces import BallOnFacets, GaussianSurface, GridSurface, Surface
 from spine_mj.theory._kernels import run_trajectories
-from spine_mj.theory._streamline_numpy import run_numpy
+from spine_mj.theory._streamline_numpy import CREASE_KINK, _two_contact_kappa, run_numpy
+from spine_mj.theory.engagement import DEFAULT_TOL
 from spine_mj.theory.streamline_types import StreamlineParams, StreamlineResult
 
 __all__ = [
@@ -139,11 +142,15 @@ def _trajectories(surface, starts, params, *, ideal, store_paths, backend):
     xs, ys = start_points(surface, starts)
     check_step(surface, params.dl)
     data = _surface_data(surface)
-    if backend == "numba" and data is None:
+    facets = isinstance(surface, BallOnFacets) and surface.compiled
+    if backend == "numba" and data is None and not facets:
         raise SpineInputError(
-            f"backend 'numba' supports GaussianSurface and GridSurface, got {type(surface).__name__}"
+            "backend 'numba' supports GaussianSurface, GridSurface and compiled BallOnFacets, "
+            f"got {type(surface).__name__}"
         )
-    if backend == "numpy" or data is None:
+    if backend != "numpy" and facets:
+        out = _run_facets(surface, xs, ys, params, ideal=ideal, store=store_paths)
+    elif backend == "numpy" or data is None:
         out = run_numpy(surface, xs, ys, params, ideal=ideal, store=store_paths)
     else:
         kind, g, coef, sp = data
@@ -188,6 +195,55 @@ def _trajectories(surface, starts, params, *, ideal, store_paths, backend):
         kappa=pk,
         region=pr,
     )
+
+
+def _run_facets(surface: BallOnFacets, xs, ys, params, *, ideal, store):
+    """:func:`run_numpy`'s outputs on a compiled ball on facets from the compiled walk
+    (:mod:`spine_mj.theory._facet_streamline_kernel`); the wedges where only the friction-cone
+    bound decides are answered here by the reference's rule (:func:`_two_contact_kappa`)."""
+    from spine_mj.theory import _facet_streamline_kernel as fk
+
+    st = fk.new_state(xs, ys, float(params.dl), int(params.stall_window))
+    outcome = np.zeros(xs.size, np.int8)
+    ask = np.zeros((xs.size, 4))
+    pieces = []
+    while True:
+        pieces.append(
+            fk.run_facets(
+                *surface.kernel_args(),
+                np.asarray(params.domain(surface), dtype=float),
+                st,
+                outcome,
+                ask,
+                bool(ideal),
+                float(params.mu),
+                float(params.dl),
+                float(params.tol),
+                DEFAULT_TOL,
+                CREASE_KINK,
+                int(params.max_steps),
+                int(params.stall_window),
+                float(params.stall_distance_value),
+                bool(store),
+                float(params.kappa_cap),
+                int(params.max_halvings),
+            )
+        )
+        paused = np.flatnonzero(outcome == fk.PAUSED)
+        if not paused.size:
+            break
+        k, region = _two_contact_kappa(*ask[paused].T, float(params.mu))
+        st[paused, fk.ANSWER] = np.c_[np.ones(paused.size), k, region]
+    n_steps = st[:, fk.STEPS].astype(np.int64)
+    fields = (st[:, c].copy() for c in (fk.MAX_KAPPA, fk.X, fk.Y, fk.HEIGHT))
+    offsets = np.zeros(xs.size + 1, np.int64)
+    if not store:
+        empty = np.empty(0)
+        return outcome, n_steps, *fields, offsets, empty, empty, empty, empty, np.empty(0, np.int8)
+    start, *cols = (np.concatenate(c) for c in zip(*pieces, strict=True))
+    order = np.argsort(start, kind="stable")  # each start's points stay in path order
+    offsets[1:] = np.cumsum(np.bincount(start, minlength=xs.size))
+    return outcome, n_steps, *fields, offsets, *(c[order] for c in cols)
 
 
 #: The step of a streamline given no ``dl``, as a fraction of the domain's shorter side.

@@ -252,6 +252,15 @@ def test_mujoco_static_probe_at_a_fractal_crease_breaks_away_near_the_two_contac
     assert res.kappa_mj > 1.3 * single.max()
 
 
+def _close(got, want, name):
+    """A compiled rule's numbers against the numpy rule's: regions equal, values within
+    rounding (two code paths; a CPU's fused or vectorized arithmetic may round differently)."""
+    if np.asarray(want).dtype.kind in "iub":
+        np.testing.assert_array_equal(got, want, err_msg=name)
+    else:
+        np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-15, err_msg=name)
+
+
 def _slope_pairs(n: int = 4000):
     """Random contact pairs over every regime (flat to steep, opposed and alike), with the
     degenerate ones: equal slopes (no crease), mirrored walls, a flat floor."""
@@ -272,7 +281,7 @@ def test_the_compiled_crease_rule_gives_the_numpy_rules_numbers(mu):
     args = _slope_pairs()
     got, want = crease(*args, mu, DEFAULT_TOL), crease_engagement(*args, mu)
     for g, w, name in zip(got, want, ("kappa", "region", "vx", "vy"), strict=True):
-        np.testing.assert_array_equal(g, w, err_msg=name)
+        _close(g, w, name)
 
 
 @pytest.mark.parametrize("mu", [0.3, 0.8, 2.5])
@@ -286,11 +295,11 @@ def test_the_compiled_two_contact_rule_gives_the_numpy_rules_numbers(mu):
     want_k, want_region = two_contact_kappa(*args, mu)
     # where a motion counts the kernel decides alone; elsewhere the caller's linear program
     assert bound.any() and (~bound).sum() > 1000
-    np.testing.assert_array_equal(k[~bound], want_k[~bound])
-    np.testing.assert_array_equal(region[~bound], want_region[~bound])
+    _close(k[~bound], want_k[~bound], "kappa")
+    _close(region[~bound], want_region[~bound], "region")
     got_k, got_region = _two_contact_kappa(*args, mu)
-    np.testing.assert_array_equal(got_k, want_k)
-    np.testing.assert_array_equal(got_region, want_region)
+    _close(got_k, want_k, "kappa")
+    _close(got_region, want_region, "region")
 
 
 @pytest.mark.parametrize("mu", [0.3, 0.8, 2.5])
@@ -311,4 +320,4 @@ def test_the_compiled_single_contact_rule_gives_kappa_and_the_slip_direction(mu)
         (vx, want_vx, "vx"),
         (vy, want_vy, "vy"),
     ):
-        np.testing.assert_array_equal(got, want, err_msg=name)
+        _close(got, want, name)

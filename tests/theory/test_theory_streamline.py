@@ -470,3 +470,52 @@ def test_a_ball_slides_along_a_v_groove_at_the_wedge_kappa():
     assert res.outcome[0] == Outcome.LEFT_DOMAIN
     assert res.end_x[0] > 0.98 and abs(res.end_y[0]) < 1e-3
     assert res.max_kappa[0] == pytest.approx(0.5 * math.sqrt(5.0), rel=1e-9)
+
+
+def _same_facets(a, b):
+    """The compiled facet walk against the reference: the same outcomes, steps and regions,
+    points within rounding (the same operations in the same order; compared with a
+    tolerance, as floats from two code paths on any CPU)."""
+    _same(a, b, 1e-9)
+    for key in ("end_x", "end_y", "end_z", "max_kappa", "kappa"):
+        np.testing.assert_allclose(getattr(a, key), getattr(b, key), rtol=1e-9, atol=1e-12, err_msg=key)
+
+
+def test_facet_kernel_matches_the_reference_on_a_rough_ball_path(monkeypatch):
+    """A ball on a steep fractal's facets: wedges in concave creases (held on two contacts,
+    some only by the friction-cone bound, which the kernel asks its caller for), creases
+    followed, self-locks, a stall and the edge; paths and summaries as the numpy reference's."""
+    import spine_mj.theory.streamline as sl_module
+    from spine_mj.surfaces import BallOnFacets, TriangulatedSurface
+
+    grid = fractal_fbm(nx=48, size=6.0, hurst=0.7, rms_slope=1.0, rng=0)
+    ball = BallOnFacets(TriangulatedSurface.from_grid(grid), 0.125)
+    starts = np.c_[np.full(10, -2.0), np.linspace(-2.5, 2.5, 10)]
+    params = StreamlineParams(mu=0.5, dl=0.125 / 8, kappa_cap=20.0)
+    asked = []
+    answer = sl_module._two_contact_kappa
+    monkeypatch.setattr(sl_module, "_two_contact_kappa", lambda *a: asked.append(a[0].size) or answer(*a))
+    fast = streamlines(ball, starts, params, backend="numba")
+    assert sum(asked) > 10  # the kernel paused on the bound and resumed
+    assert {Outcome.SELF_LOCKED, Outcome.LEFT_DOMAIN, Outcome.STALLED} <= set(fast.outcome.tolist())
+    _same_facets(fast, streamlines(ball, starts, params, backend="numpy"))
+    brief = streamlines(ball, starts, params, store_paths=False)
+    np.testing.assert_array_equal(brief.n_steps, fast.n_steps)
+    np.testing.assert_allclose(brief.end_x, fast.end_x, rtol=0, atol=1e-12)
+    a, b = (ideal_trajectories(ball, starts, params, backend=k) for k in ("numba", "numpy"))
+    _same_facets(a, b)
+
+
+@pytest.mark.parametrize("descent", [0.0, 0.1])
+def test_facet_kernel_follows_a_v_groove_as_the_reference(descent):
+    """The crease state (a reversal at the shortest step, then the crease followed on two
+    contacts) in the compiled facet walk, against the reference."""
+    from spine_mj.surfaces import BallOnFacets, TriangulatedSurface
+
+    x = np.linspace(0.0, 1.0, 21)
+    y = np.linspace(-0.5, 0.5, 21)
+    groove = TriangulatedSurface(heights=2.0 * np.abs(y)[:, None] - descent * x[None, :], x=x, y=y)
+    ball = BallOnFacets(groove, 0.05)
+    params = StreamlineParams(mu=0.5, dl=0.01, max_steps=100_000)
+    starts = [(0.3, 0.12), (0.2, -0.3), (0.5, 0.05)]
+    _same_facets(*(streamlines(ball, starts, params, backend=k) for k in ("numba", "numpy")))
