@@ -15,8 +15,10 @@ lowest I_e, :mod:`spine_mj.validate.quasistatic_limit`) are recomputed under ref
   I_e = 1e-4);
 - ``hfield_doubled``: the rig's hfield at twice the samples a side, every old sample kept
   and the tip's radius kept: an analytic surface sampled twice as densely, a gridded one (a
-  generated fractal, a scan) refined through the interpolant it is defined by
-  (:func:`spine_mj.surfaces.refine_grid`: only the facets change, not the surface).
+  generated fractal, a scan) refined through the interpolant it is defined by, or where the
+  rig resamples it (a grit coarsened to a quarter tip radius) through that of the samples
+  it was resampled to (:func:`spine_mj.sim.hfield_of`: only the facets change, not the
+  surface).
 
 A refinement reruns a subset of the corner's starts (``plan.limit.convergence_starts`` y
 starts per surface, the same points, one run each), and the change of a headline is the

@@ -54,3 +54,27 @@ def test_the_planned_sides_are_the_sides_the_rig_s_sizing_makes(surface, sizing)
     assert planned_hfield_sides(surface, tip=tip, hfield_resolution=keeps, **sizing) == (hf.nrow, hf.ncol)
     if tip.tip_radius_m is not None:
         assert scales.hfield_resolution < max(surface.shape)  # coarsened
+
+
+def test_a_coarsened_grid_is_refined_through_its_coarse_samples_not_its_own():
+    """Refinement verifies the facets of one surface: a grid the rig resamples (a grit
+    coarsened to a quarter tip radius) is refined through the interpolant of the samples it
+    was resampled to. Closed form: a wave sin(pi x / d) on a fine grid, resampled at nodes d
+    apart, samples 0 at every node; the rig's surface is then flat, and so must its x 2 and
+    x 4 hfields be, where resampling the fine grid again drew a wave of amplitude 1."""
+    d, n = 0.25, 17  # 17 nodes over [0, 4], d apart
+    x = np.linspace(0.0, 4.0, 161)  # 10 samples a node spacing
+    y = np.linspace(-1.0, 1.0, 81)
+    wave = GridSurface(np.broadcast_to(np.sin(np.pi * x / d), (y.size, x.size)).copy(), x, y)
+    base = hfield_of(wave, n)
+    levels = (base, hfield_of(wave, n, 2), hfield_of(wave, n, 4))
+    heights = [hf.data.astype(float) * hf.size[2] + hf.pos[2] for hf in levels]
+    assert base.data.shape == (n, n)
+    for h in heights:
+        assert np.abs(h).max() < 1e-12  # flat: the nodes' samples, and their interpolant between them
+    assert np.abs(wave.sample(2 * n - 1).heights).max() > 0.99  # what the old refinement resampled
+    # every old sample kept, and each level the one below refined (the same surface throughout)
+    hf4 = hfield_of(OPEN, 13, 4)
+    h2, h4 = (hf.data.astype(float) * hf.size[2] + hf.pos[2] for hf in (hfield_of(OPEN, 13, 2), hf4))
+    np.testing.assert_allclose(h4[::2, ::2], h2, atol=1e-6 * np.ptp(OPEN.heights))
+    np.testing.assert_allclose(h4[::4, ::4], OPEN.sample(13).heights, atol=1e-6 * np.ptp(OPEN.heights))
