@@ -359,6 +359,7 @@ def build_drive(
             stiffness_n_m=stiffness_n_m,
             duration_s=duration_s,
             settle_time_s=settle_time_s,
+            start_force_n=start_force_n,
         )
     if protocol == "static":
         return StaticProbe(rate_n_s=rate_n_s, start_force_n=start_force_n, settle_time_s=settle_time_s)

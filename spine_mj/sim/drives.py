@@ -35,6 +35,11 @@ class SpringDrive:
     increment ``k V dt``: soft springs, slow drives; ``rollout.SPRING_MIN_CLIMB_STEPS``), on
     the CPU backends.
 
+    ``start_force_n``: a constant force in +x added to the spring's from the settle on (the
+    push actuator), as if the spring started stretched by ``start_force_n / k``: a soft
+    spring's climb to the first breakaway can be longer than any run (on the ``abbm``
+    preset at K 10, 1600 units of carriage), and this starts the run just below it.
+
     Attributes
     ----------
     speed_m_s : float
@@ -46,6 +51,8 @@ class SpringDrive:
     fast_forward : bool
     fast_forward_margin : float
         Fraction below the predicted breakaway where the fast climb stops.
+    start_force_n : float
+        The constant force [N] >= 0 added to the spring's.
     """
 
     speed_m_s: float
@@ -54,9 +61,13 @@ class SpringDrive:
     settle_time_s: float | None = None
     fast_forward: bool = True
     fast_forward_margin: float = 0.03
+    start_force_n: float = 0.0
 
     def __post_init__(self):
         object.__setattr__(self, "speed_m_s", check_positive("speed_m_s", self.speed_m_s))
+        object.__setattr__(
+            self, "start_force_n", check_positive("start_force_n", self.start_force_n, allow_zero=True)
+        )
         check_optional(self, ["stiffness_n_m", "duration_s"])
         check_optional(self, ["settle_time_s"], allow_zero=True)
         _check_margin(self)

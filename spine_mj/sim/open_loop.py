@@ -103,6 +103,7 @@ def control_profile(rig: RigModel, drive: Drive, x0_m: float, detection: Detecti
     if isinstance(drive, SpringDrive):
         ctrl[n_settle:, 0] = (drive.speed_m_s / u.speed_m_s) * ramp_t
         ctrl[:, 3] = ctrl[:, 0]
+        ctrl[:, 1] = drive.start_force_n / u.force_n
     else:
         cap = detection.kappa_cap * rig.scales.preload_n / u.force_n
         f0 = drive.start_force_n / u.force_n

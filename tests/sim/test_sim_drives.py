@@ -82,3 +82,22 @@ def test_flat_ground_spring_drive_pulls_with_mu_w():
     assert abs(res.position_m[-1, 1] - res.position_m[0, 1]) < 1e-5
     table = res.table()
     assert len(table) == res.n and {"position_x_m", "drive_force_n", "moving"} <= set(table)
+
+
+def test_spring_drive_start_force_is_a_stretched_spring():
+    """A constant start force f0 stands for a spring stretched by f0 / k at the start: on flat
+    ground the tip breaks away when f0 + k (X - x0) reaches mu W, after (mu W - f0) / k of
+    carriage, and the recorded drive force holds f0 + k (X - x)."""
+    rig = flat_rig()
+    fp = rig.scales.preload_n
+    k = 0.1 * MU * fp / 0.002  # a tenth of mu W over 2 mm of stretch
+    drive = SpringDrive(speed_m_s=0.005, stiffness_n_m=k, duration_s=1.0, start_force_n=0.9 * MU * fp)
+    res = rig.run(drive, start=(-0.04, 2.3e-4))
+    s = res.drive_start_index
+    first = s + int(res.moving[s:].argmax())
+    advance = res.carriage_x_m[first] - res.carriage_x_m[s]
+    assert advance == pytest.approx(0.1 * MU * fp / k, rel=0.1)
+    stretch = res.carriage_x_m[s:] - res.position_m[s:, 0] - (res.carriage_x_m[0] - res.position_m[0, 0])
+    assert res.drive_force_n[s:] == pytest.approx(drive.start_force_n + k * stretch, rel=1e-3, abs=1e-3 * fp)
+    with pytest.raises(ValueError, match="start_force_n"):
+        SpringDrive(speed_m_s=0.005, start_force_n=-1.0)

@@ -236,3 +236,24 @@ def test_a_refined_landscape_keeps_the_references_jumps_and_refuses_a_fraction()
     for bad in (0, 1.5, True):
         with pytest.raises(SpineInputError, match="refinement"):
             track_landscape(surf, 0.5, 0.0, (0.25, 3.75), refinement=bad)
+
+
+def test_engine_run_starts_a_soft_spring_stretched_near_the_threshold():
+    """A run shorter than the spring's stretch at the start's threshold starts with all but
+    START_MARGIN of it (the carriage would otherwise spend the run climbing); a longer run
+    climbs from zero."""
+    from spine_mj.sim.build import build_rig
+    from spine_mj.validate.slip_catalog import TrackUnits, track_landscape
+    from spine_mj.validate.stickslip_outputs import START_MARGIN, _engine_run
+
+    surf = surfaces.corrugation(n_waves=4, points_per_wave=128, width=0.5)
+    land = track_landscape(surf, 0.5, 1e-4, (0.25, 3.75))
+    k = 0.2
+    rig = build_rig(surf, engine="mujoco", mu=0.5, ie=1e-4, stiffness_number=k, tip_radius_m=1e-4)
+    units = TrackUnits.of(rig.scales, 1e-4)
+    for stretched in (True, False):
+        lead = land.force[0] / units.stiffness(k)
+        run = _engine_run(rig, units, land, k, 1e-4, 0.25, lead / 2 if stretched else 1.2 * lead)
+        start = run.drive_force_n[run.drive_start_index] / units.preload_n
+        expected = (1 - START_MARGIN) * land.force[0] if stretched else 0.0
+        assert start == pytest.approx(expected, abs=2e-3)
