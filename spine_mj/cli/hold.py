@@ -48,8 +48,9 @@ from spine_mj.errors import SpineInputError
     type=float,
     default=3600.0,
     show_default=True,
-    help="Wall seconds from the start; a refinement level or round of added starts predicted to end "
-    "past them is not run (the corner's limits and its first MuJoCo runs always run, and count).",
+    help="Wall seconds from the start; the rest of the starts, a refinement level or a round of added "
+    "starts predicted to end past them is not run (the corner's limits, the self-lock share and the "
+    "first 12 starts' MuJoCo runs always run, and count).",
 )
 @click.option(
     "--workers", type=click.IntRange(min=1), default=None, help="Worker processes (default: all cores)."

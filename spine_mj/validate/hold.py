@@ -12,7 +12,9 @@
 3. The check: MuJoCo at that corner from a subsample of those places (the first
    ``starts``), each run as an ensemble (:mod:`~spine_mj.validate.ensembles`), through the
    sweep machinery (:class:`~spine_mj.validate.study_runner.StudyRunner`: a killed run
-   resumes where it stopped); the agreement over the well-conditioned starts, Wilson.
+   resumes where it stopped); the agreement over the well-conditioned starts, Wilson. The
+   first case of starts runs first, and the rest only where, at its pace, they fit the
+   budget (:func:`_rest_of_base`).
    Where fewer than :data:`MIN_PAIRED_STARTS` of them are left paired at every level (starts
    on watersheds, references stalled in pits), more places are added as starts
    (:func:`_more_starts`: by their count, never by their outcome) and everything is judged
@@ -108,9 +110,11 @@ class HoldSettings:
     members : int
         Ensemble members per MuJoCo start (:mod:`spine_mj.validate.ensembles`).
     budget_s : float
-        Wall seconds from the start: a refinement level or a round of added starts predicted
-        to end past them is not run. The corner's limits, the self-lock share and the base
-        level's MuJoCo runs always run (and count): the budget cannot shorten them.
+        Wall seconds from the start. The corner's limits, the self-lock share and its first
+        case of MuJoCo runs (the first :data:`_CASE_STARTS` starts) always run, and count;
+        the rest of the starts asked for, a refinement level or a round of added starts,
+        predicted at the pace measured so far to end past them, is not run, and the verdict
+        says so.
     seed : int
         Seed of the random places.
     """
@@ -169,22 +173,25 @@ def hold_to(
 
     t0 = time.perf_counter()
     out = Path(out_dir).absolute()
-    tip, lc, places, limits, corner = _corner(surface, settings)
     runner = StudyRunner(out, workers, progress, t0)
     runner.study = "hold"
+    tip, lc, places, limits, corner = _corner(surface, settings, runner.report)
     held, share = _self_lock_share(runner, surface, places, tip, settings.mu)
+    first = places[: settings.starts]
     batches = _Batches(
         runner,
         out / "surface.npz",
         {"protocol": "spring", "ie": corner.ie, "K": corner.k},
         {"mu": settings.mu, "tip_radius": tip, "dl": tip / 2},
         (ENSEMBLE_RADIUS_LC * lc,) * 2,
-        [places[: settings.starts]],
+        [first[:_CASE_STARTS]],
     )
     with _undone_on_refusal(out):
         writable_path(out / "summary.json")
         save_surface(surface, batches.surface_file)
         base = batches.base(settings.members)
+    base, base_note = _rest_of_base(batches, base, first[_CASE_STARTS:], settings, t0)
+    first_batches = len(batches.points)
     while True:
         judged = _judge(batches, base, settings, budget_left=settings.budget_s - (time.perf_counter() - t0))
         n_run = batches.starts()
@@ -195,10 +202,10 @@ def hold_to(
             settings.budget_s - (time.perf_counter() - t0),
             (time.perf_counter() - base["started"]) / max(len(batches.points[-1]), 1),
         )
-        if add and len(batches.points) > POWER_ROUNDS:
+        if add and len(batches.points) - first_batches >= POWER_ROUNDS:
             note = f"{POWER_ROUNDS} rounds of added starts were not enough"
         if judged["converged"] or note or not add:
-            why = "; ".join(w for w in (judged["why"], note) if w)
+            why = "; ".join(w for w in (base_note, judged["why"], note) if w)
             break
         batches.points.append(places[n_run : n_run + add])
         base = batches.base(settings.members)
@@ -209,7 +216,7 @@ def hold_to(
     summary["mujoco_starts"] = {
         "run": n_run,
         "asked": settings.starts,
-        "added_rounds": len(batches.points) - 1,
+        "added_rounds": len(batches.points) - first_batches,
     }
     summary["timings_s"] = {"total": time.perf_counter() - t0, "base_level": base["seconds"]}
     with all_or_none(out / "summary.json", out / "report.md", out / "hold.png"):
@@ -287,6 +294,27 @@ def _judge(batches: _Batches, base: dict, settings: HoldSettings, *, budget_left
     }
 
 
+def _rest_of_base(batches: _Batches, base: dict, rest, settings: HoldSettings, t0: float):
+    """``(base, note)``: the corner's first case (its first :data:`_CASE_STARTS` starts) has
+    run; the rest of the starts asked for run too where, at the first case's pace, they end
+    within the budget, else the verdict rests on the first case and ``note`` says why. The
+    base's seconds are both batches'."""
+    if not len(rest):
+        return base, ""
+    first = len(batches.points[0])
+    predicted = base["seconds"] / first * len(rest)
+    left = settings.budget_s - (time.perf_counter() - t0)
+    if predicted > left:
+        return base, (
+            f"the corner's other {len(rest)} starts would take {predicted:.0f} s, past the budget "
+            f"({_left(left)}): its first {first} ran"
+        )
+    batches.points.append(rest)
+    spent = base["seconds"]
+    base = batches.base(settings.members)
+    return {**base, "seconds": base["seconds"] + spent}, ""
+
+
 def _ensembles(points, members: int, radius) -> dict:
     """The starts table of ``points``, each the first of an ensemble of ``members``."""
     table = {"frame": "absolute", "points": [tuple(map(float, p)) for p in points]}
@@ -314,7 +342,7 @@ def _more_starts(paired: int, n_run: int, n_places: int, budget_left: float, per
 
 def _left(budget_left: float) -> str:
     """What is left of the budget, in words: ``"120 s left"``, or ``"spent 30 s over"`` where
-    the corner and the base level (which always run) took more than all of it."""
+    the corner and its first case of runs (which always run) took more than all of it."""
     return f"{budget_left:.0f} s left" if budget_left >= 0 else f"spent {-budget_left:.0f} s over"
 
 
@@ -334,20 +362,27 @@ def _undone_on_refusal(out: Path):
         raise
 
 
-def _corner(surface, settings: HoldSettings):
+def _corner(surface, settings: HoldSettings, report: Callable[[str, int, int], None]):
     """``(tip, L_c, places, limits, corner)``: the rig's tip radius and L_c (surface units),
     the random places (:func:`_places`), the surface's
     :func:`~spine_mj.theory.drive_limits.drive_limits` with that tip and the corner placed
     inside them by the validation's rule
     (:func:`~spine_mj.validate.predicted_limits.surface_corner`), ``K_path`` read on the
     first :data:`~spine_mj.validate.predicted_limits.CORNER_PATH_STARTS` places with each
-    carriage stopping where a run's does."""
+    carriage stopping where a run's does. ``report(step, done, total)`` hears the two parts
+    that grow with the grid where they are long (the rig's sizing of a large hfield, the
+    limits' dilation of a large grid by the tip: a quick one, and a refusal, print nothing),
+    and the corner once placed."""
     from spine_mj import sim
     from spine_mj.theory import drive_limits as dlim
     from spine_mj.validate.predicted_limits import CORNER_PATH_STARTS, surface_corner
 
     tip_m = sim.scales.engine_tip_radius_m(surface, settings.tip_radius, name="--tip-radius")
-    scales = sim.Scales.for_surface(surface, tip=sim.TipParams(tip_radius_m=tip_m, mu_s=settings.mu))
+    scales = sim.Scales.for_surface(
+        surface,
+        tip=sim.TipParams(tip_radius_m=tip_m, mu_s=settings.mu),
+        progress=lambda done, total, stage: report(f"corner: {stage}", int(done), int(total)),
+    )
     tip = scales.tip_radius_m / scales.length_scale_m
     places = _places(surface, tip, settings)
     limits = dlim.drive_limits(
@@ -356,6 +391,7 @@ def _corner(surface, settings: HoldSettings):
         tip_radius=tip,
         path_starts=places[:CORNER_PATH_STARTS],
         carriage_edge=surface.bounds[1],
+        progress=lambda done, total: report("corner: drive limits (dilating by the tip)", done, total),
     )
     if not limits.k_star > 0:
         raise SpineInputError(
@@ -363,6 +399,7 @@ def _corner(surface, settings: HoldSettings):
             "or a slope without features), so there is no drive corner to check MuJoCo at"
         )
     corner = surface_corner([limits])
+    report("corner", 1, 1)
     return tip, scales.char_length_m / scales.length_scale_m, places, limits, corner
 
 

@@ -90,18 +90,19 @@ class StudyRunner:
         phase reported only as it started was left at 0 % by the CLI's bar)."""
         done = 0
 
-        def report(n: int) -> None:
-            if self.progress is not None:
-                self.progress(ValidationProgress(self.study, step, n, total, time.perf_counter() - self.t0))
-
         def tick() -> None:
             nonlocal done
             done = min(done + 1, total)
-            report(done)
+            self.report(step, done, total)
 
-        report(0)
+        self.report(step, 0, total)
         yield tick
-        report(total)
+        self.report(step, total, total)
+
+    def report(self, step: str, done: int, total: int) -> None:
+        """Report ``done`` of ``total`` parts of ``step``, a stage that runs no sweep."""
+        if self.progress is not None:
+            self.progress(ValidationProgress(self.study, step, done, total, time.perf_counter() - self.t0))
 
     def _sweep_progress(self, step: str) -> Callable:
         """A sweep's progress callback reporting its cases as ``step`` of this study."""

@@ -102,3 +102,24 @@ def test_starts_are_added_at_the_yield_so_far_until_30_paired_or_the_budget_says
 def test_bad_settings_are_refused_by_the_options_name(kwargs, match):
     with pytest.raises(SpineInputError, match=match):
         HoldSettings(mu=0.5, **kwargs)
+
+
+def test_the_budget_is_checked_after_the_corners_first_case_and_the_corner_reports_progress(
+    tmp_path, monkeypatch
+):
+    """The corner's first case of starts runs; the rest of the starts asked for run only
+    where, at its pace, they end within --budget (here spent: they do not, and the verdict
+    says so). The corner reports its progress before the self-lock share."""
+    from spine_mj.validate import hold
+
+    monkeypatch.setattr(hold, "_CASE_STARTS", 1)  # a case of one start: the first case is one start
+    steps = []
+    settings = HoldSettings(mu=0.8, starts=2, reference_starts=4, budget_s=1e-6)
+    s = hold_to(
+        single_gaussian(), tmp_path / "hold", settings, workers=1, progress=lambda p: steps.append(p.step)
+    )
+    assert steps.index("corner") < steps.index("self-lock share")  # the corner reported once placed
+    assert s["mujoco_starts"] == {"run": 1, "asked": 2, "added_rounds": 0}
+    assert "the corner's other 1 starts would take" in s["why_unconverged"] and s["converged"] is False
+    assert not (tmp_path / "hold" / "sweeps" / "base-2").exists()
+    assert all(not r["run"] for r in s["refinements"])  # no level fits a spent budget either
