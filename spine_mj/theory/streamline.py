@@ -62,9 +62,18 @@ def _get_kernel():
     return run_trajectories
 
 
+def _readonly(a: np.ndarray) -> np.ndarray:
+    """A read-only view of ``a``: the kernel's grid argument is read-only for every surface
+    (a GridSurface's spline coefficients are), so that Gaussians and grids share one
+    compiled signature (a writable dummy cost a second compile, ~16 CPU-s cold)."""
+    v = a.view()
+    v.flags.writeable = False
+    return v
+
+
 def _surface_data(surface: Surface):
     dummy_g = np.zeros((5, 0))
-    dummy_coef = np.zeros((1, 1))
+    dummy_coef = _readonly(np.zeros((1, 1)))
     dummy_sp = np.zeros(8)
     if isinstance(surface, GaussianSurface):
         g = np.ascontiguousarray(
@@ -82,7 +91,7 @@ def _surface_data(surface: Surface):
     if isinstance(surface, GridSurface):
         s = surface.spline
         sp = np.array([s.offset, s.x0, s.dx, s.nx, s.y0, s.dy, s.ny, float(s.periodic)])
-        return _KIND_GRID, dummy_g, np.ascontiguousarray(s.coef), sp
+        return _KIND_GRID, dummy_g, _readonly(np.ascontiguousarray(s.coef)), sp
     return None
 
 

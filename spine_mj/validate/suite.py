@@ -16,6 +16,7 @@ from spine_mj.atomic import remove_temporaries
 from spine_mj.errors import SpineInputError
 from spine_mj.jsonio import write_json
 from spine_mj.surfaces import single_gaussian
+from spine_mj.sweep.kernel_warmup import warm_kernels
 from spine_mj.theory.targets import FRECHET_TARGET, OUTCOME_TARGET
 from spine_mj.validate import studies
 from spine_mj.validate.intervals import TARGET_RULE
@@ -74,6 +75,10 @@ def run_validation(
     runner = StudyRunner(out, workers, progress, t0)
     timings, cpu = {}, {}
     c0 = _cpu_seconds()
+    runner.study = "kernels"
+    with runner.phase("compiling the kernels"):
+        warm_kernels(runner.n_workers)  # once, not in every worker of the first sweeps
+    timings["kernels"], cpu["kernels"] = round(time.perf_counter() - t0, 2), round(_cpu_seconds() - c0, 2)
     results = []
     for study in studies.STUDIES:
         t, c = time.perf_counter(), _cpu_seconds()
