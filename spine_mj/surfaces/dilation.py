@@ -107,7 +107,8 @@ def ball_dilation(
     check_memory(_GRID_ARRAYS * h.nbytes, where=f"dilating a {h.shape[0]} x {h.shape[1]} grid by a tip")
     from spine_mj.surfaces._dilation_kernel import ball_rows, footprint_rows
 
-    h = np.ascontiguousarray(h)
+    h = np.ascontiguousarray(h).view()
+    h.flags.writeable = False  # one compiled signature whether the heights were read-only or not
     out = np.full(h.shape, -np.inf)
     n = footprint_rows(radius, dy, h.shape[0], bool(periodic))
     for k in range(n):

@@ -56,16 +56,16 @@ def _compliant_kernels() -> None:
 
 
 def _engine_kernels() -> None:
-    """The engine runs' window analysis: one short spring run on a plane."""
+    """The engine runs' window analysis: a short spring run on a plane (the rollout's
+    strided carriage) and a short force ramp (the ramp's and Bullet's contiguous one)."""
     from spine_mj import presets
-    from spine_mj.sim import Rig, SpringDrive
+    from spine_mj.sim import RampDrive, Rig, SpringDrive
 
     rig = Rig(presets.make_surface("plane"))
     xmin, xmax, ymin, ymax = rig.surface.bounds
-    speed = rig.scales.speed_for(1e-2)
-    rig.run_batch(
-        SpringDrive(speed_m_s=speed, duration_s=0.01), [(0.5 * (xmin + xmax), 0.5 * (ymin + ymax))], nthread=1
-    )
+    start = (0.5 * (xmin + xmax), 0.5 * (ymin + ymax))
+    rig.run_batch(SpringDrive(speed_m_s=rig.scales.speed_for(1e-2), duration_s=0.01), [start], nthread=1)
+    rig.run(RampDrive(duration_s=0.01), start=start)
 
 
 def _grid():

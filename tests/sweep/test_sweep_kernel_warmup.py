@@ -1,6 +1,6 @@
 """The kernel warm-up compiles the signatures a job calls: after it, the real calls of a
 comparison (a preset's streamline, the engine's facets and their compliant reference, an
-engine run's analysis) compile nothing new."""
+engine run's and a force ramp's analysis, a dilation) compile nothing new."""
 
 from __future__ import annotations
 
@@ -34,8 +34,8 @@ def _dispatchers():
 
 
 def test_after_the_warm_up_a_comparison_compiles_nothing_new():
-    from spine_mj.sim import Rig, SpringDrive, TipParams
-    from spine_mj.surfaces.dilation import dilate
+    from spine_mj.sim import RampDrive, Rig, SpringDrive, TipParams
+    from spine_mj.surfaces.dilation import ball_dilation, dilate
     from spine_mj.theory import agreement
     from spine_mj.theory._streamline_numpy import _two_contact_kappa
     from spine_mj.theory.compliant import compliant_streamlines
@@ -58,9 +58,10 @@ def test_after_the_warm_up_a_comparison_compiles_nothing_new():
     streamlines(contact, [(-3.0, -1.0)], p)
     _two_contact_kappa(*(np.array([v, v]) for v in (0.2, 0.1, -0.3, 0.0)), 0.5)
     compliant_streamlines(contact, [(-3.0, -1.0)], p, stiffness=1.0)
-    run = rig.run_batch(
-        SpringDrive(speed_m_s=rig.scales.speed_for(0.1), duration_s=0.02), [(-3.0, -1.0)], nthread=1
-    )
+    drive = SpringDrive(speed_m_s=rig.scales.speed_for(0.1), duration_s=0.02)
+    run = rig.run_batch(drive, [(-3.0, -1.0)], nthread=1)
+    rig.run(RampDrive(duration_s=0.02), start=(-3.0, -1.0))
+    ball_dilation(np.zeros((9, 9)), 0.2, spacing=(0.1, 0.1))  # writable heights
     path = run[0].position_m[:, :2] / rig.length_scale_m
     agreement.path_frechet(path, path[::-1], length_scale=1.0)
 
