@@ -71,6 +71,61 @@ def plan_cost(out_dir: Path) -> dict:
     return {"studies": studies, "wall_s": timings.get("total")}
 
 
+#: The full plan's target (issue 41: within 30 min on an idle 2-core machine).
+FULL_WALL_TARGET_S = 1800.0
+#: The committed reports whose wall time is tracked against the targets (no new run: the
+#: full plan takes tens of minutes; the lead regenerates them on an idle machine).
+REPORTS = Path(__file__).resolve().parents[1] / "analysis" / "reports"
+
+
+def committed_reports() -> dict:
+    """Wall time (``timings_s.total``) and CPU seconds (``cpu_s.total``, None in a report
+    written before it) of the committed quick and full reports."""
+    out = {}
+    for plan in ("quick", "full"):
+        f = REPORTS / f"validation-{plan}" / "validation.json"
+        if f.is_file():
+            doc = json.loads(f.read_text())
+            out[plan] = {
+                "wall_s": doc["timings_s"].get("total"),
+                "cpu_s": (doc.get("cpu_s") or {}).get("total"),
+            }
+    return out
+
+
+_COMPILE = """
+import json, resource, sys, time
+from spine_mj.sweep.kernel_warmup import warm_kernels
+t = time.perf_counter()
+warm_kernels(int(sys.argv[1]))
+ch = resource.getrusage(resource.RUSAGE_CHILDREN)
+cpu = time.process_time() + ch.ru_utime + ch.ru_stime
+print(json.dumps({"wall_s": time.perf_counter() - t, "cpu_s": cpu}))
+"""
+
+
+def kernel_compile() -> dict:
+    """What a fresh clone pays to compile the numba kernels
+    (:func:`spine_mj.sweep.kernel_warmup.warm_kernels`), each in a fresh process with an
+    empty numba cache: on one process (``one``: its CPU seconds are the compile's) and
+    spread over two (``two``: the wall time a 2-core demo waits)."""
+    import os
+
+    out = {}
+    for name, workers in (("one", 1), ("two", 2)):
+        with tempfile.TemporaryDirectory() as cache:
+            env = {**os.environ, "NUMBA_CACHE_DIR": cache}
+            res = subprocess.run(
+                [sys.executable, "-c", _COMPILE, str(workers)],
+                env=env,
+                capture_output=True,
+                text=True,
+                check=True,
+            )
+        out[name] = {k: round(v, 1) for k, v in json.loads(res.stdout.strip().splitlines()[-1]).items()}
+    return out
+
+
 def bench_plan_cost(quick: bool) -> dict:
     plan = "smoke" if quick else "quick"
     with tempfile.TemporaryDirectory() as tmp:
@@ -90,6 +145,8 @@ def bench_plan_cost(quick: bool) -> dict:
         cpu_s=round(cpu, 1),
         outside_cases_cpu_s=round(cpu - swept, 1),
         target_wall_s=QUICK_WALL_TARGET_S if plan == "quick" else None,
+        compile=kernel_compile(),
+        committed=committed_reports(),
     )
     return out
 
@@ -108,6 +165,21 @@ def markdown(res: dict | None) -> list[str]:
         f"| {res['plan']} plan: CPU of the command and its workers (in the sweeps' cases {cases:.0f} s, "
         f"outside them {res['outside_cases_cpu_s']:.0f} s) | {res['cpu_s']:.0f} s | | {ld} |",
     ]
+    if "compile" in res:
+        one, two = res["compile"]["one"], res["compile"]["two"]
+        rows.append(
+            f"| numba kernels compiled from an empty cache (`sweep.kernel_warmup`, what a fresh clone's "
+            f"`make demo` pays once): CPU on one process (wall on two) | {one['cpu_s']:.0f} s "
+            f"({two['wall_s']:.0f} s) | | {ld} |"
+        )
+    for plan, r in res.get("committed", {}).items():
+        target = FULL_WALL_TARGET_S if plan == "full" else None
+        goal = target_cell(r["wall_s"], "<=", target, " s") if target else ""
+        cpu = f", {r['cpu_s']:.0f} CPU-s" if r.get("cpu_s") is not None else ""
+        rows.append(
+            f"| committed `analysis/reports/validation-{plan}` (its own machine and load): wall{cpu} | "
+            f"{r['wall_s']:.0f} s | {goal} | |"
+        )
     for name, r in res["studies"].items():
         wall = f"{r['wall_s']:.0f} s wall" if r["wall_s"] is not None else "no wall time"
         cases = f"{r['sweep_cpu_s']:.0f} s in {r['runs']} MuJoCo runs' cases" if r["runs"] else "no sweep"

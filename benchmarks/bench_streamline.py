@@ -69,11 +69,53 @@ def bench_streamline(quick: bool) -> dict:
             "numpy_steps_s": numpy_rate,
             "kernel_over_numpy": kernel / numpy_rate,
         }
+    out["facets"] = facet_rates(quick)
     if not quick:
         t0 = time.perf_counter()
         fractal_hurst(workers=2)
         out["fractal_hurst_full_s"] = time.perf_counter() - t0
     return out
+
+
+#: The facet walk's target: the quick plan's compare analyses trace every start on the
+#: engine's facets at R / 8 steps, ~4e5 steps (the numpy reference's ~94 CPU-s there at its
+#: ~4e3 steps per CPU-s on the P600 facets); at 4e4 steps per CPU-s they cost 10 CPU-s of
+#: the demo. Steps here are accepted ones: a rejected, halved step costs an evaluation too.
+FACET_TARGET_STEPS_PER_CPU_S = 4e4
+
+
+def facet_rates(quick: bool) -> dict:
+    """Steps per CPU second of the facet streamline (the compare analysis's reference: the
+    engine's ball on the P600 sandpaper's facets, steps of R / 8) compiled
+    (:mod:`spine_mj.theory._facet_streamline_kernel`) and numpy, on the same starts, and
+    whether the two gave the same paths (within 1e-9)."""
+    from spine_mj import presets
+    from spine_mj.sim import Rig, TipParams
+
+    contact = Rig(presets.make_surface("sandpaper-P600"), tip=TipParams(mu_s=0.5)).contact_surface()
+    xmin, xmax, ymin, ymax = contact.bounds
+    n = 4 if quick else 12
+    starts = np.c_[np.full(n, xmin + 0.25 * (xmax - xmin)), np.linspace(ymin, ymax, n + 2)[1:-1]]
+    params = StreamlineParams(mu=0.5, dl=contact.radius / 8, kappa_cap=20.0)
+
+    def cpu(backend):
+        t = time.process_time()
+        r = streamlines(contact, starts, params, backend=backend)
+        return r, time.process_time() - t
+
+    cpu("numba")  # compile or load the cache
+    fast, fast_s = min((cpu("numba") for _ in range(3)), key=lambda r: r[1])
+    slow, slow_s = cpu("numpy")
+    same = np.array_equal(fast.outcome, slow.outcome) and fast.x.shape == slow.x.shape
+    same = same and bool(np.allclose(fast.x, slow.x, rtol=0, atol=1e-9 * contact.radius))
+    steps = int(fast.n_steps.sum())
+    return {
+        "starts": n,
+        "steps": steps,
+        "kernel_steps_per_cpu_s": steps / max(fast_s, 1e-9),
+        "numpy_steps_per_cpu_s": steps / max(slow_s, 1e-9),
+        "same_paths": same,
+    }
 
 
 def markdown(sl: dict | None) -> list[str]:
@@ -93,6 +135,16 @@ def markdown(sl: dict | None) -> list[str]:
                 f"| plain numpy streamline (`backend='numpy'`), {name}, {r['numpy_starts']} starts | "
                 f"{fmt(r['numpy_steps_s'])} steps/s (kernel / numpy = "
                 f"{r['kernel_over_numpy']:.0f}x) | | {ld} |"
+            )
+        if "facets" in sl:
+            f = sl["facets"]
+            same = "the same paths" if f["same_paths"] else "**paths differ**"
+            rate = f["kernel_steps_per_cpu_s"]
+            lines.append(
+                f"| facet streamline (compare's reference: ball on the P600 facets, steps R / 8), "
+                f"{f['starts']} starts, compiled | {fmt(rate)} steps / CPU-s (numpy "
+                f"{fmt(f['numpy_steps_per_cpu_s'])}: {rate / f['numpy_steps_per_cpu_s']:.0f}x; {same}) | "
+                f"{target_cell(rate, '>=', FACET_TARGET_STEPS_PER_CPU_S)} | {ld} |"
             )
         if "fractal_hurst_full_s" in sl:
             lines.append(

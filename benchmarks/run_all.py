@@ -7,7 +7,9 @@
 Sections (each records the machine's load average before and after it):
 
 * ``streamline``: steps/s of the compiled kernel (analytic single Gaussian, gridded
-  fractal) and of the plain numpy reference (``backend="numpy"``) on the same starts.
+  fractal) and of the plain numpy reference (``backend="numpy"``) on the same starts; and
+  steps per CPU second of the facet streamline (compare's reference on the P600 facets),
+  compiled and numpy (target 4e4).
 * ``rollout``: ``Rig.run_batch`` against bare ``mujoco.rollout`` (same model, controls and
   recording, runs that do not end early), paired runs in alternating order; the median of
   the per-pair ratios of wall time (the target) and of the process's CPU time; the calling
@@ -34,7 +36,9 @@ Sections (each records the machine's load average before and after it):
 * ``plan_cost``: ``spine-mj validate --quick`` (``--quick``: the smoke plan) as a user runs
   it, its wall time and CPU seconds, and each study's CPU seconds (the command and its
   workers) and those of its sweeps' runs (``benchmarks/bench_plan_cost.py``): target
-  ``make demo`` within 5 min.
+  ``make demo`` within 5 min. Also the numba kernels compiled from an empty cache (CPU
+  seconds on one process, wall on two) and the committed quick and full reports' wall
+  time (the full plan: target 30 min).
 * ``memory``: wall time and peak resident memory of the main jobs, each in a process of
   its own (``benchmarks/bench_memory.py``), marked where a peak grew by more than 20 %
   against the committed ``benchmarks/results.json``.
