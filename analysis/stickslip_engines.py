@@ -34,6 +34,7 @@ import argparse
 import itertools
 import json
 import math
+import pickle
 import time
 from pathlib import Path
 
@@ -90,6 +91,32 @@ def _pool(parts: list[dict]) -> dict:
     return {c: np.concatenate([np.asarray(p[c]) for p in parts]) if parts else np.zeros(0) for c in COLUMNS}
 
 
+def _segment(engine, rig, units, surf, k: float, ie: float, a: float, b: float, floors) -> dict:
+    """One run from rest over [a, b] and the references on the same stretch (spline and
+    facets): the catalog parts, the engine's CPU seconds, end, creep and jitter."""
+    land = track_landscape(surf, MU, units.tip_radius, (a, b))
+    faceted = track_landscape(surf, MU, units.tip_radius, (a, b), facets=facet_count(rig))
+    c0 = time.process_time()
+    result = _engine_run(rig, units, land, k, ie, a, b - a)
+    piece = {"cpu": time.process_time() - c0, "end": result.end_reason.value}
+    piece["eng"] = engine_rows(result, units, engine, k)
+    piece["refs"] = reference_rows(land, units, k)
+    start = result.drive_start_index
+    stuck = np.asarray(result.motion)[start:] == STUCK
+    vx = result.velocity_m_s[start:, 0] / (units.speed * units.length_scale_m)
+    dx = np.diff(result.position_m[start:, 0], prepend=result.position_m[start, 0])
+    piece |= {"stuck_v": vx[stuck], "creep": float(dx[stuck].sum()), "travel": float(dx.sum())}
+    piece["jitter"] = jitter_scale(result.drive_force_n[start:] / units.preload_n)
+    piece["drops"] = {}
+    for floor in floors:
+        refs = dict(reference_drop_rows(land, units, k, floor))
+        for source, r in reference_drop_rows(faceted, units, k, floor).items():
+            r["source"] = [f"{source}_facets"] * len(r["source"])
+            refs[f"{source}_facets"] = r
+        piece["drops"][floor] = (engine_drop_rows(result, units, engine, k, floor), refs)
+    return piece
+
+
 def one(
     engine: str,
     variant: str,
@@ -101,51 +128,63 @@ def one(
     segment: float = 80.0,
     track_length: float | None = None,
     seed: int = 1,
+    track: str = "abbm-short",
+    start: float | None = None,
+    cache: Path | None = None,
 ) -> dict:
     """One engine, variant, I_e and K over the track in runs of ``segment`` units (each
     from rest, the references on the same stretch): the catalogs pooled over the runs.
     ``track_length``: the abbm preset made that long (its spacing kept) instead; ``seed``:
-    the preset's draw."""
+    the preset's draw; ``track`` "abbm": the long preset's stretch from ``start``, a rig per
+    run on its stretch; ``cache``: a folder that keeps each run's parts (a rerun resumes)."""
     longer = (
         {} if track_length is None else {"length": track_length, "points": int(round(track_length * 10)) + 1}
     )
-    surf = presets.make_surface("abbm-short", seed=seed, **longer)
-    xmin, xmax, _, _ = surf.bounds
-    x0, length = xmin + EDGE_SHARE * (xmax - xmin), (1 - 2 * EDGE_SHARE) * (xmax - xmin)
-    length = length if travel is None else travel
-    rig = _variant(engine, variant, ie, k, surf)
-    units = TrackUnits.of(rig.scales, ie)
+    if track == "abbm":  # the long preset: its prefix, and a rig per run on the run's stretch
+        surf = whole = abbm_prefix(seed, start + travel + segment)
+        xmin, xmax, _, _ = surf.bounds
+        x0, length = start, travel
+    else:
+        surf = presets.make_surface("abbm-short", seed=seed, **longer)
+        xmin, xmax, _, _ = surf.bounds
+        x0, length = xmin + EDGE_SHARE * (xmax - xmin), (1 - 2 * EDGE_SHARE) * (xmax - xmin)
+        length = length if travel is None else travel
+        rig = _variant(engine, variant, ie, k, surf)
+        units = TrackUnits.of(rig.scales, ie)
     count = max(1, math.ceil(length / segment - 1e-9))
     bounds = x0 + length * np.arange(count + 1) / count
     parts: dict = {"eng": [], "refs": {s: [] for s in REFERENCES}, "drops": {f: ([], {}) for f in floors}}
     cpu, ends, stuck_v, creep, travel_sum, jitter = 0.0, [], [], 0.0, 0.0, []
-    for a, b in itertools.pairwise(bounds):
-        land = track_landscape(surf, MU, units.tip_radius, (a, b))
-        faceted = track_landscape(surf, MU, units.tip_radius, (a, b), facets=facet_count(rig))
-        for source, r in reference_rows(land, units, k).items():
+    for i, (a, b) in enumerate(itertools.pairwise(bounds)):
+        saved = None if cache is None else Path(cache) / f"segment_{i:04d}.pkl"
+        if saved is not None and saved.exists():
+            piece = pickle.loads(saved.read_bytes())
+        else:
+            if track == "abbm":
+                surf = crop(whole, a - segment / 4, b + segment / 4)
+                rig = _variant(engine, variant, ie, k, surf)
+                units = TrackUnits.of(rig.scales, ie)
+            piece = _segment(engine, rig, units, surf, k, ie, a, b, floors)
+            if saved is not None:
+                saved.parent.mkdir(parents=True, exist_ok=True)
+                with atomic_output(saved) as tmp:
+                    Path(tmp).write_bytes(pickle.dumps(piece))
+            if cache is not None:
+                print(f"  segment {i + 1}/{count}: {piece['cpu']:.0f} CPU s", flush=True)
+        cpu += piece["cpu"]
+        ends.append(piece["end"])
+        parts["eng"].append(piece["eng"])
+        for source, r in piece["refs"].items():
             parts["refs"][source].append(r)
-        c0 = time.process_time()
-        result = _engine_run(rig, units, land, k, ie, a, b - a)
-        cpu += time.process_time() - c0
-        ends.append(result.end_reason.value)
-        parts["eng"].append(engine_rows(result, units, engine, k))
-        start = result.drive_start_index
-        stuck = np.asarray(result.motion)[start:] == STUCK
-        vx = result.velocity_m_s[start:, 0] / (units.speed * units.length_scale_m)
-        dx = np.diff(result.position_m[start:, 0], prepend=result.position_m[start, 0])
-        stuck_v.append(vx[stuck])
-        creep += float(dx[stuck].sum())
-        travel_sum += float(dx.sum())
-        jitter.append(jitter_scale(result.drive_force_n[start:] / units.preload_n))
+        stuck_v.append(piece["stuck_v"])
+        creep += piece["creep"]
+        travel_sum += piece["travel"]
+        jitter.append(piece["jitter"])
         for floor in floors:
             eng_parts, ref_parts = parts["drops"][floor]
-            eng_parts.append(engine_drop_rows(result, units, engine, k, floor))
-            for source, r in reference_drop_rows(land, units, k, floor).items():
+            eng_parts.append(piece["drops"][floor][0])
+            for source, r in piece["drops"][floor][1].items():
                 ref_parts.setdefault(source, []).append(r)
-            for source, r in reference_drop_rows(faceted, units, k, floor).items():
-                r["source"] = [f"{source}_facets"] * len(r["source"])
-                ref_parts.setdefault(f"{source}_facets", []).append(r)
-        del result
     eng = _pool(parts["eng"])
     refs = {s: _pool(v) for s, v in parts["refs"].items()}
     row = {
@@ -154,6 +193,8 @@ def one(
         "ie": ie,
         "K": k,
         "seed": seed,
+        "track": track,
+        "start": float(x0),
         "track_length": float(xmax - xmin),
         "segments": count,
         "segment_length": float(length / count),
@@ -196,6 +237,117 @@ def one(
     return row
 
 
+#: A slip's share of the carriage's advance ``V T`` (T the spring-block's half period
+#: ``pi sqrt(m / k)``) over the median inertial drop, below which the drive counts as slow
+#: (:func:`slow_ie`). Derived from the saved ``abbm-short`` runs (seed 1, K 1, floor 1e-3,
+#: before any run on the ``abbm`` preset): the size distance there fell as ``D = 0.31 Lambda``
+#: (0.214 at Lambda 0.69, I_e 1e-4), and Lambda 0.12 keeps it to a third of the KS critical
+#: value of 300 against 300 drops (0.111).
+SLOWNESS = 0.12
+#: The force-drop floor as a share of the cutoff's drop ``k S_m = sigma / k``: the
+#: ``abbm-short`` runs' 1e-3 F_p at their K 1 (``sigma / k`` 9.1e-3 F_p), so that every K
+#: keeps the same part of its size distribution.
+FLOOR_SHARE = 0.11
+#: Inertial drops a cell's travel must hold (the test's power: KS's 95 % critical distance
+#: 1.36 sqrt(2 / 300) = 0.11 against as many reference drops).
+DROPS_PER_CELL = 300
+#: A run's stretch in cutoffs ``S_m = sigma / k^2``: every slip (up to ~4 inertial cutoffs,
+#: 3 S_m each) fits many times, and MuJoCo's float32 hfield keeps a tenth of the walk's
+#: curvature per node over it (height range <= 0.1 x 40 S_m).
+SEGMENT_CUTOFFS = 40.0
+
+
+def abbm_prefix(seed: int, end: float):
+    """The ``abbm`` preset drawn with ``seed`` from x = 0 to at least ``end`` (and at least
+    its correlation length): the preset's own first points, since the slope walk is drawn
+    point after point from the seed (heights differ by a constant, the mean removed)."""
+    from spine_mj.presets import load_preset
+
+    params = load_preset("abbm").params
+    dx = params["length"] / (params["points"] - 1)
+    end = max(end, params["correlation_length"])
+    n = int(math.ceil(end / dx)) + 1
+    return presets.make_surface("abbm", seed=seed, length=(n - 1) * dx, points=n)
+
+
+def crop(surf, a: float, b: float):
+    """The strip of ``surf`` over x in [a, b] (its grid points there, metadata kept: the
+    slope length and so K mean the same spring)."""
+    import dataclasses
+
+    keep = (surf.x >= a) & (surf.x <= b)
+    return dataclasses.replace(surf, heights=surf.heights[:, keep].copy(), x=surf.x[keep].copy())
+
+
+def abbm_plan(surf, k: float, start: float, longest: float, drops: int = DROPS_PER_CELL) -> dict:
+    """One K's cell on an ``abbm`` track, fixed from the inertial reference before any
+    engine run: the floor (:data:`FLOOR_SHARE` of ``sigma / k``), the travel that holds
+    :data:`DROPS_PER_CELL` inertial drops (searched up to ``longest`` units), and the I_e at
+    which the carriage advances :data:`SLOWNESS` median drops in a half period."""
+    from spine_mj.surfaces.tracks import abbm_force_intensity
+
+    params = surf.metadata["params"]
+    xi = params["correlation_length"]
+    sigma = abbm_force_intensity(params["slope_intensity"], MU)
+    kk = k / xi
+    floor = float(f"{FLOOR_SHARE * sigma / kk:.2g}")
+    cutoff = sigma / kk**2
+    segment = SEGMENT_CUTOFFS * cutoff
+    probe = crop(surf, start - 1, start + 50)
+    units = TrackUnits.of(build_rig(probe, engine="mujoco", mu=MU, ie=1.0, stiffness_number=k).scales, 1.0)
+    sizes, ends = [], []
+    x = start
+    while x < start + longest and len(sizes) < drops:
+        land = track_landscape(surf, MU, units.tip_radius, (x, x + segment))
+        r = reference_drop_rows(land, units, k, floor)["inertial"]
+        sizes += list(np.asarray(r["size_lc"]) * units.char_length)
+        x += segment
+        ends.append(x)
+    travel = x - start
+    s_med = float(np.median(sizes))
+    half_period = math.pi * math.sqrt(units.mass / kk)
+    speed = SLOWNESS * s_med / half_period
+    ie = float(f"{(speed / units.speed) ** 2:.2g}")
+    return {
+        "K": k,
+        "floor_fp": floor,
+        "cutoff": cutoff,
+        "segment": segment,
+        "travel": travel,
+        "inertial_drops": len(sizes),
+        "median_drop": s_med,
+        "half_period_s": half_period,
+        "ie": ie,
+        "speed": speed,
+    }
+
+
+def cached_summary(folder: Path, engine: str = "mujoco") -> dict:
+    """The runs a cell's ``cache`` folder holds (a cell stopped before its last run): counts,
+    engine CPU seconds, end reasons and the engine's drop sizes against each reference's on
+    the same stretches (KS and AD, :func:`~spine_mj.validate.avalanche_stats.two_sample`)."""
+    pieces = [pickle.loads(f.read_bytes()) for f in sorted(Path(folder).glob("segment_*.pkl"))]
+    ((floor, _),) = pieces[0]["drops"].items()
+    eng = _pool([p["drops"][floor][0] for p in pieces])
+    refs = {s: _pool([p["drops"][floor][1][s] for p in pieces]) for s in pieces[0]["drops"][floor][1]}
+    out = {
+        "runs": len(pieces),
+        "floor_fp": floor,
+        "cpu_s": sum(p["cpu"] for p in pieces),
+        "ends": sorted({p["end"] for p in pieces}),
+        "n": {engine: len(eng["size_lc"])} | {s: len(r["size_lc"]) for s, r in refs.items()},
+        "jitter_fp": max(p["jitter"] for p in pieces),
+    }
+    for source, r in refs.items():
+        if len(eng["size_lc"]) >= 2 and len(r["size_lc"]) >= 2:
+            out[f"size_lc_vs_{source}"] = two_sample(eng["size_lc"], r["size_lc"])
+    out["median_size_lc"] = {
+        s: float(np.median(r["size_lc"])) for s, r in (refs | {engine: eng}).items() if len(r["size_lc"])
+    }
+    out["median_duration_s"] = float(np.median(eng["duration_s"])) if len(eng["duration_s"]) else math.nan
+    return out
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--ie", default="1e-4,1e-5")
@@ -211,8 +363,17 @@ def main(argv=None):
     ap.add_argument("--tag", default=None, help="output name (default: engines_variants)")
     ap.add_argument("--report", action="store_true", help="only tabulate the saved drop catalogs")
     ap.add_argument("--fits", action="store_true", help="only fit tau and S_m to the saved catalogs")
+    ap.add_argument("--track", default="abbm-short", help="abbm-short, or abbm (the long preset)")
+    ap.add_argument("--drops", type=int, default=DROPS_PER_CELL, help="abbm: inertial drops a cell holds")
+    ap.add_argument("--start", type=float, default=None, help="abbm: the cell's first x (default: 5 %% in)")
+    ap.add_argument("--cached", default=None, help="only summarize a cell's cached runs (a segments_ folder)")
     a = ap.parse_args(argv)
     out = Path(a.out)
+    if a.cached:
+        summary = cached_summary(Path(a.cached))
+        write_json(out / f"{Path(a.cached).name}_cached.json", summary)
+        print(json.dumps(summary, indent=1))
+        return
     if a.report:
         print(report(out))
         return
@@ -225,6 +386,51 @@ def main(argv=None):
     rows = json.loads(path.read_text()) if path.exists() else []
     catalogs = [pd.read_parquet(cat_path)] if cat_path.exists() else []
     floors = [float(v) for v in a.floors.split(",") if v.strip()]
+    if a.track == "abbm":  # each K's floor, travel and I_e from the inertial reference (abbm_plan)
+        start = EDGE_SHARE * presets.load_preset("abbm").params["length"] if a.start is None else a.start
+        for k in (float(v) for v in a.K.split(",")):
+            plan_path = out / f"stickslip_plan_{a.tag}_K{k:g}.json"
+            if plan_path.exists():
+                plan = json.loads(plan_path.read_text())
+            else:
+                plan = abbm_plan(abbm_prefix(a.seed, start + 60000), k, start, 60000, a.drops)
+                write_json(plan_path, plan)
+            print(f"plan K {k:g}: {plan}", flush=True)
+            for engine in a.engines.split(","):
+                for variant in a.variants.split(","):
+                    if any(
+                        (r["engine"], r["variant"], r["K"], r.get("seed", 1)) == (engine, variant, k, a.seed)
+                        for r in rows
+                    ):
+                        continue
+                    row = one(
+                        engine,
+                        variant,
+                        plan["ie"],
+                        k,
+                        plan["travel"] if a.travel is None else min(a.travel, plan["travel"]),
+                        [plan["floor_fp"]],
+                        catalogs,
+                        a.segment,
+                        None,
+                        a.seed,
+                        "abbm",
+                        start,
+                        out / f"segments_{a.tag}_K{k:g}",
+                    )
+                    row["plan"] = plan
+                    rows.append(row)
+                    write_json(path, rows)
+                    with atomic_output(cat_path) as tmp:
+                        pd.concat(catalogs, ignore_index=True).to_parquet(tmp, index=False)
+                    e = row["drops"][f"{plan['floor_fp']:g}"]
+                    tests = {c: (v["ks"], v["ks_p"]) for c, v in e.items() if c.startswith("size_lc_vs")}
+                    print(
+                        f"{engine} {variant} seed {a.seed} K {k:g} I_e {plan['ie']:g}: {e['n']} {tests} "
+                        f"jitter {row['jitter_fp']:.3g} F_p; {row['cpu_s']:.0f} CPU s",
+                        flush=True,
+                    )
+        return
     for engine in a.engines.split(","):
         for variant in a.variants.split(","):
             for ie in (float(v) for v in a.ie.split(",")):

@@ -7,6 +7,9 @@ and MuJoCo per slip on the ABBM track.
 
 from __future__ import annotations
 
+import json
+import subprocess
+import sys
 import tempfile
 import time
 
@@ -17,6 +20,61 @@ from bench_common import fmt, target_cell
 POINTS = 2_000_000
 #: Target: slips per CPU second of each reference (a study's 10^5 slips in a second).
 REFERENCE_TARGET = 1e5
+
+
+#: The ``abbm`` preset's engine cell timed: K 10 at the I_e of its study cell on seed 1
+#: (``analysis/stickslip_engines.py --track abbm``: the carriage advances 0.12 median drops
+#: in a half period), one run of :data:`ABBM_ENGINE_TRAVEL` units.
+ABBM_ENGINE = {"K": 10.0, "ie": 7.3e-6}
+ABBM_ENGINE_TRAVEL = 10.0
+
+_ABBM_CHILD = r"""
+import dataclasses, json, resource, sys, tempfile, time
+from spine_mj import presets
+from spine_mj.sim.build import build_rig
+from spine_mj.validate.slip_catalog import TrackUnits, track_landscape
+from spine_mj.validate.stickslip_outputs import _engine_run, stickslip_to
+length = float(sys.argv[1])
+K, ie, travel = float(sys.argv[2]), float(sys.argv[3]), float(sys.argv[4])
+c0 = time.process_time()
+surf = presets.make_surface("abbm", length=length, points=int(round(10 * length)) + 1)
+make_s = time.process_time() - c0
+c0 = time.process_time()
+with tempfile.TemporaryDirectory() as tmp:
+    out = stickslip_to(tmp, surf, mu=0.5, ie=ie, n_bootstrap=10)
+refs_s = time.process_time() - c0
+slips = sum(e["n_events"] for per_k in out.summary["sources"].values() for e in per_k.values())
+x0 = 0.05 * length
+keep = (surf.x >= x0 - 5) & (surf.x <= x0 + travel + 5)
+part = dataclasses.replace(surf, heights=surf.heights[:, keep].copy(), x=surf.x[keep].copy())
+del surf, out
+rig = build_rig(part, engine="mujoco", mu=0.5, ie=ie, stiffness_number=K)
+units = TrackUnits.of(rig.scales, ie)
+land = track_landscape(part, 0.5, units.tip_radius, (x0, x0 + travel))
+c0 = time.process_time()
+_engine_run(rig, units, land, K, ie, x0, travel)
+mj_s = time.process_time() - c0
+print(json.dumps({"length": length, "make_cpu_s": make_s, "references_cpu_s": refs_s, "slips": slips,
+                  "mujoco_cpu_s": mj_s, "mujoco_steps_per_unit": 1 / (units.speed * rig.engine.timestep_s),
+                  "peak_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss // 1024}))
+"""
+
+
+def bench_abbm_preset(quick: bool) -> dict:
+    """The ``abbm`` preset (``--quick``: its first tenth, 45 000 units) in a process of its
+    own: CPU seconds to make it, to run both references and their statistics over it at its
+    default K (``spine-mj stickslip abbm``), MuJoCo's per unit of travel at K 10, and the
+    peak resident memory."""
+    from spine_mj import presets
+
+    length = presets.load_preset("abbm").params["length"] / (10 if quick else 1)
+    args = [str(length), str(ABBM_ENGINE["K"]), str(ABBM_ENGINE["ie"]), str(ABBM_ENGINE_TRAVEL)]
+    out = subprocess.run(
+        [sys.executable, "-c", _ABBM_CHILD, *args], capture_output=True, text=True, check=True
+    )
+    res = json.loads(out.stdout.strip().splitlines()[-1])
+    res["mujoco_cpu_s_per_unit"] = res["mujoco_cpu_s"] / ABBM_ENGINE_TRAVEL
+    return res | {"K": ABBM_ENGINE["K"], "ie": ABBM_ENGINE["ie"]}
 
 
 def bench_stickslip(quick: bool) -> dict:
@@ -70,6 +128,7 @@ def bench_stickslip(quick: bool) -> dict:
         "pulses": {"slips": int(sizes.size), "cpu_s": pulse_cpu},
         "drops": {"rows": n, "cpu_s": drop_cpu},
         "mujoco": {"travel": 100.0, "ie": 1e-3, "K": 0.5, "slips": mj_slips, "cpu_s": mj_cpu},
+        "abbm": bench_abbm_preset(quick),
     }
 
 
@@ -104,4 +163,16 @@ def markdown(res: dict | None) -> list[str]:
         f"{mj['travel']:g} units | "
         f"{fmt(mj['cpu_s'])} CPU s, {mj['slips']} MuJoCo slips | - | {load} |"
     )
+    if "abbm" in res:
+        ab = res["abbm"]
+        rows.append(
+            f"| `abbm` preset, {ab['length']:g} units: made; both references and their statistics at "
+            f"its K ({ab['slips']} slips) | {fmt(ab['make_cpu_s'])} + {fmt(ab['references_cpu_s'])} CPU s, "
+            f"peak {ab['peak_rss_mb'] / 1024:.1f} GB | - | {load} |"
+        )
+        rows.append(
+            f"| MuJoCo on the `abbm` preset, K {ab['K']:g}, I_e {ab['ie']:g} "
+            f"({ab['mujoco_steps_per_unit']:.3g} steps a unit) | "
+            f"{fmt(ab['mujoco_cpu_s_per_unit'])} CPU s per unit of travel | - | {load} |"
+        )
     return rows
