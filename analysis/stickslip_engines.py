@@ -322,6 +322,44 @@ def abbm_plan(surf, k: float, start: float, longest: float, drops: int = DROPS_P
     }
 
 
+def flat_friction(seed: int, k: float, ie: float, step_share: float, x0: float = 22580.0) -> dict:
+    """MuJoCo's spring drive on a flat strip of the ``abbm`` preset's rig (its crop at ``x0``,
+    heights zeroed, so the same scales, tip and step): the breakaway force and the sliding
+    force over the second half of a run of 20 units (the reference's is ``mu W`` for both),
+    at the rule's step times ``step_share`` (the contact's time constant following it)."""
+    import dataclasses
+
+    part = crop(abbm_prefix(seed, x0 + 40), x0 - 10, x0 + 30)
+    flat = dataclasses.replace(part, heights=np.zeros_like(part.heights))
+    base = build_rig(flat, engine="mujoco", mu=MU, ie=ie, stiffness_number=k, line=True)
+    rig = build_rig(
+        flat,
+        engine="mujoco",
+        mu=MU,
+        ie=ie,
+        stiffness_number=k,
+        line=True,
+        timestep_s=base.engine.timestep_s * step_share,
+    )
+    units = TrackUnits.of(rig.scales, ie)
+    land = track_landscape(flat, MU, units.tip_radius, (x0, x0 + 20))
+    c0 = time.process_time()
+    res = _engine_run(rig, units, land, k, ie, x0, 20.0)
+    f = res.drive_force_n[res.drive_start_index :] / units.preload_n
+    late = f[f.size // 2 :]
+    return {
+        "seed": seed,
+        "K": k,
+        "ie": ie,
+        "timestep_s": rig.engine.timestep_s,
+        "breakaway_fp": float(f.max()),
+        "sliding_fp": float(late.mean()),
+        "sliding_std_fp": float(late.std()),
+        "mu": MU,
+        "cpu_s": time.process_time() - c0,
+    }
+
+
 def cached_summary(folder: Path, engine: str = "mujoco") -> dict:
     """The runs a cell's ``cache`` folder holds (a cell stopped before its last run): counts,
     engine CPU seconds, end reasons and the engine's drop sizes against each reference's on
@@ -366,9 +404,17 @@ def main(argv=None):
     ap.add_argument("--track", default="abbm-short", help="abbm-short, or abbm (the long preset)")
     ap.add_argument("--drops", type=int, default=DROPS_PER_CELL, help="abbm: inertial drops a cell holds")
     ap.add_argument("--start", type=float, default=None, help="abbm: the cell's first x (default: 5 %% in)")
+    ap.add_argument(
+        "--flat", action="store_true", help="only MuJoCo's friction on a flat strip (default, dt / 2)"
+    )
     ap.add_argument("--cached", default=None, help="only summarize a cell's cached runs (a segments_ folder)")
     a = ap.parse_args(argv)
     out = Path(a.out)
+    if a.flat:
+        rows = [flat_friction(a.seed, float(a.K), float(a.ie), share) for share in (1.0, 0.5)]
+        write_json(out / "stickslip_engines_abbm_flat.json", rows)
+        print(json.dumps(rows, indent=1))
+        return
     if a.cached:
         summary = cached_summary(Path(a.cached))
         write_json(out / f"{Path(a.cached).name}_cached.json", summary)
@@ -470,7 +516,7 @@ def _saved_runs(out: Path) -> dict:
     """Every saved drop catalog under ``out`` by ``(seed, variant, ie, K, floor)``; a run
     that two files hold, the first file's."""
     runs: dict = {}
-    for path in sorted(out.glob("stickslip_drops_*.parquet")):
+    for path in _short_track_catalogs(out):
         for key, g in _with_seed(pd.read_parquet(path)).groupby(["seed", "variant", "ie", "K", "floor_fp"]):
             runs.setdefault(key, g)
     return runs
@@ -542,7 +588,7 @@ def report(out: Path) -> str:
         "| sizes D, p (AD p) | drops D, p (AD p) | drops at fixed carriage D, p (AD p) |",
         "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |",
     ]
-    for path in sorted(out.glob("stickslip_drops_*.parquet")):
+    for path in _short_track_catalogs(out):
         cat = _with_seed(pd.read_parquet(path))
         runs = json.loads(
             (out / path.name.replace("stickslip_drops_", "stickslip_engines_"))
@@ -592,6 +638,16 @@ def _carriage_rate(engine: str, ie: float, k: float, seed: int = 1) -> float:
     surf = presets.make_surface("abbm-short", seed=int(seed))
     units = TrackUnits.of(build_rig(surf, engine=engine, mu=MU, ie=ie, stiffness_number=k).scales, ie)
     return units.stiffness(k) * units.speed
+
+
+def _short_track_catalogs(out: Path) -> list[Path]:
+    """The saved drop catalogs of the ``abbm-short`` runs (the ``abbm`` preset's cells,
+    ``stickslip_drops_abbm_*``, carry their own summaries in their JSON)."""
+    return [
+        p
+        for p in sorted(out.glob("stickslip_drops_*.parquet"))
+        if not p.name.startswith("stickslip_drops_abbm_")
+    ]
 
 
 def _with_seed(cat: pd.DataFrame) -> pd.DataFrame:
@@ -652,7 +708,7 @@ def order_lines(out: Path, n_boot: int = 400, seed: int = 0) -> list[str]:
     falls, before it reaches the floor), with a 95 % bootstrap interval (the catalogs
     resampled ``n_boot`` times). A D above D_95 again at smaller I_e is in the cells."""
     frames, seen = [], set()
-    for path in sorted(out.glob("stickslip_drops_*.parquet")):  # a run repeated in a later file: the first
+    for path in _short_track_catalogs(out):  # a run repeated in a later file: the first
         for key, g in _with_seed(pd.read_parquet(path)).groupby(["variant", "ie", "K", "floor_fp", "seed"]):
             if key not in seen:
                 seen.add(key)
