@@ -438,14 +438,7 @@ def _doc(name: str, surface_file: Path, starts: dict, drive: dict, grid: dict, m
     size = _CASE_STARTS * members
     chunks = [pts[i : i + size] for i in range(0, len(pts), size)]
     return {
-        # the verdict reads the run tables alone: a grit's paths at every step took 177-329 MB a
-        # case (sandpaper-P36, 24 runs), and filled a disk before a verdict
-        "sweep": {
-            "name": name,
-            "seed": 11,
-            "analyses": ["quasistatic", "engine", "compare"],
-            "store_trajectories": False,
-        },
+        "sweep": {"name": name, "seed": 11, "analyses": ["quasistatic", "engine", "compare"]},
         "surfaces": [
             {"file": str(surface_file), "starts": {"frame": "absolute", "points": c}} for c in chunks
         ],
