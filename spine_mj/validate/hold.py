@@ -52,10 +52,11 @@ from spine_mj.validate.ensembles import (
     ensemble_starts,
     ensemble_verdicts,
 )
+from spine_mj.validate.hold_summary import hold_summary, interval_bounds
 from spine_mj.validate.intervals import bootstrap, wilson
 from spine_mj.validate.study_runner import StudyRunner, ValidationProgress
 
-__all__ = ["LADDERS", "MIN_PAIRED_STARTS", "HoldSettings", "hold_to", "verdict_sentence"]
+__all__ = ["LADDERS", "MIN_PAIRED_STARTS", "HoldSettings", "hold_to"]
 
 #: Refinement axes, each a ladder of levels (key, label, the sweep's grid keys): a level
 #: runs only where the one before it still moved the headlines.
@@ -210,7 +211,7 @@ def hold_to(
         batches.points.append(places[n_run : n_run + add])
         base = batches.base(settings.members)
     summ, verdicts, levels = judged["summ"], judged["verdicts"], judged["levels"]
-    summary = _summary(
+    summary = hold_summary(
         label, settings, corner, limits, tip, share, summ, verdicts, levels, judged["converged"], why
     )
     summary["mujoco_starts"] = {
@@ -417,7 +418,11 @@ def _self_lock_share(runner, surface, places, tip: float, mu: float) -> tuple[np
         tick()
     held = np.asarray(ref.self_locked, bool)
     n_held = int(held.sum())
-    return held, {"value": n_held / len(held), **_bounds(wilson(n_held, len(held))), "n": int(len(held))}
+    return held, {
+        "value": n_held / len(held),
+        **interval_bounds(wilson(n_held, len(held))),
+        "n": int(len(held)),
+    }
 
 
 def _places(surface, tip: float, settings: HoldSettings) -> np.ndarray:
@@ -551,75 +556,3 @@ def _level(
         entry[f"{headline}_converged"] = ok
     entry["converged"] = all(entry[f"{h}_converged"] is not False for h in JUDGED)
     return entry
-
-
-def _bounds(interval) -> dict:
-    low, high = interval
-    return {"low": float(low), "high": float(high)}
-
-
-def _summary(label, settings, corner, limits, tip, share, summ, verdicts, levels, converged, why) -> dict:
-    agreement = {
-        "value": summ["agreement_well_conditioned"],
-        **_bounds(summ["agreement_ci"]),
-        "n_well_conditioned": int(verdicts["well_conditioned_runs"]),
-        "starts": int(verdicts["starts"]),
-        "ill_conditioned_starts": int(verdicts["ill_conditioned_starts"]),
-        "all_starts": summ["outcome_agreement"],
-        "all_starts_interval": list(summ["outcome_agreement_ci"]),
-    }
-    refinements = [
-        {
-            "level": lv["label"],
-            "key": lv["key"],
-            "run": lv["run"],
-            **(
-                {
-                    "from": lv["from"],
-                    "runs": lv["runs"],
-                    "well_conditioned_runs": lv["well_conditioned_runs"],
-                    "reference_stalled": lv["reference_stalled"],
-                    "change": lv["agreement_well_conditioned"]["change"],
-                    "median_frechet_change": lv["median_frechet"]["change"],
-                    "failed_runs": lv["failed_runs"],
-                    "converged": lv["converged"],
-                }
-                if lv["run"]
-                else {"note": lv["note"]}
-            ),
-        }
-        for lv in levels
-    ]
-    out = {
-        "surface": label,
-        "mu": settings.mu,
-        "tip_radius": tip,
-        "corner": corner.as_dict(),
-        "drive_limits": limits.as_dict(),
-        "self_lock_share": share,
-        "agreement": agreement,
-        "median_frechet": {"value": summ["median_frechet"], **_bounds(summ["median_frechet_ci"])},
-        "failed_runs": summ["failed_runs"],
-        "converged": bool(converged),
-        "why_unconverged": why,
-        "refinements": refinements,
-    }
-    out["verdict"] = verdict_sentence(out)
-    return out
-
-
-def verdict_sentence(s: dict) -> str:
-    """The summary's one-sentence verdict."""
-    sh, ag, c = s["self_lock_share"], s["agreement"], s["corner"]
-    hold = (
-        f"a spine pulled along x holds from {sh['value']:.1%} of {sh['n']} places "
-        f"[{sh['low']:.1%}, {sh['high']:.1%}] on {s['surface']} at mu_s {s['mu']:g}"
-    )
-    check = (
-        f"MuJoCo at I_e {c['ie']:.3g}, K {c['K']:.3g} agrees on {ag['value']:.3f} "
-        f"[{ag['low']:.2f}, {ag['high']:.2f}] of {ag['n_well_conditioned']} well-conditioned starts"
-    )
-    run = [r["level"] for r in s["refinements"] if r.get("run")]
-    if s["converged"]:
-        return f"{hold.capitalize()}; {check}, converged under {', '.join(run)}."
-    return f"{hold.capitalize()}; {check}, not converged: {s['why_unconverged']}."
