@@ -26,6 +26,13 @@ the distance's order in I_e (:func:`order_lines`); ``--fits`` gives every saved 
 truncated power law ``tau`` and cutoff ``S_m`` for the engine and the references, and
 whether a variant's values leave the base run's intervals (``engines_fits.md``,
 :func:`fits`).
+
+``--track abbm``: a cell on the long ``abbm`` preset instead (:func:`abbm_plan` fixes its
+floor, travel and I_e from the inertial reference before any run; ``--start``, ``--travel``
+a part of it; each run cached under ``segments_<tag>_K<K>``, so a killed cell resumes);
+``--cached a,b`` pools the cached runs of stopped cells (:func:`cached_summary`);
+``--flat`` measures MuJoCo's breakaway and sliding friction on the preset's rig made flat,
+at the rule's step and at half of it (:func:`flat_friction`).
 """
 
 from __future__ import annotations
@@ -360,11 +367,12 @@ def flat_friction(seed: int, k: float, ie: float, step_share: float, x0: float =
     }
 
 
-def cached_summary(folder: Path, engine: str = "mujoco") -> dict:
-    """The runs a cell's ``cache`` folder holds (a cell stopped before its last run): counts,
+def cached_summary(folders: list[Path], engine: str = "mujoco") -> dict:
+    """The runs cells' ``cache`` folders hold (a cell stopped before its last run), pooled: counts,
     engine CPU seconds, end reasons and the engine's drop sizes against each reference's on
     the same stretches (KS and AD, :func:`~spine_mj.validate.avalanche_stats.two_sample`)."""
-    pieces = [pickle.loads(f.read_bytes()) for f in sorted(Path(folder).glob("segment_*.pkl"))]
+    files = [f for folder in folders for f in sorted(Path(folder).glob("segment_*.pkl"))]
+    pieces = [pickle.loads(f.read_bytes()) for f in files]
     ((floor, _),) = pieces[0]["drops"].items()
     eng = _pool([p["drops"][floor][0] for p in pieces])
     refs = {s: _pool([p["drops"][floor][1][s] for p in pieces]) for s in pieces[0]["drops"][floor][1]}
@@ -407,7 +415,7 @@ def main(argv=None):
     ap.add_argument(
         "--flat", action="store_true", help="only MuJoCo's friction on a flat strip (default, dt / 2)"
     )
-    ap.add_argument("--cached", default=None, help="only summarize a cell's cached runs (a segments_ folder)")
+    ap.add_argument("--cached", default=None, help="only summarize cached runs (folders, a,b)")
     a = ap.parse_args(argv)
     out = Path(a.out)
     if a.flat:
@@ -416,8 +424,9 @@ def main(argv=None):
         print(json.dumps(rows, indent=1))
         return
     if a.cached:
-        summary = cached_summary(Path(a.cached))
-        write_json(out / f"{Path(a.cached).name}_cached.json", summary)
+        folders = [Path(f) for f in a.cached.split(",")]
+        summary = cached_summary(folders)
+        write_json(out / f"{folders[0].name}_cached.json", summary | {"folders": [f.name for f in folders]})
         print(json.dumps(summary, indent=1))
         return
     if a.report:
