@@ -171,7 +171,8 @@ def markdown(res: dict | None) -> list[str]:
             f"peak {ab['peak_rss_mb'] / 1024:.1f} GB | - | {load} |"
         )
         rows.append(
-            f"| MuJoCo on the `abbm` preset, K {ab['K']:g}, I_e {ab['ie']:g} "
+            f"| MuJoCo on the `abbm` preset, K {ab['K']:g}, I_e {ab['ie']:g}, a run of "
+            f"{ABBM_ENGINE_TRAVEL:g} units and the spring's last 0.2 % of stretch "
             f"({ab['mujoco_steps_per_unit']:.3g} steps a unit) | "
             f"{fmt(ab['mujoco_cpu_s_per_unit'])} CPU s per unit of travel | - | {load} |"
         )
