@@ -261,14 +261,23 @@ class _Batches:
         return self.runner.many(jobs, key)
 
     def base(self, members: int) -> dict:
-        """The corner's ensembles on every batch, with when it started and its seconds."""
+        """The corner's ensembles on every batch, with when it started and its seconds: the
+        wall time now, or where cases were resumed from their stores, the time they recorded
+        then (:func:`_recorded_s`), so that a resumed hold paces its budget as a fresh one."""
         started = time.perf_counter()
         ran = self.run("hold-base", {"ensemble_members": members}, members, "base")
-        return {"ran": ran, "started": started, "seconds": time.perf_counter() - started}
+        wall = time.perf_counter() - started
+        return {"ran": ran, "started": started, "seconds": max(wall, _recorded_s(ran, self.runner.n_workers))}
 
     def level(self, key: str, grid: dict) -> pd.DataFrame:
         """A refinement level's run table: one run a start, every batch."""
         return pd.concat([df for df, _ in self.run(f"hold-{key}", grid, 1, key)], ignore_index=True)
+
+
+def _recorded_s(ran, workers: int) -> float:
+    """The wall seconds the sweeps ``ran`` took when their cases ran: each run row's share of
+    its case's time (``time_s``), summed and shared by the ``workers``."""
+    return sum(float(df["time_s"].sum()) for df, _ in ran if "time_s" in df) / max(workers, 1)
 
 
 def _judge(batches: _Batches, base: dict, settings: HoldSettings, *, budget_left: float) -> dict:

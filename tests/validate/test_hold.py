@@ -123,3 +123,9 @@ def test_the_budget_is_checked_after_the_corners_first_case_and_the_corner_repor
     assert "the corner's other 1 starts would take" in s["why_unconverged"] and s["converged"] is False
     assert not (tmp_path / "hold" / "sweeps" / "base-2").exists()
     assert all(not r["run"] for r in s["refinements"])  # no level fits a spent budget either
+
+    # resumed, the first case is read from its store: paced at the seconds it took, not ~0
+    again = hold_to(single_gaussian(), tmp_path / "hold", settings, workers=1)
+    first_s = s["timings_s"]["base_level"]
+    assert again["timings_s"]["base_level"] == pytest.approx(first_s, rel=0.5)
+    assert again["why_unconverged"] == s["why_unconverged"] or "would take" in again["why_unconverged"]
