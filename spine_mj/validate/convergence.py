@@ -24,11 +24,14 @@ A refinement reruns a subset of the corner's starts (``plan.limit.convergence_st
 starts per surface, the same points, one run each), and the change of a headline is the
 paired change on those starts: the refined runs' number minus the same number of the
 corner's own runs from those starts, like for like. The corner's agreement headline, the one its target
-judges, is over the starts well-conditioned on both sides
-(:mod:`spine_mj.validate.ensembles`): its change is paired on the subset's well-conditioned
-starts only. An ill-conditioned start lies within 1e-3 L_c of a watershed, so any change of
-the engine's rounding (a finer step, a tighter tolerance) flips it as a coin would, and the
-headline leaves it out for that reason (measured on the full plan's fractal, 30 paired
+judges, is over the starts well-conditioned on both sides and in their verdict
+(:mod:`spine_mj.validate.ensembles`: every MuJoCo-reference member pair gives the same
+verdict, so the lead run's verdict, the one a refined level's single run is paired with, is
+the one the headline counts): its change is paired on the subset's well-conditioned
+starts only, the set fixed once, at the corner's level. An ill-conditioned start lies
+within 1e-3 L_c of a watershed, so any change of the engine's rounding (a finer step, a
+tighter tolerance) flips it as a coin would, and the headline leaves it out for that
+reason (measured on the full plan's fractal, 30 paired
 starts: dt / 2 flipped 2 runs, 1 of them ill-conditioned; tolerance / 100 flipped 3, 2 of
 them ill-conditioned). The agreement over all starts is judged on all paired starts, beside
 it. A headline is *converged* under a refinement when the headline

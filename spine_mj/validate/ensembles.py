@@ -14,10 +14,20 @@ offsets 0.001-0.08 L_c) sit at that scale.
 
 A start is ill-conditioned on a side (MuJoCo, or the reference streamline) when its members
 there do not all end in the same outcome (held or free, and where held, the same trap:
-:func:`spine_mj.theory.agreement.outcome_agreement` between members, the comparison's own rule).
-Agreement is then judged on the starts well-conditioned on both sides, where each side's
-outcome is one; the others are counted per side, with the overlap of the two outcome
-distributions (the share of MuJoCo-reference member pairs that agree).
+:func:`spine_mj.theory.agreement.outcome_agreement` between members, the comparison's own rule),
+and ill-conditioned in its *verdict* when each side is one outcome but the MuJoCo-reference
+member pairs do not all give the same verdict: the comparison's own watershed, its end
+tolerance, runs through the ensemble (the outcome rule is not transitive: members 0.09 L_c
+apart on one side can straddle the 0.25 L_c tolerance from the other's end), so which member
+is drawn decides agree or not, a coin toss as a split side is. Measured on the full plan's
+sandpaper P36 (y -1.5e-3): MuJoCo's three members locked 0.193, 0.27 and 0.27 L_c from the
+reference's lock; the lead run agreed, the ensemble did not, and hfield x 2 moved the lead
+to where its neighbours already were (0.271 L_c), a flip of a verdict the headline never
+counted. Agreement is then judged on the starts well-conditioned on both sides and in their
+verdict, where every member pair gives the same verdict (so the lead run's verdict is the
+ensemble's, and a refinement's single run is paired like for like); the others are counted
+per side, with the overlap of the two outcome distributions (the share of MuJoCo-reference
+member pairs that agree).
 """
 
 from __future__ import annotations
@@ -111,7 +121,9 @@ def ensemble_verdicts(groups: Sequence[dict]) -> dict:
     dict
         ``starts``, ``members``, ``ill_conditioned_share`` ({``mujoco``, ``reference``}: the
         share of starts whose ensemble splits there), ``ill_conditioned_starts`` (either
-        side), ``well_conditioned_runs`` (starts one outcome on both sides, none stopped),
+        side, or the verdict), ``verdict_split_starts`` (each side one outcome, the member
+        pairs' verdicts not one), ``well_conditioned_runs`` (starts one outcome on both sides
+        and one verdict, none stopped),
         ``stopped_starts`` (a member stopped by the engine or stalled on the reference),
         ``agreement_well_conditioned`` (the share of those where the outcomes agree) with
         its Wilson ``agreement_ci``, and ``distribution_agreement`` (over all starts, the
@@ -123,6 +135,7 @@ def ensemble_verdicts(groups: Sequence[dict]) -> dict:
     n = len(groups)
     mj_split = np.zeros(n, bool)
     ref_split = np.zeros(n, bool)
+    verdict_split = np.zeros(n, bool)
     agree = np.zeros(n, bool)
     overlap = np.full(n, np.nan)
     ok = np.array([bool(g["ok"]) for g in groups], bool)
@@ -135,7 +148,10 @@ def ensemble_verdicts(groups: Sequence[dict]) -> dict:
         pairs = _same(mh[i.ravel()], me[i.ravel()], rh[j.ravel()], re[j.ravel()], lc)
         overlap[k] = float(pairs.mean()) if ok[k] else 0.0
         agree[k] = ok[k] and bool(pairs.all())
-    well = ok & ~mj_split & ~ref_split
+        verdict_split[k] = bool(pairs.any()) and not bool(pairs.all())
+    # a verdict split counts only where neither side splits (a split side already says it)
+    verdict_split &= ~mj_split & ~ref_split
+    well = ok & ~mj_split & ~ref_split & ~verdict_split
     n_well, n_agree = int(well.sum()), int((agree & well).sum())
     return {
         "starts": n,
@@ -144,21 +160,27 @@ def ensemble_verdicts(groups: Sequence[dict]) -> dict:
             "mujoco": float(mj_split.mean()) if n else math.nan,
             "reference": float(ref_split.mean()) if n else math.nan,
         },
-        "ill_conditioned_starts": int((mj_split | ref_split).sum()),
+        "ill_conditioned_starts": int((mj_split | ref_split | verdict_split).sum()),
+        "verdict_split_starts": int(verdict_split.sum()),
         "well_conditioned_runs": n_well,
         "stopped_starts": int((~ok).sum()),
         "agreement_well_conditioned": n_agree / n_well if n_well else math.nan,
         "agreement_ci": list(wilson(n_agree, n_well)),
         "distribution_agreement": float(np.mean(overlap)) if n else math.nan,
         "ill_conditioned": {
-            g["key"]: _sides(mj_split[k], ref_split[k]) for k, g in enumerate(groups) if "key" in g
+            g["key"]: _sides(mj_split[k], ref_split[k], verdict_split[k])
+            for k, g in enumerate(groups)
+            if "key" in g
         },
         "well_conditioned": {g["key"]: bool(well[k]) for k, g in enumerate(groups) if "key" in g},
     }
 
 
-def _sides(mj: bool, ref: bool) -> str:
-    """Which sides split: ``""``, ``mujoco``, ``reference`` or ``both``."""
+def _sides(mj: bool, ref: bool, verdict: bool = False) -> str:
+    """Which sides split: ``""``, ``mujoco``, ``reference`` or ``both``; ``verdict`` where
+    neither does but the member pairs' verdicts do."""
+    if verdict and not (mj or ref):
+        return "verdict"
     return {(False, False): "", (True, False): "mujoco", (False, True): "reference"}.get(
         (bool(mj), bool(ref)), "both"
     )

@@ -69,6 +69,26 @@ def test_a_start_whose_members_end_in_different_traps_is_ill_conditioned_on_that
     assert v["distribution_agreement"] == pytest.approx((1 + 1 + 0 + 6 / 9 + 6 / 9 + 0) / 6)
 
 
+def test_a_start_whose_member_pairs_straddle_the_end_tolerance_is_ill_conditioned_in_its_verdict():
+    # each side one outcome (MuJoCo's members 0.2 L_c apart, within the 0.25 L_c tolerance),
+    # but the lead lands 0.1 L_c from the reference's lock and its neighbours 0.3: which member
+    # is drawn decides the verdict (the full plan's sandpaper P36, y -1.5e-3: 0.193, 0.27, 0.27)
+    straddles = _group([1, 1, 1], [[0.0, 0], [0.2, 0], [0.2, 0]], [1, 1, 1], [[-0.1, 0]] * 3)
+    agrees = _group([1, 1, 1], [[0.0, 0]] * 3, [1, 1, 1], [[0.05, 0]] * 3)
+    misses = _group([1, 1, 1], [[1.0, 0]] * 3, [1, 1, 1], [[0.0, 0]] * 3)
+    v = ensemble_verdicts([{**straddles, "key": "a/0"}, {**agrees, "key": "a/1"}, {**misses, "key": "a/2"}])
+    assert v["ill_conditioned_share"] == {"mujoco": 0.0, "reference": 0.0}
+    assert v["verdict_split_starts"] == 1 and v["ill_conditioned_starts"] == 1
+    assert v["ill_conditioned"] == {"a/0": "verdict", "a/1": "", "a/2": ""}
+    assert v["well_conditioned"] == {"a/0": False, "a/1": True, "a/2": True}
+    # judged on the two whose every member pair gives one verdict, not as a miss
+    assert v["well_conditioned_runs"] == 2 and v["agreement_well_conditioned"] == pytest.approx(1 / 2)
+    # a split side keeps its own label, whatever the pairs' verdicts
+    split = _group([1, 1, 1], [[0, 0], [1, 0], [0, 0]], [1, 1, 1], [[0, 0]] * 3)
+    side = ensemble_verdicts([{**split, "key": "b"}])
+    assert side["ill_conditioned"] == {"b": "mujoco"} and side["verdict_split_starts"] == 0
+
+
 def test_one_member_finds_nothing_ill_conditioned():
     v = ensemble_verdicts([_group([1], [[0, 0]], [1], [[5, 0]]), _group([0], [[0, 0]], [0], [[0, 0]])])
     assert v["ill_conditioned_starts"] == 0 and v["well_conditioned_runs"] == 2
