@@ -31,8 +31,9 @@ whether a variant's values leave the base run's intervals (``engines_fits.md``,
 floor, travel and I_e from the inertial reference before any run; ``--start``, ``--travel``
 a part of it; each run cached under ``segments_<tag>_K<K>``, so a killed cell resumes);
 ``--cached a,b`` pools the cached runs of stopped cells (:func:`cached_summary`);
-``--flat`` measures MuJoCo's breakaway and sliding friction on the preset's rig made flat,
-at the rule's step and at half of it (:func:`flat_friction`).
+``--flat`` measures the first of ``--engines``' breakaway and sliding friction on the preset's
+rig made flat, at the rule's step and at half of it (:func:`flat_friction`; ``--flat-length``
+units, 20 by default).
 """
 
 from __future__ import annotations
@@ -329,32 +330,42 @@ def abbm_plan(surf, k: float, start: float, longest: float, drops: int = DROPS_P
     }
 
 
-def flat_friction(seed: int, k: float, ie: float, step_share: float, x0: float = 22580.0) -> dict:
-    """MuJoCo's spring drive on a flat strip of the ``abbm`` preset's rig (its crop at ``x0``,
+def flat_friction(
+    seed: int,
+    k: float,
+    ie: float,
+    step_share: float,
+    x0: float = 22580.0,
+    engine: str = "mujoco",
+    length: float = 20.0,
+) -> dict:
+    """An engine's spring drive on a flat strip of the ``abbm`` preset's rig (its crop at ``x0``,
     heights zeroed, so the same scales, tip and step): the breakaway force and the sliding
-    force over the second half of a run of 20 units (the reference's is ``mu W`` for both),
+    force over the second half of a run of ``length`` units (the reference's is ``mu W`` for both),
     at the rule's step times ``step_share`` (the contact's time constant following it)."""
     import dataclasses
 
     part = crop(abbm_prefix(seed, x0 + 40), x0 - 10, x0 + 30)
     flat = dataclasses.replace(part, heights=np.zeros_like(part.heights))
-    base = build_rig(flat, engine="mujoco", mu=MU, ie=ie, stiffness_number=k, line=True)
+    rail = {"line": True} if engine == "mujoco" else {}  # Bullet's tip has no lateral force here
+    base = build_rig(flat, engine=engine, mu=MU, ie=ie, stiffness_number=k, **rail)
     rig = build_rig(
         flat,
-        engine="mujoco",
+        engine=engine,
         mu=MU,
         ie=ie,
         stiffness_number=k,
-        line=True,
         timestep_s=base.engine.timestep_s * step_share,
+        **rail,
     )
     units = TrackUnits.of(rig.scales, ie)
-    land = track_landscape(flat, MU, units.tip_radius, (x0, x0 + 20))
+    land = track_landscape(flat, MU, units.tip_radius, (x0, x0 + length))
     c0 = time.process_time()
-    res = _engine_run(rig, units, land, k, ie, x0, 20.0)
+    res = _engine_run(rig, units, land, k, ie, x0, length)
     f = res.drive_force_n[res.drive_start_index :] / units.preload_n
     late = f[f.size // 2 :]
     return {
+        "engine": engine,
         "seed": seed,
         "K": k,
         "ie": ie,
@@ -413,14 +424,22 @@ def main(argv=None):
     ap.add_argument("--drops", type=int, default=DROPS_PER_CELL, help="abbm: inertial drops a cell holds")
     ap.add_argument("--start", type=float, default=None, help="abbm: the cell's first x (default: 5 %% in)")
     ap.add_argument(
-        "--flat", action="store_true", help="only MuJoCo's friction on a flat strip (default, dt / 2)"
+        "--flat", action="store_true", help="only the engine's friction on a flat strip (default, dt / 2)"
+    )
+    ap.add_argument(
+        "--flat-length", type=float, default=20.0, help="--flat: the run's units past the start's lead"
     )
     ap.add_argument("--cached", default=None, help="only summarize cached runs (folders, a,b)")
     a = ap.parse_args(argv)
     out = Path(a.out)
     if a.flat:
-        rows = [flat_friction(a.seed, float(a.K), float(a.ie), share) for share in (1.0, 0.5)]
-        write_json(out / "stickslip_engines_abbm_flat.json", rows)
+        engine = a.engines.split(",")[0]
+        rows = [
+            flat_friction(a.seed, float(a.K), float(a.ie), share, engine=engine, length=a.flat_length)
+            for share in (1.0, 0.5)
+        ]
+        name = "abbm_flat" if engine == "mujoco" else f"abbm_flat_{engine}"
+        write_json(out / f"stickslip_engines_{name}.json", rows)
         print(json.dumps(rows, indent=1))
         return
     if a.cached:
