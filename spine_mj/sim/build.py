@@ -49,6 +49,7 @@ __all__ = [
     "drive_speed_m_s",
     "plan_rig",
     "plan_settings",
+    "rig_of_plan",
     "rig_scales",
     "rig_sizing",
 ]
@@ -148,14 +149,20 @@ def build_rig(
     elif keywords:
         raise SpineInputError(f"build_rig: give RigInputs or keywords, not both (got {', '.join(keywords)})")
     plan = plan_rig(surface, inputs, progress=progress)
-    rig_class = check_engine(inputs.engine).rig_class()
     stage, big = f"building {inputs.engine}'s model", plan.hfield.data.size >= PROGRESS_MIN_SAMPLES
     if progress is not None and big:
         progress(0, 1, stage)
-    rig = rig_class(surface, tip=plan.tip, engine=plan.engine, sized=(plan.scales, plan.hfield))
+    rig = rig_of_plan(plan, inputs.engine)
     if progress is not None and big:
         progress(1, 1, stage)
     return rig
+
+
+def rig_of_plan(plan: RigPlan, engine: str) -> EngineRig:
+    """The rig of ``engine`` that :func:`plan_rig` planned (:func:`build_rig` without the
+    sizing: a caller that measured it once, :func:`rig_sizing`, builds many rigs on it)."""
+    rig_class = check_engine(engine).rig_class()
+    return rig_class(plan.surface, tip=plan.tip, engine=plan.engine, sized=(plan.scales, plan.hfield))
 
 
 @dataclasses.dataclass(frozen=True, eq=False)

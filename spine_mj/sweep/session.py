@@ -206,15 +206,19 @@ def _preparing(config: SweepConfig, notice) -> Callable[[str], None] | None:
     return lambda text: notice(f"preparing {n:,} cases: {text}")
 
 
-def _checked_cases(config: SweepConfig, say: Callable[[str], None] | None = None) -> list:
-    """The cases of ``config``, read afresh (:func:`clear_caches`) and checked: an input
-    error refuses the config, not every run. ``say`` hears of each step of a long one."""
+def _checked_cases(
+    config: SweepConfig, say: Callable[[str], None] | None = None, *, afresh: bool = True
+) -> list:
+    """The cases of ``config``, read afresh (:func:`clear_caches`; ``afresh`` False: the
+    caller cleared them once for several sweeps) and checked: an input error refuses the
+    config, not every run. ``say`` hears of each step of a long one."""
     check_cases_memory(config)  # before the first notice: a refusal is one line
     if say is not None:
         say("listing them")
     listed = None if say is None else (lambda i, n: say(f"listed {i:,} of {n:,}"))
     cases = expand_cases(config, listed)
-    clear_caches()
+    if afresh:
+        clear_caches()
     if say is not None:
         say("checking every one before the first runs")
     progress = None if say is None else (lambda i, n: say(f"checked {i:,} of {n:,}") if i < n else None)
@@ -344,6 +348,7 @@ def run_sweeps(
     workers: int | None = None,
     overwrite: bool = False,
     progress: Callable[[Progress], None] | None = None,
+    afresh: bool = True,
 ) -> list[SweepSummary]:
     """Run (or resume) several sweeps, their cases sharing one pool of local workers.
 
@@ -363,6 +368,11 @@ def run_sweeps(
         Replace stores that hold another config.
     progress : callable, optional
         Called with a :class:`Progress` over all the sweeps' cases.
+    afresh : bool
+        Read the surfaces afresh, once for all the sweeps (:func:`clear_caches`: a preset or
+        file edited since an earlier sweep in this process is read again); False keeps what
+        this process built (surfaces, sizings, dilations, streamlines) for a caller whose
+        inputs do not change under it (:class:`~spine_mj.validate.StudyRunner`).
 
     Returns
     -------
@@ -374,7 +384,9 @@ def run_sweeps(
     dirs = [Path(d) for _, d in jobs]
     if len({d.resolve() for d in dirs}) != len(dirs):
         raise SpineInputError("run_sweeps: every sweep needs its own out_dir")
-    expanded = [_checked_cases(c) for c in configs]
+    if afresh:  # once: the sweeps share the surfaces, their sizing and dilation
+        clear_caches()
+    expanded = [_checked_cases(c, afresh=False) for c in configs]
     session = _session_record(backend)
     with contextlib.ExitStack() as locks:
         stores = []

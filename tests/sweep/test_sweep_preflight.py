@@ -105,7 +105,7 @@ def test_a_limit_one_engine_breaks_is_refused_before_any_case_is_sized(tmp_path)
     engine.case_rig.cache_clear()
     with pytest.raises(SpineInputError, match=r"^sweep case \(paper-single-peak, engine = 'bullet'\): "):
         preflight.check_cases(cases, swept=["engine"])
-    assert engine._sizing.cache_info().misses == 0
+    assert not engine._SIZINGS  # nothing sized
 
 
 ARRAY = """
@@ -351,3 +351,24 @@ def test_a_case_s_plan_is_the_plan_of_its_inputs(tmp_path):
         sized.setdefault(key, rig_sizing(surface, tip=inputs.tip, **inputs.sizing))
         plain, fast = plan_rig(surface, inputs, sized=sized[key]), engine.case_plan(case, surface)
         assert (fast.engine, fast.scales, fast.tip) == (plain.engine, plain.scales, plain.tip)
+
+
+def test_sweeps_run_together_size_each_surface_once_and_their_rigs_are_build_rigs(tmp_path, monkeypatch):
+    """The checks of sweeps run together and the cases' rigs share one sizing per surface and
+    tip (the validation's studies sized each surface once per sweep and again per case); the
+    rig built on it is the one :func:`spine_mj.sim.build_rig` builds from the case's inputs."""
+    from spine_mj import sim
+    from spine_mj.sweep.analyses import engine
+
+    sized = []
+    measure = engine.rig_sizing
+    monkeypatch.setattr(engine, "rig_sizing", lambda *a, **k: sized.append(k) or measure(*a, **k))
+    text = PEAK_ENGINE + "[drive]\nduration = 0.002\n"
+    configs = [sweep.load_config(write_config(tmp_path, text, name=f"{n}.toml")) for n in ("a", "b")]
+    sweep.run_sweeps([(c, tmp_path / f"out-{i}") for i, c in enumerate(configs)], workers=1)
+    assert len(sized) == 1
+    case = sweep.expand_cases(configs[0])[0]
+    rig = engine.case_rig(case)
+    built = sim.build_rig(case.surface.make(), engine.case_inputs(case))
+    assert rig.scales == built.scales and rig.tip == built.tip and rig.engine == built.engine
+    assert (rig.hfield.data == built.hfield.data).all()

@@ -9,6 +9,7 @@ in the drive share it.
 
 from __future__ import annotations
 
+import collections
 import dataclasses
 import functools
 
@@ -17,7 +18,7 @@ import numpy as np
 from spine_mj import sim
 from spine_mj.choices import DEFAULT_ENGINE, ENGINES, PROTOCOLS
 from spine_mj.errors import SpineInputError
-from spine_mj.sim.build import RigPlan, check_planned_hfield, plan_settings, rig_sizing
+from spine_mj.sim.build import RigPlan, check_planned_hfield, plan_rig, plan_settings, rig_of_plan, rig_sizing
 from spine_mj.sim.model import has_mujoco_model
 from spine_mj.sim.open_loop import drive_steps
 from spine_mj.sim.rig_inputs import RigInputs
@@ -275,8 +276,14 @@ def check_speed(config) -> None:
 @functools.lru_cache(maxsize=4)
 def _rig(spec, inputs: RigInputs):
     """The rig of a surface and a case's :class:`RigInputs` (cached: cases differing only in
-    the protocol share it; the speed and the spring's stiffness set the engine step)."""
-    return sim.build_rig(spec.make(), inputs)
+    the protocol share it; the speed and the spring's stiffness set the engine step), built
+    as :func:`spine_mj.sim.build_rig` builds it on the surface's sizing measured once
+    (:func:`_sizing`: the grid's checks measured it before the cases, and a forked worker
+    inherits it)."""
+    surface = spec.make()
+    check_planned_hfield(surface, inputs)
+    sized = _sizing(spec, inputs.tip, tuple(inputs.sizing.items()))
+    return rig_of_plan(plan_rig(surface, inputs, sized=sized), inputs.engine)
 
 
 def case_inputs(case, surface=None) -> RigInputs:
@@ -320,7 +327,7 @@ def case_rig(case, surface=None):
 
 def _clear_caches() -> None:
     _rig.cache_clear()
-    _sizing.cache_clear()
+    _SIZINGS.clear()
     _BASE_PLANS.clear()
     _STARTS_CHECKED.clear()
 
@@ -328,11 +335,27 @@ def _clear_caches() -> None:
 case_rig.cache_clear = _clear_caches
 
 
-@functools.lru_cache(maxsize=4)
 def _sizing(spec, tip, sizing: tuple):
-    """The ``(tip, scales, hfield)`` of a surface, a tip and its sizing keywords (cached:
-    the cases of a grid that differ in the drive or the engine settings share it)."""
-    return rig_sizing(spec.make(), tip=tip, **dict(sizing))
+    """The ``(tip, scales, hfield)`` of a surface, a tip and its sizing keywords (cached,
+    the most recent within :data:`SIZING_CACHE_BYTES` of hfield samples: the cases of a grid
+    that differ in the drive or the engine settings share it, so do the sweeps a validation
+    runs together, and :func:`_rig` builds on it; the quick plan's quasistatic limit has 30
+    sizings, which its checks measured 60 times, then each case once more as it ran)."""
+    key = (spec, tip, sizing)
+    if key in _SIZINGS:
+        _SIZINGS.move_to_end(key)
+        return _SIZINGS[key]
+    sized = _SIZINGS[key] = rig_sizing(spec.make(), tip=tip, **dict(sizing))
+    while len(_SIZINGS) > 1 and sum(s[2].data.nbytes for s in _SIZINGS.values()) > SIZING_CACHE_BYTES:
+        _SIZINGS.popitem(last=False)
+    return sized
+
+
+#: Bytes of hfield samples the sizings :func:`_sizing` keeps may hold (the newest is kept
+#: whatever its size).
+SIZING_CACHE_BYTES = 2**27
+#: :func:`_sizing`'s cache, oldest use first.
+_SIZINGS: collections.OrderedDict = collections.OrderedDict()
 
 
 def case_plan(case, surface=None):
