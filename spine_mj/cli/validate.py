@@ -26,7 +26,7 @@ _workers_option = click.option(
     "out_dir",
     required=True,
     type=click.Path(),
-    help="Output folder: report.md, validation.json, figures/, sweeps/ (resumable).",
+    help="Output folder: report.md, validation.json, figures/, sweeps/ and stored/ (resumable).",
 )
 @click.option(
     "--quick",

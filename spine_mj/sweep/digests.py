@@ -34,23 +34,27 @@ def input_digests(config) -> dict[str, str]:
     out = {}
     for spec in config.surfaces:
         key = f"{spec.kind}:{spec.source}"
-        if key in out:
-            continue
-        if spec.kind == "file":
-            out[key] = _file_digest(Path(spec.source))
-            continue
-        preset = presets.load_preset(spec.source)
-        resolved = {
-            "generator": preset.generator,
-            "params": to_jsonable(preset.params),
-            "seed": preset.seed,
-            "extras": to_jsonable(preset.extras),
-        }
-        measured = preset.params.get("file") if preset.generator == "measured" else None
-        if isinstance(measured, str) and Path(measured).is_file():
-            resolved["file_sha256"] = _file_digest(Path(measured))
-        out[key] = digest(resolved)
+        if key not in out:
+            out[key] = surface_digest(spec.kind, spec.source)
     return out
+
+
+def surface_digest(kind: str, source: str) -> str:
+    """sha256 of one surface input of :func:`input_digests`: a file's contents (``kind``
+    ``"file"``, ``source`` its path) or a resolved preset (``"preset"``, its name)."""
+    if kind == "file":
+        return _file_digest(Path(source))
+    preset = presets.load_preset(source)
+    resolved = {
+        "generator": preset.generator,
+        "params": to_jsonable(preset.params),
+        "seed": preset.seed,
+        "extras": to_jsonable(preset.extras),
+    }
+    measured = preset.params.get("file") if preset.generator == "measured" else None
+    if isinstance(measured, str) and Path(measured).is_file():
+        resolved["file_sha256"] = _file_digest(Path(measured))
+    return digest(resolved)
 
 
 def _file_digest(path: Path) -> str:

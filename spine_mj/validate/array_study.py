@@ -48,7 +48,7 @@ interval from the two Wilson intervals) and in the extrapolated holding per spin
 
 from __future__ import annotations
 
-import contextlib
+import functools
 import math
 from dataclasses import dataclass, field
 
@@ -67,6 +67,7 @@ from spine_mj.validate.convergence import is_converged, observed_order, richards
 from spine_mj.validate.fractal_lock import CONFIDENCE, lock_rate
 from spine_mj.validate.intervals import newcombe_difference
 from spine_mj.validate.plans import SANDPAPER_MU, ValidationPlan
+from spine_mj.validate.sweep_configs import surface_inputs
 
 __all__ = [
     "ARRAY_PLANS",
@@ -470,8 +471,14 @@ def array_study(plan: ValidationPlan, runner=None) -> ArrayStudyResult:
     for key, preset, mu in SURFACES:
         if key not in ap.surfaces:
             continue
-        with contextlib.nullcontext() if runner is None else runner.phase(f"arrays on {key}"):
+        if runner is None:
             rows += _surface_rows(key, preset, mu, ap)
+            continue
+        with runner.phase(f"arrays on {key}"):
+            # kept in the output folder: a resumed validation reads each surface's rows back
+            inputs = {"surface": [key, preset, mu, surface_inputs(preset)], "plan": ap}
+            compute = functools.partial(_surface_rows, key, preset, mu, ap)
+            rows += runner.stored(f"arrays-{key}", inputs, compute)
     conj, pooled = _conjecture(rows, ap)
     for r in rows:
         r.pop("_hold"), r.pop("_ok")

@@ -20,6 +20,7 @@ its surfaces (the spring-block swing's scale, :func:`spine_mj.sim.holding.spring
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -30,6 +31,7 @@ from spine_mj.sweep.executors import map_processes
 from spine_mj.theory.drive_limits import Corner, DriveLimits, drive_limits, quasistatic_corner
 from spine_mj.validate.paths import tip_radius
 from spine_mj.validate.plans import FamilySpec, ValidationPlan
+from spine_mj.validate.sweep_configs import surface_inputs
 
 __all__ = [
     "CORNER_GRID_STARTS",
@@ -42,6 +44,7 @@ __all__ = [
     "family_limits",
     "k_ladder",
     "path_starts",
+    "stored_corners",
     "surface_corner",
 ]
 
@@ -173,6 +176,21 @@ def family_corners(plan: ValidationPlan, fams, *, workers: int = 1) -> dict:
             corners[preset] = surface_corner(own).as_dict()
         out[fam.name] = {"presets": corners, "surfaces": per}
     return out
+
+
+def stored_corners(plan: ValidationPlan, fams, runner) -> dict:
+    """:func:`family_corners` of ``fams`` on the runner's workers, kept in its output folder
+    (:meth:`~spine_mj.validate.study_runner.StudyRunner.stored`, keyed by the families, the
+    plan's hfield resolution, the corner's start counts and the surfaces' inputs): a resumed
+    validation reads them back instead of tracing them again (~30 CPU-s of the quick plan)."""
+    inputs = {
+        "families": list(fams),
+        "hfield_resolution": plan.hfield_resolution,
+        "starts": [CORNER_GRID_STARTS, CORNER_PATH_STARTS],
+        "surfaces": [surface_inputs(p) for fam in fams for p in fam.presets],
+    }
+    compute = functools.partial(family_corners, plan, fams, workers=runner.n_workers)
+    return runner.stored("limit-corners", inputs, compute)
 
 
 def _surface_limits(job) -> DriveLimits:

@@ -24,7 +24,7 @@ from spine_mj.validate.landing_verdicts import landing_judged, landing_summary
 from spine_mj.validate.miss_causes import MISS_CAUSES, miss_cause
 from spine_mj.validate.paths import stored_paths, tip_radius
 from spine_mj.validate.plans import RECOMMENDED, FamilySpec, ValidationPlan
-from spine_mj.validate.predicted_limits import corner_drives, family_corners
+from spine_mj.validate.predicted_limits import corner_drives, stored_corners
 from spine_mj.validate.study_runner import StudyRunner
 from spine_mj.validate.sweep_configs import engine_grid, family_doc, gridded, refused_by_rig
 
@@ -188,7 +188,7 @@ def quasistatic_limit(plan: ValidationPlan, runner: StudyRunner) -> QuasistaticL
     families, runs_rows, paths = {}, [], {}
     corner = [plan.limit.corner_family(fam) for fam in plan.families]
     with runner.phase("the quasistatic corners of the families"):
-        corners = family_corners(plan, corner, workers=runner.n_workers)
+        corners = stored_corners(plan, corner, runner)
     for fam in corner:
         for c in corners[fam.name]["presets"].values():
             c["timestep_factor"] = fam.timestep_factor

@@ -8,13 +8,19 @@ where it stopped) and reports :class:`ValidationProgress` to the caller's callba
 from __future__ import annotations
 
 import contextlib
+import json
 import os
 import time
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from spine_mj import sweep
+from spine_mj.atomic import atomic_output
+from spine_mj.jsonio import to_jsonable
+from spine_mj.sweep.digests import digest
+from spine_mj.sweep.session import clear_caches
 
 __all__ = ["StudyRunner", "ValidationProgress"]
 
@@ -77,6 +83,10 @@ class StudyRunner:
         self.progress = progress
         self.t0 = t0
         self.study = ""
+        # the inputs read once, here: the studies' sweeps share the surfaces, their sizing and
+        # dilation (the quick plan's quasistatic limit sized its 30 surfaces 60 times before
+        # its cases ran, each case once more in its worker), and a forked worker inherits them
+        clear_caches()
 
     @property
     def n_workers(self) -> int:
@@ -129,8 +139,29 @@ class StudyRunner:
         # not capped at the case count: a sweep of one case steps its engine batch on the
         # workers' threads instead of starting processes
         w = workers or self.n_workers
-        sweep.run_sweep(config, store, workers=w, overwrite=True, progress=self._sweep_progress(name))
+        sweep.run_sweeps(
+            [(config, store)], workers=w, overwrite=True, progress=self._sweep_progress(name), afresh=False
+        )
         return sweep.load_runs(store), store
+
+    def stored(self, name: str, inputs: dict, compute: Callable[[], Any]) -> Any:
+        """``compute()``, kept in ``out/stored/<name>.json`` with the digest of ``inputs``
+        (JSON: what it depends on) and read back instead of computed while that digest is
+        unchanged: a stage that runs no sweep resumes as a sweep's store does (the full
+        plan's arrays, 393 s, ran again on every resume). The value must be JSON (NaN and
+        infinities kept); written atomically, so a killed write leaves none."""
+        path = self.out_dir / "stored" / f"{name}.json"
+        key = digest(to_jsonable(inputs, nonfinite=True))
+        with contextlib.suppress(OSError, ValueError):
+            doc = json.loads(path.read_text())
+            if doc.get("inputs") == key:
+                return doc["value"]
+        value = compute()
+        path.parent.mkdir(parents=True, exist_ok=True)
+        text = json.dumps({"inputs": key, "value": to_jsonable(value, nonfinite=True)}, allow_nan=True)
+        with atomic_output(path) as tmp:
+            tmp.write_text(text)
+        return json.loads(text)["value"]
 
     def many(self, jobs, step: str):
         """Run the sweep configs of ``jobs`` (``(doc, name)`` pairs) together, their cases
@@ -147,5 +178,7 @@ class StudyRunner:
 
         w = self.n_workers
         progress = self._sweep_progress(step)
-        sweep.run_sweeps(list(zip(configs, stores)), workers=w, overwrite=True, progress=progress)
+        sweep.run_sweeps(
+            list(zip(configs, stores)), workers=w, overwrite=True, progress=progress, afresh=False
+        )
         return [(sweep.load_runs(store), store) for store in stores]

@@ -15,6 +15,7 @@ from spine_mj.errors import SpineInputError
 from spine_mj.sim.drives import spring_stiffness_n_m
 from spine_mj.sim.rig_hfield import grid_keeps_samples
 from spine_mj.sim.scales import engine_tip_radius_m
+from spine_mj.sweep.digests import surface_digest
 from spine_mj.sweep.preflight import check_cases
 from spine_mj.validate.plans import MASS_KG, FamilySpec, ValidationPlan
 
@@ -28,6 +29,7 @@ __all__ = [
     "refused_by_rig",
     "relative_engine_keys",
     "rig_engine",
+    "surface_inputs",
     "surfaces_table",
 ]
 
@@ -46,6 +48,15 @@ def surfaces_table(presets_: Sequence[str], seeds, variants=((),)) -> list[dict]
                 entry["set"] = dict(variant)
             out.append(entry)
     return out
+
+
+def surface_inputs(preset: str) -> str:
+    """The digest of what ``preset`` of a family reads (a shipped scan's file, else the
+    resolved preset: :func:`~spine_mj.sweep.digests.surface_digest`), as a sweep's store keys
+    its resume: for a stage computed from the family's surfaces outside any sweep."""
+    if preset.startswith(examples.PREFIX):
+        return surface_digest("file", str(examples.resolve(preset)))
+    return surface_digest("preset", preset)
 
 
 def family_doc(

@@ -121,3 +121,24 @@ def test_the_median_relative_error_leaves_out_placements_whose_reference_holds_n
 
     assert _median_rel_error([1.1, 0.3, 0.9], [1.0, 0.0, 1.0]) == pytest.approx(0.1)
     assert np.isnan(_median_rel_error([0.2], [0.0])) and np.isnan(_median_rel_error([], []))
+
+
+def test_a_resumed_study_reads_each_surfaces_rows_back_as_the_first_run_computed_them(
+    smoke, tmp_path, monkeypatch
+):
+    import spine_mj.validate.array_study as study
+    from spine_mj.jsonio import to_jsonable
+    from spine_mj.validate.study_runner import StudyRunner
+
+    first = array_study(PLANS["smoke"], StudyRunner(tmp_path, 1, None, 0.0))
+    assert sorted(p.name for p in (tmp_path / "stored").iterdir()) == [
+        f"arrays-{k}.json" for k in sorted(study.ARRAY_PLANS["smoke"].surfaces)
+    ]
+
+    def recomputed(*args):
+        raise AssertionError("a stored surface was computed again")
+
+    monkeypatch.setattr(study, "_surface_rows", recomputed)
+    resumed = array_study(PLANS["smoke"], StudyRunner(tmp_path, 1, None, 0.0))
+    assert to_jsonable(resumed.validation_keys()) == to_jsonable(first.validation_keys())
+    assert to_jsonable(first.validation_keys()) == to_jsonable(smoke.validation_keys())
