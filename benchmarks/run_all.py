@@ -36,9 +36,10 @@ Sections (each records the machine's load average before and after it):
 * ``plan_cost``: ``spine-mj validate --quick`` (``--quick``: the smoke plan) as a user runs
   it, its wall time and CPU seconds, and each study's CPU seconds (the command and its
   workers) and those of its sweeps' runs (``benchmarks/bench_plan_cost.py``): target
-  ``make demo`` within 5 min. Also the numba kernels compiled from an empty cache (CPU
-  seconds on one process, wall on two) and the committed quick and full reports' wall
-  time (the full plan: target 30 min).
+  ``make demo`` within 5 min. Also the same command again on its finished folder (what a
+  resume costs: every store, the corners and the arrays' rows read back), the numba
+  kernels compiled from an empty cache (CPU seconds on one process, wall on two) and the
+  committed quick and full reports' wall time (the full plan: target 30 min).
 * ``memory``: wall time and peak resident memory of the main jobs, each in a process of
   its own (``benchmarks/bench_memory.py``), marked where a peak grew by more than 20 %
   against the committed ``benchmarks/results.json``.
