@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from scipy.stats import binom
 
 REPORTS = Path(__file__).resolve().parent / "reports" / "stickslip"
 CELLS = {
@@ -96,6 +97,10 @@ def cell(label: str, tags, flat: dict) -> dict:
         "ends_at_both": int(np.sum(near_in & near_od)),
         "chance_near_overdamped_end": chance_od,
         "chance_near_inertial_end": chance_in,
+        # Binomial tail of the overdamped-only count, the two windows taken as independent.
+        "overdamped_only_p": float(
+            binom.sf(np.sum(near_od & ~near_in) - 1, len(e), chance_od * (1 - chance_in))
+        ),
     }
     if label in flat:
         out["flat_sliding_excess_fp"] = flat[label]
