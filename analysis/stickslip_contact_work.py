@@ -30,9 +30,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from stickslip_engines import MU, abbm_prefix, crop
 
 import spine_mj.sim.lanes as lanes
-from spine_mj.sim.build import build_drive, build_rig
+from spine_mj.sim.build import build_rig
 from spine_mj.validate.slip_catalog import TrackUnits, engine_drop_rows, track_landscape
-from spine_mj.validate.stickslip_outputs import START_MARGIN
+from spine_mj.validate.stickslip_outputs import pre_stretched_drive
 
 OUT = Path(__file__).resolve().parent / "reports" / "stickslip" / "contact_work.json"
 SEED, K, IE, FLOOR = 1, 10.0, 7.3e-6, 1.7e-4  # the dt2a cell's plan
@@ -120,17 +120,7 @@ def run(dampratio: float, noslip: int | None, b: float = B) -> dict:
     )
     units = TrackUnits.of(rig.scales, IE)
     land = track_landscape(surf, MU, units.tip_radius, (A, b))
-    threshold = max(float(land.force[0]), 0.0)
-    share = 1 - START_MARGIN
-    lead = (1 - share) * threshold / units.stiffness(K)
-    drive = build_drive(
-        rig.scales,
-        "spring",
-        ie=IE,
-        stiffness_number=K,
-        duration_s=(b - A + lead) / units.speed,
-        start_force_n=share * threshold * units.preload_n,
-    )
+    drive = pre_stretched_drive(rig.scales, units, land, K, IE, b - A)
     _pieces.clear()
     lanes.python_steps, plain = _recording_steps, lanes.python_steps
     c0 = time.process_time()

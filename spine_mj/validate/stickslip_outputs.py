@@ -50,7 +50,14 @@ from spine_mj.validate.slip_catalog import (
     track_landscape,
 )
 
-__all__ = ["OUTPUT_FILES", "StickSlipOutputs", "drop_summary", "regime_map", "stickslip_to"]
+__all__ = [
+    "OUTPUT_FILES",
+    "StickSlipOutputs",
+    "drop_summary",
+    "pre_stretched_drive",
+    "regime_map",
+    "stickslip_to",
+]
 
 OUTPUT_FILES = (
     "events.parquet",
@@ -321,26 +328,30 @@ def _rig_and_scales(surface, engine, mu: float, ie: float, k_number: float, rig_
 
 
 def _engine_run(rig, units: TrackUnits, land, k_number: float, ie: float, x0: float, length: float):
-    """One spring drive from ``x0``: the carriage runs the track's ``length`` plus the
-    spring's stretch at the start's threshold (the stick phase before the first slide is
-    fast-forwarded). A stretch longer than the run (a soft spring: 1600 units on the
-    ``abbm`` preset at K 10, beyond any run's steps) is mostly made at the start instead: the
-    spring starts stretched to all but :data:`START_MARGIN` of it
+    """One spring drive from ``x0`` (:func:`pre_stretched_drive`) on ``rig``."""
+    return rig.run(pre_stretched_drive(rig.scales, units, land, k_number, ie, length), start=(x0, 0.0))
+
+
+def pre_stretched_drive(scales, units: TrackUnits, land, k_number: float, ie: float, length: float):
+    """The spring drive of one run over ``length`` of track: the carriage runs the track's
+    ``length`` plus the spring's stretch at the start's threshold (the stick phase before the
+    first slide is fast-forwarded). A stretch longer than the run (a soft spring: 1600 units
+    on the ``abbm`` preset at K 10, beyond any run's steps) is mostly made at the start
+    instead: the spring starts stretched to all but :data:`START_MARGIN` of it
     (``SpringDrive.start_force_n``)."""
     from spine_mj.sim.build import build_drive
 
     threshold = max(float(land.force[0]), 0.0)
     share = 1 - START_MARGIN if threshold / units.stiffness(k_number) > length else 0.0
     lead = (1 - share) * threshold / units.stiffness(k_number)
-    drive = build_drive(
-        rig.scales,
+    return build_drive(
+        scales,
         "spring",
         ie=ie,
         stiffness_number=k_number,
         duration_s=(length + lead) / units.speed,
         start_force_n=share * threshold * units.preload_n,
     )
-    return rig.run(drive, start=(x0, 0.0))
 
 
 #: The share of the start's threshold force a pre-stretched spring still climbs
