@@ -70,7 +70,7 @@ def analyse_window(
     per-run inputs are in ``out_rows`` order.
 
     ``adr``: sensor addresses (tip_pos, tip_vel, contact_net, contact_deepest,
-    spring_force, push_force). ``units``: metres, newtons, m/s and seconds per engine unit.
+    spring_force, push_force, contact_normal). ``units``: metres, newtons, m/s and seconds per engine unit.
     ``prm``: step [s], domain (xmin, xmax, ymin, ymax, zmin, zmax + span) [m], edge margin
     [m], slip speed [m/s], penetration tolerance [m], the cap's force times (1 - 1e-9) [N],
     mu_s, the self-lock tolerance, the lock rule's rise [N]. ``spring`` (g,)
@@ -80,7 +80,7 @@ def analyse_window(
     ``marks`` (g, 10) in :data:`~spine_mj.sim.detection.MARK_KEYS` order (-1: none) and ``held_out`` (g,).
     """
     g = out_rows.size
-    p, v, cn, cd, sp, pu = adr[0], adr[1], adr[2], adr[3], adr[4], adr[5]
+    p, v, cn, cd, sp, pu, tn = adr[0], adr[1], adr[2], adr[3], adr[4], adr[5], adr[6]
     length, force_n, speed, time_u = units[0], units[1], units[2], units[3]
     dt, xmin, xmax, ymin, ymax, zmin, ztop = prm[0], prm[1], prm[2], prm[3], prm[4], prm[5], prm[6]
     mg, slip_speed, pen_tol, cap = prm[7], prm[8], prm[9], prm[10]
@@ -115,9 +115,10 @@ def analyse_window(
             c1 = _finite_or_clipped(n1) if touching else 0.0
             c2 = _finite_or_clipped(n2) if touching else 0.0
             f0, f1, f2 = -s[cn + 1], -s[cn + 2], -s[cn + 3]
-            fn = ((c0 * f0 + c2 * f2) + c1 * f1) if touching else 0.0
+            fn = s[tn] if touching else 0.0
             if touching:
-                t0, t1, t2 = f0 - fn * c0, f1 - fn * c1, f2 - fn * c2
+                along = (c0 * f0 + c2 * f2) + c1 * f1
+                t0, t1, t2 = f0 - along * c0, f1 - along * c1, f2 - along * c2
                 ft = math.sqrt(t0 * t0 + t1 * t1 + t2 * t2)
             else:
                 ft = 0.0

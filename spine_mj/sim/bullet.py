@@ -76,8 +76,10 @@ SENSOR_ADR = {
     "contact_deepest": 10,
     "spring_force": 18,
     "push_force": 19,
+    "contact_normal": 20,
 }
-_NSENS = 20
+#: Values in a recorded sensor row (the last address plus its one value).
+SENSOR_SIZE = 21
 _NSTATE = 7  # time, position, velocity
 
 
@@ -275,7 +277,7 @@ class BulletRig:
             ctrl = controls(self, drive, qpos0, det)
             nstep, ctl = ctrl.shape[0], None
         state = np.zeros((1, nstep, _NSTATE))
-        sens = np.zeros((1, nstep, _NSENS))
+        sens = np.zeros((1, nstep, SENSOR_SIZE))
         carriage = ctrl[None, :, 3] if isinstance(drive, SpringDrive) else np.full((1, nstep), np.nan)
         analysis = GroupAnalysis(self, [drive], [start], det, carriage)
         k = stiffness_n_m(drive, self.scales) / u.stiffness_n_m if isinstance(drive, SpringDrive) else 0.0
@@ -520,6 +522,7 @@ class _Run:
             return
         touch = 0.5 * self.w.rig.engine.contact_slop_m / self.w.lu
         net = np.zeros(3)
+        load = 0.0
         deepest = None
         normals = []
         for p in pts:
@@ -528,6 +531,7 @@ class _Run:
                 continue
             normals.append(p[7])
             net += p[9] * np.asarray(p[7]) + p[10] * np.asarray(p[11]) + p[12] * np.asarray(p[13])
+            load += p[9]
             if deepest is None or dist < deepest[8]:
                 deepest = p
         if deepest is None:
@@ -540,6 +544,7 @@ class _Run:
         sens[11] = deepest[8]
         sens[12:15] = deepest[6]
         sens[15:18] = deepest[7]
+        sens[20] = load  # MuJoCo's touch sensor: the contacts' normal forces summed
 
     def _anchor(self) -> None:
         """Friction anchors, rule ``"held"`` (:mod:`spine_mj.sim.bullet_settings`): set

@@ -329,11 +329,12 @@ def _penetration_cause(rec: Recording, k: int, preload_n: float) -> str:
 
 
 def _held_by(rec: Recording, k: int, preload_n: float) -> str:
-    """The contact that holds a lock at step ``k``: its normal force (the net contact force
-    along the deepest contact's normal) in F_p and its depth. A tip wedged between facets
-    carries more normal force than a single contact would (``(W cos theta + F sin theta)
-    cos alpha`` along each flank of a V-groove, docs/physics.md §6), held at the soft
-    contact's depth, which is not engine trouble while it stays within the tolerance."""
+    """The contacts that hold a lock at step ``k``: their normal forces summed, in F_p, and
+    the deepest one's depth. A tip wedged between facets carries more normal force than a
+    single contact would (``(W cos theta + F sin theta) / cos alpha`` on the two flanks of
+    a V-groove it slides along, docs/physics.md §6; a jam's is not determined), held at
+    the soft contact's depth, which is not engine trouble while it stays within the
+    tolerance."""
     return (
         f"held with a normal force of {rec.normal_force_n[k] / preload_n:.3g} F_p "
         f"at a depth of {rec.penetration_m[k]:.3g} m"

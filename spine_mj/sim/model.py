@@ -154,6 +154,11 @@ def check_drive_on(rig, drive: Drive) -> None:
 #: units (F_p per L_c / tau): a lateral force F_y moves it at ``F_y / F_p / RAIL_DAMPING`` L_c
 #: per tau (3e-10 m over a 6 cm run across a 0.4-high y slope, tests/sim/test_sim_model.py).
 RAIL_DAMPING = 1e9
+#: Radius of the touch sensor's zone (the site ``tip_zone``) in tip radii. MuJoCo's touch
+#: sensor sums the normal force of each contact whose point lies in the zone (or whose
+#: normal ray meets it); a contact point lies within its depth of the tip's surface, and
+#: the penetration rule ends a run long before that reaches a tip radius.
+TOUCH_ZONE_RADII = 2.0
 
 
 def hfield_userdata(hf: HField) -> memoryview:
@@ -226,6 +231,7 @@ class RigModel:
         tip_geom = spec.geom("tip")
         tip_geom.size = [r, 0, 0]
         tip_geom.mass = tip.mass_kg / u.mass_kg
+        spec.site("tip_zone").size = [TOUCH_ZONE_RADII * r, 0, 0]
         car = spec.geom("carriage")
         car.size = [r, r, r]
         if eng.line:

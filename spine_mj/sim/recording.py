@@ -18,7 +18,18 @@ import numpy as np
 
 from spine_mj.sim.scales import EngineUnits
 
-SENSOR_NAMES = ("tip_pos", "tip_vel", "contact_net", "contact_deepest", "spring_force", "push_force")
+#: The rig's sensors (``models/spine_rig.xml``): ``contact_net`` is the net force of all the
+#: tip's contacts, ``contact_deepest`` the deepest contact, ``contact_normal`` the sum of the
+#: normal forces of all the tip's contacts (MuJoCo's touch sensor).
+SENSOR_NAMES = (
+    "tip_pos",
+    "tip_vel",
+    "contact_net",
+    "contact_deepest",
+    "spring_force",
+    "push_force",
+    "contact_normal",
+)
 
 
 @dataclass(frozen=True, eq=False)
@@ -138,8 +149,11 @@ def sensor_columns(
     if not all(np.isfinite(c).all() for c in nn):  # engine trouble: keep the arithmetic finite
         nn = [np.nan_to_num(c) for c in nn]
     force = [np.negative(col[cn + 1 + j]) for j in range(3)]  # the sensor: the tip's force on the surface
-    fn = np.where(contact, _dot3(nn, force), 0.0)
-    ft = np.where(contact, _norm3([force[j] - fn * nn[j] for j in range(3)]), 0.0)
+    # the normal load is the sum over the contacts, not the net force along one normal: in a
+    # wedge that projection is smaller, even negative (-16 F_p held at a P60 grit's crease)
+    fn = np.where(contact, col[a["contact_normal"]], 0.0)
+    along = _dot3(nn, force)  # 0 without contact (nn = 0)
+    ft = np.where(contact, _norm3([force[j] - along * nn[j] for j in range(3)]), 0.0)
     vel = [col[v + j] for j in range(3)]
     vn = _dot3(vel, nn)
     np.multiply(_norm3([vel[j] - vn * nn[j] for j in range(3)]), speed, out=out.tangential_speed_m_s)

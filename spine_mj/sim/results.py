@@ -80,8 +80,13 @@ class RunResult(RunColumns):
         Position of the deepest contact (NaN without contact).
     penetration_m : (n,)
         Depth of the deepest contact (>= 0; 0 without contact).
-    normal_force_n, tangential_force_n : (n,)
-        Net contact force on the tip along the normal and its magnitude in the tangent plane.
+    normal_force_n : (n,)
+        Sum of the normal forces of all the tip's contacts (>= 0; MuJoCo's touch sensor). On
+        one contact it is the net contact force along the normal; a tip wedged between
+        facets touches several, whose normal forces add up to more than the net force
+        along any one normal (which can even be negative).
+    tangential_force_n : (n,)
+        Magnitude of the net contact force in the tangent plane of the deepest contact.
     drive_force_n : (n,)
         Force of the drive on the tip in +x [N].
     carriage_x_m : (n,)

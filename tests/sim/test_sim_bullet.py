@@ -27,7 +27,7 @@ from spine_mj.theory import engagement
 
 pytest.importorskip("pybullet", reason="the Bullet engine needs the [bullet] extra (pybullet)")
 
-from spine_mj.sim.bullet import BulletRig
+from spine_mj.sim.bullet import SENSOR_SIZE, BulletRig
 from spine_mj.sim.bullet_settings import default_bullet_engine
 
 MU = 0.5
@@ -144,7 +144,7 @@ def test_internal_edge_pitfall():
         run = w.start(rig.place(-0.012, -0.01), 1)
         v = 3.0  # L_c / tau
         pb.resetBaseVelocity(w.tip, [0.8 * v, 0.6 * v, 0.0], physicsClientId=w.cid)
-        state, sens = np.zeros(7), np.zeros(20)
+        state, sens = np.zeros(7), np.zeros(SENSOR_SIZE)
         up, i = 0.0, 0
         while state[1] * rig.units.length_m < 0.012:  # on the plane, 1.5 L_c of sliding
             run.step(i, np.zeros(6), 0.0, 0.0, state, sens)
@@ -170,7 +170,7 @@ def test_landings_do_not_bounce():
         for body in (w.tip, w.ground):
             pb.changeDynamics(body, -1, restitution=restitution, physicsClientId=w.cid)
         pb.resetBaseVelocity(w.tip, [0.0, 0.0, -v], physicsClientId=w.cid)
-        state, sens = np.zeros(7), np.zeros(20)
+        state, sens = np.zeros(7), np.zeros(SENSOR_SIZE)
         up = 0.0
         for i in range(400):
             run.step(i, np.zeros(6), 0.0, 0.0, state, sens)
