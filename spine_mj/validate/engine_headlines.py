@@ -112,7 +112,7 @@ class MissStart:
 
 
 #: The runs of the full plan's corner that its report (analysis/reports/validation-full, run
-#: table; analysis/reports/validation.md) attributes to MuJoCo's soft contact: miss reason
+#: table) attributes to MuJoCo's soft contact: miss reason
 #: ``engine_held``, MuJoCo held where the rigid-facet reference moves on. The fractal rows
 #: of that table run H = 0.7 (its first 60) before H = 0.9; the quick plan's one such miss
 #: is the last one here.
