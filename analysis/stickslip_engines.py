@@ -51,6 +51,7 @@ import pandas as pd
 
 from spine_mj import presets
 from spine_mj.atomic import atomic_output
+from spine_mj.errors import check_positive
 from spine_mj.jsonio import write_json
 from spine_mj.sim.build import build_rig
 from spine_mj.theory.force_drops import jitter_scale
@@ -72,13 +73,33 @@ from spine_mj.validate.stickslip_outputs import EDGE_SHARE, _engine_run
 MU = 0.5
 
 
-def _variant(engine: str, variant: str, ie: float, k: float, surf):
-    rig = build_rig(surf, engine=engine, mu=MU, ie=ie, stiffness_number=k)
+def _variant(engine: str, variant: str, ie: float, k: float, surf, dampratio: float | None = None):
+    """The variant's rig; with ``dampratio`` its contact's damping ratio set to that at the
+    variant's own contact stiffness and step: ``solref = (tc r0 / r, r)`` from the variant's
+    ``(tc, r0)`` (the rule's ``(2 dt, 1)`` gives ``(2 dt / r, r)``), since MuJoCo's contact
+    stiffness goes as ``1 / (tc r)^2`` and its damping as ``1 / tc``: the damping falls as
+    ``r``, the stiffness stays."""
+    rig = _variant_rig(engine, variant, ie, k, surf)
+    if dampratio is None:
+        return rig
+    r = check_positive("dampratio", dampratio)
+    tc, r0 = rig.engine.solref
+    return _variant_rig(engine, variant, ie, k, surf, solref_timeconst_s=tc * r0 / r, solref_dampratio=r)
+
+
+def _variant_rig(engine: str, variant: str, ie: float, k: float, surf, **contact):
+    rig = build_rig(surf, engine=engine, mu=MU, ie=ie, stiffness_number=k, **contact)
     if variant == "base":
         return rig
     if variant in ("step2", "step4"):  # only the step: the contact's time constant kept
         return build_rig(
-            surf, engine=engine, mu=MU, ie=ie, stiffness_number=k, timestep_factor=1 / int(variant[4])
+            surf,
+            engine=engine,
+            mu=MU,
+            ie=ie,
+            stiffness_number=k,
+            timestep_factor=1 / int(variant[4]),
+            **contact,
         )
     if variant in ("dt2", "dt4"):  # the step, and with it the rule's contact time constant (2 dt)
         return build_rig(
@@ -88,9 +109,12 @@ def _variant(engine: str, variant: str, ie: float, k: float, surf):
             ie=ie,
             stiffness_number=k,
             timestep_s=rig.engine.timestep_s / int(variant[2]),
+            **contact,
         )
     if variant == "hfield2":
-        return build_rig(surf, engine=engine, mu=MU, ie=ie, stiffness_number=k, hfield_refinement=2)
+        return build_rig(
+            surf, engine=engine, mu=MU, ie=ie, stiffness_number=k, hfield_refinement=2, **contact
+        )
     raise SystemExit(f"unknown variant {variant}")
 
 
@@ -139,12 +163,15 @@ def one(
     track: str = "abbm-short",
     start: float | None = None,
     cache: Path | None = None,
+    dampratio: float | None = None,
 ) -> dict:
     """One engine, variant, I_e and K over the track in runs of ``segment`` units (each
     from rest, the references on the same stretch): the catalogs pooled over the runs.
     ``track_length``: the abbm preset made that long (its spacing kept) instead; ``seed``:
     the preset's draw; ``track`` "abbm": the long preset's stretch from ``start``, a rig per
-    run on its stretch; ``cache``: a folder that keeps each run's parts (a rerun resumes)."""
+    run on its stretch; ``cache``: a folder that keeps each run's parts (a rerun resumes);
+    ``dampratio``: the contact's damping ratio at the variant's contact stiffness
+    (:func:`_variant`; None: the rule's)."""
     longer = (
         {} if track_length is None else {"length": track_length, "points": int(round(track_length * 10)) + 1}
     )
@@ -157,12 +184,13 @@ def one(
         xmin, xmax, _, _ = surf.bounds
         x0, length = xmin + EDGE_SHARE * (xmax - xmin), (1 - 2 * EDGE_SHARE) * (xmax - xmin)
         length = length if travel is None else travel
-        rig = _variant(engine, variant, ie, k, surf)
+        rig = _variant(engine, variant, ie, k, surf, dampratio)
         units = TrackUnits.of(rig.scales, ie)
     count = max(1, math.ceil(length / segment - 1e-9))
     bounds = x0 + length * np.arange(count + 1) / count
     parts: dict = {"eng": [], "refs": {s: [] for s in REFERENCES}, "drops": {f: ([], {}) for f in floors}}
     cpu, ends, stuck_v, creep, travel_sum, jitter = 0.0, [], [], 0.0, 0.0, []
+    solrefs: set = set()
     for i, (a, b) in enumerate(itertools.pairwise(bounds)):
         saved = None if cache is None else Path(cache) / f"segment_{i:04d}.pkl"
         if saved is not None and saved.exists():
@@ -170,9 +198,10 @@ def one(
         else:
             if track == "abbm":
                 surf = crop(whole, a - segment / 4, b + segment / 4)
-                rig = _variant(engine, variant, ie, k, surf)
+                rig = _variant(engine, variant, ie, k, surf, dampratio)
                 units = TrackUnits.of(rig.scales, ie)
             piece = _segment(engine, rig, units, surf, k, ie, a, b, floors)
+            piece["solref"] = list(rig.engine.solref)
             if saved is not None:
                 saved.parent.mkdir(parents=True, exist_ok=True)
                 with atomic_output(saved) as tmp:
@@ -181,6 +210,7 @@ def one(
                 print(f"  segment {i + 1}/{count}: {piece['cpu']:.0f} CPU s", flush=True)
         cpu += piece["cpu"]
         ends.append(piece["end"])
+        solrefs.add(tuple(piece.get("solref", ())))
         parts["eng"].append(piece["eng"])
         for source, r in piece["refs"].items():
             parts["refs"][source].append(r)
@@ -208,6 +238,8 @@ def one(
         "segment_length": float(length / count),
         "cpu_s": cpu,
         "end": sorted(set(ends)),
+        "dampratio": dampratio,
+        "solref": [list(v) for v in sorted(solrefs) if v],
     }
     row["n"] = {engine: len(eng["size_lc"])} | {s: int(np.size(r["size_lc"])) for s, r in refs.items()}
     for source, r in refs.items():
@@ -241,6 +273,7 @@ def one(
             for r in (eng_d, *ref_d.values()):
                 frame = pd.DataFrame(r, columns=COLUMNS)
                 frame["variant"], frame["floor_fp"], frame["ie"], frame["seed"] = variant, floor, ie, seed
+                frame["dampratio"] = math.nan if dampratio is None else dampratio
                 catalogs.append(frame)
     return row
 
@@ -405,6 +438,21 @@ def cached_summary(folders: list[Path], engine: str = "mujoco") -> dict:
     return out
 
 
+def _positive(name: str):
+    """An argparse type: a float > 0, else argparse's error line naming ``name`` (exit 2)."""
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            value = math.nan
+        if not value > 0 or not math.isfinite(value):
+            raise argparse.ArgumentTypeError(f"{name} expects a positive number, got {text!r}")
+        return value
+
+    return parse
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--ie", default="1e-4,1e-5")
@@ -428,6 +476,12 @@ def main(argv=None):
     )
     ap.add_argument(
         "--flat-length", type=float, default=20.0, help="--flat: the run's units past the start's lead"
+    )
+    ap.add_argument(
+        "--dampratio",
+        type=_positive("--dampratio"),
+        default=None,
+        help="the contact's damping ratio at the variant's contact stiffness (default: the rule's 1)",
     )
     ap.add_argument("--cached", default=None, help="only summarize cached runs (folders, a,b)")
     a = ap.parse_args(argv)
@@ -473,7 +527,8 @@ def main(argv=None):
             for engine in a.engines.split(","):
                 for variant in a.variants.split(","):
                     if any(
-                        (r["engine"], r["variant"], r["K"], r.get("seed", 1)) == (engine, variant, k, a.seed)
+                        (r["engine"], r["variant"], r["K"], r.get("seed", 1), r.get("dampratio"))
+                        == (engine, variant, k, a.seed, a.dampratio)
                         for r in rows
                     ):
                         continue
@@ -491,6 +546,7 @@ def main(argv=None):
                         "abbm",
                         start,
                         out / f"segments_{a.tag}_K{k:g}",
+                        a.dampratio,
                     )
                     row["plan"] = plan
                     rows.append(row)
@@ -510,13 +566,23 @@ def main(argv=None):
             for ie in (float(v) for v in a.ie.split(",")):
                 for k in (float(v) for v in a.K.split(",")):
                     if any(
-                        (r["engine"], r["variant"], r["ie"], r["K"], r.get("seed", 1))
-                        == (engine, variant, ie, k, a.seed)
+                        (r["engine"], r["variant"], r["ie"], r["K"], r.get("seed", 1), r.get("dampratio"))
+                        == (engine, variant, ie, k, a.seed, a.dampratio)
                         for r in rows
                     ):
                         continue
                     row = one(
-                        engine, variant, ie, k, a.travel, floors, catalogs, a.segment, a.track_length, a.seed
+                        engine,
+                        variant,
+                        ie,
+                        k,
+                        a.travel,
+                        floors,
+                        catalogs,
+                        a.segment,
+                        a.track_length,
+                        a.seed,
+                        dampratio=a.dampratio,
                     )
                     rows.append(row)
                     write_json(path, rows)
