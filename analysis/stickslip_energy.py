@@ -1,7 +1,8 @@
 """Does an engine stop a slip early on the abbm preset at K 10 because it loses more than
 Coulomb friction? Reads the saved drop catalogs and flat-strip results only
 (analysis/reports/stickslip/); prints the numbers of the README's section "Where
-MuJoCo's slips stop, and the energy".
+MuJoCo's slips stop, and the energy" (and those of the cells at a lowered contact damping)
+and writes them to ``stickslip_energy.json``.
 
 The drop catalogs carry no dissipated energy (``drop_rows`` writes NaN) and the references
 no speed, so the energy is bounded from the engines' own peak speeds: a slip's kinetic
@@ -22,14 +23,28 @@ import numpy as np
 import pandas as pd
 from scipy.stats import binom
 
+from spine_mj.jsonio import write_json
+
 REPORTS = Path(__file__).resolve().parent / "reports" / "stickslip"
 CELLS = {
     "seed 1, default": ("abbm_k10_seed1",),
     "seed 1, dt / 2": ("abbm_k10_seed1_dt2a", "abbm_k10_seed1_dt2b"),
     "seed 8181, dt / 2": ("abbm_k10_seed8181_dt2",),
     "seed 1, Bullet": ("abbm_k10_seed1_bullet",),
+    "seed 8181, dt / 2, damping 0.5": ("abbm_k10_seed8181_dt2_r05",),
+    "seed 1 first half, dt / 2": ("abbm_k10_seed1_dt2a",),
+    "seed 1 first half, dt / 2, damping 0.5": ("abbm_k10_seed1_dt2a_r05",),
 }
-FLAT = {"seed 1, default": ("mujoco", 0), "seed 1, dt / 2": ("mujoco", 1), "seed 8181, dt / 2": ("mujoco", 1)}
+FLAT = {
+    "seed 1, default": ("mujoco", 0),
+    "seed 1, dt / 2": ("mujoco", 1),
+    "seed 8181, dt / 2": ("mujoco", 1),
+    "seed 8181, dt / 2, damping 0.5": ("mujoco_r0.5", 1),
+    "seed 1 first half, dt / 2": ("mujoco", 1),
+    "seed 1 first half, dt / 2, damping 0.5": ("mujoco_r0.5", 1),
+}
+#: The flat-strip results by engine (and contact): the file's rows are the rule's step, dt / 2.
+FLAT_FILES = {"mujoco": "abbm_flat", "bullet": "abbm_flat_bullet", "mujoco_r0.5": "abbm_flat_r0.5"}
 MATCH_LC = 1.0
 
 
@@ -47,8 +62,9 @@ def _plan(tag: str) -> dict:
 def _flat_excess() -> dict:
     """Sliding force minus mu W [F_p] on the flat strip, per (engine, row)."""
     out = {}
-    for engine, name in (("mujoco", "abbm_flat"), ("bullet", "abbm_flat_bullet")):
-        for i, r in enumerate(json.loads((REPORTS / f"stickslip_engines_{name}.json").read_text())):
+    for engine, name in FLAT_FILES.items():
+        path = REPORTS / f"stickslip_engines_{name}.json"
+        for i, r in enumerate(json.loads(path.read_text()) if path.exists() else []):
             out[(engine, i)] = r["sliding_fp"] - r["mu"]
     return out
 
@@ -110,9 +126,14 @@ def cell(label: str, tags, flat: dict) -> dict:
 
 def main() -> None:
     excess = _flat_excess()
-    flat = {label: excess[key] for label, key in FLAT.items()}
-    for label, tags in CELLS.items():
-        print(json.dumps(cell(label, tags, flat), indent=1))
+    flat = {label: excess[key] for label, key in FLAT.items() if key in excess}
+    rows = [
+        cell(label, tags, flat)
+        for label, tags in CELLS.items()
+        if all((REPORTS / f"stickslip_drops_{t}.parquet").exists() for t in tags)
+    ]
+    write_json(REPORTS / "stickslip_energy.json", rows)
+    print(json.dumps(rows, indent=1))
 
 
 if __name__ == "__main__":

@@ -75,16 +75,22 @@ MU = 0.5
 
 def _variant(engine: str, variant: str, ie: float, k: float, surf, dampratio: float | None = None):
     """The variant's rig; with ``dampratio`` its contact's damping ratio set to that at the
-    variant's own contact stiffness and step: ``solref = (tc r0 / r, r)`` from the variant's
-    ``(tc, r0)`` (the rule's ``(2 dt, 1)`` gives ``(2 dt / r, r)``), since MuJoCo's contact
-    stiffness goes as ``1 / (tc r)^2`` and its damping as ``1 / tc``: the damping falls as
-    ``r``, the stiffness stays."""
+    variant's own contact stiffness and step (:func:`at_dampratio`)."""
     rig = _variant_rig(engine, variant, ie, k, surf)
     if dampratio is None:
         return rig
+    return _variant_rig(engine, variant, ie, k, surf, **at_dampratio(rig.engine.solref, dampratio))
+
+
+def at_dampratio(solref, dampratio: float) -> dict:
+    """The engine options that give a contact of ``solref = (tc, r0)`` the damping ratio
+    ``dampratio`` at the same stiffness: ``solref = (tc r0 / r, r)`` (the rule's ``(2 dt,
+    1)`` gives ``(2 dt / r, r)``), since MuJoCo's contact stiffness goes as ``1 / (tc r)^2``
+    and its damping as ``1 / tc``: the damping falls as ``r``, the stiffness and the resting
+    depth stay."""
     r = check_positive("dampratio", dampratio)
-    tc, r0 = rig.engine.solref
-    return _variant_rig(engine, variant, ie, k, surf, solref_timeconst_s=tc * r0 / r, solref_dampratio=r)
+    tc, r0 = solref
+    return {"solref_timeconst_s": tc * r0 / r, "solref_dampratio": r}
 
 
 def _variant_rig(engine: str, variant: str, ie: float, k: float, surf, **contact):
@@ -371,26 +377,24 @@ def flat_friction(
     x0: float = 22580.0,
     engine: str = "mujoco",
     length: float = 20.0,
+    dampratio: float | None = None,
 ) -> dict:
     """An engine's spring drive on a flat strip of the ``abbm`` preset's rig (its crop at ``x0``,
     heights zeroed, so the same scales, tip and step): the breakaway force and the sliding
     force over the second half of a run of ``length`` units (the reference's is ``mu W`` for both),
-    at the rule's step times ``step_share`` (the contact's time constant following it)."""
+    at the rule's step times ``step_share`` (the contact's time constant following it; with
+    ``dampratio``, its damping ratio that at the same contact stiffness, :func:`at_dampratio`)."""
     import dataclasses
 
     part = crop(abbm_prefix(seed, x0 + 40), x0 - 10, x0 + 30)
     flat = dataclasses.replace(part, heights=np.zeros_like(part.heights))
     rail = {"line": True} if engine == "mujoco" else {}  # Bullet's tip has no lateral force here
     base = build_rig(flat, engine=engine, mu=MU, ie=ie, stiffness_number=k, **rail)
-    rig = build_rig(
-        flat,
-        engine=engine,
-        mu=MU,
-        ie=ie,
-        stiffness_number=k,
-        timestep_s=base.engine.timestep_s * step_share,
-        **rail,
-    )
+    step = {"timestep_s": base.engine.timestep_s * step_share}
+    rig = build_rig(flat, engine=engine, mu=MU, ie=ie, stiffness_number=k, **step, **rail)
+    if dampratio is not None:
+        contact = at_dampratio(rig.engine.solref, dampratio)
+        rig = build_rig(flat, engine=engine, mu=MU, ie=ie, stiffness_number=k, **step, **rail, **contact)
     units = TrackUnits.of(rig.scales, ie)
     land = track_landscape(flat, MU, units.tip_radius, (x0, x0 + length))
     c0 = time.process_time()
@@ -403,6 +407,7 @@ def flat_friction(
         "K": k,
         "ie": ie,
         "timestep_s": rig.engine.timestep_s,
+        "solref": list(rig.engine.solref),
         "breakaway_fp": float(f.max()),
         "sliding_fp": float(late.mean()),
         "sliding_std_fp": float(late.std()),
@@ -489,10 +494,19 @@ def main(argv=None):
     if a.flat:
         engine = a.engines.split(",")[0]
         rows = [
-            flat_friction(a.seed, float(a.K), float(a.ie), share, engine=engine, length=a.flat_length)
+            flat_friction(
+                a.seed,
+                float(a.K),
+                float(a.ie),
+                share,
+                engine=engine,
+                length=a.flat_length,
+                dampratio=a.dampratio,
+            )
             for share in (1.0, 0.5)
         ]
         name = "abbm_flat" if engine == "mujoco" else f"abbm_flat_{engine}"
+        name += "" if a.dampratio is None else f"_r{a.dampratio:g}"
         write_json(out / f"stickslip_engines_{name}.json", rows)
         print(json.dumps(rows, indent=1))
         return
