@@ -15,6 +15,10 @@ drops). Run from the repository root (~60 CPU s a contact at dt / 2)::
         --run 1 --dampratio 1,0.5
 
 Writes ``analysis/reports/stickslip/contact_cost_<tag>_run<i>.json`` and prints it.
+``--flat 2:0.5,4:1``: instead, the flat strip's breakaway and sliding force
+(:func:`stickslip_engines.flat_friction`; seed 1's rig at K 10, I_e 7.3e-6) at dt / 2 with
+``solref = (n dt, r)`` for each ``n:r``: which of the time constant and the damping ratio
+moves the sliding force (``contact_cost_flat.json``; ~30 CPU s each).
 """
 
 from __future__ import annotations
@@ -32,7 +36,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from stickslip_engines import MU, _variant, abbm_prefix, crop
+from stickslip_engines import MU, _variant, abbm_prefix, crop, flat_friction
 
 from spine_mj.jsonio import write_json
 from spine_mj.sim.step_rule import rest_depth_m
@@ -126,7 +130,14 @@ def main(argv=None) -> None:
     p.add_argument("--run", type=int, default=1, help="which of the cell's runs (0-based)")
     p.add_argument("--dampratio", default="1,0.5", help="1: the rule's contact; others at its stiffness")
     p.add_argument("--cached-tags", default="", help="cells whose cached runs to compare, ratio=tag,...")
+    p.add_argument("--flat", default=None, help="only the flat strip at dt / 2, solref (n dt, r): n:r,...")
     a = p.parse_args(argv)
+    if a.flat:
+        pairs = [tuple(float(v) for v in item.split(":")) for item in a.flat.split(",")]
+        rows = [flat_friction(1, 10.0, 7.3e-6, 0.5, solref_steps=pair) for pair in pairs]
+        write_json(OUT / "contact_cost_flat.json", rows)
+        print(json.dumps(rows, indent=1))
+        return
     plan = json.loads((OUT / f"stickslip_plan_{a.tag}_K{a.K:g}.json").read_text())
     bounds = run_bounds(plan, a.start, a.segment)
     x0, x1 = bounds[a.run]

@@ -378,12 +378,14 @@ def flat_friction(
     engine: str = "mujoco",
     length: float = 20.0,
     dampratio: float | None = None,
+    solref_steps: tuple[float, float] | None = None,
 ) -> dict:
     """An engine's spring drive on a flat strip of the ``abbm`` preset's rig (its crop at ``x0``,
     heights zeroed, so the same scales, tip and step): the breakaway force and the sliding
     force over the second half of a run of ``length`` units (the reference's is ``mu W`` for both),
     at the rule's step times ``step_share`` (the contact's time constant following it; with
-    ``dampratio``, its damping ratio that at the same contact stiffness, :func:`at_dampratio`)."""
+    ``dampratio``, its damping ratio that at the same contact stiffness, :func:`at_dampratio`;
+    with ``solref_steps = (n, r)``, ``solref = (n dt, r)`` at the run's step dt)."""
     import dataclasses
 
     part = crop(abbm_prefix(seed, x0 + 40), x0 - 10, x0 + 30)
@@ -392,8 +394,13 @@ def flat_friction(
     base = build_rig(flat, engine=engine, mu=MU, ie=ie, stiffness_number=k, **rail)
     step = {"timestep_s": base.engine.timestep_s * step_share}
     rig = build_rig(flat, engine=engine, mu=MU, ie=ie, stiffness_number=k, **step, **rail)
+    contact = {}
     if dampratio is not None:
         contact = at_dampratio(rig.engine.solref, dampratio)
+    if solref_steps is not None:
+        n, r = solref_steps
+        contact = {"solref_timeconst_s": n * rig.engine.timestep_s, "solref_dampratio": r}
+    if contact:
         rig = build_rig(flat, engine=engine, mu=MU, ie=ie, stiffness_number=k, **step, **rail, **contact)
     units = TrackUnits.of(rig.scales, ie)
     land = track_landscape(flat, MU, units.tip_radius, (x0, x0 + length))
