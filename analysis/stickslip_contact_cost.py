@@ -7,9 +7,9 @@ other rows in contact), against the resting depth MuJoCo's contact predicts
 (:func:`spine_mj.sim.step_rule.rest_depth_m`), with the share of moving rows in flight; the
 resting force jitter (the 99th percentile of the elementary force drops), the held tip's
 creep (mean x-speed over V in STUCK rows, and the share of the run's travel made while
-STUCK), and the run's drops above the plan's floor (start x, size; against the cell's
+STUCK), the run's drops above the plan's floor (start x, size; against the cell's
 cached run of the same contact where one is saved: the same rig and crop, so the same
-drops). Run from the repository root (~60 CPU s a contact at dt / 2)::
+drops) and a trace of tip, carriage and force. Run from the repository root (~60 CPU s a contact at dt / 2)::
 
     python analysis/stickslip_contact_cost.py --tag abbm_k10_seed8181_dt2 --seed 8181 \\
         --run 1 --dampratio 1,0.5
@@ -106,6 +106,20 @@ def measure(seed: int, plan: dict, a: float, b: float, segment: float, end: floa
             {"start_x": float(x * lc), "size_lc": float(z), "force_drop_fp": float(f)}
             for x, z, f in zip(drops["start_x_lc"], drops["size_lc"], drops["force_drop_fp"])
         ],
+        "trace": _trace(res, units, s),
+    }
+
+
+def _trace(res, units: TrackUnits, start: int, points: int = 600) -> dict:
+    """The run's tip x and carriage x [units], drive force [F_p] and whether STUCK, at
+    ``points`` times from the drive's start (where the tip slid, where it stuck)."""
+    idx = np.linspace(start, len(res.time_s) - 1, points).astype(int)
+    scale = units.length_scale_m
+    return {
+        "x": np.round(res.position_m[idx, 0] / scale, 3).tolist(),
+        "carriage_x": np.round(np.asarray(res.carriage_x_m)[idx] / scale, 3).tolist(),
+        "force_fp": np.round(res.drive_force_n[idx] / units.preload_n, 7).tolist(),
+        "stuck": (np.asarray(res.motion)[idx] == STUCK).astype(int).tolist(),
     }
 
 
@@ -122,9 +136,9 @@ def cached_drops(tag: str, k: float, run: int, lc: float) -> list | None:
 
 def main(argv=None) -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--tag", required=True, help="the cell's tag (its plan: stickslip_plan_<tag>_K<K>.json)")
+    p.add_argument("--tag", help="the cell's tag (its plan: stickslip_plan_<tag>_K<K>.json)")
     p.add_argument("--K", type=float, default=10.0)
-    p.add_argument("--seed", type=int, required=True)
+    p.add_argument("--seed", type=int, help="the cell's seed")
     p.add_argument("--start", type=float, default=22500.0, help="the cell's first x")
     p.add_argument("--segment", type=float, default=44.0, help="the cell's --segment")
     p.add_argument("--run", type=int, default=1, help="which of the cell's runs (0-based)")
@@ -138,6 +152,8 @@ def main(argv=None) -> None:
         write_json(OUT / "contact_cost_flat.json", rows)
         print(json.dumps(rows, indent=1))
         return
+    if a.tag is None or a.seed is None:
+        p.error("--tag and --seed are required (or --flat)")
     plan = json.loads((OUT / f"stickslip_plan_{a.tag}_K{a.K:g}.json").read_text())
     bounds = run_bounds(plan, a.start, a.segment)
     x0, x1 = bounds[a.run]
