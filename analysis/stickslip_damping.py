@@ -85,10 +85,17 @@ def _boot(counts: pd.DataFrame, sizes: dict, rng) -> dict:
         med_m.append(np.median(m) if m.size else math.nan)
         med_i.append(np.median(r) if r.size else math.nan)
     return {
-        "count_ratio_95": list(np.nanpercentile(ratios, [2.5, 97.5])),
-        "median_size_mujoco_95": list(np.nanpercentile(med_m, [2.5, 97.5])),
-        "median_size_inertial_95": list(np.nanpercentile(med_i, [2.5, 97.5])),
+        "count_ratio_95": _interval(ratios),
+        "median_size_mujoco_95": _interval(med_m),
+        "median_size_inertial_95": _interval(med_i),
     }
+
+
+def _interval(values) -> list:
+    """The 2.5 and 97.5 percentiles of the finite ``values`` (NaN if none)."""
+    v = np.asarray(values, float)
+    v = v[np.isfinite(v)]
+    return [float(x) for x in np.percentile(v, [2.5, 97.5])] if v.size else [math.nan, math.nan]
 
 
 def _paired(a: np.ndarray, b: np.ndarray) -> dict:
@@ -123,6 +130,7 @@ def cell(label: str, tags, dampratio: float, rng) -> dict | None:
         "seed": rows[0]["seed"],
         "start": rows[0]["start"],
         "runs": int(len(counts)),
+        "segment_length": rows[0]["segment_length"],
         "cpu_s": float(sum(r["cpu_s"] for r in rows)),
         "ends": sorted({e for r in rows for e in r["end"]}),
         "lc_units": lc,
@@ -146,35 +154,52 @@ def cell(label: str, tags, dampratio: float, rng) -> dict | None:
     return out
 
 
+def _sizes(c: dict, runs: int, source: str = "mujoco") -> np.ndarray:
+    """A source's drop sizes in cell ``c``'s first ``runs`` runs."""
+    row = {"start": c["start"], "segment_length": c["segment_length"], "segments": c["runs"]}
+    cat = pd.read_parquet(REPORTS / f"stickslip_drops_{c['tags'][0]}.parquet")
+    cat = cat[cat.source == source]
+    return cat["size_lc"].to_numpy()[run_index(cat, row, c["lc_units"]) < runs]
+
+
+def pair(low: dict, rule: dict) -> dict:
+    """Two contacts' cells on the same runs (the first ``n`` of both, n the fewer): MuJoCo's
+    per-run counts and sizes against each other, and whether the references' counts agree
+    (the same stretches, so they must)."""
+    n = min(low["runs"], rule["runs"])
+    counts = {c["cell"]: {s: c["per_run"][s][:n] for s in SOURCES} for c in (low, rule)}
+    a, b = counts[low["cell"]], counts[rule["cell"]]
+    ea, eb = _sizes(low, n), _sizes(rule, n)
+    refs = {c["cell"]: _sizes(c, n, "inertial") for c in (low, rule)}
+    return {
+        "lowered": low["cell"],
+        "rule": rule["cell"],
+        "runs": n,
+        "n": {k: {s: int(sum(v[s])) for s in SOURCES} for k, v in counts.items()},
+        "mujoco_per_run": _paired(np.array(a["mujoco"]), np.array(b["mujoco"])),
+        "inertial_counts_equal": a["inertial"] == b["inertial"],
+        "mujoco_sizes_lowered_vs_rule": two_sample(ea, eb) if min(ea.size, eb.size) >= 2 else None,
+        "mujoco_sizes_vs_inertial": {
+            c["cell"]: two_sample(e, refs[c["cell"]]) if e.size >= 2 else None
+            for c, e in ((low, ea), (rule, eb))
+        },
+    }
+
+
 def main() -> None:
     rng = np.random.default_rng(0)
     cells = [c for c in (cell(label, tags, r, rng) for label, tags, r in CELLS) if c is not None]
-    by_seed: dict = {}
-    for c in cells:  # cells on the same seed, stretch and runs
-        by_seed.setdefault((c["seed"], c["start"], c["runs"]), []).append(c)
-    pairs = []
-    for group in by_seed.values():
-        rule = [c for c in group if c["dampratio"] == 1.0]
-        low = [c for c in group if c["dampratio"] != 1.0]
-        for a in low:
-            for b in rule:
-                ea, eb = (
-                    pd.read_parquet(REPORTS / f"stickslip_drops_{c['tags'][0]}.parquet")
-                    .query("source == 'mujoco'")["size_lc"]
-                    .to_numpy()
-                    for c in (a, b)
-                )
-                pairs.append(
-                    {
-                        "lowered": a["cell"],
-                        "rule": b["cell"],
-                        "mujoco_per_run": _paired(
-                            np.array(a["per_run"]["mujoco"]), np.array(b["per_run"]["mujoco"])
-                        ),
-                        "inertial_counts_equal": a["per_run"]["inertial"] == b["per_run"]["inertial"],
-                        "mujoco_sizes_lowered_vs_rule": two_sample(ea, eb),
-                    }
-                )
+    by_stretch: dict = {}
+    for c in cells:  # cells on the same seed, start and run length
+        by_stretch.setdefault((c["seed"], c["start"], round(c["segment_length"], 6)), []).append(c)
+    pairs = [
+        pair(low, rule)
+        for group in by_stretch.values()
+        for low in group
+        if low["dampratio"] != 1.0
+        for rule in group
+        if rule["dampratio"] == 1.0
+    ]
     out = {"cells": cells, "pairs": pairs}
     write_json(REPORTS / "damping_cells.json", out)
     print(json.dumps(out, indent=1))

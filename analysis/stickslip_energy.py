@@ -84,6 +84,8 @@ def cell(label: str, tags, flat: dict) -> dict:
     ratio = ref.force_drop_fp / ref.size_lc
     k = float(ratio.median())
     e = d[d.source == engine].copy()
+    if e.empty:  # no drop above the floor: nothing ends anywhere
+        return {"cell": label, "n_engine": 0, "n_inertial": len(ref)}
     # The carriage advances V D in a slip, so the spring's drop is k (S - V D): read L_c [units].
     lag = 1.0 - e.force_drop_fp / (k * e.size_lc)
     lc = float(np.median(plan["speed"] * e.duration_s / (e.size_lc * lag)))
