@@ -18,7 +18,9 @@ Writes ``analysis/reports/stickslip/contact_cost_<tag>_run<i>.json`` and prints 
 ``--flat 2:0.5,4:1``: instead, the flat strip's breakaway and sliding force
 (:func:`stickslip_engines.flat_friction`; seed 1's rig at K 10, I_e 7.3e-6) at dt / 2 with
 ``solref = (n dt, r)`` for each ``n:r``: which of the time constant and the damping ratio
-moves the sliding force (``contact_cost_flat.json``; ~30 CPU s each).
+moves the sliding force (``contact_cost_flat.json``; ~30 CPU s each); ``n:r:i`` also sets
+MuJoCo's ``impratio`` to i (the friction's impedance over the normal's; the rule's is 1),
+``--flat-out`` names the file.
 """
 
 from __future__ import annotations
@@ -36,7 +38,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from stickslip_engines import MU, _variant, abbm_prefix, crop, flat_friction
+from stickslip_engines import MU, _positive, _variant, abbm_prefix, crop, flat_friction
 
 from spine_mj.jsonio import write_json
 from spine_mj.sim.step_rule import rest_depth_m
@@ -134,6 +136,19 @@ def cached_drops(tag: str, k: float, run: int, lc: float) -> list | None:
     return [{"start_x": float(x * lc), "size_lc": float(z)} for x, z in rows]
 
 
+def flat_settings(text: str) -> list[tuple[float, float, float | None]]:
+    """``--flat``'s ``n:r[:i],...``: each contact's ``(n, r, impratio)`` (None: the rule's
+    impratio), every number positive; else argparse's error line naming ``--flat`` (exit 2)."""
+    rows = []
+    for item in text.split(","):
+        parts = item.split(":")
+        if len(parts) not in (2, 3):
+            raise argparse.ArgumentTypeError(f"--flat expects n:r or n:r:i, comma-separated, got {item!r}")
+        n, r, *i = (_positive("--flat")(part) for part in parts)
+        rows.append((n, r, i[0] if i else None))
+    return rows
+
+
 def main(argv=None) -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--tag", help="the cell's tag (its plan: stickslip_plan_<tag>_K<K>.json)")
@@ -144,12 +159,17 @@ def main(argv=None) -> None:
     p.add_argument("--run", type=int, default=1, help="which of the cell's runs (0-based)")
     p.add_argument("--dampratio", default="1,0.5", help="1: the rule's contact; others at its stiffness")
     p.add_argument("--cached-tags", default="", help="cells whose cached runs to compare, ratio=tag,...")
-    p.add_argument("--flat", default=None, help="only the flat strip at dt / 2, solref (n dt, r): n:r,...")
+    p.add_argument(
+        "--flat",
+        type=flat_settings,
+        default=None,
+        help="only the flat strip at dt / 2, solref (n dt, r) and impratio i: n:r[:i],...",
+    )
+    p.add_argument("--flat-out", default="contact_cost_flat", help="--flat: the json's name (no suffix)")
     a = p.parse_args(argv)
     if a.flat:
-        pairs = [tuple(float(v) for v in item.split(":")) for item in a.flat.split(",")]
-        rows = [flat_friction(1, 10.0, 7.3e-6, 0.5, solref_steps=pair) for pair in pairs]
-        write_json(OUT / "contact_cost_flat.json", rows)
+        rows = [flat_friction(1, 10.0, 7.3e-6, 0.5, solref_steps=(n, r), impratio=i) for n, r, i in a.flat]
+        write_json(OUT / f"{a.flat_out}.json", rows)
         print(json.dumps(rows, indent=1))
         return
     if a.tag is None or a.seed is None:

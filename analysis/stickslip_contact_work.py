@@ -6,7 +6,8 @@ work of the contact's normal force (nonzero only through the soft contact's pene
 speed), of its friction force, and Coulomb's ``mu int N |v_t| dt`` are split per slip.
 ``--dampratio r`` reruns it with the contact's damping ratio lowered to r at the same
 contact stiffness: ``solref = (2 dt / r, r)`` (MuJoCo's stiffness goes as ``1 / (tc r)^2``,
-its damping as ``1 / tc``; the rule's is ``(2 dt, 1)``). Stepped without the package's
+its damping as ``1 / tc``; the rule's is ``(2 dt, 1)``); ``--impratio i`` sets MuJoCo's
+frictional-to-normal impedance ratio (the rule's 1). Stepped without the package's
 refine-on-penetration rerun, so that each row is the rig asked for. Run from the repository
 root (each damping ratio ~300 CPU s)::
 
@@ -27,7 +28,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from stickslip_engines import MU, abbm_prefix, crop
+from stickslip_engines import MU, _positive, abbm_prefix, crop
 
 import spine_mj.sim.lanes as lanes
 from spine_mj.sim.build import build_rig
@@ -101,12 +102,13 @@ def _steps() -> np.ndarray:
     return np.concatenate(kept)
 
 
-def run(dampratio: float, noslip: int | None, b: float = B) -> dict:
+def run(dampratio: float, noslip: int | None, b: float = B, impratio: float | None = None) -> dict:
     whole = abbm_prefix(SEED, b + SEGMENT)
     surf = crop(whole, A - SEGMENT / 4, b + SEGMENT / 4)
     base = build_rig(surf, engine="mujoco", mu=MU, ie=IE, stiffness_number=K)
     dt = base.engine.timestep_s / 2  # the dt2 variant: the rule sets solref = (2 dt, ...)
     options = {"noslip_iterations": noslip} if noslip is not None else {}
+    options |= {"impratio": impratio} if impratio is not None else {}
     rig = build_rig(
         surf,
         engine="mujoco",
@@ -166,6 +168,7 @@ def run(dampratio: float, noslip: int | None, b: float = B) -> dict:
     return {
         "dampratio": dampratio,
         "noslip_iterations": int(rig.model.opt.noslip_iterations),
+        "impratio": float(rig.model.opt.impratio),
         "timestep_s": dt,
         "cpu_s": cpu,
         "end": result.end_reason.value,
@@ -199,17 +202,28 @@ def main(argv=None) -> None:
     p.add_argument("--dampratio", default="1,0.5,0.2", help="solref damping ratios, comma-separated")
     p.add_argument("--noslip", type=int, default=None, help="noslip iterations (default: the rule's)")
     p.add_argument("--end", type=float, default=B, help="the run's end x (a shorter check)")
+    p.add_argument(
+        "--impratio",
+        type=_positive("--impratio"),
+        default=None,
+        help="MuJoCo's impratio (default: the rule's 1)",
+    )
     p.add_argument("--out", type=Path, default=OUT)
     args = p.parse_args(argv)
     out = args.out
-    rows = [run(float(r), args.noslip, args.end) for r in args.dampratio.split(",")]
+    rows = [run(float(r), args.noslip, args.end, args.impratio) for r in args.dampratio.split(",")]
     saved = json.loads(out.read_text()) if out.exists() else []
-    keep = {(r["dampratio"], r["noslip_iterations"]) for r in rows}
-    saved = [r for r in saved if (r["dampratio"], r["noslip_iterations"]) not in keep] + rows
+
+    def key(r):
+        return r["dampratio"], r["noslip_iterations"], r.get("impratio", 1.0)
+
+    keep = {key(r) for r in rows}
+    saved = [r for r in saved if key(r) not in keep] + rows
     out.write_text(json.dumps(saved, indent=1) + "\n")
     for r in rows:
         print(
-            f"dampratio {r['dampratio']:g}, noslip {r['noslip_iterations']}: {r['cpu_s']:.0f} CPU s, "
+            f"dampratio {r['dampratio']:g}, noslip {r['noslip_iterations']}, impratio {r['impratio']:g}: "
+            f"{r['cpu_s']:.0f} CPU s, "
             f"{r['steps']} steps, end {r['end']}, "
             f"friction / Coulomb {r['whole_run']['friction_over_coulomb']:.6f}, "
             f"normal / friction {r['whole_run']['normal_over_friction']:.2e}"

@@ -369,27 +369,27 @@ def abbm_plan(surf, k: float, start: float, longest: float, drops: int = DROPS_P
     }
 
 
-def flat_friction(
-    seed: int,
-    k: float,
+def batch_mean_se(series: np.ndarray, batches: int = 20) -> float:
+    """The standard error of a correlated series' mean by batch means: the spread of the
+    means of ``batches`` contiguous blocks over ``sqrt(batches)`` (a sliding force rings, so
+    its rows are not independent and ``std / sqrt(n)`` would be far too narrow)."""
+    blocks = np.array_split(np.asarray(series, dtype=float), batches)
+    means = np.array([b.mean() for b in blocks])
+    return float(means.std(ddof=1) / np.sqrt(batches))
+
+
+def flat_rig(
+    flat,
+    engine: str,
     ie: float,
+    k: float,
     step_share: float,
-    x0: float = 22580.0,
-    engine: str = "mujoco",
-    length: float = 20.0,
     dampratio: float | None = None,
     solref_steps: tuple[float, float] | None = None,
-) -> dict:
-    """An engine's spring drive on a flat strip of the ``abbm`` preset's rig (its crop at ``x0``,
-    heights zeroed, so the same scales, tip and step): the breakaway force and the sliding
-    force over the second half of a run of ``length`` units (the reference's is ``mu W`` for both),
-    at the rule's step times ``step_share`` (the contact's time constant following it; with
-    ``dampratio``, its damping ratio that at the same contact stiffness, :func:`at_dampratio`;
-    with ``solref_steps = (n, r)``, ``solref = (n dt, r)`` at the run's step dt)."""
-    import dataclasses
-
-    part = crop(abbm_prefix(seed, x0 + 40), x0 - 10, x0 + 30)
-    flat = dataclasses.replace(part, heights=np.zeros_like(part.heights))
+    impratio: float | None = None,
+):
+    """:func:`flat_friction`'s rig on the strip ``flat``: the rule's step times ``step_share``,
+    the contact as :func:`flat_friction` says (MuJoCo's tip held on its line)."""
     rail = {"line": True} if engine == "mujoco" else {}  # Bullet's tip has no lateral force here
     base = build_rig(flat, engine=engine, mu=MU, ie=ie, stiffness_number=k, **rail)
     step = {"timestep_s": base.engine.timestep_s * step_share}
@@ -400,8 +400,37 @@ def flat_friction(
     if solref_steps is not None:
         n, r = solref_steps
         contact = {"solref_timeconst_s": n * rig.engine.timestep_s, "solref_dampratio": r}
+    if impratio is not None:
+        contact["impratio"] = impratio
     if contact:
         rig = build_rig(flat, engine=engine, mu=MU, ie=ie, stiffness_number=k, **step, **rail, **contact)
+    return rig
+
+
+def flat_friction(
+    seed: int,
+    k: float,
+    ie: float,
+    step_share: float,
+    x0: float = 22580.0,
+    engine: str = "mujoco",
+    length: float = 20.0,
+    dampratio: float | None = None,
+    solref_steps: tuple[float, float] | None = None,
+    impratio: float | None = None,
+) -> dict:
+    """An engine's spring drive on a flat strip of the ``abbm`` preset's rig (its crop at ``x0``,
+    heights zeroed, so the same scales, tip and step): the breakaway force and the sliding
+    force over the second half of a run of ``length`` units (the reference's is ``mu W`` for both),
+    at the rule's step times ``step_share`` (the contact's time constant following it; with
+    ``dampratio``, its damping ratio that at the same contact stiffness, :func:`at_dampratio`;
+    with ``solref_steps = (n, r)``, ``solref = (n dt, r)`` at the run's step dt; with
+    ``impratio``, MuJoCo's frictional-to-normal impedance ratio, the rule's 1 otherwise)."""
+    import dataclasses
+
+    part = crop(abbm_prefix(seed, x0 + 40), x0 - 10, x0 + 30)
+    flat = dataclasses.replace(part, heights=np.zeros_like(part.heights))
+    rig = flat_rig(flat, engine, ie, k, step_share, dampratio, solref_steps, impratio)
     units = TrackUnits.of(rig.scales, ie)
     land = track_landscape(flat, MU, units.tip_radius, (x0, x0 + length))
     c0 = time.process_time()
@@ -415,9 +444,11 @@ def flat_friction(
         "ie": ie,
         "timestep_s": rig.engine.timestep_s,
         "solref": list(rig.engine.solref),
+        "impratio": rig.engine.impratio,
         "breakaway_fp": float(f.max()),
         "sliding_fp": float(late.mean()),
         "sliding_std_fp": float(late.std()),
+        "sliding_se_fp": batch_mean_se(late),
         "mu": MU,
         "cpu_s": time.process_time() - c0,
     }
