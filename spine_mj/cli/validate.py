@@ -31,7 +31,7 @@ _workers_option = click.option(
 @click.option(
     "--quick",
     is_flag=True,
-    help=("The quick plan (about 7 min on 2 idle cores): fewer starts and I_e values, coarser hfields."),
+    help="The quick plan (about 7 min on 2 idle cores): fewer starts and I_e values, coarser hfields.",
 )
 @click.option(
     "--plan",
