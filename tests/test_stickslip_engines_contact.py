@@ -1,8 +1,6 @@
 """analysis/stickslip_engines.py's ``--dampratio``: the contact's damping ratio lowered at
 the variant's own contact stiffness and step (issue 42 item 5's cells at damping 0.5)."""
 
-import importlib.util
-import sys
 from pathlib import Path
 
 import pytest
@@ -15,14 +13,8 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 @pytest.fixture(scope="module")
-def script():
-    sys.path.insert(0, str(ROOT / "analysis"))
-    spec = importlib.util.spec_from_file_location(
-        "stickslip_engines", ROOT / "analysis" / "stickslip_engines.py"
-    )
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+def script(analysis_script):
+    return analysis_script("stickslip_engines")
 
 
 @pytest.fixture(scope="module")

@@ -3,8 +3,6 @@ item 5): the frictional-to-normal impedance ratio reaches the model, and a bad v
 error line naming the option."""
 
 import dataclasses
-import importlib.util
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -15,17 +13,9 @@ from spine_mj import presets
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def _load(name: str):
-    sys.path.insert(0, str(ROOT / "analysis"))
-    spec = importlib.util.spec_from_file_location(name, ROOT / "analysis" / f"{name}.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
 @pytest.fixture(scope="module")
-def engines():
-    return _load("stickslip_engines")
+def engines(analysis_script):
+    return analysis_script("stickslip_engines")
 
 
 @pytest.fixture(scope="module")
@@ -45,14 +35,14 @@ def test_the_flat_rig_carries_impratio(engines, flat):
     assert low.engine.solref == pytest.approx((4 * dt, 0.5), rel=1e-12)
 
 
-def test_flat_settings_reads_an_optional_impratio():
-    cost = _load("stickslip_contact_cost")
+def test_flat_settings_reads_an_optional_impratio(analysis_script):
+    cost = analysis_script("stickslip_contact_cost")
     assert cost.flat_settings("2:1,4:0.5:10") == [(2.0, 1.0, None), (4.0, 0.5, 10.0)]
 
 
 @pytest.mark.parametrize("text", ["2:1:0", "2", "2:soft", "4:0.5:-1", "2:1:1:1"])
-def test_a_bad_flat_setting_is_one_error_line(capsys, text):
-    cost = _load("stickslip_contact_cost")
+def test_a_bad_flat_setting_is_one_error_line(analysis_script, capsys, text):
+    cost = analysis_script("stickslip_contact_cost")
     with pytest.raises(SystemExit) as exit_:
         cost.main(["--flat", text])
     err = capsys.readouterr().err.strip().splitlines()
@@ -61,8 +51,8 @@ def test_a_bad_flat_setting_is_one_error_line(capsys, text):
 
 
 @pytest.mark.parametrize("text", ["0", "-3", "stiff"])
-def test_a_bad_impratio_is_one_error_line(capsys, text):
-    work = _load("stickslip_contact_work")
+def test_a_bad_impratio_is_one_error_line(analysis_script, capsys, text):
+    work = analysis_script("stickslip_contact_work")
     with pytest.raises(SystemExit) as exit_:
         work.main(["--impratio", text])
     err = capsys.readouterr().err.strip().splitlines()
